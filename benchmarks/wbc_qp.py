@@ -208,13 +208,13 @@ class TaskCommands:
 class Weights:
     """Diagonal cost weights (task errors in m/s^2 or rad/s^2, forces in N, torques in Nm)."""
 
-    com: float = 10.0
+    com: float = 100.0
     base_angular: float = 10.0
-    points: float = 10.0
-    posture: float = 1.0
+    points: float = 100.0
+    posture: float = 0.1
     vdot: float = 1e-4
     u: float = 1e-4
-    eps: float = 1e3
+    eps: float = 1e4
     lambda_c: float = 1e-6
     lambda_h: float = 1e-6
 
@@ -391,7 +391,6 @@ def solve_reference(qp: WbcQP, tol: float = 1e-9) -> np.ndarray:
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = tol
-    settings.tol_ktratio = tol
     solver = clarabel.DefaultSolver(
         sparse.csc_matrix(np.triu(qp.P)),
         np.asarray(qp.q),

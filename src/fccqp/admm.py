@@ -1,0 +1,416 @@
+"""The ADMM iteration, compiled with numba.
+
+Splitting: the constrained entries ``x_S`` (finite bound or cone) are copied into a
+slack ``z`` that must lie in ``C`` = box x cones; the equalities stay in the x-update.
+With multipliers ``y`` of ``x_S = z`` and over-relaxation ``alpha``, one iteration is
+
+    (x~, nu) = argmin_{A x = b} 1/2 x'Px + q'x + sigma/2 ||x - x_k||^2
+                                 + rho/2 ||x_S - z_k + y_k / rho||^2     (KKT solve)
+    x_S^r    = alpha x~_S + (1 - alpha) z_k
+    z_{k+1}  = P_C(x_S^r + y_k / rho)
+    y_{k+1}  = y_k + rho (x_S^r - z_{k+1})
+    x_{k+1}  = alpha x~ + (1 - alpha) x_k
+
+Unlike the paper, rho touches the constrained entries only: a free variable gets no
+penalty (sigma is a 1e-6 regularization). Every ``x_{k+1}`` is a combination of KKT
+solutions, so ``A x = b`` holds at every iterate. Everything here works on the
+scaled problem (see :mod:`fccqp.scaling`); residuals and tolerances are unscaled.
+"""
+
+import time
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit, objmode
+
+from fccqp import kkt
+from fccqp.projections import project_cone_block, project_constraint_set
+
+SOLVED, SOLVED_INACCURATE, MAX_ITER, TIME_LIMIT, PRIMAL_INFEASIBLE, DUAL_INFEASIBLE = range(1, 7)
+NOT_CONVEX = -1
+"""Kernel code: the KKT inertia shows that P is not positive semidefinite."""
+INACCURATE_FACTOR = 10.0
+"""A budget-stopped iterate within this multiple of the tolerances is 'inaccurate'."""
+RHO_MIN, RHO_MAX = 1e-6, 1e6
+"""Range of the adaptive rho."""
+FIXED_RHO_SCALE = 1e3
+"""rho multiplier on entries with lb == ub, which act as equalities (as in OSQP)."""
+EQUALITY_START_LIMIT = 1e-3
+"""Cold start falls back to the origin when sigma * ||x_eq|| exceeds this * max(1, ||q||):
+the equality-constrained QP is then unbounded but for sigma, and its solution useless."""
+
+
+class ScaledProblem(NamedTuple):
+    """Problem data after equilibration; bounds and cones act on ``x[constrained]``."""
+
+    P: np.ndarray
+    q: np.ndarray
+    A: np.ndarray
+    b: np.ndarray
+    constrained: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    cones: tuple
+    D: np.ndarray
+    E: np.ndarray
+    c: float
+    A_norm: float
+
+
+class Workspace(NamedTuple):
+    """Iterates, factorization and scratch arrays, reused across solves."""
+
+    K: np.ndarray
+    ipiv: np.ndarray
+    work: np.ndarray
+    rhs: np.ndarray
+    sol: np.ndarray
+    residual: np.ndarray
+    x: np.ndarray
+    nu: np.ndarray
+    z: np.ndarray
+    y: np.ndarray
+    x_prev: np.ndarray
+    nu_prev: np.ndarray
+    z_prev: np.ndarray
+    y_prev: np.ndarray
+    rho_vec: np.ndarray
+    rho_scale: np.ndarray
+    relaxed: np.ndarray
+    log: np.ndarray
+
+
+class Params(NamedTuple):
+    """Scalar settings of one run of :func:`run`."""
+
+    rho: float
+    sigma: float
+    alpha: float
+    eps_abs: float
+    eps_rel: float
+    eps_prim_inf: float
+    eps_dual_inf: float
+    max_iter: int
+    check_termination: int
+    adaptive_rho: bool
+    adaptive_rho_interval: int
+    adaptive_rho_tolerance: float
+    time_limit: float
+    start_time: float
+    cold_start: bool
+    factorize: bool
+
+
+@njit(cache=True)
+def _now():
+    with objmode(now="float64"):
+        now = time.perf_counter()
+    return now
+
+
+@njit(cache=True)
+def _inf_norm(v):
+    out = 0.0
+    for i in range(v.shape[0]):
+        out = max(out, abs(v[i]))
+    return out
+
+
+@njit(cache=True)
+def _factor_kkt(p, w, sigma):
+    kkt.assemble(p.P, p.A, sigma, p.constrained, w.rho_vec, w.K)
+    return kkt.factor(w.K, w.ipiv, w.work) == p.A.shape[0]
+
+
+@njit(cache=True)
+def _solve_x(p, w, sigma):
+    """Solve the KKT system for ``w.rhs`` into ``w.sol``."""
+    kkt.solve_refined(
+        w.K, w.ipiv, p.P, p.A, p.A_norm, sigma, p.constrained, w.rho_vec, w.rhs, w.sol, w.residual
+    )
+
+
+@njit(cache=True)
+def residuals(p, w):
+    """Unscaled primal and dual residuals and tolerance scales, plus their scaled versions.
+
+    Returns ``(prim, dual, prim_scale, dual_scale, prim_s, dual_s, prim_scale_s,
+    dual_scale_s)``: a residual passes when ``res <= eps_abs + eps_rel * scale``.
+    """
+    n = p.P.shape[0]
+    D, E, c = p.D, p.E, p.c
+    prim = prim_scale = prim_s = prim_scale_s = 0.0
+    if p.A.shape[0] > 0:
+        Ax = p.A @ w.x
+        for i in range(Ax.shape[0]):
+            prim = max(prim, abs(Ax[i] - p.b[i]) / E[i])
+            prim_scale = max(prim_scale, abs(Ax[i]) / E[i], abs(p.b[i]) / E[i])
+            prim_s = max(prim_s, abs(Ax[i] - p.b[i]))
+            prim_scale_s = max(prim_scale_s, abs(Ax[i]), abs(p.b[i]))
+        ATnu = p.A.T @ w.nu
+    else:
+        ATnu = np.zeros(n)
+    for j in range(p.constrained.shape[0]):
+        i = p.constrained[j]
+        xs, zs = w.x[i], w.z[j]
+        prim = max(prim, abs(xs - zs) * D[i])
+        prim_scale = max(prim_scale, abs(xs) * D[i], abs(zs) * D[i])
+        prim_s = max(prim_s, abs(xs - zs))
+        prim_scale_s = max(prim_scale_s, abs(xs), abs(zs))
+    Px = p.P @ w.x
+    grad = Px + p.q + ATnu
+    dual_scale = dual_scale_s = 0.0
+    for i in range(n):
+        scale = 1.0 / (c * D[i])
+        dual_scale = max(dual_scale, abs(Px[i]) * scale, abs(p.q[i]) * scale, abs(ATnu[i]) * scale)
+        dual_scale_s = max(dual_scale_s, abs(Px[i]), abs(p.q[i]), abs(ATnu[i]))
+    for j in range(p.constrained.shape[0]):
+        i = p.constrained[j]
+        grad[i] += w.y[j]
+        dual_scale = max(dual_scale, abs(w.y[j]) / (c * D[i]))
+        dual_scale_s = max(dual_scale_s, abs(w.y[j]))
+    dual = dual_s = 0.0
+    for i in range(n):
+        dual = max(dual, abs(grad[i]) / (c * D[i]))
+        dual_s = max(dual_s, abs(grad[i]))
+    return prim, dual, prim_scale, dual_scale, prim_s, dual_s, prim_scale_s, dual_scale_s
+
+
+@njit(cache=True)
+def is_primal_infeasible(p, w, eps):
+    """Test ``(d_nu, d_y)`` of the last step as a Farkas certificate.
+
+    ``d_y`` is first projected onto the polar of the recession cone of C (so that the
+    support function is finite); the certificate needs ``A'd_nu + d_y`` (on S) to be
+    small and ``b'd_nu + sigma_C(d_y) < 0`` relative to ``||(d_nu, d_y)||``.
+    """
+    n = p.P.shape[0]
+    s = p.constrained.shape[0]
+    d_nu = w.nu - w.nu_prev
+    d_y = w.y - w.y_prev
+    kind, offset, dim, mu, normal = p.cones
+    in_cone = np.zeros(s, dtype=np.bool_)
+    for k in range(kind.shape[0]):
+        a, e = offset[k], offset[k] + dim[k]
+        in_cone[a:e] = True
+        projected = np.empty(e - a)
+        project_cone_block(d_y[a:e], kind[k], mu[k], normal[k], projected)
+        d_y[a:e] -= projected
+    support = 0.0
+    for j in range(s):
+        if in_cone[j]:
+            continue
+        if p.hi[j] == np.inf:
+            d_y[j] = min(d_y[j], 0.0)
+        if p.lo[j] == -np.inf:
+            d_y[j] = max(d_y[j], 0.0)
+        if d_y[j] > 0:
+            support += p.hi[j] * d_y[j]
+        elif d_y[j] < 0:
+            support += p.lo[j] * d_y[j]
+    norm = 0.0
+    for i in range(d_nu.shape[0]):
+        norm = max(norm, abs(d_nu[i] * p.E[i]))
+    for j in range(s):
+        norm = max(norm, abs(d_y[j] / p.D[p.constrained[j]]))
+    if norm <= 1e-300:
+        return False
+    lhs = p.A.T @ d_nu if p.A.shape[0] > 0 else np.zeros(n)
+    for j in range(s):
+        lhs[p.constrained[j]] += d_y[j]
+    for i in range(n):
+        if abs(lhs[i] / p.D[i]) > eps * norm:
+            return False
+    return p.b @ d_nu + support < -eps * norm
+
+
+@njit(cache=True)
+def is_equality_inconsistent(p, w, eps):
+    """Test the equality residual ``r = b - A x`` as a certificate that ``A x = b`` has no solution.
+
+    ``x`` is a KKT solution of the regularized system, so when the equalities are
+    inconsistent ``r`` is their least-squares residual: ``A'r = 0`` and ``b'r = ||r||^2 > 0``.
+    """
+    if p.A.shape[0] == 0:
+        return False
+    r = p.b - p.A @ w.x
+    norm = 0.0
+    for i in range(r.shape[0]):
+        norm = max(norm, abs(r[i] * p.E[i]))
+    ATr = p.A.T @ r
+    for i in range(ATr.shape[0]):
+        if abs(ATr[i] / p.D[i]) > eps * norm:
+            return False
+    return p.b @ r > eps * norm
+
+
+@njit(cache=True)
+def is_dual_infeasible(p, w, eps):
+    """Test the last step ``dx`` as an unbounded direction.
+
+    Needs ``P dx ~ 0``, ``q'dx < 0``, ``A dx ~ 0`` and ``dx_S`` in the recession cone
+    of C, all relative to ``||dx||``.
+    """
+    dx = w.x - w.x_prev
+    norm = 0.0
+    for i in range(dx.shape[0]):
+        norm = max(norm, abs(dx[i] * p.D[i]))
+    if norm <= 1e-300:
+        return False
+    tol = eps * norm
+    if p.q @ dx / p.c >= -tol:
+        return False
+    Pdx = p.P @ dx
+    for i in range(dx.shape[0]):
+        if abs(Pdx[i] / (p.c * p.D[i])) > tol:
+            return False
+    if p.A.shape[0] > 0:
+        Adx = p.A @ dx
+        for i in range(Adx.shape[0]):
+            if abs(Adx[i] / p.E[i]) > tol:
+                return False
+    for j in range(p.constrained.shape[0]):
+        i = p.constrained[j]
+        step = dx[i] * p.D[i]
+        if (p.hi[j] < np.inf and step > tol) or (p.lo[j] > -np.inf and step < -tol):
+            return False
+    kind, offset, dim, mu, normal = p.cones
+    for k in range(kind.shape[0]):
+        a, e = offset[k], offset[k] + dim[k]
+        block = np.empty(e - a)
+        for t in range(a, e):
+            block[t - a] = dx[p.constrained[t]]
+        projected = np.empty(e - a)
+        project_cone_block(block, kind[k], mu[k], normal[k], projected)
+        scale = p.D[p.constrained[a]]
+        if _inf_norm(block - projected) * scale > tol:
+            return False
+    return True
+
+
+@njit(cache=True)
+def _equality_qp_start(p, w, sigma):
+    """Paper's cold start: ``x`` solves the QP with equalities only, ``z = P_C(x_S)``, ``y = 0``.
+
+    Returns False if the KKT inertia shows that P is not positive semidefinite.
+    """
+    n = p.P.shape[0]
+    w.rho_vec[:] = 0.0
+    if not _factor_kkt(p, w, sigma):
+        return False
+    w.rhs[:n] = -p.q
+    w.rhs[n:] = p.b
+    _solve_x(p, w, sigma)
+    w.x[:] = w.sol[:n]
+    w.nu[:] = w.sol[n:]
+    if sigma * _inf_norm(w.x) > EQUALITY_START_LIMIT * max(1.0, _inf_norm(p.q)):
+        w.x[:] = 0.0
+        w.nu[:] = 0.0
+    for j in range(p.constrained.shape[0]):
+        w.relaxed[j] = w.x[p.constrained[j]]
+    project_constraint_set(w.relaxed, p.lo, p.hi, p.cones, w.z)
+    w.y[:] = 0.0
+    return True
+
+
+@njit(cache=True)
+def _update_rho(p, w, rho, prim_s, dual_s, prim_scale_s, dual_scale_s, tolerance):
+    """OSQP's rule: rho *= sqrt(relative primal / relative dual residual), clipped."""
+    ratio = (prim_s / max(prim_scale_s, 1e-30)) / max(dual_s / max(dual_scale_s, 1e-30), 1e-30)
+    new_rho = min(max(rho * np.sqrt(ratio), RHO_MIN), RHO_MAX)
+    if new_rho > rho * tolerance or new_rho < rho / tolerance:
+        return new_rho
+    return rho
+
+
+@njit(cache=True)
+def run(p, w, prm):
+    """Run ADMM from the iterate in ``w`` (or a cold start); return a summary tuple.
+
+    Returns ``(status, iterations, rho, prim, dual, factorizations)``;
+    status ``NOT_CONVEX`` means the KKT inertia rejected P. ``w.log`` rows receive
+    ``(iteration, prim, dual, rho)`` at each residual check, as long as there is room.
+    """
+    n = p.P.shape[0]
+    s = p.constrained.shape[0]
+    rho = prm.rho
+    factorizations = 0
+    iteration = 0
+    if prm.cold_start:
+        if not _equality_qp_start(p, w, prm.sigma):
+            return NOT_CONVEX, 0, rho, 0.0, 0.0, 1
+        factorizations += 1
+    prim, dual, prim_scale, dual_scale, prim_s, dual_s, prim_scale_s, dual_scale_s = residuals(p, w)
+    eps_p = prm.eps_abs + prm.eps_rel * prim_scale
+    eps_d = prm.eps_abs + prm.eps_rel * dual_scale
+    if w.log.shape[0] > 0:
+        w.log[0, 0], w.log[0, 1], w.log[0, 2], w.log[0, 3] = 0, prim, dual, rho
+    if prm.cold_start and prim <= eps_p and dual <= eps_d:
+        return SOLVED, 0, rho, prim, dual, factorizations
+    for j in range(s):
+        w.rho_vec[j] = rho * w.rho_scale[j]
+    if prm.factorize or prm.cold_start:
+        if not _factor_kkt(p, w, prm.sigma):
+            return NOT_CONVEX, 0, rho, prim, dual, factorizations + 1
+        factorizations += 1
+    status = 0
+    timed = prm.time_limit < np.inf
+    while status == 0:
+        iteration += 1
+        w.x_prev[:] = w.x
+        w.nu_prev[:] = w.nu
+        w.z_prev[:] = w.z
+        w.y_prev[:] = w.y
+        w.rhs[:n] = prm.sigma * w.x - p.q
+        w.rhs[n:] = p.b
+        for j in range(s):
+            w.rhs[p.constrained[j]] += w.rho_vec[j] * w.z[j] - w.y[j]
+        _solve_x(p, w, prm.sigma)
+        for j in range(s):
+            w.relaxed[j] = prm.alpha * w.sol[p.constrained[j]] + (1.0 - prm.alpha) * w.z_prev[j]
+        for i in range(n):
+            w.x[i] = prm.alpha * w.sol[i] + (1.0 - prm.alpha) * w.x_prev[i]
+        w.nu[:] = w.sol[n:]
+        for j in range(s):
+            w.z[j] = w.relaxed[j] + w.y[j] / w.rho_vec[j]
+        project_constraint_set(w.z, p.lo, p.hi, p.cones, w.z)
+        for j in range(s):
+            w.y[j] += w.rho_vec[j] * (w.relaxed[j] - w.z[j])
+
+        last = iteration >= prm.max_iter or (timed and _now() - prm.start_time >= prm.time_limit)
+        adapt = prm.adaptive_rho and iteration % prm.adaptive_rho_interval == 0
+        if iteration % prm.check_termination != 0 and not last and not adapt:
+            continue
+        prim, dual, prim_scale, dual_scale, prim_s, dual_s, prim_scale_s, dual_scale_s = residuals(p, w)
+        eps_p = prm.eps_abs + prm.eps_rel * prim_scale
+        eps_d = prm.eps_abs + prm.eps_rel * dual_scale
+        if iteration < w.log.shape[0]:
+            row = w.log[iteration]
+            row[0], row[1], row[2], row[3] = iteration, prim, dual, rho
+        if prim <= eps_p and dual <= eps_d:
+            status = SOLVED
+        elif is_primal_infeasible(p, w, prm.eps_prim_inf) or (
+            prim > eps_p and is_equality_inconsistent(p, w, prm.eps_prim_inf)
+        ):
+            status = PRIMAL_INFEASIBLE
+        elif is_dual_infeasible(p, w, prm.eps_dual_inf):
+            status = DUAL_INFEASIBLE
+        elif last:
+            if prim <= INACCURATE_FACTOR * eps_p and dual <= INACCURATE_FACTOR * eps_d:
+                status = SOLVED_INACCURATE
+            elif iteration >= prm.max_iter:
+                status = MAX_ITER
+            else:
+                status = TIME_LIMIT
+        elif adapt:
+            new_rho = _update_rho(
+                p, w, rho, prim_s, dual_s, prim_scale_s, dual_scale_s, prm.adaptive_rho_tolerance
+            )
+            if new_rho != rho:
+                rho = new_rho
+                for j in range(s):
+                    w.rho_vec[j] = rho * w.rho_scale[j]
+                if not _factor_kkt(p, w, prm.sigma):
+                    return NOT_CONVEX, iteration, rho, prim, dual, factorizations + 1
+                factorizations += 1
+    return status, iteration, rho, prim, dual, factorizations

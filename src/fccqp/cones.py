@@ -1,0 +1,178 @@
+"""Cone blocks of the decision vector: the user-facing specs and their flat form.
+
+A cone constrains a contiguous block ``x[start:start + dim]``:
+
+- :class:`FrictionCone` -- ``{f in R^3 : ||f - (n'f) n|| <= mu * n'f}``, the Coulomb
+  friction cone about the unit normal ``n`` (default ``(0, 0, 1)``, so the block is
+  ``(fx, fy, fz)`` with the normal force last, as in the paper).
+- :class:`SecondOrderCone` -- ``{(t, v) : ||v|| <= t}`` of any dimension ``>= 2``.
+
+The numba kernels never see these objects: :func:`flatten_cones` turns them into
+:class:`ConeArrays`, plain arrays of kinds, offsets, sizes, friction coefficients and
+normals.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+FRICTION = 0
+"""Kind code of a friction cone in :class:`ConeArrays`."""
+SECOND_ORDER = 1
+"""Kind code of a standard second-order cone in :class:`ConeArrays`."""
+
+_UNIT_TOLERANCE = 1e-8
+
+
+@dataclass(frozen=True)
+class FrictionCone:
+    """Friction cone on ``x[start:start + 3]``.
+
+    Parameters
+    ----------
+    start : int
+        Index of the first of the three force entries.
+    mu : float
+        Friction coefficient, finite and positive.
+    normal : sequence of 3 floats, optional
+        Unit contact normal; ``None`` means ``(0, 0, 1)``: the block is
+        ``(fx, fy, fz)`` with the normal force last.
+    """
+
+    start: int
+    mu: float
+    normal: tuple[float, float, float] | None = None
+
+    @property
+    def dim(self) -> int:
+        """Number of entries of ``x`` in the block (always 3)."""
+        return 3
+
+
+@dataclass(frozen=True)
+class SecondOrderCone:
+    """Second-order (Lorentz) cone ``||x[start+1:start+dim]|| <= x[start]``.
+
+    Parameters
+    ----------
+    start : int
+        Index of the first entry (the cone's "t").
+    dim : int
+        Size of the block, at least 2.
+    """
+
+    start: int
+    dim: int
+
+
+Cone = FrictionCone | SecondOrderCone
+
+
+@dataclass(frozen=True)
+class ConeArrays:
+    """Flat description of cone blocks for the numba kernels.
+
+    All arrays have one entry per cone, ``normal`` one row per cone (unused rows of
+    second-order cones hold zeros). ``offset`` indexes the vector the cone acts on,
+    which the solver sets to the position of the block in its constrained-entry
+    vector, not in ``x``.
+    """
+
+    kind: np.ndarray
+    offset: np.ndarray
+    dim: np.ndarray
+    mu: np.ndarray
+    normal: np.ndarray
+
+    @property
+    def count(self) -> int:
+        """Number of cones."""
+        return int(self.kind.shape[0])
+
+    def entries(self) -> np.ndarray:
+        """Indices, in the vector the cones act on, of every entry in some cone."""
+        if self.count == 0:
+            return np.zeros(0, dtype=np.int64)
+        return np.concatenate(
+            [np.arange(o, o + d) for o, d in zip(self.offset, self.dim)]
+        ).astype(np.int64)
+
+    def relocated(self, offset: np.ndarray) -> ConeArrays:
+        """The same cones with new block offsets."""
+        return ConeArrays(self.kind, offset.astype(np.int64), self.dim, self.mu, self.normal)
+
+
+def _integer(value: object, what: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{what} must be an integer, got {value!r}")
+    return int(value)
+
+
+def _check_friction(cone: FrictionCone, index: int) -> np.ndarray:
+    mu = cone.mu
+    if isinstance(mu, bool) or not isinstance(mu, (int, float, np.integer, np.floating)):
+        raise TypeError(f"cones[{index}].mu must be a number, got {mu!r}")
+    if not math.isfinite(mu) or mu <= 0:
+        raise ValueError(f"cones[{index}].mu must be finite and > 0, got {mu}")
+    if cone.normal is None:
+        return np.array([0.0, 0.0, 1.0])
+    normal = np.asarray(cone.normal, dtype=float)
+    if normal.shape != (3,):
+        raise ValueError(f"cones[{index}].normal must have 3 entries, got shape {normal.shape}")
+    if not np.all(np.isfinite(normal)):
+        raise ValueError(f"cones[{index}].normal contains NaN or inf")
+    norm = float(np.linalg.norm(normal))
+    if abs(norm - 1.0) > _UNIT_TOLERANCE:
+        raise ValueError(f"cones[{index}].normal must be a unit vector, its norm is {norm:.6g}")
+    return normal / norm
+
+
+def flatten_cones(cones: Sequence[Cone], n: int) -> ConeArrays:
+    """Validate cone specs for an ``n``-vector and return them as flat arrays.
+
+    Raises
+    ------
+    TypeError
+        If an entry is not a :class:`FrictionCone` or :class:`SecondOrderCone`.
+    ValueError
+        If a block leaves ``[0, n)``, overlaps another block, a second-order cone has
+        ``dim < 2``, or a friction cone has a bad ``mu`` or normal.
+    """
+    if isinstance(cones, (FrictionCone, SecondOrderCone)):
+        cones = (cones,)
+    k = len(cones)
+    kind = np.zeros(k, dtype=np.int64)
+    offset = np.zeros(k, dtype=np.int64)
+    dim = np.zeros(k, dtype=np.int64)
+    mu = np.zeros(k)
+    normal = np.zeros((k, 3))
+    for i, cone in enumerate(cones):
+        if isinstance(cone, FrictionCone):
+            normal[i] = _check_friction(cone, i)
+            kind[i], dim[i], mu[i] = FRICTION, 3, float(cone.mu)
+        elif isinstance(cone, SecondOrderCone):
+            kind[i] = SECOND_ORDER
+            dim[i] = _integer(cone.dim, f"cones[{i}].dim")
+            if dim[i] < 2:
+                raise ValueError(f"cones[{i}].dim must be >= 2, got {dim[i]}")
+        else:
+            raise TypeError(
+                f"cones[{i}] must be a FrictionCone or SecondOrderCone, got {type(cone).__name__}"
+            )
+        offset[i] = _integer(cone.start, f"cones[{i}].start")
+        if offset[i] < 0 or offset[i] + dim[i] > n:
+            raise ValueError(
+                f"cones[{i}] covers x[{offset[i]}:{offset[i] + dim[i]}], outside x of length {n}"
+            )
+    order = np.argsort(offset, kind="stable")
+    for a, b in zip(order[:-1], order[1:]):
+        if offset[a] + dim[a] > offset[b]:
+            raise ValueError(
+                f"cones[{a}] (x[{offset[a]}:{offset[a] + dim[a]}]) overlaps "
+                f"cones[{b}] (x[{offset[b]}:{offset[b] + dim[b]}])"
+            )
+    return ConeArrays(kind, offset, dim, mu, normal)

@@ -1,0 +1,51 @@
+"""The result of a solve."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from fccqp.status import Status
+
+
+@dataclass(frozen=True)
+class Result:
+    """Primal and dual solution with diagnostics.
+
+    Sign convention (the same as qpsolvers' for the box):
+    ``P x + q + A' y + z = 0``. For a box entry ``z_i < 0`` where the lower bound is
+    active and ``z_i > 0`` where the upper bound is; for a cone block ``-z_block``
+    lies in the dual cone. Entries with no bound and no cone have ``z_i = 0``.
+
+    When the status is :attr:`Status.PRIMAL_INFEASIBLE`, ``certificate`` holds the
+    dual direction ``(y, z)`` concatenated; for :attr:`Status.DUAL_INFEASIBLE` it holds
+    the primal direction ``dx``; otherwise it is ``None``.
+    """
+
+    x: np.ndarray
+    """Primal solution (or last iterate)."""
+    y: np.ndarray
+    """Multipliers of ``A x = b``."""
+    z: np.ndarray
+    """Multipliers of the box and cone constraints, one per entry of ``x``."""
+    status: Status
+    """How the solve ended."""
+    obj: float
+    """Objective ``1/2 x'Px + q'x`` at ``x``."""
+    iterations: int
+    """ADMM iterations performed."""
+    prim_res: float
+    """Primal residual ``max(||Ax - b||, ||x - P_C(x)||)`` in the infinity norm."""
+    dual_res: float
+    """Dual residual ``||Px + q + A'y + z||`` in the infinity norm."""
+    setup_time: float
+    """Seconds spent validating, scaling and factorizing before the iterations."""
+    solve_time: float
+    """Seconds spent in the whole call."""
+    rho: float
+    """Final rho (scaled problem)."""
+    factorizations: int
+    """KKT factorizations performed during the call."""
+    certificate: np.ndarray | None = None
+    """Infeasibility certificate, see the class docstring."""

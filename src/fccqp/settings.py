@@ -1,0 +1,102 @@
+"""Solver settings and presets."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Settings of the ADMM solver; every field has a default.
+
+    Names follow OSQP where the meaning is the same. Tolerances apply to the
+    unscaled problem, in the infinity norm.
+    """
+
+    rho: float = 0.1
+    """Initial ADMM penalty on the box and cone constraints (scaled problem)."""
+    sigma: float = 1e-6
+    """Proximal regularization of the x-update; keeps the KKT matrix quasi-definite."""
+    alpha: float = 1.6
+    """Over-relaxation parameter, in (0, 2)."""
+    eps_abs: float = 1e-5
+    """Absolute tolerance on primal and dual residuals."""
+    eps_rel: float = 1e-5
+    """Relative tolerance on primal and dual residuals."""
+    eps_prim_inf: float = 1e-6
+    """Tolerance of the primal infeasibility certificate."""
+    eps_dual_inf: float = 1e-6
+    """Tolerance of the dual infeasibility certificate."""
+    max_iter: int = 4000
+    """Iteration budget; when it runs out the current iterate is returned."""
+    time_limit: float = math.inf
+    """Wall-clock budget of one solve in seconds (setup included); ``inf`` for none."""
+    check_termination: int = 1
+    """Check residuals every this many iterations."""
+    adaptive_rho: bool = True
+    """Rescale rho to balance primal and dual residuals, refactoring when it changes."""
+    adaptive_rho_interval: int = 25
+    """Iterations between two rho updates."""
+    adaptive_rho_tolerance: float = 5.0
+    """Refactor only when rho would change by more than this factor."""
+    scaling: int = 10
+    """Ruiz equilibration iterations (0 disables scaling)."""
+    warm_start: bool = True
+    """Start from the previous solution (used by :class:`fccqp.Solver`)."""
+    verbose: bool = False
+    """Print one line per residual check."""
+
+    def __post_init__(self) -> None:
+        positive = ("rho", "sigma", "eps_prim_inf", "eps_dual_inf", "time_limit")
+        for name in positive:
+            value = getattr(self, name)
+            if not isinstance(value, (int, float)) or isinstance(value, bool) or math.isnan(value):
+                raise TypeError(f"setting {name} must be a number, got {value!r}")
+            if value <= 0 or (name != "time_limit" and not math.isfinite(value)):
+                raise ValueError(f"setting {name} must be finite and > 0, got {value}")
+        for name in ("eps_abs", "eps_rel"):
+            value = getattr(self, name)
+            if not isinstance(value, (int, float)) or isinstance(value, bool):
+                raise TypeError(f"setting {name} must be a number, got {value!r}")
+            if not (0 <= value < math.inf):
+                raise ValueError(f"setting {name} must be finite and >= 0, got {value}")
+        if self.eps_abs == 0 and self.eps_rel == 0:
+            raise ValueError("settings eps_abs and eps_rel cannot both be 0")
+        if not (0 < self.alpha < 2):
+            raise ValueError(f"setting alpha must lie in (0, 2), got {self.alpha}")
+        if not (self.adaptive_rho_tolerance > 1):
+            raise ValueError(
+                f"setting adaptive_rho_tolerance must be > 1, got {self.adaptive_rho_tolerance}"
+            )
+        for name in ("max_iter", "check_termination", "adaptive_rho_interval", "scaling"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int):
+                raise TypeError(f"setting {name} must be an integer, got {value!r}")
+            minimum = 0 if name == "scaling" else 1
+            if value < minimum:
+                raise ValueError(f"setting {name} must be >= {minimum}, got {value}")
+        for name in ("adaptive_rho", "warm_start", "verbose"):
+            if not isinstance(getattr(self, name), bool):
+                raise TypeError(f"setting {name} must be a bool, got {getattr(self, name)!r}")
+
+    def replace(self, **overrides: object) -> Settings:
+        """Return a copy with some fields changed; unknown names raise ``ValueError``."""
+        unknown = sorted(set(overrides) - {f.name for f in dataclasses.fields(self)})
+        if unknown:
+            valid = ", ".join(f.name for f in dataclasses.fields(self))
+            raise ValueError(f"unknown setting(s) {', '.join(unknown)}; valid settings: {valid}")
+        return dataclasses.replace(self, **overrides)
+
+    @classmethod
+    def realtime(cls, **overrides: object) -> Settings:
+        """Preset for control loops: warm start, a 15-iteration budget, loose tolerance.
+
+        The paper ran 15 iterations at ``rho = 5e-5`` and ``eps = 1e-4`` on Cassie.
+        Here rho applies to the scaled problem and only to constrained entries, so the
+        value differs; it was re-tuned on the whole-body-control test sets in
+        ``benchmarks/`` (see ``docs/performance.md``).
+        """
+        preset = cls(max_iter=15, eps_abs=1e-4, eps_rel=1e-4, warm_start=True)
+        return preset.replace(**overrides)

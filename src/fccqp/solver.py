@@ -1,0 +1,279 @@
+"""The user-facing solver: validation, scaling, warm starts and results."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from fccqp import admm
+from fccqp.cones import Cone
+from fccqp.problem import ProblemData, validate
+from fccqp.projections import project_constraint_set
+from fccqp.result import Result
+from fccqp.scaling import equilibrate
+from fccqp.settings import Settings
+from fccqp.status import STATUS_BY_CODE, Status
+
+_LAPACK_BLOCK = 64
+"""Work size per row given to dsytrf (its blocked algorithm's block size)."""
+
+
+@dataclass
+class _Previous:
+    """What a solve leaves for the next one: data to compare, factorization, solution."""
+
+    data: ProblemData
+    scaled: admm.ScaledProblem
+    rho: float
+    x: np.ndarray
+    y: np.ndarray
+    z: np.ndarray
+
+
+def _scale(data: ProblemData, iterations: int) -> admm.ScaledProblem:
+    P, q, A, b = data.P.copy(), data.q.copy(), data.A.copy(), data.b.copy()
+    D, E = np.ones(data.n), np.ones(data.m)
+    cones = data.cones
+    block_start = data.constrained[cones.offset] if cones.count else np.zeros(0, np.int64)
+    c = equilibrate(P, q, A, b, block_start, cones.dim, iterations, D, E) if iterations else 1.0
+    Ds = D[data.constrained]
+    return admm.ScaledProblem(
+        P=P, q=q, A=A, b=b, constrained=data.constrained,
+        lo=data.lb[data.constrained] / Ds, hi=data.ub[data.constrained] / Ds,
+        cones=(cones.kind, cones.offset, cones.dim, cones.mu, cones.normal),
+        D=D, E=E, c=float(c), A_norm=float(np.max(np.abs(A), initial=0.0)),
+    )
+
+
+def _workspace(data: ProblemData, log_rows: int) -> admm.Workspace:
+    n, m, s = data.n, data.m, data.constrained.shape[0]
+    N = n + m
+    fixed = data.lb[data.constrained] == data.ub[data.constrained]
+    return admm.Workspace(
+        K=np.zeros((N, N), order="F"), ipiv=np.zeros(N, np.int32),
+        work=np.zeros(N * _LAPACK_BLOCK), rhs=np.zeros(N), sol=np.zeros(N),
+        residual=np.zeros(N), x=np.zeros(n), nu=np.zeros(m), z=np.zeros(s), y=np.zeros(s),
+        x_prev=np.zeros(n), nu_prev=np.zeros(m), z_prev=np.zeros(s), y_prev=np.zeros(s),
+        rho_vec=np.zeros(s), rho_scale=np.where(fixed, admm.FIXED_RHO_SCALE, 1.0),
+        relaxed=np.zeros(s), log=np.zeros((log_rows, 4)),
+    )
+
+
+def _same_matrices(a: ProblemData, b: ProblemData) -> bool:
+    return (
+        a.P.shape == b.P.shape and a.A.shape == b.A.shape
+        and np.array_equal(a.constrained, b.constrained)
+        and np.array_equal(a.lb == a.ub, b.lb == b.ub)
+        and np.array_equal(a.cones.offset, b.cones.offset)
+        and np.array_equal(a.cones.dim, b.cones.dim)
+        and np.array_equal(a.P, b.P) and np.array_equal(a.A, b.A)
+    )
+
+
+def _objective(data: ProblemData, x: np.ndarray) -> float:
+    return float(0.5 * x @ (data.P @ x) + data.q @ x)
+
+
+def _smallest_eigenvalue(P: np.ndarray) -> float:
+    return float(np.linalg.eigvalsh(P)[0])
+
+
+class Solver:
+    """ADMM solver for QPs with equalities, a box and friction / second-order cones.
+
+    A ``Solver`` keeps its workspace between :meth:`solve` calls. With
+    ``settings.warm_start`` each solve starts from the previous primal and dual
+    solution and rho; when ``P``, ``A``, the constrained entries and rho are
+    unchanged the scaling and the KKT factorization are reused as well.
+
+    Parameters
+    ----------
+    settings : Settings, optional
+        Defaults to ``Settings()``.
+    **overrides
+        Fields of :class:`Settings` to change, e.g. ``Solver(max_iter=100)``.
+    """
+
+    def __init__(self, settings: Settings | None = None, **overrides: object) -> None:
+        if settings is not None and not isinstance(settings, Settings):
+            raise TypeError(f"settings must be a fccqp.Settings, got {type(settings).__name__}")
+        self.settings = (settings or Settings()).replace(**overrides)
+        self._previous: _Previous | None = None
+        self._workspace: admm.Workspace | None = None
+
+    def reset(self) -> None:
+        """Forget the previous solve: the next one starts cold."""
+        self._previous = None
+
+    def solve(
+        self,
+        P: object,
+        q: object,
+        A: object = None,
+        b: object = None,
+        lb: object = None,
+        ub: object = None,
+        cones: Sequence[Cone] = (),
+        *,
+        x0: object = None,
+    ) -> Result:
+        """Solve ``min 1/2 x'Px + q'x  s.t.  A x = b, lb <= x <= ub, x[block] in cone``.
+
+        Parameters
+        ----------
+        P : (n, n) array_like or scipy.sparse matrix
+            Symmetric positive semidefinite cost matrix (densified if sparse).
+        q : (n,) array_like
+            Linear cost.
+        A, b : (m, n) and (m,) array_like, optional
+            Equality constraints, held to factorization accuracy at every iterate.
+        lb, ub : (n,) array_like, optional
+            Bounds, ``-inf``/``+inf`` where absent. Entries of cone blocks must be free.
+        cones : sequence of FrictionCone or SecondOrderCone
+            Disjoint cone blocks of ``x``.
+        x0 : (n,) array_like, optional
+            Primal initial guess; overrides the warm start from the previous solve.
+
+        Returns
+        -------
+        Result
+            Only ``Status.SOLVED`` means both residuals are within tolerance.
+
+        Raises
+        ------
+        ValueError, TypeError
+            On malformed input, naming the argument, and when ``P`` is not positive
+            semidefinite (detected from the inertia of the KKT factorization).
+        """
+        start = time.perf_counter()
+        settings = self.settings
+        data = validate(P, q, A, b, lb, ub, cones)
+        prev = self._previous
+        reuse = prev is not None and _same_matrices(prev.data, data)
+        if reuse:
+            scaled = self._rescale_vectors(prev.scaled, data)
+        else:
+            scaled = _scale(data, settings.scaling)
+        log_rows = settings.max_iter + 1 if settings.verbose else 0
+        w = self._workspace
+        if w is None or not reuse or w.log.shape[0] != log_rows:
+            w = self._workspace = _workspace(data, log_rows)
+        warm = settings.warm_start and prev is not None and prev.x.shape == data.q.shape
+        warm = warm and prev.y.shape == data.b.shape
+        rho = prev.rho if warm else settings.rho
+        if x0 is not None:
+            self._start_from_guess(scaled, data, x0, w)
+        elif warm:
+            self._start_from_previous(scaled, prev, w)
+        cold = x0 is None and not warm
+        params = admm.Params(
+            rho=rho, sigma=settings.sigma, alpha=settings.alpha,
+            eps_abs=settings.eps_abs, eps_rel=settings.eps_rel,
+            eps_prim_inf=settings.eps_prim_inf, eps_dual_inf=settings.eps_dual_inf,
+            max_iter=settings.max_iter, check_termination=settings.check_termination,
+            adaptive_rho=settings.adaptive_rho,
+            adaptive_rho_interval=settings.adaptive_rho_interval,
+            adaptive_rho_tolerance=settings.adaptive_rho_tolerance,
+            time_limit=float(settings.time_limit), start_time=start,
+            cold_start=cold, factorize=not (reuse and prev is not None and rho == prev.rho),
+        )
+        setup_time = time.perf_counter() - start
+        code, iterations, rho, prim, dual, factorizations = admm.run(scaled, w, params)
+        if code == admm.NOT_CONVEX:
+            self._previous = None
+            raise ValueError(
+                "P is not positive semidefinite: its smallest eigenvalue is "
+                f"{_smallest_eigenvalue(data.P):.3g}"
+            )
+        status = STATUS_BY_CODE[code]
+        x, y, z = self._unscale(scaled, w)
+        certificate = self._certificate(scaled, w, status)
+        self._previous = _Previous(data, scaled, rho, x, y, z)
+        if settings.verbose:
+            self._print_log(w, status, iterations)
+        return Result(
+            x=x, y=y, z=z, status=status, obj=_objective(data, x), iterations=int(iterations),
+            prim_res=float(prim), dual_res=float(dual), setup_time=setup_time,
+            solve_time=time.perf_counter() - start, rho=float(rho),
+            factorizations=int(factorizations), certificate=certificate,
+        )
+
+    @staticmethod
+    def _rescale_vectors(old: admm.ScaledProblem, data: ProblemData) -> admm.ScaledProblem:
+        """Reuse the scaling of unchanged matrices for new q, b and bounds."""
+        Ds = old.D[data.constrained]
+        return old._replace(
+            q=old.c * old.D * data.q, b=old.E * data.b,
+            lo=data.lb[data.constrained] / Ds, hi=data.ub[data.constrained] / Ds,
+        )
+
+    @staticmethod
+    def _start_from_previous(scaled: admm.ScaledProblem, prev: _Previous, w: admm.Workspace) -> None:
+        s = scaled.constrained
+        w.x[:] = prev.x / scaled.D
+        w.nu[:] = prev.y * scaled.c / scaled.E
+        w.y[:] = prev.z[s] * scaled.c * scaled.D[s]
+        project_constraint_set(w.x[s] + w.y / max(prev.rho, 1e-12), scaled.lo, scaled.hi,
+                               scaled.cones, w.z)
+
+    @staticmethod
+    def _start_from_guess(
+        scaled: admm.ScaledProblem, data: ProblemData, x0: object, w: admm.Workspace
+    ) -> None:
+        guess = np.asarray(x0, dtype=np.float64).reshape(-1)
+        if guess.shape != (data.n,) or not np.all(np.isfinite(guess)):
+            raise ValueError(f"x0 must be a finite vector of {data.n} entries")
+        w.x[:] = guess / scaled.D
+        w.nu[:] = 0.0
+        w.y[:] = 0.0
+        project_constraint_set(w.x[scaled.constrained], scaled.lo, scaled.hi, scaled.cones, w.z)
+
+    @staticmethod
+    def _unscale(scaled: admm.ScaledProblem, w: admm.Workspace):
+        s = scaled.constrained
+        x = w.x * scaled.D
+        y = w.nu * scaled.E / scaled.c
+        z = np.zeros_like(x)
+        z[s] = w.y / (scaled.c * scaled.D[s])
+        return x, y, z
+
+    @staticmethod
+    def _certificate(scaled: admm.ScaledProblem, w: admm.Workspace, status: Status):
+        if status is Status.DUAL_INFEASIBLE:
+            return (w.x - w.x_prev) * scaled.D
+        if status is Status.PRIMAL_INFEASIBLE:
+            s = scaled.constrained
+            d_z = np.zeros(w.x.shape[0])
+            d_z[s] = (w.y - w.y_prev) / scaled.D[s]
+            return np.concatenate([(w.nu - w.nu_prev) * scaled.E, d_z])
+        return None
+
+    @staticmethod
+    def _print_log(w: admm.Workspace, status: Status, iterations: int) -> None:
+        print(f"{'iter':>6} {'prim_res':>10} {'dual_res':>10} {'rho':>9}")
+        for it, prim, dual, rho in w.log[: iterations + 1]:
+            if it > 0 or (prim, dual) != (0.0, 0.0):
+                print(f"{int(it):6d} {prim:10.3e} {dual:10.3e} {rho:9.2e}")
+        print(f"status: {status.value} after {iterations} iterations")
+
+
+def solve(
+    P: object,
+    q: object,
+    A: object = None,
+    b: object = None,
+    lb: object = None,
+    ub: object = None,
+    cones: Sequence[Cone] = (),
+    settings: Settings | None = None,
+    **overrides: object,
+) -> Result:
+    """Solve one QP from a cold start; see :meth:`Solver.solve` for the arguments.
+
+    ``settings`` and keyword ``overrides`` (fields of :class:`Settings`) configure
+    the solve; an unknown keyword raises ``ValueError``.
+    """
+    return Solver(settings, **overrides).solve(P, q, A, b, lb, ub, cones)

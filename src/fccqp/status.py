@@ -1,0 +1,43 @@
+"""Solver statuses."""
+
+from enum import Enum
+
+
+class Status(Enum):
+    """Outcome of a solve.
+
+    Only :attr:`SOLVED` means every residual is within the requested tolerances.
+    """
+
+    SOLVED = "solved"
+    """Primal and dual residuals are within ``eps_abs + eps_rel * scale``."""
+    SOLVED_INACCURATE = "solved_inaccurate"
+    """A budget ran out with residuals within 10x the tolerances."""
+    MAX_ITER_REACHED = "max_iter_reached"
+    """``max_iter`` iterations ran without reaching (10x) tolerance."""
+    TIME_LIMIT_REACHED = "time_limit_reached"
+    """``time_limit`` seconds passed without reaching (10x) tolerance."""
+    PRIMAL_INFEASIBLE = "primal_infeasible"
+    """A certificate of primal infeasibility was found (see ``Result.certificate``)."""
+    DUAL_INFEASIBLE = "dual_infeasible"
+    """A certificate of dual infeasibility (an unbounded direction) was found."""
+
+    def is_solved(self) -> bool:
+        """True for :attr:`SOLVED` only."""
+        return self is Status.SOLVED
+
+    def is_infeasible(self) -> bool:
+        """True when a primal or dual infeasibility certificate was found."""
+        return self in (Status.PRIMAL_INFEASIBLE, Status.DUAL_INFEASIBLE)
+
+
+# Codes the numba kernels return; STATUS_BY_CODE maps them back.
+RUNNING = 0
+STATUS_BY_CODE = {
+    1: Status.SOLVED,
+    2: Status.SOLVED_INACCURATE,
+    3: Status.MAX_ITER_REACHED,
+    4: Status.TIME_LIMIT_REACHED,
+    5: Status.PRIMAL_INFEASIBLE,
+    6: Status.DUAL_INFEASIBLE,
+}
