@@ -67,7 +67,9 @@ class SequenceSpec:
     """Everything that defines one sequence besides the robot and ``dt``.
 
     Sinusoids are ``amp * sin(2 pi freq t + phase)`` per axis, added to the CoM position
-    (m) and to the base orientation as a world-frame rotation vector (rad).
+    (m) and to the base orientation as a world-frame rotation vector (rad). A swing
+    foot follows a half-sine bump over its phase of duration ``T`` whose height
+    ``swing_accel (T / pi)^2`` gives a peak vertical acceleration of ``swing_accel``.
     """
 
     scenario: str
@@ -79,7 +81,7 @@ class SequenceSpec:
     base_amp: np.ndarray
     base_freq: np.ndarray
     base_phase: np.ndarray
-    swing_height: float
+    swing_accel: float
     pushes: dict[int, np.ndarray] = field(default_factory=dict)
 
 
@@ -129,10 +131,7 @@ def _foot_xy(robot: LoadedRobot) -> dict[str, np.ndarray]:
     """Horizontal position of each foot at the starting posture."""
     data = robot.model.createData()
     pin.framesForwardKinematics(robot.model, data, robot.q0)
-    return {
-        name: data.oMf[fid].translation[:2].copy()
-        for name, fid in robot.foot_frames.items()
-    }
+    return {name: data.oMf[fid].translation[:2].copy() for name, fid in robot.foot_frames.items()}
 
 
 def _com_xy(robot: LoadedRobot) -> np.ndarray:
@@ -146,9 +145,9 @@ def _contact_phases(
     """Contact schedule of ``contact_switch``: trot, or one foot lifted then put down."""
     feet = tuple(f.name for f in robot.config.feet)
     pre = round(0.3 / dt)
-    if robot.config.kind == "quadruped" and rng.random() < 0.5:
+    if robot.config.kind == "quadruped" and rng.random() < 0.6:
         pairs = ((feet[0], feet[3]), (feet[1], feet[2]))
-        half = round(rng.uniform(0.06, 0.1) / dt)
+        half = round(rng.uniform(0.08, 0.15) / dt)
         phases = [Phase(min(10, n_ticks), feet)]
         left, i = n_ticks - phases[0].ticks, int(rng.integers(2))
         while left > 0:
@@ -192,7 +191,7 @@ def make_sequence(
 
     def push() -> np.ndarray:
         heading = rng.uniform(0.0, 2.0 * np.pi)
-        speed = rng.uniform(0.2, 0.4) * np.sqrt(_GRAVITY * L)
+        speed = rng.uniform(0.15, 0.3) * np.sqrt(_GRAVITY * L)
         lin = speed * np.array([np.cos(heading), np.sin(heading), 0.0])
         return np.concatenate([lin, rng.uniform(-0.8, 0.8, 3)])
 
@@ -200,28 +199,31 @@ def make_sequence(
         pushes = {t: push() for t in range(5, n_ticks, max(n_ticks // 3, 1))}
     elif scenario == "aggressive":
         com_lo, com_hi = (
-            L * np.array([0.05, 0.05, 0.02]),
-            L * np.array([0.12, 0.12, 0.05]),
+            L * np.array([0.08, 0.08, 0.02]),
+            L * np.array([0.15, 0.15, 0.05]),
         )
         base_lo, base_hi = np.array([0.1, 0.1, 0.1]), np.array([0.25, 0.25, 0.3])
-        com_f, base_f = (1.5, 3.0), (1.0, 2.5)
+        com_f, base_f = (2.0, 3.5), (1.0, 2.5)
     elif scenario == "low_friction":
-        mu = float(rng.uniform(0.2, 1.0))
+        mu = 0.2 + 0.8 * float(rng.random()) ** 2  # low values more often
         com_lo, com_hi = (
-            L * np.array([0.03, 0.03, 0.01]),
-            L * np.array([0.08, 0.08, 0.03]),
+            L * np.array([0.04, 0.04, 0.01]),
+            L * np.array([0.1, 0.1, 0.03]),
         )
-        com_f = (1.0, 2.0)
+        com_f = (1.5, 2.5)
         pushes = {n_ticks // 2: push()}
     else:
         phases = _contact_phases(robot, rng, n_ticks, dt)
+        mu = float(rng.uniform(0.3, 0.7))
+        com_lo, com_hi = L * np.array([0.03, 0.03, 0.01]), L * np.array([0.06, 0.06, 0.02])
+        com_f = (1.5, 2.5)
     return SequenceSpec(
         scenario,
         phases,
         mu,
         *_random_sinusoids(rng, com_lo, com_hi, com_f),
         *_random_sinusoids(rng, base_lo, base_hi, base_f),
-        swing_height=0.15 * L if robot.config.kind == "quadruped" else 0.05,
+        swing_accel=15.0 if robot.config.kind == "quadruped" else 4.0,
         pushes=pushes,
     )
 
@@ -235,33 +237,33 @@ SCENARIOS: tuple[str, ...] = (
 
 
 def _push(
-    robot: LoadedRobot,
-    data: pin.Data,
-    q: np.ndarray,
-    frames: list[int],
-    dv: np.ndarray,
+    robot: LoadedRobot, data: pin.Data, q: np.ndarray, frames: list[int], dv: np.ndarray
 ) -> np.ndarray:
-    """Velocity jump of a base impulse ``dv`` projected onto the contacts' null space.
+    """Velocity jump of a base impulse that would change the free base velocity by ``dv``.
 
-    A real impact leaves the feet (and a grasping hand) at rest, so the jump is
-    ``(I - J^+ J) [dv; 0]`` with ``J`` the stacked contact and hand Jacobians.
+    The impulse ``p = M_bb dv`` (base block of the mass matrix) hits a robot whose feet
+    and grasping hand stay put, so the jump is the constrained impulse response
+    ``M^-1 (S'p + J'L)`` with contact impulses ``L`` keeping ``J jump = 0``.
     """
     model = robot.model
+    M = pin.crba(model, data, q)
+    M = np.triu(M) + np.triu(M, 1).T
     pin.computeJointJacobians(model, data, q)
     pin.updateFramePlacements(model, data)
     rows = [pin.getFrameJacobian(model, data, fid, _LWA)[:3] for fid in frames]
     if robot.hand_frame is not None:
         rows.append(pin.getFrameJacobian(model, data, robot.hand_frame, _LWA))
-    jump = np.concatenate([dv, np.zeros(model.nv - 6)])
+    impulse = np.zeros(model.nv)
+    impulse[:6] = M[:6, :6] @ dv
+    jump = np.linalg.solve(M, impulse)
     if rows:
         J = np.vstack(rows)
-        jump -= np.linalg.pinv(J) @ (J @ jump)
+        MinvJt = np.linalg.solve(M, J.T)
+        jump -= MinvJt @ np.linalg.lstsq(J @ MinvJt, J @ jump, rcond=None)[0]
     return jump
 
 
-def _hand_feedback(
-    robot: LoadedRobot, data: pin.Data, handle: pin.SE3, g: Gains
-) -> np.ndarray:
+def _hand_feedback(robot: LoadedRobot, data: pin.Data, handle: pin.SE3, g: Gains) -> np.ndarray:
     """Baumgarte term ``-Kp e - Kd J v`` keeping the hand on the handle.
 
     The error and velocity are expressed like the constraint rows: LOCAL twist and
@@ -270,9 +272,7 @@ def _hand_feedback(
     hand = robot.hand_frame
     if robot.config.hand_dim == 6:
         err = pin.log6(handle.actInv(data.oMf[hand])).vector
-        vel = pin.getFrameVelocity(
-            robot.model, data, hand, pin.ReferenceFrame.LOCAL
-        ).vector
+        vel = pin.getFrameVelocity(robot.model, data, hand, pin.ReferenceFrame.LOCAL).vector
     else:
         err = data.oMf[hand].translation - handle.translation
         vel = pin.getFrameVelocity(robot.model, data, hand, _LWA).linear
@@ -326,9 +326,7 @@ def rollout(
     model, data = robot.model, robot.model.createData()
     q, v = robot.q0.copy(), np.zeros(model.nv)
     pin.framesForwardKinematics(model, data, q)
-    anchors = {
-        fid: data.oMf[fid].translation.copy() for fid in robot.foot_frames.values()
-    }
+    anchors = {fid: data.oMf[fid].translation.copy() for fid in robot.foot_frames.values()}
     anchors |= {
         fid: data.oMf[fid].translation.copy()
         for ids in robot.contact_frames.values()
@@ -361,37 +359,35 @@ def rollout(
         c_acc = c_acc + np.r_[blend[2] * dshift / T**2, 0.0]
         com_cmd = c_acc + g.com[0] * (c_ref - com) + g.com[1] * (c_vel - vcom)
 
-        r_ref, w_ref, a_ref = _sinusoid(
-            spec.base_amp, spec.base_freq, spec.base_phase, t
-        )
+        r_ref, w_ref, a_ref = _sinusoid(spec.base_amp, spec.base_freq, spec.base_phase, t)
         R = data.oMi[1].rotation
         err = pin.log3(pin.exp3(r_ref) @ R0 @ R.T)
         omega = R @ v[3:6]
         base_cmd = a_ref + g.base[0] * err + g.base[1] * (w_ref - omega)
 
-        posture_cmd = (
-            g.posture[0] * pin.difference(model, q, robot.q0)[6:] - g.posture[1] * v[6:]
-        )
+        posture_cmd = g.posture[0] * pin.difference(model, q, robot.q0)[6:] - g.posture[1] * v[6:]
 
         points = {}
         for foot, fid in robot.foot_frames.items():
             if foot in phase.stance:
                 continue
-            bump = spec.swing_height * np.array(
-                [
-                    np.sin(np.pi * s),
-                    np.pi / T * np.cos(np.pi * s),
-                    -((np.pi / T) ** 2) * np.sin(np.pi * s),
-                ]
+            bump = (
+                spec.swing_accel
+                * (T / np.pi) ** 2
+                * np.array(
+                    [
+                        np.sin(np.pi * s),
+                        np.pi / T * np.cos(np.pi * s),
+                        -((np.pi / T) ** 2) * np.sin(np.pi * s),
+                    ]
+                )
             )
             p = data.oMf[fid].translation
             pv = pin.getFrameVelocity(model, data, fid, _LWA).linear
             p_ref = anchors[fid] + np.r_[0.0, 0.0, bump[0]]
             v_ref = np.r_[0.0, 0.0, bump[1]]
             points[fid] = (
-                np.r_[0.0, 0.0, bump[2]]
-                + g.swing[0] * (p_ref - p)
-                + g.swing[1] * (v_ref - pv)
+                np.r_[0.0, 0.0, bump[2]] + g.swing[0] * (p_ref - p) + g.swing[1] * (v_ref - pv)
             )
 
         contact_acc = np.concatenate(

@@ -151,7 +151,9 @@ class WbcQP:
         shrink = np.cos(np.pi / facets) if inner else 1.0
         rows = facets + 1
         G = np.zeros((rows * self.n_contacts, self.n))
-        for i, (s, mu, normal) in enumerate(zip(self.cone_starts, self.mus, self.normals)):
+        for i, (s, mu, normal) in enumerate(
+            zip(self.cone_starts, self.mus, self.normals, strict=True)
+        ):
             t1, t2, nrm = tangent_basis(normal)
             block = np.cos(angles)[:, None] * t1 + np.sin(angles)[:, None] * t2
             G[rows * i : rows * i + facets, s : s + 3] = block - mu * shrink * nrm
@@ -206,7 +208,12 @@ class TaskCommands:
 
 @dataclass(frozen=True)
 class Weights:
-    """Diagonal cost weights (task errors in m/s^2 or rad/s^2, forces in N, torques in Nm)."""
+    """Diagonal cost weights (task errors in m/s^2 or rad/s^2, forces in N, torques in Nm).
+
+    ``eps`` is heavy so that contacts hold unless the tasks are infeasible; ``lambda_c``
+    is light (it only makes ``P`` definite); ``lambda_h`` is larger so that a humanoid
+    holding a handle does not hang its weight on its (weak) wrist joints.
+    """
 
     com: float = 100.0
     base_angular: float = 10.0
@@ -216,7 +223,7 @@ class Weights:
     u: float = 1e-4
     eps: float = 1e4
     lambda_c: float = 1e-6
-    lambda_h: float = 1e-6
+    lambda_h: float = 1e-3
 
 
 def _frame_terms(
@@ -356,6 +363,15 @@ def build_wbc_qp(
     return WbcQP(P, qv, A, b, lb, ub, starts, mus, nrm, layout, nv)
 
 
+# Settings tried in turn when Clarabel stops short of a tight tolerance (AlmostSolved):
+# the default, a smaller static regularization, then no equilibration.
+_RETRIES: tuple[dict[str, object], ...] = (
+    {},
+    {"static_regularization_constant": 1e-10},
+    {"equilibrate_enable": False},
+)
+
+
 class ReferenceSolveError(RuntimeError):
     """Clarabel did not solve a QP to the requested tolerance."""
 
@@ -365,7 +381,9 @@ def solve_reference(qp: WbcQP, tol: float = 1e-9) -> np.ndarray:
 
     Clarabel's form is ``A x + s = b, s in K``: the equalities are a zero cone, each
     finite bound a nonnegative row, and each contact the cone
-    ``(mu n.f, t1.f, t2.f) in SOC(3)``.
+    ``(mu n.f, t1.f, t2.f) in SOC(3)``. At very tight tolerances Clarabel sometimes
+    stops at ``AlmostSolved``; the solve is then retried with the settings of
+    ``_RETRIES``.
 
     Raises
     ------
@@ -381,25 +399,25 @@ def solve_reference(qp: WbcQP, tol: float = 1e-9) -> np.ndarray:
         rows += [eye[up], -eye[lo]]
         rhs += [qp.ub[up], -qp.lb[lo]]
         cones.append(clarabel.NonnegativeConeT(up.size + lo.size))
-    for s, mu, normal in zip(qp.cone_starts, qp.mus, qp.normals):
+    for s, mu, normal in zip(qp.cone_starts, qp.mus, qp.normals, strict=True):
         t1, t2, nrm = tangent_basis(normal)
         block = np.zeros((3, qp.n))
         block[:, s : s + 3] = -np.vstack([mu * nrm, t1, t2])
         rows.append(block)
         rhs.append(np.zeros(3))
         cones.append(clarabel.SecondOrderConeT(3))
-    settings = clarabel.DefaultSettings()
-    settings.verbose = False
-    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = tol
-    solver = clarabel.DefaultSolver(
-        sparse.csc_matrix(np.triu(qp.P)),
-        np.asarray(qp.q),
-        sparse.csc_matrix(np.vstack(rows)),
-        np.concatenate(rhs),
-        cones,
-        settings,
-    )
-    sol = solver.solve()
-    if str(sol.status) != "Solved":
-        raise ReferenceSolveError(f"Clarabel status {sol.status} (tol {tol})")
-    return np.array(sol.x)
+    P = sparse.csc_matrix(np.triu(qp.P))
+    G = sparse.csc_matrix(np.vstack(rows))
+    h = np.concatenate(rhs)
+    statuses = []
+    for retry in _RETRIES:
+        settings = clarabel.DefaultSettings()
+        settings.verbose = False
+        settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = tol
+        for key, value in retry.items():
+            setattr(settings, key, value)
+        sol = clarabel.DefaultSolver(P, np.asarray(qp.q), G, h, cones, settings).solve()
+        if str(sol.status) == "Solved":
+            return np.array(sol.x)
+        statuses.append(str(sol.status))
+    raise ReferenceSolveError(f"Clarabel statuses {statuses} at tol {tol}")

@@ -1,0 +1,206 @@
+"""Test sets: sequences of WBC QPs with Clarabel reference solutions, saved as one npz.
+
+:func:`generate_test_set` rolls sequences of a scenario (or of the ``"mix"`` of all
+scenarios) and keeps every QP with its reference solution; :func:`save` and
+:func:`load` round-trip a set exactly; :func:`active_fraction` reports how many QPs
+have an active friction cone or a saturated torque, the ones that make solvers work.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from benchmarks.robots import load_robot
+from benchmarks.scenarios import SCENARIOS, make_sequence, rollout
+from benchmarks.wbc_qp import WbcQP
+
+__all__ = [
+    "LAYOUT_NAMES",
+    "MIX",
+    "TestSet",
+    "active_flags",
+    "active_fraction",
+    "generate_test_set",
+    "load",
+    "save",
+]
+
+MIX = "mix"
+"""Scenario name of the default mix: sequence ``j`` runs ``SCENARIOS[j % 4]``."""
+
+LAYOUT_NAMES: tuple[str, ...] = ("vdot", "u", "lambda_h", "eps", "lambda_c")
+"""Blocks of ``x``, in order."""
+
+_QP_ARRAYS: tuple[str, ...] = ("P", "q", "A", "b", "lb", "ub", "cone_starts", "mus", "normals")
+
+
+@dataclass(frozen=True, eq=False)
+class TestSet:
+    """QPs of one robot and scenario, in controller-loop order.
+
+    Attributes
+    ----------
+    robot, scenario, seed, dt
+        What generated the set (``dt`` is the controller period in seconds).
+    qps
+        The QPs.
+    x_ref
+        Clarabel reference solution of each QP (tolerance 1e-9).
+    sequence
+        Index of the sequence each QP belongs to: a new index is where a controller
+        (and a warm start) would restart from rest.
+    """
+
+    __test__ = False  # not a pytest test class
+
+    robot: str
+    scenario: str
+    seed: int
+    dt: float
+    qps: list[WbcQP]
+    x_ref: list[np.ndarray]
+    sequence: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.qps)
+
+
+def generate_test_set(
+    robot: str,
+    scenario: str,
+    n_qps: int,
+    seed: int,
+    *,
+    dt: float = 0.002,
+    seq_len: int = 100,
+    verbose: bool = False,
+) -> TestSet:
+    """Generate ``n_qps`` QPs of ``robot`` in sequences of ``seq_len`` ticks.
+
+    Parameters
+    ----------
+    robot
+        A key of :data:`benchmarks.robots.ROBOTS`.
+    scenario
+        One of :data:`benchmarks.scenarios.SCENARIOS`, or ``"mix"`` to cycle through
+        them one sequence each.
+    n_qps
+        Number of QPs; the last sequence is cut short if needed.
+    seed
+        Seed; sequence ``j`` draws from ``numpy.random.default_rng([seed, j])``, so a
+        set is deterministic and its prefix does not depend on ``n_qps``.
+    dt
+        Controller period (s).
+    seq_len
+        Recorded ticks per sequence.
+    verbose
+        Show a progress bar.
+    """
+    if scenario != MIX and scenario not in SCENARIOS:
+        raise ValueError(f"unknown scenario {scenario!r}; known: {[*SCENARIOS, MIX]}")
+    if n_qps < 1 or seq_len < 1:
+        raise ValueError(f"n_qps and seq_len must be positive, got {n_qps} and {seq_len}")
+    loaded = load_robot(robot)
+    qps: list[WbcQP] = []
+    xs: list[np.ndarray] = []
+    seq: list[int] = []
+    bar = None
+    if verbose:
+        from tqdm import tqdm
+
+        bar = tqdm(total=n_qps, desc=f"{robot}/{scenario}")
+    j = 0
+    while len(qps) < n_qps:
+        name = SCENARIOS[j % len(SCENARIOS)] if scenario == MIX else scenario
+        ticks = min(seq_len, n_qps - len(qps))
+        spec = make_sequence(loaded, name, np.random.default_rng([seed, j]), ticks, dt)
+        new_qps, new_xs = rollout(loaded, spec, dt, progress=bar.update if bar else None)
+        qps += new_qps
+        xs += new_xs
+        seq += [j] * len(new_qps)
+        j += 1
+    if bar is not None:
+        bar.close()
+    return TestSet(robot, scenario, seed, dt, qps, xs, np.array(seq))
+
+
+def active_flags(qp: WbcQP, x: np.ndarray, rtol: float = 1e-6) -> tuple[bool, bool]:
+    """Whether ``x`` has a friction cone at its boundary and a torque at its limit.
+
+    A cone counts as active when ``mu f_n - ||f_t|| <= rtol ||f||`` for a force that is
+    not zero (``||f|| > rtol`` times the largest contact force); a torque when
+    ``u_max - |u| <= rtol u_max``.
+    """
+    cone = False
+    if qp.n_contacts:
+        f = qp.forces(x)
+        fn = np.einsum("ij,ij->i", f, qp.normals)
+        ft = np.linalg.norm(f - fn[:, None] * qp.normals, axis=1)
+        norm = np.linalg.norm(f, axis=1)
+        nonzero = norm > rtol * max(1.0, norm.max())
+        cone = bool(np.any(nonzero & (qp.mus * fn - ft <= rtol * norm)))
+    u = np.abs(np.asarray(x)[qp.layout["u"]])
+    ub = qp.ub[qp.layout["u"]]
+    torque = bool(np.any(ub - u <= rtol * ub))
+    return cone, torque
+
+
+def active_fraction(test_set: TestSet, rtol: float = 1e-6) -> float:
+    """Fraction of QPs whose reference has an active friction cone or a saturated torque."""
+    flags = [
+        any(active_flags(qp, x, rtol)) for qp, x in zip(test_set.qps, test_set.x_ref, strict=True)
+    ]
+    return float(np.mean(flags))
+
+
+def save(test_set: TestSet, path: str | Path) -> None:
+    """Write ``test_set`` to one compressed ``.npz`` (format in docs/benchmarks-generator.md).
+
+    Keys: ``robot``, ``scenario`` (str), ``seed``, ``dt``, ``n_qps``, ``sequence``, and
+    per QP ``i``: ``qp{i}_P``, ``_q``, ``_A``, ``_b``, ``_lb``, ``_ub``, ``_cone_starts``,
+    ``_mus``, ``_normals``, ``_nv``, ``_layout`` (5 x 2 ``[start, stop]`` in the order of
+    :data:`LAYOUT_NAMES`) and ``_x_ref``.
+    """
+    arrays: dict[str, np.ndarray] = {
+        "robot": np.array(test_set.robot),
+        "scenario": np.array(test_set.scenario),
+        "seed": np.array(test_set.seed),
+        "dt": np.array(test_set.dt),
+        "n_qps": np.array(len(test_set)),
+        "sequence": np.asarray(test_set.sequence),
+    }
+    for i, (qp, x) in enumerate(zip(test_set.qps, test_set.x_ref, strict=True)):
+        for name in _QP_ARRAYS:
+            arrays[f"qp{i}_{name}"] = getattr(qp, name)
+        arrays[f"qp{i}_nv"] = np.array(qp.nv)
+        arrays[f"qp{i}_layout"] = np.array(
+            [[qp.layout[k].start, qp.layout[k].stop] for k in LAYOUT_NAMES]
+        )
+        arrays[f"qp{i}_x_ref"] = x
+    np.savez_compressed(path, **arrays)
+
+
+def load(path: str | Path) -> TestSet:
+    """Read a test set written by :func:`save` (no pickles involved)."""
+    with np.load(path, allow_pickle=False) as z:
+        qps, xs = [], []
+        for i in range(int(z["n_qps"])):
+            layout = {
+                k: slice(int(a), int(b))
+                for k, (a, b) in zip(LAYOUT_NAMES, z[f"qp{i}_layout"], strict=True)
+            }
+            fields = {name: z[f"qp{i}_{name}"] for name in _QP_ARRAYS}
+            qps.append(WbcQP(**fields, layout=layout, nv=int(z[f"qp{i}_nv"])))
+            xs.append(z[f"qp{i}_x_ref"])
+        return TestSet(
+            str(z["robot"]),
+            str(z["scenario"]),
+            int(z["seed"]),
+            float(z["dt"]),
+            qps,
+            xs,
+            z["sequence"],
+        )
