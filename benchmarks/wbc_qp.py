@@ -332,6 +332,7 @@ def build_wbc_qp(
     for name in sizes:
         idx = np.arange(n)[layout[name]]
         P[idx, idx] += getattr(w, name)
+    P = 0.5 * (P + P.T)  # exactly symmetric, not just up to rounding
 
     # Equalities.
     Jc = np.vstack([J for J, _ in contact_terms]) if k else np.zeros((0, nv))
