@@ -9,11 +9,13 @@ With multipliers ``y`` of ``x_S = z`` and over-relaxation ``alpha``, one iterati
     x_S^r    = alpha x~_S + (1 - alpha) z_k
     z_{k+1}  = P_C(x_S^r + y_k / rho)
     y_{k+1}  = y_k + rho (x_S^r - z_{k+1})
-    x_{k+1}  = alpha x~ + (1 - alpha) x_k
+    x_{k+1}  = alpha x~ + (1 - alpha) x_k     (x_1 = x~)
 
 Unlike the paper, rho touches the constrained entries only: a free variable gets no
-penalty (sigma is a 1e-6 regularization). Every ``x_{k+1}`` is a combination of KKT
-solutions, so ``A x = b`` holds at every iterate. Everything here works on the
+penalty (sigma is a 1e-6 proximal regularization). The first x of a run is not
+relaxed, because the start (a warm start after ``b`` changed, say) may violate the
+equalities; from then on every ``x_k`` is a combination of KKT solutions for the same
+``b``, so ``A x = b`` holds at every iterate. Everything here works on the
 scaled problem (see :mod:`fccqp.scaling`); residuals and tolerances are unscaled.
 """
 
@@ -54,7 +56,6 @@ class ScaledProblem(NamedTuple):
     D: np.ndarray
     E: np.ndarray
     c: float
-    A_norm: float
 
 
 class Workspace(NamedTuple):
@@ -126,7 +127,7 @@ def _factor_kkt(p, w, sigma):
 def _solve_x(p, w, sigma):
     """Solve the KKT system for ``w.rhs`` into ``w.sol``."""
     kkt.solve_refined(
-        w.K, w.ipiv, p.P, p.A, p.A_norm, sigma, p.constrained, w.rho_vec, w.rhs, w.sol, w.residual
+        w.K, w.ipiv, p.P, p.A, p.E, sigma, p.constrained, w.rho_vec, w.rhs, w.sol, w.residual
     )
 
 
@@ -368,8 +369,9 @@ def run(p, w, prm):
         _solve_x(p, w, prm.sigma)
         for j in range(s):
             w.relaxed[j] = prm.alpha * w.sol[p.constrained[j]] + (1.0 - prm.alpha) * w.z_prev[j]
+        relax_x = prm.alpha if iteration > 1 else 1.0
         for i in range(n):
-            w.x[i] = prm.alpha * w.sol[i] + (1.0 - prm.alpha) * w.x_prev[i]
+            w.x[i] = relax_x * w.sol[i] + (1.0 - relax_x) * w.x_prev[i]
         w.nu[:] = w.sol[n:]
         for j in range(s):
             w.z[j] = w.relaxed[j] + w.y[j] / w.rho_vec[j]

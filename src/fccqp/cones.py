@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -134,6 +135,9 @@ def _check_friction(cone: FrictionCone, index: int) -> np.ndarray:
 def flatten_cones(cones: Sequence[Cone], n: int) -> ConeArrays:
     """Validate cone specs for an ``n``-vector and return them as flat arrays.
 
+    Results are memoized for hashable inputs: a control loop passes the same cones
+    every tick.
+
     Raises
     ------
     TypeError
@@ -144,6 +148,18 @@ def flatten_cones(cones: Sequence[Cone], n: int) -> ConeArrays:
     """
     if isinstance(cones, (FrictionCone, SecondOrderCone)):
         cones = (cones,)
+    try:
+        return _flatten_cached(tuple(cones), n)
+    except TypeError:  # unhashable field, e.g. a numpy normal: validate uncached
+        return _flatten(cones, n)
+
+
+@lru_cache(maxsize=64)
+def _flatten_cached(cones: tuple[Cone, ...], n: int) -> ConeArrays:
+    return _flatten(cones, n)
+
+
+def _flatten(cones: Sequence[Cone], n: int) -> ConeArrays:
     k = len(cones)
     kind = np.zeros(k, dtype=np.int64)
     offset = np.zeros(k, dtype=np.int64)

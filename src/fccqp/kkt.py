@@ -22,12 +22,12 @@ from numba import njit
 
 from fccqp._lapack import dsytrf, dsytrs
 
-DELTA = 1e-10
+DELTA = 1e-13
 """Quasi-definite regularization of the (2, 2) block (scaled problem)."""
 MAX_REFINE = 5
 """Most refinement steps per solve."""
 REFINE_TOLERANCE = 1e-13
-"""Refine while ``||A x - b||`` exceeds this times ``max(1, ||b||, ||A|| ||x||)``."""
+"""Refine while ``||A x - b||`` (unscaled) exceeds this times ``max(1, ||b||, ||A|| ||x||)``."""
 
 _LOWER = 76  # ord("L")
 
@@ -91,9 +91,11 @@ def _solve_factored(K, ipiv, rhs):
 
 
 @njit(cache=True)
-def solve_refined(K, ipiv, P, A, A_norm, sigma, constrained, rho_vec, rhs, sol, residual):
+def solve_refined(K, ipiv, P, A, row_scale, sigma, constrained, rho_vec, rhs, sol, residual):
     """Solve the unregularized KKT system for ``rhs`` into ``sol``; return the steps used.
 
+    ``A`` has equilibrated rows ``E A_user D``; ``row_scale`` is ``E``, so that the
+    stopping test measures the user's equality residual ``E^-1 (b - A x)``.
     ``residual`` is scratch space of the same size as ``rhs``.
     """
     n = P.shape[0]
@@ -102,14 +104,17 @@ def solve_refined(K, ipiv, P, A, A_norm, sigma, constrained, rho_vec, rhs, sol, 
     if A.shape[0] == 0:
         return 0
     b = rhs[n:]
-    b_norm = np.max(np.abs(b))
     for step in range(MAX_REFINE):
         x = sol[:n]
         nu = sol[n:]
-        eq = b - A @ x
-        x_norm = np.max(np.abs(x))
-        if np.max(np.abs(eq)) <= REFINE_TOLERANCE * max(1.0, b_norm, A_norm * x_norm):
+        Ax = A @ x
+        error = size = 0.0
+        for i in range(Ax.shape[0]):
+            error = max(error, abs(b[i] - Ax[i]) / row_scale[i])
+            size = max(size, abs(b[i]) / row_scale[i], abs(Ax[i]) / row_scale[i])
+        if error <= REFINE_TOLERANCE * max(1.0, size):
             return step
+        eq = b - Ax
         residual[:n] = rhs[:n] - P @ x - sigma * x - A.T @ nu
         for k in range(constrained.shape[0]):
             residual[constrained[k]] -= rho_vec[k] * x[constrained[k]]

@@ -47,13 +47,11 @@ def _dense_matrix(value: object, name: str) -> np.ndarray:
     if sp.issparse(value):
         value = value.toarray()
     try:
-        array = np.array(value, dtype=np.float64, order="C")
+        array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError) as exn:
         raise TypeError(f"{name} must be a numeric matrix: {exn}") from exn
     if array.ndim != 2:
         raise ValueError(f"{name} must be 2-dimensional, got shape {array.shape}")
-    if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} contains NaN or inf")
     return array
 
 
@@ -61,33 +59,42 @@ def _vector(value: object, name: str, n: int, allow_inf: bool = False) -> np.nda
     if sp.issparse(value):
         value = value.toarray()
     try:
-        array = np.array(value, dtype=np.float64).reshape(-1)
+        array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError) as exn:
         raise TypeError(f"{name} must be a numeric vector: {exn}") from exn
-    if np.ndim(value) > 2 or (np.ndim(value) == 2 and 1 not in np.shape(value)):
-        raise ValueError(f"{name} must be a vector, got shape {np.shape(value)}")
+    if array.ndim != 1:
+        if array.ndim > 2 or (array.ndim == 2 and 1 not in array.shape):
+            raise ValueError(f"{name} must be a vector, got shape {array.shape}")
+        array = array.reshape(-1)
     if array.shape[0] != n:
         raise ValueError(f"{name} must have {n} entries, got {array.shape[0]}")
-    if np.any(np.isnan(array)) or (not allow_inf and not np.all(np.isfinite(array))):
-        raise ValueError(f"{name} contains NaN" + ("" if allow_inf else " or inf"))
+    if allow_inf:
+        if np.isnan(array).any():
+            raise ValueError(f"{name} contains NaN")
+    elif not np.isfinite(array).all():
+        raise ValueError(f"{name} contains NaN or inf")
     return array
 
 
 def _symmetric(P: np.ndarray) -> np.ndarray:
-    """Return ``P`` made exactly symmetric, or raise if it is clearly not symmetric.
+    """Return ``P`` made exactly symmetric, or raise if it is not finite and symmetric.
 
     Entries that differ by rounding (relative ``1e-10``) are averaged, as a user who
     built ``P = J'WJ`` in floating point expects; a real asymmetry is an error rather
-    than silently replaced by ``(P + P')/2``.
+    than silently replaced by ``(P + P')/2``. A NaN or inf entry makes the asymmetry
+    non-finite, so one pass checks both.
     """
-    asymmetry = float(np.max(np.abs(P - P.T), initial=0.0))
-    scale = max(1.0, float(np.max(np.abs(P), initial=0.0)))
+    difference = P - P.T
+    asymmetry = float(np.abs(difference).max(initial=0.0))
+    if not np.isfinite(asymmetry):
+        raise ValueError("P contains NaN or inf")
+    scale = max(1.0, float(np.abs(P).max(initial=0.0)))
     if asymmetry > SYMMETRY_TOLERANCE * scale:
         raise ValueError(
             f"P must be symmetric: max |P - P'| is {asymmetry:.3g} "
             f"(pass (P + P.T) / 2 if only its symmetric part matters)"
         )
-    return 0.5 * (P + P.T)
+    return P - 0.5 * difference
 
 
 def validate(
@@ -124,19 +131,21 @@ def validate(
         A = _dense_matrix(A, "A")
         if A.shape[1] != n:
             raise ValueError(f"A must have {n} columns (the size of P), got shape {A.shape}")
+        if not np.isfinite(A).all():
+            raise ValueError("A contains NaN or inf")
+        A = np.ascontiguousarray(A)
         b = _vector(b, "b", A.shape[0])
     lb = np.full(n, -np.inf) if lb is None else _vector(lb, "lb", n, allow_inf=True)
     ub = np.full(n, np.inf) if ub is None else _vector(ub, "ub", n, allow_inf=True)
-    bad = np.flatnonzero(lb > ub)
-    if bad.size:
-        i = int(bad[0])
+    if (lb > ub).any():
+        i = int(np.flatnonzero(lb > ub)[0])
         raise ValueError(f"lb > ub at index {i}: lb[{i}] = {lb[i]}, ub[{i}] = {ub[i]}")
-    if np.any(lb == np.inf) or np.any(ub == -np.inf):
+    if (lb == np.inf).any() or (ub == -np.inf).any():
         raise ValueError("lb may not be +inf and ub may not be -inf")
     flat = flatten_cones(cones, n)
     in_cone = flat.entries()
     bounded = np.isfinite(lb[in_cone]) | np.isfinite(ub[in_cone])
-    if np.any(bounded):
+    if bounded.any():
         i = int(in_cone[np.flatnonzero(bounded)[0]])
         raise ValueError(
             f"x[{i}] is in a cone block and has a finite bound (lb[{i}] = {lb[i]}, "

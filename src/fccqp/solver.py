@@ -44,7 +44,7 @@ def _scale(data: ProblemData, iterations: int) -> admm.ScaledProblem:
         P=P, q=q, A=A, b=b, constrained=data.constrained,
         lo=data.lb[data.constrained] / Ds, hi=data.ub[data.constrained] / Ds,
         cones=(cones.kind, cones.offset, cones.dim, cones.mu, cones.normal),
-        D=D, E=E, c=float(c), A_norm=float(np.max(np.abs(A), initial=0.0)),
+        D=D, E=E, c=float(c),
     )
 
 
