@@ -37,6 +37,7 @@ __all__ = ["SCENARIOS", "Gains", "Phase", "SequenceSpec", "make_sequence", "roll
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 _GRAVITY = 9.81
+_COM_CAP = np.array([0.15, 0.15, 0.05])  # CoM sinusoid amplitude caps, in base heights
 
 
 @dataclass(frozen=True)
@@ -174,8 +175,11 @@ def make_sequence(
 ) -> SequenceSpec:
     """Draw one sequence of ``scenario`` for ``robot`` with ``n_ticks`` recorded ticks.
 
-    Amplitudes scale with the standing base height ``L`` so that one definition fits
-    a 0.24 m quadruped and a 1 m humanoid; push speeds scale with ``sqrt(g L)``.
+    CoM sinusoids are drawn by their peak acceleration -- horizontal in units of
+    ``mu g``, the most friction can give, vertical in units of ``g`` -- so that one
+    definition stresses the cones of a 2.5 kg quadruped and of a 90 kg humanoid alike;
+    amplitudes are capped at ``0.15 L`` horizontally and ``0.05 L`` vertically, ``L``
+    being the standing base height. Push speeds are also in units of ``mu g`` (s).
     """
     if scenario not in SCENARIOS:
         raise ValueError(f"unknown scenario {scenario!r}; known: {sorted(SCENARIOS)}")
@@ -184,44 +188,44 @@ def make_sequence(
     phases: tuple[Phase, ...] = (Phase(n_ticks, feet),)
     mu = robot.config.mu
     pushes: dict[int, np.ndarray] = {}
-    zero3 = np.zeros(3)
-    com_lo, com_hi = zero3, L * np.array([0.02, 0.02, 0.01])
-    base_lo, base_hi = zero3, np.array([0.03, 0.03, 0.03])
+    # Peak CoM accelerations: (x, y) in mu g, z in g; base amplitudes in rad.
+    com_lo, com_hi = np.array([0.1, 0.1, 0.02]), np.array([0.2, 0.2, 0.05])
+    base_lo, base_hi = np.zeros(3), np.full(3, 0.03)
     com_f, base_f = (0.5, 1.5), (0.5, 1.5)
+    if scenario == "aggressive":
+        com_lo, com_hi = np.array([0.8, 0.8, 0.1]), np.array([1.6, 1.6, 0.3])
+        base_lo, base_hi = np.array([0.1, 0.1, 0.1]), np.array([0.25, 0.25, 0.3])
+        com_f, base_f = (2.0, 3.5), (1.0, 2.5)
+    elif scenario == "low_friction":
+        mu = 0.2 + 0.8 * float(rng.random()) ** 2  # low values more often
+        com_lo, com_hi = np.array([0.7, 0.7, 0.05]), np.array([1.4, 1.4, 0.1])
+        com_f = (1.5, 2.5)
+    elif scenario == "contact_switch":
+        phases = _contact_phases(robot, rng, n_ticks, dt)
+        mu = float(rng.uniform(0.3, 0.7))
+        com_lo, com_hi = np.array([0.5, 0.5, 0.02]), np.array([1.0, 1.0, 0.05])
+        com_f = (1.5, 2.5)
+    scale = np.array([mu * _GRAVITY, mu * _GRAVITY, _GRAVITY])
+    acc, com_freq, com_phase = _random_sinusoids(rng, com_lo * scale, com_hi * scale, com_f)
+    com_amp = np.clip(acc / (2 * np.pi * com_freq) ** 2, -L * _COM_CAP, L * _COM_CAP)
 
     def push() -> np.ndarray:
         heading = rng.uniform(0.0, 2.0 * np.pi)
-        speed = rng.uniform(0.15, 0.3) * np.sqrt(_GRAVITY * L)
+        speed = rng.uniform(0.05, 0.1) * mu * _GRAVITY
         lin = speed * np.array([np.cos(heading), np.sin(heading), 0.0])
         return np.concatenate([lin, rng.uniform(-0.8, 0.8, 3)])
 
     if scenario == "stand_push":
         pushes = {t: push() for t in range(5, n_ticks, max(n_ticks // 3, 1))}
-    elif scenario == "aggressive":
-        com_lo, com_hi = (
-            L * np.array([0.08, 0.08, 0.02]),
-            L * np.array([0.15, 0.15, 0.05]),
-        )
-        base_lo, base_hi = np.array([0.1, 0.1, 0.1]), np.array([0.25, 0.25, 0.3])
-        com_f, base_f = (2.0, 3.5), (1.0, 2.5)
     elif scenario == "low_friction":
-        mu = 0.2 + 0.8 * float(rng.random()) ** 2  # low values more often
-        com_lo, com_hi = (
-            L * np.array([0.04, 0.04, 0.01]),
-            L * np.array([0.1, 0.1, 0.03]),
-        )
-        com_f = (1.5, 2.5)
         pushes = {n_ticks // 2: push()}
-    else:
-        phases = _contact_phases(robot, rng, n_ticks, dt)
-        mu = float(rng.uniform(0.3, 0.7))
-        com_lo, com_hi = L * np.array([0.03, 0.03, 0.01]), L * np.array([0.06, 0.06, 0.02])
-        com_f = (1.5, 2.5)
     return SequenceSpec(
         scenario,
         phases,
         mu,
-        *_random_sinusoids(rng, com_lo, com_hi, com_f),
+        com_amp,
+        com_freq,
+        com_phase,
         *_random_sinusoids(rng, base_lo, base_hi, base_f),
         swing_accel=15.0 if robot.config.kind == "quadruped" else 4.0,
         pushes=pushes,
