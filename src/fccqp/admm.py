@@ -37,6 +37,8 @@ RHO_MIN, RHO_MAX = 1e-6, 1e6
 """Range of the adaptive rho."""
 FIXED_RHO_SCALE = 1e3
 """rho multiplier on entries with lb == ub, which act as equalities (as in OSQP)."""
+EQUALITY_START_STEPS = 3
+"""Proximal steps of the cold start's equality-constrained QP (see _equality_qp_start)."""
 EQUALITY_START_LIMIT = 1e-3
 """Cold start falls back to the origin when sigma * ||x_eq|| exceeds this * max(1, ||q||):
 the equality-constrained QP is then unbounded but for sigma, and its solution useless."""
@@ -293,16 +295,21 @@ def is_dual_infeasible(p, w, eps):
 def _equality_qp_start(p, w, sigma):
     """Paper's cold start: ``x`` solves the QP with equalities only, ``z = P_C(x_S)``, ``y = 0``.
 
+    The factorization carries the regularization ``sigma I``; a few proximal steps
+    (``x_{j+1} = argmin f + sigma/2 ||x - x_j||^2`` on the same factorization) remove
+    its bias, so that an optimum with no active constraint is recognised at once.
     Returns False if the KKT inertia shows that P is not positive semidefinite.
     """
     n = p.P.shape[0]
     w.rho_vec[:] = 0.0
     if not _factor_kkt(p, w, sigma):
         return False
-    w.rhs[:n] = -p.q
+    w.x[:] = 0.0
     w.rhs[n:] = p.b
-    _solve_x(p, w, sigma)
-    w.x[:] = w.sol[:n]
+    for _ in range(EQUALITY_START_STEPS):
+        w.rhs[:n] = sigma * w.x - p.q
+        _solve_x(p, w, sigma)
+        w.x[:] = w.sol[:n]
     w.nu[:] = w.sol[n:]
     if sigma * _inf_norm(w.x) > EQUALITY_START_LIMIT * max(1.0, _inf_norm(p.q)):
         w.x[:] = 0.0

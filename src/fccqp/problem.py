@@ -84,7 +84,8 @@ def _symmetric(P: np.ndarray) -> np.ndarray:
     than silently replaced by ``(P + P')/2``. A NaN or inf entry makes the asymmetry
     non-finite, so one pass checks both.
     """
-    difference = P - P.T
+    with np.errstate(invalid="ignore"):
+        difference = P - P.T
     asymmetry = float(np.abs(difference).max(initial=0.0))
     if not np.isfinite(asymmetry):
         raise ValueError("P contains NaN or inf")

@@ -1,0 +1,242 @@
+"""The solver against Clarabel, the KKT conditions, and its statuses."""
+
+import math
+
+import numpy as np
+import pytest
+from problems import random_problem
+from reference import clarabel_solve, kkt_violation
+
+import fccqp
+from fccqp import FrictionCone, SecondOrderCone, Status
+
+TIGHT = dict(eps_abs=1e-8, eps_rel=1e-8, max_iter=20000)
+
+
+def assert_kkt(problem, result, tol):
+    violation = kkt_violation(*problem, result)
+    assert violation["equality"] <= 1e-9, violation
+    for key in ("box", "cone", "stationarity", "box_dual_sign", "cone_dual"):
+        assert violation[key] <= tol, (key, violation)
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_matches_clarabel_on_random_problems(seed):
+    problem = random_problem(seed, soc_dim=4 if seed % 2 else 0)
+    reference = clarabel_solve(*problem)
+    result = fccqp.solve(*problem, **TIGHT)
+    assert result.status is Status.SOLVED
+    # Clarabel's x can be off by 1e-5 on near-degenerate instances while its
+    # objective is not better than ours: compare x loosely, objective and KKT tightly.
+    np.testing.assert_allclose(result.x, reference.x, atol=1e-4)
+    assert result.obj - reference.obj <= 1e-7 * (1 + abs(reference.obj))
+    assert_kkt(problem, result, 1e-6)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_default_settings_reach_tolerance_and_report_true_residuals(seed):
+    problem = P, q, A, b, lb, ub, cones = random_problem(
+        seed, psd_rank=10, n=40, m=10, n_cones=4, n_box=8
+    )
+    reference = clarabel_solve(*problem)
+    result = fccqp.solve(*problem)
+    assert result.status is Status.SOLVED
+    x, y, z = result.x, result.y, result.z
+    violation = kkt_violation(*problem, result)
+    # prim_res is an infinity norm; a cone distance is Euclidean over 3 entries
+    assert max(violation["box"], violation["cone"]) <= np.sqrt(3) * result.prim_res
+    assert violation["stationarity"] <= result.dual_res * (1 + 1e-9)
+    inf = lambda v: np.abs(v).max()  # noqa: E731
+    assert result.prim_res <= 1e-5 + 1e-5 * max(inf(A @ x), inf(b), inf(x))
+    assert result.dual_res <= 1e-5 + 1e-5 * max(inf(P @ x), inf(q), inf(A.T @ y), inf(z))
+    assert abs(result.obj - reference.obj) <= 1e-3 * (1 + abs(reference.obj))
+
+
+def test_rank_deficient_equalities():
+    problem = random_problem(3, duplicate_rows=3)
+    reference = clarabel_solve(*problem)
+    result = fccqp.solve(*problem, **TIGHT)
+    assert result.status is Status.SOLVED
+    np.testing.assert_allclose(result.x, reference.x, atol=1e-5)
+    assert_kkt(problem, result, 1e-6)
+
+
+def test_nearly_dependent_equalities_stay_exact():
+    P, q, A, b, lb, ub, cones = random_problem(4)
+    A = np.vstack([A, A[0] + 1e-9 * np.random.default_rng(0).standard_normal(A.shape[1])])
+    result = fccqp.solve(P, q, A, np.append(b, b[0]), lb, ub, cones)
+    assert np.abs(A @ result.x - np.append(b, b[0])).max() <= 1e-8
+    assert result.status is Status.SOLVED
+
+
+def test_equalities_exact_at_every_budget():
+    problem = random_problem(5, m=12)
+    P, q, A, b = problem[:4]
+    for budget in (1, 2, 3, 7, 15):
+        result = fccqp.solve(*problem, max_iter=budget)
+        assert result.iterations == budget
+        assert np.abs(A @ result.x - b).max() <= 1e-10 * (1 + np.abs(b).max())
+
+
+def test_warm_start_with_changed_b_keeps_equalities_exact():
+    P, q, A, b, lb, ub, cones = random_problem(6)
+    solver = fccqp.Solver(max_iter=3)
+    solver.solve(P, q, A, b, lb, ub, cones)
+    b2 = b + 0.5
+    result = solver.solve(P, q, A, b2, lb, ub, cones)
+    assert np.abs(A @ result.x - b2).max() <= 1e-10 * (1 + np.abs(b2).max())
+
+
+def test_solution_without_active_constraints_takes_one_factorization():
+    P, q, A, b, lb, ub, cones = random_problem(7, n_cones=0)
+    result = fccqp.solve(P, q, A, b)
+    assert result.status is Status.SOLVED
+    assert (result.iterations, result.factorizations) == (0, 1)
+    assert np.abs(result.z).max() == 0.0
+
+
+def test_warm_start_cuts_iterations_on_nearby_problems():
+    P, q, A, b, lb, ub, cones = random_problem(8, n=40, m=10, n_cones=4, n_box=8)
+    rng = np.random.default_rng(1)
+    warm, cold = fccqp.Solver(), []
+    warm_iterations = []
+    for _ in range(10):
+        q = q + 0.02 * rng.standard_normal(q.shape)
+        warm_iterations.append(warm.solve(P, q, A, b, lb, ub, cones).iterations)
+        cold.append(fccqp.solve(P, q, A, b, lb, ub, cones).iterations)
+    assert sum(warm_iterations[1:]) < 0.6 * sum(cold[1:])
+
+
+def test_reuses_factorization_when_matrices_unchanged():
+    P, q, A, b, lb, ub, cones = random_problem(9)
+    solver = fccqp.Solver(adaptive_rho=False)
+    solver.solve(P, q, A, b, lb, ub, cones)
+    again = solver.solve(P, q + 0.01, A, b, lb, ub, cones)
+    assert again.factorizations == 0
+    assert again.status is Status.SOLVED
+    changed = solver.solve(P * 1.01, q, A, b, lb, ub, cones)
+    assert changed.factorizations == 1
+
+
+def test_x0_initial_guess():
+    problem = random_problem(10)
+    reference = clarabel_solve(*problem)
+    result = fccqp.Solver().solve(*problem, x0=reference.x)
+    assert result.status is Status.SOLVED
+    assert result.iterations < fccqp.solve(*problem).iterations
+
+
+def test_box_infeasible():
+    P = np.eye(3)
+    q = np.zeros(3)
+    A = np.array([[1.0, 1.0, 1.0]])
+    result = fccqp.solve(P, q, A, [10.0], lb=-np.ones(3), ub=np.ones(3))
+    assert result.status is Status.PRIMAL_INFEASIBLE
+    assert clarabel_solve(P, q, A, [10.0], -np.ones(3), np.ones(3)).status == "primal_infeasible"
+    y_dir, z_dir = result.certificate[:1], result.certificate[1:]
+    assert np.abs(A.T @ y_dir + z_dir).max() <= 1e-5 * np.abs(result.certificate).max()
+
+
+def test_cone_infeasible():
+    """The normal force must be negative: impossible inside a friction cone."""
+    P = np.eye(3)
+    q = np.zeros(3)
+    A = np.array([[0.0, 0.0, 1.0]])
+    result = fccqp.solve(P, q, A, [-1.0], cones=[FrictionCone(0, 0.5)])
+    assert result.status is Status.PRIMAL_INFEASIBLE
+
+
+def test_inconsistent_equalities():
+    P = np.eye(2)
+    A = np.array([[1.0, 1.0], [2.0, 2.0]])
+    result = fccqp.solve(P, np.zeros(2), A, [1.0, 3.0], lb=[-5, -5], ub=[5, 5])
+    assert result.status is Status.PRIMAL_INFEASIBLE
+
+
+def test_unbounded_lp():
+    P = np.zeros((3, 3))
+    q = np.array([-1.0, 0.0, 0.0])
+    A = np.array([[0.0, 1.0, 1.0]])
+    result = fccqp.solve(P, q, A, [1.0], lb=[0, 0, 0], ub=[np.inf, 1, 1])
+    assert result.status is Status.DUAL_INFEASIBLE
+    direction = result.certificate
+    assert q @ direction < 0 and direction[0] > 0
+
+
+def test_unbounded_along_cone():
+    P = np.zeros((3, 3))
+    q = np.array([0.0, 0.0, -1.0])
+    result = fccqp.solve(P, q, cones=[SecondOrderCone(0, 3)])
+    assert result.status is Status.DUAL_INFEASIBLE
+
+
+def test_lp_solution_matches_clarabel():
+    rng = np.random.default_rng(3)
+    n = 12
+    A = rng.standard_normal((4, n))
+    x_f = rng.uniform(0.1, 1, n)
+    q = rng.uniform(0.1, 1, n)
+    problem = (np.zeros((n, n)), q, A, A @ x_f, np.zeros(n), np.full(n, 2.0), ())
+    reference = clarabel_solve(*problem)
+    result = fccqp.solve(*problem, **TIGHT)
+    assert result.status is Status.SOLVED
+    assert abs(result.obj - reference.obj) <= 1e-6 * (1 + abs(reference.obj))
+
+
+def test_budget_statuses():
+    problem = random_problem(11, psd_rank=10)
+    result = fccqp.solve(*problem, max_iter=2, eps_abs=1e-12, eps_rel=0.0)
+    assert result.status is Status.MAX_ITER_REACHED
+    result = fccqp.solve(*problem, time_limit=1e-9, eps_abs=1e-12, eps_rel=0.0)
+    assert result.status is Status.TIME_LIMIT_REACHED
+    assert result.iterations >= 1
+
+
+def test_inaccurate_status_within_ten_times_tolerance():
+    problem = random_problem(1)
+    exact = fccqp.solve(*problem, **TIGHT)
+    for budget in range(1, 200):
+        result = fccqp.solve(*problem, max_iter=budget, eps_abs=1e-6, eps_rel=0.0)
+        if result.status is not Status.MAX_ITER_REACHED:
+            break
+    assert result.status in (Status.SOLVED_INACCURATE, Status.SOLVED)
+    if result.status is Status.SOLVED_INACCURATE:
+        assert max(result.prim_res, result.dual_res) <= 1e-5
+        assert max(result.prim_res, result.dual_res) > 1e-6
+    assert np.abs(result.x - exact.x).max() < 1e-2
+
+
+def test_realtime_preset():
+    settings = fccqp.Settings.realtime()
+    assert settings.max_iter <= 20 and settings.warm_start
+    result = fccqp.solve(*random_problem(2), settings=settings)
+    assert result.iterations <= settings.max_iter
+
+
+def test_nonconvex_objective_is_rejected():
+    P = np.diag([1.0, -2.0, 1.0])
+    with pytest.raises(ValueError, match="positive semidefinite.*-2"):
+        fccqp.solve(P, np.zeros(3), lb=-np.ones(3), ub=np.ones(3))
+
+
+def test_sparse_input_matches_dense():
+    scipy_sparse = pytest.importorskip("scipy.sparse")
+    P, q, A, b, lb, ub, cones = random_problem(12)
+    dense = fccqp.solve(P, q, A, b, lb, ub, cones)
+    sparse = fccqp.solve(
+        scipy_sparse.csc_matrix(P), q, scipy_sparse.csc_array(A), b, lb, ub, cones
+    )
+    np.testing.assert_array_equal(dense.x, sparse.x)
+
+
+def test_objective_and_timings_reported():
+    P, q, A, b, lb, ub, cones = problem = random_problem(13)
+    result = fccqp.solve(*problem)
+    assert math.isclose(result.obj, 0.5 * result.x @ P @ result.x + q @ result.x)
+    assert 0 < result.setup_time <= result.solve_time
+
+
+def test_verbose_prints_log(capsys):
+    fccqp.solve(*random_problem(14), verbose=True)
+    out = capsys.readouterr().out
+    assert "prim_res" in out and "status: solved" in out

@@ -1,0 +1,109 @@
+"""Bad input raises a clear error that names the argument."""
+
+import numpy as np
+import pytest
+
+import fccqp
+from fccqp import FrictionCone, SecondOrderCone
+
+P = np.eye(6)
+q = np.ones(6)
+A = np.ones((2, 6))
+b = np.ones(2)
+
+
+def solve(**changes):
+    args = dict(P=P, q=q, A=A, b=b, lb=None, ub=None, cones=())
+    args.update(changes)
+    return fccqp.solve(**args)
+
+
+@pytest.mark.parametrize(
+    "changes, error, message",
+    [
+        (dict(P=np.eye(5)), ValueError, "q must have 5 entries"),
+        (dict(P=np.ones((6, 5))), ValueError, "P must be square"),
+        (dict(P=np.ones(6)), ValueError, "P must be 2-dimensional"),
+        (dict(P=np.triu(np.ones((6, 6)))), ValueError, "P must be symmetric"),
+        (dict(P=np.diag([1, 1, np.nan, 1, 1, 1])), ValueError, "P contains NaN or inf"),
+        (dict(P=np.diag([1, 1, np.inf, 1, 1, 1])), ValueError, "P contains NaN or inf"),
+        (dict(P=[["a"] * 6] * 6), TypeError, "P must be a numeric matrix"),
+        (dict(q=np.ones(5)), ValueError, "q must have 6 entries"),
+        (dict(q=np.ones((2, 6))), ValueError, "q must be a vector"),
+        (dict(q=np.full(6, np.nan)), ValueError, "q contains NaN"),
+        (dict(A=np.ones((2, 5))), ValueError, "A must have 6 columns"),
+        (dict(A=np.full((2, 6), np.inf)), ValueError, "A contains NaN or inf"),
+        (dict(b=np.ones(3)), ValueError, "b must have 2 entries"),
+        (dict(b=np.array([1.0, np.inf])), ValueError, "b contains NaN or inf"),
+        (dict(b=None), ValueError, "A and b must be given together"),
+        (dict(lb=np.ones(6), ub=np.zeros(6)), ValueError, r"lb > ub at index 0"),
+        (dict(lb=np.full(6, np.nan)), ValueError, "lb contains NaN"),
+        (dict(ub=np.ones(4)), ValueError, "ub must have 6 entries"),
+        (dict(lb=np.full(6, np.inf)), ValueError, r"lb may not be \+inf"),
+        (dict(cones=[FrictionCone(0, 0.0)]), ValueError, r"cones\[0\].mu must be finite and > 0"),
+        (dict(cones=[FrictionCone(0, -1.0)]), ValueError, r"cones\[0\].mu"),
+        (dict(cones=[FrictionCone(0, np.nan)]), ValueError, r"cones\[0\].mu"),
+        (dict(cones=[FrictionCone(0, np.inf)]), ValueError, r"cones\[0\].mu"),
+        (dict(cones=[FrictionCone(0, "a")]), TypeError, r"cones\[0\].mu must be a number"),
+        (dict(cones=[FrictionCone(4, 0.5)]), ValueError, r"cones\[0\] covers x\[4:7\], outside"),
+        (dict(cones=[FrictionCone(-1, 0.5)]), ValueError, r"outside x of length 6"),
+        (
+            dict(cones=[FrictionCone(0, 0.5), SecondOrderCone(2, 3)]),
+            ValueError, r"cones\[0\] \(x\[0:3\]\) overlaps cones\[1\]",
+        ),
+        (dict(cones=[SecondOrderCone(0, 1)]), ValueError, r"cones\[0\].dim must be >= 2"),
+        (dict(cones=[SecondOrderCone(0.5, 2)]), TypeError, r"cones\[0\].start must be an integer"),
+        (dict(cones=[FrictionCone(0, 0.5, (0, 0, 2))]), ValueError, "normal must be a unit vector"),
+        (dict(cones=[FrictionCone(0, 0.5, (0, 0, 0))]), ValueError, "normal must be a unit vector"),
+        (dict(cones=[FrictionCone(0, 0.5, (0, 1))]), ValueError, "normal must have 3 entries"),
+        (dict(cones=[FrictionCone(0, 0.5, (0, np.nan, 1))]), ValueError, "normal contains NaN"),
+        (dict(cones=["cone"]), TypeError, r"cones\[0\] must be a FrictionCone or SecondOrderCone"),
+        (
+            dict(cones=[FrictionCone(0, 0.5)], ub=np.full(6, 10.0)),
+            ValueError, r"x\[0\] is in a cone block and has a finite bound",
+        ),
+        (dict(P=-np.eye(6)), ValueError, "P is not positive semidefinite"),
+    ],
+)
+def test_bad_input(changes, error, message):
+    with pytest.raises(error, match=message):
+        solve(**changes)
+
+
+@pytest.mark.parametrize(
+    "overrides, message",
+    [
+        (dict(foo=1), "unknown setting.*foo"),
+        (dict(rho=0.0), "rho must be finite and > 0"),
+        (dict(rho=np.nan), "rho must be a number"),
+        (dict(alpha=2.0), r"alpha must lie in \(0, 2\)"),
+        (dict(eps_abs=-1.0), "eps_abs must be finite and >= 0"),
+        (dict(eps_abs=0.0, eps_rel=0.0), "cannot both be 0"),
+        (dict(max_iter=0), "max_iter must be >= 1"),
+        (dict(max_iter=1.5), "max_iter must be an integer"),
+        (dict(time_limit=-1.0), "time_limit must be finite and > 0"),
+        (dict(adaptive_rho="yes"), "adaptive_rho must be a bool"),
+    ],
+)
+def test_bad_settings(overrides, message):
+    with pytest.raises((ValueError, TypeError), match=message):
+        solve(**overrides)
+
+
+def test_settings_argument_must_be_settings():
+    with pytest.raises(TypeError, match="settings must be a fccqp.Settings"):
+        fccqp.Solver(settings={"rho": 1.0})
+
+
+def test_bad_initial_guess():
+    with pytest.raises(ValueError, match="x0 must be a finite vector of 6 entries"):
+        fccqp.Solver().solve(P, q, A, b, x0=np.ones(3))
+
+
+def test_rounding_asymmetry_is_accepted():
+    noisy = P + 1e-14 * np.triu(np.ones((6, 6)), 1)
+    assert solve(P=noisy).status is fccqp.Status.SOLVED
+
+
+def test_time_limit_infinity_is_default():
+    assert fccqp.Settings().time_limit == np.inf
