@@ -216,7 +216,7 @@ def is_primal_infeasible(p, w, eps):
         norm = max(norm, abs(d_nu[i] * p.E[i]))
     for j in range(s):
         norm = max(norm, abs(d_y[j] / p.D[p.constrained[j]]))
-    if norm <= 1e-300:
+    if norm <= 1e-300 or p.b @ d_nu + support >= -eps * norm:
         return False
     lhs = p.A.T @ d_nu if p.A.shape[0] > 0 else np.zeros(n)
     for j in range(s):
@@ -224,7 +224,7 @@ def is_primal_infeasible(p, w, eps):
     for i in range(n):
         if abs(lhs[i] / p.D[i]) > eps * norm:
             return False
-    return p.b @ d_nu + support < -eps * norm
+    return True
 
 
 @njit(cache=True)

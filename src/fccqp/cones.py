@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cached_property, lru_cache
 
 import numpy as np
 
@@ -94,13 +94,12 @@ class ConeArrays:
         """Number of cones."""
         return int(self.kind.shape[0])
 
-    def entries(self) -> np.ndarray:
+    @cached_property
+    def members(self) -> np.ndarray:
         """Indices, in the vector the cones act on, of every entry in some cone."""
         if self.count == 0:
             return np.zeros(0, dtype=np.int64)
-        return np.concatenate(
-            [np.arange(o, o + d) for o, d in zip(self.offset, self.dim)]
-        ).astype(np.int64)
+        return np.concatenate([np.arange(o, o + d) for o, d in zip(self.offset, self.dim)])
 
     def relocated(self, offset: np.ndarray) -> ConeArrays:
         """The same cones with new block offsets."""

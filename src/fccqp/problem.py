@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
+from numba import njit
 
 from fccqp.cones import Cone, ConeArrays, flatten_cones
 
@@ -44,6 +45,7 @@ class ProblemData:
 
 
 def _dense_matrix(value: object, name: str) -> np.ndarray:
+    """Convert to a 2-D float64 array (densifying scipy.sparse), checking only the rank."""
     if sp.issparse(value):
         value = value.toarray()
     try:
@@ -55,7 +57,7 @@ def _dense_matrix(value: object, name: str) -> np.ndarray:
     return array
 
 
-def _vector(value: object, name: str, n: int, allow_inf: bool = False) -> np.ndarray:
+def _vector(value: object, name: str, n: int) -> np.ndarray:
     if sp.issparse(value):
         value = value.toarray()
     try:
@@ -68,34 +70,76 @@ def _vector(value: object, name: str, n: int, allow_inf: bool = False) -> np.nda
         array = array.reshape(-1)
     if array.shape[0] != n:
         raise ValueError(f"{name} must have {n} entries, got {array.shape[0]}")
-    if allow_inf:
-        if np.isnan(array).any():
-            raise ValueError(f"{name} contains NaN")
-    elif not np.isfinite(array).all():
-        raise ValueError(f"{name} contains NaN or inf")
     return array
 
 
-def _symmetric(P: np.ndarray) -> np.ndarray:
-    """Return ``P`` made exactly symmetric, or raise if it is not finite and symmetric.
+# Codes of _scan's findings, turned into messages by _raise_finding.
+_OK, _P_NOT_FINITE, _P_ASYMMETRIC, _NOT_FINITE, _NAN, _CROSSED, _INFINITE_SIDE = range(7)
 
-    Entries that differ by rounding (relative ``1e-10``) are averaged, as a user who
-    built ``P = J'WJ`` in floating point expects; a real asymmetry is an error rather
-    than silently replaced by ``(P + P')/2``. A NaN or inf entry makes the asymmetry
-    non-finite, so one pass checks both.
+
+@njit(cache=True)
+def _scan(P, q, A, b, lb, ub, P_sym):
+    """One pass over the data: finiteness, symmetry and bounds; fills ``P_sym``.
+
+    Returns ``(code, argument, index, value)``: ``argument`` numbers the vectors
+    ``q, A, b, lb, ub`` as 0-4 and ``index`` locates the first offending entry.
+    Entries of ``P`` that differ from their transpose by rounding are averaged.
     """
-    with np.errstate(invalid="ignore"):
-        difference = P - P.T
-    asymmetry = float(np.abs(difference).max(initial=0.0))
-    if not np.isfinite(asymmetry):
-        raise ValueError("P contains NaN or inf")
-    scale = max(1.0, float(np.abs(P).max(initial=0.0)))
+    n = P.shape[0]
+    scale = 1.0
+    asymmetry = 0.0
+    for i in range(n):
+        for j in range(n):
+            v = P[i, j]
+            if not np.isfinite(v):
+                return _P_NOT_FINITE, -1, i, v
+            scale = max(scale, abs(v))
+            asymmetry = max(asymmetry, abs(v - P[j, i]))
+            P_sym[i, j] = 0.5 * (v + P[j, i])
     if asymmetry > SYMMETRY_TOLERANCE * scale:
+        return _P_ASYMMETRIC, -1, -1, asymmetry
+    for i in range(n):
+        if not np.isfinite(q[i]):
+            return _NOT_FINITE, 0, i, q[i]
+    for i in range(A.shape[0]):
+        for j in range(n):
+            if not np.isfinite(A[i, j]):
+                return _NOT_FINITE, 1, i, A[i, j]
+        if not np.isfinite(b[i]):
+            return _NOT_FINITE, 2, i, b[i]
+    for i in range(n):
+        if np.isnan(lb[i]):
+            return _NAN, 3, i, lb[i]
+        if np.isnan(ub[i]):
+            return _NAN, 4, i, ub[i]
+        if lb[i] > ub[i]:
+            return _CROSSED, 3, i, lb[i]
+        if lb[i] == np.inf:
+            return _INFINITE_SIDE, 3, i, lb[i]
+        if ub[i] == -np.inf:
+            return _INFINITE_SIDE, 4, i, ub[i]
+    return _OK, -1, -1, 0.0
+
+
+def _raise_finding(code: int, argument: int, index: int, value: float, lb, ub) -> None:
+    name = ("q", "A", "b", "lb", "ub")[argument] if argument >= 0 else "P"
+    if code == _P_NOT_FINITE:
+        raise ValueError(f"P contains NaN or inf (P[{index}, :] holds {value})")
+    if code == _P_ASYMMETRIC:
         raise ValueError(
-            f"P must be symmetric: max |P - P'| is {asymmetry:.3g} "
+            f"P must be symmetric: max |P - P'| is {value:.3g} "
             f"(pass (P + P.T) / 2 if only its symmetric part matters)"
         )
-    return P - 0.5 * difference
+    if code == _NOT_FINITE:
+        where = f"row {index}" if name == "A" else f"index {index}"
+        raise ValueError(f"{name} contains NaN or inf (at {where})")
+    if code == _NAN:
+        raise ValueError(f"{name} contains NaN (at index {index})")
+    if code == _CROSSED:
+        raise ValueError(
+            f"lb > ub at index {index}: lb[{index}] = {lb[index]}, ub[{index}] = {ub[index]}"
+        )
+    raise ValueError(f"{name}[{index}] = {value}: lb may not be +inf and ub may not be -inf")
 
 
 def validate(
@@ -122,7 +166,6 @@ def validate(
     n = P.shape[0]
     if n == 0:
         raise ValueError("P must have at least one row (the problem has no variables)")
-    P = _symmetric(P)
     q = _vector(q, "q", n)
     if (A is None) != (b is None):
         raise ValueError("A and b must be given together")
@@ -132,19 +175,16 @@ def validate(
         A = _dense_matrix(A, "A")
         if A.shape[1] != n:
             raise ValueError(f"A must have {n} columns (the size of P), got shape {A.shape}")
-        if not np.isfinite(A).all():
-            raise ValueError("A contains NaN or inf")
         A = np.ascontiguousarray(A)
         b = _vector(b, "b", A.shape[0])
-    lb = np.full(n, -np.inf) if lb is None else _vector(lb, "lb", n, allow_inf=True)
-    ub = np.full(n, np.inf) if ub is None else _vector(ub, "ub", n, allow_inf=True)
-    if (lb > ub).any():
-        i = int(np.flatnonzero(lb > ub)[0])
-        raise ValueError(f"lb > ub at index {i}: lb[{i}] = {lb[i]}, ub[{i}] = {ub[i]}")
-    if (lb == np.inf).any() or (ub == -np.inf).any():
-        raise ValueError("lb may not be +inf and ub may not be -inf")
+    lb = np.full(n, -np.inf) if lb is None else _vector(lb, "lb", n)
+    ub = np.full(n, np.inf) if ub is None else _vector(ub, "ub", n)
+    P_sym = np.empty((n, n))
+    finding = _scan(P, q, A, b, lb, ub, P_sym)
+    if finding[0] != _OK:
+        _raise_finding(*finding, lb, ub)
     flat = flatten_cones(cones, n)
-    in_cone = flat.entries()
+    in_cone = flat.members
     bounded = np.isfinite(lb[in_cone]) | np.isfinite(ub[in_cone])
     if bounded.any():
         i = int(in_cone[np.flatnonzero(bounded)[0]])
@@ -154,6 +194,6 @@ def validate(
         )
     is_constrained = np.isfinite(lb) | np.isfinite(ub)
     is_constrained[in_cone] = True
-    constrained = np.flatnonzero(is_constrained).astype(np.int64)
+    constrained = np.flatnonzero(is_constrained)
     position = np.searchsorted(constrained, flat.offset)
-    return ProblemData(P, q, A, b, lb, ub, flat.relocated(position), constrained)
+    return ProblemData(P_sym, q, A, b, lb, ub, flat.relocated(position), constrained)

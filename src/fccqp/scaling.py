@@ -41,18 +41,21 @@ def equilibrate(P, q, A, b, block_start, block_dim, iterations, D, E):
     d = np.empty(n)
     e = np.empty(m)
     for _ in range(iterations):
-        for j in range(n):
+        # P is symmetric: its column norms are its row norms (contiguous rows).
+        for i in range(n):
             norm = 0.0
-            for i in range(n):
+            for j in range(n):
                 norm = max(norm, abs(P[i, j]))
-            for i in range(m):
-                norm = max(norm, abs(A[i, j]))
-            d[j] = _inverse_sqrt_norm(norm)
+            d[i] = norm
         for i in range(m):
             norm = 0.0
             for j in range(n):
-                norm = max(norm, abs(A[i, j]))
+                a = abs(A[i, j])
+                norm = max(norm, a)
+                d[j] = max(d[j], a)
             e[i] = _inverse_sqrt_norm(norm)
+        for j in range(n):
+            d[j] = _inverse_sqrt_norm(d[j])
         for k in range(block_start.shape[0]):
             s, t = block_start[k], block_start[k] + block_dim[k]
             log_mean = 0.0
@@ -70,9 +73,9 @@ def equilibrate(P, q, A, b, block_start, block_dim, iterations, D, E):
             b[i] *= e[i]
             E[i] *= e[i]
     mean_col = 0.0
-    for j in range(n):
+    for i in range(n):
         norm = 0.0
-        for i in range(n):
+        for j in range(n):
             norm = max(norm, abs(P[i, j]))
         mean_col += norm
     mean_col /= n

@@ -48,16 +48,21 @@ def _scale(data: ProblemData, iterations: int) -> admm.ScaledProblem:
     )
 
 
+def _rho_scale(data: ProblemData) -> np.ndarray:
+    """Per-entry rho multiplier: entries with lb == ub act as equalities and get more."""
+    fixed = data.lb[data.constrained] == data.ub[data.constrained]
+    return np.where(fixed, admm.FIXED_RHO_SCALE, 1.0)
+
+
 def _workspace(data: ProblemData, log_rows: int) -> admm.Workspace:
     n, m, s = data.n, data.m, data.constrained.shape[0]
     N = n + m
-    fixed = data.lb[data.constrained] == data.ub[data.constrained]
     return admm.Workspace(
         K=np.zeros((N, N), order="F"), ipiv=np.zeros(N, np.int32),
         work=np.zeros(N * _LAPACK_BLOCK), rhs=np.zeros(N), sol=np.zeros(N),
         residual=np.zeros(N), x=np.zeros(n), nu=np.zeros(m), z=np.zeros(s), y=np.zeros(s),
         x_prev=np.zeros(n), nu_prev=np.zeros(m), z_prev=np.zeros(s), y_prev=np.zeros(s),
-        rho_vec=np.zeros(s), rho_scale=np.where(fixed, admm.FIXED_RHO_SCALE, 1.0),
+        rho_vec=np.zeros(s), rho_scale=_rho_scale(data),
         relaxed=np.zeros(s), log=np.zeros((log_rows, 4)),
     )
 
@@ -159,8 +164,11 @@ class Solver:
             scaled = _scale(data, settings.scaling)
         log_rows = settings.max_iter + 1 if settings.verbose else 0
         w = self._workspace
-        if w is None or not reuse or w.log.shape[0] != log_rows:
+        if w is None or w.x.shape != data.q.shape or w.nu.shape != data.b.shape \
+                or w.z.shape != data.constrained.shape or w.log.shape[0] != log_rows:
             w = self._workspace = _workspace(data, log_rows)
+        elif not reuse:
+            w.rho_scale[:] = _rho_scale(data)
         warm = settings.warm_start and prev is not None and prev.x.shape == data.q.shape
         warm = warm and prev.y.shape == data.b.shape
         rho = prev.rho if warm else settings.rho
