@@ -42,6 +42,7 @@ __all__ = [
     "WbcQP",
     "Weights",
     "build_wbc_qp",
+    "clarabel_problem",
     "solve_reference",
     "tangent_basis",
 ]
@@ -377,19 +378,14 @@ class ReferenceSolveError(RuntimeError):
     """Clarabel did not solve a QP to the requested tolerance."""
 
 
-def solve_reference(qp: WbcQP, tol: float = 1e-9) -> np.ndarray:
-    """Solve ``qp`` with Clarabel and exact second-order friction cones.
+def clarabel_problem(
+    qp: WbcQP,
+) -> tuple[sparse.csc_matrix, np.ndarray, sparse.csc_matrix, np.ndarray, list[object]]:
+    """Clarabel's data ``(P, q, G, h, cones)`` for ``qp`` with exact friction cones.
 
-    Clarabel's form is ``A x + s = b, s in K``: the equalities are a zero cone, each
+    Clarabel's form is ``G x + s = h, s in K``: the equalities are a zero cone, each
     finite bound a nonnegative row, and each contact the cone
-    ``(mu n.f, t1.f, t2.f) in SOC(3)``. At very tight tolerances Clarabel sometimes
-    stops at ``AlmostSolved``; the solve is then retried with the settings of
-    ``_RETRIES``.
-
-    Raises
-    ------
-    ReferenceSolveError
-        If the status is not ``Solved`` (the test set would carry a wrong reference).
+    ``(mu n.f, t1.f, t2.f) in SOC(3)``. ``P`` is the upper triangle, as Clarabel wants.
     """
     rows = [qp.A]
     rhs = [qp.b]
@@ -408,8 +404,22 @@ def solve_reference(qp: WbcQP, tol: float = 1e-9) -> np.ndarray:
         rhs.append(np.zeros(3))
         cones.append(clarabel.SecondOrderConeT(3))
     P = sparse.csc_matrix(np.triu(qp.P))
-    G = sparse.csc_matrix(np.vstack(rows))
-    h = np.concatenate(rhs)
+    return P, np.array(qp.q), sparse.csc_matrix(np.vstack(rows)), np.concatenate(rhs), cones
+
+
+def solve_reference(qp: WbcQP, tol: float = 1e-9) -> np.ndarray:
+    """Solve ``qp`` with Clarabel and exact second-order friction cones.
+
+    The data come from :func:`clarabel_problem`. At very tight tolerances Clarabel
+    sometimes stops at ``AlmostSolved``; the solve is then retried with the settings
+    of ``_RETRIES``.
+
+    Raises
+    ------
+    ReferenceSolveError
+        If the status is not ``Solved`` (the test set would carry a wrong reference).
+    """
+    P, q, G, h, cones = clarabel_problem(qp)
     statuses = []
     for retry in _RETRIES:
         settings = clarabel.DefaultSettings()
@@ -417,7 +427,7 @@ def solve_reference(qp: WbcQP, tol: float = 1e-9) -> np.ndarray:
         settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = tol
         for key, value in retry.items():
             setattr(settings, key, value)
-        sol = clarabel.DefaultSolver(P, np.asarray(qp.q), G, h, cones, settings).solve()
+        sol = clarabel.DefaultSolver(P, q, G, h, cones, settings).solve()
         if str(sol.status) == "Solved":
             return np.array(sol.x)
         statuses.append(str(sol.status))
