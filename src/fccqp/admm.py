@@ -33,6 +33,8 @@ NOT_CONVEX = -1
 """Kernel code: the KKT inertia shows that P is not positive semidefinite."""
 INACCURATE_FACTOR = 10.0
 """A budget-stopped iterate within this multiple of the tolerances is 'inaccurate'."""
+AA_REGULARIZATION = 1e-8
+"""Tikhonov weight of Anderson's least-squares problem, relative to its largest diagonal."""
 RHO_MIN, RHO_MAX = 1e-6, 1e6
 """Range of the adaptive rho."""
 FIXED_RHO_SCALE = 1e3
@@ -81,6 +83,12 @@ class Workspace(NamedTuple):
     rho_scale: np.ndarray
     relaxed: np.ndarray
     log: np.ndarray
+    aa_dg: np.ndarray
+    aa_df: np.ndarray
+    aa_g: np.ndarray
+    aa_f: np.ndarray
+    aa_plain: np.ndarray
+    aa_counts: np.ndarray
 
 
 class Params(NamedTuple):
@@ -98,6 +106,7 @@ class Params(NamedTuple):
     adaptive_rho: bool
     adaptive_rho_interval: int
     adaptive_rho_tolerance: float
+    anderson_memory: int
     time_limit: float
     start_time: float
     cold_start: bool
@@ -332,6 +341,96 @@ def _update_rho(p, w, rho, prim_s, dual_s, prim_scale_s, dual_scale_s, tolerance
 
 
 @njit(cache=True)
+def _admm_step(p, w, prm, relax_x):
+    """One ADMM iteration from ``(x, z, y)`` in ``w``; the previous values go to ``*_prev``."""
+    n = p.P.shape[0]
+    s = p.constrained.shape[0]
+    w.x_prev[:] = w.x
+    w.nu_prev[:] = w.nu
+    w.z_prev[:] = w.z
+    w.y_prev[:] = w.y
+    w.rhs[:n] = prm.sigma * w.x - p.q
+    w.rhs[n:] = p.b
+    for j in range(s):
+        w.rhs[p.constrained[j]] += w.rho_vec[j] * w.z[j] - w.y[j]
+    _solve_x(p, w, prm.sigma)
+    for j in range(s):
+        w.relaxed[j] = prm.alpha * w.sol[p.constrained[j]] + (1.0 - prm.alpha) * w.z_prev[j]
+    alpha_x = prm.alpha if relax_x else 1.0
+    for i in range(n):
+        w.x[i] = alpha_x * w.sol[i] + (1.0 - alpha_x) * w.x_prev[i]
+    w.nu[:] = w.sol[n:]
+    for j in range(s):
+        w.z[j] = w.relaxed[j] + w.y[j] / w.rho_vec[j]
+    project_constraint_set(w.z, p.lo, p.hi, p.cones, w.z)
+    for j in range(s):
+        w.y[j] += w.rho_vec[j] * (w.relaxed[j] - w.z[j])
+
+
+@njit(cache=True)
+def _anderson(w, capacity):
+    """Type-II Anderson acceleration of the ADMM map ``g = (z, y/rho) -> T(g)``.
+
+    The step just taken went from ``g = (z_prev, y_prev/rho)`` to ``T(g) = (z, y/rho)``,
+    with fixed-point residual ``f = T(g) - g``. With the last differences ``dG, dF`` of
+    ``g`` and ``f``, the next point is ``T(g) - (dG + dF) gamma``, ``gamma`` minimizing
+    ``||f - dF gamma||``. Safeguard: when the step from an accelerated point has a larger
+    residual than the step before it, the plain ``T`` of the previous point is restored
+    and the memory cleared, and plain ADMM runs ``capacity`` steps before the next try.
+    ``w.aa_counts`` holds (pairs stored so far, previous point known, current point
+    accelerated, steps left before accelerating again); zero it to reset.
+    """
+    s = w.z.shape[0]
+    counts = w.aa_counts
+    g = np.empty(2 * s)
+    f = np.empty(2 * s)
+    for j in range(s):
+        g[j] = w.z_prev[j]
+        g[s + j] = w.y_prev[j] / w.rho_vec[j]
+        f[j] = w.z[j] - g[j]
+        f[s + j] = w.y[j] / w.rho_vec[j] - g[s + j]
+    f_norm = np.sqrt(f @ f)
+    if counts[2] == 1 and f_norm > w.aa_plain[2 * s]:
+        for j in range(s):
+            w.z[j] = w.aa_plain[j]
+            w.y[j] = w.aa_plain[s + j] * w.rho_vec[j]
+        counts[:] = 0
+        counts[3] = capacity  # let plain ADMM run before trying again
+        return
+    if counts[3] > 0:
+        counts[3] -= 1
+        return
+    if counts[1] == 1:
+        slot = counts[0] % capacity
+        w.aa_dg[slot] = g - w.aa_g
+        w.aa_df[slot] = f - w.aa_f
+        counts[0] += 1
+    w.aa_g[:] = g
+    w.aa_f[:] = f
+    w.aa_plain[2 * s] = f_norm
+    counts[1] = 1
+    stored = min(counts[0], capacity)
+    counts[2] = 0
+    if stored == 0:
+        return
+    dF = w.aa_df[:stored]
+    gram = dF @ dF.T
+    ridge = 0.0
+    for i in range(stored):
+        ridge = max(ridge, gram[i, i])
+    for i in range(stored):
+        gram[i, i] += AA_REGULARIZATION * ridge + 1e-300
+    gamma = np.linalg.solve(gram, dF @ f)
+    step = (w.aa_dg[:stored] + dF).T @ gamma
+    for j in range(s):
+        w.aa_plain[j] = w.z[j]
+        w.aa_plain[s + j] = w.y[j] / w.rho_vec[j]
+        w.z[j] -= step[j]
+        w.y[j] -= step[s + j] * w.rho_vec[j]
+    counts[2] = 1
+
+
+@njit(cache=True)
 def run(p, w, prm):
     """Run ADMM from the iterate in ``w`` (or a cold start); return a summary tuple.
 
@@ -363,63 +462,49 @@ def run(p, w, prm):
         factorizations += 1
     status = 0
     timed = prm.time_limit < np.inf
+    w.aa_counts[:] = 0
     while status == 0:
         iteration += 1
-        w.x_prev[:] = w.x
-        w.nu_prev[:] = w.nu
-        w.z_prev[:] = w.z
-        w.y_prev[:] = w.y
-        w.rhs[:n] = prm.sigma * w.x - p.q
-        w.rhs[n:] = p.b
-        for j in range(s):
-            w.rhs[p.constrained[j]] += w.rho_vec[j] * w.z[j] - w.y[j]
-        _solve_x(p, w, prm.sigma)
-        for j in range(s):
-            w.relaxed[j] = prm.alpha * w.sol[p.constrained[j]] + (1.0 - prm.alpha) * w.z_prev[j]
-        relax_x = prm.alpha if iteration > 1 else 1.0
-        for i in range(n):
-            w.x[i] = relax_x * w.sol[i] + (1.0 - relax_x) * w.x_prev[i]
-        w.nu[:] = w.sol[n:]
-        for j in range(s):
-            w.z[j] = w.relaxed[j] + w.y[j] / w.rho_vec[j]
-        project_constraint_set(w.z, p.lo, p.hi, p.cones, w.z)
-        for j in range(s):
-            w.y[j] += w.rho_vec[j] * (w.relaxed[j] - w.z[j])
-
+        _admm_step(p, w, prm, iteration > 1)
         last = iteration >= prm.max_iter or (timed and _now() - prm.start_time >= prm.time_limit)
         adapt = prm.adaptive_rho and iteration % prm.adaptive_rho_interval == 0
-        if iteration % prm.check_termination != 0 and not last and not adapt:
-            continue
-        prim, dual, prim_scale, dual_scale, prim_s, dual_s, prim_scale_s, dual_scale_s = residuals(p, w)
-        eps_p = prm.eps_abs + prm.eps_rel * prim_scale
-        eps_d = prm.eps_abs + prm.eps_rel * dual_scale
-        if iteration < w.log.shape[0]:
-            row = w.log[iteration]
-            row[0], row[1], row[2], row[3] = iteration, prim, dual, rho
-        if prim <= eps_p and dual <= eps_d:
-            status = SOLVED
-        elif is_primal_infeasible(p, w, prm.eps_prim_inf) or (
-            prim > eps_p and is_equality_inconsistent(p, w, prm.eps_prim_inf)
-        ):
-            status = PRIMAL_INFEASIBLE
-        elif is_dual_infeasible(p, w, prm.eps_dual_inf):
-            status = DUAL_INFEASIBLE
-        elif last:
-            if prim <= INACCURATE_FACTOR * eps_p and dual <= INACCURATE_FACTOR * eps_d:
-                status = SOLVED_INACCURATE
-            elif iteration >= prm.max_iter:
-                status = MAX_ITER
-            else:
-                status = TIME_LIMIT
-        elif adapt:
-            new_rho = _update_rho(
-                p, w, rho, prim_s, dual_s, prim_scale_s, dual_scale_s, prm.adaptive_rho_tolerance
+        if iteration % prm.check_termination == 0 or last or adapt:
+            prim, dual, prim_scale, dual_scale, prim_s, dual_s, prim_scale_s, dual_scale_s = (
+                residuals(p, w)
             )
-            if new_rho != rho:
-                rho = new_rho
-                for j in range(s):
-                    w.rho_vec[j] = rho * w.rho_scale[j]
-                if not _factor_kkt(p, w, prm.sigma):
-                    return NOT_CONVEX, iteration, rho, prim, dual, factorizations + 1
-                factorizations += 1
+            eps_p = prm.eps_abs + prm.eps_rel * prim_scale
+            eps_d = prm.eps_abs + prm.eps_rel * dual_scale
+            if iteration < w.log.shape[0]:
+                row = w.log[iteration]
+                row[0], row[1], row[2], row[3] = iteration, prim, dual, rho
+            if prim <= eps_p and dual <= eps_d:
+                status = SOLVED
+            elif is_primal_infeasible(p, w, prm.eps_prim_inf) or (
+                prim > eps_p and is_equality_inconsistent(p, w, prm.eps_prim_inf)
+            ):
+                status = PRIMAL_INFEASIBLE
+            elif is_dual_infeasible(p, w, prm.eps_dual_inf):
+                status = DUAL_INFEASIBLE
+            elif last:
+                if prim <= INACCURATE_FACTOR * eps_p and dual <= INACCURATE_FACTOR * eps_d:
+                    status = SOLVED_INACCURATE
+                elif iteration >= prm.max_iter:
+                    status = MAX_ITER
+                else:
+                    status = TIME_LIMIT
+            elif adapt:
+                new_rho = _update_rho(
+                    p, w, rho, prim_s, dual_s, prim_scale_s, dual_scale_s,
+                    prm.adaptive_rho_tolerance,
+                )
+                if new_rho != rho:
+                    rho = new_rho
+                    for j in range(s):
+                        w.rho_vec[j] = rho * w.rho_scale[j]
+                    if not _factor_kkt(p, w, prm.sigma):
+                        return NOT_CONVEX, iteration, rho, prim, dual, factorizations + 1
+                    factorizations += 1
+                    w.aa_counts[:] = 0
+        if status == 0 and prm.anderson_memory > 0:
+            _anderson(w, prm.anderson_memory)
     return status, iteration, rho, prim, dual, factorizations

@@ -37,10 +37,12 @@ class Settings:
     """Check residuals every this many iterations."""
     adaptive_rho: bool = True
     """Rescale rho to balance primal and dual residuals, refactoring when it changes."""
-    adaptive_rho_interval: int = 25
+    adaptive_rho_interval: int = 10
     """Iterations between two rho updates."""
     adaptive_rho_tolerance: float = 5.0
     """Refactor only when rho would change by more than this factor."""
+    anderson_memory: int = 10
+    """Anderson acceleration memory (0 disables); safeguarded, see fccqp.admm._anderson."""
     scaling: int = 10
     """Ruiz equilibration iterations (0 disables scaling)."""
     warm_start: bool = True
@@ -70,11 +72,14 @@ class Settings:
             raise ValueError(
                 f"setting adaptive_rho_tolerance must be > 1, got {self.adaptive_rho_tolerance}"
             )
-        for name in ("max_iter", "check_termination", "adaptive_rho_interval", "scaling"):
+        integers = (
+            "max_iter", "check_termination", "adaptive_rho_interval", "scaling", "anderson_memory"
+        )
+        for name in integers:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int):
                 raise TypeError(f"setting {name} must be an integer, got {value!r}")
-            minimum = 0 if name == "scaling" else 1
+            minimum = 0 if name in ("scaling", "anderson_memory") else 1
             if value < minimum:
                 raise ValueError(f"setting {name} must be >= {minimum}, got {value}")
         for name in ("adaptive_rho", "warm_start", "verbose"):

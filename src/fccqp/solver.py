@@ -54,7 +54,7 @@ def _rho_scale(data: ProblemData) -> np.ndarray:
     return np.where(fixed, admm.FIXED_RHO_SCALE, 1.0)
 
 
-def _workspace(data: ProblemData, log_rows: int) -> admm.Workspace:
+def _workspace(data: ProblemData, log_rows: int, memory: int) -> admm.Workspace:
     n, m, s = data.n, data.m, data.constrained.shape[0]
     N = n + m
     return admm.Workspace(
@@ -64,6 +64,9 @@ def _workspace(data: ProblemData, log_rows: int) -> admm.Workspace:
         x_prev=np.zeros(n), nu_prev=np.zeros(m), z_prev=np.zeros(s), y_prev=np.zeros(s),
         rho_vec=np.zeros(s), rho_scale=_rho_scale(data),
         relaxed=np.zeros(s), log=np.zeros((log_rows, 4)),
+        aa_dg=np.zeros((memory, 2 * s)), aa_df=np.zeros((memory, 2 * s)),
+        aa_g=np.zeros(2 * s), aa_f=np.zeros(2 * s), aa_plain=np.zeros(2 * s + 1),
+        aa_counts=np.zeros(4, np.int64),
     )
 
 
@@ -165,8 +168,9 @@ class Solver:
         log_rows = settings.max_iter + 1 if settings.verbose else 0
         w = self._workspace
         if w is None or w.x.shape != data.q.shape or w.nu.shape != data.b.shape \
-                or w.z.shape != data.constrained.shape or w.log.shape[0] != log_rows:
-            w = self._workspace = _workspace(data, log_rows)
+                or w.z.shape != data.constrained.shape or w.log.shape[0] != log_rows \
+                or w.aa_dg.shape[0] != settings.anderson_memory:
+            w = self._workspace = _workspace(data, log_rows, settings.anderson_memory)
         elif not reuse:
             w.rho_scale[:] = _rho_scale(data)
         warm = settings.warm_start and prev is not None and prev.x.shape == data.q.shape
@@ -185,7 +189,7 @@ class Solver:
             adaptive_rho=settings.adaptive_rho,
             adaptive_rho_interval=settings.adaptive_rho_interval,
             adaptive_rho_tolerance=settings.adaptive_rho_tolerance,
-            time_limit=float(settings.time_limit), start_time=start,
+            anderson_memory=settings.anderson_memory, time_limit=float(settings.time_limit), start_time=start,
             cold_start=cold, factorize=not (reuse and prev is not None and rho == prev.rho),
         )
         setup_time = time.perf_counter() - start
