@@ -20,3 +20,7 @@ __all__ = [
     "solve",
 ]
 __version__ = "0.1.0"
+
+from fccqp.qpsolvers_backend import register as _register_qpsolvers
+
+_register_qpsolvers()

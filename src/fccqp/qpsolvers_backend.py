@@ -1,0 +1,329 @@
+"""fccqp as a qpsolvers backend: ``qpsolvers.solve_qp(..., solver="fccqp")``.
+
+qpsolvers poses ``min 1/2 x'Px + q'x  s.t.  G x <= h, A x = b, lb <= x <= ub``.
+fccqp has no general inequalities, only equalities, a box and cones, so each row of
+``G`` gets a slack variable ``s_i = G_i x`` with the upper bound ``s_i <= h_i``::
+
+    min  1/2 x'Px + q'x          over  v = [x; s]
+    s.t. [A  0] [x]   [b]
+         [G -I] [s] = [0],       [lb; -inf] <= [x; s] <= [ub; h]
+
+The equalities, ``G x = s`` included, hold to factorization accuracy at every
+iterate, and every inequality becomes a box bound, which ADMM handles by a clamp.
+The cost is size: ``m_G`` more variables and ``m_G`` more equality rows, so the
+dense KKT matrix grows from ``n + m_A`` to ``n + m_A + 2 m_G`` rows, and the
+factorization cost with its cube.
+
+Duals. fccqp returns ``(y_ext, z_ext)`` with ``P_ext v + q_ext + A_ext' y_ext +
+z_ext = 0``. Its rows for ``s`` read ``-y_G + z_s = 0``, so the multiplier of
+``G x <= h`` is ``z = z_s``, the box multiplier of the slack: it comes from the
+projection onto ``s <= h``, hence is exactly ``>= 0`` and exactly zero on inactive
+rows. Its rows for ``x`` then give qpsolvers' convention
+``P x + q + A'y + G'z + z_box = 0`` with ``y = y_A`` and ``z_box = z_x``
+(negative at an active lower bound, positive at an active upper bound).
+
+fccqp is a dense solver, meant for 30-300 variables: sparse ``P``, ``G``, ``A``
+(``scipy.sparse`` matrices or arrays, ``csc_array`` included) are accepted and
+densified. It is therefore registered in ``qpsolvers.dense_solvers`` only, as
+qpsolvers does for ECOS, which also densifies.
+
+Registration. qpsolvers has no plugin mechanism: :func:`register` adds "fccqp" to
+its module-level registry, which ``import fccqp`` calls. Importing qpsolvers takes
+about 60 ms (it imports every installed backend), more than fccqp may add to its
+own import, so :func:`register` never imports it. If qpsolvers is already imported
+the registry is updated at once; otherwise a one-shot finder on ``sys.meta_path``
+updates it right after ``import qpsolvers`` finishes, then removes itself.
+"""
+
+from __future__ import annotations
+
+import importlib.abc
+import importlib.util
+import sys
+import time
+from collections.abc import Sequence
+from types import ModuleType
+from typing import TYPE_CHECKING
+
+import numpy as np
+import scipy.sparse as sp
+
+from fccqp.problem import ProblemData, validate
+from fccqp.settings import Settings
+from fccqp.solver import Solver
+
+if TYPE_CHECKING:
+    from importlib.machinery import ModuleSpec
+
+    from qpsolvers import Problem, Solution
+
+SOLVER_NAME = "fccqp"
+"""Name of the solver in qpsolvers' registry."""
+
+
+def _settings(verbose: bool, kwargs: dict[str, object]) -> Settings:
+    """Map qpsolvers keyword arguments onto :class:`fccqp.Settings`.
+
+    Every field of ``Settings`` is a valid keyword; qpsolvers' usual names
+    (``eps_abs``, ``eps_rel``, ``max_iter``, ``time_limit``) are fields already.
+    """
+    from qpsolvers import ParamError
+
+    try:
+        return Settings(verbose=bool(verbose)).replace(**kwargs)
+    except (TypeError, ValueError) as exn:
+        raise ParamError(f"fccqp: {exn}") from exn
+
+
+def _inequalities(G: object, h: object, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Check ``G x <= h`` and return it dense; errors name ``G`` or ``h``."""
+    if sp.issparse(G):
+        G = G.toarray()
+    try:
+        G = np.asarray(G, dtype=np.float64)
+        h = np.asarray(h, dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError) as exn:
+        raise TypeError(f"G and h must be numeric: {exn}") from exn
+    if G.ndim != 2 or G.shape[1] != n:
+        raise ValueError(f"G must have {n} columns (the size of P), got shape {G.shape}")
+    if h.shape[0] != G.shape[0]:
+        raise ValueError(f"G has {G.shape[0]} rows but h has {h.shape[0]} entries")
+    if not np.isfinite(G).all():
+        raise ValueError("G contains NaN or inf")
+    if np.isnan(h).any():
+        raise ValueError("h contains NaN")
+    if (h == -np.inf).any():
+        i = int(np.flatnonzero(h == -np.inf)[0])
+        raise ValueError(f"h[{i}] is -inf: the inequality G[{i}] x <= -inf cannot hold")
+    return G, h
+
+
+def _with_slacks(data: ProblemData, G: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Return ``(P, q, A, b, lb, ub)`` over ``[x; s]`` with ``G x - s = 0``, ``s <= h``."""
+    n, m, k = data.n, data.m, G.shape[0]
+    P = np.zeros((n + k, n + k))
+    P[:n, :n] = data.P
+    A = np.zeros((m + k, n + k))
+    A[:m, :n] = data.A
+    A[m:, :n] = G
+    A[m:, n:] = -np.eye(k)
+    return (
+        P,
+        np.concatenate([data.q, np.zeros(k)]),
+        A,
+        np.concatenate([data.b, np.zeros(k)]),
+        np.concatenate([data.lb, np.full(k, -np.inf)]),
+        np.concatenate([data.ub, h]),
+    )
+
+
+def _initial_guess(initvals: object, n: int) -> np.ndarray:
+    try:
+        guess = np.asarray(initvals, dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError) as exn:
+        raise TypeError(f"initvals must be a numeric vector: {exn}") from exn
+    if guess.shape != (n,) or not np.isfinite(guess).all():
+        raise ValueError(f"initvals must be a finite vector of {n} entries, got {guess.shape}")
+    return guess
+
+
+def fccqp_solve_problem(
+    problem: Problem,
+    initvals: np.ndarray | None = None,
+    verbose: bool = False,
+    **kwargs: object,
+) -> Solution:
+    """Solve a qpsolvers ``Problem`` with fccqp.
+
+    Parameters
+    ----------
+    problem : qpsolvers.Problem
+        ``min 1/2 x'Px + q'x  s.t.  G x <= h, A x = b, lb <= x <= ub``. ``P`` must be
+        symmetric positive semidefinite; matrices may be dense or ``scipy.sparse``
+        (densified). Inequalities become slack variables (see the module docstring).
+    initvals : (n,) array_like, optional
+        Primal initial guess ``x0``; the slacks start at ``G x0``. Without it the
+        solve starts cold.
+    verbose : bool
+        Print fccqp's iteration log.
+    **kwargs
+        Fields of :class:`fccqp.Settings`, e.g. ``eps_abs``, ``eps_rel``, ``max_iter``,
+        ``time_limit``, ``rho``.
+
+    Returns
+    -------
+    qpsolvers.Solution
+        ``found`` is True only for ``Status.SOLVED``. Duals follow qpsolvers:
+        ``P x + q + A'y + G'z + z_box = 0`` with ``z >= 0``; absent constraint blocks
+        give empty arrays. When the budget runs out ``x, y, z, z_box`` hold the last
+        iterate; on infeasibility they are None. ``extras`` holds the fccqp ``status``,
+        ``iterations``, ``prim_res``, ``dual_res`` (of the slack form), ``setup_time``,
+        ``solve_time``, ``rho`` and ``factorizations``.
+
+    Raises
+    ------
+    qpsolvers.ParamError
+        On an unknown keyword or an invalid setting value, naming it.
+    ValueError, TypeError
+        On malformed problem data, naming the argument (``P``, ``q``, ``G``, ``h``,
+        ``A``, ``b``, ``lb``, ``ub``, ``initvals``), or when ``P`` is not positive
+        semidefinite.
+    """
+    from qpsolvers import Solution
+
+    build_start = time.perf_counter()
+    problem.check_constraints()
+    settings = _settings(verbose, kwargs)
+    P, q, G, h, A, b, lb, ub = problem.unpack()
+    data = validate(P, q, A, b, lb, ub)
+    x0 = None if initvals is None else _initial_guess(initvals, data.n)
+    if G is None:
+        args = (data.P, data.q, data.A, data.b, data.lb, data.ub)
+        m_G = 0
+    else:
+        G, h = _inequalities(G, h, data.n)
+        args = _with_slacks(data, G, h)
+        m_G = G.shape[0]
+        if x0 is not None:
+            x0 = np.concatenate([x0, G @ x0])
+    solve_start = time.perf_counter()
+    result = Solver(settings).solve(*args, x0=x0)
+    solve_end = time.perf_counter()
+
+    solution = Solution(problem)
+    solution.found = result.status.is_solved()
+    solution.extras = {
+        "status": result.status,
+        "iterations": result.iterations,
+        "prim_res": result.prim_res,
+        "dual_res": result.dual_res,
+        "setup_time": result.setup_time,
+        "solve_time": result.solve_time,
+        "rho": result.rho,
+        "factorizations": result.factorizations,
+    }
+    solution.build_time = solve_start - build_start
+    solution.solve_time = solve_end - solve_start
+    if result.status.is_infeasible():
+        return solution
+    n, m_A = data.n, data.m
+    solution.obj = result.obj
+    solution.x = result.x[:n]
+    solution.y = result.y[:m_A]
+    solution.z = result.z[n:] if m_G else np.empty(0)
+    solution.z_box = result.z[:n] if lb is not None or ub is not None else np.empty(0)
+    return solution
+
+
+def fccqp_solve_qp(
+    P: np.ndarray | sp.sparray | sp.spmatrix,
+    q: np.ndarray,
+    G: np.ndarray | sp.sparray | sp.spmatrix | None = None,
+    h: np.ndarray | None = None,
+    A: np.ndarray | sp.sparray | sp.spmatrix | None = None,
+    b: np.ndarray | None = None,
+    lb: np.ndarray | None = None,
+    ub: np.ndarray | None = None,
+    initvals: np.ndarray | None = None,
+    verbose: bool = False,
+    **kwargs: object,
+) -> np.ndarray | None:
+    """Solve ``min 1/2 x'Px + q'x  s.t.  G x <= h, A x = b, lb <= x <= ub`` with fccqp.
+
+    The arguments are those of :func:`qpsolvers.solve_qp` (see
+    :func:`fccqp_solve_problem` for ``initvals``, ``verbose`` and ``kwargs``).
+
+    Returns
+    -------
+    (n,) numpy.ndarray or None
+        The solution when fccqp reports ``Status.SOLVED``, otherwise None.
+    """
+    from qpsolvers import Problem
+
+    problem = Problem(P, q, G, h, A, b, lb, ub)
+    solution = fccqp_solve_problem(problem, initvals, verbose, **kwargs)
+    return solution.x if solution.found else None
+
+
+def _add_to_registry() -> bool:
+    """Put fccqp in qpsolvers' registry, mutating its lists and dict in place.
+
+    ``qpsolvers.solve_problem`` looks solvers up in ``solve_function``; the lists
+    ``available_solvers`` and ``dense_solvers`` are what users and qpsolvers'
+    messages consult. Other modules hold these same objects, hence in place.
+    """
+    try:
+        from qpsolvers import solvers
+    except ImportError:
+        return False
+    for names in (solvers.available_solvers, solvers.dense_solvers):
+        if SOLVER_NAME not in names:
+            names.append(SOLVER_NAME)
+    solvers.solve_function[SOLVER_NAME] = fccqp_solve_problem
+    return True
+
+
+class _RegisteringLoader(importlib.abc.Loader):
+    """Runs qpsolvers' own loader, then registers fccqp and retires the hook."""
+
+    def __init__(self, loader: importlib.abc.Loader, hook: _RegisterOnImport) -> None:
+        self._loader = loader
+        self._hook = hook
+
+    def create_module(self, spec: ModuleSpec) -> ModuleType | None:
+        return self._loader.create_module(spec)
+
+    def exec_module(self, module: ModuleType) -> None:
+        # Hand the module its real loader before its code runs, so nothing
+        # (submodule imports, importlib.resources, inspect) ever sees this wrapper.
+        module.__loader__ = self._loader
+        module.__spec__.loader = self._loader
+        self._loader.exec_module(module)
+        if self._hook in sys.meta_path:
+            sys.meta_path.remove(self._hook)
+        _add_to_registry()
+
+
+class _RegisterOnImport(importlib.abc.MetaPathFinder):
+    """Meta-path finder that registers fccqp once ``import qpsolvers`` completes.
+
+    It finds nothing itself: for the name ``qpsolvers`` it asks the other finders
+    and wraps the loader they return; every other name goes straight past it.
+    """
+
+    def find_spec(
+        self, fullname: str, path: Sequence[str] | None, target: ModuleType | None = None
+    ) -> ModuleSpec | None:
+        if fullname != "qpsolvers":
+            return None
+        for finder in sys.meta_path:
+            find = getattr(finder, "find_spec", None)
+            if finder is self or find is None:
+                continue
+            spec = find(fullname, path, target)
+            if spec is not None:
+                if spec.loader is not None and hasattr(spec.loader, "exec_module"):
+                    spec.loader = _RegisteringLoader(spec.loader, self)
+                return spec
+        return None
+
+
+def register() -> bool:
+    """Make ``solver="fccqp"`` available in qpsolvers, without importing it.
+
+    If qpsolvers is imported already, fccqp is added to its registry now; if it is
+    installed but not imported, a one-shot import hook adds it right after
+    ``import qpsolvers``. Calling this again is harmless.
+
+    Returns
+    -------
+    bool
+        False, having done nothing, when qpsolvers is not installed.
+    """
+    if "qpsolvers" in sys.modules:
+        return _add_to_registry()
+    if importlib.util.find_spec("qpsolvers") is None:
+        return False
+    if not any(isinstance(finder, _RegisterOnImport) for finder in sys.meta_path):
+        sys.meta_path.insert(0, _RegisterOnImport())
+    return True
