@@ -13,6 +13,7 @@ from __future__ import annotations
 import csv
 import os
 import platform
+import subprocess
 from collections.abc import Sequence
 from dataclasses import dataclass
 from importlib import metadata
@@ -88,6 +89,23 @@ def _version(package: str) -> str:
         return "not installed"
 
 
+def _git_revision() -> str:
+    """Commit of the working tree, with ``+ local changes in src/`` when it is dirty."""
+    root = Path(__file__).resolve().parent.parent
+    try:
+        head = subprocess.run(
+            ["git", "rev-parse", "--short", "HEAD"], cwd=root, capture_output=True, text=True,
+            check=True,
+        ).stdout.strip()
+        dirty = subprocess.run(
+            ["git", "status", "--porcelain", "--", "src"], cwd=root, capture_output=True,
+            text=True, check=True,
+        ).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+    return f"{head} + local changes in src/" if dirty else head
+
+
 def _us(seconds: float) -> str:
     return f"{seconds * 1e6:.0f}" if seconds >= 1e-5 else f"{seconds * 1e6:.1f}"
 
@@ -101,14 +119,14 @@ def _g(value: float) -> str:
 
 
 def write_csv(rows: Sequence[dict[str, object]], path: Path) -> None:
-    """Write one CSV row per (solver, QP); array columns are left out."""
+    """Write one CSV row per (solver, QP), floats to 4 digits; array columns are left out."""
     fields = [k for k in rows[0] if k not in _CSV_SKIP]
     with open(path, "w", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
         writer.writeheader()
         for row in rows:
             writer.writerow(
-                {k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()}
+                {k: (f"{v:.4g}" if isinstance(v, float) else v) for k, v in row.items()}
             )
 
 
@@ -131,15 +149,23 @@ def _plotted_joint(ts: TestSet, idx: np.ndarray) -> int:
 
 
 def plot_sequence(ts: TestSet, rows: Sequence[dict[str, object]], out: Path) -> tuple[str, str]:
-    """Figure 1 of the paper for one robot: times (top) and a torque (bottom)."""
+    """Figure 1 of the paper for one robot: times (top) and a torque (bottom).
+
+    The time plot shows the direct-API variants and the dsytrf baseline (the qpsolvers
+    variants are in the distribution plot).
+    """
     seq = _plotted_sequence(ts)
     idx = np.flatnonzero(ts.sequence == seq)
     t_ms = (idx - idx[0]) * ts.dt * 1e3
     solvers = list(dict.fromkeys(str(r["solver"]) for r in rows))
     by = {(str(r["solver"]), int(r["qp"])): r for r in rows}
     fig, ax = plt.subplots(figsize=(8, 4))
+    ax.set_prop_cycle(color=plt.get_cmap("tab10").colors)
     for s in solvers:
-        ax.plot(t_ms, [1e6 * float(by[s, i]["time"]) for i in idx], label=s, lw=1)
+        if not s.startswith("qpsolvers:"):
+            ax.plot(t_ms, [1e6 * float(by[s, i]["time"]) for i in idx], label=s, lw=1)
+    kkt = [1e6 * float(by[solvers[0], i]["dsytrf_time"]) for i in idx]
+    ax.plot(t_ms, kkt, "k--", lw=1, label="one dsytrf (baseline)")
     ax.set_yscale("log")
     ax.set_xlabel("time along the sequence [ms]")
     ax.set_ylabel("solve time [us]")
@@ -147,7 +173,7 @@ def plot_sequence(ts: TestSet, rows: Sequence[dict[str, object]], out: Path) -> 
     ax.legend(fontsize=7, ncol=2)
     fig.tight_layout()
     times_png = f"times_{ts.robot}.png"
-    fig.savefig(out / times_png, dpi=90)
+    fig.savefig(out / times_png, dpi=80)
     plt.close(fig)
 
     joint = _plotted_joint(ts, idx)
@@ -166,7 +192,7 @@ def plot_sequence(ts: TestSet, rows: Sequence[dict[str, object]], out: Path) -> 
     ax.legend(fontsize=7, ncol=3)
     fig.tight_layout()
     torque_png = f"torque_{ts.robot}.png"
-    fig.savefig(out / torque_png, dpi=90)
+    fig.savefig(out / torque_png, dpi=80)
     plt.close(fig)
     return times_png, torque_png
 
@@ -183,7 +209,7 @@ def plot_distribution(sets: Sequence[tuple[TestSet, list[dict[str, object]]]], o
         ax.set_title(f"{ts.robot} / {ts.scenario}: solve time [us] (whiskers 5-95 %)", fontsize=9)
     fig.tight_layout()
     name = "time_distribution.png"
-    fig.savefig(out / name, dpi=90)
+    fig.savefig(out / name, dpi=80)
     plt.close(fig)
     return name
 
@@ -288,6 +314,7 @@ def _header(info: RunInfo, variants: Sequence[str]) -> list[str]:
         "|---|---|",
         f"| CPU | {_cpu_model()} |",
         f"| cores | {os.cpu_count()} |",
+        f"| fccqp revision | {_git_revision()} |",
         f"| python | {platform.python_version()} ({platform.system()} {platform.release()}) |",
         *[f"| {lib} | {_version(lib)} |" for lib in _LIBRARIES],
         "",
