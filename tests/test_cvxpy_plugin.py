@@ -307,7 +307,9 @@ def test_parameter_resolve_warm_starts() -> None:
     assert warm["warm_started"]
     assert warm["result"].iterations < cold.iterations / 2
     assert warm["result"].factorizations == 0  # same P and A: factorization reused
-    np.testing.assert_allclose(problem.variables()[0].value, cold.x, rtol=0, atol=1e-3)
+    # both stop at the default tolerance, where a flat cost leaves x some play:
+    # compare what the tolerance controls, the objective
+    assert abs(problem.value - cold.obj) <= 1e-4 * (1 + abs(cold.obj))
 
     problem.solve(solver=FCCQP, warm_start=False)
     assert not problem.solver_stats.extra_stats["warm_started"]

@@ -33,6 +33,8 @@ NOT_CONVEX = -1
 """Kernel code: the KKT inertia shows that P is not positive semidefinite."""
 INACCURATE_FACTOR = 10.0
 """A budget-stopped iterate within this multiple of the tolerances is 'inaccurate'."""
+AA_MAX_REJECTIONS = 3
+"""Anderson steps rejected by the safeguard before a run gives up accelerating."""
 AA_REGULARIZATION = 1e-8
 """Tikhonov weight of Anderson's least-squares problem, relative to its largest diagonal."""
 RHO_MIN, RHO_MAX = 1e-6, 1e6
@@ -376,9 +378,10 @@ def _anderson(w, capacity):
     ``g`` and ``f``, the next point is ``T(g) - (dG + dF) gamma``, ``gamma`` minimizing
     ``||f - dF gamma||``. Safeguard: when the step from an accelerated point has a larger
     residual than the step before it, the plain ``T`` of the previous point is restored
-    and the memory cleared, and plain ADMM runs ``capacity`` steps before the next try.
-    ``w.aa_counts`` holds (pairs stored so far, previous point known, current point
-    accelerated, steps left before accelerating again); zero it to reset.
+    and the memory cleared, and plain ADMM runs ``capacity`` steps before the next try
+    (for the rest of the run after ``AA_MAX_REJECTIONS`` rejections). ``w.aa_counts``
+    holds (pairs stored so far, previous point known, current point accelerated, steps
+    left before accelerating again, rejections); zero it to reset.
     """
     s = w.z.shape[0]
     counts = w.aa_counts
@@ -394,8 +397,11 @@ def _anderson(w, capacity):
         for j in range(s):
             w.z[j] = w.aa_plain[j]
             w.y[j] = w.aa_plain[s + j] * w.rho_vec[j]
+        rejections = counts[4] + 1
         counts[:] = 0
-        counts[3] = capacity  # let plain ADMM run before trying again
+        counts[4] = rejections
+        # let plain ADMM run before trying again; after a few failures, for good
+        counts[3] = capacity if rejections < AA_MAX_REJECTIONS else 1 << 62
         return
     if counts[3] > 0:
         counts[3] -= 1
@@ -504,7 +510,7 @@ def run(p, w, prm):
                     if not _factor_kkt(p, w, prm.sigma):
                         return NOT_CONVEX, iteration, rho, prim, dual, factorizations + 1
                     factorizations += 1
-                    w.aa_counts[:] = 0
+                    w.aa_counts[:3] = 0
         if status == 0 and prm.anderson_memory > 0:
             _anderson(w, prm.anderson_memory)
     return status, iteration, rho, prim, dual, factorizations
