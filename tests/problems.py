@@ -21,8 +21,9 @@ def random_problem(
 
     Friction cones (every other one with a tilted normal) come first, then an
     optional second-order cone of size ``soc_dim``, then ``n_box`` boxed entries, then
-    free entries (with a low-rank ``P``, plus unit curvature). ``b = A x_f`` for a point ``x_f`` inside every set. ``duplicate_rows``
-    appends multiples of the first rows of ``A`` (rank-deficient, consistent).
+    free entries (with a low-rank ``P``, plus unit curvature). ``b = A x_f`` for a point
+    ``x_f`` inside every set. ``duplicate_rows`` appends multiples of the first rows of
+    ``A`` (rank-deficient, consistent).
     """
     rng = np.random.default_rng(seed)
     rank = psd_rank or n

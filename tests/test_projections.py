@@ -28,7 +28,10 @@ normals = arrays(np.float64, 3, elements=st.floats(-1, 1)).filter(
 ).map(unit)
 
 
-def friction(v, mu, normal=np.array([0.0, 0.0, 1.0])):
+UP = np.array([0.0, 0.0, 1.0])
+
+
+def friction(v, mu, normal=UP):
     out = np.empty(3)
     project_friction_cone(v, mu, normal, out)
     return out

@@ -4,11 +4,11 @@ import math
 
 import numpy as np
 import pytest
-from problems import random_problem
-from reference import clarabel_solve, kkt_violation
 
 import fccqp
 from fccqp import FrictionCone, SecondOrderCone, Status
+from problems import random_problem
+from reference import clarabel_solve, kkt_violation
 
 TIGHT = dict(eps_abs=1e-8, eps_rel=1e-8, max_iter=20000)
 

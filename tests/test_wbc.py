@@ -15,11 +15,12 @@ def test_set():
 
 
 def cones_of(qp):
-    return [fccqp.FrictionCone(int(s), float(mu)) for s, mu in zip(qp.cone_starts, qp.mus)]
+    pairs = zip(qp.cone_starts, qp.mus, strict=True)
+    return [fccqp.FrictionCone(int(s), float(mu)) for s, mu in pairs]
 
 
 def test_matches_clarabel_reference(test_set):
-    for qp, x_ref in zip(test_set.qps, test_set.x_ref):
+    for qp, x_ref in zip(test_set.qps, test_set.x_ref, strict=True):
         result = fccqp.solve(
             qp.P, qp.q, qp.A, qp.b, qp.lb, qp.ub, cones_of(qp),
             eps_abs=1e-9, eps_rel=1e-9, max_iter=20000,

@@ -32,7 +32,7 @@ def _call_by_reference(symbol: str):
         byte_ptr = ir.IntType(8).as_pointer()
         pointers = [
             builder.bitcast(context.make_array(ty)(context, builder, val).data, byte_ptr)
-            for ty, val in zip(signature.args, args)
+            for ty, val in zip(signature.args, args, strict=True)
         ]
         fnty = ir.FunctionType(ir.VoidType(), [byte_ptr] * len(pointers))
         function = cgutils.get_or_insert_function(builder.module, fnty, symbol)

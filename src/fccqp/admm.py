@@ -444,7 +444,6 @@ def run(p, w, prm):
     status ``NOT_CONVEX`` means the KKT inertia rejected P. ``w.log`` rows receive
     ``(iteration, prim, dual, rho)`` at each residual check, as long as there is room.
     """
-    n = p.P.shape[0]
     s = p.constrained.shape[0]
     rho = prm.rho
     factorizations = 0

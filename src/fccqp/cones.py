@@ -99,7 +99,8 @@ class ConeArrays:
         """Indices, in the vector the cones act on, of every entry in some cone."""
         if self.count == 0:
             return np.zeros(0, dtype=np.int64)
-        return np.concatenate([np.arange(o, o + d) for o, d in zip(self.offset, self.dim)])
+        blocks = zip(self.offset, self.dim, strict=True)
+        return np.concatenate([np.arange(o, o + d) for o, d in blocks])
 
     def relocated(self, offset: np.ndarray) -> ConeArrays:
         """The same cones with new block offsets."""
@@ -184,7 +185,7 @@ def _flatten(cones: Sequence[Cone], n: int) -> ConeArrays:
                 f"cones[{i}] covers x[{offset[i]}:{offset[i] + dim[i]}], outside x of length {n}"
             )
     order = np.argsort(offset, kind="stable")
-    for a, b in zip(order[:-1], order[1:]):
+    for a, b in zip(order[:-1], order[1:], strict=True):
         if offset[a] + dim[a] > offset[b]:
             raise ValueError(
                 f"cones[{a}] (x[{offset[a]}:{offset[a] + dim[a]}]) overlaps "

@@ -13,7 +13,6 @@ coefficient ``1/mu`` about the same normal; second-order cones are self-dual.
 
 import math
 
-import numpy as np
 from numba import njit
 
 from fccqp.cones import FRICTION

@@ -189,7 +189,8 @@ class Solver:
             adaptive_rho=settings.adaptive_rho,
             adaptive_rho_interval=settings.adaptive_rho_interval,
             adaptive_rho_tolerance=settings.adaptive_rho_tolerance,
-            anderson_memory=settings.anderson_memory, time_limit=float(settings.time_limit), start_time=start,
+            anderson_memory=settings.anderson_memory,
+            time_limit=float(settings.time_limit), start_time=start,
             cold_start=cold, factorize=not (reuse and prev is not None and rho == prev.rho),
         )
         setup_time = time.perf_counter() - start
@@ -223,7 +224,9 @@ class Solver:
         )
 
     @staticmethod
-    def _start_from_previous(scaled: admm.ScaledProblem, prev: _Previous, w: admm.Workspace) -> None:
+    def _start_from_previous(
+        scaled: admm.ScaledProblem, prev: _Previous, w: admm.Workspace
+    ) -> None:
         s = scaled.constrained
         w.x[:] = prev.x / scaled.D
         w.nu[:] = prev.y * scaled.c / scaled.E
