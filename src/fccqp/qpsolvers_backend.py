@@ -48,14 +48,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 import scipy.sparse as sp
 
-from fccqp.problem import ProblemData, validate
 from fccqp.settings import Settings
-from fccqp.solver import Solver
 
 if TYPE_CHECKING:
     from importlib.machinery import ModuleSpec
 
     from qpsolvers import Problem, Solution
+
+    from fccqp.problem import ProblemData
 
 SOLVER_NAME = "fccqp"
 """Name of the solver in qpsolvers' registry."""
@@ -170,6 +170,11 @@ def fccqp_solve_problem(
         semidefinite.
     """
     from qpsolvers import Solution
+
+    # Imported here, not at module level: `import fccqp` registers this backend and
+    # must not pay for numba (see fccqp/__init__.py).
+    from fccqp.problem import validate
+    from fccqp.solver import Solver
 
     build_start = time.perf_counter()
     problem.check_constraints()
