@@ -121,6 +121,17 @@ def _scan(P, q, A, b, lb, ub, P_sym):
     return _OK, -1, -1, 0.0
 
 
+@njit(cache=True)
+def same_entries(a, b):
+    """True if the 2-D arrays ``a`` and ``b`` (same shape) are equal; exits at the first
+    difference, which a control loop's changed matrices show at once."""
+    for i in range(a.shape[0]):
+        for j in range(a.shape[1]):
+            if a[i, j] != b[i, j]:
+                return False
+    return True
+
+
 def _raise_finding(code: int, argument: int, index: int, value: float, lb, ub) -> None:
     name = ("q", "A", "b", "lb", "ub")[argument] if argument >= 0 else "P"
     if code == _P_NOT_FINITE:

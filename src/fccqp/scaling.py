@@ -30,14 +30,22 @@ def _inverse_sqrt_norm(norm):
 
 @njit(cache=True)
 def equilibrate(P, q, A, b, block_start, block_dim, iterations, D, E):
-    """Scale ``P, q, A, b`` in place; fill ``D`` and ``E``; return the cost scale ``c``.
+    """Scale ``P, q, A, b`` in place; update ``D`` and ``E``; return the cost scale ``c``.
 
-    ``block_start``/``block_dim`` give the cone blocks in ``x``.
+    ``D`` and ``E`` come in as a starting scaling (ones for a fresh start), are applied,
+    then refined by ``iterations`` Ruiz passes. ``block_start``/``block_dim`` give the cone
+    blocks in ``x``.
     """
     n = P.shape[0]
     m = A.shape[0]
-    D[:] = 1.0
-    E[:] = 1.0
+    for i in range(n):
+        for j in range(n):
+            P[i, j] *= D[i] * D[j]
+        q[i] *= D[i]
+    for i in range(m):
+        for j in range(n):
+            A[i, j] *= E[i] * D[j]
+        b[i] *= E[i]
     d = np.empty(n)
     e = np.empty(m)
     for _ in range(iterations):

@@ -10,7 +10,7 @@ import numpy as np
 
 from fccqp import admm
 from fccqp.cones import Cone
-from fccqp.problem import ProblemData, validate
+from fccqp.problem import ProblemData, same_entries, validate
 from fccqp.projections import project_constraint_set
 from fccqp.result import Result
 from fccqp.scaling import equilibrate
@@ -34,6 +34,12 @@ class _Previous:
 
 
 def _scale(data: ProblemData, iterations: int) -> admm.ScaledProblem:
+    """Equilibrate ``data`` with ``iterations`` Ruiz passes.
+
+    Starting from the previous tick's scaling with a single pass was measured on the
+    WBC sets: 50 us faster per solve, but the slowest QPs took 2-4x more iterations
+    (ADMM is sensitive to the scaling), so every solve scales from scratch.
+    """
     P, q, A, b = data.P.copy(), data.q.copy(), data.A.copy(), data.b.copy()
     D, E = np.ones(data.n), np.ones(data.m)
     cones = data.cones
@@ -70,14 +76,14 @@ def _workspace(data: ProblemData, log_rows: int, memory: int) -> admm.Workspace:
     )
 
 
-def _same_matrices(a: ProblemData, b: ProblemData) -> bool:
+def _same_structure(a: ProblemData, b: ProblemData) -> bool:
+    """Same sizes, constrained entries, fixed entries and cone blocks."""
     return (
         a.P.shape == b.P.shape and a.A.shape == b.A.shape
         and np.array_equal(a.constrained, b.constrained)
         and np.array_equal(a.lb == a.ub, b.lb == b.ub)
         and np.array_equal(a.cones.offset, b.cones.offset)
         and np.array_equal(a.cones.dim, b.cones.dim)
-        and np.array_equal(a.P, b.P) and np.array_equal(a.A, b.A)
     )
 
 
@@ -160,7 +166,10 @@ class Solver:
         settings = self.settings
         data = validate(P, q, A, b, lb, ub, cones)
         prev = self._previous
-        reuse = prev is not None and _same_matrices(prev.data, data)
+        reuse = (
+            prev is not None and _same_structure(prev.data, data)
+            and same_entries(prev.data.P, data.P) and same_entries(prev.data.A, data.A)
+        )
         if reuse:
             scaled = self._rescale_vectors(prev.scaled, data)
         else:
