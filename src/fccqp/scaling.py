@@ -30,22 +30,17 @@ def _inverse_sqrt_norm(norm):
 
 @njit(cache=True)
 def equilibrate(P, q, A, b, block_start, block_dim, iterations, D, E):
-    """Scale ``P, q, A, b`` in place; update ``D`` and ``E``; return the cost scale ``c``.
+    """Scale ``P, q, A, b`` in place; fill ``D`` and ``E``; return the cost scale ``c``.
 
-    ``D`` and ``E`` come in as a starting scaling (ones for a fresh start), are applied,
-    then refined by ``iterations`` Ruiz passes. ``block_start``/``block_dim`` give the cone
-    blocks in ``x``.
+    Each pass reads the norms of the currently scaled matrix off the original entries
+    (row ``i`` of ``D P D`` has norm ``D_i max_j |P_ij| D_j``), so the data is touched
+    once per pass and rescaled once at the end. ``block_start``/``block_dim`` give the
+    cone blocks in ``x``.
     """
     n = P.shape[0]
     m = A.shape[0]
-    for i in range(n):
-        for j in range(n):
-            P[i, j] *= D[i] * D[j]
-        q[i] *= D[i]
-    for i in range(m):
-        for j in range(n):
-            A[i, j] *= E[i] * D[j]
-        b[i] *= E[i]
+    D[:] = 1.0
+    E[:] = 1.0
     d = np.empty(n)
     e = np.empty(m)
     for _ in range(iterations):
@@ -53,15 +48,15 @@ def equilibrate(P, q, A, b, block_start, block_dim, iterations, D, E):
         for i in range(n):
             norm = 0.0
             for j in range(n):
-                norm = max(norm, abs(P[i, j]))
-            d[i] = norm
+                norm = max(norm, abs(P[i, j]) * D[j])
+            d[i] = norm * D[i]
         for i in range(m):
             norm = 0.0
             for j in range(n):
-                a = abs(A[i, j])
+                a = abs(A[i, j]) * D[j]
                 norm = max(norm, a)
-                d[j] = max(d[j], a)
-            e[i] = _inverse_sqrt_norm(norm)
+                d[j] = max(d[j], a * E[i])
+            e[i] = _inverse_sqrt_norm(norm * E[i])
         for j in range(n):
             d[j] = _inverse_sqrt_norm(d[j])
         for k in range(block_start.shape[0]):
@@ -70,16 +65,16 @@ def equilibrate(P, q, A, b, block_start, block_dim, iterations, D, E):
             for j in range(s, t):
                 log_mean += math.log(d[j])
             d[s:t] = math.exp(log_mean / (t - s))
-        for i in range(n):
-            for j in range(n):
-                P[i, j] *= d[i] * d[j]
-            q[i] *= d[i]
-            D[i] *= d[i]
-        for i in range(m):
-            for j in range(n):
-                A[i, j] *= e[i] * d[j]
-            b[i] *= e[i]
-            E[i] *= e[i]
+        D *= d
+        E *= e
+    for i in range(n):
+        for j in range(n):
+            P[i, j] *= D[i] * D[j]
+        q[i] *= D[i]
+    for i in range(m):
+        for j in range(n):
+            A[i, j] *= E[i] * D[j]
+        b[i] *= E[i]
     mean_col = 0.0
     for i in range(n):
         norm = 0.0
