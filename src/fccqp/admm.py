@@ -15,8 +15,9 @@ Unlike the paper, rho touches the constrained entries only: a free variable gets
 penalty (sigma is a 1e-6 proximal regularization). The first x of a run is not
 relaxed, because the start (a warm start after ``b`` changed, say) may violate the
 equalities; from then on every ``x_k`` is a combination of KKT solutions for the same
-``b``, so ``A x = b`` holds at every iterate. Everything here works on the
-scaled problem (see :mod:`fccqp.scaling`); residuals and tolerances are unscaled.
+``b``, so ``A x = b`` holds at every iterate. After each step, safeguarded Anderson
+acceleration may extrapolate ``(z, y)`` (see :func:`_anderson`). Everything here works
+on the scaled problem (see :mod:`fccqp.scaling`); residuals and tolerances are unscaled.
 """
 
 import time
@@ -333,7 +334,7 @@ def _equality_qp_start(p, w, sigma):
 
 
 @njit(cache=True)
-def _update_rho(p, w, rho, prim_s, dual_s, prim_scale_s, dual_scale_s, tolerance):
+def _update_rho(rho, prim_s, dual_s, prim_scale_s, dual_scale_s, tolerance):
     """OSQP's rule: rho *= sqrt(relative primal / relative dual residual), clipped."""
     ratio = (prim_s / max(prim_scale_s, 1e-30)) / max(dual_s / max(dual_scale_s, 1e-30), 1e-30)
     new_rho = min(max(rho * np.sqrt(ratio), RHO_MIN), RHO_MAX)
@@ -499,8 +500,7 @@ def run(p, w, prm):
                     status = TIME_LIMIT
             elif adapt:
                 new_rho = _update_rho(
-                    p, w, rho, prim_s, dual_s, prim_scale_s, dual_scale_s,
-                    prm.adaptive_rho_tolerance,
+                    rho, prim_s, dual_s, prim_scale_s, dual_scale_s, prm.adaptive_rho_tolerance
                 )
                 if new_rho != rho:
                     rho = new_rho

@@ -36,7 +36,8 @@ class Result:
     iterations: int
     """ADMM iterations performed."""
     prim_res: float
-    """Primal residual ``max(||Ax - b||, ||x - P_C(x)||)`` in the infinity norm."""
+    """Primal residual ``max(||Ax - b||, ||x_S - z||)`` (infinity norm), ``z`` the ADMM
+    slack in the box and cones; it bounds the entrywise violation of the box and cones."""
     dual_res: float
     """Dual residual ``||Px + q + A'y + z||`` in the infinity norm."""
     setup_time: float

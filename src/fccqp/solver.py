@@ -15,8 +15,16 @@ from fccqp.projections import project_constraint_set
 from fccqp.result import Result
 from fccqp.scaling import equilibrate
 from fccqp.settings import Settings
-from fccqp.status import STATUS_BY_CODE, Status
+from fccqp.status import Status
 
+_STATUS_BY_CODE = {
+    admm.SOLVED: Status.SOLVED,
+    admm.SOLVED_INACCURATE: Status.SOLVED_INACCURATE,
+    admm.MAX_ITER: Status.MAX_ITER_REACHED,
+    admm.TIME_LIMIT: Status.TIME_LIMIT_REACHED,
+    admm.PRIMAL_INFEASIBLE: Status.PRIMAL_INFEASIBLE,
+    admm.DUAL_INFEASIBLE: Status.DUAL_INFEASIBLE,
+}
 _LAPACK_BLOCK = 64
 """Work size per row given to dsytrf (its blocked algorithm's block size)."""
 
@@ -210,7 +218,7 @@ class Solver:
                 "P is not positive semidefinite: its smallest eigenvalue is "
                 f"{_smallest_eigenvalue(data.P):.3g}"
             )
-        status = STATUS_BY_CODE[code]
+        status = _STATUS_BY_CODE[code]
         x, y, z = self._unscale(scaled, w)
         certificate = self._certificate(scaled, w, status)
         self._previous = _Previous(data, scaled, rho, x, y, z)

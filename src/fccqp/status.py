@@ -30,14 +30,3 @@ class Status(Enum):
         """True when a primal or dual infeasibility certificate was found."""
         return self in (Status.PRIMAL_INFEASIBLE, Status.DUAL_INFEASIBLE)
 
-
-# Codes the numba kernels return; STATUS_BY_CODE maps them back.
-RUNNING = 0
-STATUS_BY_CODE = {
-    1: Status.SOLVED,
-    2: Status.SOLVED_INACCURATE,
-    3: Status.MAX_ITER_REACHED,
-    4: Status.TIME_LIMIT_REACHED,
-    5: Status.PRIMAL_INFEASIBLE,
-    6: Status.DUAL_INFEASIBLE,
-}
