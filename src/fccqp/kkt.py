@@ -82,10 +82,12 @@ def factor(K, ipiv, work):
 
 @njit(cache=True)
 def _solve_factored(K, ipiv, rhs):
+    """Solve in place for one right-hand side (a vector) or several (a Fortran matrix)."""
     size = np.array([K.shape[0]], dtype=np.int32)
     info = np.zeros(1, dtype=np.int32)
+    columns = 1 if rhs.ndim == 1 else rhs.shape[1]
     dsytrs(
-        np.array([_LOWER], dtype=np.uint8), size, np.array([1], dtype=np.int32),
+        np.array([_LOWER], dtype=np.uint8), size, np.array([columns], dtype=np.int32),
         K, size, ipiv, rhs, size, info,
     )
 
@@ -122,3 +124,43 @@ def solve_refined(K, ipiv, P, A, row_scale, sigma, constrained, rho_vec, rhs, so
         _solve_factored(K, ipiv, residual)
         sol += residual
     return MAX_REFINE
+
+
+@njit(cache=True)
+def solve_unit_columns(K, ipiv, P, A, row_scale, constrained, rho_vec, W):
+    """Fill ``W`` (Fortran, ``(n + m) x s``) with the KKT solutions for ``[e_S(j); 0]``.
+
+    Column ``j`` is the response of ``(x, nu)`` to a unit right-hand side on the
+    constrained entry ``constrained[j]``; the KKT matrix is taken with ``sigma = 0``.
+    Refined like :func:`solve_refined`, all columns at once; returns False when the
+    equality part does not reach ``REFINE_TOLERANCE`` (then the caller falls back).
+    """
+    n = P.shape[0]
+    s = constrained.shape[0]
+    W[:, :] = 0.0
+    for j in range(s):
+        W[constrained[j], j] = 1.0
+    _solve_factored(K, ipiv, W)
+    if A.shape[0] == 0:
+        return True
+    A_norm = np.max(np.abs(A))
+    for _ in range(MAX_REFINE + 1):
+        Wx = np.ascontiguousarray(W[:n])
+        AW = A @ Wx
+        error = 0.0
+        for i in range(AW.shape[0]):
+            for j in range(s):
+                error = max(error, abs(AW[i, j]) / row_scale[i])
+        size = A_norm * np.max(np.abs(Wx)) / np.min(row_scale)
+        if error <= REFINE_TOLERANCE * max(1.0, size):
+            return True
+        residual = np.zeros((s, W.shape[0])).T  # Fortran order, as dsytrs wants
+        residual[:n] = -(P @ Wx) - A.T @ np.ascontiguousarray(W[n:])
+        for j in range(s):
+            residual[constrained[j], j] += 1.0
+            for k in range(s):
+                residual[constrained[k], j] -= rho_vec[k] * Wx[constrained[k], j]
+        residual[n:] = -AW
+        _solve_factored(K, ipiv, residual)
+        W += residual
+    return False

@@ -80,7 +80,9 @@ def _workspace(data: ProblemData, log_rows: int, memory: int) -> admm.Workspace:
         relaxed=np.zeros(s), log=np.zeros((log_rows, 4)),
         aa_dg=np.zeros((memory, 2 * s)), aa_df=np.zeros((memory, 2 * s)),
         aa_g=np.zeros(2 * s), aa_f=np.zeros(2 * s), aa_plain=np.zeros(2 * s + 1),
-        aa_counts=np.zeros(5, np.int64),
+        aa_counts=np.zeros(5, np.int64), reduced=np.zeros(1, np.int64),
+        W=np.zeros((N, s), order="F"), W_S=np.zeros((s, s)), base=np.zeros(N),
+        v=np.zeros(s), v_prev=np.zeros(s), u=np.zeros(s), u_prev=np.zeros(s),
     )
 
 
