@@ -118,6 +118,20 @@ def test_reuses_factorization_when_matrices_unchanged():
     assert changed.factorizations == 1
 
 
+def test_reuse_after_a_solve_that_needed_no_iteration():
+    """The cold start's equality-only factorization must not be mistaken for rho's."""
+    P, q, A, b, lb, ub, cones = random_problem(7, n_cones=0)
+    solver = fccqp.Solver()
+    boxed = np.isfinite(lb)
+    first = solver.solve(P, q, A, b, np.where(boxed, -100.0, lb), np.where(boxed, 100.0, ub))
+    assert (first.iterations, first.factorizations) == (0, 1)
+    tight = solver.solve(P, q, A, b, lb, ub, cones)  # same structure, active bounds now
+    assert tight.status is Status.SOLVED
+    assert tight.factorizations >= 1
+    reference = clarabel_solve(P, q, A, b, lb, ub, cones)
+    assert abs(tight.obj - reference.obj) <= 1e-4 * (1 + abs(reference.obj))
+
+
 def test_x0_initial_guess():
     problem = random_problem(10)
     reference = clarabel_solve(*problem)

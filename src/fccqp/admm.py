@@ -97,6 +97,7 @@ class Workspace(NamedTuple):
     aa_plain: np.ndarray
     aa_counts: np.ndarray
     reduced: np.ndarray
+    factored_rho: np.ndarray
     W: np.ndarray
     W_S: np.ndarray
     base: np.ndarray
@@ -326,6 +327,7 @@ def _equality_qp_start(p, w, sigma):
     """
     n = p.P.shape[0]
     w.rho_vec[:] = 0.0
+    w.factored_rho[0] = -1.0  # the KKT matrix now holds no rho factorization
     if not _factor_kkt(p, w, sigma):
         return False
     w.x[:] = 0.0
@@ -470,17 +472,19 @@ def _factor_reduced(p, w):
 
 
 @njit(cache=True)
-def _factor(p, w, sigma, max_iter):
+def _factor(p, w, rho, sigma, max_iter):
     """Factor for the current rho, in reduced form when it pays and ``P + R`` allows it.
 
     The reduced form costs ``s`` extra right-hand sides up front and saves one solve
     per iteration, so it is tried when the iteration budget covers that (see
     ``REDUCED_COST``) and the constrained entries are at most half the KKT size. Records
-    the form in ``w.reduced``; returns the number of factorizations, negated when the
-    inertia shows that P is not positive semidefinite.
+    the form in ``w.reduced`` and ``rho`` in ``w.factored_rho`` (what a later solve with
+    the same matrices may reuse); returns the number of factorizations, negated when
+    the inertia shows that P is not positive semidefinite.
     """
     s = p.constrained.shape[0]
     count = 0
+    w.factored_rho[0] = rho
     if 2 * s <= p.P.shape[0] + p.A.shape[0] and REDUCED_COST * s <= max_iter:
         count += 1
         if _factor_reduced(p, w):
@@ -576,7 +580,7 @@ def run(p, w, prm):
     for j in range(s):
         w.rho_vec[j] = rho * w.rho_scale[j]
     if prm.factorize or prm.cold_start:
-        count = _factor(p, w, prm.sigma, prm.max_iter)
+        count = _factor(p, w, rho, prm.sigma, prm.max_iter)
         if count < 0:
             return NOT_CONVEX, 0, rho, prim, dual, factorizations - count
         factorizations += count
@@ -633,7 +637,7 @@ def run(p, w, prm):
                     rho = new_rho
                     for j in range(s):
                         w.rho_vec[j] = rho * w.rho_scale[j]
-                    count = _factor(p, w, prm.sigma, prm.max_iter - iteration)
+                    count = _factor(p, w, rho, prm.sigma, prm.max_iter - iteration)
                     if count < 0:
                         return NOT_CONVEX, iteration, rho, prim, dual, factorizations - count
                     factorizations += count

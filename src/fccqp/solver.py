@@ -81,6 +81,7 @@ def _workspace(data: ProblemData, log_rows: int, memory: int) -> admm.Workspace:
         aa_dg=np.zeros((memory, 2 * s)), aa_df=np.zeros((memory, 2 * s)),
         aa_g=np.zeros(2 * s), aa_f=np.zeros(2 * s), aa_plain=np.zeros(2 * s + 1),
         aa_counts=np.zeros(5, np.int64), reduced=np.zeros(1, np.int64),
+        factored_rho=np.full(1, -1.0),
         W=np.zeros((N, s), order="F"), W_S=np.zeros((s, s)), base=np.zeros(N),
         v=np.zeros(s), v_prev=np.zeros(s), u=np.zeros(s), u_prev=np.zeros(s),
     )
@@ -210,7 +211,7 @@ class Solver:
             adaptive_rho_tolerance=settings.adaptive_rho_tolerance,
             anderson_memory=settings.anderson_memory,
             time_limit=float(settings.time_limit), start_time=start,
-            cold_start=cold, factorize=not (reuse and prev is not None and rho == prev.rho),
+            cold_start=cold, factorize=not (reuse and w.factored_rho[0] == rho),
         )
         setup_time = time.perf_counter() - start
         code, iterations, rho, prim, dual, factorizations = admm.run(scaled, w, params)
