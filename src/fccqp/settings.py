@@ -18,7 +18,7 @@ class Settings:
     rho: float = 0.1
     """Initial ADMM penalty on the box and cone constraints (scaled problem)."""
     sigma: float = 1e-6
-    """Proximal regularization of the x-update; keeps the KKT matrix quasi-definite."""
+    """Proximal regularization of the x-update's full form (unused by the reduced form)."""
     alpha: float = 1.6
     """Over-relaxation parameter, in (0, 2)."""
     eps_abs: float = 1e-5
