@@ -14,7 +14,8 @@ decomposition is needed. The inertia of the factorization certifies that
 eigenvalues.
 
 Contract: :func:`assemble` + :func:`factor` build the factorization for given
-(P, A, sigma, rho); :func:`solve_refined` solves with it.
+(P, A, sigma, rho); :func:`solve_refined` solves with it for one right-hand side,
+:func:`solve_unit_columns` for the unit vectors on the constrained entries.
 """
 
 import numpy as np
@@ -27,7 +28,7 @@ DELTA = 1e-13
 MAX_REFINE = 5
 """Most refinement steps per solve."""
 REFINE_TOLERANCE = 1e-13
-"""Refine while ``||A x - b||`` (unscaled) exceeds this times ``max(1, ||b||, ||A|| ||x||)``."""
+"""Refine while ``||A x - b||`` (unscaled) exceeds this times ``max(1, ||b||, ||A x||)``."""
 
 _LOWER = 76  # ord("L")
 
@@ -94,7 +95,7 @@ def _solve_factored(K, ipiv, rhs):
 
 @njit(cache=True)
 def solve_refined(K, ipiv, P, A, row_scale, sigma, constrained, rho_vec, rhs, sol, residual):
-    """Solve the unregularized KKT system for ``rhs`` into ``sol``; return the steps used.
+    """Solve the unregularized KKT system for ``rhs`` into ``sol``.
 
     ``A`` has equilibrated rows ``E A_user D``; ``row_scale`` is ``E``, so that the
     stopping test measures the user's equality residual ``E^-1 (b - A x)``.
@@ -104,9 +105,9 @@ def solve_refined(K, ipiv, P, A, row_scale, sigma, constrained, rho_vec, rhs, so
     sol[:] = rhs
     _solve_factored(K, ipiv, sol)
     if A.shape[0] == 0:
-        return 0
+        return
     b = rhs[n:]
-    for step in range(MAX_REFINE):
+    for _ in range(MAX_REFINE):
         x = sol[:n]
         nu = sol[n:]
         Ax = A @ x
@@ -115,7 +116,7 @@ def solve_refined(K, ipiv, P, A, row_scale, sigma, constrained, rho_vec, rhs, so
             error = max(error, abs(b[i] - Ax[i]) / row_scale[i])
             size = max(size, abs(b[i]) / row_scale[i], abs(Ax[i]) / row_scale[i])
         if error <= REFINE_TOLERANCE * max(1.0, size):
-            return step
+            return
         eq = b - Ax
         residual[:n] = rhs[:n] - P @ x - sigma * x - A.T @ nu
         for k in range(constrained.shape[0]):
@@ -123,7 +124,6 @@ def solve_refined(K, ipiv, P, A, row_scale, sigma, constrained, rho_vec, rhs, so
         residual[n:] = eq
         _solve_factored(K, ipiv, residual)
         sol += residual
-    return MAX_REFINE
 
 
 @njit(cache=True)
