@@ -124,6 +124,20 @@ def _torque_box(qp: WbcQP) -> tuple[np.ndarray, np.ndarray]:
     return idx, np.stack([qp.lb[idx], qp.ub[idx]])
 
 
+def fccqp_arguments(qp: WbcQP) -> tuple[Any, ...]:
+    """``(P, q, A, b, lb, ub, cones)`` for ``fccqp.Solver.solve``: exact friction cones."""
+    import fccqp
+
+    flat = np.array([0.0, 0.0, 1.0])
+    cones = tuple(
+        fccqp.FrictionCone(
+            int(s), float(mu), None if np.allclose(n, flat) else tuple(map(float, n))
+        )
+        for s, mu, n in zip(qp.cone_starts, qp.mus, qp.normals, strict=True)
+    )
+    return (qp.P, qp.q, qp.A, qp.b, qp.lb, qp.ub, cones)
+
+
 class FccqpAdapter(Adapter):
     """fccqp with exact friction cones, warm started across a sequence."""
 
@@ -135,18 +149,10 @@ class FccqpAdapter(Adapter):
 
         self.name = name
         settings = fccqp.Settings.realtime() if realtime else fccqp.Settings()
-        self._fccqp = fccqp
         self._solver = fccqp.Solver(settings)
 
     def prepare(self, qp: WbcQP) -> tuple[Any, ...]:
-        flat = np.array([0.0, 0.0, 1.0])
-        cones = tuple(
-            self._fccqp.FrictionCone(
-                int(s), float(mu), None if np.allclose(n, flat) else tuple(map(float, n))
-            )
-            for s, mu, n in zip(qp.cone_starts, qp.mus, qp.normals, strict=True)
-        )
-        return (qp.P, qp.q, qp.A, qp.b, qp.lb, qp.ub, cones)
+        return fccqp_arguments(qp)
 
     def solve(self, data: tuple[Any, ...]) -> SolveOutcome:
         start = time.perf_counter()

@@ -1,7 +1,8 @@
 """LAPACK routines callable from numba ``nopython`` code, with ``cache=True``.
 
 numba's own ``np.linalg`` has no symmetric-indefinite (Bunch-Kaufman) factorization,
-which the KKT system of the x-update needs. We take the routines from
+which the KKT system of the x-update needs, and its Cholesky raises on a matrix that
+is not positive definite where the caller wants to fall back. We take the routines from
 ``scipy.linalg.cython_lapack`` and register their addresses with LLVM under our own
 symbol names; the compiled kernels call those names, so cached machine code stays
 valid in a new process (a raw function pointer would be baked into the cache).
@@ -16,7 +17,7 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import get_cython_function_address, intrinsic
 
-_ROUTINES = ("dsytrf", "dsytrs")
+_ROUTINES = ("dsytrf", "dsytrs", "dpotrf", "dpotrs")
 
 for _name in _ROUTINES:
     llvm.add_symbol(
@@ -55,4 +56,18 @@ def dsytrs(typingctx, uplo, n, nrhs, a, lda, ipiv, b, ldb, info):
     """Solve ``A X = B`` with the factors computed by :func:`dsytrf`."""
     return types.void(uplo, n, nrhs, a, lda, ipiv, b, ldb, info), _call_by_reference(
         "fccqp_dsytrs"
+    )
+
+
+@intrinsic
+def dpotrf(typingctx, uplo, n, a, lda, info):
+    """Cholesky factorization ``A = L L'`` of a symmetric positive definite matrix."""
+    return types.void(uplo, n, a, lda, info), _call_by_reference("fccqp_dpotrf")
+
+
+@intrinsic
+def dpotrs(typingctx, uplo, n, nrhs, a, lda, b, ldb, info):
+    """Solve ``A X = B`` with the factor computed by :func:`dpotrf`."""
+    return types.void(uplo, n, nrhs, a, lda, b, ldb, info), _call_by_reference(
+        "fccqp_dpotrs"
     )

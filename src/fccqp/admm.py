@@ -26,7 +26,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, objmode
 
-from fccqp import kkt
+from fccqp import kkt, restoration
 from fccqp.projections import project_cone_block, project_constraint_set
 
 SOLVED, SOLVED_INACCURATE, MAX_ITER, TIME_LIMIT, PRIMAL_INFEASIBLE, DUAL_INFEASIBLE = range(1, 7)
@@ -48,6 +48,10 @@ FIXED_RHO_SCALE = 1e3
 """rho multiplier on entries with lb == ub, which act as equalities (as in OSQP)."""
 EQUALITY_START_STEPS = 3
 """Proximal steps of the cold start's equality-constrained QP (see _equality_qp_start)."""
+RESTORED_EQUALITY = 1e-9
+"""A restored point is kept only if its equality residual is below this times the
+residual's scale (refinement aims at 1e-13): otherwise the free entries could not
+absorb ``x_S = z``."""
 EQUALITY_START_LIMIT = 1e-3
 """Cold start falls back to the origin when sigma * ||x_eq|| exceeds this * max(1, ||q||):
 the equality-constrained QP is then unbounded but for sigma, and its solution useless."""
@@ -127,6 +131,7 @@ class Params(NamedTuple):
     start_time: float
     cold_start: bool
     factorize: bool
+    restore_feasibility: bool
 
 
 @njit(cache=True)
@@ -555,6 +560,51 @@ def _restore_equalities(p, w):
 
 
 @njit(cache=True)
+def _budget_status(prim, dual, eps_p, eps_d, out_of_iterations):
+    """Status of an iterate that stopped on a budget without meeting the tolerances."""
+    if prim <= INACCURATE_FACTOR * eps_p and dual <= INACCURATE_FACTOR * eps_d:
+        return SOLVED_INACCURATE
+    return MAX_ITER if out_of_iterations else TIME_LIMIT
+
+
+@njit(cache=True)
+def _keep_restored(p, w, prm, reduced, status, iteration, prim, dual):
+    """Replace the final iterate by its feasibility restoration (see :mod:`fccqp.restoration`).
+
+    The restored point is in the box and the cones exactly; its status comes from its
+    own residuals. It is kept when its equality residual shows that the free entries
+    absorbed ``x_S = z`` (``RESTORED_EQUALITY``) and, if the iterate was solved, when it
+    is solved too. Returns ``(status, prim, dual)`` of the point left in ``w``, whose
+    equalities hold to factorization accuracy in either case.
+    """
+    x, nu = w.x.copy(), w.nu.copy()
+    if reduced:
+        restored = restoration.restore_reduced(p, w)
+        if restored:
+            _restore_equalities(p, w)
+    else:
+        restored = restoration.restore(p, w, prm.sigma)
+    if restored:
+        new_prim, new_dual, prim_scale, dual_scale = residuals(p, w)[:4]
+        eps_p = prm.eps_abs + prm.eps_rel * prim_scale
+        eps_d = prm.eps_abs + prm.eps_rel * dual_scale
+        if new_prim <= eps_p and new_dual <= eps_d:
+            new_status = SOLVED
+        else:
+            new_status = _budget_status(
+                new_prim, new_dual, eps_p, eps_d, iteration >= prm.max_iter
+            )
+        exact = new_prim <= RESTORED_EQUALITY * max(1.0, prim_scale)
+        if exact and (status != SOLVED or new_status == SOLVED):
+            return new_status, new_prim, new_dual
+    w.x[:] = x
+    w.nu[:] = nu
+    if reduced:
+        _restore_equalities(p, w)
+    return status, prim, dual
+
+
+@njit(cache=True)
 def run(p, w, prm):
     """Run ADMM from the iterate in ``w`` (or a cold start); return a summary tuple.
 
@@ -623,12 +673,7 @@ def run(p, w, prm):
             elif is_dual_infeasible(p, w, prm.eps_dual_inf):
                 status = DUAL_INFEASIBLE
             elif last:
-                if prim <= INACCURATE_FACTOR * eps_p and dual <= INACCURATE_FACTOR * eps_d:
-                    status = SOLVED_INACCURATE
-                elif iteration >= prm.max_iter:
-                    status = MAX_ITER
-                else:
-                    status = TIME_LIMIT
+                status = _budget_status(prim, dual, eps_p, eps_d, iteration >= prm.max_iter)
             elif adapt:
                 new_rho = _update_rho(
                     rho, prim_s, dual_s, prim_scale_s, dual_scale_s, prm.adaptive_rho_tolerance
@@ -648,6 +693,9 @@ def run(p, w, prm):
                     w.aa_counts[:3] = 0
         if status == 0 and prm.anderson_memory > 0:
             _anderson(w, prm.anderson_memory)
-    if reduced:
+    if prm.restore_feasibility and status <= TIME_LIMIT:
+        status, prim, dual = _keep_restored(p, w, prm, reduced, status, iteration, prim, dual)
+        factorizations += 0 if reduced else 1
+    elif reduced:
         _restore_equalities(p, w)
     return status, iteration, rho, prim, dual, factorizations

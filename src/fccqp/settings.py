@@ -45,6 +45,10 @@ class Settings:
     """Anderson acceleration memory (0 disables); safeguarded, see fccqp.admm._anderson."""
     scaling: int = 10
     """Ruiz equilibration iterations (0 disables scaling)."""
+    restore_feasibility: bool = True
+    """Return a point exactly in the box and the cones: the constrained entries take
+    their projection ``z`` and the free ones are re-solved with the equalities (one
+    factorization of the free entries' KKT matrix); see :mod:`fccqp.restoration`."""
     warm_start: bool = True
     """Start from the previous solution (used by :class:`fccqp.Solver`)."""
     verbose: bool = False
@@ -82,7 +86,7 @@ class Settings:
             minimum = 0 if name in ("scaling", "anderson_memory") else 1
             if value < minimum:
                 raise ValueError(f"setting {name} must be >= {minimum}, got {value}")
-        for name in ("adaptive_rho", "warm_start", "verbose"):
+        for name in ("adaptive_rho", "restore_feasibility", "warm_start", "verbose"):
             if not isinstance(getattr(self, name), bool):
                 raise TypeError(f"setting {name} must be a bool, got {getattr(self, name)!r}")
 

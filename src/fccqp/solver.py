@@ -212,6 +212,7 @@ class Solver:
             anderson_memory=settings.anderson_memory,
             time_limit=float(settings.time_limit), start_time=start,
             cold_start=cold, factorize=not (reuse and w.factored_rho[0] == rho),
+            restore_feasibility=settings.restore_feasibility,
         )
         setup_time = time.perf_counter() - start
         code, iterations, rho, prim, dual, factorizations = admm.run(scaled, w, params)

@@ -1,0 +1,75 @@
+"""Feasibility restoration: a budget-stopped solve returns a point in the box and cones."""
+
+import numpy as np
+import pytest
+
+import fccqp
+from fccqp import Status
+from problems import random_problem
+from reference import cone_distance, kkt_violation
+
+
+def _infeasibility(problem, x):
+    P, q, A, b, lb, ub, cones = problem
+    box = float(np.max(np.maximum(lb - x, 0) + np.maximum(x - ub, 0)))
+    return max(box, cone_distance(x, cones, x.shape[0]))
+
+
+# max_iter 3 is below the reduced form's break-even (s / 2 = 7.5 for 15 constrained
+# entries), so it exercises the full form; 10 the reduced one.
+@pytest.mark.parametrize(("budget", "reduced"), [(3, 0), (10, 1)])
+def test_budget_stopped_solve_is_exactly_feasible(budget, reduced):
+    settings = dict(max_iter=budget, eps_abs=1e-10, eps_rel=0.0)
+    unrestored = []
+    for seed in range(4):
+        problem = P, q, A, b, lb, ub, cones = random_problem(seed)
+        solver = fccqp.Solver(**settings)
+        result = solver.solve(*problem)
+        assert solver._workspace.reduced[0] == reduced
+        assert result.status is Status.MAX_ITER_REACHED
+        assert _infeasibility(problem, result.x) <= 1e-12
+        assert np.abs(A @ result.x - b).max() <= 1e-10 * (1 + np.abs(b).max())
+        # the free entries are optimal for the constrained ones (z vanishes there)
+        free = ~(np.isfinite(lb) | np.isfinite(ub))
+        free[: 3 * len(cones)] = False
+        stationarity = P @ result.x + q + A.T @ result.y + result.z
+        assert np.abs(stationarity[free]).max() <= 1e-9 * (1 + np.abs(q).max())
+        # the reported residuals are those of the returned point
+        violation = kkt_violation(*problem, result)
+        assert violation["stationarity"] <= result.dual_res * (1 + 1e-6)
+        plain = fccqp.solve(*problem, restore_feasibility=False, **settings)
+        unrestored.append(_infeasibility(problem, plain.x))
+    assert max(unrestored) > 1e-3  # without restoration the same iterates are infeasible
+
+
+def test_restoration_that_cannot_meet_the_equalities_is_dropped():
+    # every entry is bounded and sum(x) = 1 ties them: x_S = z breaks the equality
+    P, q = np.eye(3), np.array([1.0, -2.0, 0.5])
+    A, b = np.ones((1, 3)), np.array([1.0])
+    lb, ub = np.zeros(3), np.full(3, 0.8)
+    problem = (P, q, A, b, lb, ub)
+    kept = fccqp.solve(*problem, max_iter=2, eps_abs=1e-12, eps_rel=0.0)
+    plain = fccqp.solve(*problem, max_iter=2, eps_abs=1e-12, eps_rel=0.0,
+                        restore_feasibility=False)
+    np.testing.assert_array_equal(kept.x, plain.x)
+    assert kept.status is plain.status is Status.MAX_ITER_REACHED
+    assert abs(A @ kept.x - b).max() <= 1e-12
+
+
+def test_solved_answers_stay_solved_with_true_residuals():
+    for seed in range(4):
+        problem = random_problem(seed, soc_dim=4 if seed % 2 else 0)
+        result = fccqp.solve(*problem)
+        assert result.status is Status.SOLVED
+        violation = kkt_violation(*problem, result)
+        assert max(violation["box"], violation["cone"]) <= np.sqrt(3) * result.prim_res
+        assert violation["stationarity"] <= result.dual_res * (1 + 1e-6)
+
+
+def test_infeasible_problem_is_not_restored():
+    P, q, A, b, lb, ub, cones = random_problem(0, n_cones=0)
+    lb[5:8], ub[5:8] = 1.0, 2.0
+    A = np.vstack([A, np.eye(30)[5]])
+    b = np.append(b, -1.0)  # x5 = -1 against lb 1
+    result = fccqp.solve(P, q, A, b, lb, ub, cones)
+    assert result.status is Status.PRIMAL_INFEASIBLE
