@@ -14,12 +14,16 @@ Scenarios (:data:`SCENARIOS`):
 ``aggressive``
     All feet down, large fast CoM and base-orientation sinusoids.
 ``low_friction``
-    Friction coefficient drawn in [0.2, 1.0], moderate CoM motion and one push.
+    Friction coefficient drawn in [0.2, 1.0], CoM motion peaking at 0.7-1.4 ``mu g`` and
+    one push.
 ``contact_switch``
     Quadrupeds: a trot in place (diagonal pairs alternate) or one foot lifted then put
     down again. Humanoid: single support on the left foot then double support. Before a
     foot lifts the CoM is shifted over the remaining support during an unrecorded
-    pre-roll.
+    pre-roll. The CoM sways as hard as in ``low_friction``.
+
+Sinusoid frequencies follow Froude scaling (see :func:`_froude_scaled`), so a scenario
+is the same motion, in units of the robot's size, on every robot.
 """
 
 from __future__ import annotations
@@ -38,6 +42,7 @@ __all__ = ["SCENARIOS", "Gains", "Phase", "SequenceSpec", "make_sequence", "roll
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 _GRAVITY = 9.81
 _COM_CAP = np.array([0.15, 0.15, 0.05])  # CoM sinusoid amplitude caps, in base heights
+_REF_HEIGHT = 0.5  # base height (m) the sinusoid frequency ranges are given for
 
 
 @dataclass(frozen=True)
@@ -128,6 +133,19 @@ def _random_sinusoids(
     )
 
 
+def _froude_scaled(freq: tuple[float, float], height: float) -> tuple[float, float]:
+    """Frequency range ``freq`` (Hz for a 0.5 m base height) for a base ``height`` m high.
+
+    Dynamically similar motions of robots of different sizes have their times in
+    proportion to ``sqrt(height / g)`` (Froude scaling), so frequencies go as
+    ``sqrt(0.5 / height)``. The CoM amplitudes are capped in units of the height, so at
+    one frequency for all robots the caps would cut the drawn accelerations of small
+    robots only (solo12's aggressive sway lost up to half its drawn acceleration).
+    """
+    k = np.sqrt(_REF_HEIGHT / height)
+    return freq[0] * k, freq[1] * k
+
+
 def _foot_xy(robot: LoadedRobot) -> dict[str, np.ndarray]:
     """Horizontal position of each foot at the starting posture."""
     data = robot.model.createData()
@@ -179,7 +197,8 @@ def make_sequence(
     ``mu g``, the most friction can give, vertical in units of ``g`` -- so that one
     definition stresses the cones of a 2.5 kg quadruped and of a 90 kg humanoid alike;
     amplitudes are capped at ``0.15 L`` horizontally and ``0.05 L`` vertically, ``L``
-    being the standing base height. Push speeds are also in units of ``mu g`` (s).
+    being the standing base height, and frequencies are Froude-scaled from ``L`` so that
+    the caps bind alike on every robot. Push speeds are also in units of ``mu g`` (s).
     """
     if scenario not in SCENARIOS:
         raise ValueError(f"unknown scenario {scenario!r}; known: {sorted(SCENARIOS)}")
@@ -203,8 +222,9 @@ def make_sequence(
     elif scenario == "contact_switch":
         phases = _contact_phases(robot, rng, n_ticks, dt)
         mu = float(rng.uniform(0.3, 0.7))
-        com_lo, com_hi = np.array([0.5, 0.5, 0.02]), np.array([1.0, 1.0, 0.05])
+        com_lo, com_hi = np.array([0.7, 0.7, 0.02]), np.array([1.4, 1.4, 0.05])
         com_f = (1.5, 2.5)
+    com_f, base_f = _froude_scaled(com_f, L), _froude_scaled(base_f, L)
     scale = np.array([mu * _GRAVITY, mu * _GRAVITY, _GRAVITY])
     acc, com_freq, com_phase = _random_sinusoids(rng, com_lo * scale, com_hi * scale, com_f)
     com_amp = np.clip(acc / (2 * np.pi * com_freq) ** 2, -L * _COM_CAP, L * _COM_CAP)
