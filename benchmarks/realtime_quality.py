@@ -7,7 +7,9 @@ feasibility restoration, warm along the controller-loop sequences and cold (ever
 from scratch). It prints, per variant, the largest exact friction-cone violation
 [N], torque-limit violation [Nm] and equality residual, the torque error against the
 test set's Clarabel reference (median and p95 over QPs of the largest joint error,
-[Nm]), the share of QPs reported solved, and the median solve time. Times are
+[Nm]), the p95 of the cost excess over the reference (relative to ``max(1, |cost|)``;
+negative when the answer is infeasible and cheaper), the share of QPs reported solved,
+and the median solve time. Times are
 medians over ``K`` passes that alternate the variants, so the restoration's cost is a
 same-run ratio.
 """
@@ -36,6 +38,7 @@ class Quality:
     equality: float
     torque_error_median: float
     torque_error_p95: float
+    cost_excess_p95: float
     solved: float
 
 
@@ -59,6 +62,10 @@ def _quality(test_set: TestSet, results: list) -> Quality:
         float(np.max(np.abs(r.x[qp.layout["u"]] - x_ref[qp.layout["u"]])))
         for qp, x_ref, r in zip(test_set.qps, test_set.x_ref, results, strict=True)
     ]
+    excess = [
+        (qp.objective(r.x) - qp.objective(x_ref)) / max(1.0, abs(qp.objective(x_ref)))
+        for qp, x_ref, r in zip(test_set.qps, test_set.x_ref, results, strict=True)
+    ]
     return Quality(
         cone=max(qp.cone_violation(r.x) for qp, r in zip(test_set.qps, results, strict=True)),
         torque_limit=max(
@@ -69,6 +76,7 @@ def _quality(test_set: TestSet, results: list) -> Quality:
         ),
         torque_error_median=float(np.median(errors)),
         torque_error_p95=float(np.percentile(errors, 95)),
+        cost_excess_p95=float(np.percentile(excess, 95)),
         solved=sum(r.status.is_solved() for r in results) / len(results),
     )
 
@@ -83,8 +91,9 @@ def main() -> None:
     if options.qps < 1 or options.passes < 1:
         parser.error("--qps and --passes must be >= 1")
     print("| robot | start | restoration | cone viol. [N] | torque-limit viol. [Nm] "
-          "| equality res. | torque err. median / p95 [Nm] | solved | median time [us] |")
-    print("|---|---|---|---|---|---|---|---|---|")
+          "| equality res. | torque err. median / p95 [Nm] | cost excess p95 | solved "
+          "| median time [us] |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for robot in options.robots:
         test_set = generate_test_set(robot, "mix", options.qps, 0)
         arguments = [fccqp_arguments(qp) for qp in test_set.qps]
@@ -102,6 +111,7 @@ def main() -> None:
                     f"| {robot} | {'cold' if cold else 'warm'} | {'on' if restore else 'off'} "
                     f"| {q.cone:.2g} | {q.torque_limit:.2g} | {q.equality:.1g} "
                     f"| {q.torque_error_median:.2g} / {q.torque_error_p95:.2g} "
+                    f"| {q.cost_excess_p95:.2g} "
                     f"| {100 * q.solved:.0f} % "
                     f"| {1e6 * statistics.median(medians[restore]):.0f} |"
                 )

@@ -29,16 +29,16 @@ def test_budget_stopped_solve_is_exactly_feasible(budget, reduced):
         assert result.status is Status.MAX_ITER_REACHED
         assert _infeasibility(problem, result.x) <= 1e-12
         assert np.abs(A @ result.x - b).max() <= 1e-10 * (1 + np.abs(b).max())
-        # the free entries are optimal for the constrained ones (z vanishes there)
-        free = ~(np.isfinite(lb) | np.isfinite(ub))
-        free[: 3 * len(cones)] = False
-        stationarity = P @ result.x + q + A.T @ result.y + result.z
-        assert np.abs(stationarity[free]).max() <= 1e-9 * (1 + np.abs(q).max())
         # the reported residuals are those of the returned point
         violation = kkt_violation(*problem, result)
         assert violation["stationarity"] <= result.dual_res * (1 + 1e-6)
+        # entries that violated in the plain iterate are pinned at their projection
         plain = fccqp.solve(*problem, restore_feasibility=False, **settings)
         unrestored.append(_infeasibility(problem, plain.x))
+        box = np.isfinite(lb) | np.isfinite(ub)
+        clipped = np.clip(plain.x, lb, ub)
+        moved = box & (clipped != plain.x)
+        np.testing.assert_allclose(result.x[moved], clipped[moved], rtol=1e-9, atol=1e-12)
     assert max(unrestored) > 1e-3  # without restoration the same iterates are infeasible
 
 

@@ -48,10 +48,10 @@ FIXED_RHO_SCALE = 1e3
 """rho multiplier on entries with lb == ub, which act as equalities (as in OSQP)."""
 EQUALITY_START_STEPS = 3
 """Proximal steps of the cold start's equality-constrained QP (see _equality_qp_start)."""
-RESTORED_EQUALITY = 1e-9
-"""A restored point is kept only if its equality residual is below this times the
-residual's scale (refinement aims at 1e-13): otherwise the free entries could not
-absorb ``x_S = z``."""
+RESTORED_EQUALITY = 1e-7
+"""A restored point is kept only if its primal residual is below this times its scale:
+otherwise the other entries could not absorb the pinning. Refinement aims at 1e-13, but
+an ill-conditioned ``W_TT`` (condition 1e8 on solo12) costs digits."""
 EQUALITY_START_LIMIT = 1e-3
 """Cold start falls back to the origin when sigma * ||x_eq|| exceeds this * max(1, ||q||):
 the equality-constrained QP is then unbounded but for sigma, and its solution useless."""
@@ -469,7 +469,9 @@ def _factor_reduced(p, w):
     """
     if not _factor_kkt(p, w, 0.0):
         return False
-    if not kkt.solve_unit_columns(w.K, w.ipiv, p.P, p.A, p.E, p.constrained, w.rho_vec, w.W):
+    if not kkt.solve_unit_columns(
+        w.K, w.ipiv, p.P, p.A, p.E, 0.0, p.constrained, w.rho_vec, p.constrained, w.W
+    ):
         return False
     for j in range(p.constrained.shape[0]):
         w.W_S[j] = w.W[p.constrained[j]]
@@ -544,19 +546,22 @@ def _materialize(p, w):
 
 
 @njit(cache=True)
-def _restore_equalities(p, w):
-    """Remove the rounding that ``x = base + W u`` accumulates in ``A x = b``.
+def _restore_equalities(p, w, sigma):
+    """Remove the rounding that a combination of KKT solutions (``x = base + W u`` in
+    the reduced form, a restoration) accumulates in ``A x = b``.
 
-    One refined KKT solve for ``(0, b - A x)``: the returned ``x`` then satisfies the
-    equalities to factorization accuracy, as in the full form.
+    One refined KKT solve for ``(0, b - A x)`` with the current factorization (``sigma``
+    as factored): the returned ``x`` then satisfies the equalities to factorization
+    accuracy.
     """
     n = p.P.shape[0]
     if p.A.shape[0] == 0:
         return
     w.rhs[:n] = 0.0
     w.rhs[n:] = p.b - p.A @ w.x
-    _solve_x(p, w, 0.0)
+    _solve_x(p, w, sigma)
     w.x[:] += w.sol[:n]
+    w.nu[:] += w.sol[n:]
 
 
 @njit(cache=True)
@@ -571,20 +576,19 @@ def _budget_status(prim, dual, eps_p, eps_d, out_of_iterations):
 def _keep_restored(p, w, prm, reduced, status, iteration, prim, dual):
     """Replace the final iterate by its feasibility restoration (see :mod:`fccqp.restoration`).
 
-    The restored point is in the box and the cones exactly; its status comes from its
-    own residuals. It is kept when its equality residual shows that the free entries
-    absorbed ``x_S = z`` (``RESTORED_EQUALITY``) and, if the iterate was solved, when it
-    is solved too. Returns ``(status, prim, dual)`` of the point left in ``w``, whose
-    equalities hold to factorization accuracy in either case.
+    The restored point has its violating constrained entries pinned at their projection
+    onto the box and the cones; its status comes from its own residuals, with the slack
+    ``z`` set to its (feasible) ``x_S``. It is kept when its primal residual shows that
+    the other entries absorbed the pinning (``RESTORED_EQUALITY``) and, if the iterate
+    was solved, when it is solved too. Returns ``(status, prim, dual)`` of the point left
+    in ``w``, whose equalities hold to factorization accuracy in either case.
     """
-    x, nu = w.x.copy(), w.nu.copy()
-    if reduced:
-        restored = restoration.restore_reduced(p, w)
-        if restored:
-            _restore_equalities(p, w)
-    else:
-        restored = restoration.restore(p, w, prm.sigma)
-    if restored:
+    x, nu, z = w.x.copy(), w.nu.copy(), w.z.copy()
+    if restoration.restore(p, w, prm.sigma, reduced):
+        _restore_equalities(p, w, 0.0 if reduced else prm.sigma)
+        for j in range(z.shape[0]):
+            w.z[j] = w.x[p.constrained[j]]
+        project_constraint_set(w.z, p.lo, p.hi, p.cones, w.z)
         new_prim, new_dual, prim_scale, dual_scale = residuals(p, w)[:4]
         eps_p = prm.eps_abs + prm.eps_rel * prim_scale
         eps_d = prm.eps_abs + prm.eps_rel * dual_scale
@@ -599,8 +603,9 @@ def _keep_restored(p, w, prm, reduced, status, iteration, prim, dual):
             return new_status, new_prim, new_dual
     w.x[:] = x
     w.nu[:] = nu
+    w.z[:] = z
     if reduced:
-        _restore_equalities(p, w)
+        _restore_equalities(p, w, 0.0)
     return status, prim, dual
 
 
@@ -695,7 +700,6 @@ def run(p, w, prm):
             _anderson(w, prm.anderson_memory)
     if prm.restore_feasibility and status <= TIME_LIMIT:
         status, prim, dual = _keep_restored(p, w, prm, reduced, status, iteration, prim, dual)
-        factorizations += 0 if reduced else 1
     elif reduced:
-        _restore_equalities(p, w)
+        _restore_equalities(p, w, 0.0)
     return status, iteration, rho, prim, dual, factorizations

@@ -15,7 +15,7 @@ eigenvalues.
 
 Contract: :func:`assemble` + :func:`factor` build the factorization for given
 (P, A, sigma, rho); :func:`solve_refined` solves with it for one right-hand side,
-:func:`solve_unit_columns` for the unit vectors on the constrained entries.
+:func:`solve_unit_columns` for unit vectors on chosen entries of ``x``.
 """
 
 import numpy as np
@@ -127,19 +127,19 @@ def solve_refined(K, ipiv, P, A, row_scale, sigma, constrained, rho_vec, rhs, so
 
 
 @njit(cache=True)
-def solve_unit_columns(K, ipiv, P, A, row_scale, constrained, rho_vec, W):
-    """Fill ``W`` (Fortran, ``(n + m) x s``) with the KKT solutions for ``[e_S(j); 0]``.
+def solve_unit_columns(K, ipiv, P, A, row_scale, sigma, constrained, rho_vec, entries, W):
+    """Fill ``W`` (Fortran, ``(n + m) x len(entries)``) with the KKT solutions for ``[e_i; 0]``.
 
-    Column ``j`` is the response of ``(x, nu)`` to a unit right-hand side on the
-    constrained entry ``constrained[j]``; the KKT matrix is taken with ``sigma = 0``.
-    Refined like :func:`solve_refined`, all columns at once; returns False when the
-    equality part does not reach ``REFINE_TOLERANCE`` (then the caller falls back).
+    Column ``j`` is the response of ``(x, nu)`` to a unit right-hand side on entry
+    ``entries[j]`` of ``x``. Refined like :func:`solve_refined`, all columns at once;
+    returns False when the equality part does not reach ``REFINE_TOLERANCE`` (then the
+    caller falls back).
     """
     n = P.shape[0]
-    s = constrained.shape[0]
+    s = entries.shape[0]
     W[:, :] = 0.0
     for j in range(s):
-        W[constrained[j], j] = 1.0
+        W[entries[j], j] = 1.0
     _solve_factored(K, ipiv, W)
     if A.shape[0] == 0:
         return True
@@ -155,10 +155,10 @@ def solve_unit_columns(K, ipiv, P, A, row_scale, constrained, rho_vec, W):
         if error <= REFINE_TOLERANCE * max(1.0, size):
             return True
         residual = np.zeros((s, W.shape[0])).T  # Fortran order, as dsytrs wants
-        residual[:n] = -(P @ Wx) - A.T @ np.ascontiguousarray(W[n:])
+        residual[:n] = -(P @ Wx) - sigma * Wx - A.T @ np.ascontiguousarray(W[n:])
         for j in range(s):
-            residual[constrained[j], j] += 1.0
-            for k in range(s):
+            residual[entries[j], j] += 1.0
+            for k in range(constrained.shape[0]):
                 residual[constrained[k], j] -= rho_vec[k] * Wx[constrained[k], j]
         residual[n:] = -AW
         _solve_factored(K, ipiv, residual)
