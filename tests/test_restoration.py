@@ -15,14 +15,14 @@ def _infeasibility(problem, x):
     return max(box, cone_distance(x, cones, x.shape[0]))
 
 
-# max_iter 3 is below the reduced form's break-even (s / 2 = 7.5 for 15 constrained
-# entries), so it exercises the full form; 10 the reduced one.
-@pytest.mark.parametrize(("budget", "reduced"), [(3, 0), (10, 1)])
-def test_budget_stopped_solve_is_exactly_feasible(budget, reduced):
-    settings = dict(max_iter=budget, eps_abs=1e-10, eps_rel=0.0)
+# The reduced form needs at most half the KKT size constrained (n + m = 38 here): 15
+# constrained entries use it, 21 take the full form.
+@pytest.mark.parametrize(("n_box", "reduced"), [(6, 1), (12, 0)])
+def test_budget_stopped_solve_is_exactly_feasible(n_box, reduced):
+    settings = dict(max_iter=3, eps_abs=1e-10, eps_rel=0.0)
     unrestored = []
     for seed in range(4):
-        problem = P, q, A, b, lb, ub, cones = random_problem(seed)
+        problem = P, q, A, b, lb, ub, cones = random_problem(seed, n_box=n_box)
         solver = fccqp.Solver(**settings)
         result = solver.solve(*problem)
         assert solver._workspace.reduced[0] == reduced

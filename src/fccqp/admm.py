@@ -479,12 +479,20 @@ def _factor_reduced(p, w):
 
 
 @njit(cache=True)
-def _factor(p, w, rho, sigma, max_iter):
+def _reduced_budget(p, prm, iteration):
+    """Solves the reduced form's table can save: the iterations left, plus, when the
+    result will be restored, the columns the restoration would otherwise compute."""
+    restoring = p.constrained.shape[0] if prm.restore_feasibility else 0
+    return prm.max_iter - iteration + restoring
+
+
+@njit(cache=True)
+def _factor(p, w, rho, sigma, budget):
     """Factor for the current rho, in reduced form when it pays and ``P + R`` allows it.
 
     The reduced form costs ``s`` extra right-hand sides up front and saves one solve
-    per iteration, so it is tried when the iteration budget covers that (see
-    ``REDUCED_COST``) and the constrained entries are at most half the KKT size. Records
+    per iteration, so it is tried when ``budget`` (see :func:`_reduced_budget`) covers
+    that (``REDUCED_COST``) and the constrained entries are at most half the KKT size. Records
     the form in ``w.reduced`` and ``rho`` in ``w.factored_rho`` (what a later solve with
     the same matrices may reuse); returns the number of factorizations, negated when
     the inertia shows that P is not positive semidefinite.
@@ -492,7 +500,7 @@ def _factor(p, w, rho, sigma, max_iter):
     s = p.constrained.shape[0]
     count = 0
     w.factored_rho[0] = rho
-    if 2 * s <= p.P.shape[0] + p.A.shape[0] and REDUCED_COST * s <= max_iter:
+    if 2 * s <= p.P.shape[0] + p.A.shape[0] and REDUCED_COST * s <= budget:
         count += 1
         if _factor_reduced(p, w):
             w.reduced[0] = 1
@@ -635,7 +643,7 @@ def run(p, w, prm):
     for j in range(s):
         w.rho_vec[j] = rho * w.rho_scale[j]
     if prm.factorize or prm.cold_start:
-        count = _factor(p, w, rho, prm.sigma, prm.max_iter)
+        count = _factor(p, w, rho, prm.sigma, _reduced_budget(p, prm, 0))
         if count < 0:
             return NOT_CONVEX, 0, rho, prim, dual, factorizations - count
         factorizations += count
@@ -687,7 +695,7 @@ def run(p, w, prm):
                     rho = new_rho
                     for j in range(s):
                         w.rho_vec[j] = rho * w.rho_scale[j]
-                    count = _factor(p, w, rho, prm.sigma, prm.max_iter - iteration)
+                    count = _factor(p, w, rho, prm.sigma, _reduced_budget(p, prm, iteration))
                     if count < 0:
                         return NOT_CONVEX, iteration, rho, prim, dual, factorizations - count
                     factorizations += count

@@ -46,9 +46,9 @@ class Settings:
     scaling: int = 10
     """Ruiz equilibration iterations (0 disables scaling)."""
     restore_feasibility: bool = True
-    """Return a point exactly in the box and the cones: the constrained entries take
-    their projection ``z`` and the free ones are re-solved with the equalities (one
-    factorization of the free entries' KKT matrix); see :mod:`fccqp.restoration`."""
+    """Return a point in the box and the cones: the violating entries are pinned at
+    their projection and the others respond through the KKT system, keeping
+    ``A x = b``; see :mod:`fccqp.restoration`."""
     warm_start: bool = True
     """Start from the previous solution (used by :class:`fccqp.Solver`)."""
     verbose: bool = False
