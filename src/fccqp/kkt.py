@@ -21,7 +21,7 @@ Contract: :func:`assemble` + :func:`factor` build the factorization for given
 import numpy as np
 from numba import njit
 
-from fccqp._lapack import dsytrf, dsytrs
+from fccqp._lapack import dsytrf, dsytrs, dsytrs2
 
 DELTA = 1e-13
 """Quasi-definite regularization of the (2, 2) block (scaled problem)."""
@@ -83,14 +83,16 @@ def factor(K, ipiv, work):
 
 @njit(cache=True)
 def _solve_factored(K, ipiv, rhs):
-    """Solve in place for one right-hand side (a vector) or several (a Fortran matrix)."""
+    """Solve in place for one right-hand side (a vector) or several (a Fortran matrix,
+    with the level-3 ``dsytrs2``)."""
     size = np.array([K.shape[0]], dtype=np.int32)
     info = np.zeros(1, dtype=np.int32)
-    columns = 1 if rhs.ndim == 1 else rhs.shape[1]
-    dsytrs(
-        np.array([_LOWER], dtype=np.uint8), size, np.array([columns], dtype=np.int32),
-        K, size, ipiv, rhs, size, info,
-    )
+    uplo = np.array([_LOWER], dtype=np.uint8)
+    if rhs.ndim == 1:
+        dsytrs(uplo, size, np.ones(1, dtype=np.int32), K, size, ipiv, rhs, size, info)
+    else:
+        columns = np.array([rhs.shape[1]], dtype=np.int32)
+        dsytrs2(uplo, size, columns, K, size, ipiv, rhs, size, np.empty(K.shape[0]), info)
 
 
 @njit(cache=True)
