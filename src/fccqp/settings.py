@@ -108,8 +108,13 @@ class Settings:
         found no value better than the default 0.1 on every robot (see
         ``docs/performance.md``). Residuals are checked every 5 iterations (each check
         costs about half a KKT solve), so a solve ends after 5, 10 or 15 iterations.
+        Anderson acceleration is off: within 15 iterations it changed the p95 torque
+        error by -28 % to +16 % across the four robots and cost 12 % of the solve time.
+        Ruiz scaling runs 4 passes instead of 10: 20 us less per solve, p95 torque error
+        within -9 % to +11 % of 10 passes.
         """
         preset = cls(
-            max_iter=15, eps_abs=1e-4, eps_rel=1e-4, warm_start=True, check_termination=5
+            max_iter=15, eps_abs=1e-4, eps_rel=1e-4, warm_start=True, check_termination=5,
+            anderson_memory=0, scaling=4,
         )
         return preset.replace(**overrides)
