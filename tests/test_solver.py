@@ -132,6 +132,18 @@ def test_reuse_after_a_solve_that_needed_no_iteration():
     assert abs(tight.obj - reference.obj) <= 1e-4 * (1 + abs(reference.obj))
 
 
+def test_matrix_changed_in_place_is_not_mistaken_for_the_previous():
+    """A control loop may refill the same A array each tick: no stale factorization."""
+    P, q, A, b, lb, ub, cones = random_problem(3)
+    solver = fccqp.Solver()
+    solver.solve(P, q, A, b, lb, ub, cones)
+    A[0] *= 2.0
+    b[:2] += (b[0], 0.3)
+    result = solver.solve(P, q, A, b, lb, ub, cones)
+    assert result.status is Status.SOLVED
+    assert np.abs(A @ result.x - b).max() <= 1e-9 * (1 + np.abs(b).max())
+
+
 def test_x0_initial_guess():
     problem = random_problem(10)
     reference = clarabel_solve(*problem)

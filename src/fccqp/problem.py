@@ -46,6 +46,8 @@ class ProblemData:
 
 def _dense_matrix(value: object, name: str) -> np.ndarray:
     """Convert to a 2-D float64 array (densifying scipy.sparse), checking only the rank."""
+    if type(value) is np.ndarray and value.dtype == np.float64 and value.ndim == 2:
+        return value  # the control-loop case, at a tenth of the general path's cost
     if sp.issparse(value):
         value = value.toarray()
     try:
@@ -58,6 +60,8 @@ def _dense_matrix(value: object, name: str) -> np.ndarray:
 
 
 def _vector(value: object, name: str, n: int) -> np.ndarray:
+    if type(value) is np.ndarray and value.dtype == np.float64 and value.shape == (n,):
+        return value
     if sp.issparse(value):
         value = value.toarray()
     try:
@@ -119,6 +123,20 @@ def _scan(P, q, A, b, lb, ub, P_sym):
         if ub[i] == -np.inf:
             return _INFINITE_SIDE, 4, i, ub[i]
     return _OK, -1, -1, 0.0
+
+
+@njit(cache=True)
+def _constrained_entries(lb, ub, members, offset):
+    """Entries with a finite bound or in a cone, ascending; the first cone member (in
+    block order) with a finite bound, or -1; the cone offsets into the first list."""
+    is_constrained = np.isfinite(lb) | np.isfinite(ub)
+    bounded_member = -1
+    for i in members:
+        if is_constrained[i] and bounded_member < 0:
+            bounded_member = i
+        is_constrained[i] = True
+    constrained = np.flatnonzero(is_constrained)
+    return constrained, bounded_member, np.searchsorted(constrained, offset)
 
 
 @njit(cache=True)
@@ -186,7 +204,7 @@ def validate(
         A = _dense_matrix(A, "A")
         if A.shape[1] != n:
             raise ValueError(f"A must have {n} columns (the size of P), got shape {A.shape}")
-        A = np.ascontiguousarray(A)
+        A = np.array(A, order="C")  # a private copy: the next solve compares against it
         b = _vector(b, "b", A.shape[0])
     lb = np.full(n, -np.inf) if lb is None else _vector(lb, "lb", n)
     ub = np.full(n, np.inf) if ub is None else _vector(ub, "ub", n)
@@ -195,16 +213,11 @@ def validate(
     if finding[0] != _OK:
         _raise_finding(*finding, lb, ub)
     flat = flatten_cones(cones, n)
-    in_cone = flat.members
-    bounded = np.isfinite(lb[in_cone]) | np.isfinite(ub[in_cone])
-    if bounded.any():
-        i = int(in_cone[np.flatnonzero(bounded)[0]])
+    constrained, bounded_member, position = _constrained_entries(lb, ub, flat.members, flat.offset)
+    if bounded_member >= 0:
+        i = bounded_member
         raise ValueError(
             f"x[{i}] is in a cone block and has a finite bound (lb[{i}] = {lb[i]}, "
             f"ub[{i}] = {ub[i]}); cone entries must have infinite bounds"
         )
-    is_constrained = np.isfinite(lb) | np.isfinite(ub)
-    is_constrained[in_cone] = True
-    constrained = np.flatnonzero(is_constrained)
-    position = np.searchsorted(constrained, flat.offset)
     return ProblemData(P_sym, q, A, b, lb, ub, flat.relocated(position), constrained)
