@@ -1,11 +1,12 @@
-"""LAPACK routines callable from numba ``nopython`` code, with ``cache=True``.
+"""LAPACK and BLAS routines callable from numba ``nopython`` code, with ``cache=True``.
 
 numba's own ``np.linalg`` has no symmetric-indefinite (Bunch-Kaufman) factorization,
 which the KKT system of the x-update needs, and its Cholesky raises on a matrix that
 is not positive definite where the caller wants to fall back. We take the routines from
-``scipy.linalg.cython_lapack`` and register their addresses with LLVM under our own
-symbol names; the compiled kernels call those names, so cached machine code stays
-valid in a new process (a raw function pointer would be baked into the cache).
+``scipy.linalg.cython_lapack`` (and two from ``cython_blas``) and register their
+addresses with LLVM under our own symbol names; the compiled kernels call those names,
+so cached machine code stays valid in a new process (a raw function pointer would be
+baked into the cache).
 
 Every argument is passed by reference, as Fortran expects: scalars travel as
 one-element arrays.
@@ -19,10 +20,17 @@ from numba.extending import get_cython_function_address, intrinsic
 
 _ROUTINES = ("dsytrf", "dsytrs", "dsytrs2", "dpotrf", "dpotrs")
 
+_BLAS_ROUTINES = ("dtrsm", "dsyrk")
+
 for _name in _ROUTINES:
     llvm.add_symbol(
         f"fccqp_{_name}",
         get_cython_function_address("scipy.linalg.cython_lapack", _name),
+    )
+for _name in _BLAS_ROUTINES:
+    llvm.add_symbol(
+        f"fccqp_{_name}",
+        get_cython_function_address("scipy.linalg.cython_blas", _name),
     )
 
 
@@ -79,4 +87,20 @@ def dpotrs(typingctx, uplo, n, nrhs, a, lda, b, ldb, info):
     """Solve ``A X = B`` with the factor computed by :func:`dpotrf`."""
     return types.void(uplo, n, nrhs, a, lda, b, ldb, info), _call_by_reference(
         "fccqp_dpotrs"
+    )
+
+
+@intrinsic
+def dtrsm(typingctx, side, uplo, transa, diag, m, n, alpha, a, lda, b, ldb):
+    """Triangular solve with many right-hand sides, ``B := alpha op(A)^-1 B`` (side L)."""
+    return types.void(side, uplo, transa, diag, m, n, alpha, a, lda, b, ldb), (
+        _call_by_reference("fccqp_dtrsm")
+    )
+
+
+@intrinsic
+def dsyrk(typingctx, uplo, trans, n, k, alpha, a, lda, beta, c, ldc):
+    """Symmetric rank-k update, ``C := alpha A'A + beta C`` (trans T), one triangle."""
+    return types.void(uplo, trans, n, k, alpha, a, lda, beta, c, ldc), (
+        _call_by_reference("fccqp_dsyrk")
     )

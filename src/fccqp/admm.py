@@ -26,10 +26,13 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, objmode
 
-from fccqp import kkt, restoration
+from fccqp import kkt, restoration, schur
 from fccqp.projections import project_cone_block, project_constraint_set
 
 SOLVED, SOLVED_INACCURATE, MAX_ITER, TIME_LIMIT, PRIMAL_INFEASIBLE, DUAL_INFEASIBLE = range(1, 7)
+FULL, REDUCED, SCHUR = range(3)
+"""Forms of the x-update (``w.reduced``): full KKT solves; the reduced iteration with the
+LDL' backend; the reduced iteration with the Schur-complement backend."""
 NOT_CONVEX = -1
 """Kernel code: the KKT inertia shows that P is not positive semidefinite."""
 INACCURATE_FACTOR = 10.0
@@ -102,6 +105,9 @@ class Workspace(NamedTuple):
     aa_counts: np.ndarray
     reduced: np.ndarray
     factored_rho: np.ndarray
+    L: np.ndarray
+    LS: np.ndarray
+    Y: np.ndarray
     W: np.ndarray
     W_S: np.ndarray
     base: np.ndarray
@@ -157,10 +163,14 @@ def _factor_kkt(p, w, sigma):
 
 @njit(cache=True)
 def _solve_x(p, w, sigma):
-    """Solve the KKT system for ``w.rhs`` into ``w.sol``."""
-    kkt.solve_refined(
-        w.K, w.ipiv, p.P, p.A, p.E, sigma, p.constrained, w.rho_vec, w.rhs, w.sol, w.residual
-    )
+    """Solve the KKT system for ``w.rhs`` into ``w.sol``, with the backend factored last."""
+    if w.reduced[0] == SCHUR:
+        schur.solve_refined(w.L, w.LS, p.P, p.A, p.E, p.constrained, w.rho_vec, w.rhs, w.sol)
+    else:
+        kkt.solve_refined(
+            w.K, w.ipiv, p.P, p.A, p.E, sigma, p.constrained, w.rho_vec, w.rhs, w.sol,
+            w.residual,
+        )
 
 
 @njit(cache=True)
@@ -333,6 +343,7 @@ def _equality_qp_start(p, w, sigma):
     n = p.P.shape[0]
     w.rho_vec[:] = 0.0
     w.factored_rho[0] = -1.0  # the KKT matrix now holds no rho factorization
+    w.reduced[0] = FULL
     if not _factor_kkt(p, w, sigma):
         return False
     w.x[:] = 0.0
@@ -464,15 +475,21 @@ def _factor_reduced(p, w):
     ``(x~, nu) = base + W v`` with ``v = rho z - y`` and ``W`` the ``(n + m) x s`` block of
     the inverse on the constrained entries, so an iteration needs only ``x~_S = base_S
     + W_S v``, an ``s x s`` product, instead of an ``(n + m)``-sized KKT solve; ``x`` and
-    ``nu`` are formed only when residuals are checked. Returns False (no reduced form)
-    when the inertia or the refinement of ``W`` fails.
+    ``nu`` are formed only when residuals are checked. The Schur-complement backend
+    (:mod:`fccqp.schur`) is tried first, the LDL' one when ``A`` is rank-deficient.
+    Returns False (no reduced form) when the inertia or the refinement of ``W`` fails.
     """
-    if not _factor_kkt(p, w, 0.0):
-        return False
-    if not kkt.solve_unit_columns(
-        w.K, w.ipiv, p.P, p.A, p.E, 0.0, p.constrained, w.rho_vec, p.constrained, w.W
-    ):
-        return False
+    schur_form = schur.factor(p.P, p.A, p.constrained, w.rho_vec, w.L, w.LS, w.Y) and (
+        schur.unit_columns(w.L, w.LS, w.Y, p.A, p.E, p.constrained, w.W)
+    )
+    w.reduced[0] = SCHUR if schur_form else REDUCED
+    if not schur_form:
+        if not _factor_kkt(p, w, 0.0):
+            return False
+        if not kkt.solve_unit_columns(
+            w.K, w.ipiv, p.P, p.A, p.E, 0.0, p.constrained, w.rho_vec, p.constrained, w.W
+        ):
+            return False
     for j in range(p.constrained.shape[0]):
         w.W_S[j] = w.W[p.constrained[j]]
     return True
@@ -503,9 +520,8 @@ def _factor(p, w, rho, sigma, budget):
     if 2 * s <= p.P.shape[0] + p.A.shape[0] and REDUCED_COST * s <= budget:
         count += 1
         if _factor_reduced(p, w):
-            w.reduced[0] = 1
             return count
-    w.reduced[0] = 0
+    w.reduced[0] = FULL
     count += 1
     return count if _factor_kkt(p, w, sigma) else -count
 
@@ -647,7 +663,7 @@ def run(p, w, prm):
         if count < 0:
             return NOT_CONVEX, 0, rho, prim, dual, factorizations - count
         factorizations += count
-    reduced = w.reduced[0] == 1
+    reduced = w.reduced[0] != FULL
     if reduced:
         _reduced_base(p, w)
         for j in range(s):
@@ -699,7 +715,7 @@ def run(p, w, prm):
                     if count < 0:
                         return NOT_CONVEX, iteration, rho, prim, dual, factorizations - count
                     factorizations += count
-                    reduced = w.reduced[0] == 1
+                    reduced = w.reduced[0] != FULL
                     if reduced:
                         _reduced_base(p, w)
                     fresh = True

@@ -82,6 +82,8 @@ def _workspace(data: ProblemData, log_rows: int, memory: int) -> admm.Workspace:
         aa_g=np.zeros(2 * s), aa_f=np.zeros(2 * s), aa_plain=np.zeros(2 * s + 1),
         aa_counts=np.zeros(5, np.int64), reduced=np.zeros(1, np.int64),
         factored_rho=np.full(1, -1.0),
+        L=np.zeros((n, n), order="F"), LS=np.zeros((m, m), order="F"),
+        Y=np.zeros((n, m), order="F"),
         W=np.zeros((N, s), order="F"), W_S=np.zeros((s, s)), base=np.zeros(N),
         v=np.zeros(s), v_prev=np.zeros(s), u=np.zeros(s), u_prev=np.zeros(s),
     )
