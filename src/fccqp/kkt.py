@@ -96,6 +96,29 @@ def _solve_factored(K, ipiv, rhs):
 
 
 @njit(cache=True)
+def meets_equalities(Ax, b, row_scale):
+    """Refinement's stopping test: ``||E^-1 (b - A x)|| <= REFINE_TOLERANCE`` times its
+    scale, ``E`` being ``row_scale`` (the user's equality residual)."""
+    error = size = 0.0
+    for i in range(Ax.shape[0]):
+        error = max(error, abs(b[i] - Ax[i]) / row_scale[i])
+        size = max(size, abs(b[i]) / row_scale[i], abs(Ax[i]) / row_scale[i])
+    return error <= REFINE_TOLERANCE * max(1.0, size)
+
+
+@njit(cache=True)
+def in_null_space(AW, A, Wx, row_scale):
+    """:func:`meets_equalities` for columns ``W_x`` that should satisfy ``A W_x = 0``,
+    given ``AW = A W_x``."""
+    error = 0.0
+    for i in range(AW.shape[0]):
+        for j in range(AW.shape[1]):
+            error = max(error, abs(AW[i, j]) / row_scale[i])
+    size = np.max(np.abs(A)) * np.max(np.abs(Wx)) / np.min(row_scale)
+    return error <= REFINE_TOLERANCE * max(1.0, size)
+
+
+@njit(cache=True)
 def solve_refined(K, ipiv, P, A, row_scale, sigma, constrained, rho_vec, rhs, sol, residual):
     """Solve the unregularized KKT system for ``rhs`` into ``sol``.
 
@@ -113,11 +136,7 @@ def solve_refined(K, ipiv, P, A, row_scale, sigma, constrained, rho_vec, rhs, so
         x = sol[:n]
         nu = sol[n:]
         Ax = A @ x
-        error = size = 0.0
-        for i in range(Ax.shape[0]):
-            error = max(error, abs(b[i] - Ax[i]) / row_scale[i])
-            size = max(size, abs(b[i]) / row_scale[i], abs(Ax[i]) / row_scale[i])
-        if error <= REFINE_TOLERANCE * max(1.0, size):
+        if meets_equalities(Ax, b, row_scale):
             return
         eq = b - Ax
         residual[:n] = rhs[:n] - P @ x - sigma * x - A.T @ nu
@@ -145,16 +164,10 @@ def solve_unit_columns(K, ipiv, P, A, row_scale, sigma, constrained, rho_vec, en
     _solve_factored(K, ipiv, W)
     if A.shape[0] == 0:
         return True
-    A_norm = np.max(np.abs(A))
     for _ in range(MAX_REFINE + 1):
         Wx = np.ascontiguousarray(W[:n])
         AW = A @ Wx
-        error = 0.0
-        for i in range(AW.shape[0]):
-            for j in range(s):
-                error = max(error, abs(AW[i, j]) / row_scale[i])
-        size = A_norm * np.max(np.abs(Wx)) / np.min(row_scale)
-        if error <= REFINE_TOLERANCE * max(1.0, size):
+        if in_null_space(AW, A, Wx, row_scale):
             return True
         residual = np.zeros((s, W.shape[0])).T  # Fortran order, as dsytrs wants
         residual[:n] = -(P @ Wx) - sigma * Wx - A.T @ np.ascontiguousarray(W[n:])

@@ -28,32 +28,23 @@ import numpy as np
 from numba import njit
 
 from fccqp import kkt
-from fccqp._lapack import dpotrf, dpotrs
 from fccqp.projections import project_constraint_set
+from fccqp.schur import cholesky, cholesky_solve
 
-_LOWER = 76  # ord("L")
 VIOLATION_TOLERANCE = 1e-12
 """An entry violates when its projection moves it by more than this (relative)."""
 
 
 @njit(cache=True)
-def _projection(p, x):
-    """``(x_S, P_C(x_S))`` for the constrained entries of ``x``."""
+def _pin_violators(p, x, pinned):
+    """Mark in ``pinned`` the constrained entries of ``x`` that the projection moves
+    (whole cone blocks). Returns whether any was not pinned yet, and the projection."""
     s = p.constrained.shape[0]
     x_S = np.empty(s)
     for j in range(s):
         x_S[j] = x[p.constrained[j]]
     projected = np.empty(s)
     project_constraint_set(x_S, p.lo, p.hi, p.cones, projected)
-    return x_S, projected
-
-
-@njit(cache=True)
-def _pin_violators(p, x, pinned):
-    """Mark in ``pinned`` the constrained entries of ``x`` that the projection moves
-    (whole cone blocks); return True if any was not pinned yet."""
-    x_S, projected = _projection(p, x)
-    s = x_S.shape[0]
     moved = np.zeros(s, dtype=np.bool_)
     for j in range(s):
         moved[j] = abs(projected[j] - x_S[j]) > VIOLATION_TOLERANCE * max(1.0, abs(x_S[j]))
@@ -67,19 +58,19 @@ def _pin_violators(p, x, pinned):
         if moved[j] and not pinned[j]:
             pinned[j] = True
             new = True
-    return new
+    return new, projected
 
 
 @njit(cache=True)
 def _columns(p, w, sigma, reduced, pinned_entries, positions):
-    """KKT responses ``W_T`` to unit right-hand sides on the pinned entries."""
+    """KKT responses ``W_T`` to unit right-hand sides on the pinned entries, and
+    whether they reached the refinement tolerance."""
     if reduced:
-        return np.asfortranarray(w.W[:, positions])
+        return np.asfortranarray(w.W[:, positions]), True
     columns = np.zeros((positions.shape[0], w.K.shape[0])).T  # Fortran order
-    if not kkt.solve_unit_columns(w.K, w.ipiv, p.P, p.A, p.E, sigma, p.constrained,
-                                  w.rho_vec, pinned_entries, columns):
-        columns[:, :] = np.nan
-    return columns
+    exact = kkt.solve_unit_columns(w.K, w.ipiv, p.P, p.A, p.E, sigma, p.constrained,
+                                   w.rho_vec, pinned_entries, columns)
+    return columns, exact
 
 
 @njit(cache=True)
@@ -93,17 +84,15 @@ def restore(p, w, sigma, reduced):
     """
     n, s = p.P.shape[0], p.constrained.shape[0]
     start = np.concatenate((w.x, w.nu))
-    target = _projection(p, w.x)[1]
     pinned = np.zeros(s, dtype=np.bool_)
-    if not _pin_violators(p, w.x, pinned):
+    violating, target = _pin_violators(p, w.x, pinned)
+    if not violating:
         return True
-    uplo = np.array([_LOWER], dtype=np.uint8)
-    info = np.zeros(1, dtype=np.int32)
     point = start
-    while True:  # each pass pins at least one more entry, so at most s passes
+    while violating:  # each pass pins at least one more entry, so at most s passes
         positions = np.flatnonzero(pinned)
         entries = p.constrained[positions]
-        W_T = _columns(p, w, sigma, reduced, entries, positions)
+        W_T, exact = _columns(p, w, sigma, reduced, entries, positions)
         t = positions.shape[0]
         gram = np.empty((t, t)).T  # Fortran order
         step = np.empty(t)
@@ -111,16 +100,11 @@ def restore(p, w, sigma, reduced):
             step[a] = target[positions[a]] - start[entries[a]]
             for c in range(t):
                 gram[a, c] = W_T[entries[a], c]
-        if not np.all(np.isfinite(gram)):
+        if not (exact and cholesky(gram)):
             return False
-        size = np.array([t], dtype=np.int32)
-        dpotrf(uplo, size, gram, size, info)
-        if info[0] != 0:
-            return False
-        dpotrs(uplo, size, np.ones(1, dtype=np.int32), gram, size, step, size, info)
+        cholesky_solve(gram, step)
         point = start + W_T @ step
-        if not _pin_violators(p, point[:n], pinned):
-            break
+        violating = _pin_violators(p, point[:n], pinned)[0]
     w.x[:] = point[:n]
     w.nu[:] = point[n:]
     return True

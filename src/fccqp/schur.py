@@ -22,7 +22,7 @@ import numpy as np
 from numba import njit
 
 from fccqp._lapack import dpotrf, dpotrs, dsyrk, dtrsm
-from fccqp.kkt import MAX_REFINE, REFINE_TOLERANCE
+from fccqp.kkt import MAX_REFINE, in_null_space, meets_equalities
 
 RANK_TOLERANCE = 1e-10
 """``S`` counts as singular when a Cholesky pivot falls below this times its largest
@@ -35,7 +35,7 @@ _NON_UNIT = np.array([78], dtype=np.uint8)  # "N"
 
 
 @njit(cache=True)
-def _cholesky(M):
+def cholesky(M):
     """Factor ``M`` (Fortran, lower triangle) in place; False if not positive definite."""
     size = np.array([M.shape[0]], dtype=np.int32)
     info = np.zeros(1, dtype=np.int32)
@@ -54,8 +54,8 @@ def _triangular_solve(L, B, transpose):
 
 
 @njit(cache=True)
-def _cholesky_solve(L, b):
-    """``b := (L L')^-1 b`` in place for a vector ``b``."""
+def cholesky_solve(L, b):
+    """``b := (L L')^-1 b`` in place for a vector ``b``, ``L`` from :func:`cholesky`."""
     size = np.array([L.shape[0]], dtype=np.int32)
     info = np.zeros(1, dtype=np.int32)
     dpotrs(_LOWER.copy(), size, np.ones(1, dtype=np.int32), L, size, b, size, info)
@@ -74,7 +74,7 @@ def factor(P, A, constrained, rho_vec, L, LS, Y):
             L[i, j] = P[i, j]
     for k in range(constrained.shape[0]):
         L[constrained[k], constrained[k]] += rho_vec[k]
-    if not _cholesky(L):
+    if not cholesky(L):
         return False
     if m == 0:
         return True
@@ -89,7 +89,7 @@ def factor(P, A, constrained, rho_vec, L, LS, Y):
     largest = 0.0
     for i in range(m):
         largest = max(largest, LS[i, i])
-    if not _cholesky(LS):
+    if not cholesky(LS):
         return False
     for i in range(m):  # a pivot lost to cancellation: dependent rows, leave them to LDL'
         if LS[i, i] * LS[i, i] <= RANK_TOLERANCE * largest:
@@ -101,13 +101,13 @@ def factor(P, A, constrained, rho_vec, L, LS, Y):
 def _solve(L, LS, A, f, g, x, nu):
     """One unrefined solve of the system for ``(f, g)`` into ``x, nu``."""
     x[:] = f
-    _cholesky_solve(L, x)
+    cholesky_solve(L, x)
     if A.shape[0] == 0:
         return
     nu[:] = A @ x - g
-    _cholesky_solve(LS, nu)
+    cholesky_solve(LS, nu)
     correction = A.T @ nu
-    _cholesky_solve(L, correction)
+    cholesky_solve(L, correction)
     x -= correction
 
 
@@ -123,11 +123,7 @@ def solve_refined(L, LS, P, A, row_scale, constrained, rho_vec, rhs, sol):
     dx, dnu = np.empty(n), np.empty(A.shape[0])
     for _ in range(MAX_REFINE):
         Ax = A @ x
-        error = size = 0.0
-        for i in range(Ax.shape[0]):
-            error = max(error, abs(g[i] - Ax[i]) / row_scale[i])
-            size = max(size, abs(g[i]) / row_scale[i], abs(Ax[i]) / row_scale[i])
-        if error <= REFINE_TOLERANCE * max(1.0, size):
+        if meets_equalities(Ax, g, row_scale):
             return
         r_f = f - P @ x - A.T @ nu
         for k in range(constrained.shape[0]):
@@ -161,10 +157,5 @@ def unit_columns(L, LS, Y, A, row_scale, constrained, W):
     W[:n] = Z
     if m == 0:
         return True
-    AW = A @ np.ascontiguousarray(Z)
-    error = 0.0
-    for i in range(m):
-        for j in range(s):
-            error = max(error, abs(AW[i, j]) / row_scale[i])
-    size_ = np.max(np.abs(A)) * np.max(np.abs(Z)) / np.min(row_scale)
-    return error <= REFINE_TOLERANCE * max(1.0, size_)
+    Wx = np.ascontiguousarray(Z)
+    return in_null_space(A @ Wx, A, Wx, row_scale)
