@@ -108,6 +108,7 @@ class Workspace(NamedTuple):
     L: np.ndarray
     LS: np.ndarray
     Y: np.ndarray
+    order: np.ndarray
     W: np.ndarray
     W_S: np.ndarray
     base: np.ndarray
@@ -165,7 +166,9 @@ def _factor_kkt(p, w, sigma):
 def _solve_x(p, w, sigma):
     """Solve the KKT system for ``w.rhs`` into ``w.sol``, with the backend factored last."""
     if w.reduced[0] == SCHUR:
-        schur.solve_refined(w.L, w.LS, p.P, p.A, p.E, p.constrained, w.rho_vec, w.rhs, w.sol)
+        schur.solve_refined(
+            w.L, w.LS, p.P, p.A, p.E, w.order, p.constrained, w.rho_vec, w.rhs, w.sol
+        )
     else:
         kkt.solve_refined(
             w.K, w.ipiv, p.P, p.A, p.E, sigma, p.constrained, w.rho_vec, w.rhs, w.sol,
@@ -479,11 +482,11 @@ def _factor_reduced(p, w):
     (:mod:`fccqp.schur`) is tried first, the LDL' one when ``A`` is rank-deficient.
     Returns False (no reduced form) when the inertia or the refinement of ``W`` fails.
     """
-    schur_form = schur.factor(p.P, p.A, p.constrained, w.rho_vec, w.L, w.LS, w.Y) and (
-        schur.unit_columns(w.L, w.LS, w.Y, p.A, p.E, p.constrained, w.W)
-    )
-    w.reduced[0] = SCHUR if schur_form else REDUCED
-    if not schur_form:
+    if schur.factor(p.P, p.A, w.order, w.rho_vec, w.L, w.LS, w.Y):
+        schur.unit_columns(w.L, w.LS, w.Y, w.order, w.W)
+        w.reduced[0] = SCHUR
+    else:
+        w.reduced[0] = REDUCED
         if not _factor_kkt(p, w, 0.0):
             return False
         if not kkt.solve_unit_columns(

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fccqp import admm
+from fccqp import admm, schur
 from fccqp.cones import Cone
 from fccqp.problem import ProblemData, same_entries, validate
 from fccqp.projections import project_constraint_set
@@ -83,7 +83,7 @@ def _workspace(data: ProblemData, log_rows: int, memory: int) -> admm.Workspace:
         aa_counts=np.zeros(5, np.int64), reduced=np.zeros(1, np.int64),
         factored_rho=np.full(1, -1.0),
         L=np.zeros((n, n), order="F"), LS=np.zeros((m, m), order="F"),
-        Y=np.zeros((n, m), order="F"),
+        Y=np.zeros((n, m), order="F"), order=schur.ordering(n, data.constrained),
         W=np.zeros((N, s), order="F"), W_S=np.zeros((s, s)), base=np.zeros(N),
         v=np.zeros(s), v_prev=np.zeros(s), u=np.zeros(s), u_prev=np.zeros(s),
     )
@@ -183,9 +183,10 @@ class Solver:
         settings = self.settings
         data = validate(P, q, A, b, lb, ub, cones)
         prev = self._previous
+        same_structure = prev is not None and _same_structure(prev.data, data)
         reuse = (
-            prev is not None and _same_structure(prev.data, data)
-            and same_entries(prev.data.P, data.P) and same_entries(prev.data.A, data.A)
+            same_structure and same_entries(prev.data.P, data.P)
+            and same_entries(prev.data.A, data.A)
         )
         if reuse:
             scaled = self._rescale_vectors(prev.scaled, data)
@@ -197,8 +198,9 @@ class Solver:
                 or w.z.shape != data.constrained.shape or w.log.shape[0] != log_rows \
                 or w.aa_dg.shape[0] != settings.anderson_memory:
             w = self._workspace = _workspace(data, log_rows, settings.anderson_memory)
-        elif not reuse:
+        elif not same_structure:
             w.rho_scale[:] = _rho_scale(data)
+            w.order[:] = schur.ordering(data.n, data.constrained)
         warm = settings.warm_start and prev is not None and prev.x.shape == data.q.shape
         warm = warm and prev.y.shape == data.b.shape
         rho = prev.rho if warm else settings.rho
