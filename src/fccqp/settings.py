@@ -34,11 +34,12 @@ class Settings:
     time_limit: float = math.inf
     """Wall-clock budget of one solve in seconds (setup included); ``inf`` for none."""
     check_termination: int = 1
-    """Check residuals every this many iterations."""
+    """Check residuals every this many iterations (in the reduced form an ``O(s^2)``
+    estimate first decides whether the full check is worth running)."""
     adaptive_rho: bool = True
     """Rescale rho to balance primal and dual residuals, refactoring when it changes."""
     adaptive_rho_interval: int = 10
-    """Iterations between two rho updates."""
+    """Iterations between two rho updates, and between two unconditional residual checks."""
     adaptive_rho_tolerance: float = 5.0
     """Refactor only when rho would change by more than this factor."""
     anderson_memory: int = 10
