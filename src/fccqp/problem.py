@@ -90,18 +90,26 @@ def _scan(P, q, A, b, lb, ub, P_sym):
     Entries of ``P`` that differ from their transpose by rounding are averaged.
     """
     n = P.shape[0]
-    scale = 1.0
-    asymmetry = 0.0
+    # Row by row with one accumulator per column, so that the inner loop vectorizes:
+    # v - v is 0 for a finite v and NaN otherwise.
+    P_sym[:, :] = P.T
+    scale = np.ones(n)
+    asymmetry = np.zeros(n)
+    not_finite = np.zeros(n)
     for i in range(n):
         for j in range(n):
-            v = P[i, j]
-            if not np.isfinite(v):
-                return _P_NOT_FINITE, -1, i, v
-            scale = max(scale, abs(v))
-            asymmetry = max(asymmetry, abs(v - P[j, i]))
-            P_sym[i, j] = 0.5 * (v + P[j, i])
-    if asymmetry > SYMMETRY_TOLERANCE * scale:
-        return _P_ASYMMETRIC, -1, -1, asymmetry
+            v, t = P[i, j], P_sym[i, j]
+            not_finite[j] += v - v
+            scale[j] = max(scale[j], abs(v))
+            asymmetry[j] = max(asymmetry[j], abs(v - t))
+            P_sym[i, j] = 0.5 * (v + t)
+    if not np.all(np.isfinite(not_finite)):
+        for i in range(n):
+            for j in range(n):
+                if not np.isfinite(P[i, j]):
+                    return _P_NOT_FINITE, -1, i, P[i, j]
+    if asymmetry.max() > SYMMETRY_TOLERANCE * scale.max():
+        return _P_ASYMMETRIC, -1, -1, asymmetry.max()
     for i in range(n):
         if not np.isfinite(q[i]):
             return _NOT_FINITE, 0, i, q[i]

@@ -29,6 +29,28 @@ def _inverse_sqrt_norm(norm):
 
 
 @njit(cache=True)
+def _row_max(row, weight):
+    """``max_j |row_j| weight_j`` with four running maxima.
+
+    One running maximum is a chain of dependent ``max`` operations that the compiler
+    may not reorder; four independent ones run about twice as fast on these rows.
+    """
+    n = row.shape[0]
+    m0 = m1 = m2 = m3 = 0.0
+    j = 0
+    while j + 4 <= n:
+        m0 = max(m0, abs(row[j]) * weight[j])
+        m1 = max(m1, abs(row[j + 1]) * weight[j + 1])
+        m2 = max(m2, abs(row[j + 2]) * weight[j + 2])
+        m3 = max(m3, abs(row[j + 3]) * weight[j + 3])
+        j += 4
+    while j < n:
+        m0 = max(m0, abs(row[j]) * weight[j])
+        j += 1
+    return max(max(m0, m1), max(m2, m3))
+
+
+@njit(cache=True)
 def equilibrate(P, q, A, b, block_start, block_dim, iterations, D, E):
     """Scale ``P, q, A, b`` in place; fill ``D`` and ``E``; return the cost scale ``c``.
 
@@ -44,19 +66,18 @@ def equilibrate(P, q, A, b, block_start, block_dim, iterations, D, E):
     d = np.empty(n)
     e = np.empty(m)
     for _ in range(iterations):
-        # P is symmetric: its column norms are its row norms (contiguous rows).
+        # Column maxima accumulate row by row (independent per column, so the inner
+        # loops vectorize); the row maxima of A go through _row_max.
+        d[:] = 0.0
         for i in range(n):
-            norm = 0.0
             for j in range(n):
-                norm = max(norm, abs(P[i, j]) * D[j])
-            d[i] = norm * D[i]
+                d[j] = max(d[j], abs(P[i, j]) * D[i])
+        for j in range(n):
+            d[j] *= D[j]
         for i in range(m):
-            norm = 0.0
             for j in range(n):
-                a = abs(A[i, j]) * D[j]
-                norm = max(norm, a)
-                d[j] = max(d[j], a * E[i])
-            e[i] = _inverse_sqrt_norm(norm * E[i])
+                d[j] = max(d[j], abs(A[i, j]) * D[j] * E[i])
+            e[i] = _inverse_sqrt_norm(_row_max(A[i], D) * E[i])
         for j in range(n):
             d[j] = _inverse_sqrt_norm(d[j])
         for k in range(block_start.shape[0]):
@@ -76,11 +97,9 @@ def equilibrate(P, q, A, b, block_start, block_dim, iterations, D, E):
             A[i, j] *= E[i] * D[j]
         b[i] *= E[i]
     mean_col = 0.0
+    ones = np.ones(n)
     for i in range(n):
-        norm = 0.0
-        for j in range(n):
-            norm = max(norm, abs(P[i, j]))
-        mean_col += norm
+        mean_col += _row_max(P[i], ones)
     mean_col /= n
     q_norm = 0.0
     for i in range(n):
