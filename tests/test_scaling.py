@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from fccqp.scaling import MAX_NORM, MIN_NORM, equilibrate
+from fccqp.projections import project_constraint_set
+from fccqp.scaling import MAX_NORM, MIN_NORM, equilibrate, scale_start, unscale_solution
 
 
 def _inverse_sqrt(norm):
@@ -52,3 +53,30 @@ def test_equilibrate_matches_its_definition(seed, n, m, iterations):
     np.testing.assert_allclose(A_s, E[:, None] * A * D[None, :], rtol=1e-12, atol=1e-300)
     np.testing.assert_allclose(b_s, E * b, rtol=1e-12)
     assert np.ptp(D[2:5]) <= 1e-12 * D[2]  # a cone block keeps one scale
+
+
+def test_warm_start_and_unscaling_are_inverse():
+    rng = np.random.default_rng(0)
+    n, m = 8, 3
+    constrained = np.array([1, 2, 3, 4, 6])  # a friction cone on 2-4, a box on 1 and 6
+    D, E, c = rng.uniform(0.1, 10, n), rng.uniform(0.1, 10, m), 0.37
+    lo = np.array([-1.0, -np.inf, -np.inf, -np.inf, 0.0]) / D[constrained]
+    hi = np.array([1.0, np.inf, np.inf, np.inf, 2.0]) / D[constrained]
+    cones = (np.array([0]), np.array([1]), np.array([3]), np.array([0.5]), np.zeros((1, 3)))
+    cones[4][0, 2] = 1.0
+    x, y, z = rng.standard_normal(n), rng.standard_normal(m), np.zeros(n)
+    z[constrained] = rng.standard_normal(constrained.shape[0])
+    rho = 0.3
+    x_s, nu_s, y_s, z_s = np.empty(n), np.empty(m), np.empty(5), np.empty(5)
+    scale_start(x, y, z, rho, D, E, c, constrained, lo, hi, cones, x_s, nu_s, y_s, z_s)
+    np.testing.assert_allclose(x_s, x / D)
+    expected_z = np.empty(5)
+    project_constraint_set(x_s[constrained] + y_s / rho, lo, hi, cones, expected_z)
+    np.testing.assert_array_equal(z_s, expected_z)
+    G = rng.standard_normal((n, n))
+    P, q = G @ G.T, rng.standard_normal(n)
+    x2, y2, z2, objective = unscale_solution(x_s, nu_s, y_s, D, E, c, constrained, P, q)
+    np.testing.assert_allclose(x2, x, rtol=1e-14)
+    np.testing.assert_allclose(y2, y, rtol=1e-14)
+    np.testing.assert_allclose(z2, z, rtol=1e-14)
+    assert objective == pytest.approx(0.5 * x @ P @ x + q @ x, rel=1e-12)

@@ -8,12 +8,18 @@ where each Ruiz pass divides every column of ``[[P, A'], [A, 0]]`` by the square
 root of its infinity norm (as OSQP does) and ``c`` normalizes the cost. ``D`` is
 kept constant over each cone block (geometric mean), so a scaled cone is the same
 cone: friction cones keep their ``mu`` and normal.
+
+:func:`scale_start` and :func:`unscale_solution` carry iterates across the scaling:
+``x = D x_s``, equality multipliers ``y = E nu_s / c`` and constraint multipliers
+``z_S = y_s / (c D_S)``.
 """
 
 import math
 
 import numpy as np
 from numba import njit
+
+from fccqp.projections import project_constraint_set
 
 MIN_NORM = 1e-4
 """Column norms below this are treated as 1 (a column of zeros is left alone)."""
@@ -109,3 +115,38 @@ def equilibrate(P, q, A, b, block_start, block_dim, iterations, D, E):
     P *= c
     q *= c
     return c
+
+
+@njit(cache=True)
+def scale_start(x, y, z, rho, D, E, c, constrained, lo, hi, cones, x_s, nu_s, y_s, z_s):
+    """Warm start from an unscaled solution ``(x, y, z)`` of a previous solve.
+
+    Fills the scaled iterate ``x_s, nu_s`` (x and equality multipliers), ``y_s``
+    (constraint multipliers on the constrained entries) and the slack ``z_s = P_C(x_s
+    + y_s / rho)``, the point ADMM's z-update would produce from them.
+    """
+    for i in range(x.shape[0]):
+        x_s[i] = x[i] / D[i]
+    for i in range(y.shape[0]):
+        nu_s[i] = y[i] * c / E[i]
+    inverse_rho = 1.0 / max(rho, 1e-12)
+    shifted = np.empty(constrained.shape[0])
+    for j in range(constrained.shape[0]):
+        i = constrained[j]
+        y_s[j] = z[i] * c * D[i]
+        shifted[j] = x_s[i] + y_s[j] * inverse_rho
+    project_constraint_set(shifted, lo, hi, cones, z_s)
+
+
+@njit(cache=True)
+def unscale_solution(x_s, nu_s, y_s, D, E, c, constrained, P, q):
+    """``(x, y, z, objective)`` of the unscaled problem ``(P, q)`` from a scaled iterate;
+    ``z`` is zero off the constrained entries."""
+    x = x_s * D
+    y = nu_s * E / c
+    z = np.zeros(x.shape[0])
+    for j in range(constrained.shape[0]):
+        i = constrained[j]
+        z[i] = y_s[j] / (c * D[i])
+    objective = x @ (0.5 * (P @ x) + q)
+    return x, y, z, objective

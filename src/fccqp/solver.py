@@ -13,7 +13,7 @@ from fccqp.cones import Cone
 from fccqp.problem import ProblemData, same_entries, validate
 from fccqp.projections import project_constraint_set
 from fccqp.result import Result
-from fccqp.scaling import equilibrate
+from fccqp.scaling import equilibrate, scale_start, unscale_solution
 from fccqp.settings import Settings
 from fccqp.status import Status
 
@@ -102,10 +102,6 @@ def _same_structure(a: ProblemData, b: ProblemData) -> bool:
         and a.cones.offset.tobytes() == b.cones.offset.tobytes()
         and a.cones.dim.tobytes() == b.cones.dim.tobytes()
     )
-
-
-def _objective(data: ProblemData, x: np.ndarray) -> float:
-    return float(x @ (0.5 * (data.P @ x) + data.q))
 
 
 def _smallest_eigenvalue(P: np.ndarray) -> float:
@@ -207,7 +203,9 @@ class Solver:
         if x0 is not None:
             self._start_from_guess(scaled, data, x0, w)
         elif warm:
-            self._start_from_previous(scaled, prev, w)
+            scale_start(prev.x, prev.y, prev.z, prev.rho, scaled.D, scaled.E, scaled.c,
+                        scaled.constrained, scaled.lo, scaled.hi, scaled.cones,
+                        w.x, w.nu, w.y, w.z)
         cold = x0 is None and not warm
         params = admm.Params(
             rho=rho, sigma=settings.sigma, alpha=settings.alpha,
@@ -231,13 +229,14 @@ class Solver:
                 f"{_smallest_eigenvalue(data.P):.3g}"
             )
         status = _STATUS_BY_CODE[code]
-        x, y, z = self._unscale(scaled, w)
+        x, y, z, obj = unscale_solution(w.x, w.nu, w.y, scaled.D, scaled.E, scaled.c,
+                                        scaled.constrained, data.P, data.q)
         certificate = self._certificate(scaled, w, status)
         self._previous = _Previous(data, scaled, rho, x, y, z)
         if settings.verbose:
             self._print_log(w, status, iterations)
         return Result(
-            x=x, y=y, z=z, status=status, obj=_objective(data, x), iterations=int(iterations),
+            x=x, y=y, z=z, status=status, obj=float(obj), iterations=int(iterations),
             prim_res=float(prim), dual_res=float(dual), setup_time=setup_time,
             solve_time=time.perf_counter() - start, rho=float(rho),
             factorizations=int(factorizations), certificate=certificate,
@@ -253,17 +252,6 @@ class Solver:
         )
 
     @staticmethod
-    def _start_from_previous(
-        scaled: admm.ScaledProblem, prev: _Previous, w: admm.Workspace
-    ) -> None:
-        s = scaled.constrained
-        w.x[:] = prev.x / scaled.D
-        w.nu[:] = prev.y * scaled.c / scaled.E
-        w.y[:] = prev.z[s] * scaled.c * scaled.D[s]
-        project_constraint_set(w.x[s] + w.y / max(prev.rho, 1e-12), scaled.lo, scaled.hi,
-                               scaled.cones, w.z)
-
-    @staticmethod
     def _start_from_guess(
         scaled: admm.ScaledProblem, data: ProblemData, x0: object, w: admm.Workspace
     ) -> None:
@@ -274,15 +262,6 @@ class Solver:
         w.nu[:] = 0.0
         w.y[:] = 0.0
         project_constraint_set(w.x[scaled.constrained], scaled.lo, scaled.hi, scaled.cones, w.z)
-
-    @staticmethod
-    def _unscale(scaled: admm.ScaledProblem, w: admm.Workspace):
-        s = scaled.constrained
-        x = w.x * scaled.D
-        y = w.nu * scaled.E / scaled.c
-        z = np.zeros_like(x)
-        z[s] = w.y / (scaled.c * scaled.D[s])
-        return x, y, z
 
     @staticmethod
     def _certificate(scaled: admm.ScaledProblem, w: admm.Workspace, status: Status):
