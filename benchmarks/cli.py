@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from benchmarks.harness import baseline, run_variant
+from benchmarks.harness import baseline, run_variants
 from benchmarks.report import RunInfo, write_outputs
 from benchmarks.robots import ROBOTS
 from benchmarks.scenarios import SCENARIOS
@@ -126,10 +126,8 @@ def main(argv: Sequence[str] | None = None) -> Path:
         ts = generate_test_set(robot, args.scenario, n_qps, args.seed, seq_len=seq_len,
                                verbose=progress)
         kkt = baseline(ts, repeats)
-        rows = []
-        for variant in variants:
-            rows += run_variant(make_adapter(variant), ts, repeats, kkt, progress=progress)
-        sets.append((ts, rows))
+        adapters = [make_adapter(variant) for variant in variants]
+        sets.append((ts, run_variants(adapters, ts, repeats, kkt, progress=progress)))
     report = write_outputs(out, sets, variants, info)
     print(f"wrote {report} in {time.perf_counter() - start:.0f} s")
     return report

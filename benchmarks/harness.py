@@ -1,13 +1,16 @@
 """Timing loop: run solver variants over a test set and collect one row per QP.
 
-Each variant runs on its own, one after another (never interleaved per QP, so caches
-and warm-start state belong to one solver at a time):
+A pass is one variant solving the whole set; passes never interleave per QP, so caches
+and warm-start state belong to one solver at a time:
 
 1. every QP is prepared (:meth:`~benchmarks.solvers.Adapter.prepare`) before timing;
-2. warm-up: the variant solves the first few QPs and is reset, so that JIT
+2. warm-up: each variant solves the first few QPs and is reset, so that JIT
    compilation (fccqp's numba kernels) and first-call costs are not timed;
-3. ``repeats`` passes over the whole set in controller-loop order, resetting the
-   warm start at each sequence boundary; the garbage collector is off during a pass.
+3. ``repeats`` rounds; in each, every variant makes one pass over the set in
+   controller-loop order, resetting the warm start at each sequence boundary, with
+   the garbage collector off. Rotating the variants round by round (instead of
+   running each variant's passes back to back) spreads the drifts of a shared
+   machine's speed, which last minutes, over all variants alike.
    A pass is deterministic, so the per-QP time reported is the median over the passes
    and the solution is the one of the first pass.
 """
@@ -25,7 +28,7 @@ from benchmarks.metrics import qp_metrics
 from benchmarks.solvers import Adapter, SolveOutcome, kkt_factorization_time
 from benchmarks.testsets import TestSet
 
-__all__ = ["WARMUP_QPS", "baseline", "run_variant"]
+__all__ = ["WARMUP_QPS", "baseline", "run_variants"]
 
 WARMUP_QPS = 5
 """QPs solved (and discarded) by each variant before timing."""
@@ -53,23 +56,23 @@ def baseline(test_set: TestSet, repeats: int) -> list[tuple[float, float]]:
         gc.enable()
 
 
-def run_variant(
-    adapter: Adapter,
+def run_variants(
+    adapters: Sequence[Adapter],
     test_set: TestSet,
     repeats: int,
     kkt: Sequence[tuple[float, float]],
     progress: bool = True,
 ) -> list[dict[str, object]]:
-    """Time ``adapter`` on every QP of ``test_set`` and judge its solutions.
+    """Time every adapter on every QP of ``test_set`` and judge its solutions.
 
     Parameters
     ----------
-    adapter
-        A fresh adapter of the variant.
+    adapters
+        Fresh adapters of the variants, with distinct names.
     test_set
         The QPs, with reference solutions and sequence indices.
     repeats
-        Passes over the set; the time per QP is the median over passes.
+        Rounds of passes; the time per QP is the median over a variant's passes.
     kkt
         Output of :func:`baseline` for the set, copied into each row.
     progress
@@ -78,28 +81,46 @@ def run_variant(
     Returns
     -------
     list of dict
-        One row per QP, the columns of ``results.csv``.
+        One row per variant and QP (variants in the given order), the columns of
+        ``results.csv``.
     """
-    data = [adapter.prepare(qp) for qp in test_set.qps]
-    warm = min(WARMUP_QPS, len(data))
-    _one_pass(adapter, data[:warm], test_set.sequence[:warm])
-    times = np.zeros((repeats, len(data)))
-    first: list[SolveOutcome] = []
+    data = [[adapter.prepare(qp) for qp in test_set.qps] for adapter in adapters]
+    n_qps = len(test_set.qps)
+    warm = min(WARMUP_QPS, n_qps)
+    for adapter, prepared in zip(adapters, data, strict=True):
+        _one_pass(adapter, prepared[:warm], test_set.sequence[:warm])
+    times = np.zeros((len(adapters), repeats, n_qps))
+    first: list[list[SolveOutcome]] = [[] for _ in adapters]
     bar = tqdm(
-        total=repeats * len(data), desc=f"{test_set.robot} {adapter.name}", leave=False,
+        total=repeats * n_qps * len(adapters), desc=f"{test_set.robot}", leave=False,
         disable=not progress,
     )
     for r in range(repeats):
-        gc.collect()
-        gc.disable()
-        try:
-            outcomes = _one_pass(adapter, data, test_set.sequence)
-        finally:
-            gc.enable()
-        times[r] = [o.time for o in outcomes]
-        first = first or outcomes
-        bar.update(len(data))
+        for k, (adapter, prepared) in enumerate(zip(adapters, data, strict=True)):
+            gc.collect()
+            gc.disable()
+            try:
+                outcomes = _one_pass(adapter, prepared, test_set.sequence)
+            finally:
+                gc.enable()
+            times[k, r] = [o.time for o in outcomes]
+            first[k] = first[k] or outcomes
+            bar.update(n_qps)
     bar.close()
+    rows = []
+    for k, adapter in enumerate(adapters):
+        rows += _rows(adapter, test_set, times[k], first[k], kkt)
+    return rows
+
+
+def _rows(
+    adapter: Adapter,
+    test_set: TestSet,
+    times: np.ndarray,
+    first: Sequence[SolveOutcome],
+    kkt: Sequence[tuple[float, float]],
+) -> list[dict[str, object]]:
+    """One result row per QP of one variant, from its pass times and first outcomes."""
     rows = []
     for i, (qp, x_ref, o) in enumerate(zip(test_set.qps, test_set.x_ref, first, strict=True)):
         m = qp_metrics(qp, o.x, x_ref)

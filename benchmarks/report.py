@@ -336,10 +336,12 @@ def _header(info: RunInfo, variants: Sequence[str]) -> list[str]:
         " has no update for new matrices, so its construction is timed with its solve; OSQP"
         " is set up for each QP (setup timed) and warm started with `warm_start(x, y)`;"
         " ProxQP's dense model is `update`d and warm started within a sequence.",
-        "- Solvers run one after another on the whole set, in controller-loop order,"
-        " restarting warm starts at each sequence boundary. Each first solves a few QPs"
-        " untimed (warm-up: numba compilation and first-call costs are excluded). The"
-        " garbage collector is off during timed passes. The machine is shared: read medians.",
+        "- A pass is one solver solving the whole set in controller-loop order, restarting"
+        " warm starts at each sequence boundary; passes never interleave per QP. Each"
+        " solver first solves a few QPs untimed (warm-up: numba compilation and first-call"
+        " costs are excluded). Passes rotate through the solvers round by round, so drifts"
+        " of the shared machine's speed reach every solver alike. The garbage collector is"
+        " off during timed passes. Read medians.",
         "- Every solution is judged on the exact-cone problem against Clarabel's reference"
         " at 1e-9 (also for pyramid solvers). **success** (qpbenchmark's convention): the"
         f" solver reports success and the equality residual, exact-cone violation and bound"
@@ -369,7 +371,7 @@ def write_outputs(
     out
         Output folder (created if needed).
     sets
-        Each test set with its result rows (from :func:`benchmarks.harness.run_variant`).
+        Each test set with its result rows (from :func:`benchmarks.harness.run_variants`).
     variants
         Variants that ran, in table order.
     info
