@@ -83,7 +83,8 @@ _OK, _P_NOT_FINITE, _P_ASYMMETRIC, _NOT_FINITE, _NAN, _CROSSED, _INFINITE_SIDE =
 
 @njit(cache=True)
 def _scan(P, q, A, b, lb, ub, P_sym):
-    """One pass over the data: finiteness, symmetry and bounds; fills ``P_sym``.
+    """Check finiteness, symmetry and bounds in one scan (``P`` is read twice: once
+    transposed into ``P_sym``, once row by row); fills ``P_sym`` with ``(P + P') / 2``.
 
     Returns ``(code, argument, index, value)``: ``argument`` numbers the vectors
     ``q, A, b, lb, ub`` as 0-4 and ``index`` locates the first offending entry.
