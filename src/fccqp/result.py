@@ -50,3 +50,6 @@ class Result:
     """KKT factorizations performed during the call."""
     certificate: np.ndarray | None = None
     """Infeasibility certificate, see the class docstring."""
+    gap: float = float("nan")
+    """Duality gap ``|x'Px + q'x + b'y + support_C(-z)|`` of the returned point (see
+    docs/formulation.md); NaN when the status is an infeasibility certificate."""

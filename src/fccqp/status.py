@@ -10,7 +10,8 @@ class Status(Enum):
     """
 
     SOLVED = "solved"
-    """Primal and dual residuals are within ``eps_abs + eps_rel * scale``."""
+    """Primal residual, dual residual and duality gap of the returned point are within
+    ``eps_abs + eps_rel * scale``, the scales taken from the problem data."""
     SOLVED_INACCURATE = "solved_inaccurate"
     """A budget ran out with residuals within 10x the tolerances."""
     MAX_ITER_REACHED = "max_iter_reached"
@@ -21,6 +22,9 @@ class Status(Enum):
     """A certificate of primal infeasibility was found (see ``Result.certificate``)."""
     DUAL_INFEASIBLE = "dual_infeasible"
     """A certificate of dual infeasibility (an unbounded direction) was found."""
+    NUMERICAL_ERROR = "numerical_error"
+    """The iterates stopped being finite (overflow in extreme data or settings): the
+    returned point is the last finite one and carries no guarantee."""
 
     def is_solved(self) -> bool:
         """True for :attr:`SOLVED` only."""
