@@ -51,5 +51,6 @@ class Result:
     certificate: np.ndarray | None = None
     """Infeasibility certificate, see the class docstring."""
     gap: float = float("nan")
-    """Duality gap ``|x'Px + q'x + b'y + support_C(-z)|`` of the returned point (see
-    docs/formulation.md); NaN when the status is an infeasibility certificate."""
+    """Duality gap ``|x'Px + q'x + b'y + sigma_C(z)|`` of the returned point, ``sigma_C``
+    the support function of the box and cones (see docs/formulation.md); NaN when the
+    status is an infeasibility certificate."""
