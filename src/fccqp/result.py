@@ -36,10 +36,10 @@ class Result:
     iterations: int
     """ADMM iterations performed."""
     prim_res: float
-    """Primal residual ``max(||Ax - b||, ||x_S - z||)`` (infinity norm), ``z`` the ADMM
-    slack in the box and cones; it bounds the entrywise violation of the box and cones."""
+    """Primal residual of the returned ``x``: ``max(||Ax - b||, ||x_S - P_C(x_S)||)``
+    (infinity norm), the second term its largest distance to the box and the cones."""
     dual_res: float
-    """Dual residual ``||Px + q + A'y + z||`` in the infinity norm."""
+    """Dual residual ``||Px + q + A'y + z||`` of the returned point (infinity norm)."""
     setup_time: float
     """Seconds spent validating, scaling and factorizing before the iterations."""
     solve_time: float
@@ -50,6 +50,8 @@ class Result:
     """KKT factorizations performed during the call."""
     certificate: np.ndarray | None = None
     """Infeasibility certificate, see the class docstring."""
+    backend: str = ""
+    """KKT backend of the last factorization (see ``Settings.kkt_backend``)."""
     gap: float = float("nan")
     """Duality gap ``|x'Px + q'x + b'y + sigma_C(z)|`` of the returned point, ``sigma_C``
     the support function of the box and cones (see docs/formulation.md); NaN when the

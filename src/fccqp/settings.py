@@ -50,6 +50,13 @@ class Settings:
     """Return a point in the box and the cones: the violating entries are pinned at
     their projection and the others respond through the KKT system, keeping
     ``A x = b``; see :mod:`fccqp.restoration`."""
+    kkt_backend: str = "auto"
+    """Linear-system backend of the x-update: ``"schur_reduced"`` (Cholesky of ``P + R``
+    and of ``A (P + R)^-1 A'``, reduced iteration), ``"ldl_reduced"`` (LDL', reduced
+    iteration), ``"ldl_full"`` (LDL', one KKT solve per iteration) or ``"auto"`` (the
+    first of these that applies and pays; see docs/algorithm.md). A forced backend
+    that cannot factor the matrix falls back to the next one in that order;
+    ``Result.backend`` says which ran."""
     warm_start: bool = True
     """Start from the previous solution (used by :class:`fccqp.Solver`)."""
     verbose: bool = False
@@ -87,6 +94,11 @@ class Settings:
             minimum = 0 if name in ("scaling", "anderson_memory") else 1
             if value < minimum:
                 raise ValueError(f"setting {name} must be >= {minimum}, got {value}")
+        backends = ("auto", "schur_reduced", "ldl_reduced", "ldl_full")
+        if self.kkt_backend not in backends:
+            raise ValueError(
+                f"setting kkt_backend must be one of {', '.join(backends)}, got {self.kkt_backend!r}"
+            )
         for name in ("adaptive_rho", "restore_feasibility", "warm_start", "verbose"):
             if not isinstance(getattr(self, name), bool):
                 raise TypeError(f"setting {name} must be a bool, got {getattr(self, name)!r}")

@@ -1,0 +1,27 @@
+"""Build the compiled core: one extension module per .pyx beside the Python modules.
+
+LAPACK and BLAS come from ``scipy.linalg.cython_lapack`` / ``cython_blas`` at run time,
+so nothing is linked here; a C compiler, Cython and scipy's .pxd files are needed at
+build time (pyproject.toml's build requirements).
+"""
+
+from pathlib import Path
+
+from Cython.Build import cythonize
+from setuptools import Extension, setup
+
+MODULES = sorted(path.stem for path in Path("src/fccqp").glob("*.pyx"))
+
+extensions = [
+    Extension(f"fccqp.{name}", [f"src/fccqp/{name}.pyx"], extra_compile_args=["-O3"])
+    for name in MODULES
+]
+
+setup(
+    ext_modules=cythonize(
+        extensions,
+        include_path=["src"],
+        compiler_directives={"language_level": 3},
+        quiet=True,
+    ),
+)

@@ -1,0 +1,48 @@
+# cython: language_level=3
+"""Column-major (Fortran) level-3 BLAS and Cholesky through scipy's LAPACK, as one-line
+calls: ``scipy.linalg.cython_blas`` / ``cython_lapack`` are pointers into scipy's own
+OpenBLAS, so nothing is linked at build time. Used for the factorizations and the
+many-column products of the KKT backends, where a hand-written loop would be several
+times slower at our sizes; single vectors go through the loops of ``fccqp._dense``.
+"""
+
+from scipy.linalg.cython_blas cimport dgemm, dsyrk, dtrsm
+from scipy.linalg.cython_lapack cimport dpotrf, dpotrs
+
+
+cdef inline void gemm(char ta, char tb, int m, int n, int k, double alpha, const double* a,
+                      int lda, const double* b, int ldb, double beta, double* c,
+                      int ldc) noexcept nogil:
+    """``C = alpha op(A) op(B) + beta C``."""
+    dgemm(&ta, &tb, &m, &n, &k, &alpha, <double*>a, &lda, <double*>b, &ldb, &beta, c, &ldc)
+
+
+cdef inline void trsm(char side, char trans, int m, int n, const double* L, int ldl,
+                      double* B, int ldb) noexcept nogil:
+    """``B := op(L)^-1 B`` (side ``L``) or ``B op(L)^-1`` (side ``R``), ``L`` lower."""
+    cdef char lower = b"L", non_unit = b"N"
+    cdef double one = 1.0
+    dtrsm(&side, &lower, &trans, &non_unit, &m, &n, &one, <double*>L, &ldl, B, &ldb)
+
+
+cdef inline void syrk_t(int n, int k, const double* a, int lda, double* c, int ldc) noexcept nogil:
+    """Lower triangle of ``C = A' A`` (``A`` is ``k x n``)."""
+    cdef char lower = b"L", trans = b"T"
+    cdef double one = 1.0, zero = 0.0
+    dsyrk(&lower, &trans, &n, &k, &one, <double*>a, &lda, &zero, c, &ldc)
+
+
+cdef inline bint cholesky(double* M, int n, int ld) noexcept nogil:
+    """Factor the lower triangle of ``M`` in place; False if not positive definite."""
+    cdef char lower = b"L"
+    cdef int info = 0
+    dpotrf(&lower, &n, M, &ld, &info)
+    return info == 0
+
+
+cdef inline void cholesky_solve(const double* L, int n, int ld, double* B, int columns,
+                                int ldb) noexcept nogil:
+    """``B := (L L')^-1 B`` for ``L`` from :func:`cholesky`."""
+    cdef char lower = b"L"
+    cdef int info = 0
+    dpotrs(&lower, &n, &columns, <double*>L, &ld, B, &ldb, &info)

@@ -1,0 +1,53 @@
+# cython: language_level=3
+"""C-level views of the problem and the cone blocks, shared by the compiled kernels.
+
+The kernels take raw pointers into arrays that the Python layer allocated once per
+problem structure (:class:`fccqp.admm.Workspace`): nothing is allocated in a solve.
+Matrices are dense; ``P`` is symmetric (so its storage order does not matter) and
+``A`` is row-major, ``A[i * n + j]``.
+"""
+
+cdef enum:
+    FRICTION = 0        # kind code of a friction cone (see fccqp.cones)
+    SECOND_ORDER = 1    # kind code of a second-order cone
+
+
+cdef struct Cones:
+    # Disjoint cone blocks of the constrained-entry vector.
+    Py_ssize_t count
+    const Py_ssize_t* kind
+    const Py_ssize_t* offset    # into the constrained-entry vector, not into x
+    const Py_ssize_t* dim
+    const double* mu
+    const double* normal        # count x 3, unit normals of friction cones
+
+
+cdef struct Problem:
+    # The equilibrated problem min 1/2 x'Px + q'x  s.t.  Ax = b, x_S in C (see scaling).
+    Py_ssize_t n, m, s          # variables, equality rows, constrained entries
+    double* P                   # n x n
+    double* q
+    double* A                   # m x n, row-major
+    double* b
+    const Py_ssize_t* constrained   # the s entries S of x with a bound or in a cone
+    double* lo                  # bounds of x_S (s entries, +-inf where absent)
+    double* hi
+    Cones cones
+    double* D                   # x = D x_scaled
+    double* E                   # equality rows were multiplied by E
+    double c                    # the cost was multiplied by c
+
+
+cdef struct Iterates:
+    # ADMM's iterate on the scaled problem: x (n), nu (m), slack z and multiplier y (s),
+    # their values before the last step, and the penalty per constrained entry.
+    double* x
+    double* nu
+    double* z
+    double* y
+    double* x_prev
+    double* nu_prev
+    double* z_prev
+    double* y_prev
+    double* relaxed     # s scratch: the over-relaxed x_S
+    double* rho_vec

@@ -1,0 +1,905 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""The ADMM iteration and the one compiled call per solve.
+
+Splitting: the constrained entries ``x_S`` (finite bound or cone) are copied into a
+slack ``z`` that must lie in ``C`` = box x cones; the equalities stay in the x-update.
+With multipliers ``y`` of ``x_S = z`` and over-relaxation ``alpha``, one iteration is
+
+    (x~, nu) = argmin_{A x = b} 1/2 x'Px + q'x + sigma/2 ||x - x_k||^2
+                                 + rho/2 ||x_S - z_k + y_k / rho||^2     (update_x)
+    x_S^r    = alpha x~_S + (1 - alpha) z_k
+    z_{k+1}  = P_C(x_S^r + y_k / rho)                                    (update_z)
+    y_{k+1}  = y_k + rho (x_S^r - z_{k+1})                               (update_y)
+    x_{k+1}  = alpha x~ + (1 - alpha) x_k     (x_1 = x~)
+
+Unlike the paper, rho touches the constrained entries only: a free variable gets no
+penalty (sigma is a 1e-6 proximal regularization of the full form; the reduced form,
+:mod:`fccqp.reduced`, needs none). The first x of a run is not relaxed, because the
+start (a warm start after ``b`` changed, say) may violate the equalities; from then on
+every ``x_k`` is a combination of KKT solutions for the same ``b``, so ``A x = b`` holds
+at every iterate. After each step, safeguarded Anderson acceleration may extrapolate
+``(z, y)`` (:mod:`fccqp.anderson`). Everything here works on the scaled problem
+(:mod:`fccqp.scaling`); residuals and tolerances are in the user's units
+(:mod:`fccqp.termination`).
+
+:class:`Workspace` holds every array a solve touches, allocated once per problem
+structure; :meth:`Workspace.solve` validates the numbers, scales, runs and unscales
+without allocating and without the GIL.
+"""
+
+import numpy as np
+
+from libc.math cimport INFINITY, fabs, isfinite, sqrt
+
+from fccqp._dense cimport copy, fill, inf_norm, matvec, matvec_t
+from fccqp._types cimport Cones, Iterates, Problem
+from fccqp.anderson cimport Anderson, anderson_reset, anderson_step
+from fccqp.certificates cimport dual_infeasible, equality_inconsistent, primal_infeasible
+from fccqp.kkt cimport (AUTO, FACTORED, KKT, LDL_FULL, LDL_REDUCED, NOT_CONVEX, SCHUR_REDUCED,
+                        UNAVAILABLE, kkt_convexity, kkt_factor, kkt_solve)
+from fccqp.projections cimport proj_block, proj_set
+from fccqp.reduced cimport (Reduced, materialize, near_convergence, reduced_rebase,
+                            reduced_start, reduced_step, reduced_table)
+from fccqp.restoration cimport Restoration, restore
+from fccqp.scaling cimport equilibrate, scale_start, unscale
+from fccqp.termination cimport Residuals, box_support, converged, nearly_converged, residuals
+from fccqp.validation cimport SCAN_OK, Finding, scan_and_copy
+
+cdef extern from *:
+    """
+    #ifdef _WIN32
+    #include <windows.h>
+    static double fccqp_now(void) {
+        LARGE_INTEGER count, frequency;
+        QueryPerformanceCounter(&count);
+        QueryPerformanceFrequency(&frequency);
+        return (double)count.QuadPart / (double)frequency.QuadPart;
+    }
+    #else
+    #include <time.h>
+    static double fccqp_now(void) {
+        struct timespec t;
+        clock_gettime(CLOCK_MONOTONIC, &t);
+        return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+    }
+    #endif
+    """
+    double fccqp_now() nogil
+
+# Run codes, mapped to fccqp.Status in fccqp.solver (one table).
+SOLVED, SOLVED_INACCURATE, MAX_ITER, TIME_LIMIT = 1, 2, 3, 4
+PRIMAL_INFEASIBLE, DUAL_INFEASIBLE, NUMERICAL_ERROR = 5, 6, 7
+NOT_CONVEX_CODE = -1
+"""The KKT inertia shows that the QP is not convex."""
+BAD_DATA = -2
+"""The validation scan found bad numbers (see ``Workspace.finding``)."""
+cdef enum:
+    _RUNNING = 0
+    _SOLVED = 1
+    _INACCURATE = 2
+    _MAX_ITER = 3
+    _TIME_LIMIT = 4
+    _PRIMAL_INFEASIBLE = 5
+    _DUAL_INFEASIBLE = 6
+    _NUMERICAL_ERROR = 7
+    _NOT_CONVEX = -1
+    _BAD_DATA = -2
+
+BACKENDS = {"schur_reduced": SCHUR_REDUCED, "ldl_reduced": LDL_REDUCED, "ldl_full": LDL_FULL,
+            "auto": AUTO}
+"""``Settings.kkt_backend`` names and their codes (see :mod:`fccqp.kkt`)."""
+BACKEND_NAMES = {code: name for name, code in BACKENDS.items()}
+
+INACCURATE_FACTOR = 10.0
+"""A budget-stopped iterate within this multiple of the tolerances is 'inaccurate'."""
+RHO_MIN, RHO_MAX = 1e-6, 1e6
+"""Range of the adaptive rho."""
+REDUCED_COST = 0.5
+"""The reduced iteration is used when ``REDUCED_COST * s`` fits in the iteration budget:
+tabulating ``s`` columns costs about ``s / 4`` single KKT solves (measured at KKT sizes
+84 and 192), each iteration then saves about one; 0.5 leaves a factor 2 of margin."""
+FIXED_RHO_SCALE = 1e3
+"""rho multiplier on entries with lb == ub, which act as equalities (as in OSQP)."""
+EQUALITY_START_STEPS = 3
+"""Proximal steps of the cold start's equality-constrained QP (see _equality_start)."""
+EQUALITY_START_LIMIT = 1e-3
+"""The cold start's equality-constrained QP counts as unbounded when sigma * ||x_eq||
+exceeds this * max(1, ||q||): its solution is then an (unbounded) direction, tested as
+a dual infeasibility certificate, and the start falls back to the origin."""
+RESTORED_EQUALITY = 1e-7
+"""A restored point is kept only if its primal residual is below this times its scale:
+otherwise the other entries could not absorb the pinning. Refinement aims at 1e-13, but
+an ill-conditioned ``W_TT`` (condition 1e8 on solo12) costs digits."""
+LOG_INTERVAL = 25
+"""With ``verbose``, the log keeps one line every this many iterations (as OSQP)."""
+cdef double _INACCURATE_FACTOR = INACCURATE_FACTOR
+cdef double _REDUCED_COST = REDUCED_COST
+cdef double _RHO_MIN = RHO_MIN, _RHO_MAX = RHO_MAX
+cdef double _EQUALITY_START_LIMIT = EQUALITY_START_LIMIT
+cdef double _RESTORED_EQUALITY = RESTORED_EQUALITY
+cdef long _EQUALITY_START_STEPS = EQUALITY_START_STEPS
+cdef long _LOG_INTERVAL = LOG_INTERVAL
+
+
+cdef struct Options:
+    # Settings of fccqp.Settings the kernels read.
+    double rho, sigma, alpha, eps_abs, eps_rel, eps_prim_inf, eps_dual_inf
+    double time_limit, adaptive_rho_tolerance
+    long max_iter, check_termination, adaptive_rho_interval, scaling
+    bint adaptive_rho, restore_feasibility
+    int backend, anderson_memory
+
+
+cdef struct Run:
+    # What one run reports back.
+    int status
+    long iterations
+    double rho
+    int factorizations
+    double setup_time
+    int backend
+
+
+cdef class Workspace:
+    """Every array of a solve, allocated once for a problem structure.
+
+    The structure is the sizes, the constrained entries, the entries with ``lb == ub``
+    and the cone blocks; :class:`fccqp.Solver` builds a new workspace when it changes.
+    Between solves the workspace keeps the user's last ``P`` and ``A`` (to detect
+    reuse), their scaling and factorization, and the last solution (for a warm start).
+    """
+
+    cdef list _arrays
+    cdef Problem prob
+    cdef Iterates it
+    cdef KKT kkt
+    cdef Reduced red
+    cdef Anderson aa
+    cdef Restoration rest
+    cdef Options opt
+    cdef Residuals res
+    cdef Finding found
+    # user data (private copies) and scratch
+    cdef double* P_user
+    cdef double* q_user
+    cdef double* A_user
+    cdef double* b_user
+    cdef double* lb_user
+    cdef double* ub_user
+    cdef double* rho_scale
+    cdef double* d_scratch
+    cdef double* e_scratch
+    cdef double* rhs
+    cdef double* sol
+    cdef double* vec_n
+    cdef double* vec_n2
+    cdef double* vec_n3
+    cdef double* vec_s
+    cdef double* vec_s2
+    cdef double* vec_m
+    cdef double* direction
+    cdef double* cert
+    cdef double* saved
+    cdef double* log
+    cdef double* prev_x
+    cdef double* prev_y
+    cdef double* prev_z
+    cdef Py_ssize_t* block_start
+    cdef Py_ssize_t log_rows, log_count
+    cdef double prev_rho, factored_rho, setup_time
+    cdef bint has_previous, has_matrices, certified, scaled_once
+    cdef int form
+    cdef object _keep
+
+    def __init__(self, Py_ssize_t n, Py_ssize_t m, constrained, cones, fixed, order,
+                 settings, Py_ssize_t log_rows):
+        """Allocate for ``n`` variables, ``m`` rows, the ``constrained`` entries (intp,
+        ascending), ``cones`` (the tuple of :class:`fccqp.cones.ConeArrays` with offsets
+        into ``constrained``), the boolean mask ``fixed`` of constrained entries with
+        ``lb == ub``, the Schur ``order`` and a :class:`fccqp.Settings`."""
+        cdef Py_ssize_t s = len(constrained), N = n + m, memory = settings.anderson_memory
+        cdef Py_ssize_t k
+        self._arrays = []
+        kind, offset, dim, mu, normal = cones
+        self._keep = (np.ascontiguousarray(constrained, dtype=np.intp),
+                      np.ascontiguousarray(kind, dtype=np.intp),
+                      np.ascontiguousarray(offset, dtype=np.intp),
+                      np.ascontiguousarray(dim, dtype=np.intp),
+                      np.ascontiguousarray(mu, dtype=np.float64),
+                      np.ascontiguousarray(normal, dtype=np.float64).reshape(-1),
+                      np.ascontiguousarray(order, dtype=np.intp),
+                      np.zeros(max(len(kind), 1), dtype=np.intp))
+        cdef Py_ssize_t[::1] c_view = self._keep[0], kind_v = self._keep[1]
+        cdef Py_ssize_t[::1] offset_v = self._keep[2], dim_v = self._keep[3]
+        cdef Py_ssize_t[::1] order_v = self._keep[6], start_v = self._keep[7]
+        cdef double[::1] mu_v = self._keep[4], normal_v = self._keep[5]
+        p = &self.prob
+        p.n, p.m, p.s = n, m, s
+        p.constrained = &c_view[0] if s else NULL
+        p.cones.count = len(kind)
+        if p.cones.count:
+            p.cones.kind, p.cones.offset, p.cones.dim = &kind_v[0], &offset_v[0], &dim_v[0]
+            p.cones.mu, p.cones.normal = &mu_v[0], &normal_v[0]
+            for k in range(p.cones.count):
+                start_v[k] = c_view[offset_v[k]]
+        self.block_start = &start_v[0]
+        p.P, p.q, p.A, p.b = self._new(n * n), self._new(n), self._new(m * n), self._new(m)
+        p.lo, p.hi, p.D, p.E = self._new(s), self._new(s), self._new(n), self._new(m)
+        p.c = 1.0
+        self.P_user, self.q_user = self._new(n * n), self._new(n)
+        self.A_user, self.b_user = self._new(m * n), self._new(m)
+        self.lb_user, self.ub_user = self._new(n), self._new(n)
+        self.rho_scale = self._new(s)
+        for k in range(s):
+            self.rho_scale[k] = FIXED_RHO_SCALE if fixed[k] else 1.0
+        self.d_scratch, self.e_scratch = self._new(n), self._new(m)
+        it = &self.it
+        it.x, it.nu, it.z, it.y = self._new(n), self._new(m), self._new(s), self._new(s)
+        it.x_prev, it.nu_prev = self._new(n), self._new(m)
+        it.z_prev, it.y_prev = self._new(s), self._new(s)
+        it.relaxed, it.rho_vec = self._new(s), self._new(s)
+        self.rhs, self.sol = self._new(N), self._new(N)
+        cdef Py_ssize_t wide = max(n, m)
+        self.vec_n, self.vec_n2, self.vec_n3 = self._new(wide), self._new(wide), self._new(wide)
+        self.vec_s, self.vec_s2, self.vec_m = self._new(s), self._new(s), self._new(m)
+        self.direction, self.saved, self.cert = self._new(n), self._new(N + s), self._new(N)
+        self.prev_x, self.prev_y, self.prev_z = self._new(n), self._new(m), self._new(n)
+        kk = &self.kkt
+        kk.ldl.N = <int>N
+        kk.ldl.K = self._new(N * N)
+        kk.ldl.ipiv = <int*>self._new_int(N)
+        kk.ldl.lwork = <int>(64 * N)
+        kk.ldl.work, kk.ldl.residual = self._new(64 * N), self._new(N)
+        kk.ldl.Ax, kk.ldl.ATnu = self._new(m), self._new(n)
+        kk.schur.n, kk.schur.m = <int>n, <int>m
+        kk.schur.L, kk.schur.LS, kk.schur.Y = self._new(n * n), self._new(m * m), self._new(n * m)
+        kk.schur.order = &order_v[0]
+        kk.schur.perm, kk.schur.dx, kk.schur.r = self._new(n), self._new(n), self._new(n)
+        kk.schur.ATnu, kk.schur.dnu, kk.schur.Ax = self._new(n), self._new(m), self._new(m)
+        kk.schur.X, kk.schur.Wnu, kk.schur.M = self._new(n * s), self._new(m * s), self._new(s * s)
+        kk.R, kk.work = self._new(N * s), self._new(N)
+        red = &self.red
+        red.W, red.W_S, red.base = self._new(N * s), self._new(s * s), self._new(N)
+        red.u, red.u_prev, red.v, red.v_prev = self._new(s), self._new(s), self._new(s), self._new(s)
+        red.xs, red.rhs = self._new(s), self._new(N)
+        aa = &self.aa
+        aa.capacity = <int>memory
+        aa.dg, aa.df = self._new(memory * 2 * s), self._new(memory * 2 * s)
+        aa.g, aa.f, aa.g_new, aa.f_new = self._new(2 * s), self._new(2 * s), self._new(2 * s), self._new(2 * s)
+        aa.plain, aa.gram, aa.gamma = self._new(2 * s + 1), self._new(memory * memory), self._new(memory)
+        anderson_reset(aa, False)
+        rs = &self.rest
+        rs.pinned = <char*>self._new(s)
+        rs.target, rs.projected = self._new(s), self._new(s)
+        rs.positions, rs.entries = <Py_ssize_t*>self._new_int(s), <Py_ssize_t*>self._new_int(s)
+        rs.W_T, rs.gram, rs.step = self._new(N * s), self._new(s * s), self._new(s)
+        rs.start, rs.point = self._new(N), self._new(N)
+        self.log_rows = log_rows
+        self.log = self._new(5 * log_rows)
+        o = &self.opt
+        o.rho, o.sigma, o.alpha = settings.rho, settings.sigma, settings.alpha
+        o.eps_abs, o.eps_rel = settings.eps_abs, settings.eps_rel
+        o.eps_prim_inf, o.eps_dual_inf = settings.eps_prim_inf, settings.eps_dual_inf
+        o.time_limit = settings.time_limit
+        o.adaptive_rho_tolerance = settings.adaptive_rho_tolerance
+        o.max_iter, o.check_termination = settings.max_iter, settings.check_termination
+        o.adaptive_rho_interval, o.scaling = settings.adaptive_rho_interval, settings.scaling
+        o.adaptive_rho, o.restore_feasibility = settings.adaptive_rho, settings.restore_feasibility
+        o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
+        self.has_previous = self.has_matrices = self.certified = self.scaled_once = False
+        self.factored_rho = -1.0
+
+    cdef double* _new(self, Py_ssize_t size):
+        """A zeroed array of ``size`` doubles (at least one) that lives with ``self``."""
+        array = np.zeros(max(size, 1))
+        self._arrays.append(array)
+        cdef double[::1] view = array
+        return &view[0]
+
+    cdef void* _new_int(self, Py_ssize_t size):
+        """An array of ``size`` pointer-sized integers that lives with ``self``."""
+        array = np.zeros(max(size, 1), dtype=np.intp)
+        self._arrays.append(array)
+        cdef Py_ssize_t[::1] view = array
+        return &view[0]
+
+    def update_cones(self, mu, normal):
+        """New friction coefficients and normals for the same cone blocks."""
+        self._keep[4][:] = mu
+        self._keep[5][:] = np.asarray(normal, dtype=np.float64).reshape(-1)
+
+    def forget(self):
+        """Drop the previous solution, so that the next solve starts cold."""
+        self.has_previous = False
+
+    @property
+    def finding(self):
+        """``(code, argument, index, value)`` of the last scan (see fccqp.validation)."""
+        return self.found.code, self.found.argument, self.found.index, self.found.value
+
+    @property
+    def log_lines(self):
+        """Rows ``(iteration, prim, dual, gap, rho)`` of the last solve's log."""
+        cdef Py_ssize_t i, j
+        return [tuple(self.log[5 * i + j] for j in range(5)) for i in range(self.log_count)]
+
+    def solve(self, double[:, ::1] P, double[::1] q, double[:, ::1] A, double[::1] b,
+              double[::1] lb, double[::1] ub, x0, bint warm, double start_time,
+              double[::1] x_out, double[::1] y_out, double[::1] z_out, double[::1] cert_out):
+        """Validate, scale, run ADMM and unscale into ``x_out``, ``y_out``, ``z_out``.
+
+        ``x0`` (None or a float64 vector) overrides the warm start; ``warm`` asks for a
+        start from the previous solution (when there is one). ``cert_out`` (``m + n``
+        entries) receives an infeasibility certificate. Returns ``(code, iterations, rho,
+        prim, dual, gap, factorizations, setup_time, backend)``; code ``BAD_DATA`` (see
+        :attr:`finding`) and ``NOT_CONVEX_CODE`` leave the previous solution untouched.
+        """
+        cdef Problem* p = &self.prob
+        cdef Py_ssize_t n = p.n, m = p.m
+        cdef bint same = self.has_matrices
+        cdef double[::1] guess
+        cdef const double* x0_ptr = NULL
+        cdef Run run
+        if x0 is not None:
+            guess = x0
+            x0_ptr = &guess[0]
+        with nogil:
+            self.found = scan_and_copy(
+                &P[0, 0], &q[0], &A[0, 0] if m else NULL, &b[0] if m else NULL, &lb[0], &ub[0],
+                n, m, self.P_user, self.q_user, self.A_user, self.b_user, self.lb_user,
+                self.ub_user, &same)
+        if self.found.code != SCAN_OK:
+            self.has_matrices = False
+            return BAD_DATA, 0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, ""
+        with nogil:
+            run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)
+            if run.status != _NOT_CONVEX:
+                self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0], &cert_out[0])
+        if run.status == _NOT_CONVEX:
+            self.has_matrices = self.has_previous = self.certified = False
+            return NOT_CONVEX_CODE, 0, 0.0, 0.0, 0.0, 0.0, run.factorizations, 0.0, ""
+        r = &self.res
+        return (run.status, run.iterations, run.rho, r.prim, r.dual, r.gap, run.factorizations,
+                run.setup_time, BACKEND_NAMES[run.backend])
+
+    # ----------------------------------------------------------------- one solve
+
+    cdef Run _solve(self, bint same_matrices, const double* x0, bint warm,
+                    double start_time) noexcept nogil:
+        """Scale (or reuse the scaling), start, run."""
+        cdef Problem* p = &self.prob
+        cdef Run run
+        cdef bint reuse = same_matrices and self.scaled_once
+        if not same_matrices:
+            self.certified = False
+        self.has_matrices = True
+        self._scale(reuse)
+        self.log_count = 0
+        run.rho = self.prev_rho if warm else self.opt.rho
+        if x0 != NULL:
+            self._start_from_guess(x0)
+        elif warm:
+            scale_start(self.prev_x, self.prev_y, self.prev_z, self.prev_rho, p.D, p.E, p.c,
+                        p.n, p.m, p.s, p.constrained, p.lo, p.hi, p.cones, self.it.x,
+                        self.it.nu, self.it.y, self.it.z)
+        if not reuse:
+            self.factored_rho = -1.0
+        run.setup_time = fccqp_now() - start_time
+        self._iterate(&run, x0 == NULL and not warm, start_time)
+        return run
+
+    cdef void _scale(self, bint reuse) noexcept nogil:
+        """Equilibrate the user's data into the scaled problem, or, with ``reuse``, apply
+        the scaling of the unchanged matrices to the new vectors only."""
+        cdef Problem* p = &self.prob
+        cdef Py_ssize_t n = p.n, m = p.m, i, j
+        if not reuse:
+            copy(self.P_user, p.P, n * n)
+            copy(self.A_user, p.A, m * n)
+            copy(self.q_user, p.q, n)
+            copy(self.b_user, p.b, m)
+            p.c = equilibrate(p.P, p.q, p.A, p.b, n, m, self.block_start, p.cones.dim,
+                              p.cones.count, self.opt.scaling, p.D, p.E, self.d_scratch,
+                              self.e_scratch)
+            self.scaled_once = True
+        else:
+            for i in range(n):
+                p.q[i] = p.c * p.D[i] * self.q_user[i]
+            for i in range(m):
+                p.b[i] = p.E[i] * self.b_user[i]
+        for j in range(p.s):
+            i = p.constrained[j]
+            p.lo[j] = self.lb_user[i] / p.D[i]
+            p.hi[j] = self.ub_user[i] / p.D[i]
+
+    cdef void _start_from_guess(self, const double* x0) noexcept nogil:
+        """Primal guess ``x0`` (user's units), duals zero, slack its projection."""
+        cdef Problem* p = &self.prob
+        cdef Py_ssize_t i, j
+        for i in range(p.n):
+            self.it.x[i] = x0[i] / p.D[i]
+        fill(self.it.nu, 0.0, p.m)
+        fill(self.it.y, 0.0, p.s)
+        for j in range(p.s):
+            self.it.z[j] = self.it.x[p.constrained[j]]
+        proj_set(self.it.z, p.lo, p.hi, p.cones, p.s, self.it.z)
+
+    # ------------------------------------------------------------ the iteration
+
+    cdef void _iterate(self, Run* run, bint cold, double start_time) noexcept nogil:
+        """Run ADMM from the iterate in the workspace (or a cold start)."""
+        cdef Problem* p = &self.prob
+        cdef Iterates* it = &self.it
+        cdef Options* o = &self.opt
+        cdef Residuals* r = &self.res
+        cdef Py_ssize_t s = p.s, j
+        cdef long iteration = 0
+        cdef int status = _RUNNING, code
+        cdef bint unbounded_start = False, timed = isfinite(o.time_limit)
+        cdef bint reduced, fresh, last, periodic, adapt, check
+        cdef double eps_p, eps_d, new_rho
+        run.factorizations = 0
+        run.backend = self.form
+        if cold or s == 0:
+            code = self._equality_start(&unbounded_start)
+            run.factorizations += 1
+            if code == NOT_CONVEX:
+                run.status = _NOT_CONVEX
+                return
+        self._residuals()
+        self._log(0, run.rho)
+        if unbounded_start and self._unbounded():
+            self._finish_run(run, _DUAL_INFEASIBLE, 0)
+            return
+        if (cold or s == 0) and converged(r, o.eps_abs, o.eps_rel) and not unbounded_start:
+            self._finish_run(run, _SOLVED, 0)
+            return
+        if s == 0:  # nothing to iterate: the equality-constrained QP was the answer
+            if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():
+                status = _PRIMAL_INFEASIBLE
+            else:
+                status = self._classify(0, False, start_time)
+            self._finish_run(run, status, 0)
+            return
+        for j in range(s):
+            it.rho_vec[j] = run.rho * self.rho_scale[j]
+        if self.factored_rho != run.rho or cold:
+            code = self._factor(run, self._budget(0))
+            if code != FACTORED:
+                run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR
+                return
+        reduced = self.form != LDL_FULL
+        if reduced:
+            self._reduced_base()
+            reduced_start(&self.red, p, it)
+        eps_p = o.eps_abs + o.eps_rel * r.prim_scale
+        eps_d = o.eps_abs + o.eps_rel * r.dual_scale
+        anderson_reset(&self.aa, False)
+        fresh = True  # the next step starts a run of KKT solutions: do not relax x
+        while status == _RUNNING:
+            iteration += 1
+            if reduced:
+                reduced_step(&self.red, p, it, o.alpha, not fresh)
+            else:
+                self._full_step(not fresh)
+            fresh = False
+            last = iteration >= o.max_iter or (timed and fccqp_now() - start_time >= o.time_limit)
+            periodic = iteration % o.adaptive_rho_interval == 0
+            adapt = o.adaptive_rho and periodic
+            check = iteration % o.check_termination == 0 or last or adapt
+            if check and reduced and not (last or periodic):
+                # a scheduled full check (and with it infeasibility detection) still runs
+                # every adaptive_rho_interval iterations
+                check = near_convergence(&self.red, p, it, eps_p, eps_d)
+            if check:
+                if reduced:
+                    materialize(&self.red, p, it)
+                self._residuals()
+                eps_p = o.eps_abs + o.eps_rel * r.prim_scale
+                eps_d = o.eps_abs + o.eps_rel * r.dual_scale
+                if iteration % _LOG_INTERVAL == 0:
+                    self._log(iteration, run.rho)
+                status = self._check(iteration, last, start_time)
+                if status == _RUNNING and adapt:
+                    new_rho = self._new_rho(run.rho)
+                    if new_rho != run.rho:
+                        if reduced:
+                            for j in range(s):
+                                self.vec_s[j] = new_rho * self.rho_scale[j]
+                            reduced_rebase(&self.red, p, it.rho_vec, self.vec_s)
+                        run.rho = new_rho
+                        for j in range(s):
+                            it.rho_vec[j] = run.rho * self.rho_scale[j]
+                        code = self._factor(run, self._budget(iteration))
+                        if code != FACTORED:
+                            run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR
+                            return
+                        reduced = self.form != LDL_FULL
+                        if reduced:
+                            self._reduced_base()
+                        fresh = True
+                        anderson_reset(&self.aa, True)
+            if status == _RUNNING and o.anderson_memory > 0:
+                anderson_step(&self.aa, it, s)
+        if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
+            status = self._keep_restored(status, iteration, reduced, start_time)
+        elif reduced and status != _NUMERICAL_ERROR:
+            self._restore_equalities()   # certificates are already in cert
+        self._finish_run(run, status, iteration)
+
+    cdef int _check(self, long iteration, bint last, double start_time) noexcept nogil:
+        """Termination and infeasibility tests after the residuals of ``iteration``."""
+        cdef Problem* p = &self.prob
+        cdef Iterates* it = &self.it
+        cdef Options* o = &self.opt
+        cdef Residuals* r = &self.res
+        cdef Py_ssize_t i
+        if not r.finite:
+            return _NUMERICAL_ERROR
+        if converged(r, o.eps_abs, o.eps_rel):
+            return _SOLVED
+        if primal_infeasible(p, it, o.eps_prim_inf, self.vec_m, self.vec_s, self.vec_n,
+                             self.vec_n2):
+            fill(self.cert, 0.0, p.n + p.m)
+            for i in range(p.m):   # in the user's units (the common factor 1/c dropped)
+                self.cert[i] = self.vec_m[i] * p.E[i]
+            for i in range(p.s):
+                self.cert[p.m + p.constrained[i]] = self.vec_s[i] / p.D[p.constrained[i]]
+            return _PRIMAL_INFEASIBLE
+        if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():
+            return _PRIMAL_INFEASIBLE
+        for i in range(p.n):
+            self.direction[i] = it.x[i] - it.x_prev[i]
+        if self._unbounded():
+            return _DUAL_INFEASIBLE
+        if last:
+            return self._classify(iteration, True, start_time)
+        return _RUNNING
+
+    cdef bint _inconsistent(self) noexcept nogil:
+        """The equality certificate; on success ``cert`` holds ``(-E r, 0)``, ``r = b_s - A_s
+        x_s``: ``A'y ~ 0`` and ``b'y < 0`` in the user's units."""
+        cdef Problem* p = &self.prob
+        cdef Py_ssize_t i
+        if not equality_inconsistent(p, &self.it, self.opt.eps_prim_inf, self.vec_m,
+                                     self.vec_n, self.vec_n2):
+            return False
+        fill(self.cert, 0.0, p.n + p.m)
+        for i in range(p.m):
+            self.cert[i] = -self.vec_m[i] * p.E[i]
+        return True
+
+    cdef bint _unbounded(self) noexcept nogil:
+        """The dual certificate for ``direction``; on success ``cert`` holds it, unscaled."""
+        cdef Problem* p = &self.prob
+        cdef Py_ssize_t i
+        if not dual_infeasible(p, self.direction, self.opt.eps_dual_inf, self.vec_n,
+                               self.vec_n2, self.vec_s2):
+            return False
+        for i in range(p.n):
+            self.cert[i] = self.direction[i] * p.D[i]
+        return True
+
+    cdef int _classify(self, long iteration, bint stopped, double start_time) noexcept nogil:
+        """Status of an iterate from its residuals alone: solved, inaccurate (within
+        ``INACCURATE_FACTOR`` of the tolerances), or the budget that ran out."""
+        cdef Residuals* r = &self.res
+        if not r.finite:
+            return _NUMERICAL_ERROR
+        if converged(r, self.opt.eps_abs, self.opt.eps_rel):
+            return _SOLVED
+        if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
+            return _INACCURATE
+        if iteration >= self.opt.max_iter or not stopped:
+            return _MAX_ITER
+        return _TIME_LIMIT
+
+    cdef void _full_step(self, bint relax_x) noexcept nogil:
+        """One ADMM iteration with a KKT solve (update_x, update_z, update_y)."""
+        cdef Problem* p = &self.prob
+        cdef Iterates* it = &self.it
+        cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
+        cdef double alpha = self.opt.alpha, alpha_x = alpha if relax_x else 1.0
+        cdef double sigma = self.opt.sigma
+        copy(it.x, it.x_prev, n)
+        copy(it.nu, it.nu_prev, m)
+        copy(it.z, it.z_prev, s)
+        copy(it.y, it.y_prev, s)
+        for i in range(n):
+            self.rhs[i] = sigma * it.x[i] - p.q[i]
+        for i in range(m):
+            self.rhs[n + i] = p.b[i]
+        for j in range(s):
+            self.rhs[p.constrained[j]] += it.rho_vec[j] * it.z[j] - it.y[j]
+        kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
+        for j in range(s):
+            it.relaxed[j] = alpha * self.sol[p.constrained[j]] + (1.0 - alpha) * it.z_prev[j]
+        for i in range(n):
+            it.x[i] = alpha_x * self.sol[i] + (1.0 - alpha_x) * it.x_prev[i]
+        copy(self.sol + n, it.nu, m)
+        for j in range(s):
+            it.z[j] = it.relaxed[j] + it.y[j] / it.rho_vec[j]
+        proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
+        for j in range(s):
+            it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])
+
+    cdef double _new_rho(self, double rho) noexcept nogil:
+        """OSQP's rule: rho *= sqrt(relative primal / relative dual residual), clipped;
+        unchanged unless it moves by more than ``adaptive_rho_tolerance``."""
+        cdef Residuals* r = &self.res
+        cdef double ratio = (r.prim_s / max(r.prim_scale_s, 1e-30)) / max(
+            r.dual_s / max(r.dual_scale_s, 1e-30), 1e-30)
+        cdef double new_rho = min(max(rho * sqrt(ratio), _RHO_MIN), _RHO_MAX)
+        cdef double tolerance = self.opt.adaptive_rho_tolerance
+        if new_rho > rho * tolerance or new_rho < rho / tolerance:
+            return new_rho
+        return rho
+
+    # -------------------------------------------------------- factorizations
+
+    cdef long _budget(self, long iteration) noexcept nogil:
+        """Solves the reduced form's table can save: the iterations left, plus, when the
+        result will be restored, the columns the restoration would otherwise compute."""
+        cdef long restoring = self.prob.s if self.opt.restore_feasibility else 0
+        return self.opt.max_iter - iteration + restoring
+
+    cdef int _certify(self, bint schur_factored) noexcept nogil:
+        """Establish convexity for the current matrices (see :func:`fccqp.kkt.kkt_convexity`);
+        ``schur_factored`` says that the Schur backend has just factored them."""
+        cdef int code = kkt_convexity(&self.kkt, &self.prob, self.opt.sigma, self.it.rho_vec,
+                                      schur_factored)
+        if code == FACTORED:
+            self.certified = True
+        return code
+
+    cdef int _factor(self, Run* run, long budget) noexcept nogil:
+        """Factor for the current rho with the backend the settings ask for, falling back
+        in the order Schur, LDL' reduced, LDL' full ("auto" starts with Schur when the
+        reduced table pays for itself within ``budget`` and the constrained entries are
+        at most half the KKT size, else with LDL' full). Certifies convexity when the
+        matrices are new. Returns FACTORED, NOT_CONVEX, or UNAVAILABLE (numerical
+        breakdown); records the form and the rho it factored."""
+        cdef Problem* p = &self.prob
+        cdef int backend, code, first = self.opt.backend
+        cdef bint reduced_pays
+        if first == AUTO:
+            reduced_pays = 2 * p.s <= p.n + p.m and _REDUCED_COST * p.s <= budget
+            first = SCHUR_REDUCED if reduced_pays else LDL_FULL
+        for backend in range(first, LDL_FULL + 1):
+            if not self.certified and backend != SCHUR_REDUCED:
+                # certify first: the certificate overwrites an LDL' factorization
+                code = self._certify(False)
+                run.factorizations += 1
+                if code == NOT_CONVEX:
+                    return NOT_CONVEX
+            code = kkt_factor(&self.kkt, p, backend,
+                              self.opt.sigma if backend == LDL_FULL else 0.0, self.it.rho_vec)
+            run.factorizations += 1
+            if code != FACTORED:
+                if backend == LDL_FULL:
+                    return UNAVAILABLE
+                continue
+            if not self.certified and self._certify(True) == NOT_CONVEX:
+                return NOT_CONVEX
+            if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,
+                                                         self.it.rho_vec):
+                continue
+            self.form = backend
+            run.backend = backend
+            self.factored_rho = run.rho
+            return FACTORED
+        return UNAVAILABLE
+
+    cdef void _reduced_base(self) noexcept nogil:
+        """``base``: the x-update's response to ``(-q, b)`` alone (q and b change every
+        solve; the table only with the factorization)."""
+        cdef Problem* p = &self.prob
+        cdef Py_ssize_t i
+        for i in range(p.n):
+            self.rhs[i] = -p.q[i]
+        for i in range(p.m):
+            self.rhs[p.n + i] = p.b[i]
+        kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.red.base)
+
+    cdef int _equality_start(self, bint* unbounded) noexcept nogil:
+        """Paper's cold start: ``x`` solves the QP with equalities only, ``z = P_C(x_S)``,
+        ``y = 0``.
+
+        The factorization carries the regularization ``sigma I`` and no rho, so its
+        inertia certifies convexity; a few proximal steps (``x_{j+1} = argmin f +
+        sigma/2 ||x - x_j||^2`` on the same factorization) remove sigma's bias, so that
+        an optimum with no active constraint is recognised at once. When the solution
+        is huge the equality-constrained QP is unbounded: ``direction`` keeps it (a
+        candidate certificate) and the start falls back to the origin.
+        """
+        cdef Problem* p = &self.prob
+        cdef Iterates* it = &self.it
+        cdef Py_ssize_t n = p.n, m = p.m, i, step
+        cdef double sigma = self.opt.sigma
+        fill(it.rho_vec, 0.0, p.s)
+        self.factored_rho = -1.0  # the KKT matrix now holds no rho factorization
+        self.form = LDL_FULL
+        cdef int code = kkt_factor(&self.kkt, p, LDL_FULL, sigma, it.rho_vec)
+        if code != FACTORED:
+            return NOT_CONVEX
+        self.certified = True
+        fill(it.x, 0.0, n)
+        for i in range(m):
+            self.rhs[n + i] = p.b[i]
+        for step in range(_EQUALITY_START_STEPS):
+            for i in range(n):
+                self.rhs[i] = sigma * it.x[i] - p.q[i]
+            kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
+            copy(self.sol, it.x, n)
+        copy(self.sol + n, it.nu, m)
+        unbounded[0] = sigma * inf_norm(it.x, n) > _EQUALITY_START_LIMIT * max(
+            1.0, inf_norm(p.q, n))
+        if unbounded[0]:
+            copy(it.x, self.direction, n)
+            fill(it.x, 0.0, n)
+            fill(it.nu, 0.0, m)
+        for i in range(p.s):
+            it.z[i] = it.x[p.constrained[i]]
+        proj_set(it.z, p.lo, p.hi, p.cones, p.s, it.z)
+        fill(it.y, 0.0, p.s)
+        copy(it.x, it.x_prev, n)
+        copy(it.nu, it.nu_prev, m)
+        copy(it.y, it.y_prev, p.s)
+        return FACTORED
+
+    cdef void _restore_equalities(self) noexcept nogil:
+        """Remove the rounding that a combination of KKT solutions (``x = base + W u`` in
+        the reduced form, a restoration) accumulates in ``A x = b``: one refined KKT
+        solve for ``(0, b - A x)`` with the current factorization."""
+        cdef Problem* p = &self.prob
+        cdef Py_ssize_t n = p.n, m = p.m, i
+        if m == 0:
+            return
+        fill(self.rhs, 0.0, n)
+        matvec(p.A, self.it.x, self.rhs + n, m, n)
+        for i in range(m):
+            self.rhs[n + i] = p.b[i] - self.rhs[n + i]
+        kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.sol)
+        for i in range(n):
+            self.it.x[i] += self.sol[i]
+        for i in range(m):
+            self.it.nu[i] += self.sol[n + i]
+
+    cdef int _keep_restored(self, int status, long iteration, bint reduced,
+                            double start_time) noexcept nogil:
+        """Replace the final iterate by its feasibility restoration (see
+        :mod:`fccqp.restoration`) when that is better.
+
+        The restored point has its violating constrained entries pinned at their
+        projection; its status comes from its own residuals, with the slack set to its
+        (feasible) ``x_S``. It is kept when its primal residual shows that the other
+        entries absorbed the pinning (``RESTORED_EQUALITY``) and, if the iterate was
+        solved, when it is solved too. Equalities hold to factorization accuracy in
+        either case.
+        """
+        cdef Problem* p = &self.prob
+        cdef Iterates* it = &self.it
+        cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j
+        cdef int new_status
+        copy(it.x, self.saved, n)
+        copy(it.nu, self.saved + n, m)
+        copy(it.z, self.saved + n + m, s)
+        if restore(&self.rest, &self.kkt, &self.red, reduced, p, it):
+            self._restore_equalities()
+            for j in range(s):
+                it.z[j] = it.x[p.constrained[j]]
+            proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
+            self._residuals()
+            new_status = self._classify(iteration, True, start_time)
+            if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)
+                    and (status != _SOLVED or new_status == _SOLVED)):
+                return new_status
+        copy(self.saved, it.x, n)
+        copy(self.saved + n, it.nu, m)
+        copy(self.saved + n + m, it.z, s)
+        if reduced:
+            self._restore_equalities()
+        return status
+
+    # ------------------------------------------------------------- bookkeeping
+
+    cdef void _residuals(self) noexcept nogil:
+        residuals(&self.prob, &self.it, self.vec_m, self.vec_n, self.vec_n2, &self.res)
+
+    cdef void _log(self, long iteration, double rho) noexcept nogil:
+        cdef double* row
+        if self.log_count < self.log_rows:
+            row = self.log + 5 * self.log_count
+            row[0], row[1], row[2], row[3], row[4] = (
+                iteration, self.res.prim, self.res.dual, self.res.gap, rho)
+            self.log_count += 1
+
+    cdef void _finish_run(self, Run* run, int status, long iteration) noexcept nogil:
+        run.status = status
+        run.iterations = iteration
+        run.backend = self.form
+
+    cdef void _finish(self, Run* run, double* x, double* y, double* z,
+                      double* cert) noexcept nogil:
+        """Unscale the iterate into the result arrays, recompute its residuals in the
+        user's units from the returned point alone (the primal one as the distance of
+        ``x_S`` to C), settle the status on them and keep the point for a warm start."""
+        cdef Problem* p = &self.prob
+        cdef Iterates* it = &self.it
+        cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
+        unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)
+        if run.status == _PRIMAL_INFEASIBLE or run.status == _DUAL_INFEASIBLE:
+            copy(self.cert, cert, n + m)
+        self._user_residuals(x, y, z)
+        if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):
+            if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):
+                run.status = _SOLVED
+            elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
+                run.status = _INACCURATE
+            elif run.status in (_SOLVED, _INACCURATE):
+                run.status = _NUMERICAL_ERROR   # the scaled test passed, the point does not
+        if not self.res.finite:
+            run.status = _NUMERICAL_ERROR
+        self.has_previous = self.res.finite and run.status not in (
+            _PRIMAL_INFEASIBLE, _DUAL_INFEASIBLE)
+        if self.has_previous:
+            copy(x, self.prev_x, n)
+            copy(y, self.prev_y, m)
+            copy(z, self.prev_z, n)
+            self.prev_rho = run.rho
+
+    cdef void _user_residuals(self, const double* x, const double* y,
+                              const double* z) noexcept nogil:
+        """:mod:`fccqp.termination`'s residuals of the returned ``(x, y, z)`` on the user's
+        data, with ``dist(x_S, C)`` as the primal part off the equalities."""
+        cdef Problem* p = &self.prob
+        cdef Residuals* r = &self.res
+        cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
+        cdef double* Ax = self.vec_m
+        cdef double* grad = self.vec_n
+        cdef double* ATy = self.vec_n2
+        cdef double* proj = self.vec_s
+        cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, total = 0.0, value
+        matvec(self.A_user, x, Ax, m, n)
+        matvec_t(self.A_user, y, ATy, m, n)
+        matvec(self.P_user, x, grad, n, n)
+        r.prim = r.prim_scale = 0.0
+        for i in range(m):
+            r.prim = max(r.prim, fabs(Ax[i] - self.b_user[i]))
+            r.prim_scale = max(r.prim_scale, max(fabs(Ax[i]), fabs(self.b_user[i])))
+            by += self.b_user[i] * y[i]
+        for j in range(s):
+            i = p.constrained[j]
+            value = x[i]
+            if value < self.lb_user[i]:
+                value = self.lb_user[i]
+            if value > self.ub_user[i]:
+                value = self.ub_user[i]
+            proj[j] = value
+        for j in range(p.cones.count):   # cone blocks are contiguous in x too
+            i = p.cones.offset[j]
+            proj_block(x + p.constrained[i], p.cones.kind[j], p.cones.dim[j], p.cones.mu[j],
+                       p.cones.normal + 3 * j, proj + i)
+        r.dual_scale = 0.0
+        for j in range(s):
+            i = p.constrained[j]
+            r.prim = max(r.prim, fabs(x[i] - proj[j]))
+            r.prim_scale = max(r.prim_scale, fabs(x[i]))
+            if z[i] > 0.0 and isfinite(self.ub_user[i]):
+                support += self.ub_user[i] * z[i]
+            elif z[i] < 0.0 and isfinite(self.lb_user[i]):
+                support += self.lb_user[i] * z[i]
+        r.dual = 0.0
+        for i in range(n):
+            xPx += x[i] * grad[i]
+            qx += self.q_user[i] * x[i]
+            r.dual_scale = max(r.dual_scale, max(fabs(grad[i]), fabs(self.q_user[i])))
+            value = grad[i] + self.q_user[i] + ATy[i] + z[i]
+            r.dual = max(r.dual, fabs(value))
+            total += fabs(value) + fabs(x[i]) + fabs(z[i])
+        for i in range(m):
+            total += fabs(y[i])
+        r.gap = fabs(xPx + qx + by + support)
+        r.gap_scale = max(fabs(xPx), fabs(qx))
+        r.finite = isfinite(total) and isfinite(r.gap) and isfinite(r.prim)
+

@@ -1,0 +1,149 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""Safeguarded type-II Anderson acceleration of the ADMM map ``g = (z, y/rho) -> T(g)``.
+
+The step just taken went from ``g = (z_prev, y_prev/rho)`` to ``T(g) = (z, y/rho)``,
+with fixed-point residual ``f = T(g) - g``. With the last differences ``dG, dF`` of
+``g`` and ``f``, the next point is ``T(g) - (dG + dF) gamma``, ``gamma`` minimizing
+``||f - dF gamma||`` (a ridge-regularized normal equation). Safeguard: when the step
+from an accelerated point has a larger residual than the step before it, the plain
+``T`` of the previous point is restored and the memory cleared, and plain ADMM runs
+``capacity`` steps before the next try (for the rest of the run after
+``MAX_REJECTIONS`` rejections).
+"""
+
+import numpy as np
+
+from libc.math cimport sqrt
+
+from fccqp._types cimport Iterates
+
+MAX_REJECTIONS = 3
+"""Anderson steps rejected by the safeguard before a run gives up accelerating."""
+REGULARIZATION = 1e-8
+"""Tikhonov weight of the least-squares problem, relative to its largest diagonal."""
+cdef long _MAX_REJECTIONS = MAX_REJECTIONS
+cdef double _REGULARIZATION = REGULARIZATION
+
+
+cdef void anderson_reset(Anderson* a, bint keep_rejections) noexcept nogil:
+    """Forget the memory (after a change of rho, or at the start of a run)."""
+    a.stored = 0
+    a.have_previous = False
+    a.accelerated = False
+    if not keep_rejections:
+        a.wait = 0
+        a.rejections = 0
+
+
+cdef bint solve_small_spd(double* M, double* b, int k) noexcept nogil:
+    """Solve ``M x = b`` in place (``b`` becomes ``x``, ``M`` row-major its Cholesky
+    factor) for the tiny positive definite Gram matrix; False if a pivot is not
+    positive. At size 10 this loop beats LAPACK's call overhead (0.5 us against 1.2 us
+    for ``dpotrf`` + ``dpotrs``, measured through numba), and it runs every iteration.
+    """
+    cdef int c, r, t
+    cdef double pivot, value
+    for c in range(k):
+        pivot = M[c * k + c]
+        for t in range(c):
+            pivot -= M[c * k + t] * M[c * k + t]
+        if not pivot > 0.0:
+            return False
+        pivot = sqrt(pivot)
+        M[c * k + c] = pivot
+        for r in range(c + 1, k):
+            value = M[r * k + c]
+            for t in range(c):
+                value -= M[r * k + t] * M[c * k + t]
+            M[r * k + c] = value / pivot
+    for r in range(k):
+        value = b[r]
+        for t in range(r):
+            value -= M[r * k + t] * b[t]
+        b[r] = value / M[r * k + r]
+    for r in range(k - 1, -1, -1):
+        value = b[r]
+        for t in range(r + 1, k):
+            value -= M[t * k + r] * b[t]
+        b[r] = value / M[r * k + r]
+    return True
+
+
+cdef void anderson_step(Anderson* a, Iterates* it, Py_ssize_t s) noexcept nogil:
+    """Record the step just taken and extrapolate ``(z, y)`` in ``it`` when possible."""
+    cdef Py_ssize_t j, i, l, two_s = 2 * s, slot
+    cdef int stored, cap = a.capacity
+    cdef double f_norm = 0.0, ridge, acc, step_z, step_y, coefficient
+    cdef double* g = a.g_new
+    cdef double* f = a.f_new
+    for j in range(s):
+        g[j] = it.z_prev[j]
+        g[s + j] = it.y_prev[j] / it.rho_vec[j]
+        f[j] = it.z[j] - g[j]
+        f[s + j] = it.y[j] / it.rho_vec[j] - g[s + j]
+    for j in range(two_s):
+        f_norm += f[j] * f[j]
+    f_norm = sqrt(f_norm)
+    if a.accelerated and f_norm > a.plain[two_s]:
+        for j in range(s):
+            it.z[j] = a.plain[j]
+            it.y[j] = a.plain[s + j] * it.rho_vec[j]
+        a.rejections += 1
+        anderson_reset(a, True)
+        # let plain ADMM run before trying again; after a few failures, for good
+        a.wait = cap if a.rejections < _MAX_REJECTIONS else (<long>1) << 62
+        return
+    if a.wait > 0:
+        a.wait -= 1
+        return
+    if a.have_previous:
+        slot = a.stored % cap
+        for j in range(two_s):
+            a.dg[slot * two_s + j] = g[j] - a.g[j]
+            a.df[slot * two_s + j] = f[j] - a.f[j]
+        a.stored += 1
+    for j in range(two_s):
+        a.g[j] = g[j]
+        a.f[j] = f[j]
+    a.plain[two_s] = f_norm
+    a.have_previous = True
+    stored = <int>min(a.stored, <long>cap)
+    a.accelerated = False
+    if stored == 0:
+        return
+    ridge = 0.0
+    for i in range(stored):
+        for l in range(i + 1):
+            acc = 0.0
+            for j in range(two_s):
+                acc += a.df[i * two_s + j] * a.df[l * two_s + j]
+            a.gram[i * stored + l] = acc
+            a.gram[l * stored + i] = acc
+        ridge = max(ridge, a.gram[i * stored + i])
+        acc = 0.0
+        for j in range(two_s):
+            acc += a.df[i * two_s + j] * f[j]
+        a.gamma[i] = acc
+    for i in range(stored):
+        a.gram[i * stored + i] += _REGULARIZATION * ridge + 1e-300
+    if not solve_small_spd(a.gram, a.gamma, stored):
+        return
+    for j in range(s):
+        a.plain[j] = it.z[j]
+        a.plain[s + j] = it.y[j] / it.rho_vec[j]
+        step_z = 0.0
+        step_y = 0.0
+        for i in range(stored):
+            coefficient = a.gamma[i]
+            step_z += (a.dg[i * two_s + j] + a.df[i * two_s + j]) * coefficient
+            step_y += (a.dg[i * two_s + s + j] + a.df[i * two_s + s + j]) * coefficient
+        it.z[j] -= step_z
+        it.y[j] -= step_y * it.rho_vec[j]
+    a.accelerated = True
+
+
+def solve_small_spd_py(double[:, ::1] M, double[::1] b):
+    """:func:`solve_small_spd` on numpy arrays (``M`` is overwritten by its factor)."""
+    if M.shape[0] != M.shape[1] or M.shape[0] != b.shape[0] or b.shape[0] == 0:
+        raise ValueError("M must be square and match b")
+    return solve_small_spd(&M[0, 0], &b[0], <int>b.shape[0])

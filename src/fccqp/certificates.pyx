@@ -1,0 +1,157 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""Infeasibility certificates from ADMM's last step, judged relative to their own terms.
+
+On an infeasible problem ADMM's iterates diverge along a certificate, so the last step
+is tested (as in OSQP), but with every "approximately zero" judged against the size of
+the terms that must cancel, not in absolute terms: a certificate is then invariant to
+the scale of the data, and the rounding noise of a sum (``1e-16`` of its terms) never
+passes for one. Concretely, for terms ``t_k`` of a sum ``S``, "``S ~ 0``" is ``|S| <= eps
+max |t_k|`` and "``S < 0``" is ``S < -eps sum |t_k|``. All tests run on the scaled
+problem; norms are taken in the user's units.
+
+- primal: ``(d_nu, d_y)`` with ``A'd_nu + E_S d_y ~ 0`` and ``b'd_nu + sigma_C(d_y) < 0``,
+  ``d_y`` first projected onto the polar of C's recession cone (where ``sigma_C`` is
+  finite);
+- equality: the residual ``r = b - A x`` of a KKT solution, when ``A x = b`` has no
+  solution, is the least-squares residual: ``A'r ~ 0`` and ``b'r > 0``;
+- dual: a direction ``dx`` with ``P dx ~ 0``, ``A dx ~ 0``, ``q'dx < 0`` and ``dx_S`` in the
+  recession cone of C.
+"""
+
+from libc.math cimport fabs, isfinite
+
+from fccqp._types cimport Iterates, Problem
+from fccqp.projections cimport proj_block
+
+
+cdef bint primal_infeasible(const Problem* p, const Iterates* it, double eps, double* d_nu,
+                            double* d_y, double* lhs, double* terms) noexcept nogil:
+    """Test ``(nu - nu_prev, y - y_prev)``; ``d_nu`` (m), ``d_y`` (s), ``lhs`` and ``terms``
+    (n) are scratch, and on success hold the certificate (``d_y`` projected)."""
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j, k, a, dim
+    cdef double value, support = 0.0, size = 0.0, lhs_max = 0.0, terms_max = 0.0
+    for i in range(m):
+        d_nu[i] = it.nu[i] - it.nu_prev[i]
+    for j in range(s):
+        d_y[j] = it.y[j] - it.y_prev[j]
+    for k in range(p.cones.count):   # onto the polar: d_y - P_K(d_y), terms as scratch
+        a, dim = p.cones.offset[k], p.cones.dim[k]
+        proj_block(d_y + a, p.cones.kind[k], dim, p.cones.mu[k], p.cones.normal + 3 * k,
+                   terms)
+        for j in range(dim):
+            d_y[a + j] -= terms[j]
+    for j in range(s):
+        if not isfinite(p.hi[j]) and d_y[j] > 0.0:
+            d_y[j] = 0.0
+        if not isfinite(p.lo[j]) and d_y[j] < 0.0:
+            d_y[j] = 0.0
+        if d_y[j] > 0.0:
+            support += p.hi[j] * d_y[j]
+            size += fabs(p.hi[j] * d_y[j])
+        elif d_y[j] < 0.0:
+            support += p.lo[j] * d_y[j]
+            size += fabs(p.lo[j] * d_y[j])
+    for i in range(m):
+        support += p.b[i] * d_nu[i]
+        size += fabs(p.b[i] * d_nu[i])
+    if not (support < -eps * size) or not isfinite(support):
+        return False
+    for i in range(n):
+        lhs[i] = 0.0
+        terms[i] = 0.0
+    for i in range(m):
+        for j in range(n):
+            value = p.A[i * n + j] * d_nu[i]
+            lhs[j] += value
+            terms[j] += fabs(value)
+    for j in range(s):
+        i = p.constrained[j]
+        lhs[i] += d_y[j]
+        terms[i] += fabs(d_y[j])
+    for i in range(n):
+        lhs_max = max(lhs_max, fabs(lhs[i]) / p.D[i])
+        terms_max = max(terms_max, terms[i] / p.D[i])
+    return lhs_max <= eps * terms_max
+
+
+cdef bint equality_inconsistent(const Problem* p, const Iterates* it, double eps, double* r,
+                                double* ATr, double* terms) noexcept nogil:
+    """Test ``r = b - A x`` (``r``: m scratch; ``ATr``, ``terms``: n scratch)."""
+    cdef Py_ssize_t n = p.n, m = p.m, i, j
+    cdef double value, br = 0.0, size = 0.0, lhs_max = 0.0, terms_max = 0.0
+    if m == 0:
+        return False
+    for i in range(m):
+        value = p.b[i]
+        for j in range(n):
+            value -= p.A[i * n + j] * it.x[j]
+        r[i] = value
+        br += p.b[i] * value
+        size += fabs(p.b[i] * value)
+    if not (br > eps * size) or not isfinite(br):
+        return False
+    for j in range(n):
+        ATr[j] = 0.0
+        terms[j] = 0.0
+    for i in range(m):
+        for j in range(n):
+            value = p.A[i * n + j] * r[i]
+            ATr[j] += value
+            terms[j] += fabs(value)
+    for j in range(n):
+        lhs_max = max(lhs_max, fabs(ATr[j]) / p.D[j])
+        terms_max = max(terms_max, terms[j] / p.D[j])
+    return lhs_max <= eps * terms_max
+
+
+cdef inline bint _near_zero(const double* M, const double* dx, Py_ssize_t rows,
+                            Py_ssize_t cols, const double* row_unit, double unit_scale,
+                            double eps, double* out, double* terms) noexcept nogil:
+    """``M dx ~ 0`` (row-major ``M``) relative to the largest row of terms, row ``i``
+    divided by ``unit_scale * row_unit[i]`` (the user's units); ``out`` and ``terms``
+    are scratch of ``rows`` entries."""
+    cdef Py_ssize_t i, j
+    cdef double value, lhs_max = 0.0, terms_max = 0.0, unit
+    for i in range(rows):
+        out[i] = 0.0
+        terms[i] = 0.0
+        for j in range(cols):
+            value = M[i * cols + j] * dx[j]
+            out[i] += value
+            terms[i] += fabs(value)
+        unit = unit_scale * row_unit[i]
+        lhs_max = max(lhs_max, fabs(out[i]) / unit)
+        terms_max = max(terms_max, terms[i] / unit)
+    return lhs_max <= eps * terms_max
+
+
+cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double* Pdx,
+                          double* terms, double* block) noexcept nogil:
+    """Test the direction ``dx`` (scaled); ``Pdx`` and ``terms`` (``max(n, m)``) and
+    ``block`` (s) are scratch."""
+    cdef Py_ssize_t n = p.n, s = p.s, i, j, k, a, dim
+    cdef double qdx = 0.0, size = 0.0, norm = 0.0, step, tol
+    for i in range(n):
+        qdx += p.q[i] * dx[i]
+        size += fabs(p.q[i] * dx[i])
+        norm = max(norm, fabs(dx[i] * p.D[i]))
+    if not (qdx < -eps * size) or not isfinite(qdx) or norm <= 1e-300:
+        return False
+    tol = eps * norm
+    for j in range(s):
+        i = p.constrained[j]
+        step = dx[i] * p.D[i]
+        if (isfinite(p.hi[j]) and step > tol) or (isfinite(p.lo[j]) and step < -tol):
+            return False
+    for k in range(p.cones.count):
+        a, dim = p.cones.offset[k], p.cones.dim[k]
+        for j in range(dim):
+            block[a + j] = dx[p.constrained[a + j]]
+        proj_block(block + a, p.cones.kind[k], dim, p.cones.mu[k], p.cones.normal + 3 * k,
+                   terms)
+        for j in range(dim):
+            if fabs(block[a + j] - terms[j]) * p.D[p.constrained[a]] > tol:
+                return False
+    if not _near_zero(p.P, dx, n, n, p.D, p.c, eps, Pdx, terms):
+        return False
+    return p.m == 0 or _near_zero(p.A, dx, p.m, n, p.E, 1.0, eps, Pdx, terms)

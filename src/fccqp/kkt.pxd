@@ -1,0 +1,34 @@
+# cython: language_level=3
+from fccqp._types cimport Problem
+from fccqp.ldl cimport LDL
+from fccqp.schur cimport Schur
+
+cdef enum:
+    # Backends of the x-update (Settings.kkt_backend), in the order "auto" tries them.
+    SCHUR_REDUCED = 0   # Cholesky of P + R and of A H^-1 A', reduced iteration
+    LDL_REDUCED = 1     # quasi-definite LDL', reduced iteration
+    LDL_FULL = 2        # quasi-definite LDL', one refined KKT solve per iteration
+    AUTO = 3
+
+cdef enum:
+    # Outcomes of kkt_factor.
+    FACTORED = 0
+    NOT_CONVEX = 1      # the inertia shows negative curvature of P on the null space of A
+    UNAVAILABLE = 2     # this backend cannot factor this matrix (caller falls back)
+
+cdef struct KKT:
+    int backend         # the backend factored last
+    double sigma        # the proximal term it was factored with
+    LDL ldl
+    Schur schur
+    double* R           # (n + m) x s scratch, for refining columns
+    double* work        # n + m scratch
+
+cdef int kkt_factor(KKT* k, const Problem* p, int backend, double sigma,
+                    const double* rho_vec) noexcept nogil
+cdef void kkt_solve(KKT* k, const Problem* p, const double* rho_vec, const double* rhs,
+                    double* sol) noexcept nogil
+cdef bint kkt_unit_columns(KKT* k, const Problem* p, const double* rho_vec,
+                           const Py_ssize_t* entries, int count, double* W) noexcept nogil
+cdef int kkt_convexity(KKT* k, const Problem* p, double sigma, const double* rho_vec,
+                       bint schur_factored) noexcept nogil

@@ -1,0 +1,81 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""The linear-system contract of the x-update, over the two dense backends.
+
+Every backend solves the KKT system of the x-update,
+
+    [ P + sigma I + R   A' ] [x ]   [r]
+    [ A                 0  ] [nu] = [b],      R = diag(rho on constrained entries),
+
+through four calls: :func:`kkt_factor` (for given P, A, sigma, rho), :func:`kkt_solve`
+(one refined right-hand side), :func:`kkt_unit_columns` (responses to unit right-hand
+sides on chosen entries, the reduced form's table and the restoration's columns) and
+:func:`kkt_convexity` (is the QP convex?). The backends are :mod:`fccqp.schur`
+(Cholesky, needs ``P + R`` positive definite and ``A`` of full row rank; the reduced
+form only) and :mod:`fccqp.ldl` (quasi-definite LDL', any ``A``). ``sigma`` is 0 in
+the reduced forms.
+"""
+
+from fccqp._types cimport Problem
+from fccqp.ldl cimport ldl_factor, ldl_solve, ldl_unit_columns
+from fccqp.schur cimport schur_certifies_convexity, schur_factor, schur_solve, schur_unit_columns
+
+
+cdef int kkt_factor(KKT* k, const Problem* p, int backend, double sigma,
+                    const double* rho_vec) noexcept nogil:
+    """Factor with ``backend`` (not AUTO). The LDL' inertia rejects a matrix with more
+    than ``m`` negative eigenvalues (``P + R`` not convex on the null space of ``A``)."""
+    cdef int negative
+    k.backend = backend
+    k.sigma = sigma
+    if backend == SCHUR_REDUCED:
+        return FACTORED if schur_factor(&k.schur, p, rho_vec) else UNAVAILABLE
+    negative = ldl_factor(&k.ldl, p, sigma, rho_vec)
+    if negative < 0 or (negative < p.m and backend == LDL_REDUCED):
+        return UNAVAILABLE   # the reduced form needs P + R definite on the null space of A
+    return NOT_CONVEX if negative > p.m else FACTORED
+
+
+cdef void kkt_solve(KKT* k, const Problem* p, const double* rho_vec, const double* rhs,
+                    double* sol) noexcept nogil:
+    """Solve for ``rhs`` into ``sol`` with the backend factored last, refined."""
+    if k.backend == SCHUR_REDUCED:
+        schur_solve(&k.schur, p, rho_vec, rhs, sol)
+    else:
+        ldl_solve(&k.ldl, p, k.sigma, rho_vec, rhs, sol)
+
+
+cdef bint kkt_unit_columns(KKT* k, const Problem* p, const double* rho_vec,
+                           const Py_ssize_t* entries, int count, double* W) noexcept nogil:
+    """Fill ``W`` (Fortran, ``(n + m) x count``) with the responses to ``[e_i; 0]``,
+    ``i`` in ``entries``. The Schur backend serves only ``entries`` = all of the
+    constrained entries, in order. False when refinement missed its tolerance."""
+    if k.backend == SCHUR_REDUCED:
+        schur_unit_columns(&k.schur, p, W)
+        return True
+    return ldl_unit_columns(&k.ldl, p, k.sigma, rho_vec, entries, count, W, k.R, k.work)
+
+
+cdef int kkt_convexity(KKT* k, const Problem* p, double sigma, const double* rho_vec,
+                       bint schur_factored) noexcept nogil:
+    """Decide whether the QP is convex: ``P + sigma I`` positive semidefinite on the null
+    space of ``A`` (FACTORED) or not (NOT_CONVEX).
+
+    A Schur factorization just computed (``schur_factored``) proves the common case for free (``P``
+    positive semidefinite); otherwise the penalty-free KKT matrix is factored with
+    LDL' and its inertia decides. That overwrites an LDL' factorization (not a Schur
+    one), so a caller iterating with LDL' certifies first and factors afterwards.
+    """
+    if schur_factored and schur_certifies_convexity(&k.schur, p, rho_vec, sigma):
+        return FACTORED
+    cdef int negative = ldl_factor(&k.ldl, p, sigma, _zeros(k, p.s))
+    if negative < 0:
+        return NOT_CONVEX
+    return NOT_CONVEX if negative > p.m else FACTORED
+
+
+cdef inline const double* _zeros(KKT* k, Py_ssize_t s) noexcept nogil:
+    """``s`` zeros in the scratch ``work`` (a penalty vector of zero)."""
+    cdef Py_ssize_t i
+    for i in range(s):
+        k.work[i] = 0.0
+    return k.work

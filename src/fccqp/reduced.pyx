@@ -1,0 +1,147 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""The reduced iteration: an ADMM step in ``O(s^2)`` instead of a KKT solve.
+
+When ``P + R`` is positive definite (no ``sigma`` needed), the x-update is ``(x~, nu)
+= base + W v`` with ``v = rho z - y`` and ``W`` the ``(n + m) x s`` block of the KKT
+inverse on the constrained entries, so an iteration needs only ``x~_S = base_S + W_S
+v``, an ``s x s`` product; ``x`` and ``nu`` are formed (:func:`materialize`) only when
+residuals are checked. Works on top of either backend of :mod:`fccqp.kkt`.
+
+Coordinates: ``x = base + W u`` means that ``x`` solves the x-update's KKT system for
+the right-hand side ``(-q + E_S u, b)``. After a change of ``R`` the same ``x`` has the
+coordinate ``u + (R' - R) x_S`` in the new table (:func:`reduced_rebase`).
+"""
+
+from fccqp._types cimport Iterates, Problem
+from fccqp.kkt cimport KKT, kkt_solve, kkt_unit_columns
+from fccqp.projections cimport proj_set
+
+
+cdef bint reduced_table(Reduced* r, KKT* k, const Problem* p, const double* rho_vec) noexcept nogil:
+    """Tabulate ``W``, ``W_S`` and ``base`` with the factorization in ``k``; False when
+    the columns missed the refinement tolerance."""
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, N = n + m, i, j
+    if not kkt_unit_columns(k, p, rho_vec, p.constrained, <int>s, r.W):
+        return False
+    for j in range(s):
+        for i in range(s):
+            r.W_S[j * s + i] = r.W[p.constrained[j] + i * N]
+    for i in range(n):
+        r.rhs[i] = -p.q[i]
+    for i in range(m):
+        r.rhs[n + i] = p.b[i]
+    kkt_solve(k, p, rho_vec, r.rhs, r.base)
+    return True
+
+
+cdef void reduced_start(Reduced* r, const Problem* p, Iterates* it) noexcept nogil:
+    """Coordinates of the start: ``u = v = rho z - y`` (the first step is not relaxed)."""
+    cdef Py_ssize_t j
+    for j in range(p.s):
+        r.v[j] = it.rho_vec[j] * it.z[j] - it.y[j]
+        r.u[j] = r.v[j]
+        r.v_prev[j] = r.v[j]
+        r.u_prev[j] = r.u[j]
+
+
+cdef inline void _table_product(const Reduced* r, const double* c, double* out,
+                                Py_ssize_t s) noexcept nogil:
+    """``out = W_S c`` (row-major ``s x s``)."""
+    cdef Py_ssize_t i, j
+    cdef double acc
+    cdef const double* row
+    for i in range(s):
+        row = r.W_S + i * s
+        acc = 0.0
+        for j in range(s):
+            acc += row[j] * c[j]
+        out[i] = acc
+
+
+cdef void reduced_step(Reduced* r, const Problem* p, Iterates* it, double alpha,
+                       bint relax_x) noexcept nogil:
+    """One ADMM iteration with ``x = base + W u`` kept implicit through ``u``."""
+    cdef Py_ssize_t s = p.s, j
+    cdef double alpha_x = alpha if relax_x else 1.0
+    for j in range(s):
+        it.z_prev[j] = it.z[j]
+        it.y_prev[j] = it.y[j]
+        r.v_prev[j] = r.v[j]
+        r.u_prev[j] = r.u[j]
+        r.v[j] = it.rho_vec[j] * it.z[j] - it.y[j]
+    _table_product(r, r.v, r.xs, s)
+    for j in range(s):
+        it.relaxed[j] = alpha * (r.base[p.constrained[j]] + r.xs[j]) + (1.0 - alpha) * it.z_prev[j]
+        r.u[j] = alpha_x * r.v[j] + (1.0 - alpha_x) * r.u_prev[j]
+        it.z[j] = it.relaxed[j] + it.y[j] / it.rho_vec[j]
+    proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
+    for j in range(s):
+        it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])
+
+
+cdef bint near_convergence(Reduced* r, const Problem* p, Iterates* it, double eps_p,
+                           double eps_d) noexcept nogil:
+    """Cheap gate before a residual check, in ``O(s^2)``.
+
+    ``(x, nu) = base + W u`` satisfies ``P x + q + A'nu = E_S (u - R x_S)`` (the KKT
+    identity of ``base`` and ``W``), so with that ``nu`` the dual residual is ``u - R x_S
+    + y`` on the constrained entries and zero elsewhere; the primal residual is ``x_S -
+    z`` (``A x = b`` holds by construction). The iterate's ``nu`` comes from ``v``, not
+    ``u``, and ``eps_p``, ``eps_d`` are from the last full check, so this only decides
+    whether the full check is worth running.
+    """
+    cdef Py_ssize_t j, i
+    cdef double x
+    _table_product(r, r.u, r.xs, p.s)
+    for j in range(p.s):
+        i = p.constrained[j]
+        x = r.base[i] + r.xs[j]
+        if abs(x - it.z[j]) * p.D[i] > eps_p:
+            return False
+        if abs(r.u[j] - it.rho_vec[j] * x + it.y[j]) > eps_d * p.c * p.D[i]:
+            return False
+    return True
+
+
+cdef inline void _combine(const Reduced* r, const double* c, double* out, Py_ssize_t first,
+                          Py_ssize_t count, Py_ssize_t N, Py_ssize_t s) noexcept nogil:
+    """``out = (base + W c)[first:first + count]`` (column by column: contiguous)."""
+    cdef Py_ssize_t i, j
+    cdef const double* column
+    cdef double cj
+    for i in range(count):
+        out[i] = r.base[first + i]
+    for j in range(s):
+        column = r.W + j * N + first
+        cj = c[j]
+        for i in range(count):
+            out[i] += column[i] * cj
+
+
+cdef void materialize(Reduced* r, const Problem* p, Iterates* it) noexcept nogil:
+    """Form ``x, nu`` and their previous values from ``base + W (u, v)``."""
+    cdef Py_ssize_t n = p.n, m = p.m, N = n + m, s = p.s
+    _combine(r, r.u, it.x, 0, n, N, s)
+    _combine(r, r.u_prev, it.x_prev, 0, n, N, s)
+    _combine(r, r.v, it.nu, n, m, N, s)
+    _combine(r, r.v_prev, it.nu_prev, n, m, N, s)
+
+
+cdef inline void _shift(Reduced* r, const Problem* p, double* c, const double* old_rho,
+                        const double* new_rho) noexcept nogil:
+    """``c += (R' - R) x_S(c)`` with ``x_S(c) = base_S + W_S c`` in the old table."""
+    cdef Py_ssize_t j
+    _table_product(r, c, r.xs, p.s)
+    for j in range(p.s):
+        c[j] += (new_rho[j] - old_rho[j]) * (r.base[p.constrained[j]] + r.xs[j])
+
+
+cdef void reduced_rebase(Reduced* r, const Problem* p, const double* old_rho,
+                         const double* new_rho) noexcept nogil:
+    """Carry ``u, u_prev, v, v_prev`` into the coordinates of the table for ``new_rho``,
+    so that the iterates they stand for (and the steps between them, which the
+    infeasibility tests read) are unchanged. Call before refactoring."""
+    _shift(r, p, r.u, old_rho, new_rho)
+    _shift(r, p, r.u_prev, old_rho, new_rho)
+    _shift(r, p, r.v, old_rho, new_rho)
+    _shift(r, p, r.v_prev, old_rho, new_rho)

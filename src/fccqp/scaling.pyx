@@ -1,0 +1,219 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""Ruiz equilibration of the problem data.
+
+With ``x = D x_s`` and the equality rows multiplied by ``E``, the solver works on
+
+    P_s = c D P D,   q_s = c D q,   A_s = E A D,   b_s = E b,   bounds / D,
+
+where each Ruiz pass divides every column of ``[[P, A'], [A, 0]]`` by the square
+root of its infinity norm (as OSQP does) and ``c`` normalizes the cost. ``D`` is
+kept constant over each cone block (geometric mean), so a scaled cone is the same
+cone: friction cones keep their ``mu`` and normal.
+
+:func:`scale_start` and :func:`unscale` carry iterates across the scaling:
+``x = D x_s``, equality multipliers ``y = E nu_s / c`` and constraint multipliers
+``z_S = y_s / (c D_S)``. The ``def`` functions at the end wrap them for tests.
+"""
+
+import numpy as np
+
+from libc.math cimport exp, fabs, log, sqrt
+
+from fccqp._types cimport Cones
+from fccqp.projections cimport proj_set
+
+MIN_NORM = 1e-4
+"""Column norms below this are treated as 1 (a column of zeros is left alone)."""
+MAX_NORM = 1e4
+"""Column norms are capped here, bounding one pass's scale change to 100x."""
+cdef double _MIN_NORM = MIN_NORM
+cdef double _MAX_NORM = MAX_NORM
+
+
+cdef inline double _inverse_sqrt_norm(double norm) noexcept nogil:
+    if norm < _MIN_NORM:
+        return 1.0
+    return 1.0 / sqrt(norm if norm < _MAX_NORM else _MAX_NORM)
+
+
+cdef inline double _row_max(const double* row, const double* weight, Py_ssize_t n) noexcept nogil:
+    """``max_j |row_j| weight_j`` with four running maxima: one running maximum is a
+    chain of dependent operations the compiler may not reorder; four run about twice
+    as fast on these rows (measured with the numba kernels this replaces)."""
+    cdef double m0 = 0.0, m1 = 0.0, m2 = 0.0, m3 = 0.0
+    cdef Py_ssize_t j = 0
+    while j + 4 <= n:
+        m0 = max(m0, fabs(row[j]) * weight[j])
+        m1 = max(m1, fabs(row[j + 1]) * weight[j + 1])
+        m2 = max(m2, fabs(row[j + 2]) * weight[j + 2])
+        m3 = max(m3, fabs(row[j + 3]) * weight[j + 3])
+        j += 4
+    while j < n:
+        m0 = max(m0, fabs(row[j]) * weight[j])
+        j += 1
+    return max(max(m0, m1), max(m2, m3))
+
+
+cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n,
+                        Py_ssize_t m, const Py_ssize_t* block_start,
+                        const Py_ssize_t* block_dim, Py_ssize_t blocks, Py_ssize_t iterations,
+                        double* D, double* E, double* d, double* e) noexcept nogil:
+    """Scale ``P, q, A, b`` in place; fill ``D`` and ``E``; return the cost scale ``c``.
+
+    Each pass reads the norms of the currently scaled matrix off the original entries
+    (row ``i`` of ``D P D`` has norm ``D_i max_j |P_ij| D_j``), so the data is touched
+    once per pass and rescaled once at the end. ``block_start``/``block_dim`` give the
+    cone blocks in ``x``; ``d`` and ``e`` are scratch of sizes ``n`` and ``m``.
+    """
+    cdef Py_ssize_t it, i, j, k, a, t
+    cdef double value, log_mean, mean_col, q_norm, size, c
+    cdef const double* row
+    for j in range(n):
+        D[j] = 1.0
+    for i in range(m):
+        E[i] = 1.0
+    for it in range(iterations):
+        # column maxima accumulate row by row (independent per column: the loops vectorize)
+        for j in range(n):
+            d[j] = 0.0
+        for i in range(n):
+            row = P + i * n
+            for j in range(n):
+                d[j] = max(d[j], fabs(row[j]) * D[i])
+        for j in range(n):
+            d[j] *= D[j]
+        for i in range(m):
+            row = A + i * n
+            for j in range(n):
+                d[j] = max(d[j], fabs(row[j]) * D[j] * E[i])
+            e[i] = _inverse_sqrt_norm(_row_max(row, D, n) * E[i])
+        for j in range(n):
+            d[j] = _inverse_sqrt_norm(d[j])
+        for k in range(blocks):
+            a, t = block_start[k], block_start[k] + block_dim[k]
+            log_mean = 0.0
+            for j in range(a, t):
+                log_mean += log(d[j])
+            value = exp(log_mean / (t - a))
+            for j in range(a, t):
+                d[j] = value
+        for j in range(n):
+            D[j] *= d[j]
+        for i in range(m):
+            E[i] *= e[i]
+    for i in range(n):
+        row = P + i * n
+        for j in range(n):
+            P[i * n + j] = row[j] * D[i] * D[j]
+        q[i] *= D[i]
+    for i in range(m):
+        for j in range(n):
+            A[i * n + j] *= E[i] * D[j]
+        b[i] *= E[i]
+    mean_col = 0.0
+    for j in range(n):
+        d[j] = 1.0
+    for i in range(n):
+        mean_col += _row_max(P + i * n, d, n)
+    mean_col /= n
+    q_norm = 0.0
+    for i in range(n):
+        q_norm = max(q_norm, fabs(q[i]))
+    size = max(mean_col if mean_col >= _MIN_NORM else 1.0,
+               q_norm if q_norm >= _MIN_NORM else 1.0)
+    c = 1.0 / min(size, _MAX_NORM)
+    for i in range(n * n):
+        P[i] *= c
+    for i in range(n):
+        q[i] *= c
+    return c
+
+
+cdef void scale_start(const double* x, const double* y, const double* z, double rho,
+                      const double* D, const double* E, double c, Py_ssize_t n, Py_ssize_t m,
+                      Py_ssize_t s, const Py_ssize_t* constrained, const double* lo,
+                      const double* hi, Cones cones, double* x_s, double* nu_s, double* y_s,
+                      double* z_s) noexcept nogil:
+    """Warm start from an unscaled solution ``(x, y, z)`` of a previous solve.
+
+    Fills the scaled iterate ``x_s, nu_s`` (x and equality multipliers), ``y_s``
+    (constraint multipliers on the constrained entries) and the slack ``z_s = P_C(x_s
+    + y_s / rho)``, the point ADMM's z-update would produce from them.
+    """
+    cdef Py_ssize_t i, j
+    cdef double inverse_rho = 1.0 / max(rho, 1e-12)
+    for i in range(n):
+        x_s[i] = x[i] / D[i]
+    for i in range(m):
+        nu_s[i] = y[i] * c / E[i]
+    for j in range(s):
+        i = constrained[j]
+        y_s[j] = z[i] * c * D[i]
+        z_s[j] = x_s[i] + y_s[j] * inverse_rho
+    proj_set(z_s, lo, hi, cones, s, z_s)
+
+
+cdef void unscale(const double* x_s, const double* nu_s, const double* y_s, const double* D,
+                  const double* E, double c, Py_ssize_t n, Py_ssize_t m, Py_ssize_t s,
+                  const Py_ssize_t* constrained, double* x, double* y,
+                  double* z) noexcept nogil:
+    """``(x, y, z)`` of the user's problem from a scaled iterate; ``z`` is zero off the
+    constrained entries."""
+    cdef Py_ssize_t i, j
+    for i in range(n):
+        x[i] = x_s[i] * D[i]
+        z[i] = 0.0
+    for i in range(m):
+        y[i] = nu_s[i] * E[i] / c
+    for j in range(s):
+        i = constrained[j]
+        z[i] = y_s[j] / (c * D[i])
+
+
+cdef inline double* _ptr(double[::1] v) noexcept:
+    return &v[0] if v.shape[0] else NULL
+
+
+def equilibrate_py(double[:, ::1] P, double[::1] q, double[:, ::1] A, double[::1] b,
+                   Py_ssize_t[::1] block_start, Py_ssize_t[::1] block_dim,
+                   Py_ssize_t iterations, double[::1] D, double[::1] E):
+    """:func:`equilibrate` on numpy arrays (``P, A`` C-ordered); returns ``c``."""
+    cdef Py_ssize_t n = P.shape[0], m = A.shape[0]
+    cdef double[::1] d = np.empty(n), e = np.empty(max(m, 1))
+    cdef double* A_ptr = &A[0, 0] if m else NULL
+    return equilibrate(&P[0, 0], &q[0], A_ptr, _ptr(b), n, m,
+                       &block_start[0] if block_start.shape[0] else NULL,
+                       &block_dim[0] if block_dim.shape[0] else NULL, block_start.shape[0],
+                       iterations, &D[0], _ptr(E), &d[0], &e[0])
+
+
+def scale_start_py(double[::1] x, double[::1] y, double[::1] z, double rho, double[::1] D,
+                   double[::1] E, double c, Py_ssize_t[::1] constrained, double[::1] lo,
+                   double[::1] hi, cones, double[::1] x_s, double[::1] nu_s, double[::1] y_s,
+                   double[::1] z_s):
+    """:func:`scale_start` on numpy arrays; ``cones`` as in
+    :func:`fccqp.projections.project_constraint_set`."""
+    cdef Py_ssize_t[::1] kind, offset, dim
+    cdef double[::1] mu
+    cdef double[:, ::1] normal
+    kind, offset, dim, mu, normal = cones
+    cdef Cones c_
+    c_.count = kind.shape[0]
+    if c_.count:
+        c_.kind, c_.offset, c_.dim = &kind[0], &offset[0], &dim[0]
+        c_.mu, c_.normal = &mu[0], &normal[0, 0]
+    cdef Py_ssize_t s = constrained.shape[0]
+    scale_start(&x[0], _ptr(y), &z[0], rho, &D[0], _ptr(E), c, x.shape[0], y.shape[0], s,
+                &constrained[0] if s else NULL, _ptr(lo), _ptr(hi), c_, &x_s[0], _ptr(nu_s),
+                _ptr(y_s), _ptr(z_s))
+
+
+def unscale_py(double[::1] x_s, double[::1] nu_s, double[::1] y_s, double[::1] D,
+               double[::1] E, double c, Py_ssize_t[::1] constrained):
+    """:func:`unscale` on numpy arrays; returns new arrays ``(x, y, z)``."""
+    cdef Py_ssize_t n = x_s.shape[0], m = nu_s.shape[0], s = constrained.shape[0]
+    x, y, z = np.empty(n), np.empty(m), np.empty(n)
+    cdef double[::1] xv = x, yv = y, zv = z
+    unscale(&x_s[0], _ptr(nu_s), _ptr(y_s), &D[0], _ptr(E), c, n, m, s,
+            &constrained[0] if s else NULL, &xv[0], _ptr(yv), &zv[0])
+    return x, y, z

@@ -1,0 +1,26 @@
+# cython: language_level=3
+from fccqp._types cimport Problem
+
+cdef struct Schur:
+    # Cholesky factors of H = P + R (rows in `order`) and of S = A H^-1 A'.
+    int n, m
+    double* L            # n x n, Fortran
+    double* LS           # m x m, Fortran
+    double* Y            # n x m, Fortran: L^-1 A' (rows in order)
+    const Py_ssize_t* order   # free entries first, the s constrained entries last
+    double* perm         # n scratch
+    double* dx           # n scratch
+    double* r            # n scratch
+    double* ATnu         # n scratch
+    double* dnu          # m scratch
+    double* Ax           # m scratch
+    double* X            # n x s scratch (unit columns)
+    double* Wnu          # m x s scratch (unit columns)
+    double* M            # s x s scratch (convexity test)
+
+cdef bint schur_factor(Schur* f, const Problem* p, const double* rho_vec) noexcept nogil
+cdef bint schur_certifies_convexity(Schur* f, const Problem* p, const double* rho_vec,
+                                    double sigma) noexcept nogil
+cdef void schur_solve(Schur* f, const Problem* p, const double* rho_vec, const double* rhs,
+                      double* sol) noexcept nogil
+cdef void schur_unit_columns(Schur* f, const Problem* p, double* W) noexcept nogil

@@ -1,0 +1,17 @@
+# cython: language_level=3
+from fccqp._types cimport Iterates, Problem
+
+cdef struct Residuals:
+    # Residuals of an iterate in the user's units, the scales of their relative
+    # tolerances, and the scaled values that rho adaptation balances.
+    double prim, dual, gap
+    double prim_scale, dual_scale, gap_scale
+    double prim_s, dual_s, prim_scale_s, dual_scale_s
+    bint finite
+
+cdef void residuals(const Problem* p, const Iterates* it, double* Ax, double* ATnu,
+                    double* Px, Residuals* r) noexcept nogil
+cdef bint converged(const Residuals* r, double eps_abs, double eps_rel) noexcept nogil
+cdef bint nearly_converged(const Residuals* r, double eps_abs, double eps_rel,
+                           double factor) noexcept nogil
+cdef double box_support(const Problem* p, const double* y) noexcept nogil

@@ -1,0 +1,107 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""Residuals, duality gap and the termination test of an ADMM iterate.
+
+For the user's problem and an iterate ``(x, y, z)`` with slack ``w`` in ``C``:
+
+    prim = max(||A x - b||, ||x_S - w||)            <= eps_abs + eps_rel * prim_scale
+    dual = ||P x + q + A'y + z||                     <= eps_abs + eps_rel * dual_scale
+    gap  = |x'Px + q'x + b'y + sigma_C(z)|           <= eps_abs + eps_rel * gap_scale
+
+(infinity norms). The scales come from the data and the primal point only:
+``prim_scale = max(||b||, ||A x||, ||x_S||, ||w||)``, ``dual_scale = max(||q||, ||P x||)``
+and ``gap_scale = max(|x'Px|, |q'x|)``: none of them grows with the multipliers, which
+diverge on an infeasible problem (a scale that included them let a dual residual of
+486 pass against multipliers of 3.6e8). ``sigma_C`` is the support function of the box
+and the cones; ADMM's multiplier lies in the normal cone of ``C`` at its slack, so it is
+finite (``sum hi_i z_i`` over upper, ``lo_i z_i`` over lower entries, 0 on cones).
+
+Everything is computed from the scaled iterate (see :mod:`fccqp.scaling`) and mapped
+back: ``x = D x_s``, ``y = E nu_s / c``, ``z_S = y_s / (c D_S)``, so that the residual of
+row ``i`` is the scaled one divided by ``E_i``, of entry ``i`` of ``x`` by ``c D_i``.
+"""
+
+from libc.math cimport fabs, isfinite
+
+from fccqp._dense cimport matvec, matvec_t
+from fccqp._types cimport Iterates, Problem
+
+
+cdef double box_support(const Problem* p, const double* y) noexcept nogil:
+    """``sigma_C(y)`` over the box entries (cones contribute 0 to a multiplier in their
+    polar), on the scaled problem; infinite sides are skipped (ADMM's y is exactly 0
+    there)."""
+    cdef double out = 0.0
+    cdef Py_ssize_t j
+    for j in range(p.s):
+        if y[j] > 0.0 and isfinite(p.hi[j]):
+            out += p.hi[j] * y[j]
+        elif y[j] < 0.0 and isfinite(p.lo[j]):
+            out += p.lo[j] * y[j]
+    return out
+
+
+cdef void residuals(const Problem* p, const Iterates* it, double* Ax, double* ATnu,
+                    double* Px, Residuals* r) noexcept nogil:
+    """Fill ``r`` for the iterate ``it`` (``Ax``, ``ATnu``, ``Px``: scratch of sizes m, n, n)."""
+    cdef Py_ssize_t n = p.n, m = p.m, i, j
+    cdef double c = p.c, value, scale, xPx, qx, bnu, total = 0.0
+    r.prim = r.prim_scale = r.prim_s = r.prim_scale_s = 0.0
+    matvec(p.A, it.x, Ax, m, n)
+    matvec_t(p.A, it.nu, ATnu, m, n)
+    matvec(p.P, it.x, Px, n, n)
+    for i in range(m):
+        value = fabs(Ax[i] - p.b[i])
+        scale = max(fabs(Ax[i]), fabs(p.b[i]))
+        r.prim = max(r.prim, value / p.E[i])
+        r.prim_scale = max(r.prim_scale, scale / p.E[i])
+        r.prim_s = max(r.prim_s, value)
+        r.prim_scale_s = max(r.prim_scale_s, scale)
+        total += value
+    for j in range(p.s):
+        i = p.constrained[j]
+        value = fabs(it.x[i] - it.z[j])
+        scale = max(fabs(it.x[i]), fabs(it.z[j]))
+        r.prim = max(r.prim, value * p.D[i])
+        r.prim_scale = max(r.prim_scale, scale * p.D[i])
+        r.prim_s = max(r.prim_s, value)
+        r.prim_scale_s = max(r.prim_scale_s, scale)
+        total += value + fabs(it.y[j])
+    r.dual = r.dual_scale = r.dual_s = r.dual_scale_s = 0.0
+    xPx = qx = 0.0
+    for i in range(n):
+        xPx += it.x[i] * Px[i]
+        qx += p.q[i] * it.x[i]
+        scale = 1.0 / (c * p.D[i])
+        r.dual_scale = max(r.dual_scale, max(fabs(Px[i]), fabs(p.q[i])) * scale)
+        # rho adaptation balances the scaled residuals against all their terms, as OSQP
+        r.dual_scale_s = max(r.dual_scale_s, max(max(fabs(Px[i]), fabs(p.q[i])), fabs(ATnu[i])))
+        Px[i] += p.q[i] + ATnu[i]   # Px now holds the gradient of the Lagrangian
+    for j in range(p.s):
+        i = p.constrained[j]
+        Px[i] += it.y[j]
+        r.dual_scale_s = max(r.dual_scale_s, fabs(it.y[j]))
+    for i in range(n):
+        value = fabs(Px[i])
+        r.dual = max(r.dual, value / (c * p.D[i]))
+        r.dual_s = max(r.dual_s, value)
+        total += value + fabs(it.x[i])
+    bnu = 0.0
+    for i in range(m):
+        bnu += p.b[i] * it.nu[i]
+    r.gap = fabs(xPx + qx + bnu + box_support(p, it.y)) / c
+    r.gap_scale = max(fabs(xPx), fabs(qx)) / c
+    r.finite = isfinite(total) and isfinite(r.gap)
+
+
+cdef bint converged(const Residuals* r, double eps_abs, double eps_rel) noexcept nogil:
+    """The termination test: all three within tolerance (and finite)."""
+    return nearly_converged(r, eps_abs, eps_rel, 1.0)
+
+
+cdef bint nearly_converged(const Residuals* r, double eps_abs, double eps_rel,
+                           double factor) noexcept nogil:
+    """:func:`converged` with tolerances multiplied by ``factor``."""
+    return (r.finite
+            and r.prim <= factor * (eps_abs + eps_rel * r.prim_scale)
+            and r.dual <= factor * (eps_abs + eps_rel * r.dual_scale)
+            and r.gap <= factor * (eps_abs + eps_rel * r.gap_scale))

@@ -1,0 +1,23 @@
+# cython: language_level=3
+
+cdef enum:
+    # Codes of scan_and_copy's findings, turned into messages by fccqp.problem.
+    SCAN_OK = 0
+    P_NOT_FINITE = 1
+    P_ASYMMETRIC = 2
+    NOT_FINITE = 3      # q, A, b (argument 0-2)
+    NAN_BOUND = 4       # lb, ub (argument 3-4)
+    CROSSED = 5
+    INFINITE_SIDE = 6
+    TOO_LARGE = 7       # an entry beyond MAX_ENTRY
+
+cdef struct Finding:
+    int code
+    int argument        # q, A, b, lb, ub numbered 0-4; -1 for P
+    Py_ssize_t index
+    double value
+
+cdef Finding scan_and_copy(const double* P, const double* q, const double* A, const double* b,
+                           const double* lb, const double* ub, Py_ssize_t n, Py_ssize_t m,
+                           double* P_out, double* q_out, double* A_out, double* b_out,
+                           double* lb_out, double* ub_out, bint* same_matrices) noexcept nogil

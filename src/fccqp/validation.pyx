@@ -1,0 +1,100 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""The numeric half of input validation, fused with the copy into the workspace.
+
+One pass over the user's arrays checks that they are finite (bounds: not NaN, ``lb <=
+ub``, no ``lb = +inf`` or ``ub = -inf``), that ``P`` is symmetric up to rounding, and
+that no entry exceeds ``MAX_ENTRY``; it writes ``(P + P') / 2`` and the other arrays
+into the workspace's private copies (a caller may refill its arrays in place before
+the next solve) and reports whether ``P`` and ``A`` equal the previous copies, which
+decides whether the scaling and the factorization can be reused. Bounds of magnitude
+``INFINITE_BOUND`` or more are stored as infinite, as Clarabel's presolve does.
+The shape and type half lives in :mod:`fccqp.problem`.
+"""
+
+from libc.math cimport INFINITY, fabs, isfinite, isnan
+
+SYMMETRY_TOLERANCE = 1e-10
+"""Relative asymmetry of ``P`` above which it is rejected rather than symmetrized."""
+MAX_ENTRY = 1e20
+"""Largest magnitude accepted in ``P, q, A, b``: equilibration brings at most ``1e20``
+of spread to unit scale, beyond it products overflow or lose every digit."""
+INFINITE_BOUND = 1e20
+"""Bounds at or beyond this magnitude are no bounds."""
+cdef double _SYMMETRY_TOLERANCE = SYMMETRY_TOLERANCE
+cdef double _MAX_ENTRY = MAX_ENTRY
+cdef double _INFINITE_BOUND = INFINITE_BOUND
+
+
+cdef inline Finding _found(int code, int argument, Py_ssize_t index, double value) noexcept nogil:
+    cdef Finding f
+    f.code, f.argument, f.index, f.value = code, argument, index, value
+    return f
+
+
+cdef inline Finding _check_vector(const double* v, double* out, Py_ssize_t k,
+                                  int argument) noexcept nogil:
+    cdef Py_ssize_t i
+    for i in range(k):
+        if not isfinite(v[i]):
+            return _found(NOT_FINITE, argument, i, v[i])
+        if fabs(v[i]) > _MAX_ENTRY:
+            return _found(TOO_LARGE, argument, i, v[i])
+        out[i] = v[i]
+    return _found(SCAN_OK, -1, -1, 0.0)
+
+
+cdef Finding scan_and_copy(const double* P, const double* q, const double* A, const double* b,
+                           const double* lb, const double* ub, Py_ssize_t n, Py_ssize_t m,
+                           double* P_out, double* q_out, double* A_out, double* b_out,
+                           double* lb_out, double* ub_out, bint* same_matrices) noexcept nogil:
+    """Check and copy; ``same_matrices`` becomes False as soon as ``P`` or ``A`` differs
+    from what ``P_out``, ``A_out`` held."""
+    cdef Py_ssize_t i, j
+    cdef double v, t, value, scale = 0.0, asymmetry = 0.0
+    cdef bint same = same_matrices[0]
+    cdef Finding f
+    for i in range(n):
+        for j in range(n):
+            v, t = P[i * n + j], P[j * n + i]
+            if not isfinite(v):
+                return _found(P_NOT_FINITE, -1, i, v)
+            scale = max(scale, fabs(v))
+            asymmetry = max(asymmetry, fabs(v - t))
+            value = 0.5 * (v + t)
+            if same and P_out[i * n + j] != value:
+                same = False
+            P_out[i * n + j] = value
+    if scale > _MAX_ENTRY:
+        return _found(TOO_LARGE, -1, 0, scale)
+    if asymmetry > _SYMMETRY_TOLERANCE * scale:
+        return _found(P_ASYMMETRIC, -1, -1, asymmetry)
+    for i in range(m * n):
+        v = A[i]
+        if not isfinite(v):
+            return _found(NOT_FINITE, 1, i // n, v)
+        if fabs(v) > _MAX_ENTRY:
+            return _found(TOO_LARGE, 1, i // n, v)
+        if same and A_out[i] != v:
+            same = False
+        A_out[i] = v
+    same_matrices[0] = same
+    f = _check_vector(q, q_out, n, 0)
+    if f.code != SCAN_OK:
+        return f
+    f = _check_vector(b, b_out, m, 2)
+    if f.code != SCAN_OK:
+        return f
+    for i in range(n):
+        if isnan(lb[i]):
+            return _found(NAN_BOUND, 3, i, lb[i])
+        if isnan(ub[i]):
+            return _found(NAN_BOUND, 4, i, ub[i])
+        if lb[i] > ub[i]:
+            return _found(CROSSED, 3, i, lb[i])
+        if lb[i] == INFINITY:
+            return _found(INFINITE_SIDE, 3, i, lb[i])
+        if ub[i] == -INFINITY:
+            return _found(INFINITE_SIDE, 4, i, ub[i])
+        lb_out[i] = lb[i] if lb[i] > -_INFINITE_BOUND else -INFINITY
+        ub_out[i] = ub[i] if ub[i] < _INFINITE_BOUND else INFINITY
+    return _found(SCAN_OK, -1, -1, 0.0)
