@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from fccqp.admm import _solve_small_spd
+from fccqp.anderson import solve_small_spd_py as _solve_small_spd
 
 
 @pytest.mark.parametrize("size", [1, 2, 5, 10])

@@ -25,7 +25,7 @@ def test_budget_stopped_solve_is_exactly_feasible(n_box, reduced):
         problem = P, q, A, b, lb, ub, cones = random_problem(seed, n_box=n_box)
         solver = fccqp.Solver(**settings)
         result = solver.solve(*problem)
-        assert (solver._workspace.reduced[0] != 0) == reduced
+        assert (result.backend != "ldl_full") == reduced
         assert result.status is Status.MAX_ITER_REACHED
         assert _infeasibility(problem, result.x) <= 1e-12
         assert np.abs(A @ result.x - b).max() <= 1e-10 * (1 + np.abs(b).max())

@@ -30,6 +30,7 @@ cdef struct Problem:
     double* A                   # m x n, row-major
     double* b
     const Py_ssize_t* constrained   # the s entries S of x with a bound or in a cone
+    const char* in_cone         # s flags: the constrained entry belongs to a cone block
     double* lo                  # bounds of x_S (s entries, +-inf where absent)
     double* hi
     Cones cones

@@ -1821,6 +1821,7 @@ struct __pyx_t_5fccqp_6_types_Problem {
   double *A;
   double *b;
   Py_ssize_t const *constrained;
+  char const *in_cone;
   double *lo;
   double *hi;
   struct __pyx_t_5fccqp_6_types_Cones cones;
@@ -1829,7 +1830,7 @@ struct __pyx_t_5fccqp_6_types_Problem {
   double c;
 };
 
-/* "fccqp/_types.pxd":41
+/* "fccqp/_types.pxd":42
  * 
  * 
  * cdef struct Iterates:             # <<<<<<<<<<<<<<
@@ -2184,7 +2185,7 @@ struct __pyx_obj_5fccqp_4admm_Workspace {
 };
 
 
-/* "fccqp/admm.pyx":320
+/* "fccqp/admm.pyx":325
  *         return self.found.code, self.found.argument, self.found.index, self.found.value
  * 
  *     @property             # <<<<<<<<<<<<<<
@@ -2198,12 +2199,12 @@ struct __pyx_obj_5fccqp_4admm___pyx_scope_struct____get__ {
 };
 
 
-/* "fccqp/admm.pyx":324
+/* "fccqp/admm.pyx":329
  *         """Rows ``(iteration, prim, dual, gap, rho)`` of the last solve's log."""
  *         cdef Py_ssize_t i, j
  *         return [tuple(self.log[5 * i + j] for j in range(5)) for i in range(self.log_count)]             # <<<<<<<<<<<<<<
  * 
- *     def solve(self, double[:, ::1] P, double[::1] q, double[:, ::1] A, double[::1] b,
+ *     def solve(self, const double[:, ::1] P, const double[::1] q, const double[:, ::1] A,
 */
 struct __pyx_obj_5fccqp_4admm___pyx_scope_struct_1_genexpr {
   PyObject_HEAD
@@ -3649,7 +3650,10 @@ static int __Pyx_ValidateAndInit_memviewslice(
                 PyObject *original_obj);
 
 /* ObjectToMemviewSlice.proto */
-static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_d_dc_double(PyObject *, int writable_flag);
+static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_d_dc_double__const__(PyObject *, int writable_flag);
+
+/* ObjectToMemviewSlice.proto */
+static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(PyObject *, int writable_flag);
 
 /* ObjectToMemviewSlice.proto */
 static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_dc_double(PyObject *, int writable_flag);
@@ -3987,7 +3991,6 @@ static void (*__pyx_f_5fccqp_7scaling_unscale)(double const *, double const *, d
 static void (*__pyx_f_5fccqp_11termination_residuals)(struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates const *, double *, double *, double *, struct __pyx_t_5fccqp_11termination_Residuals *); /*proto*/
 static int (*__pyx_f_5fccqp_11termination_converged)(struct __pyx_t_5fccqp_11termination_Residuals const *, double, double); /*proto*/
 static int (*__pyx_f_5fccqp_11termination_nearly_converged)(struct __pyx_t_5fccqp_11termination_Residuals const *, double, double, double); /*proto*/
-static double (*__pyx_f_5fccqp_11termination_box_support)(struct __pyx_t_5fccqp_6_types_Problem const *, double const *); /*proto*/
 
 /* Module declarations from "fccqp.validation" */
 static struct __pyx_t_5fccqp_10validation_Finding (*__pyx_f_5fccqp_10validation_scan_and_copy)(double const *, double const *, double const *, double const *, double const *, double const *, Py_ssize_t, Py_ssize_t, double *, double *, double *, double *, double *, double *, int *); /*proto*/
@@ -4049,6 +4052,7 @@ static void __pyx_memoryview_slice_assign_scalar(__Pyx_memviewslice *, int, size
 static void __pyx_memoryview__slice_assign_scalar(char *, Py_ssize_t *, Py_ssize_t *, int, size_t, void *); /*proto*/
 static PyObject *__pyx_unpickle_Enum__set_state(struct __pyx_MemviewEnum_obj *, PyObject *); /*proto*/
 /* #### Code section: typeinfo ### */
+static const __Pyx_TypeInfo __Pyx_TypeInfo_double__const__ = { "const double", NULL, sizeof(double const ), { 0 }, 0, 'R', 0, 0 };
 static const __Pyx_TypeInfo __Pyx_TypeInfo_double = { "double", NULL, sizeof(double), { 0 }, 0, 'R', 0, 0 };
 static const __Pyx_TypeInfo __Pyx_TypeInfo_Py_ssize_t = { "Py_ssize_t", NULL, sizeof(Py_ssize_t), { 0 }, 0, __PYX_IS_UNSIGNED(Py_ssize_t) ? 'U' : 'I', __PYX_IS_UNSIGNED(Py_ssize_t), 0 };
 /* #### Code section: before_global_var ### */
@@ -4610,8 +4614,8 @@ static __pyx_mstatetype * const __pyx_mstate_global = &__pyx_mstate_global_stati
 #define __pyx_n_u_zeros __pyx_string_tab[193]
 #define __pyx_n_b_O __pyx_string_tab[194]
 #define __pyx_kp_b_double_double_double_double_doub __pyx_string_tab[195]
-#define __pyx_kp_b_double_struct___pyx_t_5fccqp_6_t __pyx_string_tab[196]
-#define __pyx_kp_b_int_struct___pyx_t_5fccqp_11rest __pyx_string_tab[197]
+#define __pyx_kp_b_int_struct___pyx_t_5fccqp_11rest __pyx_string_tab[196]
+#define __pyx_kp_b_int_struct___pyx_t_5fccqp_11term __pyx_string_tab[197]
 #define __pyx_kp_b_int_struct___pyx_t_5fccqp_3kkt_K __pyx_string_tab[198]
 #define __pyx_kp_b_int_struct___pyx_t_5fccqp_6_type __pyx_string_tab[199]
 #define __pyx_kp_b_int_struct___pyx_t_5fccqp_7reduc __pyx_string_tab[200]
@@ -19576,6 +19580,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   Py_ssize_t __pyx_v_N;
   Py_ssize_t __pyx_v_memory;
   Py_ssize_t __pyx_v_k;
+  Py_ssize_t __pyx_v_j;
   PyObject *__pyx_v_kind = NULL;
   PyObject *__pyx_v_offset = NULL;
   PyObject *__pyx_v_dim = NULL;
@@ -19590,6 +19595,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   __Pyx_memviewslice __pyx_v_mu_v = { 0, 0, { 0 }, { 0 }, { 0 } };
   __Pyx_memviewslice __pyx_v_normal_v = { 0, 0, { 0 }, { 0 }, { 0 } };
   struct __pyx_t_5fccqp_6_types_Problem *__pyx_v_p;
+  char *__pyx_v_in_cone;
   struct __pyx_t_5fccqp_6_types_Iterates *__pyx_v_it;
   Py_ssize_t __pyx_v_wide;
   struct __pyx_t_5fccqp_3kkt_KKT *__pyx_v_kk;
@@ -19629,16 +19635,19 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   double *__pyx_t_28;
   Py_ssize_t __pyx_t_29;
   Py_ssize_t __pyx_t_30;
-  double *__pyx_t_31;
-  double *__pyx_t_32;
-  double __pyx_t_33;
-  double __pyx_t_34;
-  void *__pyx_t_35;
-  int __pyx_t_36;
-  int __pyx_t_37;
-  double __pyx_t_38;
-  long __pyx_t_39;
+  Py_ssize_t __pyx_t_31;
+  Py_ssize_t __pyx_t_32;
+  Py_ssize_t __pyx_t_33;
+  double *__pyx_t_34;
+  double *__pyx_t_35;
+  double __pyx_t_36;
+  double __pyx_t_37;
+  void *__pyx_t_38;
+  int __pyx_t_39;
   int __pyx_t_40;
+  double __pyx_t_41;
+  long __pyx_t_42;
+  int __pyx_t_43;
   int __pyx_lineno = 0;
   const char *__pyx_filename = NULL;
   int __pyx_clineno = 0;
@@ -19648,7 +19657,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
  *         into ``constrained``), the boolean mask ``fixed`` of constrained entries with
  *         ``lb == ub``, the Schur ``order`` and a :class:`fccqp.Settings`."""
  *         cdef Py_ssize_t s = len(constrained), N = n + m, memory = settings.anderson_memory             # <<<<<<<<<<<<<<
- *         cdef Py_ssize_t k
+ *         cdef Py_ssize_t k, j
  *         self._arrays = []
 */
   __pyx_t_1 = PyObject_Length(__pyx_v_constrained); if (unlikely(__pyx_t_1 == ((Py_ssize_t)-1))) __PYX_ERR(0, 200, __pyx_L1_error)
@@ -19662,7 +19671,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 
   /* "fccqp/admm.pyx":202
  *         cdef Py_ssize_t s = len(constrained), N = n + m, memory = settings.anderson_memory
- *         cdef Py_ssize_t k
+ *         cdef Py_ssize_t k, j
  *         self._arrays = []             # <<<<<<<<<<<<<<
  *         kind, offset, dim, mu, normal = cones
  *         self._keep = (np.ascontiguousarray(constrained, dtype=np.intp),
@@ -19675,7 +19684,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   __pyx_t_2 = 0;
 
   /* "fccqp/admm.pyx":203
- *         cdef Py_ssize_t k
+ *         cdef Py_ssize_t k, j
  *         self._arrays = []
  *         kind, offset, dim, mu, normal = cones             # <<<<<<<<<<<<<<
  *         self._keep = (np.ascontiguousarray(constrained, dtype=np.intp),
@@ -20496,7 +20505,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
  *             for k in range(p.cones.count):
  *                 start_v[k] = c_view[offset_v[k]]             # <<<<<<<<<<<<<<
  *         self.block_start = &start_v[0]
- *         p.P, p.q, p.A, p.b = self._new(n * n), self._new(n), self._new(m * n), self._new(m)
+ *         cdef char* in_cone = <char*>self._new(s)
 */
       __pyx_t_24 = __pyx_v_k;
       __pyx_t_29 = (*((Py_ssize_t *) ( /* dim=0 */ ((char *) (((Py_ssize_t *) __pyx_v_offset_v.data) + __pyx_t_24)) )));
@@ -20518,8 +20527,8 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
  *             for k in range(p.cones.count):
  *                 start_v[k] = c_view[offset_v[k]]
  *         self.block_start = &start_v[0]             # <<<<<<<<<<<<<<
- *         p.P, p.q, p.A, p.b = self._new(n * n), self._new(n), self._new(m * n), self._new(m)
- *         p.lo, p.hi, p.D, p.E = self._new(s), self._new(s), self._new(n), self._new(m)
+ *         cdef char* in_cone = <char*>self._new(s)
+ *         for k in range(p.cones.count):
 */
   __pyx_t_24 = 0;
   __pyx_v_self->block_start = (&(*((Py_ssize_t *) ( /* dim=0 */ ((char *) (((Py_ssize_t *) __pyx_v_start_v.data) + __pyx_t_24)) ))));
@@ -20527,36 +20536,100 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   /* "fccqp/admm.pyx":226
  *                 start_v[k] = c_view[offset_v[k]]
  *         self.block_start = &start_v[0]
+ *         cdef char* in_cone = <char*>self._new(s)             # <<<<<<<<<<<<<<
+ *         for k in range(p.cones.count):
+ *             for j in range(offset_v[k], offset_v[k] + dim_v[k]):
+*/
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 226, __pyx_L1_error)
+  __pyx_v_in_cone = ((char *)__pyx_t_28);
+
+
+  /* "fccqp/admm.pyx":227
+ *         self.block_start = &start_v[0]
+ *         cdef char* in_cone = <char*>self._new(s)
+ *         for k in range(p.cones.count):             # <<<<<<<<<<<<<<
+ *             for j in range(offset_v[k], offset_v[k] + dim_v[k]):
+ *                 in_cone[j] = 1
+*/
+
+  __pyx_t_22 = __pyx_v_p->cones.count;
+  __pyx_t_1 = __pyx_t_22;
+
+  for (__pyx_t_17 = 0; __pyx_t_17 < __pyx_t_1; __pyx_t_17+=1) {
+    __pyx_v_k = __pyx_t_17;
+
+    /* "fccqp/admm.pyx":228
+ *         cdef char* in_cone = <char*>self._new(s)
+ *         for k in range(p.cones.count):
+ *             for j in range(offset_v[k], offset_v[k] + dim_v[k]):             # <<<<<<<<<<<<<<
+ *                 in_cone[j] = 1
+ *         p.in_cone = in_cone
+*/
+    __pyx_t_24 = __pyx_v_k;
+    __pyx_t_29 = __pyx_v_k;
+
+    __pyx_t_31 = ((*((Py_ssize_t *) ( /* dim=0 */ ((char *) (((Py_ssize_t *) __pyx_v_offset_v.data) + __pyx_t_24)) ))) + (*((Py_ssize_t *) ( /* dim=0 */ ((char *) (((Py_ssize_t *) __pyx_v_dim_v.data) + __pyx_t_29)) ))));
+    __pyx_t_29 = __pyx_v_k;
+    __pyx_t_32 = __pyx_t_31;
+
+    for (__pyx_t_33 = (*((Py_ssize_t *) ( /* dim=0 */ ((char *) (((Py_ssize_t *) __pyx_v_offset_v.data) + __pyx_t_29)) ))); __pyx_t_33 < __pyx_t_32; __pyx_t_33+=1) {
+      __pyx_v_j = __pyx_t_33;
+
+      /* "fccqp/admm.pyx":229
+ *         for k in range(p.cones.count):
+ *             for j in range(offset_v[k], offset_v[k] + dim_v[k]):
+ *                 in_cone[j] = 1             # <<<<<<<<<<<<<<
+ *         p.in_cone = in_cone
+ *         p.P, p.q, p.A, p.b = self._new(n * n), self._new(n), self._new(m * n), self._new(m)
+*/
+      (__pyx_v_in_cone[__pyx_v_j]) = 1;
+    }
+
+  }
+
+
+  /* "fccqp/admm.pyx":230
+ *             for j in range(offset_v[k], offset_v[k] + dim_v[k]):
+ *                 in_cone[j] = 1
+ *         p.in_cone = in_cone             # <<<<<<<<<<<<<<
+ *         p.P, p.q, p.A, p.b = self._new(n * n), self._new(n), self._new(m * n), self._new(m)
+ *         p.lo, p.hi, p.D, p.E = self._new(s), self._new(s), self._new(n), self._new(m)
+*/
+  __pyx_v_p->in_cone = __pyx_v_in_cone;
+
+  /* "fccqp/admm.pyx":231
+ *                 in_cone[j] = 1
+ *         p.in_cone = in_cone
  *         p.P, p.q, p.A, p.b = self._new(n * n), self._new(n), self._new(m * n), self._new(m)             # <<<<<<<<<<<<<<
  *         p.lo, p.hi, p.D, p.E = self._new(s), self._new(s), self._new(n), self._new(m)
  *         p.c = 1.0
 */
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_n * __pyx_v_n)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 226, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 226, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_m * __pyx_v_n)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 226, __pyx_L1_error)
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 226, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_n * __pyx_v_n)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 231, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 231, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_m * __pyx_v_n)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 231, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 231, __pyx_L1_error)
   __pyx_v_p->P = __pyx_t_28;
   __pyx_v_p->q = __pyx_t_27;
-  __pyx_v_p->A = __pyx_t_31;
-  __pyx_v_p->b = __pyx_t_32;
+  __pyx_v_p->A = __pyx_t_34;
+  __pyx_v_p->b = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":227
- *         self.block_start = &start_v[0]
+  /* "fccqp/admm.pyx":232
+ *         p.in_cone = in_cone
  *         p.P, p.q, p.A, p.b = self._new(n * n), self._new(n), self._new(m * n), self._new(m)
  *         p.lo, p.hi, p.D, p.E = self._new(s), self._new(s), self._new(n), self._new(m)             # <<<<<<<<<<<<<<
  *         p.c = 1.0
  *         self.P_user, self.q_user = self._new(n * n), self._new(n)
 */
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 227, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 227, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 227, __pyx_L1_error)
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 227, __pyx_L1_error)
-  __pyx_v_p->lo = __pyx_t_32;
-  __pyx_v_p->hi = __pyx_t_31;
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 232, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 232, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 232, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 232, __pyx_L1_error)
+  __pyx_v_p->lo = __pyx_t_35;
+  __pyx_v_p->hi = __pyx_t_34;
   __pyx_v_p->D = __pyx_t_27;
   __pyx_v_p->E = __pyx_t_28;
 
-  /* "fccqp/admm.pyx":228
+  /* "fccqp/admm.pyx":233
  *         p.P, p.q, p.A, p.b = self._new(n * n), self._new(n), self._new(m * n), self._new(m)
  *         p.lo, p.hi, p.D, p.E = self._new(s), self._new(s), self._new(n), self._new(m)
  *         p.c = 1.0             # <<<<<<<<<<<<<<
@@ -20565,53 +20638,53 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_p->c = 1.0;
 
-  /* "fccqp/admm.pyx":229
+  /* "fccqp/admm.pyx":234
  *         p.lo, p.hi, p.D, p.E = self._new(s), self._new(s), self._new(n), self._new(m)
  *         p.c = 1.0
  *         self.P_user, self.q_user = self._new(n * n), self._new(n)             # <<<<<<<<<<<<<<
  *         self.A_user, self.b_user = self._new(m * n), self._new(m)
  *         self.lb_user, self.ub_user = self._new(n), self._new(n)
 */
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_n * __pyx_v_n)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 229, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 229, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_n * __pyx_v_n)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 234, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 234, __pyx_L1_error)
   __pyx_v_self->P_user = __pyx_t_28;
   __pyx_v_self->q_user = __pyx_t_27;
 
-  /* "fccqp/admm.pyx":230
+  /* "fccqp/admm.pyx":235
  *         p.c = 1.0
  *         self.P_user, self.q_user = self._new(n * n), self._new(n)
  *         self.A_user, self.b_user = self._new(m * n), self._new(m)             # <<<<<<<<<<<<<<
  *         self.lb_user, self.ub_user = self._new(n), self._new(n)
  *         self.rho_scale = self._new(s)
 */
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_m * __pyx_v_n)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 230, __pyx_L1_error)
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 230, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_m * __pyx_v_n)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 235, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 235, __pyx_L1_error)
   __pyx_v_self->A_user = __pyx_t_27;
   __pyx_v_self->b_user = __pyx_t_28;
 
-  /* "fccqp/admm.pyx":231
+  /* "fccqp/admm.pyx":236
  *         self.P_user, self.q_user = self._new(n * n), self._new(n)
  *         self.A_user, self.b_user = self._new(m * n), self._new(m)
  *         self.lb_user, self.ub_user = self._new(n), self._new(n)             # <<<<<<<<<<<<<<
  *         self.rho_scale = self._new(s)
  *         for k in range(s):
 */
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 231, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 231, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 236, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 236, __pyx_L1_error)
   __pyx_v_self->lb_user = __pyx_t_28;
   __pyx_v_self->ub_user = __pyx_t_27;
 
-  /* "fccqp/admm.pyx":232
+  /* "fccqp/admm.pyx":237
  *         self.A_user, self.b_user = self._new(m * n), self._new(m)
  *         self.lb_user, self.ub_user = self._new(n), self._new(n)
  *         self.rho_scale = self._new(s)             # <<<<<<<<<<<<<<
  *         for k in range(s):
  *             self.rho_scale[k] = FIXED_RHO_SCALE if fixed[k] else 1.0
 */
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 232, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 237, __pyx_L1_error)
   __pyx_v_self->rho_scale = __pyx_t_27;
 
-  /* "fccqp/admm.pyx":233
+  /* "fccqp/admm.pyx":238
  *         self.lb_user, self.ub_user = self._new(n), self._new(n)
  *         self.rho_scale = self._new(s)
  *         for k in range(s):             # <<<<<<<<<<<<<<
@@ -20625,46 +20698,46 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   for (__pyx_t_17 = 0; __pyx_t_17 < __pyx_t_1; __pyx_t_17+=1) {
     __pyx_v_k = __pyx_t_17;
 
-    /* "fccqp/admm.pyx":234
+    /* "fccqp/admm.pyx":239
  *         self.rho_scale = self._new(s)
  *         for k in range(s):
  *             self.rho_scale[k] = FIXED_RHO_SCALE if fixed[k] else 1.0             # <<<<<<<<<<<<<<
  *         self.d_scratch, self.e_scratch = self._new(n), self._new(m)
  *         it = &self.it
 */
-    __pyx_t_11 = __Pyx_GetItemInt(__pyx_v_fixed, __pyx_v_k, Py_ssize_t, 1, PyLong_FromSsize_t, 0, 0, 1, __Pyx_ReferenceSharing_FunctionArgument); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 234, __pyx_L1_error)
+    __pyx_t_11 = __Pyx_GetItemInt(__pyx_v_fixed, __pyx_v_k, Py_ssize_t, 1, PyLong_FromSsize_t, 0, 0, 1, __Pyx_ReferenceSharing_FunctionArgument); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 239, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_11);
-    __pyx_t_18 = __Pyx_PyObject_IsTrue(__pyx_t_11); if (unlikely((__pyx_t_18 < 0))) __PYX_ERR(0, 234, __pyx_L1_error)
+    __pyx_t_18 = __Pyx_PyObject_IsTrue(__pyx_t_11); if (unlikely((__pyx_t_18 < 0))) __PYX_ERR(0, 239, __pyx_L1_error)
     __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
     if (__pyx_t_18) {
-      __Pyx_GetModuleGlobalName(__pyx_t_11, __pyx_mstate_global->__pyx_n_u_FIXED_RHO_SCALE); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 234, __pyx_L1_error)
+      __Pyx_GetModuleGlobalName(__pyx_t_11, __pyx_mstate_global->__pyx_n_u_FIXED_RHO_SCALE); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 239, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_11);
-      __pyx_t_34 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_34 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 234, __pyx_L1_error)
+      __pyx_t_37 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_37 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 239, __pyx_L1_error)
       __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-      __pyx_t_33 = __pyx_t_34;
+      __pyx_t_36 = __pyx_t_37;
     } else {
 
-      __pyx_t_33 = 1.0;
+      __pyx_t_36 = 1.0;
     }
 
-    (__pyx_v_self->rho_scale[__pyx_v_k]) = __pyx_t_33;
+    (__pyx_v_self->rho_scale[__pyx_v_k]) = __pyx_t_36;
 
   }
 
 
-  /* "fccqp/admm.pyx":235
+  /* "fccqp/admm.pyx":240
  *         for k in range(s):
  *             self.rho_scale[k] = FIXED_RHO_SCALE if fixed[k] else 1.0
  *         self.d_scratch, self.e_scratch = self._new(n), self._new(m)             # <<<<<<<<<<<<<<
  *         it = &self.it
  *         it.x, it.nu, it.z, it.y = self._new(n), self._new(m), self._new(s), self._new(s)
 */
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 235, __pyx_L1_error)
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 235, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 240, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 240, __pyx_L1_error)
   __pyx_v_self->d_scratch = __pyx_t_27;
   __pyx_v_self->e_scratch = __pyx_t_28;
 
-  /* "fccqp/admm.pyx":236
+  /* "fccqp/admm.pyx":241
  *             self.rho_scale[k] = FIXED_RHO_SCALE if fixed[k] else 1.0
  *         self.d_scratch, self.e_scratch = self._new(n), self._new(m)
  *         it = &self.it             # <<<<<<<<<<<<<<
@@ -20673,71 +20746,71 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":237
+  /* "fccqp/admm.pyx":242
  *         self.d_scratch, self.e_scratch = self._new(n), self._new(m)
  *         it = &self.it
  *         it.x, it.nu, it.z, it.y = self._new(n), self._new(m), self._new(s), self._new(s)             # <<<<<<<<<<<<<<
  *         it.x_prev, it.nu_prev = self._new(n), self._new(m)
  *         it.z_prev, it.y_prev = self._new(s), self._new(s)
 */
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 237, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 237, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 237, __pyx_L1_error)
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 237, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 242, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 242, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 242, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 242, __pyx_L1_error)
   __pyx_v_it->x = __pyx_t_28;
   __pyx_v_it->nu = __pyx_t_27;
-  __pyx_v_it->z = __pyx_t_31;
-  __pyx_v_it->y = __pyx_t_32;
+  __pyx_v_it->z = __pyx_t_34;
+  __pyx_v_it->y = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":238
+  /* "fccqp/admm.pyx":243
  *         it = &self.it
  *         it.x, it.nu, it.z, it.y = self._new(n), self._new(m), self._new(s), self._new(s)
  *         it.x_prev, it.nu_prev = self._new(n), self._new(m)             # <<<<<<<<<<<<<<
  *         it.z_prev, it.y_prev = self._new(s), self._new(s)
  *         it.relaxed, it.rho_vec = self._new(s), self._new(s)
 */
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 238, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 238, __pyx_L1_error)
-  __pyx_v_it->x_prev = __pyx_t_32;
-  __pyx_v_it->nu_prev = __pyx_t_31;
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 243, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 243, __pyx_L1_error)
+  __pyx_v_it->x_prev = __pyx_t_35;
+  __pyx_v_it->nu_prev = __pyx_t_34;
 
-  /* "fccqp/admm.pyx":239
+  /* "fccqp/admm.pyx":244
  *         it.x, it.nu, it.z, it.y = self._new(n), self._new(m), self._new(s), self._new(s)
  *         it.x_prev, it.nu_prev = self._new(n), self._new(m)
  *         it.z_prev, it.y_prev = self._new(s), self._new(s)             # <<<<<<<<<<<<<<
  *         it.relaxed, it.rho_vec = self._new(s), self._new(s)
  *         self.rhs, self.sol = self._new(N), self._new(N)
 */
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 239, __pyx_L1_error)
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 239, __pyx_L1_error)
-  __pyx_v_it->z_prev = __pyx_t_31;
-  __pyx_v_it->y_prev = __pyx_t_32;
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 244, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 244, __pyx_L1_error)
+  __pyx_v_it->z_prev = __pyx_t_34;
+  __pyx_v_it->y_prev = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":240
+  /* "fccqp/admm.pyx":245
  *         it.x_prev, it.nu_prev = self._new(n), self._new(m)
  *         it.z_prev, it.y_prev = self._new(s), self._new(s)
  *         it.relaxed, it.rho_vec = self._new(s), self._new(s)             # <<<<<<<<<<<<<<
  *         self.rhs, self.sol = self._new(N), self._new(N)
  *         cdef Py_ssize_t wide = max(n, m)
 */
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 240, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 240, __pyx_L1_error)
-  __pyx_v_it->relaxed = __pyx_t_32;
-  __pyx_v_it->rho_vec = __pyx_t_31;
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 245, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 245, __pyx_L1_error)
+  __pyx_v_it->relaxed = __pyx_t_35;
+  __pyx_v_it->rho_vec = __pyx_t_34;
 
-  /* "fccqp/admm.pyx":241
+  /* "fccqp/admm.pyx":246
  *         it.z_prev, it.y_prev = self._new(s), self._new(s)
  *         it.relaxed, it.rho_vec = self._new(s), self._new(s)
  *         self.rhs, self.sol = self._new(N), self._new(N)             # <<<<<<<<<<<<<<
  *         cdef Py_ssize_t wide = max(n, m)
  *         self.vec_n, self.vec_n2, self.vec_n3 = self._new(wide), self._new(wide), self._new(wide)
 */
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 241, __pyx_L1_error)
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 241, __pyx_L1_error)
-  __pyx_v_self->rhs = __pyx_t_31;
-  __pyx_v_self->sol = __pyx_t_32;
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 246, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 246, __pyx_L1_error)
+  __pyx_v_self->rhs = __pyx_t_34;
+  __pyx_v_self->sol = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":242
+  /* "fccqp/admm.pyx":247
  *         it.relaxed, it.rho_vec = self._new(s), self._new(s)
  *         self.rhs, self.sol = self._new(N), self._new(N)
  *         cdef Py_ssize_t wide = max(n, m)             # <<<<<<<<<<<<<<
@@ -20761,63 +20834,63 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   __pyx_v_wide = __pyx_t_17;
 
 
-  /* "fccqp/admm.pyx":243
+  /* "fccqp/admm.pyx":248
  *         self.rhs, self.sol = self._new(N), self._new(N)
  *         cdef Py_ssize_t wide = max(n, m)
  *         self.vec_n, self.vec_n2, self.vec_n3 = self._new(wide), self._new(wide), self._new(wide)             # <<<<<<<<<<<<<<
  *         self.vec_s, self.vec_s2, self.vec_m = self._new(s), self._new(s), self._new(m)
  *         self.direction, self.saved, self.cert = self._new(n), self._new(N + s), self._new(N)
 */
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_wide); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 243, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_wide); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 243, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_wide); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 243, __pyx_L1_error)
-  __pyx_v_self->vec_n = __pyx_t_32;
-  __pyx_v_self->vec_n2 = __pyx_t_31;
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_wide); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 248, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_wide); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 248, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_wide); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 248, __pyx_L1_error)
+  __pyx_v_self->vec_n = __pyx_t_35;
+  __pyx_v_self->vec_n2 = __pyx_t_34;
   __pyx_v_self->vec_n3 = __pyx_t_27;
 
-  /* "fccqp/admm.pyx":244
+  /* "fccqp/admm.pyx":249
  *         cdef Py_ssize_t wide = max(n, m)
  *         self.vec_n, self.vec_n2, self.vec_n3 = self._new(wide), self._new(wide), self._new(wide)
  *         self.vec_s, self.vec_s2, self.vec_m = self._new(s), self._new(s), self._new(m)             # <<<<<<<<<<<<<<
  *         self.direction, self.saved, self.cert = self._new(n), self._new(N + s), self._new(N)
  *         self.prev_x, self.prev_y, self.prev_z = self._new(n), self._new(m), self._new(n)
 */
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 244, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 244, __pyx_L1_error)
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 244, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 249, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 249, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 249, __pyx_L1_error)
   __pyx_v_self->vec_s = __pyx_t_27;
-  __pyx_v_self->vec_s2 = __pyx_t_31;
-  __pyx_v_self->vec_m = __pyx_t_32;
+  __pyx_v_self->vec_s2 = __pyx_t_34;
+  __pyx_v_self->vec_m = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":245
+  /* "fccqp/admm.pyx":250
  *         self.vec_n, self.vec_n2, self.vec_n3 = self._new(wide), self._new(wide), self._new(wide)
  *         self.vec_s, self.vec_s2, self.vec_m = self._new(s), self._new(s), self._new(m)
  *         self.direction, self.saved, self.cert = self._new(n), self._new(N + s), self._new(N)             # <<<<<<<<<<<<<<
  *         self.prev_x, self.prev_y, self.prev_z = self._new(n), self._new(m), self._new(n)
  *         kk = &self.kkt
 */
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 245, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_N + __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 245, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 245, __pyx_L1_error)
-  __pyx_v_self->direction = __pyx_t_32;
-  __pyx_v_self->saved = __pyx_t_31;
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 250, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_N + __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 250, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 250, __pyx_L1_error)
+  __pyx_v_self->direction = __pyx_t_35;
+  __pyx_v_self->saved = __pyx_t_34;
   __pyx_v_self->cert = __pyx_t_27;
 
-  /* "fccqp/admm.pyx":246
+  /* "fccqp/admm.pyx":251
  *         self.vec_s, self.vec_s2, self.vec_m = self._new(s), self._new(s), self._new(m)
  *         self.direction, self.saved, self.cert = self._new(n), self._new(N + s), self._new(N)
  *         self.prev_x, self.prev_y, self.prev_z = self._new(n), self._new(m), self._new(n)             # <<<<<<<<<<<<<<
  *         kk = &self.kkt
  *         kk.ldl.N = <int>N
 */
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 246, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 246, __pyx_L1_error)
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 246, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 251, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 251, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 251, __pyx_L1_error)
   __pyx_v_self->prev_x = __pyx_t_27;
-  __pyx_v_self->prev_y = __pyx_t_31;
-  __pyx_v_self->prev_z = __pyx_t_32;
+  __pyx_v_self->prev_y = __pyx_t_34;
+  __pyx_v_self->prev_z = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":247
+  /* "fccqp/admm.pyx":252
  *         self.direction, self.saved, self.cert = self._new(n), self._new(N + s), self._new(N)
  *         self.prev_x, self.prev_y, self.prev_z = self._new(n), self._new(m), self._new(n)
  *         kk = &self.kkt             # <<<<<<<<<<<<<<
@@ -20826,7 +20899,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_kk = (&__pyx_v_self->kkt);
 
-  /* "fccqp/admm.pyx":248
+  /* "fccqp/admm.pyx":253
  *         self.prev_x, self.prev_y, self.prev_z = self._new(n), self._new(m), self._new(n)
  *         kk = &self.kkt
  *         kk.ldl.N = <int>N             # <<<<<<<<<<<<<<
@@ -20835,28 +20908,28 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_kk->ldl.N = ((int)__pyx_v_N);
 
-  /* "fccqp/admm.pyx":249
+  /* "fccqp/admm.pyx":254
  *         kk = &self.kkt
  *         kk.ldl.N = <int>N
  *         kk.ldl.K = self._new(N * N)             # <<<<<<<<<<<<<<
  *         kk.ldl.ipiv = <int*>self._new_int(N)
  *         kk.ldl.lwork = <int>(64 * N)
 */
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_N * __pyx_v_N)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 249, __pyx_L1_error)
-  __pyx_v_kk->ldl.K = __pyx_t_32;
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_N * __pyx_v_N)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 254, __pyx_L1_error)
+  __pyx_v_kk->ldl.K = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":250
+  /* "fccqp/admm.pyx":255
  *         kk.ldl.N = <int>N
  *         kk.ldl.K = self._new(N * N)
  *         kk.ldl.ipiv = <int*>self._new_int(N)             # <<<<<<<<<<<<<<
  *         kk.ldl.lwork = <int>(64 * N)
  *         kk.ldl.work, kk.ldl.residual = self._new(64 * N), self._new(N)
 */
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new_int(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 250, __pyx_L1_error)
-  __pyx_v_kk->ldl.ipiv = ((int *)__pyx_t_35);
+  __pyx_t_38 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new_int(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 255, __pyx_L1_error)
+  __pyx_v_kk->ldl.ipiv = ((int *)__pyx_t_38);
 
 
-  /* "fccqp/admm.pyx":251
+  /* "fccqp/admm.pyx":256
  *         kk.ldl.K = self._new(N * N)
  *         kk.ldl.ipiv = <int*>self._new_int(N)
  *         kk.ldl.lwork = <int>(64 * N)             # <<<<<<<<<<<<<<
@@ -20865,123 +20938,123 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_kk->ldl.lwork = ((int)(64 * __pyx_v_N));
 
-  /* "fccqp/admm.pyx":252
+  /* "fccqp/admm.pyx":257
  *         kk.ldl.ipiv = <int*>self._new_int(N)
  *         kk.ldl.lwork = <int>(64 * N)
  *         kk.ldl.work, kk.ldl.residual = self._new(64 * N), self._new(N)             # <<<<<<<<<<<<<<
  *         kk.ldl.Ax, kk.ldl.ATnu = self._new(m), self._new(n)
  *         kk.schur.n, kk.schur.m = <int>n, <int>m
 */
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (64 * __pyx_v_N)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 252, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 252, __pyx_L1_error)
-  __pyx_v_kk->ldl.work = __pyx_t_32;
-  __pyx_v_kk->ldl.residual = __pyx_t_31;
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (64 * __pyx_v_N)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 257, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 257, __pyx_L1_error)
+  __pyx_v_kk->ldl.work = __pyx_t_35;
+  __pyx_v_kk->ldl.residual = __pyx_t_34;
 
-  /* "fccqp/admm.pyx":253
+  /* "fccqp/admm.pyx":258
  *         kk.ldl.lwork = <int>(64 * N)
  *         kk.ldl.work, kk.ldl.residual = self._new(64 * N), self._new(N)
  *         kk.ldl.Ax, kk.ldl.ATnu = self._new(m), self._new(n)             # <<<<<<<<<<<<<<
  *         kk.schur.n, kk.schur.m = <int>n, <int>m
  *         kk.schur.L, kk.schur.LS, kk.schur.Y = self._new(n * n), self._new(m * m), self._new(n * m)
 */
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 253, __pyx_L1_error)
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 253, __pyx_L1_error)
-  __pyx_v_kk->ldl.Ax = __pyx_t_31;
-  __pyx_v_kk->ldl.ATnu = __pyx_t_32;
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 258, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 258, __pyx_L1_error)
+  __pyx_v_kk->ldl.Ax = __pyx_t_34;
+  __pyx_v_kk->ldl.ATnu = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":254
+  /* "fccqp/admm.pyx":259
  *         kk.ldl.work, kk.ldl.residual = self._new(64 * N), self._new(N)
  *         kk.ldl.Ax, kk.ldl.ATnu = self._new(m), self._new(n)
  *         kk.schur.n, kk.schur.m = <int>n, <int>m             # <<<<<<<<<<<<<<
  *         kk.schur.L, kk.schur.LS, kk.schur.Y = self._new(n * n), self._new(m * m), self._new(n * m)
  *         kk.schur.order = &order_v[0]
 */
-  __pyx_t_36 = ((int)__pyx_v_n);
+  __pyx_t_39 = ((int)__pyx_v_n);
 
-  __pyx_t_37 = ((int)__pyx_v_m);
+  __pyx_t_40 = ((int)__pyx_v_m);
 
-  __pyx_v_kk->schur.n = __pyx_t_36;
-  __pyx_v_kk->schur.m = __pyx_t_37;
+  __pyx_v_kk->schur.n = __pyx_t_39;
+  __pyx_v_kk->schur.m = __pyx_t_40;
 
-  /* "fccqp/admm.pyx":255
+  /* "fccqp/admm.pyx":260
  *         kk.ldl.Ax, kk.ldl.ATnu = self._new(m), self._new(n)
  *         kk.schur.n, kk.schur.m = <int>n, <int>m
  *         kk.schur.L, kk.schur.LS, kk.schur.Y = self._new(n * n), self._new(m * m), self._new(n * m)             # <<<<<<<<<<<<<<
  *         kk.schur.order = &order_v[0]
  *         kk.schur.perm, kk.schur.dx, kk.schur.r = self._new(n), self._new(n), self._new(n)
 */
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_n * __pyx_v_n)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 255, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_m * __pyx_v_m)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 255, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_n * __pyx_v_m)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 255, __pyx_L1_error)
-  __pyx_v_kk->schur.L = __pyx_t_32;
-  __pyx_v_kk->schur.LS = __pyx_t_31;
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_n * __pyx_v_n)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 260, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_m * __pyx_v_m)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 260, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_n * __pyx_v_m)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 260, __pyx_L1_error)
+  __pyx_v_kk->schur.L = __pyx_t_35;
+  __pyx_v_kk->schur.LS = __pyx_t_34;
   __pyx_v_kk->schur.Y = __pyx_t_27;
 
-  /* "fccqp/admm.pyx":256
+  /* "fccqp/admm.pyx":261
  *         kk.schur.n, kk.schur.m = <int>n, <int>m
  *         kk.schur.L, kk.schur.LS, kk.schur.Y = self._new(n * n), self._new(m * m), self._new(n * m)
  *         kk.schur.order = &order_v[0]             # <<<<<<<<<<<<<<
  *         kk.schur.perm, kk.schur.dx, kk.schur.r = self._new(n), self._new(n), self._new(n)
  *         kk.schur.ATnu, kk.schur.dnu, kk.schur.Ax = self._new(n), self._new(m), self._new(m)
 */
-  __pyx_t_24 = 0;
-  __pyx_v_kk->schur.order = (&(*((Py_ssize_t *) ( /* dim=0 */ ((char *) (((Py_ssize_t *) __pyx_v_order_v.data) + __pyx_t_24)) ))));
+  __pyx_t_29 = 0;
+  __pyx_v_kk->schur.order = (&(*((Py_ssize_t *) ( /* dim=0 */ ((char *) (((Py_ssize_t *) __pyx_v_order_v.data) + __pyx_t_29)) ))));
 
-  /* "fccqp/admm.pyx":257
+  /* "fccqp/admm.pyx":262
  *         kk.schur.L, kk.schur.LS, kk.schur.Y = self._new(n * n), self._new(m * m), self._new(n * m)
  *         kk.schur.order = &order_v[0]
  *         kk.schur.perm, kk.schur.dx, kk.schur.r = self._new(n), self._new(n), self._new(n)             # <<<<<<<<<<<<<<
  *         kk.schur.ATnu, kk.schur.dnu, kk.schur.Ax = self._new(n), self._new(m), self._new(m)
  *         kk.schur.X, kk.schur.Wnu, kk.schur.M = self._new(n * s), self._new(m * s), self._new(s * s)
 */
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 257, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 257, __pyx_L1_error)
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 257, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 262, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 262, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 262, __pyx_L1_error)
   __pyx_v_kk->schur.perm = __pyx_t_27;
-  __pyx_v_kk->schur.dx = __pyx_t_31;
-  __pyx_v_kk->schur.r = __pyx_t_32;
+  __pyx_v_kk->schur.dx = __pyx_t_34;
+  __pyx_v_kk->schur.r = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":258
+  /* "fccqp/admm.pyx":263
  *         kk.schur.order = &order_v[0]
  *         kk.schur.perm, kk.schur.dx, kk.schur.r = self._new(n), self._new(n), self._new(n)
  *         kk.schur.ATnu, kk.schur.dnu, kk.schur.Ax = self._new(n), self._new(m), self._new(m)             # <<<<<<<<<<<<<<
  *         kk.schur.X, kk.schur.Wnu, kk.schur.M = self._new(n * s), self._new(m * s), self._new(s * s)
  *         kk.R, kk.work = self._new(N * s), self._new(N)
 */
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 258, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 258, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 258, __pyx_L1_error)
-  __pyx_v_kk->schur.ATnu = __pyx_t_32;
-  __pyx_v_kk->schur.dnu = __pyx_t_31;
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 263, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 263, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 263, __pyx_L1_error)
+  __pyx_v_kk->schur.ATnu = __pyx_t_35;
+  __pyx_v_kk->schur.dnu = __pyx_t_34;
   __pyx_v_kk->schur.Ax = __pyx_t_27;
 
-  /* "fccqp/admm.pyx":259
+  /* "fccqp/admm.pyx":264
  *         kk.schur.perm, kk.schur.dx, kk.schur.r = self._new(n), self._new(n), self._new(n)
  *         kk.schur.ATnu, kk.schur.dnu, kk.schur.Ax = self._new(n), self._new(m), self._new(m)
  *         kk.schur.X, kk.schur.Wnu, kk.schur.M = self._new(n * s), self._new(m * s), self._new(s * s)             # <<<<<<<<<<<<<<
  *         kk.R, kk.work = self._new(N * s), self._new(N)
  *         red = &self.red
 */
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_n * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 259, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_m * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 259, __pyx_L1_error)
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_s * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 259, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_n * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 264, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_m * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 264, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_s * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 264, __pyx_L1_error)
   __pyx_v_kk->schur.X = __pyx_t_27;
-  __pyx_v_kk->schur.Wnu = __pyx_t_31;
-  __pyx_v_kk->schur.M = __pyx_t_32;
+  __pyx_v_kk->schur.Wnu = __pyx_t_34;
+  __pyx_v_kk->schur.M = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":260
+  /* "fccqp/admm.pyx":265
  *         kk.schur.ATnu, kk.schur.dnu, kk.schur.Ax = self._new(n), self._new(m), self._new(m)
  *         kk.schur.X, kk.schur.Wnu, kk.schur.M = self._new(n * s), self._new(m * s), self._new(s * s)
  *         kk.R, kk.work = self._new(N * s), self._new(N)             # <<<<<<<<<<<<<<
  *         red = &self.red
  *         red.W, red.W_S, red.base = self._new(N * s), self._new(s * s), self._new(N)
 */
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_N * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 260, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 260, __pyx_L1_error)
-  __pyx_v_kk->R = __pyx_t_32;
-  __pyx_v_kk->work = __pyx_t_31;
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_N * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 265, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 265, __pyx_L1_error)
+  __pyx_v_kk->R = __pyx_t_35;
+  __pyx_v_kk->work = __pyx_t_34;
 
-  /* "fccqp/admm.pyx":261
+  /* "fccqp/admm.pyx":266
  *         kk.schur.X, kk.schur.Wnu, kk.schur.M = self._new(n * s), self._new(m * s), self._new(s * s)
  *         kk.R, kk.work = self._new(N * s), self._new(N)
  *         red = &self.red             # <<<<<<<<<<<<<<
@@ -20990,49 +21063,49 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_red = (&__pyx_v_self->red);
 
-  /* "fccqp/admm.pyx":262
+  /* "fccqp/admm.pyx":267
  *         kk.R, kk.work = self._new(N * s), self._new(N)
  *         red = &self.red
  *         red.W, red.W_S, red.base = self._new(N * s), self._new(s * s), self._new(N)             # <<<<<<<<<<<<<<
  *         red.u, red.u_prev, red.v, red.v_prev = self._new(s), self._new(s), self._new(s), self._new(s)
  *         red.xs, red.rhs = self._new(s), self._new(N)
 */
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_N * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 262, __pyx_L1_error)
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_s * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 262, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 262, __pyx_L1_error)
-  __pyx_v_red->W = __pyx_t_31;
-  __pyx_v_red->W_S = __pyx_t_32;
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_N * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 267, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_s * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 267, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 267, __pyx_L1_error)
+  __pyx_v_red->W = __pyx_t_34;
+  __pyx_v_red->W_S = __pyx_t_35;
   __pyx_v_red->base = __pyx_t_27;
 
-  /* "fccqp/admm.pyx":263
+  /* "fccqp/admm.pyx":268
  *         red = &self.red
  *         red.W, red.W_S, red.base = self._new(N * s), self._new(s * s), self._new(N)
  *         red.u, red.u_prev, red.v, red.v_prev = self._new(s), self._new(s), self._new(s), self._new(s)             # <<<<<<<<<<<<<<
  *         red.xs, red.rhs = self._new(s), self._new(N)
  *         aa = &self.aa
 */
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 263, __pyx_L1_error)
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 263, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 263, __pyx_L1_error)
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 263, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 268, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 268, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 268, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 268, __pyx_L1_error)
   __pyx_v_red->u = __pyx_t_27;
-  __pyx_v_red->u_prev = __pyx_t_32;
-  __pyx_v_red->v = __pyx_t_31;
+  __pyx_v_red->u_prev = __pyx_t_35;
+  __pyx_v_red->v = __pyx_t_34;
   __pyx_v_red->v_prev = __pyx_t_28;
 
-  /* "fccqp/admm.pyx":264
+  /* "fccqp/admm.pyx":269
  *         red.W, red.W_S, red.base = self._new(N * s), self._new(s * s), self._new(N)
  *         red.u, red.u_prev, red.v, red.v_prev = self._new(s), self._new(s), self._new(s), self._new(s)
  *         red.xs, red.rhs = self._new(s), self._new(N)             # <<<<<<<<<<<<<<
  *         aa = &self.aa
  *         aa.capacity = <int>memory
 */
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 264, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 264, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 269, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 269, __pyx_L1_error)
   __pyx_v_red->xs = __pyx_t_28;
-  __pyx_v_red->rhs = __pyx_t_31;
+  __pyx_v_red->rhs = __pyx_t_34;
 
-  /* "fccqp/admm.pyx":265
+  /* "fccqp/admm.pyx":270
  *         red.u, red.u_prev, red.v, red.v_prev = self._new(s), self._new(s), self._new(s), self._new(s)
  *         red.xs, red.rhs = self._new(s), self._new(N)
  *         aa = &self.aa             # <<<<<<<<<<<<<<
@@ -21041,7 +21114,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_aa = (&__pyx_v_self->aa);
 
-  /* "fccqp/admm.pyx":266
+  /* "fccqp/admm.pyx":271
  *         red.xs, red.rhs = self._new(s), self._new(N)
  *         aa = &self.aa
  *         aa.capacity = <int>memory             # <<<<<<<<<<<<<<
@@ -21050,49 +21123,49 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_aa->capacity = ((int)__pyx_v_memory);
 
-  /* "fccqp/admm.pyx":267
+  /* "fccqp/admm.pyx":272
  *         aa = &self.aa
  *         aa.capacity = <int>memory
  *         aa.dg, aa.df = self._new(memory * 2 * s), self._new(memory * 2 * s)             # <<<<<<<<<<<<<<
  *         aa.g, aa.f, aa.g_new, aa.f_new = self._new(2 * s), self._new(2 * s), self._new(2 * s), self._new(2 * s)
  *         aa.plain, aa.gram, aa.gamma = self._new(2 * s + 1), self._new(memory * memory), self._new(memory)
 */
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, ((__pyx_v_memory * 2) * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 267, __pyx_L1_error)
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, ((__pyx_v_memory * 2) * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 267, __pyx_L1_error)
-  __pyx_v_aa->dg = __pyx_t_31;
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, ((__pyx_v_memory * 2) * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 272, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, ((__pyx_v_memory * 2) * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 272, __pyx_L1_error)
+  __pyx_v_aa->dg = __pyx_t_34;
   __pyx_v_aa->df = __pyx_t_28;
 
-  /* "fccqp/admm.pyx":268
+  /* "fccqp/admm.pyx":273
  *         aa.capacity = <int>memory
  *         aa.dg, aa.df = self._new(memory * 2 * s), self._new(memory * 2 * s)
  *         aa.g, aa.f, aa.g_new, aa.f_new = self._new(2 * s), self._new(2 * s), self._new(2 * s), self._new(2 * s)             # <<<<<<<<<<<<<<
  *         aa.plain, aa.gram, aa.gamma = self._new(2 * s + 1), self._new(memory * memory), self._new(memory)
  *         anderson_reset(aa, False)
 */
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (2 * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 268, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (2 * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 268, __pyx_L1_error)
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (2 * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 268, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (2 * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 268, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (2 * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 273, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (2 * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 273, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (2 * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 273, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (2 * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 273, __pyx_L1_error)
   __pyx_v_aa->g = __pyx_t_28;
-  __pyx_v_aa->f = __pyx_t_31;
-  __pyx_v_aa->g_new = __pyx_t_32;
+  __pyx_v_aa->f = __pyx_t_34;
+  __pyx_v_aa->g_new = __pyx_t_35;
   __pyx_v_aa->f_new = __pyx_t_27;
 
-  /* "fccqp/admm.pyx":269
+  /* "fccqp/admm.pyx":274
  *         aa.dg, aa.df = self._new(memory * 2 * s), self._new(memory * 2 * s)
  *         aa.g, aa.f, aa.g_new, aa.f_new = self._new(2 * s), self._new(2 * s), self._new(2 * s), self._new(2 * s)
  *         aa.plain, aa.gram, aa.gamma = self._new(2 * s + 1), self._new(memory * memory), self._new(memory)             # <<<<<<<<<<<<<<
  *         anderson_reset(aa, False)
  *         rs = &self.rest
 */
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, ((2 * __pyx_v_s) + 1)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 269, __pyx_L1_error)
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_memory * __pyx_v_memory)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 269, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_memory); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 269, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, ((2 * __pyx_v_s) + 1)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 274, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_memory * __pyx_v_memory)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 274, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_memory); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 274, __pyx_L1_error)
   __pyx_v_aa->plain = __pyx_t_27;
-  __pyx_v_aa->gram = __pyx_t_32;
-  __pyx_v_aa->gamma = __pyx_t_31;
+  __pyx_v_aa->gram = __pyx_t_35;
+  __pyx_v_aa->gamma = __pyx_t_34;
 
-  /* "fccqp/admm.pyx":270
+  /* "fccqp/admm.pyx":275
  *         aa.g, aa.f, aa.g_new, aa.f_new = self._new(2 * s), self._new(2 * s), self._new(2 * s), self._new(2 * s)
  *         aa.plain, aa.gram, aa.gamma = self._new(2 * s + 1), self._new(memory * memory), self._new(memory)
  *         anderson_reset(aa, False)             # <<<<<<<<<<<<<<
@@ -21101,7 +21174,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_f_5fccqp_8anderson_anderson_reset(__pyx_v_aa, 0);
 
-  /* "fccqp/admm.pyx":271
+  /* "fccqp/admm.pyx":276
  *         aa.plain, aa.gram, aa.gamma = self._new(2 * s + 1), self._new(memory * memory), self._new(memory)
  *         anderson_reset(aa, False)
  *         rs = &self.rest             # <<<<<<<<<<<<<<
@@ -21110,74 +21183,74 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_rs = (&__pyx_v_self->rest);
 
-  /* "fccqp/admm.pyx":272
+  /* "fccqp/admm.pyx":277
  *         anderson_reset(aa, False)
  *         rs = &self.rest
  *         rs.pinned = <char*>self._new(s)             # <<<<<<<<<<<<<<
  *         rs.target, rs.projected = self._new(s), self._new(s)
  *         rs.positions, rs.entries = <Py_ssize_t*>self._new_int(s), <Py_ssize_t*>self._new_int(s)
 */
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 272, __pyx_L1_error)
-  __pyx_v_rs->pinned = ((char *)__pyx_t_31);
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 277, __pyx_L1_error)
+  __pyx_v_rs->pinned = ((char *)__pyx_t_34);
 
 
-  /* "fccqp/admm.pyx":273
+  /* "fccqp/admm.pyx":278
  *         rs = &self.rest
  *         rs.pinned = <char*>self._new(s)
  *         rs.target, rs.projected = self._new(s), self._new(s)             # <<<<<<<<<<<<<<
  *         rs.positions, rs.entries = <Py_ssize_t*>self._new_int(s), <Py_ssize_t*>self._new_int(s)
  *         rs.W_T, rs.gram, rs.step = self._new(N * s), self._new(s * s), self._new(s)
 */
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 273, __pyx_L1_error)
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 273, __pyx_L1_error)
-  __pyx_v_rs->target = __pyx_t_31;
-  __pyx_v_rs->projected = __pyx_t_32;
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 278, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 278, __pyx_L1_error)
+  __pyx_v_rs->target = __pyx_t_34;
+  __pyx_v_rs->projected = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":274
+  /* "fccqp/admm.pyx":279
  *         rs.pinned = <char*>self._new(s)
  *         rs.target, rs.projected = self._new(s), self._new(s)
  *         rs.positions, rs.entries = <Py_ssize_t*>self._new_int(s), <Py_ssize_t*>self._new_int(s)             # <<<<<<<<<<<<<<
  *         rs.W_T, rs.gram, rs.step = self._new(N * s), self._new(s * s), self._new(s)
  *         rs.start, rs.point = self._new(N), self._new(N)
 */
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new_int(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 274, __pyx_L1_error)
-  __pyx_t_26 = ((Py_ssize_t *)__pyx_t_35);
+  __pyx_t_38 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new_int(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 279, __pyx_L1_error)
+  __pyx_t_26 = ((Py_ssize_t *)__pyx_t_38);
 
 
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new_int(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 274, __pyx_L1_error)
-  __pyx_t_25 = ((Py_ssize_t *)__pyx_t_35);
+  __pyx_t_38 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new_int(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 279, __pyx_L1_error)
+  __pyx_t_25 = ((Py_ssize_t *)__pyx_t_38);
 
 
   __pyx_v_rs->positions = __pyx_t_26;
   __pyx_v_rs->entries = __pyx_t_25;
 
-  /* "fccqp/admm.pyx":275
+  /* "fccqp/admm.pyx":280
  *         rs.target, rs.projected = self._new(s), self._new(s)
  *         rs.positions, rs.entries = <Py_ssize_t*>self._new_int(s), <Py_ssize_t*>self._new_int(s)
  *         rs.W_T, rs.gram, rs.step = self._new(N * s), self._new(s * s), self._new(s)             # <<<<<<<<<<<<<<
  *         rs.start, rs.point = self._new(N), self._new(N)
  *         self.log_rows = log_rows
 */
-  __pyx_t_32 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_N * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 275, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_s * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 275, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 275, __pyx_L1_error)
-  __pyx_v_rs->W_T = __pyx_t_32;
-  __pyx_v_rs->gram = __pyx_t_31;
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_N * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 280, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_s * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 280, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 280, __pyx_L1_error)
+  __pyx_v_rs->W_T = __pyx_t_35;
+  __pyx_v_rs->gram = __pyx_t_34;
   __pyx_v_rs->step = __pyx_t_27;
 
-  /* "fccqp/admm.pyx":276
+  /* "fccqp/admm.pyx":281
  *         rs.positions, rs.entries = <Py_ssize_t*>self._new_int(s), <Py_ssize_t*>self._new_int(s)
  *         rs.W_T, rs.gram, rs.step = self._new(N * s), self._new(s * s), self._new(s)
  *         rs.start, rs.point = self._new(N), self._new(N)             # <<<<<<<<<<<<<<
  *         self.log_rows = log_rows
  *         self.log = self._new(5 * log_rows)
 */
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 276, __pyx_L1_error)
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 276, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 281, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 281, __pyx_L1_error)
   __pyx_v_rs->start = __pyx_t_27;
-  __pyx_v_rs->point = __pyx_t_31;
+  __pyx_v_rs->point = __pyx_t_34;
 
-  /* "fccqp/admm.pyx":277
+  /* "fccqp/admm.pyx":282
  *         rs.W_T, rs.gram, rs.step = self._new(N * s), self._new(s * s), self._new(s)
  *         rs.start, rs.point = self._new(N), self._new(N)
  *         self.log_rows = log_rows             # <<<<<<<<<<<<<<
@@ -21186,17 +21259,17 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_self->log_rows = __pyx_v_log_rows;
 
-  /* "fccqp/admm.pyx":278
+  /* "fccqp/admm.pyx":283
  *         rs.start, rs.point = self._new(N), self._new(N)
  *         self.log_rows = log_rows
  *         self.log = self._new(5 * log_rows)             # <<<<<<<<<<<<<<
  *         o = &self.opt
  *         o.rho, o.sigma, o.alpha = settings.rho, settings.sigma, settings.alpha
 */
-  __pyx_t_31 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (5 * __pyx_v_log_rows)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 278, __pyx_L1_error)
-  __pyx_v_self->log = __pyx_t_31;
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (5 * __pyx_v_log_rows)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 283, __pyx_L1_error)
+  __pyx_v_self->log = __pyx_t_34;
 
-  /* "fccqp/admm.pyx":279
+  /* "fccqp/admm.pyx":284
  *         self.log_rows = log_rows
  *         self.log = self._new(5 * log_rows)
  *         o = &self.opt             # <<<<<<<<<<<<<<
@@ -21205,170 +21278,170 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_o = (&__pyx_v_self->opt);
 
-  /* "fccqp/admm.pyx":280
+  /* "fccqp/admm.pyx":285
  *         self.log = self._new(5 * log_rows)
  *         o = &self.opt
  *         o.rho, o.sigma, o.alpha = settings.rho, settings.sigma, settings.alpha             # <<<<<<<<<<<<<<
  *         o.eps_abs, o.eps_rel = settings.eps_abs, settings.eps_rel
  *         o.eps_prim_inf, o.eps_dual_inf = settings.eps_prim_inf, settings.eps_dual_inf
 */
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_rho); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 280, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_rho); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 285, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_33 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_33 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 280, __pyx_L1_error)
+  __pyx_t_36 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_36 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 285, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_sigma); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 280, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_sigma); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 285, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_34 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_34 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 280, __pyx_L1_error)
+  __pyx_t_37 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_37 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 285, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_alpha); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 280, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_alpha); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 285, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_38 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_38 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 280, __pyx_L1_error)
+  __pyx_t_41 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_41 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 285, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __pyx_v_o->rho = __pyx_t_33;
-  __pyx_v_o->sigma = __pyx_t_34;
-  __pyx_v_o->alpha = __pyx_t_38;
+  __pyx_v_o->rho = __pyx_t_36;
+  __pyx_v_o->sigma = __pyx_t_37;
+  __pyx_v_o->alpha = __pyx_t_41;
 
-  /* "fccqp/admm.pyx":281
+  /* "fccqp/admm.pyx":286
  *         o = &self.opt
  *         o.rho, o.sigma, o.alpha = settings.rho, settings.sigma, settings.alpha
  *         o.eps_abs, o.eps_rel = settings.eps_abs, settings.eps_rel             # <<<<<<<<<<<<<<
  *         o.eps_prim_inf, o.eps_dual_inf = settings.eps_prim_inf, settings.eps_dual_inf
  *         o.time_limit = settings.time_limit
 */
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_eps_abs); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 281, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_eps_abs); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 286, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_38 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_38 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 281, __pyx_L1_error)
+  __pyx_t_41 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_41 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 286, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_eps_rel); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 281, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_eps_rel); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 286, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_34 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_34 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 281, __pyx_L1_error)
+  __pyx_t_37 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_37 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 286, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __pyx_v_o->eps_abs = __pyx_t_38;
-  __pyx_v_o->eps_rel = __pyx_t_34;
+  __pyx_v_o->eps_abs = __pyx_t_41;
+  __pyx_v_o->eps_rel = __pyx_t_37;
 
-  /* "fccqp/admm.pyx":282
+  /* "fccqp/admm.pyx":287
  *         o.rho, o.sigma, o.alpha = settings.rho, settings.sigma, settings.alpha
  *         o.eps_abs, o.eps_rel = settings.eps_abs, settings.eps_rel
  *         o.eps_prim_inf, o.eps_dual_inf = settings.eps_prim_inf, settings.eps_dual_inf             # <<<<<<<<<<<<<<
  *         o.time_limit = settings.time_limit
  *         o.adaptive_rho_tolerance = settings.adaptive_rho_tolerance
 */
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_eps_prim_inf); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 282, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_eps_prim_inf); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 287, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_34 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_34 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 282, __pyx_L1_error)
+  __pyx_t_37 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_37 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 287, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_eps_dual_inf); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 282, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_eps_dual_inf); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 287, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_38 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_38 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 282, __pyx_L1_error)
+  __pyx_t_41 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_41 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 287, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __pyx_v_o->eps_prim_inf = __pyx_t_34;
-  __pyx_v_o->eps_dual_inf = __pyx_t_38;
+  __pyx_v_o->eps_prim_inf = __pyx_t_37;
+  __pyx_v_o->eps_dual_inf = __pyx_t_41;
 
-  /* "fccqp/admm.pyx":283
+  /* "fccqp/admm.pyx":288
  *         o.eps_abs, o.eps_rel = settings.eps_abs, settings.eps_rel
  *         o.eps_prim_inf, o.eps_dual_inf = settings.eps_prim_inf, settings.eps_dual_inf
  *         o.time_limit = settings.time_limit             # <<<<<<<<<<<<<<
  *         o.adaptive_rho_tolerance = settings.adaptive_rho_tolerance
  *         o.max_iter, o.check_termination = settings.max_iter, settings.check_termination
 */
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_time_limit); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 283, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_time_limit); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 288, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_38 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_38 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 283, __pyx_L1_error)
+  __pyx_t_41 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_41 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 288, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __pyx_v_o->time_limit = __pyx_t_38;
+  __pyx_v_o->time_limit = __pyx_t_41;
 
-  /* "fccqp/admm.pyx":284
+  /* "fccqp/admm.pyx":289
  *         o.eps_prim_inf, o.eps_dual_inf = settings.eps_prim_inf, settings.eps_dual_inf
  *         o.time_limit = settings.time_limit
  *         o.adaptive_rho_tolerance = settings.adaptive_rho_tolerance             # <<<<<<<<<<<<<<
  *         o.max_iter, o.check_termination = settings.max_iter, settings.check_termination
  *         o.adaptive_rho_interval, o.scaling = settings.adaptive_rho_interval, settings.scaling
 */
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_adaptive_rho_tolerance); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 284, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_adaptive_rho_tolerance); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 289, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_38 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_38 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 284, __pyx_L1_error)
+  __pyx_t_41 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_41 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 289, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __pyx_v_o->adaptive_rho_tolerance = __pyx_t_38;
+  __pyx_v_o->adaptive_rho_tolerance = __pyx_t_41;
 
-  /* "fccqp/admm.pyx":285
+  /* "fccqp/admm.pyx":290
  *         o.time_limit = settings.time_limit
  *         o.adaptive_rho_tolerance = settings.adaptive_rho_tolerance
  *         o.max_iter, o.check_termination = settings.max_iter, settings.check_termination             # <<<<<<<<<<<<<<
  *         o.adaptive_rho_interval, o.scaling = settings.adaptive_rho_interval, settings.scaling
  *         o.adaptive_rho, o.restore_feasibility = settings.adaptive_rho, settings.restore_feasibility
 */
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_max_iter); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 285, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_max_iter); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 290, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_16 = __Pyx_PyLong_As_long(__pyx_t_11); if (unlikely((__pyx_t_16 == (long)-1) && PyErr_Occurred())) __PYX_ERR(0, 285, __pyx_L1_error)
+  __pyx_t_16 = __Pyx_PyLong_As_long(__pyx_t_11); if (unlikely((__pyx_t_16 == (long)-1) && PyErr_Occurred())) __PYX_ERR(0, 290, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_check_termination); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 285, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_check_termination); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 290, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_39 = __Pyx_PyLong_As_long(__pyx_t_11); if (unlikely((__pyx_t_39 == (long)-1) && PyErr_Occurred())) __PYX_ERR(0, 285, __pyx_L1_error)
+  __pyx_t_42 = __Pyx_PyLong_As_long(__pyx_t_11); if (unlikely((__pyx_t_42 == (long)-1) && PyErr_Occurred())) __PYX_ERR(0, 290, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   __pyx_v_o->max_iter = __pyx_t_16;
-  __pyx_v_o->check_termination = __pyx_t_39;
+  __pyx_v_o->check_termination = __pyx_t_42;
 
-  /* "fccqp/admm.pyx":286
+  /* "fccqp/admm.pyx":291
  *         o.adaptive_rho_tolerance = settings.adaptive_rho_tolerance
  *         o.max_iter, o.check_termination = settings.max_iter, settings.check_termination
  *         o.adaptive_rho_interval, o.scaling = settings.adaptive_rho_interval, settings.scaling             # <<<<<<<<<<<<<<
  *         o.adaptive_rho, o.restore_feasibility = settings.adaptive_rho, settings.restore_feasibility
  *         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
 */
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_adaptive_rho_interval); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 286, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_adaptive_rho_interval); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 291, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_39 = __Pyx_PyLong_As_long(__pyx_t_11); if (unlikely((__pyx_t_39 == (long)-1) && PyErr_Occurred())) __PYX_ERR(0, 286, __pyx_L1_error)
+  __pyx_t_42 = __Pyx_PyLong_As_long(__pyx_t_11); if (unlikely((__pyx_t_42 == (long)-1) && PyErr_Occurred())) __PYX_ERR(0, 291, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_scaling); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 286, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_scaling); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 291, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_16 = __Pyx_PyLong_As_long(__pyx_t_11); if (unlikely((__pyx_t_16 == (long)-1) && PyErr_Occurred())) __PYX_ERR(0, 286, __pyx_L1_error)
+  __pyx_t_16 = __Pyx_PyLong_As_long(__pyx_t_11); if (unlikely((__pyx_t_16 == (long)-1) && PyErr_Occurred())) __PYX_ERR(0, 291, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __pyx_v_o->adaptive_rho_interval = __pyx_t_39;
+  __pyx_v_o->adaptive_rho_interval = __pyx_t_42;
   __pyx_v_o->scaling = __pyx_t_16;
 
-  /* "fccqp/admm.pyx":287
+  /* "fccqp/admm.pyx":292
  *         o.max_iter, o.check_termination = settings.max_iter, settings.check_termination
  *         o.adaptive_rho_interval, o.scaling = settings.adaptive_rho_interval, settings.scaling
  *         o.adaptive_rho, o.restore_feasibility = settings.adaptive_rho, settings.restore_feasibility             # <<<<<<<<<<<<<<
  *         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
  *         self.has_previous = self.has_matrices = self.certified = self.scaled_once = False
 */
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_adaptive_rho); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 287, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_adaptive_rho); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 292, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_18 = __Pyx_PyObject_IsTrue(__pyx_t_11); if (unlikely((__pyx_t_18 == (int)-1) && PyErr_Occurred())) __PYX_ERR(0, 287, __pyx_L1_error)
+  __pyx_t_18 = __Pyx_PyObject_IsTrue(__pyx_t_11); if (unlikely((__pyx_t_18 == (int)-1) && PyErr_Occurred())) __PYX_ERR(0, 292, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_restore_feasibility); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 287, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_restore_feasibility); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 292, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_40 = __Pyx_PyObject_IsTrue(__pyx_t_11); if (unlikely((__pyx_t_40 == (int)-1) && PyErr_Occurred())) __PYX_ERR(0, 287, __pyx_L1_error)
+  __pyx_t_43 = __Pyx_PyObject_IsTrue(__pyx_t_11); if (unlikely((__pyx_t_43 == (int)-1) && PyErr_Occurred())) __PYX_ERR(0, 292, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   __pyx_v_o->adaptive_rho = __pyx_t_18;
-  __pyx_v_o->restore_feasibility = __pyx_t_40;
+  __pyx_v_o->restore_feasibility = __pyx_t_43;
 
-  /* "fccqp/admm.pyx":288
+  /* "fccqp/admm.pyx":293
  *         o.adaptive_rho_interval, o.scaling = settings.adaptive_rho_interval, settings.scaling
  *         o.adaptive_rho, o.restore_feasibility = settings.adaptive_rho, settings.restore_feasibility
  *         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory             # <<<<<<<<<<<<<<
  *         self.has_previous = self.has_matrices = self.certified = self.scaled_once = False
  *         self.factored_rho = -1.0
 */
-  __Pyx_GetModuleGlobalName(__pyx_t_11, __pyx_mstate_global->__pyx_n_u_BACKENDS); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 288, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_11, __pyx_mstate_global->__pyx_n_u_BACKENDS); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 293, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_13 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_kkt_backend); if (unlikely(!__pyx_t_13)) __PYX_ERR(0, 288, __pyx_L1_error)
+  __pyx_t_13 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_kkt_backend); if (unlikely(!__pyx_t_13)) __PYX_ERR(0, 293, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_13);
-  __pyx_t_12 = __Pyx_PyObject_GetItem(__pyx_t_11, __pyx_t_13); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 288, __pyx_L1_error)
+  __pyx_t_12 = __Pyx_PyObject_GetItem(__pyx_t_11, __pyx_t_13); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 293, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_12);
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   __Pyx_DECREF(__pyx_t_13); __pyx_t_13 = 0;
-  __pyx_t_37 = __Pyx_PyLong_As_int(__pyx_t_12); if (unlikely((__pyx_t_37 == (int)-1) && PyErr_Occurred())) __PYX_ERR(0, 288, __pyx_L1_error)
+  __pyx_t_40 = __Pyx_PyLong_As_int(__pyx_t_12); if (unlikely((__pyx_t_40 == (int)-1) && PyErr_Occurred())) __PYX_ERR(0, 293, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_12); __pyx_t_12 = 0;
-  __pyx_t_12 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_anderson_memory); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 288, __pyx_L1_error)
+  __pyx_t_12 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_anderson_memory); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 293, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_12);
-  __pyx_t_36 = __Pyx_PyLong_As_int(__pyx_t_12); if (unlikely((__pyx_t_36 == (int)-1) && PyErr_Occurred())) __PYX_ERR(0, 288, __pyx_L1_error)
+  __pyx_t_39 = __Pyx_PyLong_As_int(__pyx_t_12); if (unlikely((__pyx_t_39 == (int)-1) && PyErr_Occurred())) __PYX_ERR(0, 293, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_12); __pyx_t_12 = 0;
-  __pyx_v_o->backend = __pyx_t_37;
-  __pyx_v_o->anderson_memory = __pyx_t_36;
+  __pyx_v_o->backend = __pyx_t_40;
+  __pyx_v_o->anderson_memory = __pyx_t_39;
 
-  /* "fccqp/admm.pyx":289
+  /* "fccqp/admm.pyx":294
  *         o.adaptive_rho, o.restore_feasibility = settings.adaptive_rho, settings.restore_feasibility
  *         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
  *         self.has_previous = self.has_matrices = self.certified = self.scaled_once = False             # <<<<<<<<<<<<<<
@@ -21380,7 +21453,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   __pyx_v_self->certified = 0;
   __pyx_v_self->scaled_once = 0;
 
-  /* "fccqp/admm.pyx":290
+  /* "fccqp/admm.pyx":295
  *         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
  *         self.has_previous = self.has_matrices = self.certified = self.scaled_once = False
  *         self.factored_rho = -1.0             # <<<<<<<<<<<<<<
@@ -21423,6 +21496,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 
 
 
+
   __Pyx_XDECREF(__pyx_v_kind);
   __Pyx_XDECREF(__pyx_v_offset);
   __Pyx_XDECREF(__pyx_v_dim);
@@ -21445,11 +21519,12 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 
 
 
+
   __Pyx_RefNannyFinishContext();
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":292
+/* "fccqp/admm.pyx":297
  *         self.factored_rho = -1.0
  * 
  *     cdef double* _new(self, Py_ssize_t size):             # <<<<<<<<<<<<<<
@@ -21479,7 +21554,7 @@ static double *__pyx_f_5fccqp_4admm_9Workspace__new(struct __pyx_obj_5fccqp_4adm
   int __pyx_clineno = 0;
   __Pyx_RefNannySetupContext("_new", 0);
 
-  /* "fccqp/admm.pyx":294
+  /* "fccqp/admm.pyx":299
  *     cdef double* _new(self, Py_ssize_t size):
  *         """A zeroed array of ``size`` doubles (at least one) that lives with ``self``."""
  *         array = np.zeros(max(size, 1))             # <<<<<<<<<<<<<<
@@ -21487,9 +21562,9 @@ static double *__pyx_f_5fccqp_4admm_9Workspace__new(struct __pyx_obj_5fccqp_4adm
  *         cdef double[::1] view = array
 */
   __pyx_t_2 = NULL;
-  __Pyx_GetModuleGlobalName(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 294, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 299, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_3);
-  __pyx_t_4 = __Pyx_PyObject_GetAttrStr(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_zeros); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 294, __pyx_L1_error)
+  __pyx_t_4 = __Pyx_PyObject_GetAttrStr(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_zeros); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 299, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_4);
   __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
 
@@ -21506,7 +21581,7 @@ static double *__pyx_f_5fccqp_4admm_9Workspace__new(struct __pyx_obj_5fccqp_4adm
     __pyx_t_7 = __pyx_t_6;
   }
 
-  __pyx_t_3 = PyLong_FromSsize_t(__pyx_t_7); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 294, __pyx_L1_error)
+  __pyx_t_3 = PyLong_FromSsize_t(__pyx_t_7); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 299, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_3);
 
   __pyx_t_9 = 1;
@@ -21527,13 +21602,13 @@ static double *__pyx_f_5fccqp_4admm_9Workspace__new(struct __pyx_obj_5fccqp_4adm
     __Pyx_XDECREF(__pyx_t_2); __pyx_t_2 = 0;
     __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
     __Pyx_DECREF(__pyx_t_4); __pyx_t_4 = 0;
-    if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 294, __pyx_L1_error)
+    if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 299, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_1);
   }
   __pyx_v_array = __pyx_t_1;
   __pyx_t_1 = 0;
 
-  /* "fccqp/admm.pyx":295
+  /* "fccqp/admm.pyx":300
  *         """A zeroed array of ``size`` doubles (at least one) that lives with ``self``."""
  *         array = np.zeros(max(size, 1))
  *         self._arrays.append(array)             # <<<<<<<<<<<<<<
@@ -21542,24 +21617,24 @@ static double *__pyx_f_5fccqp_4admm_9Workspace__new(struct __pyx_obj_5fccqp_4adm
 */
   if (unlikely(__pyx_v_self->_arrays == Py_None)) {
     PyErr_Format(PyExc_AttributeError, "\047NoneType\047 object has no attribute \047%.30s\047", "append");
-    __PYX_ERR(0, 295, __pyx_L1_error)
+    __PYX_ERR(0, 300, __pyx_L1_error)
   }
-  __pyx_t_10 = __Pyx_PyList_Append(__pyx_v_self->_arrays, __pyx_v_array); if (unlikely(__pyx_t_10 == ((int)-1))) __PYX_ERR(0, 295, __pyx_L1_error)
+  __pyx_t_10 = __Pyx_PyList_Append(__pyx_v_self->_arrays, __pyx_v_array); if (unlikely(__pyx_t_10 == ((int)-1))) __PYX_ERR(0, 300, __pyx_L1_error)
 
 
-  /* "fccqp/admm.pyx":296
+  /* "fccqp/admm.pyx":301
  *         array = np.zeros(max(size, 1))
  *         self._arrays.append(array)
  *         cdef double[::1] view = array             # <<<<<<<<<<<<<<
  *         return &view[0]
  * 
 */
-  __pyx_t_11 = __Pyx_PyObject_to_MemoryviewSlice_dc_double(__pyx_v_array, PyBUF_WRITABLE); if (unlikely(!__pyx_t_11.memview)) __PYX_ERR(0, 296, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_to_MemoryviewSlice_dc_double(__pyx_v_array, PyBUF_WRITABLE); if (unlikely(!__pyx_t_11.memview)) __PYX_ERR(0, 301, __pyx_L1_error)
   __pyx_v_view = __pyx_t_11;
   __pyx_t_11.memview = NULL;
   __pyx_t_11.data = NULL;
 
-  /* "fccqp/admm.pyx":297
+  /* "fccqp/admm.pyx":302
  *         self._arrays.append(array)
  *         cdef double[::1] view = array
  *         return &view[0]             # <<<<<<<<<<<<<<
@@ -21573,7 +21648,7 @@ static double *__pyx_f_5fccqp_4admm_9Workspace__new(struct __pyx_obj_5fccqp_4adm
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":292
+  /* "fccqp/admm.pyx":297
  *         self.factored_rho = -1.0
  * 
  *     cdef double* _new(self, Py_ssize_t size):             # <<<<<<<<<<<<<<
@@ -21598,7 +21673,7 @@ static double *__pyx_f_5fccqp_4admm_9Workspace__new(struct __pyx_obj_5fccqp_4adm
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":299
+/* "fccqp/admm.pyx":304
  *         return &view[0]
  * 
  *     cdef void* _new_int(self, Py_ssize_t size):             # <<<<<<<<<<<<<<
@@ -21630,7 +21705,7 @@ static void *__pyx_f_5fccqp_4admm_9Workspace__new_int(struct __pyx_obj_5fccqp_4a
   int __pyx_clineno = 0;
   __Pyx_RefNannySetupContext("_new_int", 0);
 
-  /* "fccqp/admm.pyx":301
+  /* "fccqp/admm.pyx":306
  *     cdef void* _new_int(self, Py_ssize_t size):
  *         """An array of ``size`` pointer-sized integers that lives with ``self``."""
  *         array = np.zeros(max(size, 1), dtype=np.intp)             # <<<<<<<<<<<<<<
@@ -21638,9 +21713,9 @@ static void *__pyx_f_5fccqp_4admm_9Workspace__new_int(struct __pyx_obj_5fccqp_4a
  *         cdef Py_ssize_t[::1] view = array
 */
   __pyx_t_2 = NULL;
-  __Pyx_GetModuleGlobalName(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 301, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 306, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_3);
-  __pyx_t_4 = __Pyx_PyObject_GetAttrStr(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_zeros); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 301, __pyx_L1_error)
+  __pyx_t_4 = __Pyx_PyObject_GetAttrStr(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_zeros); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 306, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_4);
   __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
 
@@ -21657,12 +21732,12 @@ static void *__pyx_f_5fccqp_4admm_9Workspace__new_int(struct __pyx_obj_5fccqp_4a
     __pyx_t_7 = __pyx_t_6;
   }
 
-  __pyx_t_3 = PyLong_FromSsize_t(__pyx_t_7); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 301, __pyx_L1_error)
+  __pyx_t_3 = PyLong_FromSsize_t(__pyx_t_7); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 306, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_3);
 
-  __Pyx_GetModuleGlobalName(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 301, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 306, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_9);
-  __pyx_t_10 = __Pyx_PyObject_GetAttrStr(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_intp); if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 301, __pyx_L1_error)
+  __pyx_t_10 = __Pyx_PyObject_GetAttrStr(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_intp); if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 306, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_10);
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
   #if CYTHON_VECTORCALL
@@ -21683,13 +21758,13 @@ static void *__pyx_f_5fccqp_4admm_9Workspace__new_int(struct __pyx_obj_5fccqp_4a
     PyObject *__pyx_callargs[3] = {__pyx_t_2, __pyx_t_3, __pyx_t_10};
     #if CYTHON_VECTORCALL
     __pyx_t_9 = __pyx_mstate_global->__pyx_tuple[2];
-    if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 301, __pyx_L1_error)
+    if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 306, __pyx_L1_error)
     __Pyx_INCREF(__pyx_t_9);
     #else
     {
       PyObject *__pyx_temp[1] = {__pyx_mstate_global->__pyx_n_u_dtype};
       __pyx_t_9 = __Pyx_MakeKwargDict(__pyx_temp, __pyx_callargs+2, 1);
-      if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 301, __pyx_L1_error)
+      if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 306, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_9);
     }
     #endif
@@ -21701,13 +21776,13 @@ static void *__pyx_f_5fccqp_4admm_9Workspace__new_int(struct __pyx_obj_5fccqp_4a
     __Pyx_DECREF(__pyx_t_10); __pyx_t_10 = 0;
     __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
     __Pyx_DECREF(__pyx_t_4); __pyx_t_4 = 0;
-    if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 301, __pyx_L1_error)
+    if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 306, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_1);
   }
   __pyx_v_array = __pyx_t_1;
   __pyx_t_1 = 0;
 
-  /* "fccqp/admm.pyx":302
+  /* "fccqp/admm.pyx":307
  *         """An array of ``size`` pointer-sized integers that lives with ``self``."""
  *         array = np.zeros(max(size, 1), dtype=np.intp)
  *         self._arrays.append(array)             # <<<<<<<<<<<<<<
@@ -21716,24 +21791,24 @@ static void *__pyx_f_5fccqp_4admm_9Workspace__new_int(struct __pyx_obj_5fccqp_4a
 */
   if (unlikely(__pyx_v_self->_arrays == Py_None)) {
     PyErr_Format(PyExc_AttributeError, "\047NoneType\047 object has no attribute \047%.30s\047", "append");
-    __PYX_ERR(0, 302, __pyx_L1_error)
+    __PYX_ERR(0, 307, __pyx_L1_error)
   }
-  __pyx_t_12 = __Pyx_PyList_Append(__pyx_v_self->_arrays, __pyx_v_array); if (unlikely(__pyx_t_12 == ((int)-1))) __PYX_ERR(0, 302, __pyx_L1_error)
+  __pyx_t_12 = __Pyx_PyList_Append(__pyx_v_self->_arrays, __pyx_v_array); if (unlikely(__pyx_t_12 == ((int)-1))) __PYX_ERR(0, 307, __pyx_L1_error)
 
 
-  /* "fccqp/admm.pyx":303
+  /* "fccqp/admm.pyx":308
  *         array = np.zeros(max(size, 1), dtype=np.intp)
  *         self._arrays.append(array)
  *         cdef Py_ssize_t[::1] view = array             # <<<<<<<<<<<<<<
  *         return &view[0]
  * 
 */
-  __pyx_t_13 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(__pyx_v_array, PyBUF_WRITABLE); if (unlikely(!__pyx_t_13.memview)) __PYX_ERR(0, 303, __pyx_L1_error)
+  __pyx_t_13 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(__pyx_v_array, PyBUF_WRITABLE); if (unlikely(!__pyx_t_13.memview)) __PYX_ERR(0, 308, __pyx_L1_error)
   __pyx_v_view = __pyx_t_13;
   __pyx_t_13.memview = NULL;
   __pyx_t_13.data = NULL;
 
-  /* "fccqp/admm.pyx":304
+  /* "fccqp/admm.pyx":309
  *         self._arrays.append(array)
  *         cdef Py_ssize_t[::1] view = array
  *         return &view[0]             # <<<<<<<<<<<<<<
@@ -21747,7 +21822,7 @@ static void *__pyx_f_5fccqp_4admm_9Workspace__new_int(struct __pyx_obj_5fccqp_4a
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":299
+  /* "fccqp/admm.pyx":304
  *         return &view[0]
  * 
  *     cdef void* _new_int(self, Py_ssize_t size):             # <<<<<<<<<<<<<<
@@ -21774,7 +21849,7 @@ static void *__pyx_f_5fccqp_4admm_9Workspace__new_int(struct __pyx_obj_5fccqp_4a
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":306
+/* "fccqp/admm.pyx":311
  *         return &view[0]
  * 
  *     def update_cones(self, mu, normal):             # <<<<<<<<<<<<<<
@@ -21823,39 +21898,39 @@ PyObject *__pyx_args, PyObject *__pyx_kwds
   {
     PyObject ** const __pyx_pyargnames[] = {&__pyx_mstate_global->__pyx_n_u_mu,&__pyx_mstate_global->__pyx_n_u_normal,0};
     const Py_ssize_t __pyx_kwds_len = (__pyx_kwds) ? __Pyx_NumKwargs_FASTCALL(__pyx_kwds) : 0;
-    if (unlikely(__pyx_kwds_len < 0)) __PYX_ERR(0, 306, __pyx_L3_error)
+    if (unlikely(__pyx_kwds_len < 0)) __PYX_ERR(0, 311, __pyx_L3_error)
     if (__pyx_kwds_len > 0) {
       switch (__pyx_nargs) {
         case  2:
         values[1] = __Pyx_ArgRef_FASTCALL(__pyx_args, 1);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 306, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 311, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  1:
         values[0] = __Pyx_ArgRef_FASTCALL(__pyx_args, 0);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 306, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 311, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  0: break;
         default: goto __pyx_L5_argtuple_error;
       }
       const Py_ssize_t kwd_pos_args = __pyx_nargs;
-      if (__Pyx_ParseKeywords(__pyx_kwds, __pyx_kwvalues, __pyx_pyargnames, 0, values, kwd_pos_args, __pyx_kwds_len, "update_cones", 0) < (0)) __PYX_ERR(0, 306, __pyx_L3_error)
+      if (__Pyx_ParseKeywords(__pyx_kwds, __pyx_kwvalues, __pyx_pyargnames, 0, values, kwd_pos_args, __pyx_kwds_len, "update_cones", 0) < (0)) __PYX_ERR(0, 311, __pyx_L3_error)
       for (Py_ssize_t i = __pyx_nargs; i < 2; i++) {
-        if (unlikely(!values[i])) { __Pyx_RaiseArgtupleInvalid("update_cones", 1, 2, 2, i); __PYX_ERR(0, 306, __pyx_L3_error) }
+        if (unlikely(!values[i])) { __Pyx_RaiseArgtupleInvalid("update_cones", 1, 2, 2, i); __PYX_ERR(0, 311, __pyx_L3_error) }
       }
     } else if (unlikely(__pyx_nargs != 2)) {
       goto __pyx_L5_argtuple_error;
     } else {
       values[0] = __Pyx_ArgRef_FASTCALL(__pyx_args, 0);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 306, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 311, __pyx_L3_error)
       values[1] = __Pyx_ArgRef_FASTCALL(__pyx_args, 1);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 306, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 311, __pyx_L3_error)
     }
     __pyx_v_mu = values[0];
     __pyx_v_normal = values[1];
   }
   goto __pyx_L6_skip;
   __pyx_L5_argtuple_error:;
-  __Pyx_RaiseArgtupleInvalid("update_cones", 1, 2, 2, __pyx_nargs); __PYX_ERR(0, 306, __pyx_L3_error)
+  __Pyx_RaiseArgtupleInvalid("update_cones", 1, 2, 2, __pyx_nargs); __PYX_ERR(0, 311, __pyx_L3_error)
   __pyx_L6_skip:;
   goto __pyx_L4_argument_unpacking_done;
   __pyx_L3_error:;
@@ -21892,19 +21967,19 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_2update_cones(struct __pyx_obj
   int __pyx_clineno = 0;
   __Pyx_RefNannySetupContext("update_cones", 0);
 
-  /* "fccqp/admm.pyx":308
+  /* "fccqp/admm.pyx":313
  *     def update_cones(self, mu, normal):
  *         """New friction coefficients and normals for the same cone blocks."""
  *         self._keep[4][:] = mu             # <<<<<<<<<<<<<<
  *         self._keep[5][:] = np.asarray(normal, dtype=np.float64).reshape(-1)
  * 
 */
-  __pyx_t_1 = __Pyx_GetItemInt(__pyx_v_self->_keep, 4, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 308, __pyx_L1_error)
+  __pyx_t_1 = __Pyx_GetItemInt(__pyx_v_self->_keep, 4, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 313, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_1);
-  if (__Pyx_PyObject_SetSlice(__pyx_t_1, __pyx_v_mu, 0, 0, NULL, NULL, &__pyx_mstate_global->__pyx_slice[0], 0, 0, 0) < (0)) __PYX_ERR(0, 308, __pyx_L1_error)
+  if (__Pyx_PyObject_SetSlice(__pyx_t_1, __pyx_v_mu, 0, 0, NULL, NULL, &__pyx_mstate_global->__pyx_slice[0], 0, 0, 0) < (0)) __PYX_ERR(0, 313, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_1); __pyx_t_1 = 0;
 
-  /* "fccqp/admm.pyx":309
+  /* "fccqp/admm.pyx":314
  *         """New friction coefficients and normals for the same cone blocks."""
  *         self._keep[4][:] = mu
  *         self._keep[5][:] = np.asarray(normal, dtype=np.float64).reshape(-1)             # <<<<<<<<<<<<<<
@@ -21912,14 +21987,14 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_2update_cones(struct __pyx_obj
  *     def forget(self):
 */
   __pyx_t_4 = NULL;
-  __Pyx_GetModuleGlobalName(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 309, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 314, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_5);
-  __pyx_t_6 = __Pyx_PyObject_GetAttrStr(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_asarray); if (unlikely(!__pyx_t_6)) __PYX_ERR(0, 309, __pyx_L1_error)
+  __pyx_t_6 = __Pyx_PyObject_GetAttrStr(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_asarray); if (unlikely(!__pyx_t_6)) __PYX_ERR(0, 314, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_6);
   __Pyx_DECREF(__pyx_t_5); __pyx_t_5 = 0;
-  __Pyx_GetModuleGlobalName(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 309, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 314, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_5);
-  __pyx_t_7 = __Pyx_PyObject_GetAttrStr(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_float64); if (unlikely(!__pyx_t_7)) __PYX_ERR(0, 309, __pyx_L1_error)
+  __pyx_t_7 = __Pyx_PyObject_GetAttrStr(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_float64); if (unlikely(!__pyx_t_7)) __PYX_ERR(0, 314, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_7);
   __Pyx_DECREF(__pyx_t_5); __pyx_t_5 = 0;
   #if CYTHON_VECTORCALL
@@ -21940,13 +22015,13 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_2update_cones(struct __pyx_obj
     PyObject *__pyx_callargs[3] = {__pyx_t_4, __pyx_v_normal, __pyx_t_7};
     #if CYTHON_VECTORCALL
     __pyx_t_5 = __pyx_mstate_global->__pyx_tuple[2];
-    if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 309, __pyx_L1_error)
+    if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 314, __pyx_L1_error)
     __Pyx_INCREF(__pyx_t_5);
     #else
     {
       PyObject *__pyx_temp[1] = {__pyx_mstate_global->__pyx_n_u_dtype};
       __pyx_t_5 = __Pyx_MakeKwargDict(__pyx_temp, __pyx_callargs+2, 1);
-      if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 309, __pyx_L1_error)
+      if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 314, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_5);
     }
     #endif
@@ -21957,7 +22032,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_2update_cones(struct __pyx_obj
     __Pyx_DECREF(__pyx_t_7); __pyx_t_7 = 0;
     __Pyx_DECREF(__pyx_t_5); __pyx_t_5 = 0;
     __Pyx_DECREF(__pyx_t_6); __pyx_t_6 = 0;
-    if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 309, __pyx_L1_error)
+    if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 314, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_3);
   }
   __pyx_t_2 = __pyx_t_3;
@@ -21968,16 +22043,16 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_2update_cones(struct __pyx_obj
     __pyx_t_1 = __Pyx_PyObject_FastCallMethod((PyObject*)__pyx_mstate_global->__pyx_n_u_reshape, __pyx_callargs+__pyx_t_8, (2-__pyx_t_8) | (1*__Pyx_PY_VECTORCALL_ARGUMENTS_OFFSET));
     __Pyx_XDECREF(__pyx_t_2); __pyx_t_2 = 0;
     __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
-    if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 309, __pyx_L1_error)
+    if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 314, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_1);
   }
-  __pyx_t_3 = __Pyx_GetItemInt(__pyx_v_self->_keep, 5, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 309, __pyx_L1_error)
+  __pyx_t_3 = __Pyx_GetItemInt(__pyx_v_self->_keep, 5, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 314, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_3);
-  if (__Pyx_PyObject_SetSlice(__pyx_t_3, __pyx_t_1, 0, 0, NULL, NULL, &__pyx_mstate_global->__pyx_slice[0], 0, 0, 0) < (0)) __PYX_ERR(0, 309, __pyx_L1_error)
+  if (__Pyx_PyObject_SetSlice(__pyx_t_3, __pyx_t_1, 0, 0, NULL, NULL, &__pyx_mstate_global->__pyx_slice[0], 0, 0, 0) < (0)) __PYX_ERR(0, 314, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
   __Pyx_DECREF(__pyx_t_1); __pyx_t_1 = 0;
 
-  /* "fccqp/admm.pyx":306
+  /* "fccqp/admm.pyx":311
  *         return &view[0]
  * 
  *     def update_cones(self, mu, normal):             # <<<<<<<<<<<<<<
@@ -22004,7 +22079,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_2update_cones(struct __pyx_obj
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":311
+/* "fccqp/admm.pyx":316
  *         self._keep[5][:] = np.asarray(normal, dtype=np.float64).reshape(-1)
  * 
  *     def forget(self):             # <<<<<<<<<<<<<<
@@ -22060,7 +22135,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_4forget(struct __pyx_obj_5fccq
   __Pyx_RefNannyDeclarations
   __Pyx_RefNannySetupContext("forget", 0);
 
-  /* "fccqp/admm.pyx":313
+  /* "fccqp/admm.pyx":318
  *     def forget(self):
  *         """Drop the previous solution, so that the next solve starts cold."""
  *         self.has_previous = False             # <<<<<<<<<<<<<<
@@ -22069,7 +22144,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_4forget(struct __pyx_obj_5fccq
 */
   __pyx_v_self->has_previous = 0;
 
-  /* "fccqp/admm.pyx":311
+  /* "fccqp/admm.pyx":316
  *         self._keep[5][:] = np.asarray(normal, dtype=np.float64).reshape(-1)
  * 
  *     def forget(self):             # <<<<<<<<<<<<<<
@@ -22084,7 +22159,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_4forget(struct __pyx_obj_5fccq
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":315
+/* "fccqp/admm.pyx":320
  *         self.has_previous = False
  * 
  *     @property             # <<<<<<<<<<<<<<
@@ -22120,31 +22195,31 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_7finding___get__(struct __pyx_
   int __pyx_clineno = 0;
   __Pyx_RefNannySetupContext("__get__", 0);
 
-  /* "fccqp/admm.pyx":318
+  /* "fccqp/admm.pyx":323
  *     def finding(self):
  *         """``(code, argument, index, value)`` of the last scan (see fccqp.validation)."""
  *         return self.found.code, self.found.argument, self.found.index, self.found.value             # <<<<<<<<<<<<<<
  * 
  *     @property
 */
-  __pyx_t_1 = __Pyx_PyLong_From_int(__pyx_v_self->found.code); if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 318, __pyx_L1_error)
+  __pyx_t_1 = __Pyx_PyLong_From_int(__pyx_v_self->found.code); if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 323, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_1);
-  __pyx_t_2 = __Pyx_PyLong_From_int(__pyx_v_self->found.argument); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 318, __pyx_L1_error)
+  __pyx_t_2 = __Pyx_PyLong_From_int(__pyx_v_self->found.argument); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 323, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_2);
-  __pyx_t_3 = PyLong_FromSsize_t(__pyx_v_self->found.index); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 318, __pyx_L1_error)
+  __pyx_t_3 = PyLong_FromSsize_t(__pyx_v_self->found.index); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 323, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_3);
-  __pyx_t_4 = PyFloat_FromDouble(__pyx_v_self->found.value); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 318, __pyx_L1_error)
+  __pyx_t_4 = PyFloat_FromDouble(__pyx_v_self->found.value); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 323, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_4);
-  __pyx_t_5 = PyTuple_New(4); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 318, __pyx_L1_error)
+  __pyx_t_5 = PyTuple_New(4); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 323, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_5);
   __Pyx_GIVEREF(__pyx_t_1);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_5, 0, __pyx_t_1) != (0)) __PYX_ERR(0, 318, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_5, 0, __pyx_t_1) != (0)) __PYX_ERR(0, 323, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_2);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_5, 1, __pyx_t_2) != (0)) __PYX_ERR(0, 318, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_5, 1, __pyx_t_2) != (0)) __PYX_ERR(0, 323, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_3);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_5, 2, __pyx_t_3) != (0)) __PYX_ERR(0, 318, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_5, 2, __pyx_t_3) != (0)) __PYX_ERR(0, 323, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_4);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_5, 3, __pyx_t_4) != (0)) __PYX_ERR(0, 318, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_5, 3, __pyx_t_4) != (0)) __PYX_ERR(0, 323, __pyx_L1_error);
   __pyx_t_1 = 0;
   __pyx_t_2 = 0;
   __pyx_t_3 = 0;
@@ -22160,7 +22235,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_7finding___get__(struct __pyx_
   __pyx_t_5 = 0;
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":315
+  /* "fccqp/admm.pyx":320
  *         self.has_previous = False
  * 
  *     @property             # <<<<<<<<<<<<<<
@@ -22183,7 +22258,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_7finding___get__(struct __pyx_
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":320
+/* "fccqp/admm.pyx":325
  *         return self.found.code, self.found.argument, self.found.index, self.found.value
  * 
  *     @property             # <<<<<<<<<<<<<<
@@ -22207,12 +22282,12 @@ static PyObject *__pyx_pw_5fccqp_4admm_9Workspace_9log_lines_1__get__(PyObject *
 }
 static PyObject *__pyx_gb_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_2generator(__pyx_CoroutineObject *__pyx_generator, CYTHON_UNUSED PyThreadState *__pyx_tstate, PyObject *__pyx_sent_value); /* proto */
 
-/* "fccqp/admm.pyx":324
+/* "fccqp/admm.pyx":329
  *         """Rows ``(iteration, prim, dual, gap, rho)`` of the last solve's log."""
  *         cdef Py_ssize_t i, j
  *         return [tuple(self.log[5 * i + j] for j in range(5)) for i in range(self.log_count)]             # <<<<<<<<<<<<<<
  * 
- *     def solve(self, double[:, ::1] P, double[::1] q, double[:, ::1] A, double[::1] b,
+ *     def solve(self, const double[:, ::1] P, const double[::1] q, const double[:, ::1] A,
 */
 
 static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_genexpr(PyObject *__pyx_self) {
@@ -22227,7 +22302,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_
   if (unlikely(!__pyx_cur_scope)) {
     __pyx_cur_scope = ((struct __pyx_obj_5fccqp_4admm___pyx_scope_struct_1_genexpr *)Py_None);
     __Pyx_INCREF(Py_None);
-    __PYX_ERR(0, 324, __pyx_L1_error)
+    __PYX_ERR(0, 329, __pyx_L1_error)
   } else {
     __Pyx_GOTREF((PyObject *)__pyx_cur_scope);
   }
@@ -22235,7 +22310,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_
   __Pyx_INCREF((PyObject *)__pyx_cur_scope->__pyx_outer_scope);
   __Pyx_GIVEREF((PyObject *)__pyx_cur_scope->__pyx_outer_scope);
   {
-    __pyx_CoroutineObject *gen = __Pyx_Generator_New((__pyx_coroutine_body_t) __pyx_gb_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_2generator, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[0]), (PyObject *) __pyx_cur_scope, __pyx_mstate_global->__pyx_n_u_genexpr, __pyx_mstate_global->__pyx_n_u_Workspace___get___locals_genexpr, __pyx_mstate_global->__pyx_n_u_fccqp_admm); if (unlikely(!gen)) __PYX_ERR(0, 324, __pyx_L1_error)
+    __pyx_CoroutineObject *gen = __Pyx_Generator_New((__pyx_coroutine_body_t) __pyx_gb_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_2generator, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[0]), (PyObject *) __pyx_cur_scope, __pyx_mstate_global->__pyx_n_u_genexpr, __pyx_mstate_global->__pyx_n_u_Workspace___get___locals_genexpr, __pyx_mstate_global->__pyx_n_u_fccqp_admm); if (unlikely(!gen)) __PYX_ERR(0, 329, __pyx_L1_error)
     __Pyx_DECREF(__pyx_cur_scope);
     __Pyx_RefNannyFinishContext();
     return (PyObject *) gen;
@@ -22274,24 +22349,24 @@ static PyObject *__pyx_gb_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_
   __pyx_L3_first_run:;
   if (unlikely(__pyx_sent_value != Py_None)) {
     if (unlikely(__pyx_sent_value)) PyErr_SetString(PyExc_TypeError, "can't send non-None value to a just-started generator");
-    __PYX_ERR(0, 324, __pyx_L1_error)
+    __PYX_ERR(0, 329, __pyx_L1_error)
   }
   for (__pyx_t_1 = 0; __pyx_t_1 < 5; __pyx_t_1+=1) {
-    __pyx_t_2 = PyLong_FromSsize_t(__pyx_t_1); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 324, __pyx_L1_error)
+    __pyx_t_2 = PyLong_FromSsize_t(__pyx_t_1); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 329, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_2);
     __Pyx_XGOTREF(__pyx_cur_scope->__pyx_v_j);
     __Pyx_XDECREF_SET(__pyx_cur_scope->__pyx_v_j, ((PyObject*)__pyx_t_2));
     __Pyx_GIVEREF(__pyx_t_2);
     __pyx_t_2 = 0;
-    if (unlikely(!__pyx_cur_scope->__pyx_outer_scope->__pyx_v_self)) { __Pyx_RaiseClosureNameError("self"); __PYX_ERR(0, 324, __pyx_L1_error) }
-    __pyx_t_2 = PyLong_FromSsize_t((5 * __pyx_cur_scope->__pyx_outer_scope->__pyx_8genexpr1__pyx_v_i)); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 324, __pyx_L1_error)
+    if (unlikely(!__pyx_cur_scope->__pyx_outer_scope->__pyx_v_self)) { __Pyx_RaiseClosureNameError("self"); __PYX_ERR(0, 329, __pyx_L1_error) }
+    __pyx_t_2 = PyLong_FromSsize_t((5 * __pyx_cur_scope->__pyx_outer_scope->__pyx_8genexpr1__pyx_v_i)); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 329, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_2);
-    __pyx_t_3 = __Pyx_PyNumber_Add_int_int(__pyx_t_2, __pyx_cur_scope->__pyx_v_j); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 324, __pyx_L1_error)
+    __pyx_t_3 = __Pyx_PyNumber_Add_int_int(__pyx_t_2, __pyx_cur_scope->__pyx_v_j); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 329, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_3);
     __Pyx_DECREF(__pyx_t_2); __pyx_t_2 = 0;
-    __pyx_t_4 = __Pyx_PyIndex_AsSsize_t(__pyx_t_3); if (unlikely((__pyx_t_4 == (Py_ssize_t)-1) && PyErr_Occurred())) __PYX_ERR(0, 324, __pyx_L1_error)
+    __pyx_t_4 = __Pyx_PyIndex_AsSsize_t(__pyx_t_3); if (unlikely((__pyx_t_4 == (Py_ssize_t)-1) && PyErr_Occurred())) __PYX_ERR(0, 329, __pyx_L1_error)
     __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
-    __pyx_t_3 = PyFloat_FromDouble((__pyx_cur_scope->__pyx_outer_scope->__pyx_v_self->log[__pyx_t_4])); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 324, __pyx_L1_error)
+    __pyx_t_3 = PyFloat_FromDouble((__pyx_cur_scope->__pyx_outer_scope->__pyx_v_self->log[__pyx_t_4])); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 329, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_3);
 
     __pyx_r = __pyx_t_3;
@@ -22306,7 +22381,7 @@ static PyObject *__pyx_gb_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_
     return __pyx_r;
     __pyx_L6_resume_from_yield:;
     __pyx_t_1 = __pyx_cur_scope->__pyx_t_0;
-    if (unlikely(!__pyx_sent_value)) __PYX_ERR(0, 324, __pyx_L1_error)
+    if (unlikely(!__pyx_sent_value)) __PYX_ERR(0, 329, __pyx_L1_error)
   }
   CYTHON_MAYBE_UNUSED_VAR(__pyx_cur_scope);
 
@@ -22331,7 +22406,7 @@ static PyObject *__pyx_gb_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":320
+/* "fccqp/admm.pyx":325
  *         return self.found.code, self.found.argument, self.found.index, self.found.value
  * 
  *     @property             # <<<<<<<<<<<<<<
@@ -22358,7 +22433,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_9log_lines___get__(struct __py
   if (unlikely(!__pyx_cur_scope)) {
     __pyx_cur_scope = ((struct __pyx_obj_5fccqp_4admm___pyx_scope_struct____get__ *)Py_None);
     __Pyx_INCREF(Py_None);
-    __PYX_ERR(0, 320, __pyx_L1_error)
+    __PYX_ERR(0, 325, __pyx_L1_error)
   } else {
     __Pyx_GOTREF((PyObject *)__pyx_cur_scope);
   }
@@ -22366,15 +22441,15 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_9log_lines___get__(struct __py
   __Pyx_INCREF((PyObject *)__pyx_cur_scope->__pyx_v_self);
   __Pyx_GIVEREF((PyObject *)__pyx_cur_scope->__pyx_v_self);
 
-  /* "fccqp/admm.pyx":324
+  /* "fccqp/admm.pyx":329
  *         """Rows ``(iteration, prim, dual, gap, rho)`` of the last solve's log."""
  *         cdef Py_ssize_t i, j
  *         return [tuple(self.log[5 * i + j] for j in range(5)) for i in range(self.log_count)]             # <<<<<<<<<<<<<<
  * 
- *     def solve(self, double[:, ::1] P, double[::1] q, double[:, ::1] A, double[::1] b,
+ *     def solve(self, const double[:, ::1] P, const double[::1] q, const double[:, ::1] A,
 */
   { /* enter inner scope */
-    __pyx_t_1 = PyList_New(0); if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 324, __pyx_L1_error)
+    __pyx_t_1 = PyList_New(0); if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 329, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_1);
 
     __pyx_t_2 = __pyx_cur_scope->__pyx_v_self->log_count;
@@ -22382,13 +22457,13 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_9log_lines___get__(struct __py
 
     for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
       __pyx_cur_scope->__pyx_8genexpr1__pyx_v_i = __pyx_t_4;
-      __pyx_t_5 = __pyx_pf_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_genexpr(((PyObject*)__pyx_cur_scope)); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 324, __pyx_L1_error)
+      __pyx_t_5 = __pyx_pf_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_genexpr(((PyObject*)__pyx_cur_scope)); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 329, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_5);
-      __pyx_t_6 = __Pyx_PySequence_Tuple(__pyx_t_5); if (unlikely(!__pyx_t_6)) __PYX_ERR(0, 324, __pyx_L1_error)
+      __pyx_t_6 = __Pyx_PySequence_Tuple(__pyx_t_5); if (unlikely(!__pyx_t_6)) __PYX_ERR(0, 329, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_6);
       __Pyx_DECREF(__pyx_t_5); __pyx_t_5 = 0;
       __Pyx_GIVEREF(__pyx_t_6);
-      if (unlikely(__Pyx_ListComp_AppendAndDecref(__pyx_t_1, __pyx_t_6))) __PYX_ERR(0, 324, __pyx_L1_error)
+      if (unlikely(__Pyx_ListComp_AppendAndDecref(__pyx_t_1, __pyx_t_6))) __PYX_ERR(0, 329, __pyx_L1_error)
       __pyx_t_6 = 0;
     }
 
@@ -22404,7 +22479,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_9log_lines___get__(struct __py
   __pyx_t_1 = 0;
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":320
+  /* "fccqp/admm.pyx":325
  *         return self.found.code, self.found.argument, self.found.index, self.found.value
  * 
  *     @property             # <<<<<<<<<<<<<<
@@ -22427,12 +22502,12 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_9log_lines___get__(struct __py
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":326
+/* "fccqp/admm.pyx":331
  *         return [tuple(self.log[5 * i + j] for j in range(5)) for i in range(self.log_count)]
  * 
- *     def solve(self, double[:, ::1] P, double[::1] q, double[:, ::1] A, double[::1] b,             # <<<<<<<<<<<<<<
- *               double[::1] lb, double[::1] ub, x0, bint warm, double start_time,
- *               double[::1] x_out, double[::1] y_out, double[::1] z_out, double[::1] cert_out):
+ *     def solve(self, const double[:, ::1] P, const double[::1] q, const double[:, ::1] A,             # <<<<<<<<<<<<<<
+ *               const double[::1] b, const double[::1] lb, const double[::1] ub, x0,
+ *               bint warm, double start_time,
 */
 
 /* Python wrapper */
@@ -22487,116 +22562,116 @@ PyObject *__pyx_args, PyObject *__pyx_kwds
   {
     PyObject ** const __pyx_pyargnames[] = {&__pyx_mstate_global->__pyx_n_u_P,&__pyx_mstate_global->__pyx_n_u_q,&__pyx_mstate_global->__pyx_n_u_A,&__pyx_mstate_global->__pyx_n_u_b,&__pyx_mstate_global->__pyx_n_u_lb,&__pyx_mstate_global->__pyx_n_u_ub,&__pyx_mstate_global->__pyx_n_u_x0,&__pyx_mstate_global->__pyx_n_u_warm,&__pyx_mstate_global->__pyx_n_u_start_time,&__pyx_mstate_global->__pyx_n_u_x_out,&__pyx_mstate_global->__pyx_n_u_y_out,&__pyx_mstate_global->__pyx_n_u_z_out,&__pyx_mstate_global->__pyx_n_u_cert_out,0};
     const Py_ssize_t __pyx_kwds_len = (__pyx_kwds) ? __Pyx_NumKwargs_FASTCALL(__pyx_kwds) : 0;
-    if (unlikely(__pyx_kwds_len < 0)) __PYX_ERR(0, 326, __pyx_L3_error)
+    if (unlikely(__pyx_kwds_len < 0)) __PYX_ERR(0, 331, __pyx_L3_error)
     if (__pyx_kwds_len > 0) {
       switch (__pyx_nargs) {
         case 13:
         values[12] = __Pyx_ArgRef_FASTCALL(__pyx_args, 12);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[12])) __PYX_ERR(0, 326, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[12])) __PYX_ERR(0, 331, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case 12:
         values[11] = __Pyx_ArgRef_FASTCALL(__pyx_args, 11);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[11])) __PYX_ERR(0, 326, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[11])) __PYX_ERR(0, 331, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case 11:
         values[10] = __Pyx_ArgRef_FASTCALL(__pyx_args, 10);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[10])) __PYX_ERR(0, 326, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[10])) __PYX_ERR(0, 331, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case 10:
         values[9] = __Pyx_ArgRef_FASTCALL(__pyx_args, 9);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[9])) __PYX_ERR(0, 326, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[9])) __PYX_ERR(0, 331, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  9:
         values[8] = __Pyx_ArgRef_FASTCALL(__pyx_args, 8);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[8])) __PYX_ERR(0, 326, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[8])) __PYX_ERR(0, 331, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  8:
         values[7] = __Pyx_ArgRef_FASTCALL(__pyx_args, 7);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[7])) __PYX_ERR(0, 326, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[7])) __PYX_ERR(0, 331, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  7:
         values[6] = __Pyx_ArgRef_FASTCALL(__pyx_args, 6);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[6])) __PYX_ERR(0, 326, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[6])) __PYX_ERR(0, 331, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  6:
         values[5] = __Pyx_ArgRef_FASTCALL(__pyx_args, 5);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[5])) __PYX_ERR(0, 326, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[5])) __PYX_ERR(0, 331, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  5:
         values[4] = __Pyx_ArgRef_FASTCALL(__pyx_args, 4);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[4])) __PYX_ERR(0, 326, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[4])) __PYX_ERR(0, 331, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  4:
         values[3] = __Pyx_ArgRef_FASTCALL(__pyx_args, 3);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 326, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 331, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  3:
         values[2] = __Pyx_ArgRef_FASTCALL(__pyx_args, 2);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 326, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 331, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  2:
         values[1] = __Pyx_ArgRef_FASTCALL(__pyx_args, 1);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 326, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 331, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  1:
         values[0] = __Pyx_ArgRef_FASTCALL(__pyx_args, 0);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 326, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 331, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  0: break;
         default: goto __pyx_L5_argtuple_error;
       }
       const Py_ssize_t kwd_pos_args = __pyx_nargs;
-      if (__Pyx_ParseKeywords(__pyx_kwds, __pyx_kwvalues, __pyx_pyargnames, 0, values, kwd_pos_args, __pyx_kwds_len, "solve", 0) < (0)) __PYX_ERR(0, 326, __pyx_L3_error)
+      if (__Pyx_ParseKeywords(__pyx_kwds, __pyx_kwvalues, __pyx_pyargnames, 0, values, kwd_pos_args, __pyx_kwds_len, "solve", 0) < (0)) __PYX_ERR(0, 331, __pyx_L3_error)
       for (Py_ssize_t i = __pyx_nargs; i < 13; i++) {
-        if (unlikely(!values[i])) { __Pyx_RaiseArgtupleInvalid("solve", 1, 13, 13, i); __PYX_ERR(0, 326, __pyx_L3_error) }
+        if (unlikely(!values[i])) { __Pyx_RaiseArgtupleInvalid("solve", 1, 13, 13, i); __PYX_ERR(0, 331, __pyx_L3_error) }
       }
     } else if (unlikely(__pyx_nargs != 13)) {
       goto __pyx_L5_argtuple_error;
     } else {
       values[0] = __Pyx_ArgRef_FASTCALL(__pyx_args, 0);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 326, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 331, __pyx_L3_error)
       values[1] = __Pyx_ArgRef_FASTCALL(__pyx_args, 1);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 326, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 331, __pyx_L3_error)
       values[2] = __Pyx_ArgRef_FASTCALL(__pyx_args, 2);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 326, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 331, __pyx_L3_error)
       values[3] = __Pyx_ArgRef_FASTCALL(__pyx_args, 3);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 326, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 331, __pyx_L3_error)
       values[4] = __Pyx_ArgRef_FASTCALL(__pyx_args, 4);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[4])) __PYX_ERR(0, 326, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[4])) __PYX_ERR(0, 331, __pyx_L3_error)
       values[5] = __Pyx_ArgRef_FASTCALL(__pyx_args, 5);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[5])) __PYX_ERR(0, 326, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[5])) __PYX_ERR(0, 331, __pyx_L3_error)
       values[6] = __Pyx_ArgRef_FASTCALL(__pyx_args, 6);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[6])) __PYX_ERR(0, 326, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[6])) __PYX_ERR(0, 331, __pyx_L3_error)
       values[7] = __Pyx_ArgRef_FASTCALL(__pyx_args, 7);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[7])) __PYX_ERR(0, 326, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[7])) __PYX_ERR(0, 331, __pyx_L3_error)
       values[8] = __Pyx_ArgRef_FASTCALL(__pyx_args, 8);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[8])) __PYX_ERR(0, 326, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[8])) __PYX_ERR(0, 331, __pyx_L3_error)
       values[9] = __Pyx_ArgRef_FASTCALL(__pyx_args, 9);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[9])) __PYX_ERR(0, 326, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[9])) __PYX_ERR(0, 331, __pyx_L3_error)
       values[10] = __Pyx_ArgRef_FASTCALL(__pyx_args, 10);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[10])) __PYX_ERR(0, 326, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[10])) __PYX_ERR(0, 331, __pyx_L3_error)
       values[11] = __Pyx_ArgRef_FASTCALL(__pyx_args, 11);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[11])) __PYX_ERR(0, 326, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[11])) __PYX_ERR(0, 331, __pyx_L3_error)
       values[12] = __Pyx_ArgRef_FASTCALL(__pyx_args, 12);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[12])) __PYX_ERR(0, 326, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[12])) __PYX_ERR(0, 331, __pyx_L3_error)
     }
-    __pyx_v_P = __Pyx_PyObject_to_MemoryviewSlice_d_dc_double(values[0], PyBUF_WRITABLE); if (unlikely(!__pyx_v_P.memview)) __PYX_ERR(0, 326, __pyx_L3_error)
-    __pyx_v_q = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[1], PyBUF_WRITABLE); if (unlikely(!__pyx_v_q.memview)) __PYX_ERR(0, 326, __pyx_L3_error)
-    __pyx_v_A = __Pyx_PyObject_to_MemoryviewSlice_d_dc_double(values[2], PyBUF_WRITABLE); if (unlikely(!__pyx_v_A.memview)) __PYX_ERR(0, 326, __pyx_L3_error)
-    __pyx_v_b = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[3], PyBUF_WRITABLE); if (unlikely(!__pyx_v_b.memview)) __PYX_ERR(0, 326, __pyx_L3_error)
-    __pyx_v_lb = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[4], PyBUF_WRITABLE); if (unlikely(!__pyx_v_lb.memview)) __PYX_ERR(0, 327, __pyx_L3_error)
-    __pyx_v_ub = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[5], PyBUF_WRITABLE); if (unlikely(!__pyx_v_ub.memview)) __PYX_ERR(0, 327, __pyx_L3_error)
+    __pyx_v_P = __Pyx_PyObject_to_MemoryviewSlice_d_dc_double__const__(values[0], 0); if (unlikely(!__pyx_v_P.memview)) __PYX_ERR(0, 331, __pyx_L3_error)
+    __pyx_v_q = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(values[1], 0); if (unlikely(!__pyx_v_q.memview)) __PYX_ERR(0, 331, __pyx_L3_error)
+    __pyx_v_A = __Pyx_PyObject_to_MemoryviewSlice_d_dc_double__const__(values[2], 0); if (unlikely(!__pyx_v_A.memview)) __PYX_ERR(0, 331, __pyx_L3_error)
+    __pyx_v_b = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(values[3], 0); if (unlikely(!__pyx_v_b.memview)) __PYX_ERR(0, 332, __pyx_L3_error)
+    __pyx_v_lb = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(values[4], 0); if (unlikely(!__pyx_v_lb.memview)) __PYX_ERR(0, 332, __pyx_L3_error)
+    __pyx_v_ub = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(values[5], 0); if (unlikely(!__pyx_v_ub.memview)) __PYX_ERR(0, 332, __pyx_L3_error)
     __pyx_v_x0 = values[6];
-    __pyx_v_warm = __Pyx_PyObject_IsTrue(values[7]); if (unlikely((__pyx_v_warm == (int)-1) && PyErr_Occurred())) __PYX_ERR(0, 327, __pyx_L3_error)
-    __pyx_v_start_time = __Pyx_PyFloat_AsDouble(values[8]); if (unlikely((__pyx_v_start_time == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 327, __pyx_L3_error)
-    __pyx_v_x_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[9], PyBUF_WRITABLE); if (unlikely(!__pyx_v_x_out.memview)) __PYX_ERR(0, 328, __pyx_L3_error)
-    __pyx_v_y_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[10], PyBUF_WRITABLE); if (unlikely(!__pyx_v_y_out.memview)) __PYX_ERR(0, 328, __pyx_L3_error)
-    __pyx_v_z_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[11], PyBUF_WRITABLE); if (unlikely(!__pyx_v_z_out.memview)) __PYX_ERR(0, 328, __pyx_L3_error)
-    __pyx_v_cert_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[12], PyBUF_WRITABLE); if (unlikely(!__pyx_v_cert_out.memview)) __PYX_ERR(0, 328, __pyx_L3_error)
+    __pyx_v_warm = __Pyx_PyObject_IsTrue(values[7]); if (unlikely((__pyx_v_warm == (int)-1) && PyErr_Occurred())) __PYX_ERR(0, 333, __pyx_L3_error)
+    __pyx_v_start_time = __Pyx_PyFloat_AsDouble(values[8]); if (unlikely((__pyx_v_start_time == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 333, __pyx_L3_error)
+    __pyx_v_x_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[9], PyBUF_WRITABLE); if (unlikely(!__pyx_v_x_out.memview)) __PYX_ERR(0, 334, __pyx_L3_error)
+    __pyx_v_y_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[10], PyBUF_WRITABLE); if (unlikely(!__pyx_v_y_out.memview)) __PYX_ERR(0, 334, __pyx_L3_error)
+    __pyx_v_z_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[11], PyBUF_WRITABLE); if (unlikely(!__pyx_v_z_out.memview)) __PYX_ERR(0, 334, __pyx_L3_error)
+    __pyx_v_cert_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[12], PyBUF_WRITABLE); if (unlikely(!__pyx_v_cert_out.memview)) __PYX_ERR(0, 334, __pyx_L3_error)
   }
   goto __pyx_L6_skip;
   __pyx_L5_argtuple_error:;
-  __Pyx_RaiseArgtupleInvalid("solve", 1, 13, 13, __pyx_nargs); __PYX_ERR(0, 326, __pyx_L3_error)
+  __Pyx_RaiseArgtupleInvalid("solve", 1, 13, 13, __pyx_nargs); __PYX_ERR(0, 331, __pyx_L3_error)
   __pyx_L6_skip:;
   goto __pyx_L4_argument_unpacking_done;
   __pyx_L3_error:;
@@ -22656,13 +22731,13 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
   Py_ssize_t __pyx_t_4;
   Py_ssize_t __pyx_t_5;
   Py_ssize_t __pyx_t_6;
-  double *__pyx_t_7;
+  double const *__pyx_t_7;
   Py_ssize_t __pyx_t_8;
   Py_ssize_t __pyx_t_9;
-  double *__pyx_t_10;
+  double const *__pyx_t_10;
   PyObject *__pyx_t_11 = NULL;
   PyObject *__pyx_t_12 = NULL;
-  PyObject *__pyx_t_13 = NULL;
+  double *__pyx_t_13;
   PyObject *__pyx_t_14 = NULL;
   PyObject *__pyx_t_15 = NULL;
   PyObject *__pyx_t_16 = NULL;
@@ -22670,12 +22745,13 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
   PyObject *__pyx_t_18 = NULL;
   PyObject *__pyx_t_19 = NULL;
   PyObject *__pyx_t_20 = NULL;
+  PyObject *__pyx_t_21 = NULL;
   int __pyx_lineno = 0;
   const char *__pyx_filename = NULL;
   int __pyx_clineno = 0;
   __Pyx_RefNannySetupContext("solve", 0);
 
-  /* "fccqp/admm.pyx":337
+  /* "fccqp/admm.pyx":343
  *         :attr:`finding`) and ``NOT_CONVEX_CODE`` leave the previous solution untouched.
  *         """
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -22684,12 +22760,12 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":338
+  /* "fccqp/admm.pyx":344
  *         """
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m             # <<<<<<<<<<<<<<
  *         cdef bint same = self.has_matrices
- *         cdef double[::1] guess
+ *         cdef const double[::1] guess
 */
   __pyx_t_1 = __pyx_v_p->n;
 
@@ -22698,27 +22774,27 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
 
   __pyx_v_m = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":339
+  /* "fccqp/admm.pyx":345
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m
  *         cdef bint same = self.has_matrices             # <<<<<<<<<<<<<<
- *         cdef double[::1] guess
+ *         cdef const double[::1] guess
  *         cdef const double* x0_ptr = NULL
 */
   __pyx_t_2 = __pyx_v_self->has_matrices;
 
   __pyx_v_same = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":341
+  /* "fccqp/admm.pyx":347
  *         cdef bint same = self.has_matrices
- *         cdef double[::1] guess
+ *         cdef const double[::1] guess
  *         cdef const double* x0_ptr = NULL             # <<<<<<<<<<<<<<
  *         cdef Run run
  *         if x0 is not None:
 */
   __pyx_v_x0_ptr = NULL;
 
-  /* "fccqp/admm.pyx":343
+  /* "fccqp/admm.pyx":349
  *         cdef const double* x0_ptr = NULL
  *         cdef Run run
  *         if x0 is not None:             # <<<<<<<<<<<<<<
@@ -22729,19 +22805,19 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
   if (__pyx_t_2) {
 
 
-    /* "fccqp/admm.pyx":344
+    /* "fccqp/admm.pyx":350
  *         cdef Run run
  *         if x0 is not None:
  *             guess = x0             # <<<<<<<<<<<<<<
  *             x0_ptr = &guess[0]
  *         with nogil:
 */
-    __pyx_t_3 = __Pyx_PyObject_to_MemoryviewSlice_dc_double(__pyx_v_x0, PyBUF_WRITABLE); if (unlikely(!__pyx_t_3.memview)) __PYX_ERR(0, 344, __pyx_L1_error)
+    __pyx_t_3 = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(__pyx_v_x0, 0); if (unlikely(!__pyx_t_3.memview)) __PYX_ERR(0, 350, __pyx_L1_error)
     __pyx_v_guess = __pyx_t_3;
     __pyx_t_3.memview = NULL;
     __pyx_t_3.data = NULL;
 
-    /* "fccqp/admm.pyx":345
+    /* "fccqp/admm.pyx":351
  *         if x0 is not None:
  *             guess = x0
  *             x0_ptr = &guess[0]             # <<<<<<<<<<<<<<
@@ -22749,9 +22825,9 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
  *             self.found = scan_and_copy(
 */
     __pyx_t_4 = 0;
-    __pyx_v_x0_ptr = (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_guess.data) + __pyx_t_4)) ))));
+    __pyx_v_x0_ptr = (&(*((double const  *) ( /* dim=0 */ ((char *) (((double const  *) __pyx_v_guess.data) + __pyx_t_4)) ))));
 
-    /* "fccqp/admm.pyx":343
+    /* "fccqp/admm.pyx":349
  *         cdef const double* x0_ptr = NULL
  *         cdef Run run
  *         if x0 is not None:             # <<<<<<<<<<<<<<
@@ -22760,7 +22836,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
 */
   }
 
-  /* "fccqp/admm.pyx":346
+  /* "fccqp/admm.pyx":352
  *             guess = x0
  *             x0_ptr = &guess[0]
  *         with nogil:             # <<<<<<<<<<<<<<
@@ -22773,7 +22849,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
       __Pyx_FastGIL_Remember();
       /*try:*/ {
 
-        /* "fccqp/admm.pyx":348
+        /* "fccqp/admm.pyx":354
  *         with nogil:
  *             self.found = scan_and_copy(
  *                 &P[0, 0], &q[0], &A[0, 0] if m else NULL, &b[0] if m else NULL, &lb[0], &ub[0],             # <<<<<<<<<<<<<<
@@ -22789,7 +22865,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
           __pyx_t_8 = 0;
           __pyx_t_9 = 0;
 
-          __pyx_t_7 = (&(*((double *) ( /* dim=1 */ ((char *) (((double *) ( /* dim=0 */ (__pyx_v_A.data + __pyx_t_8 * __pyx_v_A.strides[0]) )) + __pyx_t_9)) ))));
+          __pyx_t_7 = (&(*((double const  *) ( /* dim=1 */ ((char *) (((double const  *) ( /* dim=0 */ (__pyx_v_A.data + __pyx_t_8 * __pyx_v_A.strides[0]) )) + __pyx_t_9)) ))));
         } else {
 
           __pyx_t_7 = NULL;
@@ -22800,7 +22876,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
         if (__pyx_t_2) {
           __pyx_t_9 = 0;
 
-          __pyx_t_10 = (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_b.data) + __pyx_t_9)) ))));
+          __pyx_t_10 = (&(*((double const  *) ( /* dim=0 */ ((char *) (((double const  *) __pyx_v_b.data) + __pyx_t_9)) ))));
         } else {
 
           __pyx_t_10 = NULL;
@@ -22809,19 +22885,19 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
         __pyx_t_9 = 0;
         __pyx_t_8 = 0;
 
-        /* "fccqp/admm.pyx":347
+        /* "fccqp/admm.pyx":353
  *             x0_ptr = &guess[0]
  *         with nogil:
  *             self.found = scan_and_copy(             # <<<<<<<<<<<<<<
  *                 &P[0, 0], &q[0], &A[0, 0] if m else NULL, &b[0] if m else NULL, &lb[0], &ub[0],
  *                 n, m, self.P_user, self.q_user, self.A_user, self.b_user, self.lb_user,
 */
-        __pyx_v_self->found = __pyx_f_5fccqp_10validation_scan_and_copy((&(*((double *) ( /* dim=1 */ ((char *) (((double *) ( /* dim=0 */ (__pyx_v_P.data + __pyx_t_4 * __pyx_v_P.strides[0]) )) + __pyx_t_5)) )))), (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_q.data) + __pyx_t_6)) )))), __pyx_t_7, __pyx_t_10, (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_lb.data) + __pyx_t_9)) )))), (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_ub.data) + __pyx_t_8)) )))), __pyx_v_n, __pyx_v_m, __pyx_v_self->P_user, __pyx_v_self->q_user, __pyx_v_self->A_user, __pyx_v_self->b_user, __pyx_v_self->lb_user, __pyx_v_self->ub_user, (&__pyx_v_same));
+        __pyx_v_self->found = __pyx_f_5fccqp_10validation_scan_and_copy((&(*((double const  *) ( /* dim=1 */ ((char *) (((double const  *) ( /* dim=0 */ (__pyx_v_P.data + __pyx_t_4 * __pyx_v_P.strides[0]) )) + __pyx_t_5)) )))), (&(*((double const  *) ( /* dim=0 */ ((char *) (((double const  *) __pyx_v_q.data) + __pyx_t_6)) )))), __pyx_t_7, __pyx_t_10, (&(*((double const  *) ( /* dim=0 */ ((char *) (((double const  *) __pyx_v_lb.data) + __pyx_t_9)) )))), (&(*((double const  *) ( /* dim=0 */ ((char *) (((double const  *) __pyx_v_ub.data) + __pyx_t_8)) )))), __pyx_v_n, __pyx_v_m, __pyx_v_self->P_user, __pyx_v_self->q_user, __pyx_v_self->A_user, __pyx_v_self->b_user, __pyx_v_self->lb_user, __pyx_v_self->ub_user, (&__pyx_v_same));
 
 
       }
 
-      /* "fccqp/admm.pyx":346
+      /* "fccqp/admm.pyx":352
  *             guess = x0
  *             x0_ptr = &guess[0]
  *         with nogil:             # <<<<<<<<<<<<<<
@@ -22838,7 +22914,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
       }
   }
 
-  /* "fccqp/admm.pyx":351
+  /* "fccqp/admm.pyx":357
  *                 n, m, self.P_user, self.q_user, self.A_user, self.b_user, self.lb_user,
  *                 self.ub_user, &same)
  *         if self.found.code != SCAN_OK:             # <<<<<<<<<<<<<<
@@ -22850,7 +22926,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
   if (__pyx_t_2) {
 
 
-    /* "fccqp/admm.pyx":352
+    /* "fccqp/admm.pyx":358
  *                 self.ub_user, &same)
  *         if self.found.code != SCAN_OK:
  *             self.has_matrices = False             # <<<<<<<<<<<<<<
@@ -22859,43 +22935,43 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
 */
     __pyx_v_self->has_matrices = 0;
 
-    /* "fccqp/admm.pyx":353
+    /* "fccqp/admm.pyx":359
  *         if self.found.code != SCAN_OK:
  *             self.has_matrices = False
  *             return BAD_DATA, 0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, ""             # <<<<<<<<<<<<<<
  *         with nogil:
  *             run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)
 */
-    __Pyx_GetModuleGlobalName(__pyx_t_11, __pyx_mstate_global->__pyx_n_u_BAD_DATA); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 353, __pyx_L1_error)
+    __Pyx_GetModuleGlobalName(__pyx_t_11, __pyx_mstate_global->__pyx_n_u_BAD_DATA); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 359, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_11);
-    __pyx_t_12 = PyTuple_New(9); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 353, __pyx_L1_error)
+    __pyx_t_12 = PyTuple_New(9); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 359, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_12);
     __Pyx_GIVEREF(__pyx_t_11);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 0, __pyx_t_11) != (0)) __PYX_ERR(0, 353, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 0, __pyx_t_11) != (0)) __PYX_ERR(0, 359, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_int_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_int_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 1, __pyx_mstate_global->__pyx_int_0) != (0)) __PYX_ERR(0, 353, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 1, __pyx_mstate_global->__pyx_int_0) != (0)) __PYX_ERR(0, 359, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_float_0_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_float_0_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 2, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 353, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 2, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 359, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_float_0_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_float_0_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 3, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 353, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 3, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 359, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_float_0_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_float_0_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 4, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 353, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 4, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 359, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_float_0_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_float_0_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 5, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 353, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 5, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 359, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_int_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_int_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 6, __pyx_mstate_global->__pyx_int_0) != (0)) __PYX_ERR(0, 353, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 6, __pyx_mstate_global->__pyx_int_0) != (0)) __PYX_ERR(0, 359, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_float_0_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_float_0_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 7, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 353, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 7, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 359, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_kp_u__5);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_kp_u__5);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 8, __pyx_mstate_global->__pyx_kp_u__5) != (0)) __PYX_ERR(0, 353, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 8, __pyx_mstate_global->__pyx_kp_u__5) != (0)) __PYX_ERR(0, 359, __pyx_L1_error);
     __pyx_t_11 = 0;
     {
       PyObject *__pyx_temp;
@@ -22908,7 +22984,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
     __pyx_t_12 = 0;
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":351
+    /* "fccqp/admm.pyx":357
  *                 n, m, self.P_user, self.q_user, self.A_user, self.b_user, self.lb_user,
  *                 self.ub_user, &same)
  *         if self.found.code != SCAN_OK:             # <<<<<<<<<<<<<<
@@ -22917,7 +22993,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
 */
   }
 
-  /* "fccqp/admm.pyx":354
+  /* "fccqp/admm.pyx":360
  *             self.has_matrices = False
  *             return BAD_DATA, 0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, ""
  *         with nogil:             # <<<<<<<<<<<<<<
@@ -22930,7 +23006,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
       __Pyx_FastGIL_Remember();
       /*try:*/ {
 
-        /* "fccqp/admm.pyx":355
+        /* "fccqp/admm.pyx":361
  *             return BAD_DATA, 0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, ""
  *         with nogil:
  *             run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)             # <<<<<<<<<<<<<<
@@ -22949,7 +23025,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
         __pyx_v_run = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_solve(__pyx_v_self, __pyx_v_same, __pyx_v_x0_ptr, __pyx_t_2, __pyx_v_start_time);
 
 
-        /* "fccqp/admm.pyx":356
+        /* "fccqp/admm.pyx":362
  *         with nogil:
  *             run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)
  *             if run.status != _NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -22961,7 +23037,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
         if (__pyx_t_2) {
 
 
-          /* "fccqp/admm.pyx":357
+          /* "fccqp/admm.pyx":363
  *             run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)
  *             if run.status != _NOT_CONVEX:
  *                 self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0], &cert_out[0])             # <<<<<<<<<<<<<<
@@ -22974,18 +23050,18 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
           if (__pyx_t_2) {
             __pyx_t_9 = 0;
 
-            __pyx_t_10 = (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_y_out.data) + __pyx_t_9)) ))));
+            __pyx_t_13 = (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_y_out.data) + __pyx_t_9)) ))));
           } else {
 
-            __pyx_t_10 = NULL;
+            __pyx_t_13 = NULL;
           }
 
           __pyx_t_9 = 0;
           __pyx_t_6 = 0;
-          ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_finish(__pyx_v_self, (&__pyx_v_run), (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_x_out.data) + __pyx_t_8)) )))), __pyx_t_10, (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_z_out.data) + __pyx_t_9)) )))), (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_cert_out.data) + __pyx_t_6)) )))));
+          ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_finish(__pyx_v_self, (&__pyx_v_run), (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_x_out.data) + __pyx_t_8)) )))), __pyx_t_13, (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_z_out.data) + __pyx_t_9)) )))), (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_cert_out.data) + __pyx_t_6)) )))));
 
 
-          /* "fccqp/admm.pyx":356
+          /* "fccqp/admm.pyx":362
  *         with nogil:
  *             run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)
  *             if run.status != _NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -22995,7 +23071,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
         }
       }
 
-      /* "fccqp/admm.pyx":354
+      /* "fccqp/admm.pyx":360
  *             self.has_matrices = False
  *             return BAD_DATA, 0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, ""
  *         with nogil:             # <<<<<<<<<<<<<<
@@ -23012,7 +23088,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
       }
   }
 
-  /* "fccqp/admm.pyx":358
+  /* "fccqp/admm.pyx":364
  *             if run.status != _NOT_CONVEX:
  *                 self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0], &cert_out[0])
  *         if run.status == _NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -23024,7 +23100,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
   if (__pyx_t_2) {
 
 
-    /* "fccqp/admm.pyx":359
+    /* "fccqp/admm.pyx":365
  *                 self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0], &cert_out[0])
  *         if run.status == _NOT_CONVEX:
  *             self.has_matrices = self.has_previous = self.certified = False             # <<<<<<<<<<<<<<
@@ -23035,58 +23111,58 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
     __pyx_v_self->has_previous = 0;
     __pyx_v_self->certified = 0;
 
-    /* "fccqp/admm.pyx":360
+    /* "fccqp/admm.pyx":366
  *         if run.status == _NOT_CONVEX:
  *             self.has_matrices = self.has_previous = self.certified = False
  *             return NOT_CONVEX_CODE, 0, 0.0, 0.0, 0.0, 0.0, run.factorizations, 0.0, ""             # <<<<<<<<<<<<<<
  *         r = &self.res
  *         return (run.status, run.iterations, run.rho, r.prim, r.dual, r.gap, run.factorizations,
 */
-    __Pyx_GetModuleGlobalName(__pyx_t_12, __pyx_mstate_global->__pyx_n_u_NOT_CONVEX_CODE); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 360, __pyx_L1_error)
+    __Pyx_GetModuleGlobalName(__pyx_t_12, __pyx_mstate_global->__pyx_n_u_NOT_CONVEX_CODE); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 366, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_12);
-    __pyx_t_11 = __Pyx_PyLong_From_int(__pyx_v_run.factorizations); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 360, __pyx_L1_error)
+    __pyx_t_11 = __Pyx_PyLong_From_int(__pyx_v_run.factorizations); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 366, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_11);
-    __pyx_t_13 = PyTuple_New(9); if (unlikely(!__pyx_t_13)) __PYX_ERR(0, 360, __pyx_L1_error)
-    __Pyx_GOTREF(__pyx_t_13);
+    __pyx_t_14 = PyTuple_New(9); if (unlikely(!__pyx_t_14)) __PYX_ERR(0, 366, __pyx_L1_error)
+    __Pyx_GOTREF(__pyx_t_14);
     __Pyx_GIVEREF(__pyx_t_12);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_13, 0, __pyx_t_12) != (0)) __PYX_ERR(0, 360, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 0, __pyx_t_12) != (0)) __PYX_ERR(0, 366, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_int_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_int_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_13, 1, __pyx_mstate_global->__pyx_int_0) != (0)) __PYX_ERR(0, 360, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 1, __pyx_mstate_global->__pyx_int_0) != (0)) __PYX_ERR(0, 366, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_float_0_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_float_0_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_13, 2, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 360, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 2, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 366, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_float_0_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_float_0_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_13, 3, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 360, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 3, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 366, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_float_0_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_float_0_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_13, 4, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 360, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 4, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 366, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_float_0_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_float_0_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_13, 5, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 360, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 5, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 366, __pyx_L1_error);
     __Pyx_GIVEREF(__pyx_t_11);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_13, 6, __pyx_t_11) != (0)) __PYX_ERR(0, 360, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 6, __pyx_t_11) != (0)) __PYX_ERR(0, 366, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_float_0_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_float_0_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_13, 7, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 360, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 7, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 366, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_kp_u__5);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_kp_u__5);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_13, 8, __pyx_mstate_global->__pyx_kp_u__5) != (0)) __PYX_ERR(0, 360, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 8, __pyx_mstate_global->__pyx_kp_u__5) != (0)) __PYX_ERR(0, 366, __pyx_L1_error);
     __pyx_t_12 = 0;
     __pyx_t_11 = 0;
     {
       PyObject *__pyx_temp;
       {
         __pyx_temp = __pyx_r;
-        __pyx_r = __pyx_t_13;
+        __pyx_r = __pyx_t_14;
       }
       __Pyx_XDECREF(__pyx_temp);
     }
-    __pyx_t_13 = 0;
+    __pyx_t_14 = 0;
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":358
+    /* "fccqp/admm.pyx":364
  *             if run.status != _NOT_CONVEX:
  *                 self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0], &cert_out[0])
  *         if run.status == _NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -23095,7 +23171,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
 */
   }
 
-  /* "fccqp/admm.pyx":361
+  /* "fccqp/admm.pyx":367
  *             self.has_matrices = self.has_previous = self.certified = False
  *             return NOT_CONVEX_CODE, 0, 0.0, 0.0, 0.0, 0.0, run.factorizations, 0.0, ""
  *         r = &self.res             # <<<<<<<<<<<<<<
@@ -23104,96 +23180,96 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
 */
   __pyx_v_r = (&__pyx_v_self->res);
 
-  /* "fccqp/admm.pyx":362
+  /* "fccqp/admm.pyx":368
  *             return NOT_CONVEX_CODE, 0, 0.0, 0.0, 0.0, 0.0, run.factorizations, 0.0, ""
  *         r = &self.res
  *         return (run.status, run.iterations, run.rho, r.prim, r.dual, r.gap, run.factorizations,             # <<<<<<<<<<<<<<
  *                 run.setup_time, BACKEND_NAMES[run.backend])
  * 
 */
-  __pyx_t_13 = __Pyx_PyLong_From_int(__pyx_v_run.status); if (unlikely(!__pyx_t_13)) __PYX_ERR(0, 362, __pyx_L1_error)
-  __Pyx_GOTREF(__pyx_t_13);
-  __pyx_t_11 = __Pyx_PyLong_From_long(__pyx_v_run.iterations); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 362, __pyx_L1_error)
-  __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_12 = PyFloat_FromDouble(__pyx_v_run.rho); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 362, __pyx_L1_error)
-  __Pyx_GOTREF(__pyx_t_12);
-  __pyx_t_14 = PyFloat_FromDouble(__pyx_v_r->prim); if (unlikely(!__pyx_t_14)) __PYX_ERR(0, 362, __pyx_L1_error)
+  __pyx_t_14 = __Pyx_PyLong_From_int(__pyx_v_run.status); if (unlikely(!__pyx_t_14)) __PYX_ERR(0, 368, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_14);
-  __pyx_t_15 = PyFloat_FromDouble(__pyx_v_r->dual); if (unlikely(!__pyx_t_15)) __PYX_ERR(0, 362, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyLong_From_long(__pyx_v_run.iterations); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 368, __pyx_L1_error)
+  __Pyx_GOTREF(__pyx_t_11);
+  __pyx_t_12 = PyFloat_FromDouble(__pyx_v_run.rho); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 368, __pyx_L1_error)
+  __Pyx_GOTREF(__pyx_t_12);
+  __pyx_t_15 = PyFloat_FromDouble(__pyx_v_r->prim); if (unlikely(!__pyx_t_15)) __PYX_ERR(0, 368, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_15);
-  __pyx_t_16 = PyFloat_FromDouble(__pyx_v_r->gap); if (unlikely(!__pyx_t_16)) __PYX_ERR(0, 362, __pyx_L1_error)
+  __pyx_t_16 = PyFloat_FromDouble(__pyx_v_r->dual); if (unlikely(!__pyx_t_16)) __PYX_ERR(0, 368, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_16);
-  __pyx_t_17 = __Pyx_PyLong_From_int(__pyx_v_run.factorizations); if (unlikely(!__pyx_t_17)) __PYX_ERR(0, 362, __pyx_L1_error)
+  __pyx_t_17 = PyFloat_FromDouble(__pyx_v_r->gap); if (unlikely(!__pyx_t_17)) __PYX_ERR(0, 368, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_17);
+  __pyx_t_18 = __Pyx_PyLong_From_int(__pyx_v_run.factorizations); if (unlikely(!__pyx_t_18)) __PYX_ERR(0, 368, __pyx_L1_error)
+  __Pyx_GOTREF(__pyx_t_18);
 
-  /* "fccqp/admm.pyx":363
+  /* "fccqp/admm.pyx":369
  *         r = &self.res
  *         return (run.status, run.iterations, run.rho, r.prim, r.dual, r.gap, run.factorizations,
  *                 run.setup_time, BACKEND_NAMES[run.backend])             # <<<<<<<<<<<<<<
  * 
  *     # ----------------------------------------------------------------- one solve
 */
-  __pyx_t_18 = PyFloat_FromDouble(__pyx_v_run.setup_time); if (unlikely(!__pyx_t_18)) __PYX_ERR(0, 363, __pyx_L1_error)
-  __Pyx_GOTREF(__pyx_t_18);
-  __Pyx_GetModuleGlobalName(__pyx_t_19, __pyx_mstate_global->__pyx_n_u_BACKEND_NAMES); if (unlikely(!__pyx_t_19)) __PYX_ERR(0, 363, __pyx_L1_error)
+  __pyx_t_19 = PyFloat_FromDouble(__pyx_v_run.setup_time); if (unlikely(!__pyx_t_19)) __PYX_ERR(0, 369, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_19);
-  __pyx_t_20 = __Pyx_GetItemInt(__pyx_t_19, __pyx_v_run.backend, int, 1, __Pyx_PyLong_From_int, 0, 0, 1, __Pyx_ReferenceSharing_OwnStrongReference); if (unlikely(!__pyx_t_20)) __PYX_ERR(0, 363, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_20, __pyx_mstate_global->__pyx_n_u_BACKEND_NAMES); if (unlikely(!__pyx_t_20)) __PYX_ERR(0, 369, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_20);
-  __Pyx_DECREF(__pyx_t_19); __pyx_t_19 = 0;
+  __pyx_t_21 = __Pyx_GetItemInt(__pyx_t_20, __pyx_v_run.backend, int, 1, __Pyx_PyLong_From_int, 0, 0, 1, __Pyx_ReferenceSharing_OwnStrongReference); if (unlikely(!__pyx_t_21)) __PYX_ERR(0, 369, __pyx_L1_error)
+  __Pyx_GOTREF(__pyx_t_21);
+  __Pyx_DECREF(__pyx_t_20); __pyx_t_20 = 0;
 
-  /* "fccqp/admm.pyx":362
+  /* "fccqp/admm.pyx":368
  *             return NOT_CONVEX_CODE, 0, 0.0, 0.0, 0.0, 0.0, run.factorizations, 0.0, ""
  *         r = &self.res
  *         return (run.status, run.iterations, run.rho, r.prim, r.dual, r.gap, run.factorizations,             # <<<<<<<<<<<<<<
  *                 run.setup_time, BACKEND_NAMES[run.backend])
  * 
 */
-  __pyx_t_19 = PyTuple_New(9); if (unlikely(!__pyx_t_19)) __PYX_ERR(0, 362, __pyx_L1_error)
-  __Pyx_GOTREF(__pyx_t_19);
-  __Pyx_GIVEREF(__pyx_t_13);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_19, 0, __pyx_t_13) != (0)) __PYX_ERR(0, 362, __pyx_L1_error);
-  __Pyx_GIVEREF(__pyx_t_11);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_19, 1, __pyx_t_11) != (0)) __PYX_ERR(0, 362, __pyx_L1_error);
-  __Pyx_GIVEREF(__pyx_t_12);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_19, 2, __pyx_t_12) != (0)) __PYX_ERR(0, 362, __pyx_L1_error);
+  __pyx_t_20 = PyTuple_New(9); if (unlikely(!__pyx_t_20)) __PYX_ERR(0, 368, __pyx_L1_error)
+  __Pyx_GOTREF(__pyx_t_20);
   __Pyx_GIVEREF(__pyx_t_14);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_19, 3, __pyx_t_14) != (0)) __PYX_ERR(0, 362, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 0, __pyx_t_14) != (0)) __PYX_ERR(0, 368, __pyx_L1_error);
+  __Pyx_GIVEREF(__pyx_t_11);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 1, __pyx_t_11) != (0)) __PYX_ERR(0, 368, __pyx_L1_error);
+  __Pyx_GIVEREF(__pyx_t_12);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 2, __pyx_t_12) != (0)) __PYX_ERR(0, 368, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_15);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_19, 4, __pyx_t_15) != (0)) __PYX_ERR(0, 362, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 3, __pyx_t_15) != (0)) __PYX_ERR(0, 368, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_16);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_19, 5, __pyx_t_16) != (0)) __PYX_ERR(0, 362, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 4, __pyx_t_16) != (0)) __PYX_ERR(0, 368, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_17);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_19, 6, __pyx_t_17) != (0)) __PYX_ERR(0, 362, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 5, __pyx_t_17) != (0)) __PYX_ERR(0, 368, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_18);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_19, 7, __pyx_t_18) != (0)) __PYX_ERR(0, 362, __pyx_L1_error);
-  __Pyx_GIVEREF(__pyx_t_20);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_19, 8, __pyx_t_20) != (0)) __PYX_ERR(0, 362, __pyx_L1_error);
-  __pyx_t_13 = 0;
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 6, __pyx_t_18) != (0)) __PYX_ERR(0, 368, __pyx_L1_error);
+  __Pyx_GIVEREF(__pyx_t_19);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 7, __pyx_t_19) != (0)) __PYX_ERR(0, 368, __pyx_L1_error);
+  __Pyx_GIVEREF(__pyx_t_21);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 8, __pyx_t_21) != (0)) __PYX_ERR(0, 368, __pyx_L1_error);
+  __pyx_t_14 = 0;
   __pyx_t_11 = 0;
   __pyx_t_12 = 0;
-  __pyx_t_14 = 0;
   __pyx_t_15 = 0;
   __pyx_t_16 = 0;
   __pyx_t_17 = 0;
   __pyx_t_18 = 0;
-  __pyx_t_20 = 0;
+  __pyx_t_19 = 0;
+  __pyx_t_21 = 0;
   {
     PyObject *__pyx_temp;
     {
       __pyx_temp = __pyx_r;
-      __pyx_r = __pyx_t_19;
+      __pyx_r = __pyx_t_20;
     }
     __Pyx_XDECREF(__pyx_temp);
   }
-  __pyx_t_19 = 0;
+  __pyx_t_20 = 0;
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":326
+  /* "fccqp/admm.pyx":331
  *         return [tuple(self.log[5 * i + j] for j in range(5)) for i in range(self.log_count)]
  * 
- *     def solve(self, double[:, ::1] P, double[::1] q, double[:, ::1] A, double[::1] b,             # <<<<<<<<<<<<<<
- *               double[::1] lb, double[::1] ub, x0, bint warm, double start_time,
- *               double[::1] x_out, double[::1] y_out, double[::1] z_out, double[::1] cert_out):
+ *     def solve(self, const double[:, ::1] P, const double[::1] q, const double[:, ::1] A,             # <<<<<<<<<<<<<<
+ *               const double[::1] b, const double[::1] lb, const double[::1] ub, x0,
+ *               bint warm, double start_time,
 */
 
   /* function exit code */
@@ -23201,7 +23277,6 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
   __PYX_XCLEAR_MEMVIEW(&__pyx_t_3, 1);
   __Pyx_XDECREF(__pyx_t_11);
   __Pyx_XDECREF(__pyx_t_12);
-  __Pyx_XDECREF(__pyx_t_13);
   __Pyx_XDECREF(__pyx_t_14);
   __Pyx_XDECREF(__pyx_t_15);
   __Pyx_XDECREF(__pyx_t_16);
@@ -23209,6 +23284,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
   __Pyx_XDECREF(__pyx_t_18);
   __Pyx_XDECREF(__pyx_t_19);
   __Pyx_XDECREF(__pyx_t_20);
+  __Pyx_XDECREF(__pyx_t_21);
   __Pyx_AddTraceback("fccqp.admm.Workspace.solve", __pyx_clineno, __pyx_lineno, __pyx_filename);
   __pyx_r = NULL;
   __pyx_L0:;
@@ -23225,7 +23301,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":367
+/* "fccqp/admm.pyx":373
  *     # ----------------------------------------------------------------- one solve
  * 
  *     cdef Run _solve(self, bint same_matrices, const double* x0, bint warm,             # <<<<<<<<<<<<<<
@@ -23242,7 +23318,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
   double __pyx_t_2;
   int __pyx_t_3;
 
-  /* "fccqp/admm.pyx":370
+  /* "fccqp/admm.pyx":376
  *                     double start_time) noexcept nogil:
  *         """Scale (or reuse the scaling), start, run."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -23251,7 +23327,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":372
+  /* "fccqp/admm.pyx":378
  *         cdef Problem* p = &self.prob
  *         cdef Run run
  *         cdef bint reuse = same_matrices and self.scaled_once             # <<<<<<<<<<<<<<
@@ -23269,7 +23345,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
   __pyx_L3_bool_binop_done:;
   __pyx_v_reuse = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":373
+  /* "fccqp/admm.pyx":379
  *         cdef Run run
  *         cdef bint reuse = same_matrices and self.scaled_once
  *         if not same_matrices:             # <<<<<<<<<<<<<<
@@ -23281,7 +23357,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":374
+    /* "fccqp/admm.pyx":380
  *         cdef bint reuse = same_matrices and self.scaled_once
  *         if not same_matrices:
  *             self.certified = False             # <<<<<<<<<<<<<<
@@ -23290,7 +23366,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
     __pyx_v_self->certified = 0;
 
-    /* "fccqp/admm.pyx":373
+    /* "fccqp/admm.pyx":379
  *         cdef Run run
  *         cdef bint reuse = same_matrices and self.scaled_once
  *         if not same_matrices:             # <<<<<<<<<<<<<<
@@ -23299,7 +23375,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
   }
 
-  /* "fccqp/admm.pyx":375
+  /* "fccqp/admm.pyx":381
  *         if not same_matrices:
  *             self.certified = False
  *         self.has_matrices = True             # <<<<<<<<<<<<<<
@@ -23308,7 +23384,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
   __pyx_v_self->has_matrices = 1;
 
-  /* "fccqp/admm.pyx":376
+  /* "fccqp/admm.pyx":382
  *             self.certified = False
  *         self.has_matrices = True
  *         self._scale(reuse)             # <<<<<<<<<<<<<<
@@ -23317,7 +23393,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
   ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_scale(__pyx_v_self, __pyx_v_reuse);
 
-  /* "fccqp/admm.pyx":377
+  /* "fccqp/admm.pyx":383
  *         self.has_matrices = True
  *         self._scale(reuse)
  *         self.log_count = 0             # <<<<<<<<<<<<<<
@@ -23326,7 +23402,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
   __pyx_v_self->log_count = 0;
 
-  /* "fccqp/admm.pyx":378
+  /* "fccqp/admm.pyx":384
  *         self._scale(reuse)
  *         self.log_count = 0
  *         run.rho = self.prev_rho if warm else self.opt.rho             # <<<<<<<<<<<<<<
@@ -23342,7 +23418,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
   }
   __pyx_v_run.rho = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":379
+  /* "fccqp/admm.pyx":385
  *         self.log_count = 0
  *         run.rho = self.prev_rho if warm else self.opt.rho
  *         if x0 != NULL:             # <<<<<<<<<<<<<<
@@ -23354,7 +23430,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":380
+    /* "fccqp/admm.pyx":386
  *         run.rho = self.prev_rho if warm else self.opt.rho
  *         if x0 != NULL:
  *             self._start_from_guess(x0)             # <<<<<<<<<<<<<<
@@ -23363,7 +23439,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_start_from_guess(__pyx_v_self, __pyx_v_x0);
 
-    /* "fccqp/admm.pyx":379
+    /* "fccqp/admm.pyx":385
  *         self.log_count = 0
  *         run.rho = self.prev_rho if warm else self.opt.rho
  *         if x0 != NULL:             # <<<<<<<<<<<<<<
@@ -23373,7 +23449,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
     goto __pyx_L6;
   }
 
-  /* "fccqp/admm.pyx":381
+  /* "fccqp/admm.pyx":387
  *         if x0 != NULL:
  *             self._start_from_guess(x0)
  *         elif warm:             # <<<<<<<<<<<<<<
@@ -23382,7 +23458,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
   if (__pyx_v_warm) {
 
-    /* "fccqp/admm.pyx":382
+    /* "fccqp/admm.pyx":388
  *             self._start_from_guess(x0)
  *         elif warm:
  *             scale_start(self.prev_x, self.prev_y, self.prev_z, self.prev_rho, p.D, p.E, p.c,             # <<<<<<<<<<<<<<
@@ -23391,7 +23467,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
     __pyx_f_5fccqp_7scaling_scale_start(__pyx_v_self->prev_x, __pyx_v_self->prev_y, __pyx_v_self->prev_z, __pyx_v_self->prev_rho, __pyx_v_p->D, __pyx_v_p->E, __pyx_v_p->c, __pyx_v_p->n, __pyx_v_p->m, __pyx_v_p->s, __pyx_v_p->constrained, __pyx_v_p->lo, __pyx_v_p->hi, __pyx_v_p->cones, __pyx_v_self->it.x, __pyx_v_self->it.nu, __pyx_v_self->it.y, __pyx_v_self->it.z);
 
-    /* "fccqp/admm.pyx":381
+    /* "fccqp/admm.pyx":387
  *         if x0 != NULL:
  *             self._start_from_guess(x0)
  *         elif warm:             # <<<<<<<<<<<<<<
@@ -23401,7 +23477,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
   }
   __pyx_L6:;
 
-  /* "fccqp/admm.pyx":385
+  /* "fccqp/admm.pyx":391
  *                         p.n, p.m, p.s, p.constrained, p.lo, p.hi, p.cones, self.it.x,
  *                         self.it.nu, self.it.y, self.it.z)
  *         if not reuse:             # <<<<<<<<<<<<<<
@@ -23413,7 +23489,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":386
+    /* "fccqp/admm.pyx":392
  *                         self.it.nu, self.it.y, self.it.z)
  *         if not reuse:
  *             self.factored_rho = -1.0             # <<<<<<<<<<<<<<
@@ -23422,7 +23498,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
     __pyx_v_self->factored_rho = -1.0;
 
-    /* "fccqp/admm.pyx":385
+    /* "fccqp/admm.pyx":391
  *                         p.n, p.m, p.s, p.constrained, p.lo, p.hi, p.cones, self.it.x,
  *                         self.it.nu, self.it.y, self.it.z)
  *         if not reuse:             # <<<<<<<<<<<<<<
@@ -23431,7 +23507,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
   }
 
-  /* "fccqp/admm.pyx":387
+  /* "fccqp/admm.pyx":393
  *         if not reuse:
  *             self.factored_rho = -1.0
  *         run.setup_time = fccqp_now() - start_time             # <<<<<<<<<<<<<<
@@ -23440,7 +23516,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
   __pyx_v_run.setup_time = (fccqp_now() - __pyx_v_start_time);
 
-  /* "fccqp/admm.pyx":388
+  /* "fccqp/admm.pyx":394
  *             self.factored_rho = -1.0
  *         run.setup_time = fccqp_now() - start_time
  *         self._iterate(&run, x0 == NULL and not warm, start_time)             # <<<<<<<<<<<<<<
@@ -23466,7 +23542,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
   ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_iterate(__pyx_v_self, (&__pyx_v_run), __pyx_t_1, __pyx_v_start_time);
 
 
-  /* "fccqp/admm.pyx":389
+  /* "fccqp/admm.pyx":395
  *         run.setup_time = fccqp_now() - start_time
  *         self._iterate(&run, x0 == NULL and not warm, start_time)
  *         return run             # <<<<<<<<<<<<<<
@@ -23479,7 +23555,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":367
+  /* "fccqp/admm.pyx":373
  *     # ----------------------------------------------------------------- one solve
  * 
  *     cdef Run _solve(self, bint same_matrices, const double* x0, bint warm,             # <<<<<<<<<<<<<<
@@ -23495,7 +23571,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":391
+/* "fccqp/admm.pyx":397
  *         return run
  * 
  *     cdef void _scale(self, bint reuse) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -23514,7 +23590,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
   Py_ssize_t __pyx_t_3;
   Py_ssize_t __pyx_t_4;
 
-  /* "fccqp/admm.pyx":394
+  /* "fccqp/admm.pyx":400
  *         """Equilibrate the user's data into the scaled problem, or, with ``reuse``, apply
  *         the scaling of the unchanged matrices to the new vectors only."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -23523,7 +23599,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":395
+  /* "fccqp/admm.pyx":401
  *         the scaling of the unchanged matrices to the new vectors only."""
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m, i, j             # <<<<<<<<<<<<<<
@@ -23537,7 +23613,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 
   __pyx_v_m = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":396
+  /* "fccqp/admm.pyx":402
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m, i, j
  *         if not reuse:             # <<<<<<<<<<<<<<
@@ -23549,7 +23625,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
   if (__pyx_t_2) {
 
 
-    /* "fccqp/admm.pyx":397
+    /* "fccqp/admm.pyx":403
  *         cdef Py_ssize_t n = p.n, m = p.m, i, j
  *         if not reuse:
  *             copy(self.P_user, p.P, n * n)             # <<<<<<<<<<<<<<
@@ -23558,7 +23634,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_self->P_user, __pyx_v_p->P, (__pyx_v_n * __pyx_v_n));
 
-    /* "fccqp/admm.pyx":398
+    /* "fccqp/admm.pyx":404
  *         if not reuse:
  *             copy(self.P_user, p.P, n * n)
  *             copy(self.A_user, p.A, m * n)             # <<<<<<<<<<<<<<
@@ -23567,7 +23643,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_self->A_user, __pyx_v_p->A, (__pyx_v_m * __pyx_v_n));
 
-    /* "fccqp/admm.pyx":399
+    /* "fccqp/admm.pyx":405
  *             copy(self.P_user, p.P, n * n)
  *             copy(self.A_user, p.A, m * n)
  *             copy(self.q_user, p.q, n)             # <<<<<<<<<<<<<<
@@ -23576,7 +23652,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_self->q_user, __pyx_v_p->q, __pyx_v_n);
 
-    /* "fccqp/admm.pyx":400
+    /* "fccqp/admm.pyx":406
  *             copy(self.A_user, p.A, m * n)
  *             copy(self.q_user, p.q, n)
  *             copy(self.b_user, p.b, m)             # <<<<<<<<<<<<<<
@@ -23585,7 +23661,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_self->b_user, __pyx_v_p->b, __pyx_v_m);
 
-    /* "fccqp/admm.pyx":401
+    /* "fccqp/admm.pyx":407
  *             copy(self.q_user, p.q, n)
  *             copy(self.b_user, p.b, m)
  *             p.c = equilibrate(p.P, p.q, p.A, p.b, n, m, self.block_start, p.cones.dim,             # <<<<<<<<<<<<<<
@@ -23594,7 +23670,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_v_p->c = __pyx_f_5fccqp_7scaling_equilibrate(__pyx_v_p->P, __pyx_v_p->q, __pyx_v_p->A, __pyx_v_p->b, __pyx_v_n, __pyx_v_m, __pyx_v_self->block_start, __pyx_v_p->cones.dim, __pyx_v_p->cones.count, __pyx_v_self->opt.scaling, __pyx_v_p->D, __pyx_v_p->E, __pyx_v_self->d_scratch, __pyx_v_self->e_scratch);
 
-    /* "fccqp/admm.pyx":404
+    /* "fccqp/admm.pyx":410
  *                               p.cones.count, self.opt.scaling, p.D, p.E, self.d_scratch,
  *                               self.e_scratch)
  *             self.scaled_once = True             # <<<<<<<<<<<<<<
@@ -23603,7 +23679,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_v_self->scaled_once = 1;
 
-    /* "fccqp/admm.pyx":396
+    /* "fccqp/admm.pyx":402
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m, i, j
  *         if not reuse:             # <<<<<<<<<<<<<<
@@ -23613,7 +23689,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
     goto __pyx_L3;
   }
 
-  /* "fccqp/admm.pyx":406
+  /* "fccqp/admm.pyx":412
  *             self.scaled_once = True
  *         else:
  *             for i in range(n):             # <<<<<<<<<<<<<<
@@ -23628,7 +23704,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
     for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
       __pyx_v_i = __pyx_t_4;
 
-      /* "fccqp/admm.pyx":407
+      /* "fccqp/admm.pyx":413
  *         else:
  *             for i in range(n):
  *                 p.q[i] = p.c * p.D[i] * self.q_user[i]             # <<<<<<<<<<<<<<
@@ -23639,7 +23715,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
     }
 
 
-    /* "fccqp/admm.pyx":408
+    /* "fccqp/admm.pyx":414
  *             for i in range(n):
  *                 p.q[i] = p.c * p.D[i] * self.q_user[i]
  *             for i in range(m):             # <<<<<<<<<<<<<<
@@ -23653,7 +23729,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
     for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
       __pyx_v_i = __pyx_t_4;
 
-      /* "fccqp/admm.pyx":409
+      /* "fccqp/admm.pyx":415
  *                 p.q[i] = p.c * p.D[i] * self.q_user[i]
  *             for i in range(m):
  *                 p.b[i] = p.E[i] * self.b_user[i]             # <<<<<<<<<<<<<<
@@ -23666,7 +23742,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
   }
   __pyx_L3:;
 
-  /* "fccqp/admm.pyx":410
+  /* "fccqp/admm.pyx":416
  *             for i in range(m):
  *                 p.b[i] = p.E[i] * self.b_user[i]
  *         for j in range(p.s):             # <<<<<<<<<<<<<<
@@ -23680,7 +23756,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":411
+    /* "fccqp/admm.pyx":417
  *                 p.b[i] = p.E[i] * self.b_user[i]
  *         for j in range(p.s):
  *             i = p.constrained[j]             # <<<<<<<<<<<<<<
@@ -23689,7 +23765,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_v_i = (__pyx_v_p->constrained[__pyx_v_j]);
 
-    /* "fccqp/admm.pyx":412
+    /* "fccqp/admm.pyx":418
  *         for j in range(p.s):
  *             i = p.constrained[j]
  *             p.lo[j] = self.lb_user[i] / p.D[i]             # <<<<<<<<<<<<<<
@@ -23698,7 +23774,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 */
     (__pyx_v_p->lo[__pyx_v_j]) = ((__pyx_v_self->lb_user[__pyx_v_i]) / (__pyx_v_p->D[__pyx_v_i]));
 
-    /* "fccqp/admm.pyx":413
+    /* "fccqp/admm.pyx":419
  *             i = p.constrained[j]
  *             p.lo[j] = self.lb_user[i] / p.D[i]
  *             p.hi[j] = self.ub_user[i] / p.D[i]             # <<<<<<<<<<<<<<
@@ -23709,7 +23785,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
   }
 
 
-  /* "fccqp/admm.pyx":391
+  /* "fccqp/admm.pyx":397
  *         return run
  * 
  *     cdef void _scale(self, bint reuse) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -23725,7 +23801,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 
 }
 
-/* "fccqp/admm.pyx":415
+/* "fccqp/admm.pyx":421
  *             p.hi[j] = self.ub_user[i] / p.D[i]
  * 
  *     cdef void _start_from_guess(self, const double* x0) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -23741,7 +23817,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__start_from_guess(struct __pyx_obj_5
   Py_ssize_t __pyx_t_2;
   Py_ssize_t __pyx_t_3;
 
-  /* "fccqp/admm.pyx":417
+  /* "fccqp/admm.pyx":423
  *     cdef void _start_from_guess(self, const double* x0) noexcept nogil:
  *         """Primal guess ``x0`` (user's units), duals zero, slack its projection."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -23750,7 +23826,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__start_from_guess(struct __pyx_obj_5
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":419
+  /* "fccqp/admm.pyx":425
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i, j
  *         for i in range(p.n):             # <<<<<<<<<<<<<<
@@ -23764,7 +23840,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__start_from_guess(struct __pyx_obj_5
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":420
+    /* "fccqp/admm.pyx":426
  *         cdef Py_ssize_t i, j
  *         for i in range(p.n):
  *             self.it.x[i] = x0[i] / p.D[i]             # <<<<<<<<<<<<<<
@@ -23775,7 +23851,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__start_from_guess(struct __pyx_obj_5
   }
 
 
-  /* "fccqp/admm.pyx":421
+  /* "fccqp/admm.pyx":427
  *         for i in range(p.n):
  *             self.it.x[i] = x0[i] / p.D[i]
  *         fill(self.it.nu, 0.0, p.m)             # <<<<<<<<<<<<<<
@@ -23784,7 +23860,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__start_from_guess(struct __pyx_obj_5
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_self->it.nu, 0.0, __pyx_v_p->m);
 
-  /* "fccqp/admm.pyx":422
+  /* "fccqp/admm.pyx":428
  *             self.it.x[i] = x0[i] / p.D[i]
  *         fill(self.it.nu, 0.0, p.m)
  *         fill(self.it.y, 0.0, p.s)             # <<<<<<<<<<<<<<
@@ -23793,7 +23869,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__start_from_guess(struct __pyx_obj_5
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_self->it.y, 0.0, __pyx_v_p->s);
 
-  /* "fccqp/admm.pyx":423
+  /* "fccqp/admm.pyx":429
  *         fill(self.it.nu, 0.0, p.m)
  *         fill(self.it.y, 0.0, p.s)
  *         for j in range(p.s):             # <<<<<<<<<<<<<<
@@ -23807,7 +23883,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__start_from_guess(struct __pyx_obj_5
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_j = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":424
+    /* "fccqp/admm.pyx":430
  *         fill(self.it.y, 0.0, p.s)
  *         for j in range(p.s):
  *             self.it.z[j] = self.it.x[p.constrained[j]]             # <<<<<<<<<<<<<<
@@ -23818,7 +23894,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__start_from_guess(struct __pyx_obj_5
   }
 
 
-  /* "fccqp/admm.pyx":425
+  /* "fccqp/admm.pyx":431
  *         for j in range(p.s):
  *             self.it.z[j] = self.it.x[p.constrained[j]]
  *         proj_set(self.it.z, p.lo, p.hi, p.cones, p.s, self.it.z)             # <<<<<<<<<<<<<<
@@ -23827,7 +23903,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__start_from_guess(struct __pyx_obj_5
 */
   __pyx_f_5fccqp_11projections_proj_set(__pyx_v_self->it.z, __pyx_v_p->lo, __pyx_v_p->hi, __pyx_v_p->cones, __pyx_v_p->s, __pyx_v_self->it.z);
 
-  /* "fccqp/admm.pyx":415
+  /* "fccqp/admm.pyx":421
  *             p.hi[j] = self.ub_user[i] / p.D[i]
  * 
  *     cdef void _start_from_guess(self, const double* x0) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -23841,7 +23917,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__start_from_guess(struct __pyx_obj_5
 
 }
 
-/* "fccqp/admm.pyx":429
+/* "fccqp/admm.pyx":435
  *     # ------------------------------------------------------------ the iteration
  * 
  *     cdef void _iterate(self, Run* run, bint cold, double start_time) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -23879,7 +23955,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   int __pyx_t_7;
   int __pyx_t_8;
 
-  /* "fccqp/admm.pyx":431
+  /* "fccqp/admm.pyx":437
  *     cdef void _iterate(self, Run* run, bint cold, double start_time) noexcept nogil:
  *         """Run ADMM from the iterate in the workspace (or a cold start)."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -23888,7 +23964,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":432
+  /* "fccqp/admm.pyx":438
  *         """Run ADMM from the iterate in the workspace (or a cold start)."""
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -23897,7 +23973,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":433
+  /* "fccqp/admm.pyx":439
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Options* o = &self.opt             # <<<<<<<<<<<<<<
@@ -23906,7 +23982,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_o = (&__pyx_v_self->opt);
 
-  /* "fccqp/admm.pyx":434
+  /* "fccqp/admm.pyx":440
  *         cdef Iterates* it = &self.it
  *         cdef Options* o = &self.opt
  *         cdef Residuals* r = &self.res             # <<<<<<<<<<<<<<
@@ -23915,7 +23991,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_r = (&__pyx_v_self->res);
 
-  /* "fccqp/admm.pyx":435
+  /* "fccqp/admm.pyx":441
  *         cdef Options* o = &self.opt
  *         cdef Residuals* r = &self.res
  *         cdef Py_ssize_t s = p.s, j             # <<<<<<<<<<<<<<
@@ -23926,7 +24002,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":436
+  /* "fccqp/admm.pyx":442
  *         cdef Residuals* r = &self.res
  *         cdef Py_ssize_t s = p.s, j
  *         cdef long iteration = 0             # <<<<<<<<<<<<<<
@@ -23935,7 +24011,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_iteration = 0;
 
-  /* "fccqp/admm.pyx":437
+  /* "fccqp/admm.pyx":443
  *         cdef Py_ssize_t s = p.s, j
  *         cdef long iteration = 0
  *         cdef int status = _RUNNING, code             # <<<<<<<<<<<<<<
@@ -23944,7 +24020,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_status = __pyx_e_5fccqp_4admm__RUNNING;
 
-  /* "fccqp/admm.pyx":438
+  /* "fccqp/admm.pyx":444
  *         cdef long iteration = 0
  *         cdef int status = _RUNNING, code
  *         cdef bint unbounded_start = False, timed = isfinite(o.time_limit)             # <<<<<<<<<<<<<<
@@ -23954,7 +24030,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   __pyx_v_unbounded_start = 0;
   __pyx_v_timed = isfinite(__pyx_v_o->time_limit);
 
-  /* "fccqp/admm.pyx":441
+  /* "fccqp/admm.pyx":447
  *         cdef bint reduced, fresh, last, periodic, adapt, check
  *         cdef double eps_p, eps_d, new_rho
  *         run.factorizations = 0             # <<<<<<<<<<<<<<
@@ -23963,7 +24039,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_run->factorizations = 0;
 
-  /* "fccqp/admm.pyx":442
+  /* "fccqp/admm.pyx":448
  *         cdef double eps_p, eps_d, new_rho
  *         run.factorizations = 0
  *         run.backend = self.form             # <<<<<<<<<<<<<<
@@ -23974,7 +24050,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
   __pyx_v_run->backend = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":443
+  /* "fccqp/admm.pyx":449
  *         run.factorizations = 0
  *         run.backend = self.form
  *         if cold or s == 0:             # <<<<<<<<<<<<<<
@@ -23996,7 +24072,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":444
+    /* "fccqp/admm.pyx":450
  *         run.backend = self.form
  *         if cold or s == 0:
  *             code = self._equality_start(&unbounded_start)             # <<<<<<<<<<<<<<
@@ -24005,7 +24081,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_code = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_equality_start(__pyx_v_self, (&__pyx_v_unbounded_start));
 
-    /* "fccqp/admm.pyx":445
+    /* "fccqp/admm.pyx":451
  *         if cold or s == 0:
  *             code = self._equality_start(&unbounded_start)
  *             run.factorizations += 1             # <<<<<<<<<<<<<<
@@ -24014,7 +24090,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_run->factorizations = (__pyx_v_run->factorizations + 1);
 
-    /* "fccqp/admm.pyx":446
+    /* "fccqp/admm.pyx":452
  *             code = self._equality_start(&unbounded_start)
  *             run.factorizations += 1
  *             if code == NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -24026,7 +24102,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     if (__pyx_t_3) {
 
 
-      /* "fccqp/admm.pyx":447
+      /* "fccqp/admm.pyx":453
  *             run.factorizations += 1
  *             if code == NOT_CONVEX:
  *                 run.status = _NOT_CONVEX             # <<<<<<<<<<<<<<
@@ -24035,7 +24111,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_v_run->status = __pyx_e_5fccqp_4admm__NOT_CONVEX;
 
-      /* "fccqp/admm.pyx":448
+      /* "fccqp/admm.pyx":454
  *             if code == NOT_CONVEX:
  *                 run.status = _NOT_CONVEX
  *                 return             # <<<<<<<<<<<<<<
@@ -24046,7 +24122,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
       }
       goto __pyx_L0;
 
-      /* "fccqp/admm.pyx":446
+      /* "fccqp/admm.pyx":452
  *             code = self._equality_start(&unbounded_start)
  *             run.factorizations += 1
  *             if code == NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -24055,7 +24131,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     }
 
-    /* "fccqp/admm.pyx":443
+    /* "fccqp/admm.pyx":449
  *         run.factorizations = 0
  *         run.backend = self.form
  *         if cold or s == 0:             # <<<<<<<<<<<<<<
@@ -24064,7 +24140,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":449
+  /* "fccqp/admm.pyx":455
  *                 run.status = _NOT_CONVEX
  *                 return
  *         self._residuals()             # <<<<<<<<<<<<<<
@@ -24073,7 +24149,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_residuals(__pyx_v_self);
 
-  /* "fccqp/admm.pyx":450
+  /* "fccqp/admm.pyx":456
  *                 return
  *         self._residuals()
  *         self._log(0, run.rho)             # <<<<<<<<<<<<<<
@@ -24082,7 +24158,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_log(__pyx_v_self, 0, __pyx_v_run->rho);
 
-  /* "fccqp/admm.pyx":451
+  /* "fccqp/admm.pyx":457
  *         self._residuals()
  *         self._log(0, run.rho)
  *         if unbounded_start and self._unbounded():             # <<<<<<<<<<<<<<
@@ -24104,7 +24180,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":452
+    /* "fccqp/admm.pyx":458
  *         self._log(0, run.rho)
  *         if unbounded_start and self._unbounded():
  *             self._finish_run(run, _DUAL_INFEASIBLE, 0)             # <<<<<<<<<<<<<<
@@ -24113,7 +24189,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_finish_run(__pyx_v_self, __pyx_v_run, __pyx_e_5fccqp_4admm__DUAL_INFEASIBLE, 0);
 
-    /* "fccqp/admm.pyx":453
+    /* "fccqp/admm.pyx":459
  *         if unbounded_start and self._unbounded():
  *             self._finish_run(run, _DUAL_INFEASIBLE, 0)
  *             return             # <<<<<<<<<<<<<<
@@ -24124,7 +24200,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":451
+    /* "fccqp/admm.pyx":457
  *         self._residuals()
  *         self._log(0, run.rho)
  *         if unbounded_start and self._unbounded():             # <<<<<<<<<<<<<<
@@ -24133,7 +24209,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":454
+  /* "fccqp/admm.pyx":460
  *             self._finish_run(run, _DUAL_INFEASIBLE, 0)
  *             return
  *         if (cold or s == 0) and converged(r, o.eps_abs, o.eps_rel) and not unbounded_start:             # <<<<<<<<<<<<<<
@@ -24174,7 +24250,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":455
+    /* "fccqp/admm.pyx":461
  *             return
  *         if (cold or s == 0) and converged(r, o.eps_abs, o.eps_rel) and not unbounded_start:
  *             self._finish_run(run, _SOLVED, 0)             # <<<<<<<<<<<<<<
@@ -24183,7 +24259,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_finish_run(__pyx_v_self, __pyx_v_run, __pyx_e_5fccqp_4admm__SOLVED, 0);
 
-    /* "fccqp/admm.pyx":456
+    /* "fccqp/admm.pyx":462
  *         if (cold or s == 0) and converged(r, o.eps_abs, o.eps_rel) and not unbounded_start:
  *             self._finish_run(run, _SOLVED, 0)
  *             return             # <<<<<<<<<<<<<<
@@ -24194,7 +24270,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":454
+    /* "fccqp/admm.pyx":460
  *             self._finish_run(run, _DUAL_INFEASIBLE, 0)
  *             return
  *         if (cold or s == 0) and converged(r, o.eps_abs, o.eps_rel) and not unbounded_start:             # <<<<<<<<<<<<<<
@@ -24203,7 +24279,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":457
+  /* "fccqp/admm.pyx":463
  *             self._finish_run(run, _SOLVED, 0)
  *             return
  *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer             # <<<<<<<<<<<<<<
@@ -24215,7 +24291,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":458
+    /* "fccqp/admm.pyx":464
  *             return
  *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer
  *             if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():             # <<<<<<<<<<<<<<
@@ -24241,7 +24317,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     if (__pyx_t_3) {
 
 
-      /* "fccqp/admm.pyx":459
+      /* "fccqp/admm.pyx":465
  *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer
  *             if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():
  *                 status = _PRIMAL_INFEASIBLE             # <<<<<<<<<<<<<<
@@ -24250,7 +24326,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_v_status = __pyx_e_5fccqp_4admm__PRIMAL_INFEASIBLE;
 
-      /* "fccqp/admm.pyx":458
+      /* "fccqp/admm.pyx":464
  *             return
  *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer
  *             if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():             # <<<<<<<<<<<<<<
@@ -24260,7 +24336,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
       goto __pyx_L16;
     }
 
-    /* "fccqp/admm.pyx":461
+    /* "fccqp/admm.pyx":467
  *                 status = _PRIMAL_INFEASIBLE
  *             else:
  *                 status = self._classify(0, False, start_time)             # <<<<<<<<<<<<<<
@@ -24272,7 +24348,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     }
     __pyx_L16:;
 
-    /* "fccqp/admm.pyx":462
+    /* "fccqp/admm.pyx":468
  *             else:
  *                 status = self._classify(0, False, start_time)
  *             self._finish_run(run, status, 0)             # <<<<<<<<<<<<<<
@@ -24281,7 +24357,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_finish_run(__pyx_v_self, __pyx_v_run, __pyx_v_status, 0);
 
-    /* "fccqp/admm.pyx":463
+    /* "fccqp/admm.pyx":469
  *                 status = self._classify(0, False, start_time)
  *             self._finish_run(run, status, 0)
  *             return             # <<<<<<<<<<<<<<
@@ -24292,7 +24368,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":457
+    /* "fccqp/admm.pyx":463
  *             self._finish_run(run, _SOLVED, 0)
  *             return
  *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer             # <<<<<<<<<<<<<<
@@ -24301,7 +24377,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":464
+  /* "fccqp/admm.pyx":470
  *             self._finish_run(run, status, 0)
  *             return
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -24315,7 +24391,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
     __pyx_v_j = __pyx_t_6;
 
-    /* "fccqp/admm.pyx":465
+    /* "fccqp/admm.pyx":471
  *             return
  *         for j in range(s):
  *             it.rho_vec[j] = run.rho * self.rho_scale[j]             # <<<<<<<<<<<<<<
@@ -24326,7 +24402,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   }
 
 
-  /* "fccqp/admm.pyx":466
+  /* "fccqp/admm.pyx":472
  *         for j in range(s):
  *             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *         if self.factored_rho != run.rho or cold:             # <<<<<<<<<<<<<<
@@ -24349,7 +24425,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":467
+    /* "fccqp/admm.pyx":473
  *             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *         if self.factored_rho != run.rho or cold:
  *             code = self._factor(run, self._budget(0))             # <<<<<<<<<<<<<<
@@ -24358,7 +24434,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_code = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_factor(__pyx_v_self, __pyx_v_run, ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_budget(__pyx_v_self, 0));
 
-    /* "fccqp/admm.pyx":468
+    /* "fccqp/admm.pyx":474
  *         if self.factored_rho != run.rho or cold:
  *             code = self._factor(run, self._budget(0))
  *             if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -24370,7 +24446,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     if (__pyx_t_3) {
 
 
-      /* "fccqp/admm.pyx":469
+      /* "fccqp/admm.pyx":475
  *             code = self._factor(run, self._budget(0))
  *             if code != FACTORED:
  *                 run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR             # <<<<<<<<<<<<<<
@@ -24389,7 +24465,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
       __pyx_v_run->status = __pyx_t_7;
 
-      /* "fccqp/admm.pyx":470
+      /* "fccqp/admm.pyx":476
  *             if code != FACTORED:
  *                 run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR
  *                 return             # <<<<<<<<<<<<<<
@@ -24400,7 +24476,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
       }
       goto __pyx_L0;
 
-      /* "fccqp/admm.pyx":468
+      /* "fccqp/admm.pyx":474
  *         if self.factored_rho != run.rho or cold:
  *             code = self._factor(run, self._budget(0))
  *             if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -24409,7 +24485,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     }
 
-    /* "fccqp/admm.pyx":466
+    /* "fccqp/admm.pyx":472
  *         for j in range(s):
  *             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *         if self.factored_rho != run.rho or cold:             # <<<<<<<<<<<<<<
@@ -24418,7 +24494,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":471
+  /* "fccqp/admm.pyx":477
  *                 run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR
  *                 return
  *         reduced = self.form != LDL_FULL             # <<<<<<<<<<<<<<
@@ -24427,7 +24503,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_reduced = (__pyx_v_self->form != __pyx_e_5fccqp_3kkt_LDL_FULL);
 
-  /* "fccqp/admm.pyx":472
+  /* "fccqp/admm.pyx":478
  *                 return
  *         reduced = self.form != LDL_FULL
  *         if reduced:             # <<<<<<<<<<<<<<
@@ -24436,7 +24512,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   if (__pyx_v_reduced) {
 
-    /* "fccqp/admm.pyx":473
+    /* "fccqp/admm.pyx":479
  *         reduced = self.form != LDL_FULL
  *         if reduced:
  *             self._reduced_base()             # <<<<<<<<<<<<<<
@@ -24445,7 +24521,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_reduced_base(__pyx_v_self);
 
-    /* "fccqp/admm.pyx":474
+    /* "fccqp/admm.pyx":480
  *         if reduced:
  *             self._reduced_base()
  *             reduced_start(&self.red, p, it)             # <<<<<<<<<<<<<<
@@ -24454,7 +24530,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_f_5fccqp_7reduced_reduced_start((&__pyx_v_self->red), __pyx_v_p, __pyx_v_it);
 
-    /* "fccqp/admm.pyx":472
+    /* "fccqp/admm.pyx":478
  *                 return
  *         reduced = self.form != LDL_FULL
  *         if reduced:             # <<<<<<<<<<<<<<
@@ -24463,7 +24539,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":475
+  /* "fccqp/admm.pyx":481
  *             self._reduced_base()
  *             reduced_start(&self.red, p, it)
  *         eps_p = o.eps_abs + o.eps_rel * r.prim_scale             # <<<<<<<<<<<<<<
@@ -24472,7 +24548,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_eps_p = (__pyx_v_o->eps_abs + (__pyx_v_o->eps_rel * __pyx_v_r->prim_scale));
 
-  /* "fccqp/admm.pyx":476
+  /* "fccqp/admm.pyx":482
  *             reduced_start(&self.red, p, it)
  *         eps_p = o.eps_abs + o.eps_rel * r.prim_scale
  *         eps_d = o.eps_abs + o.eps_rel * r.dual_scale             # <<<<<<<<<<<<<<
@@ -24481,7 +24557,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_eps_d = (__pyx_v_o->eps_abs + (__pyx_v_o->eps_rel * __pyx_v_r->dual_scale));
 
-  /* "fccqp/admm.pyx":477
+  /* "fccqp/admm.pyx":483
  *         eps_p = o.eps_abs + o.eps_rel * r.prim_scale
  *         eps_d = o.eps_abs + o.eps_rel * r.dual_scale
  *         anderson_reset(&self.aa, False)             # <<<<<<<<<<<<<<
@@ -24490,7 +24566,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_f_5fccqp_8anderson_anderson_reset((&__pyx_v_self->aa), 0);
 
-  /* "fccqp/admm.pyx":478
+  /* "fccqp/admm.pyx":484
  *         eps_d = o.eps_abs + o.eps_rel * r.dual_scale
  *         anderson_reset(&self.aa, False)
  *         fresh = True  # the next step starts a run of KKT solutions: do not relax x             # <<<<<<<<<<<<<<
@@ -24499,7 +24575,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_fresh = 1;
 
-  /* "fccqp/admm.pyx":479
+  /* "fccqp/admm.pyx":485
  *         anderson_reset(&self.aa, False)
  *         fresh = True  # the next step starts a run of KKT solutions: do not relax x
  *         while status == _RUNNING:             # <<<<<<<<<<<<<<
@@ -24512,7 +24588,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
     if (!__pyx_t_3) break;
 
-    /* "fccqp/admm.pyx":480
+    /* "fccqp/admm.pyx":486
  *         fresh = True  # the next step starts a run of KKT solutions: do not relax x
  *         while status == _RUNNING:
  *             iteration += 1             # <<<<<<<<<<<<<<
@@ -24521,7 +24597,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_iteration = (__pyx_v_iteration + 1);
 
-    /* "fccqp/admm.pyx":481
+    /* "fccqp/admm.pyx":487
  *         while status == _RUNNING:
  *             iteration += 1
  *             if reduced:             # <<<<<<<<<<<<<<
@@ -24530,7 +24606,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     if (__pyx_v_reduced) {
 
-      /* "fccqp/admm.pyx":482
+      /* "fccqp/admm.pyx":488
  *             iteration += 1
  *             if reduced:
  *                 reduced_step(&self.red, p, it, o.alpha, not fresh)             # <<<<<<<<<<<<<<
@@ -24539,7 +24615,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_f_5fccqp_7reduced_reduced_step((&__pyx_v_self->red), __pyx_v_p, __pyx_v_it, __pyx_v_o->alpha, (!__pyx_v_fresh));
 
-      /* "fccqp/admm.pyx":481
+      /* "fccqp/admm.pyx":487
  *         while status == _RUNNING:
  *             iteration += 1
  *             if reduced:             # <<<<<<<<<<<<<<
@@ -24549,7 +24625,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
       goto __pyx_L28;
     }
 
-    /* "fccqp/admm.pyx":484
+    /* "fccqp/admm.pyx":490
  *                 reduced_step(&self.red, p, it, o.alpha, not fresh)
  *             else:
  *                 self._full_step(not fresh)             # <<<<<<<<<<<<<<
@@ -24561,7 +24637,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     }
     __pyx_L28:;
 
-    /* "fccqp/admm.pyx":485
+    /* "fccqp/admm.pyx":491
  *             else:
  *                 self._full_step(not fresh)
  *             fresh = False             # <<<<<<<<<<<<<<
@@ -24570,7 +24646,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_fresh = 0;
 
-    /* "fccqp/admm.pyx":486
+    /* "fccqp/admm.pyx":492
  *                 self._full_step(not fresh)
  *             fresh = False
  *             last = iteration >= o.max_iter or (timed and fccqp_now() - start_time >= o.time_limit)             # <<<<<<<<<<<<<<
@@ -24601,7 +24677,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     __pyx_L29_bool_binop_done:;
     __pyx_v_last = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":487
+    /* "fccqp/admm.pyx":493
  *             fresh = False
  *             last = iteration >= o.max_iter or (timed and fccqp_now() - start_time >= o.time_limit)
  *             periodic = iteration % o.adaptive_rho_interval == 0             # <<<<<<<<<<<<<<
@@ -24610,7 +24686,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_periodic = ((__pyx_v_iteration % __pyx_v_o->adaptive_rho_interval) == 0);
 
-    /* "fccqp/admm.pyx":488
+    /* "fccqp/admm.pyx":494
  *             last = iteration >= o.max_iter or (timed and fccqp_now() - start_time >= o.time_limit)
  *             periodic = iteration % o.adaptive_rho_interval == 0
  *             adapt = o.adaptive_rho and periodic             # <<<<<<<<<<<<<<
@@ -24628,7 +24704,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     __pyx_L32_bool_binop_done:;
     __pyx_v_adapt = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":489
+    /* "fccqp/admm.pyx":495
  *             periodic = iteration % o.adaptive_rho_interval == 0
  *             adapt = o.adaptive_rho and periodic
  *             check = iteration % o.check_termination == 0 or last or adapt             # <<<<<<<<<<<<<<
@@ -24656,7 +24732,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     __pyx_L34_bool_binop_done:;
     __pyx_v_check = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":490
+    /* "fccqp/admm.pyx":496
  *             adapt = o.adaptive_rho and periodic
  *             check = iteration % o.check_termination == 0 or last or adapt
  *             if check and reduced and not (last or periodic):             # <<<<<<<<<<<<<<
@@ -24694,7 +24770,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     if (__pyx_t_3) {
 
 
-      /* "fccqp/admm.pyx":493
+      /* "fccqp/admm.pyx":499
  *                 # a scheduled full check (and with it infeasibility detection) still runs
  *                 # every adaptive_rho_interval iterations
  *                 check = near_convergence(&self.red, p, it, eps_p, eps_d)             # <<<<<<<<<<<<<<
@@ -24703,7 +24779,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_v_check = __pyx_f_5fccqp_7reduced_near_convergence((&__pyx_v_self->red), __pyx_v_p, __pyx_v_it, __pyx_v_eps_p, __pyx_v_eps_d);
 
-      /* "fccqp/admm.pyx":490
+      /* "fccqp/admm.pyx":496
  *             adapt = o.adaptive_rho and periodic
  *             check = iteration % o.check_termination == 0 or last or adapt
  *             if check and reduced and not (last or periodic):             # <<<<<<<<<<<<<<
@@ -24712,7 +24788,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     }
 
-    /* "fccqp/admm.pyx":494
+    /* "fccqp/admm.pyx":500
  *                 # every adaptive_rho_interval iterations
  *                 check = near_convergence(&self.red, p, it, eps_p, eps_d)
  *             if check:             # <<<<<<<<<<<<<<
@@ -24721,7 +24797,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     if (__pyx_v_check) {
 
-      /* "fccqp/admm.pyx":495
+      /* "fccqp/admm.pyx":501
  *                 check = near_convergence(&self.red, p, it, eps_p, eps_d)
  *             if check:
  *                 if reduced:             # <<<<<<<<<<<<<<
@@ -24730,7 +24806,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       if (__pyx_v_reduced) {
 
-        /* "fccqp/admm.pyx":496
+        /* "fccqp/admm.pyx":502
  *             if check:
  *                 if reduced:
  *                     materialize(&self.red, p, it)             # <<<<<<<<<<<<<<
@@ -24739,7 +24815,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
         __pyx_f_5fccqp_7reduced_materialize((&__pyx_v_self->red), __pyx_v_p, __pyx_v_it);
 
-        /* "fccqp/admm.pyx":495
+        /* "fccqp/admm.pyx":501
  *                 check = near_convergence(&self.red, p, it, eps_p, eps_d)
  *             if check:
  *                 if reduced:             # <<<<<<<<<<<<<<
@@ -24748,7 +24824,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       }
 
-      /* "fccqp/admm.pyx":497
+      /* "fccqp/admm.pyx":503
  *                 if reduced:
  *                     materialize(&self.red, p, it)
  *                 self._residuals()             # <<<<<<<<<<<<<<
@@ -24757,7 +24833,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_residuals(__pyx_v_self);
 
-      /* "fccqp/admm.pyx":498
+      /* "fccqp/admm.pyx":504
  *                     materialize(&self.red, p, it)
  *                 self._residuals()
  *                 eps_p = o.eps_abs + o.eps_rel * r.prim_scale             # <<<<<<<<<<<<<<
@@ -24766,7 +24842,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_v_eps_p = (__pyx_v_o->eps_abs + (__pyx_v_o->eps_rel * __pyx_v_r->prim_scale));
 
-      /* "fccqp/admm.pyx":499
+      /* "fccqp/admm.pyx":505
  *                 self._residuals()
  *                 eps_p = o.eps_abs + o.eps_rel * r.prim_scale
  *                 eps_d = o.eps_abs + o.eps_rel * r.dual_scale             # <<<<<<<<<<<<<<
@@ -24775,7 +24851,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_v_eps_d = (__pyx_v_o->eps_abs + (__pyx_v_o->eps_rel * __pyx_v_r->dual_scale));
 
-      /* "fccqp/admm.pyx":500
+      /* "fccqp/admm.pyx":506
  *                 eps_p = o.eps_abs + o.eps_rel * r.prim_scale
  *                 eps_d = o.eps_abs + o.eps_rel * r.dual_scale
  *                 if iteration % _LOG_INTERVAL == 0:             # <<<<<<<<<<<<<<
@@ -24787,7 +24863,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
       if (__pyx_t_3) {
 
 
-        /* "fccqp/admm.pyx":501
+        /* "fccqp/admm.pyx":507
  *                 eps_d = o.eps_abs + o.eps_rel * r.dual_scale
  *                 if iteration % _LOG_INTERVAL == 0:
  *                     self._log(iteration, run.rho)             # <<<<<<<<<<<<<<
@@ -24796,7 +24872,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
         ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_log(__pyx_v_self, __pyx_v_iteration, __pyx_v_run->rho);
 
-        /* "fccqp/admm.pyx":500
+        /* "fccqp/admm.pyx":506
  *                 eps_p = o.eps_abs + o.eps_rel * r.prim_scale
  *                 eps_d = o.eps_abs + o.eps_rel * r.dual_scale
  *                 if iteration % _LOG_INTERVAL == 0:             # <<<<<<<<<<<<<<
@@ -24805,7 +24881,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       }
 
-      /* "fccqp/admm.pyx":502
+      /* "fccqp/admm.pyx":508
  *                 if iteration % _LOG_INTERVAL == 0:
  *                     self._log(iteration, run.rho)
  *                 status = self._check(iteration, last, start_time)             # <<<<<<<<<<<<<<
@@ -24814,7 +24890,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_v_status = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_check(__pyx_v_self, __pyx_v_iteration, __pyx_v_last, __pyx_v_start_time);
 
-      /* "fccqp/admm.pyx":503
+      /* "fccqp/admm.pyx":509
  *                     self._log(iteration, run.rho)
  *                 status = self._check(iteration, last, start_time)
  *                 if status == _RUNNING and adapt:             # <<<<<<<<<<<<<<
@@ -24837,7 +24913,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
       if (__pyx_t_3) {
 
 
-        /* "fccqp/admm.pyx":504
+        /* "fccqp/admm.pyx":510
  *                 status = self._check(iteration, last, start_time)
  *                 if status == _RUNNING and adapt:
  *                     new_rho = self._new_rho(run.rho)             # <<<<<<<<<<<<<<
@@ -24846,7 +24922,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
         __pyx_v_new_rho = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new_rho(__pyx_v_self, __pyx_v_run->rho);
 
-        /* "fccqp/admm.pyx":505
+        /* "fccqp/admm.pyx":511
  *                 if status == _RUNNING and adapt:
  *                     new_rho = self._new_rho(run.rho)
  *                     if new_rho != run.rho:             # <<<<<<<<<<<<<<
@@ -24858,7 +24934,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
         if (__pyx_t_3) {
 
 
-          /* "fccqp/admm.pyx":506
+          /* "fccqp/admm.pyx":512
  *                     new_rho = self._new_rho(run.rho)
  *                     if new_rho != run.rho:
  *                         if reduced:             # <<<<<<<<<<<<<<
@@ -24867,7 +24943,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           if (__pyx_v_reduced) {
 
-            /* "fccqp/admm.pyx":507
+            /* "fccqp/admm.pyx":513
  *                     if new_rho != run.rho:
  *                         if reduced:
  *                             for j in range(s):             # <<<<<<<<<<<<<<
@@ -24881,7 +24957,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
             for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
               __pyx_v_j = __pyx_t_6;
 
-              /* "fccqp/admm.pyx":508
+              /* "fccqp/admm.pyx":514
  *                         if reduced:
  *                             for j in range(s):
  *                                 self.vec_s[j] = new_rho * self.rho_scale[j]             # <<<<<<<<<<<<<<
@@ -24892,7 +24968,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
             }
 
 
-            /* "fccqp/admm.pyx":509
+            /* "fccqp/admm.pyx":515
  *                             for j in range(s):
  *                                 self.vec_s[j] = new_rho * self.rho_scale[j]
  *                             reduced_rebase(&self.red, p, it.rho_vec, self.vec_s)             # <<<<<<<<<<<<<<
@@ -24901,7 +24977,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
             __pyx_f_5fccqp_7reduced_reduced_rebase((&__pyx_v_self->red), __pyx_v_p, __pyx_v_it->rho_vec, __pyx_v_self->vec_s);
 
-            /* "fccqp/admm.pyx":506
+            /* "fccqp/admm.pyx":512
  *                     new_rho = self._new_rho(run.rho)
  *                     if new_rho != run.rho:
  *                         if reduced:             # <<<<<<<<<<<<<<
@@ -24910,7 +24986,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           }
 
-          /* "fccqp/admm.pyx":510
+          /* "fccqp/admm.pyx":516
  *                                 self.vec_s[j] = new_rho * self.rho_scale[j]
  *                             reduced_rebase(&self.red, p, it.rho_vec, self.vec_s)
  *                         run.rho = new_rho             # <<<<<<<<<<<<<<
@@ -24919,7 +24995,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           __pyx_v_run->rho = __pyx_v_new_rho;
 
-          /* "fccqp/admm.pyx":511
+          /* "fccqp/admm.pyx":517
  *                             reduced_rebase(&self.red, p, it.rho_vec, self.vec_s)
  *                         run.rho = new_rho
  *                         for j in range(s):             # <<<<<<<<<<<<<<
@@ -24933,7 +25009,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
           for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
             __pyx_v_j = __pyx_t_6;
 
-            /* "fccqp/admm.pyx":512
+            /* "fccqp/admm.pyx":518
  *                         run.rho = new_rho
  *                         for j in range(s):
  *                             it.rho_vec[j] = run.rho * self.rho_scale[j]             # <<<<<<<<<<<<<<
@@ -24944,7 +25020,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
           }
 
 
-          /* "fccqp/admm.pyx":513
+          /* "fccqp/admm.pyx":519
  *                         for j in range(s):
  *                             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *                         code = self._factor(run, self._budget(iteration))             # <<<<<<<<<<<<<<
@@ -24953,7 +25029,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           __pyx_v_code = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_factor(__pyx_v_self, __pyx_v_run, ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_budget(__pyx_v_self, __pyx_v_iteration));
 
-          /* "fccqp/admm.pyx":514
+          /* "fccqp/admm.pyx":520
  *                             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *                         code = self._factor(run, self._budget(iteration))
  *                         if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -24965,7 +25041,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
           if (__pyx_t_3) {
 
 
-            /* "fccqp/admm.pyx":515
+            /* "fccqp/admm.pyx":521
  *                         code = self._factor(run, self._budget(iteration))
  *                         if code != FACTORED:
  *                             run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR             # <<<<<<<<<<<<<<
@@ -24984,7 +25060,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
             __pyx_v_run->status = __pyx_t_7;
 
-            /* "fccqp/admm.pyx":516
+            /* "fccqp/admm.pyx":522
  *                         if code != FACTORED:
  *                             run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR
  *                             return             # <<<<<<<<<<<<<<
@@ -24995,7 +25071,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
             }
             goto __pyx_L0;
 
-            /* "fccqp/admm.pyx":514
+            /* "fccqp/admm.pyx":520
  *                             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *                         code = self._factor(run, self._budget(iteration))
  *                         if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -25004,7 +25080,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           }
 
-          /* "fccqp/admm.pyx":517
+          /* "fccqp/admm.pyx":523
  *                             run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR
  *                             return
  *                         reduced = self.form != LDL_FULL             # <<<<<<<<<<<<<<
@@ -25013,7 +25089,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           __pyx_v_reduced = (__pyx_v_self->form != __pyx_e_5fccqp_3kkt_LDL_FULL);
 
-          /* "fccqp/admm.pyx":518
+          /* "fccqp/admm.pyx":524
  *                             return
  *                         reduced = self.form != LDL_FULL
  *                         if reduced:             # <<<<<<<<<<<<<<
@@ -25022,7 +25098,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           if (__pyx_v_reduced) {
 
-            /* "fccqp/admm.pyx":519
+            /* "fccqp/admm.pyx":525
  *                         reduced = self.form != LDL_FULL
  *                         if reduced:
  *                             self._reduced_base()             # <<<<<<<<<<<<<<
@@ -25031,7 +25107,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
             ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_reduced_base(__pyx_v_self);
 
-            /* "fccqp/admm.pyx":518
+            /* "fccqp/admm.pyx":524
  *                             return
  *                         reduced = self.form != LDL_FULL
  *                         if reduced:             # <<<<<<<<<<<<<<
@@ -25040,7 +25116,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           }
 
-          /* "fccqp/admm.pyx":520
+          /* "fccqp/admm.pyx":526
  *                         if reduced:
  *                             self._reduced_base()
  *                         fresh = True             # <<<<<<<<<<<<<<
@@ -25049,7 +25125,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           __pyx_v_fresh = 1;
 
-          /* "fccqp/admm.pyx":521
+          /* "fccqp/admm.pyx":527
  *                             self._reduced_base()
  *                         fresh = True
  *                         anderson_reset(&self.aa, True)             # <<<<<<<<<<<<<<
@@ -25058,7 +25134,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           __pyx_f_5fccqp_8anderson_anderson_reset((&__pyx_v_self->aa), 1);
 
-          /* "fccqp/admm.pyx":505
+          /* "fccqp/admm.pyx":511
  *                 if status == _RUNNING and adapt:
  *                     new_rho = self._new_rho(run.rho)
  *                     if new_rho != run.rho:             # <<<<<<<<<<<<<<
@@ -25067,7 +25143,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
         }
 
-        /* "fccqp/admm.pyx":503
+        /* "fccqp/admm.pyx":509
  *                     self._log(iteration, run.rho)
  *                 status = self._check(iteration, last, start_time)
  *                 if status == _RUNNING and adapt:             # <<<<<<<<<<<<<<
@@ -25076,7 +25152,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       }
 
-      /* "fccqp/admm.pyx":494
+      /* "fccqp/admm.pyx":500
  *                 # every adaptive_rho_interval iterations
  *                 check = near_convergence(&self.red, p, it, eps_p, eps_d)
  *             if check:             # <<<<<<<<<<<<<<
@@ -25085,7 +25161,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     }
 
-    /* "fccqp/admm.pyx":522
+    /* "fccqp/admm.pyx":528
  *                         fresh = True
  *                         anderson_reset(&self.aa, True)
  *             if status == _RUNNING and o.anderson_memory > 0:             # <<<<<<<<<<<<<<
@@ -25111,7 +25187,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     if (__pyx_t_3) {
 
 
-      /* "fccqp/admm.pyx":523
+      /* "fccqp/admm.pyx":529
  *                         anderson_reset(&self.aa, True)
  *             if status == _RUNNING and o.anderson_memory > 0:
  *                 anderson_step(&self.aa, it, s)             # <<<<<<<<<<<<<<
@@ -25120,7 +25196,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_f_5fccqp_8anderson_anderson_step((&__pyx_v_self->aa), __pyx_v_it, __pyx_v_s);
 
-      /* "fccqp/admm.pyx":522
+      /* "fccqp/admm.pyx":528
  *                         fresh = True
  *                         anderson_reset(&self.aa, True)
  *             if status == _RUNNING and o.anderson_memory > 0:             # <<<<<<<<<<<<<<
@@ -25130,7 +25206,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     }
   }
 
-  /* "fccqp/admm.pyx":524
+  /* "fccqp/admm.pyx":530
  *             if status == _RUNNING and o.anderson_memory > 0:
  *                 anderson_step(&self.aa, it, s)
  *         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:             # <<<<<<<<<<<<<<
@@ -25154,7 +25230,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":525
+    /* "fccqp/admm.pyx":531
  *                 anderson_step(&self.aa, it, s)
  *         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
  *             status = self._keep_restored(status, iteration, reduced, start_time)             # <<<<<<<<<<<<<<
@@ -25163,7 +25239,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_status = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_keep_restored(__pyx_v_self, __pyx_v_status, __pyx_v_iteration, __pyx_v_reduced, __pyx_v_start_time);
 
-    /* "fccqp/admm.pyx":524
+    /* "fccqp/admm.pyx":530
  *             if status == _RUNNING and o.anderson_memory > 0:
  *                 anderson_step(&self.aa, it, s)
  *         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:             # <<<<<<<<<<<<<<
@@ -25173,7 +25249,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     goto __pyx_L60;
   }
 
-  /* "fccqp/admm.pyx":526
+  /* "fccqp/admm.pyx":532
  *         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
  *             status = self._keep_restored(status, iteration, reduced, start_time)
  *         elif reduced and status != _NUMERICAL_ERROR:             # <<<<<<<<<<<<<<
@@ -25195,7 +25271,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":527
+    /* "fccqp/admm.pyx":533
  *             status = self._keep_restored(status, iteration, reduced, start_time)
  *         elif reduced and status != _NUMERICAL_ERROR:
  *             self._restore_equalities()   # certificates are already in cert             # <<<<<<<<<<<<<<
@@ -25204,7 +25280,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_restore_equalities(__pyx_v_self);
 
-    /* "fccqp/admm.pyx":526
+    /* "fccqp/admm.pyx":532
  *         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
  *             status = self._keep_restored(status, iteration, reduced, start_time)
  *         elif reduced and status != _NUMERICAL_ERROR:             # <<<<<<<<<<<<<<
@@ -25214,7 +25290,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   }
   __pyx_L60:;
 
-  /* "fccqp/admm.pyx":528
+  /* "fccqp/admm.pyx":534
  *         elif reduced and status != _NUMERICAL_ERROR:
  *             self._restore_equalities()   # certificates are already in cert
  *         self._finish_run(run, status, iteration)             # <<<<<<<<<<<<<<
@@ -25223,7 +25299,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_finish_run(__pyx_v_self, __pyx_v_run, __pyx_v_status, __pyx_v_iteration);
 
-  /* "fccqp/admm.pyx":429
+  /* "fccqp/admm.pyx":435
  *     # ------------------------------------------------------------ the iteration
  * 
  *     cdef void _iterate(self, Run* run, bint cold, double start_time) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -25255,7 +25331,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
 }
 
-/* "fccqp/admm.pyx":530
+/* "fccqp/admm.pyx":536
  *         self._finish_run(run, status, iteration)
  * 
  *     cdef int _check(self, long iteration, bint last, double start_time) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -25276,7 +25352,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   Py_ssize_t __pyx_t_4;
   int __pyx_t_5;
 
-  /* "fccqp/admm.pyx":532
+  /* "fccqp/admm.pyx":538
  *     cdef int _check(self, long iteration, bint last, double start_time) noexcept nogil:
  *         """Termination and infeasibility tests after the residuals of ``iteration``."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -25285,7 +25361,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":533
+  /* "fccqp/admm.pyx":539
  *         """Termination and infeasibility tests after the residuals of ``iteration``."""
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -25294,7 +25370,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":534
+  /* "fccqp/admm.pyx":540
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Options* o = &self.opt             # <<<<<<<<<<<<<<
@@ -25303,7 +25379,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   __pyx_v_o = (&__pyx_v_self->opt);
 
-  /* "fccqp/admm.pyx":535
+  /* "fccqp/admm.pyx":541
  *         cdef Iterates* it = &self.it
  *         cdef Options* o = &self.opt
  *         cdef Residuals* r = &self.res             # <<<<<<<<<<<<<<
@@ -25312,7 +25388,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   __pyx_v_r = (&__pyx_v_self->res);
 
-  /* "fccqp/admm.pyx":537
+  /* "fccqp/admm.pyx":543
  *         cdef Residuals* r = &self.res
  *         cdef Py_ssize_t i
  *         if not r.finite:             # <<<<<<<<<<<<<<
@@ -25324,7 +25400,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":538
+    /* "fccqp/admm.pyx":544
  *         cdef Py_ssize_t i
  *         if not r.finite:
  *             return _NUMERICAL_ERROR             # <<<<<<<<<<<<<<
@@ -25337,7 +25413,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":537
+    /* "fccqp/admm.pyx":543
  *         cdef Residuals* r = &self.res
  *         cdef Py_ssize_t i
  *         if not r.finite:             # <<<<<<<<<<<<<<
@@ -25346,7 +25422,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":539
+  /* "fccqp/admm.pyx":545
  *         if not r.finite:
  *             return _NUMERICAL_ERROR
  *         if converged(r, o.eps_abs, o.eps_rel):             # <<<<<<<<<<<<<<
@@ -25358,7 +25434,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":540
+    /* "fccqp/admm.pyx":546
  *             return _NUMERICAL_ERROR
  *         if converged(r, o.eps_abs, o.eps_rel):
  *             return _SOLVED             # <<<<<<<<<<<<<<
@@ -25371,7 +25447,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":539
+    /* "fccqp/admm.pyx":545
  *         if not r.finite:
  *             return _NUMERICAL_ERROR
  *         if converged(r, o.eps_abs, o.eps_rel):             # <<<<<<<<<<<<<<
@@ -25380,7 +25456,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":541
+  /* "fccqp/admm.pyx":547
  *         if converged(r, o.eps_abs, o.eps_rel):
  *             return _SOLVED
  *         if primal_infeasible(p, it, o.eps_prim_inf, self.vec_m, self.vec_s, self.vec_n,             # <<<<<<<<<<<<<<
@@ -25392,7 +25468,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":543
+    /* "fccqp/admm.pyx":549
  *         if primal_infeasible(p, it, o.eps_prim_inf, self.vec_m, self.vec_s, self.vec_n,
  *                              self.vec_n2):
  *             fill(self.cert, 0.0, p.n + p.m)             # <<<<<<<<<<<<<<
@@ -25401,7 +25477,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
     __pyx_f_5fccqp_6_dense_fill(__pyx_v_self->cert, 0.0, (__pyx_v_p->n + __pyx_v_p->m));
 
-    /* "fccqp/admm.pyx":544
+    /* "fccqp/admm.pyx":550
  *                              self.vec_n2):
  *             fill(self.cert, 0.0, p.n + p.m)
  *             for i in range(p.m):   # in the user's units (the common factor 1/c dropped)             # <<<<<<<<<<<<<<
@@ -25415,7 +25491,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
       __pyx_v_i = __pyx_t_4;
 
-      /* "fccqp/admm.pyx":545
+      /* "fccqp/admm.pyx":551
  *             fill(self.cert, 0.0, p.n + p.m)
  *             for i in range(p.m):   # in the user's units (the common factor 1/c dropped)
  *                 self.cert[i] = self.vec_m[i] * p.E[i]             # <<<<<<<<<<<<<<
@@ -25426,7 +25502,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
 
 
-    /* "fccqp/admm.pyx":546
+    /* "fccqp/admm.pyx":552
  *             for i in range(p.m):   # in the user's units (the common factor 1/c dropped)
  *                 self.cert[i] = self.vec_m[i] * p.E[i]
  *             for i in range(p.s):             # <<<<<<<<<<<<<<
@@ -25440,7 +25516,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
       __pyx_v_i = __pyx_t_4;
 
-      /* "fccqp/admm.pyx":547
+      /* "fccqp/admm.pyx":553
  *                 self.cert[i] = self.vec_m[i] * p.E[i]
  *             for i in range(p.s):
  *                 self.cert[p.m + p.constrained[i]] = self.vec_s[i] / p.D[p.constrained[i]]             # <<<<<<<<<<<<<<
@@ -25451,7 +25527,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
 
 
-    /* "fccqp/admm.pyx":548
+    /* "fccqp/admm.pyx":554
  *             for i in range(p.s):
  *                 self.cert[p.m + p.constrained[i]] = self.vec_s[i] / p.D[p.constrained[i]]
  *             return _PRIMAL_INFEASIBLE             # <<<<<<<<<<<<<<
@@ -25464,7 +25540,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":541
+    /* "fccqp/admm.pyx":547
  *         if converged(r, o.eps_abs, o.eps_rel):
  *             return _SOLVED
  *         if primal_infeasible(p, it, o.eps_prim_inf, self.vec_m, self.vec_s, self.vec_n,             # <<<<<<<<<<<<<<
@@ -25473,7 +25549,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":549
+  /* "fccqp/admm.pyx":555
  *                 self.cert[p.m + p.constrained[i]] = self.vec_s[i] / p.D[p.constrained[i]]
  *             return _PRIMAL_INFEASIBLE
  *         if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():             # <<<<<<<<<<<<<<
@@ -25499,7 +25575,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":550
+    /* "fccqp/admm.pyx":556
  *             return _PRIMAL_INFEASIBLE
  *         if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():
  *             return _PRIMAL_INFEASIBLE             # <<<<<<<<<<<<<<
@@ -25512,7 +25588,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":549
+    /* "fccqp/admm.pyx":555
  *                 self.cert[p.m + p.constrained[i]] = self.vec_s[i] / p.D[p.constrained[i]]
  *             return _PRIMAL_INFEASIBLE
  *         if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():             # <<<<<<<<<<<<<<
@@ -25521,7 +25597,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":551
+  /* "fccqp/admm.pyx":557
  *         if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():
  *             return _PRIMAL_INFEASIBLE
  *         for i in range(p.n):             # <<<<<<<<<<<<<<
@@ -25535,7 +25611,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":552
+    /* "fccqp/admm.pyx":558
  *             return _PRIMAL_INFEASIBLE
  *         for i in range(p.n):
  *             self.direction[i] = it.x[i] - it.x_prev[i]             # <<<<<<<<<<<<<<
@@ -25546,7 +25622,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   }
 
 
-  /* "fccqp/admm.pyx":553
+  /* "fccqp/admm.pyx":559
  *         for i in range(p.n):
  *             self.direction[i] = it.x[i] - it.x_prev[i]
  *         if self._unbounded():             # <<<<<<<<<<<<<<
@@ -25558,7 +25634,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":554
+    /* "fccqp/admm.pyx":560
  *             self.direction[i] = it.x[i] - it.x_prev[i]
  *         if self._unbounded():
  *             return _DUAL_INFEASIBLE             # <<<<<<<<<<<<<<
@@ -25571,7 +25647,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":553
+    /* "fccqp/admm.pyx":559
  *         for i in range(p.n):
  *             self.direction[i] = it.x[i] - it.x_prev[i]
  *         if self._unbounded():             # <<<<<<<<<<<<<<
@@ -25580,7 +25656,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":555
+  /* "fccqp/admm.pyx":561
  *         if self._unbounded():
  *             return _DUAL_INFEASIBLE
  *         if last:             # <<<<<<<<<<<<<<
@@ -25589,7 +25665,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   if (__pyx_v_last) {
 
-    /* "fccqp/admm.pyx":556
+    /* "fccqp/admm.pyx":562
  *             return _DUAL_INFEASIBLE
  *         if last:
  *             return self._classify(iteration, True, start_time)             # <<<<<<<<<<<<<<
@@ -25602,7 +25678,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":555
+    /* "fccqp/admm.pyx":561
  *         if self._unbounded():
  *             return _DUAL_INFEASIBLE
  *         if last:             # <<<<<<<<<<<<<<
@@ -25611,7 +25687,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":557
+  /* "fccqp/admm.pyx":563
  *         if last:
  *             return self._classify(iteration, True, start_time)
  *         return _RUNNING             # <<<<<<<<<<<<<<
@@ -25624,7 +25700,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":530
+  /* "fccqp/admm.pyx":536
  *         self._finish_run(run, status, iteration)
  * 
  *     cdef int _check(self, long iteration, bint last, double start_time) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -25642,7 +25718,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":559
+/* "fccqp/admm.pyx":565
  *         return _RUNNING
  * 
  *     cdef bint _inconsistent(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -25659,7 +25735,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   Py_ssize_t __pyx_t_3;
   Py_ssize_t __pyx_t_4;
 
-  /* "fccqp/admm.pyx":562
+  /* "fccqp/admm.pyx":568
  *         """The equality certificate; on success ``cert`` holds ``(-E r, 0)``, ``r = b_s - A_s
  *         x_s``: ``A'y ~ 0`` and ``b'y < 0`` in the user's units."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -25668,7 +25744,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":564
+  /* "fccqp/admm.pyx":570
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i
  *         if not equality_inconsistent(p, &self.it, self.opt.eps_prim_inf, self.vec_m,             # <<<<<<<<<<<<<<
@@ -25680,7 +25756,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":566
+    /* "fccqp/admm.pyx":572
  *         if not equality_inconsistent(p, &self.it, self.opt.eps_prim_inf, self.vec_m,
  *                                      self.vec_n, self.vec_n2):
  *             return False             # <<<<<<<<<<<<<<
@@ -25693,7 +25769,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":564
+    /* "fccqp/admm.pyx":570
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i
  *         if not equality_inconsistent(p, &self.it, self.opt.eps_prim_inf, self.vec_m,             # <<<<<<<<<<<<<<
@@ -25702,7 +25778,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
 */
   }
 
-  /* "fccqp/admm.pyx":567
+  /* "fccqp/admm.pyx":573
  *                                      self.vec_n, self.vec_n2):
  *             return False
  *         fill(self.cert, 0.0, p.n + p.m)             # <<<<<<<<<<<<<<
@@ -25711,7 +25787,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_self->cert, 0.0, (__pyx_v_p->n + __pyx_v_p->m));
 
-  /* "fccqp/admm.pyx":568
+  /* "fccqp/admm.pyx":574
  *             return False
  *         fill(self.cert, 0.0, p.n + p.m)
  *         for i in range(p.m):             # <<<<<<<<<<<<<<
@@ -25725,7 +25801,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":569
+    /* "fccqp/admm.pyx":575
  *         fill(self.cert, 0.0, p.n + p.m)
  *         for i in range(p.m):
  *             self.cert[i] = -self.vec_m[i] * p.E[i]             # <<<<<<<<<<<<<<
@@ -25736,7 +25812,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   }
 
 
-  /* "fccqp/admm.pyx":570
+  /* "fccqp/admm.pyx":576
  *         for i in range(p.m):
  *             self.cert[i] = -self.vec_m[i] * p.E[i]
  *         return True             # <<<<<<<<<<<<<<
@@ -25749,7 +25825,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":559
+  /* "fccqp/admm.pyx":565
  *         return _RUNNING
  * 
  *     cdef bint _inconsistent(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -25764,7 +25840,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":572
+/* "fccqp/admm.pyx":578
  *         return True
  * 
  *     cdef bint _unbounded(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -25781,7 +25857,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   Py_ssize_t __pyx_t_3;
   Py_ssize_t __pyx_t_4;
 
-  /* "fccqp/admm.pyx":574
+  /* "fccqp/admm.pyx":580
  *     cdef bint _unbounded(self) noexcept nogil:
  *         """The dual certificate for ``direction``; on success ``cert`` holds it, unscaled."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -25790,7 +25866,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":576
+  /* "fccqp/admm.pyx":582
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i
  *         if not dual_infeasible(p, self.direction, self.opt.eps_dual_inf, self.vec_n,             # <<<<<<<<<<<<<<
@@ -25802,7 +25878,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":578
+    /* "fccqp/admm.pyx":584
  *         if not dual_infeasible(p, self.direction, self.opt.eps_dual_inf, self.vec_n,
  *                                self.vec_n2, self.vec_s2):
  *             return False             # <<<<<<<<<<<<<<
@@ -25815,7 +25891,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":576
+    /* "fccqp/admm.pyx":582
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i
  *         if not dual_infeasible(p, self.direction, self.opt.eps_dual_inf, self.vec_n,             # <<<<<<<<<<<<<<
@@ -25824,7 +25900,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
 */
   }
 
-  /* "fccqp/admm.pyx":579
+  /* "fccqp/admm.pyx":585
  *                                self.vec_n2, self.vec_s2):
  *             return False
  *         for i in range(p.n):             # <<<<<<<<<<<<<<
@@ -25838,7 +25914,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":580
+    /* "fccqp/admm.pyx":586
  *             return False
  *         for i in range(p.n):
  *             self.cert[i] = self.direction[i] * p.D[i]             # <<<<<<<<<<<<<<
@@ -25849,7 +25925,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   }
 
 
-  /* "fccqp/admm.pyx":581
+  /* "fccqp/admm.pyx":587
  *         for i in range(p.n):
  *             self.cert[i] = self.direction[i] * p.D[i]
  *         return True             # <<<<<<<<<<<<<<
@@ -25862,7 +25938,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":572
+  /* "fccqp/admm.pyx":578
  *         return True
  * 
  *     cdef bint _unbounded(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -25877,7 +25953,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":583
+/* "fccqp/admm.pyx":589
  *         return True
  * 
  *     cdef int _classify(self, long iteration, bint stopped, double start_time) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -25891,7 +25967,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   int __pyx_t_1;
   int __pyx_t_2;
 
-  /* "fccqp/admm.pyx":586
+  /* "fccqp/admm.pyx":592
  *         """Status of an iterate from its residuals alone: solved, inaccurate (within
  *         ``INACCURATE_FACTOR`` of the tolerances), or the budget that ran out."""
  *         cdef Residuals* r = &self.res             # <<<<<<<<<<<<<<
@@ -25900,7 +25976,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_r = (&__pyx_v_self->res);
 
-  /* "fccqp/admm.pyx":587
+  /* "fccqp/admm.pyx":593
  *         ``INACCURATE_FACTOR`` of the tolerances), or the budget that ran out."""
  *         cdef Residuals* r = &self.res
  *         if not r.finite:             # <<<<<<<<<<<<<<
@@ -25912,7 +25988,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":588
+    /* "fccqp/admm.pyx":594
  *         cdef Residuals* r = &self.res
  *         if not r.finite:
  *             return _NUMERICAL_ERROR             # <<<<<<<<<<<<<<
@@ -25925,7 +26001,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":587
+    /* "fccqp/admm.pyx":593
  *         ``INACCURATE_FACTOR`` of the tolerances), or the budget that ran out."""
  *         cdef Residuals* r = &self.res
  *         if not r.finite:             # <<<<<<<<<<<<<<
@@ -25934,7 +26010,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":589
+  /* "fccqp/admm.pyx":595
  *         if not r.finite:
  *             return _NUMERICAL_ERROR
  *         if converged(r, self.opt.eps_abs, self.opt.eps_rel):             # <<<<<<<<<<<<<<
@@ -25946,7 +26022,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":590
+    /* "fccqp/admm.pyx":596
  *             return _NUMERICAL_ERROR
  *         if converged(r, self.opt.eps_abs, self.opt.eps_rel):
  *             return _SOLVED             # <<<<<<<<<<<<<<
@@ -25959,7 +26035,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":589
+    /* "fccqp/admm.pyx":595
  *         if not r.finite:
  *             return _NUMERICAL_ERROR
  *         if converged(r, self.opt.eps_abs, self.opt.eps_rel):             # <<<<<<<<<<<<<<
@@ -25968,7 +26044,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":591
+  /* "fccqp/admm.pyx":597
  *         if converged(r, self.opt.eps_abs, self.opt.eps_rel):
  *             return _SOLVED
  *         if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):             # <<<<<<<<<<<<<<
@@ -25980,7 +26056,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":592
+    /* "fccqp/admm.pyx":598
  *             return _SOLVED
  *         if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *             return _INACCURATE             # <<<<<<<<<<<<<<
@@ -25993,7 +26069,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":591
+    /* "fccqp/admm.pyx":597
  *         if converged(r, self.opt.eps_abs, self.opt.eps_rel):
  *             return _SOLVED
  *         if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):             # <<<<<<<<<<<<<<
@@ -26002,7 +26078,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":593
+  /* "fccqp/admm.pyx":599
  *         if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *             return _INACCURATE
  *         if iteration >= self.opt.max_iter or not stopped:             # <<<<<<<<<<<<<<
@@ -26028,7 +26104,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":594
+    /* "fccqp/admm.pyx":600
  *             return _INACCURATE
  *         if iteration >= self.opt.max_iter or not stopped:
  *             return _MAX_ITER             # <<<<<<<<<<<<<<
@@ -26041,7 +26117,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":593
+    /* "fccqp/admm.pyx":599
  *         if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *             return _INACCURATE
  *         if iteration >= self.opt.max_iter or not stopped:             # <<<<<<<<<<<<<<
@@ -26050,7 +26126,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":595
+  /* "fccqp/admm.pyx":601
  *         if iteration >= self.opt.max_iter or not stopped:
  *             return _MAX_ITER
  *         return _TIME_LIMIT             # <<<<<<<<<<<<<<
@@ -26063,7 +26139,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":583
+  /* "fccqp/admm.pyx":589
  *         return True
  * 
  *     cdef int _classify(self, long iteration, bint stopped, double start_time) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26077,7 +26153,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":597
+/* "fccqp/admm.pyx":603
  *         return _TIME_LIMIT
  * 
  *     cdef void _full_step(self, bint relax_x) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26102,7 +26178,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   Py_ssize_t __pyx_t_4;
   Py_ssize_t __pyx_t_5;
 
-  /* "fccqp/admm.pyx":599
+  /* "fccqp/admm.pyx":605
  *     cdef void _full_step(self, bint relax_x) noexcept nogil:
  *         """One ADMM iteration with a KKT solve (update_x, update_z, update_y)."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -26111,7 +26187,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":600
+  /* "fccqp/admm.pyx":606
  *         """One ADMM iteration with a KKT solve (update_x, update_z, update_y)."""
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -26120,7 +26196,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":601
+  /* "fccqp/admm.pyx":607
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j             # <<<<<<<<<<<<<<
@@ -26137,7 +26213,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":602
+  /* "fccqp/admm.pyx":608
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         cdef double alpha = self.opt.alpha, alpha_x = alpha if relax_x else 1.0             # <<<<<<<<<<<<<<
@@ -26156,7 +26232,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
   __pyx_v_alpha_x = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":603
+  /* "fccqp/admm.pyx":609
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         cdef double alpha = self.opt.alpha, alpha_x = alpha if relax_x else 1.0
  *         cdef double sigma = self.opt.sigma             # <<<<<<<<<<<<<<
@@ -26167,7 +26243,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 
   __pyx_v_sigma = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":604
+  /* "fccqp/admm.pyx":610
  *         cdef double alpha = self.opt.alpha, alpha_x = alpha if relax_x else 1.0
  *         cdef double sigma = self.opt.sigma
  *         copy(it.x, it.x_prev, n)             # <<<<<<<<<<<<<<
@@ -26176,7 +26252,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->x, __pyx_v_it->x_prev, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":605
+  /* "fccqp/admm.pyx":611
  *         cdef double sigma = self.opt.sigma
  *         copy(it.x, it.x_prev, n)
  *         copy(it.nu, it.nu_prev, m)             # <<<<<<<<<<<<<<
@@ -26185,7 +26261,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->nu, __pyx_v_it->nu_prev, __pyx_v_m);
 
-  /* "fccqp/admm.pyx":606
+  /* "fccqp/admm.pyx":612
  *         copy(it.x, it.x_prev, n)
  *         copy(it.nu, it.nu_prev, m)
  *         copy(it.z, it.z_prev, s)             # <<<<<<<<<<<<<<
@@ -26194,7 +26270,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->z, __pyx_v_it->z_prev, __pyx_v_s);
 
-  /* "fccqp/admm.pyx":607
+  /* "fccqp/admm.pyx":613
  *         copy(it.nu, it.nu_prev, m)
  *         copy(it.z, it.z_prev, s)
  *         copy(it.y, it.y_prev, s)             # <<<<<<<<<<<<<<
@@ -26203,7 +26279,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->y, __pyx_v_it->y_prev, __pyx_v_s);
 
-  /* "fccqp/admm.pyx":608
+  /* "fccqp/admm.pyx":614
  *         copy(it.z, it.z_prev, s)
  *         copy(it.y, it.y_prev, s)
  *         for i in range(n):             # <<<<<<<<<<<<<<
@@ -26217,7 +26293,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":609
+    /* "fccqp/admm.pyx":615
  *         copy(it.y, it.y_prev, s)
  *         for i in range(n):
  *             self.rhs[i] = sigma * it.x[i] - p.q[i]             # <<<<<<<<<<<<<<
@@ -26228,7 +26304,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":610
+  /* "fccqp/admm.pyx":616
  *         for i in range(n):
  *             self.rhs[i] = sigma * it.x[i] - p.q[i]
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -26242,7 +26318,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":611
+    /* "fccqp/admm.pyx":617
  *             self.rhs[i] = sigma * it.x[i] - p.q[i]
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i]             # <<<<<<<<<<<<<<
@@ -26253,7 +26329,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":612
+  /* "fccqp/admm.pyx":618
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i]
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -26267,7 +26343,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":613
+    /* "fccqp/admm.pyx":619
  *             self.rhs[n + i] = p.b[i]
  *         for j in range(s):
  *             self.rhs[p.constrained[j]] += it.rho_vec[j] * it.z[j] - it.y[j]             # <<<<<<<<<<<<<<
@@ -26280,7 +26356,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":614
+  /* "fccqp/admm.pyx":620
  *         for j in range(s):
  *             self.rhs[p.constrained[j]] += it.rho_vec[j] * it.z[j] - it.y[j]
  *         kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)             # <<<<<<<<<<<<<<
@@ -26289,7 +26365,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_3kkt_kkt_solve((&__pyx_v_self->kkt), __pyx_v_p, __pyx_v_it->rho_vec, __pyx_v_self->rhs, __pyx_v_self->sol);
 
-  /* "fccqp/admm.pyx":615
+  /* "fccqp/admm.pyx":621
  *             self.rhs[p.constrained[j]] += it.rho_vec[j] * it.z[j] - it.y[j]
  *         kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -26303,7 +26379,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":616
+    /* "fccqp/admm.pyx":622
  *         kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
  *         for j in range(s):
  *             it.relaxed[j] = alpha * self.sol[p.constrained[j]] + (1.0 - alpha) * it.z_prev[j]             # <<<<<<<<<<<<<<
@@ -26314,7 +26390,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":617
+  /* "fccqp/admm.pyx":623
  *         for j in range(s):
  *             it.relaxed[j] = alpha * self.sol[p.constrained[j]] + (1.0 - alpha) * it.z_prev[j]
  *         for i in range(n):             # <<<<<<<<<<<<<<
@@ -26328,7 +26404,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":618
+    /* "fccqp/admm.pyx":624
  *             it.relaxed[j] = alpha * self.sol[p.constrained[j]] + (1.0 - alpha) * it.z_prev[j]
  *         for i in range(n):
  *             it.x[i] = alpha_x * self.sol[i] + (1.0 - alpha_x) * it.x_prev[i]             # <<<<<<<<<<<<<<
@@ -26339,7 +26415,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":619
+  /* "fccqp/admm.pyx":625
  *         for i in range(n):
  *             it.x[i] = alpha_x * self.sol[i] + (1.0 - alpha_x) * it.x_prev[i]
  *         copy(self.sol + n, it.nu, m)             # <<<<<<<<<<<<<<
@@ -26348,7 +26424,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_6_dense_copy((__pyx_v_self->sol + __pyx_v_n), __pyx_v_it->nu, __pyx_v_m);
 
-  /* "fccqp/admm.pyx":620
+  /* "fccqp/admm.pyx":626
  *             it.x[i] = alpha_x * self.sol[i] + (1.0 - alpha_x) * it.x_prev[i]
  *         copy(self.sol + n, it.nu, m)
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -26362,7 +26438,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":621
+    /* "fccqp/admm.pyx":627
  *         copy(self.sol + n, it.nu, m)
  *         for j in range(s):
  *             it.z[j] = it.relaxed[j] + it.y[j] / it.rho_vec[j]             # <<<<<<<<<<<<<<
@@ -26373,7 +26449,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":622
+  /* "fccqp/admm.pyx":628
  *         for j in range(s):
  *             it.z[j] = it.relaxed[j] + it.y[j] / it.rho_vec[j]
  *         proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)             # <<<<<<<<<<<<<<
@@ -26382,7 +26458,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_11projections_proj_set(__pyx_v_it->z, __pyx_v_p->lo, __pyx_v_p->hi, __pyx_v_p->cones, __pyx_v_s, __pyx_v_it->z);
 
-  /* "fccqp/admm.pyx":623
+  /* "fccqp/admm.pyx":629
  *             it.z[j] = it.relaxed[j] + it.y[j] / it.rho_vec[j]
  *         proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -26396,7 +26472,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":624
+    /* "fccqp/admm.pyx":630
  *         proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
  *         for j in range(s):
  *             it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])             # <<<<<<<<<<<<<<
@@ -26409,7 +26485,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":597
+  /* "fccqp/admm.pyx":603
  *         return _TIME_LIMIT
  * 
  *     cdef void _full_step(self, bint relax_x) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26430,7 +26506,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 
 }
 
-/* "fccqp/admm.pyx":626
+/* "fccqp/admm.pyx":632
  *             it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])
  * 
  *     cdef double _new_rho(self, double rho) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26452,7 +26528,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   double __pyx_t_6;
   int __pyx_t_7;
 
-  /* "fccqp/admm.pyx":629
+  /* "fccqp/admm.pyx":635
  *         """OSQP's rule: rho *= sqrt(relative primal / relative dual residual), clipped;
  *         unchanged unless it moves by more than ``adaptive_rho_tolerance``."""
  *         cdef Residuals* r = &self.res             # <<<<<<<<<<<<<<
@@ -26461,7 +26537,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
 */
   __pyx_v_r = (&__pyx_v_self->res);
 
-  /* "fccqp/admm.pyx":630
+  /* "fccqp/admm.pyx":636
  *         unchanged unless it moves by more than ``adaptive_rho_tolerance``."""
  *         cdef Residuals* r = &self.res
  *         cdef double ratio = (r.prim_s / max(r.prim_scale_s, 1e-30)) / max(             # <<<<<<<<<<<<<<
@@ -26485,7 +26561,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
 
   __pyx_t_1 = 1e-30;
 
-  /* "fccqp/admm.pyx":631
+  /* "fccqp/admm.pyx":637
  *         cdef Residuals* r = &self.res
  *         cdef double ratio = (r.prim_s / max(r.prim_scale_s, 1e-30)) / max(
  *             r.dual_s / max(r.dual_scale_s, 1e-30), 1e-30)             # <<<<<<<<<<<<<<
@@ -26520,7 +26596,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":630
+  /* "fccqp/admm.pyx":636
  *         unchanged unless it moves by more than ``adaptive_rho_tolerance``."""
  *         cdef Residuals* r = &self.res
  *         cdef double ratio = (r.prim_s / max(r.prim_scale_s, 1e-30)) / max(             # <<<<<<<<<<<<<<
@@ -26531,7 +26607,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
 
 
 
-  /* "fccqp/admm.pyx":632
+  /* "fccqp/admm.pyx":638
  *         cdef double ratio = (r.prim_s / max(r.prim_scale_s, 1e-30)) / max(
  *             r.dual_s / max(r.dual_scale_s, 1e-30), 1e-30)
  *         cdef double new_rho = min(max(rho * sqrt(ratio), _RHO_MIN), _RHO_MAX)             # <<<<<<<<<<<<<<
@@ -26570,7 +26646,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   __pyx_v_new_rho = __pyx_t_2;
 
 
-  /* "fccqp/admm.pyx":633
+  /* "fccqp/admm.pyx":639
  *             r.dual_s / max(r.dual_scale_s, 1e-30), 1e-30)
  *         cdef double new_rho = min(max(rho * sqrt(ratio), _RHO_MIN), _RHO_MAX)
  *         cdef double tolerance = self.opt.adaptive_rho_tolerance             # <<<<<<<<<<<<<<
@@ -26581,7 +26657,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
 
   __pyx_v_tolerance = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":634
+  /* "fccqp/admm.pyx":640
  *         cdef double new_rho = min(max(rho * sqrt(ratio), _RHO_MIN), _RHO_MAX)
  *         cdef double tolerance = self.opt.adaptive_rho_tolerance
  *         if new_rho > rho * tolerance or new_rho < rho / tolerance:             # <<<<<<<<<<<<<<
@@ -26607,7 +26683,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   if (__pyx_t_4) {
 
 
-    /* "fccqp/admm.pyx":635
+    /* "fccqp/admm.pyx":641
  *         cdef double tolerance = self.opt.adaptive_rho_tolerance
  *         if new_rho > rho * tolerance or new_rho < rho / tolerance:
  *             return new_rho             # <<<<<<<<<<<<<<
@@ -26620,7 +26696,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":634
+    /* "fccqp/admm.pyx":640
  *         cdef double new_rho = min(max(rho * sqrt(ratio), _RHO_MIN), _RHO_MAX)
  *         cdef double tolerance = self.opt.adaptive_rho_tolerance
  *         if new_rho > rho * tolerance or new_rho < rho / tolerance:             # <<<<<<<<<<<<<<
@@ -26629,7 +26705,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
 */
   }
 
-  /* "fccqp/admm.pyx":636
+  /* "fccqp/admm.pyx":642
  *         if new_rho > rho * tolerance or new_rho < rho / tolerance:
  *             return new_rho
  *         return rho             # <<<<<<<<<<<<<<
@@ -26642,7 +26718,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":626
+  /* "fccqp/admm.pyx":632
  *             it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])
  * 
  *     cdef double _new_rho(self, double rho) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26659,7 +26735,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":640
+/* "fccqp/admm.pyx":646
  *     # -------------------------------------------------------- factorizations
  * 
  *     cdef long _budget(self, long iteration) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26672,7 +26748,7 @@ static long __pyx_f_5fccqp_4admm_9Workspace__budget(struct __pyx_obj_5fccqp_4adm
   long __pyx_r;
   Py_ssize_t __pyx_t_1;
 
-  /* "fccqp/admm.pyx":643
+  /* "fccqp/admm.pyx":649
  *         """Solves the reduced form's table can save: the iterations left, plus, when the
  *         result will be restored, the columns the restoration would otherwise compute."""
  *         cdef long restoring = self.prob.s if self.opt.restore_feasibility else 0             # <<<<<<<<<<<<<<
@@ -26688,7 +26764,7 @@ static long __pyx_f_5fccqp_4admm_9Workspace__budget(struct __pyx_obj_5fccqp_4adm
   }
   __pyx_v_restoring = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":644
+  /* "fccqp/admm.pyx":650
  *         result will be restored, the columns the restoration would otherwise compute."""
  *         cdef long restoring = self.prob.s if self.opt.restore_feasibility else 0
  *         return self.opt.max_iter - iteration + restoring             # <<<<<<<<<<<<<<
@@ -26701,7 +26777,7 @@ static long __pyx_f_5fccqp_4admm_9Workspace__budget(struct __pyx_obj_5fccqp_4adm
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":640
+  /* "fccqp/admm.pyx":646
  *     # -------------------------------------------------------- factorizations
  * 
  *     cdef long _budget(self, long iteration) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26715,7 +26791,7 @@ static long __pyx_f_5fccqp_4admm_9Workspace__budget(struct __pyx_obj_5fccqp_4adm
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":646
+/* "fccqp/admm.pyx":652
  *         return self.opt.max_iter - iteration + restoring
  * 
  *     cdef int _certify(self, bint schur_factored) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26728,7 +26804,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
   int __pyx_r;
   int __pyx_t_1;
 
-  /* "fccqp/admm.pyx":649
+  /* "fccqp/admm.pyx":655
  *         """Establish convexity for the current matrices (see :func:`fccqp.kkt.kkt_convexity`);
  *         ``schur_factored`` says that the Schur backend has just factored them."""
  *         cdef int code = kkt_convexity(&self.kkt, &self.prob, self.opt.sigma, self.it.rho_vec,             # <<<<<<<<<<<<<<
@@ -26737,7 +26813,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
 */
   __pyx_v_code = __pyx_f_5fccqp_3kkt_kkt_convexity((&__pyx_v_self->kkt), (&__pyx_v_self->prob), __pyx_v_self->opt.sigma, __pyx_v_self->it.rho_vec, __pyx_v_schur_factored);
 
-  /* "fccqp/admm.pyx":651
+  /* "fccqp/admm.pyx":657
  *         cdef int code = kkt_convexity(&self.kkt, &self.prob, self.opt.sigma, self.it.rho_vec,
  *                                       schur_factored)
  *         if code == FACTORED:             # <<<<<<<<<<<<<<
@@ -26749,7 +26825,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":652
+    /* "fccqp/admm.pyx":658
  *                                       schur_factored)
  *         if code == FACTORED:
  *             self.certified = True             # <<<<<<<<<<<<<<
@@ -26758,7 +26834,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_v_self->certified = 1;
 
-    /* "fccqp/admm.pyx":651
+    /* "fccqp/admm.pyx":657
  *         cdef int code = kkt_convexity(&self.kkt, &self.prob, self.opt.sigma, self.it.rho_vec,
  *                                       schur_factored)
  *         if code == FACTORED:             # <<<<<<<<<<<<<<
@@ -26767,7 +26843,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
 */
   }
 
-  /* "fccqp/admm.pyx":653
+  /* "fccqp/admm.pyx":659
  *         if code == FACTORED:
  *             self.certified = True
  *         return code             # <<<<<<<<<<<<<<
@@ -26780,7 +26856,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":646
+  /* "fccqp/admm.pyx":652
  *         return self.opt.max_iter - iteration + restoring
  * 
  *     cdef int _certify(self, bint schur_factored) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26794,7 +26870,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":655
+/* "fccqp/admm.pyx":661
  *         return code
  * 
  *     cdef int _factor(self, Run* run, long budget) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26817,7 +26893,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   long __pyx_t_6;
   double __pyx_t_7;
 
-  /* "fccqp/admm.pyx":662
+  /* "fccqp/admm.pyx":668
  *         matrices are new. Returns FACTORED, NOT_CONVEX, or UNAVAILABLE (numerical
  *         breakdown); records the form and the rho it factored."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -26826,7 +26902,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":663
+  /* "fccqp/admm.pyx":669
  *         breakdown); records the form and the rho it factored."""
  *         cdef Problem* p = &self.prob
  *         cdef int backend, code, first = self.opt.backend             # <<<<<<<<<<<<<<
@@ -26837,7 +26913,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 
   __pyx_v_first = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":665
+  /* "fccqp/admm.pyx":671
  *         cdef int backend, code, first = self.opt.backend
  *         cdef bint reduced_pays
  *         if first == AUTO:             # <<<<<<<<<<<<<<
@@ -26849,7 +26925,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   if (__pyx_t_2) {
 
 
-    /* "fccqp/admm.pyx":666
+    /* "fccqp/admm.pyx":672
  *         cdef bint reduced_pays
  *         if first == AUTO:
  *             reduced_pays = 2 * p.s <= p.n + p.m and _REDUCED_COST * p.s <= budget             # <<<<<<<<<<<<<<
@@ -26874,7 +26950,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     __pyx_L4_bool_binop_done:;
     __pyx_v_reduced_pays = __pyx_t_2;
 
-    /* "fccqp/admm.pyx":667
+    /* "fccqp/admm.pyx":673
  *         if first == AUTO:
  *             reduced_pays = 2 * p.s <= p.n + p.m and _REDUCED_COST * p.s <= budget
  *             first = SCHUR_REDUCED if reduced_pays else LDL_FULL             # <<<<<<<<<<<<<<
@@ -26890,7 +26966,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     }
     __pyx_v_first = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":665
+    /* "fccqp/admm.pyx":671
  *         cdef int backend, code, first = self.opt.backend
  *         cdef bint reduced_pays
  *         if first == AUTO:             # <<<<<<<<<<<<<<
@@ -26899,7 +26975,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
   }
 
-  /* "fccqp/admm.pyx":668
+  /* "fccqp/admm.pyx":674
  *             reduced_pays = 2 * p.s <= p.n + p.m and _REDUCED_COST * p.s <= budget
  *             first = SCHUR_REDUCED if reduced_pays else LDL_FULL
  *         for backend in range(first, LDL_FULL + 1):             # <<<<<<<<<<<<<<
@@ -26913,7 +26989,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   for (__pyx_t_1 = __pyx_v_first; __pyx_t_1 < __pyx_t_6; __pyx_t_1+=1) {
     __pyx_v_backend = __pyx_t_1;
 
-    /* "fccqp/admm.pyx":669
+    /* "fccqp/admm.pyx":675
  *             first = SCHUR_REDUCED if reduced_pays else LDL_FULL
  *         for backend in range(first, LDL_FULL + 1):
  *             if not self.certified and backend != SCHUR_REDUCED:             # <<<<<<<<<<<<<<
@@ -26939,7 +27015,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":671
+      /* "fccqp/admm.pyx":677
  *             if not self.certified and backend != SCHUR_REDUCED:
  *                 # certify first: the certificate overwrites an LDL' factorization
  *                 code = self._certify(False)             # <<<<<<<<<<<<<<
@@ -26948,7 +27024,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       __pyx_v_code = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_certify(__pyx_v_self, 0);
 
-      /* "fccqp/admm.pyx":672
+      /* "fccqp/admm.pyx":678
  *                 # certify first: the certificate overwrites an LDL' factorization
  *                 code = self._certify(False)
  *                 run.factorizations += 1             # <<<<<<<<<<<<<<
@@ -26957,7 +27033,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       __pyx_v_run->factorizations = (__pyx_v_run->factorizations + 1);
 
-      /* "fccqp/admm.pyx":673
+      /* "fccqp/admm.pyx":679
  *                 code = self._certify(False)
  *                 run.factorizations += 1
  *                 if code == NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -26969,7 +27045,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
       if (__pyx_t_2) {
 
 
-        /* "fccqp/admm.pyx":674
+        /* "fccqp/admm.pyx":680
  *                 run.factorizations += 1
  *                 if code == NOT_CONVEX:
  *                     return NOT_CONVEX             # <<<<<<<<<<<<<<
@@ -26982,7 +27058,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
         }
         goto __pyx_L0;
 
-        /* "fccqp/admm.pyx":673
+        /* "fccqp/admm.pyx":679
  *                 code = self._certify(False)
  *                 run.factorizations += 1
  *                 if code == NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -26991,7 +27067,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       }
 
-      /* "fccqp/admm.pyx":669
+      /* "fccqp/admm.pyx":675
  *             first = SCHUR_REDUCED if reduced_pays else LDL_FULL
  *         for backend in range(first, LDL_FULL + 1):
  *             if not self.certified and backend != SCHUR_REDUCED:             # <<<<<<<<<<<<<<
@@ -27000,7 +27076,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     }
 
-    /* "fccqp/admm.pyx":676
+    /* "fccqp/admm.pyx":682
  *                     return NOT_CONVEX
  *             code = kkt_factor(&self.kkt, p, backend,
  *                               self.opt.sigma if backend == LDL_FULL else 0.0, self.it.rho_vec)             # <<<<<<<<<<<<<<
@@ -27018,7 +27094,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     }
 
 
-    /* "fccqp/admm.pyx":675
+    /* "fccqp/admm.pyx":681
  *                 if code == NOT_CONVEX:
  *                     return NOT_CONVEX
  *             code = kkt_factor(&self.kkt, p, backend,             # <<<<<<<<<<<<<<
@@ -27028,7 +27104,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     __pyx_v_code = __pyx_f_5fccqp_3kkt_kkt_factor((&__pyx_v_self->kkt), __pyx_v_p, __pyx_v_backend, __pyx_t_7, __pyx_v_self->it.rho_vec);
 
 
-    /* "fccqp/admm.pyx":677
+    /* "fccqp/admm.pyx":683
  *             code = kkt_factor(&self.kkt, p, backend,
  *                               self.opt.sigma if backend == LDL_FULL else 0.0, self.it.rho_vec)
  *             run.factorizations += 1             # <<<<<<<<<<<<<<
@@ -27037,7 +27113,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_v_run->factorizations = (__pyx_v_run->factorizations + 1);
 
-    /* "fccqp/admm.pyx":678
+    /* "fccqp/admm.pyx":684
  *                               self.opt.sigma if backend == LDL_FULL else 0.0, self.it.rho_vec)
  *             run.factorizations += 1
  *             if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -27049,7 +27125,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":679
+      /* "fccqp/admm.pyx":685
  *             run.factorizations += 1
  *             if code != FACTORED:
  *                 if backend == LDL_FULL:             # <<<<<<<<<<<<<<
@@ -27061,7 +27137,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
       if (__pyx_t_2) {
 
 
-        /* "fccqp/admm.pyx":680
+        /* "fccqp/admm.pyx":686
  *             if code != FACTORED:
  *                 if backend == LDL_FULL:
  *                     return UNAVAILABLE             # <<<<<<<<<<<<<<
@@ -27074,7 +27150,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
         }
         goto __pyx_L0;
 
-        /* "fccqp/admm.pyx":679
+        /* "fccqp/admm.pyx":685
  *             run.factorizations += 1
  *             if code != FACTORED:
  *                 if backend == LDL_FULL:             # <<<<<<<<<<<<<<
@@ -27083,7 +27159,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       }
 
-      /* "fccqp/admm.pyx":681
+      /* "fccqp/admm.pyx":687
  *                 if backend == LDL_FULL:
  *                     return UNAVAILABLE
  *                 continue             # <<<<<<<<<<<<<<
@@ -27092,7 +27168,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       goto __pyx_L6_continue;
 
-      /* "fccqp/admm.pyx":678
+      /* "fccqp/admm.pyx":684
  *                               self.opt.sigma if backend == LDL_FULL else 0.0, self.it.rho_vec)
  *             run.factorizations += 1
  *             if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -27101,7 +27177,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     }
 
-    /* "fccqp/admm.pyx":682
+    /* "fccqp/admm.pyx":688
  *                     return UNAVAILABLE
  *                 continue
  *             if not self.certified and self._certify(True) == NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -27127,7 +27203,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":683
+      /* "fccqp/admm.pyx":689
  *                 continue
  *             if not self.certified and self._certify(True) == NOT_CONVEX:
  *                 return NOT_CONVEX             # <<<<<<<<<<<<<<
@@ -27140,7 +27216,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
       }
       goto __pyx_L0;
 
-      /* "fccqp/admm.pyx":682
+      /* "fccqp/admm.pyx":688
  *                     return UNAVAILABLE
  *                 continue
  *             if not self.certified and self._certify(True) == NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -27149,7 +27225,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     }
 
-    /* "fccqp/admm.pyx":684
+    /* "fccqp/admm.pyx":690
  *             if not self.certified and self._certify(True) == NOT_CONVEX:
  *                 return NOT_CONVEX
  *             if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,             # <<<<<<<<<<<<<<
@@ -27167,7 +27243,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
       goto __pyx_L18_bool_binop_done;
     }
 
-    /* "fccqp/admm.pyx":685
+    /* "fccqp/admm.pyx":691
  *                 return NOT_CONVEX
  *             if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,
  *                                                          self.it.rho_vec):             # <<<<<<<<<<<<<<
@@ -27181,7 +27257,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 
     __pyx_L18_bool_binop_done:;
 
-    /* "fccqp/admm.pyx":684
+    /* "fccqp/admm.pyx":690
  *             if not self.certified and self._certify(True) == NOT_CONVEX:
  *                 return NOT_CONVEX
  *             if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,             # <<<<<<<<<<<<<<
@@ -27191,7 +27267,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":686
+      /* "fccqp/admm.pyx":692
  *             if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,
  *                                                          self.it.rho_vec):
  *                 continue             # <<<<<<<<<<<<<<
@@ -27200,7 +27276,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       goto __pyx_L6_continue;
 
-      /* "fccqp/admm.pyx":684
+      /* "fccqp/admm.pyx":690
  *             if not self.certified and self._certify(True) == NOT_CONVEX:
  *                 return NOT_CONVEX
  *             if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,             # <<<<<<<<<<<<<<
@@ -27209,7 +27285,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     }
 
-    /* "fccqp/admm.pyx":687
+    /* "fccqp/admm.pyx":693
  *                                                          self.it.rho_vec):
  *                 continue
  *             self.form = backend             # <<<<<<<<<<<<<<
@@ -27218,7 +27294,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_v_self->form = __pyx_v_backend;
 
-    /* "fccqp/admm.pyx":688
+    /* "fccqp/admm.pyx":694
  *                 continue
  *             self.form = backend
  *             run.backend = backend             # <<<<<<<<<<<<<<
@@ -27227,7 +27303,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_v_run->backend = __pyx_v_backend;
 
-    /* "fccqp/admm.pyx":689
+    /* "fccqp/admm.pyx":695
  *             self.form = backend
  *             run.backend = backend
  *             self.factored_rho = run.rho             # <<<<<<<<<<<<<<
@@ -27238,7 +27314,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 
     __pyx_v_self->factored_rho = __pyx_t_7;
 
-    /* "fccqp/admm.pyx":690
+    /* "fccqp/admm.pyx":696
  *             run.backend = backend
  *             self.factored_rho = run.rho
  *             return FACTORED             # <<<<<<<<<<<<<<
@@ -27254,7 +27330,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   }
 
 
-  /* "fccqp/admm.pyx":691
+  /* "fccqp/admm.pyx":697
  *             self.factored_rho = run.rho
  *             return FACTORED
  *         return UNAVAILABLE             # <<<<<<<<<<<<<<
@@ -27267,7 +27343,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":655
+  /* "fccqp/admm.pyx":661
  *         return code
  * 
  *     cdef int _factor(self, Run* run, long budget) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27285,7 +27361,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":693
+/* "fccqp/admm.pyx":699
  *         return UNAVAILABLE
  * 
  *     cdef void _reduced_base(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27300,7 +27376,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
   Py_ssize_t __pyx_t_2;
   Py_ssize_t __pyx_t_3;
 
-  /* "fccqp/admm.pyx":696
+  /* "fccqp/admm.pyx":702
  *         """``base``: the x-update's response to ``(-q, b)`` alone (q and b change every
  *         solve; the table only with the factorization)."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -27309,7 +27385,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":698
+  /* "fccqp/admm.pyx":704
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i
  *         for i in range(p.n):             # <<<<<<<<<<<<<<
@@ -27323,7 +27399,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":699
+    /* "fccqp/admm.pyx":705
  *         cdef Py_ssize_t i
  *         for i in range(p.n):
  *             self.rhs[i] = -p.q[i]             # <<<<<<<<<<<<<<
@@ -27334,7 +27410,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
   }
 
 
-  /* "fccqp/admm.pyx":700
+  /* "fccqp/admm.pyx":706
  *         for i in range(p.n):
  *             self.rhs[i] = -p.q[i]
  *         for i in range(p.m):             # <<<<<<<<<<<<<<
@@ -27348,7 +27424,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":701
+    /* "fccqp/admm.pyx":707
  *             self.rhs[i] = -p.q[i]
  *         for i in range(p.m):
  *             self.rhs[p.n + i] = p.b[i]             # <<<<<<<<<<<<<<
@@ -27359,7 +27435,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
   }
 
 
-  /* "fccqp/admm.pyx":702
+  /* "fccqp/admm.pyx":708
  *         for i in range(p.m):
  *             self.rhs[p.n + i] = p.b[i]
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.red.base)             # <<<<<<<<<<<<<<
@@ -27368,7 +27444,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_3kkt_kkt_solve((&__pyx_v_self->kkt), __pyx_v_p, __pyx_v_self->it.rho_vec, __pyx_v_self->rhs, __pyx_v_self->red.base);
 
-  /* "fccqp/admm.pyx":693
+  /* "fccqp/admm.pyx":699
  *         return UNAVAILABLE
  * 
  *     cdef void _reduced_base(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27381,7 +27457,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
 
 }
 
-/* "fccqp/admm.pyx":704
+/* "fccqp/admm.pyx":710
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.red.base)
  * 
  *     cdef int _equality_start(self, bint* unbounded) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27410,7 +27486,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   double __pyx_t_9;
   double __pyx_t_10;
 
-  /* "fccqp/admm.pyx":715
+  /* "fccqp/admm.pyx":721
  *         candidate certificate) and the start falls back to the origin.
  *         """
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -27419,7 +27495,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":716
+  /* "fccqp/admm.pyx":722
  *         """
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -27428,7 +27504,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":717
+  /* "fccqp/admm.pyx":723
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, i, step             # <<<<<<<<<<<<<<
@@ -27442,7 +27518,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 
   __pyx_v_m = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":718
+  /* "fccqp/admm.pyx":724
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, i, step
  *         cdef double sigma = self.opt.sigma             # <<<<<<<<<<<<<<
@@ -27453,7 +27529,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 
   __pyx_v_sigma = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":719
+  /* "fccqp/admm.pyx":725
  *         cdef Py_ssize_t n = p.n, m = p.m, i, step
  *         cdef double sigma = self.opt.sigma
  *         fill(it.rho_vec, 0.0, p.s)             # <<<<<<<<<<<<<<
@@ -27462,7 +27538,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_it->rho_vec, 0.0, __pyx_v_p->s);
 
-  /* "fccqp/admm.pyx":720
+  /* "fccqp/admm.pyx":726
  *         cdef double sigma = self.opt.sigma
  *         fill(it.rho_vec, 0.0, p.s)
  *         self.factored_rho = -1.0  # the KKT matrix now holds no rho factorization             # <<<<<<<<<<<<<<
@@ -27471,7 +27547,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_self->factored_rho = -1.0;
 
-  /* "fccqp/admm.pyx":721
+  /* "fccqp/admm.pyx":727
  *         fill(it.rho_vec, 0.0, p.s)
  *         self.factored_rho = -1.0  # the KKT matrix now holds no rho factorization
  *         self.form = LDL_FULL             # <<<<<<<<<<<<<<
@@ -27480,7 +27556,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_self->form = __pyx_e_5fccqp_3kkt_LDL_FULL;
 
-  /* "fccqp/admm.pyx":722
+  /* "fccqp/admm.pyx":728
  *         self.factored_rho = -1.0  # the KKT matrix now holds no rho factorization
  *         self.form = LDL_FULL
  *         cdef int code = kkt_factor(&self.kkt, p, LDL_FULL, sigma, it.rho_vec)             # <<<<<<<<<<<<<<
@@ -27489,7 +27565,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_code = __pyx_f_5fccqp_3kkt_kkt_factor((&__pyx_v_self->kkt), __pyx_v_p, __pyx_e_5fccqp_3kkt_LDL_FULL, __pyx_v_sigma, __pyx_v_it->rho_vec);
 
-  /* "fccqp/admm.pyx":723
+  /* "fccqp/admm.pyx":729
  *         self.form = LDL_FULL
  *         cdef int code = kkt_factor(&self.kkt, p, LDL_FULL, sigma, it.rho_vec)
  *         if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -27501,7 +27577,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":724
+    /* "fccqp/admm.pyx":730
  *         cdef int code = kkt_factor(&self.kkt, p, LDL_FULL, sigma, it.rho_vec)
  *         if code != FACTORED:
  *             return NOT_CONVEX             # <<<<<<<<<<<<<<
@@ -27514,7 +27590,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":723
+    /* "fccqp/admm.pyx":729
  *         self.form = LDL_FULL
  *         cdef int code = kkt_factor(&self.kkt, p, LDL_FULL, sigma, it.rho_vec)
  *         if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -27523,7 +27599,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   }
 
-  /* "fccqp/admm.pyx":725
+  /* "fccqp/admm.pyx":731
  *         if code != FACTORED:
  *             return NOT_CONVEX
  *         self.certified = True             # <<<<<<<<<<<<<<
@@ -27532,7 +27608,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_self->certified = 1;
 
-  /* "fccqp/admm.pyx":726
+  /* "fccqp/admm.pyx":732
  *             return NOT_CONVEX
  *         self.certified = True
  *         fill(it.x, 0.0, n)             # <<<<<<<<<<<<<<
@@ -27541,7 +27617,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_it->x, 0.0, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":727
+  /* "fccqp/admm.pyx":733
  *         self.certified = True
  *         fill(it.x, 0.0, n)
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -27555,7 +27631,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   for (__pyx_t_5 = 0; __pyx_t_5 < __pyx_t_4; __pyx_t_5+=1) {
     __pyx_v_i = __pyx_t_5;
 
-    /* "fccqp/admm.pyx":728
+    /* "fccqp/admm.pyx":734
  *         fill(it.x, 0.0, n)
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i]             # <<<<<<<<<<<<<<
@@ -27566,7 +27642,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   }
 
 
-  /* "fccqp/admm.pyx":729
+  /* "fccqp/admm.pyx":735
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i]
  *         for step in range(_EQUALITY_START_STEPS):             # <<<<<<<<<<<<<<
@@ -27580,7 +27656,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   for (__pyx_t_1 = 0; __pyx_t_1 < __pyx_t_7; __pyx_t_1+=1) {
     __pyx_v_step = __pyx_t_1;
 
-    /* "fccqp/admm.pyx":730
+    /* "fccqp/admm.pyx":736
  *             self.rhs[n + i] = p.b[i]
  *         for step in range(_EQUALITY_START_STEPS):
  *             for i in range(n):             # <<<<<<<<<<<<<<
@@ -27594,7 +27670,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
     for (__pyx_t_8 = 0; __pyx_t_8 < __pyx_t_5; __pyx_t_8+=1) {
       __pyx_v_i = __pyx_t_8;
 
-      /* "fccqp/admm.pyx":731
+      /* "fccqp/admm.pyx":737
  *         for step in range(_EQUALITY_START_STEPS):
  *             for i in range(n):
  *                 self.rhs[i] = sigma * it.x[i] - p.q[i]             # <<<<<<<<<<<<<<
@@ -27605,7 +27681,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
     }
 
 
-    /* "fccqp/admm.pyx":732
+    /* "fccqp/admm.pyx":738
  *             for i in range(n):
  *                 self.rhs[i] = sigma * it.x[i] - p.q[i]
  *             kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)             # <<<<<<<<<<<<<<
@@ -27614,7 +27690,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
     __pyx_f_5fccqp_3kkt_kkt_solve((&__pyx_v_self->kkt), __pyx_v_p, __pyx_v_it->rho_vec, __pyx_v_self->rhs, __pyx_v_self->sol);
 
-    /* "fccqp/admm.pyx":733
+    /* "fccqp/admm.pyx":739
  *                 self.rhs[i] = sigma * it.x[i] - p.q[i]
  *             kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
  *             copy(self.sol, it.x, n)             # <<<<<<<<<<<<<<
@@ -27625,7 +27701,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   }
 
 
-  /* "fccqp/admm.pyx":734
+  /* "fccqp/admm.pyx":740
  *             kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
  *             copy(self.sol, it.x, n)
  *         copy(self.sol + n, it.nu, m)             # <<<<<<<<<<<<<<
@@ -27634,7 +27710,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_copy((__pyx_v_self->sol + __pyx_v_n), __pyx_v_it->nu, __pyx_v_m);
 
-  /* "fccqp/admm.pyx":736
+  /* "fccqp/admm.pyx":742
  *         copy(self.sol + n, it.nu, m)
  *         unbounded[0] = sigma * inf_norm(it.x, n) > _EQUALITY_START_LIMIT * max(
  *             1.0, inf_norm(p.q, n))             # <<<<<<<<<<<<<<
@@ -27656,7 +27732,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   }
 
 
-  /* "fccqp/admm.pyx":735
+  /* "fccqp/admm.pyx":741
  *             copy(self.sol, it.x, n)
  *         copy(self.sol + n, it.nu, m)
  *         unbounded[0] = sigma * inf_norm(it.x, n) > _EQUALITY_START_LIMIT * max(             # <<<<<<<<<<<<<<
@@ -27666,7 +27742,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   (__pyx_v_unbounded[0]) = ((__pyx_v_sigma * __pyx_f_5fccqp_6_dense_inf_norm(__pyx_v_it->x, __pyx_v_n)) > (__pyx_v_5fccqp_4admm__EQUALITY_START_LIMIT * __pyx_t_10));
 
 
-  /* "fccqp/admm.pyx":737
+  /* "fccqp/admm.pyx":743
  *         unbounded[0] = sigma * inf_norm(it.x, n) > _EQUALITY_START_LIMIT * max(
  *             1.0, inf_norm(p.q, n))
  *         if unbounded[0]:             # <<<<<<<<<<<<<<
@@ -27675,7 +27751,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   if ((__pyx_v_unbounded[0])) {
 
-    /* "fccqp/admm.pyx":738
+    /* "fccqp/admm.pyx":744
  *             1.0, inf_norm(p.q, n))
  *         if unbounded[0]:
  *             copy(it.x, self.direction, n)             # <<<<<<<<<<<<<<
@@ -27684,7 +27760,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->x, __pyx_v_self->direction, __pyx_v_n);
 
-    /* "fccqp/admm.pyx":739
+    /* "fccqp/admm.pyx":745
  *         if unbounded[0]:
  *             copy(it.x, self.direction, n)
  *             fill(it.x, 0.0, n)             # <<<<<<<<<<<<<<
@@ -27693,7 +27769,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
     __pyx_f_5fccqp_6_dense_fill(__pyx_v_it->x, 0.0, __pyx_v_n);
 
-    /* "fccqp/admm.pyx":740
+    /* "fccqp/admm.pyx":746
  *             copy(it.x, self.direction, n)
  *             fill(it.x, 0.0, n)
  *             fill(it.nu, 0.0, m)             # <<<<<<<<<<<<<<
@@ -27702,7 +27778,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
     __pyx_f_5fccqp_6_dense_fill(__pyx_v_it->nu, 0.0, __pyx_v_m);
 
-    /* "fccqp/admm.pyx":737
+    /* "fccqp/admm.pyx":743
  *         unbounded[0] = sigma * inf_norm(it.x, n) > _EQUALITY_START_LIMIT * max(
  *             1.0, inf_norm(p.q, n))
  *         if unbounded[0]:             # <<<<<<<<<<<<<<
@@ -27711,7 +27787,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   }
 
-  /* "fccqp/admm.pyx":741
+  /* "fccqp/admm.pyx":747
  *             fill(it.x, 0.0, n)
  *             fill(it.nu, 0.0, m)
  *         for i in range(p.s):             # <<<<<<<<<<<<<<
@@ -27725,7 +27801,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   for (__pyx_t_5 = 0; __pyx_t_5 < __pyx_t_4; __pyx_t_5+=1) {
     __pyx_v_i = __pyx_t_5;
 
-    /* "fccqp/admm.pyx":742
+    /* "fccqp/admm.pyx":748
  *             fill(it.nu, 0.0, m)
  *         for i in range(p.s):
  *             it.z[i] = it.x[p.constrained[i]]             # <<<<<<<<<<<<<<
@@ -27736,7 +27812,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   }
 
 
-  /* "fccqp/admm.pyx":743
+  /* "fccqp/admm.pyx":749
  *         for i in range(p.s):
  *             it.z[i] = it.x[p.constrained[i]]
  *         proj_set(it.z, p.lo, p.hi, p.cones, p.s, it.z)             # <<<<<<<<<<<<<<
@@ -27745,7 +27821,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_11projections_proj_set(__pyx_v_it->z, __pyx_v_p->lo, __pyx_v_p->hi, __pyx_v_p->cones, __pyx_v_p->s, __pyx_v_it->z);
 
-  /* "fccqp/admm.pyx":744
+  /* "fccqp/admm.pyx":750
  *             it.z[i] = it.x[p.constrained[i]]
  *         proj_set(it.z, p.lo, p.hi, p.cones, p.s, it.z)
  *         fill(it.y, 0.0, p.s)             # <<<<<<<<<<<<<<
@@ -27754,7 +27830,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_it->y, 0.0, __pyx_v_p->s);
 
-  /* "fccqp/admm.pyx":745
+  /* "fccqp/admm.pyx":751
  *         proj_set(it.z, p.lo, p.hi, p.cones, p.s, it.z)
  *         fill(it.y, 0.0, p.s)
  *         copy(it.x, it.x_prev, n)             # <<<<<<<<<<<<<<
@@ -27763,7 +27839,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->x, __pyx_v_it->x_prev, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":746
+  /* "fccqp/admm.pyx":752
  *         fill(it.y, 0.0, p.s)
  *         copy(it.x, it.x_prev, n)
  *         copy(it.nu, it.nu_prev, m)             # <<<<<<<<<<<<<<
@@ -27772,7 +27848,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->nu, __pyx_v_it->nu_prev, __pyx_v_m);
 
-  /* "fccqp/admm.pyx":747
+  /* "fccqp/admm.pyx":753
  *         copy(it.x, it.x_prev, n)
  *         copy(it.nu, it.nu_prev, m)
  *         copy(it.y, it.y_prev, p.s)             # <<<<<<<<<<<<<<
@@ -27781,7 +27857,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->y, __pyx_v_it->y_prev, __pyx_v_p->s);
 
-  /* "fccqp/admm.pyx":748
+  /* "fccqp/admm.pyx":754
  *         copy(it.nu, it.nu_prev, m)
  *         copy(it.y, it.y_prev, p.s)
  *         return FACTORED             # <<<<<<<<<<<<<<
@@ -27794,7 +27870,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":704
+  /* "fccqp/admm.pyx":710
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.red.base)
  * 
  *     cdef int _equality_start(self, bint* unbounded) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27815,7 +27891,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":750
+/* "fccqp/admm.pyx":756
  *         return FACTORED
  * 
  *     cdef void _restore_equalities(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27834,7 +27910,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   Py_ssize_t __pyx_t_4;
   Py_ssize_t __pyx_t_5;
 
-  /* "fccqp/admm.pyx":754
+  /* "fccqp/admm.pyx":760
  *         the reduced form, a restoration) accumulates in ``A x = b``: one refined KKT
  *         solve for ``(0, b - A x)`` with the current factorization."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -27843,7 +27919,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":755
+  /* "fccqp/admm.pyx":761
  *         solve for ``(0, b - A x)`` with the current factorization."""
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m, i             # <<<<<<<<<<<<<<
@@ -27857,7 +27933,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 
   __pyx_v_m = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":756
+  /* "fccqp/admm.pyx":762
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m, i
  *         if m == 0:             # <<<<<<<<<<<<<<
@@ -27869,7 +27945,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   if (__pyx_t_2) {
 
 
-    /* "fccqp/admm.pyx":757
+    /* "fccqp/admm.pyx":763
  *         cdef Py_ssize_t n = p.n, m = p.m, i
  *         if m == 0:
  *             return             # <<<<<<<<<<<<<<
@@ -27880,7 +27956,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":756
+    /* "fccqp/admm.pyx":762
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m, i
  *         if m == 0:             # <<<<<<<<<<<<<<
@@ -27889,7 +27965,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 */
   }
 
-  /* "fccqp/admm.pyx":758
+  /* "fccqp/admm.pyx":764
  *         if m == 0:
  *             return
  *         fill(self.rhs, 0.0, n)             # <<<<<<<<<<<<<<
@@ -27898,7 +27974,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_self->rhs, 0.0, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":759
+  /* "fccqp/admm.pyx":765
  *             return
  *         fill(self.rhs, 0.0, n)
  *         matvec(p.A, self.it.x, self.rhs + n, m, n)             # <<<<<<<<<<<<<<
@@ -27907,7 +27983,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 */
   __pyx_f_5fccqp_6_dense_matvec(__pyx_v_p->A, __pyx_v_self->it.x, (__pyx_v_self->rhs + __pyx_v_n), __pyx_v_m, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":760
+  /* "fccqp/admm.pyx":766
  *         fill(self.rhs, 0.0, n)
  *         matvec(p.A, self.it.x, self.rhs + n, m, n)
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -27921,7 +27997,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":761
+    /* "fccqp/admm.pyx":767
  *         matvec(p.A, self.it.x, self.rhs + n, m, n)
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i] - self.rhs[n + i]             # <<<<<<<<<<<<<<
@@ -27932,7 +28008,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   }
 
 
-  /* "fccqp/admm.pyx":762
+  /* "fccqp/admm.pyx":768
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i] - self.rhs[n + i]
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.sol)             # <<<<<<<<<<<<<<
@@ -27941,7 +28017,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 */
   __pyx_f_5fccqp_3kkt_kkt_solve((&__pyx_v_self->kkt), __pyx_v_p, __pyx_v_self->it.rho_vec, __pyx_v_self->rhs, __pyx_v_self->sol);
 
-  /* "fccqp/admm.pyx":763
+  /* "fccqp/admm.pyx":769
  *             self.rhs[n + i] = p.b[i] - self.rhs[n + i]
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.sol)
  *         for i in range(n):             # <<<<<<<<<<<<<<
@@ -27955,7 +28031,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":764
+    /* "fccqp/admm.pyx":770
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.sol)
  *         for i in range(n):
  *             self.it.x[i] += self.sol[i]             # <<<<<<<<<<<<<<
@@ -27968,7 +28044,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   }
 
 
-  /* "fccqp/admm.pyx":765
+  /* "fccqp/admm.pyx":771
  *         for i in range(n):
  *             self.it.x[i] += self.sol[i]
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -27982,7 +28058,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":766
+    /* "fccqp/admm.pyx":772
  *             self.it.x[i] += self.sol[i]
  *         for i in range(m):
  *             self.it.nu[i] += self.sol[n + i]             # <<<<<<<<<<<<<<
@@ -27995,7 +28071,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   }
 
 
-  /* "fccqp/admm.pyx":750
+  /* "fccqp/admm.pyx":756
  *         return FACTORED
  * 
  *     cdef void _restore_equalities(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28011,7 +28087,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 
 }
 
-/* "fccqp/admm.pyx":768
+/* "fccqp/admm.pyx":774
  *             self.it.nu[i] += self.sol[n + i]
  * 
  *     cdef int _keep_restored(self, int status, long iteration, bint reduced,             # <<<<<<<<<<<<<<
@@ -28037,7 +28113,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
   double __pyx_t_7;
   int __pyx_t_8;
 
-  /* "fccqp/admm.pyx":780
+  /* "fccqp/admm.pyx":786
  *         either case.
  *         """
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -28046,7 +28122,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":781
+  /* "fccqp/admm.pyx":787
  *         """
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -28055,7 +28131,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":782
+  /* "fccqp/admm.pyx":788
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j             # <<<<<<<<<<<<<<
@@ -28072,7 +28148,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":784
+  /* "fccqp/admm.pyx":790
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j
  *         cdef int new_status
  *         copy(it.x, self.saved, n)             # <<<<<<<<<<<<<<
@@ -28081,7 +28157,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->x, __pyx_v_self->saved, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":785
+  /* "fccqp/admm.pyx":791
  *         cdef int new_status
  *         copy(it.x, self.saved, n)
  *         copy(it.nu, self.saved + n, m)             # <<<<<<<<<<<<<<
@@ -28090,7 +28166,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->nu, (__pyx_v_self->saved + __pyx_v_n), __pyx_v_m);
 
-  /* "fccqp/admm.pyx":786
+  /* "fccqp/admm.pyx":792
  *         copy(it.x, self.saved, n)
  *         copy(it.nu, self.saved + n, m)
  *         copy(it.z, self.saved + n + m, s)             # <<<<<<<<<<<<<<
@@ -28099,7 +28175,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->z, ((__pyx_v_self->saved + __pyx_v_n) + __pyx_v_m), __pyx_v_s);
 
-  /* "fccqp/admm.pyx":787
+  /* "fccqp/admm.pyx":793
  *         copy(it.nu, self.saved + n, m)
  *         copy(it.z, self.saved + n + m, s)
  *         if restore(&self.rest, &self.kkt, &self.red, reduced, p, it):             # <<<<<<<<<<<<<<
@@ -28111,7 +28187,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
   if (__pyx_t_2) {
 
 
-    /* "fccqp/admm.pyx":788
+    /* "fccqp/admm.pyx":794
  *         copy(it.z, self.saved + n + m, s)
  *         if restore(&self.rest, &self.kkt, &self.red, reduced, p, it):
  *             self._restore_equalities()             # <<<<<<<<<<<<<<
@@ -28120,7 +28196,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_restore_equalities(__pyx_v_self);
 
-    /* "fccqp/admm.pyx":789
+    /* "fccqp/admm.pyx":795
  *         if restore(&self.rest, &self.kkt, &self.red, reduced, p, it):
  *             self._restore_equalities()
  *             for j in range(s):             # <<<<<<<<<<<<<<
@@ -28134,7 +28210,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
     for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
       __pyx_v_j = __pyx_t_4;
 
-      /* "fccqp/admm.pyx":790
+      /* "fccqp/admm.pyx":796
  *             self._restore_equalities()
  *             for j in range(s):
  *                 it.z[j] = it.x[p.constrained[j]]             # <<<<<<<<<<<<<<
@@ -28145,7 +28221,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
     }
 
 
-    /* "fccqp/admm.pyx":791
+    /* "fccqp/admm.pyx":797
  *             for j in range(s):
  *                 it.z[j] = it.x[p.constrained[j]]
  *             proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)             # <<<<<<<<<<<<<<
@@ -28154,7 +28230,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     __pyx_f_5fccqp_11projections_proj_set(__pyx_v_it->z, __pyx_v_p->lo, __pyx_v_p->hi, __pyx_v_p->cones, __pyx_v_s, __pyx_v_it->z);
 
-    /* "fccqp/admm.pyx":792
+    /* "fccqp/admm.pyx":798
  *                 it.z[j] = it.x[p.constrained[j]]
  *             proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
  *             self._residuals()             # <<<<<<<<<<<<<<
@@ -28163,7 +28239,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_residuals(__pyx_v_self);
 
-    /* "fccqp/admm.pyx":793
+    /* "fccqp/admm.pyx":799
  *             proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
  *             self._residuals()
  *             new_status = self._classify(iteration, True, start_time)             # <<<<<<<<<<<<<<
@@ -28172,7 +28248,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     __pyx_v_new_status = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_classify(__pyx_v_self, __pyx_v_iteration, 1, __pyx_v_start_time);
 
-    /* "fccqp/admm.pyx":794
+    /* "fccqp/admm.pyx":800
  *             self._residuals()
  *             new_status = self._classify(iteration, True, start_time)
  *             if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)             # <<<<<<<<<<<<<<
@@ -28205,7 +28281,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
       goto __pyx_L7_bool_binop_done;
     }
 
-    /* "fccqp/admm.pyx":795
+    /* "fccqp/admm.pyx":801
  *             new_status = self._classify(iteration, True, start_time)
  *             if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)
  *                     and (status != _SOLVED or new_status == _SOLVED)):             # <<<<<<<<<<<<<<
@@ -28229,7 +28305,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 
     __pyx_L7_bool_binop_done:;
 
-    /* "fccqp/admm.pyx":794
+    /* "fccqp/admm.pyx":800
  *             self._residuals()
  *             new_status = self._classify(iteration, True, start_time)
  *             if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)             # <<<<<<<<<<<<<<
@@ -28239,7 +28315,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":796
+      /* "fccqp/admm.pyx":802
  *             if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)
  *                     and (status != _SOLVED or new_status == _SOLVED)):
  *                 return new_status             # <<<<<<<<<<<<<<
@@ -28252,7 +28328,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
       }
       goto __pyx_L0;
 
-      /* "fccqp/admm.pyx":794
+      /* "fccqp/admm.pyx":800
  *             self._residuals()
  *             new_status = self._classify(iteration, True, start_time)
  *             if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)             # <<<<<<<<<<<<<<
@@ -28261,7 +28337,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     }
 
-    /* "fccqp/admm.pyx":787
+    /* "fccqp/admm.pyx":793
  *         copy(it.nu, self.saved + n, m)
  *         copy(it.z, self.saved + n + m, s)
  *         if restore(&self.rest, &self.kkt, &self.red, reduced, p, it):             # <<<<<<<<<<<<<<
@@ -28270,7 +28346,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   }
 
-  /* "fccqp/admm.pyx":797
+  /* "fccqp/admm.pyx":803
  *                     and (status != _SOLVED or new_status == _SOLVED)):
  *                 return new_status
  *         copy(self.saved, it.x, n)             # <<<<<<<<<<<<<<
@@ -28279,7 +28355,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_self->saved, __pyx_v_it->x, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":798
+  /* "fccqp/admm.pyx":804
  *                 return new_status
  *         copy(self.saved, it.x, n)
  *         copy(self.saved + n, it.nu, m)             # <<<<<<<<<<<<<<
@@ -28288,7 +28364,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy((__pyx_v_self->saved + __pyx_v_n), __pyx_v_it->nu, __pyx_v_m);
 
-  /* "fccqp/admm.pyx":799
+  /* "fccqp/admm.pyx":805
  *         copy(self.saved, it.x, n)
  *         copy(self.saved + n, it.nu, m)
  *         copy(self.saved + n + m, it.z, s)             # <<<<<<<<<<<<<<
@@ -28297,7 +28373,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy(((__pyx_v_self->saved + __pyx_v_n) + __pyx_v_m), __pyx_v_it->z, __pyx_v_s);
 
-  /* "fccqp/admm.pyx":800
+  /* "fccqp/admm.pyx":806
  *         copy(self.saved + n, it.nu, m)
  *         copy(self.saved + n + m, it.z, s)
  *         if reduced:             # <<<<<<<<<<<<<<
@@ -28306,7 +28382,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   if (__pyx_v_reduced) {
 
-    /* "fccqp/admm.pyx":801
+    /* "fccqp/admm.pyx":807
  *         copy(self.saved + n + m, it.z, s)
  *         if reduced:
  *             self._restore_equalities()             # <<<<<<<<<<<<<<
@@ -28315,7 +28391,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_restore_equalities(__pyx_v_self);
 
-    /* "fccqp/admm.pyx":800
+    /* "fccqp/admm.pyx":806
  *         copy(self.saved + n, it.nu, m)
  *         copy(self.saved + n + m, it.z, s)
  *         if reduced:             # <<<<<<<<<<<<<<
@@ -28324,7 +28400,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   }
 
-  /* "fccqp/admm.pyx":802
+  /* "fccqp/admm.pyx":808
  *         if reduced:
  *             self._restore_equalities()
  *         return status             # <<<<<<<<<<<<<<
@@ -28337,7 +28413,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":768
+  /* "fccqp/admm.pyx":774
  *             self.it.nu[i] += self.sol[n + i]
  * 
  *     cdef int _keep_restored(self, int status, long iteration, bint reduced,             # <<<<<<<<<<<<<<
@@ -28357,7 +28433,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":806
+/* "fccqp/admm.pyx":812
  *     # ------------------------------------------------------------- bookkeeping
  * 
  *     cdef void _residuals(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28367,7 +28443,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 
 static void __pyx_f_5fccqp_4admm_9Workspace__residuals(struct __pyx_obj_5fccqp_4admm_Workspace *__pyx_v_self) {
 
-  /* "fccqp/admm.pyx":807
+  /* "fccqp/admm.pyx":813
  * 
  *     cdef void _residuals(self) noexcept nogil:
  *         residuals(&self.prob, &self.it, self.vec_m, self.vec_n, self.vec_n2, &self.res)             # <<<<<<<<<<<<<<
@@ -28376,7 +28452,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__residuals(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_11termination_residuals((&__pyx_v_self->prob), (&__pyx_v_self->it), __pyx_v_self->vec_m, __pyx_v_self->vec_n, __pyx_v_self->vec_n2, (&__pyx_v_self->res));
 
-  /* "fccqp/admm.pyx":806
+  /* "fccqp/admm.pyx":812
  *     # ------------------------------------------------------------- bookkeeping
  * 
  *     cdef void _residuals(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28387,7 +28463,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__residuals(struct __pyx_obj_5fccqp_4
   /* function exit code */
 }
 
-/* "fccqp/admm.pyx":809
+/* "fccqp/admm.pyx":815
  *         residuals(&self.prob, &self.it, self.vec_m, self.vec_n, self.vec_n2, &self.res)
  * 
  *     cdef void _log(self, long iteration, double rho) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28404,7 +28480,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
   double __pyx_t_5;
   double __pyx_t_6;
 
-  /* "fccqp/admm.pyx":811
+  /* "fccqp/admm.pyx":817
  *     cdef void _log(self, long iteration, double rho) noexcept nogil:
  *         cdef double* row
  *         if self.log_count < self.log_rows:             # <<<<<<<<<<<<<<
@@ -28416,7 +28492,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":812
+    /* "fccqp/admm.pyx":818
  *         cdef double* row
  *         if self.log_count < self.log_rows:
  *             row = self.log + 5 * self.log_count             # <<<<<<<<<<<<<<
@@ -28425,7 +28501,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
 */
     __pyx_v_row = (__pyx_v_self->log + (5 * __pyx_v_self->log_count));
 
-    /* "fccqp/admm.pyx":814
+    /* "fccqp/admm.pyx":820
  *             row = self.log + 5 * self.log_count
  *             row[0], row[1], row[2], row[3], row[4] = (
  *                 iteration, self.res.prim, self.res.dual, self.res.gap, rho)             # <<<<<<<<<<<<<<
@@ -28443,7 +28519,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
     __pyx_t_6 = __pyx_v_rho;
 
 
-    /* "fccqp/admm.pyx":813
+    /* "fccqp/admm.pyx":819
  *         if self.log_count < self.log_rows:
  *             row = self.log + 5 * self.log_count
  *             row[0], row[1], row[2], row[3], row[4] = (             # <<<<<<<<<<<<<<
@@ -28461,7 +28537,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
     (__pyx_v_row[4]) = __pyx_t_6;
 
 
-    /* "fccqp/admm.pyx":815
+    /* "fccqp/admm.pyx":821
  *             row[0], row[1], row[2], row[3], row[4] = (
  *                 iteration, self.res.prim, self.res.dual, self.res.gap, rho)
  *             self.log_count += 1             # <<<<<<<<<<<<<<
@@ -28470,7 +28546,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
 */
     __pyx_v_self->log_count = (__pyx_v_self->log_count + 1);
 
-    /* "fccqp/admm.pyx":811
+    /* "fccqp/admm.pyx":817
  *     cdef void _log(self, long iteration, double rho) noexcept nogil:
  *         cdef double* row
  *         if self.log_count < self.log_rows:             # <<<<<<<<<<<<<<
@@ -28479,7 +28555,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
 */
   }
 
-  /* "fccqp/admm.pyx":809
+  /* "fccqp/admm.pyx":815
  *         residuals(&self.prob, &self.it, self.vec_m, self.vec_n, self.vec_n2, &self.res)
  * 
  *     cdef void _log(self, long iteration, double rho) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28491,7 +28567,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
 
 }
 
-/* "fccqp/admm.pyx":817
+/* "fccqp/admm.pyx":823
  *             self.log_count += 1
  * 
  *     cdef void _finish_run(self, Run* run, int status, long iteration) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28502,7 +28578,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
 static void __pyx_f_5fccqp_4admm_9Workspace__finish_run(struct __pyx_obj_5fccqp_4admm_Workspace *__pyx_v_self, struct __pyx_t_5fccqp_4admm_Run *__pyx_v_run, int __pyx_v_status, long __pyx_v_iteration) {
   int __pyx_t_1;
 
-  /* "fccqp/admm.pyx":818
+  /* "fccqp/admm.pyx":824
  * 
  *     cdef void _finish_run(self, Run* run, int status, long iteration) noexcept nogil:
  *         run.status = status             # <<<<<<<<<<<<<<
@@ -28511,7 +28587,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish_run(struct __pyx_obj_5fccqp_
 */
   __pyx_v_run->status = __pyx_v_status;
 
-  /* "fccqp/admm.pyx":819
+  /* "fccqp/admm.pyx":825
  *     cdef void _finish_run(self, Run* run, int status, long iteration) noexcept nogil:
  *         run.status = status
  *         run.iterations = iteration             # <<<<<<<<<<<<<<
@@ -28520,7 +28596,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish_run(struct __pyx_obj_5fccqp_
 */
   __pyx_v_run->iterations = __pyx_v_iteration;
 
-  /* "fccqp/admm.pyx":820
+  /* "fccqp/admm.pyx":826
  *         run.status = status
  *         run.iterations = iteration
  *         run.backend = self.form             # <<<<<<<<<<<<<<
@@ -28531,7 +28607,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish_run(struct __pyx_obj_5fccqp_
 
   __pyx_v_run->backend = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":817
+  /* "fccqp/admm.pyx":823
  *             self.log_count += 1
  * 
  *     cdef void _finish_run(self, Run* run, int status, long iteration) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28542,7 +28618,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish_run(struct __pyx_obj_5fccqp_
   /* function exit code */
 }
 
-/* "fccqp/admm.pyx":822
+/* "fccqp/admm.pyx":828
  *         run.backend = self.form
  * 
  *     cdef void _finish(self, Run* run, double* x, double* y, double* z,             # <<<<<<<<<<<<<<
@@ -28562,7 +28638,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
   int __pyx_t_4;
   double __pyx_t_5;
 
-  /* "fccqp/admm.pyx":827
+  /* "fccqp/admm.pyx":833
  *         user's units from the returned point alone (the primal one as the distance of
  *         ``x_S`` to C), settle the status on them and keep the point for a warm start."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -28571,7 +28647,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":828
+  /* "fccqp/admm.pyx":834
  *         ``x_S`` to C), settle the status on them and keep the point for a warm start."""
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -28580,7 +28656,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":829
+  /* "fccqp/admm.pyx":835
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j             # <<<<<<<<<<<<<<
@@ -28597,7 +28673,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":830
+  /* "fccqp/admm.pyx":836
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)             # <<<<<<<<<<<<<<
@@ -28606,7 +28682,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   __pyx_f_5fccqp_7scaling_unscale(__pyx_v_it->x, __pyx_v_it->nu, __pyx_v_it->y, __pyx_v_p->D, __pyx_v_p->E, __pyx_v_p->c, __pyx_v_n, __pyx_v_m, __pyx_v_s, __pyx_v_p->constrained, __pyx_v_x, __pyx_v_y, __pyx_v_z);
 
-  /* "fccqp/admm.pyx":831
+  /* "fccqp/admm.pyx":837
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)
  *         if run.status == _PRIMAL_INFEASIBLE or run.status == _DUAL_INFEASIBLE:             # <<<<<<<<<<<<<<
@@ -28617,7 +28693,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     case __pyx_e_5fccqp_4admm__PRIMAL_INFEASIBLE:
     case __pyx_e_5fccqp_4admm__DUAL_INFEASIBLE:
 
-    /* "fccqp/admm.pyx":832
+    /* "fccqp/admm.pyx":838
  *         unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)
  *         if run.status == _PRIMAL_INFEASIBLE or run.status == _DUAL_INFEASIBLE:
  *             copy(self.cert, cert, n + m)             # <<<<<<<<<<<<<<
@@ -28626,7 +28702,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_self->cert, __pyx_v_cert, (__pyx_v_n + __pyx_v_m));
 
-    /* "fccqp/admm.pyx":831
+    /* "fccqp/admm.pyx":837
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)
  *         if run.status == _PRIMAL_INFEASIBLE or run.status == _DUAL_INFEASIBLE:             # <<<<<<<<<<<<<<
@@ -28637,7 +28713,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     default: break;
   }
 
-  /* "fccqp/admm.pyx":833
+  /* "fccqp/admm.pyx":839
  *         if run.status == _PRIMAL_INFEASIBLE or run.status == _DUAL_INFEASIBLE:
  *             copy(self.cert, cert, n + m)
  *         self._user_residuals(x, y, z)             # <<<<<<<<<<<<<<
@@ -28646,7 +28722,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_user_residuals(__pyx_v_self, __pyx_v_x, __pyx_v_y, __pyx_v_z);
 
-  /* "fccqp/admm.pyx":834
+  /* "fccqp/admm.pyx":840
  *             copy(self.cert, cert, n + m)
  *         self._user_residuals(x, y, z)
  *         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):             # <<<<<<<<<<<<<<
@@ -28659,7 +28735,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     case __pyx_e_5fccqp_4admm__MAX_ITER:
     case __pyx_e_5fccqp_4admm__TIME_LIMIT:
 
-    /* "fccqp/admm.pyx":835
+    /* "fccqp/admm.pyx":841
  *         self._user_residuals(x, y, z)
  *         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):
  *             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):             # <<<<<<<<<<<<<<
@@ -28671,7 +28747,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":836
+      /* "fccqp/admm.pyx":842
  *         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):
  *             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):
  *                 run.status = _SOLVED             # <<<<<<<<<<<<<<
@@ -28680,7 +28756,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
       __pyx_v_run->status = __pyx_e_5fccqp_4admm__SOLVED;
 
-      /* "fccqp/admm.pyx":835
+      /* "fccqp/admm.pyx":841
  *         self._user_residuals(x, y, z)
  *         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):
  *             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):             # <<<<<<<<<<<<<<
@@ -28690,7 +28766,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
       goto __pyx_L3;
     }
 
-    /* "fccqp/admm.pyx":837
+    /* "fccqp/admm.pyx":843
  *             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):
  *                 run.status = _SOLVED
  *             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):             # <<<<<<<<<<<<<<
@@ -28702,7 +28778,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":838
+      /* "fccqp/admm.pyx":844
  *                 run.status = _SOLVED
  *             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *                 run.status = _INACCURATE             # <<<<<<<<<<<<<<
@@ -28711,7 +28787,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
       __pyx_v_run->status = __pyx_e_5fccqp_4admm__INACCURATE;
 
-      /* "fccqp/admm.pyx":837
+      /* "fccqp/admm.pyx":843
  *             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):
  *                 run.status = _SOLVED
  *             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):             # <<<<<<<<<<<<<<
@@ -28721,7 +28797,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
       goto __pyx_L3;
     }
 
-    /* "fccqp/admm.pyx":839
+    /* "fccqp/admm.pyx":845
  *             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *                 run.status = _INACCURATE
  *             elif run.status in (_SOLVED, _INACCURATE):             # <<<<<<<<<<<<<<
@@ -28743,7 +28819,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     if (__pyx_t_3) {
 
 
-      /* "fccqp/admm.pyx":840
+      /* "fccqp/admm.pyx":846
  *                 run.status = _INACCURATE
  *             elif run.status in (_SOLVED, _INACCURATE):
  *                 run.status = _NUMERICAL_ERROR   # the scaled test passed, the point does not             # <<<<<<<<<<<<<<
@@ -28752,7 +28828,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
       __pyx_v_run->status = __pyx_e_5fccqp_4admm__NUMERICAL_ERROR;
 
-      /* "fccqp/admm.pyx":839
+      /* "fccqp/admm.pyx":845
  *             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *                 run.status = _INACCURATE
  *             elif run.status in (_SOLVED, _INACCURATE):             # <<<<<<<<<<<<<<
@@ -28762,7 +28838,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     }
     __pyx_L3:;
 
-    /* "fccqp/admm.pyx":834
+    /* "fccqp/admm.pyx":840
  *             copy(self.cert, cert, n + m)
  *         self._user_residuals(x, y, z)
  *         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):             # <<<<<<<<<<<<<<
@@ -28773,7 +28849,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     default: break;
   }
 
-  /* "fccqp/admm.pyx":841
+  /* "fccqp/admm.pyx":847
  *             elif run.status in (_SOLVED, _INACCURATE):
  *                 run.status = _NUMERICAL_ERROR   # the scaled test passed, the point does not
  *         if not self.res.finite:             # <<<<<<<<<<<<<<
@@ -28785,7 +28861,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":842
+    /* "fccqp/admm.pyx":848
  *                 run.status = _NUMERICAL_ERROR   # the scaled test passed, the point does not
  *         if not self.res.finite:
  *             run.status = _NUMERICAL_ERROR             # <<<<<<<<<<<<<<
@@ -28794,7 +28870,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_v_run->status = __pyx_e_5fccqp_4admm__NUMERICAL_ERROR;
 
-    /* "fccqp/admm.pyx":841
+    /* "fccqp/admm.pyx":847
  *             elif run.status in (_SOLVED, _INACCURATE):
  *                 run.status = _NUMERICAL_ERROR   # the scaled test passed, the point does not
  *         if not self.res.finite:             # <<<<<<<<<<<<<<
@@ -28803,7 +28879,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   }
 
-  /* "fccqp/admm.pyx":843
+  /* "fccqp/admm.pyx":849
  *         if not self.res.finite:
  *             run.status = _NUMERICAL_ERROR
  *         self.has_previous = self.res.finite and run.status not in (             # <<<<<<<<<<<<<<
@@ -28817,7 +28893,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     goto __pyx_L5_bool_binop_done;
   }
 
-  /* "fccqp/admm.pyx":844
+  /* "fccqp/admm.pyx":850
  *             run.status = _NUMERICAL_ERROR
  *         self.has_previous = self.res.finite and run.status not in (
  *             _PRIMAL_INFEASIBLE, _DUAL_INFEASIBLE)             # <<<<<<<<<<<<<<
@@ -28828,7 +28904,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     case __pyx_e_5fccqp_4admm__PRIMAL_INFEASIBLE:
     case __pyx_e_5fccqp_4admm__DUAL_INFEASIBLE:
 
-    /* "fccqp/admm.pyx":843
+    /* "fccqp/admm.pyx":849
  *         if not self.res.finite:
  *             run.status = _NUMERICAL_ERROR
  *         self.has_previous = self.res.finite and run.status not in (             # <<<<<<<<<<<<<<
@@ -28850,7 +28926,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
   __pyx_L5_bool_binop_done:;
   __pyx_v_self->has_previous = __pyx_t_3;
 
-  /* "fccqp/admm.pyx":845
+  /* "fccqp/admm.pyx":851
  *         self.has_previous = self.res.finite and run.status not in (
  *             _PRIMAL_INFEASIBLE, _DUAL_INFEASIBLE)
  *         if self.has_previous:             # <<<<<<<<<<<<<<
@@ -28859,7 +28935,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   if (__pyx_v_self->has_previous) {
 
-    /* "fccqp/admm.pyx":846
+    /* "fccqp/admm.pyx":852
  *             _PRIMAL_INFEASIBLE, _DUAL_INFEASIBLE)
  *         if self.has_previous:
  *             copy(x, self.prev_x, n)             # <<<<<<<<<<<<<<
@@ -28868,7 +28944,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_x, __pyx_v_self->prev_x, __pyx_v_n);
 
-    /* "fccqp/admm.pyx":847
+    /* "fccqp/admm.pyx":853
  *         if self.has_previous:
  *             copy(x, self.prev_x, n)
  *             copy(y, self.prev_y, m)             # <<<<<<<<<<<<<<
@@ -28877,7 +28953,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_y, __pyx_v_self->prev_y, __pyx_v_m);
 
-    /* "fccqp/admm.pyx":848
+    /* "fccqp/admm.pyx":854
  *             copy(x, self.prev_x, n)
  *             copy(y, self.prev_y, m)
  *             copy(z, self.prev_z, n)             # <<<<<<<<<<<<<<
@@ -28886,7 +28962,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_z, __pyx_v_self->prev_z, __pyx_v_n);
 
-    /* "fccqp/admm.pyx":849
+    /* "fccqp/admm.pyx":855
  *             copy(y, self.prev_y, m)
  *             copy(z, self.prev_z, n)
  *             self.prev_rho = run.rho             # <<<<<<<<<<<<<<
@@ -28897,7 +28973,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 
     __pyx_v_self->prev_rho = __pyx_t_5;
 
-    /* "fccqp/admm.pyx":845
+    /* "fccqp/admm.pyx":851
  *         self.has_previous = self.res.finite and run.status not in (
  *             _PRIMAL_INFEASIBLE, _DUAL_INFEASIBLE)
  *         if self.has_previous:             # <<<<<<<<<<<<<<
@@ -28906,7 +28982,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   }
 
-  /* "fccqp/admm.pyx":822
+  /* "fccqp/admm.pyx":828
  *         run.backend = self.form
  * 
  *     cdef void _finish(self, Run* run, double* x, double* y, double* z,             # <<<<<<<<<<<<<<
@@ -28922,7 +28998,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 
 }
 
-/* "fccqp/admm.pyx":851
+/* "fccqp/admm.pyx":857
  *             self.prev_rho = run.rho
  * 
  *     cdef void _user_residuals(self, const double* x, const double* y,             # <<<<<<<<<<<<<<
@@ -28946,6 +29022,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   double __pyx_v_qx;
   double __pyx_v_by;
   double __pyx_v_support;
+  double __pyx_v_terms;
   double __pyx_v_total;
   double __pyx_v_value;
   Py_ssize_t __pyx_t_1;
@@ -28957,8 +29034,9 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   double __pyx_t_7;
   int __pyx_t_8;
   int __pyx_t_9;
+  double __pyx_t_10;
 
-  /* "fccqp/admm.pyx":855
+  /* "fccqp/admm.pyx":861
  *         """:mod:`fccqp.termination`'s residuals of the returned ``(x, y, z)`` on the user's
  *         data, with ``dist(x_S, C)`` as the primal part off the equalities."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -28967,7 +29045,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":856
+  /* "fccqp/admm.pyx":862
  *         data, with ``dist(x_S, C)`` as the primal part off the equalities."""
  *         cdef Problem* p = &self.prob
  *         cdef Residuals* r = &self.res             # <<<<<<<<<<<<<<
@@ -28976,7 +29054,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_v_r = (&__pyx_v_self->res);
 
-  /* "fccqp/admm.pyx":857
+  /* "fccqp/admm.pyx":863
  *         cdef Problem* p = &self.prob
  *         cdef Residuals* r = &self.res
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j             # <<<<<<<<<<<<<<
@@ -28993,7 +29071,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":858
+  /* "fccqp/admm.pyx":864
  *         cdef Residuals* r = &self.res
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         cdef double* Ax = self.vec_m             # <<<<<<<<<<<<<<
@@ -29004,7 +29082,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 
   __pyx_v_Ax = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":859
+  /* "fccqp/admm.pyx":865
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         cdef double* Ax = self.vec_m
  *         cdef double* grad = self.vec_n             # <<<<<<<<<<<<<<
@@ -29015,52 +29093,53 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 
   __pyx_v_grad = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":860
+  /* "fccqp/admm.pyx":866
  *         cdef double* Ax = self.vec_m
  *         cdef double* grad = self.vec_n
  *         cdef double* ATy = self.vec_n2             # <<<<<<<<<<<<<<
  *         cdef double* proj = self.vec_s
- *         cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, total = 0.0, value
+ *         cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, terms = 0.0, total = 0.0
 */
   __pyx_t_2 = __pyx_v_self->vec_n2;
 
   __pyx_v_ATy = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":861
+  /* "fccqp/admm.pyx":867
  *         cdef double* grad = self.vec_n
  *         cdef double* ATy = self.vec_n2
  *         cdef double* proj = self.vec_s             # <<<<<<<<<<<<<<
- *         cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, total = 0.0, value
- *         matvec(self.A_user, x, Ax, m, n)
+ *         cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, terms = 0.0, total = 0.0
+ *         cdef double value
 */
   __pyx_t_2 = __pyx_v_self->vec_s;
 
   __pyx_v_proj = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":862
+  /* "fccqp/admm.pyx":868
  *         cdef double* ATy = self.vec_n2
  *         cdef double* proj = self.vec_s
- *         cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, total = 0.0, value             # <<<<<<<<<<<<<<
+ *         cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, terms = 0.0, total = 0.0             # <<<<<<<<<<<<<<
+ *         cdef double value
  *         matvec(self.A_user, x, Ax, m, n)
- *         matvec_t(self.A_user, y, ATy, m, n)
 */
   __pyx_v_xPx = 0.0;
   __pyx_v_qx = 0.0;
   __pyx_v_by = 0.0;
   __pyx_v_support = 0.0;
+  __pyx_v_terms = 0.0;
   __pyx_v_total = 0.0;
 
-  /* "fccqp/admm.pyx":863
- *         cdef double* proj = self.vec_s
- *         cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, total = 0.0, value
+  /* "fccqp/admm.pyx":870
+ *         cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, terms = 0.0, total = 0.0
+ *         cdef double value
  *         matvec(self.A_user, x, Ax, m, n)             # <<<<<<<<<<<<<<
  *         matvec_t(self.A_user, y, ATy, m, n)
  *         matvec(self.P_user, x, grad, n, n)
 */
   __pyx_f_5fccqp_6_dense_matvec(__pyx_v_self->A_user, __pyx_v_x, __pyx_v_Ax, __pyx_v_m, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":864
- *         cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, total = 0.0, value
+  /* "fccqp/admm.pyx":871
+ *         cdef double value
  *         matvec(self.A_user, x, Ax, m, n)
  *         matvec_t(self.A_user, y, ATy, m, n)             # <<<<<<<<<<<<<<
  *         matvec(self.P_user, x, grad, n, n)
@@ -29068,7 +29147,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_f_5fccqp_6_dense_matvec_t(__pyx_v_self->A_user, __pyx_v_y, __pyx_v_ATy, __pyx_v_m, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":865
+  /* "fccqp/admm.pyx":872
  *         matvec(self.A_user, x, Ax, m, n)
  *         matvec_t(self.A_user, y, ATy, m, n)
  *         matvec(self.P_user, x, grad, n, n)             # <<<<<<<<<<<<<<
@@ -29077,7 +29156,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_f_5fccqp_6_dense_matvec(__pyx_v_self->P_user, __pyx_v_x, __pyx_v_grad, __pyx_v_n, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":866
+  /* "fccqp/admm.pyx":873
  *         matvec_t(self.A_user, y, ATy, m, n)
  *         matvec(self.P_user, x, grad, n, n)
  *         r.prim = r.prim_scale = 0.0             # <<<<<<<<<<<<<<
@@ -29087,7 +29166,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   __pyx_v_r->prim = 0.0;
   __pyx_v_r->prim_scale = 0.0;
 
-  /* "fccqp/admm.pyx":867
+  /* "fccqp/admm.pyx":874
  *         matvec(self.P_user, x, grad, n, n)
  *         r.prim = r.prim_scale = 0.0
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -29101,7 +29180,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":868
+    /* "fccqp/admm.pyx":875
  *         r.prim = r.prim_scale = 0.0
  *         for i in range(m):
  *             r.prim = max(r.prim, fabs(Ax[i] - self.b_user[i]))             # <<<<<<<<<<<<<<
@@ -29125,12 +29204,12 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->prim = __pyx_t_7;
 
 
-    /* "fccqp/admm.pyx":869
+    /* "fccqp/admm.pyx":876
  *         for i in range(m):
  *             r.prim = max(r.prim, fabs(Ax[i] - self.b_user[i]))
  *             r.prim_scale = max(r.prim_scale, max(fabs(Ax[i]), fabs(self.b_user[i])))             # <<<<<<<<<<<<<<
  *             by += self.b_user[i] * y[i]
- *         for j in range(s):
+ *             terms += fabs(self.b_user[i] * y[i])
 */
 
     __pyx_t_7 = fabs((__pyx_v_self->b_user[__pyx_v_i]));
@@ -29164,20 +29243,29 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->prim_scale = __pyx_t_5;
 
 
-    /* "fccqp/admm.pyx":870
+    /* "fccqp/admm.pyx":877
  *             r.prim = max(r.prim, fabs(Ax[i] - self.b_user[i]))
  *             r.prim_scale = max(r.prim_scale, max(fabs(Ax[i]), fabs(self.b_user[i])))
  *             by += self.b_user[i] * y[i]             # <<<<<<<<<<<<<<
+ *             terms += fabs(self.b_user[i] * y[i])
+ *         for j in range(s):
+*/
+    __pyx_v_by = (__pyx_v_by + ((__pyx_v_self->b_user[__pyx_v_i]) * (__pyx_v_y[__pyx_v_i])));
+
+    /* "fccqp/admm.pyx":878
+ *             r.prim_scale = max(r.prim_scale, max(fabs(Ax[i]), fabs(self.b_user[i])))
+ *             by += self.b_user[i] * y[i]
+ *             terms += fabs(self.b_user[i] * y[i])             # <<<<<<<<<<<<<<
  *         for j in range(s):
  *             i = p.constrained[j]
 */
-    __pyx_v_by = (__pyx_v_by + ((__pyx_v_self->b_user[__pyx_v_i]) * (__pyx_v_y[__pyx_v_i])));
+    __pyx_v_terms = (__pyx_v_terms + fabs(((__pyx_v_self->b_user[__pyx_v_i]) * (__pyx_v_y[__pyx_v_i]))));
   }
 
 
-  /* "fccqp/admm.pyx":871
- *             r.prim_scale = max(r.prim_scale, max(fabs(Ax[i]), fabs(self.b_user[i])))
+  /* "fccqp/admm.pyx":879
  *             by += self.b_user[i] * y[i]
+ *             terms += fabs(self.b_user[i] * y[i])
  *         for j in range(s):             # <<<<<<<<<<<<<<
  *             i = p.constrained[j]
  *             value = x[i]
@@ -29189,8 +29277,8 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":872
- *             by += self.b_user[i] * y[i]
+    /* "fccqp/admm.pyx":880
+ *             terms += fabs(self.b_user[i] * y[i])
  *         for j in range(s):
  *             i = p.constrained[j]             # <<<<<<<<<<<<<<
  *             value = x[i]
@@ -29198,7 +29286,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_i = (__pyx_v_p->constrained[__pyx_v_j]);
 
-    /* "fccqp/admm.pyx":873
+    /* "fccqp/admm.pyx":881
  *         for j in range(s):
  *             i = p.constrained[j]
  *             value = x[i]             # <<<<<<<<<<<<<<
@@ -29207,7 +29295,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_value = (__pyx_v_x[__pyx_v_i]);
 
-    /* "fccqp/admm.pyx":874
+    /* "fccqp/admm.pyx":882
  *             i = p.constrained[j]
  *             value = x[i]
  *             if value < self.lb_user[i]:             # <<<<<<<<<<<<<<
@@ -29219,7 +29307,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     if (__pyx_t_8) {
 
 
-      /* "fccqp/admm.pyx":875
+      /* "fccqp/admm.pyx":883
  *             value = x[i]
  *             if value < self.lb_user[i]:
  *                 value = self.lb_user[i]             # <<<<<<<<<<<<<<
@@ -29228,7 +29316,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
       __pyx_v_value = (__pyx_v_self->lb_user[__pyx_v_i]);
 
-      /* "fccqp/admm.pyx":874
+      /* "fccqp/admm.pyx":882
  *             i = p.constrained[j]
  *             value = x[i]
  *             if value < self.lb_user[i]:             # <<<<<<<<<<<<<<
@@ -29237,7 +29325,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     }
 
-    /* "fccqp/admm.pyx":876
+    /* "fccqp/admm.pyx":884
  *             if value < self.lb_user[i]:
  *                 value = self.lb_user[i]
  *             if value > self.ub_user[i]:             # <<<<<<<<<<<<<<
@@ -29249,7 +29337,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     if (__pyx_t_8) {
 
 
-      /* "fccqp/admm.pyx":877
+      /* "fccqp/admm.pyx":885
  *                 value = self.lb_user[i]
  *             if value > self.ub_user[i]:
  *                 value = self.ub_user[i]             # <<<<<<<<<<<<<<
@@ -29258,7 +29346,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
       __pyx_v_value = (__pyx_v_self->ub_user[__pyx_v_i]);
 
-      /* "fccqp/admm.pyx":876
+      /* "fccqp/admm.pyx":884
  *             if value < self.lb_user[i]:
  *                 value = self.lb_user[i]
  *             if value > self.ub_user[i]:             # <<<<<<<<<<<<<<
@@ -29267,7 +29355,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     }
 
-    /* "fccqp/admm.pyx":878
+    /* "fccqp/admm.pyx":886
  *             if value > self.ub_user[i]:
  *                 value = self.ub_user[i]
  *             proj[j] = value             # <<<<<<<<<<<<<<
@@ -29278,7 +29366,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":879
+  /* "fccqp/admm.pyx":887
  *                 value = self.ub_user[i]
  *             proj[j] = value
  *         for j in range(p.cones.count):   # cone blocks are contiguous in x too             # <<<<<<<<<<<<<<
@@ -29292,7 +29380,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":880
+    /* "fccqp/admm.pyx":888
  *             proj[j] = value
  *         for j in range(p.cones.count):   # cone blocks are contiguous in x too
  *             i = p.cones.offset[j]             # <<<<<<<<<<<<<<
@@ -29301,7 +29389,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_i = (__pyx_v_p->cones.offset[__pyx_v_j]);
 
-    /* "fccqp/admm.pyx":881
+    /* "fccqp/admm.pyx":889
  *         for j in range(p.cones.count):   # cone blocks are contiguous in x too
  *             i = p.cones.offset[j]
  *             proj_block(x + p.constrained[i], p.cones.kind[j], p.cones.dim[j], p.cones.mu[j],             # <<<<<<<<<<<<<<
@@ -29312,7 +29400,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":883
+  /* "fccqp/admm.pyx":891
  *             proj_block(x + p.constrained[i], p.cones.kind[j], p.cones.dim[j], p.cones.mu[j],
  *                        p.cones.normal + 3 * j, proj + i)
  *         r.dual_scale = 0.0             # <<<<<<<<<<<<<<
@@ -29321,7 +29409,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_v_r->dual_scale = 0.0;
 
-  /* "fccqp/admm.pyx":884
+  /* "fccqp/admm.pyx":892
  *                        p.cones.normal + 3 * j, proj + i)
  *         r.dual_scale = 0.0
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -29335,7 +29423,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":885
+    /* "fccqp/admm.pyx":893
  *         r.dual_scale = 0.0
  *         for j in range(s):
  *             i = p.constrained[j]             # <<<<<<<<<<<<<<
@@ -29344,7 +29432,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_i = (__pyx_v_p->constrained[__pyx_v_j]);
 
-    /* "fccqp/admm.pyx":886
+    /* "fccqp/admm.pyx":894
  *         for j in range(s):
  *             i = p.constrained[j]
  *             r.prim = max(r.prim, fabs(x[i] - proj[j]))             # <<<<<<<<<<<<<<
@@ -29368,7 +29456,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->prim = __pyx_t_6;
 
 
-    /* "fccqp/admm.pyx":887
+    /* "fccqp/admm.pyx":895
  *             i = p.constrained[j]
  *             r.prim = max(r.prim, fabs(x[i] - proj[j]))
  *             r.prim_scale = max(r.prim_scale, fabs(x[i]))             # <<<<<<<<<<<<<<
@@ -29392,12 +29480,12 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->prim_scale = __pyx_t_7;
 
 
-    /* "fccqp/admm.pyx":888
+    /* "fccqp/admm.pyx":896
  *             r.prim = max(r.prim, fabs(x[i] - proj[j]))
  *             r.prim_scale = max(r.prim_scale, fabs(x[i]))
  *             if z[i] > 0.0 and isfinite(self.ub_user[i]):             # <<<<<<<<<<<<<<
  *                 support += self.ub_user[i] * z[i]
- *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):
+ *                 terms += fabs(self.ub_user[i] * z[i])
 */
     __pyx_t_9 = ((__pyx_v_z[__pyx_v_i]) > 0.0);
 
@@ -29418,31 +29506,40 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     if (__pyx_t_8) {
 
 
-      /* "fccqp/admm.pyx":889
+      /* "fccqp/admm.pyx":897
  *             r.prim_scale = max(r.prim_scale, fabs(x[i]))
  *             if z[i] > 0.0 and isfinite(self.ub_user[i]):
  *                 support += self.ub_user[i] * z[i]             # <<<<<<<<<<<<<<
+ *                 terms += fabs(self.ub_user[i] * z[i])
  *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):
- *                 support += self.lb_user[i] * z[i]
 */
       __pyx_v_support = (__pyx_v_support + ((__pyx_v_self->ub_user[__pyx_v_i]) * (__pyx_v_z[__pyx_v_i])));
 
-      /* "fccqp/admm.pyx":888
+      /* "fccqp/admm.pyx":898
+ *             if z[i] > 0.0 and isfinite(self.ub_user[i]):
+ *                 support += self.ub_user[i] * z[i]
+ *                 terms += fabs(self.ub_user[i] * z[i])             # <<<<<<<<<<<<<<
+ *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):
+ *                 support += self.lb_user[i] * z[i]
+*/
+      __pyx_v_terms = (__pyx_v_terms + fabs(((__pyx_v_self->ub_user[__pyx_v_i]) * (__pyx_v_z[__pyx_v_i]))));
+
+      /* "fccqp/admm.pyx":896
  *             r.prim = max(r.prim, fabs(x[i] - proj[j]))
  *             r.prim_scale = max(r.prim_scale, fabs(x[i]))
  *             if z[i] > 0.0 and isfinite(self.ub_user[i]):             # <<<<<<<<<<<<<<
  *                 support += self.ub_user[i] * z[i]
- *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):
+ *                 terms += fabs(self.ub_user[i] * z[i])
 */
       goto __pyx_L13;
     }
 
-    /* "fccqp/admm.pyx":890
- *             if z[i] > 0.0 and isfinite(self.ub_user[i]):
+    /* "fccqp/admm.pyx":899
  *                 support += self.ub_user[i] * z[i]
+ *                 terms += fabs(self.ub_user[i] * z[i])
  *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):             # <<<<<<<<<<<<<<
  *                 support += self.lb_user[i] * z[i]
- *         r.dual = 0.0
+ *                 terms += fabs(self.lb_user[i] * z[i])
 */
     __pyx_t_9 = ((__pyx_v_z[__pyx_v_i]) < 0.0);
 
@@ -29463,38 +29560,47 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     if (__pyx_t_8) {
 
 
-      /* "fccqp/admm.pyx":891
- *                 support += self.ub_user[i] * z[i]
+      /* "fccqp/admm.pyx":900
+ *                 terms += fabs(self.ub_user[i] * z[i])
  *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):
  *                 support += self.lb_user[i] * z[i]             # <<<<<<<<<<<<<<
+ *                 terms += fabs(self.lb_user[i] * z[i])
  *         r.dual = 0.0
- *         for i in range(n):
 */
       __pyx_v_support = (__pyx_v_support + ((__pyx_v_self->lb_user[__pyx_v_i]) * (__pyx_v_z[__pyx_v_i])));
 
-      /* "fccqp/admm.pyx":890
- *             if z[i] > 0.0 and isfinite(self.ub_user[i]):
+      /* "fccqp/admm.pyx":901
+ *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):
+ *                 support += self.lb_user[i] * z[i]
+ *                 terms += fabs(self.lb_user[i] * z[i])             # <<<<<<<<<<<<<<
+ *         r.dual = 0.0
+ *         for i in range(n):
+*/
+      __pyx_v_terms = (__pyx_v_terms + fabs(((__pyx_v_self->lb_user[__pyx_v_i]) * (__pyx_v_z[__pyx_v_i]))));
+
+      /* "fccqp/admm.pyx":899
  *                 support += self.ub_user[i] * z[i]
+ *                 terms += fabs(self.ub_user[i] * z[i])
  *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):             # <<<<<<<<<<<<<<
  *                 support += self.lb_user[i] * z[i]
- *         r.dual = 0.0
+ *                 terms += fabs(self.lb_user[i] * z[i])
 */
     }
     __pyx_L13:;
   }
 
 
-  /* "fccqp/admm.pyx":892
- *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):
+  /* "fccqp/admm.pyx":902
  *                 support += self.lb_user[i] * z[i]
+ *                 terms += fabs(self.lb_user[i] * z[i])
  *         r.dual = 0.0             # <<<<<<<<<<<<<<
  *         for i in range(n):
  *             xPx += x[i] * grad[i]
 */
   __pyx_v_r->dual = 0.0;
 
-  /* "fccqp/admm.pyx":893
- *                 support += self.lb_user[i] * z[i]
+  /* "fccqp/admm.pyx":903
+ *                 terms += fabs(self.lb_user[i] * z[i])
  *         r.dual = 0.0
  *         for i in range(n):             # <<<<<<<<<<<<<<
  *             xPx += x[i] * grad[i]
@@ -29507,7 +29613,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":894
+    /* "fccqp/admm.pyx":904
  *         r.dual = 0.0
  *         for i in range(n):
  *             xPx += x[i] * grad[i]             # <<<<<<<<<<<<<<
@@ -29516,7 +29622,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_xPx = (__pyx_v_xPx + ((__pyx_v_x[__pyx_v_i]) * (__pyx_v_grad[__pyx_v_i])));
 
-    /* "fccqp/admm.pyx":895
+    /* "fccqp/admm.pyx":905
  *         for i in range(n):
  *             xPx += x[i] * grad[i]
  *             qx += self.q_user[i] * x[i]             # <<<<<<<<<<<<<<
@@ -29525,7 +29631,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_qx = (__pyx_v_qx + ((__pyx_v_self->q_user[__pyx_v_i]) * (__pyx_v_x[__pyx_v_i])));
 
-    /* "fccqp/admm.pyx":896
+    /* "fccqp/admm.pyx":906
  *             xPx += x[i] * grad[i]
  *             qx += self.q_user[i] * x[i]
  *             r.dual_scale = max(r.dual_scale, max(fabs(grad[i]), fabs(self.q_user[i])))             # <<<<<<<<<<<<<<
@@ -29564,7 +29670,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->dual_scale = __pyx_t_6;
 
 
-    /* "fccqp/admm.pyx":897
+    /* "fccqp/admm.pyx":907
  *             qx += self.q_user[i] * x[i]
  *             r.dual_scale = max(r.dual_scale, max(fabs(grad[i]), fabs(self.q_user[i])))
  *             value = grad[i] + self.q_user[i] + ATy[i] + z[i]             # <<<<<<<<<<<<<<
@@ -29573,7 +29679,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_value = ((((__pyx_v_grad[__pyx_v_i]) + (__pyx_v_self->q_user[__pyx_v_i])) + (__pyx_v_ATy[__pyx_v_i])) + (__pyx_v_z[__pyx_v_i]));
 
-    /* "fccqp/admm.pyx":898
+    /* "fccqp/admm.pyx":908
  *             r.dual_scale = max(r.dual_scale, max(fabs(grad[i]), fabs(self.q_user[i])))
  *             value = grad[i] + self.q_user[i] + ATy[i] + z[i]
  *             r.dual = max(r.dual, fabs(value))             # <<<<<<<<<<<<<<
@@ -29597,7 +29703,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->dual = __pyx_t_5;
 
 
-    /* "fccqp/admm.pyx":899
+    /* "fccqp/admm.pyx":909
  *             value = grad[i] + self.q_user[i] + ATy[i] + z[i]
  *             r.dual = max(r.dual, fabs(value))
  *             total += fabs(value) + fabs(x[i]) + fabs(z[i])             # <<<<<<<<<<<<<<
@@ -29608,7 +29714,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":900
+  /* "fccqp/admm.pyx":910
  *             r.dual = max(r.dual, fabs(value))
  *             total += fabs(value) + fabs(x[i]) + fabs(z[i])
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -29622,53 +29728,68 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":901
+    /* "fccqp/admm.pyx":911
  *             total += fabs(value) + fabs(x[i]) + fabs(z[i])
  *         for i in range(m):
  *             total += fabs(y[i])             # <<<<<<<<<<<<<<
  *         r.gap = fabs(xPx + qx + by + support)
- *         r.gap_scale = max(fabs(xPx), fabs(qx))
+ *         r.gap_scale = max(max(fabs(xPx), fabs(qx)), terms)
 */
     __pyx_v_total = (__pyx_v_total + fabs((__pyx_v_y[__pyx_v_i])));
   }
 
 
-  /* "fccqp/admm.pyx":902
+  /* "fccqp/admm.pyx":912
  *         for i in range(m):
  *             total += fabs(y[i])
  *         r.gap = fabs(xPx + qx + by + support)             # <<<<<<<<<<<<<<
- *         r.gap_scale = max(fabs(xPx), fabs(qx))
+ *         r.gap_scale = max(max(fabs(xPx), fabs(qx)), terms)
  *         r.finite = isfinite(total) and isfinite(r.gap) and isfinite(r.prim)
 */
   __pyx_v_r->gap = fabs((((__pyx_v_xPx + __pyx_v_qx) + __pyx_v_by) + __pyx_v_support));
 
-  /* "fccqp/admm.pyx":903
+  /* "fccqp/admm.pyx":913
  *             total += fabs(y[i])
  *         r.gap = fabs(xPx + qx + by + support)
- *         r.gap_scale = max(fabs(xPx), fabs(qx))             # <<<<<<<<<<<<<<
+ *         r.gap_scale = max(max(fabs(xPx), fabs(qx)), terms)             # <<<<<<<<<<<<<<
  *         r.finite = isfinite(total) and isfinite(r.gap) and isfinite(r.prim)
  * 
 */
 
-  __pyx_t_5 = fabs(__pyx_v_qx);
+  __pyx_t_5 = __pyx_v_terms;
 
-  __pyx_t_6 = fabs(__pyx_v_xPx);
+  __pyx_t_6 = fabs(__pyx_v_qx);
+
+  __pyx_t_7 = fabs(__pyx_v_xPx);
+  __pyx_t_8 = (__pyx_t_6 > __pyx_t_7);
+
+  if (__pyx_t_8) {
+
+    __pyx_t_10 = __pyx_t_6;
+  } else {
+
+    __pyx_t_10 = __pyx_t_7;
+  }
+
+
+  __pyx_t_6 = __pyx_t_10;
+
   __pyx_t_8 = (__pyx_t_5 > __pyx_t_6);
 
   if (__pyx_t_8) {
 
-    __pyx_t_7 = __pyx_t_5;
+    __pyx_t_10 = __pyx_t_5;
   } else {
 
-    __pyx_t_7 = __pyx_t_6;
+    __pyx_t_10 = __pyx_t_6;
   }
 
-  __pyx_v_r->gap_scale = __pyx_t_7;
+  __pyx_v_r->gap_scale = __pyx_t_10;
 
 
-  /* "fccqp/admm.pyx":904
+  /* "fccqp/admm.pyx":914
  *         r.gap = fabs(xPx + qx + by + support)
- *         r.gap_scale = max(fabs(xPx), fabs(qx))
+ *         r.gap_scale = max(max(fabs(xPx), fabs(qx)), terms)
  *         r.finite = isfinite(total) and isfinite(r.gap) and isfinite(r.prim)             # <<<<<<<<<<<<<<
  * 
 */
@@ -29700,7 +29821,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   __pyx_L22_bool_binop_done:;
   __pyx_v_r->finite = __pyx_t_8;
 
-  /* "fccqp/admm.pyx":851
+  /* "fccqp/admm.pyx":857
  *             self.prev_rho = run.rho
  * 
  *     cdef void _user_residuals(self, const double* x, const double* y,             # <<<<<<<<<<<<<<
@@ -29709,6 +29830,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
 
   /* function exit code */
+
 
 
 
@@ -31838,14 +31960,14 @@ static int __Pyx_modinit_Exttype___pyx_obj_5fccqp_4admm___pyx_scope_struct____ge
   __Pyx_RefNannySetupContext("__Pyx_modinit_Exttype___pyx_obj_5fccqp_4admm___pyx_scope_struct____get__", 0);
   /*--- Exttype __pyx_obj_5fccqp_4admm___pyx_scope_struct____get__ ---*/
   #if CYTHON_USE_TYPE_SPECS
-  __pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct____get__ = (PyTypeObject *) __Pyx_PyType_FromModuleAndSpec(__pyx_m, &__pyx_type_5fccqp_4admm___pyx_scope_struct____get___spec, NULL); if (unlikely(!__pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct____get__)) __PYX_ERR(0, 320, __pyx_L1_error)
+  __pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct____get__ = (PyTypeObject *) __Pyx_PyType_FromModuleAndSpec(__pyx_m, &__pyx_type_5fccqp_4admm___pyx_scope_struct____get___spec, NULL); if (unlikely(!__pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct____get__)) __PYX_ERR(0, 325, __pyx_L1_error)
   #else
   __pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct____get__ = &__pyx_type_5fccqp_4admm___pyx_scope_struct____get__;
   #endif
   #if !CYTHON_COMPILING_IN_LIMITED_API
   #endif
   #if !CYTHON_USE_TYPE_SPECS
-  if (__Pyx_PyType_Ready(__pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct____get__) < (0)) __PYX_ERR(0, 320, __pyx_L1_error)
+  if (__Pyx_PyType_Ready(__pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct____get__) < (0)) __PYX_ERR(0, 325, __pyx_L1_error)
   #endif
   #if CYTHON_COMPILING_IN_CPYTHON && PY_VERSION_HEX >= 0x030E0000
   PyUnstable_Object_EnableDeferredRefcount((PyObject*)__pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct____get__);
@@ -31871,14 +31993,14 @@ static int __Pyx_modinit_Exttype___pyx_obj_5fccqp_4admm___pyx_scope_struct_1_gen
   __Pyx_RefNannySetupContext("__Pyx_modinit_Exttype___pyx_obj_5fccqp_4admm___pyx_scope_struct_1_genexpr", 0);
   /*--- Exttype __pyx_obj_5fccqp_4admm___pyx_scope_struct_1_genexpr ---*/
   #if CYTHON_USE_TYPE_SPECS
-  __pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct_1_genexpr = (PyTypeObject *) __Pyx_PyType_FromModuleAndSpec(__pyx_m, &__pyx_type_5fccqp_4admm___pyx_scope_struct_1_genexpr_spec, NULL); if (unlikely(!__pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct_1_genexpr)) __PYX_ERR(0, 324, __pyx_L1_error)
+  __pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct_1_genexpr = (PyTypeObject *) __Pyx_PyType_FromModuleAndSpec(__pyx_m, &__pyx_type_5fccqp_4admm___pyx_scope_struct_1_genexpr_spec, NULL); if (unlikely(!__pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct_1_genexpr)) __PYX_ERR(0, 329, __pyx_L1_error)
   #else
   __pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct_1_genexpr = &__pyx_type_5fccqp_4admm___pyx_scope_struct_1_genexpr;
   #endif
   #if !CYTHON_COMPILING_IN_LIMITED_API
   #endif
   #if !CYTHON_USE_TYPE_SPECS
-  if (__Pyx_PyType_Ready(__pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct_1_genexpr) < (0)) __PYX_ERR(0, 324, __pyx_L1_error)
+  if (__Pyx_PyType_Ready(__pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct_1_genexpr) < (0)) __PYX_ERR(0, 329, __pyx_L1_error)
   #endif
   #if CYTHON_COMPILING_IN_CPYTHON && PY_VERSION_HEX >= 0x030E0000
   PyUnstable_Object_EnableDeferredRefcount((PyObject*)__pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct_1_genexpr);
@@ -32249,12 +32371,12 @@ static int __Pyx_modinit_Function_import_code(__pyx_mstatetype *__pyx_mstate) {
   {
     __pyx_t_1 = PyImport_ImportModule("fccqp.termination"); if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 1, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_1);
-    const char * __pyx_import_signature = __Pyx_PyBytes_AsString(__pyx_mstate_global->__pyx_kp_b_double_struct___pyx_t_5fccqp_6_t);
+    const char * __pyx_import_signature = __Pyx_PyBytes_AsString(__pyx_mstate_global->__pyx_kp_b_int_struct___pyx_t_5fccqp_11term);
     #if !CYTHON_ASSUME_SAFE_MACROS
     if (unlikely(!__pyx_import_signature)) __PYX_ERR(0, 1, __pyx_L1_error)
     #endif
-    const char * __pyx_import_name = __pyx_import_signature + 411;
-    void (**const __pyx_import_pointers[])(void) = {(void (**)(void))&__pyx_f_5fccqp_11termination_box_support, (void (**)(void))&__pyx_f_5fccqp_11termination_converged, (void (**)(void))&__pyx_f_5fccqp_11termination_nearly_converged, (void (**)(void))&__pyx_f_5fccqp_11termination_residuals, (void (**)(void)) NULL};
+    const char * __pyx_import_name = __pyx_import_signature + 340;
+    void (**const __pyx_import_pointers[])(void) = {(void (**)(void))&__pyx_f_5fccqp_11termination_converged, (void (**)(void))&__pyx_f_5fccqp_11termination_nearly_converged, (void (**)(void))&__pyx_f_5fccqp_11termination_residuals, (void (**)(void)) NULL};
     void (**const *__pyx_import_pointer)(void) = __pyx_import_pointers;
     const char *__pyx_import_current_signature = __pyx_import_signature;
     while (*__pyx_import_pointer) {
@@ -33429,49 +33551,49 @@ __Pyx_RefNannySetupContext("PyInit_admm", 0);
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
   __pyx_v_5fccqp_4admm__LOG_INTERVAL = __pyx_t_16;
 
-  /* "fccqp/admm.pyx":306
+  /* "fccqp/admm.pyx":311
  *         return &view[0]
  * 
  *     def update_cones(self, mu, normal):             # <<<<<<<<<<<<<<
  *         """New friction coefficients and normals for the same cone blocks."""
  *         self._keep[4][:] = mu
 */
-  __pyx_t_9 = __Pyx_CyFunction_New(&__pyx_mdef_5fccqp_4admm_9Workspace_3update_cones, __Pyx_CYFUNCTION_CCLASS, __pyx_mstate_global->__pyx_n_u_Workspace_update_cones, NULL, __pyx_mstate_global->__pyx_n_u_fccqp_admm, __pyx_mstate_global->__pyx_d, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[1])); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 306, __pyx_L1_error)
+  __pyx_t_9 = __Pyx_CyFunction_New(&__pyx_mdef_5fccqp_4admm_9Workspace_3update_cones, __Pyx_CYFUNCTION_CCLASS, __pyx_mstate_global->__pyx_n_u_Workspace_update_cones, NULL, __pyx_mstate_global->__pyx_n_u_fccqp_admm, __pyx_mstate_global->__pyx_d, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[1])); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 311, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_9);
   #if CYTHON_COMPILING_IN_CPYTHON && PY_VERSION_HEX >= 0x030E0000
   PyUnstable_Object_EnableDeferredRefcount(__pyx_t_9);
   #endif
-  if (__Pyx_SetItemOnTypeDict(__pyx_mstate_global->__pyx_ptype_5fccqp_4admm_Workspace, __pyx_mstate_global->__pyx_n_u_update_cones, __pyx_t_9) < (0)) __PYX_ERR(0, 306, __pyx_L1_error)
+  if (__Pyx_SetItemOnTypeDict(__pyx_mstate_global->__pyx_ptype_5fccqp_4admm_Workspace, __pyx_mstate_global->__pyx_n_u_update_cones, __pyx_t_9) < (0)) __PYX_ERR(0, 311, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
 
-  /* "fccqp/admm.pyx":311
+  /* "fccqp/admm.pyx":316
  *         self._keep[5][:] = np.asarray(normal, dtype=np.float64).reshape(-1)
  * 
  *     def forget(self):             # <<<<<<<<<<<<<<
  *         """Drop the previous solution, so that the next solve starts cold."""
  *         self.has_previous = False
 */
-  __pyx_t_9 = __Pyx_CyFunction_New(&__pyx_mdef_5fccqp_4admm_9Workspace_5forget, __Pyx_CYFUNCTION_CCLASS, __pyx_mstate_global->__pyx_n_u_Workspace_forget, NULL, __pyx_mstate_global->__pyx_n_u_fccqp_admm, __pyx_mstate_global->__pyx_d, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[2])); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 311, __pyx_L1_error)
+  __pyx_t_9 = __Pyx_CyFunction_New(&__pyx_mdef_5fccqp_4admm_9Workspace_5forget, __Pyx_CYFUNCTION_CCLASS, __pyx_mstate_global->__pyx_n_u_Workspace_forget, NULL, __pyx_mstate_global->__pyx_n_u_fccqp_admm, __pyx_mstate_global->__pyx_d, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[2])); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 316, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_9);
   #if CYTHON_COMPILING_IN_CPYTHON && PY_VERSION_HEX >= 0x030E0000
   PyUnstable_Object_EnableDeferredRefcount(__pyx_t_9);
   #endif
-  if (__Pyx_SetItemOnTypeDict(__pyx_mstate_global->__pyx_ptype_5fccqp_4admm_Workspace, __pyx_mstate_global->__pyx_n_u_forget, __pyx_t_9) < (0)) __PYX_ERR(0, 311, __pyx_L1_error)
+  if (__Pyx_SetItemOnTypeDict(__pyx_mstate_global->__pyx_ptype_5fccqp_4admm_Workspace, __pyx_mstate_global->__pyx_n_u_forget, __pyx_t_9) < (0)) __PYX_ERR(0, 316, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
 
-  /* "fccqp/admm.pyx":326
+  /* "fccqp/admm.pyx":331
  *         return [tuple(self.log[5 * i + j] for j in range(5)) for i in range(self.log_count)]
  * 
- *     def solve(self, double[:, ::1] P, double[::1] q, double[:, ::1] A, double[::1] b,             # <<<<<<<<<<<<<<
- *               double[::1] lb, double[::1] ub, x0, bint warm, double start_time,
- *               double[::1] x_out, double[::1] y_out, double[::1] z_out, double[::1] cert_out):
+ *     def solve(self, const double[:, ::1] P, const double[::1] q, const double[:, ::1] A,             # <<<<<<<<<<<<<<
+ *               const double[::1] b, const double[::1] lb, const double[::1] ub, x0,
+ *               bint warm, double start_time,
 */
-  __pyx_t_9 = __Pyx_CyFunction_New(&__pyx_mdef_5fccqp_4admm_9Workspace_7solve, __Pyx_CYFUNCTION_CCLASS, __pyx_mstate_global->__pyx_n_u_Workspace_solve, NULL, __pyx_mstate_global->__pyx_n_u_fccqp_admm, __pyx_mstate_global->__pyx_d, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[3])); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 326, __pyx_L1_error)
+  __pyx_t_9 = __Pyx_CyFunction_New(&__pyx_mdef_5fccqp_4admm_9Workspace_7solve, __Pyx_CYFUNCTION_CCLASS, __pyx_mstate_global->__pyx_n_u_Workspace_solve, NULL, __pyx_mstate_global->__pyx_n_u_fccqp_admm, __pyx_mstate_global->__pyx_d, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[3])); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 331, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_9);
   #if CYTHON_COMPILING_IN_CPYTHON && PY_VERSION_HEX >= 0x030E0000
   PyUnstable_Object_EnableDeferredRefcount(__pyx_t_9);
   #endif
-  if (__Pyx_SetItemOnTypeDict(__pyx_mstate_global->__pyx_ptype_5fccqp_4admm_Workspace, __pyx_mstate_global->__pyx_n_u_solve, __pyx_t_9) < (0)) __PYX_ERR(0, 326, __pyx_L1_error)
+  if (__Pyx_SetItemOnTypeDict(__pyx_mstate_global->__pyx_ptype_5fccqp_4admm_Workspace, __pyx_mstate_global->__pyx_n_u_solve, __pyx_t_9) < (0)) __PYX_ERR(0, 331, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
 
   /* "(tree fragment)":1
@@ -33692,30 +33814,30 @@ static int __Pyx_InitConstants(__pyx_mstatetype *__pyx_mstate) {
   CYTHON_UNUSED_VAR(__pyx_mstate);
   {
     const struct { const unsigned int length: 9; } str_length_index[] = {{0},{6},{8},{15},{1},{2},{15},{23},{25},{32},{20},{22},{1},{1},{37},{45},{22},{179},{8},{15},{7},{6},{2},{9},{50},{409},{18},{30},{37},{1},{5},{8},{13},{8},{15},{20},{20},{8},{15},{17},{12},{8},{15},{15},{1},{17},{12},{17},{7},{7},{6},{17},{8},{10},{15},{9},{34},{27},{29},{16},{15},{22},{20},{12},{9},{17},{8},{8},{12},{10},{8},{10},{8},{7},{14},{11},{10},{19},{14},{12},{10},{17},{13},{12},{12},{19},{8},{13},{3},{12},{21},{22},{15},{5},{15},{7},{17},{18},{4},{1},{4},{1},{8},{17},{18},{5},{5},{11},{5},{5},{15},{6},{9},{7},{12},{12},{7},{5},{10},{5},{5},{7},{6},{6},{7},{7},{5},{2},{5},{4},{5},{8},{1},{11},{2},{8},{11},{8},{1},{8},{7},{4},{2},{1},{4},{4},{4},{6},{2},{5},{3},{5},{1},{4},{3},{1},{1},{8},{7},{19},{3},{3},{4},{7},{13},{4},{4},{10},{8},{5},{5},{4},{5},{5},{10},{4},{4},{6},{5},{10},{2},{6},{6},{12},{5},{6},{4},{1},{2},{6},{5},{5},{5},{5}};
-    const struct { const unsigned int length: 10; } bytes_length_index[] = {{1},{654},{459},{233},{393},{447},{795},{244},{212},{187},{9},{46},{10},{413},{2}};
+    const struct { const unsigned int length: 10; } bytes_length_index[] = {{1},{654},{233},{376},{393},{447},{795},{244},{212},{187},{9},{46},{10},{413},{2}};
     #ifndef CYTHON_COMPRESS_STRINGS
       #define CYTHON_COMPRESS_STRINGS 90
     #endif
-    #if (CYTHON_COMPRESS_STRINGS) == 1 /* compression: zlib (2246 bytes) */
-static const char cstring[] = "x\332\325X\315o\033\271\025W\320\024\360v\2356n\222\002\213\266\350\004u\327q\233h\343\330\335l\027i\212\211<n\324\330\326\247\275\016v\267\0045CI\023\317\220c\222\243H\001\n\344\350\243\216s\324QG\035u\364QG\035u\334?\241\177B\0379\372\030ol\331\371*Z\003&\037\277\336\027\337\373=\216\014,\215\373M\203U^\020[>\276#9!F\225\343\232O\250\\M\177m<\332!>\343\255}\227\2744X\325xd3*\335Z\310Ba`\352\030\216\313\325\271\037O\273t\262 $w\035\342$6\033\214\317]?=7\335\371\370o\031L)\223\006\026\302\255QC2\203\023\354\334c\324k\031\276V\262\001Jfi\003{\256c\370\314!w\r\322\014\340,\260Z\261W\224\334\225*\343\222c\272r\327\250\001\253\311fQ\307\001\001Q\006n\272\302\330e\222\030\262\016\216\311\264d\235Q\003\346\034\342\271\025\302\261$ M\351\007\\\271\332D\215\274\225\277\267\361\325\206\326\226\023\345Fa\210\260b{\240(\021\312i\225\320\365$p\227\255\200\210\264\221\255\032-\026\032\224\200^`E\000\373\222\007d\235PC\020\251\010cE\333\214\245\313(\202\343.\255\255\214\335\3446\210:\275\205=A\322\330q\020\354#6\363<\265\306\250H\343\212\355\270\002W<B\250jk\266+b\312\241\014\014\252\342\320\223\006B\2348\241M\0202\234Ps\244\214\336\003\003\033.\366`\325v\251+\021\022\304\253\246M\024\n\302\357j:\237\2401\216\373Jb\256\3421\373\020\t\211\271\214\047l2\241\034$l\360\244]\037\017cs\030\215\207\344\364\252;>tx8&\274\244\024\217\325b\"\340\244\201\232\t\272\225\240_MhV\211\251\243\004\0130\177B\210\261\010^g\240\004\366\310d(bB\340\306d\263`^L\204Iu\032\304F\376\214\244\t\362A\202^\237\321\"A>0\3548\302+\304\200|j\200\303\342\010\301F>\016\3048K\r\010b#p\355C\017\302Ap\373\213\252m\037\005_`\307\367\323A\253\031\352;\326\347<\270\004\010Y\003s\216[\206\203%N\237\261\032G\277\n\3378\361D\3324K\231l\366\211\231yf\355n\226\306=\3325w,\030l\242M\263ln\356\231\333(\273\273e\231\245\354\223m\313*\3008[~\216Je\263XF\333\331\235l\371Gs\245\262\225/Y\236\347\006\302\025[\331\003k\023\025\237\346P)cn[\331]3\223\331+\232e\013m\231\231r\256\270\235\373;p/[\305}s{\307<@\300\255\270\233+\243Lnw""\337:\200n\323\332\335\333\261\212Y8\215\254b1W\314\347\213\331\235S:\025\255\315\275\014H\311\344J\345\242U\002\2560\230(\245D\003c\335ewK\271\355}k3n\321L\231\0229\n\t\265I9\273c\3056)\034L\317 \361\033\306\017E\200m2%\322\010\325\010$L\372\221\362\256\047\036\247k\204\002\014\361\344\216q\312\331\372V\021J.A\342C\322\310\263\026\341\332\201\365l\0141\330H\010\016\003G\237c\224\010\204\362\255&\374o\002N\241]\322\224EREh\214%\220\353\220\327\nmf\0040v%\361\325\204\243\316\300_5\244\266\352k\023\215\340\317\365\003\000PE\371\330\245\272gN\350\3515\212\375\270\047/U\007\221\210\354:\261\017E\350\307\2431\027E*$\214\251\220\352H&\310\242\223}\r\251BT\3618\n\2617a;\201\2517\2747\235 M5\000\007NU\021\t\325\337p,B\0222^\031%\300i\234\205\000\321\004@\023;8P\350\212\000\006\2224r)`>\024\214S\223\222yP\026 F&\351\204*a\265\nS^P\307\220S\204\013\020\026\327\047,t\"b1\253\226\343\211\026\265]\226\236j!p(Y\245\202\005\261\025l\"\230\325\256\004\215\271\357R]\016l\310~\002:!\250g6\251`\373\320\366\030\034P\327\017\r\2442\334\020ql\026R\351(\177\353F\031\033\243\010\3045\224H\002^\327e\215\004\002\341\212P\235\003^\007\306UE\007\334\365\0474\047`*g\\\303MZ\301M\325m\022\247\352\341\232\250z\014\313/7\342\020\205\326\307r\\j\307\341_\013\t\324m\007\3129i\202#\003\025m\"n^\221\027\200\356H\231@\250\343U<\307\203\340\363<\325\307W\353\000\316#\316^\n\337\307M\344*/\020_U{U\345\375\220\252\373\206w\202\017\222$U\302=\032\200aA\013Le\034\356 \200\0149\014Xp\3049\251\271\002\030\000\332+\330S\240\3178AU\202\205[q=W\266\340VyH\005\260T5@A\254]\017\371D\023\005\327PF\241\227\343\022\n\224T\2734?x\232\370X\231\244\223S\227?\335 \351\002?\tn\224\014\376yhKY\007\213\3244\362\\\337\225a\005R\001\264\214\3238\231\314\020r!\321\215x\211\271\337l\336o\336G\201\344M\025\027-\325\274\322\r\341L\344\034\026*|\2773\356\377x\327\230O\345[H(}\221<\2176t4\235\336{\326\334i\372r\362WS\r\006\357\257\211\266S\256\037f|\031\353\316\266\352\343\351\374_\323\375\334q\034}\306\030\210\321\237u:\243/5&""\013\224Q\021w\371\353\203\002\tISQ\010\222\202\244Q\217\246\224n\343\247\337$\032\347\313\314\303\303\314#\376y*\257\246\0000\316\343\261\266\226\300DT\204\004T\360%\316s\373\207\3445\343\031\007\304[\0329\177{VjX\026\227\213\311\363\270\235g\021\370\264\302\240\"\207\201\252\347\251\370\265Y#N\n* \367Zh6\301\047g\346\372-\206\321\251\224\t}\276b\353\n\361\237=+\237\277\343\341\030p\201\237\356\325N\320\341\"\277\275\253\233\301#\343Z0\307\320\213\265\276 \244\337\314F\22067&\337C\244\366\326\331r\347\207\354{\233y\341\030\024P2t\2305\241\346\352Q\025\333\340\177M\352\3529\307+o)\377\"\024{\027I\357\226\276\377/\232$u\232\276\007\325\023\t\360\235\250g9\\\032\314)\236\3529EeJ\275\024O\355\233c\312Y\271\375\221Cq\256k/\257\317{\303\314\333\025\217\017\240\330\374\214\374\350\342/\017\277\377+\232\314nHc\363D\260\376(\325\365qZ\035\341\253o\272\314\211\372\\K\301w\017\341.\244\307\253\331\222~\t%F$8\247\214\336\327\277F\306UtK\375\360Ik\037\353i\374\241\036\360gS*\325\340F\341!H\021|\003\203\303\202\326\331\217\346\371\322\347\325\217w{\204_\352\361{\226\033V\001\340\330\013\244\177\326\214I\370\356\233\027\261_M?\376\31511-\367o\177\354\362\261;\323}55e\005/\033\"gC\025\202\257\257\214\256\376\354\370O\355\302k\363\207\205\305\343\255\366\355\366\203\366~\2646J\014\036D\007\235B\247\336\255\366\236\364\334~\363\204\017\226\364\356\341\342o\"\363\265\371\357_\245>\371ut;\332\210\216F\0130\243w\343\321\302g\321\315\250\360\303\302r\007\366~z\274~\\k\027F\2137\333\346h\361V\273\320&\321Zd\216\256\375|\264x\275\375I\364[8p}\251\275\004\022\327\333\0160\203\305\250\334Y\352\334\356\254u2\235F\367\233\336V\377v\177\255o\366\367O\036\016>\037\346\013\303BiX*\017\313\007\303\203\347\303\347\337\016\277\375n\370\335\367\243\35374\203\325\316F\247\325\273\332\313\366\313\047\237\r\226\007\300\375f\373\037\021V*~z\274q\334\000\263\326#\014\302\207\327\215\316\225\321\342\215\366\327Q\251\363\323\316^\367\017\335\260\227\351\205\375X\271_\266\227\333\265\250\020U;O\273V\357f""\257\334\377\335\000\266\377\342X\264\357D\277\217\n\212\357S\320\265\020\021\320\324\352.u\227\273\0308\230\275\375\376\303\223\317\007W\006\267\006x \265\246J\301\341\367\377\034io\324\333v\2644\226\177u\270\274\321\333\354_;\001\007\335\030\336X\006\213C\220v\253G\372\353\303\307\271A8,\357\251\0131\217\313\355\245\321\302\365\366O\332\177\2112\321\277\272\231n\243W\350\325\372\205~\355\244pR\035d\006G\312\003\177\355\\\353\026\272vo)\302\377\001\327\376\231\227";
-    PyObject *data = __Pyx_DecompressString(cstring, 2246, 1);
+    #if (CYTHON_COMPRESS_STRINGS) == 1 /* compression: zlib (2231 bytes) */
+static const char cstring[] = "x\332\325X\313o\033\307\031\227Q\027p\032\271\265j\033h\320\026\035\243jd56cYj\234\006\256\2135\265\252Y\353\305\207\024\031I:\030\356\016\311\265vgV3\2634i\240\200\217:\362\270G\036y\344\221G\035y\344\221\307\374\t\375\023\372\315,\037\253D\242\345W\320\n\320\3147\257\3575\337\367\373f\211\210B\367\032\210\227\237SG=\272\255\004\245\250\"H5\240L-g\276B\017\267h\300Es\337\243/\020\257\240\207\016g\312\253F<\222\2100\027\271\236\320\347~8\355\261\361\202T\302s\251\233\332\214\270\230\271~zn\262\363\321\337\263\2041\256\020\221\322\2532\2448\022\224\270w9\363\233(0J\326A\311\034\253\023\337sQ\300]z\007\321F\010g\201\325\222\263\244\345.U\270P\202\260\245;\250\n\254\306\233e\215\204\024D!\322\360$\332\346\212\"U\003\307d\233\252\306\031\2029\227\372^\231\n\242(H\323\372\001W\24171\264k\357\336]\373r\315h+\250v\243D2*;>(J\245vZ9\362|\005\334U3\2442\203r\025\324\344\021b\024\364\002+B\330\227>\240j\224!I\225&\320\222\261\231(\2173\014\307=V]\032\271\311\253S}z\203\370\222f\210\353b\330G\035\356\373z\2153\231!e\307\365$)\373\2242\335V\035O&\224\3138\030T!\221\257\020\306\202\272\221C1Fnd82\316\356\202\201u\217\370\260\352x\314S\030K\352W2\026\216$\025w\014\275\233\242\tI\372rj\256\354s\347\020KE\204J&\034:\246\\,\035\360\244S\033\r\023s8K\206\364\364\2527:tx8\"\374\264\024\237W\023\"\024\264\216\033)\272\231\242_\216i^N\250\243\024\0130\177L\310\221\010Q\343\240\004\361\351x(\023B\222\372x\263\344~BDiu\352\324\301\301\224d)\362~\212^\235\3222E\336GN\022\341e\212 \237\352\340\260$B\010\332M\0021\311R\004A\214B\3179\364!\034\244p>\2578\316Q\3709q\203 \0236\033\221\271cs\316\207K\200\220ED\010\322D.Q$s\306j\022\375:|\223\304\223\031\313*fs\271\307V\366\251\275\275^\034\365x\333\332\262a\260\216\327\255\222\265\276gm\342\334\366\206m\025s\2177m;\017\343\\\351\031.\226\254B\to\346\266r\245\037\314\025K\366n\321\366}/\224\236\334\310\035\330\353\270\360d\007\027\263\326\246\235\333\266\262\331\275\202U\262\361\206\225-\355\0246w\376\001\334Kva\337\332\334\262\0160p+l\357\224pvg""{\337>\200n\335\336\336\333\262\01398\215\355Ba\247\260\273[\310m\235\322\251`\257\357eAJv\247X*\330E\340\n\203\261RZ406]n\273\270\263\271o\257\047-\236*S\244G\021e\016-\345\266\354\304&\215\203\231)$~\315\305\241\014\211C\047D\006\343*\205\204\311<\324\336\365\345\243L\2252\200!\221\3361J9\307\334*\306\351%H|H\032u\326\"\\;\260\236\216!\006\353)\301Q\350\232s\234Q\211\361n\263\001\377\353\200Sx\2336T\201V0\036a\t\344:\344\265F\233)\001\214=E\003=\341\3523\360W\211\230\243\373\352X#\370\363\202\020\000TS\001\361\230\351\271\033\371f\215\221 \351\351\013\335A$b\247F\235C\031\005\311h\304E\223\032\t\023*b&\222)\266\331x_]\351\020\325<\216\"\342\217\331\216a\352G\336\233L\320\206\036\200\003\047\252\310\224\352?r,\306\n2^\033%\301i\202G\000\321\024@\223\270$\324\350\212\001\006\3224\366\030`>\024\214S\223\212\373P\026 F\306\351\204\313Q\245\002S~X#\220STH\020\226\324\047\"M\"\0229\255\226\243\211&s<\236\231h!I\244x\271L$u4lb\2305\256\004\215E\3401S\016\034\310~\n:a\250g\016-\023\347\320\3619\034\320\327\017\r\2442\334\020u\035\0361\345j\177\233F\033\233\240\010\3045\224H\n^7e\215\206\022\223\262\324\235\013^\007\306\025M\207\302\013\306\264\240`\252\340\302\300MF\303M\305kP\267\342\223\252\254\370\234\250/\326\222\020\2056 jTjG\341_\215(\324m\027\3129m\200#C\035m2i^\322\347\200\356X\233@\231\353\227}\327\207\340\363}\335\047W\353\002\316c\301_\310  \r\354i/\320@W{]\345\203\210\351\373\206wB\000\222\024\323\302}\026\202aa\023L\345\002\356 \204\0149\014yx$\004\255z\022\030\000\332k\330\323\240\317\005\305\025J\244W\366|O5\341VE\304$\260\3245@C\254S\213\304X\023\r\327PF\241W\243\022\n\224\322\273\014?x\232\004D\233d\222\323\224?\323`\345\001?\005nT\034\376E\344(U\003\213\3644\366\275\300SQ\031R\001\264L\3228\235\314\020r\0215\215|AD\320h\334k\334\303\241\022\r\035\027M\335\2744\r\025\\\356\270<\322\370~{\324\377\371\016\232M\3556\261\324\372bu\036\215L4\235\336{\326\334i\372b\362\227\347\352\034\336_cm\047\\\337\317\370\"\326\235m\325\207\323\371\047\323\375\334q\022}h""\004\304\370/&\235\361\027\006\223%\316\352\210\273\370\365A\201\204\244)k\004\231\203\244\321\217\2469\323&O?\310tt\373l\201++I\356%o\333\302\224>_\307U\r\023O\237\226\316\337\361`\224\245\300\317\364z\047\350\360:\243w\341e\350\323\340\242>\312)\003\231R;`\004 3\rM\241\2666\324\323\000+\317\013\214\345\271\367\307k\3123\t\331\017\343\205\013e\315y\334\316\263\010\\\233\274\201\253\324\235\203\272,\374&\236N\210\361\276\031\276z}\264\234k\370y\251\n\322f^\317;\2104Qz\266\334\331\267\367\316f\276v\014\nh\031\306\373\r(\220fT!\016\304\275!M\251\233\341\2257\224\377:\310y\033Io\027\311\377/\232\244u\232<\336\364{\006\300\230\35274\\\032\314i\236\372\355\303\324\234~\326\235\3327\303\224\2630\365\003\207\342L\327^\\\237w\206\3677\303\321\367\240\330\354\214\374\340\342/^\366\376W4\231\336\220\301\346\261`\363\005i\312\306\244h\300\047\332dYP\375m5\007\037)Tx\220\036/\247K\346\331\222\032\321\360\234\272u\317\374t\230\224\255\r\375+%\253~\250w\354\373zm\237M\351T\203\033\205W\033\303\360\301\n\016\013\233g\277pgK\237U?\336\356\305|\241\227\352YnX\006\200\343\317\261\371\r2!\341#mV\304~9\371R\267F\304\244\334\277\371\261\213\307\356T\367\345\271\t+x\333P5\035\352\020|uix\371\027\307\237\265\362\257\254\357\257\314\037o\264n\265\356\267\366\343\225ajp?>h\347\333\265N\245\373\270\353\365\032\047\242\277`v\017\346\177\027[\257\254\377\374f\356\243\337\306\267\342\265\370hx\005f\314n2\274\362I|#\316\177\177e\261\r{?>^=\256\266\362\303\371\033-k8\177\263\225o\321x%\266\206W\1779\234\277\326\372(\376=\034\270\266\320Z\000\211\253-\027\230\301b\\j/\264o\265W\332\331v\275\363uw\243w\253\267\322\263z\373\047\017\372\237\016v\363\203|qP,\rJ\007\203\203g\203g\337\014\276\371v\360\355w\303k\327\r\203\345\366Z\273\331\275\334\315\365J\047\237\364\027\373\300\375F\353\2371\321*~|\274v\\\007\263Vc\002\302\007\327P\373\322p\376z\353\253\270\330\376y{\257\363\247N\324\315v\243^\242\334\257[\213\255j\234\217+\355\047\035\273{\243[\352\375\241\017\333\177u,[\267\343?\306y\315\367\t\350""\232\217)hjw\026:\213\035\002\034\254\356~\357\301\311\247\375K\375\233}\322WFS\255\340\340\273\177\r\2157j-\047^\030\311\277<X\\\353\256\367\256\236\200\203\256\017\256/\202\305\021H\273\331\245\275\325\301\243\235~4(\355\351\013\261\216K\255\205\341\225k\255\237\265\376\032g\343\177w\262\235z7\337\255\366\362\275\352I\376\244\322\317\366\217\264\007\376\326\276\332\311w\234\356BL\376\013\014\237{N";
+    PyObject *data = __Pyx_DecompressString(cstring, 2231, 1);
     #define __Pyx_DecompressString_LZSS_UNUSED
     if (unlikely(!data)) __PYX_ERR(0, 1, __pyx_L1_error)
     const char* const bytes = __Pyx_PyBytes_AsString(data);
     #if !CYTHON_ASSUME_SAFE_MACROS
     if (likely(bytes)); else { Py_DECREF(data); __PYX_ERR(0, 1, __pyx_L1_error) }
     #endif
-    #elif (CYTHON_COMPRESS_STRINGS) > 0 && (CYTHON_COMPRESS_STRINGS) <= 90 /* compression: lzss (2999 bytes) */
-static const char cstring[] = "\377 at 0x o\377bject>(t\377ree frag\377ment).: \377<MemoryV\377iew of <\377contiguo\377us and d\263ir4\001\007\rin\021\005s\277trided\"\010 7or \004\031><(\tA\006\377>?Cannot\377 assign \377to read-\277only m\240\002v\376\242\000Invalid\377 mode, esxp\324\000|\000\047c\047t\001\377\047fortran\317\047, gH\000%\005sh\367ape\222\000 axi\377s Note t\375h\226 Cython\375 \021\000delibe\317ratek\000\320\001ct\373er!\001n PEPo-484\212\"re\303!\177s subcl\246\000\373es\261!built\375i\260\000ypes. \377If you n\311e\224 \303\000p\316\000%\tth\277en set\200\000e\373 \047\357\002ation\377_typing\047\366\355$iv\242\000o Fa\377lse.add_>\231 ecoll\305@+\000\377s.abcdis\277ableen\002\001g\367cis\004\003dno \377default \377__reduce\337__ duM\002no{n-\262@vial\033\000\377cinit__s\377elf.A_us\327er,\007\002P\001\010aa\372\016\003b\025\010block\277_start+\003c\275e\002\005d_sc\307 c\241hD\003\275c\336\000S\003e\020\013i\3268\004kkA\004lZ\tlo\375g\211\003prev_xj\001\010y\r\010z\034\005ob\267\003qq\276\010\374\000\314\003res\244\004wrho\240\000ale\022\004\373hs\356\003saved\326\004\004ol\202#u\351\tve\247c_m\232#\007\001n\000\0102\352\014\0103\031\007s\000\0102 c\376\334\204\003be conv\234\256 \234ca P\203\204\003\240\206\003 \377for pick\375l\214`src/fc\377cqp/admm\237.pyxu\351B\234\205\001a\375l\202@ate ar\377ray data\341.\013\020\370\204\003\312\206\001\247\206\003s.A\377ASCIIBAC\337KENDS\001\004_N\367AME\n\000D_DA\377TADUAL_I\377NFEASIBL\367EEQ\r\000ITY_\377START_LI\367MIT\005\014STEP\377SEllipsi\377sFIXED_R\377HO_SCALE\377INACCURA\377TE_FACTO\357RLOG[\000TER\177VALMAX_K\000\377RNOT_CON\367VEX\004\000DENU\357MERI;\000_ER\377RORPPRIM\276\207\nREDUCc\000C?OSTRESS\000p\000\360\241\005w\001V\000\002\002INSO\257LVED\000\003_\203\007S\377equenceT\247IME\316\003\204\211\001.\211\211\007W\377orkspace\376\000\006.__get_\367_.<\370!ls>.\177genexpr\026\t\332\354\205\004c\332\207\002__1\tse\177tstate_\013\017\347forX\000`\007sol\335vn\010upd3\002on\177es__Pyx\001\000\377Dict_Nex\277tRef__\305""\207\004e\217____\232\210\002\000\006\260\001i\227tem\026\001d0\001 \000f\227unc&\001g\212\0054\000i\337mport<\001ma{in\003\002odulM\002\267nam\002\003ew]\001p\376~\000checksu\350T\000\n\001\322\003_\025\001typ\333e_\005\002un\305\204\002e_\233En \005vt\261\210\001\241\001q\007ualO\005\237\210\005\250\210\006\266%\271\210\006Kex\325\001s\373 \203\005s\260\010\276\310.__tes\310\001i\377s_corout\377ineabcad\377aptive_r\373ho\000\t_inte\357rval\010\ntol\347era\241`\345\205\005_bu\377fferalph\377aanderso\333n_\232\214\003as\204\206\002as\374\273\215\007\n\004yncio.\376}\006sautobb/asec\263\211\001_\231\000\306\"\336\257\000rmin\212\213\002cl\334\254\000\221\000_tr\375`ba\237ckclo.\000\373Ac\337onstr\237@ed?countd\354!\000\002\371_\352\000\346\216\003encod\363ee\363 \322\214\002eps_\227abs\003\001d\363 \352\000f\336\017\001prim\004\005re\256\350\000ror\352\207\002.\353\207\001f\377ixedflag\377sfloat64~\235\204\003format\344\215\004\376\370\204\004guessidUi\217 x\306 p\352as\000\002\377izejkkt_\376\277\001endlbld?l_full\004\001\227\214\003\377dlog_row\377smmax_it\237ermem\352\216\001\342\216\001m\373un\367andimn\357extny\001lnp\376\314`pyobjor\366\201@pp\235 popq\377rregiste\370\005\000\360\216\002\361\212\001ore_f\377easibili\377tyrhorun\177samesca\336\211\002\257chur\240\215\004d\205\215\001s\356\244\000set\274\215\004setyt\205\212\001\300\217\002sigmG\000\343ze\230\206\002\372\214\002\377\214\002_ti\372M\000t\343 topst?ructth\317\000\023\001\377_limitub\343un\242\001\301\206\003\301\206\tval\373ue\000\002swarm\377xx0x0_pt\253rx\224ay\231az\000\002e\377rosOdoub\357le (\001\004*, |\000\007\000\021Py_ss\200@\217_t, \000\t\016\007\210\214\001s\207t *\024\t\000\0212\013Z#)\237\000void\245\006\263\204\002 \000\252\007\000\r\000\0351\014\272\025\310\037\2429v;\240\207F\315\034{>\2636\370c \371\211\003t\333_5\271\217\002_6\333\223\001es\343_C\273\213\001\225}\325e)\000e\277quilib\225\225\001\000\033un\255\205\001e\000\001\002\365\222\003\206\204\005\376V\033Problem\375 \350T)""\000int \315(\242\02311\212\207\001\215\211\004_R\027esi\273\210\001s<\r\377\204\005\000I0J\007\277\204\003\266\200,\352;It\351\227\002\270\016\371 \273\206\024\360\200+*)\000bo_x_sup\314\216\001\000\350\223\003\377ged\000near\027ly_\007\007r\312%\347:\301\211\003\034\241\230\003\201@tor\256\230\002\261\207\001\331s]3\356\212\001KKT\010\0277\364\212\004\364\321@\234\230\001d\375\207\001int,\001 \221\201S\217 \205\213\004\322x\224\037\277\205\005\274\204\024\016\354\206\017int\303\204\03288\251\"\212\213\003\020\346\207\r\360\211\005\345\2015\310\034 \251\212\035\375`\357\216\001\276\341\230\002xity\000\375\216\001f\003ac\266`\006\002\326\224\002\333\206\030Q,\347\214\033\200\303\207\032\270V\211\2063\000\207\272\212\047\207\223\006\237\221\001lue\360\212\001a\245\221\001_in\345\223\001n\313\221\001nt\000\246\223\001al\263\223\002\000\"\003\232\212\030\310\206\021\254\203\\\250\213\032f\047\317\202=\207\222\006\300\227\213#V@\212\223\004\303\215\026\240\214\031\255\200h)\000\031\000\003\204\252\225\005, \227\212\002\377\213\005\220\234\002\274\233\215\002\225\215\006nce\000\236\214\005r\375e\253\232\001\000mater\037ializ\021\007\200\245\002 \0061s\200\227\002\375\226\001\363\221\r10\266\250\002\347\246\003\rF\277\251\001ng\303\224U\371\225E\311\227\023\254\222\001\373*)\205\223\001n_and\037_copy\323\226\023\347\227\025\241\214\023\340\303\230\007\201\2275\330\224\"\210\231\t\341\224\007pro\353j_\322\250\002\000\006\002set\n\334\222\0318\364\236\006A\377\236\004\273\220\004\336\215\033!\023\354\205\223$\227\232\n)\000\366\237\006res\363et\005\007\377a\200\001\330\004\377\n\210+\220Q\200A\340\377\010\014\210F\220!\2202\337\220V\2301\330\002\0102\230\377X\240Q\240h\250f\260\377B\260i\270x\300r\310\375\021)\002\320\014\034\230A\200\377A\360\026\000\t\033\230!?\2304\230q\330\010\017\000)\002\377a\330\010\031\230\024\230Q\357\340\010$\240W\000\013\2103\377\210g\220Q\330\014\024\220\377A\330\014\025\220Q\220e\377\2301\230A\330\r\016\330\377\014\020\220\t\230\035\240a\337""\330\020\021\220\021|\0003\220\371dJ\000\032\000\230T\240\021\240\377!\2401\240C\240v\250\377W\260F\270!\2701\270\377A\270V\3007\310&\320\377PQ\320QS\320ST\377\320TX\320XY\320Y\377[\320[\\\320\\]\330\367\020\023\220=\001)\2404\240\377y\260\004\260I\270T\300\357\031\310$\310[\000\024\220J\373\230a\237\001\013\2104\210v\356\341\0003\230az\000\320\020 \377\240\001\330\014\023\220:\230\377S\240\005\240U\250%\250\277u\260C\260u\270\227\003\022\377\220$\220g\230Q\230f\377\240H\250E\260\024\260T\367\270\037\310,\000\017\210s\220\377(\230#\230Q\330\020\024\257\220H\230A\037\000e\247\000E\277\250\021\250$\250a?\000A\377\260V\2707\300&\310\001?\310\025\310a\310t\245\002\235\001\337\320]^\330\010\212!h\220\367c\230\021y\004\004\320$4\337\260D\270\r\300\236 \023\320\353\023$\357\000uk\000\025\260e\377\2703\320>O\310u\320\373TU\215AA\210T\220\021\377\330\010\020\220\003\2209\230\377C\230}\250C\250v\260\377Q\260g\270Q\270g\300\177Q\300f\310C\310q\376\001\377=\240\r\250Q\250c\260\007\021\230a";
-    PyObject *data = __Pyx_DecompressString_LZSS(cstring, 2999, 6616);
+    #elif (CYTHON_COMPRESS_STRINGS) > 0 && (CYTHON_COMPRESS_STRINGS) <= 90 /* compression: lzss (3000 bytes) */
+static const char cstring[] = "\377 at 0x o\377bject>(t\377ree frag\377ment).: \377<MemoryV\377iew of <\377contiguo\377us and d\263ir4\001\007\rin\021\005s\277trided\"\010 7or \004\031><(\tA\006\377>?Cannot\377 assign \377to read-\277only m\240\002v\376\242\000Invalid\377 mode, esxp\324\000|\000\047c\047t\001\377\047fortran\317\047, gH\000%\005sh\367ape\222\000 axi\377s Note t\375h\226 Cython\375 \021\000delibe\317ratek\000\320\001ct\373er!\001n PEPo-484\212\"re\303!\177s subcl\246\000\373es\261!built\375i\260\000ypes. \377If you n\311e\224 \303\000p\316\000%\tth\277en set\200\000e\373 \047\357\002ation\377_typing\047\366\355$iv\242\000o Fa\377lse.add_>\231 ecoll\305@+\000\377s.abcdis\277ableen\002\001g\367cis\004\003dno \377default \377__reduce\337__ duM\002no{n-\262@vial\033\000\377cinit__s\377elf.A_us\327er,\007\002P\001\010aa\372\016\003b\025\010block\277_start+\003c\275e\002\005d_sc\307 c\241hD\003\275c\336\000S\003e\020\013i\3268\004kkA\004lZ\tlo\375g\211\003prev_xj\001\010y\r\010z\034\005ob\267\003qq\276\010\374\000\314\003res\244\004wrho\240\000ale\022\004\373hs\356\003saved\326\004\004ol\202#u\351\tve\247c_m\232#\007\001n\000\0102\352\014\0103\031\007s\000\0102 c\376\334\204\003be conv\234\256 \234ca P\203\204\003\240\206\003 \377for pick\375l\214`src/fc\377cqp/admm\237.pyxu\351B\234\205\001a\375l\202@ate ar\377ray data\341.\013\020\370\204\003\312\206\001\247\206\003s.A\377ASCIIBAC\337KENDS\001\004_N\367AME\n\000D_DA\377TADUAL_I\377NFEASIBL\367EEQ\r\000ITY_\377START_LI\367MIT\005\014STEP\377SEllipsi\377sFIXED_R\377HO_SCALE\377INACCURA\377TE_FACTO\357RLOG[\000TER\177VALMAX_K\000\377RNOT_CON\367VEX\004\000DENU\357MERI;\000_ER\377RORPPRIM\276\207\nREDUCc\000C?OSTRESS\000p\000\360\241\005w\001V\000\002\002INSO\257LVED\000\003_\203\007S\377equenceT\247IME\316\003\204\211\001.\211\211\007W\377orkspace\376\000\006.__get_\367_.<\370!ls>.\177genexpr\026\t\332\354\205\004c\332\207\002__1\tse\177tstate_\013\017\347forX\000`\007sol\335vn\010upd3\002on\177es__Pyx\001\000\377Dict_Nex\277tRef__\305""\207\004e\217____\232\210\002\000\006\260\001i\227tem\026\001d0\001 \000f\227unc&\001g\212\0054\000i\337mport<\001ma{in\003\002odulM\002\267nam\002\003ew]\001p\376~\000checksu\350T\000\n\001\322\003_\025\001typ\333e_\005\002un\305\204\002e_\233En \005vt\261\210\001\241\001q\007ualO\005\237\210\005\250\210\006\266%\271\210\006Kex\325\001s\373 \203\005s\260\010\276\310.__tes\310\001i\377s_corout\377ineabcad\377aptive_r\373ho\000\t_inte\357rval\010\ntol\347era\241`\345\205\005_bu\377fferalph\377aanderso\333n_\232\214\003as\204\206\002as\374\273\215\007\n\004yncio.\376}\006sautobb/asec\263\211\001_\231\000\306\"\336\257\000rmin\212\213\002cl\334\254\000\221\000_tr\375`ba\237ckclo.\000\373Ac\337onstr\237@ed?countd\354!\000\002\371_\352\000\346\216\003encod\363ee\363 \322\214\002eps_\227abs\003\001d\363 \352\000f\336\017\001prim\004\005re\256\350\000ror\352\207\002.\353\207\001f\377ixedflag\377sfloat64~\235\204\003format\344\215\004\376\370\204\004guessidUi\217 x\306 p\352as\000\002\377izejkkt_\376\277\001endlbld?l_full\004\001\227\214\003\377dlog_row\377smmax_it\237ermem\352\216\001\342\216\001m\373un\367andimn\357extny\001lnp\376\314`pyobjor\366\201@pp\235 popq\377rregiste\370\005\000\360\216\002\361\212\001ore_f\377easibili\377tyrhorun\177samesca\336\211\002\257chur\240\215\004d\205\215\001s\356\244\000set\274\215\004setyt\205\212\001\300\217\002sigmG\000\343ze\230\206\002\372\214\002\377\214\002_ti\372M\000t\343 topst?ructth\317\000\023\001\377_limitub\343un\242\001\301\206\003\301\206\tval\373ue\000\002swarm\377xx0x0_pt\253rx\224ay\231az\000\002e\377rosOdoub\357le (\001\004*, |\000\007\000\021Py_ss\200@\217_t, \000\t\016\007\210\214\001s\207t *\024\t\000\0212\013Z#)\237\000void\245\006\263\204\002 \000\252\007\000\r\000\0351\014\272\025\310\037\2429v;\240\207F\315\034{>\2636\370c \371\211\003t\333_5\271\217\002_6\333\223\001es\343_C\273\213\001\225}\325e)\000e\277quilib\225\225\001\000\233un\255\205\001e\000\001\002\365\222\003iont ([\02311\366\205\003~\326\224\003Re""stor\343\224\002t\346a\216\0233\243\207\001KKT\010\027\2557\251\207\004_R\320\224\002d\262\204\001i\357nt, \327\033Pro\317blem\340\204\007\206;It>\205\227\002s *)\000\272\207\004\314\032\330\254\210\001\257\212\004\226\000si\335\211\001s \014\234\204\016\265\206\003)\000\002G\365\206\005\337\205\005\260\200S\300\246\206\r\335\207\024\357U\2103\330 \376\224\003ge\377d\000nearly\r_\007\007re\277$\306x\214\177\354\204\0058\356N\277\211\003\231\206\017int\202Z88\320\241\204\002b\023\240[\246\200> \326\211\035*)y\000\234\216\001\216\230\002xity\t\002?factor\024\002\203\224\002\010\317\206\030\310<\361\204\025 \247\214\022\202\205\032\270V\251\206$4\374\205\024\000\207 \261\216\034)\000\264\222\006\314\220\001\353le\235\212\001a\322\220\001_in\334\222\223\001\370\220\001nt\000\323\222\001al\000\340\222\002\"\003\216\212\030\300\211\021\350\2115\344\202$\347\210\032f\047\000\317\202=\264\221\006\242\211#V@\267\222\004\361\220\024\251\212\033\255\200h\003)\000\261\222\004\266\217\023\255\201r\227\212\002\367\216\005\275\233\002\274\262\213\002\254\213\006nce\000\226\217\005r\375e\330\231\001\000mater\037ializ\021\007\255\244\002 \0061s\255\226\002\252\226\001\240\221\r10\343\247\002\224\246\003\rF\354\250\001ng\360\223U\246\225E\366\226\023\240\222\001\373*)\262\222\001n_and\037_copy\200\226\023\224\227\025\227\215\025\340\235\223\007\260\2263\205\224\"\265\230\t\216\224\007pro\353j_\377\247\002\000\006\002set\024\344\227\003\350\224\0238\241\236\006A\254\236\004\263\223\004\234\221\033\330!\023\225\223%\345\231\t)\000\243\237\006re\347set\005\007\377a\200\001\330\377\004\n\210+\220Q\200A\377\340\010\014\210F\220!\220\2772\220V\2301\330\002\0102\377\230X\240Q\240h\250f\377\260B\260i\270x\300r\373\310\021)\002\320\014\034\230A\377\200A\360\030\000\t\033\230\177!\2304\230q\330\010\017\000\376)\002a\330\010\031\230\024\230\337Q\340\010$\240W\000\013\210\3773\210g\220Q\330\014\024\377\220A\330\014\025\220Q\220\377e\2301\230A\330\r\016\377\330\014\020\220\t\230\035\240\277a\330""\020\021\220\021|\0003\363\220dJ\000\032\000\230T\240\021\377\240!\2401\240C\240v\377\250W\260F\270!\2701\377\270A\270V\3007\310&\377\320PQ\320QS\320S\377T\320TX\320XY\320\377Y[\320[\\\320\\]\357\330\020\023\220=\001)\2404\377\240y\260\004\260I\270T\337\300\031\310$\310[\000\024\220\367J\230a\237\001\013\2104\210\335v\341\0003\230az\000\320\020\377 \240\001\330\014\023\220:\377\230S\240\005\240U\250%\177\250u\260C\260u\270\227\003\377\022\220$\220g\230Q\230\377f\240H\250E\260\024\260\357T\270\037\310,\000\017\210s\377\220(\230#\230Q\330\020_\024\220H\230A\037\000e\247\000\177E\250\021\250$\250a?\000\377A\260V\2707\300&\310\177\001\310\025\310a\310t\245\002\276\235\001\320]^\330\010\212!h\357\220c\230\021y\004\004\320$\2774\260D\270\r\300\236 \023\327\320\023$\357\000uk\000\025\260\377e\2703\320>O\310u\367\320TU\215AA\210T\220\377\021\330\010\020\220\003\2209\377\230C\230}\250C\250v\377\260Q\260g\270Q\270g\377\300Q\300f\310C\310q\376\376\001=\240\r\250Q\250c\017\260\021\230a";
+    PyObject *data = __Pyx_DecompressString_LZSS(cstring, 3000, 6533);
     #define __Pyx_DecompressString_UNUSED
     if (unlikely(!data)) __PYX_ERR(0, 1, __pyx_L1_error)
     const char* const bytes = __Pyx_PyBytes_AsString(data);
     #if !CYTHON_ASSUME_SAFE_MACROS
     if (likely(bytes)); else { Py_DECREF(data); __PYX_ERR(0, 1, __pyx_L1_error) }
     #endif
-    #else /* compression: none (6616 bytes) */
-static const char bytes[] = " at 0x object>(tree fragment).: <MemoryView of <contiguous and direct><contiguous and indirect><strided and direct or indirect><strided and direct><strided and indirect>>?Cannot assign to read-only memoryviewInvalid mode, expected \047c\047 or \047fortran\047, got Invalid shape in axis Note that Cython is deliberately stricter than PEP-484 and rejects subclasses of builtin types. If you need to pass subclasses then set the \047annotation_typing\047 directive to False.add_notecollections.abcdisableenablegcisenabledno default __reduce__ due to non-trivial __cinit__self.A_user,self.P_user,self.aa,self.b_user,self.block_start,self.cert,self.d_scratch,self.direction,self.e_scratch,self.it,self.kkt,self.lb_user,self.log,self.prev_x,self.prev_y,self.prev_z,self.prob,self.q_user,self.red,self.rest,self.rho_scale,self.rhs,self.saved,self.sol,self.ub_user,self.vec_m,self.vec_n,self.vec_n2,self.vec_n3,self.vec_s,self.vec_s2 cannot be converted to a Python object for picklingsrc/fccqp/admm.pyxunable to allocate array data.unable to allocate shape and strides.AASCIIBACKENDSBACKEND_NAMESBAD_DATADUAL_INFEASIBLEEQUALITY_START_LIMITEQUALITY_START_STEPSEllipsisFIXED_RHO_SCALEINACCURATE_FACTORLOG_INTERVALMAX_ITERNOT_CONVEX_CODENUMERICAL_ERRORPPRIMAL_INFEASIBLEREDUCED_COSTRESTORED_EQUALITYRHO_MAXRHO_MINSOLVEDSOLVED_INACCURATESequenceTIME_LIMITView.MemoryViewWorkspaceWorkspace.__get__.<locals>.genexprWorkspace.__reduce_cython__Workspace.__setstate_cython__Workspace.forgetWorkspace.solveWorkspace.update_cones__Pyx_PyDict_NextRef__annotate____class____class_getitem____dict____func____getstate____import____main____module____name____new____pyx_checksum__pyx_state__pyx_type__pyx_unpickle_Enum__pyx_vtable____qualname____reduce____reduce_cython____reduce_ex____set_name____setstate____setstate_cython____test___is_coroutineabcadaptive_rhoadaptive_rho_intervaladaptive_rho_toleranceallocate_bufferalphaanderson_memoryasarrayascontiguousarrayasyncio.coroutinesautobbaseccert_outcheck_terminationcline""_in_tracebackcloseconesconstrainedcountdtypedtype_is_objectencodeenumerateeps_abseps_dual_infeps_prim_infeps_relerrorfccqp.admmfixedflagsfloat64forgetformatfortrangenexprguessidindexintpitemsitemsizejkkt_backendlbldl_fullldl_reducedlog_rowsmmax_itermemviewmodemunnamendimnextnormalnpnumpyobjorderppackpopqrregisterreshaperestore_feasibilityrhorunsamescalingschur_reducedselfsendsetdefaultsettingsshapesigmasizesolvestartstart_timestepstopstructthrowtime_limitubunpackupdateupdate_conesvaluevalueswarmxx0x0_ptrx_outy_outz_outzerosOdouble (double *, double *, double *, double *, Py_ssize_t, Py_ssize_t, Py_ssize_t const *, Py_ssize_t const *, Py_ssize_t, Py_ssize_t, double *, double *, double *, double *)\000void (double const *, double const *, double const *, double const *, double const *, double, Py_ssize_t, Py_ssize_t, Py_ssize_t, Py_ssize_t const *, double *, double *, double *)\000void (double const *, double const *, double const *, double, double const *, double const *, double, Py_ssize_t, Py_ssize_t, Py_ssize_t, Py_ssize_t const *, double const *, double const *, struct __pyx_t_5fccqp_6_types_Cones, double *, double *, double *, double *)\000equilibrate\000unscale\000scale_startdouble (struct __pyx_t_5fccqp_6_types_Problem const *, double const *)\000int (struct __pyx_t_5fccqp_11termination_Residuals const *, double, double)\000int (struct __pyx_t_5fccqp_11termination_Residuals const *, double, double, double)\000void (struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates const *, double *, double *, double *, struct __pyx_t_5fccqp_11termination_Residuals *)\000box_support\000converged\000nearly_converged\000residualsint (struct __pyx_t_5fccqp_11restoration_Restoration *, struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_7reduced_Reduced *, int, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *)\000restoreint (struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *,"" double, double const *, int)\000int (struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *, int, double, double const *)\000void (struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double const *, double *)\000kkt_convexity\000kkt_factor\000kkt_solveint (struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double, double *, double *, double *)\000int (struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates const *, double, double *, double *, double *)\000int (struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates const *, double, double *, double *, double *, double *)\000dual_infeasible\000equality_inconsistent\000primal_infeasibleint (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *)\000int (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *, double, double)\000void (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double const *)\000void (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *)\000\000void (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *, double, int)\000reduced_table\000near_convergence\000reduced_rebase\000materialize\000reduced_start\000reduced_stepstruct __pyx_t_5fccqp_10validation_Finding (double const *, double const *, double const *, double const *, double const *, double const *, Py_ssize_t, Py_ssize_t, double *, double *, double *, double *, double *, double *, int *)\000scan_and_copyvoid (double const *, Py_ssize_t, Py_ssize_t, double, double const *, double *)\000void (double const *, double const *, double const *, str""uct __pyx_t_5fccqp_6_types_Cones, Py_ssize_t, double *)\000proj_block\000proj_setvoid (struct __pyx_t_5fccqp_8anderson_Anderson *, int)\000void (struct __pyx_t_5fccqp_8anderson_Anderson *, struct __pyx_t_5fccqp_6_types_Iterates *, Py_ssize_t)\000anderson_reset\000anderson_step\200\001\330\004\n\210+\220Q\200A\340\010\014\210F\220!\2202\220V\2301\330\010\014\210F\220!\2202\220V\2302\230X\240Q\240h\250f\260B\260i\270x\300r\310\021\200A\340\010\014\320\014\034\230A\200A\360\026\000\t\033\230!\2304\230q\330\010\034\230A\230X\240Q\240a\330\010\031\230\024\230Q\340\010$\240A\340\010\013\2103\210g\220Q\330\014\024\220A\330\014\025\220Q\220e\2301\230A\330\r\016\330\014\020\220\t\230\035\240a\330\020\021\220\021\220!\2203\220d\230!\2301\230A\230T\240\021\240!\2401\240C\240v\250W\260F\270!\2701\270A\270V\3007\310&\320PQ\320QS\320ST\320TX\320XY\320Y[\320[\\\320\\]\330\020\023\2203\220d\230)\2404\240y\260\004\260I\270T\300\031\310$\310a\330\020\024\220J\230a\230q\330\010\013\2104\210v\220V\2303\230a\330\014\020\320\020 \240\001\330\014\023\220:\230S\240\005\240U\250%\250u\260C\260u\270A\330\r\016\330\014\022\220$\220g\230Q\230f\240H\250E\260\024\260T\270\037\310\001\330\014\017\210s\220(\230#\230Q\330\020\024\220H\230A\230Q\230e\2401\240E\250\021\250$\250a\250u\260A\260V\2707\300&\310\001\310\025\310a\310t\320ST\320T\\\320\\]\320]^\330\010\013\2103\210h\220c\230\021\330\014\020\320\020 \240\004\320$4\260D\270\r\300Q\330\014\023\320\023$\240C\240u\250E\260\025\260e\2703\320>O\310u\320TU\330\010\014\210A\210T\220\021\330\010\020\220\003\2209\230C\230}\250C\250v\260Q\260g\270Q\270g\300Q\300f\310C\310q\330\020\023\220=\240\r\250Q\250c\260\021\230a";
+    #else /* compression: none (6533 bytes) */
+static const char bytes[] = " at 0x object>(tree fragment).: <MemoryView of <contiguous and direct><contiguous and indirect><strided and direct or indirect><strided and direct><strided and indirect>>?Cannot assign to read-only memoryviewInvalid mode, expected \047c\047 or \047fortran\047, got Invalid shape in axis Note that Cython is deliberately stricter than PEP-484 and rejects subclasses of builtin types. If you need to pass subclasses then set the \047annotation_typing\047 directive to False.add_notecollections.abcdisableenablegcisenabledno default __reduce__ due to non-trivial __cinit__self.A_user,self.P_user,self.aa,self.b_user,self.block_start,self.cert,self.d_scratch,self.direction,self.e_scratch,self.it,self.kkt,self.lb_user,self.log,self.prev_x,self.prev_y,self.prev_z,self.prob,self.q_user,self.red,self.rest,self.rho_scale,self.rhs,self.saved,self.sol,self.ub_user,self.vec_m,self.vec_n,self.vec_n2,self.vec_n3,self.vec_s,self.vec_s2 cannot be converted to a Python object for picklingsrc/fccqp/admm.pyxunable to allocate array data.unable to allocate shape and strides.AASCIIBACKENDSBACKEND_NAMESBAD_DATADUAL_INFEASIBLEEQUALITY_START_LIMITEQUALITY_START_STEPSEllipsisFIXED_RHO_SCALEINACCURATE_FACTORLOG_INTERVALMAX_ITERNOT_CONVEX_CODENUMERICAL_ERRORPPRIMAL_INFEASIBLEREDUCED_COSTRESTORED_EQUALITYRHO_MAXRHO_MINSOLVEDSOLVED_INACCURATESequenceTIME_LIMITView.MemoryViewWorkspaceWorkspace.__get__.<locals>.genexprWorkspace.__reduce_cython__Workspace.__setstate_cython__Workspace.forgetWorkspace.solveWorkspace.update_cones__Pyx_PyDict_NextRef__annotate____class____class_getitem____dict____func____getstate____import____main____module____name____new____pyx_checksum__pyx_state__pyx_type__pyx_unpickle_Enum__pyx_vtable____qualname____reduce____reduce_cython____reduce_ex____set_name____setstate____setstate_cython____test___is_coroutineabcadaptive_rhoadaptive_rho_intervaladaptive_rho_toleranceallocate_bufferalphaanderson_memoryasarrayascontiguousarrayasyncio.coroutinesautobbaseccert_outcheck_terminationcline""_in_tracebackcloseconesconstrainedcountdtypedtype_is_objectencodeenumerateeps_abseps_dual_infeps_prim_infeps_relerrorfccqp.admmfixedflagsfloat64forgetformatfortrangenexprguessidindexintpitemsitemsizejkkt_backendlbldl_fullldl_reducedlog_rowsmmax_itermemviewmodemunnamendimnextnormalnpnumpyobjorderppackpopqrregisterreshaperestore_feasibilityrhorunsamescalingschur_reducedselfsendsetdefaultsettingsshapesigmasizesolvestartstart_timestepstopstructthrowtime_limitubunpackupdateupdate_conesvaluevalueswarmxx0x0_ptrx_outy_outz_outzerosOdouble (double *, double *, double *, double *, Py_ssize_t, Py_ssize_t, Py_ssize_t const *, Py_ssize_t const *, Py_ssize_t, Py_ssize_t, double *, double *, double *, double *)\000void (double const *, double const *, double const *, double const *, double const *, double, Py_ssize_t, Py_ssize_t, Py_ssize_t, Py_ssize_t const *, double *, double *, double *)\000void (double const *, double const *, double const *, double, double const *, double const *, double, Py_ssize_t, Py_ssize_t, Py_ssize_t, Py_ssize_t const *, double const *, double const *, struct __pyx_t_5fccqp_6_types_Cones, double *, double *, double *, double *)\000equilibrate\000unscale\000scale_startint (struct __pyx_t_5fccqp_11restoration_Restoration *, struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_7reduced_Reduced *, int, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *)\000restoreint (struct __pyx_t_5fccqp_11termination_Residuals const *, double, double)\000int (struct __pyx_t_5fccqp_11termination_Residuals const *, double, double, double)\000void (struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates const *, double *, double *, double *, struct __pyx_t_5fccqp_11termination_Residuals *)\000converged\000nearly_converged\000residualsint (struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *, double, double const *, int)\000int (struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5f""ccqp_6_types_Problem const *, int, double, double const *)\000void (struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double const *, double *)\000kkt_convexity\000kkt_factor\000kkt_solveint (struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double, double *, double *, double *)\000int (struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates const *, double, double *, double *, double *)\000int (struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates const *, double, double *, double *, double *, double *)\000dual_infeasible\000equality_inconsistent\000primal_infeasibleint (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *)\000int (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *, double, double)\000void (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double const *)\000void (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *)\000\000void (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *, double, int)\000reduced_table\000near_convergence\000reduced_rebase\000materialize\000reduced_start\000reduced_stepstruct __pyx_t_5fccqp_10validation_Finding (double const *, double const *, double const *, double const *, double const *, double const *, Py_ssize_t, Py_ssize_t, double *, double *, double *, double *, double *, double *, int *)\000scan_and_copyvoid (double const *, Py_ssize_t, Py_ssize_t, double, double const *, double *)\000void (double const *, double const *, double const *, struct __pyx_t_5fccqp_6_types_Cones, Py_ssize_t, double *)\000proj_block\000proj_setvoid (st""ruct __pyx_t_5fccqp_8anderson_Anderson *, int)\000void (struct __pyx_t_5fccqp_8anderson_Anderson *, struct __pyx_t_5fccqp_6_types_Iterates *, Py_ssize_t)\000anderson_reset\000anderson_step\200\001\330\004\n\210+\220Q\200A\340\010\014\210F\220!\2202\220V\2301\330\010\014\210F\220!\2202\220V\2302\230X\240Q\240h\250f\260B\260i\270x\300r\310\021\200A\340\010\014\320\014\034\230A\200A\360\030\000\t\033\230!\2304\230q\330\010\034\230A\230X\240Q\240a\330\010\031\230\024\230Q\340\010$\240A\340\010\013\2103\210g\220Q\330\014\024\220A\330\014\025\220Q\220e\2301\230A\330\r\016\330\014\020\220\t\230\035\240a\330\020\021\220\021\220!\2203\220d\230!\2301\230A\230T\240\021\240!\2401\240C\240v\250W\260F\270!\2701\270A\270V\3007\310&\320PQ\320QS\320ST\320TX\320XY\320Y[\320[\\\320\\]\330\020\023\2203\220d\230)\2404\240y\260\004\260I\270T\300\031\310$\310a\330\020\024\220J\230a\230q\330\010\013\2104\210v\220V\2303\230a\330\014\020\320\020 \240\001\330\014\023\220:\230S\240\005\240U\250%\250u\260C\260u\270A\330\r\016\330\014\022\220$\220g\230Q\230f\240H\250E\260\024\260T\270\037\310\001\330\014\017\210s\220(\230#\230Q\330\020\024\220H\230A\230Q\230e\2401\240E\250\021\250$\250a\250u\260A\260V\2707\300&\310\001\310\025\310a\310t\320ST\320T\\\320\\]\320]^\330\010\013\2103\210h\220c\230\021\330\014\020\320\020 \240\004\320$4\260D\270\r\300Q\330\014\023\320\023$\240C\240u\250E\260\025\260e\2703\320>O\310u\320TU\330\010\014\210A\210T\220\021\330\010\020\220\003\2209\230C\230}\250C\250v\260Q\260g\270Q\270g\300Q\300f\310C\310q\330\020\023\220=\240\r\250Q\250c\260\021\230a";
     PyObject *data = NULL;
     #define __Pyx_DecompressString_UNUSED
     #define __Pyx_DecompressString_LZSS_UNUSED
@@ -33847,22 +33969,22 @@ static int __Pyx_CreateCodeObjects(__pyx_mstatetype *__pyx_mstate) {
   PyObject* tuple_dedup_map = PyDict_New();
   if (unlikely(!tuple_dedup_map)) return -1;
   {
-    const __Pyx_PyCode_New_function_description descr = {0, 0, 0, 1, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS|CO_GENERATOR), 324};
+    const __Pyx_PyCode_New_function_description descr = {0, 0, 0, 1, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS|CO_GENERATOR), 329};
     PyObject* const varnames[] = {__pyx_mstate->__pyx_n_u_j};
     __pyx_mstate_global->__pyx_codeobj_tab[0] = __Pyx_PyCode_New(descr, varnames, __pyx_mstate->__pyx_kp_u_src_fccqp_admm_pyx, __pyx_mstate->__pyx_n_u_genexpr, __pyx_mstate->__pyx_kp_b_iso88591_a, tuple_dedup_map); if (unlikely(!__pyx_mstate_global->__pyx_codeobj_tab[0])) goto bad;
   }
   {
-    const __Pyx_PyCode_New_function_description descr = {3, 0, 0, 3, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS), 306};
+    const __Pyx_PyCode_New_function_description descr = {3, 0, 0, 3, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS), 311};
     PyObject* const varnames[] = {__pyx_mstate->__pyx_n_u_self, __pyx_mstate->__pyx_n_u_mu, __pyx_mstate->__pyx_n_u_normal};
     __pyx_mstate_global->__pyx_codeobj_tab[1] = __Pyx_PyCode_New(descr, varnames, __pyx_mstate->__pyx_kp_u_src_fccqp_admm_pyx, __pyx_mstate->__pyx_n_u_update_cones, __pyx_mstate->__pyx_kp_b_iso88591_A_F_2V1_F_2V2XQhfBixr, tuple_dedup_map); if (unlikely(!__pyx_mstate_global->__pyx_codeobj_tab[1])) goto bad;
   }
   {
-    const __Pyx_PyCode_New_function_description descr = {1, 0, 0, 1, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS), 311};
+    const __Pyx_PyCode_New_function_description descr = {1, 0, 0, 1, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS), 316};
     PyObject* const varnames[] = {__pyx_mstate->__pyx_n_u_self};
     __pyx_mstate_global->__pyx_codeobj_tab[2] = __Pyx_PyCode_New(descr, varnames, __pyx_mstate->__pyx_kp_u_src_fccqp_admm_pyx, __pyx_mstate->__pyx_n_u_forget, __pyx_mstate->__pyx_kp_b_iso88591_A_A, tuple_dedup_map); if (unlikely(!__pyx_mstate_global->__pyx_codeobj_tab[2])) goto bad;
   }
   {
-    const __Pyx_PyCode_New_function_description descr = {14, 0, 0, 22, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS), 326};
+    const __Pyx_PyCode_New_function_description descr = {14, 0, 0, 22, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS), 331};
     PyObject* const varnames[] = {__pyx_mstate->__pyx_n_u_self, __pyx_mstate->__pyx_n_u_P, __pyx_mstate->__pyx_n_u_q, __pyx_mstate->__pyx_n_u_A, __pyx_mstate->__pyx_n_u_b, __pyx_mstate->__pyx_n_u_lb, __pyx_mstate->__pyx_n_u_ub, __pyx_mstate->__pyx_n_u_x0, __pyx_mstate->__pyx_n_u_warm, __pyx_mstate->__pyx_n_u_start_time, __pyx_mstate->__pyx_n_u_x_out, __pyx_mstate->__pyx_n_u_y_out, __pyx_mstate->__pyx_n_u_z_out, __pyx_mstate->__pyx_n_u_cert_out, __pyx_mstate->__pyx_n_u_p, __pyx_mstate->__pyx_n_u_n, __pyx_mstate->__pyx_n_u_m, __pyx_mstate->__pyx_n_u_same, __pyx_mstate->__pyx_n_u_guess, __pyx_mstate->__pyx_n_u_x0_ptr, __pyx_mstate->__pyx_n_u_run, __pyx_mstate->__pyx_n_u_r};
     __pyx_mstate_global->__pyx_codeobj_tab[3] = __Pyx_PyCode_New(descr, varnames, __pyx_mstate->__pyx_kp_u_src_fccqp_admm_pyx, __pyx_mstate->__pyx_n_u_solve, __pyx_mstate->__pyx_kp_b_iso88591_A_4q_AXQa_Q_A_3gQ_A_Qe1A_a_3d_1A, tuple_dedup_map); if (unlikely(!__pyx_mstate_global->__pyx_codeobj_tab[3])) goto bad;
   }
@@ -41346,7 +41468,7 @@ no_fail:
 }
 
 /* ObjectToMemviewSlice */
-static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_d_dc_double(PyObject *obj, int writable_flag) {
+static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_d_dc_double__const__(PyObject *obj, int writable_flag) {
     __Pyx_memviewslice result = __Pyx_MEMSLICE_INIT;
     __Pyx_BufFmt_StackElem stack[1];
     int axes_specs[] = { (__Pyx_MEMVIEW_DIRECT | __Pyx_MEMVIEW_FOLLOW), (__Pyx_MEMVIEW_DIRECT | __Pyx_MEMVIEW_CONTIG) };
@@ -41357,7 +41479,30 @@ static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_d_dc_d
     }
     retcode = __Pyx_ValidateAndInit_memviewslice(axes_specs, __Pyx_IS_C_CONTIG,
                                                  (PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) | writable_flag, 2,
-                                                 &__Pyx_TypeInfo_double, stack,
+                                                 &__Pyx_TypeInfo_double__const__, stack,
+                                                 &result, obj);
+    if (unlikely(retcode == -1))
+        goto __pyx_fail;
+    return result;
+__pyx_fail:
+    result.memview = NULL;
+    result.data = NULL;
+    return result;
+}
+
+/* ObjectToMemviewSlice */
+static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(PyObject *obj, int writable_flag) {
+    __Pyx_memviewslice result = __Pyx_MEMSLICE_INIT;
+    __Pyx_BufFmt_StackElem stack[1];
+    int axes_specs[] = { (__Pyx_MEMVIEW_DIRECT | __Pyx_MEMVIEW_CONTIG) };
+    int retcode;
+    if (obj == Py_None) {
+        result.memview = (struct __pyx_memoryview_obj *) Py_None;
+        return result;
+    }
+    retcode = __Pyx_ValidateAndInit_memviewslice(axes_specs, __Pyx_IS_C_CONTIG,
+                                                 (PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) | writable_flag, 1,
+                                                 &__Pyx_TypeInfo_double__const__, stack,
                                                  &result, obj);
     if (unlikely(retcode == -1))
         goto __pyx_fail;

@@ -42,7 +42,7 @@ from fccqp.reduced cimport (Reduced, materialize, near_convergence, reduced_reba
                             reduced_start, reduced_step, reduced_table)
 from fccqp.restoration cimport Restoration, restore
 from fccqp.scaling cimport equilibrate, scale_start, unscale
-from fccqp.termination cimport Residuals, box_support, converged, nearly_converged, residuals
+from fccqp.termination cimport Residuals, converged, nearly_converged, residuals
 from fccqp.validation cimport SCAN_OK, Finding, scan_and_copy
 
 cdef extern from *:
@@ -198,7 +198,7 @@ cdef class Workspace:
         into ``constrained``), the boolean mask ``fixed`` of constrained entries with
         ``lb == ub``, the Schur ``order`` and a :class:`fccqp.Settings`."""
         cdef Py_ssize_t s = len(constrained), N = n + m, memory = settings.anderson_memory
-        cdef Py_ssize_t k
+        cdef Py_ssize_t k, j
         self._arrays = []
         kind, offset, dim, mu, normal = cones
         self._keep = (np.ascontiguousarray(constrained, dtype=np.intp),
@@ -223,6 +223,11 @@ cdef class Workspace:
             for k in range(p.cones.count):
                 start_v[k] = c_view[offset_v[k]]
         self.block_start = &start_v[0]
+        cdef char* in_cone = <char*>self._new(s)
+        for k in range(p.cones.count):
+            for j in range(offset_v[k], offset_v[k] + dim_v[k]):
+                in_cone[j] = 1
+        p.in_cone = in_cone
         p.P, p.q, p.A, p.b = self._new(n * n), self._new(n), self._new(m * n), self._new(m)
         p.lo, p.hi, p.D, p.E = self._new(s), self._new(s), self._new(n), self._new(m)
         p.c = 1.0
@@ -323,8 +328,9 @@ cdef class Workspace:
         cdef Py_ssize_t i, j
         return [tuple(self.log[5 * i + j] for j in range(5)) for i in range(self.log_count)]
 
-    def solve(self, double[:, ::1] P, double[::1] q, double[:, ::1] A, double[::1] b,
-              double[::1] lb, double[::1] ub, x0, bint warm, double start_time,
+    def solve(self, const double[:, ::1] P, const double[::1] q, const double[:, ::1] A,
+              const double[::1] b, const double[::1] lb, const double[::1] ub, x0,
+              bint warm, double start_time,
               double[::1] x_out, double[::1] y_out, double[::1] z_out, double[::1] cert_out):
         """Validate, scale, run ADMM and unscale into ``x_out``, ``y_out``, ``z_out``.
 
@@ -337,7 +343,7 @@ cdef class Workspace:
         cdef Problem* p = &self.prob
         cdef Py_ssize_t n = p.n, m = p.m
         cdef bint same = self.has_matrices
-        cdef double[::1] guess
+        cdef const double[::1] guess
         cdef const double* x0_ptr = NULL
         cdef Run run
         if x0 is not None:
@@ -859,7 +865,8 @@ cdef class Workspace:
         cdef double* grad = self.vec_n
         cdef double* ATy = self.vec_n2
         cdef double* proj = self.vec_s
-        cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, total = 0.0, value
+        cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, terms = 0.0, total = 0.0
+        cdef double value
         matvec(self.A_user, x, Ax, m, n)
         matvec_t(self.A_user, y, ATy, m, n)
         matvec(self.P_user, x, grad, n, n)
@@ -868,6 +875,7 @@ cdef class Workspace:
             r.prim = max(r.prim, fabs(Ax[i] - self.b_user[i]))
             r.prim_scale = max(r.prim_scale, max(fabs(Ax[i]), fabs(self.b_user[i])))
             by += self.b_user[i] * y[i]
+            terms += fabs(self.b_user[i] * y[i])
         for j in range(s):
             i = p.constrained[j]
             value = x[i]
@@ -887,8 +895,10 @@ cdef class Workspace:
             r.prim_scale = max(r.prim_scale, fabs(x[i]))
             if z[i] > 0.0 and isfinite(self.ub_user[i]):
                 support += self.ub_user[i] * z[i]
+                terms += fabs(self.ub_user[i] * z[i])
             elif z[i] < 0.0 and isfinite(self.lb_user[i]):
                 support += self.lb_user[i] * z[i]
+                terms += fabs(self.lb_user[i] * z[i])
         r.dual = 0.0
         for i in range(n):
             xPx += x[i] * grad[i]
@@ -900,6 +910,6 @@ cdef class Workspace:
         for i in range(m):
             total += fabs(y[i])
         r.gap = fabs(xPx + qx + by + support)
-        r.gap_scale = max(fabs(xPx), fabs(qx))
+        r.gap_scale = max(max(fabs(xPx), fabs(qx)), terms)
         r.finite = isfinite(total) and isfinite(r.gap) and isfinite(r.prim)
 

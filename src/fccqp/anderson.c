@@ -1800,6 +1800,7 @@ struct __pyx_t_5fccqp_6_types_Problem {
   double *A;
   double *b;
   Py_ssize_t const *constrained;
+  char const *in_cone;
   double *lo;
   double *hi;
   struct __pyx_t_5fccqp_6_types_Cones cones;
@@ -1808,7 +1809,7 @@ struct __pyx_t_5fccqp_6_types_Problem {
   double c;
 };
 
-/* "fccqp/_types.pxd":41
+/* "fccqp/_types.pxd":42
  * 
  * 
  * cdef struct Iterates:             # <<<<<<<<<<<<<<

@@ -1679,6 +1679,7 @@ struct __pyx_t_5fccqp_6_types_Problem {
   double *A;
   double *b;
   Py_ssize_t const *constrained;
+  char const *in_cone;
   double *lo;
   double *hi;
   struct __pyx_t_5fccqp_6_types_Cones cones;
@@ -1687,7 +1688,7 @@ struct __pyx_t_5fccqp_6_types_Problem {
   double c;
 };
 
-/* "fccqp/_types.pxd":41
+/* "fccqp/_types.pxd":42
  * 
  * 
  * cdef struct Iterates:             # <<<<<<<<<<<<<<
@@ -2403,7 +2404,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
  *         for j in range(dim):
  *             d_y[a + j] -= terms[j]             # <<<<<<<<<<<<<<
  *     for j in range(s):
- *         if not isfinite(p.hi[j]) and d_y[j] > 0.0:
+ *         if p.in_cone[j]:
 */
 
       __pyx_t_7 = (__pyx_v_a + __pyx_v_j);
@@ -2417,8 +2418,8 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
  *         for j in range(dim):
  *             d_y[a + j] -= terms[j]
  *     for j in range(s):             # <<<<<<<<<<<<<<
- *         if not isfinite(p.hi[j]) and d_y[j] > 0.0:
- *             d_y[j] = 0.0
+ *         if p.in_cone[j]:
+ *             continue
 */
 
   __pyx_t_1 = __pyx_v_s;
@@ -2430,6 +2431,36 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
     /* "fccqp/certificates.pyx":44
  *             d_y[a + j] -= terms[j]
  *     for j in range(s):
+ *         if p.in_cone[j]:             # <<<<<<<<<<<<<<
+ *             continue
+ *         if not isfinite(p.hi[j]) and d_y[j] > 0.0:
+*/
+    __pyx_t_8 = ((__pyx_v_p->in_cone[__pyx_v_j]) != 0);
+
+    if (__pyx_t_8) {
+
+
+      /* "fccqp/certificates.pyx":45
+ *     for j in range(s):
+ *         if p.in_cone[j]:
+ *             continue             # <<<<<<<<<<<<<<
+ *         if not isfinite(p.hi[j]) and d_y[j] > 0.0:
+ *             d_y[j] = 0.0
+*/
+      goto __pyx_L11_continue;
+
+      /* "fccqp/certificates.pyx":44
+ *             d_y[a + j] -= terms[j]
+ *     for j in range(s):
+ *         if p.in_cone[j]:             # <<<<<<<<<<<<<<
+ *             continue
+ *         if not isfinite(p.hi[j]) and d_y[j] > 0.0:
+*/
+    }
+
+    /* "fccqp/certificates.pyx":46
+ *         if p.in_cone[j]:
+ *             continue
  *         if not isfinite(p.hi[j]) and d_y[j] > 0.0:             # <<<<<<<<<<<<<<
  *             d_y[j] = 0.0
  *         if not isfinite(p.lo[j]) and d_y[j] < 0.0:
@@ -2442,19 +2473,19 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
 
       __pyx_t_8 = __pyx_t_9;
 
-      goto __pyx_L14_bool_binop_done;
+      goto __pyx_L15_bool_binop_done;
     }
     __pyx_t_9 = ((__pyx_v_d_y[__pyx_v_j]) > 0.0);
 
 
     __pyx_t_8 = __pyx_t_9;
 
-    __pyx_L14_bool_binop_done:;
+    __pyx_L15_bool_binop_done:;
     if (__pyx_t_8) {
 
 
-      /* "fccqp/certificates.pyx":45
- *     for j in range(s):
+      /* "fccqp/certificates.pyx":47
+ *             continue
  *         if not isfinite(p.hi[j]) and d_y[j] > 0.0:
  *             d_y[j] = 0.0             # <<<<<<<<<<<<<<
  *         if not isfinite(p.lo[j]) and d_y[j] < 0.0:
@@ -2462,16 +2493,16 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
 */
       (__pyx_v_d_y[__pyx_v_j]) = 0.0;
 
-      /* "fccqp/certificates.pyx":44
- *             d_y[a + j] -= terms[j]
- *     for j in range(s):
+      /* "fccqp/certificates.pyx":46
+ *         if p.in_cone[j]:
+ *             continue
  *         if not isfinite(p.hi[j]) and d_y[j] > 0.0:             # <<<<<<<<<<<<<<
  *             d_y[j] = 0.0
  *         if not isfinite(p.lo[j]) and d_y[j] < 0.0:
 */
     }
 
-    /* "fccqp/certificates.pyx":46
+    /* "fccqp/certificates.pyx":48
  *         if not isfinite(p.hi[j]) and d_y[j] > 0.0:
  *             d_y[j] = 0.0
  *         if not isfinite(p.lo[j]) and d_y[j] < 0.0:             # <<<<<<<<<<<<<<
@@ -2486,18 +2517,18 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
 
       __pyx_t_8 = __pyx_t_9;
 
-      goto __pyx_L17_bool_binop_done;
+      goto __pyx_L18_bool_binop_done;
     }
     __pyx_t_9 = ((__pyx_v_d_y[__pyx_v_j]) < 0.0);
 
 
     __pyx_t_8 = __pyx_t_9;
 
-    __pyx_L17_bool_binop_done:;
+    __pyx_L18_bool_binop_done:;
     if (__pyx_t_8) {
 
 
-      /* "fccqp/certificates.pyx":47
+      /* "fccqp/certificates.pyx":49
  *             d_y[j] = 0.0
  *         if not isfinite(p.lo[j]) and d_y[j] < 0.0:
  *             d_y[j] = 0.0             # <<<<<<<<<<<<<<
@@ -2506,7 +2537,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
 */
       (__pyx_v_d_y[__pyx_v_j]) = 0.0;
 
-      /* "fccqp/certificates.pyx":46
+      /* "fccqp/certificates.pyx":48
  *         if not isfinite(p.hi[j]) and d_y[j] > 0.0:
  *             d_y[j] = 0.0
  *         if not isfinite(p.lo[j]) and d_y[j] < 0.0:             # <<<<<<<<<<<<<<
@@ -2515,7 +2546,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
 */
     }
 
-    /* "fccqp/certificates.pyx":48
+    /* "fccqp/certificates.pyx":50
  *         if not isfinite(p.lo[j]) and d_y[j] < 0.0:
  *             d_y[j] = 0.0
  *         if d_y[j] > 0.0:             # <<<<<<<<<<<<<<
@@ -2527,7 +2558,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
     if (__pyx_t_8) {
 
 
-      /* "fccqp/certificates.pyx":49
+      /* "fccqp/certificates.pyx":51
  *             d_y[j] = 0.0
  *         if d_y[j] > 0.0:
  *             support += p.hi[j] * d_y[j]             # <<<<<<<<<<<<<<
@@ -2536,7 +2567,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
 */
       __pyx_v_support = (__pyx_v_support + ((__pyx_v_p->hi[__pyx_v_j]) * (__pyx_v_d_y[__pyx_v_j])));
 
-      /* "fccqp/certificates.pyx":50
+      /* "fccqp/certificates.pyx":52
  *         if d_y[j] > 0.0:
  *             support += p.hi[j] * d_y[j]
  *             size += fabs(p.hi[j] * d_y[j])             # <<<<<<<<<<<<<<
@@ -2545,17 +2576,17 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
 */
       __pyx_v_size = (__pyx_v_size + fabs(((__pyx_v_p->hi[__pyx_v_j]) * (__pyx_v_d_y[__pyx_v_j]))));
 
-      /* "fccqp/certificates.pyx":48
+      /* "fccqp/certificates.pyx":50
  *         if not isfinite(p.lo[j]) and d_y[j] < 0.0:
  *             d_y[j] = 0.0
  *         if d_y[j] > 0.0:             # <<<<<<<<<<<<<<
  *             support += p.hi[j] * d_y[j]
  *             size += fabs(p.hi[j] * d_y[j])
 */
-      goto __pyx_L19;
+      goto __pyx_L20;
     }
 
-    /* "fccqp/certificates.pyx":51
+    /* "fccqp/certificates.pyx":53
  *             support += p.hi[j] * d_y[j]
  *             size += fabs(p.hi[j] * d_y[j])
  *         elif d_y[j] < 0.0:             # <<<<<<<<<<<<<<
@@ -2567,7 +2598,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
     if (__pyx_t_8) {
 
 
-      /* "fccqp/certificates.pyx":52
+      /* "fccqp/certificates.pyx":54
  *             size += fabs(p.hi[j] * d_y[j])
  *         elif d_y[j] < 0.0:
  *             support += p.lo[j] * d_y[j]             # <<<<<<<<<<<<<<
@@ -2576,7 +2607,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
 */
       __pyx_v_support = (__pyx_v_support + ((__pyx_v_p->lo[__pyx_v_j]) * (__pyx_v_d_y[__pyx_v_j])));
 
-      /* "fccqp/certificates.pyx":53
+      /* "fccqp/certificates.pyx":55
  *         elif d_y[j] < 0.0:
  *             support += p.lo[j] * d_y[j]
  *             size += fabs(p.lo[j] * d_y[j])             # <<<<<<<<<<<<<<
@@ -2585,7 +2616,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
 */
       __pyx_v_size = (__pyx_v_size + fabs(((__pyx_v_p->lo[__pyx_v_j]) * (__pyx_v_d_y[__pyx_v_j]))));
 
-      /* "fccqp/certificates.pyx":51
+      /* "fccqp/certificates.pyx":53
  *             support += p.hi[j] * d_y[j]
  *             size += fabs(p.hi[j] * d_y[j])
  *         elif d_y[j] < 0.0:             # <<<<<<<<<<<<<<
@@ -2593,11 +2624,12 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
  *             size += fabs(p.lo[j] * d_y[j])
 */
     }
-    __pyx_L19:;
+    __pyx_L20:;
+    __pyx_L11_continue:;
   }
 
 
-  /* "fccqp/certificates.pyx":54
+  /* "fccqp/certificates.pyx":56
  *             support += p.lo[j] * d_y[j]
  *             size += fabs(p.lo[j] * d_y[j])
  *     for i in range(m):             # <<<<<<<<<<<<<<
@@ -2611,7 +2643,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/certificates.pyx":55
+    /* "fccqp/certificates.pyx":57
  *             size += fabs(p.lo[j] * d_y[j])
  *     for i in range(m):
  *         support += p.b[i] * d_nu[i]             # <<<<<<<<<<<<<<
@@ -2620,7 +2652,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
 */
     __pyx_v_support = (__pyx_v_support + ((__pyx_v_p->b[__pyx_v_i]) * (__pyx_v_d_nu[__pyx_v_i])));
 
-    /* "fccqp/certificates.pyx":56
+    /* "fccqp/certificates.pyx":58
  *     for i in range(m):
  *         support += p.b[i] * d_nu[i]
  *         size += fabs(p.b[i] * d_nu[i])             # <<<<<<<<<<<<<<
@@ -2631,7 +2663,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
   }
 
 
-  /* "fccqp/certificates.pyx":57
+  /* "fccqp/certificates.pyx":59
  *         support += p.b[i] * d_nu[i]
  *         size += fabs(p.b[i] * d_nu[i])
  *     if not (support < -eps * size) or not isfinite(support):             # <<<<<<<<<<<<<<
@@ -2646,18 +2678,18 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
 
     __pyx_t_8 = __pyx_t_9;
 
-    goto __pyx_L23_bool_binop_done;
+    goto __pyx_L24_bool_binop_done;
   }
   __pyx_t_9 = (!isfinite(__pyx_v_support));
 
 
   __pyx_t_8 = __pyx_t_9;
 
-  __pyx_L23_bool_binop_done:;
+  __pyx_L24_bool_binop_done:;
   if (__pyx_t_8) {
 
 
-    /* "fccqp/certificates.pyx":58
+    /* "fccqp/certificates.pyx":60
  *         size += fabs(p.b[i] * d_nu[i])
  *     if not (support < -eps * size) or not isfinite(support):
  *         return False             # <<<<<<<<<<<<<<
@@ -2670,7 +2702,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
     }
     goto __pyx_L0;
 
-    /* "fccqp/certificates.pyx":57
+    /* "fccqp/certificates.pyx":59
  *         support += p.b[i] * d_nu[i]
  *         size += fabs(p.b[i] * d_nu[i])
  *     if not (support < -eps * size) or not isfinite(support):             # <<<<<<<<<<<<<<
@@ -2679,7 +2711,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
 */
   }
 
-  /* "fccqp/certificates.pyx":59
+  /* "fccqp/certificates.pyx":61
  *     if not (support < -eps * size) or not isfinite(support):
  *         return False
  *     for i in range(n):             # <<<<<<<<<<<<<<
@@ -2693,7 +2725,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/certificates.pyx":60
+    /* "fccqp/certificates.pyx":62
  *         return False
  *     for i in range(n):
  *         lhs[i] = 0.0             # <<<<<<<<<<<<<<
@@ -2702,7 +2734,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
 */
     (__pyx_v_lhs[__pyx_v_i]) = 0.0;
 
-    /* "fccqp/certificates.pyx":61
+    /* "fccqp/certificates.pyx":63
  *     for i in range(n):
  *         lhs[i] = 0.0
  *         terms[i] = 0.0             # <<<<<<<<<<<<<<
@@ -2713,7 +2745,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
   }
 
 
-  /* "fccqp/certificates.pyx":62
+  /* "fccqp/certificates.pyx":64
  *         lhs[i] = 0.0
  *         terms[i] = 0.0
  *     for i in range(m):             # <<<<<<<<<<<<<<
@@ -2727,7 +2759,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/certificates.pyx":63
+    /* "fccqp/certificates.pyx":65
  *         terms[i] = 0.0
  *     for i in range(m):
  *         for j in range(n):             # <<<<<<<<<<<<<<
@@ -2741,7 +2773,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
     for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_4; __pyx_t_6+=1) {
       __pyx_v_j = __pyx_t_6;
 
-      /* "fccqp/certificates.pyx":64
+      /* "fccqp/certificates.pyx":66
  *     for i in range(m):
  *         for j in range(n):
  *             value = p.A[i * n + j] * d_nu[i]             # <<<<<<<<<<<<<<
@@ -2750,7 +2782,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
 */
       __pyx_v_value = ((__pyx_v_p->A[((__pyx_v_i * __pyx_v_n) + __pyx_v_j)]) * (__pyx_v_d_nu[__pyx_v_i]));
 
-      /* "fccqp/certificates.pyx":65
+      /* "fccqp/certificates.pyx":67
  *         for j in range(n):
  *             value = p.A[i * n + j] * d_nu[i]
  *             lhs[j] += value             # <<<<<<<<<<<<<<
@@ -2761,7 +2793,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
       __pyx_t_7 = __pyx_v_j;
       (__pyx_v_lhs[__pyx_t_7]) = ((__pyx_v_lhs[__pyx_t_7]) + __pyx_v_value);
 
-      /* "fccqp/certificates.pyx":66
+      /* "fccqp/certificates.pyx":68
  *             value = p.A[i * n + j] * d_nu[i]
  *             lhs[j] += value
  *             terms[j] += fabs(value)             # <<<<<<<<<<<<<<
@@ -2776,7 +2808,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
   }
 
 
-  /* "fccqp/certificates.pyx":67
+  /* "fccqp/certificates.pyx":69
  *             lhs[j] += value
  *             terms[j] += fabs(value)
  *     for j in range(s):             # <<<<<<<<<<<<<<
@@ -2790,7 +2822,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_j = __pyx_t_3;
 
-    /* "fccqp/certificates.pyx":68
+    /* "fccqp/certificates.pyx":70
  *             terms[j] += fabs(value)
  *     for j in range(s):
  *         i = p.constrained[j]             # <<<<<<<<<<<<<<
@@ -2799,7 +2831,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
 */
     __pyx_v_i = (__pyx_v_p->constrained[__pyx_v_j]);
 
-    /* "fccqp/certificates.pyx":69
+    /* "fccqp/certificates.pyx":71
  *     for j in range(s):
  *         i = p.constrained[j]
  *         lhs[i] += d_y[j]             # <<<<<<<<<<<<<<
@@ -2810,7 +2842,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
     __pyx_t_5 = __pyx_v_i;
     (__pyx_v_lhs[__pyx_t_5]) = ((__pyx_v_lhs[__pyx_t_5]) + (__pyx_v_d_y[__pyx_v_j]));
 
-    /* "fccqp/certificates.pyx":70
+    /* "fccqp/certificates.pyx":72
  *         i = p.constrained[j]
  *         lhs[i] += d_y[j]
  *         terms[i] += fabs(d_y[j])             # <<<<<<<<<<<<<<
@@ -2823,7 +2855,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
   }
 
 
-  /* "fccqp/certificates.pyx":71
+  /* "fccqp/certificates.pyx":73
  *         lhs[i] += d_y[j]
  *         terms[i] += fabs(d_y[j])
  *     for i in range(n):             # <<<<<<<<<<<<<<
@@ -2837,7 +2869,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/certificates.pyx":72
+    /* "fccqp/certificates.pyx":74
  *         terms[i] += fabs(d_y[j])
  *     for i in range(n):
  *         lhs_max = max(lhs_max, fabs(lhs[i]) / p.D[i])             # <<<<<<<<<<<<<<
@@ -2861,7 +2893,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
     __pyx_v_lhs_max = __pyx_t_12;
 
 
-    /* "fccqp/certificates.pyx":73
+    /* "fccqp/certificates.pyx":75
  *     for i in range(n):
  *         lhs_max = max(lhs_max, fabs(lhs[i]) / p.D[i])
  *         terms_max = max(terms_max, terms[i] / p.D[i])             # <<<<<<<<<<<<<<
@@ -2887,7 +2919,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
   }
 
 
-  /* "fccqp/certificates.pyx":74
+  /* "fccqp/certificates.pyx":76
  *         lhs_max = max(lhs_max, fabs(lhs[i]) / p.D[i])
  *         terms_max = max(terms_max, terms[i] / p.D[i])
  *     return lhs_max <= eps * terms_max             # <<<<<<<<<<<<<<
@@ -2926,7 +2958,7 @@ static int __pyx_f_5fccqp_12certificates_primal_infeasible(struct __pyx_t_5fccqp
   return __pyx_r;
 }
 
-/* "fccqp/certificates.pyx":77
+/* "fccqp/certificates.pyx":79
  * 
  * 
  * cdef bint equality_inconsistent(const Problem* p, const Iterates* it, double eps, double* r,             # <<<<<<<<<<<<<<
@@ -2958,7 +2990,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
   double __pyx_t_11;
   double __pyx_t_12;
 
-  /* "fccqp/certificates.pyx":80
+  /* "fccqp/certificates.pyx":82
  *                                 double* ATr, double* terms) noexcept nogil:
  *     """Test ``r = b - A x`` (``r``: m scratch; ``ATr``, ``terms``: n scratch)."""
  *     cdef Py_ssize_t n = p.n, m = p.m, i, j             # <<<<<<<<<<<<<<
@@ -2972,7 +3004,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
 
   __pyx_v_m = __pyx_t_1;
 
-  /* "fccqp/certificates.pyx":81
+  /* "fccqp/certificates.pyx":83
  *     """Test ``r = b - A x`` (``r``: m scratch; ``ATr``, ``terms``: n scratch)."""
  *     cdef Py_ssize_t n = p.n, m = p.m, i, j
  *     cdef double value, br = 0.0, size = 0.0, lhs_max = 0.0, terms_max = 0.0             # <<<<<<<<<<<<<<
@@ -2984,7 +3016,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
   __pyx_v_lhs_max = 0.0;
   __pyx_v_terms_max = 0.0;
 
-  /* "fccqp/certificates.pyx":82
+  /* "fccqp/certificates.pyx":84
  *     cdef Py_ssize_t n = p.n, m = p.m, i, j
  *     cdef double value, br = 0.0, size = 0.0, lhs_max = 0.0, terms_max = 0.0
  *     if m == 0:             # <<<<<<<<<<<<<<
@@ -2996,7 +3028,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
   if (__pyx_t_2) {
 
 
-    /* "fccqp/certificates.pyx":83
+    /* "fccqp/certificates.pyx":85
  *     cdef double value, br = 0.0, size = 0.0, lhs_max = 0.0, terms_max = 0.0
  *     if m == 0:
  *         return False             # <<<<<<<<<<<<<<
@@ -3009,7 +3041,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
     }
     goto __pyx_L0;
 
-    /* "fccqp/certificates.pyx":82
+    /* "fccqp/certificates.pyx":84
  *     cdef Py_ssize_t n = p.n, m = p.m, i, j
  *     cdef double value, br = 0.0, size = 0.0, lhs_max = 0.0, terms_max = 0.0
  *     if m == 0:             # <<<<<<<<<<<<<<
@@ -3018,7 +3050,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
 */
   }
 
-  /* "fccqp/certificates.pyx":84
+  /* "fccqp/certificates.pyx":86
  *     if m == 0:
  *         return False
  *     for i in range(m):             # <<<<<<<<<<<<<<
@@ -3032,7 +3064,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/certificates.pyx":85
+    /* "fccqp/certificates.pyx":87
  *         return False
  *     for i in range(m):
  *         value = p.b[i]             # <<<<<<<<<<<<<<
@@ -3041,7 +3073,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
 */
     __pyx_v_value = (__pyx_v_p->b[__pyx_v_i]);
 
-    /* "fccqp/certificates.pyx":86
+    /* "fccqp/certificates.pyx":88
  *     for i in range(m):
  *         value = p.b[i]
  *         for j in range(n):             # <<<<<<<<<<<<<<
@@ -3055,7 +3087,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
     for (__pyx_t_7 = 0; __pyx_t_7 < __pyx_t_6; __pyx_t_7+=1) {
       __pyx_v_j = __pyx_t_7;
 
-      /* "fccqp/certificates.pyx":87
+      /* "fccqp/certificates.pyx":89
  *         value = p.b[i]
  *         for j in range(n):
  *             value -= p.A[i * n + j] * it.x[j]             # <<<<<<<<<<<<<<
@@ -3066,7 +3098,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
     }
 
 
-    /* "fccqp/certificates.pyx":88
+    /* "fccqp/certificates.pyx":90
  *         for j in range(n):
  *             value -= p.A[i * n + j] * it.x[j]
  *         r[i] = value             # <<<<<<<<<<<<<<
@@ -3075,7 +3107,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
 */
     (__pyx_v_r[__pyx_v_i]) = __pyx_v_value;
 
-    /* "fccqp/certificates.pyx":89
+    /* "fccqp/certificates.pyx":91
  *             value -= p.A[i * n + j] * it.x[j]
  *         r[i] = value
  *         br += p.b[i] * value             # <<<<<<<<<<<<<<
@@ -3084,7 +3116,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
 */
     __pyx_v_br = (__pyx_v_br + ((__pyx_v_p->b[__pyx_v_i]) * __pyx_v_value));
 
-    /* "fccqp/certificates.pyx":90
+    /* "fccqp/certificates.pyx":92
  *         r[i] = value
  *         br += p.b[i] * value
  *         size += fabs(p.b[i] * value)             # <<<<<<<<<<<<<<
@@ -3095,7 +3127,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
   }
 
 
-  /* "fccqp/certificates.pyx":91
+  /* "fccqp/certificates.pyx":93
  *         br += p.b[i] * value
  *         size += fabs(p.b[i] * value)
  *     if not (br > eps * size) or not isfinite(br):             # <<<<<<<<<<<<<<
@@ -3121,7 +3153,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
   if (__pyx_t_2) {
 
 
-    /* "fccqp/certificates.pyx":92
+    /* "fccqp/certificates.pyx":94
  *         size += fabs(p.b[i] * value)
  *     if not (br > eps * size) or not isfinite(br):
  *         return False             # <<<<<<<<<<<<<<
@@ -3134,7 +3166,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
     }
     goto __pyx_L0;
 
-    /* "fccqp/certificates.pyx":91
+    /* "fccqp/certificates.pyx":93
  *         br += p.b[i] * value
  *         size += fabs(p.b[i] * value)
  *     if not (br > eps * size) or not isfinite(br):             # <<<<<<<<<<<<<<
@@ -3143,7 +3175,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
 */
   }
 
-  /* "fccqp/certificates.pyx":93
+  /* "fccqp/certificates.pyx":95
  *     if not (br > eps * size) or not isfinite(br):
  *         return False
  *     for j in range(n):             # <<<<<<<<<<<<<<
@@ -3157,7 +3189,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/certificates.pyx":94
+    /* "fccqp/certificates.pyx":96
  *         return False
  *     for j in range(n):
  *         ATr[j] = 0.0             # <<<<<<<<<<<<<<
@@ -3166,7 +3198,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
 */
     (__pyx_v_ATr[__pyx_v_j]) = 0.0;
 
-    /* "fccqp/certificates.pyx":95
+    /* "fccqp/certificates.pyx":97
  *     for j in range(n):
  *         ATr[j] = 0.0
  *         terms[j] = 0.0             # <<<<<<<<<<<<<<
@@ -3177,7 +3209,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
   }
 
 
-  /* "fccqp/certificates.pyx":96
+  /* "fccqp/certificates.pyx":98
  *         ATr[j] = 0.0
  *         terms[j] = 0.0
  *     for i in range(m):             # <<<<<<<<<<<<<<
@@ -3191,7 +3223,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/certificates.pyx":97
+    /* "fccqp/certificates.pyx":99
  *         terms[j] = 0.0
  *     for i in range(m):
  *         for j in range(n):             # <<<<<<<<<<<<<<
@@ -3205,7 +3237,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
     for (__pyx_t_7 = 0; __pyx_t_7 < __pyx_t_6; __pyx_t_7+=1) {
       __pyx_v_j = __pyx_t_7;
 
-      /* "fccqp/certificates.pyx":98
+      /* "fccqp/certificates.pyx":100
  *     for i in range(m):
  *         for j in range(n):
  *             value = p.A[i * n + j] * r[i]             # <<<<<<<<<<<<<<
@@ -3214,7 +3246,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
 */
       __pyx_v_value = ((__pyx_v_p->A[((__pyx_v_i * __pyx_v_n) + __pyx_v_j)]) * (__pyx_v_r[__pyx_v_i]));
 
-      /* "fccqp/certificates.pyx":99
+      /* "fccqp/certificates.pyx":101
  *         for j in range(n):
  *             value = p.A[i * n + j] * r[i]
  *             ATr[j] += value             # <<<<<<<<<<<<<<
@@ -3225,7 +3257,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
       __pyx_t_9 = __pyx_v_j;
       (__pyx_v_ATr[__pyx_t_9]) = ((__pyx_v_ATr[__pyx_t_9]) + __pyx_v_value);
 
-      /* "fccqp/certificates.pyx":100
+      /* "fccqp/certificates.pyx":102
  *             value = p.A[i * n + j] * r[i]
  *             ATr[j] += value
  *             terms[j] += fabs(value)             # <<<<<<<<<<<<<<
@@ -3240,7 +3272,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
   }
 
 
-  /* "fccqp/certificates.pyx":101
+  /* "fccqp/certificates.pyx":103
  *             ATr[j] += value
  *             terms[j] += fabs(value)
  *     for j in range(n):             # <<<<<<<<<<<<<<
@@ -3254,7 +3286,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/certificates.pyx":102
+    /* "fccqp/certificates.pyx":104
  *             terms[j] += fabs(value)
  *     for j in range(n):
  *         lhs_max = max(lhs_max, fabs(ATr[j]) / p.D[j])             # <<<<<<<<<<<<<<
@@ -3278,7 +3310,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
     __pyx_v_lhs_max = __pyx_t_12;
 
 
-    /* "fccqp/certificates.pyx":103
+    /* "fccqp/certificates.pyx":105
  *     for j in range(n):
  *         lhs_max = max(lhs_max, fabs(ATr[j]) / p.D[j])
  *         terms_max = max(terms_max, terms[j] / p.D[j])             # <<<<<<<<<<<<<<
@@ -3304,7 +3336,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
   }
 
 
-  /* "fccqp/certificates.pyx":104
+  /* "fccqp/certificates.pyx":106
  *         lhs_max = max(lhs_max, fabs(ATr[j]) / p.D[j])
  *         terms_max = max(terms_max, terms[j] / p.D[j])
  *     return lhs_max <= eps * terms_max             # <<<<<<<<<<<<<<
@@ -3317,7 +3349,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
   }
   goto __pyx_L0;
 
-  /* "fccqp/certificates.pyx":77
+  /* "fccqp/certificates.pyx":79
  * 
  * 
  * cdef bint equality_inconsistent(const Problem* p, const Iterates* it, double eps, double* r,             # <<<<<<<<<<<<<<
@@ -3339,7 +3371,7 @@ static int __pyx_f_5fccqp_12certificates_equality_inconsistent(struct __pyx_t_5f
   return __pyx_r;
 }
 
-/* "fccqp/certificates.pyx":107
+/* "fccqp/certificates.pyx":109
  * 
  * 
  * cdef inline bint _near_zero(const double* M, const double* dx, Py_ssize_t rows,             # <<<<<<<<<<<<<<
@@ -3367,7 +3399,7 @@ static CYTHON_INLINE int __pyx_f_5fccqp_12certificates__near_zero(double const *
   double __pyx_t_10;
   int __pyx_t_11;
 
-  /* "fccqp/certificates.pyx":114
+  /* "fccqp/certificates.pyx":116
  *     are scratch of ``rows`` entries."""
  *     cdef Py_ssize_t i, j
  *     cdef double value, lhs_max = 0.0, terms_max = 0.0, unit             # <<<<<<<<<<<<<<
@@ -3377,7 +3409,7 @@ static CYTHON_INLINE int __pyx_f_5fccqp_12certificates__near_zero(double const *
   __pyx_v_lhs_max = 0.0;
   __pyx_v_terms_max = 0.0;
 
-  /* "fccqp/certificates.pyx":115
+  /* "fccqp/certificates.pyx":117
  *     cdef Py_ssize_t i, j
  *     cdef double value, lhs_max = 0.0, terms_max = 0.0, unit
  *     for i in range(rows):             # <<<<<<<<<<<<<<
@@ -3391,7 +3423,7 @@ static CYTHON_INLINE int __pyx_f_5fccqp_12certificates__near_zero(double const *
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/certificates.pyx":116
+    /* "fccqp/certificates.pyx":118
  *     cdef double value, lhs_max = 0.0, terms_max = 0.0, unit
  *     for i in range(rows):
  *         out[i] = 0.0             # <<<<<<<<<<<<<<
@@ -3400,7 +3432,7 @@ static CYTHON_INLINE int __pyx_f_5fccqp_12certificates__near_zero(double const *
 */
     (__pyx_v_out[__pyx_v_i]) = 0.0;
 
-    /* "fccqp/certificates.pyx":117
+    /* "fccqp/certificates.pyx":119
  *     for i in range(rows):
  *         out[i] = 0.0
  *         terms[i] = 0.0             # <<<<<<<<<<<<<<
@@ -3409,7 +3441,7 @@ static CYTHON_INLINE int __pyx_f_5fccqp_12certificates__near_zero(double const *
 */
     (__pyx_v_terms[__pyx_v_i]) = 0.0;
 
-    /* "fccqp/certificates.pyx":118
+    /* "fccqp/certificates.pyx":120
  *         out[i] = 0.0
  *         terms[i] = 0.0
  *         for j in range(cols):             # <<<<<<<<<<<<<<
@@ -3423,7 +3455,7 @@ static CYTHON_INLINE int __pyx_f_5fccqp_12certificates__near_zero(double const *
     for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
       __pyx_v_j = __pyx_t_6;
 
-      /* "fccqp/certificates.pyx":119
+      /* "fccqp/certificates.pyx":121
  *         terms[i] = 0.0
  *         for j in range(cols):
  *             value = M[i * cols + j] * dx[j]             # <<<<<<<<<<<<<<
@@ -3432,7 +3464,7 @@ static CYTHON_INLINE int __pyx_f_5fccqp_12certificates__near_zero(double const *
 */
       __pyx_v_value = ((__pyx_v_M[((__pyx_v_i * __pyx_v_cols) + __pyx_v_j)]) * (__pyx_v_dx[__pyx_v_j]));
 
-      /* "fccqp/certificates.pyx":120
+      /* "fccqp/certificates.pyx":122
  *         for j in range(cols):
  *             value = M[i * cols + j] * dx[j]
  *             out[i] += value             # <<<<<<<<<<<<<<
@@ -3443,7 +3475,7 @@ static CYTHON_INLINE int __pyx_f_5fccqp_12certificates__near_zero(double const *
       __pyx_t_7 = __pyx_v_i;
       (__pyx_v_out[__pyx_t_7]) = ((__pyx_v_out[__pyx_t_7]) + __pyx_v_value);
 
-      /* "fccqp/certificates.pyx":121
+      /* "fccqp/certificates.pyx":123
  *             value = M[i * cols + j] * dx[j]
  *             out[i] += value
  *             terms[i] += fabs(value)             # <<<<<<<<<<<<<<
@@ -3456,7 +3488,7 @@ static CYTHON_INLINE int __pyx_f_5fccqp_12certificates__near_zero(double const *
     }
 
 
-    /* "fccqp/certificates.pyx":122
+    /* "fccqp/certificates.pyx":124
  *             out[i] += value
  *             terms[i] += fabs(value)
  *         unit = unit_scale * row_unit[i]             # <<<<<<<<<<<<<<
@@ -3465,7 +3497,7 @@ static CYTHON_INLINE int __pyx_f_5fccqp_12certificates__near_zero(double const *
 */
     __pyx_v_unit = (__pyx_v_unit_scale * (__pyx_v_row_unit[__pyx_v_i]));
 
-    /* "fccqp/certificates.pyx":123
+    /* "fccqp/certificates.pyx":125
  *             terms[i] += fabs(value)
  *         unit = unit_scale * row_unit[i]
  *         lhs_max = max(lhs_max, fabs(out[i]) / unit)             # <<<<<<<<<<<<<<
@@ -3489,7 +3521,7 @@ static CYTHON_INLINE int __pyx_f_5fccqp_12certificates__near_zero(double const *
     __pyx_v_lhs_max = __pyx_t_10;
 
 
-    /* "fccqp/certificates.pyx":124
+    /* "fccqp/certificates.pyx":126
  *         unit = unit_scale * row_unit[i]
  *         lhs_max = max(lhs_max, fabs(out[i]) / unit)
  *         terms_max = max(terms_max, terms[i] / unit)             # <<<<<<<<<<<<<<
@@ -3515,7 +3547,7 @@ static CYTHON_INLINE int __pyx_f_5fccqp_12certificates__near_zero(double const *
   }
 
 
-  /* "fccqp/certificates.pyx":125
+  /* "fccqp/certificates.pyx":127
  *         lhs_max = max(lhs_max, fabs(out[i]) / unit)
  *         terms_max = max(terms_max, terms[i] / unit)
  *     return lhs_max <= eps * terms_max             # <<<<<<<<<<<<<<
@@ -3528,7 +3560,7 @@ static CYTHON_INLINE int __pyx_f_5fccqp_12certificates__near_zero(double const *
   }
   goto __pyx_L0;
 
-  /* "fccqp/certificates.pyx":107
+  /* "fccqp/certificates.pyx":109
  * 
  * 
  * cdef inline bint _near_zero(const double* M, const double* dx, Py_ssize_t rows,             # <<<<<<<<<<<<<<
@@ -3547,7 +3579,7 @@ static CYTHON_INLINE int __pyx_f_5fccqp_12certificates__near_zero(double const *
   return __pyx_r;
 }
 
-/* "fccqp/certificates.pyx":128
+/* "fccqp/certificates.pyx":130
  * 
  * 
  * cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double* Pdx,             # <<<<<<<<<<<<<<
@@ -3581,7 +3613,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
   Py_ssize_t __pyx_t_10;
   Py_ssize_t __pyx_t_11;
 
-  /* "fccqp/certificates.pyx":132
+  /* "fccqp/certificates.pyx":134
  *     """Test the direction ``dx`` (scaled); ``Pdx`` and ``terms`` (``max(n, m)``) and
  *     ``block`` (s) are scratch."""
  *     cdef Py_ssize_t n = p.n, s = p.s, i, j, k, a, dim             # <<<<<<<<<<<<<<
@@ -3595,7 +3627,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/certificates.pyx":133
+  /* "fccqp/certificates.pyx":135
  *     ``block`` (s) are scratch."""
  *     cdef Py_ssize_t n = p.n, s = p.s, i, j, k, a, dim
  *     cdef double qdx = 0.0, size = 0.0, norm = 0.0, step, tol             # <<<<<<<<<<<<<<
@@ -3606,7 +3638,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
   __pyx_v_size = 0.0;
   __pyx_v_norm = 0.0;
 
-  /* "fccqp/certificates.pyx":134
+  /* "fccqp/certificates.pyx":136
  *     cdef Py_ssize_t n = p.n, s = p.s, i, j, k, a, dim
  *     cdef double qdx = 0.0, size = 0.0, norm = 0.0, step, tol
  *     for i in range(n):             # <<<<<<<<<<<<<<
@@ -3620,7 +3652,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/certificates.pyx":135
+    /* "fccqp/certificates.pyx":137
  *     cdef double qdx = 0.0, size = 0.0, norm = 0.0, step, tol
  *     for i in range(n):
  *         qdx += p.q[i] * dx[i]             # <<<<<<<<<<<<<<
@@ -3629,7 +3661,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
 */
     __pyx_v_qdx = (__pyx_v_qdx + ((__pyx_v_p->q[__pyx_v_i]) * (__pyx_v_dx[__pyx_v_i])));
 
-    /* "fccqp/certificates.pyx":136
+    /* "fccqp/certificates.pyx":138
  *     for i in range(n):
  *         qdx += p.q[i] * dx[i]
  *         size += fabs(p.q[i] * dx[i])             # <<<<<<<<<<<<<<
@@ -3638,7 +3670,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
 */
     __pyx_v_size = (__pyx_v_size + fabs(((__pyx_v_p->q[__pyx_v_i]) * (__pyx_v_dx[__pyx_v_i]))));
 
-    /* "fccqp/certificates.pyx":137
+    /* "fccqp/certificates.pyx":139
  *         qdx += p.q[i] * dx[i]
  *         size += fabs(p.q[i] * dx[i])
  *         norm = max(norm, fabs(dx[i] * p.D[i]))             # <<<<<<<<<<<<<<
@@ -3664,7 +3696,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
   }
 
 
-  /* "fccqp/certificates.pyx":138
+  /* "fccqp/certificates.pyx":140
  *         size += fabs(p.q[i] * dx[i])
  *         norm = max(norm, fabs(dx[i] * p.D[i]))
  *     if not (qdx < -eps * size) or not isfinite(qdx) or norm <= 1e-300:             # <<<<<<<<<<<<<<
@@ -3700,7 +3732,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
   if (__pyx_t_7) {
 
 
-    /* "fccqp/certificates.pyx":139
+    /* "fccqp/certificates.pyx":141
  *         norm = max(norm, fabs(dx[i] * p.D[i]))
  *     if not (qdx < -eps * size) or not isfinite(qdx) or norm <= 1e-300:
  *         return False             # <<<<<<<<<<<<<<
@@ -3713,7 +3745,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
     }
     goto __pyx_L0;
 
-    /* "fccqp/certificates.pyx":138
+    /* "fccqp/certificates.pyx":140
  *         size += fabs(p.q[i] * dx[i])
  *         norm = max(norm, fabs(dx[i] * p.D[i]))
  *     if not (qdx < -eps * size) or not isfinite(qdx) or norm <= 1e-300:             # <<<<<<<<<<<<<<
@@ -3722,7 +3754,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
 */
   }
 
-  /* "fccqp/certificates.pyx":140
+  /* "fccqp/certificates.pyx":142
  *     if not (qdx < -eps * size) or not isfinite(qdx) or norm <= 1e-300:
  *         return False
  *     tol = eps * norm             # <<<<<<<<<<<<<<
@@ -3731,7 +3763,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
 */
   __pyx_v_tol = (__pyx_v_eps * __pyx_v_norm);
 
-  /* "fccqp/certificates.pyx":141
+  /* "fccqp/certificates.pyx":143
  *         return False
  *     tol = eps * norm
  *     for j in range(s):             # <<<<<<<<<<<<<<
@@ -3745,7 +3777,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_j = __pyx_t_3;
 
-    /* "fccqp/certificates.pyx":142
+    /* "fccqp/certificates.pyx":144
  *     tol = eps * norm
  *     for j in range(s):
  *         i = p.constrained[j]             # <<<<<<<<<<<<<<
@@ -3754,7 +3786,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
 */
     __pyx_v_i = (__pyx_v_p->constrained[__pyx_v_j]);
 
-    /* "fccqp/certificates.pyx":143
+    /* "fccqp/certificates.pyx":145
  *     for j in range(s):
  *         i = p.constrained[j]
  *         step = dx[i] * p.D[i]             # <<<<<<<<<<<<<<
@@ -3763,7 +3795,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
 */
     __pyx_v_step = ((__pyx_v_dx[__pyx_v_i]) * (__pyx_v_p->D[__pyx_v_i]));
 
-    /* "fccqp/certificates.pyx":144
+    /* "fccqp/certificates.pyx":146
  *         i = p.constrained[j]
  *         step = dx[i] * p.D[i]
  *         if (isfinite(p.hi[j]) and step > tol) or (isfinite(p.lo[j]) and step < -tol):             # <<<<<<<<<<<<<<
@@ -3808,7 +3840,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
     if (__pyx_t_7) {
 
 
-      /* "fccqp/certificates.pyx":145
+      /* "fccqp/certificates.pyx":147
  *         step = dx[i] * p.D[i]
  *         if (isfinite(p.hi[j]) and step > tol) or (isfinite(p.lo[j]) and step < -tol):
  *             return False             # <<<<<<<<<<<<<<
@@ -3821,7 +3853,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
       }
       goto __pyx_L0;
 
-      /* "fccqp/certificates.pyx":144
+      /* "fccqp/certificates.pyx":146
  *         i = p.constrained[j]
  *         step = dx[i] * p.D[i]
  *         if (isfinite(p.hi[j]) and step > tol) or (isfinite(p.lo[j]) and step < -tol):             # <<<<<<<<<<<<<<
@@ -3832,7 +3864,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
   }
 
 
-  /* "fccqp/certificates.pyx":146
+  /* "fccqp/certificates.pyx":148
  *         if (isfinite(p.hi[j]) and step > tol) or (isfinite(p.lo[j]) and step < -tol):
  *             return False
  *     for k in range(p.cones.count):             # <<<<<<<<<<<<<<
@@ -3846,7 +3878,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_k = __pyx_t_3;
 
-    /* "fccqp/certificates.pyx":147
+    /* "fccqp/certificates.pyx":149
  *             return False
  *     for k in range(p.cones.count):
  *         a, dim = p.cones.offset[k], p.cones.dim[k]             # <<<<<<<<<<<<<<
@@ -3860,7 +3892,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
     __pyx_v_a = __pyx_t_9;
     __pyx_v_dim = __pyx_t_10;
 
-    /* "fccqp/certificates.pyx":148
+    /* "fccqp/certificates.pyx":150
  *     for k in range(p.cones.count):
  *         a, dim = p.cones.offset[k], p.cones.dim[k]
  *         for j in range(dim):             # <<<<<<<<<<<<<<
@@ -3874,7 +3906,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
     for (__pyx_t_11 = 0; __pyx_t_11 < __pyx_t_9; __pyx_t_11+=1) {
       __pyx_v_j = __pyx_t_11;
 
-      /* "fccqp/certificates.pyx":149
+      /* "fccqp/certificates.pyx":151
  *         a, dim = p.cones.offset[k], p.cones.dim[k]
  *         for j in range(dim):
  *             block[a + j] = dx[p.constrained[a + j]]             # <<<<<<<<<<<<<<
@@ -3885,7 +3917,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
     }
 
 
-    /* "fccqp/certificates.pyx":150
+    /* "fccqp/certificates.pyx":152
  *         for j in range(dim):
  *             block[a + j] = dx[p.constrained[a + j]]
  *         proj_block(block + a, p.cones.kind[k], dim, p.cones.mu[k], p.cones.normal + 3 * k,             # <<<<<<<<<<<<<<
@@ -3894,7 +3926,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
 */
     __pyx_f_5fccqp_11projections_proj_block((__pyx_v_block + __pyx_v_a), (__pyx_v_p->cones.kind[__pyx_v_k]), __pyx_v_dim, (__pyx_v_p->cones.mu[__pyx_v_k]), (__pyx_v_p->cones.normal + (3 * __pyx_v_k)), __pyx_v_terms);
 
-    /* "fccqp/certificates.pyx":152
+    /* "fccqp/certificates.pyx":154
  *         proj_block(block + a, p.cones.kind[k], dim, p.cones.mu[k], p.cones.normal + 3 * k,
  *                    terms)
  *         for j in range(dim):             # <<<<<<<<<<<<<<
@@ -3908,7 +3940,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
     for (__pyx_t_11 = 0; __pyx_t_11 < __pyx_t_9; __pyx_t_11+=1) {
       __pyx_v_j = __pyx_t_11;
 
-      /* "fccqp/certificates.pyx":153
+      /* "fccqp/certificates.pyx":155
  *                    terms)
  *         for j in range(dim):
  *             if fabs(block[a + j] - terms[j]) * p.D[p.constrained[a]] > tol:             # <<<<<<<<<<<<<<
@@ -3920,7 +3952,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
       if (__pyx_t_7) {
 
 
-        /* "fccqp/certificates.pyx":154
+        /* "fccqp/certificates.pyx":156
  *         for j in range(dim):
  *             if fabs(block[a + j] - terms[j]) * p.D[p.constrained[a]] > tol:
  *                 return False             # <<<<<<<<<<<<<<
@@ -3933,7 +3965,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
         }
         goto __pyx_L0;
 
-        /* "fccqp/certificates.pyx":153
+        /* "fccqp/certificates.pyx":155
  *                    terms)
  *         for j in range(dim):
  *             if fabs(block[a + j] - terms[j]) * p.D[p.constrained[a]] > tol:             # <<<<<<<<<<<<<<
@@ -3946,7 +3978,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
   }
 
 
-  /* "fccqp/certificates.pyx":155
+  /* "fccqp/certificates.pyx":157
  *             if fabs(block[a + j] - terms[j]) * p.D[p.constrained[a]] > tol:
  *                 return False
  *     if not _near_zero(p.P, dx, n, n, p.D, p.c, eps, Pdx, terms):             # <<<<<<<<<<<<<<
@@ -3958,7 +3990,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
   if (__pyx_t_7) {
 
 
-    /* "fccqp/certificates.pyx":156
+    /* "fccqp/certificates.pyx":158
  *                 return False
  *     if not _near_zero(p.P, dx, n, n, p.D, p.c, eps, Pdx, terms):
  *         return False             # <<<<<<<<<<<<<<
@@ -3970,7 +4002,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
     }
     goto __pyx_L0;
 
-    /* "fccqp/certificates.pyx":155
+    /* "fccqp/certificates.pyx":157
  *             if fabs(block[a + j] - terms[j]) * p.D[p.constrained[a]] > tol:
  *                 return False
  *     if not _near_zero(p.P, dx, n, n, p.D, p.c, eps, Pdx, terms):             # <<<<<<<<<<<<<<
@@ -3979,7 +4011,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
 */
   }
 
-  /* "fccqp/certificates.pyx":157
+  /* "fccqp/certificates.pyx":159
  *     if not _near_zero(p.P, dx, n, n, p.D, p.c, eps, Pdx, terms):
  *         return False
  *     return p.m == 0 or _near_zero(p.A, dx, p.m, n, p.E, 1.0, eps, Pdx, terms)             # <<<<<<<<<<<<<<
@@ -4005,7 +4037,7 @@ static int __pyx_f_5fccqp_12certificates_dual_infeasible(struct __pyx_t_5fccqp_6
   }
   goto __pyx_L0;
 
-  /* "fccqp/certificates.pyx":128
+  /* "fccqp/certificates.pyx":130
  * 
  * 
  * cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double* Pdx,             # <<<<<<<<<<<<<<

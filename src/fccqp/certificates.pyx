@@ -41,6 +41,8 @@ cdef bint primal_infeasible(const Problem* p, const Iterates* it, double eps, do
         for j in range(dim):
             d_y[a + j] -= terms[j]
     for j in range(s):
+        if p.in_cone[j]:
+            continue
         if not isfinite(p.hi[j]) and d_y[j] > 0.0:
             d_y[j] = 0.0
         if not isfinite(p.lo[j]) and d_y[j] < 0.0:

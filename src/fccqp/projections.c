@@ -1800,6 +1800,7 @@ struct __pyx_t_5fccqp_6_types_Problem {
   double *A;
   double *b;
   Py_ssize_t const *constrained;
+  char const *in_cone;
   double *lo;
   double *hi;
   struct __pyx_t_5fccqp_6_types_Cones cones;
@@ -1808,7 +1809,7 @@ struct __pyx_t_5fccqp_6_types_Problem {
   double c;
 };
 
-/* "fccqp/_types.pxd":41
+/* "fccqp/_types.pxd":42
  * 
  * 
  * cdef struct Iterates:             # <<<<<<<<<<<<<<
@@ -2794,6 +2795,16 @@ static void __Pyx_RaiseUnboundLocalError(const char *varname);
 /* DivInt[long].proto */
 static CYTHON_INLINE long __Pyx_div_long(long, long, int b_is_constant);
 
+/* PyObjectVectorcallKwds.proto */
+#if CYTHON_VECTORCALL
+#define __Pyx_Object_VectorcallKwds PyObject_Vectorcall
+CYTHON_UNUSED static int __Pyx_CheckVectorcallKwarg(PyObject *kwnames, Py_ssize_t i);
+#else
+#define __Pyx_Object_VectorcallKwds __Pyx_PyObject_FastCallDict
+CYTHON_UNUSED static PyObject *__Pyx_MakeKwargDict(PyObject **keys, PyObject **values, Py_ssize_t n);
+CYTHON_UNUSED static int __Pyx_CheckVectorcallKwarg(PyObject **kwnames, Py_ssize_t i);
+#endif
+
 /* IterFinish.proto */
 static CYTHON_INLINE int __Pyx_IterFinish(void);
 
@@ -3158,10 +3169,13 @@ static int __Pyx_ValidateAndInit_memviewslice(
 static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_dc_double(PyObject *, int writable_flag);
 
 /* ObjectToMemviewSlice.proto */
-static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(PyObject *, int writable_flag);
+static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(PyObject *, int writable_flag);
 
 /* ObjectToMemviewSlice.proto */
-static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_d_dc_double(PyObject *, int writable_flag);
+static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t__const__(PyObject *, int writable_flag);
+
+/* ObjectToMemviewSlice.proto */
+static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_d_dc_double__const__(PyObject *, int writable_flag);
 
 /* MemviewSliceCopy.proto */
 static __Pyx_memviewslice
@@ -3187,16 +3201,6 @@ static CYTHON_INLINE int __Pyx_PyLong_As_int(PyObject *);
 
 /* CIntFromPy.proto */
 static CYTHON_INLINE long __Pyx_PyLong_As_long(PyObject *);
-
-/* PyObjectVectorcallKwds.proto (used by PyObjectVectorcallMethodKwds) */
-#if CYTHON_VECTORCALL
-#define __Pyx_Object_VectorcallKwds PyObject_Vectorcall
-CYTHON_UNUSED static int __Pyx_CheckVectorcallKwarg(PyObject *kwnames, Py_ssize_t i);
-#else
-#define __Pyx_Object_VectorcallKwds __Pyx_PyObject_FastCallDict
-CYTHON_UNUSED static PyObject *__Pyx_MakeKwargDict(PyObject **keys, PyObject **values, Py_ssize_t n);
-CYTHON_UNUSED static int __Pyx_CheckVectorcallKwarg(PyObject **kwnames, Py_ssize_t i);
-#endif
 
 /* PyObjectVectorcallMethodKwds.proto (used by CIntToPy) */
 #if CYTHON_VECTORCALL
@@ -3374,7 +3378,8 @@ static void __pyx_memoryview__slice_assign_scalar(char *, Py_ssize_t *, Py_ssize
 static PyObject *__pyx_unpickle_Enum__set_state(struct __pyx_MemviewEnum_obj *, PyObject *); /*proto*/
 /* #### Code section: typeinfo ### */
 static const __Pyx_TypeInfo __Pyx_TypeInfo_double = { "double", NULL, sizeof(double), { 0 }, 0, 'R', 0, 0 };
-static const __Pyx_TypeInfo __Pyx_TypeInfo_Py_ssize_t = { "Py_ssize_t", NULL, sizeof(Py_ssize_t), { 0 }, 0, __PYX_IS_UNSIGNED(Py_ssize_t) ? 'U' : 'I', __PYX_IS_UNSIGNED(Py_ssize_t), 0 };
+static const __Pyx_TypeInfo __Pyx_TypeInfo_double__const__ = { "const double", NULL, sizeof(double const ), { 0 }, 0, 'R', 0, 0 };
+static const __Pyx_TypeInfo __Pyx_TypeInfo_Py_ssize_t__const__ = { "const Py_ssize_t", NULL, sizeof(Py_ssize_t const ), { 0 }, 0, __PYX_IS_UNSIGNED(Py_ssize_t const ) ? 'U' : 'I', __PYX_IS_UNSIGNED(Py_ssize_t const ), 0 };
 /* #### Code section: before_global_var ### */
 #define __Pyx_MODULE_NAME "fccqp.projections"
 extern int __pyx_module_is_main_fccqp__projections;
@@ -3445,7 +3450,7 @@ static void __pyx_memoryviewslice___pyx_pf_15View_dot_MemoryView_16_memoryviewsl
 static PyObject *__pyx_pf___pyx_memoryviewslice___reduce_cython__(CYTHON_UNUSED struct __pyx_memoryviewslice_obj *__pyx_v_self); /* proto */
 static PyObject *__pyx_pf___pyx_memoryviewslice_2__setstate_cython__(CYTHON_UNUSED struct __pyx_memoryviewslice_obj *__pyx_v_self, CYTHON_UNUSED PyObject *__pyx_v___pyx_state); /* proto */
 static PyObject *__pyx_pf_15View_dot_MemoryView___pyx_unpickle_Enum(CYTHON_UNUSED PyObject *__pyx_self, PyObject *__pyx_v___pyx_type, long __pyx_v___pyx_checksum, PyObject *__pyx_v___pyx_state); /* proto */
-static PyObject *__pyx_pf_5fccqp_11projections_project_friction_cone(CYTHON_UNUSED PyObject *__pyx_self, __Pyx_memviewslice __pyx_v_v, double __pyx_v_mu, __Pyx_memviewslice __pyx_v_normal, __Pyx_memviewslice __pyx_v_out); /* proto */
+static PyObject *__pyx_pf_5fccqp_11projections_project_friction_cone(CYTHON_UNUSED PyObject *__pyx_self, PyObject *__pyx_v_v, double __pyx_v_mu, PyObject *__pyx_v_normal, __Pyx_memviewslice __pyx_v_out); /* proto */
 static PyObject *__pyx_pf_5fccqp_11projections_2project_second_order_cone(CYTHON_UNUSED PyObject *__pyx_self, __Pyx_memviewslice __pyx_v_v, __Pyx_memviewslice __pyx_v_out); /* proto */
 static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UNUSED PyObject *__pyx_self, __Pyx_memviewslice __pyx_v_v, __Pyx_memviewslice __pyx_v_lo, __Pyx_memviewslice __pyx_v_hi, PyObject *__pyx_v_cones, __Pyx_memviewslice __pyx_v_out); /* proto */
 static PyObject *__pyx_pf_5fccqp_11projections_6project_cone_block(CYTHON_UNUSED PyObject *__pyx_self, __Pyx_memviewslice __pyx_v_v, Py_ssize_t __pyx_v_kind, double __pyx_v_mu, __Pyx_memviewslice __pyx_v_normal, __Pyx_memviewslice __pyx_v_out); /* proto */
@@ -3582,9 +3587,9 @@ namespace {
     __Pyx_CachedCFunction __pyx_umethod_PyDict_Type_pop;
     __Pyx_CachedCFunction __pyx_umethod_PyDict_Type_values;
     PyObject *__pyx_slice[1];
-    PyObject *__pyx_tuple[2];
+    PyObject *__pyx_tuple[3];
     PyObject *__pyx_codeobj_tab[4];
-    PyObject *__pyx_string_tab[124];
+    PyObject *__pyx_string_tab[131];
     PyObject *__pyx_number_tab[3];
 /* #### Code section: module_state_contents ### */
 /* PyFrozenDict.module_state_decls */
@@ -3700,64 +3705,71 @@ static __pyx_mstatetype * const __pyx_mstate_global = &__pyx_mstate_global_stati
 #define __pyx_n_u_is_coroutine __pyx_string_tab[63]
 #define __pyx_n_u_abc __pyx_string_tab[64]
 #define __pyx_n_u_allocate_buffer __pyx_string_tab[65]
-#define __pyx_n_u_asyncio_coroutines __pyx_string_tab[66]
-#define __pyx_n_u_base __pyx_string_tab[67]
-#define __pyx_n_u_c __pyx_string_tab[68]
-#define __pyx_n_u_cline_in_traceback __pyx_string_tab[69]
-#define __pyx_n_u_cones __pyx_string_tab[70]
-#define __pyx_n_u_count __pyx_string_tab[71]
-#define __pyx_n_u_dim __pyx_string_tab[72]
-#define __pyx_n_u_dtype_is_object __pyx_string_tab[73]
-#define __pyx_n_u_encode __pyx_string_tab[74]
-#define __pyx_n_u_enumerate __pyx_string_tab[75]
-#define __pyx_n_u_error __pyx_string_tab[76]
-#define __pyx_n_u_fccqp_projections __pyx_string_tab[77]
-#define __pyx_n_u_flags __pyx_string_tab[78]
-#define __pyx_n_u_format __pyx_string_tab[79]
-#define __pyx_n_u_fortran __pyx_string_tab[80]
-#define __pyx_n_u_hi __pyx_string_tab[81]
-#define __pyx_n_u_id __pyx_string_tab[82]
-#define __pyx_n_u_index __pyx_string_tab[83]
-#define __pyx_n_u_items __pyx_string_tab[84]
-#define __pyx_n_u_itemsize __pyx_string_tab[85]
-#define __pyx_n_u_k __pyx_string_tab[86]
-#define __pyx_n_u_kind __pyx_string_tab[87]
-#define __pyx_n_u_lo __pyx_string_tab[88]
-#define __pyx_n_u_memview __pyx_string_tab[89]
-#define __pyx_n_u_mode __pyx_string_tab[90]
-#define __pyx_n_u_mu __pyx_string_tab[91]
-#define __pyx_n_u_name __pyx_string_tab[92]
-#define __pyx_n_u_ndim __pyx_string_tab[93]
-#define __pyx_n_u_normal __pyx_string_tab[94]
-#define __pyx_n_u_obj __pyx_string_tab[95]
-#define __pyx_n_u_offset __pyx_string_tab[96]
-#define __pyx_n_u_out __pyx_string_tab[97]
-#define __pyx_n_u_pack __pyx_string_tab[98]
-#define __pyx_n_u_pop __pyx_string_tab[99]
-#define __pyx_n_u_project_cone_block __pyx_string_tab[100]
-#define __pyx_n_u_project_constraint_set __pyx_string_tab[101]
-#define __pyx_n_u_project_friction_cone __pyx_string_tab[102]
-#define __pyx_n_u_project_second_order_cone __pyx_string_tab[103]
-#define __pyx_n_u_register __pyx_string_tab[104]
-#define __pyx_n_u_s __pyx_string_tab[105]
-#define __pyx_n_u_setdefault __pyx_string_tab[106]
-#define __pyx_n_u_shape __pyx_string_tab[107]
-#define __pyx_n_u_size __pyx_string_tab[108]
-#define __pyx_n_u_start __pyx_string_tab[109]
-#define __pyx_n_u_step __pyx_string_tab[110]
-#define __pyx_n_u_stop __pyx_string_tab[111]
-#define __pyx_n_u_struct __pyx_string_tab[112]
-#define __pyx_n_u_unpack __pyx_string_tab[113]
-#define __pyx_n_u_update __pyx_string_tab[114]
-#define __pyx_n_u_v __pyx_string_tab[115]
-#define __pyx_n_u_values __pyx_string_tab[116]
-#define __pyx_n_u_x __pyx_string_tab[117]
-#define __pyx_n_b_O __pyx_string_tab[118]
-#define __pyx_kp_b_void_double_const_Py_ssize_t_Py __pyx_string_tab[119]
-#define __pyx_kp_b_iso88591_q_as_Bc_F_3c_j_AQaq_AV1D_AQ __pyx_string_tab[120]
-#define __pyx_kp_b_iso88591_q_as_Rs_as_Rs_V1Cs_j_1AT_QfAT_Q __pyx_string_tab[121]
-#define __pyx_kp_b_iso88591_s_Cq_as_QfAS_CvV1Cs_j_uCy_AV1Cs __pyx_string_tab[122]
-#define __pyx_kp_b_iso88591_t9A_q_r_q_3b_2V1Cs_Cs_Cq_j_U_4v __pyx_string_tab[123]
+#define __pyx_n_u_ascontiguousarray __pyx_string_tab[66]
+#define __pyx_n_u_asyncio_coroutines __pyx_string_tab[67]
+#define __pyx_n_u_base __pyx_string_tab[68]
+#define __pyx_n_u_c __pyx_string_tab[69]
+#define __pyx_n_u_cline_in_traceback __pyx_string_tab[70]
+#define __pyx_n_u_cones __pyx_string_tab[71]
+#define __pyx_n_u_count __pyx_string_tab[72]
+#define __pyx_n_u_dim __pyx_string_tab[73]
+#define __pyx_n_u_dtype __pyx_string_tab[74]
+#define __pyx_n_u_dtype_is_object __pyx_string_tab[75]
+#define __pyx_n_u_encode __pyx_string_tab[76]
+#define __pyx_n_u_enumerate __pyx_string_tab[77]
+#define __pyx_n_u_error __pyx_string_tab[78]
+#define __pyx_n_u_fccqp_projections __pyx_string_tab[79]
+#define __pyx_n_u_flags __pyx_string_tab[80]
+#define __pyx_n_u_float64 __pyx_string_tab[81]
+#define __pyx_n_u_format __pyx_string_tab[82]
+#define __pyx_n_u_fortran __pyx_string_tab[83]
+#define __pyx_n_u_hi __pyx_string_tab[84]
+#define __pyx_n_u_id __pyx_string_tab[85]
+#define __pyx_n_u_index __pyx_string_tab[86]
+#define __pyx_n_u_items __pyx_string_tab[87]
+#define __pyx_n_u_itemsize __pyx_string_tab[88]
+#define __pyx_n_u_k __pyx_string_tab[89]
+#define __pyx_n_u_kind __pyx_string_tab[90]
+#define __pyx_n_u_lo __pyx_string_tab[91]
+#define __pyx_n_u_memview __pyx_string_tab[92]
+#define __pyx_n_u_mode __pyx_string_tab[93]
+#define __pyx_n_u_mu __pyx_string_tab[94]
+#define __pyx_n_u_name __pyx_string_tab[95]
+#define __pyx_n_u_ndim __pyx_string_tab[96]
+#define __pyx_n_u_normal __pyx_string_tab[97]
+#define __pyx_n_u_normal_2 __pyx_string_tab[98]
+#define __pyx_n_u_np __pyx_string_tab[99]
+#define __pyx_n_u_numpy __pyx_string_tab[100]
+#define __pyx_n_u_obj __pyx_string_tab[101]
+#define __pyx_n_u_offset __pyx_string_tab[102]
+#define __pyx_n_u_out __pyx_string_tab[103]
+#define __pyx_n_u_pack __pyx_string_tab[104]
+#define __pyx_n_u_pop __pyx_string_tab[105]
+#define __pyx_n_u_project_cone_block __pyx_string_tab[106]
+#define __pyx_n_u_project_constraint_set __pyx_string_tab[107]
+#define __pyx_n_u_project_friction_cone __pyx_string_tab[108]
+#define __pyx_n_u_project_second_order_cone __pyx_string_tab[109]
+#define __pyx_n_u_register __pyx_string_tab[110]
+#define __pyx_n_u_s __pyx_string_tab[111]
+#define __pyx_n_u_setdefault __pyx_string_tab[112]
+#define __pyx_n_u_shape __pyx_string_tab[113]
+#define __pyx_n_u_size __pyx_string_tab[114]
+#define __pyx_n_u_start __pyx_string_tab[115]
+#define __pyx_n_u_step __pyx_string_tab[116]
+#define __pyx_n_u_stop __pyx_string_tab[117]
+#define __pyx_n_u_struct __pyx_string_tab[118]
+#define __pyx_n_u_unpack __pyx_string_tab[119]
+#define __pyx_n_u_update __pyx_string_tab[120]
+#define __pyx_n_u_v __pyx_string_tab[121]
+#define __pyx_n_u_v_2 __pyx_string_tab[122]
+#define __pyx_n_u_values __pyx_string_tab[123]
+#define __pyx_n_u_x __pyx_string_tab[124]
+#define __pyx_n_b_O __pyx_string_tab[125]
+#define __pyx_kp_b_void_double_const_Py_ssize_t_Py __pyx_string_tab[126]
+#define __pyx_kp_b_iso88591_q_as_Bc_F_3c_j_AQaq_AV1D_AQ __pyx_string_tab[127]
+#define __pyx_kp_b_iso88591_s_Cq_as_QfAS_CvV1Cs_j_uCy_AV1Cs __pyx_string_tab[128]
+#define __pyx_kp_b_iso88591_4AS_b_R_9_r_q_3b_7_Cr_CvQc_A_j __pyx_string_tab[129]
+#define __pyx_kp_b_iso88591_t9A_q_r_q_3b_2V1Cs_Cs_Cq_j_U_4v __pyx_string_tab[130]
 #define __pyx_int_0 __pyx_number_tab[0]
 #define __pyx_int_neg_1 __pyx_number_tab[1]
 #define __pyx_int_136983863 __pyx_number_tab[2]
@@ -3787,9 +3799,9 @@ static CYTHON_SMALL_CODE int __pyx_m_clear(PyObject *m) {
   Py_CLEAR(clear_module_state->__pyx_umethod_PyDict_Type_pop.method);
   Py_CLEAR(clear_module_state->__pyx_umethod_PyDict_Type_values.method);
   for (int i=0; i<1; ++i) { Py_CLEAR(clear_module_state->__pyx_slice[i]); }
-  for (int i=0; i<2; ++i) { Py_CLEAR(clear_module_state->__pyx_tuple[i]); }
+  for (int i=0; i<3; ++i) { Py_CLEAR(clear_module_state->__pyx_tuple[i]); }
   for (int i=0; i<4; ++i) { Py_CLEAR(clear_module_state->__pyx_codeobj_tab[i]); }
-  for (int i=0; i<124; ++i) { Py_CLEAR(clear_module_state->__pyx_string_tab[i]); }
+  for (int i=0; i<131; ++i) { Py_CLEAR(clear_module_state->__pyx_string_tab[i]); }
   for (int i=0; i<3; ++i) { Py_CLEAR(clear_module_state->__pyx_number_tab[i]); }
 /* #### Code section: module_state_clear_contents ### */
 /* CommonTypesMetaclass.module_state_clear */
@@ -3825,9 +3837,9 @@ static CYTHON_SMALL_CODE int __pyx_m_traverse(PyObject *m, visitproc visit, void
   Py_VISIT(traverse_module_state->__pyx_umethod_PyDict_Type_pop.method);
   Py_VISIT(traverse_module_state->__pyx_umethod_PyDict_Type_values.method);
   for (int i=0; i<1; ++i) { __Pyx_VISIT_CONST(traverse_module_state->__pyx_slice[i]); }
-  for (int i=0; i<2; ++i) { __Pyx_VISIT_CONST(traverse_module_state->__pyx_tuple[i]); }
+  for (int i=0; i<3; ++i) { __Pyx_VISIT_CONST(traverse_module_state->__pyx_tuple[i]); }
   for (int i=0; i<4; ++i) { __Pyx_VISIT_CONST(traverse_module_state->__pyx_codeobj_tab[i]); }
-  for (int i=0; i<124; ++i) { __Pyx_VISIT_CONST(traverse_module_state->__pyx_string_tab[i]); }
+  for (int i=0; i<131; ++i) { __Pyx_VISIT_CONST(traverse_module_state->__pyx_string_tab[i]); }
   for (int i=0; i<3; ++i) { __Pyx_VISIT_CONST(traverse_module_state->__pyx_number_tab[i]); }
 /* #### Code section: module_state_traverse_contents ### */
 /* CommonTypesMetaclass.module_state_traverse */
@@ -18014,7 +18026,7 @@ static PyObject *__pyx_unpickle_Enum__set_state(struct __pyx_MemviewEnum_obj *__
   return __pyx_r;
 }
 
-/* "fccqp/projections.pyx":22
+/* "fccqp/projections.pyx":24
  * 
  * 
  * cdef void proj_friction(const double* v, double mu, const double* normal,             # <<<<<<<<<<<<<<
@@ -18034,7 +18046,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
   double __pyx_v_scale;
   int __pyx_t_1;
 
-  /* "fccqp/projections.pyx":34
+  /* "fccqp/projections.pyx":36
  *     which the original C++ got wrong. ``out`` may be ``v``.
  *     """
  *     cdef double fn = normal[0] * v[0] + normal[1] * v[1] + normal[2] * v[2]             # <<<<<<<<<<<<<<
@@ -18043,7 +18055,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
 */
   __pyx_v_fn = ((((__pyx_v_normal[0]) * (__pyx_v_v[0])) + ((__pyx_v_normal[1]) * (__pyx_v_v[1]))) + ((__pyx_v_normal[2]) * (__pyx_v_v[2])));
 
-  /* "fccqp/projections.pyx":35
+  /* "fccqp/projections.pyx":37
  *     """
  *     cdef double fn = normal[0] * v[0] + normal[1] * v[1] + normal[2] * v[2]
  *     cdef double t0 = v[0] - fn * normal[0]             # <<<<<<<<<<<<<<
@@ -18052,7 +18064,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
 */
   __pyx_v_t0 = ((__pyx_v_v[0]) - (__pyx_v_fn * (__pyx_v_normal[0])));
 
-  /* "fccqp/projections.pyx":36
+  /* "fccqp/projections.pyx":38
  *     cdef double fn = normal[0] * v[0] + normal[1] * v[1] + normal[2] * v[2]
  *     cdef double t0 = v[0] - fn * normal[0]
  *     cdef double t1 = v[1] - fn * normal[1]             # <<<<<<<<<<<<<<
@@ -18061,7 +18073,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
 */
   __pyx_v_t1 = ((__pyx_v_v[1]) - (__pyx_v_fn * (__pyx_v_normal[1])));
 
-  /* "fccqp/projections.pyx":37
+  /* "fccqp/projections.pyx":39
  *     cdef double t0 = v[0] - fn * normal[0]
  *     cdef double t1 = v[1] - fn * normal[1]
  *     cdef double t2 = v[2] - fn * normal[2]             # <<<<<<<<<<<<<<
@@ -18070,7 +18082,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
 */
   __pyx_v_t2 = ((__pyx_v_v[2]) - (__pyx_v_fn * (__pyx_v_normal[2])));
 
-  /* "fccqp/projections.pyx":38
+  /* "fccqp/projections.pyx":40
  *     cdef double t1 = v[1] - fn * normal[1]
  *     cdef double t2 = v[2] - fn * normal[2]
  *     cdef double a = sqrt(t0 * t0 + t1 * t1 + t2 * t2)             # <<<<<<<<<<<<<<
@@ -18079,7 +18091,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
 */
   __pyx_v_a = sqrt((((__pyx_v_t0 * __pyx_v_t0) + (__pyx_v_t1 * __pyx_v_t1)) + (__pyx_v_t2 * __pyx_v_t2)));
 
-  /* "fccqp/projections.pyx":40
+  /* "fccqp/projections.pyx":42
  *     cdef double a = sqrt(t0 * t0 + t1 * t1 + t2 * t2)
  *     cdef double normal_part, tangential_part, inv, scale
  *     if a <= mu * fn:             # <<<<<<<<<<<<<<
@@ -18091,7 +18103,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
   if (__pyx_t_1) {
 
 
-    /* "fccqp/projections.pyx":41
+    /* "fccqp/projections.pyx":43
  *     cdef double normal_part, tangential_part, inv, scale
  *     if a <= mu * fn:
  *         out[0] = v[0]             # <<<<<<<<<<<<<<
@@ -18100,7 +18112,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
 */
     (__pyx_v_out[0]) = (__pyx_v_v[0]);
 
-    /* "fccqp/projections.pyx":42
+    /* "fccqp/projections.pyx":44
  *     if a <= mu * fn:
  *         out[0] = v[0]
  *         out[1] = v[1]             # <<<<<<<<<<<<<<
@@ -18109,7 +18121,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
 */
     (__pyx_v_out[1]) = (__pyx_v_v[1]);
 
-    /* "fccqp/projections.pyx":43
+    /* "fccqp/projections.pyx":45
  *         out[0] = v[0]
  *         out[1] = v[1]
  *         out[2] = v[2]             # <<<<<<<<<<<<<<
@@ -18118,7 +18130,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
 */
     (__pyx_v_out[2]) = (__pyx_v_v[2]);
 
-    /* "fccqp/projections.pyx":40
+    /* "fccqp/projections.pyx":42
  *     cdef double a = sqrt(t0 * t0 + t1 * t1 + t2 * t2)
  *     cdef double normal_part, tangential_part, inv, scale
  *     if a <= mu * fn:             # <<<<<<<<<<<<<<
@@ -18128,7 +18140,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
     goto __pyx_L3;
   }
 
-  /* "fccqp/projections.pyx":44
+  /* "fccqp/projections.pyx":46
  *         out[1] = v[1]
  *         out[2] = v[2]
  *     elif mu * a <= -fn:             # <<<<<<<<<<<<<<
@@ -18140,7 +18152,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
   if (__pyx_t_1) {
 
 
-    /* "fccqp/projections.pyx":45
+    /* "fccqp/projections.pyx":47
  *         out[2] = v[2]
  *     elif mu * a <= -fn:
  *         out[0] = 0.0             # <<<<<<<<<<<<<<
@@ -18149,7 +18161,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
 */
     (__pyx_v_out[0]) = 0.0;
 
-    /* "fccqp/projections.pyx":46
+    /* "fccqp/projections.pyx":48
  *     elif mu * a <= -fn:
  *         out[0] = 0.0
  *         out[1] = 0.0             # <<<<<<<<<<<<<<
@@ -18158,7 +18170,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
 */
     (__pyx_v_out[1]) = 0.0;
 
-    /* "fccqp/projections.pyx":47
+    /* "fccqp/projections.pyx":49
  *         out[0] = 0.0
  *         out[1] = 0.0
  *         out[2] = 0.0             # <<<<<<<<<<<<<<
@@ -18167,7 +18179,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
 */
     (__pyx_v_out[2]) = 0.0;
 
-    /* "fccqp/projections.pyx":44
+    /* "fccqp/projections.pyx":46
  *         out[1] = v[1]
  *         out[2] = v[2]
  *     elif mu * a <= -fn:             # <<<<<<<<<<<<<<
@@ -18177,7 +18189,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
     goto __pyx_L3;
   }
 
-  /* "fccqp/projections.pyx":49
+  /* "fccqp/projections.pyx":51
  *         out[2] = 0.0
  *     else:
  *         if mu <= 1.0:             # <<<<<<<<<<<<<<
@@ -18190,7 +18202,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
     if (__pyx_t_1) {
 
 
-      /* "fccqp/projections.pyx":50
+      /* "fccqp/projections.pyx":52
  *     else:
  *         if mu <= 1.0:
  *             normal_part = (mu * a + fn) / (1.0 + mu * mu)             # <<<<<<<<<<<<<<
@@ -18199,7 +18211,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
 */
       __pyx_v_normal_part = (((__pyx_v_mu * __pyx_v_a) + __pyx_v_fn) / (1.0 + (__pyx_v_mu * __pyx_v_mu)));
 
-      /* "fccqp/projections.pyx":51
+      /* "fccqp/projections.pyx":53
  *         if mu <= 1.0:
  *             normal_part = (mu * a + fn) / (1.0 + mu * mu)
  *             tangential_part = mu * normal_part             # <<<<<<<<<<<<<<
@@ -18208,7 +18220,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
 */
       __pyx_v_tangential_part = (__pyx_v_mu * __pyx_v_normal_part);
 
-      /* "fccqp/projections.pyx":49
+      /* "fccqp/projections.pyx":51
  *         out[2] = 0.0
  *     else:
  *         if mu <= 1.0:             # <<<<<<<<<<<<<<
@@ -18218,7 +18230,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
       goto __pyx_L4;
     }
 
-    /* "fccqp/projections.pyx":53
+    /* "fccqp/projections.pyx":55
  *             tangential_part = mu * normal_part
  *         else:
  *             inv = 1.0 / mu             # <<<<<<<<<<<<<<
@@ -18228,7 +18240,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
     /*else*/ {
       __pyx_v_inv = (1.0 / __pyx_v_mu);
 
-      /* "fccqp/projections.pyx":54
+      /* "fccqp/projections.pyx":56
  *         else:
  *             inv = 1.0 / mu
  *             tangential_part = (a + fn * inv) / (1.0 + inv * inv)             # <<<<<<<<<<<<<<
@@ -18237,7 +18249,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
 */
       __pyx_v_tangential_part = ((__pyx_v_a + (__pyx_v_fn * __pyx_v_inv)) / (1.0 + (__pyx_v_inv * __pyx_v_inv)));
 
-      /* "fccqp/projections.pyx":55
+      /* "fccqp/projections.pyx":57
  *             inv = 1.0 / mu
  *             tangential_part = (a + fn * inv) / (1.0 + inv * inv)
  *             normal_part = tangential_part * inv             # <<<<<<<<<<<<<<
@@ -18248,7 +18260,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
     }
     __pyx_L4:;
 
-    /* "fccqp/projections.pyx":56
+    /* "fccqp/projections.pyx":58
  *             tangential_part = (a + fn * inv) / (1.0 + inv * inv)
  *             normal_part = tangential_part * inv
  *         scale = tangential_part / a             # <<<<<<<<<<<<<<
@@ -18257,7 +18269,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
 */
     __pyx_v_scale = (__pyx_v_tangential_part / __pyx_v_a);
 
-    /* "fccqp/projections.pyx":57
+    /* "fccqp/projections.pyx":59
  *             normal_part = tangential_part * inv
  *         scale = tangential_part / a
  *         out[0] = normal_part * normal[0] + scale * t0             # <<<<<<<<<<<<<<
@@ -18266,7 +18278,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
 */
     (__pyx_v_out[0]) = ((__pyx_v_normal_part * (__pyx_v_normal[0])) + (__pyx_v_scale * __pyx_v_t0));
 
-    /* "fccqp/projections.pyx":58
+    /* "fccqp/projections.pyx":60
  *         scale = tangential_part / a
  *         out[0] = normal_part * normal[0] + scale * t0
  *         out[1] = normal_part * normal[1] + scale * t1             # <<<<<<<<<<<<<<
@@ -18275,7 +18287,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
 */
     (__pyx_v_out[1]) = ((__pyx_v_normal_part * (__pyx_v_normal[1])) + (__pyx_v_scale * __pyx_v_t1));
 
-    /* "fccqp/projections.pyx":59
+    /* "fccqp/projections.pyx":61
  *         out[0] = normal_part * normal[0] + scale * t0
  *         out[1] = normal_part * normal[1] + scale * t1
  *         out[2] = normal_part * normal[2] + scale * t2             # <<<<<<<<<<<<<<
@@ -18286,7 +18298,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
   }
   __pyx_L3:;
 
-  /* "fccqp/projections.pyx":22
+  /* "fccqp/projections.pyx":24
  * 
  * 
  * cdef void proj_friction(const double* v, double mu, const double* normal,             # <<<<<<<<<<<<<<
@@ -18306,7 +18318,7 @@ static void __pyx_f_5fccqp_11projections_proj_friction(double const *__pyx_v_v, 
 
 }
 
-/* "fccqp/projections.pyx":62
+/* "fccqp/projections.pyx":64
  * 
  * 
  * cdef void proj_soc(const double* v, Py_ssize_t dim,             # <<<<<<<<<<<<<<
@@ -18325,7 +18337,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
   Py_ssize_t __pyx_t_3;
   int __pyx_t_4;
 
-  /* "fccqp/projections.pyx":65
+  /* "fccqp/projections.pyx":67
  *                                     double* out) noexcept nogil:
  *     """Project ``v = (t, w)`` onto ``{(t, w) : ||w|| <= t}`` into ``out`` (may be ``v``)."""
  *     cdef double t = v[0]             # <<<<<<<<<<<<<<
@@ -18334,7 +18346,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
 */
   __pyx_v_t = (__pyx_v_v[0]);
 
-  /* "fccqp/projections.pyx":66
+  /* "fccqp/projections.pyx":68
  *     """Project ``v = (t, w)`` onto ``{(t, w) : ||w|| <= t}`` into ``out`` (may be ``v``)."""
  *     cdef double t = v[0]
  *     cdef double norm_w = 0.0             # <<<<<<<<<<<<<<
@@ -18343,7 +18355,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
 */
   __pyx_v_norm_w = 0.0;
 
-  /* "fccqp/projections.pyx":69
+  /* "fccqp/projections.pyx":71
  *     cdef double half, scale
  *     cdef Py_ssize_t i
  *     for i in range(1, dim):             # <<<<<<<<<<<<<<
@@ -18357,7 +18369,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
   for (__pyx_t_3 = 1; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/projections.pyx":70
+    /* "fccqp/projections.pyx":72
  *     cdef Py_ssize_t i
  *     for i in range(1, dim):
  *         norm_w += v[i] * v[i]             # <<<<<<<<<<<<<<
@@ -18368,7 +18380,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
   }
 
 
-  /* "fccqp/projections.pyx":71
+  /* "fccqp/projections.pyx":73
  *     for i in range(1, dim):
  *         norm_w += v[i] * v[i]
  *     norm_w = sqrt(norm_w)             # <<<<<<<<<<<<<<
@@ -18377,7 +18389,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
 */
   __pyx_v_norm_w = sqrt(__pyx_v_norm_w);
 
-  /* "fccqp/projections.pyx":72
+  /* "fccqp/projections.pyx":74
  *         norm_w += v[i] * v[i]
  *     norm_w = sqrt(norm_w)
  *     if norm_w <= t:             # <<<<<<<<<<<<<<
@@ -18389,7 +18401,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
   if (__pyx_t_4) {
 
 
-    /* "fccqp/projections.pyx":73
+    /* "fccqp/projections.pyx":75
  *     norm_w = sqrt(norm_w)
  *     if norm_w <= t:
  *         for i in range(dim):             # <<<<<<<<<<<<<<
@@ -18403,7 +18415,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
     for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
       __pyx_v_i = __pyx_t_3;
 
-      /* "fccqp/projections.pyx":74
+      /* "fccqp/projections.pyx":76
  *     if norm_w <= t:
  *         for i in range(dim):
  *             out[i] = v[i]             # <<<<<<<<<<<<<<
@@ -18414,7 +18426,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
     }
 
 
-    /* "fccqp/projections.pyx":72
+    /* "fccqp/projections.pyx":74
  *         norm_w += v[i] * v[i]
  *     norm_w = sqrt(norm_w)
  *     if norm_w <= t:             # <<<<<<<<<<<<<<
@@ -18424,7 +18436,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
     goto __pyx_L5;
   }
 
-  /* "fccqp/projections.pyx":75
+  /* "fccqp/projections.pyx":77
  *         for i in range(dim):
  *             out[i] = v[i]
  *     elif norm_w <= -t:             # <<<<<<<<<<<<<<
@@ -18436,7 +18448,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
   if (__pyx_t_4) {
 
 
-    /* "fccqp/projections.pyx":76
+    /* "fccqp/projections.pyx":78
  *             out[i] = v[i]
  *     elif norm_w <= -t:
  *         for i in range(dim):             # <<<<<<<<<<<<<<
@@ -18450,7 +18462,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
     for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
       __pyx_v_i = __pyx_t_3;
 
-      /* "fccqp/projections.pyx":77
+      /* "fccqp/projections.pyx":79
  *     elif norm_w <= -t:
  *         for i in range(dim):
  *             out[i] = 0.0             # <<<<<<<<<<<<<<
@@ -18461,7 +18473,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
     }
 
 
-    /* "fccqp/projections.pyx":75
+    /* "fccqp/projections.pyx":77
  *         for i in range(dim):
  *             out[i] = v[i]
  *     elif norm_w <= -t:             # <<<<<<<<<<<<<<
@@ -18471,7 +18483,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
     goto __pyx_L5;
   }
 
-  /* "fccqp/projections.pyx":79
+  /* "fccqp/projections.pyx":81
  *             out[i] = 0.0
  *     else:
  *         half = 0.5 * (t + norm_w)             # <<<<<<<<<<<<<<
@@ -18481,7 +18493,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
   /*else*/ {
     __pyx_v_half = (0.5 * (__pyx_v_t + __pyx_v_norm_w));
 
-    /* "fccqp/projections.pyx":80
+    /* "fccqp/projections.pyx":82
  *     else:
  *         half = 0.5 * (t + norm_w)
  *         scale = half / norm_w             # <<<<<<<<<<<<<<
@@ -18490,7 +18502,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
 */
     __pyx_v_scale = (__pyx_v_half / __pyx_v_norm_w);
 
-    /* "fccqp/projections.pyx":81
+    /* "fccqp/projections.pyx":83
  *         half = 0.5 * (t + norm_w)
  *         scale = half / norm_w
  *         out[0] = half             # <<<<<<<<<<<<<<
@@ -18499,7 +18511,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
 */
     (__pyx_v_out[0]) = __pyx_v_half;
 
-    /* "fccqp/projections.pyx":82
+    /* "fccqp/projections.pyx":84
  *         scale = half / norm_w
  *         out[0] = half
  *         for i in range(1, dim):             # <<<<<<<<<<<<<<
@@ -18513,7 +18525,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
     for (__pyx_t_3 = 1; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
       __pyx_v_i = __pyx_t_3;
 
-      /* "fccqp/projections.pyx":83
+      /* "fccqp/projections.pyx":85
  *         out[0] = half
  *         for i in range(1, dim):
  *             out[i] = scale * v[i]             # <<<<<<<<<<<<<<
@@ -18526,7 +18538,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
   }
   __pyx_L5:;
 
-  /* "fccqp/projections.pyx":62
+  /* "fccqp/projections.pyx":64
  * 
  * 
  * cdef void proj_soc(const double* v, Py_ssize_t dim,             # <<<<<<<<<<<<<<
@@ -18542,7 +18554,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
 
 }
 
-/* "fccqp/projections.pyx":86
+/* "fccqp/projections.pyx":88
  * 
  * 
  * cdef void proj_block(const double* v, Py_ssize_t kind, Py_ssize_t dim, double mu,             # <<<<<<<<<<<<<<
@@ -18553,7 +18565,7 @@ static void __pyx_f_5fccqp_11projections_proj_soc(double const *__pyx_v_v, Py_ss
 static void __pyx_f_5fccqp_11projections_proj_block(double const *__pyx_v_v, Py_ssize_t __pyx_v_kind, Py_ssize_t __pyx_v_dim, double __pyx_v_mu, double const *__pyx_v_normal, double *__pyx_v_out) {
   int __pyx_t_1;
 
-  /* "fccqp/projections.pyx":89
+  /* "fccqp/projections.pyx":91
  *                         const double* normal, double* out) noexcept nogil:
  *     """Project one cone block, dispatching on its kind code."""
  *     if kind == FRICTION:             # <<<<<<<<<<<<<<
@@ -18565,7 +18577,7 @@ static void __pyx_f_5fccqp_11projections_proj_block(double const *__pyx_v_v, Py_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/projections.pyx":90
+    /* "fccqp/projections.pyx":92
  *     """Project one cone block, dispatching on its kind code."""
  *     if kind == FRICTION:
  *         proj_friction(v, mu, normal, out)             # <<<<<<<<<<<<<<
@@ -18574,7 +18586,7 @@ static void __pyx_f_5fccqp_11projections_proj_block(double const *__pyx_v_v, Py_
 */
     __pyx_f_5fccqp_11projections_proj_friction(__pyx_v_v, __pyx_v_mu, __pyx_v_normal, __pyx_v_out);
 
-    /* "fccqp/projections.pyx":89
+    /* "fccqp/projections.pyx":91
  *                         const double* normal, double* out) noexcept nogil:
  *     """Project one cone block, dispatching on its kind code."""
  *     if kind == FRICTION:             # <<<<<<<<<<<<<<
@@ -18584,7 +18596,7 @@ static void __pyx_f_5fccqp_11projections_proj_block(double const *__pyx_v_v, Py_
     goto __pyx_L3;
   }
 
-  /* "fccqp/projections.pyx":92
+  /* "fccqp/projections.pyx":94
  *         proj_friction(v, mu, normal, out)
  *     else:
  *         proj_soc(v, dim, out)             # <<<<<<<<<<<<<<
@@ -18596,7 +18608,7 @@ static void __pyx_f_5fccqp_11projections_proj_block(double const *__pyx_v_v, Py_
   }
   __pyx_L3:;
 
-  /* "fccqp/projections.pyx":86
+  /* "fccqp/projections.pyx":88
  * 
  * 
  * cdef void proj_block(const double* v, Py_ssize_t kind, Py_ssize_t dim, double mu,             # <<<<<<<<<<<<<<
@@ -18607,7 +18619,7 @@ static void __pyx_f_5fccqp_11projections_proj_block(double const *__pyx_v_v, Py_
   /* function exit code */
 }
 
-/* "fccqp/projections.pyx":95
+/* "fccqp/projections.pyx":97
  * 
  * 
  * cdef void proj_set(const double* v, const double* lo, const double* hi, Cones cones,             # <<<<<<<<<<<<<<
@@ -18625,7 +18637,7 @@ static void __pyx_f_5fccqp_11projections_proj_set(double const *__pyx_v_v, doubl
   Py_ssize_t __pyx_t_3;
   int __pyx_t_4;
 
-  /* "fccqp/projections.pyx":101
+  /* "fccqp/projections.pyx":103
  *     cdef Py_ssize_t i, k, o
  *     cdef double value
  *     for i in range(s):             # <<<<<<<<<<<<<<
@@ -18639,7 +18651,7 @@ static void __pyx_f_5fccqp_11projections_proj_set(double const *__pyx_v_v, doubl
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/projections.pyx":102
+    /* "fccqp/projections.pyx":104
  *     cdef double value
  *     for i in range(s):
  *         value = v[i]             # <<<<<<<<<<<<<<
@@ -18648,7 +18660,7 @@ static void __pyx_f_5fccqp_11projections_proj_set(double const *__pyx_v_v, doubl
 */
     __pyx_v_value = (__pyx_v_v[__pyx_v_i]);
 
-    /* "fccqp/projections.pyx":103
+    /* "fccqp/projections.pyx":105
  *     for i in range(s):
  *         value = v[i]
  *         if value < lo[i]:             # <<<<<<<<<<<<<<
@@ -18660,7 +18672,7 @@ static void __pyx_f_5fccqp_11projections_proj_set(double const *__pyx_v_v, doubl
     if (__pyx_t_4) {
 
 
-      /* "fccqp/projections.pyx":104
+      /* "fccqp/projections.pyx":106
  *         value = v[i]
  *         if value < lo[i]:
  *             value = lo[i]             # <<<<<<<<<<<<<<
@@ -18669,7 +18681,7 @@ static void __pyx_f_5fccqp_11projections_proj_set(double const *__pyx_v_v, doubl
 */
       __pyx_v_value = (__pyx_v_lo[__pyx_v_i]);
 
-      /* "fccqp/projections.pyx":103
+      /* "fccqp/projections.pyx":105
  *     for i in range(s):
  *         value = v[i]
  *         if value < lo[i]:             # <<<<<<<<<<<<<<
@@ -18678,7 +18690,7 @@ static void __pyx_f_5fccqp_11projections_proj_set(double const *__pyx_v_v, doubl
 */
     }
 
-    /* "fccqp/projections.pyx":105
+    /* "fccqp/projections.pyx":107
  *         if value < lo[i]:
  *             value = lo[i]
  *         if value > hi[i]:             # <<<<<<<<<<<<<<
@@ -18690,7 +18702,7 @@ static void __pyx_f_5fccqp_11projections_proj_set(double const *__pyx_v_v, doubl
     if (__pyx_t_4) {
 
 
-      /* "fccqp/projections.pyx":106
+      /* "fccqp/projections.pyx":108
  *             value = lo[i]
  *         if value > hi[i]:
  *             value = hi[i]             # <<<<<<<<<<<<<<
@@ -18699,7 +18711,7 @@ static void __pyx_f_5fccqp_11projections_proj_set(double const *__pyx_v_v, doubl
 */
       __pyx_v_value = (__pyx_v_hi[__pyx_v_i]);
 
-      /* "fccqp/projections.pyx":105
+      /* "fccqp/projections.pyx":107
  *         if value < lo[i]:
  *             value = lo[i]
  *         if value > hi[i]:             # <<<<<<<<<<<<<<
@@ -18708,7 +18720,7 @@ static void __pyx_f_5fccqp_11projections_proj_set(double const *__pyx_v_v, doubl
 */
     }
 
-    /* "fccqp/projections.pyx":107
+    /* "fccqp/projections.pyx":109
  *         if value > hi[i]:
  *             value = hi[i]
  *         out[i] = value             # <<<<<<<<<<<<<<
@@ -18719,7 +18731,7 @@ static void __pyx_f_5fccqp_11projections_proj_set(double const *__pyx_v_v, doubl
   }
 
 
-  /* "fccqp/projections.pyx":108
+  /* "fccqp/projections.pyx":110
  *             value = hi[i]
  *         out[i] = value
  *     for k in range(cones.count):             # <<<<<<<<<<<<<<
@@ -18733,7 +18745,7 @@ static void __pyx_f_5fccqp_11projections_proj_set(double const *__pyx_v_v, doubl
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_k = __pyx_t_3;
 
-    /* "fccqp/projections.pyx":109
+    /* "fccqp/projections.pyx":111
  *         out[i] = value
  *     for k in range(cones.count):
  *         o = cones.offset[k]             # <<<<<<<<<<<<<<
@@ -18742,7 +18754,7 @@ static void __pyx_f_5fccqp_11projections_proj_set(double const *__pyx_v_v, doubl
 */
     __pyx_v_o = (__pyx_v_cones.offset[__pyx_v_k]);
 
-    /* "fccqp/projections.pyx":110
+    /* "fccqp/projections.pyx":112
  *     for k in range(cones.count):
  *         o = cones.offset[k]
  *         proj_block(v + o, cones.kind[k], cones.dim[k], cones.mu[k], cones.normal + 3 * k,             # <<<<<<<<<<<<<<
@@ -18753,7 +18765,7 @@ static void __pyx_f_5fccqp_11projections_proj_set(double const *__pyx_v_v, doubl
   }
 
 
-  /* "fccqp/projections.pyx":95
+  /* "fccqp/projections.pyx":97
  * 
  * 
  * cdef void proj_set(const double* v, const double* lo, const double* hi, Cones cones,             # <<<<<<<<<<<<<<
@@ -18768,12 +18780,12 @@ static void __pyx_f_5fccqp_11projections_proj_set(double const *__pyx_v_v, doubl
 
 }
 
-/* "fccqp/projections.pyx":114
+/* "fccqp/projections.pyx":116
  * 
  * 
- * def project_friction_cone(double[::1] v, double mu, double[::1] normal, double[::1] out):             # <<<<<<<<<<<<<<
- *     """Projection of ``v`` onto the friction cone (``mu``, ``normal``) into ``out``, on numpy arrays (3 entries each)."""
- *     if v.shape[0] != 3 or normal.shape[0] != 3 or out.shape[0] != 3:
+ * def project_friction_cone(v, double mu, normal, double[::1] out):             # <<<<<<<<<<<<<<
+ *     """Project the 3-vector ``v`` onto the friction cone (``mu``, unit ``normal``) into
+ *     ``out``."""
 */
 
 /* Python wrapper */
@@ -18784,7 +18796,7 @@ PyObject *const *__pyx_args, Py_ssize_t __pyx_nargs, PyObject *__pyx_kwds
 PyObject *__pyx_args, PyObject *__pyx_kwds
 #endif
 ); /*proto*/
-PyDoc_STRVAR(__pyx_doc_5fccqp_11projections_project_friction_cone, "Projection of ``v`` onto the friction cone (``mu``, ``normal``) into ``out``, on numpy arrays (3 entries each).");
+PyDoc_STRVAR(__pyx_doc_5fccqp_11projections_project_friction_cone, "Project the 3-vector ``v`` onto the friction cone (``mu``, unit ``normal``) into\n    ``out``.");
 static PyMethodDef __pyx_mdef_5fccqp_11projections_1project_friction_cone = {"project_friction_cone", (PyCFunction)(void(*)(void))(__Pyx_PyCFunction_FastCallWithKeywords)__pyx_pw_5fccqp_11projections_1project_friction_cone, __Pyx_METH_FASTCALL|METH_KEYWORDS, __pyx_doc_5fccqp_11projections_project_friction_cone};
 static PyObject *__pyx_pw_5fccqp_11projections_1project_friction_cone(PyObject *__pyx_self, 
 #if CYTHON_VECTORCALL
@@ -18793,9 +18805,9 @@ PyObject *const *__pyx_args, Py_ssize_t __pyx_nargs, PyObject *__pyx_kwds
 PyObject *__pyx_args, PyObject *__pyx_kwds
 #endif
 ) {
-  __Pyx_memviewslice __pyx_v_v = { 0, 0, { 0 }, { 0 }, { 0 } };
+  PyObject *__pyx_v_v = 0;
   double __pyx_v_mu;
-  __Pyx_memviewslice __pyx_v_normal = { 0, 0, { 0 }, { 0 }, { 0 } };
+  PyObject *__pyx_v_normal = 0;
   __Pyx_memviewslice __pyx_v_out = { 0, 0, { 0 }, { 0 }, { 0 } };
   #if !CYTHON_VECTORCALL
   CYTHON_UNUSED Py_ssize_t __pyx_nargs;
@@ -18819,61 +18831,59 @@ PyObject *__pyx_args, PyObject *__pyx_kwds
   {
     PyObject ** const __pyx_pyargnames[] = {&__pyx_mstate_global->__pyx_n_u_v,&__pyx_mstate_global->__pyx_n_u_mu,&__pyx_mstate_global->__pyx_n_u_normal,&__pyx_mstate_global->__pyx_n_u_out,0};
     const Py_ssize_t __pyx_kwds_len = (__pyx_kwds) ? __Pyx_NumKwargs_FASTCALL(__pyx_kwds) : 0;
-    if (unlikely(__pyx_kwds_len < 0)) __PYX_ERR(0, 114, __pyx_L3_error)
+    if (unlikely(__pyx_kwds_len < 0)) __PYX_ERR(0, 116, __pyx_L3_error)
     if (__pyx_kwds_len > 0) {
       switch (__pyx_nargs) {
         case  4:
         values[3] = __Pyx_ArgRef_FASTCALL(__pyx_args, 3);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 114, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 116, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  3:
         values[2] = __Pyx_ArgRef_FASTCALL(__pyx_args, 2);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 114, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 116, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  2:
         values[1] = __Pyx_ArgRef_FASTCALL(__pyx_args, 1);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 114, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 116, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  1:
         values[0] = __Pyx_ArgRef_FASTCALL(__pyx_args, 0);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 114, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 116, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  0: break;
         default: goto __pyx_L5_argtuple_error;
       }
       const Py_ssize_t kwd_pos_args = __pyx_nargs;
-      if (__Pyx_ParseKeywords(__pyx_kwds, __pyx_kwvalues, __pyx_pyargnames, 0, values, kwd_pos_args, __pyx_kwds_len, "project_friction_cone", 0) < (0)) __PYX_ERR(0, 114, __pyx_L3_error)
+      if (__Pyx_ParseKeywords(__pyx_kwds, __pyx_kwvalues, __pyx_pyargnames, 0, values, kwd_pos_args, __pyx_kwds_len, "project_friction_cone", 0) < (0)) __PYX_ERR(0, 116, __pyx_L3_error)
       for (Py_ssize_t i = __pyx_nargs; i < 4; i++) {
-        if (unlikely(!values[i])) { __Pyx_RaiseArgtupleInvalid("project_friction_cone", 1, 4, 4, i); __PYX_ERR(0, 114, __pyx_L3_error) }
+        if (unlikely(!values[i])) { __Pyx_RaiseArgtupleInvalid("project_friction_cone", 1, 4, 4, i); __PYX_ERR(0, 116, __pyx_L3_error) }
       }
     } else if (unlikely(__pyx_nargs != 4)) {
       goto __pyx_L5_argtuple_error;
     } else {
       values[0] = __Pyx_ArgRef_FASTCALL(__pyx_args, 0);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 114, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 116, __pyx_L3_error)
       values[1] = __Pyx_ArgRef_FASTCALL(__pyx_args, 1);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 114, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 116, __pyx_L3_error)
       values[2] = __Pyx_ArgRef_FASTCALL(__pyx_args, 2);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 114, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 116, __pyx_L3_error)
       values[3] = __Pyx_ArgRef_FASTCALL(__pyx_args, 3);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 114, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 116, __pyx_L3_error)
     }
-    __pyx_v_v = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[0], PyBUF_WRITABLE); if (unlikely(!__pyx_v_v.memview)) __PYX_ERR(0, 114, __pyx_L3_error)
-    __pyx_v_mu = __Pyx_PyFloat_AsDouble(values[1]); if (unlikely((__pyx_v_mu == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 114, __pyx_L3_error)
-    __pyx_v_normal = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[2], PyBUF_WRITABLE); if (unlikely(!__pyx_v_normal.memview)) __PYX_ERR(0, 114, __pyx_L3_error)
-    __pyx_v_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[3], PyBUF_WRITABLE); if (unlikely(!__pyx_v_out.memview)) __PYX_ERR(0, 114, __pyx_L3_error)
+    __pyx_v_v = values[0];
+    __pyx_v_mu = __Pyx_PyFloat_AsDouble(values[1]); if (unlikely((__pyx_v_mu == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 116, __pyx_L3_error)
+    __pyx_v_normal = values[2];
+    __pyx_v_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[3], PyBUF_WRITABLE); if (unlikely(!__pyx_v_out.memview)) __PYX_ERR(0, 116, __pyx_L3_error)
   }
   goto __pyx_L6_skip;
   __pyx_L5_argtuple_error:;
-  __Pyx_RaiseArgtupleInvalid("project_friction_cone", 1, 4, 4, __pyx_nargs); __PYX_ERR(0, 114, __pyx_L3_error)
+  __Pyx_RaiseArgtupleInvalid("project_friction_cone", 1, 4, 4, __pyx_nargs); __PYX_ERR(0, 116, __pyx_L3_error)
   __pyx_L6_skip:;
   goto __pyx_L4_argument_unpacking_done;
   __pyx_L3_error:;
   for (Py_ssize_t __pyx_temp=0; __pyx_temp < (Py_ssize_t)(sizeof(values)/sizeof(values[0])); ++__pyx_temp) {
     Py_XDECREF(values[__pyx_temp]);
   }
-  __PYX_XCLEAR_MEMVIEW(&__pyx_v_v, 1);
-  __PYX_XCLEAR_MEMVIEW(&__pyx_v_normal, 1);
   __PYX_XCLEAR_MEMVIEW(&__pyx_v_out, 1);
   __Pyx_AddTraceback("fccqp.projections.project_friction_cone", __pyx_clineno, __pyx_lineno, __pyx_filename);
   __Pyx_RefNannyFinishContext();
@@ -18885,133 +18895,269 @@ PyObject *__pyx_args, PyObject *__pyx_kwds
   for (Py_ssize_t __pyx_temp=0; __pyx_temp < (Py_ssize_t)(sizeof(values)/sizeof(values[0])); ++__pyx_temp) {
     Py_XDECREF(values[__pyx_temp]);
   }
-  __PYX_XCLEAR_MEMVIEW(&__pyx_v_v, 1);
 
-  __PYX_XCLEAR_MEMVIEW(&__pyx_v_normal, 1);
   __PYX_XCLEAR_MEMVIEW(&__pyx_v_out, 1);
   __Pyx_RefNannyFinishContext();
   return __pyx_r;
 }
 
-static PyObject *__pyx_pf_5fccqp_11projections_project_friction_cone(CYTHON_UNUSED PyObject *__pyx_self, __Pyx_memviewslice __pyx_v_v, double __pyx_v_mu, __Pyx_memviewslice __pyx_v_normal, __Pyx_memviewslice __pyx_v_out) {
+static PyObject *__pyx_pf_5fccqp_11projections_project_friction_cone(CYTHON_UNUSED PyObject *__pyx_self, PyObject *__pyx_v_v, double __pyx_v_mu, PyObject *__pyx_v_normal, __Pyx_memviewslice __pyx_v_out) {
+  __Pyx_memviewslice __pyx_v_v_ = { 0, 0, { 0 }, { 0 }, { 0 } };
+  __Pyx_memviewslice __pyx_v_normal_ = { 0, 0, { 0 }, { 0 }, { 0 } };
   PyObject *__pyx_r = NULL;
   __Pyx_RefNannyDeclarations
-  int __pyx_t_1;
-  int __pyx_t_2;
+  PyObject *__pyx_t_1 = NULL;
+  PyObject *__pyx_t_2 = NULL;
   PyObject *__pyx_t_3 = NULL;
   PyObject *__pyx_t_4 = NULL;
-  size_t __pyx_t_5;
-  Py_ssize_t __pyx_t_6;
-  Py_ssize_t __pyx_t_7;
-  Py_ssize_t __pyx_t_8;
+  PyObject *__pyx_t_5 = NULL;
+  size_t __pyx_t_6;
+  __Pyx_memviewslice __pyx_t_7 = { 0, 0, { 0 }, { 0 }, { 0 } };
+  __Pyx_memviewslice __pyx_t_8 = { 0, 0, { 0 }, { 0 }, { 0 } };
+  int __pyx_t_9;
+  int __pyx_t_10;
+  Py_ssize_t __pyx_t_11;
+  Py_ssize_t __pyx_t_12;
+  Py_ssize_t __pyx_t_13;
   int __pyx_lineno = 0;
   const char *__pyx_filename = NULL;
   int __pyx_clineno = 0;
   __Pyx_RefNannySetupContext("project_friction_cone", 0);
 
-  /* "fccqp/projections.pyx":116
- * def project_friction_cone(double[::1] v, double mu, double[::1] normal, double[::1] out):
- *     """Projection of ``v`` onto the friction cone (``mu``, ``normal``) into ``out``, on numpy arrays (3 entries each)."""
- *     if v.shape[0] != 3 or normal.shape[0] != 3 or out.shape[0] != 3:             # <<<<<<<<<<<<<<
- *         raise ValueError("v, normal and out must have 3 entries")
- *     proj_friction(&v[0], mu, &normal[0], &out[0])
+  /* "fccqp/projections.pyx":119
+ *     """Project the 3-vector ``v`` onto the friction cone (``mu``, unit ``normal``) into
+ *     ``out``."""
+ *     cdef const double[::1] v_ = np.ascontiguousarray(v, dtype=np.float64)             # <<<<<<<<<<<<<<
+ *     cdef const double[::1] normal_ = np.ascontiguousarray(normal, dtype=np.float64)
+ *     if v_.shape[0] != 3 or normal_.shape[0] != 3 or out.shape[0] != 3:
 */
-  __pyx_t_2 = ((__pyx_v_v.shape[0]) != 3);
-
-  if (!__pyx_t_2) {
-
-  } else {
-
-    __pyx_t_1 = __pyx_t_2;
-
-    goto __pyx_L4_bool_binop_done;
+  __pyx_t_2 = NULL;
+  __Pyx_GetModuleGlobalName(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 119, __pyx_L1_error)
+  __Pyx_GOTREF(__pyx_t_3);
+  __pyx_t_4 = __Pyx_PyObject_GetAttrStr(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_ascontiguousarray); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 119, __pyx_L1_error)
+  __Pyx_GOTREF(__pyx_t_4);
+  __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
+  __Pyx_GetModuleGlobalName(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 119, __pyx_L1_error)
+  __Pyx_GOTREF(__pyx_t_3);
+  __pyx_t_5 = __Pyx_PyObject_GetAttrStr(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_float64); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 119, __pyx_L1_error)
+  __Pyx_GOTREF(__pyx_t_5);
+  __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
+  #if CYTHON_VECTORCALL
+  #endif
+  __pyx_t_6 = 1;
+  #if CYTHON_UNPACK_METHODS
+  if (unlikely(PyMethod_Check(__pyx_t_4))) {
+    __pyx_t_2 = PyMethod_GET_SELF(__pyx_t_4);
+    assert(__pyx_t_2);
+    PyObject* __pyx__function = PyMethod_GET_FUNCTION(__pyx_t_4);
+    __Pyx_INCREF(__pyx_t_2);
+    __Pyx_INCREF(__pyx__function);
+    __Pyx_DECREF_SET(__pyx_t_4, __pyx__function);
+    __pyx_t_6 = 0;
   }
-  __pyx_t_2 = ((__pyx_v_normal.shape[0]) != 3);
-
-  if (!__pyx_t_2) {
-
-  } else {
-
-    __pyx_t_1 = __pyx_t_2;
-
-    goto __pyx_L4_bool_binop_done;
-  }
-  __pyx_t_2 = ((__pyx_v_out.shape[0]) != 3);
-
-
-  __pyx_t_1 = __pyx_t_2;
-
-  __pyx_L4_bool_binop_done:;
-  if (unlikely(__pyx_t_1)) {
-
-
-    /* "fccqp/projections.pyx":117
- *     """Projection of ``v`` onto the friction cone (``mu``, ``normal``) into ``out``, on numpy arrays (3 entries each)."""
- *     if v.shape[0] != 3 or normal.shape[0] != 3 or out.shape[0] != 3:
- *         raise ValueError("v, normal and out must have 3 entries")             # <<<<<<<<<<<<<<
- *     proj_friction(&v[0], mu, &normal[0], &out[0])
- * 
-*/
-    __pyx_t_4 = NULL;
-    __pyx_t_5 = 1;
+  #endif
+  {
+    PyObject *__pyx_callargs[3] = {__pyx_t_2, __pyx_v_v, __pyx_t_5};
+    #if CYTHON_VECTORCALL
+    __pyx_t_3 = __pyx_mstate_global->__pyx_tuple[2];
+    if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 119, __pyx_L1_error)
+    __Pyx_INCREF(__pyx_t_3);
+    #else
     {
-      PyObject *__pyx_callargs[2] = {__pyx_t_4, __pyx_mstate_global->__pyx_kp_u_v_normal_and_out_must_have_3_ent};
-      __pyx_t_3 = __Pyx_PyObject_FastCall((PyObject*)(((PyTypeObject*)PyExc_ValueError)), __pyx_callargs+__pyx_t_5, (2-__pyx_t_5) | (__pyx_t_5*__Pyx_PY_VECTORCALL_ARGUMENTS_OFFSET));
-      __Pyx_XDECREF(__pyx_t_4); __pyx_t_4 = 0;
-      if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 117, __pyx_L1_error)
+      PyObject *__pyx_temp[1] = {__pyx_mstate_global->__pyx_n_u_dtype};
+      __pyx_t_3 = __Pyx_MakeKwargDict(__pyx_temp, __pyx_callargs+2, 1);
+      if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 119, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_3);
     }
-    __Pyx_Raise(__pyx_t_3, 0, 0, 0);
+    #endif
+    __pyx_t_1 = __Pyx_Object_VectorcallKwds((PyObject*)__pyx_t_4, __pyx_callargs+__pyx_t_6, (2-__pyx_t_6) | (__pyx_t_6*__Pyx_PY_VECTORCALL_ARGUMENTS_OFFSET), __pyx_t_3);
+    __Pyx_XDECREF(__pyx_t_2); __pyx_t_2 = 0;
+    #if CYTHON_VECTORCALL
+    #endif
+    __Pyx_DECREF(__pyx_t_5); __pyx_t_5 = 0;
     __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
-    __PYX_ERR(0, 117, __pyx_L1_error)
+    __Pyx_DECREF(__pyx_t_4); __pyx_t_4 = 0;
+    if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 119, __pyx_L1_error)
+    __Pyx_GOTREF(__pyx_t_1);
+  }
+  __pyx_t_7 = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(__pyx_t_1, 0); if (unlikely(!__pyx_t_7.memview)) __PYX_ERR(0, 119, __pyx_L1_error)
+  __Pyx_DECREF(__pyx_t_1); __pyx_t_1 = 0;
+  __pyx_v_v_ = __pyx_t_7;
+  __pyx_t_7.memview = NULL;
+  __pyx_t_7.data = NULL;
 
-    /* "fccqp/projections.pyx":116
- * def project_friction_cone(double[::1] v, double mu, double[::1] normal, double[::1] out):
- *     """Projection of ``v`` onto the friction cone (``mu``, ``normal``) into ``out``, on numpy arrays (3 entries each)."""
- *     if v.shape[0] != 3 or normal.shape[0] != 3 or out.shape[0] != 3:             # <<<<<<<<<<<<<<
+  /* "fccqp/projections.pyx":120
+ *     ``out``."""
+ *     cdef const double[::1] v_ = np.ascontiguousarray(v, dtype=np.float64)
+ *     cdef const double[::1] normal_ = np.ascontiguousarray(normal, dtype=np.float64)             # <<<<<<<<<<<<<<
+ *     if v_.shape[0] != 3 or normal_.shape[0] != 3 or out.shape[0] != 3:
  *         raise ValueError("v, normal and out must have 3 entries")
- *     proj_friction(&v[0], mu, &normal[0], &out[0])
+*/
+  __pyx_t_4 = NULL;
+  __Pyx_GetModuleGlobalName(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 120, __pyx_L1_error)
+  __Pyx_GOTREF(__pyx_t_3);
+  __pyx_t_5 = __Pyx_PyObject_GetAttrStr(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_ascontiguousarray); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 120, __pyx_L1_error)
+  __Pyx_GOTREF(__pyx_t_5);
+  __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
+  __Pyx_GetModuleGlobalName(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 120, __pyx_L1_error)
+  __Pyx_GOTREF(__pyx_t_3);
+  __pyx_t_2 = __Pyx_PyObject_GetAttrStr(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_float64); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 120, __pyx_L1_error)
+  __Pyx_GOTREF(__pyx_t_2);
+  __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
+  #if CYTHON_VECTORCALL
+  #endif
+  __pyx_t_6 = 1;
+  #if CYTHON_UNPACK_METHODS
+  if (unlikely(PyMethod_Check(__pyx_t_5))) {
+    __pyx_t_4 = PyMethod_GET_SELF(__pyx_t_5);
+    assert(__pyx_t_4);
+    PyObject* __pyx__function = PyMethod_GET_FUNCTION(__pyx_t_5);
+    __Pyx_INCREF(__pyx_t_4);
+    __Pyx_INCREF(__pyx__function);
+    __Pyx_DECREF_SET(__pyx_t_5, __pyx__function);
+    __pyx_t_6 = 0;
+  }
+  #endif
+  {
+    PyObject *__pyx_callargs[3] = {__pyx_t_4, __pyx_v_normal, __pyx_t_2};
+    #if CYTHON_VECTORCALL
+    __pyx_t_3 = __pyx_mstate_global->__pyx_tuple[2];
+    if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 120, __pyx_L1_error)
+    __Pyx_INCREF(__pyx_t_3);
+    #else
+    {
+      PyObject *__pyx_temp[1] = {__pyx_mstate_global->__pyx_n_u_dtype};
+      __pyx_t_3 = __Pyx_MakeKwargDict(__pyx_temp, __pyx_callargs+2, 1);
+      if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 120, __pyx_L1_error)
+      __Pyx_GOTREF(__pyx_t_3);
+    }
+    #endif
+    __pyx_t_1 = __Pyx_Object_VectorcallKwds((PyObject*)__pyx_t_5, __pyx_callargs+__pyx_t_6, (2-__pyx_t_6) | (__pyx_t_6*__Pyx_PY_VECTORCALL_ARGUMENTS_OFFSET), __pyx_t_3);
+    __Pyx_XDECREF(__pyx_t_4); __pyx_t_4 = 0;
+    #if CYTHON_VECTORCALL
+    #endif
+    __Pyx_DECREF(__pyx_t_2); __pyx_t_2 = 0;
+    __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
+    __Pyx_DECREF(__pyx_t_5); __pyx_t_5 = 0;
+    if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 120, __pyx_L1_error)
+    __Pyx_GOTREF(__pyx_t_1);
+  }
+  __pyx_t_8 = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(__pyx_t_1, 0); if (unlikely(!__pyx_t_8.memview)) __PYX_ERR(0, 120, __pyx_L1_error)
+  __Pyx_DECREF(__pyx_t_1); __pyx_t_1 = 0;
+  __pyx_v_normal_ = __pyx_t_8;
+  __pyx_t_8.memview = NULL;
+  __pyx_t_8.data = NULL;
+
+  /* "fccqp/projections.pyx":121
+ *     cdef const double[::1] v_ = np.ascontiguousarray(v, dtype=np.float64)
+ *     cdef const double[::1] normal_ = np.ascontiguousarray(normal, dtype=np.float64)
+ *     if v_.shape[0] != 3 or normal_.shape[0] != 3 or out.shape[0] != 3:             # <<<<<<<<<<<<<<
+ *         raise ValueError("v, normal and out must have 3 entries")
+ *     proj_friction(&v_[0], mu, &normal_[0], &out[0])
+*/
+  __pyx_t_10 = ((__pyx_v_v_.shape[0]) != 3);
+
+  if (!__pyx_t_10) {
+
+  } else {
+
+    __pyx_t_9 = __pyx_t_10;
+
+    goto __pyx_L4_bool_binop_done;
+  }
+  __pyx_t_10 = ((__pyx_v_normal_.shape[0]) != 3);
+
+  if (!__pyx_t_10) {
+
+  } else {
+
+    __pyx_t_9 = __pyx_t_10;
+
+    goto __pyx_L4_bool_binop_done;
+  }
+  __pyx_t_10 = ((__pyx_v_out.shape[0]) != 3);
+
+
+  __pyx_t_9 = __pyx_t_10;
+
+  __pyx_L4_bool_binop_done:;
+  if (unlikely(__pyx_t_9)) {
+
+
+    /* "fccqp/projections.pyx":122
+ *     cdef const double[::1] normal_ = np.ascontiguousarray(normal, dtype=np.float64)
+ *     if v_.shape[0] != 3 or normal_.shape[0] != 3 or out.shape[0] != 3:
+ *         raise ValueError("v, normal and out must have 3 entries")             # <<<<<<<<<<<<<<
+ *     proj_friction(&v_[0], mu, &normal_[0], &out[0])
+ * 
+*/
+    __pyx_t_5 = NULL;
+    __pyx_t_6 = 1;
+    {
+      PyObject *__pyx_callargs[2] = {__pyx_t_5, __pyx_mstate_global->__pyx_kp_u_v_normal_and_out_must_have_3_ent};
+      __pyx_t_1 = __Pyx_PyObject_FastCall((PyObject*)(((PyTypeObject*)PyExc_ValueError)), __pyx_callargs+__pyx_t_6, (2-__pyx_t_6) | (__pyx_t_6*__Pyx_PY_VECTORCALL_ARGUMENTS_OFFSET));
+      __Pyx_XDECREF(__pyx_t_5); __pyx_t_5 = 0;
+      if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 122, __pyx_L1_error)
+      __Pyx_GOTREF(__pyx_t_1);
+    }
+    __Pyx_Raise(__pyx_t_1, 0, 0, 0);
+    __Pyx_DECREF(__pyx_t_1); __pyx_t_1 = 0;
+    __PYX_ERR(0, 122, __pyx_L1_error)
+
+    /* "fccqp/projections.pyx":121
+ *     cdef const double[::1] v_ = np.ascontiguousarray(v, dtype=np.float64)
+ *     cdef const double[::1] normal_ = np.ascontiguousarray(normal, dtype=np.float64)
+ *     if v_.shape[0] != 3 or normal_.shape[0] != 3 or out.shape[0] != 3:             # <<<<<<<<<<<<<<
+ *         raise ValueError("v, normal and out must have 3 entries")
+ *     proj_friction(&v_[0], mu, &normal_[0], &out[0])
 */
   }
 
-  /* "fccqp/projections.pyx":118
- *     if v.shape[0] != 3 or normal.shape[0] != 3 or out.shape[0] != 3:
+  /* "fccqp/projections.pyx":123
+ *     if v_.shape[0] != 3 or normal_.shape[0] != 3 or out.shape[0] != 3:
  *         raise ValueError("v, normal and out must have 3 entries")
- *     proj_friction(&v[0], mu, &normal[0], &out[0])             # <<<<<<<<<<<<<<
+ *     proj_friction(&v_[0], mu, &normal_[0], &out[0])             # <<<<<<<<<<<<<<
  * 
  * 
 */
-  __pyx_t_6 = 0;
-  __pyx_t_7 = 0;
-  __pyx_t_8 = 0;
-  __pyx_f_5fccqp_11projections_proj_friction((&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_v.data) + __pyx_t_6)) )))), __pyx_v_mu, (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_normal.data) + __pyx_t_7)) )))), (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_out.data) + __pyx_t_8)) )))));
+  __pyx_t_11 = 0;
+  __pyx_t_12 = 0;
+  __pyx_t_13 = 0;
+  __pyx_f_5fccqp_11projections_proj_friction((&(*((double const  *) ( /* dim=0 */ ((char *) (((double const  *) __pyx_v_v_.data) + __pyx_t_11)) )))), __pyx_v_mu, (&(*((double const  *) ( /* dim=0 */ ((char *) (((double const  *) __pyx_v_normal_.data) + __pyx_t_12)) )))), (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_out.data) + __pyx_t_13)) )))));
 
-  /* "fccqp/projections.pyx":114
+  /* "fccqp/projections.pyx":116
  * 
  * 
- * def project_friction_cone(double[::1] v, double mu, double[::1] normal, double[::1] out):             # <<<<<<<<<<<<<<
- *     """Projection of ``v`` onto the friction cone (``mu``, ``normal``) into ``out``, on numpy arrays (3 entries each)."""
- *     if v.shape[0] != 3 or normal.shape[0] != 3 or out.shape[0] != 3:
+ * def project_friction_cone(v, double mu, normal, double[::1] out):             # <<<<<<<<<<<<<<
+ *     """Project the 3-vector ``v`` onto the friction cone (``mu``, unit ``normal``) into
+ *     ``out``."""
 */
 
   /* function exit code */
   __pyx_r = Py_None; __Pyx_INCREF(Py_None);
   goto __pyx_L0;
   __pyx_L1_error:;
+  __Pyx_XDECREF(__pyx_t_1);
+  __Pyx_XDECREF(__pyx_t_2);
   __Pyx_XDECREF(__pyx_t_3);
   __Pyx_XDECREF(__pyx_t_4);
+  __Pyx_XDECREF(__pyx_t_5);
+  __PYX_XCLEAR_MEMVIEW(&__pyx_t_7, 1);
+  __PYX_XCLEAR_MEMVIEW(&__pyx_t_8, 1);
   __Pyx_AddTraceback("fccqp.projections.project_friction_cone", __pyx_clineno, __pyx_lineno, __pyx_filename);
   __pyx_r = NULL;
   __pyx_L0:;
+  __PYX_XCLEAR_MEMVIEW(&__pyx_v_v_, 1);
+  __PYX_XCLEAR_MEMVIEW(&__pyx_v_normal_, 1);
   __Pyx_XGIVEREF(__pyx_r);
   __Pyx_RefNannyFinishContext();
   return __pyx_r;
 }
 
-/* "fccqp/projections.pyx":121
+/* "fccqp/projections.pyx":126
  * 
  * 
- * def project_second_order_cone(double[::1] v, double[::1] out):             # <<<<<<<<<<<<<<
+ * def project_second_order_cone(const double[::1] v, double[::1] out):             # <<<<<<<<<<<<<<
  *     """Projection of ``v`` onto the second-order cone, into ``out``."""
  *     if v.shape[0] < 2 or out.shape[0] != v.shape[0]:
 */
@@ -19057,39 +19203,39 @@ PyObject *__pyx_args, PyObject *__pyx_kwds
   {
     PyObject ** const __pyx_pyargnames[] = {&__pyx_mstate_global->__pyx_n_u_v,&__pyx_mstate_global->__pyx_n_u_out,0};
     const Py_ssize_t __pyx_kwds_len = (__pyx_kwds) ? __Pyx_NumKwargs_FASTCALL(__pyx_kwds) : 0;
-    if (unlikely(__pyx_kwds_len < 0)) __PYX_ERR(0, 121, __pyx_L3_error)
+    if (unlikely(__pyx_kwds_len < 0)) __PYX_ERR(0, 126, __pyx_L3_error)
     if (__pyx_kwds_len > 0) {
       switch (__pyx_nargs) {
         case  2:
         values[1] = __Pyx_ArgRef_FASTCALL(__pyx_args, 1);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 121, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 126, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  1:
         values[0] = __Pyx_ArgRef_FASTCALL(__pyx_args, 0);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 121, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 126, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  0: break;
         default: goto __pyx_L5_argtuple_error;
       }
       const Py_ssize_t kwd_pos_args = __pyx_nargs;
-      if (__Pyx_ParseKeywords(__pyx_kwds, __pyx_kwvalues, __pyx_pyargnames, 0, values, kwd_pos_args, __pyx_kwds_len, "project_second_order_cone", 0) < (0)) __PYX_ERR(0, 121, __pyx_L3_error)
+      if (__Pyx_ParseKeywords(__pyx_kwds, __pyx_kwvalues, __pyx_pyargnames, 0, values, kwd_pos_args, __pyx_kwds_len, "project_second_order_cone", 0) < (0)) __PYX_ERR(0, 126, __pyx_L3_error)
       for (Py_ssize_t i = __pyx_nargs; i < 2; i++) {
-        if (unlikely(!values[i])) { __Pyx_RaiseArgtupleInvalid("project_second_order_cone", 1, 2, 2, i); __PYX_ERR(0, 121, __pyx_L3_error) }
+        if (unlikely(!values[i])) { __Pyx_RaiseArgtupleInvalid("project_second_order_cone", 1, 2, 2, i); __PYX_ERR(0, 126, __pyx_L3_error) }
       }
     } else if (unlikely(__pyx_nargs != 2)) {
       goto __pyx_L5_argtuple_error;
     } else {
       values[0] = __Pyx_ArgRef_FASTCALL(__pyx_args, 0);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 121, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 126, __pyx_L3_error)
       values[1] = __Pyx_ArgRef_FASTCALL(__pyx_args, 1);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 121, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 126, __pyx_L3_error)
     }
-    __pyx_v_v = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[0], PyBUF_WRITABLE); if (unlikely(!__pyx_v_v.memview)) __PYX_ERR(0, 121, __pyx_L3_error)
-    __pyx_v_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[1], PyBUF_WRITABLE); if (unlikely(!__pyx_v_out.memview)) __PYX_ERR(0, 121, __pyx_L3_error)
+    __pyx_v_v = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(values[0], 0); if (unlikely(!__pyx_v_v.memview)) __PYX_ERR(0, 126, __pyx_L3_error)
+    __pyx_v_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[1], PyBUF_WRITABLE); if (unlikely(!__pyx_v_out.memview)) __PYX_ERR(0, 126, __pyx_L3_error)
   }
   goto __pyx_L6_skip;
   __pyx_L5_argtuple_error:;
-  __Pyx_RaiseArgtupleInvalid("project_second_order_cone", 1, 2, 2, __pyx_nargs); __PYX_ERR(0, 121, __pyx_L3_error)
+  __Pyx_RaiseArgtupleInvalid("project_second_order_cone", 1, 2, 2, __pyx_nargs); __PYX_ERR(0, 126, __pyx_L3_error)
   __pyx_L6_skip:;
   goto __pyx_L4_argument_unpacking_done;
   __pyx_L3_error:;
@@ -19129,8 +19275,8 @@ static PyObject *__pyx_pf_5fccqp_11projections_2project_second_order_cone(CYTHON
   int __pyx_clineno = 0;
   __Pyx_RefNannySetupContext("project_second_order_cone", 0);
 
-  /* "fccqp/projections.pyx":123
- * def project_second_order_cone(double[::1] v, double[::1] out):
+  /* "fccqp/projections.pyx":128
+ * def project_second_order_cone(const double[::1] v, double[::1] out):
  *     """Projection of ``v`` onto the second-order cone, into ``out``."""
  *     if v.shape[0] < 2 or out.shape[0] != v.shape[0]:             # <<<<<<<<<<<<<<
  *         raise ValueError("v needs at least 2 entries and out as many")
@@ -19155,7 +19301,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_2project_second_order_cone(CYTHON
   if (unlikely(__pyx_t_1)) {
 
 
-    /* "fccqp/projections.pyx":124
+    /* "fccqp/projections.pyx":129
  *     """Projection of ``v`` onto the second-order cone, into ``out``."""
  *     if v.shape[0] < 2 or out.shape[0] != v.shape[0]:
  *         raise ValueError("v needs at least 2 entries and out as many")             # <<<<<<<<<<<<<<
@@ -19168,15 +19314,15 @@ static PyObject *__pyx_pf_5fccqp_11projections_2project_second_order_cone(CYTHON
       PyObject *__pyx_callargs[2] = {__pyx_t_4, __pyx_mstate_global->__pyx_kp_u_v_needs_at_least_2_entries_and_o};
       __pyx_t_3 = __Pyx_PyObject_FastCall((PyObject*)(((PyTypeObject*)PyExc_ValueError)), __pyx_callargs+__pyx_t_5, (2-__pyx_t_5) | (__pyx_t_5*__Pyx_PY_VECTORCALL_ARGUMENTS_OFFSET));
       __Pyx_XDECREF(__pyx_t_4); __pyx_t_4 = 0;
-      if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 124, __pyx_L1_error)
+      if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 129, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_3);
     }
     __Pyx_Raise(__pyx_t_3, 0, 0, 0);
     __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
-    __PYX_ERR(0, 124, __pyx_L1_error)
+    __PYX_ERR(0, 129, __pyx_L1_error)
 
-    /* "fccqp/projections.pyx":123
- * def project_second_order_cone(double[::1] v, double[::1] out):
+    /* "fccqp/projections.pyx":128
+ * def project_second_order_cone(const double[::1] v, double[::1] out):
  *     """Projection of ``v`` onto the second-order cone, into ``out``."""
  *     if v.shape[0] < 2 or out.shape[0] != v.shape[0]:             # <<<<<<<<<<<<<<
  *         raise ValueError("v needs at least 2 entries and out as many")
@@ -19184,7 +19330,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_2project_second_order_cone(CYTHON
 */
   }
 
-  /* "fccqp/projections.pyx":125
+  /* "fccqp/projections.pyx":130
  *     if v.shape[0] < 2 or out.shape[0] != v.shape[0]:
  *         raise ValueError("v needs at least 2 entries and out as many")
  *     proj_soc(&v[0], v.shape[0], &out[0])             # <<<<<<<<<<<<<<
@@ -19193,12 +19339,12 @@ static PyObject *__pyx_pf_5fccqp_11projections_2project_second_order_cone(CYTHON
 */
   __pyx_t_6 = 0;
   __pyx_t_7 = 0;
-  __pyx_f_5fccqp_11projections_proj_soc((&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_v.data) + __pyx_t_6)) )))), (__pyx_v_v.shape[0]), (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_out.data) + __pyx_t_7)) )))));
+  __pyx_f_5fccqp_11projections_proj_soc((&(*((double const  *) ( /* dim=0 */ ((char *) (((double const  *) __pyx_v_v.data) + __pyx_t_6)) )))), (__pyx_v_v.shape[0]), (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_out.data) + __pyx_t_7)) )))));
 
-  /* "fccqp/projections.pyx":121
+  /* "fccqp/projections.pyx":126
  * 
  * 
- * def project_second_order_cone(double[::1] v, double[::1] out):             # <<<<<<<<<<<<<<
+ * def project_second_order_cone(const double[::1] v, double[::1] out):             # <<<<<<<<<<<<<<
  *     """Projection of ``v`` onto the second-order cone, into ``out``."""
  *     if v.shape[0] < 2 or out.shape[0] != v.shape[0]:
 */
@@ -19217,10 +19363,10 @@ static PyObject *__pyx_pf_5fccqp_11projections_2project_second_order_cone(CYTHON
   return __pyx_r;
 }
 
-/* "fccqp/projections.pyx":128
+/* "fccqp/projections.pyx":133
  * 
  * 
- * def project_constraint_set(double[::1] v, double[::1] lo, double[::1] hi, cones,             # <<<<<<<<<<<<<<
+ * def project_constraint_set(const double[::1] v, const double[::1] lo, const double[::1] hi, cones,             # <<<<<<<<<<<<<<
  *                            double[::1] out):
  *     """Project ``v`` onto ``[lo, hi]`` times the cones into ``out`` (may be ``v``).
 */
@@ -19269,60 +19415,60 @@ PyObject *__pyx_args, PyObject *__pyx_kwds
   {
     PyObject ** const __pyx_pyargnames[] = {&__pyx_mstate_global->__pyx_n_u_v,&__pyx_mstate_global->__pyx_n_u_lo,&__pyx_mstate_global->__pyx_n_u_hi,&__pyx_mstate_global->__pyx_n_u_cones,&__pyx_mstate_global->__pyx_n_u_out,0};
     const Py_ssize_t __pyx_kwds_len = (__pyx_kwds) ? __Pyx_NumKwargs_FASTCALL(__pyx_kwds) : 0;
-    if (unlikely(__pyx_kwds_len < 0)) __PYX_ERR(0, 128, __pyx_L3_error)
+    if (unlikely(__pyx_kwds_len < 0)) __PYX_ERR(0, 133, __pyx_L3_error)
     if (__pyx_kwds_len > 0) {
       switch (__pyx_nargs) {
         case  5:
         values[4] = __Pyx_ArgRef_FASTCALL(__pyx_args, 4);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[4])) __PYX_ERR(0, 128, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[4])) __PYX_ERR(0, 133, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  4:
         values[3] = __Pyx_ArgRef_FASTCALL(__pyx_args, 3);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 128, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 133, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  3:
         values[2] = __Pyx_ArgRef_FASTCALL(__pyx_args, 2);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 128, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 133, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  2:
         values[1] = __Pyx_ArgRef_FASTCALL(__pyx_args, 1);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 128, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 133, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  1:
         values[0] = __Pyx_ArgRef_FASTCALL(__pyx_args, 0);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 128, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 133, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  0: break;
         default: goto __pyx_L5_argtuple_error;
       }
       const Py_ssize_t kwd_pos_args = __pyx_nargs;
-      if (__Pyx_ParseKeywords(__pyx_kwds, __pyx_kwvalues, __pyx_pyargnames, 0, values, kwd_pos_args, __pyx_kwds_len, "project_constraint_set", 0) < (0)) __PYX_ERR(0, 128, __pyx_L3_error)
+      if (__Pyx_ParseKeywords(__pyx_kwds, __pyx_kwvalues, __pyx_pyargnames, 0, values, kwd_pos_args, __pyx_kwds_len, "project_constraint_set", 0) < (0)) __PYX_ERR(0, 133, __pyx_L3_error)
       for (Py_ssize_t i = __pyx_nargs; i < 5; i++) {
-        if (unlikely(!values[i])) { __Pyx_RaiseArgtupleInvalid("project_constraint_set", 1, 5, 5, i); __PYX_ERR(0, 128, __pyx_L3_error) }
+        if (unlikely(!values[i])) { __Pyx_RaiseArgtupleInvalid("project_constraint_set", 1, 5, 5, i); __PYX_ERR(0, 133, __pyx_L3_error) }
       }
     } else if (unlikely(__pyx_nargs != 5)) {
       goto __pyx_L5_argtuple_error;
     } else {
       values[0] = __Pyx_ArgRef_FASTCALL(__pyx_args, 0);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 128, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 133, __pyx_L3_error)
       values[1] = __Pyx_ArgRef_FASTCALL(__pyx_args, 1);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 128, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 133, __pyx_L3_error)
       values[2] = __Pyx_ArgRef_FASTCALL(__pyx_args, 2);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 128, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 133, __pyx_L3_error)
       values[3] = __Pyx_ArgRef_FASTCALL(__pyx_args, 3);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 128, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 133, __pyx_L3_error)
       values[4] = __Pyx_ArgRef_FASTCALL(__pyx_args, 4);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[4])) __PYX_ERR(0, 128, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[4])) __PYX_ERR(0, 133, __pyx_L3_error)
     }
-    __pyx_v_v = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[0], PyBUF_WRITABLE); if (unlikely(!__pyx_v_v.memview)) __PYX_ERR(0, 128, __pyx_L3_error)
-    __pyx_v_lo = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[1], PyBUF_WRITABLE); if (unlikely(!__pyx_v_lo.memview)) __PYX_ERR(0, 128, __pyx_L3_error)
-    __pyx_v_hi = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[2], PyBUF_WRITABLE); if (unlikely(!__pyx_v_hi.memview)) __PYX_ERR(0, 128, __pyx_L3_error)
+    __pyx_v_v = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(values[0], 0); if (unlikely(!__pyx_v_v.memview)) __PYX_ERR(0, 133, __pyx_L3_error)
+    __pyx_v_lo = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(values[1], 0); if (unlikely(!__pyx_v_lo.memview)) __PYX_ERR(0, 133, __pyx_L3_error)
+    __pyx_v_hi = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(values[2], 0); if (unlikely(!__pyx_v_hi.memview)) __PYX_ERR(0, 133, __pyx_L3_error)
     __pyx_v_cones = values[3];
-    __pyx_v_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[4], PyBUF_WRITABLE); if (unlikely(!__pyx_v_out.memview)) __PYX_ERR(0, 129, __pyx_L3_error)
+    __pyx_v_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[4], PyBUF_WRITABLE); if (unlikely(!__pyx_v_out.memview)) __PYX_ERR(0, 134, __pyx_L3_error)
   }
   goto __pyx_L6_skip;
   __pyx_L5_argtuple_error:;
-  __Pyx_RaiseArgtupleInvalid("project_constraint_set", 1, 5, 5, __pyx_nargs); __PYX_ERR(0, 128, __pyx_L3_error)
+  __Pyx_RaiseArgtupleInvalid("project_constraint_set", 1, 5, 5, __pyx_nargs); __PYX_ERR(0, 133, __pyx_L3_error)
   __pyx_L6_skip:;
   goto __pyx_L4_argument_unpacking_done;
   __pyx_L3_error:;
@@ -19385,11 +19531,11 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
   PyObject *__pyx_t_21[3];
   Py_ssize_t __pyx_t_22;
   int __pyx_t_23;
-  Py_ssize_t *__pyx_t_24;
-  Py_ssize_t *__pyx_t_25;
-  Py_ssize_t *__pyx_t_26;
-  double *__pyx_t_27;
-  double *__pyx_t_28;
+  Py_ssize_t const *__pyx_t_24;
+  Py_ssize_t const *__pyx_t_25;
+  Py_ssize_t const *__pyx_t_26;
+  double const *__pyx_t_27;
+  double const *__pyx_t_28;
   Py_ssize_t __pyx_t_29;
   Py_ssize_t __pyx_t_30;
   int __pyx_lineno = 0;
@@ -19397,9 +19543,9 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
   int __pyx_clineno = 0;
   __Pyx_RefNannySetupContext("project_constraint_set", 0);
 
-  /* "fccqp/projections.pyx":138
- *     cdef double[::1] mu
- *     cdef double[:, ::1] normal
+  /* "fccqp/projections.pyx":143
+ *     cdef const double[::1] mu
+ *     cdef const double[:, ::1] normal
  *     kind, offset, dim, mu, normal = cones             # <<<<<<<<<<<<<<
  *     cdef Py_ssize_t s = v.shape[0]
  *     if lo.shape[0] != s or hi.shape[0] != s or out.shape[0] != s:
@@ -19410,7 +19556,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
     if (unlikely(size != 5)) {
       if (size > 5) __Pyx_RaiseTooManyValuesError(5);
       else if (size >= 0) __Pyx_RaiseNeedMoreValuesError(size);
-      __PYX_ERR(0, 138, __pyx_L1_error)
+      __PYX_ERR(0, 143, __pyx_L1_error)
     }
     #if CYTHON_ASSUME_SAFE_MACROS && !CYTHON_AVOID_BORROWED_REFS
     if (likely(PyTuple_CheckExact(sequence))) {
@@ -19426,19 +19572,19 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
       __Pyx_INCREF(__pyx_t_5);
     } else {
       __pyx_t_1 = __Pyx_PyList_GET_ITEM_REF(sequence, 0, __Pyx_ReferenceSharing_SharedReference);
-      if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 138, __pyx_L1_error)
+      if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 143, __pyx_L1_error)
       __Pyx_XGOTREF(__pyx_t_1);
       __pyx_t_2 = __Pyx_PyList_GET_ITEM_REF(sequence, 1, __Pyx_ReferenceSharing_SharedReference);
-      if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 138, __pyx_L1_error)
+      if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 143, __pyx_L1_error)
       __Pyx_XGOTREF(__pyx_t_2);
       __pyx_t_3 = __Pyx_PyList_GET_ITEM_REF(sequence, 2, __Pyx_ReferenceSharing_SharedReference);
-      if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 138, __pyx_L1_error)
+      if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 143, __pyx_L1_error)
       __Pyx_XGOTREF(__pyx_t_3);
       __pyx_t_4 = __Pyx_PyList_GET_ITEM_REF(sequence, 3, __Pyx_ReferenceSharing_SharedReference);
-      if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 138, __pyx_L1_error)
+      if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 143, __pyx_L1_error)
       __Pyx_XGOTREF(__pyx_t_4);
       __pyx_t_5 = __Pyx_PyList_GET_ITEM_REF(sequence, 4, __Pyx_ReferenceSharing_SharedReference);
-      if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 138, __pyx_L1_error)
+      if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 143, __pyx_L1_error)
       __Pyx_XGOTREF(__pyx_t_5);
     }
     #else
@@ -19446,7 +19592,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
       Py_ssize_t i;
       PyObject** temps[5] = {&__pyx_t_1,&__pyx_t_2,&__pyx_t_3,&__pyx_t_4,&__pyx_t_5};
       for (i=0; i < 5; i++) {
-        PyObject* item = __Pyx_PySequence_ITEM(sequence, i); if (unlikely(!item)) __PYX_ERR(0, 138, __pyx_L1_error)
+        PyObject* item = __Pyx_PySequence_ITEM(sequence, i); if (unlikely(!item)) __PYX_ERR(0, 143, __pyx_L1_error)
         __Pyx_GOTREF(item);
         *(temps[i]) = item;
       }
@@ -19455,7 +19601,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
   } else {
     Py_ssize_t index = -1;
     PyObject** temps[5] = {&__pyx_t_1,&__pyx_t_2,&__pyx_t_3,&__pyx_t_4,&__pyx_t_5};
-    __pyx_t_6 = PyObject_GetIter(__pyx_v_cones); if (unlikely(!__pyx_t_6)) __PYX_ERR(0, 138, __pyx_L1_error)
+    __pyx_t_6 = PyObject_GetIter(__pyx_v_cones); if (unlikely(!__pyx_t_6)) __PYX_ERR(0, 143, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_6);
     __pyx_t_7 = (CYTHON_COMPILING_IN_LIMITED_API) ? PyIter_Next : __Pyx_PyObject_GetIterNextFunc(__pyx_t_6);
     for (index=0; index < 5; index++) {
@@ -19463,7 +19609,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
       __Pyx_GOTREF(item);
       *(temps[index]) = item;
     }
-    if (__Pyx_IternextUnpackEndCheck(__pyx_t_7(__pyx_t_6), 5) < (0)) __PYX_ERR(0, 138, __pyx_L1_error)
+    if (__Pyx_IternextUnpackEndCheck(__pyx_t_7(__pyx_t_6), 5) < (0)) __PYX_ERR(0, 143, __pyx_L1_error)
     __pyx_t_7 = NULL;
     __Pyx_DECREF(__pyx_t_6); __pyx_t_6 = 0;
     goto __pyx_L4_unpacking_done;
@@ -19471,18 +19617,18 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
     __Pyx_DECREF(__pyx_t_6); __pyx_t_6 = 0;
     __pyx_t_7 = NULL;
     if (__Pyx_IterFinish() == 0) __Pyx_RaiseNeedMoreValuesError(index);
-    __PYX_ERR(0, 138, __pyx_L1_error)
+    __PYX_ERR(0, 143, __pyx_L1_error)
     __pyx_L4_unpacking_done:;
   }
-  __pyx_t_8 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(__pyx_t_1, PyBUF_WRITABLE); if (unlikely(!__pyx_t_8.memview)) __PYX_ERR(0, 138, __pyx_L1_error)
+  __pyx_t_8 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t__const__(__pyx_t_1, 0); if (unlikely(!__pyx_t_8.memview)) __PYX_ERR(0, 143, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_1); __pyx_t_1 = 0;
-  __pyx_t_9 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(__pyx_t_2, PyBUF_WRITABLE); if (unlikely(!__pyx_t_9.memview)) __PYX_ERR(0, 138, __pyx_L1_error)
+  __pyx_t_9 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t__const__(__pyx_t_2, 0); if (unlikely(!__pyx_t_9.memview)) __PYX_ERR(0, 143, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_2); __pyx_t_2 = 0;
-  __pyx_t_10 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(__pyx_t_3, PyBUF_WRITABLE); if (unlikely(!__pyx_t_10.memview)) __PYX_ERR(0, 138, __pyx_L1_error)
+  __pyx_t_10 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t__const__(__pyx_t_3, 0); if (unlikely(!__pyx_t_10.memview)) __PYX_ERR(0, 143, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
-  __pyx_t_11 = __Pyx_PyObject_to_MemoryviewSlice_dc_double(__pyx_t_4, PyBUF_WRITABLE); if (unlikely(!__pyx_t_11.memview)) __PYX_ERR(0, 138, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(__pyx_t_4, 0); if (unlikely(!__pyx_t_11.memview)) __PYX_ERR(0, 143, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_4); __pyx_t_4 = 0;
-  __pyx_t_12 = __Pyx_PyObject_to_MemoryviewSlice_d_dc_double(__pyx_t_5, PyBUF_WRITABLE); if (unlikely(!__pyx_t_12.memview)) __PYX_ERR(0, 138, __pyx_L1_error)
+  __pyx_t_12 = __Pyx_PyObject_to_MemoryviewSlice_d_dc_double__const__(__pyx_t_5, 0); if (unlikely(!__pyx_t_12.memview)) __PYX_ERR(0, 143, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_5); __pyx_t_5 = 0;
   __pyx_v_kind = __pyx_t_8;
   __pyx_t_8.memview = NULL;
@@ -19500,8 +19646,8 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
   __pyx_t_12.memview = NULL;
   __pyx_t_12.data = NULL;
 
-  /* "fccqp/projections.pyx":139
- *     cdef double[:, ::1] normal
+  /* "fccqp/projections.pyx":144
+ *     cdef const double[:, ::1] normal
  *     kind, offset, dim, mu, normal = cones
  *     cdef Py_ssize_t s = v.shape[0]             # <<<<<<<<<<<<<<
  *     if lo.shape[0] != s or hi.shape[0] != s or out.shape[0] != s:
@@ -19509,7 +19655,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
 */
   __pyx_v_s = (__pyx_v_v.shape[0]);
 
-  /* "fccqp/projections.pyx":140
+  /* "fccqp/projections.pyx":145
  *     kind, offset, dim, mu, normal = cones
  *     cdef Py_ssize_t s = v.shape[0]
  *     if lo.shape[0] != s or hi.shape[0] != s or out.shape[0] != s:             # <<<<<<<<<<<<<<
@@ -19545,7 +19691,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
   if (unlikely(__pyx_t_13)) {
 
 
-    /* "fccqp/projections.pyx":141
+    /* "fccqp/projections.pyx":146
  *     cdef Py_ssize_t s = v.shape[0]
  *     if lo.shape[0] != s or hi.shape[0] != s or out.shape[0] != s:
  *         raise ValueError("v, lo, hi and out must have the same size")             # <<<<<<<<<<<<<<
@@ -19558,14 +19704,14 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
       PyObject *__pyx_callargs[2] = {__pyx_t_4, __pyx_mstate_global->__pyx_kp_u_v_lo_hi_and_out_must_have_the_sa};
       __pyx_t_5 = __Pyx_PyObject_FastCall((PyObject*)(((PyTypeObject*)PyExc_ValueError)), __pyx_callargs+__pyx_t_15, (2-__pyx_t_15) | (__pyx_t_15*__Pyx_PY_VECTORCALL_ARGUMENTS_OFFSET));
       __Pyx_XDECREF(__pyx_t_4); __pyx_t_4 = 0;
-      if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 141, __pyx_L1_error)
+      if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 146, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_5);
     }
     __Pyx_Raise(__pyx_t_5, 0, 0, 0);
     __Pyx_DECREF(__pyx_t_5); __pyx_t_5 = 0;
-    __PYX_ERR(0, 141, __pyx_L1_error)
+    __PYX_ERR(0, 146, __pyx_L1_error)
 
-    /* "fccqp/projections.pyx":140
+    /* "fccqp/projections.pyx":145
  *     kind, offset, dim, mu, normal = cones
  *     cdef Py_ssize_t s = v.shape[0]
  *     if lo.shape[0] != s or hi.shape[0] != s or out.shape[0] != s:             # <<<<<<<<<<<<<<
@@ -19574,7 +19720,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
 */
   }
 
-  /* "fccqp/projections.pyx":143
+  /* "fccqp/projections.pyx":148
  *         raise ValueError("v, lo, hi and out must have the same size")
  *     cdef Py_ssize_t k
  *     for k in range(kind.shape[0]):             # <<<<<<<<<<<<<<
@@ -19588,7 +19734,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
   for (__pyx_t_18 = 0; __pyx_t_18 < __pyx_t_17; __pyx_t_18+=1) {
     __pyx_v_k = __pyx_t_18;
 
-    /* "fccqp/projections.pyx":144
+    /* "fccqp/projections.pyx":149
  *     cdef Py_ssize_t k
  *     for k in range(kind.shape[0]):
  *         if offset[k] < 0 or offset[k] + dim[k] > s:             # <<<<<<<<<<<<<<
@@ -19596,7 +19742,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
  *     if s == 0:
 */
     __pyx_t_19 = __pyx_v_k;
-    __pyx_t_14 = ((*((Py_ssize_t *) ( /* dim=0 */ ((char *) (((Py_ssize_t *) __pyx_v_offset.data) + __pyx_t_19)) ))) < 0);
+    __pyx_t_14 = ((*((Py_ssize_t const  *) ( /* dim=0 */ ((char *) (((Py_ssize_t const  *) __pyx_v_offset.data) + __pyx_t_19)) ))) < 0);
 
     if (!__pyx_t_14) {
 
@@ -19608,7 +19754,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
     }
     __pyx_t_19 = __pyx_v_k;
     __pyx_t_20 = __pyx_v_k;
-    __pyx_t_14 = (((*((Py_ssize_t *) ( /* dim=0 */ ((char *) (((Py_ssize_t *) __pyx_v_offset.data) + __pyx_t_19)) ))) + (*((Py_ssize_t *) ( /* dim=0 */ ((char *) (((Py_ssize_t *) __pyx_v_dim.data) + __pyx_t_20)) )))) > __pyx_v_s);
+    __pyx_t_14 = (((*((Py_ssize_t const  *) ( /* dim=0 */ ((char *) (((Py_ssize_t const  *) __pyx_v_offset.data) + __pyx_t_19)) ))) + (*((Py_ssize_t const  *) ( /* dim=0 */ ((char *) (((Py_ssize_t const  *) __pyx_v_dim.data) + __pyx_t_20)) )))) > __pyx_v_s);
 
 
     __pyx_t_13 = __pyx_t_14;
@@ -19617,7 +19763,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
     if (unlikely(__pyx_t_13)) {
 
 
-      /* "fccqp/projections.pyx":145
+      /* "fccqp/projections.pyx":150
  *     for k in range(kind.shape[0]):
  *         if offset[k] < 0 or offset[k] + dim[k] > s:
  *             raise ValueError(f"cone {k} leaves the vector")             # <<<<<<<<<<<<<<
@@ -19625,7 +19771,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
  *         return
 */
       __pyx_t_4 = NULL;
-      __pyx_t_3 = __Pyx_PyUnicode_From_Py_ssize_t(__pyx_v_k, 0, ' ', 'd'); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 145, __pyx_L1_error)
+      __pyx_t_3 = __Pyx_PyUnicode_From_Py_ssize_t(__pyx_v_k, 0, ' ', 'd'); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 150, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_3);
       __pyx_t_21[0] = __pyx_mstate_global->__pyx_kp_u_cone;
       __pyx_t_21[1] = __pyx_t_3;
@@ -19636,7 +19782,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
       #endif
       __pyx_t_23 = 0;
       __pyx_t_2 = __Pyx_PyUnicode_Join(__pyx_t_21, 3, __pyx_t_22, __pyx_t_23);
-      if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 145, __pyx_L1_error)
+      if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 150, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_2);
       __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
       __pyx_t_15 = 1;
@@ -19645,14 +19791,14 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
         __pyx_t_5 = __Pyx_PyObject_FastCall((PyObject*)(((PyTypeObject*)PyExc_ValueError)), __pyx_callargs+__pyx_t_15, (2-__pyx_t_15) | (__pyx_t_15*__Pyx_PY_VECTORCALL_ARGUMENTS_OFFSET));
         __Pyx_XDECREF(__pyx_t_4); __pyx_t_4 = 0;
         __Pyx_DECREF(__pyx_t_2); __pyx_t_2 = 0;
-        if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 145, __pyx_L1_error)
+        if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 150, __pyx_L1_error)
         __Pyx_GOTREF(__pyx_t_5);
       }
       __Pyx_Raise(__pyx_t_5, 0, 0, 0);
       __Pyx_DECREF(__pyx_t_5); __pyx_t_5 = 0;
-      __PYX_ERR(0, 145, __pyx_L1_error)
+      __PYX_ERR(0, 150, __pyx_L1_error)
 
-      /* "fccqp/projections.pyx":144
+      /* "fccqp/projections.pyx":149
  *     cdef Py_ssize_t k
  *     for k in range(kind.shape[0]):
  *         if offset[k] < 0 or offset[k] + dim[k] > s:             # <<<<<<<<<<<<<<
@@ -19663,7 +19809,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
   }
 
 
-  /* "fccqp/projections.pyx":146
+  /* "fccqp/projections.pyx":151
  *         if offset[k] < 0 or offset[k] + dim[k] > s:
  *             raise ValueError(f"cone {k} leaves the vector")
  *     if s == 0:             # <<<<<<<<<<<<<<
@@ -19675,7 +19821,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
   if (__pyx_t_13) {
 
 
-    /* "fccqp/projections.pyx":147
+    /* "fccqp/projections.pyx":152
  *             raise ValueError(f"cone {k} leaves the vector")
  *     if s == 0:
  *         return             # <<<<<<<<<<<<<<
@@ -19692,7 +19838,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
     }
     goto __pyx_L0;
 
-    /* "fccqp/projections.pyx":146
+    /* "fccqp/projections.pyx":151
  *         if offset[k] < 0 or offset[k] + dim[k] > s:
  *             raise ValueError(f"cone {k} leaves the vector")
  *     if s == 0:             # <<<<<<<<<<<<<<
@@ -19701,7 +19847,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
 */
   }
 
-  /* "fccqp/projections.pyx":149
+  /* "fccqp/projections.pyx":154
  *         return
  *     cdef Cones c
  *     c.count = kind.shape[0]             # <<<<<<<<<<<<<<
@@ -19710,7 +19856,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
 */
   __pyx_v_c.count = (__pyx_v_kind.shape[0]);
 
-  /* "fccqp/projections.pyx":150
+  /* "fccqp/projections.pyx":155
  *     cdef Cones c
  *     c.count = kind.shape[0]
  *     if c.count:             # <<<<<<<<<<<<<<
@@ -19722,7 +19868,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
   if (__pyx_t_13) {
 
 
-    /* "fccqp/projections.pyx":151
+    /* "fccqp/projections.pyx":156
  *     c.count = kind.shape[0]
  *     if c.count:
  *         c.kind, c.offset, c.dim = &kind[0], &offset[0], &dim[0]             # <<<<<<<<<<<<<<
@@ -19730,19 +19876,19 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
  *     proj_set(&v[0], &lo[0], &hi[0], c, s, &out[0])
 */
     __pyx_t_20 = 0;
-    __pyx_t_24 = (&(*((Py_ssize_t *) ( /* dim=0 */ ((char *) (((Py_ssize_t *) __pyx_v_kind.data) + __pyx_t_20)) ))));
+    __pyx_t_24 = (&(*((Py_ssize_t const  *) ( /* dim=0 */ ((char *) (((Py_ssize_t const  *) __pyx_v_kind.data) + __pyx_t_20)) ))));
 
     __pyx_t_20 = 0;
-    __pyx_t_25 = (&(*((Py_ssize_t *) ( /* dim=0 */ ((char *) (((Py_ssize_t *) __pyx_v_offset.data) + __pyx_t_20)) ))));
+    __pyx_t_25 = (&(*((Py_ssize_t const  *) ( /* dim=0 */ ((char *) (((Py_ssize_t const  *) __pyx_v_offset.data) + __pyx_t_20)) ))));
 
     __pyx_t_20 = 0;
-    __pyx_t_26 = (&(*((Py_ssize_t *) ( /* dim=0 */ ((char *) (((Py_ssize_t *) __pyx_v_dim.data) + __pyx_t_20)) ))));
+    __pyx_t_26 = (&(*((Py_ssize_t const  *) ( /* dim=0 */ ((char *) (((Py_ssize_t const  *) __pyx_v_dim.data) + __pyx_t_20)) ))));
 
     __pyx_v_c.kind = __pyx_t_24;
     __pyx_v_c.offset = __pyx_t_25;
     __pyx_v_c.dim = __pyx_t_26;
 
-    /* "fccqp/projections.pyx":152
+    /* "fccqp/projections.pyx":157
  *     if c.count:
  *         c.kind, c.offset, c.dim = &kind[0], &offset[0], &dim[0]
  *         c.mu, c.normal = &mu[0], &normal[0, 0]             # <<<<<<<<<<<<<<
@@ -19750,16 +19896,16 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
  * 
 */
     __pyx_t_20 = 0;
-    __pyx_t_27 = (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_mu.data) + __pyx_t_20)) ))));
+    __pyx_t_27 = (&(*((double const  *) ( /* dim=0 */ ((char *) (((double const  *) __pyx_v_mu.data) + __pyx_t_20)) ))));
 
     __pyx_t_20 = 0;
     __pyx_t_19 = 0;
-    __pyx_t_28 = (&(*((double *) ( /* dim=1 */ ((char *) (((double *) ( /* dim=0 */ (__pyx_v_normal.data + __pyx_t_20 * __pyx_v_normal.strides[0]) )) + __pyx_t_19)) ))));
+    __pyx_t_28 = (&(*((double const  *) ( /* dim=1 */ ((char *) (((double const  *) ( /* dim=0 */ (__pyx_v_normal.data + __pyx_t_20 * __pyx_v_normal.strides[0]) )) + __pyx_t_19)) ))));
 
     __pyx_v_c.mu = __pyx_t_27;
     __pyx_v_c.normal = __pyx_t_28;
 
-    /* "fccqp/projections.pyx":150
+    /* "fccqp/projections.pyx":155
  *     cdef Cones c
  *     c.count = kind.shape[0]
  *     if c.count:             # <<<<<<<<<<<<<<
@@ -19768,7 +19914,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
 */
   }
 
-  /* "fccqp/projections.pyx":153
+  /* "fccqp/projections.pyx":158
  *         c.kind, c.offset, c.dim = &kind[0], &offset[0], &dim[0]
  *         c.mu, c.normal = &mu[0], &normal[0, 0]
  *     proj_set(&v[0], &lo[0], &hi[0], c, s, &out[0])             # <<<<<<<<<<<<<<
@@ -19779,12 +19925,12 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
   __pyx_t_20 = 0;
   __pyx_t_29 = 0;
   __pyx_t_30 = 0;
-  __pyx_f_5fccqp_11projections_proj_set((&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_v.data) + __pyx_t_19)) )))), (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_lo.data) + __pyx_t_20)) )))), (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_hi.data) + __pyx_t_29)) )))), __pyx_v_c, __pyx_v_s, (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_out.data) + __pyx_t_30)) )))));
+  __pyx_f_5fccqp_11projections_proj_set((&(*((double const  *) ( /* dim=0 */ ((char *) (((double const  *) __pyx_v_v.data) + __pyx_t_19)) )))), (&(*((double const  *) ( /* dim=0 */ ((char *) (((double const  *) __pyx_v_lo.data) + __pyx_t_20)) )))), (&(*((double const  *) ( /* dim=0 */ ((char *) (((double const  *) __pyx_v_hi.data) + __pyx_t_29)) )))), __pyx_v_c, __pyx_v_s, (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_out.data) + __pyx_t_30)) )))));
 
-  /* "fccqp/projections.pyx":128
+  /* "fccqp/projections.pyx":133
  * 
  * 
- * def project_constraint_set(double[::1] v, double[::1] lo, double[::1] hi, cones,             # <<<<<<<<<<<<<<
+ * def project_constraint_set(const double[::1] v, const double[::1] lo, const double[::1] hi, cones,             # <<<<<<<<<<<<<<
  *                            double[::1] out):
  *     """Project ``v`` onto ``[lo, hi]`` times the cones into ``out`` (may be ``v``).
 */
@@ -19820,10 +19966,10 @@ static PyObject *__pyx_pf_5fccqp_11projections_4project_constraint_set(CYTHON_UN
   return __pyx_r;
 }
 
-/* "fccqp/projections.pyx":156
+/* "fccqp/projections.pyx":161
  * 
  * 
- * def project_cone_block(double[::1] v, Py_ssize_t kind, double mu, double[::1] normal,             # <<<<<<<<<<<<<<
+ * def project_cone_block(const double[::1] v, Py_ssize_t kind, double mu, const double[::1] normal,             # <<<<<<<<<<<<<<
  *                        double[::1] out):
  *     """Project one cone block (kind code of :mod:`fccqp.cones`) into ``out``."""
 */
@@ -19872,60 +20018,60 @@ PyObject *__pyx_args, PyObject *__pyx_kwds
   {
     PyObject ** const __pyx_pyargnames[] = {&__pyx_mstate_global->__pyx_n_u_v,&__pyx_mstate_global->__pyx_n_u_kind,&__pyx_mstate_global->__pyx_n_u_mu,&__pyx_mstate_global->__pyx_n_u_normal,&__pyx_mstate_global->__pyx_n_u_out,0};
     const Py_ssize_t __pyx_kwds_len = (__pyx_kwds) ? __Pyx_NumKwargs_FASTCALL(__pyx_kwds) : 0;
-    if (unlikely(__pyx_kwds_len < 0)) __PYX_ERR(0, 156, __pyx_L3_error)
+    if (unlikely(__pyx_kwds_len < 0)) __PYX_ERR(0, 161, __pyx_L3_error)
     if (__pyx_kwds_len > 0) {
       switch (__pyx_nargs) {
         case  5:
         values[4] = __Pyx_ArgRef_FASTCALL(__pyx_args, 4);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[4])) __PYX_ERR(0, 156, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[4])) __PYX_ERR(0, 161, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  4:
         values[3] = __Pyx_ArgRef_FASTCALL(__pyx_args, 3);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 156, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 161, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  3:
         values[2] = __Pyx_ArgRef_FASTCALL(__pyx_args, 2);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 156, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 161, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  2:
         values[1] = __Pyx_ArgRef_FASTCALL(__pyx_args, 1);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 156, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 161, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  1:
         values[0] = __Pyx_ArgRef_FASTCALL(__pyx_args, 0);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 156, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 161, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  0: break;
         default: goto __pyx_L5_argtuple_error;
       }
       const Py_ssize_t kwd_pos_args = __pyx_nargs;
-      if (__Pyx_ParseKeywords(__pyx_kwds, __pyx_kwvalues, __pyx_pyargnames, 0, values, kwd_pos_args, __pyx_kwds_len, "project_cone_block", 0) < (0)) __PYX_ERR(0, 156, __pyx_L3_error)
+      if (__Pyx_ParseKeywords(__pyx_kwds, __pyx_kwvalues, __pyx_pyargnames, 0, values, kwd_pos_args, __pyx_kwds_len, "project_cone_block", 0) < (0)) __PYX_ERR(0, 161, __pyx_L3_error)
       for (Py_ssize_t i = __pyx_nargs; i < 5; i++) {
-        if (unlikely(!values[i])) { __Pyx_RaiseArgtupleInvalid("project_cone_block", 1, 5, 5, i); __PYX_ERR(0, 156, __pyx_L3_error) }
+        if (unlikely(!values[i])) { __Pyx_RaiseArgtupleInvalid("project_cone_block", 1, 5, 5, i); __PYX_ERR(0, 161, __pyx_L3_error) }
       }
     } else if (unlikely(__pyx_nargs != 5)) {
       goto __pyx_L5_argtuple_error;
     } else {
       values[0] = __Pyx_ArgRef_FASTCALL(__pyx_args, 0);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 156, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 161, __pyx_L3_error)
       values[1] = __Pyx_ArgRef_FASTCALL(__pyx_args, 1);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 156, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 161, __pyx_L3_error)
       values[2] = __Pyx_ArgRef_FASTCALL(__pyx_args, 2);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 156, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 161, __pyx_L3_error)
       values[3] = __Pyx_ArgRef_FASTCALL(__pyx_args, 3);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 156, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 161, __pyx_L3_error)
       values[4] = __Pyx_ArgRef_FASTCALL(__pyx_args, 4);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[4])) __PYX_ERR(0, 156, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[4])) __PYX_ERR(0, 161, __pyx_L3_error)
     }
-    __pyx_v_v = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[0], PyBUF_WRITABLE); if (unlikely(!__pyx_v_v.memview)) __PYX_ERR(0, 156, __pyx_L3_error)
-    __pyx_v_kind = __Pyx_PyIndex_AsSsize_t(values[1]); if (unlikely((__pyx_v_kind == (Py_ssize_t)-1) && PyErr_Occurred())) __PYX_ERR(0, 156, __pyx_L3_error)
-    __pyx_v_mu = __Pyx_PyFloat_AsDouble(values[2]); if (unlikely((__pyx_v_mu == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 156, __pyx_L3_error)
-    __pyx_v_normal = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[3], PyBUF_WRITABLE); if (unlikely(!__pyx_v_normal.memview)) __PYX_ERR(0, 156, __pyx_L3_error)
-    __pyx_v_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[4], PyBUF_WRITABLE); if (unlikely(!__pyx_v_out.memview)) __PYX_ERR(0, 157, __pyx_L3_error)
+    __pyx_v_v = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(values[0], 0); if (unlikely(!__pyx_v_v.memview)) __PYX_ERR(0, 161, __pyx_L3_error)
+    __pyx_v_kind = __Pyx_PyIndex_AsSsize_t(values[1]); if (unlikely((__pyx_v_kind == (Py_ssize_t)-1) && PyErr_Occurred())) __PYX_ERR(0, 161, __pyx_L3_error)
+    __pyx_v_mu = __Pyx_PyFloat_AsDouble(values[2]); if (unlikely((__pyx_v_mu == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 161, __pyx_L3_error)
+    __pyx_v_normal = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(values[3], 0); if (unlikely(!__pyx_v_normal.memview)) __PYX_ERR(0, 161, __pyx_L3_error)
+    __pyx_v_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[4], PyBUF_WRITABLE); if (unlikely(!__pyx_v_out.memview)) __PYX_ERR(0, 162, __pyx_L3_error)
   }
   goto __pyx_L6_skip;
   __pyx_L5_argtuple_error:;
-  __Pyx_RaiseArgtupleInvalid("project_cone_block", 1, 5, 5, __pyx_nargs); __PYX_ERR(0, 156, __pyx_L3_error)
+  __Pyx_RaiseArgtupleInvalid("project_cone_block", 1, 5, 5, __pyx_nargs); __PYX_ERR(0, 161, __pyx_L3_error)
   __pyx_L6_skip:;
   goto __pyx_L4_argument_unpacking_done;
   __pyx_L3_error:;
@@ -19970,7 +20116,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_6project_cone_block(CYTHON_UNUSED
   int __pyx_clineno = 0;
   __Pyx_RefNannySetupContext("project_cone_block", 0);
 
-  /* "fccqp/projections.pyx":159
+  /* "fccqp/projections.pyx":164
  *                        double[::1] out):
  *     """Project one cone block (kind code of :mod:`fccqp.cones`) into ``out``."""
  *     if out.shape[0] != v.shape[0] or v.shape[0] < 2 or normal.shape[0] != 3:             # <<<<<<<<<<<<<<
@@ -20006,7 +20152,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_6project_cone_block(CYTHON_UNUSED
   if (unlikely(__pyx_t_1)) {
 
 
-    /* "fccqp/projections.pyx":160
+    /* "fccqp/projections.pyx":165
  *     """Project one cone block (kind code of :mod:`fccqp.cones`) into ``out``."""
  *     if out.shape[0] != v.shape[0] or v.shape[0] < 2 or normal.shape[0] != 3:
  *         raise ValueError("v and out need the same size (>= 2) and normal 3 entries")             # <<<<<<<<<<<<<<
@@ -20019,14 +20165,14 @@ static PyObject *__pyx_pf_5fccqp_11projections_6project_cone_block(CYTHON_UNUSED
       PyObject *__pyx_callargs[2] = {__pyx_t_4, __pyx_mstate_global->__pyx_kp_u_v_and_out_need_the_same_size_2_a};
       __pyx_t_3 = __Pyx_PyObject_FastCall((PyObject*)(((PyTypeObject*)PyExc_ValueError)), __pyx_callargs+__pyx_t_5, (2-__pyx_t_5) | (__pyx_t_5*__Pyx_PY_VECTORCALL_ARGUMENTS_OFFSET));
       __Pyx_XDECREF(__pyx_t_4); __pyx_t_4 = 0;
-      if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 160, __pyx_L1_error)
+      if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 165, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_3);
     }
     __Pyx_Raise(__pyx_t_3, 0, 0, 0);
     __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
-    __PYX_ERR(0, 160, __pyx_L1_error)
+    __PYX_ERR(0, 165, __pyx_L1_error)
 
-    /* "fccqp/projections.pyx":159
+    /* "fccqp/projections.pyx":164
  *                        double[::1] out):
  *     """Project one cone block (kind code of :mod:`fccqp.cones`) into ``out``."""
  *     if out.shape[0] != v.shape[0] or v.shape[0] < 2 or normal.shape[0] != 3:             # <<<<<<<<<<<<<<
@@ -20035,7 +20181,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_6project_cone_block(CYTHON_UNUSED
 */
   }
 
-  /* "fccqp/projections.pyx":161
+  /* "fccqp/projections.pyx":166
  *     if out.shape[0] != v.shape[0] or v.shape[0] < 2 or normal.shape[0] != 3:
  *         raise ValueError("v and out need the same size (>= 2) and normal 3 entries")
  *     if kind == FRICTION and v.shape[0] != 3:             # <<<<<<<<<<<<<<
@@ -20061,7 +20207,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_6project_cone_block(CYTHON_UNUSED
   if (unlikely(__pyx_t_1)) {
 
 
-    /* "fccqp/projections.pyx":162
+    /* "fccqp/projections.pyx":167
  *         raise ValueError("v and out need the same size (>= 2) and normal 3 entries")
  *     if kind == FRICTION and v.shape[0] != 3:
  *         raise ValueError("a friction cone block has 3 entries")             # <<<<<<<<<<<<<<
@@ -20073,14 +20219,14 @@ static PyObject *__pyx_pf_5fccqp_11projections_6project_cone_block(CYTHON_UNUSED
       PyObject *__pyx_callargs[2] = {__pyx_t_4, __pyx_mstate_global->__pyx_kp_u_a_friction_cone_block_has_3_entr};
       __pyx_t_3 = __Pyx_PyObject_FastCall((PyObject*)(((PyTypeObject*)PyExc_ValueError)), __pyx_callargs+__pyx_t_5, (2-__pyx_t_5) | (__pyx_t_5*__Pyx_PY_VECTORCALL_ARGUMENTS_OFFSET));
       __Pyx_XDECREF(__pyx_t_4); __pyx_t_4 = 0;
-      if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 162, __pyx_L1_error)
+      if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 167, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_3);
     }
     __Pyx_Raise(__pyx_t_3, 0, 0, 0);
     __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
-    __PYX_ERR(0, 162, __pyx_L1_error)
+    __PYX_ERR(0, 167, __pyx_L1_error)
 
-    /* "fccqp/projections.pyx":161
+    /* "fccqp/projections.pyx":166
  *     if out.shape[0] != v.shape[0] or v.shape[0] < 2 or normal.shape[0] != 3:
  *         raise ValueError("v and out need the same size (>= 2) and normal 3 entries")
  *     if kind == FRICTION and v.shape[0] != 3:             # <<<<<<<<<<<<<<
@@ -20089,7 +20235,7 @@ static PyObject *__pyx_pf_5fccqp_11projections_6project_cone_block(CYTHON_UNUSED
 */
   }
 
-  /* "fccqp/projections.pyx":163
+  /* "fccqp/projections.pyx":168
  *     if kind == FRICTION and v.shape[0] != 3:
  *         raise ValueError("a friction cone block has 3 entries")
  *     proj_block(&v[0], kind, v.shape[0], mu, &normal[0], &out[0])             # <<<<<<<<<<<<<<
@@ -20097,12 +20243,12 @@ static PyObject *__pyx_pf_5fccqp_11projections_6project_cone_block(CYTHON_UNUSED
   __pyx_t_6 = 0;
   __pyx_t_7 = 0;
   __pyx_t_8 = 0;
-  __pyx_f_5fccqp_11projections_proj_block((&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_v.data) + __pyx_t_6)) )))), __pyx_v_kind, (__pyx_v_v.shape[0]), __pyx_v_mu, (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_normal.data) + __pyx_t_7)) )))), (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_out.data) + __pyx_t_8)) )))));
+  __pyx_f_5fccqp_11projections_proj_block((&(*((double const  *) ( /* dim=0 */ ((char *) (((double const  *) __pyx_v_v.data) + __pyx_t_6)) )))), __pyx_v_kind, (__pyx_v_v.shape[0]), __pyx_v_mu, (&(*((double const  *) ( /* dim=0 */ ((char *) (((double const  *) __pyx_v_normal.data) + __pyx_t_7)) )))), (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_out.data) + __pyx_t_8)) )))));
 
-  /* "fccqp/projections.pyx":156
+  /* "fccqp/projections.pyx":161
  * 
  * 
- * def project_cone_block(double[::1] v, Py_ssize_t kind, double mu, double[::1] normal,             # <<<<<<<<<<<<<<
+ * def project_cone_block(const double[::1] v, Py_ssize_t kind, double mu, const double[::1] normal,             # <<<<<<<<<<<<<<
  *                        double[::1] out):
  *     """Project one cone block (kind code of :mod:`fccqp.cones`) into ``out``."""
 */
@@ -22296,64 +22442,77 @@ __Pyx_RefNannySetupContext("PyInit_projections", 0);
   if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_pyx_unpickle_Enum, __pyx_t_4) < (0)) __PYX_ERR(1, 4, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_4); __pyx_t_4 = 0;
 
-  /* "fccqp/projections.pyx":114
+  /* "fccqp/projections.pyx":17
+ * """
  * 
+ * import numpy as np             # <<<<<<<<<<<<<<
  * 
- * def project_friction_cone(double[::1] v, double mu, double[::1] normal, double[::1] out):             # <<<<<<<<<<<<<<
- *     """Projection of ``v`` onto the friction cone (``mu``, ``normal``) into ``out``, on numpy arrays (3 entries each)."""
- *     if v.shape[0] != 3 or normal.shape[0] != 3 or out.shape[0] != 3:
+ * from libc.math cimport sqrt
 */
-  __pyx_t_4 = __Pyx_CyFunction_New(&__pyx_mdef_5fccqp_11projections_1project_friction_cone, 0, __pyx_mstate_global->__pyx_n_u_project_friction_cone, NULL, __pyx_mstate_global->__pyx_n_u_fccqp_projections, __pyx_mstate_global->__pyx_d, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[0])); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 114, __pyx_L1_error)
+  __pyx_t_1 = __Pyx_Import(__pyx_mstate_global->__pyx_n_u_numpy, 0, 0, NULL, 0); if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 17, __pyx_L1_error)
+  __pyx_t_4 = __pyx_t_1;
+  __Pyx_GOTREF(__pyx_t_4);
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_np, __pyx_t_4) < (0)) __PYX_ERR(0, 17, __pyx_L1_error)
+  __Pyx_DECREF(__pyx_t_4); __pyx_t_4 = 0;
+
+  /* "fccqp/projections.pyx":116
+ * 
+ * 
+ * def project_friction_cone(v, double mu, normal, double[::1] out):             # <<<<<<<<<<<<<<
+ *     """Project the 3-vector ``v`` onto the friction cone (``mu``, unit ``normal``) into
+ *     ``out``."""
+*/
+  __pyx_t_4 = __Pyx_CyFunction_New(&__pyx_mdef_5fccqp_11projections_1project_friction_cone, 0, __pyx_mstate_global->__pyx_n_u_project_friction_cone, NULL, __pyx_mstate_global->__pyx_n_u_fccqp_projections, __pyx_mstate_global->__pyx_d, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[0])); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 116, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_4);
   #if CYTHON_COMPILING_IN_CPYTHON && PY_VERSION_HEX >= 0x030E0000
   PyUnstable_Object_EnableDeferredRefcount(__pyx_t_4);
   #endif
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_project_friction_cone, __pyx_t_4) < (0)) __PYX_ERR(0, 114, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_project_friction_cone, __pyx_t_4) < (0)) __PYX_ERR(0, 116, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_4); __pyx_t_4 = 0;
 
-  /* "fccqp/projections.pyx":121
+  /* "fccqp/projections.pyx":126
  * 
  * 
- * def project_second_order_cone(double[::1] v, double[::1] out):             # <<<<<<<<<<<<<<
+ * def project_second_order_cone(const double[::1] v, double[::1] out):             # <<<<<<<<<<<<<<
  *     """Projection of ``v`` onto the second-order cone, into ``out``."""
  *     if v.shape[0] < 2 or out.shape[0] != v.shape[0]:
 */
-  __pyx_t_4 = __Pyx_CyFunction_New(&__pyx_mdef_5fccqp_11projections_3project_second_order_cone, 0, __pyx_mstate_global->__pyx_n_u_project_second_order_cone, NULL, __pyx_mstate_global->__pyx_n_u_fccqp_projections, __pyx_mstate_global->__pyx_d, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[1])); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 121, __pyx_L1_error)
+  __pyx_t_4 = __Pyx_CyFunction_New(&__pyx_mdef_5fccqp_11projections_3project_second_order_cone, 0, __pyx_mstate_global->__pyx_n_u_project_second_order_cone, NULL, __pyx_mstate_global->__pyx_n_u_fccqp_projections, __pyx_mstate_global->__pyx_d, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[1])); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 126, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_4);
   #if CYTHON_COMPILING_IN_CPYTHON && PY_VERSION_HEX >= 0x030E0000
   PyUnstable_Object_EnableDeferredRefcount(__pyx_t_4);
   #endif
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_project_second_order_cone, __pyx_t_4) < (0)) __PYX_ERR(0, 121, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_project_second_order_cone, __pyx_t_4) < (0)) __PYX_ERR(0, 126, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_4); __pyx_t_4 = 0;
 
-  /* "fccqp/projections.pyx":128
+  /* "fccqp/projections.pyx":133
  * 
  * 
- * def project_constraint_set(double[::1] v, double[::1] lo, double[::1] hi, cones,             # <<<<<<<<<<<<<<
+ * def project_constraint_set(const double[::1] v, const double[::1] lo, const double[::1] hi, cones,             # <<<<<<<<<<<<<<
  *                            double[::1] out):
  *     """Project ``v`` onto ``[lo, hi]`` times the cones into ``out`` (may be ``v``).
 */
-  __pyx_t_4 = __Pyx_CyFunction_New(&__pyx_mdef_5fccqp_11projections_5project_constraint_set, 0, __pyx_mstate_global->__pyx_n_u_project_constraint_set, NULL, __pyx_mstate_global->__pyx_n_u_fccqp_projections, __pyx_mstate_global->__pyx_d, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[2])); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 128, __pyx_L1_error)
+  __pyx_t_4 = __Pyx_CyFunction_New(&__pyx_mdef_5fccqp_11projections_5project_constraint_set, 0, __pyx_mstate_global->__pyx_n_u_project_constraint_set, NULL, __pyx_mstate_global->__pyx_n_u_fccqp_projections, __pyx_mstate_global->__pyx_d, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[2])); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 133, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_4);
   #if CYTHON_COMPILING_IN_CPYTHON && PY_VERSION_HEX >= 0x030E0000
   PyUnstable_Object_EnableDeferredRefcount(__pyx_t_4);
   #endif
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_project_constraint_set, __pyx_t_4) < (0)) __PYX_ERR(0, 128, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_project_constraint_set, __pyx_t_4) < (0)) __PYX_ERR(0, 133, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_4); __pyx_t_4 = 0;
 
-  /* "fccqp/projections.pyx":156
+  /* "fccqp/projections.pyx":161
  * 
  * 
- * def project_cone_block(double[::1] v, Py_ssize_t kind, double mu, double[::1] normal,             # <<<<<<<<<<<<<<
+ * def project_cone_block(const double[::1] v, Py_ssize_t kind, double mu, const double[::1] normal,             # <<<<<<<<<<<<<<
  *                        double[::1] out):
  *     """Project one cone block (kind code of :mod:`fccqp.cones`) into ``out``."""
 */
-  __pyx_t_4 = __Pyx_CyFunction_New(&__pyx_mdef_5fccqp_11projections_7project_cone_block, 0, __pyx_mstate_global->__pyx_n_u_project_cone_block, NULL, __pyx_mstate_global->__pyx_n_u_fccqp_projections, __pyx_mstate_global->__pyx_d, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[3])); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 156, __pyx_L1_error)
+  __pyx_t_4 = __Pyx_CyFunction_New(&__pyx_mdef_5fccqp_11projections_7project_cone_block, 0, __pyx_mstate_global->__pyx_n_u_project_cone_block, NULL, __pyx_mstate_global->__pyx_n_u_fccqp_projections, __pyx_mstate_global->__pyx_d, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[3])); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 161, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_4);
   #if CYTHON_COMPILING_IN_CPYTHON && PY_VERSION_HEX >= 0x030E0000
   PyUnstable_Object_EnableDeferredRefcount(__pyx_t_4);
   #endif
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_project_cone_block, __pyx_t_4) < (0)) __PYX_ERR(0, 156, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_project_cone_block, __pyx_t_4) < (0)) __PYX_ERR(0, 161, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_4); __pyx_t_4 = 0;
 
   /* "fccqp/projections.pyx":1
@@ -22470,10 +22629,24 @@ static int __Pyx_InitCachedConstants(__pyx_mstatetype *__pyx_mstate) {
   __Pyx_GIVEREF(__pyx_mstate_global->__pyx_slice[0]);
   if (__Pyx_PyTuple_SET_ITEM(__pyx_mstate_global->__pyx_tuple[1], 0, __pyx_mstate_global->__pyx_slice[0]) != (0)) __PYX_ERR(1, 763, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_mstate_global->__pyx_tuple[1]);
+
+  /* "fccqp/projections.pyx":119
+ *     """Project the 3-vector ``v`` onto the friction cone (``mu``, unit ``normal``) into
+ *     ``out``."""
+ *     cdef const double[::1] v_ = np.ascontiguousarray(v, dtype=np.float64)             # <<<<<<<<<<<<<<
+ *     cdef const double[::1] normal_ = np.ascontiguousarray(normal, dtype=np.float64)
+ *     if v_.shape[0] != 3 or normal_.shape[0] != 3 or out.shape[0] != 3:
+*/
+  {
+    PyObject* __pyx_temp[1] = {__pyx_mstate_global->__pyx_n_u_dtype};
+    __pyx_mstate_global->__pyx_tuple[2] = __Pyx_PyTuple_FromArray(__pyx_temp, 1); if (unlikely(!__pyx_mstate_global->__pyx_tuple[2])) __PYX_ERR(0, 119, __pyx_L1_error)
+    __Pyx_GOTREF(__pyx_mstate_global->__pyx_tuple[2]);
+  }
+  __Pyx_GIVEREF(__pyx_mstate_global->__pyx_tuple[2]);
   #if CYTHON_IMMORTAL_CONSTANTS
   {
     PyObject **table = __pyx_mstate->__pyx_tuple;
-    for (Py_ssize_t i=0; i<2; ++i) {
+    for (Py_ssize_t i=0; i<3; ++i) {
       #if PY_VERSION_HEX >= 0x030F0000
       PyUnstable_SetImmortal(table[i]);
       #elif CYTHON_COMPILING_IN_CPYTHON_FREETHREADING
@@ -22530,38 +22703,38 @@ static int __Pyx_InitConstants(__pyx_mstatetype *__pyx_mstate) {
   int __pyx_clineno = 0;
   CYTHON_UNUSED_VAR(__pyx_mstate);
   {
-    const struct { const unsigned int length: 8; } str_length_index[] = {{6},{18},{8},{1},{2},{15},{23},{25},{32},{20},{22},{1},{1},{37},{45},{22},{179},{35},{8},{15},{5},{7},{6},{2},{9},{50},{25},{30},{37},{56},{42},{41},{37},{5},{8},{8},{15},{20},{12},{9},{17},{8},{8},{12},{10},{8},{10},{8},{7},{12},{14},{11},{10},{19},{14},{12},{10},{17},{13},{12},{12},{19},{8},{13},{3},{15},{18},{4},{1},{18},{5},{5},{3},{15},{6},{9},{5},{17},{5},{6},{7},{2},{2},{5},{5},{8},{1},{4},{2},{7},{4},{2},{4},{4},{6},{3},{6},{3},{4},{3},{18},{22},{21},{25},{8},{1},{10},{5},{4},{5},{4},{4},{6},{6},{6},{1},{6},{1}};
-    const struct { const unsigned int length: 9; } bytes_length_index[] = {{1},{335},{75},{85},{135},{280}};
+    const struct { const unsigned int length: 8; } str_length_index[] = {{6},{18},{8},{1},{2},{15},{23},{25},{32},{20},{22},{1},{1},{37},{45},{22},{179},{35},{8},{15},{5},{7},{6},{2},{9},{50},{25},{30},{37},{56},{42},{41},{37},{5},{8},{8},{15},{20},{12},{9},{17},{8},{8},{12},{10},{8},{10},{8},{7},{12},{14},{11},{10},{19},{14},{12},{10},{17},{13},{12},{12},{19},{8},{13},{3},{15},{17},{18},{4},{1},{18},{5},{5},{3},{5},{15},{6},{9},{5},{17},{5},{7},{6},{7},{2},{2},{5},{5},{8},{1},{4},{2},{7},{4},{2},{4},{4},{6},{7},{2},{5},{3},{6},{3},{4},{3},{18},{22},{21},{25},{8},{1},{10},{5},{4},{5},{4},{4},{6},{6},{6},{1},{2},{6},{1}};
+    const struct { const unsigned int length: 9; } bytes_length_index[] = {{1},{335},{75},{135},{123},{280}};
     #ifndef CYTHON_COMPRESS_STRINGS
       #define CYTHON_COMPRESS_STRINGS 90
     #endif
-    #if (CYTHON_COMPRESS_STRINGS) == 1 /* compression: zlib (1342 bytes) */
-static const char cstring[] = "x\332\235TMs\3336\020\215\032\331q\047\231\314\250N\323\366\006\333\255\235d\034\245\212\335\364c\322tT9\231\361\241\251?Rwz\302@ (!&\001\n\000Y)\047\037y\344\221G\036y\324QG\037\373\023|\314O\310O\350\202\024i%\351$3\325\214\310%\260x\273\357\355b\0211\350\3331\362\030\211\230Ff\310P\304\250\221\n\311\376K0\236\264\177B\217\177c\276T\223\023\316\376F\322E\217\251\024\206\017B\031jD\204\203\034\256\254\343\273\313\\T\033\332(\3560g\301\031\001\376\207\366\337^\253=\237\374\322#BH\203\210\326| \220\221H1\342\334\227\302\233 \277H2\202$\367ED<\356 _:l\033\261q\000g\001j\213n\331\270[\256TF\021\261\265\215\006\000U9\353!\t\030\204Bd\3145z.\r\0031@\233\336\304\014\245@\260\3460\217\367\231\"\206A4\233\037\240*\353$\320\301\323\203\373\273?\354\026\331*fu\323H\207}\352A\242\240*\210\326\017\271g\000\335L\002\246\333h\337E\023\031\"\301 /`\021\200\337\342\001(\203@\232\231\242\036[\005gb\270\024\030\216s1\330\232\313\304#fO?#\236fm\202\\\233\022x!\250\004C}O\322S4$\032\355 & ]\246\211\343`\200bTz\036+\\u\233\364i\341\356pM\372\036c\302>\007\224\353\322r\204\004\342.\t=\2030V\314\t)\303\0309a\021YHq\037\220#N<\330\245\\p\203\261V\364\201K\351(x\020(\371\262\212\023L\306a\201h\317\021\017\222\003!\021Q\212L\220C\014i\377\307nY\023+j\331\016\272\035\025_24s\351@\036M|x\360W\014\335y\3623zx\267\360\020R\371\220S\315<*\374\2411\215\355tm\320\303j\247\006\004\241|\"&\3216\362\3446\032\362z\303\017\301\177H\254\326\213\341\300q\036\345}\307:n\367\270\267\277\377\324\363x\240\271>f\243\220\t\312\354Ej_\336)\214\017&c\370\357A\365\360s66G\314\305x^t\020\033\204\265mqi\014\230\341\206\371v\301\261g\340\347\206\202\3327l\351\352\024\367\003\350tk\371\204\213\342-\235\320+\366\004\260(\3366<\306P\034LI\300k{\310\350\251\016\375\362k\216hM\333\276\245\025\212\200\323S@{**\277\310\330\nZ\214QH\274*D\3253\265E\213\033\265\260\300\306\366\003\332\275NK/\320\250\355\313s\206i\313\213kL\245\002\345\271`\320\306U\333\340~\350\272pO\365DP.\333\265\213\356\023\315(\365\300\304\240\007\314""\000\312\372\204\236\332\366\327T\206\3028\334w\n\206\200\\\216?(\027\014\021\006\024\213\213\317\224\222\252\350\355\366Bo\273\036\031h\327\366\202\231\317\226!\347\016L-6\266u\322\345\343\025;=\2055O\302\240\262S\312N\047?\264\214a\274\371e+AP\351\272\300\0302\016 \265@\006\3638\330f\211\213;\275\260\002\327\002Jk\254F\325j5\004\212\003\325\"\360\226\302\301R9L\025\033\212\r\270\206\361\005\323\306\314\257wq\331l\232\240\266\002\311Y\240\215\204\277\n\251\201bC6a\000\027\225E0/C\246\307\277G\022\306\346\035G\206\366\332\026\311\240{\333\350`\202\265E\301\346m\273\364\253\336\227\376\363\357{w\257|\034\357c\276\037\373.\311\240y+\343\357\212J\342GEWk\334\263}\360\177\002~\210\224\255@Y\266\322\324\222\316\rfJ\243*\330Y\343u\363\332\331(^\216I\254\223\365\344\327\204\246\253\351\263l-\333\311h\336\3127\247\215i\353b\345f\3742m\244\255\213\346\215\270\033\037\202\357(i&\335\344$\355\244{Y#[\315\272\331\341\333P\033\311Q\242\323\315l9#\231\3167\362\243\\O7\246\047\263\316\2547\323\347k\013\220\255\244\225\254%\035\200{\221\336J\017S\027\300^@\350\215\3740\047g\2157\313W\226V\316t\274\2314\222\325\244\227\214\322\345\224\244:\333\310\01637\357\346\307\323O\246\353\323\3364\232\235\234w\316{\347\372\237E\360kga\334\213\047i3\355\246\047Y\047\353A2\213\3737\013.\rH\341\353\304\235\373\354\345M\300=\231v\246{\263\306lu\326\235\001\2677\267\256,]\217\357$\337$&\3751\353^4\277\004\200\333\351(k\330 *\276\r0W\223\235\244\237^M\037\326\241\326\363\036\360\336,`z\263Q\035\370us%^\212\377\000\336\273I\004\234\311\305\312\365\370\021daeSu\005\372\371\325\274\003\020\njp\343\263\344\036$\370\247\225\272\014\271\032w/V>}\335\\:\373+v\222\315\212\360(n\300r\374\005\260\372*]K\277\007\244\335l\364>\047\353\3649\320\177\225\266\322u@~\221\265\262\315\274\221\257\346\335w\353|\004\252[\005\217\200o\263\3240\337\311I>\372\027\263\315\276\250";
-    PyObject *data = __Pyx_DecompressString(cstring, 1342, 1);
+    #if (CYTHON_COMPRESS_STRINGS) == 1 /* compression: zlib (1389 bytes) */
+static const char cstring[] = "x\332\235T\315s\0237\024\307\340\204t`\230q\335\322\366\246\004\210\003\023L\363QZ:\224\216\353\300L\016\245\371h\323\351I#k\265\266\310ZZ\257\264\213\315)\307=\356q\217{\334\243\217>\372\310\221c\216\374\t\375\023\372\244\365:\006:0\203g\254}\222\336\307\357\375\336\323CD\243\357\207\310c$b\n\351\036C\021\243Z\006Hv^\200\360\244\3713z\374;\353\313`t\302\331K$]\364\230J\241y7\224\241BD8\310\341\201Q|\377\230\213\362B\351\200;\314YPF\340\377c\367\357\236\3155\237\374\332&BH\215\210R\274+\220\226(`\304\271/\2057B}\0132\002\220\373\"\"\036wP_:l\023\261\241\017\266\340\252A\033&n\303\225\201\016\210hl\242.\270*\225U\217\370\014B!2\344\n=\227\232\001\031\300M{\244{R 8s\230\307;, \232A4\203\017\274\006FI\240\203\247\007\367w\177\332\265h\003fxSH\205\035\352\001P`\025H\353\204\334\323\340]\217|\246\232h\337E#\031\"\301\000\027d\341\203\336\242\001\224A \305\264\255G\303\346L4\227\002\2039\027\335\306\214&\0361c\375\214x\2125\tr\r$\320BP\t\206:\236\244\247\250G\024\332AL\000\\\246\210\343`p\305\250\364<fUU\223t\250Uw\270\"\035\2171a\326.\345\252\220\034!!q\227\204\236F\030\007\314\t)\303\0309\241\215,\244\270\017\236#N<\270\245\\p\215\261\n\350\003\227\322\201\377\300\017\344\2132\216?\032\206\326\243\261#\036\200\003\"\021\t\0022B\016\321\244\371?\267EM\014\251E;\250fdw2\3243\352\200\036E\372\260\360W\014m<\371\005m\337\265\032B\006}\3004\317<\262\372\320\230\332t\272\322h\273\274\231;\004\242\372D\214\242M\344\311M\324\343\363\213~\010\372=b\270^\014\007\212\263(\037*\316\343\266\216\333\373\373O=\217\373\212\253c6\010\231\240\314<\244\346\305\233\302\370`4\204\377\036T\017?gC}\304\\\214gE\007\262\201X\323\026\027B\227i\256Y\337\0348\306\006~n(\250\371\302\225*\255x\337\207N7R\237pa\277\322\t={\047 \013\3735\3411\206\342`J|>\227{\214\236\252\260_\354f\036\215h\332\267\220B\341sz\n\336\236\212R/\322\246\202\306\307 $^\031\242\354\231\271D\355\213Z8`C\263\201v\237\303R\013i\314\345\013;\315\224\311\213+Le\000\314s\301\240\215\313\266\301\235\320u\341\235\252\213\201d\333""\214\250\221\240\\6\3476\252C\024\243\324\003\021\003A0\024(\353\020zj\336\003\030\207B;\274\357\230\224\355b\342\025C\021\212\010\243\205A\342v\034\260 \220\201\355\370\346B\307\273\036\351\302\"\211~\270\353\232F\321\263\301\323\343\334\201\221\306\206\246\210\252X^\261\323S8\363$L13\302\314\350\352\207\206\016\230}\375\242\317\212\025\013\037\342\372#@\"]\027\310\201\\|\000\355K\177\026\034\033\374\330>\377\205\023xA\320\005\332\320Y\236\226\363\302\032\224\207\300\210\024\016\226\201\303\002{\021\260.W0\351`0\351\331$\260\357\322\200\206\302\004P\035\346+-\341\037\204TC_\000\232\320\2077\315\242\010\303p\r\231\032\376\021I\230\261\033\216\014\315\033\267p\320\275Mt0\302\312\370\301\372]\271\320+\277\027\372\263\375\275\273\227>\355\357S\272\237\332\027\351\240Y\337\343\037l\201\361C\373\004\024n\233\036\371\234\200\037K\312\324\240(\\!*Ig\002\323\205P\226\354\254\362\266z\365l\020/\307$V\311Z\362[B\323z\372,[\315v2\232\327\362\365qe\\;_\271\021\277H+i\355\274z=n\305\207\240;H\252I+9I\267\322\275\254\222\325\263VvxV\371w\371\322\322\312\231\212\327\223JRO\332\311 ]NI\252\262[\331a\346\346\255\374x|y\2746n\217\243\311\311tk\332\236\252\327\253\013\256\257\236\205q;\036\245\325\264\225\236d[Y;S\371\342\375\r\033\266\222\324\222\333\211;\323\331\313\253\340\367d\2745\336\233T&\365Ik2\203\261\232]~\263\266;n\215\217\047\313\223\316\264r^\275\223\035\275i<\232\324&\033\323\365\327\227!2\004\014\342\233\340\362J\262\223t\322+\351\217\331z^\311\353y;\017\306u\013\363pB\247\365ik\001D\r\302\257&\333\311a\342\244\267!\271\227\031\311t\276\0056\203q\005B\177ui\351Z\274\221\334It\372(k\235W\277\005\263\233\351 \253|\030n{\236\345\032\230\253\361\272\315\240=\031\314\303\275\255\256\304K\361_\020p7\211\322\303\224\234\257\\\213\037\002\202[\311Q\022\314\353\324\311\257X\004\001T\352\372\227\311=\340\346oS\220\"d=\006\374_\274\255.\235\375\023;\311z\311\365 \256\300q\374\r\020\372]\272\n\271\257f\273\331\340C:\215\322\327\300\374\253\264\226\256\201\347?\263\332\214\246\326""\373\335p\004\0057\305;\202|\253E\371\362\235\234\344\203\377\000\225`\337\357";
+    PyObject *data = __Pyx_DecompressString(cstring, 1389, 1);
     #define __Pyx_DecompressString_LZSS_UNUSED
     if (unlikely(!data)) __PYX_ERR(0, 1, __pyx_L1_error)
     const char* const bytes = __Pyx_PyBytes_AsString(data);
     #if !CYTHON_ASSUME_SAFE_MACROS
     if (likely(bytes)); else { Py_DECREF(data); __PYX_ERR(0, 1, __pyx_L1_error) }
     #endif
-    #elif (CYTHON_COMPRESS_STRINGS) > 0 && (CYTHON_COMPRESS_STRINGS) <= 90 /* compression: lzss (1767 bytes) */
-static const char cstring[] = "\377 at 0x l\377eaves th\377e vector\357 obj\006\000>.:\377 <Memory\377View of \377<contigu\377ous and gdir%\001\007\rin\021\005\177strided\"\010\231 ]\000\004\031><(\tA\006>\377?Cannot \377assign t\377o read-o_nly m\240\002v\242\000\377Invalid \377mode, ex\271p\316\000|\000\047c\047t\001\047\377fortran\047\347, gH\000%\005sha\377pe in ax\177is Note\212 \376\231 Cython \376\021\000deliber\347atek\000\320\001cte\375r!\001n PEP-\267484\212\"re\264!s? subcl\246\000\323 \276\262 built[\000t\377ypes. If\177 you ne\224 \342\303\000p\316\000%\t\204@n s\353et\213B\047\357\002ati\367on_<\000ing\047\366\355$iv\242\000o Fa\377lse.a fr\353ic\"\001 \236@e b\377lock has\337 3 en\200@es\357add_\274 eco\367lle&\002s.ab\375c*\002disabl\367een\002\001gcis\376\004\003dno def\377ault __r\377educe__ {duu\002non-\332@\357vial\033\000cin\377it__src/\377fccqp/pr{oj`\005pyxuW\002\346\262Aal\232\000\306  ar\377ray data\341.\013\020\216C\340a\275cs.v\356\355bout\264$he \367sam\002\000ize \277(>= 2)\217\204\002n\247orm\221\000\361\006v\346\"s\376\351\204\001least 2\370\214%H\006\246 manyv\377, lo, hi6a\006mu-\000ha\350!c\t\300&\000_\004\201\205\001\217\001\037\007\351&AS\377CIIEllip\377sisSeque\327nce\305\205\001.\312\205\007__\327Pyx\001\000D\273@_N\377extRef__l\356D\352 __\303b__\001\005\177getitem\r\001yd0\001\027\000func\035\001\336\030\000stat1\002im\367por\215@__ma\373in;\001modulrM\002n\262 M\001newT\001\276\232@_capi\003\006h\037ecksu`\000\026\001K\004\354!\001\273\204\001__+\001unp\267ickK\000En \005vyt\276a\244\001qual[\005\304\254e\265fc\315\205\002\313\001\310dex\336\330\001set_\217\005seqt\276\006\003\006.\007tes\324\001\277is_cor\212`i\337neabc\315e_b\377ufferasy\337ncio.\032\006sb\277aseccl+\000_\376\215 traceba\373ck\252\205\001scoun\037tdimd\335\002W\000\371\210\003\236\254@odee\340\000\364\206\002e\257rror\327\204\002.\321\204\010f_lagsf\356at\325\207\004\377hiidinde\365x\244As\000\002izek\377kindlomeYm\242\210\001\232\210\001mu\205Anu\000\376\253\204\003objoffs\277etoutp""\230\000psop\275\205\004\347\000ne_\317\206\002\356\007\010str\330@t_s\203et \005\375\206\005,\0025\005\365\000o\377nd_order\376E\002registe\237rsset\330\206\004\374\210\002s\333iz\331 ar\374 ep\367sto\001\000ruct\374\352@\246 update\377vvaluesx\377Ovoid (d\337ouble\357\207\001st\377 *, Py_s6B\001_t\000\t, \"\003\000\005\034&\0079\004*)\000.\037\014\035|\r\326\214\rst\311\001 \273\204\003t_\3555\241\210\002_6\322\211\001es__Cones\241\021 \204\026\350\263\037\377\210\001\261C\000\006\002soc\346\002\004et\014\003\256\212\005\200\001\340\377\004\007\200q\210\006\210a\377\210s\220\"\220B\220c\377\230\023\230F\240!\2403\377\240c\250\021\250&\260\001\377\260\021\330\010\016\210j\230\377\001\230\021\330\004\014\210A\373\210Q)\000q\220\004\220A\377\220V\2301\230D\240\001\277\240\023\240A\240Q=\013#\377\220R\220s\230&\240\006\377\240a\240s\250#\250R\377\250s\260#\260V\2701\277\270C\270s\300!H\010\021\277\220\021\220!\2201L\000T\277\230\024\230Q\230fJ\000T\376x\000#\250Q\250a\200\001\377\360\006\000\005\010\200s\210\377&\220\001\220\023\220C\220\377q\230\006\230a\230s\240\377#\240Q\240f\250A\250\377S\260\002\260\"\260C\260\377v\270V\3001\300C\300\373s\310Q\t\007\200u\210C\377\210y\230\004\230A\230VO\2401\240C\212\000q\t\016\307\002\335\001\200\000$\220f\035\004D\250\375\004U\000V\2601\260D\270\277\001\270\023\270A\270\331\000\360\377\024\000\005\013\210(\220%\377\220t\2309\240A\330\004\375\030\216 \026\230q\240\001\330\376\276 r\210\026\210q\220\003\377\2203\220b\230\003\2302\256b\006\"\250C\365\000&B\002C\373\270q\300&\340\004\010\210\005\273\210U\365\0004\220v\361\000a\237\330\010\013\2106\206 \263!r\276\371&b\250\003\2501@\000r^\201@\014\022\220*\302\000W\347!\376m\003\023\210A\330\010\t\340\377\004\005\200Y\210d\220&\264\233C\311A\001\024\000\210\027\255 \031\357\230!\2307\311@4\240q\364\302\017!\001\025\364@z\230\021\230\375\"\234 T\240\021\240&\250_\001\250\023\250A\330MR\363 \352\276!R\355\000\004\276#\2503\250\007a\250q";
-    PyObject *data = __Pyx_DecompressString_LZSS(cstring, 1767, 2504);
+    #elif (CYTHON_COMPRESS_STRINGS) > 0 && (CYTHON_COMPRESS_STRINGS) <= 90 /* compression: lzss (1832 bytes) */
+static const char cstring[] = "\377 at 0x l\377eaves th\377e vector\357 obj\006\000>.:\377 <Memory\377View of \377<contigu\377ous and gdir%\001\007\rin\021\005\177strided\"\010\231 ]\000\004\031><(\tA\006>\377?Cannot \377assign t\377o read-o_nly m\240\002v\242\000\377Invalid \377mode, ex\271p\316\000|\000\047c\047t\001\047\377fortran\047\347, gH\000%\005sha\377pe in ax\177is Note\212 \376\231 Cython \376\021\000deliber\347atek\000\320\001cte\375r!\001n PEP-\267484\212\"re\264!s? subcl\246\000\323 \276\262 built[\000t\377ypes. If\177 you ne\224 \342\303\000p\316\000%\t\204@n s\353et\213B\047\357\002ati\367on_<\000ing\047\366\355$iv\242\000o Fa\377lse.a fr\353ic\"\001 \236@e b\377lock has\337 3 en\200@es\357add_\274 eco\367lle&\002s.ab\375c*\002disabl\367een\002\001gcis\376\004\003dno def\377ault __r\377educe__ {duu\002non-\332@\357vial\033\000cin\377it__src/\377fccqp/pr{oj`\005pyxuW\002\346\262Aal\232\000\306  ar\377ray data\341.\013\020\216C\340a\275cs.v\356\355bout\264$he \367sam\002\000ize \277(>= 2)\217\204\002n\247orm\221\000\361\006v\346\"s\376\351\204\001least 2\370\214%H\006\246 manyv\377, lo, hi6a\006mu-\000ha\350!c\t\300&\000_\004\201\205\001\217\001\037\007\351&AS\377CIIEllip\377sisSeque\327nce\305\205\001.\312\205\007__\327Pyx\001\000D\273@_N\377extRef__l\356D\352 __\303b__\001\005\177getitem\r\001yd0\001\027\000func\035\001\336\030\000stat1\002im\367por\215@__ma\373in;\001modulrM\002n\262 M\001newT\001\276\232@_capi\003\006h\037ecksu`\000\026\001K\004\354!\001\273\204\001__+\001unp\267ickK\000En \005vyt\276a\244\001qual[\005\304\254e\265fc\315\205\002\313\001\310dex\336\330\001set_\217\005seqt\276\006\003\006.\007tes\324\001\277is_cor\212`i\337neabc\315e_b\177ufferas\236\210\007\376\342basyncio\375.+\006sbasec\353cl<\000_\236 tra?ceback\273\205\001:\000\177untdimd\256\206\001\342\000\002_m\000\217\211\003\302@ode\371e\366\000\212\207\002error\372\355\204\002.\347\204\010flags\377float64f\372\213\204\001t\362\207\004hiidi\257ndex\301As\000\002i\377zekkindl\317omem\277\210\001\267\210""\001mu\342\242An\201\000\310\204\003\316\204\003_np\376\356 pyobjof\377fsetoutp\316\262\000pop\350\205\004\222 ne\271_\372\206\002\007\010str\203`t\017_set \005\250\207\005,\0025\005\376\217 ond_ord\373erE\002regis\177tersset\203\207\004n\247\211\002siz\204@ar\247@\337epsto\001\000ru\363ct\225`\300 upda\377tevv_val\377uesxOvoi\377d (doubl\375e\234\210\001st *, oPy_sD\001_t\000\t\303, \"\003\000\005&\0079\004*)a\000.\037\014\035|\r\214\rst\313\001\335 \350\204\003t_5\316\210\002_6\376\377\211\001es_Cone\205s\241\021 \204\026\263\037\254\211\001\263C\000n\006\002soc\002\004et\014\003\376\333\212\005\200\001\340\004\007\200q\377\210\006\210a\210s\220\"\377\220B\220c\230\023\230F\377\240!\2403\240c\250\021\377\250&\260\001\260\021\330\010\377\016\210j\230\001\230\021\330\277\004\014\210A\210Q)\000q\377\220\004\220A\220V\2301\377\230D\240\001\240\023\240A\377\240Q\200\001\360\006\000\005\377\010\200s\210&\220\001\220\377\023\220C\220q\230\006\230\377a\230s\240#\240Q\240\377f\250A\250S\260\002\260\377\"\260C\260v\270V\300\1771\300C\300s\310!P\010\377\007\200u\210C\210y\230\377\004\230A\230V\2401\240\257C\240s\250\024\t\016r\002\001\277\220\021\220$\220f\035\004D\373\250\004U\000V\2601\260D\177\270\001\270\023\270A\270\200\004\377!\240\002\320\"4\260A\377\260S\270\006\270b\300\001\377\330\004%\240R\320\0479\377\270\021\270(\300&\310\002\374w\000\365\000r\210\026\210q\220\377\003\2203\220b\230\003\230\3777\240&\250\001\250\023\250\337C\250r\260\023\242\002Q\270_c\300\023\300A\365\010\021|\000\377!\2202\220Q\220d\230\375$\332\000w\240a\240t\250\33511\000q\260\001\377\000\024\000\377\005\013\210(\220%\220t\177\2309\240A\330\004\030\264 o\026\230q\240~\000\007\200a\013u2\335\006\"p\000s\260&\275\002\367C\270q\346&\340\004\010\210\377\005\210U\220!\2204\220\377v\230Q\230a\330\010\013\373\2106\376\000#\220R\220r\256\237Fb\250\003}\002r\247@\014W\022\220*\275 W\215A\330\335\002\373\023\210\275\000\t\340\004\005\200\237Y\210d\220&\301C\357A\001\337\330\010\t\210\027\250@\031\230}!""\371\000!\2404\240q\275/\372!\001\025\232`z\230\021\230\"\256\227@T\240\021\240$A\376MR\324\356@\271AR\355\000\004\271C\2503\017\250a\250q";
+    PyObject *data = __Pyx_DecompressString_LZSS(cstring, 1832, 2587);
     #define __Pyx_DecompressString_UNUSED
     if (unlikely(!data)) __PYX_ERR(0, 1, __pyx_L1_error)
     const char* const bytes = __Pyx_PyBytes_AsString(data);
     #if !CYTHON_ASSUME_SAFE_MACROS
     if (likely(bytes)); else { Py_DECREF(data); __PYX_ERR(0, 1, __pyx_L1_error) }
     #endif
-    #else /* compression: none (2504 bytes) */
-static const char bytes[] = " at 0x leaves the vector object>.: <MemoryView of <contiguous and direct><contiguous and indirect><strided and direct or indirect><strided and direct><strided and indirect>>?Cannot assign to read-only memoryviewInvalid mode, expected \047c\047 or \047fortran\047, got Invalid shape in axis Note that Cython is deliberately stricter than PEP-484 and rejects subclasses of builtin types. If you need to pass subclasses then set the \047annotation_typing\047 directive to False.a friction cone block has 3 entriesadd_notecollections.abccone disableenablegcisenabledno default __reduce__ due to non-trivial __cinit__src/fccqp/projections.pyxunable to allocate array data.unable to allocate shape and strides.v and out need the same size (>= 2) and normal 3 entriesv needs at least 2 entries and out as manyv, lo, hi and out must have the same sizev, normal and out must have 3 entriesASCIIEllipsisSequenceView.MemoryView__Pyx_PyDict_NextRef__annotate____class____class_getitem____dict____func____getstate____import____main____module____name____new____pyx_capi____pyx_checksum__pyx_state__pyx_type__pyx_unpickle_Enum__pyx_vtable____qualname____reduce____reduce_cython____reduce_ex____set_name____setstate____setstate_cython____test___is_coroutineabcallocate_bufferasyncio.coroutinesbaseccline_in_tracebackconescountdimdtype_is_objectencodeenumerateerrorfccqp.projectionsflagsformatfortranhiidindexitemsitemsizekkindlomemviewmodemunamendimnormalobjoffsetoutpackpopproject_cone_blockproject_constraint_setproject_friction_coneproject_second_order_coneregisterssetdefaultshapesizestartstepstopstructunpackupdatevvaluesxOvoid (double const *, Py_ssize_t, Py_ssize_t, double, double const *, double *)\000void (double const *, Py_ssize_t, double *)\000void (double const *, double const *, double const *, struct __pyx_t_5fccqp_6_types_Cones, Py_ssize_t, double *)\000void (double const *, double, double const *, double *)\000proj_block\000proj_soc\000proj_set\000proj_friction\200\001\340\004\007\200q\210""\006\210a\210s\220\"\220B\220c\230\023\230F\240!\2403\240c\250\021\250&\260\001\260\021\330\010\016\210j\230\001\230\021\330\004\014\210A\210Q\210a\210q\220\004\220A\220V\2301\230D\240\001\240\023\240A\240Q\200\001\340\004\007\200q\210\006\210a\210s\220#\220R\220s\230&\240\006\240a\240s\250#\250R\250s\260#\260V\2701\270C\270s\300!\330\010\016\210j\230\001\230\021\330\004\021\220\021\220!\2201\220A\220T\230\024\230Q\230f\240A\240T\250\021\250#\250Q\250a\200\001\360\006\000\005\010\200s\210&\220\001\220\023\220C\220q\230\006\230a\230s\240#\240Q\240f\250A\250S\260\002\260\"\260C\260v\270V\3001\300C\300s\310!\330\010\016\210j\230\001\230\021\330\004\007\200u\210C\210y\230\004\230A\230V\2401\240C\240s\250!\330\010\016\210j\230\001\230\021\330\004\016\210a\210q\220\001\220\021\220$\220f\230A\230V\2401\240D\250\004\250A\250V\2601\260D\270\001\270\023\270A\270Q\200\001\360\024\000\005\013\210(\220%\220t\2309\240A\330\004\030\230\001\230\026\230q\240\001\330\004\007\200r\210\026\210q\220\003\2203\220b\230\003\2302\230V\2401\240C\240s\250\"\250C\250s\260&\270\001\270\023\270C\270q\330\010\016\210j\230\001\230\021\340\004\010\210\005\210U\220!\2204\220v\230Q\230a\330\010\013\2106\220\021\220#\220R\220r\230\023\230F\240!\2403\240b\250\003\2501\250C\250r\260\021\330\014\022\220*\230A\230W\240A\240Q\330\004\007\200r\210\023\210A\330\010\t\340\004\005\200Y\210d\220&\230\001\230\021\330\004\007\200q\210\001\330\010\t\210\027\220\001\220\031\230!\2307\240!\2404\240q\250\004\250A\250V\2601\260D\270\001\270\023\270A\270Q\330\010\t\210\025\210a\210z\230\021\230\"\230A\230T\240\021\240&\250\001\250\023\250A\330\004\014\210A\210Q\210a\210q\220\004\220A\220R\220q\230\004\230A\230R\230q\240\004\240C\240s\250!\2503\250a\250q";
+    #else /* compression: none (2587 bytes) */
+static const char bytes[] = " at 0x leaves the vector object>.: <MemoryView of <contiguous and direct><contiguous and indirect><strided and direct or indirect><strided and direct><strided and indirect>>?Cannot assign to read-only memoryviewInvalid mode, expected \047c\047 or \047fortran\047, got Invalid shape in axis Note that Cython is deliberately stricter than PEP-484 and rejects subclasses of builtin types. If you need to pass subclasses then set the \047annotation_typing\047 directive to False.a friction cone block has 3 entriesadd_notecollections.abccone disableenablegcisenabledno default __reduce__ due to non-trivial __cinit__src/fccqp/projections.pyxunable to allocate array data.unable to allocate shape and strides.v and out need the same size (>= 2) and normal 3 entriesv needs at least 2 entries and out as manyv, lo, hi and out must have the same sizev, normal and out must have 3 entriesASCIIEllipsisSequenceView.MemoryView__Pyx_PyDict_NextRef__annotate____class____class_getitem____dict____func____getstate____import____main____module____name____new____pyx_capi____pyx_checksum__pyx_state__pyx_type__pyx_unpickle_Enum__pyx_vtable____qualname____reduce____reduce_cython____reduce_ex____set_name____setstate____setstate_cython____test___is_coroutineabcallocate_bufferascontiguousarrayasyncio.coroutinesbaseccline_in_tracebackconescountdimdtypedtype_is_objectencodeenumerateerrorfccqp.projectionsflagsfloat64formatfortranhiidindexitemsitemsizekkindlomemviewmodemunamendimnormalnormal_npnumpyobjoffsetoutpackpopproject_cone_blockproject_constraint_setproject_friction_coneproject_second_order_coneregisterssetdefaultshapesizestartstepstopstructunpackupdatevv_valuesxOvoid (double const *, Py_ssize_t, Py_ssize_t, double, double const *, double *)\000void (double const *, Py_ssize_t, double *)\000void (double const *, double const *, double const *, struct __pyx_t_5fccqp_6_types_Cones, Py_ssize_t, double *)\000void (double const *, double, double const *, double *)\000proj_block\000proj_soc\000proj_set""\000proj_friction\200\001\340\004\007\200q\210\006\210a\210s\220\"\220B\220c\230\023\230F\240!\2403\240c\250\021\250&\260\001\260\021\330\010\016\210j\230\001\230\021\330\004\014\210A\210Q\210a\210q\220\004\220A\220V\2301\230D\240\001\240\023\240A\240Q\200\001\360\006\000\005\010\200s\210&\220\001\220\023\220C\220q\230\006\230a\230s\240#\240Q\240f\250A\250S\260\002\260\"\260C\260v\270V\3001\300C\300s\310!\330\010\016\210j\230\001\230\021\330\004\007\200u\210C\210y\230\004\230A\230V\2401\240C\240s\250!\330\010\016\210j\230\001\230\021\330\004\016\210a\210q\220\001\220\021\220$\220f\230A\230V\2401\240D\250\004\250A\250V\2601\260D\270\001\270\023\270A\270Q\200\001\360\006\000\005!\240\002\320\"4\260A\260S\270\006\270b\300\001\330\004%\240R\320\0479\270\021\270(\300&\310\002\310!\330\004\007\200r\210\026\210q\220\003\2203\220b\230\003\2307\240&\250\001\250\023\250C\250r\260\023\260C\260v\270Q\270c\300\023\300A\330\010\016\210j\230\001\230\021\330\004\021\220\021\220!\2202\220Q\220d\230$\230a\230w\240a\240t\2501\250C\250q\260\001\200\001\360\024\000\005\013\210(\220%\220t\2309\240A\330\004\030\230\001\230\026\230q\240\001\330\004\007\200r\210\026\210q\220\003\2203\220b\230\003\2302\230V\2401\240C\240s\250\"\250C\250s\260&\270\001\270\023\270C\270q\330\010\016\210j\230\001\230\021\340\004\010\210\005\210U\220!\2204\220v\230Q\230a\330\010\013\2106\220\021\220#\220R\220r\230\023\230F\240!\2403\240b\250\003\2501\250C\250r\260\021\330\014\022\220*\230A\230W\240A\240Q\330\004\007\200r\210\023\210A\330\010\t\340\004\005\200Y\210d\220&\230\001\230\021\330\004\007\200q\210\001\330\010\t\210\027\220\001\220\031\230!\2307\240!\2404\240q\250\004\250A\250V\2601\260D\270\001\270\023\270A\270Q\330\010\t\210\025\210a\210z\230\021\230\"\230A\230T\240\021\240&\250\001\250\023\250A\330\004\014\210A\210Q\210a\210q\220\004\220A\220R\220q\230\004\230A\230R\230q\240\004\240C\240s\250!\2503\250a\250q";
     PyObject *data = NULL;
     #define __Pyx_DecompressString_UNUSED
     #define __Pyx_DecompressString_LZSS_UNUSED
     #endif
     PyObject **stringtab = __pyx_mstate->__pyx_string_tab;
     Py_ssize_t pos = 0;
-    for (int i = 0; i < 118; i++) {
+    for (int i = 0; i < 125; i++) {
       Py_ssize_t bytes_length = str_length_index[i].length;
       PyObject *string = PyUnicode_DecodeUTF8(bytes + pos, bytes_length, NULL);
       if (likely(string) && i >= 33) PyUnicode_InternInPlace(&string);
@@ -22572,8 +22745,8 @@ static const char bytes[] = " at 0x leaves the vector object>.: <MemoryView of <
       stringtab[i] = string;
       pos += bytes_length;
     }
-    for (int i = 118; i < 124; i++) {
-      Py_ssize_t bytes_length = bytes_length_index[i-118].length;
+    for (int i = 125; i < 131; i++) {
+      Py_ssize_t bytes_length = bytes_length_index[i-125].length;
       PyObject *string = PyBytes_FromStringAndSize(bytes + pos, bytes_length);
       stringtab[i] = string;
       pos += bytes_length;
@@ -22583,14 +22756,14 @@ static const char bytes[] = " at 0x leaves the vector object>.: <MemoryView of <
       }
     }
     Py_XDECREF(data);
-    for (Py_ssize_t i = 0; i < 124; i++) {
+    for (Py_ssize_t i = 0; i < 131; i++) {
       if (unlikely(PyObject_Hash(stringtab[i]) == -1)) {
         __PYX_ERR(0, 1, __pyx_L1_error)
       }
     }
     #if CYTHON_IMMORTAL_CONSTANTS
     {
-      PyObject **table = stringtab + 118;
+      PyObject **table = stringtab + 125;
       for (Py_ssize_t i=0; i<6; ++i) {
         #if PY_VERSION_HEX >= 0x030F0000
         PyUnstable_SetImmortal(table[i]);
@@ -22678,22 +22851,22 @@ static int __Pyx_CreateCodeObjects(__pyx_mstatetype *__pyx_mstate) {
   PyObject* tuple_dedup_map = PyDict_New();
   if (unlikely(!tuple_dedup_map)) return -1;
   {
-    const __Pyx_PyCode_New_function_description descr = {4, 0, 0, 4, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS), 114};
-    PyObject* const varnames[] = {__pyx_mstate->__pyx_n_u_v, __pyx_mstate->__pyx_n_u_mu, __pyx_mstate->__pyx_n_u_normal, __pyx_mstate->__pyx_n_u_out};
-    __pyx_mstate_global->__pyx_codeobj_tab[0] = __Pyx_PyCode_New(descr, varnames, __pyx_mstate->__pyx_kp_u_src_fccqp_projections_pyx, __pyx_mstate->__pyx_n_u_project_friction_cone, __pyx_mstate->__pyx_kp_b_iso88591_q_as_Rs_as_Rs_V1Cs_j_1AT_QfAT_Q, tuple_dedup_map); if (unlikely(!__pyx_mstate_global->__pyx_codeobj_tab[0])) goto bad;
+    const __Pyx_PyCode_New_function_description descr = {4, 0, 0, 6, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS), 116};
+    PyObject* const varnames[] = {__pyx_mstate->__pyx_n_u_v, __pyx_mstate->__pyx_n_u_mu, __pyx_mstate->__pyx_n_u_normal, __pyx_mstate->__pyx_n_u_out, __pyx_mstate->__pyx_n_u_v_2, __pyx_mstate->__pyx_n_u_normal_2};
+    __pyx_mstate_global->__pyx_codeobj_tab[0] = __Pyx_PyCode_New(descr, varnames, __pyx_mstate->__pyx_kp_u_src_fccqp_projections_pyx, __pyx_mstate->__pyx_n_u_project_friction_cone, __pyx_mstate->__pyx_kp_b_iso88591_4AS_b_R_9_r_q_3b_7_Cr_CvQc_A_j, tuple_dedup_map); if (unlikely(!__pyx_mstate_global->__pyx_codeobj_tab[0])) goto bad;
   }
   {
-    const __Pyx_PyCode_New_function_description descr = {2, 0, 0, 2, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS), 121};
+    const __Pyx_PyCode_New_function_description descr = {2, 0, 0, 2, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS), 126};
     PyObject* const varnames[] = {__pyx_mstate->__pyx_n_u_v, __pyx_mstate->__pyx_n_u_out};
     __pyx_mstate_global->__pyx_codeobj_tab[1] = __Pyx_PyCode_New(descr, varnames, __pyx_mstate->__pyx_kp_u_src_fccqp_projections_pyx, __pyx_mstate->__pyx_n_u_project_second_order_cone, __pyx_mstate->__pyx_kp_b_iso88591_q_as_Bc_F_3c_j_AQaq_AV1D_AQ, tuple_dedup_map); if (unlikely(!__pyx_mstate_global->__pyx_codeobj_tab[1])) goto bad;
   }
   {
-    const __Pyx_PyCode_New_function_description descr = {5, 0, 0, 13, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS), 128};
+    const __Pyx_PyCode_New_function_description descr = {5, 0, 0, 13, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS), 133};
     PyObject* const varnames[] = {__pyx_mstate->__pyx_n_u_v, __pyx_mstate->__pyx_n_u_lo, __pyx_mstate->__pyx_n_u_hi, __pyx_mstate->__pyx_n_u_cones, __pyx_mstate->__pyx_n_u_out, __pyx_mstate->__pyx_n_u_kind, __pyx_mstate->__pyx_n_u_offset, __pyx_mstate->__pyx_n_u_dim, __pyx_mstate->__pyx_n_u_mu, __pyx_mstate->__pyx_n_u_normal, __pyx_mstate->__pyx_n_u_s, __pyx_mstate->__pyx_n_u_k, __pyx_mstate->__pyx_n_u_c};
     __pyx_mstate_global->__pyx_codeobj_tab[2] = __Pyx_PyCode_New(descr, varnames, __pyx_mstate->__pyx_kp_u_src_fccqp_projections_pyx, __pyx_mstate->__pyx_n_u_project_constraint_set, __pyx_mstate->__pyx_kp_b_iso88591_t9A_q_r_q_3b_2V1Cs_Cs_Cq_j_U_4v, tuple_dedup_map); if (unlikely(!__pyx_mstate_global->__pyx_codeobj_tab[2])) goto bad;
   }
   {
-    const __Pyx_PyCode_New_function_description descr = {5, 0, 0, 5, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS), 156};
+    const __Pyx_PyCode_New_function_description descr = {5, 0, 0, 5, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS), 161};
     PyObject* const varnames[] = {__pyx_mstate->__pyx_n_u_v, __pyx_mstate->__pyx_n_u_kind, __pyx_mstate->__pyx_n_u_mu, __pyx_mstate->__pyx_n_u_normal, __pyx_mstate->__pyx_n_u_out};
     __pyx_mstate_global->__pyx_codeobj_tab[3] = __Pyx_PyCode_New(descr, varnames, __pyx_mstate->__pyx_kp_u_src_fccqp_projections_pyx, __pyx_mstate->__pyx_n_u_project_cone_block, __pyx_mstate->__pyx_kp_b_iso88591_s_Cq_as_QfAS_CvV1Cs_j_uCy_AV1Cs, tuple_dedup_map); if (unlikely(!__pyx_mstate_global->__pyx_codeobj_tab[3])) goto bad;
   }
@@ -25983,6 +26156,41 @@ static CYTHON_INLINE long __Pyx_div_long(long a, long b, int b_is_constant) {
     );
     return q - adapt_python;
 }
+
+/* PyObjectVectorcallKwds */
+#if CYTHON_VECTORCALL
+CYTHON_UNUSED static int __Pyx_CheckVectorcallKwarg(PyObject *kwnames, Py_ssize_t i) {
+    PyObject *key = __Pyx_PyTuple_GET_ITEM(kwnames, i);
+#if !CYTHON_ASSUME_SAFE_MACROS
+    if (unlikely(!key)) return -1;
+#endif
+    if (unlikely(!PyUnicode_Check(key))) {
+        PyErr_SetString(PyExc_TypeError, "keywords must be strings");
+        return -1;
+    }
+    return 0;
+}
+#else
+CYTHON_UNUSED static PyObject *__Pyx_MakeKwargDict(PyObject **keys, PyObject **values, Py_ssize_t n) {
+    PyObject *out = PyDict_New();
+    if (unlikely(!out)) return NULL;
+    for (Py_ssize_t i=0; i<n; ++i) {
+        if (unlikely(PyDict_SetItem(out, keys[i], values[i]) < 0)) {
+            Py_DECREF(out);
+            return NULL;
+        }
+    }
+    return out;
+}
+CYTHON_UNUSED static int __Pyx_CheckVectorcallKwarg(PyObject **kwnames, Py_ssize_t i) {
+    PyObject *key = kwnames[i];
+    if (unlikely(!PyUnicode_Check(key))) {
+        PyErr_SetString(PyExc_TypeError, "keywords must be strings");
+        return -1;
+    }
+    return 0;
+}
+#endif
 
 /* IterFinish */
 static CYTHON_INLINE int __Pyx_IterFinish(void) {
@@ -29690,7 +29898,7 @@ __pyx_fail:
 }
 
 /* ObjectToMemviewSlice */
-static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(PyObject *obj, int writable_flag) {
+static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(PyObject *obj, int writable_flag) {
     __Pyx_memviewslice result = __Pyx_MEMSLICE_INIT;
     __Pyx_BufFmt_StackElem stack[1];
     int axes_specs[] = { (__Pyx_MEMVIEW_DIRECT | __Pyx_MEMVIEW_CONTIG) };
@@ -29701,7 +29909,7 @@ static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_dc_Py_
     }
     retcode = __Pyx_ValidateAndInit_memviewslice(axes_specs, __Pyx_IS_C_CONTIG,
                                                  (PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) | writable_flag, 1,
-                                                 &__Pyx_TypeInfo_Py_ssize_t, stack,
+                                                 &__Pyx_TypeInfo_double__const__, stack,
                                                  &result, obj);
     if (unlikely(retcode == -1))
         goto __pyx_fail;
@@ -29713,7 +29921,30 @@ __pyx_fail:
 }
 
 /* ObjectToMemviewSlice */
-static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_d_dc_double(PyObject *obj, int writable_flag) {
+static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t__const__(PyObject *obj, int writable_flag) {
+    __Pyx_memviewslice result = __Pyx_MEMSLICE_INIT;
+    __Pyx_BufFmt_StackElem stack[1];
+    int axes_specs[] = { (__Pyx_MEMVIEW_DIRECT | __Pyx_MEMVIEW_CONTIG) };
+    int retcode;
+    if (obj == Py_None) {
+        result.memview = (struct __pyx_memoryview_obj *) Py_None;
+        return result;
+    }
+    retcode = __Pyx_ValidateAndInit_memviewslice(axes_specs, __Pyx_IS_C_CONTIG,
+                                                 (PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) | writable_flag, 1,
+                                                 &__Pyx_TypeInfo_Py_ssize_t__const__, stack,
+                                                 &result, obj);
+    if (unlikely(retcode == -1))
+        goto __pyx_fail;
+    return result;
+__pyx_fail:
+    result.memview = NULL;
+    result.data = NULL;
+    return result;
+}
+
+/* ObjectToMemviewSlice */
+static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_d_dc_double__const__(PyObject *obj, int writable_flag) {
     __Pyx_memviewslice result = __Pyx_MEMSLICE_INIT;
     __Pyx_BufFmt_StackElem stack[1];
     int axes_specs[] = { (__Pyx_MEMVIEW_DIRECT | __Pyx_MEMVIEW_FOLLOW), (__Pyx_MEMVIEW_DIRECT | __Pyx_MEMVIEW_CONTIG) };
@@ -29724,7 +29955,7 @@ static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_d_dc_d
     }
     retcode = __Pyx_ValidateAndInit_memviewslice(axes_specs, __Pyx_IS_C_CONTIG,
                                                  (PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) | writable_flag, 2,
-                                                 &__Pyx_TypeInfo_double, stack,
+                                                 &__Pyx_TypeInfo_double__const__, stack,
                                                  &result, obj);
     if (unlikely(retcode == -1))
         goto __pyx_fail;
@@ -30522,41 +30753,6 @@ static CYTHON_INLINE long __Pyx_PyLong_As_long(PyObject *x) {
         return __Pyx_NonPyLong___Pyx_PyLong_As_long(x);
     }
 }
-
-/* PyObjectVectorcallKwds (used by PyObjectVectorcallMethodKwds) */
-#if CYTHON_VECTORCALL
-CYTHON_UNUSED static int __Pyx_CheckVectorcallKwarg(PyObject *kwnames, Py_ssize_t i) {
-    PyObject *key = __Pyx_PyTuple_GET_ITEM(kwnames, i);
-#if !CYTHON_ASSUME_SAFE_MACROS
-    if (unlikely(!key)) return -1;
-#endif
-    if (unlikely(!PyUnicode_Check(key))) {
-        PyErr_SetString(PyExc_TypeError, "keywords must be strings");
-        return -1;
-    }
-    return 0;
-}
-#else
-CYTHON_UNUSED static PyObject *__Pyx_MakeKwargDict(PyObject **keys, PyObject **values, Py_ssize_t n) {
-    PyObject *out = PyDict_New();
-    if (unlikely(!out)) return NULL;
-    for (Py_ssize_t i=0; i<n; ++i) {
-        if (unlikely(PyDict_SetItem(out, keys[i], values[i]) < 0)) {
-            Py_DECREF(out);
-            return NULL;
-        }
-    }
-    return out;
-}
-CYTHON_UNUSED static int __Pyx_CheckVectorcallKwarg(PyObject **kwnames, Py_ssize_t i) {
-    PyObject *key = kwnames[i];
-    if (unlikely(!PyUnicode_Check(key))) {
-        PyErr_SetString(PyExc_TypeError, "keywords must be strings");
-        return -1;
-    }
-    return 0;
-}
-#endif
 
 /* PyObjectVectorcallMethodKwds (used by CIntToPy) */
 #if !CYTHON_VECTORCALL

@@ -14,6 +14,8 @@ about the same normal; second-order cones are self-dual.
 The ``def`` functions at the end wrap the kernels for tests and for Python callers.
 """
 
+import numpy as np
+
 from libc.math cimport sqrt
 
 from fccqp._types cimport FRICTION, Cones
@@ -111,30 +113,33 @@ cdef void proj_set(const double* v, const double* lo, const double* hi, Cones co
                       out + o)
 
 
-def project_friction_cone(double[::1] v, double mu, double[::1] normal, double[::1] out):
-    """Projection of ``v`` onto the friction cone (``mu``, ``normal``) into ``out``, on numpy arrays (3 entries each)."""
-    if v.shape[0] != 3 or normal.shape[0] != 3 or out.shape[0] != 3:
+def project_friction_cone(v, double mu, normal, double[::1] out):
+    """Project the 3-vector ``v`` onto the friction cone (``mu``, unit ``normal``) into
+    ``out``."""
+    cdef const double[::1] v_ = np.ascontiguousarray(v, dtype=np.float64)
+    cdef const double[::1] normal_ = np.ascontiguousarray(normal, dtype=np.float64)
+    if v_.shape[0] != 3 or normal_.shape[0] != 3 or out.shape[0] != 3:
         raise ValueError("v, normal and out must have 3 entries")
-    proj_friction(&v[0], mu, &normal[0], &out[0])
+    proj_friction(&v_[0], mu, &normal_[0], &out[0])
 
 
-def project_second_order_cone(double[::1] v, double[::1] out):
+def project_second_order_cone(const double[::1] v, double[::1] out):
     """Projection of ``v`` onto the second-order cone, into ``out``."""
     if v.shape[0] < 2 or out.shape[0] != v.shape[0]:
         raise ValueError("v needs at least 2 entries and out as many")
     proj_soc(&v[0], v.shape[0], &out[0])
 
 
-def project_constraint_set(double[::1] v, double[::1] lo, double[::1] hi, cones,
+def project_constraint_set(const double[::1] v, const double[::1] lo, const double[::1] hi, cones,
                            double[::1] out):
     """Project ``v`` onto ``[lo, hi]`` times the cones into ``out`` (may be ``v``).
 
     ``cones`` is the tuple ``(kind, offset, dim, mu, normal)`` of
     :class:`fccqp.cones.ConeArrays`, offsets indexing ``v``.
     """
-    cdef Py_ssize_t[::1] kind, offset, dim
-    cdef double[::1] mu
-    cdef double[:, ::1] normal
+    cdef const Py_ssize_t[::1] kind, offset, dim
+    cdef const double[::1] mu
+    cdef const double[:, ::1] normal
     kind, offset, dim, mu, normal = cones
     cdef Py_ssize_t s = v.shape[0]
     if lo.shape[0] != s or hi.shape[0] != s or out.shape[0] != s:
@@ -153,7 +158,7 @@ def project_constraint_set(double[::1] v, double[::1] lo, double[::1] hi, cones,
     proj_set(&v[0], &lo[0], &hi[0], c, s, &out[0])
 
 
-def project_cone_block(double[::1] v, Py_ssize_t kind, double mu, double[::1] normal,
+def project_cone_block(const double[::1] v, Py_ssize_t kind, double mu, const double[::1] normal,
                        double[::1] out):
     """Project one cone block (kind code of :mod:`fccqp.cones`) into ``out``."""
     if out.shape[0] != v.shape[0] or v.shape[0] < 2 or normal.shape[0] != 3:

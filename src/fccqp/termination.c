@@ -1679,6 +1679,7 @@ struct __pyx_t_5fccqp_6_types_Problem {
   double *A;
   double *b;
   Py_ssize_t const *constrained;
+  char const *in_cone;
   double *lo;
   double *hi;
   struct __pyx_t_5fccqp_6_types_Cones cones;
@@ -1687,7 +1688,7 @@ struct __pyx_t_5fccqp_6_types_Problem {
   double c;
 };
 
-/* "fccqp/_types.pxd":41
+/* "fccqp/_types.pxd":42
  * 
  * 
  * cdef struct Iterates:             # <<<<<<<<<<<<<<
@@ -2135,7 +2136,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec_t(double const *, double
 
 /* Module declarations from "fccqp.termination" */
 static int __pyx_f_5fccqp_11termination_nearly_converged(struct __pyx_t_5fccqp_11termination_Residuals const *, double, double, double); /*proto*/
-static double __pyx_f_5fccqp_11termination_box_support(struct __pyx_t_5fccqp_6_types_Problem const *, double const *); /*proto*/
+static double __pyx_f_5fccqp_11termination_box_support(struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double *); /*proto*/
 /* #### Code section: typeinfo ### */
 /* #### Code section: before_global_var ### */
 #define __Pyx_MODULE_NAME "fccqp.termination"
@@ -2145,7 +2146,7 @@ int __pyx_module_is_main_fccqp__termination = 0;
 /* Implementation of "fccqp.termination" */
 /* #### Code section: global_var ### */
 /* #### Code section: string_decls ### */
-static const char __pyx_k_Residuals_duality_gap_and_the_te[] = "Residuals, duality gap and the termination test of an ADMM iterate.\n\nFor the user\047s problem and an iterate ``(x, y, z)`` with slack ``w`` in ``C``:\n\n    prim = max(||A x - b||, ||x_S - w||)            <= eps_abs + eps_rel * prim_scale\n    dual = ||P x + q + A\047y + z||                     <= eps_abs + eps_rel * dual_scale\n    gap  = |x\047Px + q\047x + b\047y + sigma_C(z)|           <= eps_abs + eps_rel * gap_scale\n\n(infinity norms). The scales come from the data and the primal point only:\n``prim_scale = max(||b||, ||A x||, ||x_S||, ||w||)``, ``dual_scale = max(||q||, ||P x||)``\nand ``gap_scale = max(|x\047Px|, |q\047x|)``: none of them grows with the multipliers, which\ndiverge on an infeasible problem (a scale that included them let a dual residual of\n486 pass against multipliers of 3.6e8). ``sigma_C`` is the support function of the box\nand the cones; ADMM\047s multiplier lies in the normal cone of ``C`` at its slack, so it is\nfinite (``sum hi_i z_i`` over upper, ``lo_i z_i`` over lower entries, 0 on cones).\n\nEverything is computed from the scaled iterate (see :mod:`fccqp.scaling`) and mapped\nback: ``x = D x_s``, ``y = E nu_s / c``, ``z_S = y_s / (c D_S)``, so that the residual of\nrow ``i`` is the scaled one divided by ``E_i``, of entry ``i`` of ``x`` by ``c D_i``.\n";
+static const char __pyx_k_Residuals_duality_gap_and_the_te[] = "Residuals, duality gap and the termination test of an ADMM iterate.\n\nFor the user\047s problem and an iterate ``(x, y, z)`` with slack ``w`` in ``C``:\n\n    prim = max(||A x - b||, ||x_S - w||)            <= eps_abs + eps_rel * prim_scale\n    dual = ||P x + q + A\047y + z||                     <= eps_abs + eps_rel * dual_scale\n    gap  = |x\047Px + q\047x + b\047y + sigma_C(z)|           <= eps_abs + eps_rel * gap_scale\n\n(infinity norms). The scales come from the data and the primal point only:\n``prim_scale = max(||b||, ||A x||, ||x_S||, ||w||)`` and ``dual_scale = max(||q||, ||P\nx||)``: neither grows with the multipliers, which diverge on an infeasible problem (a\ndual scale that included them let a dual residual of 486 pass against multipliers of\n3.6e8). The gap\047s scale is the size of its terms, as in PIQP (``|x\047Px|``, ``|q\047x|``, and the sum\nof the magnitudes of the products in ``b\047y + sigma_C(z)``): on an infeasible problem\n``b\047y + sigma_C(z)`` grows along the certificate without cancelling, so the gap stays\nof the size of its scale and the test fails; nearly dependent rows, whose large\nmultipliers cancel in ``b\047y``, do not make the gap look large. ``sigma_C`` is the support function of the box\nand the cones; ADMM\047s multiplier lies in the normal cone of ``C`` at its slack, so it is\nfinite (``sum hi_i z_i`` over upper, ``lo_i z_i`` over lower entries, 0 on cones).\n\nEverything is computed from the scaled iterate (see :mod:`fccqp.scaling`) and mapped\nback: ``x = D x_s``, ``y = E nu_s / c``, ``z_S = y_s / (c D_S)``, so that the residual of\nrow ``i`` is the scaled one divided by ``E_i``, of entry ``i`` of ``x`` by ``c D_i``.\n";
 /* #### Code section: decls ### */
 /* #### Code section: late_includes ### */
 /* #### Code section: module_state ### */
@@ -2754,16 +2755,17 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec_t(double const *__pyx_v_
 
 }
 
-/* "fccqp/termination.pyx":29
+/* "fccqp/termination.pyx":33
  * 
  * 
- * cdef double box_support(const Problem* p, const double* y) noexcept nogil:             # <<<<<<<<<<<<<<
+ * cdef double box_support(const Problem* p, const double* y, double* terms) noexcept nogil:             # <<<<<<<<<<<<<<
  *     """``sigma_C(y)`` over the box entries (cones contribute 0 to a multiplier in their
- *     polar), on the scaled problem; infinite sides are skipped (ADMM's y is exactly 0
+ *     polar), on the scaled problem, adding the magnitudes of its terms to ``terms``;
 */
 
-static double __pyx_f_5fccqp_11termination_box_support(struct __pyx_t_5fccqp_6_types_Problem const *__pyx_v_p, double const *__pyx_v_y) {
+static double __pyx_f_5fccqp_11termination_box_support(struct __pyx_t_5fccqp_6_types_Problem const *__pyx_v_p, double const *__pyx_v_y, double *__pyx_v_terms) {
   double __pyx_v_out;
+  double __pyx_v_value;
   Py_ssize_t __pyx_v_j;
   double __pyx_r;
   Py_ssize_t __pyx_t_1;
@@ -2771,22 +2773,23 @@ static double __pyx_f_5fccqp_11termination_box_support(struct __pyx_t_5fccqp_6_t
   Py_ssize_t __pyx_t_3;
   int __pyx_t_4;
   int __pyx_t_5;
+  long __pyx_t_6;
 
-  /* "fccqp/termination.pyx":33
- *     polar), on the scaled problem; infinite sides are skipped (ADMM's y is exactly 0
- *     there)."""
- *     cdef double out = 0.0             # <<<<<<<<<<<<<<
+  /* "fccqp/termination.pyx":37
+ *     polar), on the scaled problem, adding the magnitudes of its terms to ``terms``;
+ *     infinite sides are skipped (ADMM's y is exactly 0 there)."""
+ *     cdef double out = 0.0, value             # <<<<<<<<<<<<<<
  *     cdef Py_ssize_t j
  *     for j in range(p.s):
 */
   __pyx_v_out = 0.0;
 
-  /* "fccqp/termination.pyx":35
- *     cdef double out = 0.0
+  /* "fccqp/termination.pyx":39
+ *     cdef double out = 0.0, value
  *     cdef Py_ssize_t j
  *     for j in range(p.s):             # <<<<<<<<<<<<<<
+ *         value = 0.0
  *         if y[j] > 0.0 and isfinite(p.hi[j]):
- *             out += p.hi[j] * y[j]
 */
 
   __pyx_t_1 = __pyx_v_p->s;
@@ -2795,11 +2798,20 @@ static double __pyx_f_5fccqp_11termination_box_support(struct __pyx_t_5fccqp_6_t
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_j = __pyx_t_3;
 
-    /* "fccqp/termination.pyx":36
+    /* "fccqp/termination.pyx":40
  *     cdef Py_ssize_t j
  *     for j in range(p.s):
+ *         value = 0.0             # <<<<<<<<<<<<<<
+ *         if y[j] > 0.0 and isfinite(p.hi[j]):
+ *             value = p.hi[j] * y[j]
+*/
+    __pyx_v_value = 0.0;
+
+    /* "fccqp/termination.pyx":41
+ *     for j in range(p.s):
+ *         value = 0.0
  *         if y[j] > 0.0 and isfinite(p.hi[j]):             # <<<<<<<<<<<<<<
- *             out += p.hi[j] * y[j]
+ *             value = p.hi[j] * y[j]
  *         elif y[j] < 0.0 and isfinite(p.lo[j]):
 */
     __pyx_t_5 = ((__pyx_v_y[__pyx_v_j]) > 0.0);
@@ -2821,31 +2833,31 @@ static double __pyx_f_5fccqp_11termination_box_support(struct __pyx_t_5fccqp_6_t
     if (__pyx_t_4) {
 
 
-      /* "fccqp/termination.pyx":37
- *     for j in range(p.s):
+      /* "fccqp/termination.pyx":42
+ *         value = 0.0
  *         if y[j] > 0.0 and isfinite(p.hi[j]):
- *             out += p.hi[j] * y[j]             # <<<<<<<<<<<<<<
+ *             value = p.hi[j] * y[j]             # <<<<<<<<<<<<<<
  *         elif y[j] < 0.0 and isfinite(p.lo[j]):
- *             out += p.lo[j] * y[j]
+ *             value = p.lo[j] * y[j]
 */
-      __pyx_v_out = (__pyx_v_out + ((__pyx_v_p->hi[__pyx_v_j]) * (__pyx_v_y[__pyx_v_j])));
+      __pyx_v_value = ((__pyx_v_p->hi[__pyx_v_j]) * (__pyx_v_y[__pyx_v_j]));
 
-      /* "fccqp/termination.pyx":36
- *     cdef Py_ssize_t j
+      /* "fccqp/termination.pyx":41
  *     for j in range(p.s):
+ *         value = 0.0
  *         if y[j] > 0.0 and isfinite(p.hi[j]):             # <<<<<<<<<<<<<<
- *             out += p.hi[j] * y[j]
+ *             value = p.hi[j] * y[j]
  *         elif y[j] < 0.0 and isfinite(p.lo[j]):
 */
       goto __pyx_L5;
     }
 
-    /* "fccqp/termination.pyx":38
+    /* "fccqp/termination.pyx":43
  *         if y[j] > 0.0 and isfinite(p.hi[j]):
- *             out += p.hi[j] * y[j]
+ *             value = p.hi[j] * y[j]
  *         elif y[j] < 0.0 and isfinite(p.lo[j]):             # <<<<<<<<<<<<<<
- *             out += p.lo[j] * y[j]
- *     return out
+ *             value = p.lo[j] * y[j]
+ *         out += value
 */
     __pyx_t_5 = ((__pyx_v_y[__pyx_v_j]) < 0.0);
 
@@ -2866,30 +2878,50 @@ static double __pyx_f_5fccqp_11termination_box_support(struct __pyx_t_5fccqp_6_t
     if (__pyx_t_4) {
 
 
-      /* "fccqp/termination.pyx":39
- *             out += p.hi[j] * y[j]
+      /* "fccqp/termination.pyx":44
+ *             value = p.hi[j] * y[j]
  *         elif y[j] < 0.0 and isfinite(p.lo[j]):
- *             out += p.lo[j] * y[j]             # <<<<<<<<<<<<<<
- *     return out
- * 
+ *             value = p.lo[j] * y[j]             # <<<<<<<<<<<<<<
+ *         out += value
+ *         terms[0] += fabs(value)
 */
-      __pyx_v_out = (__pyx_v_out + ((__pyx_v_p->lo[__pyx_v_j]) * (__pyx_v_y[__pyx_v_j])));
+      __pyx_v_value = ((__pyx_v_p->lo[__pyx_v_j]) * (__pyx_v_y[__pyx_v_j]));
 
-      /* "fccqp/termination.pyx":38
+      /* "fccqp/termination.pyx":43
  *         if y[j] > 0.0 and isfinite(p.hi[j]):
- *             out += p.hi[j] * y[j]
+ *             value = p.hi[j] * y[j]
  *         elif y[j] < 0.0 and isfinite(p.lo[j]):             # <<<<<<<<<<<<<<
- *             out += p.lo[j] * y[j]
- *     return out
+ *             value = p.lo[j] * y[j]
+ *         out += value
 */
     }
     __pyx_L5:;
+
+    /* "fccqp/termination.pyx":45
+ *         elif y[j] < 0.0 and isfinite(p.lo[j]):
+ *             value = p.lo[j] * y[j]
+ *         out += value             # <<<<<<<<<<<<<<
+ *         terms[0] += fabs(value)
+ *     return out
+*/
+    __pyx_v_out = (__pyx_v_out + __pyx_v_value);
+
+    /* "fccqp/termination.pyx":46
+ *             value = p.lo[j] * y[j]
+ *         out += value
+ *         terms[0] += fabs(value)             # <<<<<<<<<<<<<<
+ *     return out
+ * 
+*/
+
+    __pyx_t_6 = 0;
+    (__pyx_v_terms[__pyx_t_6]) = ((__pyx_v_terms[__pyx_t_6]) + fabs(__pyx_v_value));
   }
 
 
-  /* "fccqp/termination.pyx":40
- *         elif y[j] < 0.0 and isfinite(p.lo[j]):
- *             out += p.lo[j] * y[j]
+  /* "fccqp/termination.pyx":47
+ *         out += value
+ *         terms[0] += fabs(value)
  *     return out             # <<<<<<<<<<<<<<
  * 
  * 
@@ -2900,22 +2932,23 @@ static double __pyx_f_5fccqp_11termination_box_support(struct __pyx_t_5fccqp_6_t
   }
   goto __pyx_L0;
 
-  /* "fccqp/termination.pyx":29
+  /* "fccqp/termination.pyx":33
  * 
  * 
- * cdef double box_support(const Problem* p, const double* y) noexcept nogil:             # <<<<<<<<<<<<<<
+ * cdef double box_support(const Problem* p, const double* y, double* terms) noexcept nogil:             # <<<<<<<<<<<<<<
  *     """``sigma_C(y)`` over the box entries (cones contribute 0 to a multiplier in their
- *     polar), on the scaled problem; infinite sides are skipped (ADMM's y is exactly 0
+ *     polar), on the scaled problem, adding the magnitudes of its terms to ``terms``;
 */
 
   /* function exit code */
   __pyx_L0:;
 
 
+
   return __pyx_r;
 }
 
-/* "fccqp/termination.pyx":43
+/* "fccqp/termination.pyx":50
  * 
  * 
  * cdef void residuals(const Problem* p, const Iterates* it, double* Ax, double* ATnu,             # <<<<<<<<<<<<<<
@@ -2934,6 +2967,8 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
   double __pyx_v_xPx;
   double __pyx_v_qx;
   double __pyx_v_bnu;
+  double __pyx_v_support;
+  double __pyx_v_terms;
   double __pyx_v_total;
   Py_ssize_t __pyx_t_1;
   double __pyx_t_2;
@@ -2946,11 +2981,11 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
   Py_ssize_t __pyx_t_9;
   int __pyx_t_10;
 
-  /* "fccqp/termination.pyx":46
+  /* "fccqp/termination.pyx":53
  *                     double* Px, Residuals* r) noexcept nogil:
  *     """Fill ``r`` for the iterate ``it`` (``Ax``, ``ATnu``, ``Px``: scratch of sizes m, n, n)."""
  *     cdef Py_ssize_t n = p.n, m = p.m, i, j             # <<<<<<<<<<<<<<
- *     cdef double c = p.c, value, scale, xPx, qx, bnu, total = 0.0
+ *     cdef double c = p.c, value, scale, xPx, qx, bnu, support, terms, total = 0.0
  *     r.prim = r.prim_scale = r.prim_s = r.prim_scale_s = 0.0
 */
   __pyx_t_1 = __pyx_v_p->n;
@@ -2960,10 +2995,10 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
 
   __pyx_v_m = __pyx_t_1;
 
-  /* "fccqp/termination.pyx":47
+  /* "fccqp/termination.pyx":54
  *     """Fill ``r`` for the iterate ``it`` (``Ax``, ``ATnu``, ``Px``: scratch of sizes m, n, n)."""
  *     cdef Py_ssize_t n = p.n, m = p.m, i, j
- *     cdef double c = p.c, value, scale, xPx, qx, bnu, total = 0.0             # <<<<<<<<<<<<<<
+ *     cdef double c = p.c, value, scale, xPx, qx, bnu, support, terms, total = 0.0             # <<<<<<<<<<<<<<
  *     r.prim = r.prim_scale = r.prim_s = r.prim_scale_s = 0.0
  *     matvec(p.A, it.x, Ax, m, n)
 */
@@ -2972,9 +3007,9 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
   __pyx_v_c = __pyx_t_2;
   __pyx_v_total = 0.0;
 
-  /* "fccqp/termination.pyx":48
+  /* "fccqp/termination.pyx":55
  *     cdef Py_ssize_t n = p.n, m = p.m, i, j
- *     cdef double c = p.c, value, scale, xPx, qx, bnu, total = 0.0
+ *     cdef double c = p.c, value, scale, xPx, qx, bnu, support, terms, total = 0.0
  *     r.prim = r.prim_scale = r.prim_s = r.prim_scale_s = 0.0             # <<<<<<<<<<<<<<
  *     matvec(p.A, it.x, Ax, m, n)
  *     matvec_t(p.A, it.nu, ATnu, m, n)
@@ -2984,8 +3019,8 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
   __pyx_v_r->prim_s = 0.0;
   __pyx_v_r->prim_scale_s = 0.0;
 
-  /* "fccqp/termination.pyx":49
- *     cdef double c = p.c, value, scale, xPx, qx, bnu, total = 0.0
+  /* "fccqp/termination.pyx":56
+ *     cdef double c = p.c, value, scale, xPx, qx, bnu, support, terms, total = 0.0
  *     r.prim = r.prim_scale = r.prim_s = r.prim_scale_s = 0.0
  *     matvec(p.A, it.x, Ax, m, n)             # <<<<<<<<<<<<<<
  *     matvec_t(p.A, it.nu, ATnu, m, n)
@@ -2993,7 +3028,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
 */
   __pyx_f_5fccqp_6_dense_matvec(__pyx_v_p->A, __pyx_v_it->x, __pyx_v_Ax, __pyx_v_m, __pyx_v_n);
 
-  /* "fccqp/termination.pyx":50
+  /* "fccqp/termination.pyx":57
  *     r.prim = r.prim_scale = r.prim_s = r.prim_scale_s = 0.0
  *     matvec(p.A, it.x, Ax, m, n)
  *     matvec_t(p.A, it.nu, ATnu, m, n)             # <<<<<<<<<<<<<<
@@ -3002,7 +3037,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
 */
   __pyx_f_5fccqp_6_dense_matvec_t(__pyx_v_p->A, __pyx_v_it->nu, __pyx_v_ATnu, __pyx_v_m, __pyx_v_n);
 
-  /* "fccqp/termination.pyx":51
+  /* "fccqp/termination.pyx":58
  *     matvec(p.A, it.x, Ax, m, n)
  *     matvec_t(p.A, it.nu, ATnu, m, n)
  *     matvec(p.P, it.x, Px, n, n)             # <<<<<<<<<<<<<<
@@ -3011,7 +3046,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
 */
   __pyx_f_5fccqp_6_dense_matvec(__pyx_v_p->P, __pyx_v_it->x, __pyx_v_Px, __pyx_v_n, __pyx_v_n);
 
-  /* "fccqp/termination.pyx":52
+  /* "fccqp/termination.pyx":59
  *     matvec_t(p.A, it.nu, ATnu, m, n)
  *     matvec(p.P, it.x, Px, n, n)
  *     for i in range(m):             # <<<<<<<<<<<<<<
@@ -3025,7 +3060,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/termination.pyx":53
+    /* "fccqp/termination.pyx":60
  *     matvec(p.P, it.x, Px, n, n)
  *     for i in range(m):
  *         value = fabs(Ax[i] - p.b[i])             # <<<<<<<<<<<<<<
@@ -3034,7 +3069,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
 */
     __pyx_v_value = fabs(((__pyx_v_Ax[__pyx_v_i]) - (__pyx_v_p->b[__pyx_v_i])));
 
-    /* "fccqp/termination.pyx":54
+    /* "fccqp/termination.pyx":61
  *     for i in range(m):
  *         value = fabs(Ax[i] - p.b[i])
  *         scale = max(fabs(Ax[i]), fabs(p.b[i]))             # <<<<<<<<<<<<<<
@@ -3058,7 +3093,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
     __pyx_v_scale = __pyx_t_6;
 
 
-    /* "fccqp/termination.pyx":55
+    /* "fccqp/termination.pyx":62
  *         value = fabs(Ax[i] - p.b[i])
  *         scale = max(fabs(Ax[i]), fabs(p.b[i]))
  *         r.prim = max(r.prim, value / p.E[i])             # <<<<<<<<<<<<<<
@@ -3082,7 +3117,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
     __pyx_v_r->prim = __pyx_t_5;
 
 
-    /* "fccqp/termination.pyx":56
+    /* "fccqp/termination.pyx":63
  *         scale = max(fabs(Ax[i]), fabs(p.b[i]))
  *         r.prim = max(r.prim, value / p.E[i])
  *         r.prim_scale = max(r.prim_scale, scale / p.E[i])             # <<<<<<<<<<<<<<
@@ -3106,7 +3141,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
     __pyx_v_r->prim_scale = __pyx_t_2;
 
 
-    /* "fccqp/termination.pyx":57
+    /* "fccqp/termination.pyx":64
  *         r.prim = max(r.prim, value / p.E[i])
  *         r.prim_scale = max(r.prim_scale, scale / p.E[i])
  *         r.prim_s = max(r.prim_s, value)             # <<<<<<<<<<<<<<
@@ -3130,7 +3165,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
     __pyx_v_r->prim_s = __pyx_t_6;
 
 
-    /* "fccqp/termination.pyx":58
+    /* "fccqp/termination.pyx":65
  *         r.prim_scale = max(r.prim_scale, scale / p.E[i])
  *         r.prim_s = max(r.prim_s, value)
  *         r.prim_scale_s = max(r.prim_scale_s, scale)             # <<<<<<<<<<<<<<
@@ -3154,7 +3189,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
     __pyx_v_r->prim_scale_s = __pyx_t_5;
 
 
-    /* "fccqp/termination.pyx":59
+    /* "fccqp/termination.pyx":66
  *         r.prim_s = max(r.prim_s, value)
  *         r.prim_scale_s = max(r.prim_scale_s, scale)
  *         total += value             # <<<<<<<<<<<<<<
@@ -3165,7 +3200,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
   }
 
 
-  /* "fccqp/termination.pyx":60
+  /* "fccqp/termination.pyx":67
  *         r.prim_scale_s = max(r.prim_scale_s, scale)
  *         total += value
  *     for j in range(p.s):             # <<<<<<<<<<<<<<
@@ -3179,7 +3214,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/termination.pyx":61
+    /* "fccqp/termination.pyx":68
  *         total += value
  *     for j in range(p.s):
  *         i = p.constrained[j]             # <<<<<<<<<<<<<<
@@ -3188,7 +3223,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
 */
     __pyx_v_i = (__pyx_v_p->constrained[__pyx_v_j]);
 
-    /* "fccqp/termination.pyx":62
+    /* "fccqp/termination.pyx":69
  *     for j in range(p.s):
  *         i = p.constrained[j]
  *         value = fabs(it.x[i] - it.z[j])             # <<<<<<<<<<<<<<
@@ -3197,7 +3232,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
 */
     __pyx_v_value = fabs(((__pyx_v_it->x[__pyx_v_i]) - (__pyx_v_it->z[__pyx_v_j])));
 
-    /* "fccqp/termination.pyx":63
+    /* "fccqp/termination.pyx":70
  *         i = p.constrained[j]
  *         value = fabs(it.x[i] - it.z[j])
  *         scale = max(fabs(it.x[i]), fabs(it.z[j]))             # <<<<<<<<<<<<<<
@@ -3221,7 +3256,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
     __pyx_v_scale = __pyx_t_2;
 
 
-    /* "fccqp/termination.pyx":64
+    /* "fccqp/termination.pyx":71
  *         value = fabs(it.x[i] - it.z[j])
  *         scale = max(fabs(it.x[i]), fabs(it.z[j]))
  *         r.prim = max(r.prim, value * p.D[i])             # <<<<<<<<<<<<<<
@@ -3245,7 +3280,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
     __pyx_v_r->prim = __pyx_t_6;
 
 
-    /* "fccqp/termination.pyx":65
+    /* "fccqp/termination.pyx":72
  *         scale = max(fabs(it.x[i]), fabs(it.z[j]))
  *         r.prim = max(r.prim, value * p.D[i])
  *         r.prim_scale = max(r.prim_scale, scale * p.D[i])             # <<<<<<<<<<<<<<
@@ -3269,7 +3304,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
     __pyx_v_r->prim_scale = __pyx_t_5;
 
 
-    /* "fccqp/termination.pyx":66
+    /* "fccqp/termination.pyx":73
  *         r.prim = max(r.prim, value * p.D[i])
  *         r.prim_scale = max(r.prim_scale, scale * p.D[i])
  *         r.prim_s = max(r.prim_s, value)             # <<<<<<<<<<<<<<
@@ -3293,7 +3328,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
     __pyx_v_r->prim_s = __pyx_t_2;
 
 
-    /* "fccqp/termination.pyx":67
+    /* "fccqp/termination.pyx":74
  *         r.prim_scale = max(r.prim_scale, scale * p.D[i])
  *         r.prim_s = max(r.prim_s, value)
  *         r.prim_scale_s = max(r.prim_scale_s, scale)             # <<<<<<<<<<<<<<
@@ -3317,7 +3352,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
     __pyx_v_r->prim_scale_s = __pyx_t_6;
 
 
-    /* "fccqp/termination.pyx":68
+    /* "fccqp/termination.pyx":75
  *         r.prim_s = max(r.prim_s, value)
  *         r.prim_scale_s = max(r.prim_scale_s, scale)
  *         total += value + fabs(it.y[j])             # <<<<<<<<<<<<<<
@@ -3328,7 +3363,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
   }
 
 
-  /* "fccqp/termination.pyx":69
+  /* "fccqp/termination.pyx":76
  *         r.prim_scale_s = max(r.prim_scale_s, scale)
  *         total += value + fabs(it.y[j])
  *     r.dual = r.dual_scale = r.dual_s = r.dual_scale_s = 0.0             # <<<<<<<<<<<<<<
@@ -3340,7 +3375,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
   __pyx_v_r->dual_s = 0.0;
   __pyx_v_r->dual_scale_s = 0.0;
 
-  /* "fccqp/termination.pyx":70
+  /* "fccqp/termination.pyx":77
  *         total += value + fabs(it.y[j])
  *     r.dual = r.dual_scale = r.dual_s = r.dual_scale_s = 0.0
  *     xPx = qx = 0.0             # <<<<<<<<<<<<<<
@@ -3350,7 +3385,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
   __pyx_v_xPx = 0.0;
   __pyx_v_qx = 0.0;
 
-  /* "fccqp/termination.pyx":71
+  /* "fccqp/termination.pyx":78
  *     r.dual = r.dual_scale = r.dual_s = r.dual_scale_s = 0.0
  *     xPx = qx = 0.0
  *     for i in range(n):             # <<<<<<<<<<<<<<
@@ -3364,7 +3399,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/termination.pyx":72
+    /* "fccqp/termination.pyx":79
  *     xPx = qx = 0.0
  *     for i in range(n):
  *         xPx += it.x[i] * Px[i]             # <<<<<<<<<<<<<<
@@ -3373,7 +3408,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
 */
     __pyx_v_xPx = (__pyx_v_xPx + ((__pyx_v_it->x[__pyx_v_i]) * (__pyx_v_Px[__pyx_v_i])));
 
-    /* "fccqp/termination.pyx":73
+    /* "fccqp/termination.pyx":80
  *     for i in range(n):
  *         xPx += it.x[i] * Px[i]
  *         qx += p.q[i] * it.x[i]             # <<<<<<<<<<<<<<
@@ -3382,7 +3417,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
 */
     __pyx_v_qx = (__pyx_v_qx + ((__pyx_v_p->q[__pyx_v_i]) * (__pyx_v_it->x[__pyx_v_i])));
 
-    /* "fccqp/termination.pyx":74
+    /* "fccqp/termination.pyx":81
  *         xPx += it.x[i] * Px[i]
  *         qx += p.q[i] * it.x[i]
  *         scale = 1.0 / (c * p.D[i])             # <<<<<<<<<<<<<<
@@ -3391,7 +3426,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
 */
     __pyx_v_scale = (1.0 / (__pyx_v_c * (__pyx_v_p->D[__pyx_v_i])));
 
-    /* "fccqp/termination.pyx":75
+    /* "fccqp/termination.pyx":82
  *         qx += p.q[i] * it.x[i]
  *         scale = 1.0 / (c * p.D[i])
  *         r.dual_scale = max(r.dual_scale, max(fabs(Px[i]), fabs(p.q[i])) * scale)             # <<<<<<<<<<<<<<
@@ -3430,7 +3465,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
     __pyx_v_r->dual_scale = __pyx_t_2;
 
 
-    /* "fccqp/termination.pyx":77
+    /* "fccqp/termination.pyx":84
  *         r.dual_scale = max(r.dual_scale, max(fabs(Px[i]), fabs(p.q[i])) * scale)
  *         # rho adaptation balances the scaled residuals against all their terms, as OSQP
  *         r.dual_scale_s = max(r.dual_scale_s, max(max(fabs(Px[i]), fabs(p.q[i])), fabs(ATnu[i])))             # <<<<<<<<<<<<<<
@@ -3484,7 +3519,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
     __pyx_v_r->dual_scale_s = __pyx_t_6;
 
 
-    /* "fccqp/termination.pyx":78
+    /* "fccqp/termination.pyx":85
  *         # rho adaptation balances the scaled residuals against all their terms, as OSQP
  *         r.dual_scale_s = max(r.dual_scale_s, max(max(fabs(Px[i]), fabs(p.q[i])), fabs(ATnu[i])))
  *         Px[i] += p.q[i] + ATnu[i]   # Px now holds the gradient of the Lagrangian             # <<<<<<<<<<<<<<
@@ -3497,7 +3532,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
   }
 
 
-  /* "fccqp/termination.pyx":79
+  /* "fccqp/termination.pyx":86
  *         r.dual_scale_s = max(r.dual_scale_s, max(max(fabs(Px[i]), fabs(p.q[i])), fabs(ATnu[i])))
  *         Px[i] += p.q[i] + ATnu[i]   # Px now holds the gradient of the Lagrangian
  *     for j in range(p.s):             # <<<<<<<<<<<<<<
@@ -3511,7 +3546,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/termination.pyx":80
+    /* "fccqp/termination.pyx":87
  *         Px[i] += p.q[i] + ATnu[i]   # Px now holds the gradient of the Lagrangian
  *     for j in range(p.s):
  *         i = p.constrained[j]             # <<<<<<<<<<<<<<
@@ -3520,7 +3555,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
 */
     __pyx_v_i = (__pyx_v_p->constrained[__pyx_v_j]);
 
-    /* "fccqp/termination.pyx":81
+    /* "fccqp/termination.pyx":88
  *     for j in range(p.s):
  *         i = p.constrained[j]
  *         Px[i] += it.y[j]             # <<<<<<<<<<<<<<
@@ -3531,7 +3566,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
     __pyx_t_9 = __pyx_v_i;
     (__pyx_v_Px[__pyx_t_9]) = ((__pyx_v_Px[__pyx_t_9]) + (__pyx_v_it->y[__pyx_v_j]));
 
-    /* "fccqp/termination.pyx":82
+    /* "fccqp/termination.pyx":89
  *         i = p.constrained[j]
  *         Px[i] += it.y[j]
  *         r.dual_scale_s = max(r.dual_scale_s, fabs(it.y[j]))             # <<<<<<<<<<<<<<
@@ -3557,7 +3592,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
   }
 
 
-  /* "fccqp/termination.pyx":83
+  /* "fccqp/termination.pyx":90
  *         Px[i] += it.y[j]
  *         r.dual_scale_s = max(r.dual_scale_s, fabs(it.y[j]))
  *     for i in range(n):             # <<<<<<<<<<<<<<
@@ -3571,7 +3606,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/termination.pyx":84
+    /* "fccqp/termination.pyx":91
  *         r.dual_scale_s = max(r.dual_scale_s, fabs(it.y[j]))
  *     for i in range(n):
  *         value = fabs(Px[i])             # <<<<<<<<<<<<<<
@@ -3580,7 +3615,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
 */
     __pyx_v_value = fabs((__pyx_v_Px[__pyx_v_i]));
 
-    /* "fccqp/termination.pyx":85
+    /* "fccqp/termination.pyx":92
  *     for i in range(n):
  *         value = fabs(Px[i])
  *         r.dual = max(r.dual, value / (c * p.D[i]))             # <<<<<<<<<<<<<<
@@ -3604,12 +3639,12 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
     __pyx_v_r->dual = __pyx_t_2;
 
 
-    /* "fccqp/termination.pyx":86
+    /* "fccqp/termination.pyx":93
  *         value = fabs(Px[i])
  *         r.dual = max(r.dual, value / (c * p.D[i]))
  *         r.dual_s = max(r.dual_s, value)             # <<<<<<<<<<<<<<
  *         total += value + fabs(it.x[i])
- *     bnu = 0.0
+ *     bnu = terms = 0.0
 */
 
     __pyx_t_2 = __pyx_v_value;
@@ -3628,32 +3663,33 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
     __pyx_v_r->dual_s = __pyx_t_6;
 
 
-    /* "fccqp/termination.pyx":87
+    /* "fccqp/termination.pyx":94
  *         r.dual = max(r.dual, value / (c * p.D[i]))
  *         r.dual_s = max(r.dual_s, value)
  *         total += value + fabs(it.x[i])             # <<<<<<<<<<<<<<
- *     bnu = 0.0
+ *     bnu = terms = 0.0
  *     for i in range(m):
 */
     __pyx_v_total = (__pyx_v_total + (__pyx_v_value + fabs((__pyx_v_it->x[__pyx_v_i]))));
   }
 
 
-  /* "fccqp/termination.pyx":88
+  /* "fccqp/termination.pyx":95
  *         r.dual_s = max(r.dual_s, value)
  *         total += value + fabs(it.x[i])
- *     bnu = 0.0             # <<<<<<<<<<<<<<
+ *     bnu = terms = 0.0             # <<<<<<<<<<<<<<
  *     for i in range(m):
  *         bnu += p.b[i] * it.nu[i]
 */
   __pyx_v_bnu = 0.0;
+  __pyx_v_terms = 0.0;
 
-  /* "fccqp/termination.pyx":89
+  /* "fccqp/termination.pyx":96
  *         total += value + fabs(it.x[i])
- *     bnu = 0.0
+ *     bnu = terms = 0.0
  *     for i in range(m):             # <<<<<<<<<<<<<<
  *         bnu += p.b[i] * it.nu[i]
- *     r.gap = fabs(xPx + qx + bnu + box_support(p, it.y)) / c
+ *         terms += fabs(p.b[i] * it.nu[i])
 */
 
   __pyx_t_1 = __pyx_v_m;
@@ -3662,53 +3698,86 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/termination.pyx":90
- *     bnu = 0.0
+    /* "fccqp/termination.pyx":97
+ *     bnu = terms = 0.0
  *     for i in range(m):
  *         bnu += p.b[i] * it.nu[i]             # <<<<<<<<<<<<<<
- *     r.gap = fabs(xPx + qx + bnu + box_support(p, it.y)) / c
- *     r.gap_scale = max(fabs(xPx), fabs(qx)) / c
+ *         terms += fabs(p.b[i] * it.nu[i])
+ *     support = box_support(p, it.y, &terms)
 */
     __pyx_v_bnu = (__pyx_v_bnu + ((__pyx_v_p->b[__pyx_v_i]) * (__pyx_v_it->nu[__pyx_v_i])));
+
+    /* "fccqp/termination.pyx":98
+ *     for i in range(m):
+ *         bnu += p.b[i] * it.nu[i]
+ *         terms += fabs(p.b[i] * it.nu[i])             # <<<<<<<<<<<<<<
+ *     support = box_support(p, it.y, &terms)
+ *     r.gap = fabs(xPx + qx + bnu + support) / c
+*/
+    __pyx_v_terms = (__pyx_v_terms + fabs(((__pyx_v_p->b[__pyx_v_i]) * (__pyx_v_it->nu[__pyx_v_i]))));
   }
 
 
-  /* "fccqp/termination.pyx":91
- *     for i in range(m):
+  /* "fccqp/termination.pyx":99
  *         bnu += p.b[i] * it.nu[i]
- *     r.gap = fabs(xPx + qx + bnu + box_support(p, it.y)) / c             # <<<<<<<<<<<<<<
- *     r.gap_scale = max(fabs(xPx), fabs(qx)) / c
+ *         terms += fabs(p.b[i] * it.nu[i])
+ *     support = box_support(p, it.y, &terms)             # <<<<<<<<<<<<<<
+ *     r.gap = fabs(xPx + qx + bnu + support) / c
+ *     r.gap_scale = max(max(fabs(xPx), fabs(qx)), terms) / c
+*/
+  __pyx_v_support = __pyx_f_5fccqp_11termination_box_support(__pyx_v_p, __pyx_v_it->y, (&__pyx_v_terms));
+
+  /* "fccqp/termination.pyx":100
+ *         terms += fabs(p.b[i] * it.nu[i])
+ *     support = box_support(p, it.y, &terms)
+ *     r.gap = fabs(xPx + qx + bnu + support) / c             # <<<<<<<<<<<<<<
+ *     r.gap_scale = max(max(fabs(xPx), fabs(qx)), terms) / c
  *     r.finite = isfinite(total) and isfinite(r.gap)
 */
-  __pyx_v_r->gap = (fabs((((__pyx_v_xPx + __pyx_v_qx) + __pyx_v_bnu) + __pyx_f_5fccqp_11termination_box_support(__pyx_v_p, __pyx_v_it->y))) / __pyx_v_c);
+  __pyx_v_r->gap = (fabs((((__pyx_v_xPx + __pyx_v_qx) + __pyx_v_bnu) + __pyx_v_support)) / __pyx_v_c);
 
-  /* "fccqp/termination.pyx":92
- *         bnu += p.b[i] * it.nu[i]
- *     r.gap = fabs(xPx + qx + bnu + box_support(p, it.y)) / c
- *     r.gap_scale = max(fabs(xPx), fabs(qx)) / c             # <<<<<<<<<<<<<<
+  /* "fccqp/termination.pyx":101
+ *     support = box_support(p, it.y, &terms)
+ *     r.gap = fabs(xPx + qx + bnu + support) / c
+ *     r.gap_scale = max(max(fabs(xPx), fabs(qx)), terms) / c             # <<<<<<<<<<<<<<
  *     r.finite = isfinite(total) and isfinite(r.gap)
  * 
 */
 
-  __pyx_t_6 = fabs(__pyx_v_qx);
+  __pyx_t_6 = __pyx_v_terms;
 
-  __pyx_t_2 = fabs(__pyx_v_xPx);
+  __pyx_t_2 = fabs(__pyx_v_qx);
+
+  __pyx_t_8 = fabs(__pyx_v_xPx);
+  __pyx_t_7 = (__pyx_t_2 > __pyx_t_8);
+
+  if (__pyx_t_7) {
+
+    __pyx_t_5 = __pyx_t_2;
+  } else {
+
+    __pyx_t_5 = __pyx_t_8;
+  }
+
+
+  __pyx_t_2 = __pyx_t_5;
+
   __pyx_t_7 = (__pyx_t_6 > __pyx_t_2);
 
   if (__pyx_t_7) {
 
-    __pyx_t_8 = __pyx_t_6;
+    __pyx_t_5 = __pyx_t_6;
   } else {
 
-    __pyx_t_8 = __pyx_t_2;
+    __pyx_t_5 = __pyx_t_2;
   }
 
-  __pyx_v_r->gap_scale = (__pyx_t_8 / __pyx_v_c);
+  __pyx_v_r->gap_scale = (__pyx_t_5 / __pyx_v_c);
 
 
-  /* "fccqp/termination.pyx":93
- *     r.gap = fabs(xPx + qx + bnu + box_support(p, it.y)) / c
- *     r.gap_scale = max(fabs(xPx), fabs(qx)) / c
+  /* "fccqp/termination.pyx":102
+ *     r.gap = fabs(xPx + qx + bnu + support) / c
+ *     r.gap_scale = max(max(fabs(xPx), fabs(qx)), terms) / c
  *     r.finite = isfinite(total) and isfinite(r.gap)             # <<<<<<<<<<<<<<
  * 
  * 
@@ -3731,7 +3800,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
   __pyx_L15_bool_binop_done:;
   __pyx_v_r->finite = __pyx_t_7;
 
-  /* "fccqp/termination.pyx":43
+  /* "fccqp/termination.pyx":50
  * 
  * 
  * cdef void residuals(const Problem* p, const Iterates* it, double* Ax, double* ATnu,             # <<<<<<<<<<<<<<
@@ -3751,9 +3820,11 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
 
 
 
+
+
 }
 
-/* "fccqp/termination.pyx":96
+/* "fccqp/termination.pyx":105
  * 
  * 
  * cdef bint converged(const Residuals* r, double eps_abs, double eps_rel) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -3764,7 +3835,7 @@ static void __pyx_f_5fccqp_11termination_residuals(struct __pyx_t_5fccqp_6_types
 static int __pyx_f_5fccqp_11termination_converged(struct __pyx_t_5fccqp_11termination_Residuals const *__pyx_v_r, double __pyx_v_eps_abs, double __pyx_v_eps_rel) {
   int __pyx_r;
 
-  /* "fccqp/termination.pyx":98
+  /* "fccqp/termination.pyx":107
  * cdef bint converged(const Residuals* r, double eps_abs, double eps_rel) noexcept nogil:
  *     """The termination test: all three within tolerance (and finite)."""
  *     return nearly_converged(r, eps_abs, eps_rel, 1.0)             # <<<<<<<<<<<<<<
@@ -3777,7 +3848,7 @@ static int __pyx_f_5fccqp_11termination_converged(struct __pyx_t_5fccqp_11termin
   }
   goto __pyx_L0;
 
-  /* "fccqp/termination.pyx":96
+  /* "fccqp/termination.pyx":105
  * 
  * 
  * cdef bint converged(const Residuals* r, double eps_abs, double eps_rel) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -3790,7 +3861,7 @@ static int __pyx_f_5fccqp_11termination_converged(struct __pyx_t_5fccqp_11termin
   return __pyx_r;
 }
 
-/* "fccqp/termination.pyx":101
+/* "fccqp/termination.pyx":110
  * 
  * 
  * cdef bint nearly_converged(const Residuals* r, double eps_abs, double eps_rel,             # <<<<<<<<<<<<<<
@@ -3803,7 +3874,7 @@ static int __pyx_f_5fccqp_11termination_nearly_converged(struct __pyx_t_5fccqp_1
   int __pyx_t_1;
   int __pyx_t_2;
 
-  /* "fccqp/termination.pyx":104
+  /* "fccqp/termination.pyx":113
  *                            double factor) noexcept nogil:
  *     """:func:`converged` with tolerances multiplied by ``factor``."""
  *     return (r.finite             # <<<<<<<<<<<<<<
@@ -3821,7 +3892,7 @@ static int __pyx_f_5fccqp_11termination_nearly_converged(struct __pyx_t_5fccqp_1
     goto __pyx_L3_bool_binop_done;
   }
 
-  /* "fccqp/termination.pyx":105
+  /* "fccqp/termination.pyx":114
  *     """:func:`converged` with tolerances multiplied by ``factor``."""
  *     return (r.finite
  *             and r.prim <= factor * (eps_abs + eps_rel * r.prim_scale)             # <<<<<<<<<<<<<<
@@ -3839,7 +3910,7 @@ static int __pyx_f_5fccqp_11termination_nearly_converged(struct __pyx_t_5fccqp_1
     goto __pyx_L3_bool_binop_done;
   }
 
-  /* "fccqp/termination.pyx":106
+  /* "fccqp/termination.pyx":115
  *     return (r.finite
  *             and r.prim <= factor * (eps_abs + eps_rel * r.prim_scale)
  *             and r.dual <= factor * (eps_abs + eps_rel * r.dual_scale)             # <<<<<<<<<<<<<<
@@ -3856,7 +3927,7 @@ static int __pyx_f_5fccqp_11termination_nearly_converged(struct __pyx_t_5fccqp_1
     goto __pyx_L3_bool_binop_done;
   }
 
-  /* "fccqp/termination.pyx":107
+  /* "fccqp/termination.pyx":116
  *             and r.prim <= factor * (eps_abs + eps_rel * r.prim_scale)
  *             and r.dual <= factor * (eps_abs + eps_rel * r.dual_scale)
  *             and r.gap <= factor * (eps_abs + eps_rel * r.gap_scale))             # <<<<<<<<<<<<<<
@@ -3872,7 +3943,7 @@ static int __pyx_f_5fccqp_11termination_nearly_converged(struct __pyx_t_5fccqp_1
   }
   goto __pyx_L0;
 
-  /* "fccqp/termination.pyx":101
+  /* "fccqp/termination.pyx":110
  * 
  * 
  * cdef bint nearly_converged(const Residuals* r, double eps_abs, double eps_rel,             # <<<<<<<<<<<<<<
@@ -3938,7 +4009,7 @@ static int __Pyx_modinit_Function_export_code(__pyx_mstatetype *__pyx_mstate) {
     #if !CYTHON_ASSUME_SAFE_MACROS
     if (unlikely(!__pyx_export_signature)) __PYX_ERR(0, 1, __pyx_L1_error)
     #endif
-    const char * __pyx_export_name = __pyx_export_signature + 411;
+    const char * __pyx_export_name = __pyx_export_signature + 421;
     void (*const __pyx_export_pointers[])(void) = {(void (*)(void))&__pyx_f_5fccqp_11termination_box_support, (void (*)(void))&__pyx_f_5fccqp_11termination_converged, (void (*)(void))&__pyx_f_5fccqp_11termination_nearly_converged, (void (*)(void))&__pyx_f_5fccqp_11termination_residuals, (void (*)(void)) NULL};
     void (*const *__pyx_export_pointer)(void) = __pyx_export_pointers;
     const char *__pyx_export_current_signature = __pyx_export_signature;
@@ -4332,13 +4403,13 @@ static int __Pyx_InitConstants(__pyx_mstatetype *__pyx_mstate) {
   CYTHON_UNUSED_VAR(__pyx_mstate);
   {
     const struct { const unsigned int length: 5; } str_length_index[] = {{1},{8},{10},{8},{12},{12},{8},{18},{10}};
-    const struct { const unsigned int length: 9; } bytes_length_index[] = {{459}};
+    const struct { const unsigned int length: 9; } bytes_length_index[] = {{469}};
     #ifndef CYTHON_COMPRESS_STRINGS
       #define CYTHON_COMPRESS_STRINGS 90
     #endif
-    #if (CYTHON_COMPRESS_STRINGS) == 1 /* compression: zlib (201 bytes) */
-static const char cstring[] = "x\332\255P\273\016\3020\014\354\247d\004\304\302\000+3\033\342\007,7qQD^M\234\252\375{Rh\205\004\002\251\022^|\266|g\373\216\000\026\265\203\022\326\253lhD\016\355#\207\241\007\211A\217\270\315h\346>Sb\000i\264#(\\\216(\251FyK\304\212\032\314\206\225\317\265!\261J\034\263d\361\224b\3307R\266\001\016\300C\240\004\347\350\313\224\025\322\273\304b\263\025\023m\252\327\225v\374Mc\267c\212V;d\355\035\\(iU.L\357Zs\376\247\326K\263\363Z-~\362\367\370\251\234\202\305\340\017S\276\240e\037\025Ok\337C\312!\370\310U\331\321Q\274\222\252\034a4\003\274\032q\346\334\001\241\034\312d";
-    PyObject *data = __Pyx_DecompressString(cstring, 201, 1);
+    #if (CYTHON_COMPRESS_STRINGS) == 1 /* compression: zlib (202 bytes) */
+static const char cstring[] = "x\332\255P\273\016\3020\014\354\247d\004\304\322\001Vf6\304\017XnbPD^M\234\252\375{\302\243\252T\036\022\022^|\266|g\373v\000\026\265\203\022\326\253l\350\206\034\332{\016C\017\022\203\276\3416\243\031\373L\211\001\244\321\216\240p9\242\244\006\345%\021+:a6\254|n\014\211E\342\230%\213\207\024\303\346$e\033`\013<\004Jp\210\276LY!\275K,Vk\361\244\315\353\325\262\322\216?\251\3255S\264\332!k\357\340HI\253rk\232\253\214\371\237Z\223f\347\265\372\371\335\357\343\373r\n\026\253_\355x\217~\373\250x\332\370\036R\016\301G\256\312\216\216\342\231T\345\010\243\031`j\304\221s\005\270[\315u";
+    PyObject *data = __Pyx_DecompressString(cstring, 202, 1);
     #define __Pyx_DecompressString_LZSS_UNUSED
     if (unlikely(!data)) __PYX_ERR(0, 1, __pyx_L1_error)
     const char* const bytes = __Pyx_PyBytes_AsString(data);
@@ -4346,16 +4417,16 @@ static const char cstring[] = "x\332\255P\273\016\3020\014\354\247d\004\304\302\
     if (likely(bytes)); else { Py_DECREF(data); __PYX_ERR(0, 1, __pyx_L1_error) }
     #endif
     #elif (CYTHON_COMPRESS_STRINGS) > 0 && (CYTHON_COMPRESS_STRINGS) <= 90 /* compression: lzss (253 bytes) */
-static const char cstring[] = "\377?__main_}_\005\000odule\006\001\367nam\003\002pyx_\357capi\032\001qua\375l\020\005test__\277cline_9\000t\377raceback\377setdefau\377ltdouble\377 (struct\367 __G\001t_5f\377ccqp_6_t\377ypes_Pro\376#\000m const\317 *, 0\004\t\004)\000\367int,\02511te\377rminatio\177n_Resid\237\000\341s<\rL\005\000IJ\007voi)d\264\200.\366\033I\324\000a\336 \204.\340\225\047\237\047\260 \3143\2065*)\000\377box_supp\357ort\000\366 ver\377ged\000near\027ly_\007\007r\312%";
-    PyObject *data = __Pyx_DecompressString_LZSS(cstring, 253, 546);
+static const char cstring[] = "\377?__main_}_\005\000odule\006\001\367nam\003\002pyx_\357capi\032\001qua\375l\020\005test__\277cline_9\000t\377raceback\377setdefau\377ltdouble\377 (struct\367 __G\001t_5f\377ccqp_6_t\377ypes_Pro\376#\000m const\317 *, 0\004\000\r*)\357\000int6\02511t\377erminati\377on_Resid\302\251\000sF\rV\005\000IJ\007voSid\276\200.\200;I\324\000a\350 \200\216.\237\047\251\047\272 \3263\2065\321 b\377ox_suppo\367rt\000\200@verg\377ed\000nearl\013y_\007\007r\312%";
+    PyObject *data = __Pyx_DecompressString_LZSS(cstring, 253, 556);
     #define __Pyx_DecompressString_UNUSED
     if (unlikely(!data)) __PYX_ERR(0, 1, __pyx_L1_error)
     const char* const bytes = __Pyx_PyBytes_AsString(data);
     #if !CYTHON_ASSUME_SAFE_MACROS
     if (likely(bytes)); else { Py_DECREF(data); __PYX_ERR(0, 1, __pyx_L1_error) }
     #endif
-    #else /* compression: none (546 bytes) */
-static const char bytes[] = "?__main____module____name____pyx_capi____qualname____test__cline_in_tracebacksetdefaultdouble (struct __pyx_t_5fccqp_6_types_Problem const *, double const *)\000int (struct __pyx_t_5fccqp_11termination_Residuals const *, double, double)\000int (struct __pyx_t_5fccqp_11termination_Residuals const *, double, double, double)\000void (struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates const *, double *, double *, double *, struct __pyx_t_5fccqp_11termination_Residuals *)\000box_support\000converged\000nearly_converged\000residuals";
+    #else /* compression: none (556 bytes) */
+static const char bytes[] = "?__main____module____name____pyx_capi____qualname____test__cline_in_tracebacksetdefaultdouble (struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double *)\000int (struct __pyx_t_5fccqp_11termination_Residuals const *, double, double)\000int (struct __pyx_t_5fccqp_11termination_Residuals const *, double, double, double)\000void (struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates const *, double *, double *, double *, struct __pyx_t_5fccqp_11termination_Residuals *)\000box_support\000converged\000nearly_converged\000residuals";
     PyObject *data = NULL;
     #define __Pyx_DecompressString_UNUSED
     #define __Pyx_DecompressString_LZSS_UNUSED

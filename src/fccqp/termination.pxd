@@ -14,4 +14,4 @@ cdef void residuals(const Problem* p, const Iterates* it, double* Ax, double* AT
 cdef bint converged(const Residuals* r, double eps_abs, double eps_rel) noexcept nogil
 cdef bint nearly_converged(const Residuals* r, double eps_abs, double eps_rel,
                            double factor) noexcept nogil
-cdef double box_support(const Problem* p, const double* y) noexcept nogil
+cdef double box_support(const Problem* p, const double* y, double* terms) noexcept nogil

@@ -8,10 +8,14 @@ For the user's problem and an iterate ``(x, y, z)`` with slack ``w`` in ``C``:
     gap  = |x'Px + q'x + b'y + sigma_C(z)|           <= eps_abs + eps_rel * gap_scale
 
 (infinity norms). The scales come from the data and the primal point only:
-``prim_scale = max(||b||, ||A x||, ||x_S||, ||w||)``, ``dual_scale = max(||q||, ||P x||)``
-and ``gap_scale = max(|x'Px|, |q'x|)``: none of them grows with the multipliers, which
-diverge on an infeasible problem (a scale that included them let a dual residual of
-486 pass against multipliers of 3.6e8). ``sigma_C`` is the support function of the box
+``prim_scale = max(||b||, ||A x||, ||x_S||, ||w||)`` and ``dual_scale = max(||q||, ||P
+x||)``: neither grows with the multipliers, which diverge on an infeasible problem (a
+dual scale that included them let a dual residual of 486 pass against multipliers of
+3.6e8). The gap's scale is the size of its terms, as in PIQP (``|x'Px|``, ``|q'x|``, and the sum
+of the magnitudes of the products in ``b'y + sigma_C(z)``): on an infeasible problem
+``b'y + sigma_C(z)`` grows along the certificate without cancelling, so the gap stays
+of the size of its scale and the test fails; nearly dependent rows, whose large
+multipliers cancel in ``b'y``, do not make the gap look large. ``sigma_C`` is the support function of the box
 and the cones; ADMM's multiplier lies in the normal cone of ``C`` at its slack, so it is
 finite (``sum hi_i z_i`` over upper, ``lo_i z_i`` over lower entries, 0 on cones).
 
@@ -26,17 +30,20 @@ from fccqp._dense cimport matvec, matvec_t
 from fccqp._types cimport Iterates, Problem
 
 
-cdef double box_support(const Problem* p, const double* y) noexcept nogil:
+cdef double box_support(const Problem* p, const double* y, double* terms) noexcept nogil:
     """``sigma_C(y)`` over the box entries (cones contribute 0 to a multiplier in their
-    polar), on the scaled problem; infinite sides are skipped (ADMM's y is exactly 0
-    there)."""
-    cdef double out = 0.0
+    polar), on the scaled problem, adding the magnitudes of its terms to ``terms``;
+    infinite sides are skipped (ADMM's y is exactly 0 there)."""
+    cdef double out = 0.0, value
     cdef Py_ssize_t j
     for j in range(p.s):
+        value = 0.0
         if y[j] > 0.0 and isfinite(p.hi[j]):
-            out += p.hi[j] * y[j]
+            value = p.hi[j] * y[j]
         elif y[j] < 0.0 and isfinite(p.lo[j]):
-            out += p.lo[j] * y[j]
+            value = p.lo[j] * y[j]
+        out += value
+        terms[0] += fabs(value)
     return out
 
 
@@ -44,7 +51,7 @@ cdef void residuals(const Problem* p, const Iterates* it, double* Ax, double* AT
                     double* Px, Residuals* r) noexcept nogil:
     """Fill ``r`` for the iterate ``it`` (``Ax``, ``ATnu``, ``Px``: scratch of sizes m, n, n)."""
     cdef Py_ssize_t n = p.n, m = p.m, i, j
-    cdef double c = p.c, value, scale, xPx, qx, bnu, total = 0.0
+    cdef double c = p.c, value, scale, xPx, qx, bnu, support, terms, total = 0.0
     r.prim = r.prim_scale = r.prim_s = r.prim_scale_s = 0.0
     matvec(p.A, it.x, Ax, m, n)
     matvec_t(p.A, it.nu, ATnu, m, n)
@@ -85,11 +92,13 @@ cdef void residuals(const Problem* p, const Iterates* it, double* Ax, double* AT
         r.dual = max(r.dual, value / (c * p.D[i]))
         r.dual_s = max(r.dual_s, value)
         total += value + fabs(it.x[i])
-    bnu = 0.0
+    bnu = terms = 0.0
     for i in range(m):
         bnu += p.b[i] * it.nu[i]
-    r.gap = fabs(xPx + qx + bnu + box_support(p, it.y)) / c
-    r.gap_scale = max(fabs(xPx), fabs(qx)) / c
+        terms += fabs(p.b[i] * it.nu[i])
+    support = box_support(p, it.y, &terms)
+    r.gap = fabs(xPx + qx + bnu + support) / c
+    r.gap_scale = max(max(fabs(xPx), fabs(qx)), terms) / c
     r.finite = isfinite(total) and isfinite(r.gap)
 
 
