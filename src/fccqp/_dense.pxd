@@ -1,14 +1,16 @@
 # cython: language_level=3
-"""Level-1 and level-2 loops for the small dense matrices of a whole-body-control QP.
+"""Vector loops and matrix-vector products for the small dense matrices of a WBC QP.
 
-BLAS is not called for these: at our sizes (n + m <= ~200) its call overhead and, for
-OpenBLAS, its thread pool cost more than the arithmetic (a matrix-vector product of
-124 x 124 is 15k flops, a few microseconds as a plain loop that the compiler
-vectorizes), and a loop never spins a thread when the machine is loaded. Factorizations
-and triangular solves with many right-hand sides go to LAPACK (see fccqp.ldl, fccqp.schur).
+Matrix-vector products go to BLAS ``dgemv``: a plain C loop is a chain of dependent
+additions that the compiler may not reorder (no fast-math), and it measured slower
+than ``dgemv`` on these sizes (go2 realtime 329 us with loops against the numba
+kernels' 290 us, which called BLAS); ``dgemv`` never goes multithreaded below 460,800
+entries (OpenBLAS's threshold). The vector loops stay loops: a BLAS call costs more
+than the arithmetic at these lengths.
 """
 
 from libc.math cimport fabs
+from scipy.linalg.cython_blas cimport dgemv
 
 
 cdef inline double inf_norm(const double* v, Py_ssize_t k) noexcept nogil:
@@ -42,29 +44,43 @@ cdef inline void fill(double* dst, double value, Py_ssize_t k) noexcept nogil:
 
 cdef inline void matvec(const double* M, const double* x, double* out,
                         Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
-    """``out = M x`` for a row-major ``rows x cols`` matrix ``M``."""
-    cdef Py_ssize_t i, j
-    cdef double acc
-    cdef const double* row
-    for i in range(rows):
-        row = M + i * cols
-        acc = 0.0
-        for j in range(cols):
-            acc += row[j] * x[j]
-        out[i] = acc
+    """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+    cdef int r = <int>rows, c = <int>cols, one = 1
+    cdef double alpha = 1.0, beta = 0.0
+    cdef char trans = b"T"
+    if rows == 0:
+        return
+    if cols == 0:
+        fill(out, 0.0, rows)
+        return
+    dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>x, &one, &beta, out, &one)
 
 
 cdef inline void matvec_t(const double* M, const double* y, double* out,
                           Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
-    """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (row by row, so that
-    the inner loop is contiguous)."""
-    cdef Py_ssize_t i, j
-    cdef double yi
-    cdef const double* row
-    for j in range(cols):
-        out[j] = 0.0
-    for i in range(rows):
-        row = M + i * cols
-        yi = y[i]
-        for j in range(cols):
-            out[j] += row[j] * yi
+    """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+    cdef int r = <int>rows, c = <int>cols, one = 1
+    cdef double alpha = 1.0, beta = 0.0
+    cdef char trans = b"N"
+    if cols == 0:
+        return
+    if rows == 0:
+        fill(out, 0.0, cols)
+        return
+    dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>y, &one, &beta, out, &one)
+
+
+cdef inline void colmatvec(const double* M, int ld, const double* x, double* out,
+                           Py_ssize_t rows, Py_ssize_t cols, double beta) noexcept nogil:
+    """``out = M x + beta out`` for a column-major ``rows x cols`` block ``M`` with
+    leading dimension ``ld`` (``dgemv``)."""
+    cdef int r = <int>rows, c = <int>cols, one = 1
+    cdef double alpha = 1.0
+    cdef char trans = b"N"
+    if rows == 0:
+        return
+    if cols == 0:
+        if beta == 0.0:
+            fill(out, 0.0, rows)
+        return
+    dgemv(&trans, &r, &c, &alpha, <double*>M, &ld, <double*>x, &one, &beta, out, &one)

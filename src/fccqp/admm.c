@@ -1507,6 +1507,34 @@ static PyObject *__pyx_m = NULL;
 #endif
 static const char * const __pyx_cfilenm = __FILE__;
 
+/* Header.proto */
+#if !defined(CYTHON_CCOMPLEX)
+  #if defined(__cplusplus)
+    #define CYTHON_CCOMPLEX 1
+  #elif defined(_MSC_VER)
+    #define CYTHON_CCOMPLEX 0
+  #elif (defined(__ANDROID_MIN_SDK_VERSION__) && __ANDROID_MIN_SDK_VERSION__ < 26) || (defined(__ANDROID_API__) && __ANDROID_API__ < 26)
+    #define CYTHON_CCOMPLEX 0
+  #elif defined(__STDC_NO_COMPLEX__)
+    #define CYTHON_CCOMPLEX 0
+  #elif defined(_Complex_I) || (defined (__STDC_VERSION__) && __STDC_VERSION__ >= 201112L && !defined(__STDC_NO_COMPLEX__))
+    #define CYTHON_CCOMPLEX 1
+  #else
+    #define CYTHON_CCOMPLEX 0
+  #endif
+#endif
+#if CYTHON_CCOMPLEX
+  #ifdef __cplusplus
+    #include <complex>
+  #else
+    #include <complex.h>
+  #endif
+#endif
+#if CYTHON_CCOMPLEX && !defined(__cplusplus) && defined(__sun__) && defined(__GNUC__)
+  #undef _Complex_I
+  #define _Complex_I 1.0fj
+#endif
+
 /* #### Code section: filename_table ### */
 
 static const char* const __pyx_f[] = {
@@ -1762,7 +1790,49 @@ typedef struct {
 #endif
 
 /* #### Code section: numeric_typedefs ### */
+
+/* "scipy/linalg/cython_blas.pxd":17
+ * # The original libraries should be linked directly.
+ * 
+ * ctypedef float s             # <<<<<<<<<<<<<<
+ * ctypedef double d
+ * ctypedef float complex c
+*/
+typedef float __pyx_t_5scipy_6linalg_11cython_blas_s;
+
+/* "scipy/linalg/cython_blas.pxd":18
+ * 
+ * ctypedef float s
+ * ctypedef double d             # <<<<<<<<<<<<<<
+ * ctypedef float complex c
+ * ctypedef double complex z
+*/
+typedef double __pyx_t_5scipy_6linalg_11cython_blas_d;
 /* #### Code section: complex_type_declarations ### */
+/* Declarations.proto */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+  #ifdef __cplusplus
+    typedef ::std::complex< float > __pyx_t_float_complex;
+  #else
+    typedef float _Complex __pyx_t_float_complex;
+  #endif
+#else
+    typedef struct { float real, imag; } __pyx_t_float_complex;
+#endif
+static CYTHON_INLINE __pyx_t_float_complex __pyx_t_float_complex_from_parts(float, float);
+
+/* Declarations.proto */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+  #ifdef __cplusplus
+    typedef ::std::complex< double > __pyx_t_double_complex;
+  #else
+    typedef double _Complex __pyx_t_double_complex;
+  #endif
+#else
+    typedef struct { double real, imag; } __pyx_t_double_complex;
+#endif
+static CYTHON_INLINE __pyx_t_double_complex __pyx_t_double_complex_from_parts(double, double);
+
 /* #### Code section: type_declarations ### */
 
 /*--- Type declarations ---*/
@@ -2063,7 +2133,7 @@ struct __pyx_t_5fccqp_10validation_Finding {
 struct __pyx_t_5fccqp_4admm_Options;
 struct __pyx_t_5fccqp_4admm_Run;
 
-/* "fccqp/admm.pyx":76
+/* "fccqp/admm.pyx":77
  * BAD_DATA = -2
  * """The validation scan found bad numbers (see ``Workspace.finding``)."""
  * cdef enum:             # <<<<<<<<<<<<<<
@@ -2083,7 +2153,7 @@ enum  {
   __pyx_e_5fccqp_4admm__BAD_DATA = -2L
 };
 
-/* "fccqp/admm.pyx":124
+/* "fccqp/admm.pyx":125
  * 
  * 
  * cdef struct Options:             # <<<<<<<<<<<<<<
@@ -2110,7 +2180,7 @@ struct __pyx_t_5fccqp_4admm_Options {
   int anderson_memory;
 };
 
-/* "fccqp/admm.pyx":133
+/* "fccqp/admm.pyx":134
  * 
  * 
  * cdef struct Run:             # <<<<<<<<<<<<<<
@@ -2126,7 +2196,7 @@ struct __pyx_t_5fccqp_4admm_Run {
   int backend;
 };
 
-/* "fccqp/admm.pyx":143
+/* "fccqp/admm.pyx":144
  * 
  * 
  * cdef class Workspace:             # <<<<<<<<<<<<<<
@@ -2185,7 +2255,7 @@ struct __pyx_obj_5fccqp_4admm_Workspace {
 };
 
 
-/* "fccqp/admm.pyx":325
+/* "fccqp/admm.pyx":326
  *         return self.found.code, self.found.argument, self.found.index, self.found.value
  * 
  *     @property             # <<<<<<<<<<<<<<
@@ -2199,7 +2269,7 @@ struct __pyx_obj_5fccqp_4admm___pyx_scope_struct____get__ {
 };
 
 
-/* "fccqp/admm.pyx":329
+/* "fccqp/admm.pyx":330
  *         """Rows ``(iteration, prim, dual, gap, rho)`` of the last solve's log."""
  *         cdef Py_ssize_t i, j
  *         return [tuple(self.log[5 * i + j] for j in range(5)) for i in range(self.log_count)]             # <<<<<<<<<<<<<<
@@ -2291,7 +2361,7 @@ struct __pyx_memoryviewslice_obj {
 
 
 
-/* "fccqp/admm.pyx":143
+/* "fccqp/admm.pyx":144
  * 
  * 
  * cdef class Workspace:             # <<<<<<<<<<<<<<
@@ -3661,6 +3731,104 @@ static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_dc_dou
 /* ObjectToMemviewSlice.proto */
 static CYTHON_INLINE __Pyx_memviewslice __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(PyObject *, int writable_flag);
 
+/* RealImag.proto */
+#if CYTHON_CCOMPLEX
+  #ifdef __cplusplus
+    #define __Pyx_CREAL(z) ((z).real())
+    #define __Pyx_CIMAG(z) ((z).imag())
+  #else
+    #define __Pyx_CREAL(z) (__real__(z))
+    #define __Pyx_CIMAG(z) (__imag__(z))
+  #endif
+#else
+    #define __Pyx_CREAL(z) ((z).real)
+    #define __Pyx_CIMAG(z) ((z).imag)
+#endif
+#if defined(__cplusplus) && CYTHON_CCOMPLEX\
+        && (defined(_WIN32) || defined(__clang__) || (defined(__GNUC__) && (__GNUC__ >= 5 || __GNUC__ == 4 && __GNUC_MINOR__ >= 4 )) || __cplusplus >= 201103)
+    #define __Pyx_SET_CREAL(z,x) ((z).real(x))
+    #define __Pyx_SET_CIMAG(z,y) ((z).imag(y))
+#else
+    #define __Pyx_SET_CREAL(z,x) __Pyx_CREAL(z) = (x)
+    #define __Pyx_SET_CIMAG(z,y) __Pyx_CIMAG(z) = (y)
+#endif
+
+/* Arithmetic.proto */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+    #define __Pyx_c_eq_float(a, b)   ((a)==(b))
+    #define __Pyx_c_sum_float(a, b)  ((a)+(b))
+    #define __Pyx_c_diff_float(a, b) ((a)-(b))
+    #define __Pyx_c_prod_float(a, b) ((a)*(b))
+    #define __Pyx_c_quot_float(a, b) ((a)/(b))
+    #define __Pyx_c_neg_float(a)     (-(a))
+  #ifdef __cplusplus
+    #define __Pyx_c_is_zero_float(z) ((z)==(float)0)
+    #define __Pyx_c_conj_float(z)    (::std::conj(z))
+    #if 1
+        #define __Pyx_c_abs_float(z)     (::std::abs(z))
+        #define __Pyx_c_pow_float(a, b)  (::std::pow(a, b))
+    #endif
+  #else
+    #define __Pyx_c_is_zero_float(z) ((z)==0)
+    #define __Pyx_c_conj_float(z)    (conjf(z))
+    #if 1
+        #define __Pyx_c_abs_float(z)     (cabsf(z))
+        #define __Pyx_c_pow_float(a, b)  (cpowf(a, b))
+    #endif
+ #endif
+#else
+    static CYTHON_INLINE int __Pyx_c_eq_float(__pyx_t_float_complex, __pyx_t_float_complex);
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_sum_float(__pyx_t_float_complex, __pyx_t_float_complex);
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_diff_float(__pyx_t_float_complex, __pyx_t_float_complex);
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_prod_float(__pyx_t_float_complex, __pyx_t_float_complex);
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_quot_float(__pyx_t_float_complex, __pyx_t_float_complex);
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_neg_float(__pyx_t_float_complex);
+    static CYTHON_INLINE int __Pyx_c_is_zero_float(__pyx_t_float_complex);
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_conj_float(__pyx_t_float_complex);
+    #if 1
+        static CYTHON_INLINE float __Pyx_c_abs_float(__pyx_t_float_complex);
+        static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_pow_float(__pyx_t_float_complex, __pyx_t_float_complex);
+    #endif
+#endif
+
+/* Arithmetic.proto */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+    #define __Pyx_c_eq_double(a, b)   ((a)==(b))
+    #define __Pyx_c_sum_double(a, b)  ((a)+(b))
+    #define __Pyx_c_diff_double(a, b) ((a)-(b))
+    #define __Pyx_c_prod_double(a, b) ((a)*(b))
+    #define __Pyx_c_quot_double(a, b) ((a)/(b))
+    #define __Pyx_c_neg_double(a)     (-(a))
+  #ifdef __cplusplus
+    #define __Pyx_c_is_zero_double(z) ((z)==(double)0)
+    #define __Pyx_c_conj_double(z)    (::std::conj(z))
+    #if 1
+        #define __Pyx_c_abs_double(z)     (::std::abs(z))
+        #define __Pyx_c_pow_double(a, b)  (::std::pow(a, b))
+    #endif
+  #else
+    #define __Pyx_c_is_zero_double(z) ((z)==0)
+    #define __Pyx_c_conj_double(z)    (conj(z))
+    #if 1
+        #define __Pyx_c_abs_double(z)     (cabs(z))
+        #define __Pyx_c_pow_double(a, b)  (cpow(a, b))
+    #endif
+ #endif
+#else
+    static CYTHON_INLINE int __Pyx_c_eq_double(__pyx_t_double_complex, __pyx_t_double_complex);
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_sum_double(__pyx_t_double_complex, __pyx_t_double_complex);
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_diff_double(__pyx_t_double_complex, __pyx_t_double_complex);
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_prod_double(__pyx_t_double_complex, __pyx_t_double_complex);
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_quot_double(__pyx_t_double_complex, __pyx_t_double_complex);
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_neg_double(__pyx_t_double_complex);
+    static CYTHON_INLINE int __Pyx_c_is_zero_double(__pyx_t_double_complex);
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_conj_double(__pyx_t_double_complex);
+    #if 1
+        static CYTHON_INLINE double __Pyx_c_abs_double(__pyx_t_double_complex);
+        static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_pow_double(__pyx_t_double_complex, __pyx_t_double_complex);
+    #endif
+#endif
+
 /* MemviewSliceCopy.proto */
 static __Pyx_memviewslice
 __pyx_memoryview_copy_new_contig(const __Pyx_memviewslice *from_mvs,
@@ -3940,6 +4108,9 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 
 /* Module declarations from "libc.math" */
 
+/* Module declarations from "scipy.linalg.cython_blas" */
+static void (*__pyx_f_5scipy_6linalg_11cython_blas_dgemv)(char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *); /*proto*/
+
 /* Module declarations from "fccqp._dense" */
 static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *, Py_ssize_t); /*proto*/
 static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_copy(double const *, double *, Py_ssize_t); /*proto*/
@@ -3948,6 +4119,10 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec(double const *, double c
 static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec_t(double const *, double const *, double *, Py_ssize_t, Py_ssize_t); /*proto*/
 
 /* Module declarations from "fccqp._types" */
+
+/* Module declarations from "fccqp.blas_threads" */
+static void (*__pyx_f_5fccqp_12blas_threads_enter)(void); /*proto*/
+static void (*__pyx_f_5fccqp_12blas_threads_leave)(void); /*proto*/
 
 /* Module declarations from "fccqp.anderson" */
 static void (*__pyx_f_5fccqp_8anderson_anderson_reset)(struct __pyx_t_5fccqp_8anderson_Anderson *, int); /*proto*/
@@ -4350,7 +4525,7 @@ namespace {
     PyObject *__pyx_slice[1];
     PyObject *__pyx_tuple[3];
     PyObject *__pyx_codeobj_tab[6];
-    PyObject *__pyx_string_tab[209];
+    PyObject *__pyx_string_tab[211];
     PyObject *__pyx_number_tab[20];
 /* #### Code section: module_state_contents ### */
 /* PyFrozenDict.module_state_decls */
@@ -4620,13 +4795,15 @@ static __pyx_mstatetype * const __pyx_mstate_global = &__pyx_mstate_global_stati
 #define __pyx_kp_b_int_struct___pyx_t_5fccqp_6_type __pyx_string_tab[199]
 #define __pyx_kp_b_int_struct___pyx_t_5fccqp_7reduc __pyx_string_tab[200]
 #define __pyx_kp_b_struct___pyx_t_5fccqp_10validati __pyx_string_tab[201]
-#define __pyx_kp_b_void_double_const_Py_ssize_t_Py __pyx_string_tab[202]
-#define __pyx_kp_b_void_struct___pyx_t_5fccqp_8ande __pyx_string_tab[203]
-#define __pyx_kp_b_iso88591_Q __pyx_string_tab[204]
-#define __pyx_kp_b_iso88591_A_F_2V1_F_2V2XQhfBixr __pyx_string_tab[205]
-#define __pyx_kp_b_iso88591_A_A __pyx_string_tab[206]
-#define __pyx_kp_b_iso88591_A_4q_AXQa_Q_A_3gQ_A_Qe1A_a_3d_1A __pyx_string_tab[207]
-#define __pyx_kp_b_iso88591_a __pyx_string_tab[208]
+#define __pyx_kp_b_void_char_int_int___pyx_t_5scipy __pyx_string_tab[202]
+#define __pyx_kp_b_void_double_const_Py_ssize_t_Py __pyx_string_tab[203]
+#define __pyx_kp_b_void_struct___pyx_t_5fccqp_8ande __pyx_string_tab[204]
+#define __pyx_kp_b_void_void_enter_leave __pyx_string_tab[205]
+#define __pyx_kp_b_iso88591_Q __pyx_string_tab[206]
+#define __pyx_kp_b_iso88591_A_F_2V1_F_2V2XQhfBixr __pyx_string_tab[207]
+#define __pyx_kp_b_iso88591_A_A __pyx_string_tab[208]
+#define __pyx_kp_b_iso88591_A_4q_AXQa_Q_A_3gQ_A_Qe1A_a_3d_1A __pyx_string_tab[209]
+#define __pyx_kp_b_iso88591_a __pyx_string_tab[210]
 #define __pyx_float_0_0 __pyx_number_tab[0]
 #define __pyx_float_0_5 __pyx_number_tab[1]
 #define __pyx_float_1e3 __pyx_number_tab[2]
@@ -4681,7 +4858,7 @@ static CYTHON_SMALL_CODE int __pyx_m_clear(PyObject *m) {
   for (int i=0; i<1; ++i) { Py_CLEAR(clear_module_state->__pyx_slice[i]); }
   for (int i=0; i<3; ++i) { Py_CLEAR(clear_module_state->__pyx_tuple[i]); }
   for (int i=0; i<6; ++i) { Py_CLEAR(clear_module_state->__pyx_codeobj_tab[i]); }
-  for (int i=0; i<209; ++i) { Py_CLEAR(clear_module_state->__pyx_string_tab[i]); }
+  for (int i=0; i<211; ++i) { Py_CLEAR(clear_module_state->__pyx_string_tab[i]); }
   for (int i=0; i<20; ++i) { Py_CLEAR(clear_module_state->__pyx_number_tab[i]); }
 /* #### Code section: module_state_clear_contents ### */
 /* CommonTypesMetaclass.module_state_clear */
@@ -4728,7 +4905,7 @@ static CYTHON_SMALL_CODE int __pyx_m_traverse(PyObject *m, visitproc visit, void
   for (int i=0; i<1; ++i) { __Pyx_VISIT_CONST(traverse_module_state->__pyx_slice[i]); }
   for (int i=0; i<3; ++i) { __Pyx_VISIT_CONST(traverse_module_state->__pyx_tuple[i]); }
   for (int i=0; i<6; ++i) { __Pyx_VISIT_CONST(traverse_module_state->__pyx_codeobj_tab[i]); }
-  for (int i=0; i<209; ++i) { __Pyx_VISIT_CONST(traverse_module_state->__pyx_string_tab[i]); }
+  for (int i=0; i<211; ++i) { __Pyx_VISIT_CONST(traverse_module_state->__pyx_string_tab[i]); }
   for (int i=0; i<20; ++i) { __Pyx_VISIT_CONST(traverse_module_state->__pyx_number_tab[i]); }
 /* #### Code section: module_state_traverse_contents ### */
 /* CommonTypesMetaclass.module_state_traverse */
@@ -18918,7 +19095,7 @@ static PyObject *__pyx_unpickle_Enum__set_state(struct __pyx_MemviewEnum_obj *__
   return __pyx_r;
 }
 
-/* "fccqp/_dense.pxd":14
+/* "fccqp/_dense.pxd":16
  * 
  * 
  * cdef inline double inf_norm(const double* v, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -18935,7 +19112,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
   Py_ssize_t __pyx_t_3;
   int __pyx_t_4;
 
-  /* "fccqp/_dense.pxd":15
+  /* "fccqp/_dense.pxd":17
  * 
  * cdef inline double inf_norm(const double* v, Py_ssize_t k) noexcept nogil:
  *     cdef double out = 0.0             # <<<<<<<<<<<<<<
@@ -18944,7 +19121,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
 */
   __pyx_v_out = 0.0;
 
-  /* "fccqp/_dense.pxd":17
+  /* "fccqp/_dense.pxd":19
  *     cdef double out = 0.0
  *     cdef Py_ssize_t i
  *     for i in range(k):             # <<<<<<<<<<<<<<
@@ -18958,7 +19135,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/_dense.pxd":18
+    /* "fccqp/_dense.pxd":20
  *     cdef Py_ssize_t i
  *     for i in range(k):
  *         if fabs(v[i]) > out:             # <<<<<<<<<<<<<<
@@ -18970,7 +19147,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
     if (__pyx_t_4) {
 
 
-      /* "fccqp/_dense.pxd":19
+      /* "fccqp/_dense.pxd":21
  *     for i in range(k):
  *         if fabs(v[i]) > out:
  *             out = fabs(v[i])             # <<<<<<<<<<<<<<
@@ -18979,7 +19156,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
 */
       __pyx_v_out = fabs((__pyx_v_v[__pyx_v_i]));
 
-      /* "fccqp/_dense.pxd":18
+      /* "fccqp/_dense.pxd":20
  *     cdef Py_ssize_t i
  *     for i in range(k):
  *         if fabs(v[i]) > out:             # <<<<<<<<<<<<<<
@@ -18990,7 +19167,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
   }
 
 
-  /* "fccqp/_dense.pxd":20
+  /* "fccqp/_dense.pxd":22
  *         if fabs(v[i]) > out:
  *             out = fabs(v[i])
  *     return out             # <<<<<<<<<<<<<<
@@ -19003,7 +19180,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
   }
   goto __pyx_L0;
 
-  /* "fccqp/_dense.pxd":14
+  /* "fccqp/_dense.pxd":16
  * 
  * 
  * cdef inline double inf_norm(const double* v, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -19018,7 +19195,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
   return __pyx_r;
 }
 
-/* "fccqp/_dense.pxd":23
+/* "fccqp/_dense.pxd":25
  * 
  * 
  * cdef inline double dot(const double* a, const double* b, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -19034,7 +19211,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
   Py_ssize_t __pyx_t_2;
   Py_ssize_t __pyx_t_3;
 
-  /* "fccqp/_dense.pxd":24
+  /* "fccqp/_dense.pxd":26
  * 
  * cdef inline double dot(const double* a, const double* b, Py_ssize_t k) noexcept nogil:
  *     cdef double out = 0.0             # <<<<<<<<<<<<<<
@@ -19043,7 +19220,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
 */
   __pyx_v_out = 0.0;
 
-  /* "fccqp/_dense.pxd":26
+  /* "fccqp/_dense.pxd":28
  *     cdef double out = 0.0
  *     cdef Py_ssize_t i
  *     for i in range(k):             # <<<<<<<<<<<<<<
@@ -19057,7 +19234,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/_dense.pxd":27
+    /* "fccqp/_dense.pxd":29
  *     cdef Py_ssize_t i
  *     for i in range(k):
  *         out += a[i] * b[i]             # <<<<<<<<<<<<<<
@@ -19068,7 +19245,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
   }
 
 
-  /* "fccqp/_dense.pxd":28
+  /* "fccqp/_dense.pxd":30
  *     for i in range(k):
  *         out += a[i] * b[i]
  *     return out             # <<<<<<<<<<<<<<
@@ -19081,7 +19258,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
   }
   goto __pyx_L0;
 
-  /* "fccqp/_dense.pxd":23
+  /* "fccqp/_dense.pxd":25
  * 
  * 
  * cdef inline double dot(const double* a, const double* b, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -19096,7 +19273,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
   return __pyx_r;
 }
 
-/* "fccqp/_dense.pxd":31
+/* "fccqp/_dense.pxd":33
  * 
  * 
  * cdef inline void copy(const double* src, double* dst, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -19110,7 +19287,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_copy(double const *__pyx_v_src,
   Py_ssize_t __pyx_t_2;
   Py_ssize_t __pyx_t_3;
 
-  /* "fccqp/_dense.pxd":33
+  /* "fccqp/_dense.pxd":35
  * cdef inline void copy(const double* src, double* dst, Py_ssize_t k) noexcept nogil:
  *     cdef Py_ssize_t i
  *     for i in range(k):             # <<<<<<<<<<<<<<
@@ -19124,7 +19301,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_copy(double const *__pyx_v_src,
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/_dense.pxd":34
+    /* "fccqp/_dense.pxd":36
  *     cdef Py_ssize_t i
  *     for i in range(k):
  *         dst[i] = src[i]             # <<<<<<<<<<<<<<
@@ -19135,7 +19312,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_copy(double const *__pyx_v_src,
   }
 
 
-  /* "fccqp/_dense.pxd":31
+  /* "fccqp/_dense.pxd":33
  * 
  * 
  * cdef inline void copy(const double* src, double* dst, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -19147,7 +19324,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_copy(double const *__pyx_v_src,
 
 }
 
-/* "fccqp/_dense.pxd":37
+/* "fccqp/_dense.pxd":39
  * 
  * 
  * cdef inline void fill(double* dst, double value, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -19161,7 +19338,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *__pyx_v_dst, doubl
   Py_ssize_t __pyx_t_2;
   Py_ssize_t __pyx_t_3;
 
-  /* "fccqp/_dense.pxd":39
+  /* "fccqp/_dense.pxd":41
  * cdef inline void fill(double* dst, double value, Py_ssize_t k) noexcept nogil:
  *     cdef Py_ssize_t i
  *     for i in range(k):             # <<<<<<<<<<<<<<
@@ -19175,7 +19352,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *__pyx_v_dst, doubl
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/_dense.pxd":40
+    /* "fccqp/_dense.pxd":42
  *     cdef Py_ssize_t i
  *     for i in range(k):
  *         dst[i] = value             # <<<<<<<<<<<<<<
@@ -19186,7 +19363,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *__pyx_v_dst, doubl
   }
 
 
-  /* "fccqp/_dense.pxd":37
+  /* "fccqp/_dense.pxd":39
  * 
  * 
  * cdef inline void fill(double* dst, double value, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -19198,229 +19375,463 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *__pyx_v_dst, doubl
 
 }
 
-/* "fccqp/_dense.pxd":43
+/* "fccqp/_dense.pxd":45
  * 
  * 
  * cdef inline void matvec(const double* M, const double* x, double* out,             # <<<<<<<<<<<<<<
  *                         Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
- *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M``."""
+ *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
 */
 
 static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec(double const *__pyx_v_M, double const *__pyx_v_x, double *__pyx_v_out, Py_ssize_t __pyx_v_rows, Py_ssize_t __pyx_v_cols) {
-  Py_ssize_t __pyx_v_i;
-  Py_ssize_t __pyx_v_j;
-  double __pyx_v_acc;
-  double const *__pyx_v_row;
-  Py_ssize_t __pyx_t_1;
-  Py_ssize_t __pyx_t_2;
-  Py_ssize_t __pyx_t_3;
-  Py_ssize_t __pyx_t_4;
-  Py_ssize_t __pyx_t_5;
-  Py_ssize_t __pyx_t_6;
+  int __pyx_v_r;
+  int __pyx_v_c;
+  int __pyx_v_one;
+  double __pyx_v_alpha;
+  double __pyx_v_beta;
+  char __pyx_v_trans;
+  int __pyx_t_1;
+
+  /* "fccqp/_dense.pxd":48
+ *                         Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
+ *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1             # <<<<<<<<<<<<<<
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"T"
+*/
+  __pyx_v_r = ((int)__pyx_v_rows);
+  __pyx_v_c = ((int)__pyx_v_cols);
+  __pyx_v_one = 1;
 
   /* "fccqp/_dense.pxd":49
- *     cdef double acc
- *     cdef const double* row
- *     for i in range(rows):             # <<<<<<<<<<<<<<
- *         row = M + i * cols
- *         acc = 0.0
+ *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0, beta = 0.0             # <<<<<<<<<<<<<<
+ *     cdef char trans = b"T"
+ *     if rows == 0:
 */
+  __pyx_v_alpha = 1.0;
+  __pyx_v_beta = 0.0;
 
-  __pyx_t_1 = __pyx_v_rows;
-  __pyx_t_2 = __pyx_t_1;
-
-  for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
-    __pyx_v_i = __pyx_t_3;
-
-    /* "fccqp/_dense.pxd":50
- *     cdef const double* row
- *     for i in range(rows):
- *         row = M + i * cols             # <<<<<<<<<<<<<<
- *         acc = 0.0
- *         for j in range(cols):
+  /* "fccqp/_dense.pxd":50
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"T"             # <<<<<<<<<<<<<<
+ *     if rows == 0:
+ *         return
 */
-    __pyx_v_row = (__pyx_v_M + (__pyx_v_i * __pyx_v_cols));
+  __pyx_v_trans = 'T';
 
-    /* "fccqp/_dense.pxd":51
- *     for i in range(rows):
- *         row = M + i * cols
- *         acc = 0.0             # <<<<<<<<<<<<<<
- *         for j in range(cols):
- *             acc += row[j] * x[j]
+  /* "fccqp/_dense.pxd":51
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"T"
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
 */
-    __pyx_v_acc = 0.0;
+  __pyx_t_1 = (__pyx_v_rows == 0);
+
+  if (__pyx_t_1) {
+
 
     /* "fccqp/_dense.pxd":52
- *         row = M + i * cols
- *         acc = 0.0
- *         for j in range(cols):             # <<<<<<<<<<<<<<
- *             acc += row[j] * x[j]
- *         out[i] = acc
+ *     cdef char trans = b"T"
+ *     if rows == 0:
+ *         return             # <<<<<<<<<<<<<<
+ *     if cols == 0:
+ *         fill(out, 0.0, rows)
 */
-
-    __pyx_t_4 = __pyx_v_cols;
-    __pyx_t_5 = __pyx_t_4;
-
-    for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
-      __pyx_v_j = __pyx_t_6;
-
-      /* "fccqp/_dense.pxd":53
- *         acc = 0.0
- *         for j in range(cols):
- *             acc += row[j] * x[j]             # <<<<<<<<<<<<<<
- *         out[i] = acc
- * 
-*/
-      __pyx_v_acc = (__pyx_v_acc + ((__pyx_v_row[__pyx_v_j]) * (__pyx_v_x[__pyx_v_j])));
+    {
     }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":51
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"T"
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
+*/
+  }
+
+  /* "fccqp/_dense.pxd":53
+ *     if rows == 0:
+ *         return
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         fill(out, 0.0, rows)
+ *         return
+*/
+  __pyx_t_1 = (__pyx_v_cols == 0);
+
+  if (__pyx_t_1) {
 
 
     /* "fccqp/_dense.pxd":54
- *         for j in range(cols):
- *             acc += row[j] * x[j]
- *         out[i] = acc             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
+ *         fill(out, 0.0, rows)             # <<<<<<<<<<<<<<
+ *         return
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>x, &one, &beta, out, &one)
+*/
+    __pyx_f_5fccqp_6_dense_fill(__pyx_v_out, 0.0, __pyx_v_rows);
+
+    /* "fccqp/_dense.pxd":55
+ *     if cols == 0:
+ *         fill(out, 0.0, rows)
+ *         return             # <<<<<<<<<<<<<<
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>x, &one, &beta, out, &one)
+ * 
+*/
+    {
+    }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":53
+ *     if rows == 0:
+ *         return
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         fill(out, 0.0, rows)
+ *         return
+*/
+  }
+
+  /* "fccqp/_dense.pxd":56
+ *         fill(out, 0.0, rows)
+ *         return
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>x, &one, &beta, out, &one)             # <<<<<<<<<<<<<<
  * 
  * 
 */
-    (__pyx_v_out[__pyx_v_i]) = __pyx_v_acc;
-  }
+  __pyx_f_5scipy_6linalg_11cython_blas_dgemv((&__pyx_v_trans), (&__pyx_v_c), (&__pyx_v_r), (&__pyx_v_alpha), ((double *)__pyx_v_M), (&__pyx_v_c), ((double *)__pyx_v_x), (&__pyx_v_one), (&__pyx_v_beta), __pyx_v_out, (&__pyx_v_one));
 
-
-  /* "fccqp/_dense.pxd":43
+  /* "fccqp/_dense.pxd":45
  * 
  * 
  * cdef inline void matvec(const double* M, const double* x, double* out,             # <<<<<<<<<<<<<<
  *                         Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
- *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M``."""
+ *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
 */
 
   /* function exit code */
+  __pyx_L0:;
+
+
 
 
 
 
 }
 
-/* "fccqp/_dense.pxd":57
+/* "fccqp/_dense.pxd":59
  * 
  * 
  * cdef inline void matvec_t(const double* M, const double* y, double* out,             # <<<<<<<<<<<<<<
  *                           Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
- *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (row by row, so that
+ *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
 */
 
 static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec_t(double const *__pyx_v_M, double const *__pyx_v_y, double *__pyx_v_out, Py_ssize_t __pyx_v_rows, Py_ssize_t __pyx_v_cols) {
-  Py_ssize_t __pyx_v_i;
-  Py_ssize_t __pyx_v_j;
-  double __pyx_v_yi;
-  double const *__pyx_v_row;
-  Py_ssize_t __pyx_t_1;
-  Py_ssize_t __pyx_t_2;
-  Py_ssize_t __pyx_t_3;
-  Py_ssize_t __pyx_t_4;
-  Py_ssize_t __pyx_t_5;
-  Py_ssize_t __pyx_t_6;
-  Py_ssize_t __pyx_t_7;
+  int __pyx_v_r;
+  int __pyx_v_c;
+  int __pyx_v_one;
+  double __pyx_v_alpha;
+  double __pyx_v_beta;
+  char __pyx_v_trans;
+  int __pyx_t_1;
+
+  /* "fccqp/_dense.pxd":62
+ *                           Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
+ *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1             # <<<<<<<<<<<<<<
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"N"
+*/
+  __pyx_v_r = ((int)__pyx_v_rows);
+  __pyx_v_c = ((int)__pyx_v_cols);
+  __pyx_v_one = 1;
+
+  /* "fccqp/_dense.pxd":63
+ *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0, beta = 0.0             # <<<<<<<<<<<<<<
+ *     cdef char trans = b"N"
+ *     if cols == 0:
+*/
+  __pyx_v_alpha = 1.0;
+  __pyx_v_beta = 0.0;
 
   /* "fccqp/_dense.pxd":64
- *     cdef double yi
- *     cdef const double* row
- *     for j in range(cols):             # <<<<<<<<<<<<<<
- *         out[j] = 0.0
- *     for i in range(rows):
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"N"             # <<<<<<<<<<<<<<
+ *     if cols == 0:
+ *         return
 */
+  __pyx_v_trans = 'N';
 
-  __pyx_t_1 = __pyx_v_cols;
-  __pyx_t_2 = __pyx_t_1;
+  /* "fccqp/_dense.pxd":65
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"N"
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if rows == 0:
+*/
+  __pyx_t_1 = (__pyx_v_cols == 0);
 
-  for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
-    __pyx_v_j = __pyx_t_3;
+  if (__pyx_t_1) {
+
+
+    /* "fccqp/_dense.pxd":66
+ *     cdef char trans = b"N"
+ *     if cols == 0:
+ *         return             # <<<<<<<<<<<<<<
+ *     if rows == 0:
+ *         fill(out, 0.0, cols)
+*/
+    {
+    }
+    goto __pyx_L0;
 
     /* "fccqp/_dense.pxd":65
- *     cdef const double* row
- *     for j in range(cols):
- *         out[j] = 0.0             # <<<<<<<<<<<<<<
- *     for i in range(rows):
- *         row = M + i * cols
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"N"
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if rows == 0:
 */
-    (__pyx_v_out[__pyx_v_j]) = 0.0;
   }
 
-
-  /* "fccqp/_dense.pxd":66
- *     for j in range(cols):
- *         out[j] = 0.0
- *     for i in range(rows):             # <<<<<<<<<<<<<<
- *         row = M + i * cols
- *         yi = y[i]
+  /* "fccqp/_dense.pxd":67
+ *     if cols == 0:
+ *         return
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         fill(out, 0.0, cols)
+ *         return
 */
+  __pyx_t_1 = (__pyx_v_rows == 0);
 
-  __pyx_t_1 = __pyx_v_rows;
-  __pyx_t_2 = __pyx_t_1;
+  if (__pyx_t_1) {
 
-  for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
-    __pyx_v_i = __pyx_t_3;
-
-    /* "fccqp/_dense.pxd":67
- *         out[j] = 0.0
- *     for i in range(rows):
- *         row = M + i * cols             # <<<<<<<<<<<<<<
- *         yi = y[i]
- *         for j in range(cols):
-*/
-    __pyx_v_row = (__pyx_v_M + (__pyx_v_i * __pyx_v_cols));
 
     /* "fccqp/_dense.pxd":68
- *     for i in range(rows):
- *         row = M + i * cols
- *         yi = y[i]             # <<<<<<<<<<<<<<
- *         for j in range(cols):
- *             out[j] += row[j] * yi
+ *         return
+ *     if rows == 0:
+ *         fill(out, 0.0, cols)             # <<<<<<<<<<<<<<
+ *         return
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>y, &one, &beta, out, &one)
 */
-    __pyx_v_yi = (__pyx_v_y[__pyx_v_i]);
+    __pyx_f_5fccqp_6_dense_fill(__pyx_v_out, 0.0, __pyx_v_cols);
 
     /* "fccqp/_dense.pxd":69
- *         row = M + i * cols
- *         yi = y[i]
- *         for j in range(cols):             # <<<<<<<<<<<<<<
- *             out[j] += row[j] * yi
+ *     if rows == 0:
+ *         fill(out, 0.0, cols)
+ *         return             # <<<<<<<<<<<<<<
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>y, &one, &beta, out, &one)
+ * 
 */
-
-    __pyx_t_4 = __pyx_v_cols;
-    __pyx_t_5 = __pyx_t_4;
-
-    for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
-      __pyx_v_j = __pyx_t_6;
-
-      /* "fccqp/_dense.pxd":70
- *         yi = y[i]
- *         for j in range(cols):
- *             out[j] += row[j] * yi             # <<<<<<<<<<<<<<
-*/
-
-      __pyx_t_7 = __pyx_v_j;
-      (__pyx_v_out[__pyx_t_7]) = ((__pyx_v_out[__pyx_t_7]) + ((__pyx_v_row[__pyx_v_j]) * __pyx_v_yi));
+    {
     }
+    goto __pyx_L0;
 
+    /* "fccqp/_dense.pxd":67
+ *     if cols == 0:
+ *         return
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         fill(out, 0.0, cols)
+ *         return
+*/
   }
 
+  /* "fccqp/_dense.pxd":70
+ *         fill(out, 0.0, cols)
+ *         return
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>y, &one, &beta, out, &one)             # <<<<<<<<<<<<<<
+ * 
+ * 
+*/
+  __pyx_f_5scipy_6linalg_11cython_blas_dgemv((&__pyx_v_trans), (&__pyx_v_c), (&__pyx_v_r), (&__pyx_v_alpha), ((double *)__pyx_v_M), (&__pyx_v_c), ((double *)__pyx_v_y), (&__pyx_v_one), (&__pyx_v_beta), __pyx_v_out, (&__pyx_v_one));
 
-  /* "fccqp/_dense.pxd":57
+  /* "fccqp/_dense.pxd":59
  * 
  * 
  * cdef inline void matvec_t(const double* M, const double* y, double* out,             # <<<<<<<<<<<<<<
  *                           Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
- *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (row by row, so that
+ *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
 */
 
   /* function exit code */
+  __pyx_L0:;
+
+
 
 
 
 
 }
 
-/* "fccqp/admm.pyx":194
+/* "fccqp/_dense.pxd":73
+ * 
+ * 
+ * cdef inline void colmatvec(const double* M, int ld, const double* x, double* out,             # <<<<<<<<<<<<<<
+ *                            Py_ssize_t rows, Py_ssize_t cols, double beta) noexcept nogil:
+ *     """``out = M x + beta out`` for a column-major ``rows x cols`` block ``M`` with
+*/
+
+static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_colmatvec(double const *__pyx_v_M, int __pyx_v_ld, double const *__pyx_v_x, double *__pyx_v_out, Py_ssize_t __pyx_v_rows, Py_ssize_t __pyx_v_cols, double __pyx_v_beta) {
+  int __pyx_v_r;
+  int __pyx_v_c;
+  int __pyx_v_one;
+  double __pyx_v_alpha;
+  char __pyx_v_trans;
+  int __pyx_t_1;
+
+  /* "fccqp/_dense.pxd":77
+ *     """``out = M x + beta out`` for a column-major ``rows x cols`` block ``M`` with
+ *     leading dimension ``ld`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1             # <<<<<<<<<<<<<<
+ *     cdef double alpha = 1.0
+ *     cdef char trans = b"N"
+*/
+  __pyx_v_r = ((int)__pyx_v_rows);
+  __pyx_v_c = ((int)__pyx_v_cols);
+  __pyx_v_one = 1;
+
+  /* "fccqp/_dense.pxd":78
+ *     leading dimension ``ld`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0             # <<<<<<<<<<<<<<
+ *     cdef char trans = b"N"
+ *     if rows == 0:
+*/
+  __pyx_v_alpha = 1.0;
+
+  /* "fccqp/_dense.pxd":79
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0
+ *     cdef char trans = b"N"             # <<<<<<<<<<<<<<
+ *     if rows == 0:
+ *         return
+*/
+  __pyx_v_trans = 'N';
+
+  /* "fccqp/_dense.pxd":80
+ *     cdef double alpha = 1.0
+ *     cdef char trans = b"N"
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
+*/
+  __pyx_t_1 = (__pyx_v_rows == 0);
+
+  if (__pyx_t_1) {
+
+
+    /* "fccqp/_dense.pxd":81
+ *     cdef char trans = b"N"
+ *     if rows == 0:
+ *         return             # <<<<<<<<<<<<<<
+ *     if cols == 0:
+ *         if beta == 0.0:
+*/
+    {
+    }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":80
+ *     cdef double alpha = 1.0
+ *     cdef char trans = b"N"
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
+*/
+  }
+
+  /* "fccqp/_dense.pxd":82
+ *     if rows == 0:
+ *         return
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         if beta == 0.0:
+ *             fill(out, 0.0, rows)
+*/
+  __pyx_t_1 = (__pyx_v_cols == 0);
+
+  if (__pyx_t_1) {
+
+
+    /* "fccqp/_dense.pxd":83
+ *         return
+ *     if cols == 0:
+ *         if beta == 0.0:             # <<<<<<<<<<<<<<
+ *             fill(out, 0.0, rows)
+ *         return
+*/
+    __pyx_t_1 = (__pyx_v_beta == 0.0);
+
+    if (__pyx_t_1) {
+
+
+      /* "fccqp/_dense.pxd":84
+ *     if cols == 0:
+ *         if beta == 0.0:
+ *             fill(out, 0.0, rows)             # <<<<<<<<<<<<<<
+ *         return
+ *     dgemv(&trans, &r, &c, &alpha, <double*>M, &ld, <double*>x, &one, &beta, out, &one)
+*/
+      __pyx_f_5fccqp_6_dense_fill(__pyx_v_out, 0.0, __pyx_v_rows);
+
+      /* "fccqp/_dense.pxd":83
+ *         return
+ *     if cols == 0:
+ *         if beta == 0.0:             # <<<<<<<<<<<<<<
+ *             fill(out, 0.0, rows)
+ *         return
+*/
+    }
+
+    /* "fccqp/_dense.pxd":85
+ *         if beta == 0.0:
+ *             fill(out, 0.0, rows)
+ *         return             # <<<<<<<<<<<<<<
+ *     dgemv(&trans, &r, &c, &alpha, <double*>M, &ld, <double*>x, &one, &beta, out, &one)
+*/
+    {
+    }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":82
+ *     if rows == 0:
+ *         return
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         if beta == 0.0:
+ *             fill(out, 0.0, rows)
+*/
+  }
+
+  /* "fccqp/_dense.pxd":86
+ *             fill(out, 0.0, rows)
+ *         return
+ *     dgemv(&trans, &r, &c, &alpha, <double*>M, &ld, <double*>x, &one, &beta, out, &one)             # <<<<<<<<<<<<<<
+*/
+  __pyx_f_5scipy_6linalg_11cython_blas_dgemv((&__pyx_v_trans), (&__pyx_v_r), (&__pyx_v_c), (&__pyx_v_alpha), ((double *)__pyx_v_M), (&__pyx_v_ld), ((double *)__pyx_v_x), (&__pyx_v_one), (&__pyx_v_beta), __pyx_v_out, (&__pyx_v_one));
+
+  /* "fccqp/_dense.pxd":73
+ * 
+ * 
+ * cdef inline void colmatvec(const double* M, int ld, const double* x, double* out,             # <<<<<<<<<<<<<<
+ *                            Py_ssize_t rows, Py_ssize_t cols, double beta) noexcept nogil:
+ *     """``out = M x + beta out`` for a column-major ``rows x cols`` block ``M`` with
+*/
+
+  /* function exit code */
+  __pyx_L0:;
+
+
+
+
+
+}
+
+/* "fccqp/admm.pyx":195
  *     cdef object _keep
  * 
  *     def __init__(self, Py_ssize_t n, Py_ssize_t m, constrained, cones, fixed, order,             # <<<<<<<<<<<<<<
@@ -19477,81 +19888,81 @@ PyObject *__pyx_args, PyObject *__pyx_kwds
   {
     PyObject ** const __pyx_pyargnames[] = {&__pyx_mstate_global->__pyx_n_u_n,&__pyx_mstate_global->__pyx_n_u_m,&__pyx_mstate_global->__pyx_n_u_constrained,&__pyx_mstate_global->__pyx_n_u_cones,&__pyx_mstate_global->__pyx_n_u_fixed,&__pyx_mstate_global->__pyx_n_u_order,&__pyx_mstate_global->__pyx_n_u_settings,&__pyx_mstate_global->__pyx_n_u_log_rows,0};
     const Py_ssize_t __pyx_kwds_len = (__pyx_kwds) ? __Pyx_NumKwargs_FASTCALL_TPNEW(__pyx_kwds) : 0;
-    if (unlikely(__pyx_kwds_len < 0)) __PYX_ERR(0, 194, __pyx_L3_error)
+    if (unlikely(__pyx_kwds_len < 0)) __PYX_ERR(0, 195, __pyx_L3_error)
     if (__pyx_kwds_len > 0) {
       switch (__pyx_nargs) {
         case  8:
         values[7] = __Pyx_ArgRef_FASTCALL_TPNEW(__pyx_args, 7);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[7])) __PYX_ERR(0, 194, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[7])) __PYX_ERR(0, 195, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  7:
         values[6] = __Pyx_ArgRef_FASTCALL_TPNEW(__pyx_args, 6);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[6])) __PYX_ERR(0, 194, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[6])) __PYX_ERR(0, 195, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  6:
         values[5] = __Pyx_ArgRef_FASTCALL_TPNEW(__pyx_args, 5);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[5])) __PYX_ERR(0, 194, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[5])) __PYX_ERR(0, 195, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  5:
         values[4] = __Pyx_ArgRef_FASTCALL_TPNEW(__pyx_args, 4);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[4])) __PYX_ERR(0, 194, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[4])) __PYX_ERR(0, 195, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  4:
         values[3] = __Pyx_ArgRef_FASTCALL_TPNEW(__pyx_args, 3);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 194, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 195, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  3:
         values[2] = __Pyx_ArgRef_FASTCALL_TPNEW(__pyx_args, 2);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 194, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 195, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  2:
         values[1] = __Pyx_ArgRef_FASTCALL_TPNEW(__pyx_args, 1);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 194, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 195, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  1:
         values[0] = __Pyx_ArgRef_FASTCALL_TPNEW(__pyx_args, 0);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 194, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 195, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  0: break;
         default: goto __pyx_L5_argtuple_error;
       }
       const Py_ssize_t kwd_pos_args = __pyx_nargs;
-      if (__Pyx_ParseKeywords(__pyx_kwds, __pyx_kwvalues, __pyx_pyargnames, 0, values, kwd_pos_args, __pyx_kwds_len, "__init__", 0) < (0)) __PYX_ERR(0, 194, __pyx_L3_error)
+      if (__Pyx_ParseKeywords(__pyx_kwds, __pyx_kwvalues, __pyx_pyargnames, 0, values, kwd_pos_args, __pyx_kwds_len, "__init__", 0) < (0)) __PYX_ERR(0, 195, __pyx_L3_error)
       for (Py_ssize_t i = __pyx_nargs; i < 8; i++) {
-        if (unlikely(!values[i])) { __Pyx_RaiseArgtupleInvalid("__init__", 1, 8, 8, i); __PYX_ERR(0, 194, __pyx_L3_error) }
+        if (unlikely(!values[i])) { __Pyx_RaiseArgtupleInvalid("__init__", 1, 8, 8, i); __PYX_ERR(0, 195, __pyx_L3_error) }
       }
     } else if (unlikely(__pyx_nargs != 8)) {
       goto __pyx_L5_argtuple_error;
     } else {
       values[0] = __Pyx_ArgRef_FASTCALL_TPNEW(__pyx_args, 0);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 194, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 195, __pyx_L3_error)
       values[1] = __Pyx_ArgRef_FASTCALL_TPNEW(__pyx_args, 1);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 194, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 195, __pyx_L3_error)
       values[2] = __Pyx_ArgRef_FASTCALL_TPNEW(__pyx_args, 2);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 194, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 195, __pyx_L3_error)
       values[3] = __Pyx_ArgRef_FASTCALL_TPNEW(__pyx_args, 3);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 194, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 195, __pyx_L3_error)
       values[4] = __Pyx_ArgRef_FASTCALL_TPNEW(__pyx_args, 4);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[4])) __PYX_ERR(0, 194, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[4])) __PYX_ERR(0, 195, __pyx_L3_error)
       values[5] = __Pyx_ArgRef_FASTCALL_TPNEW(__pyx_args, 5);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[5])) __PYX_ERR(0, 194, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[5])) __PYX_ERR(0, 195, __pyx_L3_error)
       values[6] = __Pyx_ArgRef_FASTCALL_TPNEW(__pyx_args, 6);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[6])) __PYX_ERR(0, 194, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[6])) __PYX_ERR(0, 195, __pyx_L3_error)
       values[7] = __Pyx_ArgRef_FASTCALL_TPNEW(__pyx_args, 7);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[7])) __PYX_ERR(0, 194, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[7])) __PYX_ERR(0, 195, __pyx_L3_error)
     }
-    __pyx_v_n = __Pyx_PyIndex_AsSsize_t(values[0]); if (unlikely((__pyx_v_n == (Py_ssize_t)-1) && PyErr_Occurred())) __PYX_ERR(0, 194, __pyx_L3_error)
-    __pyx_v_m = __Pyx_PyIndex_AsSsize_t(values[1]); if (unlikely((__pyx_v_m == (Py_ssize_t)-1) && PyErr_Occurred())) __PYX_ERR(0, 194, __pyx_L3_error)
+    __pyx_v_n = __Pyx_PyIndex_AsSsize_t(values[0]); if (unlikely((__pyx_v_n == (Py_ssize_t)-1) && PyErr_Occurred())) __PYX_ERR(0, 195, __pyx_L3_error)
+    __pyx_v_m = __Pyx_PyIndex_AsSsize_t(values[1]); if (unlikely((__pyx_v_m == (Py_ssize_t)-1) && PyErr_Occurred())) __PYX_ERR(0, 195, __pyx_L3_error)
     __pyx_v_constrained = values[2];
     __pyx_v_cones = values[3];
     __pyx_v_fixed = values[4];
     __pyx_v_order = values[5];
     __pyx_v_settings = values[6];
-    __pyx_v_log_rows = __Pyx_PyIndex_AsSsize_t(values[7]); if (unlikely((__pyx_v_log_rows == (Py_ssize_t)-1) && PyErr_Occurred())) __PYX_ERR(0, 195, __pyx_L3_error)
+    __pyx_v_log_rows = __Pyx_PyIndex_AsSsize_t(values[7]); if (unlikely((__pyx_v_log_rows == (Py_ssize_t)-1) && PyErr_Occurred())) __PYX_ERR(0, 196, __pyx_L3_error)
   }
   goto __pyx_L6_skip;
   __pyx_L5_argtuple_error:;
-  __Pyx_RaiseArgtupleInvalid("__init__", 1, 8, 8, __pyx_nargs); __PYX_ERR(0, 194, __pyx_L3_error)
+  __Pyx_RaiseArgtupleInvalid("__init__", 1, 8, 8, __pyx_nargs); __PYX_ERR(0, 195, __pyx_L3_error)
   __pyx_L6_skip:;
   goto __pyx_L4_argument_unpacking_done;
   __pyx_L3_error:;
@@ -19653,37 +20064,37 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   int __pyx_clineno = 0;
   __Pyx_RefNannySetupContext("__init__", 0);
 
-  /* "fccqp/admm.pyx":200
+  /* "fccqp/admm.pyx":201
  *         into ``constrained``), the boolean mask ``fixed`` of constrained entries with
  *         ``lb == ub``, the Schur ``order`` and a :class:`fccqp.Settings`."""
  *         cdef Py_ssize_t s = len(constrained), N = n + m, memory = settings.anderson_memory             # <<<<<<<<<<<<<<
  *         cdef Py_ssize_t k, j
  *         self._arrays = []
 */
-  __pyx_t_1 = PyObject_Length(__pyx_v_constrained); if (unlikely(__pyx_t_1 == ((Py_ssize_t)-1))) __PYX_ERR(0, 200, __pyx_L1_error)
+  __pyx_t_1 = PyObject_Length(__pyx_v_constrained); if (unlikely(__pyx_t_1 == ((Py_ssize_t)-1))) __PYX_ERR(0, 201, __pyx_L1_error)
   __pyx_v_s = __pyx_t_1;
   __pyx_v_N = (__pyx_v_n + __pyx_v_m);
-  __pyx_t_2 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_anderson_memory); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 200, __pyx_L1_error)
+  __pyx_t_2 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_anderson_memory); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 201, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_2);
-  __pyx_t_1 = __Pyx_PyIndex_AsSsize_t(__pyx_t_2); if (unlikely((__pyx_t_1 == (Py_ssize_t)-1) && PyErr_Occurred())) __PYX_ERR(0, 200, __pyx_L1_error)
+  __pyx_t_1 = __Pyx_PyIndex_AsSsize_t(__pyx_t_2); if (unlikely((__pyx_t_1 == (Py_ssize_t)-1) && PyErr_Occurred())) __PYX_ERR(0, 201, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_2); __pyx_t_2 = 0;
   __pyx_v_memory = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":202
+  /* "fccqp/admm.pyx":203
  *         cdef Py_ssize_t s = len(constrained), N = n + m, memory = settings.anderson_memory
  *         cdef Py_ssize_t k, j
  *         self._arrays = []             # <<<<<<<<<<<<<<
  *         kind, offset, dim, mu, normal = cones
  *         self._keep = (np.ascontiguousarray(constrained, dtype=np.intp),
 */
-  __pyx_t_2 = PyList_New(0); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 202, __pyx_L1_error)
+  __pyx_t_2 = PyList_New(0); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 203, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_2);
   __Pyx_GIVEREF(__pyx_t_2);
   __Pyx_GOTREF(__pyx_v_self->_arrays);
   __Pyx_DECREF_SET(__pyx_v_self->_arrays, ((PyObject*)__pyx_t_2));
   __pyx_t_2 = 0;
 
-  /* "fccqp/admm.pyx":203
+  /* "fccqp/admm.pyx":204
  *         cdef Py_ssize_t k, j
  *         self._arrays = []
  *         kind, offset, dim, mu, normal = cones             # <<<<<<<<<<<<<<
@@ -19696,7 +20107,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     if (unlikely(size != 5)) {
       if (size > 5) __Pyx_RaiseTooManyValuesError(5);
       else if (size >= 0) __Pyx_RaiseNeedMoreValuesError(size);
-      __PYX_ERR(0, 203, __pyx_L1_error)
+      __PYX_ERR(0, 204, __pyx_L1_error)
     }
     #if CYTHON_ASSUME_SAFE_MACROS && !CYTHON_AVOID_BORROWED_REFS
     if (likely(PyTuple_CheckExact(sequence))) {
@@ -19712,19 +20123,19 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
       __Pyx_INCREF(__pyx_t_6);
     } else {
       __pyx_t_2 = __Pyx_PyList_GET_ITEM_REF(sequence, 0, __Pyx_ReferenceSharing_SharedReference);
-      if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 203, __pyx_L1_error)
+      if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 204, __pyx_L1_error)
       __Pyx_XGOTREF(__pyx_t_2);
       __pyx_t_3 = __Pyx_PyList_GET_ITEM_REF(sequence, 1, __Pyx_ReferenceSharing_SharedReference);
-      if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 203, __pyx_L1_error)
+      if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 204, __pyx_L1_error)
       __Pyx_XGOTREF(__pyx_t_3);
       __pyx_t_4 = __Pyx_PyList_GET_ITEM_REF(sequence, 2, __Pyx_ReferenceSharing_SharedReference);
-      if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 203, __pyx_L1_error)
+      if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 204, __pyx_L1_error)
       __Pyx_XGOTREF(__pyx_t_4);
       __pyx_t_5 = __Pyx_PyList_GET_ITEM_REF(sequence, 3, __Pyx_ReferenceSharing_SharedReference);
-      if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 203, __pyx_L1_error)
+      if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 204, __pyx_L1_error)
       __Pyx_XGOTREF(__pyx_t_5);
       __pyx_t_6 = __Pyx_PyList_GET_ITEM_REF(sequence, 4, __Pyx_ReferenceSharing_SharedReference);
-      if (unlikely(!__pyx_t_6)) __PYX_ERR(0, 203, __pyx_L1_error)
+      if (unlikely(!__pyx_t_6)) __PYX_ERR(0, 204, __pyx_L1_error)
       __Pyx_XGOTREF(__pyx_t_6);
     }
     #else
@@ -19732,7 +20143,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
       Py_ssize_t i;
       PyObject** temps[5] = {&__pyx_t_2,&__pyx_t_3,&__pyx_t_4,&__pyx_t_5,&__pyx_t_6};
       for (i=0; i < 5; i++) {
-        PyObject* item = __Pyx_PySequence_ITEM(sequence, i); if (unlikely(!item)) __PYX_ERR(0, 203, __pyx_L1_error)
+        PyObject* item = __Pyx_PySequence_ITEM(sequence, i); if (unlikely(!item)) __PYX_ERR(0, 204, __pyx_L1_error)
         __Pyx_GOTREF(item);
         *(temps[i]) = item;
       }
@@ -19741,7 +20152,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   } else {
     Py_ssize_t index = -1;
     PyObject** temps[5] = {&__pyx_t_2,&__pyx_t_3,&__pyx_t_4,&__pyx_t_5,&__pyx_t_6};
-    __pyx_t_7 = PyObject_GetIter(__pyx_v_cones); if (unlikely(!__pyx_t_7)) __PYX_ERR(0, 203, __pyx_L1_error)
+    __pyx_t_7 = PyObject_GetIter(__pyx_v_cones); if (unlikely(!__pyx_t_7)) __PYX_ERR(0, 204, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_7);
     __pyx_t_8 = (CYTHON_COMPILING_IN_LIMITED_API) ? PyIter_Next : __Pyx_PyObject_GetIterNextFunc(__pyx_t_7);
     for (index=0; index < 5; index++) {
@@ -19749,7 +20160,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
       __Pyx_GOTREF(item);
       *(temps[index]) = item;
     }
-    if (__Pyx_IternextUnpackEndCheck(__pyx_t_8(__pyx_t_7), 5) < (0)) __PYX_ERR(0, 203, __pyx_L1_error)
+    if (__Pyx_IternextUnpackEndCheck(__pyx_t_8(__pyx_t_7), 5) < (0)) __PYX_ERR(0, 204, __pyx_L1_error)
     __pyx_t_8 = NULL;
     __Pyx_DECREF(__pyx_t_7); __pyx_t_7 = 0;
     goto __pyx_L4_unpacking_done;
@@ -19757,7 +20168,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     __Pyx_DECREF(__pyx_t_7); __pyx_t_7 = 0;
     __pyx_t_8 = NULL;
     if (__Pyx_IterFinish() == 0) __Pyx_RaiseNeedMoreValuesError(index);
-    __PYX_ERR(0, 203, __pyx_L1_error)
+    __PYX_ERR(0, 204, __pyx_L1_error)
     __pyx_L4_unpacking_done:;
   }
   __pyx_v_kind = __pyx_t_2;
@@ -19771,7 +20182,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   __pyx_v_normal = __pyx_t_6;
   __pyx_t_6 = 0;
 
-  /* "fccqp/admm.pyx":204
+  /* "fccqp/admm.pyx":205
  *         self._arrays = []
  *         kind, offset, dim, mu, normal = cones
  *         self._keep = (np.ascontiguousarray(constrained, dtype=np.intp),             # <<<<<<<<<<<<<<
@@ -19779,14 +20190,14 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
  *                       np.ascontiguousarray(offset, dtype=np.intp),
 */
   __pyx_t_5 = NULL;
-  __Pyx_GetModuleGlobalName(__pyx_t_4, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 204, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_4, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 205, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_4);
-  __pyx_t_3 = __Pyx_PyObject_GetAttrStr(__pyx_t_4, __pyx_mstate_global->__pyx_n_u_ascontiguousarray); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 204, __pyx_L1_error)
+  __pyx_t_3 = __Pyx_PyObject_GetAttrStr(__pyx_t_4, __pyx_mstate_global->__pyx_n_u_ascontiguousarray); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 205, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_3);
   __Pyx_DECREF(__pyx_t_4); __pyx_t_4 = 0;
-  __Pyx_GetModuleGlobalName(__pyx_t_4, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 204, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_4, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 205, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_4);
-  __pyx_t_2 = __Pyx_PyObject_GetAttrStr(__pyx_t_4, __pyx_mstate_global->__pyx_n_u_intp); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 204, __pyx_L1_error)
+  __pyx_t_2 = __Pyx_PyObject_GetAttrStr(__pyx_t_4, __pyx_mstate_global->__pyx_n_u_intp); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 205, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_2);
   __Pyx_DECREF(__pyx_t_4); __pyx_t_4 = 0;
   #if CYTHON_VECTORCALL
@@ -19807,13 +20218,13 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     PyObject *__pyx_callargs[3] = {__pyx_t_5, __pyx_v_constrained, __pyx_t_2};
     #if CYTHON_VECTORCALL
     __pyx_t_4 = __pyx_mstate_global->__pyx_tuple[2];
-    if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 204, __pyx_L1_error)
+    if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 205, __pyx_L1_error)
     __Pyx_INCREF(__pyx_t_4);
     #else
     {
       PyObject *__pyx_temp[1] = {__pyx_mstate_global->__pyx_n_u_dtype};
       __pyx_t_4 = __Pyx_MakeKwargDict(__pyx_temp, __pyx_callargs+2, 1);
-      if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 204, __pyx_L1_error)
+      if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 205, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_4);
     }
     #endif
@@ -19824,11 +20235,11 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     __Pyx_DECREF(__pyx_t_2); __pyx_t_2 = 0;
     __Pyx_DECREF(__pyx_t_4); __pyx_t_4 = 0;
     __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
-    if (unlikely(!__pyx_t_6)) __PYX_ERR(0, 204, __pyx_L1_error)
+    if (unlikely(!__pyx_t_6)) __PYX_ERR(0, 205, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_6);
   }
 
-  /* "fccqp/admm.pyx":205
+  /* "fccqp/admm.pyx":206
  *         kind, offset, dim, mu, normal = cones
  *         self._keep = (np.ascontiguousarray(constrained, dtype=np.intp),
  *                       np.ascontiguousarray(kind, dtype=np.intp),             # <<<<<<<<<<<<<<
@@ -19836,14 +20247,14 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
  *                       np.ascontiguousarray(dim, dtype=np.intp),
 */
   __pyx_t_4 = NULL;
-  __Pyx_GetModuleGlobalName(__pyx_t_2, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 205, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_2, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 206, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_2);
-  __pyx_t_5 = __Pyx_PyObject_GetAttrStr(__pyx_t_2, __pyx_mstate_global->__pyx_n_u_ascontiguousarray); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 205, __pyx_L1_error)
+  __pyx_t_5 = __Pyx_PyObject_GetAttrStr(__pyx_t_2, __pyx_mstate_global->__pyx_n_u_ascontiguousarray); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 206, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_5);
   __Pyx_DECREF(__pyx_t_2); __pyx_t_2 = 0;
-  __Pyx_GetModuleGlobalName(__pyx_t_2, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 205, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_2, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 206, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_2);
-  __pyx_t_7 = __Pyx_PyObject_GetAttrStr(__pyx_t_2, __pyx_mstate_global->__pyx_n_u_intp); if (unlikely(!__pyx_t_7)) __PYX_ERR(0, 205, __pyx_L1_error)
+  __pyx_t_7 = __Pyx_PyObject_GetAttrStr(__pyx_t_2, __pyx_mstate_global->__pyx_n_u_intp); if (unlikely(!__pyx_t_7)) __PYX_ERR(0, 206, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_7);
   __Pyx_DECREF(__pyx_t_2); __pyx_t_2 = 0;
   #if CYTHON_VECTORCALL
@@ -19864,13 +20275,13 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     PyObject *__pyx_callargs[3] = {__pyx_t_4, __pyx_v_kind, __pyx_t_7};
     #if CYTHON_VECTORCALL
     __pyx_t_2 = __pyx_mstate_global->__pyx_tuple[2];
-    if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 205, __pyx_L1_error)
+    if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 206, __pyx_L1_error)
     __Pyx_INCREF(__pyx_t_2);
     #else
     {
       PyObject *__pyx_temp[1] = {__pyx_mstate_global->__pyx_n_u_dtype};
       __pyx_t_2 = __Pyx_MakeKwargDict(__pyx_temp, __pyx_callargs+2, 1);
-      if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 205, __pyx_L1_error)
+      if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 206, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_2);
     }
     #endif
@@ -19881,11 +20292,11 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     __Pyx_DECREF(__pyx_t_7); __pyx_t_7 = 0;
     __Pyx_DECREF(__pyx_t_2); __pyx_t_2 = 0;
     __Pyx_DECREF(__pyx_t_5); __pyx_t_5 = 0;
-    if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 205, __pyx_L1_error)
+    if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 206, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_3);
   }
 
-  /* "fccqp/admm.pyx":206
+  /* "fccqp/admm.pyx":207
  *         self._keep = (np.ascontiguousarray(constrained, dtype=np.intp),
  *                       np.ascontiguousarray(kind, dtype=np.intp),
  *                       np.ascontiguousarray(offset, dtype=np.intp),             # <<<<<<<<<<<<<<
@@ -19893,14 +20304,14 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
  *                       np.ascontiguousarray(mu, dtype=np.float64),
 */
   __pyx_t_2 = NULL;
-  __Pyx_GetModuleGlobalName(__pyx_t_7, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_7)) __PYX_ERR(0, 206, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_7, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_7)) __PYX_ERR(0, 207, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_7);
-  __pyx_t_4 = __Pyx_PyObject_GetAttrStr(__pyx_t_7, __pyx_mstate_global->__pyx_n_u_ascontiguousarray); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 206, __pyx_L1_error)
+  __pyx_t_4 = __Pyx_PyObject_GetAttrStr(__pyx_t_7, __pyx_mstate_global->__pyx_n_u_ascontiguousarray); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 207, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_4);
   __Pyx_DECREF(__pyx_t_7); __pyx_t_7 = 0;
-  __Pyx_GetModuleGlobalName(__pyx_t_7, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_7)) __PYX_ERR(0, 206, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_7, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_7)) __PYX_ERR(0, 207, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_7);
-  __pyx_t_10 = __Pyx_PyObject_GetAttrStr(__pyx_t_7, __pyx_mstate_global->__pyx_n_u_intp); if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 206, __pyx_L1_error)
+  __pyx_t_10 = __Pyx_PyObject_GetAttrStr(__pyx_t_7, __pyx_mstate_global->__pyx_n_u_intp); if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 207, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_10);
   __Pyx_DECREF(__pyx_t_7); __pyx_t_7 = 0;
   #if CYTHON_VECTORCALL
@@ -19921,13 +20332,13 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     PyObject *__pyx_callargs[3] = {__pyx_t_2, __pyx_v_offset, __pyx_t_10};
     #if CYTHON_VECTORCALL
     __pyx_t_7 = __pyx_mstate_global->__pyx_tuple[2];
-    if (unlikely(!__pyx_t_7)) __PYX_ERR(0, 206, __pyx_L1_error)
+    if (unlikely(!__pyx_t_7)) __PYX_ERR(0, 207, __pyx_L1_error)
     __Pyx_INCREF(__pyx_t_7);
     #else
     {
       PyObject *__pyx_temp[1] = {__pyx_mstate_global->__pyx_n_u_dtype};
       __pyx_t_7 = __Pyx_MakeKwargDict(__pyx_temp, __pyx_callargs+2, 1);
-      if (unlikely(!__pyx_t_7)) __PYX_ERR(0, 206, __pyx_L1_error)
+      if (unlikely(!__pyx_t_7)) __PYX_ERR(0, 207, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_7);
     }
     #endif
@@ -19938,11 +20349,11 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     __Pyx_DECREF(__pyx_t_10); __pyx_t_10 = 0;
     __Pyx_DECREF(__pyx_t_7); __pyx_t_7 = 0;
     __Pyx_DECREF(__pyx_t_4); __pyx_t_4 = 0;
-    if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 206, __pyx_L1_error)
+    if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 207, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_5);
   }
 
-  /* "fccqp/admm.pyx":207
+  /* "fccqp/admm.pyx":208
  *                       np.ascontiguousarray(kind, dtype=np.intp),
  *                       np.ascontiguousarray(offset, dtype=np.intp),
  *                       np.ascontiguousarray(dim, dtype=np.intp),             # <<<<<<<<<<<<<<
@@ -19950,14 +20361,14 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
  *                       np.ascontiguousarray(normal, dtype=np.float64).reshape(-1),
 */
   __pyx_t_7 = NULL;
-  __Pyx_GetModuleGlobalName(__pyx_t_10, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 207, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_10, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 208, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_10);
-  __pyx_t_2 = __Pyx_PyObject_GetAttrStr(__pyx_t_10, __pyx_mstate_global->__pyx_n_u_ascontiguousarray); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 207, __pyx_L1_error)
+  __pyx_t_2 = __Pyx_PyObject_GetAttrStr(__pyx_t_10, __pyx_mstate_global->__pyx_n_u_ascontiguousarray); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 208, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_2);
   __Pyx_DECREF(__pyx_t_10); __pyx_t_10 = 0;
-  __Pyx_GetModuleGlobalName(__pyx_t_10, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 207, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_10, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 208, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_10);
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_t_10, __pyx_mstate_global->__pyx_n_u_intp); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 207, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_t_10, __pyx_mstate_global->__pyx_n_u_intp); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 208, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
   __Pyx_DECREF(__pyx_t_10); __pyx_t_10 = 0;
   #if CYTHON_VECTORCALL
@@ -19978,13 +20389,13 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     PyObject *__pyx_callargs[3] = {__pyx_t_7, __pyx_v_dim, __pyx_t_11};
     #if CYTHON_VECTORCALL
     __pyx_t_10 = __pyx_mstate_global->__pyx_tuple[2];
-    if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 207, __pyx_L1_error)
+    if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 208, __pyx_L1_error)
     __Pyx_INCREF(__pyx_t_10);
     #else
     {
       PyObject *__pyx_temp[1] = {__pyx_mstate_global->__pyx_n_u_dtype};
       __pyx_t_10 = __Pyx_MakeKwargDict(__pyx_temp, __pyx_callargs+2, 1);
-      if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 207, __pyx_L1_error)
+      if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 208, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_10);
     }
     #endif
@@ -19995,11 +20406,11 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
     __Pyx_DECREF(__pyx_t_10); __pyx_t_10 = 0;
     __Pyx_DECREF(__pyx_t_2); __pyx_t_2 = 0;
-    if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 207, __pyx_L1_error)
+    if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 208, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_4);
   }
 
-  /* "fccqp/admm.pyx":208
+  /* "fccqp/admm.pyx":209
  *                       np.ascontiguousarray(offset, dtype=np.intp),
  *                       np.ascontiguousarray(dim, dtype=np.intp),
  *                       np.ascontiguousarray(mu, dtype=np.float64),             # <<<<<<<<<<<<<<
@@ -20007,14 +20418,14 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
  *                       np.ascontiguousarray(order, dtype=np.intp),
 */
   __pyx_t_10 = NULL;
-  __Pyx_GetModuleGlobalName(__pyx_t_11, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 208, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_11, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 209, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_7 = __Pyx_PyObject_GetAttrStr(__pyx_t_11, __pyx_mstate_global->__pyx_n_u_ascontiguousarray); if (unlikely(!__pyx_t_7)) __PYX_ERR(0, 208, __pyx_L1_error)
+  __pyx_t_7 = __Pyx_PyObject_GetAttrStr(__pyx_t_11, __pyx_mstate_global->__pyx_n_u_ascontiguousarray); if (unlikely(!__pyx_t_7)) __PYX_ERR(0, 209, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_7);
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __Pyx_GetModuleGlobalName(__pyx_t_11, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 208, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_11, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 209, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_12 = __Pyx_PyObject_GetAttrStr(__pyx_t_11, __pyx_mstate_global->__pyx_n_u_float64); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 208, __pyx_L1_error)
+  __pyx_t_12 = __Pyx_PyObject_GetAttrStr(__pyx_t_11, __pyx_mstate_global->__pyx_n_u_float64); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 209, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_12);
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   #if CYTHON_VECTORCALL
@@ -20035,13 +20446,13 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     PyObject *__pyx_callargs[3] = {__pyx_t_10, __pyx_v_mu, __pyx_t_12};
     #if CYTHON_VECTORCALL
     __pyx_t_11 = __pyx_mstate_global->__pyx_tuple[2];
-    if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 208, __pyx_L1_error)
+    if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 209, __pyx_L1_error)
     __Pyx_INCREF(__pyx_t_11);
     #else
     {
       PyObject *__pyx_temp[1] = {__pyx_mstate_global->__pyx_n_u_dtype};
       __pyx_t_11 = __Pyx_MakeKwargDict(__pyx_temp, __pyx_callargs+2, 1);
-      if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 208, __pyx_L1_error)
+      if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 209, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_11);
     }
     #endif
@@ -20052,11 +20463,11 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     __Pyx_DECREF(__pyx_t_12); __pyx_t_12 = 0;
     __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
     __Pyx_DECREF(__pyx_t_7); __pyx_t_7 = 0;
-    if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 208, __pyx_L1_error)
+    if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 209, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_2);
   }
 
-  /* "fccqp/admm.pyx":209
+  /* "fccqp/admm.pyx":210
  *                       np.ascontiguousarray(dim, dtype=np.intp),
  *                       np.ascontiguousarray(mu, dtype=np.float64),
  *                       np.ascontiguousarray(normal, dtype=np.float64).reshape(-1),             # <<<<<<<<<<<<<<
@@ -20064,14 +20475,14 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
  *                       np.zeros(max(len(kind), 1), dtype=np.intp))
 */
   __pyx_t_10 = NULL;
-  __Pyx_GetModuleGlobalName(__pyx_t_13, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_13)) __PYX_ERR(0, 209, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_13, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_13)) __PYX_ERR(0, 210, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_13);
-  __pyx_t_14 = __Pyx_PyObject_GetAttrStr(__pyx_t_13, __pyx_mstate_global->__pyx_n_u_ascontiguousarray); if (unlikely(!__pyx_t_14)) __PYX_ERR(0, 209, __pyx_L1_error)
+  __pyx_t_14 = __Pyx_PyObject_GetAttrStr(__pyx_t_13, __pyx_mstate_global->__pyx_n_u_ascontiguousarray); if (unlikely(!__pyx_t_14)) __PYX_ERR(0, 210, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_14);
   __Pyx_DECREF(__pyx_t_13); __pyx_t_13 = 0;
-  __Pyx_GetModuleGlobalName(__pyx_t_13, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_13)) __PYX_ERR(0, 209, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_13, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_13)) __PYX_ERR(0, 210, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_13);
-  __pyx_t_15 = __Pyx_PyObject_GetAttrStr(__pyx_t_13, __pyx_mstate_global->__pyx_n_u_float64); if (unlikely(!__pyx_t_15)) __PYX_ERR(0, 209, __pyx_L1_error)
+  __pyx_t_15 = __Pyx_PyObject_GetAttrStr(__pyx_t_13, __pyx_mstate_global->__pyx_n_u_float64); if (unlikely(!__pyx_t_15)) __PYX_ERR(0, 210, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_15);
   __Pyx_DECREF(__pyx_t_13); __pyx_t_13 = 0;
   #if CYTHON_VECTORCALL
@@ -20092,13 +20503,13 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     PyObject *__pyx_callargs[3] = {__pyx_t_10, __pyx_v_normal, __pyx_t_15};
     #if CYTHON_VECTORCALL
     __pyx_t_13 = __pyx_mstate_global->__pyx_tuple[2];
-    if (unlikely(!__pyx_t_13)) __PYX_ERR(0, 209, __pyx_L1_error)
+    if (unlikely(!__pyx_t_13)) __PYX_ERR(0, 210, __pyx_L1_error)
     __Pyx_INCREF(__pyx_t_13);
     #else
     {
       PyObject *__pyx_temp[1] = {__pyx_mstate_global->__pyx_n_u_dtype};
       __pyx_t_13 = __Pyx_MakeKwargDict(__pyx_temp, __pyx_callargs+2, 1);
-      if (unlikely(!__pyx_t_13)) __PYX_ERR(0, 209, __pyx_L1_error)
+      if (unlikely(!__pyx_t_13)) __PYX_ERR(0, 210, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_13);
     }
     #endif
@@ -20109,7 +20520,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     __Pyx_DECREF(__pyx_t_15); __pyx_t_15 = 0;
     __Pyx_DECREF(__pyx_t_13); __pyx_t_13 = 0;
     __Pyx_DECREF(__pyx_t_14); __pyx_t_14 = 0;
-    if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 209, __pyx_L1_error)
+    if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 210, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_12);
   }
   __pyx_t_11 = __pyx_t_12;
@@ -20120,11 +20531,11 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     __pyx_t_7 = __Pyx_PyObject_FastCallMethod((PyObject*)__pyx_mstate_global->__pyx_n_u_reshape, __pyx_callargs+__pyx_t_9, (2-__pyx_t_9) | (1*__Pyx_PY_VECTORCALL_ARGUMENTS_OFFSET));
     __Pyx_XDECREF(__pyx_t_11); __pyx_t_11 = 0;
     __Pyx_DECREF(__pyx_t_12); __pyx_t_12 = 0;
-    if (unlikely(!__pyx_t_7)) __PYX_ERR(0, 209, __pyx_L1_error)
+    if (unlikely(!__pyx_t_7)) __PYX_ERR(0, 210, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_7);
   }
 
-  /* "fccqp/admm.pyx":210
+  /* "fccqp/admm.pyx":211
  *                       np.ascontiguousarray(mu, dtype=np.float64),
  *                       np.ascontiguousarray(normal, dtype=np.float64).reshape(-1),
  *                       np.ascontiguousarray(order, dtype=np.intp),             # <<<<<<<<<<<<<<
@@ -20132,14 +20543,14 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
  *         cdef Py_ssize_t[::1] c_view = self._keep[0], kind_v = self._keep[1]
 */
   __pyx_t_11 = NULL;
-  __Pyx_GetModuleGlobalName(__pyx_t_14, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_14)) __PYX_ERR(0, 210, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_14, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_14)) __PYX_ERR(0, 211, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_14);
-  __pyx_t_13 = __Pyx_PyObject_GetAttrStr(__pyx_t_14, __pyx_mstate_global->__pyx_n_u_ascontiguousarray); if (unlikely(!__pyx_t_13)) __PYX_ERR(0, 210, __pyx_L1_error)
+  __pyx_t_13 = __Pyx_PyObject_GetAttrStr(__pyx_t_14, __pyx_mstate_global->__pyx_n_u_ascontiguousarray); if (unlikely(!__pyx_t_13)) __PYX_ERR(0, 211, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_13);
   __Pyx_DECREF(__pyx_t_14); __pyx_t_14 = 0;
-  __Pyx_GetModuleGlobalName(__pyx_t_14, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_14)) __PYX_ERR(0, 210, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_14, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_14)) __PYX_ERR(0, 211, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_14);
-  __pyx_t_15 = __Pyx_PyObject_GetAttrStr(__pyx_t_14, __pyx_mstate_global->__pyx_n_u_intp); if (unlikely(!__pyx_t_15)) __PYX_ERR(0, 210, __pyx_L1_error)
+  __pyx_t_15 = __Pyx_PyObject_GetAttrStr(__pyx_t_14, __pyx_mstate_global->__pyx_n_u_intp); if (unlikely(!__pyx_t_15)) __PYX_ERR(0, 211, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_15);
   __Pyx_DECREF(__pyx_t_14); __pyx_t_14 = 0;
   #if CYTHON_VECTORCALL
@@ -20160,13 +20571,13 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     PyObject *__pyx_callargs[3] = {__pyx_t_11, __pyx_v_order, __pyx_t_15};
     #if CYTHON_VECTORCALL
     __pyx_t_14 = __pyx_mstate_global->__pyx_tuple[2];
-    if (unlikely(!__pyx_t_14)) __PYX_ERR(0, 210, __pyx_L1_error)
+    if (unlikely(!__pyx_t_14)) __PYX_ERR(0, 211, __pyx_L1_error)
     __Pyx_INCREF(__pyx_t_14);
     #else
     {
       PyObject *__pyx_temp[1] = {__pyx_mstate_global->__pyx_n_u_dtype};
       __pyx_t_14 = __Pyx_MakeKwargDict(__pyx_temp, __pyx_callargs+2, 1);
-      if (unlikely(!__pyx_t_14)) __PYX_ERR(0, 210, __pyx_L1_error)
+      if (unlikely(!__pyx_t_14)) __PYX_ERR(0, 211, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_14);
     }
     #endif
@@ -20177,11 +20588,11 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     __Pyx_DECREF(__pyx_t_15); __pyx_t_15 = 0;
     __Pyx_DECREF(__pyx_t_14); __pyx_t_14 = 0;
     __Pyx_DECREF(__pyx_t_13); __pyx_t_13 = 0;
-    if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 210, __pyx_L1_error)
+    if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 211, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_12);
   }
 
-  /* "fccqp/admm.pyx":211
+  /* "fccqp/admm.pyx":212
  *                       np.ascontiguousarray(normal, dtype=np.float64).reshape(-1),
  *                       np.ascontiguousarray(order, dtype=np.intp),
  *                       np.zeros(max(len(kind), 1), dtype=np.intp))             # <<<<<<<<<<<<<<
@@ -20189,14 +20600,14 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
  *         cdef Py_ssize_t[::1] offset_v = self._keep[2], dim_v = self._keep[3]
 */
   __pyx_t_14 = NULL;
-  __Pyx_GetModuleGlobalName(__pyx_t_15, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_15)) __PYX_ERR(0, 211, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_15, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_15)) __PYX_ERR(0, 212, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_15);
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_t_15, __pyx_mstate_global->__pyx_n_u_zeros); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 211, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_t_15, __pyx_mstate_global->__pyx_n_u_zeros); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 212, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
   __Pyx_DECREF(__pyx_t_15); __pyx_t_15 = 0;
 
   __pyx_t_16 = 1;
-  __pyx_t_1 = PyObject_Length(__pyx_v_kind); if (unlikely(__pyx_t_1 == ((Py_ssize_t)-1))) __PYX_ERR(0, 211, __pyx_L1_error)
+  __pyx_t_1 = PyObject_Length(__pyx_v_kind); if (unlikely(__pyx_t_1 == ((Py_ssize_t)-1))) __PYX_ERR(0, 212, __pyx_L1_error)
   __pyx_t_18 = (__pyx_t_16 > __pyx_t_1);
 
   if (__pyx_t_18) {
@@ -20208,12 +20619,12 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   }
 
 
-  __pyx_t_15 = PyLong_FromSsize_t(__pyx_t_17); if (unlikely(!__pyx_t_15)) __PYX_ERR(0, 211, __pyx_L1_error)
+  __pyx_t_15 = PyLong_FromSsize_t(__pyx_t_17); if (unlikely(!__pyx_t_15)) __PYX_ERR(0, 212, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_15);
 
-  __Pyx_GetModuleGlobalName(__pyx_t_10, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 211, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_10, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 212, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_10);
-  __pyx_t_19 = __Pyx_PyObject_GetAttrStr(__pyx_t_10, __pyx_mstate_global->__pyx_n_u_intp); if (unlikely(!__pyx_t_19)) __PYX_ERR(0, 211, __pyx_L1_error)
+  __pyx_t_19 = __Pyx_PyObject_GetAttrStr(__pyx_t_10, __pyx_mstate_global->__pyx_n_u_intp); if (unlikely(!__pyx_t_19)) __PYX_ERR(0, 212, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_19);
   __Pyx_DECREF(__pyx_t_10); __pyx_t_10 = 0;
   #if CYTHON_VECTORCALL
@@ -20234,13 +20645,13 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     PyObject *__pyx_callargs[3] = {__pyx_t_14, __pyx_t_15, __pyx_t_19};
     #if CYTHON_VECTORCALL
     __pyx_t_10 = __pyx_mstate_global->__pyx_tuple[2];
-    if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 211, __pyx_L1_error)
+    if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 212, __pyx_L1_error)
     __Pyx_INCREF(__pyx_t_10);
     #else
     {
       PyObject *__pyx_temp[1] = {__pyx_mstate_global->__pyx_n_u_dtype};
       __pyx_t_10 = __Pyx_MakeKwargDict(__pyx_temp, __pyx_callargs+2, 1);
-      if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 211, __pyx_L1_error)
+      if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 212, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_10);
     }
     #endif
@@ -20252,35 +20663,35 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     __Pyx_DECREF(__pyx_t_19); __pyx_t_19 = 0;
     __Pyx_DECREF(__pyx_t_10); __pyx_t_10 = 0;
     __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-    if (unlikely(!__pyx_t_13)) __PYX_ERR(0, 211, __pyx_L1_error)
+    if (unlikely(!__pyx_t_13)) __PYX_ERR(0, 212, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_13);
   }
 
-  /* "fccqp/admm.pyx":204
+  /* "fccqp/admm.pyx":205
  *         self._arrays = []
  *         kind, offset, dim, mu, normal = cones
  *         self._keep = (np.ascontiguousarray(constrained, dtype=np.intp),             # <<<<<<<<<<<<<<
  *                       np.ascontiguousarray(kind, dtype=np.intp),
  *                       np.ascontiguousarray(offset, dtype=np.intp),
 */
-  __pyx_t_11 = PyTuple_New(8); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 204, __pyx_L1_error)
+  __pyx_t_11 = PyTuple_New(8); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 205, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
   __Pyx_GIVEREF(__pyx_t_6);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_11, 0, __pyx_t_6) != (0)) __PYX_ERR(0, 204, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_11, 0, __pyx_t_6) != (0)) __PYX_ERR(0, 205, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_3);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_11, 1, __pyx_t_3) != (0)) __PYX_ERR(0, 204, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_11, 1, __pyx_t_3) != (0)) __PYX_ERR(0, 205, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_5);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_11, 2, __pyx_t_5) != (0)) __PYX_ERR(0, 204, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_11, 2, __pyx_t_5) != (0)) __PYX_ERR(0, 205, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_4);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_11, 3, __pyx_t_4) != (0)) __PYX_ERR(0, 204, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_11, 3, __pyx_t_4) != (0)) __PYX_ERR(0, 205, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_2);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_11, 4, __pyx_t_2) != (0)) __PYX_ERR(0, 204, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_11, 4, __pyx_t_2) != (0)) __PYX_ERR(0, 205, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_7);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_11, 5, __pyx_t_7) != (0)) __PYX_ERR(0, 204, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_11, 5, __pyx_t_7) != (0)) __PYX_ERR(0, 205, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_12);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_11, 6, __pyx_t_12) != (0)) __PYX_ERR(0, 204, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_11, 6, __pyx_t_12) != (0)) __PYX_ERR(0, 205, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_13);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_11, 7, __pyx_t_13) != (0)) __PYX_ERR(0, 204, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_11, 7, __pyx_t_13) != (0)) __PYX_ERR(0, 205, __pyx_L1_error);
   __pyx_t_6 = 0;
   __pyx_t_3 = 0;
   __pyx_t_5 = 0;
@@ -20294,95 +20705,95 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   __Pyx_DECREF_SET(__pyx_v_self->_keep, __pyx_t_11);
   __pyx_t_11 = 0;
 
-  /* "fccqp/admm.pyx":212
+  /* "fccqp/admm.pyx":213
  *                       np.ascontiguousarray(order, dtype=np.intp),
  *                       np.zeros(max(len(kind), 1), dtype=np.intp))
  *         cdef Py_ssize_t[::1] c_view = self._keep[0], kind_v = self._keep[1]             # <<<<<<<<<<<<<<
  *         cdef Py_ssize_t[::1] offset_v = self._keep[2], dim_v = self._keep[3]
  *         cdef Py_ssize_t[::1] order_v = self._keep[6], start_v = self._keep[7]
 */
-  __pyx_t_11 = __Pyx_GetItemInt(__pyx_v_self->_keep, 0, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 212, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_GetItemInt(__pyx_v_self->_keep, 0, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 213, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_20 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(__pyx_t_11, PyBUF_WRITABLE); if (unlikely(!__pyx_t_20.memview)) __PYX_ERR(0, 212, __pyx_L1_error)
+  __pyx_t_20 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(__pyx_t_11, PyBUF_WRITABLE); if (unlikely(!__pyx_t_20.memview)) __PYX_ERR(0, 213, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   __pyx_v_c_view = __pyx_t_20;
   __pyx_t_20.memview = NULL;
   __pyx_t_20.data = NULL;
-  __pyx_t_11 = __Pyx_GetItemInt(__pyx_v_self->_keep, 1, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 212, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_GetItemInt(__pyx_v_self->_keep, 1, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 213, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_20 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(__pyx_t_11, PyBUF_WRITABLE); if (unlikely(!__pyx_t_20.memview)) __PYX_ERR(0, 212, __pyx_L1_error)
+  __pyx_t_20 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(__pyx_t_11, PyBUF_WRITABLE); if (unlikely(!__pyx_t_20.memview)) __PYX_ERR(0, 213, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   __pyx_v_kind_v = __pyx_t_20;
   __pyx_t_20.memview = NULL;
   __pyx_t_20.data = NULL;
 
-  /* "fccqp/admm.pyx":213
+  /* "fccqp/admm.pyx":214
  *                       np.zeros(max(len(kind), 1), dtype=np.intp))
  *         cdef Py_ssize_t[::1] c_view = self._keep[0], kind_v = self._keep[1]
  *         cdef Py_ssize_t[::1] offset_v = self._keep[2], dim_v = self._keep[3]             # <<<<<<<<<<<<<<
  *         cdef Py_ssize_t[::1] order_v = self._keep[6], start_v = self._keep[7]
  *         cdef double[::1] mu_v = self._keep[4], normal_v = self._keep[5]
 */
-  __pyx_t_11 = __Pyx_GetItemInt(__pyx_v_self->_keep, 2, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 213, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_GetItemInt(__pyx_v_self->_keep, 2, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 214, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_20 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(__pyx_t_11, PyBUF_WRITABLE); if (unlikely(!__pyx_t_20.memview)) __PYX_ERR(0, 213, __pyx_L1_error)
+  __pyx_t_20 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(__pyx_t_11, PyBUF_WRITABLE); if (unlikely(!__pyx_t_20.memview)) __PYX_ERR(0, 214, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   __pyx_v_offset_v = __pyx_t_20;
   __pyx_t_20.memview = NULL;
   __pyx_t_20.data = NULL;
-  __pyx_t_11 = __Pyx_GetItemInt(__pyx_v_self->_keep, 3, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 213, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_GetItemInt(__pyx_v_self->_keep, 3, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 214, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_20 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(__pyx_t_11, PyBUF_WRITABLE); if (unlikely(!__pyx_t_20.memview)) __PYX_ERR(0, 213, __pyx_L1_error)
+  __pyx_t_20 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(__pyx_t_11, PyBUF_WRITABLE); if (unlikely(!__pyx_t_20.memview)) __PYX_ERR(0, 214, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   __pyx_v_dim_v = __pyx_t_20;
   __pyx_t_20.memview = NULL;
   __pyx_t_20.data = NULL;
 
-  /* "fccqp/admm.pyx":214
+  /* "fccqp/admm.pyx":215
  *         cdef Py_ssize_t[::1] c_view = self._keep[0], kind_v = self._keep[1]
  *         cdef Py_ssize_t[::1] offset_v = self._keep[2], dim_v = self._keep[3]
  *         cdef Py_ssize_t[::1] order_v = self._keep[6], start_v = self._keep[7]             # <<<<<<<<<<<<<<
  *         cdef double[::1] mu_v = self._keep[4], normal_v = self._keep[5]
  *         p = &self.prob
 */
-  __pyx_t_11 = __Pyx_GetItemInt(__pyx_v_self->_keep, 6, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 214, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_GetItemInt(__pyx_v_self->_keep, 6, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 215, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_20 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(__pyx_t_11, PyBUF_WRITABLE); if (unlikely(!__pyx_t_20.memview)) __PYX_ERR(0, 214, __pyx_L1_error)
+  __pyx_t_20 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(__pyx_t_11, PyBUF_WRITABLE); if (unlikely(!__pyx_t_20.memview)) __PYX_ERR(0, 215, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   __pyx_v_order_v = __pyx_t_20;
   __pyx_t_20.memview = NULL;
   __pyx_t_20.data = NULL;
-  __pyx_t_11 = __Pyx_GetItemInt(__pyx_v_self->_keep, 7, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 214, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_GetItemInt(__pyx_v_self->_keep, 7, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 215, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_20 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(__pyx_t_11, PyBUF_WRITABLE); if (unlikely(!__pyx_t_20.memview)) __PYX_ERR(0, 214, __pyx_L1_error)
+  __pyx_t_20 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(__pyx_t_11, PyBUF_WRITABLE); if (unlikely(!__pyx_t_20.memview)) __PYX_ERR(0, 215, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   __pyx_v_start_v = __pyx_t_20;
   __pyx_t_20.memview = NULL;
   __pyx_t_20.data = NULL;
 
-  /* "fccqp/admm.pyx":215
+  /* "fccqp/admm.pyx":216
  *         cdef Py_ssize_t[::1] offset_v = self._keep[2], dim_v = self._keep[3]
  *         cdef Py_ssize_t[::1] order_v = self._keep[6], start_v = self._keep[7]
  *         cdef double[::1] mu_v = self._keep[4], normal_v = self._keep[5]             # <<<<<<<<<<<<<<
  *         p = &self.prob
  *         p.n, p.m, p.s = n, m, s
 */
-  __pyx_t_11 = __Pyx_GetItemInt(__pyx_v_self->_keep, 4, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 215, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_GetItemInt(__pyx_v_self->_keep, 4, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 216, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_21 = __Pyx_PyObject_to_MemoryviewSlice_dc_double(__pyx_t_11, PyBUF_WRITABLE); if (unlikely(!__pyx_t_21.memview)) __PYX_ERR(0, 215, __pyx_L1_error)
+  __pyx_t_21 = __Pyx_PyObject_to_MemoryviewSlice_dc_double(__pyx_t_11, PyBUF_WRITABLE); if (unlikely(!__pyx_t_21.memview)) __PYX_ERR(0, 216, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   __pyx_v_mu_v = __pyx_t_21;
   __pyx_t_21.memview = NULL;
   __pyx_t_21.data = NULL;
-  __pyx_t_11 = __Pyx_GetItemInt(__pyx_v_self->_keep, 5, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 215, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_GetItemInt(__pyx_v_self->_keep, 5, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 216, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_21 = __Pyx_PyObject_to_MemoryviewSlice_dc_double(__pyx_t_11, PyBUF_WRITABLE); if (unlikely(!__pyx_t_21.memview)) __PYX_ERR(0, 215, __pyx_L1_error)
+  __pyx_t_21 = __Pyx_PyObject_to_MemoryviewSlice_dc_double(__pyx_t_11, PyBUF_WRITABLE); if (unlikely(!__pyx_t_21.memview)) __PYX_ERR(0, 216, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   __pyx_v_normal_v = __pyx_t_21;
   __pyx_t_21.memview = NULL;
   __pyx_t_21.data = NULL;
 
-  /* "fccqp/admm.pyx":216
+  /* "fccqp/admm.pyx":217
  *         cdef Py_ssize_t[::1] order_v = self._keep[6], start_v = self._keep[7]
  *         cdef double[::1] mu_v = self._keep[4], normal_v = self._keep[5]
  *         p = &self.prob             # <<<<<<<<<<<<<<
@@ -20391,7 +20802,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":217
+  /* "fccqp/admm.pyx":218
  *         cdef double[::1] mu_v = self._keep[4], normal_v = self._keep[5]
  *         p = &self.prob
  *         p.n, p.m, p.s = n, m, s             # <<<<<<<<<<<<<<
@@ -20408,7 +20819,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   __pyx_v_p->m = __pyx_t_1;
   __pyx_v_p->s = __pyx_t_22;
 
-  /* "fccqp/admm.pyx":218
+  /* "fccqp/admm.pyx":219
  *         p = &self.prob
  *         p.n, p.m, p.s = n, m, s
  *         p.constrained = &c_view[0] if s else NULL             # <<<<<<<<<<<<<<
@@ -20428,17 +20839,17 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 
   __pyx_v_p->constrained = __pyx_t_23;
 
-  /* "fccqp/admm.pyx":219
+  /* "fccqp/admm.pyx":220
  *         p.n, p.m, p.s = n, m, s
  *         p.constrained = &c_view[0] if s else NULL
  *         p.cones.count = len(kind)             # <<<<<<<<<<<<<<
  *         if p.cones.count:
  *             p.cones.kind, p.cones.offset, p.cones.dim = &kind_v[0], &offset_v[0], &dim_v[0]
 */
-  __pyx_t_22 = PyObject_Length(__pyx_v_kind); if (unlikely(__pyx_t_22 == ((Py_ssize_t)-1))) __PYX_ERR(0, 219, __pyx_L1_error)
+  __pyx_t_22 = PyObject_Length(__pyx_v_kind); if (unlikely(__pyx_t_22 == ((Py_ssize_t)-1))) __PYX_ERR(0, 220, __pyx_L1_error)
   __pyx_v_p->cones.count = __pyx_t_22;
 
-  /* "fccqp/admm.pyx":220
+  /* "fccqp/admm.pyx":221
  *         p.constrained = &c_view[0] if s else NULL
  *         p.cones.count = len(kind)
  *         if p.cones.count:             # <<<<<<<<<<<<<<
@@ -20450,7 +20861,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_18) {
 
 
-    /* "fccqp/admm.pyx":221
+    /* "fccqp/admm.pyx":222
  *         p.cones.count = len(kind)
  *         if p.cones.count:
  *             p.cones.kind, p.cones.offset, p.cones.dim = &kind_v[0], &offset_v[0], &dim_v[0]             # <<<<<<<<<<<<<<
@@ -20470,7 +20881,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     __pyx_v_p->cones.offset = __pyx_t_25;
     __pyx_v_p->cones.dim = __pyx_t_26;
 
-    /* "fccqp/admm.pyx":222
+    /* "fccqp/admm.pyx":223
  *         if p.cones.count:
  *             p.cones.kind, p.cones.offset, p.cones.dim = &kind_v[0], &offset_v[0], &dim_v[0]
  *             p.cones.mu, p.cones.normal = &mu_v[0], &normal_v[0]             # <<<<<<<<<<<<<<
@@ -20486,7 +20897,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     __pyx_v_p->cones.mu = __pyx_t_27;
     __pyx_v_p->cones.normal = __pyx_t_28;
 
-    /* "fccqp/admm.pyx":223
+    /* "fccqp/admm.pyx":224
  *             p.cones.kind, p.cones.offset, p.cones.dim = &kind_v[0], &offset_v[0], &dim_v[0]
  *             p.cones.mu, p.cones.normal = &mu_v[0], &normal_v[0]
  *             for k in range(p.cones.count):             # <<<<<<<<<<<<<<
@@ -20500,7 +20911,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     for (__pyx_t_17 = 0; __pyx_t_17 < __pyx_t_1; __pyx_t_17+=1) {
       __pyx_v_k = __pyx_t_17;
 
-      /* "fccqp/admm.pyx":224
+      /* "fccqp/admm.pyx":225
  *             p.cones.mu, p.cones.normal = &mu_v[0], &normal_v[0]
  *             for k in range(p.cones.count):
  *                 start_v[k] = c_view[offset_v[k]]             # <<<<<<<<<<<<<<
@@ -20514,7 +20925,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     }
 
 
-    /* "fccqp/admm.pyx":220
+    /* "fccqp/admm.pyx":221
  *         p.constrained = &c_view[0] if s else NULL
  *         p.cones.count = len(kind)
  *         if p.cones.count:             # <<<<<<<<<<<<<<
@@ -20523,7 +20934,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":225
+  /* "fccqp/admm.pyx":226
  *             for k in range(p.cones.count):
  *                 start_v[k] = c_view[offset_v[k]]
  *         self.block_start = &start_v[0]             # <<<<<<<<<<<<<<
@@ -20533,18 +20944,18 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   __pyx_t_24 = 0;
   __pyx_v_self->block_start = (&(*((Py_ssize_t *) ( /* dim=0 */ ((char *) (((Py_ssize_t *) __pyx_v_start_v.data) + __pyx_t_24)) ))));
 
-  /* "fccqp/admm.pyx":226
+  /* "fccqp/admm.pyx":227
  *                 start_v[k] = c_view[offset_v[k]]
  *         self.block_start = &start_v[0]
  *         cdef char* in_cone = <char*>self._new(s)             # <<<<<<<<<<<<<<
  *         for k in range(p.cones.count):
  *             for j in range(offset_v[k], offset_v[k] + dim_v[k]):
 */
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 226, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 227, __pyx_L1_error)
   __pyx_v_in_cone = ((char *)__pyx_t_28);
 
 
-  /* "fccqp/admm.pyx":227
+  /* "fccqp/admm.pyx":228
  *         self.block_start = &start_v[0]
  *         cdef char* in_cone = <char*>self._new(s)
  *         for k in range(p.cones.count):             # <<<<<<<<<<<<<<
@@ -20558,7 +20969,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   for (__pyx_t_17 = 0; __pyx_t_17 < __pyx_t_1; __pyx_t_17+=1) {
     __pyx_v_k = __pyx_t_17;
 
-    /* "fccqp/admm.pyx":228
+    /* "fccqp/admm.pyx":229
  *         cdef char* in_cone = <char*>self._new(s)
  *         for k in range(p.cones.count):
  *             for j in range(offset_v[k], offset_v[k] + dim_v[k]):             # <<<<<<<<<<<<<<
@@ -20575,7 +20986,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
     for (__pyx_t_33 = (*((Py_ssize_t *) ( /* dim=0 */ ((char *) (((Py_ssize_t *) __pyx_v_offset_v.data) + __pyx_t_29)) ))); __pyx_t_33 < __pyx_t_32; __pyx_t_33+=1) {
       __pyx_v_j = __pyx_t_33;
 
-      /* "fccqp/admm.pyx":229
+      /* "fccqp/admm.pyx":230
  *         for k in range(p.cones.count):
  *             for j in range(offset_v[k], offset_v[k] + dim_v[k]):
  *                 in_cone[j] = 1             # <<<<<<<<<<<<<<
@@ -20588,7 +20999,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   }
 
 
-  /* "fccqp/admm.pyx":230
+  /* "fccqp/admm.pyx":231
  *             for j in range(offset_v[k], offset_v[k] + dim_v[k]):
  *                 in_cone[j] = 1
  *         p.in_cone = in_cone             # <<<<<<<<<<<<<<
@@ -20597,39 +21008,39 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_p->in_cone = __pyx_v_in_cone;
 
-  /* "fccqp/admm.pyx":231
+  /* "fccqp/admm.pyx":232
  *                 in_cone[j] = 1
  *         p.in_cone = in_cone
  *         p.P, p.q, p.A, p.b = self._new(n * n), self._new(n), self._new(m * n), self._new(m)             # <<<<<<<<<<<<<<
  *         p.lo, p.hi, p.D, p.E = self._new(s), self._new(s), self._new(n), self._new(m)
  *         p.c = 1.0
 */
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_n * __pyx_v_n)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 231, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 231, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_m * __pyx_v_n)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 231, __pyx_L1_error)
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 231, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_n * __pyx_v_n)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 232, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 232, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_m * __pyx_v_n)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 232, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 232, __pyx_L1_error)
   __pyx_v_p->P = __pyx_t_28;
   __pyx_v_p->q = __pyx_t_27;
   __pyx_v_p->A = __pyx_t_34;
   __pyx_v_p->b = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":232
+  /* "fccqp/admm.pyx":233
  *         p.in_cone = in_cone
  *         p.P, p.q, p.A, p.b = self._new(n * n), self._new(n), self._new(m * n), self._new(m)
  *         p.lo, p.hi, p.D, p.E = self._new(s), self._new(s), self._new(n), self._new(m)             # <<<<<<<<<<<<<<
  *         p.c = 1.0
  *         self.P_user, self.q_user = self._new(n * n), self._new(n)
 */
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 232, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 232, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 232, __pyx_L1_error)
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 232, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 233, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 233, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 233, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 233, __pyx_L1_error)
   __pyx_v_p->lo = __pyx_t_35;
   __pyx_v_p->hi = __pyx_t_34;
   __pyx_v_p->D = __pyx_t_27;
   __pyx_v_p->E = __pyx_t_28;
 
-  /* "fccqp/admm.pyx":233
+  /* "fccqp/admm.pyx":234
  *         p.P, p.q, p.A, p.b = self._new(n * n), self._new(n), self._new(m * n), self._new(m)
  *         p.lo, p.hi, p.D, p.E = self._new(s), self._new(s), self._new(n), self._new(m)
  *         p.c = 1.0             # <<<<<<<<<<<<<<
@@ -20638,53 +21049,53 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_p->c = 1.0;
 
-  /* "fccqp/admm.pyx":234
+  /* "fccqp/admm.pyx":235
  *         p.lo, p.hi, p.D, p.E = self._new(s), self._new(s), self._new(n), self._new(m)
  *         p.c = 1.0
  *         self.P_user, self.q_user = self._new(n * n), self._new(n)             # <<<<<<<<<<<<<<
  *         self.A_user, self.b_user = self._new(m * n), self._new(m)
  *         self.lb_user, self.ub_user = self._new(n), self._new(n)
 */
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_n * __pyx_v_n)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 234, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 234, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_n * __pyx_v_n)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 235, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 235, __pyx_L1_error)
   __pyx_v_self->P_user = __pyx_t_28;
   __pyx_v_self->q_user = __pyx_t_27;
 
-  /* "fccqp/admm.pyx":235
+  /* "fccqp/admm.pyx":236
  *         p.c = 1.0
  *         self.P_user, self.q_user = self._new(n * n), self._new(n)
  *         self.A_user, self.b_user = self._new(m * n), self._new(m)             # <<<<<<<<<<<<<<
  *         self.lb_user, self.ub_user = self._new(n), self._new(n)
  *         self.rho_scale = self._new(s)
 */
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_m * __pyx_v_n)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 235, __pyx_L1_error)
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 235, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_m * __pyx_v_n)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 236, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 236, __pyx_L1_error)
   __pyx_v_self->A_user = __pyx_t_27;
   __pyx_v_self->b_user = __pyx_t_28;
 
-  /* "fccqp/admm.pyx":236
+  /* "fccqp/admm.pyx":237
  *         self.P_user, self.q_user = self._new(n * n), self._new(n)
  *         self.A_user, self.b_user = self._new(m * n), self._new(m)
  *         self.lb_user, self.ub_user = self._new(n), self._new(n)             # <<<<<<<<<<<<<<
  *         self.rho_scale = self._new(s)
  *         for k in range(s):
 */
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 236, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 236, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 237, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 237, __pyx_L1_error)
   __pyx_v_self->lb_user = __pyx_t_28;
   __pyx_v_self->ub_user = __pyx_t_27;
 
-  /* "fccqp/admm.pyx":237
+  /* "fccqp/admm.pyx":238
  *         self.A_user, self.b_user = self._new(m * n), self._new(m)
  *         self.lb_user, self.ub_user = self._new(n), self._new(n)
  *         self.rho_scale = self._new(s)             # <<<<<<<<<<<<<<
  *         for k in range(s):
  *             self.rho_scale[k] = FIXED_RHO_SCALE if fixed[k] else 1.0
 */
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 237, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 238, __pyx_L1_error)
   __pyx_v_self->rho_scale = __pyx_t_27;
 
-  /* "fccqp/admm.pyx":238
+  /* "fccqp/admm.pyx":239
  *         self.lb_user, self.ub_user = self._new(n), self._new(n)
  *         self.rho_scale = self._new(s)
  *         for k in range(s):             # <<<<<<<<<<<<<<
@@ -20698,21 +21109,21 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   for (__pyx_t_17 = 0; __pyx_t_17 < __pyx_t_1; __pyx_t_17+=1) {
     __pyx_v_k = __pyx_t_17;
 
-    /* "fccqp/admm.pyx":239
+    /* "fccqp/admm.pyx":240
  *         self.rho_scale = self._new(s)
  *         for k in range(s):
  *             self.rho_scale[k] = FIXED_RHO_SCALE if fixed[k] else 1.0             # <<<<<<<<<<<<<<
  *         self.d_scratch, self.e_scratch = self._new(n), self._new(m)
  *         it = &self.it
 */
-    __pyx_t_11 = __Pyx_GetItemInt(__pyx_v_fixed, __pyx_v_k, Py_ssize_t, 1, PyLong_FromSsize_t, 0, 0, 1, __Pyx_ReferenceSharing_FunctionArgument); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 239, __pyx_L1_error)
+    __pyx_t_11 = __Pyx_GetItemInt(__pyx_v_fixed, __pyx_v_k, Py_ssize_t, 1, PyLong_FromSsize_t, 0, 0, 1, __Pyx_ReferenceSharing_FunctionArgument); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 240, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_11);
-    __pyx_t_18 = __Pyx_PyObject_IsTrue(__pyx_t_11); if (unlikely((__pyx_t_18 < 0))) __PYX_ERR(0, 239, __pyx_L1_error)
+    __pyx_t_18 = __Pyx_PyObject_IsTrue(__pyx_t_11); if (unlikely((__pyx_t_18 < 0))) __PYX_ERR(0, 240, __pyx_L1_error)
     __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
     if (__pyx_t_18) {
-      __Pyx_GetModuleGlobalName(__pyx_t_11, __pyx_mstate_global->__pyx_n_u_FIXED_RHO_SCALE); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 239, __pyx_L1_error)
+      __Pyx_GetModuleGlobalName(__pyx_t_11, __pyx_mstate_global->__pyx_n_u_FIXED_RHO_SCALE); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 240, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_11);
-      __pyx_t_37 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_37 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 239, __pyx_L1_error)
+      __pyx_t_37 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_37 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 240, __pyx_L1_error)
       __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
       __pyx_t_36 = __pyx_t_37;
     } else {
@@ -20725,19 +21136,19 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   }
 
 
-  /* "fccqp/admm.pyx":240
+  /* "fccqp/admm.pyx":241
  *         for k in range(s):
  *             self.rho_scale[k] = FIXED_RHO_SCALE if fixed[k] else 1.0
  *         self.d_scratch, self.e_scratch = self._new(n), self._new(m)             # <<<<<<<<<<<<<<
  *         it = &self.it
  *         it.x, it.nu, it.z, it.y = self._new(n), self._new(m), self._new(s), self._new(s)
 */
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 240, __pyx_L1_error)
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 240, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 241, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 241, __pyx_L1_error)
   __pyx_v_self->d_scratch = __pyx_t_27;
   __pyx_v_self->e_scratch = __pyx_t_28;
 
-  /* "fccqp/admm.pyx":241
+  /* "fccqp/admm.pyx":242
  *             self.rho_scale[k] = FIXED_RHO_SCALE if fixed[k] else 1.0
  *         self.d_scratch, self.e_scratch = self._new(n), self._new(m)
  *         it = &self.it             # <<<<<<<<<<<<<<
@@ -20746,71 +21157,71 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":242
+  /* "fccqp/admm.pyx":243
  *         self.d_scratch, self.e_scratch = self._new(n), self._new(m)
  *         it = &self.it
  *         it.x, it.nu, it.z, it.y = self._new(n), self._new(m), self._new(s), self._new(s)             # <<<<<<<<<<<<<<
  *         it.x_prev, it.nu_prev = self._new(n), self._new(m)
  *         it.z_prev, it.y_prev = self._new(s), self._new(s)
 */
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 242, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 242, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 242, __pyx_L1_error)
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 242, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 243, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 243, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 243, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 243, __pyx_L1_error)
   __pyx_v_it->x = __pyx_t_28;
   __pyx_v_it->nu = __pyx_t_27;
   __pyx_v_it->z = __pyx_t_34;
   __pyx_v_it->y = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":243
+  /* "fccqp/admm.pyx":244
  *         it = &self.it
  *         it.x, it.nu, it.z, it.y = self._new(n), self._new(m), self._new(s), self._new(s)
  *         it.x_prev, it.nu_prev = self._new(n), self._new(m)             # <<<<<<<<<<<<<<
  *         it.z_prev, it.y_prev = self._new(s), self._new(s)
  *         it.relaxed, it.rho_vec = self._new(s), self._new(s)
 */
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 243, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 243, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 244, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 244, __pyx_L1_error)
   __pyx_v_it->x_prev = __pyx_t_35;
   __pyx_v_it->nu_prev = __pyx_t_34;
 
-  /* "fccqp/admm.pyx":244
+  /* "fccqp/admm.pyx":245
  *         it.x, it.nu, it.z, it.y = self._new(n), self._new(m), self._new(s), self._new(s)
  *         it.x_prev, it.nu_prev = self._new(n), self._new(m)
  *         it.z_prev, it.y_prev = self._new(s), self._new(s)             # <<<<<<<<<<<<<<
  *         it.relaxed, it.rho_vec = self._new(s), self._new(s)
  *         self.rhs, self.sol = self._new(N), self._new(N)
 */
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 244, __pyx_L1_error)
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 244, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 245, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 245, __pyx_L1_error)
   __pyx_v_it->z_prev = __pyx_t_34;
   __pyx_v_it->y_prev = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":245
+  /* "fccqp/admm.pyx":246
  *         it.x_prev, it.nu_prev = self._new(n), self._new(m)
  *         it.z_prev, it.y_prev = self._new(s), self._new(s)
  *         it.relaxed, it.rho_vec = self._new(s), self._new(s)             # <<<<<<<<<<<<<<
  *         self.rhs, self.sol = self._new(N), self._new(N)
  *         cdef Py_ssize_t wide = max(n, m)
 */
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 245, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 245, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 246, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 246, __pyx_L1_error)
   __pyx_v_it->relaxed = __pyx_t_35;
   __pyx_v_it->rho_vec = __pyx_t_34;
 
-  /* "fccqp/admm.pyx":246
+  /* "fccqp/admm.pyx":247
  *         it.z_prev, it.y_prev = self._new(s), self._new(s)
  *         it.relaxed, it.rho_vec = self._new(s), self._new(s)
  *         self.rhs, self.sol = self._new(N), self._new(N)             # <<<<<<<<<<<<<<
  *         cdef Py_ssize_t wide = max(n, m)
  *         self.vec_n, self.vec_n2, self.vec_n3 = self._new(wide), self._new(wide), self._new(wide)
 */
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 246, __pyx_L1_error)
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 246, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 247, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 247, __pyx_L1_error)
   __pyx_v_self->rhs = __pyx_t_34;
   __pyx_v_self->sol = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":247
+  /* "fccqp/admm.pyx":248
  *         it.relaxed, it.rho_vec = self._new(s), self._new(s)
  *         self.rhs, self.sol = self._new(N), self._new(N)
  *         cdef Py_ssize_t wide = max(n, m)             # <<<<<<<<<<<<<<
@@ -20834,63 +21245,63 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   __pyx_v_wide = __pyx_t_17;
 
 
-  /* "fccqp/admm.pyx":248
+  /* "fccqp/admm.pyx":249
  *         self.rhs, self.sol = self._new(N), self._new(N)
  *         cdef Py_ssize_t wide = max(n, m)
  *         self.vec_n, self.vec_n2, self.vec_n3 = self._new(wide), self._new(wide), self._new(wide)             # <<<<<<<<<<<<<<
  *         self.vec_s, self.vec_s2, self.vec_m = self._new(s), self._new(s), self._new(m)
  *         self.direction, self.saved, self.cert = self._new(n), self._new(N + s), self._new(N)
 */
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_wide); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 248, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_wide); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 248, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_wide); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 248, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_wide); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 249, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_wide); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 249, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_wide); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 249, __pyx_L1_error)
   __pyx_v_self->vec_n = __pyx_t_35;
   __pyx_v_self->vec_n2 = __pyx_t_34;
   __pyx_v_self->vec_n3 = __pyx_t_27;
 
-  /* "fccqp/admm.pyx":249
+  /* "fccqp/admm.pyx":250
  *         cdef Py_ssize_t wide = max(n, m)
  *         self.vec_n, self.vec_n2, self.vec_n3 = self._new(wide), self._new(wide), self._new(wide)
  *         self.vec_s, self.vec_s2, self.vec_m = self._new(s), self._new(s), self._new(m)             # <<<<<<<<<<<<<<
  *         self.direction, self.saved, self.cert = self._new(n), self._new(N + s), self._new(N)
  *         self.prev_x, self.prev_y, self.prev_z = self._new(n), self._new(m), self._new(n)
 */
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 249, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 249, __pyx_L1_error)
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 249, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 250, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 250, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 250, __pyx_L1_error)
   __pyx_v_self->vec_s = __pyx_t_27;
   __pyx_v_self->vec_s2 = __pyx_t_34;
   __pyx_v_self->vec_m = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":250
+  /* "fccqp/admm.pyx":251
  *         self.vec_n, self.vec_n2, self.vec_n3 = self._new(wide), self._new(wide), self._new(wide)
  *         self.vec_s, self.vec_s2, self.vec_m = self._new(s), self._new(s), self._new(m)
  *         self.direction, self.saved, self.cert = self._new(n), self._new(N + s), self._new(N)             # <<<<<<<<<<<<<<
  *         self.prev_x, self.prev_y, self.prev_z = self._new(n), self._new(m), self._new(n)
  *         kk = &self.kkt
 */
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 250, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_N + __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 250, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 250, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 251, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_N + __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 251, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 251, __pyx_L1_error)
   __pyx_v_self->direction = __pyx_t_35;
   __pyx_v_self->saved = __pyx_t_34;
   __pyx_v_self->cert = __pyx_t_27;
 
-  /* "fccqp/admm.pyx":251
+  /* "fccqp/admm.pyx":252
  *         self.vec_s, self.vec_s2, self.vec_m = self._new(s), self._new(s), self._new(m)
  *         self.direction, self.saved, self.cert = self._new(n), self._new(N + s), self._new(N)
  *         self.prev_x, self.prev_y, self.prev_z = self._new(n), self._new(m), self._new(n)             # <<<<<<<<<<<<<<
  *         kk = &self.kkt
  *         kk.ldl.N = <int>N
 */
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 251, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 251, __pyx_L1_error)
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 251, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 252, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 252, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 252, __pyx_L1_error)
   __pyx_v_self->prev_x = __pyx_t_27;
   __pyx_v_self->prev_y = __pyx_t_34;
   __pyx_v_self->prev_z = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":252
+  /* "fccqp/admm.pyx":253
  *         self.direction, self.saved, self.cert = self._new(n), self._new(N + s), self._new(N)
  *         self.prev_x, self.prev_y, self.prev_z = self._new(n), self._new(m), self._new(n)
  *         kk = &self.kkt             # <<<<<<<<<<<<<<
@@ -20899,7 +21310,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_kk = (&__pyx_v_self->kkt);
 
-  /* "fccqp/admm.pyx":253
+  /* "fccqp/admm.pyx":254
  *         self.prev_x, self.prev_y, self.prev_z = self._new(n), self._new(m), self._new(n)
  *         kk = &self.kkt
  *         kk.ldl.N = <int>N             # <<<<<<<<<<<<<<
@@ -20908,28 +21319,28 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_kk->ldl.N = ((int)__pyx_v_N);
 
-  /* "fccqp/admm.pyx":254
+  /* "fccqp/admm.pyx":255
  *         kk = &self.kkt
  *         kk.ldl.N = <int>N
  *         kk.ldl.K = self._new(N * N)             # <<<<<<<<<<<<<<
  *         kk.ldl.ipiv = <int*>self._new_int(N)
  *         kk.ldl.lwork = <int>(64 * N)
 */
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_N * __pyx_v_N)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 254, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_N * __pyx_v_N)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 255, __pyx_L1_error)
   __pyx_v_kk->ldl.K = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":255
+  /* "fccqp/admm.pyx":256
  *         kk.ldl.N = <int>N
  *         kk.ldl.K = self._new(N * N)
  *         kk.ldl.ipiv = <int*>self._new_int(N)             # <<<<<<<<<<<<<<
  *         kk.ldl.lwork = <int>(64 * N)
  *         kk.ldl.work, kk.ldl.residual = self._new(64 * N), self._new(N)
 */
-  __pyx_t_38 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new_int(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 255, __pyx_L1_error)
+  __pyx_t_38 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new_int(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 256, __pyx_L1_error)
   __pyx_v_kk->ldl.ipiv = ((int *)__pyx_t_38);
 
 
-  /* "fccqp/admm.pyx":256
+  /* "fccqp/admm.pyx":257
  *         kk.ldl.K = self._new(N * N)
  *         kk.ldl.ipiv = <int*>self._new_int(N)
  *         kk.ldl.lwork = <int>(64 * N)             # <<<<<<<<<<<<<<
@@ -20938,31 +21349,31 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_kk->ldl.lwork = ((int)(64 * __pyx_v_N));
 
-  /* "fccqp/admm.pyx":257
+  /* "fccqp/admm.pyx":258
  *         kk.ldl.ipiv = <int*>self._new_int(N)
  *         kk.ldl.lwork = <int>(64 * N)
  *         kk.ldl.work, kk.ldl.residual = self._new(64 * N), self._new(N)             # <<<<<<<<<<<<<<
  *         kk.ldl.Ax, kk.ldl.ATnu = self._new(m), self._new(n)
  *         kk.schur.n, kk.schur.m = <int>n, <int>m
 */
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (64 * __pyx_v_N)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 257, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 257, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (64 * __pyx_v_N)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 258, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 258, __pyx_L1_error)
   __pyx_v_kk->ldl.work = __pyx_t_35;
   __pyx_v_kk->ldl.residual = __pyx_t_34;
 
-  /* "fccqp/admm.pyx":258
+  /* "fccqp/admm.pyx":259
  *         kk.ldl.lwork = <int>(64 * N)
  *         kk.ldl.work, kk.ldl.residual = self._new(64 * N), self._new(N)
  *         kk.ldl.Ax, kk.ldl.ATnu = self._new(m), self._new(n)             # <<<<<<<<<<<<<<
  *         kk.schur.n, kk.schur.m = <int>n, <int>m
  *         kk.schur.L, kk.schur.LS, kk.schur.Y = self._new(n * n), self._new(m * m), self._new(n * m)
 */
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 258, __pyx_L1_error)
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 258, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 259, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 259, __pyx_L1_error)
   __pyx_v_kk->ldl.Ax = __pyx_t_34;
   __pyx_v_kk->ldl.ATnu = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":259
+  /* "fccqp/admm.pyx":260
  *         kk.ldl.work, kk.ldl.residual = self._new(64 * N), self._new(N)
  *         kk.ldl.Ax, kk.ldl.ATnu = self._new(m), self._new(n)
  *         kk.schur.n, kk.schur.m = <int>n, <int>m             # <<<<<<<<<<<<<<
@@ -20976,21 +21387,21 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   __pyx_v_kk->schur.n = __pyx_t_39;
   __pyx_v_kk->schur.m = __pyx_t_40;
 
-  /* "fccqp/admm.pyx":260
+  /* "fccqp/admm.pyx":261
  *         kk.ldl.Ax, kk.ldl.ATnu = self._new(m), self._new(n)
  *         kk.schur.n, kk.schur.m = <int>n, <int>m
  *         kk.schur.L, kk.schur.LS, kk.schur.Y = self._new(n * n), self._new(m * m), self._new(n * m)             # <<<<<<<<<<<<<<
  *         kk.schur.order = &order_v[0]
  *         kk.schur.perm, kk.schur.dx, kk.schur.r = self._new(n), self._new(n), self._new(n)
 */
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_n * __pyx_v_n)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 260, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_m * __pyx_v_m)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 260, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_n * __pyx_v_m)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 260, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_n * __pyx_v_n)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 261, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_m * __pyx_v_m)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 261, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_n * __pyx_v_m)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 261, __pyx_L1_error)
   __pyx_v_kk->schur.L = __pyx_t_35;
   __pyx_v_kk->schur.LS = __pyx_t_34;
   __pyx_v_kk->schur.Y = __pyx_t_27;
 
-  /* "fccqp/admm.pyx":261
+  /* "fccqp/admm.pyx":262
  *         kk.schur.n, kk.schur.m = <int>n, <int>m
  *         kk.schur.L, kk.schur.LS, kk.schur.Y = self._new(n * n), self._new(m * m), self._new(n * m)
  *         kk.schur.order = &order_v[0]             # <<<<<<<<<<<<<<
@@ -21000,61 +21411,61 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   __pyx_t_29 = 0;
   __pyx_v_kk->schur.order = (&(*((Py_ssize_t *) ( /* dim=0 */ ((char *) (((Py_ssize_t *) __pyx_v_order_v.data) + __pyx_t_29)) ))));
 
-  /* "fccqp/admm.pyx":262
+  /* "fccqp/admm.pyx":263
  *         kk.schur.L, kk.schur.LS, kk.schur.Y = self._new(n * n), self._new(m * m), self._new(n * m)
  *         kk.schur.order = &order_v[0]
  *         kk.schur.perm, kk.schur.dx, kk.schur.r = self._new(n), self._new(n), self._new(n)             # <<<<<<<<<<<<<<
  *         kk.schur.ATnu, kk.schur.dnu, kk.schur.Ax = self._new(n), self._new(m), self._new(m)
  *         kk.schur.X, kk.schur.Wnu, kk.schur.M = self._new(n * s), self._new(m * s), self._new(s * s)
 */
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 262, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 262, __pyx_L1_error)
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 262, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 263, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 263, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 263, __pyx_L1_error)
   __pyx_v_kk->schur.perm = __pyx_t_27;
   __pyx_v_kk->schur.dx = __pyx_t_34;
   __pyx_v_kk->schur.r = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":263
+  /* "fccqp/admm.pyx":264
  *         kk.schur.order = &order_v[0]
  *         kk.schur.perm, kk.schur.dx, kk.schur.r = self._new(n), self._new(n), self._new(n)
  *         kk.schur.ATnu, kk.schur.dnu, kk.schur.Ax = self._new(n), self._new(m), self._new(m)             # <<<<<<<<<<<<<<
  *         kk.schur.X, kk.schur.Wnu, kk.schur.M = self._new(n * s), self._new(m * s), self._new(s * s)
  *         kk.R, kk.work = self._new(N * s), self._new(N)
 */
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 263, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 263, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 263, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_n); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 264, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 264, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_m); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 264, __pyx_L1_error)
   __pyx_v_kk->schur.ATnu = __pyx_t_35;
   __pyx_v_kk->schur.dnu = __pyx_t_34;
   __pyx_v_kk->schur.Ax = __pyx_t_27;
 
-  /* "fccqp/admm.pyx":264
+  /* "fccqp/admm.pyx":265
  *         kk.schur.perm, kk.schur.dx, kk.schur.r = self._new(n), self._new(n), self._new(n)
  *         kk.schur.ATnu, kk.schur.dnu, kk.schur.Ax = self._new(n), self._new(m), self._new(m)
  *         kk.schur.X, kk.schur.Wnu, kk.schur.M = self._new(n * s), self._new(m * s), self._new(s * s)             # <<<<<<<<<<<<<<
  *         kk.R, kk.work = self._new(N * s), self._new(N)
  *         red = &self.red
 */
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_n * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 264, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_m * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 264, __pyx_L1_error)
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_s * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 264, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_n * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 265, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_m * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 265, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_s * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 265, __pyx_L1_error)
   __pyx_v_kk->schur.X = __pyx_t_27;
   __pyx_v_kk->schur.Wnu = __pyx_t_34;
   __pyx_v_kk->schur.M = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":265
+  /* "fccqp/admm.pyx":266
  *         kk.schur.ATnu, kk.schur.dnu, kk.schur.Ax = self._new(n), self._new(m), self._new(m)
  *         kk.schur.X, kk.schur.Wnu, kk.schur.M = self._new(n * s), self._new(m * s), self._new(s * s)
  *         kk.R, kk.work = self._new(N * s), self._new(N)             # <<<<<<<<<<<<<<
  *         red = &self.red
  *         red.W, red.W_S, red.base = self._new(N * s), self._new(s * s), self._new(N)
 */
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_N * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 265, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 265, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_N * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 266, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 266, __pyx_L1_error)
   __pyx_v_kk->R = __pyx_t_35;
   __pyx_v_kk->work = __pyx_t_34;
 
-  /* "fccqp/admm.pyx":266
+  /* "fccqp/admm.pyx":267
  *         kk.schur.X, kk.schur.Wnu, kk.schur.M = self._new(n * s), self._new(m * s), self._new(s * s)
  *         kk.R, kk.work = self._new(N * s), self._new(N)
  *         red = &self.red             # <<<<<<<<<<<<<<
@@ -21063,49 +21474,49 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_red = (&__pyx_v_self->red);
 
-  /* "fccqp/admm.pyx":267
+  /* "fccqp/admm.pyx":268
  *         kk.R, kk.work = self._new(N * s), self._new(N)
  *         red = &self.red
  *         red.W, red.W_S, red.base = self._new(N * s), self._new(s * s), self._new(N)             # <<<<<<<<<<<<<<
  *         red.u, red.u_prev, red.v, red.v_prev = self._new(s), self._new(s), self._new(s), self._new(s)
  *         red.xs, red.rhs = self._new(s), self._new(N)
 */
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_N * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 267, __pyx_L1_error)
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_s * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 267, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 267, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_N * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 268, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_s * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 268, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 268, __pyx_L1_error)
   __pyx_v_red->W = __pyx_t_34;
   __pyx_v_red->W_S = __pyx_t_35;
   __pyx_v_red->base = __pyx_t_27;
 
-  /* "fccqp/admm.pyx":268
+  /* "fccqp/admm.pyx":269
  *         red = &self.red
  *         red.W, red.W_S, red.base = self._new(N * s), self._new(s * s), self._new(N)
  *         red.u, red.u_prev, red.v, red.v_prev = self._new(s), self._new(s), self._new(s), self._new(s)             # <<<<<<<<<<<<<<
  *         red.xs, red.rhs = self._new(s), self._new(N)
  *         aa = &self.aa
 */
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 268, __pyx_L1_error)
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 268, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 268, __pyx_L1_error)
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 268, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 269, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 269, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 269, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 269, __pyx_L1_error)
   __pyx_v_red->u = __pyx_t_27;
   __pyx_v_red->u_prev = __pyx_t_35;
   __pyx_v_red->v = __pyx_t_34;
   __pyx_v_red->v_prev = __pyx_t_28;
 
-  /* "fccqp/admm.pyx":269
+  /* "fccqp/admm.pyx":270
  *         red.W, red.W_S, red.base = self._new(N * s), self._new(s * s), self._new(N)
  *         red.u, red.u_prev, red.v, red.v_prev = self._new(s), self._new(s), self._new(s), self._new(s)
  *         red.xs, red.rhs = self._new(s), self._new(N)             # <<<<<<<<<<<<<<
  *         aa = &self.aa
  *         aa.capacity = <int>memory
 */
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 269, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 269, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 270, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 270, __pyx_L1_error)
   __pyx_v_red->xs = __pyx_t_28;
   __pyx_v_red->rhs = __pyx_t_34;
 
-  /* "fccqp/admm.pyx":270
+  /* "fccqp/admm.pyx":271
  *         red.u, red.u_prev, red.v, red.v_prev = self._new(s), self._new(s), self._new(s), self._new(s)
  *         red.xs, red.rhs = self._new(s), self._new(N)
  *         aa = &self.aa             # <<<<<<<<<<<<<<
@@ -21114,7 +21525,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_aa = (&__pyx_v_self->aa);
 
-  /* "fccqp/admm.pyx":271
+  /* "fccqp/admm.pyx":272
  *         red.xs, red.rhs = self._new(s), self._new(N)
  *         aa = &self.aa
  *         aa.capacity = <int>memory             # <<<<<<<<<<<<<<
@@ -21123,49 +21534,49 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_aa->capacity = ((int)__pyx_v_memory);
 
-  /* "fccqp/admm.pyx":272
+  /* "fccqp/admm.pyx":273
  *         aa = &self.aa
  *         aa.capacity = <int>memory
  *         aa.dg, aa.df = self._new(memory * 2 * s), self._new(memory * 2 * s)             # <<<<<<<<<<<<<<
  *         aa.g, aa.f, aa.g_new, aa.f_new = self._new(2 * s), self._new(2 * s), self._new(2 * s), self._new(2 * s)
  *         aa.plain, aa.gram, aa.gamma = self._new(2 * s + 1), self._new(memory * memory), self._new(memory)
 */
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, ((__pyx_v_memory * 2) * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 272, __pyx_L1_error)
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, ((__pyx_v_memory * 2) * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 272, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, ((__pyx_v_memory * 2) * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 273, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, ((__pyx_v_memory * 2) * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 273, __pyx_L1_error)
   __pyx_v_aa->dg = __pyx_t_34;
   __pyx_v_aa->df = __pyx_t_28;
 
-  /* "fccqp/admm.pyx":273
+  /* "fccqp/admm.pyx":274
  *         aa.capacity = <int>memory
  *         aa.dg, aa.df = self._new(memory * 2 * s), self._new(memory * 2 * s)
  *         aa.g, aa.f, aa.g_new, aa.f_new = self._new(2 * s), self._new(2 * s), self._new(2 * s), self._new(2 * s)             # <<<<<<<<<<<<<<
  *         aa.plain, aa.gram, aa.gamma = self._new(2 * s + 1), self._new(memory * memory), self._new(memory)
  *         anderson_reset(aa, False)
 */
-  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (2 * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 273, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (2 * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 273, __pyx_L1_error)
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (2 * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 273, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (2 * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 273, __pyx_L1_error)
+  __pyx_t_28 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (2 * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 274, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (2 * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 274, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (2 * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 274, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (2 * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 274, __pyx_L1_error)
   __pyx_v_aa->g = __pyx_t_28;
   __pyx_v_aa->f = __pyx_t_34;
   __pyx_v_aa->g_new = __pyx_t_35;
   __pyx_v_aa->f_new = __pyx_t_27;
 
-  /* "fccqp/admm.pyx":274
+  /* "fccqp/admm.pyx":275
  *         aa.dg, aa.df = self._new(memory * 2 * s), self._new(memory * 2 * s)
  *         aa.g, aa.f, aa.g_new, aa.f_new = self._new(2 * s), self._new(2 * s), self._new(2 * s), self._new(2 * s)
  *         aa.plain, aa.gram, aa.gamma = self._new(2 * s + 1), self._new(memory * memory), self._new(memory)             # <<<<<<<<<<<<<<
  *         anderson_reset(aa, False)
  *         rs = &self.rest
 */
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, ((2 * __pyx_v_s) + 1)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 274, __pyx_L1_error)
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_memory * __pyx_v_memory)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 274, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_memory); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 274, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, ((2 * __pyx_v_s) + 1)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 275, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_memory * __pyx_v_memory)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 275, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_memory); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 275, __pyx_L1_error)
   __pyx_v_aa->plain = __pyx_t_27;
   __pyx_v_aa->gram = __pyx_t_35;
   __pyx_v_aa->gamma = __pyx_t_34;
 
-  /* "fccqp/admm.pyx":275
+  /* "fccqp/admm.pyx":276
  *         aa.g, aa.f, aa.g_new, aa.f_new = self._new(2 * s), self._new(2 * s), self._new(2 * s), self._new(2 * s)
  *         aa.plain, aa.gram, aa.gamma = self._new(2 * s + 1), self._new(memory * memory), self._new(memory)
  *         anderson_reset(aa, False)             # <<<<<<<<<<<<<<
@@ -21174,7 +21585,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_f_5fccqp_8anderson_anderson_reset(__pyx_v_aa, 0);
 
-  /* "fccqp/admm.pyx":276
+  /* "fccqp/admm.pyx":277
  *         aa.plain, aa.gram, aa.gamma = self._new(2 * s + 1), self._new(memory * memory), self._new(memory)
  *         anderson_reset(aa, False)
  *         rs = &self.rest             # <<<<<<<<<<<<<<
@@ -21183,74 +21594,74 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_rs = (&__pyx_v_self->rest);
 
-  /* "fccqp/admm.pyx":277
+  /* "fccqp/admm.pyx":278
  *         anderson_reset(aa, False)
  *         rs = &self.rest
  *         rs.pinned = <char*>self._new(s)             # <<<<<<<<<<<<<<
  *         rs.target, rs.projected = self._new(s), self._new(s)
  *         rs.positions, rs.entries = <Py_ssize_t*>self._new_int(s), <Py_ssize_t*>self._new_int(s)
 */
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 277, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 278, __pyx_L1_error)
   __pyx_v_rs->pinned = ((char *)__pyx_t_34);
 
 
-  /* "fccqp/admm.pyx":278
+  /* "fccqp/admm.pyx":279
  *         rs = &self.rest
  *         rs.pinned = <char*>self._new(s)
  *         rs.target, rs.projected = self._new(s), self._new(s)             # <<<<<<<<<<<<<<
  *         rs.positions, rs.entries = <Py_ssize_t*>self._new_int(s), <Py_ssize_t*>self._new_int(s)
  *         rs.W_T, rs.gram, rs.step = self._new(N * s), self._new(s * s), self._new(s)
 */
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 278, __pyx_L1_error)
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 278, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 279, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 279, __pyx_L1_error)
   __pyx_v_rs->target = __pyx_t_34;
   __pyx_v_rs->projected = __pyx_t_35;
 
-  /* "fccqp/admm.pyx":279
+  /* "fccqp/admm.pyx":280
  *         rs.pinned = <char*>self._new(s)
  *         rs.target, rs.projected = self._new(s), self._new(s)
  *         rs.positions, rs.entries = <Py_ssize_t*>self._new_int(s), <Py_ssize_t*>self._new_int(s)             # <<<<<<<<<<<<<<
  *         rs.W_T, rs.gram, rs.step = self._new(N * s), self._new(s * s), self._new(s)
  *         rs.start, rs.point = self._new(N), self._new(N)
 */
-  __pyx_t_38 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new_int(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 279, __pyx_L1_error)
+  __pyx_t_38 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new_int(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 280, __pyx_L1_error)
   __pyx_t_26 = ((Py_ssize_t *)__pyx_t_38);
 
 
-  __pyx_t_38 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new_int(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 279, __pyx_L1_error)
+  __pyx_t_38 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new_int(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 280, __pyx_L1_error)
   __pyx_t_25 = ((Py_ssize_t *)__pyx_t_38);
 
 
   __pyx_v_rs->positions = __pyx_t_26;
   __pyx_v_rs->entries = __pyx_t_25;
 
-  /* "fccqp/admm.pyx":280
+  /* "fccqp/admm.pyx":281
  *         rs.target, rs.projected = self._new(s), self._new(s)
  *         rs.positions, rs.entries = <Py_ssize_t*>self._new_int(s), <Py_ssize_t*>self._new_int(s)
  *         rs.W_T, rs.gram, rs.step = self._new(N * s), self._new(s * s), self._new(s)             # <<<<<<<<<<<<<<
  *         rs.start, rs.point = self._new(N), self._new(N)
  *         self.log_rows = log_rows
 */
-  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_N * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 280, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_s * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 280, __pyx_L1_error)
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 280, __pyx_L1_error)
+  __pyx_t_35 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_N * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 281, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (__pyx_v_s * __pyx_v_s)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 281, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_s); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 281, __pyx_L1_error)
   __pyx_v_rs->W_T = __pyx_t_35;
   __pyx_v_rs->gram = __pyx_t_34;
   __pyx_v_rs->step = __pyx_t_27;
 
-  /* "fccqp/admm.pyx":281
+  /* "fccqp/admm.pyx":282
  *         rs.positions, rs.entries = <Py_ssize_t*>self._new_int(s), <Py_ssize_t*>self._new_int(s)
  *         rs.W_T, rs.gram, rs.step = self._new(N * s), self._new(s * s), self._new(s)
  *         rs.start, rs.point = self._new(N), self._new(N)             # <<<<<<<<<<<<<<
  *         self.log_rows = log_rows
  *         self.log = self._new(5 * log_rows)
 */
-  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 281, __pyx_L1_error)
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 281, __pyx_L1_error)
+  __pyx_t_27 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 282, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, __pyx_v_N); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 282, __pyx_L1_error)
   __pyx_v_rs->start = __pyx_t_27;
   __pyx_v_rs->point = __pyx_t_34;
 
-  /* "fccqp/admm.pyx":282
+  /* "fccqp/admm.pyx":283
  *         rs.W_T, rs.gram, rs.step = self._new(N * s), self._new(s * s), self._new(s)
  *         rs.start, rs.point = self._new(N), self._new(N)
  *         self.log_rows = log_rows             # <<<<<<<<<<<<<<
@@ -21259,17 +21670,17 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_self->log_rows = __pyx_v_log_rows;
 
-  /* "fccqp/admm.pyx":283
+  /* "fccqp/admm.pyx":284
  *         rs.start, rs.point = self._new(N), self._new(N)
  *         self.log_rows = log_rows
  *         self.log = self._new(5 * log_rows)             # <<<<<<<<<<<<<<
  *         o = &self.opt
  *         o.rho, o.sigma, o.alpha = settings.rho, settings.sigma, settings.alpha
 */
-  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (5 * __pyx_v_log_rows)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 283, __pyx_L1_error)
+  __pyx_t_34 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new(__pyx_v_self, (5 * __pyx_v_log_rows)); if (unlikely(PyErr_Occurred())) __PYX_ERR(0, 284, __pyx_L1_error)
   __pyx_v_self->log = __pyx_t_34;
 
-  /* "fccqp/admm.pyx":284
+  /* "fccqp/admm.pyx":285
  *         self.log_rows = log_rows
  *         self.log = self._new(5 * log_rows)
  *         o = &self.opt             # <<<<<<<<<<<<<<
@@ -21278,170 +21689,170 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_o = (&__pyx_v_self->opt);
 
-  /* "fccqp/admm.pyx":285
+  /* "fccqp/admm.pyx":286
  *         self.log = self._new(5 * log_rows)
  *         o = &self.opt
  *         o.rho, o.sigma, o.alpha = settings.rho, settings.sigma, settings.alpha             # <<<<<<<<<<<<<<
  *         o.eps_abs, o.eps_rel = settings.eps_abs, settings.eps_rel
  *         o.eps_prim_inf, o.eps_dual_inf = settings.eps_prim_inf, settings.eps_dual_inf
 */
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_rho); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 285, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_rho); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 286, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_36 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_36 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 285, __pyx_L1_error)
+  __pyx_t_36 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_36 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 286, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_sigma); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 285, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_sigma); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 286, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_37 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_37 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 285, __pyx_L1_error)
+  __pyx_t_37 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_37 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 286, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_alpha); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 285, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_alpha); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 286, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_41 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_41 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 285, __pyx_L1_error)
+  __pyx_t_41 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_41 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 286, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   __pyx_v_o->rho = __pyx_t_36;
   __pyx_v_o->sigma = __pyx_t_37;
   __pyx_v_o->alpha = __pyx_t_41;
 
-  /* "fccqp/admm.pyx":286
+  /* "fccqp/admm.pyx":287
  *         o = &self.opt
  *         o.rho, o.sigma, o.alpha = settings.rho, settings.sigma, settings.alpha
  *         o.eps_abs, o.eps_rel = settings.eps_abs, settings.eps_rel             # <<<<<<<<<<<<<<
  *         o.eps_prim_inf, o.eps_dual_inf = settings.eps_prim_inf, settings.eps_dual_inf
  *         o.time_limit = settings.time_limit
 */
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_eps_abs); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 286, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_eps_abs); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 287, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_41 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_41 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 286, __pyx_L1_error)
+  __pyx_t_41 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_41 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 287, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_eps_rel); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 286, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_eps_rel); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 287, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_37 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_37 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 286, __pyx_L1_error)
+  __pyx_t_37 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_37 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 287, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   __pyx_v_o->eps_abs = __pyx_t_41;
   __pyx_v_o->eps_rel = __pyx_t_37;
 
-  /* "fccqp/admm.pyx":287
+  /* "fccqp/admm.pyx":288
  *         o.rho, o.sigma, o.alpha = settings.rho, settings.sigma, settings.alpha
  *         o.eps_abs, o.eps_rel = settings.eps_abs, settings.eps_rel
  *         o.eps_prim_inf, o.eps_dual_inf = settings.eps_prim_inf, settings.eps_dual_inf             # <<<<<<<<<<<<<<
  *         o.time_limit = settings.time_limit
  *         o.adaptive_rho_tolerance = settings.adaptive_rho_tolerance
 */
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_eps_prim_inf); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 287, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_eps_prim_inf); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 288, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_37 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_37 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 287, __pyx_L1_error)
+  __pyx_t_37 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_37 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 288, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_eps_dual_inf); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 287, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_eps_dual_inf); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 288, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_41 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_41 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 287, __pyx_L1_error)
+  __pyx_t_41 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_41 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 288, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   __pyx_v_o->eps_prim_inf = __pyx_t_37;
   __pyx_v_o->eps_dual_inf = __pyx_t_41;
 
-  /* "fccqp/admm.pyx":288
+  /* "fccqp/admm.pyx":289
  *         o.eps_abs, o.eps_rel = settings.eps_abs, settings.eps_rel
  *         o.eps_prim_inf, o.eps_dual_inf = settings.eps_prim_inf, settings.eps_dual_inf
  *         o.time_limit = settings.time_limit             # <<<<<<<<<<<<<<
  *         o.adaptive_rho_tolerance = settings.adaptive_rho_tolerance
  *         o.max_iter, o.check_termination = settings.max_iter, settings.check_termination
 */
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_time_limit); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 288, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_time_limit); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 289, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_41 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_41 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 288, __pyx_L1_error)
+  __pyx_t_41 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_41 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 289, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   __pyx_v_o->time_limit = __pyx_t_41;
 
-  /* "fccqp/admm.pyx":289
+  /* "fccqp/admm.pyx":290
  *         o.eps_prim_inf, o.eps_dual_inf = settings.eps_prim_inf, settings.eps_dual_inf
  *         o.time_limit = settings.time_limit
  *         o.adaptive_rho_tolerance = settings.adaptive_rho_tolerance             # <<<<<<<<<<<<<<
  *         o.max_iter, o.check_termination = settings.max_iter, settings.check_termination
  *         o.adaptive_rho_interval, o.scaling = settings.adaptive_rho_interval, settings.scaling
 */
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_adaptive_rho_tolerance); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 289, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_adaptive_rho_tolerance); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 290, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_41 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_41 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 289, __pyx_L1_error)
+  __pyx_t_41 = __Pyx_PyFloat_AsDouble(__pyx_t_11); if (unlikely((__pyx_t_41 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 290, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   __pyx_v_o->adaptive_rho_tolerance = __pyx_t_41;
 
-  /* "fccqp/admm.pyx":290
+  /* "fccqp/admm.pyx":291
  *         o.time_limit = settings.time_limit
  *         o.adaptive_rho_tolerance = settings.adaptive_rho_tolerance
  *         o.max_iter, o.check_termination = settings.max_iter, settings.check_termination             # <<<<<<<<<<<<<<
  *         o.adaptive_rho_interval, o.scaling = settings.adaptive_rho_interval, settings.scaling
  *         o.adaptive_rho, o.restore_feasibility = settings.adaptive_rho, settings.restore_feasibility
 */
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_max_iter); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 290, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_max_iter); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 291, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_16 = __Pyx_PyLong_As_long(__pyx_t_11); if (unlikely((__pyx_t_16 == (long)-1) && PyErr_Occurred())) __PYX_ERR(0, 290, __pyx_L1_error)
+  __pyx_t_16 = __Pyx_PyLong_As_long(__pyx_t_11); if (unlikely((__pyx_t_16 == (long)-1) && PyErr_Occurred())) __PYX_ERR(0, 291, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_check_termination); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 290, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_check_termination); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 291, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_42 = __Pyx_PyLong_As_long(__pyx_t_11); if (unlikely((__pyx_t_42 == (long)-1) && PyErr_Occurred())) __PYX_ERR(0, 290, __pyx_L1_error)
+  __pyx_t_42 = __Pyx_PyLong_As_long(__pyx_t_11); if (unlikely((__pyx_t_42 == (long)-1) && PyErr_Occurred())) __PYX_ERR(0, 291, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   __pyx_v_o->max_iter = __pyx_t_16;
   __pyx_v_o->check_termination = __pyx_t_42;
 
-  /* "fccqp/admm.pyx":291
+  /* "fccqp/admm.pyx":292
  *         o.adaptive_rho_tolerance = settings.adaptive_rho_tolerance
  *         o.max_iter, o.check_termination = settings.max_iter, settings.check_termination
  *         o.adaptive_rho_interval, o.scaling = settings.adaptive_rho_interval, settings.scaling             # <<<<<<<<<<<<<<
  *         o.adaptive_rho, o.restore_feasibility = settings.adaptive_rho, settings.restore_feasibility
  *         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
 */
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_adaptive_rho_interval); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 291, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_adaptive_rho_interval); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 292, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_42 = __Pyx_PyLong_As_long(__pyx_t_11); if (unlikely((__pyx_t_42 == (long)-1) && PyErr_Occurred())) __PYX_ERR(0, 291, __pyx_L1_error)
+  __pyx_t_42 = __Pyx_PyLong_As_long(__pyx_t_11); if (unlikely((__pyx_t_42 == (long)-1) && PyErr_Occurred())) __PYX_ERR(0, 292, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_scaling); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 291, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_scaling); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 292, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_16 = __Pyx_PyLong_As_long(__pyx_t_11); if (unlikely((__pyx_t_16 == (long)-1) && PyErr_Occurred())) __PYX_ERR(0, 291, __pyx_L1_error)
+  __pyx_t_16 = __Pyx_PyLong_As_long(__pyx_t_11); if (unlikely((__pyx_t_16 == (long)-1) && PyErr_Occurred())) __PYX_ERR(0, 292, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   __pyx_v_o->adaptive_rho_interval = __pyx_t_42;
   __pyx_v_o->scaling = __pyx_t_16;
 
-  /* "fccqp/admm.pyx":292
+  /* "fccqp/admm.pyx":293
  *         o.max_iter, o.check_termination = settings.max_iter, settings.check_termination
  *         o.adaptive_rho_interval, o.scaling = settings.adaptive_rho_interval, settings.scaling
  *         o.adaptive_rho, o.restore_feasibility = settings.adaptive_rho, settings.restore_feasibility             # <<<<<<<<<<<<<<
  *         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
  *         self.has_previous = self.has_matrices = self.certified = self.scaled_once = False
 */
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_adaptive_rho); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 292, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_adaptive_rho); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 293, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_18 = __Pyx_PyObject_IsTrue(__pyx_t_11); if (unlikely((__pyx_t_18 == (int)-1) && PyErr_Occurred())) __PYX_ERR(0, 292, __pyx_L1_error)
+  __pyx_t_18 = __Pyx_PyObject_IsTrue(__pyx_t_11); if (unlikely((__pyx_t_18 == (int)-1) && PyErr_Occurred())) __PYX_ERR(0, 293, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
-  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_restore_feasibility); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 292, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_restore_feasibility); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 293, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_43 = __Pyx_PyObject_IsTrue(__pyx_t_11); if (unlikely((__pyx_t_43 == (int)-1) && PyErr_Occurred())) __PYX_ERR(0, 292, __pyx_L1_error)
+  __pyx_t_43 = __Pyx_PyObject_IsTrue(__pyx_t_11); if (unlikely((__pyx_t_43 == (int)-1) && PyErr_Occurred())) __PYX_ERR(0, 293, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   __pyx_v_o->adaptive_rho = __pyx_t_18;
   __pyx_v_o->restore_feasibility = __pyx_t_43;
 
-  /* "fccqp/admm.pyx":293
+  /* "fccqp/admm.pyx":294
  *         o.adaptive_rho_interval, o.scaling = settings.adaptive_rho_interval, settings.scaling
  *         o.adaptive_rho, o.restore_feasibility = settings.adaptive_rho, settings.restore_feasibility
  *         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory             # <<<<<<<<<<<<<<
  *         self.has_previous = self.has_matrices = self.certified = self.scaled_once = False
  *         self.factored_rho = -1.0
 */
-  __Pyx_GetModuleGlobalName(__pyx_t_11, __pyx_mstate_global->__pyx_n_u_BACKENDS); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 293, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_11, __pyx_mstate_global->__pyx_n_u_BACKENDS); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 294, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_13 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_kkt_backend); if (unlikely(!__pyx_t_13)) __PYX_ERR(0, 293, __pyx_L1_error)
+  __pyx_t_13 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_kkt_backend); if (unlikely(!__pyx_t_13)) __PYX_ERR(0, 294, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_13);
-  __pyx_t_12 = __Pyx_PyObject_GetItem(__pyx_t_11, __pyx_t_13); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 293, __pyx_L1_error)
+  __pyx_t_12 = __Pyx_PyObject_GetItem(__pyx_t_11, __pyx_t_13); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 294, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_12);
   __Pyx_DECREF(__pyx_t_11); __pyx_t_11 = 0;
   __Pyx_DECREF(__pyx_t_13); __pyx_t_13 = 0;
-  __pyx_t_40 = __Pyx_PyLong_As_int(__pyx_t_12); if (unlikely((__pyx_t_40 == (int)-1) && PyErr_Occurred())) __PYX_ERR(0, 293, __pyx_L1_error)
+  __pyx_t_40 = __Pyx_PyLong_As_int(__pyx_t_12); if (unlikely((__pyx_t_40 == (int)-1) && PyErr_Occurred())) __PYX_ERR(0, 294, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_12); __pyx_t_12 = 0;
-  __pyx_t_12 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_anderson_memory); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 293, __pyx_L1_error)
+  __pyx_t_12 = __Pyx_PyObject_GetAttrStr(__pyx_v_settings, __pyx_mstate_global->__pyx_n_u_anderson_memory); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 294, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_12);
-  __pyx_t_39 = __Pyx_PyLong_As_int(__pyx_t_12); if (unlikely((__pyx_t_39 == (int)-1) && PyErr_Occurred())) __PYX_ERR(0, 293, __pyx_L1_error)
+  __pyx_t_39 = __Pyx_PyLong_As_int(__pyx_t_12); if (unlikely((__pyx_t_39 == (int)-1) && PyErr_Occurred())) __PYX_ERR(0, 294, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_12); __pyx_t_12 = 0;
   __pyx_v_o->backend = __pyx_t_40;
   __pyx_v_o->anderson_memory = __pyx_t_39;
 
-  /* "fccqp/admm.pyx":294
+  /* "fccqp/admm.pyx":295
  *         o.adaptive_rho, o.restore_feasibility = settings.adaptive_rho, settings.restore_feasibility
  *         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
  *         self.has_previous = self.has_matrices = self.certified = self.scaled_once = False             # <<<<<<<<<<<<<<
@@ -21453,7 +21864,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   __pyx_v_self->certified = 0;
   __pyx_v_self->scaled_once = 0;
 
-  /* "fccqp/admm.pyx":295
+  /* "fccqp/admm.pyx":296
  *         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
  *         self.has_previous = self.has_matrices = self.certified = self.scaled_once = False
  *         self.factored_rho = -1.0             # <<<<<<<<<<<<<<
@@ -21462,7 +21873,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_self->factored_rho = -1.0;
 
-  /* "fccqp/admm.pyx":194
+  /* "fccqp/admm.pyx":195
  *     cdef object _keep
  * 
  *     def __init__(self, Py_ssize_t n, Py_ssize_t m, constrained, cones, fixed, order,             # <<<<<<<<<<<<<<
@@ -21524,7 +21935,7 @@ static int __pyx_pf_5fccqp_4admm_9Workspace___init__(struct __pyx_obj_5fccqp_4ad
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":297
+/* "fccqp/admm.pyx":298
  *         self.factored_rho = -1.0
  * 
  *     cdef double* _new(self, Py_ssize_t size):             # <<<<<<<<<<<<<<
@@ -21554,7 +21965,7 @@ static double *__pyx_f_5fccqp_4admm_9Workspace__new(struct __pyx_obj_5fccqp_4adm
   int __pyx_clineno = 0;
   __Pyx_RefNannySetupContext("_new", 0);
 
-  /* "fccqp/admm.pyx":299
+  /* "fccqp/admm.pyx":300
  *     cdef double* _new(self, Py_ssize_t size):
  *         """A zeroed array of ``size`` doubles (at least one) that lives with ``self``."""
  *         array = np.zeros(max(size, 1))             # <<<<<<<<<<<<<<
@@ -21562,9 +21973,9 @@ static double *__pyx_f_5fccqp_4admm_9Workspace__new(struct __pyx_obj_5fccqp_4adm
  *         cdef double[::1] view = array
 */
   __pyx_t_2 = NULL;
-  __Pyx_GetModuleGlobalName(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 299, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 300, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_3);
-  __pyx_t_4 = __Pyx_PyObject_GetAttrStr(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_zeros); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 299, __pyx_L1_error)
+  __pyx_t_4 = __Pyx_PyObject_GetAttrStr(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_zeros); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 300, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_4);
   __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
 
@@ -21581,7 +21992,7 @@ static double *__pyx_f_5fccqp_4admm_9Workspace__new(struct __pyx_obj_5fccqp_4adm
     __pyx_t_7 = __pyx_t_6;
   }
 
-  __pyx_t_3 = PyLong_FromSsize_t(__pyx_t_7); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 299, __pyx_L1_error)
+  __pyx_t_3 = PyLong_FromSsize_t(__pyx_t_7); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 300, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_3);
 
   __pyx_t_9 = 1;
@@ -21602,13 +22013,13 @@ static double *__pyx_f_5fccqp_4admm_9Workspace__new(struct __pyx_obj_5fccqp_4adm
     __Pyx_XDECREF(__pyx_t_2); __pyx_t_2 = 0;
     __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
     __Pyx_DECREF(__pyx_t_4); __pyx_t_4 = 0;
-    if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 299, __pyx_L1_error)
+    if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 300, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_1);
   }
   __pyx_v_array = __pyx_t_1;
   __pyx_t_1 = 0;
 
-  /* "fccqp/admm.pyx":300
+  /* "fccqp/admm.pyx":301
  *         """A zeroed array of ``size`` doubles (at least one) that lives with ``self``."""
  *         array = np.zeros(max(size, 1))
  *         self._arrays.append(array)             # <<<<<<<<<<<<<<
@@ -21617,24 +22028,24 @@ static double *__pyx_f_5fccqp_4admm_9Workspace__new(struct __pyx_obj_5fccqp_4adm
 */
   if (unlikely(__pyx_v_self->_arrays == Py_None)) {
     PyErr_Format(PyExc_AttributeError, "\047NoneType\047 object has no attribute \047%.30s\047", "append");
-    __PYX_ERR(0, 300, __pyx_L1_error)
+    __PYX_ERR(0, 301, __pyx_L1_error)
   }
-  __pyx_t_10 = __Pyx_PyList_Append(__pyx_v_self->_arrays, __pyx_v_array); if (unlikely(__pyx_t_10 == ((int)-1))) __PYX_ERR(0, 300, __pyx_L1_error)
+  __pyx_t_10 = __Pyx_PyList_Append(__pyx_v_self->_arrays, __pyx_v_array); if (unlikely(__pyx_t_10 == ((int)-1))) __PYX_ERR(0, 301, __pyx_L1_error)
 
 
-  /* "fccqp/admm.pyx":301
+  /* "fccqp/admm.pyx":302
  *         array = np.zeros(max(size, 1))
  *         self._arrays.append(array)
  *         cdef double[::1] view = array             # <<<<<<<<<<<<<<
  *         return &view[0]
  * 
 */
-  __pyx_t_11 = __Pyx_PyObject_to_MemoryviewSlice_dc_double(__pyx_v_array, PyBUF_WRITABLE); if (unlikely(!__pyx_t_11.memview)) __PYX_ERR(0, 301, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyObject_to_MemoryviewSlice_dc_double(__pyx_v_array, PyBUF_WRITABLE); if (unlikely(!__pyx_t_11.memview)) __PYX_ERR(0, 302, __pyx_L1_error)
   __pyx_v_view = __pyx_t_11;
   __pyx_t_11.memview = NULL;
   __pyx_t_11.data = NULL;
 
-  /* "fccqp/admm.pyx":302
+  /* "fccqp/admm.pyx":303
  *         self._arrays.append(array)
  *         cdef double[::1] view = array
  *         return &view[0]             # <<<<<<<<<<<<<<
@@ -21648,7 +22059,7 @@ static double *__pyx_f_5fccqp_4admm_9Workspace__new(struct __pyx_obj_5fccqp_4adm
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":297
+  /* "fccqp/admm.pyx":298
  *         self.factored_rho = -1.0
  * 
  *     cdef double* _new(self, Py_ssize_t size):             # <<<<<<<<<<<<<<
@@ -21673,7 +22084,7 @@ static double *__pyx_f_5fccqp_4admm_9Workspace__new(struct __pyx_obj_5fccqp_4adm
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":304
+/* "fccqp/admm.pyx":305
  *         return &view[0]
  * 
  *     cdef void* _new_int(self, Py_ssize_t size):             # <<<<<<<<<<<<<<
@@ -21705,7 +22116,7 @@ static void *__pyx_f_5fccqp_4admm_9Workspace__new_int(struct __pyx_obj_5fccqp_4a
   int __pyx_clineno = 0;
   __Pyx_RefNannySetupContext("_new_int", 0);
 
-  /* "fccqp/admm.pyx":306
+  /* "fccqp/admm.pyx":307
  *     cdef void* _new_int(self, Py_ssize_t size):
  *         """An array of ``size`` pointer-sized integers that lives with ``self``."""
  *         array = np.zeros(max(size, 1), dtype=np.intp)             # <<<<<<<<<<<<<<
@@ -21713,9 +22124,9 @@ static void *__pyx_f_5fccqp_4admm_9Workspace__new_int(struct __pyx_obj_5fccqp_4a
  *         cdef Py_ssize_t[::1] view = array
 */
   __pyx_t_2 = NULL;
-  __Pyx_GetModuleGlobalName(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 306, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 307, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_3);
-  __pyx_t_4 = __Pyx_PyObject_GetAttrStr(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_zeros); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 306, __pyx_L1_error)
+  __pyx_t_4 = __Pyx_PyObject_GetAttrStr(__pyx_t_3, __pyx_mstate_global->__pyx_n_u_zeros); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 307, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_4);
   __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
 
@@ -21732,12 +22143,12 @@ static void *__pyx_f_5fccqp_4admm_9Workspace__new_int(struct __pyx_obj_5fccqp_4a
     __pyx_t_7 = __pyx_t_6;
   }
 
-  __pyx_t_3 = PyLong_FromSsize_t(__pyx_t_7); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 306, __pyx_L1_error)
+  __pyx_t_3 = PyLong_FromSsize_t(__pyx_t_7); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 307, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_3);
 
-  __Pyx_GetModuleGlobalName(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 306, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 307, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_9);
-  __pyx_t_10 = __Pyx_PyObject_GetAttrStr(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_intp); if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 306, __pyx_L1_error)
+  __pyx_t_10 = __Pyx_PyObject_GetAttrStr(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_intp); if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 307, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_10);
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
   #if CYTHON_VECTORCALL
@@ -21758,13 +22169,13 @@ static void *__pyx_f_5fccqp_4admm_9Workspace__new_int(struct __pyx_obj_5fccqp_4a
     PyObject *__pyx_callargs[3] = {__pyx_t_2, __pyx_t_3, __pyx_t_10};
     #if CYTHON_VECTORCALL
     __pyx_t_9 = __pyx_mstate_global->__pyx_tuple[2];
-    if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 306, __pyx_L1_error)
+    if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 307, __pyx_L1_error)
     __Pyx_INCREF(__pyx_t_9);
     #else
     {
       PyObject *__pyx_temp[1] = {__pyx_mstate_global->__pyx_n_u_dtype};
       __pyx_t_9 = __Pyx_MakeKwargDict(__pyx_temp, __pyx_callargs+2, 1);
-      if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 306, __pyx_L1_error)
+      if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 307, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_9);
     }
     #endif
@@ -21776,13 +22187,13 @@ static void *__pyx_f_5fccqp_4admm_9Workspace__new_int(struct __pyx_obj_5fccqp_4a
     __Pyx_DECREF(__pyx_t_10); __pyx_t_10 = 0;
     __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
     __Pyx_DECREF(__pyx_t_4); __pyx_t_4 = 0;
-    if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 306, __pyx_L1_error)
+    if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 307, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_1);
   }
   __pyx_v_array = __pyx_t_1;
   __pyx_t_1 = 0;
 
-  /* "fccqp/admm.pyx":307
+  /* "fccqp/admm.pyx":308
  *         """An array of ``size`` pointer-sized integers that lives with ``self``."""
  *         array = np.zeros(max(size, 1), dtype=np.intp)
  *         self._arrays.append(array)             # <<<<<<<<<<<<<<
@@ -21791,24 +22202,24 @@ static void *__pyx_f_5fccqp_4admm_9Workspace__new_int(struct __pyx_obj_5fccqp_4a
 */
   if (unlikely(__pyx_v_self->_arrays == Py_None)) {
     PyErr_Format(PyExc_AttributeError, "\047NoneType\047 object has no attribute \047%.30s\047", "append");
-    __PYX_ERR(0, 307, __pyx_L1_error)
+    __PYX_ERR(0, 308, __pyx_L1_error)
   }
-  __pyx_t_12 = __Pyx_PyList_Append(__pyx_v_self->_arrays, __pyx_v_array); if (unlikely(__pyx_t_12 == ((int)-1))) __PYX_ERR(0, 307, __pyx_L1_error)
+  __pyx_t_12 = __Pyx_PyList_Append(__pyx_v_self->_arrays, __pyx_v_array); if (unlikely(__pyx_t_12 == ((int)-1))) __PYX_ERR(0, 308, __pyx_L1_error)
 
 
-  /* "fccqp/admm.pyx":308
+  /* "fccqp/admm.pyx":309
  *         array = np.zeros(max(size, 1), dtype=np.intp)
  *         self._arrays.append(array)
  *         cdef Py_ssize_t[::1] view = array             # <<<<<<<<<<<<<<
  *         return &view[0]
  * 
 */
-  __pyx_t_13 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(__pyx_v_array, PyBUF_WRITABLE); if (unlikely(!__pyx_t_13.memview)) __PYX_ERR(0, 308, __pyx_L1_error)
+  __pyx_t_13 = __Pyx_PyObject_to_MemoryviewSlice_dc_Py_ssize_t(__pyx_v_array, PyBUF_WRITABLE); if (unlikely(!__pyx_t_13.memview)) __PYX_ERR(0, 309, __pyx_L1_error)
   __pyx_v_view = __pyx_t_13;
   __pyx_t_13.memview = NULL;
   __pyx_t_13.data = NULL;
 
-  /* "fccqp/admm.pyx":309
+  /* "fccqp/admm.pyx":310
  *         self._arrays.append(array)
  *         cdef Py_ssize_t[::1] view = array
  *         return &view[0]             # <<<<<<<<<<<<<<
@@ -21822,7 +22233,7 @@ static void *__pyx_f_5fccqp_4admm_9Workspace__new_int(struct __pyx_obj_5fccqp_4a
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":304
+  /* "fccqp/admm.pyx":305
  *         return &view[0]
  * 
  *     cdef void* _new_int(self, Py_ssize_t size):             # <<<<<<<<<<<<<<
@@ -21849,7 +22260,7 @@ static void *__pyx_f_5fccqp_4admm_9Workspace__new_int(struct __pyx_obj_5fccqp_4a
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":311
+/* "fccqp/admm.pyx":312
  *         return &view[0]
  * 
  *     def update_cones(self, mu, normal):             # <<<<<<<<<<<<<<
@@ -21898,39 +22309,39 @@ PyObject *__pyx_args, PyObject *__pyx_kwds
   {
     PyObject ** const __pyx_pyargnames[] = {&__pyx_mstate_global->__pyx_n_u_mu,&__pyx_mstate_global->__pyx_n_u_normal,0};
     const Py_ssize_t __pyx_kwds_len = (__pyx_kwds) ? __Pyx_NumKwargs_FASTCALL(__pyx_kwds) : 0;
-    if (unlikely(__pyx_kwds_len < 0)) __PYX_ERR(0, 311, __pyx_L3_error)
+    if (unlikely(__pyx_kwds_len < 0)) __PYX_ERR(0, 312, __pyx_L3_error)
     if (__pyx_kwds_len > 0) {
       switch (__pyx_nargs) {
         case  2:
         values[1] = __Pyx_ArgRef_FASTCALL(__pyx_args, 1);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 311, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 312, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  1:
         values[0] = __Pyx_ArgRef_FASTCALL(__pyx_args, 0);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 311, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 312, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  0: break;
         default: goto __pyx_L5_argtuple_error;
       }
       const Py_ssize_t kwd_pos_args = __pyx_nargs;
-      if (__Pyx_ParseKeywords(__pyx_kwds, __pyx_kwvalues, __pyx_pyargnames, 0, values, kwd_pos_args, __pyx_kwds_len, "update_cones", 0) < (0)) __PYX_ERR(0, 311, __pyx_L3_error)
+      if (__Pyx_ParseKeywords(__pyx_kwds, __pyx_kwvalues, __pyx_pyargnames, 0, values, kwd_pos_args, __pyx_kwds_len, "update_cones", 0) < (0)) __PYX_ERR(0, 312, __pyx_L3_error)
       for (Py_ssize_t i = __pyx_nargs; i < 2; i++) {
-        if (unlikely(!values[i])) { __Pyx_RaiseArgtupleInvalid("update_cones", 1, 2, 2, i); __PYX_ERR(0, 311, __pyx_L3_error) }
+        if (unlikely(!values[i])) { __Pyx_RaiseArgtupleInvalid("update_cones", 1, 2, 2, i); __PYX_ERR(0, 312, __pyx_L3_error) }
       }
     } else if (unlikely(__pyx_nargs != 2)) {
       goto __pyx_L5_argtuple_error;
     } else {
       values[0] = __Pyx_ArgRef_FASTCALL(__pyx_args, 0);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 311, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 312, __pyx_L3_error)
       values[1] = __Pyx_ArgRef_FASTCALL(__pyx_args, 1);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 311, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 312, __pyx_L3_error)
     }
     __pyx_v_mu = values[0];
     __pyx_v_normal = values[1];
   }
   goto __pyx_L6_skip;
   __pyx_L5_argtuple_error:;
-  __Pyx_RaiseArgtupleInvalid("update_cones", 1, 2, 2, __pyx_nargs); __PYX_ERR(0, 311, __pyx_L3_error)
+  __Pyx_RaiseArgtupleInvalid("update_cones", 1, 2, 2, __pyx_nargs); __PYX_ERR(0, 312, __pyx_L3_error)
   __pyx_L6_skip:;
   goto __pyx_L4_argument_unpacking_done;
   __pyx_L3_error:;
@@ -21967,19 +22378,19 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_2update_cones(struct __pyx_obj
   int __pyx_clineno = 0;
   __Pyx_RefNannySetupContext("update_cones", 0);
 
-  /* "fccqp/admm.pyx":313
+  /* "fccqp/admm.pyx":314
  *     def update_cones(self, mu, normal):
  *         """New friction coefficients and normals for the same cone blocks."""
  *         self._keep[4][:] = mu             # <<<<<<<<<<<<<<
  *         self._keep[5][:] = np.asarray(normal, dtype=np.float64).reshape(-1)
  * 
 */
-  __pyx_t_1 = __Pyx_GetItemInt(__pyx_v_self->_keep, 4, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 313, __pyx_L1_error)
+  __pyx_t_1 = __Pyx_GetItemInt(__pyx_v_self->_keep, 4, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 314, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_1);
-  if (__Pyx_PyObject_SetSlice(__pyx_t_1, __pyx_v_mu, 0, 0, NULL, NULL, &__pyx_mstate_global->__pyx_slice[0], 0, 0, 0) < (0)) __PYX_ERR(0, 313, __pyx_L1_error)
+  if (__Pyx_PyObject_SetSlice(__pyx_t_1, __pyx_v_mu, 0, 0, NULL, NULL, &__pyx_mstate_global->__pyx_slice[0], 0, 0, 0) < (0)) __PYX_ERR(0, 314, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_1); __pyx_t_1 = 0;
 
-  /* "fccqp/admm.pyx":314
+  /* "fccqp/admm.pyx":315
  *         """New friction coefficients and normals for the same cone blocks."""
  *         self._keep[4][:] = mu
  *         self._keep[5][:] = np.asarray(normal, dtype=np.float64).reshape(-1)             # <<<<<<<<<<<<<<
@@ -21987,14 +22398,14 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_2update_cones(struct __pyx_obj
  *     def forget(self):
 */
   __pyx_t_4 = NULL;
-  __Pyx_GetModuleGlobalName(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 314, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 315, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_5);
-  __pyx_t_6 = __Pyx_PyObject_GetAttrStr(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_asarray); if (unlikely(!__pyx_t_6)) __PYX_ERR(0, 314, __pyx_L1_error)
+  __pyx_t_6 = __Pyx_PyObject_GetAttrStr(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_asarray); if (unlikely(!__pyx_t_6)) __PYX_ERR(0, 315, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_6);
   __Pyx_DECREF(__pyx_t_5); __pyx_t_5 = 0;
-  __Pyx_GetModuleGlobalName(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 314, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_np); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 315, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_5);
-  __pyx_t_7 = __Pyx_PyObject_GetAttrStr(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_float64); if (unlikely(!__pyx_t_7)) __PYX_ERR(0, 314, __pyx_L1_error)
+  __pyx_t_7 = __Pyx_PyObject_GetAttrStr(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_float64); if (unlikely(!__pyx_t_7)) __PYX_ERR(0, 315, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_7);
   __Pyx_DECREF(__pyx_t_5); __pyx_t_5 = 0;
   #if CYTHON_VECTORCALL
@@ -22015,13 +22426,13 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_2update_cones(struct __pyx_obj
     PyObject *__pyx_callargs[3] = {__pyx_t_4, __pyx_v_normal, __pyx_t_7};
     #if CYTHON_VECTORCALL
     __pyx_t_5 = __pyx_mstate_global->__pyx_tuple[2];
-    if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 314, __pyx_L1_error)
+    if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 315, __pyx_L1_error)
     __Pyx_INCREF(__pyx_t_5);
     #else
     {
       PyObject *__pyx_temp[1] = {__pyx_mstate_global->__pyx_n_u_dtype};
       __pyx_t_5 = __Pyx_MakeKwargDict(__pyx_temp, __pyx_callargs+2, 1);
-      if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 314, __pyx_L1_error)
+      if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 315, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_5);
     }
     #endif
@@ -22032,7 +22443,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_2update_cones(struct __pyx_obj
     __Pyx_DECREF(__pyx_t_7); __pyx_t_7 = 0;
     __Pyx_DECREF(__pyx_t_5); __pyx_t_5 = 0;
     __Pyx_DECREF(__pyx_t_6); __pyx_t_6 = 0;
-    if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 314, __pyx_L1_error)
+    if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 315, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_3);
   }
   __pyx_t_2 = __pyx_t_3;
@@ -22043,16 +22454,16 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_2update_cones(struct __pyx_obj
     __pyx_t_1 = __Pyx_PyObject_FastCallMethod((PyObject*)__pyx_mstate_global->__pyx_n_u_reshape, __pyx_callargs+__pyx_t_8, (2-__pyx_t_8) | (1*__Pyx_PY_VECTORCALL_ARGUMENTS_OFFSET));
     __Pyx_XDECREF(__pyx_t_2); __pyx_t_2 = 0;
     __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
-    if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 314, __pyx_L1_error)
+    if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 315, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_1);
   }
-  __pyx_t_3 = __Pyx_GetItemInt(__pyx_v_self->_keep, 5, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 314, __pyx_L1_error)
+  __pyx_t_3 = __Pyx_GetItemInt(__pyx_v_self->_keep, 5, long, 1, __Pyx_PyLong_From_long, 0, 0, 1, __Pyx_ReferenceSharing_SharedReference); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 315, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_3);
-  if (__Pyx_PyObject_SetSlice(__pyx_t_3, __pyx_t_1, 0, 0, NULL, NULL, &__pyx_mstate_global->__pyx_slice[0], 0, 0, 0) < (0)) __PYX_ERR(0, 314, __pyx_L1_error)
+  if (__Pyx_PyObject_SetSlice(__pyx_t_3, __pyx_t_1, 0, 0, NULL, NULL, &__pyx_mstate_global->__pyx_slice[0], 0, 0, 0) < (0)) __PYX_ERR(0, 315, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
   __Pyx_DECREF(__pyx_t_1); __pyx_t_1 = 0;
 
-  /* "fccqp/admm.pyx":311
+  /* "fccqp/admm.pyx":312
  *         return &view[0]
  * 
  *     def update_cones(self, mu, normal):             # <<<<<<<<<<<<<<
@@ -22079,7 +22490,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_2update_cones(struct __pyx_obj
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":316
+/* "fccqp/admm.pyx":317
  *         self._keep[5][:] = np.asarray(normal, dtype=np.float64).reshape(-1)
  * 
  *     def forget(self):             # <<<<<<<<<<<<<<
@@ -22135,7 +22546,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_4forget(struct __pyx_obj_5fccq
   __Pyx_RefNannyDeclarations
   __Pyx_RefNannySetupContext("forget", 0);
 
-  /* "fccqp/admm.pyx":318
+  /* "fccqp/admm.pyx":319
  *     def forget(self):
  *         """Drop the previous solution, so that the next solve starts cold."""
  *         self.has_previous = False             # <<<<<<<<<<<<<<
@@ -22144,7 +22555,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_4forget(struct __pyx_obj_5fccq
 */
   __pyx_v_self->has_previous = 0;
 
-  /* "fccqp/admm.pyx":316
+  /* "fccqp/admm.pyx":317
  *         self._keep[5][:] = np.asarray(normal, dtype=np.float64).reshape(-1)
  * 
  *     def forget(self):             # <<<<<<<<<<<<<<
@@ -22159,7 +22570,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_4forget(struct __pyx_obj_5fccq
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":320
+/* "fccqp/admm.pyx":321
  *         self.has_previous = False
  * 
  *     @property             # <<<<<<<<<<<<<<
@@ -22195,31 +22606,31 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_7finding___get__(struct __pyx_
   int __pyx_clineno = 0;
   __Pyx_RefNannySetupContext("__get__", 0);
 
-  /* "fccqp/admm.pyx":323
+  /* "fccqp/admm.pyx":324
  *     def finding(self):
  *         """``(code, argument, index, value)`` of the last scan (see fccqp.validation)."""
  *         return self.found.code, self.found.argument, self.found.index, self.found.value             # <<<<<<<<<<<<<<
  * 
  *     @property
 */
-  __pyx_t_1 = __Pyx_PyLong_From_int(__pyx_v_self->found.code); if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 323, __pyx_L1_error)
+  __pyx_t_1 = __Pyx_PyLong_From_int(__pyx_v_self->found.code); if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 324, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_1);
-  __pyx_t_2 = __Pyx_PyLong_From_int(__pyx_v_self->found.argument); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 323, __pyx_L1_error)
+  __pyx_t_2 = __Pyx_PyLong_From_int(__pyx_v_self->found.argument); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 324, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_2);
-  __pyx_t_3 = PyLong_FromSsize_t(__pyx_v_self->found.index); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 323, __pyx_L1_error)
+  __pyx_t_3 = PyLong_FromSsize_t(__pyx_v_self->found.index); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 324, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_3);
-  __pyx_t_4 = PyFloat_FromDouble(__pyx_v_self->found.value); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 323, __pyx_L1_error)
+  __pyx_t_4 = PyFloat_FromDouble(__pyx_v_self->found.value); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 324, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_4);
-  __pyx_t_5 = PyTuple_New(4); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 323, __pyx_L1_error)
+  __pyx_t_5 = PyTuple_New(4); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 324, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_5);
   __Pyx_GIVEREF(__pyx_t_1);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_5, 0, __pyx_t_1) != (0)) __PYX_ERR(0, 323, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_5, 0, __pyx_t_1) != (0)) __PYX_ERR(0, 324, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_2);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_5, 1, __pyx_t_2) != (0)) __PYX_ERR(0, 323, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_5, 1, __pyx_t_2) != (0)) __PYX_ERR(0, 324, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_3);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_5, 2, __pyx_t_3) != (0)) __PYX_ERR(0, 323, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_5, 2, __pyx_t_3) != (0)) __PYX_ERR(0, 324, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_4);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_5, 3, __pyx_t_4) != (0)) __PYX_ERR(0, 323, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_5, 3, __pyx_t_4) != (0)) __PYX_ERR(0, 324, __pyx_L1_error);
   __pyx_t_1 = 0;
   __pyx_t_2 = 0;
   __pyx_t_3 = 0;
@@ -22235,7 +22646,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_7finding___get__(struct __pyx_
   __pyx_t_5 = 0;
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":320
+  /* "fccqp/admm.pyx":321
  *         self.has_previous = False
  * 
  *     @property             # <<<<<<<<<<<<<<
@@ -22258,7 +22669,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_7finding___get__(struct __pyx_
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":325
+/* "fccqp/admm.pyx":326
  *         return self.found.code, self.found.argument, self.found.index, self.found.value
  * 
  *     @property             # <<<<<<<<<<<<<<
@@ -22282,7 +22693,7 @@ static PyObject *__pyx_pw_5fccqp_4admm_9Workspace_9log_lines_1__get__(PyObject *
 }
 static PyObject *__pyx_gb_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_2generator(__pyx_CoroutineObject *__pyx_generator, CYTHON_UNUSED PyThreadState *__pyx_tstate, PyObject *__pyx_sent_value); /* proto */
 
-/* "fccqp/admm.pyx":329
+/* "fccqp/admm.pyx":330
  *         """Rows ``(iteration, prim, dual, gap, rho)`` of the last solve's log."""
  *         cdef Py_ssize_t i, j
  *         return [tuple(self.log[5 * i + j] for j in range(5)) for i in range(self.log_count)]             # <<<<<<<<<<<<<<
@@ -22302,7 +22713,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_
   if (unlikely(!__pyx_cur_scope)) {
     __pyx_cur_scope = ((struct __pyx_obj_5fccqp_4admm___pyx_scope_struct_1_genexpr *)Py_None);
     __Pyx_INCREF(Py_None);
-    __PYX_ERR(0, 329, __pyx_L1_error)
+    __PYX_ERR(0, 330, __pyx_L1_error)
   } else {
     __Pyx_GOTREF((PyObject *)__pyx_cur_scope);
   }
@@ -22310,7 +22721,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_
   __Pyx_INCREF((PyObject *)__pyx_cur_scope->__pyx_outer_scope);
   __Pyx_GIVEREF((PyObject *)__pyx_cur_scope->__pyx_outer_scope);
   {
-    __pyx_CoroutineObject *gen = __Pyx_Generator_New((__pyx_coroutine_body_t) __pyx_gb_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_2generator, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[0]), (PyObject *) __pyx_cur_scope, __pyx_mstate_global->__pyx_n_u_genexpr, __pyx_mstate_global->__pyx_n_u_Workspace___get___locals_genexpr, __pyx_mstate_global->__pyx_n_u_fccqp_admm); if (unlikely(!gen)) __PYX_ERR(0, 329, __pyx_L1_error)
+    __pyx_CoroutineObject *gen = __Pyx_Generator_New((__pyx_coroutine_body_t) __pyx_gb_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_2generator, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[0]), (PyObject *) __pyx_cur_scope, __pyx_mstate_global->__pyx_n_u_genexpr, __pyx_mstate_global->__pyx_n_u_Workspace___get___locals_genexpr, __pyx_mstate_global->__pyx_n_u_fccqp_admm); if (unlikely(!gen)) __PYX_ERR(0, 330, __pyx_L1_error)
     __Pyx_DECREF(__pyx_cur_scope);
     __Pyx_RefNannyFinishContext();
     return (PyObject *) gen;
@@ -22349,24 +22760,24 @@ static PyObject *__pyx_gb_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_
   __pyx_L3_first_run:;
   if (unlikely(__pyx_sent_value != Py_None)) {
     if (unlikely(__pyx_sent_value)) PyErr_SetString(PyExc_TypeError, "can't send non-None value to a just-started generator");
-    __PYX_ERR(0, 329, __pyx_L1_error)
+    __PYX_ERR(0, 330, __pyx_L1_error)
   }
   for (__pyx_t_1 = 0; __pyx_t_1 < 5; __pyx_t_1+=1) {
-    __pyx_t_2 = PyLong_FromSsize_t(__pyx_t_1); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 329, __pyx_L1_error)
+    __pyx_t_2 = PyLong_FromSsize_t(__pyx_t_1); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 330, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_2);
     __Pyx_XGOTREF(__pyx_cur_scope->__pyx_v_j);
     __Pyx_XDECREF_SET(__pyx_cur_scope->__pyx_v_j, ((PyObject*)__pyx_t_2));
     __Pyx_GIVEREF(__pyx_t_2);
     __pyx_t_2 = 0;
-    if (unlikely(!__pyx_cur_scope->__pyx_outer_scope->__pyx_v_self)) { __Pyx_RaiseClosureNameError("self"); __PYX_ERR(0, 329, __pyx_L1_error) }
-    __pyx_t_2 = PyLong_FromSsize_t((5 * __pyx_cur_scope->__pyx_outer_scope->__pyx_8genexpr1__pyx_v_i)); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 329, __pyx_L1_error)
+    if (unlikely(!__pyx_cur_scope->__pyx_outer_scope->__pyx_v_self)) { __Pyx_RaiseClosureNameError("self"); __PYX_ERR(0, 330, __pyx_L1_error) }
+    __pyx_t_2 = PyLong_FromSsize_t((5 * __pyx_cur_scope->__pyx_outer_scope->__pyx_8genexpr1__pyx_v_i)); if (unlikely(!__pyx_t_2)) __PYX_ERR(0, 330, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_2);
-    __pyx_t_3 = __Pyx_PyNumber_Add_int_int(__pyx_t_2, __pyx_cur_scope->__pyx_v_j); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 329, __pyx_L1_error)
+    __pyx_t_3 = __Pyx_PyNumber_Add_int_int(__pyx_t_2, __pyx_cur_scope->__pyx_v_j); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 330, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_3);
     __Pyx_DECREF(__pyx_t_2); __pyx_t_2 = 0;
-    __pyx_t_4 = __Pyx_PyIndex_AsSsize_t(__pyx_t_3); if (unlikely((__pyx_t_4 == (Py_ssize_t)-1) && PyErr_Occurred())) __PYX_ERR(0, 329, __pyx_L1_error)
+    __pyx_t_4 = __Pyx_PyIndex_AsSsize_t(__pyx_t_3); if (unlikely((__pyx_t_4 == (Py_ssize_t)-1) && PyErr_Occurred())) __PYX_ERR(0, 330, __pyx_L1_error)
     __Pyx_DECREF(__pyx_t_3); __pyx_t_3 = 0;
-    __pyx_t_3 = PyFloat_FromDouble((__pyx_cur_scope->__pyx_outer_scope->__pyx_v_self->log[__pyx_t_4])); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 329, __pyx_L1_error)
+    __pyx_t_3 = PyFloat_FromDouble((__pyx_cur_scope->__pyx_outer_scope->__pyx_v_self->log[__pyx_t_4])); if (unlikely(!__pyx_t_3)) __PYX_ERR(0, 330, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_3);
 
     __pyx_r = __pyx_t_3;
@@ -22381,7 +22792,7 @@ static PyObject *__pyx_gb_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_
     return __pyx_r;
     __pyx_L6_resume_from_yield:;
     __pyx_t_1 = __pyx_cur_scope->__pyx_t_0;
-    if (unlikely(!__pyx_sent_value)) __PYX_ERR(0, 329, __pyx_L1_error)
+    if (unlikely(!__pyx_sent_value)) __PYX_ERR(0, 330, __pyx_L1_error)
   }
   CYTHON_MAYBE_UNUSED_VAR(__pyx_cur_scope);
 
@@ -22406,7 +22817,7 @@ static PyObject *__pyx_gb_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":325
+/* "fccqp/admm.pyx":326
  *         return self.found.code, self.found.argument, self.found.index, self.found.value
  * 
  *     @property             # <<<<<<<<<<<<<<
@@ -22433,7 +22844,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_9log_lines___get__(struct __py
   if (unlikely(!__pyx_cur_scope)) {
     __pyx_cur_scope = ((struct __pyx_obj_5fccqp_4admm___pyx_scope_struct____get__ *)Py_None);
     __Pyx_INCREF(Py_None);
-    __PYX_ERR(0, 325, __pyx_L1_error)
+    __PYX_ERR(0, 326, __pyx_L1_error)
   } else {
     __Pyx_GOTREF((PyObject *)__pyx_cur_scope);
   }
@@ -22441,7 +22852,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_9log_lines___get__(struct __py
   __Pyx_INCREF((PyObject *)__pyx_cur_scope->__pyx_v_self);
   __Pyx_GIVEREF((PyObject *)__pyx_cur_scope->__pyx_v_self);
 
-  /* "fccqp/admm.pyx":329
+  /* "fccqp/admm.pyx":330
  *         """Rows ``(iteration, prim, dual, gap, rho)`` of the last solve's log."""
  *         cdef Py_ssize_t i, j
  *         return [tuple(self.log[5 * i + j] for j in range(5)) for i in range(self.log_count)]             # <<<<<<<<<<<<<<
@@ -22449,7 +22860,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_9log_lines___get__(struct __py
  *     def solve(self, const double[:, ::1] P, const double[::1] q, const double[:, ::1] A,
 */
   { /* enter inner scope */
-    __pyx_t_1 = PyList_New(0); if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 329, __pyx_L1_error)
+    __pyx_t_1 = PyList_New(0); if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 330, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_1);
 
     __pyx_t_2 = __pyx_cur_scope->__pyx_v_self->log_count;
@@ -22457,13 +22868,13 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_9log_lines___get__(struct __py
 
     for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
       __pyx_cur_scope->__pyx_8genexpr1__pyx_v_i = __pyx_t_4;
-      __pyx_t_5 = __pyx_pf_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_genexpr(((PyObject*)__pyx_cur_scope)); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 329, __pyx_L1_error)
+      __pyx_t_5 = __pyx_pf_5fccqp_4admm_9Workspace_9log_lines_7__get___8genexpr1_genexpr(((PyObject*)__pyx_cur_scope)); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 330, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_5);
-      __pyx_t_6 = __Pyx_PySequence_Tuple(__pyx_t_5); if (unlikely(!__pyx_t_6)) __PYX_ERR(0, 329, __pyx_L1_error)
+      __pyx_t_6 = __Pyx_PySequence_Tuple(__pyx_t_5); if (unlikely(!__pyx_t_6)) __PYX_ERR(0, 330, __pyx_L1_error)
       __Pyx_GOTREF(__pyx_t_6);
       __Pyx_DECREF(__pyx_t_5); __pyx_t_5 = 0;
       __Pyx_GIVEREF(__pyx_t_6);
-      if (unlikely(__Pyx_ListComp_AppendAndDecref(__pyx_t_1, __pyx_t_6))) __PYX_ERR(0, 329, __pyx_L1_error)
+      if (unlikely(__Pyx_ListComp_AppendAndDecref(__pyx_t_1, __pyx_t_6))) __PYX_ERR(0, 330, __pyx_L1_error)
       __pyx_t_6 = 0;
     }
 
@@ -22479,7 +22890,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_9log_lines___get__(struct __py
   __pyx_t_1 = 0;
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":325
+  /* "fccqp/admm.pyx":326
  *         return self.found.code, self.found.argument, self.found.index, self.found.value
  * 
  *     @property             # <<<<<<<<<<<<<<
@@ -22502,7 +22913,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_9log_lines___get__(struct __py
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":331
+/* "fccqp/admm.pyx":332
  *         return [tuple(self.log[5 * i + j] for j in range(5)) for i in range(self.log_count)]
  * 
  *     def solve(self, const double[:, ::1] P, const double[::1] q, const double[:, ::1] A,             # <<<<<<<<<<<<<<
@@ -22562,116 +22973,116 @@ PyObject *__pyx_args, PyObject *__pyx_kwds
   {
     PyObject ** const __pyx_pyargnames[] = {&__pyx_mstate_global->__pyx_n_u_P,&__pyx_mstate_global->__pyx_n_u_q,&__pyx_mstate_global->__pyx_n_u_A,&__pyx_mstate_global->__pyx_n_u_b,&__pyx_mstate_global->__pyx_n_u_lb,&__pyx_mstate_global->__pyx_n_u_ub,&__pyx_mstate_global->__pyx_n_u_x0,&__pyx_mstate_global->__pyx_n_u_warm,&__pyx_mstate_global->__pyx_n_u_start_time,&__pyx_mstate_global->__pyx_n_u_x_out,&__pyx_mstate_global->__pyx_n_u_y_out,&__pyx_mstate_global->__pyx_n_u_z_out,&__pyx_mstate_global->__pyx_n_u_cert_out,0};
     const Py_ssize_t __pyx_kwds_len = (__pyx_kwds) ? __Pyx_NumKwargs_FASTCALL(__pyx_kwds) : 0;
-    if (unlikely(__pyx_kwds_len < 0)) __PYX_ERR(0, 331, __pyx_L3_error)
+    if (unlikely(__pyx_kwds_len < 0)) __PYX_ERR(0, 332, __pyx_L3_error)
     if (__pyx_kwds_len > 0) {
       switch (__pyx_nargs) {
         case 13:
         values[12] = __Pyx_ArgRef_FASTCALL(__pyx_args, 12);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[12])) __PYX_ERR(0, 331, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[12])) __PYX_ERR(0, 332, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case 12:
         values[11] = __Pyx_ArgRef_FASTCALL(__pyx_args, 11);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[11])) __PYX_ERR(0, 331, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[11])) __PYX_ERR(0, 332, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case 11:
         values[10] = __Pyx_ArgRef_FASTCALL(__pyx_args, 10);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[10])) __PYX_ERR(0, 331, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[10])) __PYX_ERR(0, 332, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case 10:
         values[9] = __Pyx_ArgRef_FASTCALL(__pyx_args, 9);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[9])) __PYX_ERR(0, 331, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[9])) __PYX_ERR(0, 332, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  9:
         values[8] = __Pyx_ArgRef_FASTCALL(__pyx_args, 8);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[8])) __PYX_ERR(0, 331, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[8])) __PYX_ERR(0, 332, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  8:
         values[7] = __Pyx_ArgRef_FASTCALL(__pyx_args, 7);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[7])) __PYX_ERR(0, 331, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[7])) __PYX_ERR(0, 332, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  7:
         values[6] = __Pyx_ArgRef_FASTCALL(__pyx_args, 6);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[6])) __PYX_ERR(0, 331, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[6])) __PYX_ERR(0, 332, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  6:
         values[5] = __Pyx_ArgRef_FASTCALL(__pyx_args, 5);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[5])) __PYX_ERR(0, 331, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[5])) __PYX_ERR(0, 332, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  5:
         values[4] = __Pyx_ArgRef_FASTCALL(__pyx_args, 4);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[4])) __PYX_ERR(0, 331, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[4])) __PYX_ERR(0, 332, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  4:
         values[3] = __Pyx_ArgRef_FASTCALL(__pyx_args, 3);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 331, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 332, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  3:
         values[2] = __Pyx_ArgRef_FASTCALL(__pyx_args, 2);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 331, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 332, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  2:
         values[1] = __Pyx_ArgRef_FASTCALL(__pyx_args, 1);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 331, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 332, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  1:
         values[0] = __Pyx_ArgRef_FASTCALL(__pyx_args, 0);
-        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 331, __pyx_L3_error)
+        if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 332, __pyx_L3_error)
         CYTHON_FALLTHROUGH;
         case  0: break;
         default: goto __pyx_L5_argtuple_error;
       }
       const Py_ssize_t kwd_pos_args = __pyx_nargs;
-      if (__Pyx_ParseKeywords(__pyx_kwds, __pyx_kwvalues, __pyx_pyargnames, 0, values, kwd_pos_args, __pyx_kwds_len, "solve", 0) < (0)) __PYX_ERR(0, 331, __pyx_L3_error)
+      if (__Pyx_ParseKeywords(__pyx_kwds, __pyx_kwvalues, __pyx_pyargnames, 0, values, kwd_pos_args, __pyx_kwds_len, "solve", 0) < (0)) __PYX_ERR(0, 332, __pyx_L3_error)
       for (Py_ssize_t i = __pyx_nargs; i < 13; i++) {
-        if (unlikely(!values[i])) { __Pyx_RaiseArgtupleInvalid("solve", 1, 13, 13, i); __PYX_ERR(0, 331, __pyx_L3_error) }
+        if (unlikely(!values[i])) { __Pyx_RaiseArgtupleInvalid("solve", 1, 13, 13, i); __PYX_ERR(0, 332, __pyx_L3_error) }
       }
     } else if (unlikely(__pyx_nargs != 13)) {
       goto __pyx_L5_argtuple_error;
     } else {
       values[0] = __Pyx_ArgRef_FASTCALL(__pyx_args, 0);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 331, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[0])) __PYX_ERR(0, 332, __pyx_L3_error)
       values[1] = __Pyx_ArgRef_FASTCALL(__pyx_args, 1);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 331, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[1])) __PYX_ERR(0, 332, __pyx_L3_error)
       values[2] = __Pyx_ArgRef_FASTCALL(__pyx_args, 2);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 331, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[2])) __PYX_ERR(0, 332, __pyx_L3_error)
       values[3] = __Pyx_ArgRef_FASTCALL(__pyx_args, 3);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 331, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[3])) __PYX_ERR(0, 332, __pyx_L3_error)
       values[4] = __Pyx_ArgRef_FASTCALL(__pyx_args, 4);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[4])) __PYX_ERR(0, 331, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[4])) __PYX_ERR(0, 332, __pyx_L3_error)
       values[5] = __Pyx_ArgRef_FASTCALL(__pyx_args, 5);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[5])) __PYX_ERR(0, 331, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[5])) __PYX_ERR(0, 332, __pyx_L3_error)
       values[6] = __Pyx_ArgRef_FASTCALL(__pyx_args, 6);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[6])) __PYX_ERR(0, 331, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[6])) __PYX_ERR(0, 332, __pyx_L3_error)
       values[7] = __Pyx_ArgRef_FASTCALL(__pyx_args, 7);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[7])) __PYX_ERR(0, 331, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[7])) __PYX_ERR(0, 332, __pyx_L3_error)
       values[8] = __Pyx_ArgRef_FASTCALL(__pyx_args, 8);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[8])) __PYX_ERR(0, 331, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[8])) __PYX_ERR(0, 332, __pyx_L3_error)
       values[9] = __Pyx_ArgRef_FASTCALL(__pyx_args, 9);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[9])) __PYX_ERR(0, 331, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[9])) __PYX_ERR(0, 332, __pyx_L3_error)
       values[10] = __Pyx_ArgRef_FASTCALL(__pyx_args, 10);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[10])) __PYX_ERR(0, 331, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[10])) __PYX_ERR(0, 332, __pyx_L3_error)
       values[11] = __Pyx_ArgRef_FASTCALL(__pyx_args, 11);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[11])) __PYX_ERR(0, 331, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[11])) __PYX_ERR(0, 332, __pyx_L3_error)
       values[12] = __Pyx_ArgRef_FASTCALL(__pyx_args, 12);
-      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[12])) __PYX_ERR(0, 331, __pyx_L3_error)
+      if (!CYTHON_ASSUME_SAFE_MACROS && unlikely(!values[12])) __PYX_ERR(0, 332, __pyx_L3_error)
     }
-    __pyx_v_P = __Pyx_PyObject_to_MemoryviewSlice_d_dc_double__const__(values[0], 0); if (unlikely(!__pyx_v_P.memview)) __PYX_ERR(0, 331, __pyx_L3_error)
-    __pyx_v_q = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(values[1], 0); if (unlikely(!__pyx_v_q.memview)) __PYX_ERR(0, 331, __pyx_L3_error)
-    __pyx_v_A = __Pyx_PyObject_to_MemoryviewSlice_d_dc_double__const__(values[2], 0); if (unlikely(!__pyx_v_A.memview)) __PYX_ERR(0, 331, __pyx_L3_error)
-    __pyx_v_b = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(values[3], 0); if (unlikely(!__pyx_v_b.memview)) __PYX_ERR(0, 332, __pyx_L3_error)
-    __pyx_v_lb = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(values[4], 0); if (unlikely(!__pyx_v_lb.memview)) __PYX_ERR(0, 332, __pyx_L3_error)
-    __pyx_v_ub = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(values[5], 0); if (unlikely(!__pyx_v_ub.memview)) __PYX_ERR(0, 332, __pyx_L3_error)
+    __pyx_v_P = __Pyx_PyObject_to_MemoryviewSlice_d_dc_double__const__(values[0], 0); if (unlikely(!__pyx_v_P.memview)) __PYX_ERR(0, 332, __pyx_L3_error)
+    __pyx_v_q = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(values[1], 0); if (unlikely(!__pyx_v_q.memview)) __PYX_ERR(0, 332, __pyx_L3_error)
+    __pyx_v_A = __Pyx_PyObject_to_MemoryviewSlice_d_dc_double__const__(values[2], 0); if (unlikely(!__pyx_v_A.memview)) __PYX_ERR(0, 332, __pyx_L3_error)
+    __pyx_v_b = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(values[3], 0); if (unlikely(!__pyx_v_b.memview)) __PYX_ERR(0, 333, __pyx_L3_error)
+    __pyx_v_lb = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(values[4], 0); if (unlikely(!__pyx_v_lb.memview)) __PYX_ERR(0, 333, __pyx_L3_error)
+    __pyx_v_ub = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(values[5], 0); if (unlikely(!__pyx_v_ub.memview)) __PYX_ERR(0, 333, __pyx_L3_error)
     __pyx_v_x0 = values[6];
-    __pyx_v_warm = __Pyx_PyObject_IsTrue(values[7]); if (unlikely((__pyx_v_warm == (int)-1) && PyErr_Occurred())) __PYX_ERR(0, 333, __pyx_L3_error)
-    __pyx_v_start_time = __Pyx_PyFloat_AsDouble(values[8]); if (unlikely((__pyx_v_start_time == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 333, __pyx_L3_error)
-    __pyx_v_x_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[9], PyBUF_WRITABLE); if (unlikely(!__pyx_v_x_out.memview)) __PYX_ERR(0, 334, __pyx_L3_error)
-    __pyx_v_y_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[10], PyBUF_WRITABLE); if (unlikely(!__pyx_v_y_out.memview)) __PYX_ERR(0, 334, __pyx_L3_error)
-    __pyx_v_z_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[11], PyBUF_WRITABLE); if (unlikely(!__pyx_v_z_out.memview)) __PYX_ERR(0, 334, __pyx_L3_error)
-    __pyx_v_cert_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[12], PyBUF_WRITABLE); if (unlikely(!__pyx_v_cert_out.memview)) __PYX_ERR(0, 334, __pyx_L3_error)
+    __pyx_v_warm = __Pyx_PyObject_IsTrue(values[7]); if (unlikely((__pyx_v_warm == (int)-1) && PyErr_Occurred())) __PYX_ERR(0, 334, __pyx_L3_error)
+    __pyx_v_start_time = __Pyx_PyFloat_AsDouble(values[8]); if (unlikely((__pyx_v_start_time == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 334, __pyx_L3_error)
+    __pyx_v_x_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[9], PyBUF_WRITABLE); if (unlikely(!__pyx_v_x_out.memview)) __PYX_ERR(0, 335, __pyx_L3_error)
+    __pyx_v_y_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[10], PyBUF_WRITABLE); if (unlikely(!__pyx_v_y_out.memview)) __PYX_ERR(0, 335, __pyx_L3_error)
+    __pyx_v_z_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[11], PyBUF_WRITABLE); if (unlikely(!__pyx_v_z_out.memview)) __PYX_ERR(0, 335, __pyx_L3_error)
+    __pyx_v_cert_out = __Pyx_PyObject_to_MemoryviewSlice_dc_double(values[12], PyBUF_WRITABLE); if (unlikely(!__pyx_v_cert_out.memview)) __PYX_ERR(0, 335, __pyx_L3_error)
   }
   goto __pyx_L6_skip;
   __pyx_L5_argtuple_error:;
-  __Pyx_RaiseArgtupleInvalid("solve", 1, 13, 13, __pyx_nargs); __PYX_ERR(0, 331, __pyx_L3_error)
+  __Pyx_RaiseArgtupleInvalid("solve", 1, 13, 13, __pyx_nargs); __PYX_ERR(0, 332, __pyx_L3_error)
   __pyx_L6_skip:;
   goto __pyx_L4_argument_unpacking_done;
   __pyx_L3_error:;
@@ -22751,7 +23162,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
   int __pyx_clineno = 0;
   __Pyx_RefNannySetupContext("solve", 0);
 
-  /* "fccqp/admm.pyx":343
+  /* "fccqp/admm.pyx":344
  *         :attr:`finding`) and ``NOT_CONVEX_CODE`` leave the previous solution untouched.
  *         """
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -22760,7 +23171,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":344
+  /* "fccqp/admm.pyx":345
  *         """
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m             # <<<<<<<<<<<<<<
@@ -22774,7 +23185,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
 
   __pyx_v_m = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":345
+  /* "fccqp/admm.pyx":346
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m
  *         cdef bint same = self.has_matrices             # <<<<<<<<<<<<<<
@@ -22785,7 +23196,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
 
   __pyx_v_same = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":347
+  /* "fccqp/admm.pyx":348
  *         cdef bint same = self.has_matrices
  *         cdef const double[::1] guess
  *         cdef const double* x0_ptr = NULL             # <<<<<<<<<<<<<<
@@ -22794,7 +23205,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
 */
   __pyx_v_x0_ptr = NULL;
 
-  /* "fccqp/admm.pyx":349
+  /* "fccqp/admm.pyx":350
  *         cdef const double* x0_ptr = NULL
  *         cdef Run run
  *         if x0 is not None:             # <<<<<<<<<<<<<<
@@ -22805,19 +23216,19 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
   if (__pyx_t_2) {
 
 
-    /* "fccqp/admm.pyx":350
+    /* "fccqp/admm.pyx":351
  *         cdef Run run
  *         if x0 is not None:
  *             guess = x0             # <<<<<<<<<<<<<<
  *             x0_ptr = &guess[0]
  *         with nogil:
 */
-    __pyx_t_3 = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(__pyx_v_x0, 0); if (unlikely(!__pyx_t_3.memview)) __PYX_ERR(0, 350, __pyx_L1_error)
+    __pyx_t_3 = __Pyx_PyObject_to_MemoryviewSlice_dc_double__const__(__pyx_v_x0, 0); if (unlikely(!__pyx_t_3.memview)) __PYX_ERR(0, 351, __pyx_L1_error)
     __pyx_v_guess = __pyx_t_3;
     __pyx_t_3.memview = NULL;
     __pyx_t_3.data = NULL;
 
-    /* "fccqp/admm.pyx":351
+    /* "fccqp/admm.pyx":352
  *         if x0 is not None:
  *             guess = x0
  *             x0_ptr = &guess[0]             # <<<<<<<<<<<<<<
@@ -22827,7 +23238,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
     __pyx_t_4 = 0;
     __pyx_v_x0_ptr = (&(*((double const  *) ( /* dim=0 */ ((char *) (((double const  *) __pyx_v_guess.data) + __pyx_t_4)) ))));
 
-    /* "fccqp/admm.pyx":349
+    /* "fccqp/admm.pyx":350
  *         cdef const double* x0_ptr = NULL
  *         cdef Run run
  *         if x0 is not None:             # <<<<<<<<<<<<<<
@@ -22836,7 +23247,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
 */
   }
 
-  /* "fccqp/admm.pyx":352
+  /* "fccqp/admm.pyx":353
  *             guess = x0
  *             x0_ptr = &guess[0]
  *         with nogil:             # <<<<<<<<<<<<<<
@@ -22849,7 +23260,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
       __Pyx_FastGIL_Remember();
       /*try:*/ {
 
-        /* "fccqp/admm.pyx":354
+        /* "fccqp/admm.pyx":355
  *         with nogil:
  *             self.found = scan_and_copy(
  *                 &P[0, 0], &q[0], &A[0, 0] if m else NULL, &b[0] if m else NULL, &lb[0], &ub[0],             # <<<<<<<<<<<<<<
@@ -22885,7 +23296,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
         __pyx_t_9 = 0;
         __pyx_t_8 = 0;
 
-        /* "fccqp/admm.pyx":353
+        /* "fccqp/admm.pyx":354
  *             x0_ptr = &guess[0]
  *         with nogil:
  *             self.found = scan_and_copy(             # <<<<<<<<<<<<<<
@@ -22897,7 +23308,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
 
       }
 
-      /* "fccqp/admm.pyx":352
+      /* "fccqp/admm.pyx":353
  *             guess = x0
  *             x0_ptr = &guess[0]
  *         with nogil:             # <<<<<<<<<<<<<<
@@ -22914,7 +23325,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
       }
   }
 
-  /* "fccqp/admm.pyx":357
+  /* "fccqp/admm.pyx":358
  *                 n, m, self.P_user, self.q_user, self.A_user, self.b_user, self.lb_user,
  *                 self.ub_user, &same)
  *         if self.found.code != SCAN_OK:             # <<<<<<<<<<<<<<
@@ -22926,52 +23337,52 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
   if (__pyx_t_2) {
 
 
-    /* "fccqp/admm.pyx":358
+    /* "fccqp/admm.pyx":359
  *                 self.ub_user, &same)
  *         if self.found.code != SCAN_OK:
  *             self.has_matrices = False             # <<<<<<<<<<<<<<
  *             return BAD_DATA, 0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, ""
- *         with nogil:
+ *         enter()   # single-threaded BLAS for this solve (see fccqp.blas_threads)
 */
     __pyx_v_self->has_matrices = 0;
 
-    /* "fccqp/admm.pyx":359
+    /* "fccqp/admm.pyx":360
  *         if self.found.code != SCAN_OK:
  *             self.has_matrices = False
  *             return BAD_DATA, 0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, ""             # <<<<<<<<<<<<<<
- *         with nogil:
- *             run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)
+ *         enter()   # single-threaded BLAS for this solve (see fccqp.blas_threads)
+ *         try:
 */
-    __Pyx_GetModuleGlobalName(__pyx_t_11, __pyx_mstate_global->__pyx_n_u_BAD_DATA); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 359, __pyx_L1_error)
+    __Pyx_GetModuleGlobalName(__pyx_t_11, __pyx_mstate_global->__pyx_n_u_BAD_DATA); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 360, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_11);
-    __pyx_t_12 = PyTuple_New(9); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 359, __pyx_L1_error)
+    __pyx_t_12 = PyTuple_New(9); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 360, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_12);
     __Pyx_GIVEREF(__pyx_t_11);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 0, __pyx_t_11) != (0)) __PYX_ERR(0, 359, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 0, __pyx_t_11) != (0)) __PYX_ERR(0, 360, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_int_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_int_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 1, __pyx_mstate_global->__pyx_int_0) != (0)) __PYX_ERR(0, 359, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 1, __pyx_mstate_global->__pyx_int_0) != (0)) __PYX_ERR(0, 360, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_float_0_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_float_0_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 2, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 359, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 2, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 360, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_float_0_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_float_0_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 3, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 359, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 3, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 360, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_float_0_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_float_0_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 4, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 359, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 4, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 360, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_float_0_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_float_0_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 5, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 359, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 5, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 360, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_int_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_int_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 6, __pyx_mstate_global->__pyx_int_0) != (0)) __PYX_ERR(0, 359, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 6, __pyx_mstate_global->__pyx_int_0) != (0)) __PYX_ERR(0, 360, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_float_0_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_float_0_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 7, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 359, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 7, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 360, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_kp_u__5);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_kp_u__5);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 8, __pyx_mstate_global->__pyx_kp_u__5) != (0)) __PYX_ERR(0, 359, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_12, 8, __pyx_mstate_global->__pyx_kp_u__5) != (0)) __PYX_ERR(0, 360, __pyx_L1_error);
     __pyx_t_11 = 0;
     {
       PyObject *__pyx_temp;
@@ -22984,7 +23395,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
     __pyx_t_12 = 0;
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":357
+    /* "fccqp/admm.pyx":358
  *                 n, m, self.P_user, self.q_user, self.A_user, self.b_user, self.lb_user,
  *                 self.ub_user, &same)
  *         if self.found.code != SCAN_OK:             # <<<<<<<<<<<<<<
@@ -22993,104 +23404,154 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
 */
   }
 
-  /* "fccqp/admm.pyx":360
+  /* "fccqp/admm.pyx":361
  *             self.has_matrices = False
  *             return BAD_DATA, 0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, ""
- *         with nogil:             # <<<<<<<<<<<<<<
- *             run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)
- *             if run.status != _NOT_CONVEX:
+ *         enter()   # single-threaded BLAS for this solve (see fccqp.blas_threads)             # <<<<<<<<<<<<<<
+ *         try:
+ *             with nogil:
 */
-  {
-      PyThreadState * _save;
-      _save = PyEval_SaveThread();
-      __Pyx_FastGIL_Remember();
-      /*try:*/ {
+  __pyx_f_5fccqp_12blas_threads_enter();
 
-        /* "fccqp/admm.pyx":361
+  /* "fccqp/admm.pyx":362
  *             return BAD_DATA, 0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, ""
- *         with nogil:
- *             run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)             # <<<<<<<<<<<<<<
- *             if run.status != _NOT_CONVEX:
- *                 self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0], &cert_out[0])
+ *         enter()   # single-threaded BLAS for this solve (see fccqp.blas_threads)
+ *         try:             # <<<<<<<<<<<<<<
+ *             with nogil:
+ *                 run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)
 */
-        if (__pyx_v_warm) {
-        } else {
+  /*try:*/ {
 
-          __pyx_t_2 = __pyx_v_warm;
-          goto __pyx_L11_bool_binop_done;
+    /* "fccqp/admm.pyx":363
+ *         enter()   # single-threaded BLAS for this solve (see fccqp.blas_threads)
+ *         try:
+ *             with nogil:             # <<<<<<<<<<<<<<
+ *                 run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)
+ *                 if run.status != _NOT_CONVEX:
+*/
+    {
+        PyThreadState * _save;
+        _save = PyEval_SaveThread();
+        __Pyx_FastGIL_Remember();
+        /*try:*/ {
+
+          /* "fccqp/admm.pyx":364
+ *         try:
+ *             with nogil:
+ *                 run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)             # <<<<<<<<<<<<<<
+ *                 if run.status != _NOT_CONVEX:
+ *                     self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0],
+*/
+          if (__pyx_v_warm) {
+          } else {
+
+            __pyx_t_2 = __pyx_v_warm;
+            goto __pyx_L14_bool_binop_done;
+          }
+
+          __pyx_t_2 = __pyx_v_self->has_previous;
+          __pyx_L14_bool_binop_done:;
+          __pyx_v_run = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_solve(__pyx_v_self, __pyx_v_same, __pyx_v_x0_ptr, __pyx_t_2, __pyx_v_start_time);
+
+
+          /* "fccqp/admm.pyx":365
+ *             with nogil:
+ *                 run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)
+ *                 if run.status != _NOT_CONVEX:             # <<<<<<<<<<<<<<
+ *                     self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0],
+ *                                  &cert_out[0])
+*/
+          __pyx_t_2 = (__pyx_v_run.status != __pyx_e_5fccqp_4admm__NOT_CONVEX);
+
+          if (__pyx_t_2) {
+
+
+            /* "fccqp/admm.pyx":366
+ *                 run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)
+ *                 if run.status != _NOT_CONVEX:
+ *                     self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0],             # <<<<<<<<<<<<<<
+ *                                  &cert_out[0])
+ *         finally:
+*/
+            __pyx_t_8 = 0;
+            __pyx_t_2 = (__pyx_v_m != 0);
+
+            if (__pyx_t_2) {
+              __pyx_t_9 = 0;
+
+              __pyx_t_13 = (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_y_out.data) + __pyx_t_9)) ))));
+            } else {
+
+              __pyx_t_13 = NULL;
+            }
+
+            __pyx_t_9 = 0;
+
+            /* "fccqp/admm.pyx":367
+ *                 if run.status != _NOT_CONVEX:
+ *                     self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0],
+ *                                  &cert_out[0])             # <<<<<<<<<<<<<<
+ *         finally:
+ *             leave()
+*/
+            __pyx_t_6 = 0;
+
+            /* "fccqp/admm.pyx":366
+ *                 run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)
+ *                 if run.status != _NOT_CONVEX:
+ *                     self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0],             # <<<<<<<<<<<<<<
+ *                                  &cert_out[0])
+ *         finally:
+*/
+            ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_finish(__pyx_v_self, (&__pyx_v_run), (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_x_out.data) + __pyx_t_8)) )))), __pyx_t_13, (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_z_out.data) + __pyx_t_9)) )))), (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_cert_out.data) + __pyx_t_6)) )))));
+
+
+            /* "fccqp/admm.pyx":365
+ *             with nogil:
+ *                 run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)
+ *                 if run.status != _NOT_CONVEX:             # <<<<<<<<<<<<<<
+ *                     self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0],
+ *                                  &cert_out[0])
+*/
+          }
         }
 
-        __pyx_t_2 = __pyx_v_self->has_previous;
-        __pyx_L11_bool_binop_done:;
-        __pyx_v_run = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_solve(__pyx_v_self, __pyx_v_same, __pyx_v_x0_ptr, __pyx_t_2, __pyx_v_start_time);
-
-
-        /* "fccqp/admm.pyx":362
- *         with nogil:
- *             run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)
- *             if run.status != _NOT_CONVEX:             # <<<<<<<<<<<<<<
- *                 self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0], &cert_out[0])
- *         if run.status == _NOT_CONVEX:
+        /* "fccqp/admm.pyx":363
+ *         enter()   # single-threaded BLAS for this solve (see fccqp.blas_threads)
+ *         try:
+ *             with nogil:             # <<<<<<<<<<<<<<
+ *                 run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)
+ *                 if run.status != _NOT_CONVEX:
 */
-        __pyx_t_2 = (__pyx_v_run.status != __pyx_e_5fccqp_4admm__NOT_CONVEX);
+        /*finally:*/ {
+          /*normal exit:*/{
+            __Pyx_FastGIL_Forget();
+            PyEval_RestoreThread(_save);
+            goto __pyx_L13;
+          }
+          __pyx_L13:;
+        }
+    }
+  }
 
-        if (__pyx_t_2) {
-
-
-          /* "fccqp/admm.pyx":363
- *             run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)
- *             if run.status != _NOT_CONVEX:
- *                 self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0], &cert_out[0])             # <<<<<<<<<<<<<<
+  /* "fccqp/admm.pyx":369
+ *                                  &cert_out[0])
+ *         finally:
+ *             leave()             # <<<<<<<<<<<<<<
  *         if run.status == _NOT_CONVEX:
  *             self.has_matrices = self.has_previous = self.certified = False
 */
-          __pyx_t_8 = 0;
-          __pyx_t_2 = (__pyx_v_m != 0);
-
-          if (__pyx_t_2) {
-            __pyx_t_9 = 0;
-
-            __pyx_t_13 = (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_y_out.data) + __pyx_t_9)) ))));
-          } else {
-
-            __pyx_t_13 = NULL;
-          }
-
-          __pyx_t_9 = 0;
-          __pyx_t_6 = 0;
-          ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_finish(__pyx_v_self, (&__pyx_v_run), (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_x_out.data) + __pyx_t_8)) )))), __pyx_t_13, (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_z_out.data) + __pyx_t_9)) )))), (&(*((double *) ( /* dim=0 */ ((char *) (((double *) __pyx_v_cert_out.data) + __pyx_t_6)) )))));
-
-
-          /* "fccqp/admm.pyx":362
- *         with nogil:
- *             run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)
- *             if run.status != _NOT_CONVEX:             # <<<<<<<<<<<<<<
- *                 self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0], &cert_out[0])
- *         if run.status == _NOT_CONVEX:
-*/
-        }
-      }
-
-      /* "fccqp/admm.pyx":360
- *             self.has_matrices = False
- *             return BAD_DATA, 0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, ""
- *         with nogil:             # <<<<<<<<<<<<<<
- *             run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)
- *             if run.status != _NOT_CONVEX:
-*/
-      /*finally:*/ {
-        /*normal exit:*/{
-          __Pyx_FastGIL_Forget();
-          PyEval_RestoreThread(_save);
-          goto __pyx_L10;
-        }
-        __pyx_L10:;
-      }
+  /*finally:*/ {
+    /*normal exit:*/{
+      __pyx_f_5fccqp_12blas_threads_leave();
+      goto __pyx_L10;
+    }
+    __pyx_L10:;
   }
 
-  /* "fccqp/admm.pyx":364
- *             if run.status != _NOT_CONVEX:
- *                 self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0], &cert_out[0])
+  /* "fccqp/admm.pyx":370
+ *         finally:
+ *             leave()
  *         if run.status == _NOT_CONVEX:             # <<<<<<<<<<<<<<
  *             self.has_matrices = self.has_previous = self.certified = False
  *             return NOT_CONVEX_CODE, 0, 0.0, 0.0, 0.0, 0.0, run.factorizations, 0.0, ""
@@ -23100,8 +23561,8 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
   if (__pyx_t_2) {
 
 
-    /* "fccqp/admm.pyx":365
- *                 self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0], &cert_out[0])
+    /* "fccqp/admm.pyx":371
+ *             leave()
  *         if run.status == _NOT_CONVEX:
  *             self.has_matrices = self.has_previous = self.certified = False             # <<<<<<<<<<<<<<
  *             return NOT_CONVEX_CODE, 0, 0.0, 0.0, 0.0, 0.0, run.factorizations, 0.0, ""
@@ -23111,44 +23572,44 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
     __pyx_v_self->has_previous = 0;
     __pyx_v_self->certified = 0;
 
-    /* "fccqp/admm.pyx":366
+    /* "fccqp/admm.pyx":372
  *         if run.status == _NOT_CONVEX:
  *             self.has_matrices = self.has_previous = self.certified = False
  *             return NOT_CONVEX_CODE, 0, 0.0, 0.0, 0.0, 0.0, run.factorizations, 0.0, ""             # <<<<<<<<<<<<<<
  *         r = &self.res
  *         return (run.status, run.iterations, run.rho, r.prim, r.dual, r.gap, run.factorizations,
 */
-    __Pyx_GetModuleGlobalName(__pyx_t_12, __pyx_mstate_global->__pyx_n_u_NOT_CONVEX_CODE); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 366, __pyx_L1_error)
+    __Pyx_GetModuleGlobalName(__pyx_t_12, __pyx_mstate_global->__pyx_n_u_NOT_CONVEX_CODE); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 372, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_12);
-    __pyx_t_11 = __Pyx_PyLong_From_int(__pyx_v_run.factorizations); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 366, __pyx_L1_error)
+    __pyx_t_11 = __Pyx_PyLong_From_int(__pyx_v_run.factorizations); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 372, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_11);
-    __pyx_t_14 = PyTuple_New(9); if (unlikely(!__pyx_t_14)) __PYX_ERR(0, 366, __pyx_L1_error)
+    __pyx_t_14 = PyTuple_New(9); if (unlikely(!__pyx_t_14)) __PYX_ERR(0, 372, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_14);
     __Pyx_GIVEREF(__pyx_t_12);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 0, __pyx_t_12) != (0)) __PYX_ERR(0, 366, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 0, __pyx_t_12) != (0)) __PYX_ERR(0, 372, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_int_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_int_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 1, __pyx_mstate_global->__pyx_int_0) != (0)) __PYX_ERR(0, 366, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 1, __pyx_mstate_global->__pyx_int_0) != (0)) __PYX_ERR(0, 372, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_float_0_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_float_0_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 2, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 366, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 2, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 372, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_float_0_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_float_0_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 3, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 366, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 3, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 372, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_float_0_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_float_0_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 4, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 366, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 4, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 372, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_float_0_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_float_0_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 5, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 366, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 5, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 372, __pyx_L1_error);
     __Pyx_GIVEREF(__pyx_t_11);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 6, __pyx_t_11) != (0)) __PYX_ERR(0, 366, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 6, __pyx_t_11) != (0)) __PYX_ERR(0, 372, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_float_0_0);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_float_0_0);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 7, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 366, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 7, __pyx_mstate_global->__pyx_float_0_0) != (0)) __PYX_ERR(0, 372, __pyx_L1_error);
     __Pyx_INCREF(__pyx_mstate_global->__pyx_kp_u__5);
     __Pyx_GIVEREF(__pyx_mstate_global->__pyx_kp_u__5);
-    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 8, __pyx_mstate_global->__pyx_kp_u__5) != (0)) __PYX_ERR(0, 366, __pyx_L1_error);
+    if (__Pyx_PyTuple_SET_ITEM(__pyx_t_14, 8, __pyx_mstate_global->__pyx_kp_u__5) != (0)) __PYX_ERR(0, 372, __pyx_L1_error);
     __pyx_t_12 = 0;
     __pyx_t_11 = 0;
     {
@@ -23162,16 +23623,16 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
     __pyx_t_14 = 0;
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":364
- *             if run.status != _NOT_CONVEX:
- *                 self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0], &cert_out[0])
+    /* "fccqp/admm.pyx":370
+ *         finally:
+ *             leave()
  *         if run.status == _NOT_CONVEX:             # <<<<<<<<<<<<<<
  *             self.has_matrices = self.has_previous = self.certified = False
  *             return NOT_CONVEX_CODE, 0, 0.0, 0.0, 0.0, 0.0, run.factorizations, 0.0, ""
 */
   }
 
-  /* "fccqp/admm.pyx":367
+  /* "fccqp/admm.pyx":373
  *             self.has_matrices = self.has_previous = self.certified = False
  *             return NOT_CONVEX_CODE, 0, 0.0, 0.0, 0.0, 0.0, run.factorizations, 0.0, ""
  *         r = &self.res             # <<<<<<<<<<<<<<
@@ -23180,70 +23641,70 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
 */
   __pyx_v_r = (&__pyx_v_self->res);
 
-  /* "fccqp/admm.pyx":368
+  /* "fccqp/admm.pyx":374
  *             return NOT_CONVEX_CODE, 0, 0.0, 0.0, 0.0, 0.0, run.factorizations, 0.0, ""
  *         r = &self.res
  *         return (run.status, run.iterations, run.rho, r.prim, r.dual, r.gap, run.factorizations,             # <<<<<<<<<<<<<<
  *                 run.setup_time, BACKEND_NAMES[run.backend])
  * 
 */
-  __pyx_t_14 = __Pyx_PyLong_From_int(__pyx_v_run.status); if (unlikely(!__pyx_t_14)) __PYX_ERR(0, 368, __pyx_L1_error)
+  __pyx_t_14 = __Pyx_PyLong_From_int(__pyx_v_run.status); if (unlikely(!__pyx_t_14)) __PYX_ERR(0, 374, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_14);
-  __pyx_t_11 = __Pyx_PyLong_From_long(__pyx_v_run.iterations); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 368, __pyx_L1_error)
+  __pyx_t_11 = __Pyx_PyLong_From_long(__pyx_v_run.iterations); if (unlikely(!__pyx_t_11)) __PYX_ERR(0, 374, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_11);
-  __pyx_t_12 = PyFloat_FromDouble(__pyx_v_run.rho); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 368, __pyx_L1_error)
+  __pyx_t_12 = PyFloat_FromDouble(__pyx_v_run.rho); if (unlikely(!__pyx_t_12)) __PYX_ERR(0, 374, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_12);
-  __pyx_t_15 = PyFloat_FromDouble(__pyx_v_r->prim); if (unlikely(!__pyx_t_15)) __PYX_ERR(0, 368, __pyx_L1_error)
+  __pyx_t_15 = PyFloat_FromDouble(__pyx_v_r->prim); if (unlikely(!__pyx_t_15)) __PYX_ERR(0, 374, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_15);
-  __pyx_t_16 = PyFloat_FromDouble(__pyx_v_r->dual); if (unlikely(!__pyx_t_16)) __PYX_ERR(0, 368, __pyx_L1_error)
+  __pyx_t_16 = PyFloat_FromDouble(__pyx_v_r->dual); if (unlikely(!__pyx_t_16)) __PYX_ERR(0, 374, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_16);
-  __pyx_t_17 = PyFloat_FromDouble(__pyx_v_r->gap); if (unlikely(!__pyx_t_17)) __PYX_ERR(0, 368, __pyx_L1_error)
+  __pyx_t_17 = PyFloat_FromDouble(__pyx_v_r->gap); if (unlikely(!__pyx_t_17)) __PYX_ERR(0, 374, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_17);
-  __pyx_t_18 = __Pyx_PyLong_From_int(__pyx_v_run.factorizations); if (unlikely(!__pyx_t_18)) __PYX_ERR(0, 368, __pyx_L1_error)
+  __pyx_t_18 = __Pyx_PyLong_From_int(__pyx_v_run.factorizations); if (unlikely(!__pyx_t_18)) __PYX_ERR(0, 374, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_18);
 
-  /* "fccqp/admm.pyx":369
+  /* "fccqp/admm.pyx":375
  *         r = &self.res
  *         return (run.status, run.iterations, run.rho, r.prim, r.dual, r.gap, run.factorizations,
  *                 run.setup_time, BACKEND_NAMES[run.backend])             # <<<<<<<<<<<<<<
  * 
  *     # ----------------------------------------------------------------- one solve
 */
-  __pyx_t_19 = PyFloat_FromDouble(__pyx_v_run.setup_time); if (unlikely(!__pyx_t_19)) __PYX_ERR(0, 369, __pyx_L1_error)
+  __pyx_t_19 = PyFloat_FromDouble(__pyx_v_run.setup_time); if (unlikely(!__pyx_t_19)) __PYX_ERR(0, 375, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_19);
-  __Pyx_GetModuleGlobalName(__pyx_t_20, __pyx_mstate_global->__pyx_n_u_BACKEND_NAMES); if (unlikely(!__pyx_t_20)) __PYX_ERR(0, 369, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_20, __pyx_mstate_global->__pyx_n_u_BACKEND_NAMES); if (unlikely(!__pyx_t_20)) __PYX_ERR(0, 375, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_20);
-  __pyx_t_21 = __Pyx_GetItemInt(__pyx_t_20, __pyx_v_run.backend, int, 1, __Pyx_PyLong_From_int, 0, 0, 1, __Pyx_ReferenceSharing_OwnStrongReference); if (unlikely(!__pyx_t_21)) __PYX_ERR(0, 369, __pyx_L1_error)
+  __pyx_t_21 = __Pyx_GetItemInt(__pyx_t_20, __pyx_v_run.backend, int, 1, __Pyx_PyLong_From_int, 0, 0, 1, __Pyx_ReferenceSharing_OwnStrongReference); if (unlikely(!__pyx_t_21)) __PYX_ERR(0, 375, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_21);
   __Pyx_DECREF(__pyx_t_20); __pyx_t_20 = 0;
 
-  /* "fccqp/admm.pyx":368
+  /* "fccqp/admm.pyx":374
  *             return NOT_CONVEX_CODE, 0, 0.0, 0.0, 0.0, 0.0, run.factorizations, 0.0, ""
  *         r = &self.res
  *         return (run.status, run.iterations, run.rho, r.prim, r.dual, r.gap, run.factorizations,             # <<<<<<<<<<<<<<
  *                 run.setup_time, BACKEND_NAMES[run.backend])
  * 
 */
-  __pyx_t_20 = PyTuple_New(9); if (unlikely(!__pyx_t_20)) __PYX_ERR(0, 368, __pyx_L1_error)
+  __pyx_t_20 = PyTuple_New(9); if (unlikely(!__pyx_t_20)) __PYX_ERR(0, 374, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_20);
   __Pyx_GIVEREF(__pyx_t_14);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 0, __pyx_t_14) != (0)) __PYX_ERR(0, 368, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 0, __pyx_t_14) != (0)) __PYX_ERR(0, 374, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_11);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 1, __pyx_t_11) != (0)) __PYX_ERR(0, 368, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 1, __pyx_t_11) != (0)) __PYX_ERR(0, 374, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_12);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 2, __pyx_t_12) != (0)) __PYX_ERR(0, 368, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 2, __pyx_t_12) != (0)) __PYX_ERR(0, 374, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_15);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 3, __pyx_t_15) != (0)) __PYX_ERR(0, 368, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 3, __pyx_t_15) != (0)) __PYX_ERR(0, 374, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_16);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 4, __pyx_t_16) != (0)) __PYX_ERR(0, 368, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 4, __pyx_t_16) != (0)) __PYX_ERR(0, 374, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_17);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 5, __pyx_t_17) != (0)) __PYX_ERR(0, 368, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 5, __pyx_t_17) != (0)) __PYX_ERR(0, 374, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_18);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 6, __pyx_t_18) != (0)) __PYX_ERR(0, 368, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 6, __pyx_t_18) != (0)) __PYX_ERR(0, 374, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_19);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 7, __pyx_t_19) != (0)) __PYX_ERR(0, 368, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 7, __pyx_t_19) != (0)) __PYX_ERR(0, 374, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_t_21);
-  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 8, __pyx_t_21) != (0)) __PYX_ERR(0, 368, __pyx_L1_error);
+  if (__Pyx_PyTuple_SET_ITEM(__pyx_t_20, 8, __pyx_t_21) != (0)) __PYX_ERR(0, 374, __pyx_L1_error);
   __pyx_t_14 = 0;
   __pyx_t_11 = 0;
   __pyx_t_12 = 0;
@@ -23264,7 +23725,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
   __pyx_t_20 = 0;
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":331
+  /* "fccqp/admm.pyx":332
  *         return [tuple(self.log[5 * i + j] for j in range(5)) for i in range(self.log_count)]
  * 
  *     def solve(self, const double[:, ::1] P, const double[::1] q, const double[:, ::1] A,             # <<<<<<<<<<<<<<
@@ -23301,7 +23762,7 @@ static PyObject *__pyx_pf_5fccqp_4admm_9Workspace_6solve(struct __pyx_obj_5fccqp
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":373
+/* "fccqp/admm.pyx":379
  *     # ----------------------------------------------------------------- one solve
  * 
  *     cdef Run _solve(self, bint same_matrices, const double* x0, bint warm,             # <<<<<<<<<<<<<<
@@ -23318,7 +23779,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
   double __pyx_t_2;
   int __pyx_t_3;
 
-  /* "fccqp/admm.pyx":376
+  /* "fccqp/admm.pyx":382
  *                     double start_time) noexcept nogil:
  *         """Scale (or reuse the scaling), start, run."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -23327,7 +23788,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":378
+  /* "fccqp/admm.pyx":384
  *         cdef Problem* p = &self.prob
  *         cdef Run run
  *         cdef bint reuse = same_matrices and self.scaled_once             # <<<<<<<<<<<<<<
@@ -23345,7 +23806,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
   __pyx_L3_bool_binop_done:;
   __pyx_v_reuse = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":379
+  /* "fccqp/admm.pyx":385
  *         cdef Run run
  *         cdef bint reuse = same_matrices and self.scaled_once
  *         if not same_matrices:             # <<<<<<<<<<<<<<
@@ -23357,7 +23818,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":380
+    /* "fccqp/admm.pyx":386
  *         cdef bint reuse = same_matrices and self.scaled_once
  *         if not same_matrices:
  *             self.certified = False             # <<<<<<<<<<<<<<
@@ -23366,7 +23827,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
     __pyx_v_self->certified = 0;
 
-    /* "fccqp/admm.pyx":379
+    /* "fccqp/admm.pyx":385
  *         cdef Run run
  *         cdef bint reuse = same_matrices and self.scaled_once
  *         if not same_matrices:             # <<<<<<<<<<<<<<
@@ -23375,7 +23836,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
   }
 
-  /* "fccqp/admm.pyx":381
+  /* "fccqp/admm.pyx":387
  *         if not same_matrices:
  *             self.certified = False
  *         self.has_matrices = True             # <<<<<<<<<<<<<<
@@ -23384,7 +23845,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
   __pyx_v_self->has_matrices = 1;
 
-  /* "fccqp/admm.pyx":382
+  /* "fccqp/admm.pyx":388
  *             self.certified = False
  *         self.has_matrices = True
  *         self._scale(reuse)             # <<<<<<<<<<<<<<
@@ -23393,7 +23854,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
   ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_scale(__pyx_v_self, __pyx_v_reuse);
 
-  /* "fccqp/admm.pyx":383
+  /* "fccqp/admm.pyx":389
  *         self.has_matrices = True
  *         self._scale(reuse)
  *         self.log_count = 0             # <<<<<<<<<<<<<<
@@ -23402,7 +23863,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
   __pyx_v_self->log_count = 0;
 
-  /* "fccqp/admm.pyx":384
+  /* "fccqp/admm.pyx":390
  *         self._scale(reuse)
  *         self.log_count = 0
  *         run.rho = self.prev_rho if warm else self.opt.rho             # <<<<<<<<<<<<<<
@@ -23418,7 +23879,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
   }
   __pyx_v_run.rho = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":385
+  /* "fccqp/admm.pyx":391
  *         self.log_count = 0
  *         run.rho = self.prev_rho if warm else self.opt.rho
  *         if x0 != NULL:             # <<<<<<<<<<<<<<
@@ -23430,7 +23891,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":386
+    /* "fccqp/admm.pyx":392
  *         run.rho = self.prev_rho if warm else self.opt.rho
  *         if x0 != NULL:
  *             self._start_from_guess(x0)             # <<<<<<<<<<<<<<
@@ -23439,7 +23900,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_start_from_guess(__pyx_v_self, __pyx_v_x0);
 
-    /* "fccqp/admm.pyx":385
+    /* "fccqp/admm.pyx":391
  *         self.log_count = 0
  *         run.rho = self.prev_rho if warm else self.opt.rho
  *         if x0 != NULL:             # <<<<<<<<<<<<<<
@@ -23449,7 +23910,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
     goto __pyx_L6;
   }
 
-  /* "fccqp/admm.pyx":387
+  /* "fccqp/admm.pyx":393
  *         if x0 != NULL:
  *             self._start_from_guess(x0)
  *         elif warm:             # <<<<<<<<<<<<<<
@@ -23458,7 +23919,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
   if (__pyx_v_warm) {
 
-    /* "fccqp/admm.pyx":388
+    /* "fccqp/admm.pyx":394
  *             self._start_from_guess(x0)
  *         elif warm:
  *             scale_start(self.prev_x, self.prev_y, self.prev_z, self.prev_rho, p.D, p.E, p.c,             # <<<<<<<<<<<<<<
@@ -23467,7 +23928,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
     __pyx_f_5fccqp_7scaling_scale_start(__pyx_v_self->prev_x, __pyx_v_self->prev_y, __pyx_v_self->prev_z, __pyx_v_self->prev_rho, __pyx_v_p->D, __pyx_v_p->E, __pyx_v_p->c, __pyx_v_p->n, __pyx_v_p->m, __pyx_v_p->s, __pyx_v_p->constrained, __pyx_v_p->lo, __pyx_v_p->hi, __pyx_v_p->cones, __pyx_v_self->it.x, __pyx_v_self->it.nu, __pyx_v_self->it.y, __pyx_v_self->it.z);
 
-    /* "fccqp/admm.pyx":387
+    /* "fccqp/admm.pyx":393
  *         if x0 != NULL:
  *             self._start_from_guess(x0)
  *         elif warm:             # <<<<<<<<<<<<<<
@@ -23477,7 +23938,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
   }
   __pyx_L6:;
 
-  /* "fccqp/admm.pyx":391
+  /* "fccqp/admm.pyx":397
  *                         p.n, p.m, p.s, p.constrained, p.lo, p.hi, p.cones, self.it.x,
  *                         self.it.nu, self.it.y, self.it.z)
  *         if not reuse:             # <<<<<<<<<<<<<<
@@ -23489,7 +23950,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":392
+    /* "fccqp/admm.pyx":398
  *                         self.it.nu, self.it.y, self.it.z)
  *         if not reuse:
  *             self.factored_rho = -1.0             # <<<<<<<<<<<<<<
@@ -23498,7 +23959,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
     __pyx_v_self->factored_rho = -1.0;
 
-    /* "fccqp/admm.pyx":391
+    /* "fccqp/admm.pyx":397
  *                         p.n, p.m, p.s, p.constrained, p.lo, p.hi, p.cones, self.it.x,
  *                         self.it.nu, self.it.y, self.it.z)
  *         if not reuse:             # <<<<<<<<<<<<<<
@@ -23507,7 +23968,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
   }
 
-  /* "fccqp/admm.pyx":393
+  /* "fccqp/admm.pyx":399
  *         if not reuse:
  *             self.factored_rho = -1.0
  *         run.setup_time = fccqp_now() - start_time             # <<<<<<<<<<<<<<
@@ -23516,7 +23977,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
 */
   __pyx_v_run.setup_time = (fccqp_now() - __pyx_v_start_time);
 
-  /* "fccqp/admm.pyx":394
+  /* "fccqp/admm.pyx":400
  *             self.factored_rho = -1.0
  *         run.setup_time = fccqp_now() - start_time
  *         self._iterate(&run, x0 == NULL and not warm, start_time)             # <<<<<<<<<<<<<<
@@ -23542,7 +24003,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
   ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_iterate(__pyx_v_self, (&__pyx_v_run), __pyx_t_1, __pyx_v_start_time);
 
 
-  /* "fccqp/admm.pyx":395
+  /* "fccqp/admm.pyx":401
  *         run.setup_time = fccqp_now() - start_time
  *         self._iterate(&run, x0 == NULL and not warm, start_time)
  *         return run             # <<<<<<<<<<<<<<
@@ -23555,7 +24016,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":373
+  /* "fccqp/admm.pyx":379
  *     # ----------------------------------------------------------------- one solve
  * 
  *     cdef Run _solve(self, bint same_matrices, const double* x0, bint warm,             # <<<<<<<<<<<<<<
@@ -23571,7 +24032,7 @@ static struct __pyx_t_5fccqp_4admm_Run __pyx_f_5fccqp_4admm_9Workspace__solve(st
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":397
+/* "fccqp/admm.pyx":403
  *         return run
  * 
  *     cdef void _scale(self, bint reuse) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -23590,7 +24051,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
   Py_ssize_t __pyx_t_3;
   Py_ssize_t __pyx_t_4;
 
-  /* "fccqp/admm.pyx":400
+  /* "fccqp/admm.pyx":406
  *         """Equilibrate the user's data into the scaled problem, or, with ``reuse``, apply
  *         the scaling of the unchanged matrices to the new vectors only."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -23599,7 +24060,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":401
+  /* "fccqp/admm.pyx":407
  *         the scaling of the unchanged matrices to the new vectors only."""
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m, i, j             # <<<<<<<<<<<<<<
@@ -23613,7 +24074,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 
   __pyx_v_m = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":402
+  /* "fccqp/admm.pyx":408
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m, i, j
  *         if not reuse:             # <<<<<<<<<<<<<<
@@ -23625,7 +24086,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
   if (__pyx_t_2) {
 
 
-    /* "fccqp/admm.pyx":403
+    /* "fccqp/admm.pyx":409
  *         cdef Py_ssize_t n = p.n, m = p.m, i, j
  *         if not reuse:
  *             copy(self.P_user, p.P, n * n)             # <<<<<<<<<<<<<<
@@ -23634,7 +24095,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_self->P_user, __pyx_v_p->P, (__pyx_v_n * __pyx_v_n));
 
-    /* "fccqp/admm.pyx":404
+    /* "fccqp/admm.pyx":410
  *         if not reuse:
  *             copy(self.P_user, p.P, n * n)
  *             copy(self.A_user, p.A, m * n)             # <<<<<<<<<<<<<<
@@ -23643,7 +24104,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_self->A_user, __pyx_v_p->A, (__pyx_v_m * __pyx_v_n));
 
-    /* "fccqp/admm.pyx":405
+    /* "fccqp/admm.pyx":411
  *             copy(self.P_user, p.P, n * n)
  *             copy(self.A_user, p.A, m * n)
  *             copy(self.q_user, p.q, n)             # <<<<<<<<<<<<<<
@@ -23652,7 +24113,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_self->q_user, __pyx_v_p->q, __pyx_v_n);
 
-    /* "fccqp/admm.pyx":406
+    /* "fccqp/admm.pyx":412
  *             copy(self.A_user, p.A, m * n)
  *             copy(self.q_user, p.q, n)
  *             copy(self.b_user, p.b, m)             # <<<<<<<<<<<<<<
@@ -23661,7 +24122,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_self->b_user, __pyx_v_p->b, __pyx_v_m);
 
-    /* "fccqp/admm.pyx":407
+    /* "fccqp/admm.pyx":413
  *             copy(self.q_user, p.q, n)
  *             copy(self.b_user, p.b, m)
  *             p.c = equilibrate(p.P, p.q, p.A, p.b, n, m, self.block_start, p.cones.dim,             # <<<<<<<<<<<<<<
@@ -23670,7 +24131,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_v_p->c = __pyx_f_5fccqp_7scaling_equilibrate(__pyx_v_p->P, __pyx_v_p->q, __pyx_v_p->A, __pyx_v_p->b, __pyx_v_n, __pyx_v_m, __pyx_v_self->block_start, __pyx_v_p->cones.dim, __pyx_v_p->cones.count, __pyx_v_self->opt.scaling, __pyx_v_p->D, __pyx_v_p->E, __pyx_v_self->d_scratch, __pyx_v_self->e_scratch);
 
-    /* "fccqp/admm.pyx":410
+    /* "fccqp/admm.pyx":416
  *                               p.cones.count, self.opt.scaling, p.D, p.E, self.d_scratch,
  *                               self.e_scratch)
  *             self.scaled_once = True             # <<<<<<<<<<<<<<
@@ -23679,7 +24140,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_v_self->scaled_once = 1;
 
-    /* "fccqp/admm.pyx":402
+    /* "fccqp/admm.pyx":408
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m, i, j
  *         if not reuse:             # <<<<<<<<<<<<<<
@@ -23689,7 +24150,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
     goto __pyx_L3;
   }
 
-  /* "fccqp/admm.pyx":412
+  /* "fccqp/admm.pyx":418
  *             self.scaled_once = True
  *         else:
  *             for i in range(n):             # <<<<<<<<<<<<<<
@@ -23704,7 +24165,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
     for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
       __pyx_v_i = __pyx_t_4;
 
-      /* "fccqp/admm.pyx":413
+      /* "fccqp/admm.pyx":419
  *         else:
  *             for i in range(n):
  *                 p.q[i] = p.c * p.D[i] * self.q_user[i]             # <<<<<<<<<<<<<<
@@ -23715,7 +24176,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
     }
 
 
-    /* "fccqp/admm.pyx":414
+    /* "fccqp/admm.pyx":420
  *             for i in range(n):
  *                 p.q[i] = p.c * p.D[i] * self.q_user[i]
  *             for i in range(m):             # <<<<<<<<<<<<<<
@@ -23729,7 +24190,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
     for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
       __pyx_v_i = __pyx_t_4;
 
-      /* "fccqp/admm.pyx":415
+      /* "fccqp/admm.pyx":421
  *                 p.q[i] = p.c * p.D[i] * self.q_user[i]
  *             for i in range(m):
  *                 p.b[i] = p.E[i] * self.b_user[i]             # <<<<<<<<<<<<<<
@@ -23742,7 +24203,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
   }
   __pyx_L3:;
 
-  /* "fccqp/admm.pyx":416
+  /* "fccqp/admm.pyx":422
  *             for i in range(m):
  *                 p.b[i] = p.E[i] * self.b_user[i]
  *         for j in range(p.s):             # <<<<<<<<<<<<<<
@@ -23756,7 +24217,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":417
+    /* "fccqp/admm.pyx":423
  *                 p.b[i] = p.E[i] * self.b_user[i]
  *         for j in range(p.s):
  *             i = p.constrained[j]             # <<<<<<<<<<<<<<
@@ -23765,7 +24226,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_v_i = (__pyx_v_p->constrained[__pyx_v_j]);
 
-    /* "fccqp/admm.pyx":418
+    /* "fccqp/admm.pyx":424
  *         for j in range(p.s):
  *             i = p.constrained[j]
  *             p.lo[j] = self.lb_user[i] / p.D[i]             # <<<<<<<<<<<<<<
@@ -23774,7 +24235,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 */
     (__pyx_v_p->lo[__pyx_v_j]) = ((__pyx_v_self->lb_user[__pyx_v_i]) / (__pyx_v_p->D[__pyx_v_i]));
 
-    /* "fccqp/admm.pyx":419
+    /* "fccqp/admm.pyx":425
  *             i = p.constrained[j]
  *             p.lo[j] = self.lb_user[i] / p.D[i]
  *             p.hi[j] = self.ub_user[i] / p.D[i]             # <<<<<<<<<<<<<<
@@ -23785,7 +24246,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
   }
 
 
-  /* "fccqp/admm.pyx":397
+  /* "fccqp/admm.pyx":403
  *         return run
  * 
  *     cdef void _scale(self, bint reuse) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -23801,7 +24262,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__scale(struct __pyx_obj_5fccqp_4admm
 
 }
 
-/* "fccqp/admm.pyx":421
+/* "fccqp/admm.pyx":427
  *             p.hi[j] = self.ub_user[i] / p.D[i]
  * 
  *     cdef void _start_from_guess(self, const double* x0) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -23817,7 +24278,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__start_from_guess(struct __pyx_obj_5
   Py_ssize_t __pyx_t_2;
   Py_ssize_t __pyx_t_3;
 
-  /* "fccqp/admm.pyx":423
+  /* "fccqp/admm.pyx":429
  *     cdef void _start_from_guess(self, const double* x0) noexcept nogil:
  *         """Primal guess ``x0`` (user's units), duals zero, slack its projection."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -23826,7 +24287,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__start_from_guess(struct __pyx_obj_5
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":425
+  /* "fccqp/admm.pyx":431
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i, j
  *         for i in range(p.n):             # <<<<<<<<<<<<<<
@@ -23840,7 +24301,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__start_from_guess(struct __pyx_obj_5
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":426
+    /* "fccqp/admm.pyx":432
  *         cdef Py_ssize_t i, j
  *         for i in range(p.n):
  *             self.it.x[i] = x0[i] / p.D[i]             # <<<<<<<<<<<<<<
@@ -23851,7 +24312,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__start_from_guess(struct __pyx_obj_5
   }
 
 
-  /* "fccqp/admm.pyx":427
+  /* "fccqp/admm.pyx":433
  *         for i in range(p.n):
  *             self.it.x[i] = x0[i] / p.D[i]
  *         fill(self.it.nu, 0.0, p.m)             # <<<<<<<<<<<<<<
@@ -23860,7 +24321,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__start_from_guess(struct __pyx_obj_5
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_self->it.nu, 0.0, __pyx_v_p->m);
 
-  /* "fccqp/admm.pyx":428
+  /* "fccqp/admm.pyx":434
  *             self.it.x[i] = x0[i] / p.D[i]
  *         fill(self.it.nu, 0.0, p.m)
  *         fill(self.it.y, 0.0, p.s)             # <<<<<<<<<<<<<<
@@ -23869,7 +24330,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__start_from_guess(struct __pyx_obj_5
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_self->it.y, 0.0, __pyx_v_p->s);
 
-  /* "fccqp/admm.pyx":429
+  /* "fccqp/admm.pyx":435
  *         fill(self.it.nu, 0.0, p.m)
  *         fill(self.it.y, 0.0, p.s)
  *         for j in range(p.s):             # <<<<<<<<<<<<<<
@@ -23883,7 +24344,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__start_from_guess(struct __pyx_obj_5
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_j = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":430
+    /* "fccqp/admm.pyx":436
  *         fill(self.it.y, 0.0, p.s)
  *         for j in range(p.s):
  *             self.it.z[j] = self.it.x[p.constrained[j]]             # <<<<<<<<<<<<<<
@@ -23894,7 +24355,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__start_from_guess(struct __pyx_obj_5
   }
 
 
-  /* "fccqp/admm.pyx":431
+  /* "fccqp/admm.pyx":437
  *         for j in range(p.s):
  *             self.it.z[j] = self.it.x[p.constrained[j]]
  *         proj_set(self.it.z, p.lo, p.hi, p.cones, p.s, self.it.z)             # <<<<<<<<<<<<<<
@@ -23903,7 +24364,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__start_from_guess(struct __pyx_obj_5
 */
   __pyx_f_5fccqp_11projections_proj_set(__pyx_v_self->it.z, __pyx_v_p->lo, __pyx_v_p->hi, __pyx_v_p->cones, __pyx_v_p->s, __pyx_v_self->it.z);
 
-  /* "fccqp/admm.pyx":421
+  /* "fccqp/admm.pyx":427
  *             p.hi[j] = self.ub_user[i] / p.D[i]
  * 
  *     cdef void _start_from_guess(self, const double* x0) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -23917,7 +24378,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__start_from_guess(struct __pyx_obj_5
 
 }
 
-/* "fccqp/admm.pyx":435
+/* "fccqp/admm.pyx":441
  *     # ------------------------------------------------------------ the iteration
  * 
  *     cdef void _iterate(self, Run* run, bint cold, double start_time) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -23955,7 +24416,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   int __pyx_t_7;
   int __pyx_t_8;
 
-  /* "fccqp/admm.pyx":437
+  /* "fccqp/admm.pyx":443
  *     cdef void _iterate(self, Run* run, bint cold, double start_time) noexcept nogil:
  *         """Run ADMM from the iterate in the workspace (or a cold start)."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -23964,7 +24425,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":438
+  /* "fccqp/admm.pyx":444
  *         """Run ADMM from the iterate in the workspace (or a cold start)."""
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -23973,7 +24434,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":439
+  /* "fccqp/admm.pyx":445
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Options* o = &self.opt             # <<<<<<<<<<<<<<
@@ -23982,7 +24443,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_o = (&__pyx_v_self->opt);
 
-  /* "fccqp/admm.pyx":440
+  /* "fccqp/admm.pyx":446
  *         cdef Iterates* it = &self.it
  *         cdef Options* o = &self.opt
  *         cdef Residuals* r = &self.res             # <<<<<<<<<<<<<<
@@ -23991,7 +24452,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_r = (&__pyx_v_self->res);
 
-  /* "fccqp/admm.pyx":441
+  /* "fccqp/admm.pyx":447
  *         cdef Options* o = &self.opt
  *         cdef Residuals* r = &self.res
  *         cdef Py_ssize_t s = p.s, j             # <<<<<<<<<<<<<<
@@ -24002,7 +24463,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":442
+  /* "fccqp/admm.pyx":448
  *         cdef Residuals* r = &self.res
  *         cdef Py_ssize_t s = p.s, j
  *         cdef long iteration = 0             # <<<<<<<<<<<<<<
@@ -24011,7 +24472,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_iteration = 0;
 
-  /* "fccqp/admm.pyx":443
+  /* "fccqp/admm.pyx":449
  *         cdef Py_ssize_t s = p.s, j
  *         cdef long iteration = 0
  *         cdef int status = _RUNNING, code             # <<<<<<<<<<<<<<
@@ -24020,7 +24481,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_status = __pyx_e_5fccqp_4admm__RUNNING;
 
-  /* "fccqp/admm.pyx":444
+  /* "fccqp/admm.pyx":450
  *         cdef long iteration = 0
  *         cdef int status = _RUNNING, code
  *         cdef bint unbounded_start = False, timed = isfinite(o.time_limit)             # <<<<<<<<<<<<<<
@@ -24030,7 +24491,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   __pyx_v_unbounded_start = 0;
   __pyx_v_timed = isfinite(__pyx_v_o->time_limit);
 
-  /* "fccqp/admm.pyx":447
+  /* "fccqp/admm.pyx":453
  *         cdef bint reduced, fresh, last, periodic, adapt, check
  *         cdef double eps_p, eps_d, new_rho
  *         run.factorizations = 0             # <<<<<<<<<<<<<<
@@ -24039,7 +24500,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_run->factorizations = 0;
 
-  /* "fccqp/admm.pyx":448
+  /* "fccqp/admm.pyx":454
  *         cdef double eps_p, eps_d, new_rho
  *         run.factorizations = 0
  *         run.backend = self.form             # <<<<<<<<<<<<<<
@@ -24050,7 +24511,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
   __pyx_v_run->backend = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":449
+  /* "fccqp/admm.pyx":455
  *         run.factorizations = 0
  *         run.backend = self.form
  *         if cold or s == 0:             # <<<<<<<<<<<<<<
@@ -24072,7 +24533,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":450
+    /* "fccqp/admm.pyx":456
  *         run.backend = self.form
  *         if cold or s == 0:
  *             code = self._equality_start(&unbounded_start)             # <<<<<<<<<<<<<<
@@ -24081,7 +24542,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_code = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_equality_start(__pyx_v_self, (&__pyx_v_unbounded_start));
 
-    /* "fccqp/admm.pyx":451
+    /* "fccqp/admm.pyx":457
  *         if cold or s == 0:
  *             code = self._equality_start(&unbounded_start)
  *             run.factorizations += 1             # <<<<<<<<<<<<<<
@@ -24090,7 +24551,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_run->factorizations = (__pyx_v_run->factorizations + 1);
 
-    /* "fccqp/admm.pyx":452
+    /* "fccqp/admm.pyx":458
  *             code = self._equality_start(&unbounded_start)
  *             run.factorizations += 1
  *             if code == NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -24102,7 +24563,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     if (__pyx_t_3) {
 
 
-      /* "fccqp/admm.pyx":453
+      /* "fccqp/admm.pyx":459
  *             run.factorizations += 1
  *             if code == NOT_CONVEX:
  *                 run.status = _NOT_CONVEX             # <<<<<<<<<<<<<<
@@ -24111,7 +24572,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_v_run->status = __pyx_e_5fccqp_4admm__NOT_CONVEX;
 
-      /* "fccqp/admm.pyx":454
+      /* "fccqp/admm.pyx":460
  *             if code == NOT_CONVEX:
  *                 run.status = _NOT_CONVEX
  *                 return             # <<<<<<<<<<<<<<
@@ -24122,7 +24583,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
       }
       goto __pyx_L0;
 
-      /* "fccqp/admm.pyx":452
+      /* "fccqp/admm.pyx":458
  *             code = self._equality_start(&unbounded_start)
  *             run.factorizations += 1
  *             if code == NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -24131,7 +24592,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     }
 
-    /* "fccqp/admm.pyx":449
+    /* "fccqp/admm.pyx":455
  *         run.factorizations = 0
  *         run.backend = self.form
  *         if cold or s == 0:             # <<<<<<<<<<<<<<
@@ -24140,7 +24601,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":455
+  /* "fccqp/admm.pyx":461
  *                 run.status = _NOT_CONVEX
  *                 return
  *         self._residuals()             # <<<<<<<<<<<<<<
@@ -24149,7 +24610,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_residuals(__pyx_v_self);
 
-  /* "fccqp/admm.pyx":456
+  /* "fccqp/admm.pyx":462
  *                 return
  *         self._residuals()
  *         self._log(0, run.rho)             # <<<<<<<<<<<<<<
@@ -24158,7 +24619,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_log(__pyx_v_self, 0, __pyx_v_run->rho);
 
-  /* "fccqp/admm.pyx":457
+  /* "fccqp/admm.pyx":463
  *         self._residuals()
  *         self._log(0, run.rho)
  *         if unbounded_start and self._unbounded():             # <<<<<<<<<<<<<<
@@ -24180,7 +24641,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":458
+    /* "fccqp/admm.pyx":464
  *         self._log(0, run.rho)
  *         if unbounded_start and self._unbounded():
  *             self._finish_run(run, _DUAL_INFEASIBLE, 0)             # <<<<<<<<<<<<<<
@@ -24189,7 +24650,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_finish_run(__pyx_v_self, __pyx_v_run, __pyx_e_5fccqp_4admm__DUAL_INFEASIBLE, 0);
 
-    /* "fccqp/admm.pyx":459
+    /* "fccqp/admm.pyx":465
  *         if unbounded_start and self._unbounded():
  *             self._finish_run(run, _DUAL_INFEASIBLE, 0)
  *             return             # <<<<<<<<<<<<<<
@@ -24200,7 +24661,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":457
+    /* "fccqp/admm.pyx":463
  *         self._residuals()
  *         self._log(0, run.rho)
  *         if unbounded_start and self._unbounded():             # <<<<<<<<<<<<<<
@@ -24209,7 +24670,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":460
+  /* "fccqp/admm.pyx":466
  *             self._finish_run(run, _DUAL_INFEASIBLE, 0)
  *             return
  *         if (cold or s == 0) and converged(r, o.eps_abs, o.eps_rel) and not unbounded_start:             # <<<<<<<<<<<<<<
@@ -24250,7 +24711,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":461
+    /* "fccqp/admm.pyx":467
  *             return
  *         if (cold or s == 0) and converged(r, o.eps_abs, o.eps_rel) and not unbounded_start:
  *             self._finish_run(run, _SOLVED, 0)             # <<<<<<<<<<<<<<
@@ -24259,7 +24720,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_finish_run(__pyx_v_self, __pyx_v_run, __pyx_e_5fccqp_4admm__SOLVED, 0);
 
-    /* "fccqp/admm.pyx":462
+    /* "fccqp/admm.pyx":468
  *         if (cold or s == 0) and converged(r, o.eps_abs, o.eps_rel) and not unbounded_start:
  *             self._finish_run(run, _SOLVED, 0)
  *             return             # <<<<<<<<<<<<<<
@@ -24270,7 +24731,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":460
+    /* "fccqp/admm.pyx":466
  *             self._finish_run(run, _DUAL_INFEASIBLE, 0)
  *             return
  *         if (cold or s == 0) and converged(r, o.eps_abs, o.eps_rel) and not unbounded_start:             # <<<<<<<<<<<<<<
@@ -24279,7 +24740,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":463
+  /* "fccqp/admm.pyx":469
  *             self._finish_run(run, _SOLVED, 0)
  *             return
  *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer             # <<<<<<<<<<<<<<
@@ -24291,7 +24752,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":464
+    /* "fccqp/admm.pyx":470
  *             return
  *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer
  *             if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():             # <<<<<<<<<<<<<<
@@ -24317,7 +24778,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     if (__pyx_t_3) {
 
 
-      /* "fccqp/admm.pyx":465
+      /* "fccqp/admm.pyx":471
  *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer
  *             if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():
  *                 status = _PRIMAL_INFEASIBLE             # <<<<<<<<<<<<<<
@@ -24326,7 +24787,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_v_status = __pyx_e_5fccqp_4admm__PRIMAL_INFEASIBLE;
 
-      /* "fccqp/admm.pyx":464
+      /* "fccqp/admm.pyx":470
  *             return
  *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer
  *             if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():             # <<<<<<<<<<<<<<
@@ -24336,7 +24797,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
       goto __pyx_L16;
     }
 
-    /* "fccqp/admm.pyx":467
+    /* "fccqp/admm.pyx":473
  *                 status = _PRIMAL_INFEASIBLE
  *             else:
  *                 status = self._classify(0, False, start_time)             # <<<<<<<<<<<<<<
@@ -24348,7 +24809,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     }
     __pyx_L16:;
 
-    /* "fccqp/admm.pyx":468
+    /* "fccqp/admm.pyx":474
  *             else:
  *                 status = self._classify(0, False, start_time)
  *             self._finish_run(run, status, 0)             # <<<<<<<<<<<<<<
@@ -24357,7 +24818,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_finish_run(__pyx_v_self, __pyx_v_run, __pyx_v_status, 0);
 
-    /* "fccqp/admm.pyx":469
+    /* "fccqp/admm.pyx":475
  *                 status = self._classify(0, False, start_time)
  *             self._finish_run(run, status, 0)
  *             return             # <<<<<<<<<<<<<<
@@ -24368,7 +24829,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":463
+    /* "fccqp/admm.pyx":469
  *             self._finish_run(run, _SOLVED, 0)
  *             return
  *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer             # <<<<<<<<<<<<<<
@@ -24377,7 +24838,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":470
+  /* "fccqp/admm.pyx":476
  *             self._finish_run(run, status, 0)
  *             return
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -24391,7 +24852,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
     __pyx_v_j = __pyx_t_6;
 
-    /* "fccqp/admm.pyx":471
+    /* "fccqp/admm.pyx":477
  *             return
  *         for j in range(s):
  *             it.rho_vec[j] = run.rho * self.rho_scale[j]             # <<<<<<<<<<<<<<
@@ -24402,7 +24863,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   }
 
 
-  /* "fccqp/admm.pyx":472
+  /* "fccqp/admm.pyx":478
  *         for j in range(s):
  *             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *         if self.factored_rho != run.rho or cold:             # <<<<<<<<<<<<<<
@@ -24425,7 +24886,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":473
+    /* "fccqp/admm.pyx":479
  *             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *         if self.factored_rho != run.rho or cold:
  *             code = self._factor(run, self._budget(0))             # <<<<<<<<<<<<<<
@@ -24434,7 +24895,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_code = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_factor(__pyx_v_self, __pyx_v_run, ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_budget(__pyx_v_self, 0));
 
-    /* "fccqp/admm.pyx":474
+    /* "fccqp/admm.pyx":480
  *         if self.factored_rho != run.rho or cold:
  *             code = self._factor(run, self._budget(0))
  *             if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -24446,7 +24907,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     if (__pyx_t_3) {
 
 
-      /* "fccqp/admm.pyx":475
+      /* "fccqp/admm.pyx":481
  *             code = self._factor(run, self._budget(0))
  *             if code != FACTORED:
  *                 run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR             # <<<<<<<<<<<<<<
@@ -24465,7 +24926,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
       __pyx_v_run->status = __pyx_t_7;
 
-      /* "fccqp/admm.pyx":476
+      /* "fccqp/admm.pyx":482
  *             if code != FACTORED:
  *                 run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR
  *                 return             # <<<<<<<<<<<<<<
@@ -24476,7 +24937,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
       }
       goto __pyx_L0;
 
-      /* "fccqp/admm.pyx":474
+      /* "fccqp/admm.pyx":480
  *         if self.factored_rho != run.rho or cold:
  *             code = self._factor(run, self._budget(0))
  *             if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -24485,7 +24946,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     }
 
-    /* "fccqp/admm.pyx":472
+    /* "fccqp/admm.pyx":478
  *         for j in range(s):
  *             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *         if self.factored_rho != run.rho or cold:             # <<<<<<<<<<<<<<
@@ -24494,7 +24955,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":477
+  /* "fccqp/admm.pyx":483
  *                 run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR
  *                 return
  *         reduced = self.form != LDL_FULL             # <<<<<<<<<<<<<<
@@ -24503,7 +24964,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_reduced = (__pyx_v_self->form != __pyx_e_5fccqp_3kkt_LDL_FULL);
 
-  /* "fccqp/admm.pyx":478
+  /* "fccqp/admm.pyx":484
  *                 return
  *         reduced = self.form != LDL_FULL
  *         if reduced:             # <<<<<<<<<<<<<<
@@ -24512,7 +24973,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   if (__pyx_v_reduced) {
 
-    /* "fccqp/admm.pyx":479
+    /* "fccqp/admm.pyx":485
  *         reduced = self.form != LDL_FULL
  *         if reduced:
  *             self._reduced_base()             # <<<<<<<<<<<<<<
@@ -24521,7 +24982,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_reduced_base(__pyx_v_self);
 
-    /* "fccqp/admm.pyx":480
+    /* "fccqp/admm.pyx":486
  *         if reduced:
  *             self._reduced_base()
  *             reduced_start(&self.red, p, it)             # <<<<<<<<<<<<<<
@@ -24530,7 +24991,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_f_5fccqp_7reduced_reduced_start((&__pyx_v_self->red), __pyx_v_p, __pyx_v_it);
 
-    /* "fccqp/admm.pyx":478
+    /* "fccqp/admm.pyx":484
  *                 return
  *         reduced = self.form != LDL_FULL
  *         if reduced:             # <<<<<<<<<<<<<<
@@ -24539,7 +25000,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":481
+  /* "fccqp/admm.pyx":487
  *             self._reduced_base()
  *             reduced_start(&self.red, p, it)
  *         eps_p = o.eps_abs + o.eps_rel * r.prim_scale             # <<<<<<<<<<<<<<
@@ -24548,7 +25009,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_eps_p = (__pyx_v_o->eps_abs + (__pyx_v_o->eps_rel * __pyx_v_r->prim_scale));
 
-  /* "fccqp/admm.pyx":482
+  /* "fccqp/admm.pyx":488
  *             reduced_start(&self.red, p, it)
  *         eps_p = o.eps_abs + o.eps_rel * r.prim_scale
  *         eps_d = o.eps_abs + o.eps_rel * r.dual_scale             # <<<<<<<<<<<<<<
@@ -24557,7 +25018,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_eps_d = (__pyx_v_o->eps_abs + (__pyx_v_o->eps_rel * __pyx_v_r->dual_scale));
 
-  /* "fccqp/admm.pyx":483
+  /* "fccqp/admm.pyx":489
  *         eps_p = o.eps_abs + o.eps_rel * r.prim_scale
  *         eps_d = o.eps_abs + o.eps_rel * r.dual_scale
  *         anderson_reset(&self.aa, False)             # <<<<<<<<<<<<<<
@@ -24566,7 +25027,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_f_5fccqp_8anderson_anderson_reset((&__pyx_v_self->aa), 0);
 
-  /* "fccqp/admm.pyx":484
+  /* "fccqp/admm.pyx":490
  *         eps_d = o.eps_abs + o.eps_rel * r.dual_scale
  *         anderson_reset(&self.aa, False)
  *         fresh = True  # the next step starts a run of KKT solutions: do not relax x             # <<<<<<<<<<<<<<
@@ -24575,7 +25036,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_fresh = 1;
 
-  /* "fccqp/admm.pyx":485
+  /* "fccqp/admm.pyx":491
  *         anderson_reset(&self.aa, False)
  *         fresh = True  # the next step starts a run of KKT solutions: do not relax x
  *         while status == _RUNNING:             # <<<<<<<<<<<<<<
@@ -24588,7 +25049,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
     if (!__pyx_t_3) break;
 
-    /* "fccqp/admm.pyx":486
+    /* "fccqp/admm.pyx":492
  *         fresh = True  # the next step starts a run of KKT solutions: do not relax x
  *         while status == _RUNNING:
  *             iteration += 1             # <<<<<<<<<<<<<<
@@ -24597,7 +25058,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_iteration = (__pyx_v_iteration + 1);
 
-    /* "fccqp/admm.pyx":487
+    /* "fccqp/admm.pyx":493
  *         while status == _RUNNING:
  *             iteration += 1
  *             if reduced:             # <<<<<<<<<<<<<<
@@ -24606,7 +25067,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     if (__pyx_v_reduced) {
 
-      /* "fccqp/admm.pyx":488
+      /* "fccqp/admm.pyx":494
  *             iteration += 1
  *             if reduced:
  *                 reduced_step(&self.red, p, it, o.alpha, not fresh)             # <<<<<<<<<<<<<<
@@ -24615,7 +25076,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_f_5fccqp_7reduced_reduced_step((&__pyx_v_self->red), __pyx_v_p, __pyx_v_it, __pyx_v_o->alpha, (!__pyx_v_fresh));
 
-      /* "fccqp/admm.pyx":487
+      /* "fccqp/admm.pyx":493
  *         while status == _RUNNING:
  *             iteration += 1
  *             if reduced:             # <<<<<<<<<<<<<<
@@ -24625,7 +25086,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
       goto __pyx_L28;
     }
 
-    /* "fccqp/admm.pyx":490
+    /* "fccqp/admm.pyx":496
  *                 reduced_step(&self.red, p, it, o.alpha, not fresh)
  *             else:
  *                 self._full_step(not fresh)             # <<<<<<<<<<<<<<
@@ -24637,7 +25098,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     }
     __pyx_L28:;
 
-    /* "fccqp/admm.pyx":491
+    /* "fccqp/admm.pyx":497
  *             else:
  *                 self._full_step(not fresh)
  *             fresh = False             # <<<<<<<<<<<<<<
@@ -24646,7 +25107,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_fresh = 0;
 
-    /* "fccqp/admm.pyx":492
+    /* "fccqp/admm.pyx":498
  *                 self._full_step(not fresh)
  *             fresh = False
  *             last = iteration >= o.max_iter or (timed and fccqp_now() - start_time >= o.time_limit)             # <<<<<<<<<<<<<<
@@ -24677,7 +25138,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     __pyx_L29_bool_binop_done:;
     __pyx_v_last = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":493
+    /* "fccqp/admm.pyx":499
  *             fresh = False
  *             last = iteration >= o.max_iter or (timed and fccqp_now() - start_time >= o.time_limit)
  *             periodic = iteration % o.adaptive_rho_interval == 0             # <<<<<<<<<<<<<<
@@ -24686,7 +25147,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_periodic = ((__pyx_v_iteration % __pyx_v_o->adaptive_rho_interval) == 0);
 
-    /* "fccqp/admm.pyx":494
+    /* "fccqp/admm.pyx":500
  *             last = iteration >= o.max_iter or (timed and fccqp_now() - start_time >= o.time_limit)
  *             periodic = iteration % o.adaptive_rho_interval == 0
  *             adapt = o.adaptive_rho and periodic             # <<<<<<<<<<<<<<
@@ -24704,7 +25165,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     __pyx_L32_bool_binop_done:;
     __pyx_v_adapt = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":495
+    /* "fccqp/admm.pyx":501
  *             periodic = iteration % o.adaptive_rho_interval == 0
  *             adapt = o.adaptive_rho and periodic
  *             check = iteration % o.check_termination == 0 or last or adapt             # <<<<<<<<<<<<<<
@@ -24732,7 +25193,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     __pyx_L34_bool_binop_done:;
     __pyx_v_check = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":496
+    /* "fccqp/admm.pyx":502
  *             adapt = o.adaptive_rho and periodic
  *             check = iteration % o.check_termination == 0 or last or adapt
  *             if check and reduced and not (last or periodic):             # <<<<<<<<<<<<<<
@@ -24770,7 +25231,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     if (__pyx_t_3) {
 
 
-      /* "fccqp/admm.pyx":499
+      /* "fccqp/admm.pyx":505
  *                 # a scheduled full check (and with it infeasibility detection) still runs
  *                 # every adaptive_rho_interval iterations
  *                 check = near_convergence(&self.red, p, it, eps_p, eps_d)             # <<<<<<<<<<<<<<
@@ -24779,7 +25240,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_v_check = __pyx_f_5fccqp_7reduced_near_convergence((&__pyx_v_self->red), __pyx_v_p, __pyx_v_it, __pyx_v_eps_p, __pyx_v_eps_d);
 
-      /* "fccqp/admm.pyx":496
+      /* "fccqp/admm.pyx":502
  *             adapt = o.adaptive_rho and periodic
  *             check = iteration % o.check_termination == 0 or last or adapt
  *             if check and reduced and not (last or periodic):             # <<<<<<<<<<<<<<
@@ -24788,7 +25249,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     }
 
-    /* "fccqp/admm.pyx":500
+    /* "fccqp/admm.pyx":506
  *                 # every adaptive_rho_interval iterations
  *                 check = near_convergence(&self.red, p, it, eps_p, eps_d)
  *             if check:             # <<<<<<<<<<<<<<
@@ -24797,7 +25258,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     if (__pyx_v_check) {
 
-      /* "fccqp/admm.pyx":501
+      /* "fccqp/admm.pyx":507
  *                 check = near_convergence(&self.red, p, it, eps_p, eps_d)
  *             if check:
  *                 if reduced:             # <<<<<<<<<<<<<<
@@ -24806,7 +25267,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       if (__pyx_v_reduced) {
 
-        /* "fccqp/admm.pyx":502
+        /* "fccqp/admm.pyx":508
  *             if check:
  *                 if reduced:
  *                     materialize(&self.red, p, it)             # <<<<<<<<<<<<<<
@@ -24815,7 +25276,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
         __pyx_f_5fccqp_7reduced_materialize((&__pyx_v_self->red), __pyx_v_p, __pyx_v_it);
 
-        /* "fccqp/admm.pyx":501
+        /* "fccqp/admm.pyx":507
  *                 check = near_convergence(&self.red, p, it, eps_p, eps_d)
  *             if check:
  *                 if reduced:             # <<<<<<<<<<<<<<
@@ -24824,7 +25285,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       }
 
-      /* "fccqp/admm.pyx":503
+      /* "fccqp/admm.pyx":509
  *                 if reduced:
  *                     materialize(&self.red, p, it)
  *                 self._residuals()             # <<<<<<<<<<<<<<
@@ -24833,7 +25294,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_residuals(__pyx_v_self);
 
-      /* "fccqp/admm.pyx":504
+      /* "fccqp/admm.pyx":510
  *                     materialize(&self.red, p, it)
  *                 self._residuals()
  *                 eps_p = o.eps_abs + o.eps_rel * r.prim_scale             # <<<<<<<<<<<<<<
@@ -24842,7 +25303,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_v_eps_p = (__pyx_v_o->eps_abs + (__pyx_v_o->eps_rel * __pyx_v_r->prim_scale));
 
-      /* "fccqp/admm.pyx":505
+      /* "fccqp/admm.pyx":511
  *                 self._residuals()
  *                 eps_p = o.eps_abs + o.eps_rel * r.prim_scale
  *                 eps_d = o.eps_abs + o.eps_rel * r.dual_scale             # <<<<<<<<<<<<<<
@@ -24851,7 +25312,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_v_eps_d = (__pyx_v_o->eps_abs + (__pyx_v_o->eps_rel * __pyx_v_r->dual_scale));
 
-      /* "fccqp/admm.pyx":506
+      /* "fccqp/admm.pyx":512
  *                 eps_p = o.eps_abs + o.eps_rel * r.prim_scale
  *                 eps_d = o.eps_abs + o.eps_rel * r.dual_scale
  *                 if iteration % _LOG_INTERVAL == 0:             # <<<<<<<<<<<<<<
@@ -24863,7 +25324,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
       if (__pyx_t_3) {
 
 
-        /* "fccqp/admm.pyx":507
+        /* "fccqp/admm.pyx":513
  *                 eps_d = o.eps_abs + o.eps_rel * r.dual_scale
  *                 if iteration % _LOG_INTERVAL == 0:
  *                     self._log(iteration, run.rho)             # <<<<<<<<<<<<<<
@@ -24872,7 +25333,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
         ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_log(__pyx_v_self, __pyx_v_iteration, __pyx_v_run->rho);
 
-        /* "fccqp/admm.pyx":506
+        /* "fccqp/admm.pyx":512
  *                 eps_p = o.eps_abs + o.eps_rel * r.prim_scale
  *                 eps_d = o.eps_abs + o.eps_rel * r.dual_scale
  *                 if iteration % _LOG_INTERVAL == 0:             # <<<<<<<<<<<<<<
@@ -24881,7 +25342,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       }
 
-      /* "fccqp/admm.pyx":508
+      /* "fccqp/admm.pyx":514
  *                 if iteration % _LOG_INTERVAL == 0:
  *                     self._log(iteration, run.rho)
  *                 status = self._check(iteration, last, start_time)             # <<<<<<<<<<<<<<
@@ -24890,7 +25351,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_v_status = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_check(__pyx_v_self, __pyx_v_iteration, __pyx_v_last, __pyx_v_start_time);
 
-      /* "fccqp/admm.pyx":509
+      /* "fccqp/admm.pyx":515
  *                     self._log(iteration, run.rho)
  *                 status = self._check(iteration, last, start_time)
  *                 if status == _RUNNING and adapt:             # <<<<<<<<<<<<<<
@@ -24913,7 +25374,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
       if (__pyx_t_3) {
 
 
-        /* "fccqp/admm.pyx":510
+        /* "fccqp/admm.pyx":516
  *                 status = self._check(iteration, last, start_time)
  *                 if status == _RUNNING and adapt:
  *                     new_rho = self._new_rho(run.rho)             # <<<<<<<<<<<<<<
@@ -24922,7 +25383,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
         __pyx_v_new_rho = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new_rho(__pyx_v_self, __pyx_v_run->rho);
 
-        /* "fccqp/admm.pyx":511
+        /* "fccqp/admm.pyx":517
  *                 if status == _RUNNING and adapt:
  *                     new_rho = self._new_rho(run.rho)
  *                     if new_rho != run.rho:             # <<<<<<<<<<<<<<
@@ -24934,7 +25395,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
         if (__pyx_t_3) {
 
 
-          /* "fccqp/admm.pyx":512
+          /* "fccqp/admm.pyx":518
  *                     new_rho = self._new_rho(run.rho)
  *                     if new_rho != run.rho:
  *                         if reduced:             # <<<<<<<<<<<<<<
@@ -24943,7 +25404,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           if (__pyx_v_reduced) {
 
-            /* "fccqp/admm.pyx":513
+            /* "fccqp/admm.pyx":519
  *                     if new_rho != run.rho:
  *                         if reduced:
  *                             for j in range(s):             # <<<<<<<<<<<<<<
@@ -24957,7 +25418,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
             for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
               __pyx_v_j = __pyx_t_6;
 
-              /* "fccqp/admm.pyx":514
+              /* "fccqp/admm.pyx":520
  *                         if reduced:
  *                             for j in range(s):
  *                                 self.vec_s[j] = new_rho * self.rho_scale[j]             # <<<<<<<<<<<<<<
@@ -24968,7 +25429,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
             }
 
 
-            /* "fccqp/admm.pyx":515
+            /* "fccqp/admm.pyx":521
  *                             for j in range(s):
  *                                 self.vec_s[j] = new_rho * self.rho_scale[j]
  *                             reduced_rebase(&self.red, p, it.rho_vec, self.vec_s)             # <<<<<<<<<<<<<<
@@ -24977,7 +25438,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
             __pyx_f_5fccqp_7reduced_reduced_rebase((&__pyx_v_self->red), __pyx_v_p, __pyx_v_it->rho_vec, __pyx_v_self->vec_s);
 
-            /* "fccqp/admm.pyx":512
+            /* "fccqp/admm.pyx":518
  *                     new_rho = self._new_rho(run.rho)
  *                     if new_rho != run.rho:
  *                         if reduced:             # <<<<<<<<<<<<<<
@@ -24986,7 +25447,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           }
 
-          /* "fccqp/admm.pyx":516
+          /* "fccqp/admm.pyx":522
  *                                 self.vec_s[j] = new_rho * self.rho_scale[j]
  *                             reduced_rebase(&self.red, p, it.rho_vec, self.vec_s)
  *                         run.rho = new_rho             # <<<<<<<<<<<<<<
@@ -24995,7 +25456,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           __pyx_v_run->rho = __pyx_v_new_rho;
 
-          /* "fccqp/admm.pyx":517
+          /* "fccqp/admm.pyx":523
  *                             reduced_rebase(&self.red, p, it.rho_vec, self.vec_s)
  *                         run.rho = new_rho
  *                         for j in range(s):             # <<<<<<<<<<<<<<
@@ -25009,7 +25470,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
           for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
             __pyx_v_j = __pyx_t_6;
 
-            /* "fccqp/admm.pyx":518
+            /* "fccqp/admm.pyx":524
  *                         run.rho = new_rho
  *                         for j in range(s):
  *                             it.rho_vec[j] = run.rho * self.rho_scale[j]             # <<<<<<<<<<<<<<
@@ -25020,7 +25481,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
           }
 
 
-          /* "fccqp/admm.pyx":519
+          /* "fccqp/admm.pyx":525
  *                         for j in range(s):
  *                             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *                         code = self._factor(run, self._budget(iteration))             # <<<<<<<<<<<<<<
@@ -25029,7 +25490,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           __pyx_v_code = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_factor(__pyx_v_self, __pyx_v_run, ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_budget(__pyx_v_self, __pyx_v_iteration));
 
-          /* "fccqp/admm.pyx":520
+          /* "fccqp/admm.pyx":526
  *                             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *                         code = self._factor(run, self._budget(iteration))
  *                         if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -25041,7 +25502,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
           if (__pyx_t_3) {
 
 
-            /* "fccqp/admm.pyx":521
+            /* "fccqp/admm.pyx":527
  *                         code = self._factor(run, self._budget(iteration))
  *                         if code != FACTORED:
  *                             run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR             # <<<<<<<<<<<<<<
@@ -25060,7 +25521,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
             __pyx_v_run->status = __pyx_t_7;
 
-            /* "fccqp/admm.pyx":522
+            /* "fccqp/admm.pyx":528
  *                         if code != FACTORED:
  *                             run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR
  *                             return             # <<<<<<<<<<<<<<
@@ -25071,7 +25532,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
             }
             goto __pyx_L0;
 
-            /* "fccqp/admm.pyx":520
+            /* "fccqp/admm.pyx":526
  *                             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *                         code = self._factor(run, self._budget(iteration))
  *                         if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -25080,7 +25541,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           }
 
-          /* "fccqp/admm.pyx":523
+          /* "fccqp/admm.pyx":529
  *                             run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR
  *                             return
  *                         reduced = self.form != LDL_FULL             # <<<<<<<<<<<<<<
@@ -25089,7 +25550,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           __pyx_v_reduced = (__pyx_v_self->form != __pyx_e_5fccqp_3kkt_LDL_FULL);
 
-          /* "fccqp/admm.pyx":524
+          /* "fccqp/admm.pyx":530
  *                             return
  *                         reduced = self.form != LDL_FULL
  *                         if reduced:             # <<<<<<<<<<<<<<
@@ -25098,7 +25559,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           if (__pyx_v_reduced) {
 
-            /* "fccqp/admm.pyx":525
+            /* "fccqp/admm.pyx":531
  *                         reduced = self.form != LDL_FULL
  *                         if reduced:
  *                             self._reduced_base()             # <<<<<<<<<<<<<<
@@ -25107,7 +25568,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
             ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_reduced_base(__pyx_v_self);
 
-            /* "fccqp/admm.pyx":524
+            /* "fccqp/admm.pyx":530
  *                             return
  *                         reduced = self.form != LDL_FULL
  *                         if reduced:             # <<<<<<<<<<<<<<
@@ -25116,7 +25577,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           }
 
-          /* "fccqp/admm.pyx":526
+          /* "fccqp/admm.pyx":532
  *                         if reduced:
  *                             self._reduced_base()
  *                         fresh = True             # <<<<<<<<<<<<<<
@@ -25125,7 +25586,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           __pyx_v_fresh = 1;
 
-          /* "fccqp/admm.pyx":527
+          /* "fccqp/admm.pyx":533
  *                             self._reduced_base()
  *                         fresh = True
  *                         anderson_reset(&self.aa, True)             # <<<<<<<<<<<<<<
@@ -25134,7 +25595,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           __pyx_f_5fccqp_8anderson_anderson_reset((&__pyx_v_self->aa), 1);
 
-          /* "fccqp/admm.pyx":511
+          /* "fccqp/admm.pyx":517
  *                 if status == _RUNNING and adapt:
  *                     new_rho = self._new_rho(run.rho)
  *                     if new_rho != run.rho:             # <<<<<<<<<<<<<<
@@ -25143,7 +25604,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
         }
 
-        /* "fccqp/admm.pyx":509
+        /* "fccqp/admm.pyx":515
  *                     self._log(iteration, run.rho)
  *                 status = self._check(iteration, last, start_time)
  *                 if status == _RUNNING and adapt:             # <<<<<<<<<<<<<<
@@ -25152,7 +25613,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       }
 
-      /* "fccqp/admm.pyx":500
+      /* "fccqp/admm.pyx":506
  *                 # every adaptive_rho_interval iterations
  *                 check = near_convergence(&self.red, p, it, eps_p, eps_d)
  *             if check:             # <<<<<<<<<<<<<<
@@ -25161,7 +25622,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     }
 
-    /* "fccqp/admm.pyx":528
+    /* "fccqp/admm.pyx":534
  *                         fresh = True
  *                         anderson_reset(&self.aa, True)
  *             if status == _RUNNING and o.anderson_memory > 0:             # <<<<<<<<<<<<<<
@@ -25187,7 +25648,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     if (__pyx_t_3) {
 
 
-      /* "fccqp/admm.pyx":529
+      /* "fccqp/admm.pyx":535
  *                         anderson_reset(&self.aa, True)
  *             if status == _RUNNING and o.anderson_memory > 0:
  *                 anderson_step(&self.aa, it, s)             # <<<<<<<<<<<<<<
@@ -25196,7 +25657,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_f_5fccqp_8anderson_anderson_step((&__pyx_v_self->aa), __pyx_v_it, __pyx_v_s);
 
-      /* "fccqp/admm.pyx":528
+      /* "fccqp/admm.pyx":534
  *                         fresh = True
  *                         anderson_reset(&self.aa, True)
  *             if status == _RUNNING and o.anderson_memory > 0:             # <<<<<<<<<<<<<<
@@ -25206,7 +25667,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     }
   }
 
-  /* "fccqp/admm.pyx":530
+  /* "fccqp/admm.pyx":536
  *             if status == _RUNNING and o.anderson_memory > 0:
  *                 anderson_step(&self.aa, it, s)
  *         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:             # <<<<<<<<<<<<<<
@@ -25230,7 +25691,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":531
+    /* "fccqp/admm.pyx":537
  *                 anderson_step(&self.aa, it, s)
  *         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
  *             status = self._keep_restored(status, iteration, reduced, start_time)             # <<<<<<<<<<<<<<
@@ -25239,7 +25700,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_status = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_keep_restored(__pyx_v_self, __pyx_v_status, __pyx_v_iteration, __pyx_v_reduced, __pyx_v_start_time);
 
-    /* "fccqp/admm.pyx":530
+    /* "fccqp/admm.pyx":536
  *             if status == _RUNNING and o.anderson_memory > 0:
  *                 anderson_step(&self.aa, it, s)
  *         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:             # <<<<<<<<<<<<<<
@@ -25249,7 +25710,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     goto __pyx_L60;
   }
 
-  /* "fccqp/admm.pyx":532
+  /* "fccqp/admm.pyx":538
  *         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
  *             status = self._keep_restored(status, iteration, reduced, start_time)
  *         elif reduced and status != _NUMERICAL_ERROR:             # <<<<<<<<<<<<<<
@@ -25271,7 +25732,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":533
+    /* "fccqp/admm.pyx":539
  *             status = self._keep_restored(status, iteration, reduced, start_time)
  *         elif reduced and status != _NUMERICAL_ERROR:
  *             self._restore_equalities()   # certificates are already in cert             # <<<<<<<<<<<<<<
@@ -25280,7 +25741,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_restore_equalities(__pyx_v_self);
 
-    /* "fccqp/admm.pyx":532
+    /* "fccqp/admm.pyx":538
  *         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
  *             status = self._keep_restored(status, iteration, reduced, start_time)
  *         elif reduced and status != _NUMERICAL_ERROR:             # <<<<<<<<<<<<<<
@@ -25290,7 +25751,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   }
   __pyx_L60:;
 
-  /* "fccqp/admm.pyx":534
+  /* "fccqp/admm.pyx":540
  *         elif reduced and status != _NUMERICAL_ERROR:
  *             self._restore_equalities()   # certificates are already in cert
  *         self._finish_run(run, status, iteration)             # <<<<<<<<<<<<<<
@@ -25299,7 +25760,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_finish_run(__pyx_v_self, __pyx_v_run, __pyx_v_status, __pyx_v_iteration);
 
-  /* "fccqp/admm.pyx":435
+  /* "fccqp/admm.pyx":441
  *     # ------------------------------------------------------------ the iteration
  * 
  *     cdef void _iterate(self, Run* run, bint cold, double start_time) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -25331,7 +25792,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
 }
 
-/* "fccqp/admm.pyx":536
+/* "fccqp/admm.pyx":542
  *         self._finish_run(run, status, iteration)
  * 
  *     cdef int _check(self, long iteration, bint last, double start_time) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -25352,7 +25813,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   Py_ssize_t __pyx_t_4;
   int __pyx_t_5;
 
-  /* "fccqp/admm.pyx":538
+  /* "fccqp/admm.pyx":544
  *     cdef int _check(self, long iteration, bint last, double start_time) noexcept nogil:
  *         """Termination and infeasibility tests after the residuals of ``iteration``."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -25361,7 +25822,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":539
+  /* "fccqp/admm.pyx":545
  *         """Termination and infeasibility tests after the residuals of ``iteration``."""
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -25370,7 +25831,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":540
+  /* "fccqp/admm.pyx":546
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Options* o = &self.opt             # <<<<<<<<<<<<<<
@@ -25379,7 +25840,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   __pyx_v_o = (&__pyx_v_self->opt);
 
-  /* "fccqp/admm.pyx":541
+  /* "fccqp/admm.pyx":547
  *         cdef Iterates* it = &self.it
  *         cdef Options* o = &self.opt
  *         cdef Residuals* r = &self.res             # <<<<<<<<<<<<<<
@@ -25388,7 +25849,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   __pyx_v_r = (&__pyx_v_self->res);
 
-  /* "fccqp/admm.pyx":543
+  /* "fccqp/admm.pyx":549
  *         cdef Residuals* r = &self.res
  *         cdef Py_ssize_t i
  *         if not r.finite:             # <<<<<<<<<<<<<<
@@ -25400,7 +25861,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":544
+    /* "fccqp/admm.pyx":550
  *         cdef Py_ssize_t i
  *         if not r.finite:
  *             return _NUMERICAL_ERROR             # <<<<<<<<<<<<<<
@@ -25413,7 +25874,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":543
+    /* "fccqp/admm.pyx":549
  *         cdef Residuals* r = &self.res
  *         cdef Py_ssize_t i
  *         if not r.finite:             # <<<<<<<<<<<<<<
@@ -25422,7 +25883,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":545
+  /* "fccqp/admm.pyx":551
  *         if not r.finite:
  *             return _NUMERICAL_ERROR
  *         if converged(r, o.eps_abs, o.eps_rel):             # <<<<<<<<<<<<<<
@@ -25434,7 +25895,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":546
+    /* "fccqp/admm.pyx":552
  *             return _NUMERICAL_ERROR
  *         if converged(r, o.eps_abs, o.eps_rel):
  *             return _SOLVED             # <<<<<<<<<<<<<<
@@ -25447,7 +25908,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":545
+    /* "fccqp/admm.pyx":551
  *         if not r.finite:
  *             return _NUMERICAL_ERROR
  *         if converged(r, o.eps_abs, o.eps_rel):             # <<<<<<<<<<<<<<
@@ -25456,7 +25917,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":547
+  /* "fccqp/admm.pyx":553
  *         if converged(r, o.eps_abs, o.eps_rel):
  *             return _SOLVED
  *         if primal_infeasible(p, it, o.eps_prim_inf, self.vec_m, self.vec_s, self.vec_n,             # <<<<<<<<<<<<<<
@@ -25468,7 +25929,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":549
+    /* "fccqp/admm.pyx":555
  *         if primal_infeasible(p, it, o.eps_prim_inf, self.vec_m, self.vec_s, self.vec_n,
  *                              self.vec_n2):
  *             fill(self.cert, 0.0, p.n + p.m)             # <<<<<<<<<<<<<<
@@ -25477,7 +25938,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
     __pyx_f_5fccqp_6_dense_fill(__pyx_v_self->cert, 0.0, (__pyx_v_p->n + __pyx_v_p->m));
 
-    /* "fccqp/admm.pyx":550
+    /* "fccqp/admm.pyx":556
  *                              self.vec_n2):
  *             fill(self.cert, 0.0, p.n + p.m)
  *             for i in range(p.m):   # in the user's units (the common factor 1/c dropped)             # <<<<<<<<<<<<<<
@@ -25491,7 +25952,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
       __pyx_v_i = __pyx_t_4;
 
-      /* "fccqp/admm.pyx":551
+      /* "fccqp/admm.pyx":557
  *             fill(self.cert, 0.0, p.n + p.m)
  *             for i in range(p.m):   # in the user's units (the common factor 1/c dropped)
  *                 self.cert[i] = self.vec_m[i] * p.E[i]             # <<<<<<<<<<<<<<
@@ -25502,7 +25963,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
 
 
-    /* "fccqp/admm.pyx":552
+    /* "fccqp/admm.pyx":558
  *             for i in range(p.m):   # in the user's units (the common factor 1/c dropped)
  *                 self.cert[i] = self.vec_m[i] * p.E[i]
  *             for i in range(p.s):             # <<<<<<<<<<<<<<
@@ -25516,7 +25977,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
       __pyx_v_i = __pyx_t_4;
 
-      /* "fccqp/admm.pyx":553
+      /* "fccqp/admm.pyx":559
  *                 self.cert[i] = self.vec_m[i] * p.E[i]
  *             for i in range(p.s):
  *                 self.cert[p.m + p.constrained[i]] = self.vec_s[i] / p.D[p.constrained[i]]             # <<<<<<<<<<<<<<
@@ -25527,7 +25988,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
 
 
-    /* "fccqp/admm.pyx":554
+    /* "fccqp/admm.pyx":560
  *             for i in range(p.s):
  *                 self.cert[p.m + p.constrained[i]] = self.vec_s[i] / p.D[p.constrained[i]]
  *             return _PRIMAL_INFEASIBLE             # <<<<<<<<<<<<<<
@@ -25540,7 +26001,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":547
+    /* "fccqp/admm.pyx":553
  *         if converged(r, o.eps_abs, o.eps_rel):
  *             return _SOLVED
  *         if primal_infeasible(p, it, o.eps_prim_inf, self.vec_m, self.vec_s, self.vec_n,             # <<<<<<<<<<<<<<
@@ -25549,7 +26010,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":555
+  /* "fccqp/admm.pyx":561
  *                 self.cert[p.m + p.constrained[i]] = self.vec_s[i] / p.D[p.constrained[i]]
  *             return _PRIMAL_INFEASIBLE
  *         if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():             # <<<<<<<<<<<<<<
@@ -25575,7 +26036,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":556
+    /* "fccqp/admm.pyx":562
  *             return _PRIMAL_INFEASIBLE
  *         if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():
  *             return _PRIMAL_INFEASIBLE             # <<<<<<<<<<<<<<
@@ -25588,7 +26049,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":555
+    /* "fccqp/admm.pyx":561
  *                 self.cert[p.m + p.constrained[i]] = self.vec_s[i] / p.D[p.constrained[i]]
  *             return _PRIMAL_INFEASIBLE
  *         if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():             # <<<<<<<<<<<<<<
@@ -25597,7 +26058,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":557
+  /* "fccqp/admm.pyx":563
  *         if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():
  *             return _PRIMAL_INFEASIBLE
  *         for i in range(p.n):             # <<<<<<<<<<<<<<
@@ -25611,7 +26072,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":558
+    /* "fccqp/admm.pyx":564
  *             return _PRIMAL_INFEASIBLE
  *         for i in range(p.n):
  *             self.direction[i] = it.x[i] - it.x_prev[i]             # <<<<<<<<<<<<<<
@@ -25622,7 +26083,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   }
 
 
-  /* "fccqp/admm.pyx":559
+  /* "fccqp/admm.pyx":565
  *         for i in range(p.n):
  *             self.direction[i] = it.x[i] - it.x_prev[i]
  *         if self._unbounded():             # <<<<<<<<<<<<<<
@@ -25634,7 +26095,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":560
+    /* "fccqp/admm.pyx":566
  *             self.direction[i] = it.x[i] - it.x_prev[i]
  *         if self._unbounded():
  *             return _DUAL_INFEASIBLE             # <<<<<<<<<<<<<<
@@ -25647,7 +26108,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":559
+    /* "fccqp/admm.pyx":565
  *         for i in range(p.n):
  *             self.direction[i] = it.x[i] - it.x_prev[i]
  *         if self._unbounded():             # <<<<<<<<<<<<<<
@@ -25656,7 +26117,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":561
+  /* "fccqp/admm.pyx":567
  *         if self._unbounded():
  *             return _DUAL_INFEASIBLE
  *         if last:             # <<<<<<<<<<<<<<
@@ -25665,7 +26126,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   if (__pyx_v_last) {
 
-    /* "fccqp/admm.pyx":562
+    /* "fccqp/admm.pyx":568
  *             return _DUAL_INFEASIBLE
  *         if last:
  *             return self._classify(iteration, True, start_time)             # <<<<<<<<<<<<<<
@@ -25678,7 +26139,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":561
+    /* "fccqp/admm.pyx":567
  *         if self._unbounded():
  *             return _DUAL_INFEASIBLE
  *         if last:             # <<<<<<<<<<<<<<
@@ -25687,7 +26148,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":563
+  /* "fccqp/admm.pyx":569
  *         if last:
  *             return self._classify(iteration, True, start_time)
  *         return _RUNNING             # <<<<<<<<<<<<<<
@@ -25700,7 +26161,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":536
+  /* "fccqp/admm.pyx":542
  *         self._finish_run(run, status, iteration)
  * 
  *     cdef int _check(self, long iteration, bint last, double start_time) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -25718,7 +26179,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":565
+/* "fccqp/admm.pyx":571
  *         return _RUNNING
  * 
  *     cdef bint _inconsistent(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -25735,7 +26196,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   Py_ssize_t __pyx_t_3;
   Py_ssize_t __pyx_t_4;
 
-  /* "fccqp/admm.pyx":568
+  /* "fccqp/admm.pyx":574
  *         """The equality certificate; on success ``cert`` holds ``(-E r, 0)``, ``r = b_s - A_s
  *         x_s``: ``A'y ~ 0`` and ``b'y < 0`` in the user's units."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -25744,7 +26205,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":570
+  /* "fccqp/admm.pyx":576
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i
  *         if not equality_inconsistent(p, &self.it, self.opt.eps_prim_inf, self.vec_m,             # <<<<<<<<<<<<<<
@@ -25756,7 +26217,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":572
+    /* "fccqp/admm.pyx":578
  *         if not equality_inconsistent(p, &self.it, self.opt.eps_prim_inf, self.vec_m,
  *                                      self.vec_n, self.vec_n2):
  *             return False             # <<<<<<<<<<<<<<
@@ -25769,7 +26230,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":570
+    /* "fccqp/admm.pyx":576
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i
  *         if not equality_inconsistent(p, &self.it, self.opt.eps_prim_inf, self.vec_m,             # <<<<<<<<<<<<<<
@@ -25778,7 +26239,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
 */
   }
 
-  /* "fccqp/admm.pyx":573
+  /* "fccqp/admm.pyx":579
  *                                      self.vec_n, self.vec_n2):
  *             return False
  *         fill(self.cert, 0.0, p.n + p.m)             # <<<<<<<<<<<<<<
@@ -25787,7 +26248,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_self->cert, 0.0, (__pyx_v_p->n + __pyx_v_p->m));
 
-  /* "fccqp/admm.pyx":574
+  /* "fccqp/admm.pyx":580
  *             return False
  *         fill(self.cert, 0.0, p.n + p.m)
  *         for i in range(p.m):             # <<<<<<<<<<<<<<
@@ -25801,7 +26262,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":575
+    /* "fccqp/admm.pyx":581
  *         fill(self.cert, 0.0, p.n + p.m)
  *         for i in range(p.m):
  *             self.cert[i] = -self.vec_m[i] * p.E[i]             # <<<<<<<<<<<<<<
@@ -25812,7 +26273,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   }
 
 
-  /* "fccqp/admm.pyx":576
+  /* "fccqp/admm.pyx":582
  *         for i in range(p.m):
  *             self.cert[i] = -self.vec_m[i] * p.E[i]
  *         return True             # <<<<<<<<<<<<<<
@@ -25825,7 +26286,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":565
+  /* "fccqp/admm.pyx":571
  *         return _RUNNING
  * 
  *     cdef bint _inconsistent(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -25840,7 +26301,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":578
+/* "fccqp/admm.pyx":584
  *         return True
  * 
  *     cdef bint _unbounded(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -25857,7 +26318,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   Py_ssize_t __pyx_t_3;
   Py_ssize_t __pyx_t_4;
 
-  /* "fccqp/admm.pyx":580
+  /* "fccqp/admm.pyx":586
  *     cdef bint _unbounded(self) noexcept nogil:
  *         """The dual certificate for ``direction``; on success ``cert`` holds it, unscaled."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -25866,7 +26327,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":582
+  /* "fccqp/admm.pyx":588
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i
  *         if not dual_infeasible(p, self.direction, self.opt.eps_dual_inf, self.vec_n,             # <<<<<<<<<<<<<<
@@ -25878,7 +26339,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":584
+    /* "fccqp/admm.pyx":590
  *         if not dual_infeasible(p, self.direction, self.opt.eps_dual_inf, self.vec_n,
  *                                self.vec_n2, self.vec_s2):
  *             return False             # <<<<<<<<<<<<<<
@@ -25891,7 +26352,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":582
+    /* "fccqp/admm.pyx":588
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i
  *         if not dual_infeasible(p, self.direction, self.opt.eps_dual_inf, self.vec_n,             # <<<<<<<<<<<<<<
@@ -25900,7 +26361,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
 */
   }
 
-  /* "fccqp/admm.pyx":585
+  /* "fccqp/admm.pyx":591
  *                                self.vec_n2, self.vec_s2):
  *             return False
  *         for i in range(p.n):             # <<<<<<<<<<<<<<
@@ -25914,7 +26375,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":586
+    /* "fccqp/admm.pyx":592
  *             return False
  *         for i in range(p.n):
  *             self.cert[i] = self.direction[i] * p.D[i]             # <<<<<<<<<<<<<<
@@ -25925,7 +26386,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   }
 
 
-  /* "fccqp/admm.pyx":587
+  /* "fccqp/admm.pyx":593
  *         for i in range(p.n):
  *             self.cert[i] = self.direction[i] * p.D[i]
  *         return True             # <<<<<<<<<<<<<<
@@ -25938,7 +26399,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":578
+  /* "fccqp/admm.pyx":584
  *         return True
  * 
  *     cdef bint _unbounded(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -25953,7 +26414,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":589
+/* "fccqp/admm.pyx":595
  *         return True
  * 
  *     cdef int _classify(self, long iteration, bint stopped, double start_time) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -25967,7 +26428,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   int __pyx_t_1;
   int __pyx_t_2;
 
-  /* "fccqp/admm.pyx":592
+  /* "fccqp/admm.pyx":598
  *         """Status of an iterate from its residuals alone: solved, inaccurate (within
  *         ``INACCURATE_FACTOR`` of the tolerances), or the budget that ran out."""
  *         cdef Residuals* r = &self.res             # <<<<<<<<<<<<<<
@@ -25976,7 +26437,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_r = (&__pyx_v_self->res);
 
-  /* "fccqp/admm.pyx":593
+  /* "fccqp/admm.pyx":599
  *         ``INACCURATE_FACTOR`` of the tolerances), or the budget that ran out."""
  *         cdef Residuals* r = &self.res
  *         if not r.finite:             # <<<<<<<<<<<<<<
@@ -25988,7 +26449,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":594
+    /* "fccqp/admm.pyx":600
  *         cdef Residuals* r = &self.res
  *         if not r.finite:
  *             return _NUMERICAL_ERROR             # <<<<<<<<<<<<<<
@@ -26001,7 +26462,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":593
+    /* "fccqp/admm.pyx":599
  *         ``INACCURATE_FACTOR`` of the tolerances), or the budget that ran out."""
  *         cdef Residuals* r = &self.res
  *         if not r.finite:             # <<<<<<<<<<<<<<
@@ -26010,7 +26471,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":595
+  /* "fccqp/admm.pyx":601
  *         if not r.finite:
  *             return _NUMERICAL_ERROR
  *         if converged(r, self.opt.eps_abs, self.opt.eps_rel):             # <<<<<<<<<<<<<<
@@ -26022,7 +26483,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":596
+    /* "fccqp/admm.pyx":602
  *             return _NUMERICAL_ERROR
  *         if converged(r, self.opt.eps_abs, self.opt.eps_rel):
  *             return _SOLVED             # <<<<<<<<<<<<<<
@@ -26035,7 +26496,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":595
+    /* "fccqp/admm.pyx":601
  *         if not r.finite:
  *             return _NUMERICAL_ERROR
  *         if converged(r, self.opt.eps_abs, self.opt.eps_rel):             # <<<<<<<<<<<<<<
@@ -26044,7 +26505,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":597
+  /* "fccqp/admm.pyx":603
  *         if converged(r, self.opt.eps_abs, self.opt.eps_rel):
  *             return _SOLVED
  *         if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):             # <<<<<<<<<<<<<<
@@ -26056,7 +26517,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":598
+    /* "fccqp/admm.pyx":604
  *             return _SOLVED
  *         if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *             return _INACCURATE             # <<<<<<<<<<<<<<
@@ -26069,7 +26530,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":597
+    /* "fccqp/admm.pyx":603
  *         if converged(r, self.opt.eps_abs, self.opt.eps_rel):
  *             return _SOLVED
  *         if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):             # <<<<<<<<<<<<<<
@@ -26078,7 +26539,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":599
+  /* "fccqp/admm.pyx":605
  *         if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *             return _INACCURATE
  *         if iteration >= self.opt.max_iter or not stopped:             # <<<<<<<<<<<<<<
@@ -26104,7 +26565,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":600
+    /* "fccqp/admm.pyx":606
  *             return _INACCURATE
  *         if iteration >= self.opt.max_iter or not stopped:
  *             return _MAX_ITER             # <<<<<<<<<<<<<<
@@ -26117,7 +26578,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":599
+    /* "fccqp/admm.pyx":605
  *         if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *             return _INACCURATE
  *         if iteration >= self.opt.max_iter or not stopped:             # <<<<<<<<<<<<<<
@@ -26126,7 +26587,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":601
+  /* "fccqp/admm.pyx":607
  *         if iteration >= self.opt.max_iter or not stopped:
  *             return _MAX_ITER
  *         return _TIME_LIMIT             # <<<<<<<<<<<<<<
@@ -26139,7 +26600,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":589
+  /* "fccqp/admm.pyx":595
  *         return True
  * 
  *     cdef int _classify(self, long iteration, bint stopped, double start_time) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26153,7 +26614,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":603
+/* "fccqp/admm.pyx":609
  *         return _TIME_LIMIT
  * 
  *     cdef void _full_step(self, bint relax_x) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26178,7 +26639,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   Py_ssize_t __pyx_t_4;
   Py_ssize_t __pyx_t_5;
 
-  /* "fccqp/admm.pyx":605
+  /* "fccqp/admm.pyx":611
  *     cdef void _full_step(self, bint relax_x) noexcept nogil:
  *         """One ADMM iteration with a KKT solve (update_x, update_z, update_y)."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -26187,7 +26648,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":606
+  /* "fccqp/admm.pyx":612
  *         """One ADMM iteration with a KKT solve (update_x, update_z, update_y)."""
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -26196,7 +26657,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":607
+  /* "fccqp/admm.pyx":613
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j             # <<<<<<<<<<<<<<
@@ -26213,7 +26674,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":608
+  /* "fccqp/admm.pyx":614
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         cdef double alpha = self.opt.alpha, alpha_x = alpha if relax_x else 1.0             # <<<<<<<<<<<<<<
@@ -26232,7 +26693,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
   __pyx_v_alpha_x = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":609
+  /* "fccqp/admm.pyx":615
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         cdef double alpha = self.opt.alpha, alpha_x = alpha if relax_x else 1.0
  *         cdef double sigma = self.opt.sigma             # <<<<<<<<<<<<<<
@@ -26243,7 +26704,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 
   __pyx_v_sigma = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":610
+  /* "fccqp/admm.pyx":616
  *         cdef double alpha = self.opt.alpha, alpha_x = alpha if relax_x else 1.0
  *         cdef double sigma = self.opt.sigma
  *         copy(it.x, it.x_prev, n)             # <<<<<<<<<<<<<<
@@ -26252,7 +26713,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->x, __pyx_v_it->x_prev, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":611
+  /* "fccqp/admm.pyx":617
  *         cdef double sigma = self.opt.sigma
  *         copy(it.x, it.x_prev, n)
  *         copy(it.nu, it.nu_prev, m)             # <<<<<<<<<<<<<<
@@ -26261,7 +26722,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->nu, __pyx_v_it->nu_prev, __pyx_v_m);
 
-  /* "fccqp/admm.pyx":612
+  /* "fccqp/admm.pyx":618
  *         copy(it.x, it.x_prev, n)
  *         copy(it.nu, it.nu_prev, m)
  *         copy(it.z, it.z_prev, s)             # <<<<<<<<<<<<<<
@@ -26270,7 +26731,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->z, __pyx_v_it->z_prev, __pyx_v_s);
 
-  /* "fccqp/admm.pyx":613
+  /* "fccqp/admm.pyx":619
  *         copy(it.nu, it.nu_prev, m)
  *         copy(it.z, it.z_prev, s)
  *         copy(it.y, it.y_prev, s)             # <<<<<<<<<<<<<<
@@ -26279,7 +26740,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->y, __pyx_v_it->y_prev, __pyx_v_s);
 
-  /* "fccqp/admm.pyx":614
+  /* "fccqp/admm.pyx":620
  *         copy(it.z, it.z_prev, s)
  *         copy(it.y, it.y_prev, s)
  *         for i in range(n):             # <<<<<<<<<<<<<<
@@ -26293,7 +26754,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":615
+    /* "fccqp/admm.pyx":621
  *         copy(it.y, it.y_prev, s)
  *         for i in range(n):
  *             self.rhs[i] = sigma * it.x[i] - p.q[i]             # <<<<<<<<<<<<<<
@@ -26304,7 +26765,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":616
+  /* "fccqp/admm.pyx":622
  *         for i in range(n):
  *             self.rhs[i] = sigma * it.x[i] - p.q[i]
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -26318,7 +26779,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":617
+    /* "fccqp/admm.pyx":623
  *             self.rhs[i] = sigma * it.x[i] - p.q[i]
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i]             # <<<<<<<<<<<<<<
@@ -26329,7 +26790,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":618
+  /* "fccqp/admm.pyx":624
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i]
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -26343,7 +26804,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":619
+    /* "fccqp/admm.pyx":625
  *             self.rhs[n + i] = p.b[i]
  *         for j in range(s):
  *             self.rhs[p.constrained[j]] += it.rho_vec[j] * it.z[j] - it.y[j]             # <<<<<<<<<<<<<<
@@ -26356,7 +26817,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":620
+  /* "fccqp/admm.pyx":626
  *         for j in range(s):
  *             self.rhs[p.constrained[j]] += it.rho_vec[j] * it.z[j] - it.y[j]
  *         kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)             # <<<<<<<<<<<<<<
@@ -26365,7 +26826,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_3kkt_kkt_solve((&__pyx_v_self->kkt), __pyx_v_p, __pyx_v_it->rho_vec, __pyx_v_self->rhs, __pyx_v_self->sol);
 
-  /* "fccqp/admm.pyx":621
+  /* "fccqp/admm.pyx":627
  *             self.rhs[p.constrained[j]] += it.rho_vec[j] * it.z[j] - it.y[j]
  *         kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -26379,7 +26840,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":622
+    /* "fccqp/admm.pyx":628
  *         kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
  *         for j in range(s):
  *             it.relaxed[j] = alpha * self.sol[p.constrained[j]] + (1.0 - alpha) * it.z_prev[j]             # <<<<<<<<<<<<<<
@@ -26390,7 +26851,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":623
+  /* "fccqp/admm.pyx":629
  *         for j in range(s):
  *             it.relaxed[j] = alpha * self.sol[p.constrained[j]] + (1.0 - alpha) * it.z_prev[j]
  *         for i in range(n):             # <<<<<<<<<<<<<<
@@ -26404,7 +26865,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":624
+    /* "fccqp/admm.pyx":630
  *             it.relaxed[j] = alpha * self.sol[p.constrained[j]] + (1.0 - alpha) * it.z_prev[j]
  *         for i in range(n):
  *             it.x[i] = alpha_x * self.sol[i] + (1.0 - alpha_x) * it.x_prev[i]             # <<<<<<<<<<<<<<
@@ -26415,7 +26876,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":625
+  /* "fccqp/admm.pyx":631
  *         for i in range(n):
  *             it.x[i] = alpha_x * self.sol[i] + (1.0 - alpha_x) * it.x_prev[i]
  *         copy(self.sol + n, it.nu, m)             # <<<<<<<<<<<<<<
@@ -26424,7 +26885,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_6_dense_copy((__pyx_v_self->sol + __pyx_v_n), __pyx_v_it->nu, __pyx_v_m);
 
-  /* "fccqp/admm.pyx":626
+  /* "fccqp/admm.pyx":632
  *             it.x[i] = alpha_x * self.sol[i] + (1.0 - alpha_x) * it.x_prev[i]
  *         copy(self.sol + n, it.nu, m)
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -26438,7 +26899,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":627
+    /* "fccqp/admm.pyx":633
  *         copy(self.sol + n, it.nu, m)
  *         for j in range(s):
  *             it.z[j] = it.relaxed[j] + it.y[j] / it.rho_vec[j]             # <<<<<<<<<<<<<<
@@ -26449,7 +26910,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":628
+  /* "fccqp/admm.pyx":634
  *         for j in range(s):
  *             it.z[j] = it.relaxed[j] + it.y[j] / it.rho_vec[j]
  *         proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)             # <<<<<<<<<<<<<<
@@ -26458,7 +26919,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_11projections_proj_set(__pyx_v_it->z, __pyx_v_p->lo, __pyx_v_p->hi, __pyx_v_p->cones, __pyx_v_s, __pyx_v_it->z);
 
-  /* "fccqp/admm.pyx":629
+  /* "fccqp/admm.pyx":635
  *             it.z[j] = it.relaxed[j] + it.y[j] / it.rho_vec[j]
  *         proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -26472,7 +26933,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":630
+    /* "fccqp/admm.pyx":636
  *         proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
  *         for j in range(s):
  *             it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])             # <<<<<<<<<<<<<<
@@ -26485,7 +26946,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":603
+  /* "fccqp/admm.pyx":609
  *         return _TIME_LIMIT
  * 
  *     cdef void _full_step(self, bint relax_x) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26506,7 +26967,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 
 }
 
-/* "fccqp/admm.pyx":632
+/* "fccqp/admm.pyx":638
  *             it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])
  * 
  *     cdef double _new_rho(self, double rho) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26528,7 +26989,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   double __pyx_t_6;
   int __pyx_t_7;
 
-  /* "fccqp/admm.pyx":635
+  /* "fccqp/admm.pyx":641
  *         """OSQP's rule: rho *= sqrt(relative primal / relative dual residual), clipped;
  *         unchanged unless it moves by more than ``adaptive_rho_tolerance``."""
  *         cdef Residuals* r = &self.res             # <<<<<<<<<<<<<<
@@ -26537,7 +26998,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
 */
   __pyx_v_r = (&__pyx_v_self->res);
 
-  /* "fccqp/admm.pyx":636
+  /* "fccqp/admm.pyx":642
  *         unchanged unless it moves by more than ``adaptive_rho_tolerance``."""
  *         cdef Residuals* r = &self.res
  *         cdef double ratio = (r.prim_s / max(r.prim_scale_s, 1e-30)) / max(             # <<<<<<<<<<<<<<
@@ -26561,7 +27022,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
 
   __pyx_t_1 = 1e-30;
 
-  /* "fccqp/admm.pyx":637
+  /* "fccqp/admm.pyx":643
  *         cdef Residuals* r = &self.res
  *         cdef double ratio = (r.prim_s / max(r.prim_scale_s, 1e-30)) / max(
  *             r.dual_s / max(r.dual_scale_s, 1e-30), 1e-30)             # <<<<<<<<<<<<<<
@@ -26596,7 +27057,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":636
+  /* "fccqp/admm.pyx":642
  *         unchanged unless it moves by more than ``adaptive_rho_tolerance``."""
  *         cdef Residuals* r = &self.res
  *         cdef double ratio = (r.prim_s / max(r.prim_scale_s, 1e-30)) / max(             # <<<<<<<<<<<<<<
@@ -26607,7 +27068,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
 
 
 
-  /* "fccqp/admm.pyx":638
+  /* "fccqp/admm.pyx":644
  *         cdef double ratio = (r.prim_s / max(r.prim_scale_s, 1e-30)) / max(
  *             r.dual_s / max(r.dual_scale_s, 1e-30), 1e-30)
  *         cdef double new_rho = min(max(rho * sqrt(ratio), _RHO_MIN), _RHO_MAX)             # <<<<<<<<<<<<<<
@@ -26646,7 +27107,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   __pyx_v_new_rho = __pyx_t_2;
 
 
-  /* "fccqp/admm.pyx":639
+  /* "fccqp/admm.pyx":645
  *             r.dual_s / max(r.dual_scale_s, 1e-30), 1e-30)
  *         cdef double new_rho = min(max(rho * sqrt(ratio), _RHO_MIN), _RHO_MAX)
  *         cdef double tolerance = self.opt.adaptive_rho_tolerance             # <<<<<<<<<<<<<<
@@ -26657,7 +27118,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
 
   __pyx_v_tolerance = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":640
+  /* "fccqp/admm.pyx":646
  *         cdef double new_rho = min(max(rho * sqrt(ratio), _RHO_MIN), _RHO_MAX)
  *         cdef double tolerance = self.opt.adaptive_rho_tolerance
  *         if new_rho > rho * tolerance or new_rho < rho / tolerance:             # <<<<<<<<<<<<<<
@@ -26683,7 +27144,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   if (__pyx_t_4) {
 
 
-    /* "fccqp/admm.pyx":641
+    /* "fccqp/admm.pyx":647
  *         cdef double tolerance = self.opt.adaptive_rho_tolerance
  *         if new_rho > rho * tolerance or new_rho < rho / tolerance:
  *             return new_rho             # <<<<<<<<<<<<<<
@@ -26696,7 +27157,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":640
+    /* "fccqp/admm.pyx":646
  *         cdef double new_rho = min(max(rho * sqrt(ratio), _RHO_MIN), _RHO_MAX)
  *         cdef double tolerance = self.opt.adaptive_rho_tolerance
  *         if new_rho > rho * tolerance or new_rho < rho / tolerance:             # <<<<<<<<<<<<<<
@@ -26705,7 +27166,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
 */
   }
 
-  /* "fccqp/admm.pyx":642
+  /* "fccqp/admm.pyx":648
  *         if new_rho > rho * tolerance or new_rho < rho / tolerance:
  *             return new_rho
  *         return rho             # <<<<<<<<<<<<<<
@@ -26718,7 +27179,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":632
+  /* "fccqp/admm.pyx":638
  *             it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])
  * 
  *     cdef double _new_rho(self, double rho) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26735,7 +27196,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":646
+/* "fccqp/admm.pyx":652
  *     # -------------------------------------------------------- factorizations
  * 
  *     cdef long _budget(self, long iteration) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26748,7 +27209,7 @@ static long __pyx_f_5fccqp_4admm_9Workspace__budget(struct __pyx_obj_5fccqp_4adm
   long __pyx_r;
   Py_ssize_t __pyx_t_1;
 
-  /* "fccqp/admm.pyx":649
+  /* "fccqp/admm.pyx":655
  *         """Solves the reduced form's table can save: the iterations left, plus, when the
  *         result will be restored, the columns the restoration would otherwise compute."""
  *         cdef long restoring = self.prob.s if self.opt.restore_feasibility else 0             # <<<<<<<<<<<<<<
@@ -26764,7 +27225,7 @@ static long __pyx_f_5fccqp_4admm_9Workspace__budget(struct __pyx_obj_5fccqp_4adm
   }
   __pyx_v_restoring = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":650
+  /* "fccqp/admm.pyx":656
  *         result will be restored, the columns the restoration would otherwise compute."""
  *         cdef long restoring = self.prob.s if self.opt.restore_feasibility else 0
  *         return self.opt.max_iter - iteration + restoring             # <<<<<<<<<<<<<<
@@ -26777,7 +27238,7 @@ static long __pyx_f_5fccqp_4admm_9Workspace__budget(struct __pyx_obj_5fccqp_4adm
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":646
+  /* "fccqp/admm.pyx":652
  *     # -------------------------------------------------------- factorizations
  * 
  *     cdef long _budget(self, long iteration) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26791,7 +27252,7 @@ static long __pyx_f_5fccqp_4admm_9Workspace__budget(struct __pyx_obj_5fccqp_4adm
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":652
+/* "fccqp/admm.pyx":658
  *         return self.opt.max_iter - iteration + restoring
  * 
  *     cdef int _certify(self, bint schur_factored) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26804,7 +27265,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
   int __pyx_r;
   int __pyx_t_1;
 
-  /* "fccqp/admm.pyx":655
+  /* "fccqp/admm.pyx":661
  *         """Establish convexity for the current matrices (see :func:`fccqp.kkt.kkt_convexity`);
  *         ``schur_factored`` says that the Schur backend has just factored them."""
  *         cdef int code = kkt_convexity(&self.kkt, &self.prob, self.opt.sigma, self.it.rho_vec,             # <<<<<<<<<<<<<<
@@ -26813,7 +27274,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
 */
   __pyx_v_code = __pyx_f_5fccqp_3kkt_kkt_convexity((&__pyx_v_self->kkt), (&__pyx_v_self->prob), __pyx_v_self->opt.sigma, __pyx_v_self->it.rho_vec, __pyx_v_schur_factored);
 
-  /* "fccqp/admm.pyx":657
+  /* "fccqp/admm.pyx":663
  *         cdef int code = kkt_convexity(&self.kkt, &self.prob, self.opt.sigma, self.it.rho_vec,
  *                                       schur_factored)
  *         if code == FACTORED:             # <<<<<<<<<<<<<<
@@ -26825,7 +27286,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":658
+    /* "fccqp/admm.pyx":664
  *                                       schur_factored)
  *         if code == FACTORED:
  *             self.certified = True             # <<<<<<<<<<<<<<
@@ -26834,7 +27295,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_v_self->certified = 1;
 
-    /* "fccqp/admm.pyx":657
+    /* "fccqp/admm.pyx":663
  *         cdef int code = kkt_convexity(&self.kkt, &self.prob, self.opt.sigma, self.it.rho_vec,
  *                                       schur_factored)
  *         if code == FACTORED:             # <<<<<<<<<<<<<<
@@ -26843,7 +27304,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
 */
   }
 
-  /* "fccqp/admm.pyx":659
+  /* "fccqp/admm.pyx":665
  *         if code == FACTORED:
  *             self.certified = True
  *         return code             # <<<<<<<<<<<<<<
@@ -26856,7 +27317,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":652
+  /* "fccqp/admm.pyx":658
  *         return self.opt.max_iter - iteration + restoring
  * 
  *     cdef int _certify(self, bint schur_factored) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26870,7 +27331,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":661
+/* "fccqp/admm.pyx":667
  *         return code
  * 
  *     cdef int _factor(self, Run* run, long budget) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26893,7 +27354,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   long __pyx_t_6;
   double __pyx_t_7;
 
-  /* "fccqp/admm.pyx":668
+  /* "fccqp/admm.pyx":674
  *         matrices are new. Returns FACTORED, NOT_CONVEX, or UNAVAILABLE (numerical
  *         breakdown); records the form and the rho it factored."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -26902,7 +27363,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":669
+  /* "fccqp/admm.pyx":675
  *         breakdown); records the form and the rho it factored."""
  *         cdef Problem* p = &self.prob
  *         cdef int backend, code, first = self.opt.backend             # <<<<<<<<<<<<<<
@@ -26913,7 +27374,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 
   __pyx_v_first = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":671
+  /* "fccqp/admm.pyx":677
  *         cdef int backend, code, first = self.opt.backend
  *         cdef bint reduced_pays
  *         if first == AUTO:             # <<<<<<<<<<<<<<
@@ -26925,7 +27386,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   if (__pyx_t_2) {
 
 
-    /* "fccqp/admm.pyx":672
+    /* "fccqp/admm.pyx":678
  *         cdef bint reduced_pays
  *         if first == AUTO:
  *             reduced_pays = 2 * p.s <= p.n + p.m and _REDUCED_COST * p.s <= budget             # <<<<<<<<<<<<<<
@@ -26950,7 +27411,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     __pyx_L4_bool_binop_done:;
     __pyx_v_reduced_pays = __pyx_t_2;
 
-    /* "fccqp/admm.pyx":673
+    /* "fccqp/admm.pyx":679
  *         if first == AUTO:
  *             reduced_pays = 2 * p.s <= p.n + p.m and _REDUCED_COST * p.s <= budget
  *             first = SCHUR_REDUCED if reduced_pays else LDL_FULL             # <<<<<<<<<<<<<<
@@ -26966,7 +27427,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     }
     __pyx_v_first = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":671
+    /* "fccqp/admm.pyx":677
  *         cdef int backend, code, first = self.opt.backend
  *         cdef bint reduced_pays
  *         if first == AUTO:             # <<<<<<<<<<<<<<
@@ -26975,7 +27436,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
   }
 
-  /* "fccqp/admm.pyx":674
+  /* "fccqp/admm.pyx":680
  *             reduced_pays = 2 * p.s <= p.n + p.m and _REDUCED_COST * p.s <= budget
  *             first = SCHUR_REDUCED if reduced_pays else LDL_FULL
  *         for backend in range(first, LDL_FULL + 1):             # <<<<<<<<<<<<<<
@@ -26989,7 +27450,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   for (__pyx_t_1 = __pyx_v_first; __pyx_t_1 < __pyx_t_6; __pyx_t_1+=1) {
     __pyx_v_backend = __pyx_t_1;
 
-    /* "fccqp/admm.pyx":675
+    /* "fccqp/admm.pyx":681
  *             first = SCHUR_REDUCED if reduced_pays else LDL_FULL
  *         for backend in range(first, LDL_FULL + 1):
  *             if not self.certified and backend != SCHUR_REDUCED:             # <<<<<<<<<<<<<<
@@ -27015,7 +27476,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":677
+      /* "fccqp/admm.pyx":683
  *             if not self.certified and backend != SCHUR_REDUCED:
  *                 # certify first: the certificate overwrites an LDL' factorization
  *                 code = self._certify(False)             # <<<<<<<<<<<<<<
@@ -27024,7 +27485,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       __pyx_v_code = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_certify(__pyx_v_self, 0);
 
-      /* "fccqp/admm.pyx":678
+      /* "fccqp/admm.pyx":684
  *                 # certify first: the certificate overwrites an LDL' factorization
  *                 code = self._certify(False)
  *                 run.factorizations += 1             # <<<<<<<<<<<<<<
@@ -27033,7 +27494,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       __pyx_v_run->factorizations = (__pyx_v_run->factorizations + 1);
 
-      /* "fccqp/admm.pyx":679
+      /* "fccqp/admm.pyx":685
  *                 code = self._certify(False)
  *                 run.factorizations += 1
  *                 if code == NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -27045,7 +27506,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
       if (__pyx_t_2) {
 
 
-        /* "fccqp/admm.pyx":680
+        /* "fccqp/admm.pyx":686
  *                 run.factorizations += 1
  *                 if code == NOT_CONVEX:
  *                     return NOT_CONVEX             # <<<<<<<<<<<<<<
@@ -27058,7 +27519,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
         }
         goto __pyx_L0;
 
-        /* "fccqp/admm.pyx":679
+        /* "fccqp/admm.pyx":685
  *                 code = self._certify(False)
  *                 run.factorizations += 1
  *                 if code == NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -27067,7 +27528,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       }
 
-      /* "fccqp/admm.pyx":675
+      /* "fccqp/admm.pyx":681
  *             first = SCHUR_REDUCED if reduced_pays else LDL_FULL
  *         for backend in range(first, LDL_FULL + 1):
  *             if not self.certified and backend != SCHUR_REDUCED:             # <<<<<<<<<<<<<<
@@ -27076,7 +27537,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     }
 
-    /* "fccqp/admm.pyx":682
+    /* "fccqp/admm.pyx":688
  *                     return NOT_CONVEX
  *             code = kkt_factor(&self.kkt, p, backend,
  *                               self.opt.sigma if backend == LDL_FULL else 0.0, self.it.rho_vec)             # <<<<<<<<<<<<<<
@@ -27094,7 +27555,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     }
 
 
-    /* "fccqp/admm.pyx":681
+    /* "fccqp/admm.pyx":687
  *                 if code == NOT_CONVEX:
  *                     return NOT_CONVEX
  *             code = kkt_factor(&self.kkt, p, backend,             # <<<<<<<<<<<<<<
@@ -27104,7 +27565,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     __pyx_v_code = __pyx_f_5fccqp_3kkt_kkt_factor((&__pyx_v_self->kkt), __pyx_v_p, __pyx_v_backend, __pyx_t_7, __pyx_v_self->it.rho_vec);
 
 
-    /* "fccqp/admm.pyx":683
+    /* "fccqp/admm.pyx":689
  *             code = kkt_factor(&self.kkt, p, backend,
  *                               self.opt.sigma if backend == LDL_FULL else 0.0, self.it.rho_vec)
  *             run.factorizations += 1             # <<<<<<<<<<<<<<
@@ -27113,7 +27574,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_v_run->factorizations = (__pyx_v_run->factorizations + 1);
 
-    /* "fccqp/admm.pyx":684
+    /* "fccqp/admm.pyx":690
  *                               self.opt.sigma if backend == LDL_FULL else 0.0, self.it.rho_vec)
  *             run.factorizations += 1
  *             if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -27125,7 +27586,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":685
+      /* "fccqp/admm.pyx":691
  *             run.factorizations += 1
  *             if code != FACTORED:
  *                 if backend == LDL_FULL:             # <<<<<<<<<<<<<<
@@ -27137,7 +27598,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
       if (__pyx_t_2) {
 
 
-        /* "fccqp/admm.pyx":686
+        /* "fccqp/admm.pyx":692
  *             if code != FACTORED:
  *                 if backend == LDL_FULL:
  *                     return UNAVAILABLE             # <<<<<<<<<<<<<<
@@ -27150,7 +27611,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
         }
         goto __pyx_L0;
 
-        /* "fccqp/admm.pyx":685
+        /* "fccqp/admm.pyx":691
  *             run.factorizations += 1
  *             if code != FACTORED:
  *                 if backend == LDL_FULL:             # <<<<<<<<<<<<<<
@@ -27159,7 +27620,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       }
 
-      /* "fccqp/admm.pyx":687
+      /* "fccqp/admm.pyx":693
  *                 if backend == LDL_FULL:
  *                     return UNAVAILABLE
  *                 continue             # <<<<<<<<<<<<<<
@@ -27168,7 +27629,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       goto __pyx_L6_continue;
 
-      /* "fccqp/admm.pyx":684
+      /* "fccqp/admm.pyx":690
  *                               self.opt.sigma if backend == LDL_FULL else 0.0, self.it.rho_vec)
  *             run.factorizations += 1
  *             if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -27177,7 +27638,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     }
 
-    /* "fccqp/admm.pyx":688
+    /* "fccqp/admm.pyx":694
  *                     return UNAVAILABLE
  *                 continue
  *             if not self.certified and self._certify(True) == NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -27203,7 +27664,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":689
+      /* "fccqp/admm.pyx":695
  *                 continue
  *             if not self.certified and self._certify(True) == NOT_CONVEX:
  *                 return NOT_CONVEX             # <<<<<<<<<<<<<<
@@ -27216,7 +27677,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
       }
       goto __pyx_L0;
 
-      /* "fccqp/admm.pyx":688
+      /* "fccqp/admm.pyx":694
  *                     return UNAVAILABLE
  *                 continue
  *             if not self.certified and self._certify(True) == NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -27225,7 +27686,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     }
 
-    /* "fccqp/admm.pyx":690
+    /* "fccqp/admm.pyx":696
  *             if not self.certified and self._certify(True) == NOT_CONVEX:
  *                 return NOT_CONVEX
  *             if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,             # <<<<<<<<<<<<<<
@@ -27243,7 +27704,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
       goto __pyx_L18_bool_binop_done;
     }
 
-    /* "fccqp/admm.pyx":691
+    /* "fccqp/admm.pyx":697
  *                 return NOT_CONVEX
  *             if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,
  *                                                          self.it.rho_vec):             # <<<<<<<<<<<<<<
@@ -27257,7 +27718,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 
     __pyx_L18_bool_binop_done:;
 
-    /* "fccqp/admm.pyx":690
+    /* "fccqp/admm.pyx":696
  *             if not self.certified and self._certify(True) == NOT_CONVEX:
  *                 return NOT_CONVEX
  *             if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,             # <<<<<<<<<<<<<<
@@ -27267,7 +27728,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":692
+      /* "fccqp/admm.pyx":698
  *             if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,
  *                                                          self.it.rho_vec):
  *                 continue             # <<<<<<<<<<<<<<
@@ -27276,7 +27737,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       goto __pyx_L6_continue;
 
-      /* "fccqp/admm.pyx":690
+      /* "fccqp/admm.pyx":696
  *             if not self.certified and self._certify(True) == NOT_CONVEX:
  *                 return NOT_CONVEX
  *             if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,             # <<<<<<<<<<<<<<
@@ -27285,7 +27746,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     }
 
-    /* "fccqp/admm.pyx":693
+    /* "fccqp/admm.pyx":699
  *                                                          self.it.rho_vec):
  *                 continue
  *             self.form = backend             # <<<<<<<<<<<<<<
@@ -27294,7 +27755,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_v_self->form = __pyx_v_backend;
 
-    /* "fccqp/admm.pyx":694
+    /* "fccqp/admm.pyx":700
  *                 continue
  *             self.form = backend
  *             run.backend = backend             # <<<<<<<<<<<<<<
@@ -27303,7 +27764,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_v_run->backend = __pyx_v_backend;
 
-    /* "fccqp/admm.pyx":695
+    /* "fccqp/admm.pyx":701
  *             self.form = backend
  *             run.backend = backend
  *             self.factored_rho = run.rho             # <<<<<<<<<<<<<<
@@ -27314,7 +27775,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 
     __pyx_v_self->factored_rho = __pyx_t_7;
 
-    /* "fccqp/admm.pyx":696
+    /* "fccqp/admm.pyx":702
  *             run.backend = backend
  *             self.factored_rho = run.rho
  *             return FACTORED             # <<<<<<<<<<<<<<
@@ -27330,7 +27791,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   }
 
 
-  /* "fccqp/admm.pyx":697
+  /* "fccqp/admm.pyx":703
  *             self.factored_rho = run.rho
  *             return FACTORED
  *         return UNAVAILABLE             # <<<<<<<<<<<<<<
@@ -27343,7 +27804,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":661
+  /* "fccqp/admm.pyx":667
  *         return code
  * 
  *     cdef int _factor(self, Run* run, long budget) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27361,7 +27822,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":699
+/* "fccqp/admm.pyx":705
  *         return UNAVAILABLE
  * 
  *     cdef void _reduced_base(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27376,7 +27837,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
   Py_ssize_t __pyx_t_2;
   Py_ssize_t __pyx_t_3;
 
-  /* "fccqp/admm.pyx":702
+  /* "fccqp/admm.pyx":708
  *         """``base``: the x-update's response to ``(-q, b)`` alone (q and b change every
  *         solve; the table only with the factorization)."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -27385,7 +27846,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":704
+  /* "fccqp/admm.pyx":710
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i
  *         for i in range(p.n):             # <<<<<<<<<<<<<<
@@ -27399,7 +27860,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":705
+    /* "fccqp/admm.pyx":711
  *         cdef Py_ssize_t i
  *         for i in range(p.n):
  *             self.rhs[i] = -p.q[i]             # <<<<<<<<<<<<<<
@@ -27410,7 +27871,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
   }
 
 
-  /* "fccqp/admm.pyx":706
+  /* "fccqp/admm.pyx":712
  *         for i in range(p.n):
  *             self.rhs[i] = -p.q[i]
  *         for i in range(p.m):             # <<<<<<<<<<<<<<
@@ -27424,7 +27885,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":707
+    /* "fccqp/admm.pyx":713
  *             self.rhs[i] = -p.q[i]
  *         for i in range(p.m):
  *             self.rhs[p.n + i] = p.b[i]             # <<<<<<<<<<<<<<
@@ -27435,7 +27896,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
   }
 
 
-  /* "fccqp/admm.pyx":708
+  /* "fccqp/admm.pyx":714
  *         for i in range(p.m):
  *             self.rhs[p.n + i] = p.b[i]
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.red.base)             # <<<<<<<<<<<<<<
@@ -27444,7 +27905,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_3kkt_kkt_solve((&__pyx_v_self->kkt), __pyx_v_p, __pyx_v_self->it.rho_vec, __pyx_v_self->rhs, __pyx_v_self->red.base);
 
-  /* "fccqp/admm.pyx":699
+  /* "fccqp/admm.pyx":705
  *         return UNAVAILABLE
  * 
  *     cdef void _reduced_base(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27457,7 +27918,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
 
 }
 
-/* "fccqp/admm.pyx":710
+/* "fccqp/admm.pyx":716
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.red.base)
  * 
  *     cdef int _equality_start(self, bint* unbounded) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27486,7 +27947,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   double __pyx_t_9;
   double __pyx_t_10;
 
-  /* "fccqp/admm.pyx":721
+  /* "fccqp/admm.pyx":727
  *         candidate certificate) and the start falls back to the origin.
  *         """
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -27495,7 +27956,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":722
+  /* "fccqp/admm.pyx":728
  *         """
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -27504,7 +27965,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":723
+  /* "fccqp/admm.pyx":729
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, i, step             # <<<<<<<<<<<<<<
@@ -27518,7 +27979,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 
   __pyx_v_m = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":724
+  /* "fccqp/admm.pyx":730
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, i, step
  *         cdef double sigma = self.opt.sigma             # <<<<<<<<<<<<<<
@@ -27529,7 +27990,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 
   __pyx_v_sigma = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":725
+  /* "fccqp/admm.pyx":731
  *         cdef Py_ssize_t n = p.n, m = p.m, i, step
  *         cdef double sigma = self.opt.sigma
  *         fill(it.rho_vec, 0.0, p.s)             # <<<<<<<<<<<<<<
@@ -27538,7 +27999,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_it->rho_vec, 0.0, __pyx_v_p->s);
 
-  /* "fccqp/admm.pyx":726
+  /* "fccqp/admm.pyx":732
  *         cdef double sigma = self.opt.sigma
  *         fill(it.rho_vec, 0.0, p.s)
  *         self.factored_rho = -1.0  # the KKT matrix now holds no rho factorization             # <<<<<<<<<<<<<<
@@ -27547,7 +28008,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_self->factored_rho = -1.0;
 
-  /* "fccqp/admm.pyx":727
+  /* "fccqp/admm.pyx":733
  *         fill(it.rho_vec, 0.0, p.s)
  *         self.factored_rho = -1.0  # the KKT matrix now holds no rho factorization
  *         self.form = LDL_FULL             # <<<<<<<<<<<<<<
@@ -27556,7 +28017,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_self->form = __pyx_e_5fccqp_3kkt_LDL_FULL;
 
-  /* "fccqp/admm.pyx":728
+  /* "fccqp/admm.pyx":734
  *         self.factored_rho = -1.0  # the KKT matrix now holds no rho factorization
  *         self.form = LDL_FULL
  *         cdef int code = kkt_factor(&self.kkt, p, LDL_FULL, sigma, it.rho_vec)             # <<<<<<<<<<<<<<
@@ -27565,7 +28026,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_code = __pyx_f_5fccqp_3kkt_kkt_factor((&__pyx_v_self->kkt), __pyx_v_p, __pyx_e_5fccqp_3kkt_LDL_FULL, __pyx_v_sigma, __pyx_v_it->rho_vec);
 
-  /* "fccqp/admm.pyx":729
+  /* "fccqp/admm.pyx":735
  *         self.form = LDL_FULL
  *         cdef int code = kkt_factor(&self.kkt, p, LDL_FULL, sigma, it.rho_vec)
  *         if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -27577,7 +28038,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":730
+    /* "fccqp/admm.pyx":736
  *         cdef int code = kkt_factor(&self.kkt, p, LDL_FULL, sigma, it.rho_vec)
  *         if code != FACTORED:
  *             return NOT_CONVEX             # <<<<<<<<<<<<<<
@@ -27590,7 +28051,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":729
+    /* "fccqp/admm.pyx":735
  *         self.form = LDL_FULL
  *         cdef int code = kkt_factor(&self.kkt, p, LDL_FULL, sigma, it.rho_vec)
  *         if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -27599,7 +28060,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   }
 
-  /* "fccqp/admm.pyx":731
+  /* "fccqp/admm.pyx":737
  *         if code != FACTORED:
  *             return NOT_CONVEX
  *         self.certified = True             # <<<<<<<<<<<<<<
@@ -27608,7 +28069,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_self->certified = 1;
 
-  /* "fccqp/admm.pyx":732
+  /* "fccqp/admm.pyx":738
  *             return NOT_CONVEX
  *         self.certified = True
  *         fill(it.x, 0.0, n)             # <<<<<<<<<<<<<<
@@ -27617,7 +28078,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_it->x, 0.0, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":733
+  /* "fccqp/admm.pyx":739
  *         self.certified = True
  *         fill(it.x, 0.0, n)
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -27631,7 +28092,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   for (__pyx_t_5 = 0; __pyx_t_5 < __pyx_t_4; __pyx_t_5+=1) {
     __pyx_v_i = __pyx_t_5;
 
-    /* "fccqp/admm.pyx":734
+    /* "fccqp/admm.pyx":740
  *         fill(it.x, 0.0, n)
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i]             # <<<<<<<<<<<<<<
@@ -27642,7 +28103,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   }
 
 
-  /* "fccqp/admm.pyx":735
+  /* "fccqp/admm.pyx":741
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i]
  *         for step in range(_EQUALITY_START_STEPS):             # <<<<<<<<<<<<<<
@@ -27656,7 +28117,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   for (__pyx_t_1 = 0; __pyx_t_1 < __pyx_t_7; __pyx_t_1+=1) {
     __pyx_v_step = __pyx_t_1;
 
-    /* "fccqp/admm.pyx":736
+    /* "fccqp/admm.pyx":742
  *             self.rhs[n + i] = p.b[i]
  *         for step in range(_EQUALITY_START_STEPS):
  *             for i in range(n):             # <<<<<<<<<<<<<<
@@ -27670,7 +28131,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
     for (__pyx_t_8 = 0; __pyx_t_8 < __pyx_t_5; __pyx_t_8+=1) {
       __pyx_v_i = __pyx_t_8;
 
-      /* "fccqp/admm.pyx":737
+      /* "fccqp/admm.pyx":743
  *         for step in range(_EQUALITY_START_STEPS):
  *             for i in range(n):
  *                 self.rhs[i] = sigma * it.x[i] - p.q[i]             # <<<<<<<<<<<<<<
@@ -27681,7 +28142,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
     }
 
 
-    /* "fccqp/admm.pyx":738
+    /* "fccqp/admm.pyx":744
  *             for i in range(n):
  *                 self.rhs[i] = sigma * it.x[i] - p.q[i]
  *             kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)             # <<<<<<<<<<<<<<
@@ -27690,7 +28151,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
     __pyx_f_5fccqp_3kkt_kkt_solve((&__pyx_v_self->kkt), __pyx_v_p, __pyx_v_it->rho_vec, __pyx_v_self->rhs, __pyx_v_self->sol);
 
-    /* "fccqp/admm.pyx":739
+    /* "fccqp/admm.pyx":745
  *                 self.rhs[i] = sigma * it.x[i] - p.q[i]
  *             kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
  *             copy(self.sol, it.x, n)             # <<<<<<<<<<<<<<
@@ -27701,7 +28162,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   }
 
 
-  /* "fccqp/admm.pyx":740
+  /* "fccqp/admm.pyx":746
  *             kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
  *             copy(self.sol, it.x, n)
  *         copy(self.sol + n, it.nu, m)             # <<<<<<<<<<<<<<
@@ -27710,7 +28171,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_copy((__pyx_v_self->sol + __pyx_v_n), __pyx_v_it->nu, __pyx_v_m);
 
-  /* "fccqp/admm.pyx":742
+  /* "fccqp/admm.pyx":748
  *         copy(self.sol + n, it.nu, m)
  *         unbounded[0] = sigma * inf_norm(it.x, n) > _EQUALITY_START_LIMIT * max(
  *             1.0, inf_norm(p.q, n))             # <<<<<<<<<<<<<<
@@ -27732,7 +28193,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   }
 
 
-  /* "fccqp/admm.pyx":741
+  /* "fccqp/admm.pyx":747
  *             copy(self.sol, it.x, n)
  *         copy(self.sol + n, it.nu, m)
  *         unbounded[0] = sigma * inf_norm(it.x, n) > _EQUALITY_START_LIMIT * max(             # <<<<<<<<<<<<<<
@@ -27742,7 +28203,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   (__pyx_v_unbounded[0]) = ((__pyx_v_sigma * __pyx_f_5fccqp_6_dense_inf_norm(__pyx_v_it->x, __pyx_v_n)) > (__pyx_v_5fccqp_4admm__EQUALITY_START_LIMIT * __pyx_t_10));
 
 
-  /* "fccqp/admm.pyx":743
+  /* "fccqp/admm.pyx":749
  *         unbounded[0] = sigma * inf_norm(it.x, n) > _EQUALITY_START_LIMIT * max(
  *             1.0, inf_norm(p.q, n))
  *         if unbounded[0]:             # <<<<<<<<<<<<<<
@@ -27751,7 +28212,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   if ((__pyx_v_unbounded[0])) {
 
-    /* "fccqp/admm.pyx":744
+    /* "fccqp/admm.pyx":750
  *             1.0, inf_norm(p.q, n))
  *         if unbounded[0]:
  *             copy(it.x, self.direction, n)             # <<<<<<<<<<<<<<
@@ -27760,7 +28221,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->x, __pyx_v_self->direction, __pyx_v_n);
 
-    /* "fccqp/admm.pyx":745
+    /* "fccqp/admm.pyx":751
  *         if unbounded[0]:
  *             copy(it.x, self.direction, n)
  *             fill(it.x, 0.0, n)             # <<<<<<<<<<<<<<
@@ -27769,7 +28230,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
     __pyx_f_5fccqp_6_dense_fill(__pyx_v_it->x, 0.0, __pyx_v_n);
 
-    /* "fccqp/admm.pyx":746
+    /* "fccqp/admm.pyx":752
  *             copy(it.x, self.direction, n)
  *             fill(it.x, 0.0, n)
  *             fill(it.nu, 0.0, m)             # <<<<<<<<<<<<<<
@@ -27778,7 +28239,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
     __pyx_f_5fccqp_6_dense_fill(__pyx_v_it->nu, 0.0, __pyx_v_m);
 
-    /* "fccqp/admm.pyx":743
+    /* "fccqp/admm.pyx":749
  *         unbounded[0] = sigma * inf_norm(it.x, n) > _EQUALITY_START_LIMIT * max(
  *             1.0, inf_norm(p.q, n))
  *         if unbounded[0]:             # <<<<<<<<<<<<<<
@@ -27787,7 +28248,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   }
 
-  /* "fccqp/admm.pyx":747
+  /* "fccqp/admm.pyx":753
  *             fill(it.x, 0.0, n)
  *             fill(it.nu, 0.0, m)
  *         for i in range(p.s):             # <<<<<<<<<<<<<<
@@ -27801,7 +28262,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   for (__pyx_t_5 = 0; __pyx_t_5 < __pyx_t_4; __pyx_t_5+=1) {
     __pyx_v_i = __pyx_t_5;
 
-    /* "fccqp/admm.pyx":748
+    /* "fccqp/admm.pyx":754
  *             fill(it.nu, 0.0, m)
  *         for i in range(p.s):
  *             it.z[i] = it.x[p.constrained[i]]             # <<<<<<<<<<<<<<
@@ -27812,7 +28273,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   }
 
 
-  /* "fccqp/admm.pyx":749
+  /* "fccqp/admm.pyx":755
  *         for i in range(p.s):
  *             it.z[i] = it.x[p.constrained[i]]
  *         proj_set(it.z, p.lo, p.hi, p.cones, p.s, it.z)             # <<<<<<<<<<<<<<
@@ -27821,7 +28282,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_11projections_proj_set(__pyx_v_it->z, __pyx_v_p->lo, __pyx_v_p->hi, __pyx_v_p->cones, __pyx_v_p->s, __pyx_v_it->z);
 
-  /* "fccqp/admm.pyx":750
+  /* "fccqp/admm.pyx":756
  *             it.z[i] = it.x[p.constrained[i]]
  *         proj_set(it.z, p.lo, p.hi, p.cones, p.s, it.z)
  *         fill(it.y, 0.0, p.s)             # <<<<<<<<<<<<<<
@@ -27830,7 +28291,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_it->y, 0.0, __pyx_v_p->s);
 
-  /* "fccqp/admm.pyx":751
+  /* "fccqp/admm.pyx":757
  *         proj_set(it.z, p.lo, p.hi, p.cones, p.s, it.z)
  *         fill(it.y, 0.0, p.s)
  *         copy(it.x, it.x_prev, n)             # <<<<<<<<<<<<<<
@@ -27839,7 +28300,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->x, __pyx_v_it->x_prev, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":752
+  /* "fccqp/admm.pyx":758
  *         fill(it.y, 0.0, p.s)
  *         copy(it.x, it.x_prev, n)
  *         copy(it.nu, it.nu_prev, m)             # <<<<<<<<<<<<<<
@@ -27848,7 +28309,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->nu, __pyx_v_it->nu_prev, __pyx_v_m);
 
-  /* "fccqp/admm.pyx":753
+  /* "fccqp/admm.pyx":759
  *         copy(it.x, it.x_prev, n)
  *         copy(it.nu, it.nu_prev, m)
  *         copy(it.y, it.y_prev, p.s)             # <<<<<<<<<<<<<<
@@ -27857,7 +28318,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->y, __pyx_v_it->y_prev, __pyx_v_p->s);
 
-  /* "fccqp/admm.pyx":754
+  /* "fccqp/admm.pyx":760
  *         copy(it.nu, it.nu_prev, m)
  *         copy(it.y, it.y_prev, p.s)
  *         return FACTORED             # <<<<<<<<<<<<<<
@@ -27870,7 +28331,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":710
+  /* "fccqp/admm.pyx":716
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.red.base)
  * 
  *     cdef int _equality_start(self, bint* unbounded) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27891,7 +28352,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":756
+/* "fccqp/admm.pyx":762
  *         return FACTORED
  * 
  *     cdef void _restore_equalities(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27910,7 +28371,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   Py_ssize_t __pyx_t_4;
   Py_ssize_t __pyx_t_5;
 
-  /* "fccqp/admm.pyx":760
+  /* "fccqp/admm.pyx":766
  *         the reduced form, a restoration) accumulates in ``A x = b``: one refined KKT
  *         solve for ``(0, b - A x)`` with the current factorization."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -27919,7 +28380,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":761
+  /* "fccqp/admm.pyx":767
  *         solve for ``(0, b - A x)`` with the current factorization."""
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m, i             # <<<<<<<<<<<<<<
@@ -27933,7 +28394,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 
   __pyx_v_m = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":762
+  /* "fccqp/admm.pyx":768
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m, i
  *         if m == 0:             # <<<<<<<<<<<<<<
@@ -27945,7 +28406,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   if (__pyx_t_2) {
 
 
-    /* "fccqp/admm.pyx":763
+    /* "fccqp/admm.pyx":769
  *         cdef Py_ssize_t n = p.n, m = p.m, i
  *         if m == 0:
  *             return             # <<<<<<<<<<<<<<
@@ -27956,7 +28417,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":762
+    /* "fccqp/admm.pyx":768
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m, i
  *         if m == 0:             # <<<<<<<<<<<<<<
@@ -27965,7 +28426,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 */
   }
 
-  /* "fccqp/admm.pyx":764
+  /* "fccqp/admm.pyx":770
  *         if m == 0:
  *             return
  *         fill(self.rhs, 0.0, n)             # <<<<<<<<<<<<<<
@@ -27974,7 +28435,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_self->rhs, 0.0, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":765
+  /* "fccqp/admm.pyx":771
  *             return
  *         fill(self.rhs, 0.0, n)
  *         matvec(p.A, self.it.x, self.rhs + n, m, n)             # <<<<<<<<<<<<<<
@@ -27983,7 +28444,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 */
   __pyx_f_5fccqp_6_dense_matvec(__pyx_v_p->A, __pyx_v_self->it.x, (__pyx_v_self->rhs + __pyx_v_n), __pyx_v_m, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":766
+  /* "fccqp/admm.pyx":772
  *         fill(self.rhs, 0.0, n)
  *         matvec(p.A, self.it.x, self.rhs + n, m, n)
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -27997,7 +28458,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":767
+    /* "fccqp/admm.pyx":773
  *         matvec(p.A, self.it.x, self.rhs + n, m, n)
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i] - self.rhs[n + i]             # <<<<<<<<<<<<<<
@@ -28008,7 +28469,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   }
 
 
-  /* "fccqp/admm.pyx":768
+  /* "fccqp/admm.pyx":774
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i] - self.rhs[n + i]
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.sol)             # <<<<<<<<<<<<<<
@@ -28017,7 +28478,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 */
   __pyx_f_5fccqp_3kkt_kkt_solve((&__pyx_v_self->kkt), __pyx_v_p, __pyx_v_self->it.rho_vec, __pyx_v_self->rhs, __pyx_v_self->sol);
 
-  /* "fccqp/admm.pyx":769
+  /* "fccqp/admm.pyx":775
  *             self.rhs[n + i] = p.b[i] - self.rhs[n + i]
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.sol)
  *         for i in range(n):             # <<<<<<<<<<<<<<
@@ -28031,7 +28492,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":770
+    /* "fccqp/admm.pyx":776
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.sol)
  *         for i in range(n):
  *             self.it.x[i] += self.sol[i]             # <<<<<<<<<<<<<<
@@ -28044,7 +28505,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   }
 
 
-  /* "fccqp/admm.pyx":771
+  /* "fccqp/admm.pyx":777
  *         for i in range(n):
  *             self.it.x[i] += self.sol[i]
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -28058,7 +28519,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":772
+    /* "fccqp/admm.pyx":778
  *             self.it.x[i] += self.sol[i]
  *         for i in range(m):
  *             self.it.nu[i] += self.sol[n + i]             # <<<<<<<<<<<<<<
@@ -28071,7 +28532,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   }
 
 
-  /* "fccqp/admm.pyx":756
+  /* "fccqp/admm.pyx":762
  *         return FACTORED
  * 
  *     cdef void _restore_equalities(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28087,7 +28548,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 
 }
 
-/* "fccqp/admm.pyx":774
+/* "fccqp/admm.pyx":780
  *             self.it.nu[i] += self.sol[n + i]
  * 
  *     cdef int _keep_restored(self, int status, long iteration, bint reduced,             # <<<<<<<<<<<<<<
@@ -28113,7 +28574,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
   double __pyx_t_7;
   int __pyx_t_8;
 
-  /* "fccqp/admm.pyx":786
+  /* "fccqp/admm.pyx":792
  *         either case.
  *         """
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -28122,7 +28583,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":787
+  /* "fccqp/admm.pyx":793
  *         """
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -28131,7 +28592,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":788
+  /* "fccqp/admm.pyx":794
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j             # <<<<<<<<<<<<<<
@@ -28148,7 +28609,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":790
+  /* "fccqp/admm.pyx":796
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j
  *         cdef int new_status
  *         copy(it.x, self.saved, n)             # <<<<<<<<<<<<<<
@@ -28157,7 +28618,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->x, __pyx_v_self->saved, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":791
+  /* "fccqp/admm.pyx":797
  *         cdef int new_status
  *         copy(it.x, self.saved, n)
  *         copy(it.nu, self.saved + n, m)             # <<<<<<<<<<<<<<
@@ -28166,7 +28627,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->nu, (__pyx_v_self->saved + __pyx_v_n), __pyx_v_m);
 
-  /* "fccqp/admm.pyx":792
+  /* "fccqp/admm.pyx":798
  *         copy(it.x, self.saved, n)
  *         copy(it.nu, self.saved + n, m)
  *         copy(it.z, self.saved + n + m, s)             # <<<<<<<<<<<<<<
@@ -28175,7 +28636,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->z, ((__pyx_v_self->saved + __pyx_v_n) + __pyx_v_m), __pyx_v_s);
 
-  /* "fccqp/admm.pyx":793
+  /* "fccqp/admm.pyx":799
  *         copy(it.nu, self.saved + n, m)
  *         copy(it.z, self.saved + n + m, s)
  *         if restore(&self.rest, &self.kkt, &self.red, reduced, p, it):             # <<<<<<<<<<<<<<
@@ -28187,7 +28648,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
   if (__pyx_t_2) {
 
 
-    /* "fccqp/admm.pyx":794
+    /* "fccqp/admm.pyx":800
  *         copy(it.z, self.saved + n + m, s)
  *         if restore(&self.rest, &self.kkt, &self.red, reduced, p, it):
  *             self._restore_equalities()             # <<<<<<<<<<<<<<
@@ -28196,7 +28657,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_restore_equalities(__pyx_v_self);
 
-    /* "fccqp/admm.pyx":795
+    /* "fccqp/admm.pyx":801
  *         if restore(&self.rest, &self.kkt, &self.red, reduced, p, it):
  *             self._restore_equalities()
  *             for j in range(s):             # <<<<<<<<<<<<<<
@@ -28210,7 +28671,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
     for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
       __pyx_v_j = __pyx_t_4;
 
-      /* "fccqp/admm.pyx":796
+      /* "fccqp/admm.pyx":802
  *             self._restore_equalities()
  *             for j in range(s):
  *                 it.z[j] = it.x[p.constrained[j]]             # <<<<<<<<<<<<<<
@@ -28221,7 +28682,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
     }
 
 
-    /* "fccqp/admm.pyx":797
+    /* "fccqp/admm.pyx":803
  *             for j in range(s):
  *                 it.z[j] = it.x[p.constrained[j]]
  *             proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)             # <<<<<<<<<<<<<<
@@ -28230,7 +28691,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     __pyx_f_5fccqp_11projections_proj_set(__pyx_v_it->z, __pyx_v_p->lo, __pyx_v_p->hi, __pyx_v_p->cones, __pyx_v_s, __pyx_v_it->z);
 
-    /* "fccqp/admm.pyx":798
+    /* "fccqp/admm.pyx":804
  *                 it.z[j] = it.x[p.constrained[j]]
  *             proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
  *             self._residuals()             # <<<<<<<<<<<<<<
@@ -28239,7 +28700,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_residuals(__pyx_v_self);
 
-    /* "fccqp/admm.pyx":799
+    /* "fccqp/admm.pyx":805
  *             proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
  *             self._residuals()
  *             new_status = self._classify(iteration, True, start_time)             # <<<<<<<<<<<<<<
@@ -28248,7 +28709,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     __pyx_v_new_status = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_classify(__pyx_v_self, __pyx_v_iteration, 1, __pyx_v_start_time);
 
-    /* "fccqp/admm.pyx":800
+    /* "fccqp/admm.pyx":806
  *             self._residuals()
  *             new_status = self._classify(iteration, True, start_time)
  *             if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)             # <<<<<<<<<<<<<<
@@ -28281,7 +28742,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
       goto __pyx_L7_bool_binop_done;
     }
 
-    /* "fccqp/admm.pyx":801
+    /* "fccqp/admm.pyx":807
  *             new_status = self._classify(iteration, True, start_time)
  *             if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)
  *                     and (status != _SOLVED or new_status == _SOLVED)):             # <<<<<<<<<<<<<<
@@ -28305,7 +28766,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 
     __pyx_L7_bool_binop_done:;
 
-    /* "fccqp/admm.pyx":800
+    /* "fccqp/admm.pyx":806
  *             self._residuals()
  *             new_status = self._classify(iteration, True, start_time)
  *             if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)             # <<<<<<<<<<<<<<
@@ -28315,7 +28776,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":802
+      /* "fccqp/admm.pyx":808
  *             if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)
  *                     and (status != _SOLVED or new_status == _SOLVED)):
  *                 return new_status             # <<<<<<<<<<<<<<
@@ -28328,7 +28789,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
       }
       goto __pyx_L0;
 
-      /* "fccqp/admm.pyx":800
+      /* "fccqp/admm.pyx":806
  *             self._residuals()
  *             new_status = self._classify(iteration, True, start_time)
  *             if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)             # <<<<<<<<<<<<<<
@@ -28337,7 +28798,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     }
 
-    /* "fccqp/admm.pyx":793
+    /* "fccqp/admm.pyx":799
  *         copy(it.nu, self.saved + n, m)
  *         copy(it.z, self.saved + n + m, s)
  *         if restore(&self.rest, &self.kkt, &self.red, reduced, p, it):             # <<<<<<<<<<<<<<
@@ -28346,7 +28807,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   }
 
-  /* "fccqp/admm.pyx":803
+  /* "fccqp/admm.pyx":809
  *                     and (status != _SOLVED or new_status == _SOLVED)):
  *                 return new_status
  *         copy(self.saved, it.x, n)             # <<<<<<<<<<<<<<
@@ -28355,7 +28816,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_self->saved, __pyx_v_it->x, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":804
+  /* "fccqp/admm.pyx":810
  *                 return new_status
  *         copy(self.saved, it.x, n)
  *         copy(self.saved + n, it.nu, m)             # <<<<<<<<<<<<<<
@@ -28364,7 +28825,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy((__pyx_v_self->saved + __pyx_v_n), __pyx_v_it->nu, __pyx_v_m);
 
-  /* "fccqp/admm.pyx":805
+  /* "fccqp/admm.pyx":811
  *         copy(self.saved, it.x, n)
  *         copy(self.saved + n, it.nu, m)
  *         copy(self.saved + n + m, it.z, s)             # <<<<<<<<<<<<<<
@@ -28373,7 +28834,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy(((__pyx_v_self->saved + __pyx_v_n) + __pyx_v_m), __pyx_v_it->z, __pyx_v_s);
 
-  /* "fccqp/admm.pyx":806
+  /* "fccqp/admm.pyx":812
  *         copy(self.saved + n, it.nu, m)
  *         copy(self.saved + n + m, it.z, s)
  *         if reduced:             # <<<<<<<<<<<<<<
@@ -28382,7 +28843,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   if (__pyx_v_reduced) {
 
-    /* "fccqp/admm.pyx":807
+    /* "fccqp/admm.pyx":813
  *         copy(self.saved + n + m, it.z, s)
  *         if reduced:
  *             self._restore_equalities()             # <<<<<<<<<<<<<<
@@ -28391,7 +28852,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_restore_equalities(__pyx_v_self);
 
-    /* "fccqp/admm.pyx":806
+    /* "fccqp/admm.pyx":812
  *         copy(self.saved + n, it.nu, m)
  *         copy(self.saved + n + m, it.z, s)
  *         if reduced:             # <<<<<<<<<<<<<<
@@ -28400,7 +28861,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   }
 
-  /* "fccqp/admm.pyx":808
+  /* "fccqp/admm.pyx":814
  *         if reduced:
  *             self._restore_equalities()
  *         return status             # <<<<<<<<<<<<<<
@@ -28413,7 +28874,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":774
+  /* "fccqp/admm.pyx":780
  *             self.it.nu[i] += self.sol[n + i]
  * 
  *     cdef int _keep_restored(self, int status, long iteration, bint reduced,             # <<<<<<<<<<<<<<
@@ -28433,7 +28894,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":812
+/* "fccqp/admm.pyx":818
  *     # ------------------------------------------------------------- bookkeeping
  * 
  *     cdef void _residuals(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28443,7 +28904,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 
 static void __pyx_f_5fccqp_4admm_9Workspace__residuals(struct __pyx_obj_5fccqp_4admm_Workspace *__pyx_v_self) {
 
-  /* "fccqp/admm.pyx":813
+  /* "fccqp/admm.pyx":819
  * 
  *     cdef void _residuals(self) noexcept nogil:
  *         residuals(&self.prob, &self.it, self.vec_m, self.vec_n, self.vec_n2, &self.res)             # <<<<<<<<<<<<<<
@@ -28452,7 +28913,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__residuals(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_11termination_residuals((&__pyx_v_self->prob), (&__pyx_v_self->it), __pyx_v_self->vec_m, __pyx_v_self->vec_n, __pyx_v_self->vec_n2, (&__pyx_v_self->res));
 
-  /* "fccqp/admm.pyx":812
+  /* "fccqp/admm.pyx":818
  *     # ------------------------------------------------------------- bookkeeping
  * 
  *     cdef void _residuals(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28463,7 +28924,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__residuals(struct __pyx_obj_5fccqp_4
   /* function exit code */
 }
 
-/* "fccqp/admm.pyx":815
+/* "fccqp/admm.pyx":821
  *         residuals(&self.prob, &self.it, self.vec_m, self.vec_n, self.vec_n2, &self.res)
  * 
  *     cdef void _log(self, long iteration, double rho) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28480,7 +28941,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
   double __pyx_t_5;
   double __pyx_t_6;
 
-  /* "fccqp/admm.pyx":817
+  /* "fccqp/admm.pyx":823
  *     cdef void _log(self, long iteration, double rho) noexcept nogil:
  *         cdef double* row
  *         if self.log_count < self.log_rows:             # <<<<<<<<<<<<<<
@@ -28492,7 +28953,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":818
+    /* "fccqp/admm.pyx":824
  *         cdef double* row
  *         if self.log_count < self.log_rows:
  *             row = self.log + 5 * self.log_count             # <<<<<<<<<<<<<<
@@ -28501,7 +28962,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
 */
     __pyx_v_row = (__pyx_v_self->log + (5 * __pyx_v_self->log_count));
 
-    /* "fccqp/admm.pyx":820
+    /* "fccqp/admm.pyx":826
  *             row = self.log + 5 * self.log_count
  *             row[0], row[1], row[2], row[3], row[4] = (
  *                 iteration, self.res.prim, self.res.dual, self.res.gap, rho)             # <<<<<<<<<<<<<<
@@ -28519,7 +28980,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
     __pyx_t_6 = __pyx_v_rho;
 
 
-    /* "fccqp/admm.pyx":819
+    /* "fccqp/admm.pyx":825
  *         if self.log_count < self.log_rows:
  *             row = self.log + 5 * self.log_count
  *             row[0], row[1], row[2], row[3], row[4] = (             # <<<<<<<<<<<<<<
@@ -28537,7 +28998,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
     (__pyx_v_row[4]) = __pyx_t_6;
 
 
-    /* "fccqp/admm.pyx":821
+    /* "fccqp/admm.pyx":827
  *             row[0], row[1], row[2], row[3], row[4] = (
  *                 iteration, self.res.prim, self.res.dual, self.res.gap, rho)
  *             self.log_count += 1             # <<<<<<<<<<<<<<
@@ -28546,7 +29007,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
 */
     __pyx_v_self->log_count = (__pyx_v_self->log_count + 1);
 
-    /* "fccqp/admm.pyx":817
+    /* "fccqp/admm.pyx":823
  *     cdef void _log(self, long iteration, double rho) noexcept nogil:
  *         cdef double* row
  *         if self.log_count < self.log_rows:             # <<<<<<<<<<<<<<
@@ -28555,7 +29016,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
 */
   }
 
-  /* "fccqp/admm.pyx":815
+  /* "fccqp/admm.pyx":821
  *         residuals(&self.prob, &self.it, self.vec_m, self.vec_n, self.vec_n2, &self.res)
  * 
  *     cdef void _log(self, long iteration, double rho) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28567,7 +29028,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
 
 }
 
-/* "fccqp/admm.pyx":823
+/* "fccqp/admm.pyx":829
  *             self.log_count += 1
  * 
  *     cdef void _finish_run(self, Run* run, int status, long iteration) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28578,7 +29039,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
 static void __pyx_f_5fccqp_4admm_9Workspace__finish_run(struct __pyx_obj_5fccqp_4admm_Workspace *__pyx_v_self, struct __pyx_t_5fccqp_4admm_Run *__pyx_v_run, int __pyx_v_status, long __pyx_v_iteration) {
   int __pyx_t_1;
 
-  /* "fccqp/admm.pyx":824
+  /* "fccqp/admm.pyx":830
  * 
  *     cdef void _finish_run(self, Run* run, int status, long iteration) noexcept nogil:
  *         run.status = status             # <<<<<<<<<<<<<<
@@ -28587,7 +29048,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish_run(struct __pyx_obj_5fccqp_
 */
   __pyx_v_run->status = __pyx_v_status;
 
-  /* "fccqp/admm.pyx":825
+  /* "fccqp/admm.pyx":831
  *     cdef void _finish_run(self, Run* run, int status, long iteration) noexcept nogil:
  *         run.status = status
  *         run.iterations = iteration             # <<<<<<<<<<<<<<
@@ -28596,7 +29057,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish_run(struct __pyx_obj_5fccqp_
 */
   __pyx_v_run->iterations = __pyx_v_iteration;
 
-  /* "fccqp/admm.pyx":826
+  /* "fccqp/admm.pyx":832
  *         run.status = status
  *         run.iterations = iteration
  *         run.backend = self.form             # <<<<<<<<<<<<<<
@@ -28607,7 +29068,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish_run(struct __pyx_obj_5fccqp_
 
   __pyx_v_run->backend = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":823
+  /* "fccqp/admm.pyx":829
  *             self.log_count += 1
  * 
  *     cdef void _finish_run(self, Run* run, int status, long iteration) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28618,7 +29079,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish_run(struct __pyx_obj_5fccqp_
   /* function exit code */
 }
 
-/* "fccqp/admm.pyx":828
+/* "fccqp/admm.pyx":834
  *         run.backend = self.form
  * 
  *     cdef void _finish(self, Run* run, double* x, double* y, double* z,             # <<<<<<<<<<<<<<
@@ -28638,7 +29099,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
   int __pyx_t_4;
   double __pyx_t_5;
 
-  /* "fccqp/admm.pyx":833
+  /* "fccqp/admm.pyx":839
  *         user's units from the returned point alone (the primal one as the distance of
  *         ``x_S`` to C), settle the status on them and keep the point for a warm start."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -28647,7 +29108,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":834
+  /* "fccqp/admm.pyx":840
  *         ``x_S`` to C), settle the status on them and keep the point for a warm start."""
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -28656,7 +29117,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":835
+  /* "fccqp/admm.pyx":841
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j             # <<<<<<<<<<<<<<
@@ -28673,7 +29134,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":836
+  /* "fccqp/admm.pyx":842
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)             # <<<<<<<<<<<<<<
@@ -28682,7 +29143,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   __pyx_f_5fccqp_7scaling_unscale(__pyx_v_it->x, __pyx_v_it->nu, __pyx_v_it->y, __pyx_v_p->D, __pyx_v_p->E, __pyx_v_p->c, __pyx_v_n, __pyx_v_m, __pyx_v_s, __pyx_v_p->constrained, __pyx_v_x, __pyx_v_y, __pyx_v_z);
 
-  /* "fccqp/admm.pyx":837
+  /* "fccqp/admm.pyx":843
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)
  *         if run.status == _PRIMAL_INFEASIBLE or run.status == _DUAL_INFEASIBLE:             # <<<<<<<<<<<<<<
@@ -28693,7 +29154,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     case __pyx_e_5fccqp_4admm__PRIMAL_INFEASIBLE:
     case __pyx_e_5fccqp_4admm__DUAL_INFEASIBLE:
 
-    /* "fccqp/admm.pyx":838
+    /* "fccqp/admm.pyx":844
  *         unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)
  *         if run.status == _PRIMAL_INFEASIBLE or run.status == _DUAL_INFEASIBLE:
  *             copy(self.cert, cert, n + m)             # <<<<<<<<<<<<<<
@@ -28702,7 +29163,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_self->cert, __pyx_v_cert, (__pyx_v_n + __pyx_v_m));
 
-    /* "fccqp/admm.pyx":837
+    /* "fccqp/admm.pyx":843
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)
  *         if run.status == _PRIMAL_INFEASIBLE or run.status == _DUAL_INFEASIBLE:             # <<<<<<<<<<<<<<
@@ -28713,7 +29174,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     default: break;
   }
 
-  /* "fccqp/admm.pyx":839
+  /* "fccqp/admm.pyx":845
  *         if run.status == _PRIMAL_INFEASIBLE or run.status == _DUAL_INFEASIBLE:
  *             copy(self.cert, cert, n + m)
  *         self._user_residuals(x, y, z)             # <<<<<<<<<<<<<<
@@ -28722,7 +29183,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_user_residuals(__pyx_v_self, __pyx_v_x, __pyx_v_y, __pyx_v_z);
 
-  /* "fccqp/admm.pyx":840
+  /* "fccqp/admm.pyx":846
  *             copy(self.cert, cert, n + m)
  *         self._user_residuals(x, y, z)
  *         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):             # <<<<<<<<<<<<<<
@@ -28735,7 +29196,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     case __pyx_e_5fccqp_4admm__MAX_ITER:
     case __pyx_e_5fccqp_4admm__TIME_LIMIT:
 
-    /* "fccqp/admm.pyx":841
+    /* "fccqp/admm.pyx":847
  *         self._user_residuals(x, y, z)
  *         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):
  *             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):             # <<<<<<<<<<<<<<
@@ -28747,7 +29208,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":842
+      /* "fccqp/admm.pyx":848
  *         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):
  *             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):
  *                 run.status = _SOLVED             # <<<<<<<<<<<<<<
@@ -28756,7 +29217,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
       __pyx_v_run->status = __pyx_e_5fccqp_4admm__SOLVED;
 
-      /* "fccqp/admm.pyx":841
+      /* "fccqp/admm.pyx":847
  *         self._user_residuals(x, y, z)
  *         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):
  *             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):             # <<<<<<<<<<<<<<
@@ -28766,7 +29227,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
       goto __pyx_L3;
     }
 
-    /* "fccqp/admm.pyx":843
+    /* "fccqp/admm.pyx":849
  *             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):
  *                 run.status = _SOLVED
  *             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):             # <<<<<<<<<<<<<<
@@ -28778,7 +29239,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":844
+      /* "fccqp/admm.pyx":850
  *                 run.status = _SOLVED
  *             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *                 run.status = _INACCURATE             # <<<<<<<<<<<<<<
@@ -28787,7 +29248,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
       __pyx_v_run->status = __pyx_e_5fccqp_4admm__INACCURATE;
 
-      /* "fccqp/admm.pyx":843
+      /* "fccqp/admm.pyx":849
  *             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):
  *                 run.status = _SOLVED
  *             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):             # <<<<<<<<<<<<<<
@@ -28797,7 +29258,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
       goto __pyx_L3;
     }
 
-    /* "fccqp/admm.pyx":845
+    /* "fccqp/admm.pyx":851
  *             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *                 run.status = _INACCURATE
  *             elif run.status in (_SOLVED, _INACCURATE):             # <<<<<<<<<<<<<<
@@ -28819,7 +29280,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     if (__pyx_t_3) {
 
 
-      /* "fccqp/admm.pyx":846
+      /* "fccqp/admm.pyx":852
  *                 run.status = _INACCURATE
  *             elif run.status in (_SOLVED, _INACCURATE):
  *                 run.status = _NUMERICAL_ERROR   # the scaled test passed, the point does not             # <<<<<<<<<<<<<<
@@ -28828,7 +29289,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
       __pyx_v_run->status = __pyx_e_5fccqp_4admm__NUMERICAL_ERROR;
 
-      /* "fccqp/admm.pyx":845
+      /* "fccqp/admm.pyx":851
  *             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *                 run.status = _INACCURATE
  *             elif run.status in (_SOLVED, _INACCURATE):             # <<<<<<<<<<<<<<
@@ -28838,7 +29299,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     }
     __pyx_L3:;
 
-    /* "fccqp/admm.pyx":840
+    /* "fccqp/admm.pyx":846
  *             copy(self.cert, cert, n + m)
  *         self._user_residuals(x, y, z)
  *         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):             # <<<<<<<<<<<<<<
@@ -28849,7 +29310,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     default: break;
   }
 
-  /* "fccqp/admm.pyx":847
+  /* "fccqp/admm.pyx":853
  *             elif run.status in (_SOLVED, _INACCURATE):
  *                 run.status = _NUMERICAL_ERROR   # the scaled test passed, the point does not
  *         if not self.res.finite:             # <<<<<<<<<<<<<<
@@ -28861,7 +29322,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":848
+    /* "fccqp/admm.pyx":854
  *                 run.status = _NUMERICAL_ERROR   # the scaled test passed, the point does not
  *         if not self.res.finite:
  *             run.status = _NUMERICAL_ERROR             # <<<<<<<<<<<<<<
@@ -28870,7 +29331,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_v_run->status = __pyx_e_5fccqp_4admm__NUMERICAL_ERROR;
 
-    /* "fccqp/admm.pyx":847
+    /* "fccqp/admm.pyx":853
  *             elif run.status in (_SOLVED, _INACCURATE):
  *                 run.status = _NUMERICAL_ERROR   # the scaled test passed, the point does not
  *         if not self.res.finite:             # <<<<<<<<<<<<<<
@@ -28879,7 +29340,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   }
 
-  /* "fccqp/admm.pyx":849
+  /* "fccqp/admm.pyx":855
  *         if not self.res.finite:
  *             run.status = _NUMERICAL_ERROR
  *         self.has_previous = self.res.finite and run.status not in (             # <<<<<<<<<<<<<<
@@ -28893,7 +29354,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     goto __pyx_L5_bool_binop_done;
   }
 
-  /* "fccqp/admm.pyx":850
+  /* "fccqp/admm.pyx":856
  *             run.status = _NUMERICAL_ERROR
  *         self.has_previous = self.res.finite and run.status not in (
  *             _PRIMAL_INFEASIBLE, _DUAL_INFEASIBLE)             # <<<<<<<<<<<<<<
@@ -28904,7 +29365,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     case __pyx_e_5fccqp_4admm__PRIMAL_INFEASIBLE:
     case __pyx_e_5fccqp_4admm__DUAL_INFEASIBLE:
 
-    /* "fccqp/admm.pyx":849
+    /* "fccqp/admm.pyx":855
  *         if not self.res.finite:
  *             run.status = _NUMERICAL_ERROR
  *         self.has_previous = self.res.finite and run.status not in (             # <<<<<<<<<<<<<<
@@ -28926,7 +29387,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
   __pyx_L5_bool_binop_done:;
   __pyx_v_self->has_previous = __pyx_t_3;
 
-  /* "fccqp/admm.pyx":851
+  /* "fccqp/admm.pyx":857
  *         self.has_previous = self.res.finite and run.status not in (
  *             _PRIMAL_INFEASIBLE, _DUAL_INFEASIBLE)
  *         if self.has_previous:             # <<<<<<<<<<<<<<
@@ -28935,7 +29396,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   if (__pyx_v_self->has_previous) {
 
-    /* "fccqp/admm.pyx":852
+    /* "fccqp/admm.pyx":858
  *             _PRIMAL_INFEASIBLE, _DUAL_INFEASIBLE)
  *         if self.has_previous:
  *             copy(x, self.prev_x, n)             # <<<<<<<<<<<<<<
@@ -28944,7 +29405,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_x, __pyx_v_self->prev_x, __pyx_v_n);
 
-    /* "fccqp/admm.pyx":853
+    /* "fccqp/admm.pyx":859
  *         if self.has_previous:
  *             copy(x, self.prev_x, n)
  *             copy(y, self.prev_y, m)             # <<<<<<<<<<<<<<
@@ -28953,7 +29414,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_y, __pyx_v_self->prev_y, __pyx_v_m);
 
-    /* "fccqp/admm.pyx":854
+    /* "fccqp/admm.pyx":860
  *             copy(x, self.prev_x, n)
  *             copy(y, self.prev_y, m)
  *             copy(z, self.prev_z, n)             # <<<<<<<<<<<<<<
@@ -28962,7 +29423,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_z, __pyx_v_self->prev_z, __pyx_v_n);
 
-    /* "fccqp/admm.pyx":855
+    /* "fccqp/admm.pyx":861
  *             copy(y, self.prev_y, m)
  *             copy(z, self.prev_z, n)
  *             self.prev_rho = run.rho             # <<<<<<<<<<<<<<
@@ -28973,7 +29434,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 
     __pyx_v_self->prev_rho = __pyx_t_5;
 
-    /* "fccqp/admm.pyx":851
+    /* "fccqp/admm.pyx":857
  *         self.has_previous = self.res.finite and run.status not in (
  *             _PRIMAL_INFEASIBLE, _DUAL_INFEASIBLE)
  *         if self.has_previous:             # <<<<<<<<<<<<<<
@@ -28982,7 +29443,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   }
 
-  /* "fccqp/admm.pyx":828
+  /* "fccqp/admm.pyx":834
  *         run.backend = self.form
  * 
  *     cdef void _finish(self, Run* run, double* x, double* y, double* z,             # <<<<<<<<<<<<<<
@@ -28998,7 +29459,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 
 }
 
-/* "fccqp/admm.pyx":857
+/* "fccqp/admm.pyx":863
  *             self.prev_rho = run.rho
  * 
  *     cdef void _user_residuals(self, const double* x, const double* y,             # <<<<<<<<<<<<<<
@@ -29036,7 +29497,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   int __pyx_t_9;
   double __pyx_t_10;
 
-  /* "fccqp/admm.pyx":861
+  /* "fccqp/admm.pyx":867
  *         """:mod:`fccqp.termination`'s residuals of the returned ``(x, y, z)`` on the user's
  *         data, with ``dist(x_S, C)`` as the primal part off the equalities."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -29045,7 +29506,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":862
+  /* "fccqp/admm.pyx":868
  *         data, with ``dist(x_S, C)`` as the primal part off the equalities."""
  *         cdef Problem* p = &self.prob
  *         cdef Residuals* r = &self.res             # <<<<<<<<<<<<<<
@@ -29054,7 +29515,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_v_r = (&__pyx_v_self->res);
 
-  /* "fccqp/admm.pyx":863
+  /* "fccqp/admm.pyx":869
  *         cdef Problem* p = &self.prob
  *         cdef Residuals* r = &self.res
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j             # <<<<<<<<<<<<<<
@@ -29071,7 +29532,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":864
+  /* "fccqp/admm.pyx":870
  *         cdef Residuals* r = &self.res
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         cdef double* Ax = self.vec_m             # <<<<<<<<<<<<<<
@@ -29082,7 +29543,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 
   __pyx_v_Ax = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":865
+  /* "fccqp/admm.pyx":871
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         cdef double* Ax = self.vec_m
  *         cdef double* grad = self.vec_n             # <<<<<<<<<<<<<<
@@ -29093,7 +29554,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 
   __pyx_v_grad = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":866
+  /* "fccqp/admm.pyx":872
  *         cdef double* Ax = self.vec_m
  *         cdef double* grad = self.vec_n
  *         cdef double* ATy = self.vec_n2             # <<<<<<<<<<<<<<
@@ -29104,7 +29565,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 
   __pyx_v_ATy = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":867
+  /* "fccqp/admm.pyx":873
  *         cdef double* grad = self.vec_n
  *         cdef double* ATy = self.vec_n2
  *         cdef double* proj = self.vec_s             # <<<<<<<<<<<<<<
@@ -29115,7 +29576,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 
   __pyx_v_proj = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":868
+  /* "fccqp/admm.pyx":874
  *         cdef double* ATy = self.vec_n2
  *         cdef double* proj = self.vec_s
  *         cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, terms = 0.0, total = 0.0             # <<<<<<<<<<<<<<
@@ -29129,7 +29590,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   __pyx_v_terms = 0.0;
   __pyx_v_total = 0.0;
 
-  /* "fccqp/admm.pyx":870
+  /* "fccqp/admm.pyx":876
  *         cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, terms = 0.0, total = 0.0
  *         cdef double value
  *         matvec(self.A_user, x, Ax, m, n)             # <<<<<<<<<<<<<<
@@ -29138,7 +29599,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_f_5fccqp_6_dense_matvec(__pyx_v_self->A_user, __pyx_v_x, __pyx_v_Ax, __pyx_v_m, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":871
+  /* "fccqp/admm.pyx":877
  *         cdef double value
  *         matvec(self.A_user, x, Ax, m, n)
  *         matvec_t(self.A_user, y, ATy, m, n)             # <<<<<<<<<<<<<<
@@ -29147,7 +29608,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_f_5fccqp_6_dense_matvec_t(__pyx_v_self->A_user, __pyx_v_y, __pyx_v_ATy, __pyx_v_m, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":872
+  /* "fccqp/admm.pyx":878
  *         matvec(self.A_user, x, Ax, m, n)
  *         matvec_t(self.A_user, y, ATy, m, n)
  *         matvec(self.P_user, x, grad, n, n)             # <<<<<<<<<<<<<<
@@ -29156,7 +29617,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_f_5fccqp_6_dense_matvec(__pyx_v_self->P_user, __pyx_v_x, __pyx_v_grad, __pyx_v_n, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":873
+  /* "fccqp/admm.pyx":879
  *         matvec_t(self.A_user, y, ATy, m, n)
  *         matvec(self.P_user, x, grad, n, n)
  *         r.prim = r.prim_scale = 0.0             # <<<<<<<<<<<<<<
@@ -29166,7 +29627,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   __pyx_v_r->prim = 0.0;
   __pyx_v_r->prim_scale = 0.0;
 
-  /* "fccqp/admm.pyx":874
+  /* "fccqp/admm.pyx":880
  *         matvec(self.P_user, x, grad, n, n)
  *         r.prim = r.prim_scale = 0.0
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -29180,7 +29641,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":875
+    /* "fccqp/admm.pyx":881
  *         r.prim = r.prim_scale = 0.0
  *         for i in range(m):
  *             r.prim = max(r.prim, fabs(Ax[i] - self.b_user[i]))             # <<<<<<<<<<<<<<
@@ -29204,7 +29665,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->prim = __pyx_t_7;
 
 
-    /* "fccqp/admm.pyx":876
+    /* "fccqp/admm.pyx":882
  *         for i in range(m):
  *             r.prim = max(r.prim, fabs(Ax[i] - self.b_user[i]))
  *             r.prim_scale = max(r.prim_scale, max(fabs(Ax[i]), fabs(self.b_user[i])))             # <<<<<<<<<<<<<<
@@ -29243,7 +29704,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->prim_scale = __pyx_t_5;
 
 
-    /* "fccqp/admm.pyx":877
+    /* "fccqp/admm.pyx":883
  *             r.prim = max(r.prim, fabs(Ax[i] - self.b_user[i]))
  *             r.prim_scale = max(r.prim_scale, max(fabs(Ax[i]), fabs(self.b_user[i])))
  *             by += self.b_user[i] * y[i]             # <<<<<<<<<<<<<<
@@ -29252,7 +29713,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_by = (__pyx_v_by + ((__pyx_v_self->b_user[__pyx_v_i]) * (__pyx_v_y[__pyx_v_i])));
 
-    /* "fccqp/admm.pyx":878
+    /* "fccqp/admm.pyx":884
  *             r.prim_scale = max(r.prim_scale, max(fabs(Ax[i]), fabs(self.b_user[i])))
  *             by += self.b_user[i] * y[i]
  *             terms += fabs(self.b_user[i] * y[i])             # <<<<<<<<<<<<<<
@@ -29263,7 +29724,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":879
+  /* "fccqp/admm.pyx":885
  *             by += self.b_user[i] * y[i]
  *             terms += fabs(self.b_user[i] * y[i])
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -29277,7 +29738,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":880
+    /* "fccqp/admm.pyx":886
  *             terms += fabs(self.b_user[i] * y[i])
  *         for j in range(s):
  *             i = p.constrained[j]             # <<<<<<<<<<<<<<
@@ -29286,7 +29747,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_i = (__pyx_v_p->constrained[__pyx_v_j]);
 
-    /* "fccqp/admm.pyx":881
+    /* "fccqp/admm.pyx":887
  *         for j in range(s):
  *             i = p.constrained[j]
  *             value = x[i]             # <<<<<<<<<<<<<<
@@ -29295,7 +29756,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_value = (__pyx_v_x[__pyx_v_i]);
 
-    /* "fccqp/admm.pyx":882
+    /* "fccqp/admm.pyx":888
  *             i = p.constrained[j]
  *             value = x[i]
  *             if value < self.lb_user[i]:             # <<<<<<<<<<<<<<
@@ -29307,7 +29768,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     if (__pyx_t_8) {
 
 
-      /* "fccqp/admm.pyx":883
+      /* "fccqp/admm.pyx":889
  *             value = x[i]
  *             if value < self.lb_user[i]:
  *                 value = self.lb_user[i]             # <<<<<<<<<<<<<<
@@ -29316,7 +29777,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
       __pyx_v_value = (__pyx_v_self->lb_user[__pyx_v_i]);
 
-      /* "fccqp/admm.pyx":882
+      /* "fccqp/admm.pyx":888
  *             i = p.constrained[j]
  *             value = x[i]
  *             if value < self.lb_user[i]:             # <<<<<<<<<<<<<<
@@ -29325,7 +29786,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     }
 
-    /* "fccqp/admm.pyx":884
+    /* "fccqp/admm.pyx":890
  *             if value < self.lb_user[i]:
  *                 value = self.lb_user[i]
  *             if value > self.ub_user[i]:             # <<<<<<<<<<<<<<
@@ -29337,7 +29798,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     if (__pyx_t_8) {
 
 
-      /* "fccqp/admm.pyx":885
+      /* "fccqp/admm.pyx":891
  *                 value = self.lb_user[i]
  *             if value > self.ub_user[i]:
  *                 value = self.ub_user[i]             # <<<<<<<<<<<<<<
@@ -29346,7 +29807,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
       __pyx_v_value = (__pyx_v_self->ub_user[__pyx_v_i]);
 
-      /* "fccqp/admm.pyx":884
+      /* "fccqp/admm.pyx":890
  *             if value < self.lb_user[i]:
  *                 value = self.lb_user[i]
  *             if value > self.ub_user[i]:             # <<<<<<<<<<<<<<
@@ -29355,7 +29816,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     }
 
-    /* "fccqp/admm.pyx":886
+    /* "fccqp/admm.pyx":892
  *             if value > self.ub_user[i]:
  *                 value = self.ub_user[i]
  *             proj[j] = value             # <<<<<<<<<<<<<<
@@ -29366,7 +29827,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":887
+  /* "fccqp/admm.pyx":893
  *                 value = self.ub_user[i]
  *             proj[j] = value
  *         for j in range(p.cones.count):   # cone blocks are contiguous in x too             # <<<<<<<<<<<<<<
@@ -29380,7 +29841,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":888
+    /* "fccqp/admm.pyx":894
  *             proj[j] = value
  *         for j in range(p.cones.count):   # cone blocks are contiguous in x too
  *             i = p.cones.offset[j]             # <<<<<<<<<<<<<<
@@ -29389,7 +29850,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_i = (__pyx_v_p->cones.offset[__pyx_v_j]);
 
-    /* "fccqp/admm.pyx":889
+    /* "fccqp/admm.pyx":895
  *         for j in range(p.cones.count):   # cone blocks are contiguous in x too
  *             i = p.cones.offset[j]
  *             proj_block(x + p.constrained[i], p.cones.kind[j], p.cones.dim[j], p.cones.mu[j],             # <<<<<<<<<<<<<<
@@ -29400,7 +29861,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":891
+  /* "fccqp/admm.pyx":897
  *             proj_block(x + p.constrained[i], p.cones.kind[j], p.cones.dim[j], p.cones.mu[j],
  *                        p.cones.normal + 3 * j, proj + i)
  *         r.dual_scale = 0.0             # <<<<<<<<<<<<<<
@@ -29409,7 +29870,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_v_r->dual_scale = 0.0;
 
-  /* "fccqp/admm.pyx":892
+  /* "fccqp/admm.pyx":898
  *                        p.cones.normal + 3 * j, proj + i)
  *         r.dual_scale = 0.0
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -29423,7 +29884,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":893
+    /* "fccqp/admm.pyx":899
  *         r.dual_scale = 0.0
  *         for j in range(s):
  *             i = p.constrained[j]             # <<<<<<<<<<<<<<
@@ -29432,7 +29893,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_i = (__pyx_v_p->constrained[__pyx_v_j]);
 
-    /* "fccqp/admm.pyx":894
+    /* "fccqp/admm.pyx":900
  *         for j in range(s):
  *             i = p.constrained[j]
  *             r.prim = max(r.prim, fabs(x[i] - proj[j]))             # <<<<<<<<<<<<<<
@@ -29456,7 +29917,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->prim = __pyx_t_6;
 
 
-    /* "fccqp/admm.pyx":895
+    /* "fccqp/admm.pyx":901
  *             i = p.constrained[j]
  *             r.prim = max(r.prim, fabs(x[i] - proj[j]))
  *             r.prim_scale = max(r.prim_scale, fabs(x[i]))             # <<<<<<<<<<<<<<
@@ -29480,7 +29941,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->prim_scale = __pyx_t_7;
 
 
-    /* "fccqp/admm.pyx":896
+    /* "fccqp/admm.pyx":902
  *             r.prim = max(r.prim, fabs(x[i] - proj[j]))
  *             r.prim_scale = max(r.prim_scale, fabs(x[i]))
  *             if z[i] > 0.0 and isfinite(self.ub_user[i]):             # <<<<<<<<<<<<<<
@@ -29506,7 +29967,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     if (__pyx_t_8) {
 
 
-      /* "fccqp/admm.pyx":897
+      /* "fccqp/admm.pyx":903
  *             r.prim_scale = max(r.prim_scale, fabs(x[i]))
  *             if z[i] > 0.0 and isfinite(self.ub_user[i]):
  *                 support += self.ub_user[i] * z[i]             # <<<<<<<<<<<<<<
@@ -29515,7 +29976,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
       __pyx_v_support = (__pyx_v_support + ((__pyx_v_self->ub_user[__pyx_v_i]) * (__pyx_v_z[__pyx_v_i])));
 
-      /* "fccqp/admm.pyx":898
+      /* "fccqp/admm.pyx":904
  *             if z[i] > 0.0 and isfinite(self.ub_user[i]):
  *                 support += self.ub_user[i] * z[i]
  *                 terms += fabs(self.ub_user[i] * z[i])             # <<<<<<<<<<<<<<
@@ -29524,7 +29985,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
       __pyx_v_terms = (__pyx_v_terms + fabs(((__pyx_v_self->ub_user[__pyx_v_i]) * (__pyx_v_z[__pyx_v_i]))));
 
-      /* "fccqp/admm.pyx":896
+      /* "fccqp/admm.pyx":902
  *             r.prim = max(r.prim, fabs(x[i] - proj[j]))
  *             r.prim_scale = max(r.prim_scale, fabs(x[i]))
  *             if z[i] > 0.0 and isfinite(self.ub_user[i]):             # <<<<<<<<<<<<<<
@@ -29534,7 +29995,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
       goto __pyx_L13;
     }
 
-    /* "fccqp/admm.pyx":899
+    /* "fccqp/admm.pyx":905
  *                 support += self.ub_user[i] * z[i]
  *                 terms += fabs(self.ub_user[i] * z[i])
  *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):             # <<<<<<<<<<<<<<
@@ -29560,7 +30021,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     if (__pyx_t_8) {
 
 
-      /* "fccqp/admm.pyx":900
+      /* "fccqp/admm.pyx":906
  *                 terms += fabs(self.ub_user[i] * z[i])
  *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):
  *                 support += self.lb_user[i] * z[i]             # <<<<<<<<<<<<<<
@@ -29569,7 +30030,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
       __pyx_v_support = (__pyx_v_support + ((__pyx_v_self->lb_user[__pyx_v_i]) * (__pyx_v_z[__pyx_v_i])));
 
-      /* "fccqp/admm.pyx":901
+      /* "fccqp/admm.pyx":907
  *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):
  *                 support += self.lb_user[i] * z[i]
  *                 terms += fabs(self.lb_user[i] * z[i])             # <<<<<<<<<<<<<<
@@ -29578,7 +30039,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
       __pyx_v_terms = (__pyx_v_terms + fabs(((__pyx_v_self->lb_user[__pyx_v_i]) * (__pyx_v_z[__pyx_v_i]))));
 
-      /* "fccqp/admm.pyx":899
+      /* "fccqp/admm.pyx":905
  *                 support += self.ub_user[i] * z[i]
  *                 terms += fabs(self.ub_user[i] * z[i])
  *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):             # <<<<<<<<<<<<<<
@@ -29590,7 +30051,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":902
+  /* "fccqp/admm.pyx":908
  *                 support += self.lb_user[i] * z[i]
  *                 terms += fabs(self.lb_user[i] * z[i])
  *         r.dual = 0.0             # <<<<<<<<<<<<<<
@@ -29599,7 +30060,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_v_r->dual = 0.0;
 
-  /* "fccqp/admm.pyx":903
+  /* "fccqp/admm.pyx":909
  *                 terms += fabs(self.lb_user[i] * z[i])
  *         r.dual = 0.0
  *         for i in range(n):             # <<<<<<<<<<<<<<
@@ -29613,7 +30074,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":904
+    /* "fccqp/admm.pyx":910
  *         r.dual = 0.0
  *         for i in range(n):
  *             xPx += x[i] * grad[i]             # <<<<<<<<<<<<<<
@@ -29622,7 +30083,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_xPx = (__pyx_v_xPx + ((__pyx_v_x[__pyx_v_i]) * (__pyx_v_grad[__pyx_v_i])));
 
-    /* "fccqp/admm.pyx":905
+    /* "fccqp/admm.pyx":911
  *         for i in range(n):
  *             xPx += x[i] * grad[i]
  *             qx += self.q_user[i] * x[i]             # <<<<<<<<<<<<<<
@@ -29631,7 +30092,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_qx = (__pyx_v_qx + ((__pyx_v_self->q_user[__pyx_v_i]) * (__pyx_v_x[__pyx_v_i])));
 
-    /* "fccqp/admm.pyx":906
+    /* "fccqp/admm.pyx":912
  *             xPx += x[i] * grad[i]
  *             qx += self.q_user[i] * x[i]
  *             r.dual_scale = max(r.dual_scale, max(fabs(grad[i]), fabs(self.q_user[i])))             # <<<<<<<<<<<<<<
@@ -29670,7 +30131,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->dual_scale = __pyx_t_6;
 
 
-    /* "fccqp/admm.pyx":907
+    /* "fccqp/admm.pyx":913
  *             qx += self.q_user[i] * x[i]
  *             r.dual_scale = max(r.dual_scale, max(fabs(grad[i]), fabs(self.q_user[i])))
  *             value = grad[i] + self.q_user[i] + ATy[i] + z[i]             # <<<<<<<<<<<<<<
@@ -29679,7 +30140,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_value = ((((__pyx_v_grad[__pyx_v_i]) + (__pyx_v_self->q_user[__pyx_v_i])) + (__pyx_v_ATy[__pyx_v_i])) + (__pyx_v_z[__pyx_v_i]));
 
-    /* "fccqp/admm.pyx":908
+    /* "fccqp/admm.pyx":914
  *             r.dual_scale = max(r.dual_scale, max(fabs(grad[i]), fabs(self.q_user[i])))
  *             value = grad[i] + self.q_user[i] + ATy[i] + z[i]
  *             r.dual = max(r.dual, fabs(value))             # <<<<<<<<<<<<<<
@@ -29703,7 +30164,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->dual = __pyx_t_5;
 
 
-    /* "fccqp/admm.pyx":909
+    /* "fccqp/admm.pyx":915
  *             value = grad[i] + self.q_user[i] + ATy[i] + z[i]
  *             r.dual = max(r.dual, fabs(value))
  *             total += fabs(value) + fabs(x[i]) + fabs(z[i])             # <<<<<<<<<<<<<<
@@ -29714,7 +30175,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":910
+  /* "fccqp/admm.pyx":916
  *             r.dual = max(r.dual, fabs(value))
  *             total += fabs(value) + fabs(x[i]) + fabs(z[i])
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -29728,7 +30189,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":911
+    /* "fccqp/admm.pyx":917
  *             total += fabs(value) + fabs(x[i]) + fabs(z[i])
  *         for i in range(m):
  *             total += fabs(y[i])             # <<<<<<<<<<<<<<
@@ -29739,7 +30200,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":912
+  /* "fccqp/admm.pyx":918
  *         for i in range(m):
  *             total += fabs(y[i])
  *         r.gap = fabs(xPx + qx + by + support)             # <<<<<<<<<<<<<<
@@ -29748,7 +30209,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_v_r->gap = fabs((((__pyx_v_xPx + __pyx_v_qx) + __pyx_v_by) + __pyx_v_support));
 
-  /* "fccqp/admm.pyx":913
+  /* "fccqp/admm.pyx":919
  *             total += fabs(y[i])
  *         r.gap = fabs(xPx + qx + by + support)
  *         r.gap_scale = max(max(fabs(xPx), fabs(qx)), terms)             # <<<<<<<<<<<<<<
@@ -29787,7 +30248,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   __pyx_v_r->gap_scale = __pyx_t_10;
 
 
-  /* "fccqp/admm.pyx":914
+  /* "fccqp/admm.pyx":920
  *         r.gap = fabs(xPx + qx + by + support)
  *         r.gap_scale = max(max(fabs(xPx), fabs(qx)), terms)
  *         r.finite = isfinite(total) and isfinite(r.gap) and isfinite(r.prim)             # <<<<<<<<<<<<<<
@@ -29821,7 +30282,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   __pyx_L22_bool_binop_done:;
   __pyx_v_r->finite = __pyx_t_8;
 
-  /* "fccqp/admm.pyx":857
+  /* "fccqp/admm.pyx":863
  *             self.prev_rho = run.rho
  * 
  *     cdef void _user_residuals(self, const double* x, const double* y,             # <<<<<<<<<<<<<<
@@ -31914,14 +32375,14 @@ static int __Pyx_modinit_Exttype___pyx_obj_5fccqp_4admm_Workspace(__pyx_mstatety
   __pyx_vtable_5fccqp_4admm_Workspace._finish = (void (*)(struct __pyx_obj_5fccqp_4admm_Workspace *, struct __pyx_t_5fccqp_4admm_Run *, double *, double *, double *, double *))__pyx_f_5fccqp_4admm_9Workspace__finish;
   __pyx_vtable_5fccqp_4admm_Workspace._user_residuals = (void (*)(struct __pyx_obj_5fccqp_4admm_Workspace *, double const *, double const *, double const *))__pyx_f_5fccqp_4admm_9Workspace__user_residuals;
   #if CYTHON_USE_TYPE_SPECS
-  __pyx_mstate->__pyx_ptype_5fccqp_4admm_Workspace = (PyTypeObject *) __Pyx_PyType_FromModuleAndSpec(__pyx_m, &__pyx_type_5fccqp_4admm_Workspace_spec, NULL); if (unlikely(!__pyx_mstate->__pyx_ptype_5fccqp_4admm_Workspace)) __PYX_ERR(0, 143, __pyx_L1_error)
+  __pyx_mstate->__pyx_ptype_5fccqp_4admm_Workspace = (PyTypeObject *) __Pyx_PyType_FromModuleAndSpec(__pyx_m, &__pyx_type_5fccqp_4admm_Workspace_spec, NULL); if (unlikely(!__pyx_mstate->__pyx_ptype_5fccqp_4admm_Workspace)) __PYX_ERR(0, 144, __pyx_L1_error)
   #else
   __pyx_mstate->__pyx_ptype_5fccqp_4admm_Workspace = &__pyx_type_5fccqp_4admm_Workspace;
   #endif
   #if !CYTHON_COMPILING_IN_LIMITED_API
   #endif
   #if !CYTHON_USE_TYPE_SPECS
-  if (__Pyx_PyType_Ready(__pyx_mstate->__pyx_ptype_5fccqp_4admm_Workspace) < (0)) __PYX_ERR(0, 143, __pyx_L1_error)
+  if (__Pyx_PyType_Ready(__pyx_mstate->__pyx_ptype_5fccqp_4admm_Workspace) < (0)) __PYX_ERR(0, 144, __pyx_L1_error)
   #endif
   #if CYTHON_COMPILING_IN_CPYTHON && PY_VERSION_HEX >= 0x030E0000
   PyUnstable_Object_EnableDeferredRefcount((PyObject*)__pyx_mstate->__pyx_ptype_5fccqp_4admm_Workspace);
@@ -31933,7 +32394,7 @@ static int __Pyx_modinit_Exttype___pyx_obj_5fccqp_4admm_Workspace(__pyx_mstatety
   #endif
   #if CYTHON_UPDATE_DESCRIPTOR_DOC
   {
-    PyObject *wrapper = PyObject_GetAttrString((PyObject *)__pyx_mstate->__pyx_ptype_5fccqp_4admm_Workspace, "__init__"); if (unlikely(!wrapper)) __PYX_ERR(0, 143, __pyx_L1_error)
+    PyObject *wrapper = PyObject_GetAttrString((PyObject *)__pyx_mstate->__pyx_ptype_5fccqp_4admm_Workspace, "__init__"); if (unlikely(!wrapper)) __PYX_ERR(0, 144, __pyx_L1_error)
     if (Py_IS_TYPE(wrapper, &PyWrapperDescr_Type)) {
       __pyx_wrapperbase_5fccqp_4admm_9Workspace___init__ = *((PyWrapperDescrObject *)wrapper)->d_base;
       __pyx_wrapperbase_5fccqp_4admm_9Workspace___init__.doc = __pyx_doc_5fccqp_4admm_9Workspace___init__;
@@ -31941,9 +32402,9 @@ static int __Pyx_modinit_Exttype___pyx_obj_5fccqp_4admm_Workspace(__pyx_mstatety
     }
   }
   #endif
-  if (__Pyx_SetVtable(__pyx_mstate->__pyx_ptype_5fccqp_4admm_Workspace, __pyx_vtabptr_5fccqp_4admm_Workspace) < (0)) __PYX_ERR(0, 143, __pyx_L1_error)
-  if (PyObject_SetAttr(__pyx_m, __pyx_mstate_global->__pyx_n_u_Workspace, (PyObject *) __pyx_mstate->__pyx_ptype_5fccqp_4admm_Workspace) < (0)) __PYX_ERR(0, 143, __pyx_L1_error)
-  if (__Pyx_setup_reduce((PyObject *) __pyx_mstate->__pyx_ptype_5fccqp_4admm_Workspace) < (0)) __PYX_ERR(0, 143, __pyx_L1_error)
+  if (__Pyx_SetVtable(__pyx_mstate->__pyx_ptype_5fccqp_4admm_Workspace, __pyx_vtabptr_5fccqp_4admm_Workspace) < (0)) __PYX_ERR(0, 144, __pyx_L1_error)
+  if (PyObject_SetAttr(__pyx_m, __pyx_mstate_global->__pyx_n_u_Workspace, (PyObject *) __pyx_mstate->__pyx_ptype_5fccqp_4admm_Workspace) < (0)) __PYX_ERR(0, 144, __pyx_L1_error)
+  if (__Pyx_setup_reduce((PyObject *) __pyx_mstate->__pyx_ptype_5fccqp_4admm_Workspace) < (0)) __PYX_ERR(0, 144, __pyx_L1_error)
   __Pyx_RefNannyFinishContext();
   return 0;
   __pyx_L1_error:;
@@ -31960,14 +32421,14 @@ static int __Pyx_modinit_Exttype___pyx_obj_5fccqp_4admm___pyx_scope_struct____ge
   __Pyx_RefNannySetupContext("__Pyx_modinit_Exttype___pyx_obj_5fccqp_4admm___pyx_scope_struct____get__", 0);
   /*--- Exttype __pyx_obj_5fccqp_4admm___pyx_scope_struct____get__ ---*/
   #if CYTHON_USE_TYPE_SPECS
-  __pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct____get__ = (PyTypeObject *) __Pyx_PyType_FromModuleAndSpec(__pyx_m, &__pyx_type_5fccqp_4admm___pyx_scope_struct____get___spec, NULL); if (unlikely(!__pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct____get__)) __PYX_ERR(0, 325, __pyx_L1_error)
+  __pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct____get__ = (PyTypeObject *) __Pyx_PyType_FromModuleAndSpec(__pyx_m, &__pyx_type_5fccqp_4admm___pyx_scope_struct____get___spec, NULL); if (unlikely(!__pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct____get__)) __PYX_ERR(0, 326, __pyx_L1_error)
   #else
   __pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct____get__ = &__pyx_type_5fccqp_4admm___pyx_scope_struct____get__;
   #endif
   #if !CYTHON_COMPILING_IN_LIMITED_API
   #endif
   #if !CYTHON_USE_TYPE_SPECS
-  if (__Pyx_PyType_Ready(__pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct____get__) < (0)) __PYX_ERR(0, 325, __pyx_L1_error)
+  if (__Pyx_PyType_Ready(__pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct____get__) < (0)) __PYX_ERR(0, 326, __pyx_L1_error)
   #endif
   #if CYTHON_COMPILING_IN_CPYTHON && PY_VERSION_HEX >= 0x030E0000
   PyUnstable_Object_EnableDeferredRefcount((PyObject*)__pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct____get__);
@@ -31993,14 +32454,14 @@ static int __Pyx_modinit_Exttype___pyx_obj_5fccqp_4admm___pyx_scope_struct_1_gen
   __Pyx_RefNannySetupContext("__Pyx_modinit_Exttype___pyx_obj_5fccqp_4admm___pyx_scope_struct_1_genexpr", 0);
   /*--- Exttype __pyx_obj_5fccqp_4admm___pyx_scope_struct_1_genexpr ---*/
   #if CYTHON_USE_TYPE_SPECS
-  __pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct_1_genexpr = (PyTypeObject *) __Pyx_PyType_FromModuleAndSpec(__pyx_m, &__pyx_type_5fccqp_4admm___pyx_scope_struct_1_genexpr_spec, NULL); if (unlikely(!__pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct_1_genexpr)) __PYX_ERR(0, 329, __pyx_L1_error)
+  __pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct_1_genexpr = (PyTypeObject *) __Pyx_PyType_FromModuleAndSpec(__pyx_m, &__pyx_type_5fccqp_4admm___pyx_scope_struct_1_genexpr_spec, NULL); if (unlikely(!__pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct_1_genexpr)) __PYX_ERR(0, 330, __pyx_L1_error)
   #else
   __pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct_1_genexpr = &__pyx_type_5fccqp_4admm___pyx_scope_struct_1_genexpr;
   #endif
   #if !CYTHON_COMPILING_IN_LIMITED_API
   #endif
   #if !CYTHON_USE_TYPE_SPECS
-  if (__Pyx_PyType_Ready(__pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct_1_genexpr) < (0)) __PYX_ERR(0, 329, __pyx_L1_error)
+  if (__Pyx_PyType_Ready(__pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct_1_genexpr) < (0)) __PYX_ERR(0, 330, __pyx_L1_error)
   #endif
   #if CYTHON_COMPILING_IN_CPYTHON && PY_VERSION_HEX >= 0x030E0000
   PyUnstable_Object_EnableDeferredRefcount((PyObject*)__pyx_mstate->__pyx_ptype_5fccqp_4admm___pyx_scope_struct_1_genexpr);
@@ -32228,6 +32689,46 @@ static int __Pyx_modinit_Function_import_code(__pyx_mstatetype *__pyx_mstate) {
   CYTHON_UNUSED_VAR(__pyx_mstate);
   __Pyx_RefNannySetupContext("__Pyx_modinit_Function_import_code", 0);
   /*--- Function import code ---*/
+  {
+    __pyx_t_1 = PyImport_ImportModule("scipy.linalg.cython_blas"); if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 1, __pyx_L1_error)
+    __Pyx_GOTREF(__pyx_t_1);
+    const char * __pyx_import_signature = __Pyx_PyBytes_AsString(__pyx_mstate_global->__pyx_kp_b_void_char_int_int___pyx_t_5scipy);
+    #if !CYTHON_ASSUME_SAFE_MACROS
+    if (unlikely(!__pyx_import_signature)) __PYX_ERR(0, 1, __pyx_L1_error)
+    #endif
+    const char * __pyx_import_name = __pyx_import_signature + 259;
+    void (**const __pyx_import_pointers[])(void) = {(void (**)(void))&__pyx_f_5scipy_6linalg_11cython_blas_dgemv, (void (**)(void)) NULL};
+    void (**const *__pyx_import_pointer)(void) = __pyx_import_pointers;
+    const char *__pyx_import_current_signature = __pyx_import_signature;
+    while (*__pyx_import_pointer) {
+      if (__Pyx_ImportFunction_3_3_1(__pyx_t_1, __pyx_import_name, *__pyx_import_pointer, __pyx_import_current_signature) < (0)) __PYX_ERR(0, 1, __pyx_L1_error)
+      ++__pyx_import_pointer;
+      __pyx_import_name = strchr(__pyx_import_name, '\0') + 1;
+      __pyx_import_signature = strchr(__pyx_import_signature, '\0') + 1;
+      if (*__pyx_import_signature != '\0') __pyx_import_current_signature = __pyx_import_signature;
+    }
+    __Pyx_DECREF(__pyx_t_1); __pyx_t_1 = 0;
+  }
+  {
+    __pyx_t_1 = PyImport_ImportModule("fccqp.blas_threads"); if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 1, __pyx_L1_error)
+    __Pyx_GOTREF(__pyx_t_1);
+    const char * __pyx_import_signature = __Pyx_PyBytes_AsString(__pyx_mstate_global->__pyx_kp_b_void_void_enter_leave);
+    #if !CYTHON_ASSUME_SAFE_MACROS
+    if (unlikely(!__pyx_import_signature)) __PYX_ERR(0, 1, __pyx_L1_error)
+    #endif
+    const char * __pyx_import_name = __pyx_import_signature + 13;
+    void (**const __pyx_import_pointers[])(void) = {(void (**)(void))&__pyx_f_5fccqp_12blas_threads_enter, (void (**)(void))&__pyx_f_5fccqp_12blas_threads_leave, (void (**)(void)) NULL};
+    void (**const *__pyx_import_pointer)(void) = __pyx_import_pointers;
+    const char *__pyx_import_current_signature = __pyx_import_signature;
+    while (*__pyx_import_pointer) {
+      if (__Pyx_ImportFunction_3_3_1(__pyx_t_1, __pyx_import_name, *__pyx_import_pointer, __pyx_import_current_signature) < (0)) __PYX_ERR(0, 1, __pyx_L1_error)
+      ++__pyx_import_pointer;
+      __pyx_import_name = strchr(__pyx_import_name, '\0') + 1;
+      __pyx_import_signature = strchr(__pyx_import_signature, '\0') + 1;
+      if (*__pyx_import_signature != '\0') __pyx_import_current_signature = __pyx_import_signature;
+    }
+    __Pyx_DECREF(__pyx_t_1); __pyx_t_1 = 0;
+  }
   {
     __pyx_t_1 = PyImport_ImportModule("fccqp.anderson"); if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 1, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_t_1);
@@ -33222,7 +33723,7 @@ __Pyx_RefNannySetupContext("PyInit_admm", 0);
   if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_np, __pyx_t_4) < (0)) __PYX_ERR(0, 30, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_4); __pyx_t_4 = 0;
 
-  /* "fccqp/admm.pyx":70
+  /* "fccqp/admm.pyx":71
  * 
  * # Run codes, mapped to fccqp.Status in fccqp.solver (one table).
  * SOLVED, SOLVED_INACCURATE, MAX_ITER, TIME_LIMIT = 1, 2, 3, 4             # <<<<<<<<<<<<<<
@@ -33237,16 +33738,16 @@ __Pyx_RefNannySetupContext("PyInit_admm", 0);
   __Pyx_INCREF(__pyx_t_9);
   __pyx_t_10 = __pyx_mstate_global->__pyx_int_4;
   __Pyx_INCREF(__pyx_t_10);
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_SOLVED, __pyx_t_4) < (0)) __PYX_ERR(0, 70, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_SOLVED, __pyx_t_4) < (0)) __PYX_ERR(0, 71, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_4); __pyx_t_4 = 0;
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_SOLVED_INACCURATE, __pyx_t_5) < (0)) __PYX_ERR(0, 70, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_SOLVED_INACCURATE, __pyx_t_5) < (0)) __PYX_ERR(0, 71, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_5); __pyx_t_5 = 0;
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_MAX_ITER, __pyx_t_9) < (0)) __PYX_ERR(0, 70, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_MAX_ITER, __pyx_t_9) < (0)) __PYX_ERR(0, 71, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_TIME_LIMIT, __pyx_t_10) < (0)) __PYX_ERR(0, 70, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_TIME_LIMIT, __pyx_t_10) < (0)) __PYX_ERR(0, 71, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_10); __pyx_t_10 = 0;
 
-  /* "fccqp/admm.pyx":71
+  /* "fccqp/admm.pyx":72
  * # Run codes, mapped to fccqp.Status in fccqp.solver (one table).
  * SOLVED, SOLVED_INACCURATE, MAX_ITER, TIME_LIMIT = 1, 2, 3, 4
  * PRIMAL_INFEASIBLE, DUAL_INFEASIBLE, NUMERICAL_ERROR = 5, 6, 7             # <<<<<<<<<<<<<<
@@ -33259,68 +33760,68 @@ __Pyx_RefNannySetupContext("PyInit_admm", 0);
   __Pyx_INCREF(__pyx_t_9);
   __pyx_t_5 = __pyx_mstate_global->__pyx_int_7;
   __Pyx_INCREF(__pyx_t_5);
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_PRIMAL_INFEASIBLE, __pyx_t_10) < (0)) __PYX_ERR(0, 71, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_PRIMAL_INFEASIBLE, __pyx_t_10) < (0)) __PYX_ERR(0, 72, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_10); __pyx_t_10 = 0;
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_DUAL_INFEASIBLE, __pyx_t_9) < (0)) __PYX_ERR(0, 71, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_DUAL_INFEASIBLE, __pyx_t_9) < (0)) __PYX_ERR(0, 72, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_NUMERICAL_ERROR, __pyx_t_5) < (0)) __PYX_ERR(0, 71, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_NUMERICAL_ERROR, __pyx_t_5) < (0)) __PYX_ERR(0, 72, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_5); __pyx_t_5 = 0;
 
-  /* "fccqp/admm.pyx":72
+  /* "fccqp/admm.pyx":73
  * SOLVED, SOLVED_INACCURATE, MAX_ITER, TIME_LIMIT = 1, 2, 3, 4
  * PRIMAL_INFEASIBLE, DUAL_INFEASIBLE, NUMERICAL_ERROR = 5, 6, 7
  * NOT_CONVEX_CODE = -1             # <<<<<<<<<<<<<<
  * """The KKT inertia shows that the QP is not convex."""
  * BAD_DATA = -2
 */
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_NOT_CONVEX_CODE, __pyx_mstate_global->__pyx_int_neg_1) < (0)) __PYX_ERR(0, 72, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_NOT_CONVEX_CODE, __pyx_mstate_global->__pyx_int_neg_1) < (0)) __PYX_ERR(0, 73, __pyx_L1_error)
 
-  /* "fccqp/admm.pyx":74
+  /* "fccqp/admm.pyx":75
  * NOT_CONVEX_CODE = -1
  * """The KKT inertia shows that the QP is not convex."""
  * BAD_DATA = -2             # <<<<<<<<<<<<<<
  * """The validation scan found bad numbers (see ``Workspace.finding``)."""
  * cdef enum:
 */
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_BAD_DATA, __pyx_mstate_global->__pyx_int_neg_2) < (0)) __PYX_ERR(0, 74, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_BAD_DATA, __pyx_mstate_global->__pyx_int_neg_2) < (0)) __PYX_ERR(0, 75, __pyx_L1_error)
 
-  /* "fccqp/admm.pyx":88
+  /* "fccqp/admm.pyx":89
  *     _BAD_DATA = -2
  * 
  * BACKENDS = {"schur_reduced": SCHUR_REDUCED, "ldl_reduced": LDL_REDUCED, "ldl_full": LDL_FULL,             # <<<<<<<<<<<<<<
  *             "auto": AUTO}
  * """``Settings.kkt_backend`` names and their codes (see :mod:`fccqp.kkt`)."""
 */
-  __pyx_t_5 = __Pyx_PyDict_NewPresized(4); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 88, __pyx_L1_error)
+  __pyx_t_5 = __Pyx_PyDict_NewPresized(4); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 89, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_5);
-  __pyx_t_9 = __Pyx_PyLong_From___pyx_anon_enum(__pyx_e_5fccqp_3kkt_SCHUR_REDUCED); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 88, __pyx_L1_error)
+  __pyx_t_9 = __Pyx_PyLong_From___pyx_anon_enum(__pyx_e_5fccqp_3kkt_SCHUR_REDUCED); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 89, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_9);
-  if (PyDict_SetItem(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_schur_reduced, __pyx_t_9) < (0)) __PYX_ERR(0, 88, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_schur_reduced, __pyx_t_9) < (0)) __PYX_ERR(0, 89, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
-  __pyx_t_9 = __Pyx_PyLong_From___pyx_anon_enum(__pyx_e_5fccqp_3kkt_LDL_REDUCED); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 88, __pyx_L1_error)
+  __pyx_t_9 = __Pyx_PyLong_From___pyx_anon_enum(__pyx_e_5fccqp_3kkt_LDL_REDUCED); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 89, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_9);
-  if (PyDict_SetItem(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_ldl_reduced, __pyx_t_9) < (0)) __PYX_ERR(0, 88, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_ldl_reduced, __pyx_t_9) < (0)) __PYX_ERR(0, 89, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
-  __pyx_t_9 = __Pyx_PyLong_From___pyx_anon_enum(__pyx_e_5fccqp_3kkt_LDL_FULL); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 88, __pyx_L1_error)
+  __pyx_t_9 = __Pyx_PyLong_From___pyx_anon_enum(__pyx_e_5fccqp_3kkt_LDL_FULL); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 89, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_9);
-  if (PyDict_SetItem(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_ldl_full, __pyx_t_9) < (0)) __PYX_ERR(0, 88, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_ldl_full, __pyx_t_9) < (0)) __PYX_ERR(0, 89, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
 
-  /* "fccqp/admm.pyx":89
+  /* "fccqp/admm.pyx":90
  * 
  * BACKENDS = {"schur_reduced": SCHUR_REDUCED, "ldl_reduced": LDL_REDUCED, "ldl_full": LDL_FULL,
  *             "auto": AUTO}             # <<<<<<<<<<<<<<
  * """``Settings.kkt_backend`` names and their codes (see :mod:`fccqp.kkt`)."""
  * BACKEND_NAMES = {code: name for name, code in BACKENDS.items()}
 */
-  __pyx_t_9 = __Pyx_PyLong_From___pyx_anon_enum(__pyx_e_5fccqp_3kkt_AUTO); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 89, __pyx_L1_error)
+  __pyx_t_9 = __Pyx_PyLong_From___pyx_anon_enum(__pyx_e_5fccqp_3kkt_AUTO); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 90, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_9);
-  if (PyDict_SetItem(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_auto, __pyx_t_9) < (0)) __PYX_ERR(0, 88, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_t_5, __pyx_mstate_global->__pyx_n_u_auto, __pyx_t_9) < (0)) __PYX_ERR(0, 89, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_BACKENDS, __pyx_t_5) < (0)) __PYX_ERR(0, 88, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_BACKENDS, __pyx_t_5) < (0)) __PYX_ERR(0, 89, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_5); __pyx_t_5 = 0;
 
-  /* "fccqp/admm.pyx":91
+  /* "fccqp/admm.pyx":92
  *             "auto": AUTO}
  * """``Settings.kkt_backend`` names and their codes (see :mod:`fccqp.kkt`)."""
  * BACKEND_NAMES = {code: name for name, code in BACKENDS.items()}             # <<<<<<<<<<<<<<
@@ -33328,16 +33829,16 @@ __Pyx_RefNannySetupContext("PyInit_admm", 0);
  * INACCURATE_FACTOR = 10.0
 */
   { /* enter inner scope */
-    __pyx_t_5 = PyDict_New(); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 91, __pyx_L37_error)
+    __pyx_t_5 = PyDict_New(); if (unlikely(!__pyx_t_5)) __PYX_ERR(0, 92, __pyx_L37_error)
     __Pyx_GOTREF(__pyx_t_5);
     __pyx_t_11 = 0;
-    __Pyx_GetModuleGlobalName(__pyx_t_10, __pyx_mstate_global->__pyx_n_u_BACKENDS); if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 91, __pyx_L37_error)
+    __Pyx_GetModuleGlobalName(__pyx_t_10, __pyx_mstate_global->__pyx_n_u_BACKENDS); if (unlikely(!__pyx_t_10)) __PYX_ERR(0, 92, __pyx_L37_error)
     __Pyx_GOTREF(__pyx_t_10);
     if (unlikely(__pyx_t_10 == Py_None)) {
       PyErr_Format(PyExc_AttributeError, "\047NoneType\047 object has no attribute \047%.30s\047", "items");
-      __PYX_ERR(0, 91, __pyx_L37_error)
+      __PYX_ERR(0, 92, __pyx_L37_error)
     }
-    __pyx_t_4 = __Pyx_dict_iterator(__pyx_t_10, 0, __pyx_mstate_global->__pyx_n_u_items, (&__pyx_t_12), (&__pyx_t_13)); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 91, __pyx_L37_error)
+    __pyx_t_4 = __Pyx_dict_iterator(__pyx_t_10, 0, __pyx_mstate_global->__pyx_n_u_items, (&__pyx_t_12), (&__pyx_t_13)); if (unlikely(!__pyx_t_4)) __PYX_ERR(0, 92, __pyx_L37_error)
     __Pyx_GOTREF(__pyx_t_4);
     __Pyx_DECREF(__pyx_t_10); __pyx_t_10 = 0;
     __Pyx_XDECREF(__pyx_t_9);
@@ -33346,7 +33847,7 @@ __Pyx_RefNannySetupContext("PyInit_admm", 0);
     while (1) {
       __pyx_t_14 = __Pyx_dict_iter_next(__pyx_t_9, __pyx_t_12, &__pyx_t_11, &__pyx_t_4, &__pyx_t_10, NULL, __pyx_t_13);
       if (unlikely(__pyx_t_14 == 0)) break;
-      if (unlikely(__pyx_t_14 == -1)) __PYX_ERR(0, 91, __pyx_L37_error)
+      if (unlikely(__pyx_t_14 == -1)) __PYX_ERR(0, 92, __pyx_L37_error)
       __Pyx_GOTREF(__pyx_t_4);
       __Pyx_GOTREF(__pyx_t_10);
       __Pyx_XGOTREF(__pyx_7genexpr__pyx_v_5fccqp_4admm_name);
@@ -33357,7 +33858,7 @@ __Pyx_RefNannySetupContext("PyInit_admm", 0);
       __Pyx_DECREF_SET(__pyx_7genexpr__pyx_v_5fccqp_4admm_code, __pyx_t_10);
       __Pyx_GIVEREF(__pyx_t_10);
       __pyx_t_10 = 0;
-      if (unlikely(PyDict_SetItem(__pyx_t_5, __pyx_7genexpr__pyx_v_5fccqp_4admm_code, __pyx_7genexpr__pyx_v_5fccqp_4admm_name))) __PYX_ERR(0, 91, __pyx_L37_error)
+      if (unlikely(PyDict_SetItem(__pyx_t_5, __pyx_7genexpr__pyx_v_5fccqp_4admm_code, __pyx_7genexpr__pyx_v_5fccqp_4admm_name))) __PYX_ERR(0, 92, __pyx_L37_error)
     }
     __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
     __Pyx_GOTREF(__pyx_7genexpr__pyx_v_5fccqp_4admm_code);
@@ -33373,19 +33874,19 @@ __Pyx_RefNannySetupContext("PyInit_admm", 0);
     goto __pyx_L1_error;
     __pyx_L40_exit_scope:;
   } /* exit inner scope */
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_BACKEND_NAMES, __pyx_t_5) < (0)) __PYX_ERR(0, 91, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_BACKEND_NAMES, __pyx_t_5) < (0)) __PYX_ERR(0, 92, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_5); __pyx_t_5 = 0;
 
-  /* "fccqp/admm.pyx":93
+  /* "fccqp/admm.pyx":94
  * BACKEND_NAMES = {code: name for name, code in BACKENDS.items()}
  * 
  * INACCURATE_FACTOR = 10.0             # <<<<<<<<<<<<<<
  * """A budget-stopped iterate within this multiple of the tolerances is 'inaccurate'."""
  * RHO_MIN, RHO_MAX = 1e-6, 1e6
 */
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_INACCURATE_FACTOR, __pyx_mstate_global->__pyx_float_10_0) < (0)) __PYX_ERR(0, 93, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_INACCURATE_FACTOR, __pyx_mstate_global->__pyx_float_10_0) < (0)) __PYX_ERR(0, 94, __pyx_L1_error)
 
-  /* "fccqp/admm.pyx":95
+  /* "fccqp/admm.pyx":96
  * INACCURATE_FACTOR = 10.0
  * """A budget-stopped iterate within this multiple of the tolerances is 'inaccurate'."""
  * RHO_MIN, RHO_MAX = 1e-6, 1e6             # <<<<<<<<<<<<<<
@@ -33396,204 +33897,204 @@ __Pyx_RefNannySetupContext("PyInit_admm", 0);
   __Pyx_INCREF(__pyx_t_5);
   __pyx_t_9 = __pyx_mstate_global->__pyx_float_1e6;
   __Pyx_INCREF(__pyx_t_9);
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_RHO_MIN, __pyx_t_5) < (0)) __PYX_ERR(0, 95, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_RHO_MIN, __pyx_t_5) < (0)) __PYX_ERR(0, 96, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_5); __pyx_t_5 = 0;
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_RHO_MAX, __pyx_t_9) < (0)) __PYX_ERR(0, 95, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_RHO_MAX, __pyx_t_9) < (0)) __PYX_ERR(0, 96, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
 
-  /* "fccqp/admm.pyx":97
+  /* "fccqp/admm.pyx":98
  * RHO_MIN, RHO_MAX = 1e-6, 1e6
  * """Range of the adaptive rho."""
  * REDUCED_COST = 0.5             # <<<<<<<<<<<<<<
  * """The reduced iteration is used when ``REDUCED_COST * s`` fits in the iteration budget:
  * tabulating ``s`` columns costs about ``s / 4`` single KKT solves (measured at KKT sizes
 */
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_REDUCED_COST, __pyx_mstate_global->__pyx_float_0_5) < (0)) __PYX_ERR(0, 97, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_REDUCED_COST, __pyx_mstate_global->__pyx_float_0_5) < (0)) __PYX_ERR(0, 98, __pyx_L1_error)
 
-  /* "fccqp/admm.pyx":101
+  /* "fccqp/admm.pyx":102
  * tabulating ``s`` columns costs about ``s / 4`` single KKT solves (measured at KKT sizes
  * 84 and 192), each iteration then saves about one; 0.5 leaves a factor 2 of margin."""
  * FIXED_RHO_SCALE = 1e3             # <<<<<<<<<<<<<<
  * """rho multiplier on entries with lb == ub, which act as equalities (as in OSQP)."""
  * EQUALITY_START_STEPS = 3
 */
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_FIXED_RHO_SCALE, __pyx_mstate_global->__pyx_float_1e3) < (0)) __PYX_ERR(0, 101, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_FIXED_RHO_SCALE, __pyx_mstate_global->__pyx_float_1e3) < (0)) __PYX_ERR(0, 102, __pyx_L1_error)
 
-  /* "fccqp/admm.pyx":103
+  /* "fccqp/admm.pyx":104
  * FIXED_RHO_SCALE = 1e3
  * """rho multiplier on entries with lb == ub, which act as equalities (as in OSQP)."""
  * EQUALITY_START_STEPS = 3             # <<<<<<<<<<<<<<
  * """Proximal steps of the cold start's equality-constrained QP (see _equality_start)."""
  * EQUALITY_START_LIMIT = 1e-3
 */
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_EQUALITY_START_STEPS, __pyx_mstate_global->__pyx_int_3) < (0)) __PYX_ERR(0, 103, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_EQUALITY_START_STEPS, __pyx_mstate_global->__pyx_int_3) < (0)) __PYX_ERR(0, 104, __pyx_L1_error)
 
-  /* "fccqp/admm.pyx":105
+  /* "fccqp/admm.pyx":106
  * EQUALITY_START_STEPS = 3
  * """Proximal steps of the cold start's equality-constrained QP (see _equality_start)."""
  * EQUALITY_START_LIMIT = 1e-3             # <<<<<<<<<<<<<<
  * """The cold start's equality-constrained QP counts as unbounded when sigma * ||x_eq||
  * exceeds this * max(1, ||q||): its solution is then an (unbounded) direction, tested as
 */
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_EQUALITY_START_LIMIT, __pyx_mstate_global->__pyx_float_1eneg_3) < (0)) __PYX_ERR(0, 105, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_EQUALITY_START_LIMIT, __pyx_mstate_global->__pyx_float_1eneg_3) < (0)) __PYX_ERR(0, 106, __pyx_L1_error)
 
-  /* "fccqp/admm.pyx":109
+  /* "fccqp/admm.pyx":110
  * exceeds this * max(1, ||q||): its solution is then an (unbounded) direction, tested as
  * a dual infeasibility certificate, and the start falls back to the origin."""
  * RESTORED_EQUALITY = 1e-7             # <<<<<<<<<<<<<<
  * """A restored point is kept only if its primal residual is below this times its scale:
  * otherwise the other entries could not absorb the pinning. Refinement aims at 1e-13, but
 */
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_RESTORED_EQUALITY, __pyx_mstate_global->__pyx_float_1eneg_7) < (0)) __PYX_ERR(0, 109, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_RESTORED_EQUALITY, __pyx_mstate_global->__pyx_float_1eneg_7) < (0)) __PYX_ERR(0, 110, __pyx_L1_error)
 
-  /* "fccqp/admm.pyx":113
+  /* "fccqp/admm.pyx":114
  * otherwise the other entries could not absorb the pinning. Refinement aims at 1e-13, but
  * an ill-conditioned ``W_TT`` (condition 1e8 on solo12) costs digits."""
  * LOG_INTERVAL = 25             # <<<<<<<<<<<<<<
  * """With ``verbose``, the log keeps one line every this many iterations (as OSQP)."""
  * cdef double _INACCURATE_FACTOR = INACCURATE_FACTOR
 */
-  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_LOG_INTERVAL, __pyx_mstate_global->__pyx_int_25) < (0)) __PYX_ERR(0, 113, __pyx_L1_error)
+  if (PyDict_SetItem(__pyx_mstate_global->__pyx_d, __pyx_mstate_global->__pyx_n_u_LOG_INTERVAL, __pyx_mstate_global->__pyx_int_25) < (0)) __PYX_ERR(0, 114, __pyx_L1_error)
 
-  /* "fccqp/admm.pyx":115
+  /* "fccqp/admm.pyx":116
  * LOG_INTERVAL = 25
  * """With ``verbose``, the log keeps one line every this many iterations (as OSQP)."""
  * cdef double _INACCURATE_FACTOR = INACCURATE_FACTOR             # <<<<<<<<<<<<<<
  * cdef double _REDUCED_COST = REDUCED_COST
  * cdef double _RHO_MIN = RHO_MIN, _RHO_MAX = RHO_MAX
 */
-  __Pyx_GetModuleGlobalName(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_INACCURATE_FACTOR); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 115, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_INACCURATE_FACTOR); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 116, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_9);
-  __pyx_t_15 = __Pyx_PyFloat_AsDouble(__pyx_t_9); if (unlikely((__pyx_t_15 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 115, __pyx_L1_error)
+  __pyx_t_15 = __Pyx_PyFloat_AsDouble(__pyx_t_9); if (unlikely((__pyx_t_15 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 116, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
   __pyx_v_5fccqp_4admm__INACCURATE_FACTOR = __pyx_t_15;
 
-  /* "fccqp/admm.pyx":116
+  /* "fccqp/admm.pyx":117
  * """With ``verbose``, the log keeps one line every this many iterations (as OSQP)."""
  * cdef double _INACCURATE_FACTOR = INACCURATE_FACTOR
  * cdef double _REDUCED_COST = REDUCED_COST             # <<<<<<<<<<<<<<
  * cdef double _RHO_MIN = RHO_MIN, _RHO_MAX = RHO_MAX
  * cdef double _EQUALITY_START_LIMIT = EQUALITY_START_LIMIT
 */
-  __Pyx_GetModuleGlobalName(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_REDUCED_COST); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 116, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_REDUCED_COST); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 117, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_9);
-  __pyx_t_15 = __Pyx_PyFloat_AsDouble(__pyx_t_9); if (unlikely((__pyx_t_15 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 116, __pyx_L1_error)
+  __pyx_t_15 = __Pyx_PyFloat_AsDouble(__pyx_t_9); if (unlikely((__pyx_t_15 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 117, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
   __pyx_v_5fccqp_4admm__REDUCED_COST = __pyx_t_15;
 
-  /* "fccqp/admm.pyx":117
+  /* "fccqp/admm.pyx":118
  * cdef double _INACCURATE_FACTOR = INACCURATE_FACTOR
  * cdef double _REDUCED_COST = REDUCED_COST
  * cdef double _RHO_MIN = RHO_MIN, _RHO_MAX = RHO_MAX             # <<<<<<<<<<<<<<
  * cdef double _EQUALITY_START_LIMIT = EQUALITY_START_LIMIT
  * cdef double _RESTORED_EQUALITY = RESTORED_EQUALITY
 */
-  __Pyx_GetModuleGlobalName(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_RHO_MIN); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 117, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_RHO_MIN); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 118, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_9);
-  __pyx_t_15 = __Pyx_PyFloat_AsDouble(__pyx_t_9); if (unlikely((__pyx_t_15 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 117, __pyx_L1_error)
+  __pyx_t_15 = __Pyx_PyFloat_AsDouble(__pyx_t_9); if (unlikely((__pyx_t_15 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 118, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
   __pyx_v_5fccqp_4admm__RHO_MIN = __pyx_t_15;
-  __Pyx_GetModuleGlobalName(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_RHO_MAX); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 117, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_RHO_MAX); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 118, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_9);
-  __pyx_t_15 = __Pyx_PyFloat_AsDouble(__pyx_t_9); if (unlikely((__pyx_t_15 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 117, __pyx_L1_error)
+  __pyx_t_15 = __Pyx_PyFloat_AsDouble(__pyx_t_9); if (unlikely((__pyx_t_15 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 118, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
   __pyx_v_5fccqp_4admm__RHO_MAX = __pyx_t_15;
 
-  /* "fccqp/admm.pyx":118
+  /* "fccqp/admm.pyx":119
  * cdef double _REDUCED_COST = REDUCED_COST
  * cdef double _RHO_MIN = RHO_MIN, _RHO_MAX = RHO_MAX
  * cdef double _EQUALITY_START_LIMIT = EQUALITY_START_LIMIT             # <<<<<<<<<<<<<<
  * cdef double _RESTORED_EQUALITY = RESTORED_EQUALITY
  * cdef long _EQUALITY_START_STEPS = EQUALITY_START_STEPS
 */
-  __Pyx_GetModuleGlobalName(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_EQUALITY_START_LIMIT); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 118, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_EQUALITY_START_LIMIT); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 119, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_9);
-  __pyx_t_15 = __Pyx_PyFloat_AsDouble(__pyx_t_9); if (unlikely((__pyx_t_15 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 118, __pyx_L1_error)
+  __pyx_t_15 = __Pyx_PyFloat_AsDouble(__pyx_t_9); if (unlikely((__pyx_t_15 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 119, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
   __pyx_v_5fccqp_4admm__EQUALITY_START_LIMIT = __pyx_t_15;
 
-  /* "fccqp/admm.pyx":119
+  /* "fccqp/admm.pyx":120
  * cdef double _RHO_MIN = RHO_MIN, _RHO_MAX = RHO_MAX
  * cdef double _EQUALITY_START_LIMIT = EQUALITY_START_LIMIT
  * cdef double _RESTORED_EQUALITY = RESTORED_EQUALITY             # <<<<<<<<<<<<<<
  * cdef long _EQUALITY_START_STEPS = EQUALITY_START_STEPS
  * cdef long _LOG_INTERVAL = LOG_INTERVAL
 */
-  __Pyx_GetModuleGlobalName(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_RESTORED_EQUALITY); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 119, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_RESTORED_EQUALITY); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 120, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_9);
-  __pyx_t_15 = __Pyx_PyFloat_AsDouble(__pyx_t_9); if (unlikely((__pyx_t_15 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 119, __pyx_L1_error)
+  __pyx_t_15 = __Pyx_PyFloat_AsDouble(__pyx_t_9); if (unlikely((__pyx_t_15 == (double)-1) && PyErr_Occurred())) __PYX_ERR(0, 120, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
   __pyx_v_5fccqp_4admm__RESTORED_EQUALITY = __pyx_t_15;
 
-  /* "fccqp/admm.pyx":120
+  /* "fccqp/admm.pyx":121
  * cdef double _EQUALITY_START_LIMIT = EQUALITY_START_LIMIT
  * cdef double _RESTORED_EQUALITY = RESTORED_EQUALITY
  * cdef long _EQUALITY_START_STEPS = EQUALITY_START_STEPS             # <<<<<<<<<<<<<<
  * cdef long _LOG_INTERVAL = LOG_INTERVAL
  * 
 */
-  __Pyx_GetModuleGlobalName(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_EQUALITY_START_STEPS); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 120, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_EQUALITY_START_STEPS); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 121, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_9);
-  __pyx_t_16 = __Pyx_PyLong_As_long(__pyx_t_9); if (unlikely((__pyx_t_16 == (long)-1) && PyErr_Occurred())) __PYX_ERR(0, 120, __pyx_L1_error)
+  __pyx_t_16 = __Pyx_PyLong_As_long(__pyx_t_9); if (unlikely((__pyx_t_16 == (long)-1) && PyErr_Occurred())) __PYX_ERR(0, 121, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
   __pyx_v_5fccqp_4admm__EQUALITY_START_STEPS = __pyx_t_16;
 
-  /* "fccqp/admm.pyx":121
+  /* "fccqp/admm.pyx":122
  * cdef double _RESTORED_EQUALITY = RESTORED_EQUALITY
  * cdef long _EQUALITY_START_STEPS = EQUALITY_START_STEPS
  * cdef long _LOG_INTERVAL = LOG_INTERVAL             # <<<<<<<<<<<<<<
  * 
  * 
 */
-  __Pyx_GetModuleGlobalName(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_LOG_INTERVAL); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 121, __pyx_L1_error)
+  __Pyx_GetModuleGlobalName(__pyx_t_9, __pyx_mstate_global->__pyx_n_u_LOG_INTERVAL); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 122, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_9);
-  __pyx_t_16 = __Pyx_PyLong_As_long(__pyx_t_9); if (unlikely((__pyx_t_16 == (long)-1) && PyErr_Occurred())) __PYX_ERR(0, 121, __pyx_L1_error)
+  __pyx_t_16 = __Pyx_PyLong_As_long(__pyx_t_9); if (unlikely((__pyx_t_16 == (long)-1) && PyErr_Occurred())) __PYX_ERR(0, 122, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
   __pyx_v_5fccqp_4admm__LOG_INTERVAL = __pyx_t_16;
 
-  /* "fccqp/admm.pyx":311
+  /* "fccqp/admm.pyx":312
  *         return &view[0]
  * 
  *     def update_cones(self, mu, normal):             # <<<<<<<<<<<<<<
  *         """New friction coefficients and normals for the same cone blocks."""
  *         self._keep[4][:] = mu
 */
-  __pyx_t_9 = __Pyx_CyFunction_New(&__pyx_mdef_5fccqp_4admm_9Workspace_3update_cones, __Pyx_CYFUNCTION_CCLASS, __pyx_mstate_global->__pyx_n_u_Workspace_update_cones, NULL, __pyx_mstate_global->__pyx_n_u_fccqp_admm, __pyx_mstate_global->__pyx_d, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[1])); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 311, __pyx_L1_error)
+  __pyx_t_9 = __Pyx_CyFunction_New(&__pyx_mdef_5fccqp_4admm_9Workspace_3update_cones, __Pyx_CYFUNCTION_CCLASS, __pyx_mstate_global->__pyx_n_u_Workspace_update_cones, NULL, __pyx_mstate_global->__pyx_n_u_fccqp_admm, __pyx_mstate_global->__pyx_d, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[1])); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 312, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_9);
   #if CYTHON_COMPILING_IN_CPYTHON && PY_VERSION_HEX >= 0x030E0000
   PyUnstable_Object_EnableDeferredRefcount(__pyx_t_9);
   #endif
-  if (__Pyx_SetItemOnTypeDict(__pyx_mstate_global->__pyx_ptype_5fccqp_4admm_Workspace, __pyx_mstate_global->__pyx_n_u_update_cones, __pyx_t_9) < (0)) __PYX_ERR(0, 311, __pyx_L1_error)
+  if (__Pyx_SetItemOnTypeDict(__pyx_mstate_global->__pyx_ptype_5fccqp_4admm_Workspace, __pyx_mstate_global->__pyx_n_u_update_cones, __pyx_t_9) < (0)) __PYX_ERR(0, 312, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
 
-  /* "fccqp/admm.pyx":316
+  /* "fccqp/admm.pyx":317
  *         self._keep[5][:] = np.asarray(normal, dtype=np.float64).reshape(-1)
  * 
  *     def forget(self):             # <<<<<<<<<<<<<<
  *         """Drop the previous solution, so that the next solve starts cold."""
  *         self.has_previous = False
 */
-  __pyx_t_9 = __Pyx_CyFunction_New(&__pyx_mdef_5fccqp_4admm_9Workspace_5forget, __Pyx_CYFUNCTION_CCLASS, __pyx_mstate_global->__pyx_n_u_Workspace_forget, NULL, __pyx_mstate_global->__pyx_n_u_fccqp_admm, __pyx_mstate_global->__pyx_d, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[2])); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 316, __pyx_L1_error)
+  __pyx_t_9 = __Pyx_CyFunction_New(&__pyx_mdef_5fccqp_4admm_9Workspace_5forget, __Pyx_CYFUNCTION_CCLASS, __pyx_mstate_global->__pyx_n_u_Workspace_forget, NULL, __pyx_mstate_global->__pyx_n_u_fccqp_admm, __pyx_mstate_global->__pyx_d, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[2])); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 317, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_9);
   #if CYTHON_COMPILING_IN_CPYTHON && PY_VERSION_HEX >= 0x030E0000
   PyUnstable_Object_EnableDeferredRefcount(__pyx_t_9);
   #endif
-  if (__Pyx_SetItemOnTypeDict(__pyx_mstate_global->__pyx_ptype_5fccqp_4admm_Workspace, __pyx_mstate_global->__pyx_n_u_forget, __pyx_t_9) < (0)) __PYX_ERR(0, 316, __pyx_L1_error)
+  if (__Pyx_SetItemOnTypeDict(__pyx_mstate_global->__pyx_ptype_5fccqp_4admm_Workspace, __pyx_mstate_global->__pyx_n_u_forget, __pyx_t_9) < (0)) __PYX_ERR(0, 317, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
 
-  /* "fccqp/admm.pyx":331
+  /* "fccqp/admm.pyx":332
  *         return [tuple(self.log[5 * i + j] for j in range(5)) for i in range(self.log_count)]
  * 
  *     def solve(self, const double[:, ::1] P, const double[::1] q, const double[:, ::1] A,             # <<<<<<<<<<<<<<
  *               const double[::1] b, const double[::1] lb, const double[::1] ub, x0,
  *               bint warm, double start_time,
 */
-  __pyx_t_9 = __Pyx_CyFunction_New(&__pyx_mdef_5fccqp_4admm_9Workspace_7solve, __Pyx_CYFUNCTION_CCLASS, __pyx_mstate_global->__pyx_n_u_Workspace_solve, NULL, __pyx_mstate_global->__pyx_n_u_fccqp_admm, __pyx_mstate_global->__pyx_d, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[3])); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 331, __pyx_L1_error)
+  __pyx_t_9 = __Pyx_CyFunction_New(&__pyx_mdef_5fccqp_4admm_9Workspace_7solve, __Pyx_CYFUNCTION_CCLASS, __pyx_mstate_global->__pyx_n_u_Workspace_solve, NULL, __pyx_mstate_global->__pyx_n_u_fccqp_admm, __pyx_mstate_global->__pyx_d, ((PyObject *)__pyx_mstate_global->__pyx_codeobj_tab[3])); if (unlikely(!__pyx_t_9)) __PYX_ERR(0, 332, __pyx_L1_error)
   __Pyx_GOTREF(__pyx_t_9);
   #if CYTHON_COMPILING_IN_CPYTHON && PY_VERSION_HEX >= 0x030E0000
   PyUnstable_Object_EnableDeferredRefcount(__pyx_t_9);
   #endif
-  if (__Pyx_SetItemOnTypeDict(__pyx_mstate_global->__pyx_ptype_5fccqp_4admm_Workspace, __pyx_mstate_global->__pyx_n_u_solve, __pyx_t_9) < (0)) __PYX_ERR(0, 331, __pyx_L1_error)
+  if (__Pyx_SetItemOnTypeDict(__pyx_mstate_global->__pyx_ptype_5fccqp_4admm_Workspace, __pyx_mstate_global->__pyx_n_u_solve, __pyx_t_9) < (0)) __PYX_ERR(0, 332, __pyx_L1_error)
   __Pyx_DECREF(__pyx_t_9); __pyx_t_9 = 0;
 
   /* "(tree fragment)":1
@@ -33740,7 +34241,7 @@ static int __Pyx_InitCachedConstants(__pyx_mstatetype *__pyx_mstate) {
   if (__Pyx_PyTuple_SET_ITEM(__pyx_mstate_global->__pyx_tuple[1], 0, __pyx_mstate_global->__pyx_slice[0]) != (0)) __PYX_ERR(1, 763, __pyx_L1_error);
   __Pyx_GIVEREF(__pyx_mstate_global->__pyx_tuple[1]);
 
-  /* "fccqp/admm.pyx":204
+  /* "fccqp/admm.pyx":205
  *         self._arrays = []
  *         kind, offset, dim, mu, normal = cones
  *         self._keep = (np.ascontiguousarray(constrained, dtype=np.intp),             # <<<<<<<<<<<<<<
@@ -33749,7 +34250,7 @@ static int __Pyx_InitCachedConstants(__pyx_mstatetype *__pyx_mstate) {
 */
   {
     PyObject* __pyx_temp[1] = {__pyx_mstate_global->__pyx_n_u_dtype};
-    __pyx_mstate_global->__pyx_tuple[2] = __Pyx_PyTuple_FromArray(__pyx_temp, 1); if (unlikely(!__pyx_mstate_global->__pyx_tuple[2])) __PYX_ERR(0, 204, __pyx_L1_error)
+    __pyx_mstate_global->__pyx_tuple[2] = __Pyx_PyTuple_FromArray(__pyx_temp, 1); if (unlikely(!__pyx_mstate_global->__pyx_tuple[2])) __PYX_ERR(0, 205, __pyx_L1_error)
     __Pyx_GOTREF(__pyx_mstate_global->__pyx_tuple[2]);
   }
   __Pyx_GIVEREF(__pyx_mstate_global->__pyx_tuple[2]);
@@ -33814,30 +34315,30 @@ static int __Pyx_InitConstants(__pyx_mstatetype *__pyx_mstate) {
   CYTHON_UNUSED_VAR(__pyx_mstate);
   {
     const struct { const unsigned int length: 9; } str_length_index[] = {{0},{6},{8},{15},{1},{2},{15},{23},{25},{32},{20},{22},{1},{1},{37},{45},{22},{179},{8},{15},{7},{6},{2},{9},{50},{409},{18},{30},{37},{1},{5},{8},{13},{8},{15},{20},{20},{8},{15},{17},{12},{8},{15},{15},{1},{17},{12},{17},{7},{7},{6},{17},{8},{10},{15},{9},{34},{27},{29},{16},{15},{22},{20},{12},{9},{17},{8},{8},{12},{10},{8},{10},{8},{7},{14},{11},{10},{19},{14},{12},{10},{17},{13},{12},{12},{19},{8},{13},{3},{12},{21},{22},{15},{5},{15},{7},{17},{18},{4},{1},{4},{1},{8},{17},{18},{5},{5},{11},{5},{5},{15},{6},{9},{7},{12},{12},{7},{5},{10},{5},{5},{7},{6},{6},{7},{7},{5},{2},{5},{4},{5},{8},{1},{11},{2},{8},{11},{8},{1},{8},{7},{4},{2},{1},{4},{4},{4},{6},{2},{5},{3},{5},{1},{4},{3},{1},{1},{8},{7},{19},{3},{3},{4},{7},{13},{4},{4},{10},{8},{5},{5},{4},{5},{5},{10},{4},{4},{6},{5},{10},{2},{6},{6},{12},{5},{6},{4},{1},{2},{6},{5},{5},{5},{5}};
-    const struct { const unsigned int length: 10; } bytes_length_index[] = {{1},{654},{233},{376},{393},{447},{795},{244},{212},{187},{9},{46},{10},{413},{2}};
+    const struct { const unsigned int length: 10; } bytes_length_index[] = {{1},{654},{233},{376},{393},{447},{795},{244},{264},{212},{187},{24},{9},{46},{10},{425},{2}};
     #ifndef CYTHON_COMPRESS_STRINGS
       #define CYTHON_COMPRESS_STRINGS 90
     #endif
-    #if (CYTHON_COMPRESS_STRINGS) == 1 /* compression: zlib (2231 bytes) */
-static const char cstring[] = "x\332\325X\313o\033\307\031\227Q\027p\032\271\265j\033h\320\026\035\243jd56cYj\234\006\256\2135\265\252Y\353\305\207\024\031I:\030\356\016\311\265vgV3\2634i\240\200\217:\362\270G\036y\344\221G\035y\344\221\307\374\t\375\023\372\315,\037\253D\242\345W\320\n\320\3147\257\3575\337\367\373f\211\210B\367\032\210\227\237SG=\272\255\004\245\250\"H5\240L-g\276B\017\267h\300Es\337\243/\020\257\240\207\016g\312\253F<\222\2100\027\271\236\320\347~8\355\261\361\202T\302s\251\233\332\214\270\230\271~zn\262\363\321\337\263\2041\256\020\221\322\2532\2448\022\224\270w9\363\233(0J\326A\311\034\253\023\337sQ\300]z\007\321F\010g\201\325\222\263\244\345.U\270P\202\260\245;\250\n\254\306\233e\215\204\024D!\322\360$\332\346\212\"U\003\307d\233\252\306\031\2029\227\372^\231\n\242(H\323\372\001W\24171\264k\357\336]\373r\315h+\250v\243D2*;>(J\245vZ9\362|\005\334U3\2442\203r\025\324\344\021b\024\364\002+B\330\227>\240j\224!I\225&\320\222\261\231(\2173\014\307=V]\032\271\311\253S}z\203\370\222f\210\353b\330G\035\356\373z\2153\231!e\307\365$)\373\2242\335V\035O&\224\3138\030T!\221\257\020\306\202\272\221C1Fnd82\316\356\202\201u\217\370\260\352x\314S\030K\352W2\026\216$\025w\014\275\233\242\tI\372rj\256\354s\347\020KE\204J&\034:\246\\,\035\360\244S\033\r\023s8K\206\364\364\2527:tx8\"\374\264\024\237W\023\"\024\264\216\033)\272\231\242_\216i^N\250\243\024\0130\177L\310\221\010Q\343\240\004\361\351x(\023B\222\372x\263\344~BDiu\352\324\301\301\224d)\362~\212^\235\3222E\336GN\022\341e\212 \237\352\340\260$B\010\332M\0021\311R\004A\214B\3179\364!\034\244p>\2578\316Q\3709q\203 \0236\033\221\271cs\316\207K\200\220ED\010\322D.Q$s\306j\022\375:|\223\304\223\031\313*fs\271\307V\366\251\275\275^\034\365x\333\332\262a\260\216\327\255\222\265\276gm\342\334\366\206m\025s\2177m;\017\343\\\351\031.\226\254B\to\346\266r\245\037\314\025K\366n\321\366}/\224\236\334\310\035\330\353\270\360d\007\027\263\326\246\235\333\266\262\331\275\202U\262\361\206\225-\355\0246w\376\001\334Kva\337\332\334\262\0160p+l\357\224pvg""{\337>\200n\335\336\336\333\262\01398\215\355Ba\247\260\273[\310m\235\322\251`\257\357eAJv\247X*\330E\340\n\203\261RZ406]n\273\270\263\271o\257\047-\236*S\244G\021e\016-\345\266\354\304&\215\203\231)$~\315\305\241\014\211C\047D\006\343*\205\204\311<\324\336\365\345\243L\2252\200!\221\3361J9\307\334*\306\351%H|H\032u\326\"\\;\260\236\216!\006\353)\301Q\350\232s\234Q\211\361n\263\001\377\353\200Sx\2336T\201V0\036a\t\344:\344\265F\233)\001\214=E\003=\341\3523\360W\211\230\243\373\352X#\370\363\202\020\000TS\001\361\230\351\271\033\371f\215\221 \351\351\013\335A$b\247F\235C\031\005\311h\304E\223\032\t\023*b&\222)\266\331x_]\351\020\325<\216\"\342\217\331\216a\352G\336\233L\320\206\036\200\003\047\252\310\224\352?r,\306\n2^\033%\301i\202G\000\321\024@\223\270$\324\350\212\001\006\3224\366\030`>\024\214S\223\212\373P\026 F\306\351\204\313Q\245\002S~X#\220STH\020\226\324\047\"M\"\0229\255\226\243\211&s<\236\231h!I\244x\271L$u4lb\2305\256\004\215E\3401S\016\034\310~\n:a\250g\016-\023\347\320\3619\034\320\327\017\r\2442\334\020u\035\0361\345j\177\233F\033\233\240\010\3045\224H\n^7e\215\206\022\223\262\324\235\013^\007\306\025M\207\302\013\306\264\240`\252\340\302\300MF\303M\305kP\267\342\223\252\254\370\234\250/\326\222\020\2056 jTjG\341_\215(\324m\027\3129m\200#C\035m2i^\322\347\200\356X\233@\231\353\227}\327\207\340\363}\335\047W\353\002\316c\301_\310  \r\354i/\320@W{]\345\203\210\351\373\206wB\000\222\024\323\302}\026\202aa\023L\345\002\356 \204\0149\014yx$\004\255z\022\030\000\332k\330\323\240\317\005\305\025J\244W\366|O5\341VE\304$\260\3245@C\254S\213\304X\023\r\327PF\241W\243\022\n\224\322\273\014?x\232\004D\233d\222\323\224?\323`\345\001?\005nT\034\376E\344(U\003\213\3644\366\275\300SQ\031R\001\264L\3228\235\314\020r\0215\215|AD\320h\334k\334\303\241\022\r\035\027M\335\2744\r\025\\\356\270<\322\370~{\324\377\371\016\232M\3556\261\324\372bu\036\215L4\235\336{\326\334i\372b\362\227\347\352\034\336_cm\047\\\337\317\370\"\326\235m\325\207\323\371\047\323\375\334q\022}h""\004\304\370/&\235\361\027\006\223%\316\352\210\273\370\365A\201\204\244)k\004\231\203\244\321\217\2469\323&O?\310tt\373l\201++I\356%o\333\302\224>_\307U\r\023O\237\226\316\337\361`\224\245\300\317\364z\047\350\360:\243w\341e\350\323\340\242>\312)\003\231R;`\004 3\rM\241\2666\324\323\000+\317\013\214\345\271\367\307k\3123\t\331\017\343\205\013e\315y\334\316\263\010\\\233\274\201\253\324\235\203\272,\374&\236N\210\361\276\031\276z}\264\234k\370y\251\n\322f^\317;\2104Qz\266\334\331\267\367\316f\276v\014\nh\031\306\373\r(\220fT!\016\304\275!M\251\233\341\2257\224\377:\310y\033Io\027\311\377/\232\244u\232<\336\364{\006\300\230\35274\\\032\314i\236\372\355\303\324\234~\326\235\3327\303\224\2630\365\003\207\342L\327^\\\237w\206\3677\303\321\367\240\330\354\214\374\340\342/^\366\376W4\231\336\220\301\346\261`\363\005i\312\306\244h\300\047\332dYP\375m5\007\037)Tx\220\036/\247K\346\331\222\032\321\360\234\272u\317\374t\230\224\255\r\375+%\253~\250w\354\373zm\237M\351T\203\033\205W\033\303\360\301\n\016\013\233g\277pgK\237U?\336\356\305|\241\227\352YnX\006\200\343\317\261\371\r2!\341#mV\304~9\371R\267F\304\244\334\277\371\261\213\307\356T\367\345\271\t+x\333P5\035\352\020|uix\371\027\307\237\265\362\257\254\357\257\314\037o\264n\265\356\267\366\343\225ajp?>h\347\333\265N\245\373\270\353\365\032\047\242\277`v\017\346\177\027[\257\254\377\374f\356\243\337\306\267\342\265\370hx\005f\314n2\274\362I|#\316\177\177e\261\r{?>^=\256\266\362\303\371\033-k8\177\263\225o\321x%\266\206W\1779\234\277\326\372(\376=\034\270\266\320Z\000\211\253-\027\230\301b\\j/\264o\265W\332\331v\275\363uw\243w\253\267\322\263z\373\047\017\372\237\016v\363\203|qP,\rJ\007\203\203g\203g\337\014\276\371v\360\355w\303k\327\r\203\345\366Z\273\331\275\334\315\365J\047\237\364\027\373\300\375F\353\2371\321*~|\274v\\\007\263Vc\002\302\007\327P\373\322p\376z\353\253\270\330\376y{\257\363\247N\324\315v\243^\242\334\257[\213\255j\234\217+\355\047\035\273{\243[\352\375\241\017\333\177u,[\267\343?\306y\315\367\t\350""\232\217)hjw\026:\213\035\002\034\254\356~\357\301\311\247\375K\375\233}\322WFS\255\340\340\273\177\r\2157j-\047^\030\311\277<X\\\353\256\367\256\236\200\203\256\017\256/\202\305\021H\273\331\245\275\325\301\243\235~4(\355\351\013\261\216K\255\205\341\225k\255\237\265\376\032g\343\177w\262\235z7\337\255\366\362\275\352I\376\244\322\317\366\217\264\007\376\326\276\332\311w\234\356BL\376\013\014\237{N";
-    PyObject *data = __Pyx_DecompressString(cstring, 2231, 1);
+    #if (CYTHON_COMPRESS_STRINGS) == 1 /* compression: zlib (2305 bytes) */
+static const char cstring[] = "x\332\325X\313o\033\307\031\227Q\033\220\033\271\220j\047H\320\026X\025Nd\2656cY\212\223\006\256\2135\265j\031\353\301\227\024\031I1\030\356\016\311\261vgV3\2634i\240\200\217:\362\310#\217<\362\310\243\216:\362\310\243\377\204\376\t\375f\226\217U\"\321\362CE\"@3\337\274\276\327|\337\357\233\245\205\225u\277n\361\322s\342\252\307w\224 \304*\013\\\t\010S\313\251o\255G[$\340\242\261G\311\013\213\227\255G.g\212V\"\036I\0133\317\362\250\320\347~:M\331hA*A=\342%6[\\L]?=7\336\371\370\037i\314\030W\026\226\222V\230\245\270%\010\366\356q\3467\254\300(Y\003%3\254\206}\352Y\001\367\310]\213\324C8\013\254\226\334%-w\251\314\205\022\230-\335\265*\300j\264YVqH@\224\205\353TZ\333\\\021KU\3011\351\206\252rf\301\234G|Z\"\002+\002\322\264~\300U\350M\314\312:\331{k\337\254\031m\005\321n\224\226\214J\256\017\212\022\251\235V\212\250\257\200\273j\204D\246\254L\331j\360\310b\004\364\002+B\330\227<\240\252\204Y\222(MXK\306f\254(g\010\216SVY\032\272\211\326\210>\275\201}IR\330\363\020\354#.\367}\275\306\231L\341\222\353Q\211K>!L\267\025\227\312\230\362\030\007\203\3128\362\225\205\220 ^\344\022\204,/2\034\031g\367\300\300\032\305>\254\272\224Q\205\220$~9e\243H\022q\327\320\331\004\215q\334\227\022s%\237\273\007H*,T<\341\222\021\345!\351\202\047\335\352p\030\233\303Y<$\247W\351\360\320\301\301\220\360\223R|^\211\211P\220\032\252\047\350F\202~9\242y)\246\016\023,\300\374\021!\207\"D\225\203\022\330\047\243\241\214\t\211k\243\315\222\3731\021%\325\251\021\027\005\023\222%\310\007\tzuB\313\004\371\300r\343\010/\021\013\362\251\006\016\213#\004[\3318\020\343,\265 \210\255\220\272\007>\204\203\024\356\227e\327=\014\277\304^\020\244\302F=2wl\316\371p\t\020\262\026\026\0027,\017+\234:c5\216~\035\276q\342\311\224m\027\322\231\314\023;\375\324\331^/\014{\264mo90XG\353v\321^\337\2657Qf{\303\261\013\231\047\233\216\223\203q\246\370\014\025\212v\276\21063[\231\342O\346\nE\047[p|\237\206\222\312\215\314\276\263\216\362\377\332A\205\264\275\351d\266\355tz7o\027\035\264a\247\213;\371\315\235\177\002\367""\242\223\337\2637\267\354}\004\334\362\333;E\224\336\331\336s\366\241[w\266w\267\234|\006N#\047\237\337\311g\263\371\314\326)\235\362\316\372n\032\244\244w\n\305\274S\000\2560\030)\245E\003c\323e\266\013;\233{\316z\334\242\2112\005r\030\021\346\222bf\313\211m\3228\230\232@\342\367\\\034\310\020\273dL\244\020\252\020H\230\324#\355]_>NU\010\003\030\022\311\035\303\224s\315\255\"\224\\\202\304\207\244Qg-\302\265\003\353\311\030b\260\226\020\034\205\2369\307\031\221\010e\033u\370_\007\234B\333\244\256\362\244\214\320\020K \327!\2575\332L\010`L\025\t\364\204\247\317\300_9b\256\356+#\215\340\217\006!\000\250\246\002L\231\351\271\027\371f\215\341 \356\311\013\335A$\"\267J\334\003\031\005\361h\310E\223\032\tc*b&\222\tr\330h_M\351\020\325<\016#\354\217\330\216`\352g\336\033O\220\272\036\200\003\307\252\310\204\352?s,B\n2^\033%\301i\202G\000\321\004@\023{8\324\350\212\000\006\2224\242\0140\037\n\306\251I\305}(\013\020#\243tB\245\250\\\206)?\254b\310)\"$\010\213\353\023\226&\021\261\234T\313\341D\203\271\224\247\306ZH\034)^*aI\\\r\233\010f\215+Ac\021Pf\312\201\013\331O@\047\004\365\314%%\354\036\270>\207\003\372\372\241\201T\206\033\"\236\313#\246<\355o\323hcc\024\201\270\206\022I\300\353\246\254\221P\"\\\222\272\363\300\353\300\270\254\351P\320`D\013\002\246\n.\014\334\2444\334\224i\235xe\037Wd\331\347X=\\\213C\024\332\000\253a\251\035\206\177%\"P\267=(\347\244\016\216\014u\264\311\270yI\236\003\272#m\002a\236_\362=\037\202\317\367u\037_\255\0078\217\004\177!\203\000\327\021\325^ \201\256\366\272\312\007\021\323\367\r\357\204\000$)\246\205\373,\004\303\302\006\230\312\005\334A\010\031r\020\362\360P\010R\241\022\030\000\332k\330\323\240\317\005Ae\202%-Q\237\252\006\334\252\210\230\004\226\272\006h\210u\253\221\030i\242\341\032\312(\364jXB\201Rz\227\341\007O\223\000k\223Lr\232\362g\032\244(\360S\340F\305\341_D\256RU\260HO#\237\006TE%H\005\3202N\343d2C\310E\3044\362\005\026A\275~\277~\037\205J\324u\\4t\363\3224Dp\271\343\361H\343\373\235a\377\227\273\326t*\333@R\353\213\324y""\264e\242\351\364\336\263\346N\323\027\223\277<S\343\360\376\032i;\346\372a\306\027\261\356l\253.O\347\377\233\356\347\216\343\350\263\206@\214\2762\351\214\036\032L\226(\255#\356\342\327\007\005\022\222\246\244\021d\006\222F?\232fL\033?\375 \323\255;g\013\\Y\211s/~\333\346\047\364\371:\256j\230x\372\264x\376\216\257\207Y\n\374L\257w\202\016o2:\013/C\237\004\027\365QF\031\310\224\332\001C\000\231jh\002\265\265\241T\003\254</0\226g>\034\257\t\3178d/\307\013\027\312\232\363\270\235g\021\2706~\003W\2107\003uY\370\r4\231\020\243}S|\365\346h9\327\360\363R\025\244M\275\236\367\020i\242\364l\271\323o\357\275\315|\343\030\024\3202\214\367\353P \315\250\214]\210{C\232R7\305+o)\377M\220\363.\222\336-\222\177-\232$u\032?\336\364{\006\300\230\35074\\\032\314i\236\372\355\303\324\214~\326\235\3327\305\224\2630\365\222Cq\252k/\256\317{\303\373\333\341\350\007PlzF^\272\370\213\227\275_\212&\223\0332\330<\022l\276 M\331\030\027\r\370D\033/\013\242\277\255f\340#\205\010\n\351\361r\262d\236-\211\021\t\317\251[\367\315O\207q\331\332\320\277R\262\312e\275c?\324k\373lJ\247\032\334(\274\332\030\202\017VpX\330\210o\327\255b1\3361\356\306\216\220.\r\033\350!|\"a\277\002\205|\370a]\3621|C\276\335\316\267f}\331\272\000\220V\340\023\363\354\227\376\364[\230VG\337\355\313\341B/\366\263\302a\031\200\236?G\346\267\330\230\204\217\325i\231\373\315\370\027\013{H\214\237=o\177\354\3429<\321}yf\314\n\336xDM\206:\025c\035t\013\010D\364\31713>\3015\362\352\312\340\352o\217\376\332\314\275\262_\317\316\035m4\027\233\017\232{\255\225Ab\360\240\265\337\316\265\253\235r\367I\227\366\352\307\342d\301\354\356\317\375\261e\277\262\377\373\351\314\365?\264\026[k\255\303\301,\314\230\335x0\373Y\353V+\367z\366v\033\366~t\264zTi\346\006s\267\232\366`\356\343f\256IZ+-{p\343w\203\271\371\346\365\326\237\340\300\374Bs\001$\2566=`\006\213\255b{\241\275\330^i\247\333\265\316\367\335\215\336bo\245g\367\366\216\277>\371\242\237\315\365s\205~\241\330/\356\367\367\237\365\237\375\320\377\341\307\376\217\377\036\314\3374""\014\226\333k\355F\367j7\323+\036\177vr\373\004\270\337j~\327\302Z\305\217\216\326\216j`\326j\013\203\360\376\274\325\2762\230\273\331\374\266Uh_k\357v>\357D\335t7\352\331\203\331\033G\271\301\354\365\301\302\357\007\363\237\000\323%\320\347\213\316l\367Z\267\330\273\325C\047v,\255\332r\333\013\203[\237\266f\333W`\307\347\355\303\316\265N\256\343u\027\273_\365\256\364>\351\2758.\237\330\047\273\375\274Vx\260\370\347\366\235\316bg\345\365\034\330;0\236\2516\335\326\302P\227\253\375\333k\335\365\336\215cp\326\315\376\315\333`}\324q\272\037wIo\265\377x\347$\352\027w\365\345\330GE}|\276\371\233\346\337Z\351\326\177:\351N\255\233\353Vz\271^\3458\007\022\323\047\207Z\277\277\267o\2002nw\241\205\377\007\211]\341\331";
+    PyObject *data = __Pyx_DecompressString(cstring, 2305, 1);
     #define __Pyx_DecompressString_LZSS_UNUSED
     if (unlikely(!data)) __PYX_ERR(0, 1, __pyx_L1_error)
     const char* const bytes = __Pyx_PyBytes_AsString(data);
     #if !CYTHON_ASSUME_SAFE_MACROS
     if (likely(bytes)); else { Py_DECREF(data); __PYX_ERR(0, 1, __pyx_L1_error) }
     #endif
-    #elif (CYTHON_COMPRESS_STRINGS) > 0 && (CYTHON_COMPRESS_STRINGS) <= 90 /* compression: lzss (3000 bytes) */
-static const char cstring[] = "\377 at 0x o\377bject>(t\377ree frag\377ment).: \377<MemoryV\377iew of <\377contiguo\377us and d\263ir4\001\007\rin\021\005s\277trided\"\010 7or \004\031><(\tA\006\377>?Cannot\377 assign \377to read-\277only m\240\002v\376\242\000Invalid\377 mode, esxp\324\000|\000\047c\047t\001\377\047fortran\317\047, gH\000%\005sh\367ape\222\000 axi\377s Note t\375h\226 Cython\375 \021\000delibe\317ratek\000\320\001ct\373er!\001n PEPo-484\212\"re\303!\177s subcl\246\000\373es\261!built\375i\260\000ypes. \377If you n\311e\224 \303\000p\316\000%\tth\277en set\200\000e\373 \047\357\002ation\377_typing\047\366\355$iv\242\000o Fa\377lse.add_>\231 ecoll\305@+\000\377s.abcdis\277ableen\002\001g\367cis\004\003dno \377default \377__reduce\337__ duM\002no{n-\262@vial\033\000\377cinit__s\377elf.A_us\327er,\007\002P\001\010aa\372\016\003b\025\010block\277_start+\003c\275e\002\005d_sc\307 c\241hD\003\275c\336\000S\003e\020\013i\3268\004kkA\004lZ\tlo\375g\211\003prev_xj\001\010y\r\010z\034\005ob\267\003qq\276\010\374\000\314\003res\244\004wrho\240\000ale\022\004\373hs\356\003saved\326\004\004ol\202#u\351\tve\247c_m\232#\007\001n\000\0102\352\014\0103\031\007s\000\0102 c\376\334\204\003be conv\234\256 \234ca P\203\204\003\240\206\003 \377for pick\375l\214`src/fc\377cqp/admm\237.pyxu\351B\234\205\001a\375l\202@ate ar\377ray data\341.\013\020\370\204\003\312\206\001\247\206\003s.A\377ASCIIBAC\337KENDS\001\004_N\367AME\n\000D_DA\377TADUAL_I\377NFEASIBL\367EEQ\r\000ITY_\377START_LI\367MIT\005\014STEP\377SEllipsi\377sFIXED_R\377HO_SCALE\377INACCURA\377TE_FACTO\357RLOG[\000TER\177VALMAX_K\000\377RNOT_CON\367VEX\004\000DENU\357MERI;\000_ER\377RORPPRIM\276\207\nREDUCc\000C?OSTRESS\000p\000\360\241\005w\001V\000\002\002INSO\257LVED\000\003_\203\007S\377equenceT\247IME\316\003\204\211\001.\211\211\007W\377orkspace\376\000\006.__get_\367_.<\370!ls>.\177genexpr\026\t\332\354\205\004c\332\207\002__1\tse\177tstate_\013\017\347forX\000`\007sol\335vn\010upd3\002on\177es__Pyx\001\000\377Dict_Nex\277tRef__\305""\207\004e\217____\232\210\002\000\006\260\001i\227tem\026\001d0\001 \000f\227unc&\001g\212\0054\000i\337mport<\001ma{in\003\002odulM\002\267nam\002\003ew]\001p\376~\000checksu\350T\000\n\001\322\003_\025\001typ\333e_\005\002un\305\204\002e_\233En \005vt\261\210\001\241\001q\007ualO\005\237\210\005\250\210\006\266%\271\210\006Kex\325\001s\373 \203\005s\260\010\276\310.__tes\310\001i\377s_corout\377ineabcad\377aptive_r\373ho\000\t_inte\357rval\010\ntol\347era\241`\345\205\005_bu\377fferalph\377aanderso\333n_\232\214\003as\204\206\002as\374\273\215\007\n\004yncio.\376}\006sautobb/asec\263\211\001_\231\000\306\"\336\257\000rmin\212\213\002cl\334\254\000\221\000_tr\375`ba\237ckclo.\000\373Ac\337onstr\237@ed?countd\354!\000\002\371_\352\000\346\216\003encod\363ee\363 \322\214\002eps_\227abs\003\001d\363 \352\000f\336\017\001prim\004\005re\256\350\000ror\352\207\002.\353\207\001f\377ixedflag\377sfloat64~\235\204\003format\344\215\004\376\370\204\004guessidUi\217 x\306 p\352as\000\002\377izejkkt_\376\277\001endlbld?l_full\004\001\227\214\003\377dlog_row\377smmax_it\237ermem\352\216\001\342\216\001m\373un\367andimn\357extny\001lnp\376\314`pyobjor\366\201@pp\235 popq\377rregiste\370\005\000\360\216\002\361\212\001ore_f\377easibili\377tyrhorun\177samesca\336\211\002\257chur\240\215\004d\205\215\001s\356\244\000set\274\215\004setyt\205\212\001\300\217\002sigmG\000\343ze\230\206\002\372\214\002\377\214\002_ti\372M\000t\343 topst?ructth\317\000\023\001\377_limitub\343un\242\001\301\206\003\301\206\tval\373ue\000\002swarm\377xx0x0_pt\253rx\224ay\231az\000\002e\377rosOdoub\357le (\001\004*, |\000\007\000\021Py_ss\200@\217_t, \000\t\016\007\210\214\001s\207t *\024\t\000\0212\013Z#)\237\000void\245\006\263\204\002 \000\252\007\000\r\000\0351\014\272\025\310\037\2429v;\240\207F\315\034{>\2636\370c \371\211\003t\333_5\271\217\002_6\333\223\001es\343_C\273\213\001\225}\325e)\000e\277quilib\225\225\001\000\233un\255\205\001e\000\001\002\365\222\003iont ([\02311\366\205\003~\326\224\003Re""stor\343\224\002t\346a\216\0233\243\207\001KKT\010\027\2557\251\207\004_R\320\224\002d\262\204\001i\357nt, \327\033Pro\317blem\340\204\007\206;It>\205\227\002s *)\000\272\207\004\314\032\330\254\210\001\257\212\004\226\000si\335\211\001s \014\234\204\016\265\206\003)\000\002G\365\206\005\337\205\005\260\200S\300\246\206\r\335\207\024\357U\2103\330 \376\224\003ge\377d\000nearly\r_\007\007re\277$\306x\214\177\354\204\0058\356N\277\211\003\231\206\017int\202Z88\320\241\204\002b\023\240[\246\200> \326\211\035*)y\000\234\216\001\216\230\002xity\t\002?factor\024\002\203\224\002\010\317\206\030\310<\361\204\025 \247\214\022\202\205\032\270V\251\206$4\374\205\024\000\207 \261\216\034)\000\264\222\006\314\220\001\353le\235\212\001a\322\220\001_in\334\222\223\001\370\220\001nt\000\323\222\001al\000\340\222\002\"\003\216\212\030\300\211\021\350\2115\344\202$\347\210\032f\047\000\317\202=\264\221\006\242\211#V@\267\222\004\361\220\024\251\212\033\255\200h\003)\000\261\222\004\266\217\023\255\201r\227\212\002\367\216\005\275\233\002\274\262\213\002\254\213\006nce\000\226\217\005r\375e\330\231\001\000mater\037ializ\021\007\255\244\002 \0061s\255\226\002\252\226\001\240\221\r10\343\247\002\224\246\003\rF\354\250\001ng\360\223U\246\225E\366\226\023\240\222\001\373*)\262\222\001n_and\037_copy\200\226\023\224\227\025\227\215\025\340\235\223\007\260\2263\205\224\"\265\230\t\216\224\007pro\353j_\377\247\002\000\006\002set\024\344\227\003\350\224\0238\241\236\006A\254\236\004\263\223\004\234\221\033\330!\023\225\223%\345\231\t)\000\243\237\006re\347set\005\007\377a\200\001\330\377\004\n\210+\220Q\200A\377\340\010\014\210F\220!\220\2772\220V\2301\330\002\0102\377\230X\240Q\240h\250f\377\260B\260i\270x\300r\373\310\021)\002\320\014\034\230A\377\200A\360\030\000\t\033\230\177!\2304\230q\330\010\017\000\376)\002a\330\010\031\230\024\230\337Q\340\010$\240W\000\013\210\3773\210g\220Q\330\014\024\377\220A\330\014\025\220Q\220\377e\2301\230A\330\r\016\377\330\014\020\220\t\230\035\240\277a\330""\020\021\220\021|\0003\363\220dJ\000\032\000\230T\240\021\377\240!\2401\240C\240v\377\250W\260F\270!\2701\377\270A\270V\3007\310&\377\320PQ\320QS\320S\377T\320TX\320XY\320\377Y[\320[\\\320\\]\357\330\020\023\220=\001)\2404\377\240y\260\004\260I\270T\337\300\031\310$\310[\000\024\220\367J\230a\237\001\013\2104\210\335v\341\0003\230az\000\320\020\377 \240\001\330\014\023\220:\377\230S\240\005\240U\250%\177\250u\260C\260u\270\227\003\377\022\220$\220g\230Q\230\377f\240H\250E\260\024\260\357T\270\037\310,\000\017\210s\377\220(\230#\230Q\330\020_\024\220H\230A\037\000e\247\000\177E\250\021\250$\250a?\000\377A\260V\2707\300&\310\177\001\310\025\310a\310t\245\002\276\235\001\320]^\330\010\212!h\357\220c\230\021y\004\004\320$\2774\260D\270\r\300\236 \023\327\320\023$\357\000uk\000\025\260\377e\2703\320>O\310u\367\320TU\215AA\210T\220\377\021\330\010\020\220\003\2209\377\230C\230}\250C\250v\377\260Q\260g\270Q\270g\377\300Q\300f\310C\310q\376\376\001=\240\r\250Q\250c\017\260\021\230a";
-    PyObject *data = __Pyx_DecompressString_LZSS(cstring, 3000, 6533);
+    #elif (CYTHON_COMPRESS_STRINGS) > 0 && (CYTHON_COMPRESS_STRINGS) <= 90 /* compression: lzss (3104 bytes) */
+static const char cstring[] = "\377 at 0x o\377bject>(t\377ree frag\377ment).: \377<MemoryV\377iew of <\377contiguo\377us and d\263ir4\001\007\rin\021\005s\277trided\"\010 7or \004\031><(\tA\006\377>?Cannot\377 assign \377to read-\277only m\240\002v\376\242\000Invalid\377 mode, esxp\324\000|\000\047c\047t\001\377\047fortran\317\047, gH\000%\005sh\367ape\222\000 axi\377s Note t\375h\226 Cython\375 \021\000delibe\317ratek\000\320\001ct\373er!\001n PEPo-484\212\"re\303!\177s subcl\246\000\373es\261!built\375i\260\000ypes. \377If you n\311e\224 \303\000p\316\000%\tth\277en set\200\000e\373 \047\357\002ation\377_typing\047\366\355$iv\242\000o Fa\377lse.add_>\231 ecoll\305@+\000\377s.abcdis\277ableen\002\001g\367cis\004\003dno \377default \377__reduce\337__ duM\002no{n-\262@vial\033\000\377cinit__s\377elf.A_us\327er,\007\002P\001\010aa\372\016\003b\025\010block\277_start+\003c\275e\002\005d_sc\307 c\241hD\003\275c\336\000S\003e\020\013i\3268\004kkA\004lZ\tlo\375g\211\003prev_xj\001\010y\r\010z\034\005ob\267\003qq\276\010\374\000\314\003res\244\004wrho\240\000ale\022\004\373hs\356\003saved\326\004\004ol\202#u\351\tve\247c_m\232#\007\001n\000\0102\352\014\0103\031\007s\000\0102 c\376\334\204\003be conv\234\256 \234ca P\203\204\003\240\206\003 \377for pick\375l\214`src/fc\377cqp/admm\237.pyxu\351B\234\205\001a\375l\202@ate ar\377ray data\341.\013\020\370\204\003\312\206\001\247\206\003s.A\377ASCIIBAC\337KENDS\001\004_N\367AME\n\000D_DA\377TADUAL_I\377NFEASIBL\367EEQ\r\000ITY_\377START_LI\367MIT\005\014STEP\377SEllipsi\377sFIXED_R\377HO_SCALE\377INACCURA\377TE_FACTO\357RLOG[\000TER\177VALMAX_K\000\377RNOT_CON\367VEX\004\000DENU\357MERI;\000_ER\377RORPPRIM\276\207\nREDUCc\000C?OSTRESS\000p\000\360\241\005w\001V\000\002\002INSO\257LVED\000\003_\203\007S\377equenceT\247IME\316\003\204\211\001.\211\211\007W\377orkspace\376\000\006.__get_\367_.<\370!ls>.\177genexpr\026\t\332\354\205\004c\332\207\002__1\tse\177tstate_\013\017\347forX\000`\007sol\335vn\010upd3\002on\177es__Pyx\001\000\377Dict_Nex\277tRef__\305""\207\004e\217____\232\210\002\000\006\260\001i\227tem\026\001d0\001 \000f\227unc&\001g\212\0054\000i\337mport<\001ma{in\003\002odulM\002\267nam\002\003ew]\001p\376~\000checksu\350T\000\n\001\322\003_\025\001typ\333e_\005\002un\305\204\002e_\233En \005vt\261\210\001\241\001q\007ualO\005\237\210\005\250\210\006\266%\271\210\006Kex\325\001s\373 \203\005s\260\010\276\310.__tes\310\001i\377s_corout\377ineabcad\377aptive_r\373ho\000\t_inte\357rval\010\ntol\347era\241`\345\205\005_bu\377fferalph\377aanderso\333n_\232\214\003as\204\206\002as\374\273\215\007\n\004yncio.\376}\006sautobb/asec\263\211\001_\231\000\306\"\336\257\000rmin\212\213\002cl\334\254\000\221\000_tr\375`ba\237ckclo.\000\373Ac\337onstr\237@ed?countd\354!\000\002\371_\352\000\346\216\003encod\363ee\363 \322\214\002eps_\227abs\003\001d\363 \352\000f\336\017\001prim\004\005re\256\350\000ror\352\207\002.\353\207\001f\377ixedflag\377sfloat64~\235\204\003format\344\215\004\376\370\204\004guessidUi\217 x\306 p\352as\000\002\377izejkkt_\376\277\001endlbld?l_full\004\001\227\214\003\377dlog_row\377smmax_it\237ermem\352\216\001\342\216\001m\373un\367andimn\357extny\001lnp\376\314`pyobjor\366\201@pp\235 popq\377rregiste\370\005\000\360\216\002\361\212\001ore_f\377easibili\377tyrhorun\177samesca\336\211\002\257chur\240\215\004d\205\215\001s\356\244\000set\274\215\004setyt\205\212\001\300\217\002sigmG\000\343ze\230\206\002\372\214\002\377\214\002_ti\372M\000t\343 topst?ructth\317\000\023\001\377_limitub\343un\242\001\301\206\003\301\206\tval\373ue\000\002swarm\377xx0x0_pt\253rx\224ay\231az\000\002e\377rosOdoub\357le (\001\004*, |\000\007\000\021Py_ss\200@\217_t, \000\t\016\007\210\214\001s\207t *\024\t\000\0212\013Z#)\237\000void\245\006\263\204\002 \000\252\007\000\r\000\0351\014\272\025\310\037\2429v;\240\207F\315\034{>\2636\370c \371\211\003t\333_5\271\217\002_6\333\223\001es\343_C\273\213\001\225}\325e)\000e\277quilib\225\225\001\000\233un\255\205\001e\000\001\002\365\222\003iont ([\02311\366\205\003~\326\224\003Re""stor\343\224\002t\346a\216\0233\243\207\001KKT\010\027\2557\251\207\004_R\320\224\002d\262\204\001i\357nt, \327\033Pro\317blem\340\204\007\206;It>\205\227\002s *)\000\272\207\004\314\032\330\254\210\001\257\212\004\226\000si\335\211\001s \014\234\204\016\265\206\003)\000\002G\365\206\005\337\205\005\260\200S\300\246\206\r\335\207\024\357U\2103\330 \376\224\003ge\377d\000nearly\r_\007\007re\277$\306x\214\177\354\204\0058\356N\277\211\003\231\206\017int\202Z88\320\241\204\002b\023\240[\246\200> \326\211\035*)y\000\234\216\001\216\230\002xity\t\002?factor\024\002\203\224\002\010\317\206\030\310<\361\204\025 \247\214\022\202\205\032\270V\251\206$4\374\205\024\000\207 \261\216\034)\000\264\222\006\314\220\001\353le\235\212\001a\322\220\001_in\334\222\223\001\370\220\001nt\000\323\222\001al\000\340\222\002\"\003\216\212\030\300\211\021\350\2115\344\202$\347\210\032f\047\000\317\202=\264\221\006\242\211#V@\267\222\004\361\220\024\251\212\033\255\200h\003)\000\261\222\004\266\217\023\255\201r\227\212\002\367\216\005\275\233\002\274\262\213\002\254\213\006nce\000\226\217\005r\375e\330\231\001\000mater\037ializ\021\007\255\244\002 \0061s\255\226\002\252\226\001\240\221\r10\343\247\002\224\246\003\rF\354\250\001ng\360\223U\246\225E\366\226\023\240\222\001\373*)\262\222\001n_and\337_copy\220\226\003ch\303ar\273\221\004\302\221\004\202\227\001\260\223\006sc\377ipy_6lin\277alg_11\310\240\004b\037las_d\000\047&2\260\002\373, 3V)\000dge\003mv\210\230\023\234\231\025\237\217\025\245\225\007\270\2303\215\226\"|\275\232\t\226\226\007proj_\207\252\002\235\000\006\002set\354\231\003\360\226\0238\002\251\240\006A\264\240\004\273\225\004\244\223\033!\023\235\225%\355\233\t\373)\000\253\241\006reset\360\005\007\207\206\001\247\233\003\257\233\001)\000\000e\376\213\242\001\000leave\200\377\001\330\004\n\210+\220Q\377\200A\340\010\014\210F\220\377!\2202\220V\2301\330\376\002\0102\230X\240Q\240h\377\250f\260B\260i\270x\357\300r\310\021)\002\320\014\034\377\230A\200A\360\030\000\t\377\033\230!""\2304\230q\330\371\010\017\000)\002a\330\010\031\230\177\024\230Q\340\010$\240W\000\377\013\2103\210g\220Q\330\377\014\024\220A\330\014\025\220\377Q\220e\2301\230A\330\377\r\016\330\014\020\220\t\230\377\035\240a\330\020\021\220\021\316|\0003\220dJ\000\032\000\230T\377\240\021\240!\2401\240C\377\240v\250W\260F\270!\377\2701\270A\270V\3007\377\310&\320PQ\320QS\377\320ST\320TX\320X\377Y\320Y[\320[\\\320\277\\]\330\020\023\220=\001)\377\2404\240y\260\004\260I\177\270T\300\031\310$\310[\000\337\024\220J\230a\237\001\013\210w4\210v\341\0003\230az\000\377\320\020 \240\001\330\014\023\377\220:\230S\240\005\240U\377\250%\250u\260C\260u\377\270A\330\010\r\210Q\330\377\010\t\330\021\022\330\020\026\372\223\000\047\215\000&\250\010\260\005\377\260T\270\024\270_\310A\376h\003h\230c\240\021\330\024\337\030\230\010\240\001\257\000%\240\377q\250\005\250Q\250d\260\377!\2605\270\001\270\026\270\377w\300f\310A\310U\320\375R\255\001\330!\"\240(\250\337!\2501\340\014\355\000\330\010\276\226!h\220c\230\021\205\004\004\377\320$4\260D\270\r\300\336\252 \023\320\023$\373\000u\250\377E\260\025\260e\2703\320\177>O\310u\320TU\231A\377A\210T\220\021\330\010\020\377\220\003\2209\230C\230}\377\250C\250v\260Q\260g\277\270Q\270g\300Qo\000C\273\310q\212!=\240\r\212\000c\017\260\021\230a";
+    PyObject *data = __Pyx_DecompressString_LZSS(cstring, 3104, 6833);
     #define __Pyx_DecompressString_UNUSED
     if (unlikely(!data)) __PYX_ERR(0, 1, __pyx_L1_error)
     const char* const bytes = __Pyx_PyBytes_AsString(data);
     #if !CYTHON_ASSUME_SAFE_MACROS
     if (likely(bytes)); else { Py_DECREF(data); __PYX_ERR(0, 1, __pyx_L1_error) }
     #endif
-    #else /* compression: none (6533 bytes) */
-static const char bytes[] = " at 0x object>(tree fragment).: <MemoryView of <contiguous and direct><contiguous and indirect><strided and direct or indirect><strided and direct><strided and indirect>>?Cannot assign to read-only memoryviewInvalid mode, expected \047c\047 or \047fortran\047, got Invalid shape in axis Note that Cython is deliberately stricter than PEP-484 and rejects subclasses of builtin types. If you need to pass subclasses then set the \047annotation_typing\047 directive to False.add_notecollections.abcdisableenablegcisenabledno default __reduce__ due to non-trivial __cinit__self.A_user,self.P_user,self.aa,self.b_user,self.block_start,self.cert,self.d_scratch,self.direction,self.e_scratch,self.it,self.kkt,self.lb_user,self.log,self.prev_x,self.prev_y,self.prev_z,self.prob,self.q_user,self.red,self.rest,self.rho_scale,self.rhs,self.saved,self.sol,self.ub_user,self.vec_m,self.vec_n,self.vec_n2,self.vec_n3,self.vec_s,self.vec_s2 cannot be converted to a Python object for picklingsrc/fccqp/admm.pyxunable to allocate array data.unable to allocate shape and strides.AASCIIBACKENDSBACKEND_NAMESBAD_DATADUAL_INFEASIBLEEQUALITY_START_LIMITEQUALITY_START_STEPSEllipsisFIXED_RHO_SCALEINACCURATE_FACTORLOG_INTERVALMAX_ITERNOT_CONVEX_CODENUMERICAL_ERRORPPRIMAL_INFEASIBLEREDUCED_COSTRESTORED_EQUALITYRHO_MAXRHO_MINSOLVEDSOLVED_INACCURATESequenceTIME_LIMITView.MemoryViewWorkspaceWorkspace.__get__.<locals>.genexprWorkspace.__reduce_cython__Workspace.__setstate_cython__Workspace.forgetWorkspace.solveWorkspace.update_cones__Pyx_PyDict_NextRef__annotate____class____class_getitem____dict____func____getstate____import____main____module____name____new____pyx_checksum__pyx_state__pyx_type__pyx_unpickle_Enum__pyx_vtable____qualname____reduce____reduce_cython____reduce_ex____set_name____setstate____setstate_cython____test___is_coroutineabcadaptive_rhoadaptive_rho_intervaladaptive_rho_toleranceallocate_bufferalphaanderson_memoryasarrayascontiguousarrayasyncio.coroutinesautobbaseccert_outcheck_terminationcline""_in_tracebackcloseconesconstrainedcountdtypedtype_is_objectencodeenumerateeps_abseps_dual_infeps_prim_infeps_relerrorfccqp.admmfixedflagsfloat64forgetformatfortrangenexprguessidindexintpitemsitemsizejkkt_backendlbldl_fullldl_reducedlog_rowsmmax_itermemviewmodemunnamendimnextnormalnpnumpyobjorderppackpopqrregisterreshaperestore_feasibilityrhorunsamescalingschur_reducedselfsendsetdefaultsettingsshapesigmasizesolvestartstart_timestepstopstructthrowtime_limitubunpackupdateupdate_conesvaluevalueswarmxx0x0_ptrx_outy_outz_outzerosOdouble (double *, double *, double *, double *, Py_ssize_t, Py_ssize_t, Py_ssize_t const *, Py_ssize_t const *, Py_ssize_t, Py_ssize_t, double *, double *, double *, double *)\000void (double const *, double const *, double const *, double const *, double const *, double, Py_ssize_t, Py_ssize_t, Py_ssize_t, Py_ssize_t const *, double *, double *, double *)\000void (double const *, double const *, double const *, double, double const *, double const *, double, Py_ssize_t, Py_ssize_t, Py_ssize_t, Py_ssize_t const *, double const *, double const *, struct __pyx_t_5fccqp_6_types_Cones, double *, double *, double *, double *)\000equilibrate\000unscale\000scale_startint (struct __pyx_t_5fccqp_11restoration_Restoration *, struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_7reduced_Reduced *, int, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *)\000restoreint (struct __pyx_t_5fccqp_11termination_Residuals const *, double, double)\000int (struct __pyx_t_5fccqp_11termination_Residuals const *, double, double, double)\000void (struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates const *, double *, double *, double *, struct __pyx_t_5fccqp_11termination_Residuals *)\000converged\000nearly_converged\000residualsint (struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *, double, double const *, int)\000int (struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5f""ccqp_6_types_Problem const *, int, double, double const *)\000void (struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double const *, double *)\000kkt_convexity\000kkt_factor\000kkt_solveint (struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double, double *, double *, double *)\000int (struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates const *, double, double *, double *, double *)\000int (struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates const *, double, double *, double *, double *, double *)\000dual_infeasible\000equality_inconsistent\000primal_infeasibleint (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *)\000int (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *, double, double)\000void (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double const *)\000void (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *)\000\000void (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *, double, int)\000reduced_table\000near_convergence\000reduced_rebase\000materialize\000reduced_start\000reduced_stepstruct __pyx_t_5fccqp_10validation_Finding (double const *, double const *, double const *, double const *, double const *, double const *, Py_ssize_t, Py_ssize_t, double *, double *, double *, double *, double *, double *, int *)\000scan_and_copyvoid (double const *, Py_ssize_t, Py_ssize_t, double, double const *, double *)\000void (double const *, double const *, double const *, struct __pyx_t_5fccqp_6_types_Cones, Py_ssize_t, double *)\000proj_block\000proj_setvoid (st""ruct __pyx_t_5fccqp_8anderson_Anderson *, int)\000void (struct __pyx_t_5fccqp_8anderson_Anderson *, struct __pyx_t_5fccqp_6_types_Iterates *, Py_ssize_t)\000anderson_reset\000anderson_step\200\001\330\004\n\210+\220Q\200A\340\010\014\210F\220!\2202\220V\2301\330\010\014\210F\220!\2202\220V\2302\230X\240Q\240h\250f\260B\260i\270x\300r\310\021\200A\340\010\014\320\014\034\230A\200A\360\030\000\t\033\230!\2304\230q\330\010\034\230A\230X\240Q\240a\330\010\031\230\024\230Q\340\010$\240A\340\010\013\2103\210g\220Q\330\014\024\220A\330\014\025\220Q\220e\2301\230A\330\r\016\330\014\020\220\t\230\035\240a\330\020\021\220\021\220!\2203\220d\230!\2301\230A\230T\240\021\240!\2401\240C\240v\250W\260F\270!\2701\270A\270V\3007\310&\320PQ\320QS\320ST\320TX\320XY\320Y[\320[\\\320\\]\330\020\023\2203\220d\230)\2404\240y\260\004\260I\270T\300\031\310$\310a\330\020\024\220J\230a\230q\330\010\013\2104\210v\220V\2303\230a\330\014\020\320\020 \240\001\330\014\023\220:\230S\240\005\240U\250%\250u\260C\260u\270A\330\r\016\330\014\022\220$\220g\230Q\230f\240H\250E\260\024\260T\270\037\310\001\330\014\017\210s\220(\230#\230Q\330\020\024\220H\230A\230Q\230e\2401\240E\250\021\250$\250a\250u\260A\260V\2707\300&\310\001\310\025\310a\310t\320ST\320T\\\320\\]\320]^\330\010\013\2103\210h\220c\230\021\330\014\020\320\020 \240\004\320$4\260D\270\r\300Q\330\014\023\320\023$\240C\240u\250E\260\025\260e\2703\320>O\310u\320TU\330\010\014\210A\210T\220\021\330\010\020\220\003\2209\230C\230}\250C\250v\260Q\260g\270Q\270g\300Q\300f\310C\310q\330\020\023\220=\240\r\250Q\250c\260\021\230a";
+    #else /* compression: none (6833 bytes) */
+static const char bytes[] = " at 0x object>(tree fragment).: <MemoryView of <contiguous and direct><contiguous and indirect><strided and direct or indirect><strided and direct><strided and indirect>>?Cannot assign to read-only memoryviewInvalid mode, expected \047c\047 or \047fortran\047, got Invalid shape in axis Note that Cython is deliberately stricter than PEP-484 and rejects subclasses of builtin types. If you need to pass subclasses then set the \047annotation_typing\047 directive to False.add_notecollections.abcdisableenablegcisenabledno default __reduce__ due to non-trivial __cinit__self.A_user,self.P_user,self.aa,self.b_user,self.block_start,self.cert,self.d_scratch,self.direction,self.e_scratch,self.it,self.kkt,self.lb_user,self.log,self.prev_x,self.prev_y,self.prev_z,self.prob,self.q_user,self.red,self.rest,self.rho_scale,self.rhs,self.saved,self.sol,self.ub_user,self.vec_m,self.vec_n,self.vec_n2,self.vec_n3,self.vec_s,self.vec_s2 cannot be converted to a Python object for picklingsrc/fccqp/admm.pyxunable to allocate array data.unable to allocate shape and strides.AASCIIBACKENDSBACKEND_NAMESBAD_DATADUAL_INFEASIBLEEQUALITY_START_LIMITEQUALITY_START_STEPSEllipsisFIXED_RHO_SCALEINACCURATE_FACTORLOG_INTERVALMAX_ITERNOT_CONVEX_CODENUMERICAL_ERRORPPRIMAL_INFEASIBLEREDUCED_COSTRESTORED_EQUALITYRHO_MAXRHO_MINSOLVEDSOLVED_INACCURATESequenceTIME_LIMITView.MemoryViewWorkspaceWorkspace.__get__.<locals>.genexprWorkspace.__reduce_cython__Workspace.__setstate_cython__Workspace.forgetWorkspace.solveWorkspace.update_cones__Pyx_PyDict_NextRef__annotate____class____class_getitem____dict____func____getstate____import____main____module____name____new____pyx_checksum__pyx_state__pyx_type__pyx_unpickle_Enum__pyx_vtable____qualname____reduce____reduce_cython____reduce_ex____set_name____setstate____setstate_cython____test___is_coroutineabcadaptive_rhoadaptive_rho_intervaladaptive_rho_toleranceallocate_bufferalphaanderson_memoryasarrayascontiguousarrayasyncio.coroutinesautobbaseccert_outcheck_terminationcline""_in_tracebackcloseconesconstrainedcountdtypedtype_is_objectencodeenumerateeps_abseps_dual_infeps_prim_infeps_relerrorfccqp.admmfixedflagsfloat64forgetformatfortrangenexprguessidindexintpitemsitemsizejkkt_backendlbldl_fullldl_reducedlog_rowsmmax_itermemviewmodemunnamendimnextnormalnpnumpyobjorderppackpopqrregisterreshaperestore_feasibilityrhorunsamescalingschur_reducedselfsendsetdefaultsettingsshapesigmasizesolvestartstart_timestepstopstructthrowtime_limitubunpackupdateupdate_conesvaluevalueswarmxx0x0_ptrx_outy_outz_outzerosOdouble (double *, double *, double *, double *, Py_ssize_t, Py_ssize_t, Py_ssize_t const *, Py_ssize_t const *, Py_ssize_t, Py_ssize_t, double *, double *, double *, double *)\000void (double const *, double const *, double const *, double const *, double const *, double, Py_ssize_t, Py_ssize_t, Py_ssize_t, Py_ssize_t const *, double *, double *, double *)\000void (double const *, double const *, double const *, double, double const *, double const *, double, Py_ssize_t, Py_ssize_t, Py_ssize_t, Py_ssize_t const *, double const *, double const *, struct __pyx_t_5fccqp_6_types_Cones, double *, double *, double *, double *)\000equilibrate\000unscale\000scale_startint (struct __pyx_t_5fccqp_11restoration_Restoration *, struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_7reduced_Reduced *, int, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *)\000restoreint (struct __pyx_t_5fccqp_11termination_Residuals const *, double, double)\000int (struct __pyx_t_5fccqp_11termination_Residuals const *, double, double, double)\000void (struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates const *, double *, double *, double *, struct __pyx_t_5fccqp_11termination_Residuals *)\000converged\000nearly_converged\000residualsint (struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *, double, double const *, int)\000int (struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5f""ccqp_6_types_Problem const *, int, double, double const *)\000void (struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double const *, double *)\000kkt_convexity\000kkt_factor\000kkt_solveint (struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double, double *, double *, double *)\000int (struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates const *, double, double *, double *, double *)\000int (struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates const *, double, double *, double *, double *, double *)\000dual_infeasible\000equality_inconsistent\000primal_infeasibleint (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *)\000int (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *, double, double)\000void (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double const *)\000void (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *)\000\000void (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *, double, int)\000reduced_table\000near_convergence\000reduced_rebase\000materialize\000reduced_start\000reduced_stepstruct __pyx_t_5fccqp_10validation_Finding (double const *, double const *, double const *, double const *, double const *, double const *, Py_ssize_t, Py_ssize_t, double *, double *, double *, double *, double *, double *, int *)\000scan_and_copyvoid (char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6lin""alg_11cython_blas_d *, int *)\000dgemvvoid (double const *, Py_ssize_t, Py_ssize_t, double, double const *, double *)\000void (double const *, double const *, double const *, struct __pyx_t_5fccqp_6_types_Cones, Py_ssize_t, double *)\000proj_block\000proj_setvoid (struct __pyx_t_5fccqp_8anderson_Anderson *, int)\000void (struct __pyx_t_5fccqp_8anderson_Anderson *, struct __pyx_t_5fccqp_6_types_Iterates *, Py_ssize_t)\000anderson_reset\000anderson_stepvoid (void)\000\000enter\000leave\200\001\330\004\n\210+\220Q\200A\340\010\014\210F\220!\2202\220V\2301\330\010\014\210F\220!\2202\220V\2302\230X\240Q\240h\250f\260B\260i\270x\300r\310\021\200A\340\010\014\320\014\034\230A\200A\360\030\000\t\033\230!\2304\230q\330\010\034\230A\230X\240Q\240a\330\010\031\230\024\230Q\340\010$\240A\340\010\013\2103\210g\220Q\330\014\024\220A\330\014\025\220Q\220e\2301\230A\330\r\016\330\014\020\220\t\230\035\240a\330\020\021\220\021\220!\2203\220d\230!\2301\230A\230T\240\021\240!\2401\240C\240v\250W\260F\270!\2701\270A\270V\3007\310&\320PQ\320QS\320ST\320TX\320XY\320Y[\320[\\\320\\]\330\020\023\2203\220d\230)\2404\240y\260\004\260I\270T\300\031\310$\310a\330\020\024\220J\230a\230q\330\010\013\2104\210v\220V\2303\230a\330\014\020\320\020 \240\001\330\014\023\220:\230S\240\005\240U\250%\250u\260C\260u\270A\330\010\r\210Q\330\010\t\330\021\022\330\020\026\220d\230\047\240\021\240&\250\010\260\005\260T\270\024\270_\310A\330\020\023\2203\220h\230c\240\021\330\024\030\230\010\240\001\240\021\240%\240q\250\005\250Q\250d\260!\2605\270\001\270\026\270w\300f\310A\310U\320RS\320ST\330!\"\240(\250!\2501\340\014\021\220\021\330\010\013\2103\210h\220c\230\021\330\014\020\320\020 \240\004\320$4\260D\270\r\300Q\330\014\023\320\023$\240C\240u\250E\260\025\260e\2703\320>O\310u\320TU\330\010\014\210A\210T\220\021\330\010\020\220\003\2209\230C\230}\250C\250v\260Q\260g\270Q\270g\300Q\300f\310C\310q\330\020\023\220=\240\r\250Q\250c\260\021\230a";
     PyObject *data = NULL;
     #define __Pyx_DecompressString_UNUSED
     #define __Pyx_DecompressString_LZSS_UNUSED
@@ -33855,7 +34356,7 @@ static const char bytes[] = " at 0x object>(tree fragment).: <MemoryView of <con
       stringtab[i] = string;
       pos += bytes_length;
     }
-    for (int i = 194; i < 209; i++) {
+    for (int i = 194; i < 211; i++) {
       Py_ssize_t bytes_length = bytes_length_index[i-194].length;
       PyObject *string = PyBytes_FromStringAndSize(bytes + pos, bytes_length);
       stringtab[i] = string;
@@ -33866,7 +34367,7 @@ static const char bytes[] = " at 0x object>(tree fragment).: <MemoryView of <con
       }
     }
     Py_XDECREF(data);
-    for (Py_ssize_t i = 0; i < 209; i++) {
+    for (Py_ssize_t i = 0; i < 211; i++) {
       if (unlikely(PyObject_Hash(stringtab[i]) == -1)) {
         __PYX_ERR(0, 1, __pyx_L1_error)
       }
@@ -33874,7 +34375,7 @@ static const char bytes[] = " at 0x object>(tree fragment).: <MemoryView of <con
     #if CYTHON_IMMORTAL_CONSTANTS
     {
       PyObject **table = stringtab + 194;
-      for (Py_ssize_t i=0; i<15; ++i) {
+      for (Py_ssize_t i=0; i<17; ++i) {
         #if PY_VERSION_HEX >= 0x030F0000
         PyUnstable_SetImmortal(table[i]);
         #elif CYTHON_COMPILING_IN_CPYTHON_FREETHREADING
@@ -33969,22 +34470,22 @@ static int __Pyx_CreateCodeObjects(__pyx_mstatetype *__pyx_mstate) {
   PyObject* tuple_dedup_map = PyDict_New();
   if (unlikely(!tuple_dedup_map)) return -1;
   {
-    const __Pyx_PyCode_New_function_description descr = {0, 0, 0, 1, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS|CO_GENERATOR), 329};
+    const __Pyx_PyCode_New_function_description descr = {0, 0, 0, 1, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS|CO_GENERATOR), 330};
     PyObject* const varnames[] = {__pyx_mstate->__pyx_n_u_j};
     __pyx_mstate_global->__pyx_codeobj_tab[0] = __Pyx_PyCode_New(descr, varnames, __pyx_mstate->__pyx_kp_u_src_fccqp_admm_pyx, __pyx_mstate->__pyx_n_u_genexpr, __pyx_mstate->__pyx_kp_b_iso88591_a, tuple_dedup_map); if (unlikely(!__pyx_mstate_global->__pyx_codeobj_tab[0])) goto bad;
   }
   {
-    const __Pyx_PyCode_New_function_description descr = {3, 0, 0, 3, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS), 311};
+    const __Pyx_PyCode_New_function_description descr = {3, 0, 0, 3, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS), 312};
     PyObject* const varnames[] = {__pyx_mstate->__pyx_n_u_self, __pyx_mstate->__pyx_n_u_mu, __pyx_mstate->__pyx_n_u_normal};
     __pyx_mstate_global->__pyx_codeobj_tab[1] = __Pyx_PyCode_New(descr, varnames, __pyx_mstate->__pyx_kp_u_src_fccqp_admm_pyx, __pyx_mstate->__pyx_n_u_update_cones, __pyx_mstate->__pyx_kp_b_iso88591_A_F_2V1_F_2V2XQhfBixr, tuple_dedup_map); if (unlikely(!__pyx_mstate_global->__pyx_codeobj_tab[1])) goto bad;
   }
   {
-    const __Pyx_PyCode_New_function_description descr = {1, 0, 0, 1, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS), 316};
+    const __Pyx_PyCode_New_function_description descr = {1, 0, 0, 1, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS), 317};
     PyObject* const varnames[] = {__pyx_mstate->__pyx_n_u_self};
     __pyx_mstate_global->__pyx_codeobj_tab[2] = __Pyx_PyCode_New(descr, varnames, __pyx_mstate->__pyx_kp_u_src_fccqp_admm_pyx, __pyx_mstate->__pyx_n_u_forget, __pyx_mstate->__pyx_kp_b_iso88591_A_A, tuple_dedup_map); if (unlikely(!__pyx_mstate_global->__pyx_codeobj_tab[2])) goto bad;
   }
   {
-    const __Pyx_PyCode_New_function_description descr = {14, 0, 0, 22, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS), 331};
+    const __Pyx_PyCode_New_function_description descr = {14, 0, 0, 22, (unsigned int)(CO_OPTIMIZED|CO_NEWLOCALS), 332};
     PyObject* const varnames[] = {__pyx_mstate->__pyx_n_u_self, __pyx_mstate->__pyx_n_u_P, __pyx_mstate->__pyx_n_u_q, __pyx_mstate->__pyx_n_u_A, __pyx_mstate->__pyx_n_u_b, __pyx_mstate->__pyx_n_u_lb, __pyx_mstate->__pyx_n_u_ub, __pyx_mstate->__pyx_n_u_x0, __pyx_mstate->__pyx_n_u_warm, __pyx_mstate->__pyx_n_u_start_time, __pyx_mstate->__pyx_n_u_x_out, __pyx_mstate->__pyx_n_u_y_out, __pyx_mstate->__pyx_n_u_z_out, __pyx_mstate->__pyx_n_u_cert_out, __pyx_mstate->__pyx_n_u_p, __pyx_mstate->__pyx_n_u_n, __pyx_mstate->__pyx_n_u_m, __pyx_mstate->__pyx_n_u_same, __pyx_mstate->__pyx_n_u_guess, __pyx_mstate->__pyx_n_u_x0_ptr, __pyx_mstate->__pyx_n_u_run, __pyx_mstate->__pyx_n_u_r};
     __pyx_mstate_global->__pyx_codeobj_tab[3] = __Pyx_PyCode_New(descr, varnames, __pyx_mstate->__pyx_kp_u_src_fccqp_admm_pyx, __pyx_mstate->__pyx_n_u_solve, __pyx_mstate->__pyx_kp_b_iso88591_A_4q_AXQa_Q_A_3gQ_A_Qe1A_a_3d_1A, tuple_dedup_map); if (unlikely(!__pyx_mstate_global->__pyx_codeobj_tab[3])) goto bad;
   }
@@ -41558,6 +42059,314 @@ __pyx_fail:
     result.data = NULL;
     return result;
 }
+
+/* Declarations */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+  #ifdef __cplusplus
+    static CYTHON_INLINE __pyx_t_float_complex __pyx_t_float_complex_from_parts(float x, float y) {
+      return ::std::complex< float >(x, y);
+    }
+  #else
+    static CYTHON_INLINE __pyx_t_float_complex __pyx_t_float_complex_from_parts(float x, float y) {
+      return x + y*(__pyx_t_float_complex)_Complex_I;
+    }
+  #endif
+#else
+    static CYTHON_INLINE __pyx_t_float_complex __pyx_t_float_complex_from_parts(float x, float y) {
+      __pyx_t_float_complex z;
+      z.real = x;
+      z.imag = y;
+      return z;
+    }
+#endif
+
+/* Arithmetic */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+#else
+    static CYTHON_INLINE int __Pyx_c_eq_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+       return (a.real == b.real) && (a.imag == b.imag);
+    }
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_sum_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+        __pyx_t_float_complex z;
+        z.real = a.real + b.real;
+        z.imag = a.imag + b.imag;
+        return z;
+    }
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_diff_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+        __pyx_t_float_complex z;
+        z.real = a.real - b.real;
+        z.imag = a.imag - b.imag;
+        return z;
+    }
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_prod_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+        __pyx_t_float_complex z;
+        z.real = a.real * b.real - a.imag * b.imag;
+        z.imag = a.real * b.imag + a.imag * b.real;
+        return z;
+    }
+    #if 1
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_quot_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+        if (b.imag == 0) {
+            return __pyx_t_float_complex_from_parts(a.real / b.real, a.imag / b.real);
+        } else if (fabsf(b.real) >= fabsf(b.imag)) {
+            if (b.real == 0 && b.imag == 0) {
+                return __pyx_t_float_complex_from_parts(a.real / b.real, a.imag / b.imag);
+            } else {
+                float r = b.imag / b.real;
+                float s = (float)(1.0) / (b.real + b.imag * r);
+                return __pyx_t_float_complex_from_parts(
+                    (a.real + a.imag * r) * s, (a.imag - a.real * r) * s);
+            }
+        } else {
+            float r = b.real / b.imag;
+            float s = (float)(1.0) / (b.imag + b.real * r);
+            return __pyx_t_float_complex_from_parts(
+                (a.real * r + a.imag) * s, (a.imag * r - a.real) * s);
+        }
+    }
+    #else
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_quot_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+        if (b.imag == 0) {
+            return __pyx_t_float_complex_from_parts(a.real / b.real, a.imag / b.real);
+        } else {
+            float denom = b.real * b.real + b.imag * b.imag;
+            return __pyx_t_float_complex_from_parts(
+                (a.real * b.real + a.imag * b.imag) / denom,
+                (a.imag * b.real - a.real * b.imag) / denom);
+        }
+    }
+    #endif
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_neg_float(__pyx_t_float_complex a) {
+        __pyx_t_float_complex z;
+        z.real = -a.real;
+        z.imag = -a.imag;
+        return z;
+    }
+    static CYTHON_INLINE int __Pyx_c_is_zero_float(__pyx_t_float_complex a) {
+       return (a.real == 0) && (a.imag == 0);
+    }
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_conj_float(__pyx_t_float_complex a) {
+        __pyx_t_float_complex z;
+        z.real =  a.real;
+        z.imag = -a.imag;
+        return z;
+    }
+    #if 1
+        static CYTHON_INLINE float __Pyx_c_abs_float(__pyx_t_float_complex z) {
+          #if !defined(HAVE_HYPOT) || defined(_MSC_VER)
+            return sqrtf(z.real*z.real + z.imag*z.imag);
+          #else
+            return hypotf(z.real, z.imag);
+          #endif
+        }
+        static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_pow_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+            __pyx_t_float_complex z;
+            float r, lnr, theta, z_r, z_theta;
+            if (b.imag == 0 && b.real == (int)b.real) {
+                if (b.real < 0) {
+                    float denom = a.real * a.real + a.imag * a.imag;
+                    a.real = a.real / denom;
+                    a.imag = -a.imag / denom;
+                    b.real = -b.real;
+                }
+                switch ((int)b.real) {
+                    case 0:
+                        z.real = 1;
+                        z.imag = 0;
+                        return z;
+                    case 1:
+                        return a;
+                    case 2:
+                        return __Pyx_c_prod_float(a, a);
+                    case 3:
+                        z = __Pyx_c_prod_float(a, a);
+                        return __Pyx_c_prod_float(z, a);
+                    case 4:
+                        z = __Pyx_c_prod_float(a, a);
+                        return __Pyx_c_prod_float(z, z);
+                }
+            }
+            if (a.imag == 0) {
+                if (a.real == 0) {
+                    return a;
+                } else if ((b.imag == 0) && (a.real >= 0)) {
+                    z.real = powf(a.real, b.real);
+                    z.imag = 0;
+                    return z;
+                } else if (a.real > 0) {
+                    r = a.real;
+                    theta = 0;
+                } else {
+                    r = -a.real;
+                    theta = atan2f(0.0, -1.0);
+                }
+            } else {
+                r = __Pyx_c_abs_float(a);
+                theta = atan2f(a.imag, a.real);
+            }
+            lnr = logf(r);
+            z_r = expf(lnr * b.real - theta * b.imag);
+            z_theta = theta * b.real + lnr * b.imag;
+            z.real = z_r * cosf(z_theta);
+            z.imag = z_r * sinf(z_theta);
+            return z;
+        }
+    #endif
+#endif
+
+/* Declarations */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+  #ifdef __cplusplus
+    static CYTHON_INLINE __pyx_t_double_complex __pyx_t_double_complex_from_parts(double x, double y) {
+      return ::std::complex< double >(x, y);
+    }
+  #else
+    static CYTHON_INLINE __pyx_t_double_complex __pyx_t_double_complex_from_parts(double x, double y) {
+      return x + y*(__pyx_t_double_complex)_Complex_I;
+    }
+  #endif
+#else
+    static CYTHON_INLINE __pyx_t_double_complex __pyx_t_double_complex_from_parts(double x, double y) {
+      __pyx_t_double_complex z;
+      z.real = x;
+      z.imag = y;
+      return z;
+    }
+#endif
+
+/* Arithmetic */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+#else
+    static CYTHON_INLINE int __Pyx_c_eq_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+       return (a.real == b.real) && (a.imag == b.imag);
+    }
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_sum_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+        __pyx_t_double_complex z;
+        z.real = a.real + b.real;
+        z.imag = a.imag + b.imag;
+        return z;
+    }
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_diff_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+        __pyx_t_double_complex z;
+        z.real = a.real - b.real;
+        z.imag = a.imag - b.imag;
+        return z;
+    }
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_prod_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+        __pyx_t_double_complex z;
+        z.real = a.real * b.real - a.imag * b.imag;
+        z.imag = a.real * b.imag + a.imag * b.real;
+        return z;
+    }
+    #if 1
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_quot_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+        if (b.imag == 0) {
+            return __pyx_t_double_complex_from_parts(a.real / b.real, a.imag / b.real);
+        } else if (fabs(b.real) >= fabs(b.imag)) {
+            if (b.real == 0 && b.imag == 0) {
+                return __pyx_t_double_complex_from_parts(a.real / b.real, a.imag / b.imag);
+            } else {
+                double r = b.imag / b.real;
+                double s = (double)(1.0) / (b.real + b.imag * r);
+                return __pyx_t_double_complex_from_parts(
+                    (a.real + a.imag * r) * s, (a.imag - a.real * r) * s);
+            }
+        } else {
+            double r = b.real / b.imag;
+            double s = (double)(1.0) / (b.imag + b.real * r);
+            return __pyx_t_double_complex_from_parts(
+                (a.real * r + a.imag) * s, (a.imag * r - a.real) * s);
+        }
+    }
+    #else
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_quot_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+        if (b.imag == 0) {
+            return __pyx_t_double_complex_from_parts(a.real / b.real, a.imag / b.real);
+        } else {
+            double denom = b.real * b.real + b.imag * b.imag;
+            return __pyx_t_double_complex_from_parts(
+                (a.real * b.real + a.imag * b.imag) / denom,
+                (a.imag * b.real - a.real * b.imag) / denom);
+        }
+    }
+    #endif
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_neg_double(__pyx_t_double_complex a) {
+        __pyx_t_double_complex z;
+        z.real = -a.real;
+        z.imag = -a.imag;
+        return z;
+    }
+    static CYTHON_INLINE int __Pyx_c_is_zero_double(__pyx_t_double_complex a) {
+       return (a.real == 0) && (a.imag == 0);
+    }
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_conj_double(__pyx_t_double_complex a) {
+        __pyx_t_double_complex z;
+        z.real =  a.real;
+        z.imag = -a.imag;
+        return z;
+    }
+    #if 1
+        static CYTHON_INLINE double __Pyx_c_abs_double(__pyx_t_double_complex z) {
+          #if !defined(HAVE_HYPOT) || defined(_MSC_VER)
+            return sqrt(z.real*z.real + z.imag*z.imag);
+          #else
+            return hypot(z.real, z.imag);
+          #endif
+        }
+        static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_pow_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+            __pyx_t_double_complex z;
+            double r, lnr, theta, z_r, z_theta;
+            if (b.imag == 0 && b.real == (int)b.real) {
+                if (b.real < 0) {
+                    double denom = a.real * a.real + a.imag * a.imag;
+                    a.real = a.real / denom;
+                    a.imag = -a.imag / denom;
+                    b.real = -b.real;
+                }
+                switch ((int)b.real) {
+                    case 0:
+                        z.real = 1;
+                        z.imag = 0;
+                        return z;
+                    case 1:
+                        return a;
+                    case 2:
+                        return __Pyx_c_prod_double(a, a);
+                    case 3:
+                        z = __Pyx_c_prod_double(a, a);
+                        return __Pyx_c_prod_double(z, a);
+                    case 4:
+                        z = __Pyx_c_prod_double(a, a);
+                        return __Pyx_c_prod_double(z, z);
+                }
+            }
+            if (a.imag == 0) {
+                if (a.real == 0) {
+                    return a;
+                } else if ((b.imag == 0) && (a.real >= 0)) {
+                    z.real = pow(a.real, b.real);
+                    z.imag = 0;
+                    return z;
+                } else if (a.real > 0) {
+                    r = a.real;
+                    theta = 0;
+                } else {
+                    r = -a.real;
+                    theta = atan2(0.0, -1.0);
+                }
+            } else {
+                r = __Pyx_c_abs_double(a);
+                theta = atan2(a.imag, a.real);
+            }
+            lnr = log(r);
+            z_r = exp(lnr * b.real - theta * b.imag);
+            z_theta = theta * b.real + lnr * b.imag;
+            z.real = z_r * cos(z_theta);
+            z.imag = z_r * sin(z_theta);
+            return z;
+        }
+    #endif
+#endif
 
 /* MemviewSliceCopy */
 static __Pyx_memviewslice

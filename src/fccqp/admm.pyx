@@ -33,6 +33,7 @@ from libc.math cimport INFINITY, fabs, isfinite, sqrt
 
 from fccqp._dense cimport copy, fill, inf_norm, matvec, matvec_t
 from fccqp._types cimport Cones, Iterates, Problem
+from fccqp.blas_threads cimport enter, leave
 from fccqp.anderson cimport Anderson, anderson_reset, anderson_step
 from fccqp.certificates cimport dual_infeasible, equality_inconsistent, primal_infeasible
 from fccqp.kkt cimport (AUTO, FACTORED, KKT, LDL_FULL, LDL_REDUCED, NOT_CONVEX, SCHUR_REDUCED,
@@ -357,10 +358,15 @@ cdef class Workspace:
         if self.found.code != SCAN_OK:
             self.has_matrices = False
             return BAD_DATA, 0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, ""
-        with nogil:
-            run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)
-            if run.status != _NOT_CONVEX:
-                self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0], &cert_out[0])
+        enter()   # single-threaded BLAS for this solve (see fccqp.blas_threads)
+        try:
+            with nogil:
+                run = self._solve(same, x0_ptr, warm and self.has_previous, start_time)
+                if run.status != _NOT_CONVEX:
+                    self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0],
+                                 &cert_out[0])
+        finally:
+            leave()
         if run.status == _NOT_CONVEX:
             self.has_matrices = self.has_previous = self.certified = False
             return NOT_CONVEX_CODE, 0, 0.0, 0.0, 0.0, 0.0, run.factorizations, 0.0, ""

@@ -2428,6 +2428,7 @@ static void (*__pyx_f_5scipy_6linalg_13cython_lapack_dsytrs2)(char *, int *, int
 
 /* Module declarations from "scipy.linalg.cython_blas" */
 static void (*__pyx_f_5scipy_6linalg_11cython_blas_dgemm)(char *, char *, int *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *); /*proto*/
+static void (*__pyx_f_5scipy_6linalg_11cython_blas_dgemv)(char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *); /*proto*/
 static void (*__pyx_f_5scipy_6linalg_11cython_blas_dsyrk)(char *, char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *); /*proto*/
 static void (*__pyx_f_5scipy_6linalg_11cython_blas_dtrsm)(char *, char *, char *, char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *); /*proto*/
 
@@ -2435,6 +2436,7 @@ static void (*__pyx_f_5scipy_6linalg_11cython_blas_dtrsm)(char *, char *, char *
 static CYTHON_INLINE void __pyx_f_5fccqp_5_blas_gemm(char, char, int, int, int, double, double const *, int, double const *, int, double, double *, int); /*proto*/
 
 /* Module declarations from "fccqp._dense" */
+static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *, double, Py_ssize_t); /*proto*/
 static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec(double const *, double const *, double *, Py_ssize_t, Py_ssize_t); /*proto*/
 static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec_t(double const *, double const *, double *, Py_ssize_t, Py_ssize_t); /*proto*/
 
@@ -2832,7 +2834,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_5_blas_cholesky_solve(double const *__p
 
 }
 
-/* "fccqp/_dense.pxd":14
+/* "fccqp/_dense.pxd":16
  * 
  * 
  * cdef inline double inf_norm(const double* v, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -2849,7 +2851,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
   Py_ssize_t __pyx_t_3;
   int __pyx_t_4;
 
-  /* "fccqp/_dense.pxd":15
+  /* "fccqp/_dense.pxd":17
  * 
  * cdef inline double inf_norm(const double* v, Py_ssize_t k) noexcept nogil:
  *     cdef double out = 0.0             # <<<<<<<<<<<<<<
@@ -2858,7 +2860,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
 */
   __pyx_v_out = 0.0;
 
-  /* "fccqp/_dense.pxd":17
+  /* "fccqp/_dense.pxd":19
  *     cdef double out = 0.0
  *     cdef Py_ssize_t i
  *     for i in range(k):             # <<<<<<<<<<<<<<
@@ -2872,7 +2874,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/_dense.pxd":18
+    /* "fccqp/_dense.pxd":20
  *     cdef Py_ssize_t i
  *     for i in range(k):
  *         if fabs(v[i]) > out:             # <<<<<<<<<<<<<<
@@ -2884,7 +2886,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
     if (__pyx_t_4) {
 
 
-      /* "fccqp/_dense.pxd":19
+      /* "fccqp/_dense.pxd":21
  *     for i in range(k):
  *         if fabs(v[i]) > out:
  *             out = fabs(v[i])             # <<<<<<<<<<<<<<
@@ -2893,7 +2895,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
 */
       __pyx_v_out = fabs((__pyx_v_v[__pyx_v_i]));
 
-      /* "fccqp/_dense.pxd":18
+      /* "fccqp/_dense.pxd":20
  *     cdef Py_ssize_t i
  *     for i in range(k):
  *         if fabs(v[i]) > out:             # <<<<<<<<<<<<<<
@@ -2904,7 +2906,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
   }
 
 
-  /* "fccqp/_dense.pxd":20
+  /* "fccqp/_dense.pxd":22
  *         if fabs(v[i]) > out:
  *             out = fabs(v[i])
  *     return out             # <<<<<<<<<<<<<<
@@ -2917,7 +2919,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
   }
   goto __pyx_L0;
 
-  /* "fccqp/_dense.pxd":14
+  /* "fccqp/_dense.pxd":16
  * 
  * 
  * cdef inline double inf_norm(const double* v, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -2932,7 +2934,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
   return __pyx_r;
 }
 
-/* "fccqp/_dense.pxd":23
+/* "fccqp/_dense.pxd":25
  * 
  * 
  * cdef inline double dot(const double* a, const double* b, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -2948,7 +2950,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
   Py_ssize_t __pyx_t_2;
   Py_ssize_t __pyx_t_3;
 
-  /* "fccqp/_dense.pxd":24
+  /* "fccqp/_dense.pxd":26
  * 
  * cdef inline double dot(const double* a, const double* b, Py_ssize_t k) noexcept nogil:
  *     cdef double out = 0.0             # <<<<<<<<<<<<<<
@@ -2957,7 +2959,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
 */
   __pyx_v_out = 0.0;
 
-  /* "fccqp/_dense.pxd":26
+  /* "fccqp/_dense.pxd":28
  *     cdef double out = 0.0
  *     cdef Py_ssize_t i
  *     for i in range(k):             # <<<<<<<<<<<<<<
@@ -2971,7 +2973,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/_dense.pxd":27
+    /* "fccqp/_dense.pxd":29
  *     cdef Py_ssize_t i
  *     for i in range(k):
  *         out += a[i] * b[i]             # <<<<<<<<<<<<<<
@@ -2982,7 +2984,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
   }
 
 
-  /* "fccqp/_dense.pxd":28
+  /* "fccqp/_dense.pxd":30
  *     for i in range(k):
  *         out += a[i] * b[i]
  *     return out             # <<<<<<<<<<<<<<
@@ -2995,7 +2997,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
   }
   goto __pyx_L0;
 
-  /* "fccqp/_dense.pxd":23
+  /* "fccqp/_dense.pxd":25
  * 
  * 
  * cdef inline double dot(const double* a, const double* b, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -3010,7 +3012,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
   return __pyx_r;
 }
 
-/* "fccqp/_dense.pxd":31
+/* "fccqp/_dense.pxd":33
  * 
  * 
  * cdef inline void copy(const double* src, double* dst, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -3024,7 +3026,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_copy(double const *__pyx_v_src,
   Py_ssize_t __pyx_t_2;
   Py_ssize_t __pyx_t_3;
 
-  /* "fccqp/_dense.pxd":33
+  /* "fccqp/_dense.pxd":35
  * cdef inline void copy(const double* src, double* dst, Py_ssize_t k) noexcept nogil:
  *     cdef Py_ssize_t i
  *     for i in range(k):             # <<<<<<<<<<<<<<
@@ -3038,7 +3040,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_copy(double const *__pyx_v_src,
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/_dense.pxd":34
+    /* "fccqp/_dense.pxd":36
  *     cdef Py_ssize_t i
  *     for i in range(k):
  *         dst[i] = src[i]             # <<<<<<<<<<<<<<
@@ -3049,7 +3051,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_copy(double const *__pyx_v_src,
   }
 
 
-  /* "fccqp/_dense.pxd":31
+  /* "fccqp/_dense.pxd":33
  * 
  * 
  * cdef inline void copy(const double* src, double* dst, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -3061,7 +3063,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_copy(double const *__pyx_v_src,
 
 }
 
-/* "fccqp/_dense.pxd":37
+/* "fccqp/_dense.pxd":39
  * 
  * 
  * cdef inline void fill(double* dst, double value, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -3075,7 +3077,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *__pyx_v_dst, doubl
   Py_ssize_t __pyx_t_2;
   Py_ssize_t __pyx_t_3;
 
-  /* "fccqp/_dense.pxd":39
+  /* "fccqp/_dense.pxd":41
  * cdef inline void fill(double* dst, double value, Py_ssize_t k) noexcept nogil:
  *     cdef Py_ssize_t i
  *     for i in range(k):             # <<<<<<<<<<<<<<
@@ -3089,7 +3091,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *__pyx_v_dst, doubl
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/_dense.pxd":40
+    /* "fccqp/_dense.pxd":42
  *     cdef Py_ssize_t i
  *     for i in range(k):
  *         dst[i] = value             # <<<<<<<<<<<<<<
@@ -3100,7 +3102,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *__pyx_v_dst, doubl
   }
 
 
-  /* "fccqp/_dense.pxd":37
+  /* "fccqp/_dense.pxd":39
  * 
  * 
  * cdef inline void fill(double* dst, double value, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -3112,222 +3114,456 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *__pyx_v_dst, doubl
 
 }
 
-/* "fccqp/_dense.pxd":43
+/* "fccqp/_dense.pxd":45
  * 
  * 
  * cdef inline void matvec(const double* M, const double* x, double* out,             # <<<<<<<<<<<<<<
  *                         Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
- *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M``."""
+ *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
 */
 
 static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec(double const *__pyx_v_M, double const *__pyx_v_x, double *__pyx_v_out, Py_ssize_t __pyx_v_rows, Py_ssize_t __pyx_v_cols) {
-  Py_ssize_t __pyx_v_i;
-  Py_ssize_t __pyx_v_j;
-  double __pyx_v_acc;
-  double const *__pyx_v_row;
-  Py_ssize_t __pyx_t_1;
-  Py_ssize_t __pyx_t_2;
-  Py_ssize_t __pyx_t_3;
-  Py_ssize_t __pyx_t_4;
-  Py_ssize_t __pyx_t_5;
-  Py_ssize_t __pyx_t_6;
+  int __pyx_v_r;
+  int __pyx_v_c;
+  int __pyx_v_one;
+  double __pyx_v_alpha;
+  double __pyx_v_beta;
+  char __pyx_v_trans;
+  int __pyx_t_1;
+
+  /* "fccqp/_dense.pxd":48
+ *                         Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
+ *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1             # <<<<<<<<<<<<<<
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"T"
+*/
+  __pyx_v_r = ((int)__pyx_v_rows);
+  __pyx_v_c = ((int)__pyx_v_cols);
+  __pyx_v_one = 1;
 
   /* "fccqp/_dense.pxd":49
- *     cdef double acc
- *     cdef const double* row
- *     for i in range(rows):             # <<<<<<<<<<<<<<
- *         row = M + i * cols
- *         acc = 0.0
+ *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0, beta = 0.0             # <<<<<<<<<<<<<<
+ *     cdef char trans = b"T"
+ *     if rows == 0:
 */
+  __pyx_v_alpha = 1.0;
+  __pyx_v_beta = 0.0;
 
-  __pyx_t_1 = __pyx_v_rows;
-  __pyx_t_2 = __pyx_t_1;
-
-  for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
-    __pyx_v_i = __pyx_t_3;
-
-    /* "fccqp/_dense.pxd":50
- *     cdef const double* row
- *     for i in range(rows):
- *         row = M + i * cols             # <<<<<<<<<<<<<<
- *         acc = 0.0
- *         for j in range(cols):
+  /* "fccqp/_dense.pxd":50
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"T"             # <<<<<<<<<<<<<<
+ *     if rows == 0:
+ *         return
 */
-    __pyx_v_row = (__pyx_v_M + (__pyx_v_i * __pyx_v_cols));
+  __pyx_v_trans = 'T';
 
-    /* "fccqp/_dense.pxd":51
- *     for i in range(rows):
- *         row = M + i * cols
- *         acc = 0.0             # <<<<<<<<<<<<<<
- *         for j in range(cols):
- *             acc += row[j] * x[j]
+  /* "fccqp/_dense.pxd":51
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"T"
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
 */
-    __pyx_v_acc = 0.0;
+  __pyx_t_1 = (__pyx_v_rows == 0);
+
+  if (__pyx_t_1) {
+
 
     /* "fccqp/_dense.pxd":52
- *         row = M + i * cols
- *         acc = 0.0
- *         for j in range(cols):             # <<<<<<<<<<<<<<
- *             acc += row[j] * x[j]
- *         out[i] = acc
+ *     cdef char trans = b"T"
+ *     if rows == 0:
+ *         return             # <<<<<<<<<<<<<<
+ *     if cols == 0:
+ *         fill(out, 0.0, rows)
 */
-
-    __pyx_t_4 = __pyx_v_cols;
-    __pyx_t_5 = __pyx_t_4;
-
-    for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
-      __pyx_v_j = __pyx_t_6;
-
-      /* "fccqp/_dense.pxd":53
- *         acc = 0.0
- *         for j in range(cols):
- *             acc += row[j] * x[j]             # <<<<<<<<<<<<<<
- *         out[i] = acc
- * 
-*/
-      __pyx_v_acc = (__pyx_v_acc + ((__pyx_v_row[__pyx_v_j]) * (__pyx_v_x[__pyx_v_j])));
+    {
     }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":51
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"T"
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
+*/
+  }
+
+  /* "fccqp/_dense.pxd":53
+ *     if rows == 0:
+ *         return
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         fill(out, 0.0, rows)
+ *         return
+*/
+  __pyx_t_1 = (__pyx_v_cols == 0);
+
+  if (__pyx_t_1) {
 
 
     /* "fccqp/_dense.pxd":54
- *         for j in range(cols):
- *             acc += row[j] * x[j]
- *         out[i] = acc             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
+ *         fill(out, 0.0, rows)             # <<<<<<<<<<<<<<
+ *         return
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>x, &one, &beta, out, &one)
+*/
+    __pyx_f_5fccqp_6_dense_fill(__pyx_v_out, 0.0, __pyx_v_rows);
+
+    /* "fccqp/_dense.pxd":55
+ *     if cols == 0:
+ *         fill(out, 0.0, rows)
+ *         return             # <<<<<<<<<<<<<<
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>x, &one, &beta, out, &one)
+ * 
+*/
+    {
+    }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":53
+ *     if rows == 0:
+ *         return
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         fill(out, 0.0, rows)
+ *         return
+*/
+  }
+
+  /* "fccqp/_dense.pxd":56
+ *         fill(out, 0.0, rows)
+ *         return
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>x, &one, &beta, out, &one)             # <<<<<<<<<<<<<<
  * 
  * 
 */
-    (__pyx_v_out[__pyx_v_i]) = __pyx_v_acc;
-  }
+  __pyx_f_5scipy_6linalg_11cython_blas_dgemv((&__pyx_v_trans), (&__pyx_v_c), (&__pyx_v_r), (&__pyx_v_alpha), ((double *)__pyx_v_M), (&__pyx_v_c), ((double *)__pyx_v_x), (&__pyx_v_one), (&__pyx_v_beta), __pyx_v_out, (&__pyx_v_one));
 
-
-  /* "fccqp/_dense.pxd":43
+  /* "fccqp/_dense.pxd":45
  * 
  * 
  * cdef inline void matvec(const double* M, const double* x, double* out,             # <<<<<<<<<<<<<<
  *                         Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
- *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M``."""
+ *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
 */
 
   /* function exit code */
+  __pyx_L0:;
+
+
 
 
 
 
 }
 
-/* "fccqp/_dense.pxd":57
+/* "fccqp/_dense.pxd":59
  * 
  * 
  * cdef inline void matvec_t(const double* M, const double* y, double* out,             # <<<<<<<<<<<<<<
  *                           Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
- *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (row by row, so that
+ *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
 */
 
 static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec_t(double const *__pyx_v_M, double const *__pyx_v_y, double *__pyx_v_out, Py_ssize_t __pyx_v_rows, Py_ssize_t __pyx_v_cols) {
-  Py_ssize_t __pyx_v_i;
-  Py_ssize_t __pyx_v_j;
-  double __pyx_v_yi;
-  double const *__pyx_v_row;
-  Py_ssize_t __pyx_t_1;
-  Py_ssize_t __pyx_t_2;
-  Py_ssize_t __pyx_t_3;
-  Py_ssize_t __pyx_t_4;
-  Py_ssize_t __pyx_t_5;
-  Py_ssize_t __pyx_t_6;
-  Py_ssize_t __pyx_t_7;
+  int __pyx_v_r;
+  int __pyx_v_c;
+  int __pyx_v_one;
+  double __pyx_v_alpha;
+  double __pyx_v_beta;
+  char __pyx_v_trans;
+  int __pyx_t_1;
+
+  /* "fccqp/_dense.pxd":62
+ *                           Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
+ *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1             # <<<<<<<<<<<<<<
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"N"
+*/
+  __pyx_v_r = ((int)__pyx_v_rows);
+  __pyx_v_c = ((int)__pyx_v_cols);
+  __pyx_v_one = 1;
+
+  /* "fccqp/_dense.pxd":63
+ *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0, beta = 0.0             # <<<<<<<<<<<<<<
+ *     cdef char trans = b"N"
+ *     if cols == 0:
+*/
+  __pyx_v_alpha = 1.0;
+  __pyx_v_beta = 0.0;
 
   /* "fccqp/_dense.pxd":64
- *     cdef double yi
- *     cdef const double* row
- *     for j in range(cols):             # <<<<<<<<<<<<<<
- *         out[j] = 0.0
- *     for i in range(rows):
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"N"             # <<<<<<<<<<<<<<
+ *     if cols == 0:
+ *         return
 */
+  __pyx_v_trans = 'N';
 
-  __pyx_t_1 = __pyx_v_cols;
-  __pyx_t_2 = __pyx_t_1;
+  /* "fccqp/_dense.pxd":65
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"N"
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if rows == 0:
+*/
+  __pyx_t_1 = (__pyx_v_cols == 0);
 
-  for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
-    __pyx_v_j = __pyx_t_3;
+  if (__pyx_t_1) {
+
+
+    /* "fccqp/_dense.pxd":66
+ *     cdef char trans = b"N"
+ *     if cols == 0:
+ *         return             # <<<<<<<<<<<<<<
+ *     if rows == 0:
+ *         fill(out, 0.0, cols)
+*/
+    {
+    }
+    goto __pyx_L0;
 
     /* "fccqp/_dense.pxd":65
- *     cdef const double* row
- *     for j in range(cols):
- *         out[j] = 0.0             # <<<<<<<<<<<<<<
- *     for i in range(rows):
- *         row = M + i * cols
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"N"
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if rows == 0:
 */
-    (__pyx_v_out[__pyx_v_j]) = 0.0;
   }
 
-
-  /* "fccqp/_dense.pxd":66
- *     for j in range(cols):
- *         out[j] = 0.0
- *     for i in range(rows):             # <<<<<<<<<<<<<<
- *         row = M + i * cols
- *         yi = y[i]
+  /* "fccqp/_dense.pxd":67
+ *     if cols == 0:
+ *         return
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         fill(out, 0.0, cols)
+ *         return
 */
+  __pyx_t_1 = (__pyx_v_rows == 0);
 
-  __pyx_t_1 = __pyx_v_rows;
-  __pyx_t_2 = __pyx_t_1;
+  if (__pyx_t_1) {
 
-  for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
-    __pyx_v_i = __pyx_t_3;
-
-    /* "fccqp/_dense.pxd":67
- *         out[j] = 0.0
- *     for i in range(rows):
- *         row = M + i * cols             # <<<<<<<<<<<<<<
- *         yi = y[i]
- *         for j in range(cols):
-*/
-    __pyx_v_row = (__pyx_v_M + (__pyx_v_i * __pyx_v_cols));
 
     /* "fccqp/_dense.pxd":68
- *     for i in range(rows):
- *         row = M + i * cols
- *         yi = y[i]             # <<<<<<<<<<<<<<
- *         for j in range(cols):
- *             out[j] += row[j] * yi
+ *         return
+ *     if rows == 0:
+ *         fill(out, 0.0, cols)             # <<<<<<<<<<<<<<
+ *         return
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>y, &one, &beta, out, &one)
 */
-    __pyx_v_yi = (__pyx_v_y[__pyx_v_i]);
+    __pyx_f_5fccqp_6_dense_fill(__pyx_v_out, 0.0, __pyx_v_cols);
 
     /* "fccqp/_dense.pxd":69
- *         row = M + i * cols
- *         yi = y[i]
- *         for j in range(cols):             # <<<<<<<<<<<<<<
- *             out[j] += row[j] * yi
+ *     if rows == 0:
+ *         fill(out, 0.0, cols)
+ *         return             # <<<<<<<<<<<<<<
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>y, &one, &beta, out, &one)
+ * 
 */
-
-    __pyx_t_4 = __pyx_v_cols;
-    __pyx_t_5 = __pyx_t_4;
-
-    for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
-      __pyx_v_j = __pyx_t_6;
-
-      /* "fccqp/_dense.pxd":70
- *         yi = y[i]
- *         for j in range(cols):
- *             out[j] += row[j] * yi             # <<<<<<<<<<<<<<
-*/
-
-      __pyx_t_7 = __pyx_v_j;
-      (__pyx_v_out[__pyx_t_7]) = ((__pyx_v_out[__pyx_t_7]) + ((__pyx_v_row[__pyx_v_j]) * __pyx_v_yi));
+    {
     }
+    goto __pyx_L0;
 
+    /* "fccqp/_dense.pxd":67
+ *     if cols == 0:
+ *         return
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         fill(out, 0.0, cols)
+ *         return
+*/
   }
 
+  /* "fccqp/_dense.pxd":70
+ *         fill(out, 0.0, cols)
+ *         return
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>y, &one, &beta, out, &one)             # <<<<<<<<<<<<<<
+ * 
+ * 
+*/
+  __pyx_f_5scipy_6linalg_11cython_blas_dgemv((&__pyx_v_trans), (&__pyx_v_c), (&__pyx_v_r), (&__pyx_v_alpha), ((double *)__pyx_v_M), (&__pyx_v_c), ((double *)__pyx_v_y), (&__pyx_v_one), (&__pyx_v_beta), __pyx_v_out, (&__pyx_v_one));
 
-  /* "fccqp/_dense.pxd":57
+  /* "fccqp/_dense.pxd":59
  * 
  * 
  * cdef inline void matvec_t(const double* M, const double* y, double* out,             # <<<<<<<<<<<<<<
  *                           Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
- *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (row by row, so that
+ *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
 */
 
   /* function exit code */
+  __pyx_L0:;
+
+
+
+
+
+
+}
+
+/* "fccqp/_dense.pxd":73
+ * 
+ * 
+ * cdef inline void colmatvec(const double* M, int ld, const double* x, double* out,             # <<<<<<<<<<<<<<
+ *                            Py_ssize_t rows, Py_ssize_t cols, double beta) noexcept nogil:
+ *     """``out = M x + beta out`` for a column-major ``rows x cols`` block ``M`` with
+*/
+
+static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_colmatvec(double const *__pyx_v_M, int __pyx_v_ld, double const *__pyx_v_x, double *__pyx_v_out, Py_ssize_t __pyx_v_rows, Py_ssize_t __pyx_v_cols, double __pyx_v_beta) {
+  int __pyx_v_r;
+  int __pyx_v_c;
+  int __pyx_v_one;
+  double __pyx_v_alpha;
+  char __pyx_v_trans;
+  int __pyx_t_1;
+
+  /* "fccqp/_dense.pxd":77
+ *     """``out = M x + beta out`` for a column-major ``rows x cols`` block ``M`` with
+ *     leading dimension ``ld`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1             # <<<<<<<<<<<<<<
+ *     cdef double alpha = 1.0
+ *     cdef char trans = b"N"
+*/
+  __pyx_v_r = ((int)__pyx_v_rows);
+  __pyx_v_c = ((int)__pyx_v_cols);
+  __pyx_v_one = 1;
+
+  /* "fccqp/_dense.pxd":78
+ *     leading dimension ``ld`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0             # <<<<<<<<<<<<<<
+ *     cdef char trans = b"N"
+ *     if rows == 0:
+*/
+  __pyx_v_alpha = 1.0;
+
+  /* "fccqp/_dense.pxd":79
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0
+ *     cdef char trans = b"N"             # <<<<<<<<<<<<<<
+ *     if rows == 0:
+ *         return
+*/
+  __pyx_v_trans = 'N';
+
+  /* "fccqp/_dense.pxd":80
+ *     cdef double alpha = 1.0
+ *     cdef char trans = b"N"
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
+*/
+  __pyx_t_1 = (__pyx_v_rows == 0);
+
+  if (__pyx_t_1) {
+
+
+    /* "fccqp/_dense.pxd":81
+ *     cdef char trans = b"N"
+ *     if rows == 0:
+ *         return             # <<<<<<<<<<<<<<
+ *     if cols == 0:
+ *         if beta == 0.0:
+*/
+    {
+    }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":80
+ *     cdef double alpha = 1.0
+ *     cdef char trans = b"N"
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
+*/
+  }
+
+  /* "fccqp/_dense.pxd":82
+ *     if rows == 0:
+ *         return
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         if beta == 0.0:
+ *             fill(out, 0.0, rows)
+*/
+  __pyx_t_1 = (__pyx_v_cols == 0);
+
+  if (__pyx_t_1) {
+
+
+    /* "fccqp/_dense.pxd":83
+ *         return
+ *     if cols == 0:
+ *         if beta == 0.0:             # <<<<<<<<<<<<<<
+ *             fill(out, 0.0, rows)
+ *         return
+*/
+    __pyx_t_1 = (__pyx_v_beta == 0.0);
+
+    if (__pyx_t_1) {
+
+
+      /* "fccqp/_dense.pxd":84
+ *     if cols == 0:
+ *         if beta == 0.0:
+ *             fill(out, 0.0, rows)             # <<<<<<<<<<<<<<
+ *         return
+ *     dgemv(&trans, &r, &c, &alpha, <double*>M, &ld, <double*>x, &one, &beta, out, &one)
+*/
+      __pyx_f_5fccqp_6_dense_fill(__pyx_v_out, 0.0, __pyx_v_rows);
+
+      /* "fccqp/_dense.pxd":83
+ *         return
+ *     if cols == 0:
+ *         if beta == 0.0:             # <<<<<<<<<<<<<<
+ *             fill(out, 0.0, rows)
+ *         return
+*/
+    }
+
+    /* "fccqp/_dense.pxd":85
+ *         if beta == 0.0:
+ *             fill(out, 0.0, rows)
+ *         return             # <<<<<<<<<<<<<<
+ *     dgemv(&trans, &r, &c, &alpha, <double*>M, &ld, <double*>x, &one, &beta, out, &one)
+*/
+    {
+    }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":82
+ *     if rows == 0:
+ *         return
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         if beta == 0.0:
+ *             fill(out, 0.0, rows)
+*/
+  }
+
+  /* "fccqp/_dense.pxd":86
+ *             fill(out, 0.0, rows)
+ *         return
+ *     dgemv(&trans, &r, &c, &alpha, <double*>M, &ld, <double*>x, &one, &beta, out, &one)             # <<<<<<<<<<<<<<
+*/
+  __pyx_f_5scipy_6linalg_11cython_blas_dgemv((&__pyx_v_trans), (&__pyx_v_r), (&__pyx_v_c), (&__pyx_v_alpha), ((double *)__pyx_v_M), (&__pyx_v_ld), ((double *)__pyx_v_x), (&__pyx_v_one), (&__pyx_v_beta), __pyx_v_out, (&__pyx_v_one));
+
+  /* "fccqp/_dense.pxd":73
+ * 
+ * 
+ * cdef inline void colmatvec(const double* M, int ld, const double* x, double* out,             # <<<<<<<<<<<<<<
+ *                            Py_ssize_t rows, Py_ssize_t cols, double beta) noexcept nogil:
+ *     """``out = M x + beta out`` for a column-major ``rows x cols`` block ``M`` with
+*/
+
+  /* function exit code */
+  __pyx_L0:;
+
 
 
 
@@ -5274,8 +5510,8 @@ static int __Pyx_modinit_Function_import_code(__pyx_mstatetype *__pyx_mstate) {
     #if !CYTHON_ASSUME_SAFE_MACROS
     if (unlikely(!__pyx_import_signature)) __PYX_ERR(0, 1, __pyx_L1_error)
     #endif
-    const char * __pyx_import_name = __pyx_import_signature + 684;
-    void (**const __pyx_import_pointers[])(void) = {(void (**)(void))&__pyx_f_5scipy_6linalg_11cython_blas_dtrsm, (void (**)(void))&__pyx_f_5scipy_6linalg_11cython_blas_dsyrk, (void (**)(void))&__pyx_f_5scipy_6linalg_11cython_blas_dgemm, (void (**)(void)) NULL};
+    const char * __pyx_import_name = __pyx_import_signature + 943;
+    void (**const __pyx_import_pointers[])(void) = {(void (**)(void))&__pyx_f_5scipy_6linalg_11cython_blas_dtrsm, (void (**)(void))&__pyx_f_5scipy_6linalg_11cython_blas_dsyrk, (void (**)(void))&__pyx_f_5scipy_6linalg_11cython_blas_dgemm, (void (**)(void))&__pyx_f_5scipy_6linalg_11cython_blas_dgemv, (void (**)(void)) NULL};
     void (**const *__pyx_import_pointer)(void) = __pyx_import_pointers;
     const char *__pyx_import_current_signature = __pyx_import_signature;
     while (*__pyx_import_pointer) {
@@ -5709,30 +5945,30 @@ static int __Pyx_InitConstants(__pyx_mstatetype *__pyx_mstate) {
   CYTHON_UNUSED_VAR(__pyx_mstate);
   {
     const struct { const unsigned int length: 5; } str_length_index[] = {{1},{5},{10},{16},{8},{10},{8},{12},{12},{8},{18},{10}};
-    const struct { const unsigned int length: 10; } bytes_length_index[] = {{611},{701},{720}};
+    const struct { const unsigned int length: 10; } bytes_length_index[] = {{611},{966},{720}};
     #ifndef CYTHON_COMPRESS_STRINGS
       #define CYTHON_COMPRESS_STRINGS 90
     #endif
-    #if (CYTHON_COMPRESS_STRINGS) == 1 /* compression: zlib (371 bytes) */
-static const char cstring[] = "x\332\325TMo\3020\014\355O\351q\240]\030\032\327\t\215N\232\3241\2048\354f\205$\205\210|\224\304E\353~\375\232\026\350@ `\003\304z\250\355\324~~\317\261\372\324\213\342Q\367\255\373\001\303\350\345\265\037Uo\030\275\307\321\260\333\177\216\000\024\021\032\212G\031\226I\356=MTi\323\374\023(I\205\367\347\031\221\253s\344\016\001\250\024\232CQ\213\226P>&t\34682\236\220L\242\320\030\3361\223\215%\017\251\321\016\303\346}x(\036\344\340\234\370\342\200\215\240\004ph3\212aE\004\3411\241t\236B[2\tq/\366%\2733:\200y\312\035\014\254)\032\250\355\216\333\235\257\333\355\247\316\372\254`\260Nl\356\362\032\301\302\010v\014\313\272v\003\364x\2003\311\334\023\027D\024\347\350\200\373\225\022(\270\013|\363\204P4\266t3-\020\250\221\231\322\3257g\344\202\027\213\252\363:\254\324\320)\261\036|\237\3657[\233\265$GE\232C\247\330`\"\047\320j\321\034\247F\303X\022\007\354\264\314\223\241\313\202\325m\374\003\276\027Qvs\027r\321\2110\264N\005\314\345v\026\260\tWjsD\007\010\264\227\260\222\244\305Ov\203\363\316\211\377\021\356\354D~\217z3D\256(\341\206\270\257\26675h\023\277\276\245\361\221\253\"\367\260\264\337\341\311\345\350";
-    PyObject *data = __Pyx_DecompressString(cstring, 371, 1);
+    #if (CYTHON_COMPRESS_STRINGS) == 1 /* compression: zlib (378 bytes) */
+static const char cstring[] = "x\332\345UKo\3020\014\356O\351q\240]\030\032\327\t\215N\232\3241\2048\354f\205$\205\210<J\342\242u\277~M\013t \330\0001\304\264\036b;\265?\177~Hy\350E\361\250\373\322}\203a\364\364\334\217\252\023F\257q4\354\366\037#\000E\204\206\342S\206e\222{M\023U\3124\177\007JR\341\365yF\344\352\036\271C\000*\205\346P\304\242%\224\217\t\2359\216\214\047$\223(4\2067\314dc\311Cj\264\303\260y\033\376d\017rpN|p\300FP\0028\264\031\305\260\"\202p\237P:O\241-\231\204\270\027\373\220\335\036\035\300<\345\016\006\326\024\t\324v\306\355\314\227\315\366\265\316\372\256`\260vl\356\322\032\301\302\010v\010\313:v\003\364p\2003\225\271\307.\210(\316\321\001\367+%Pp\027\370\344\t\241hl\251fZ P#3\245\253\177\316\310\005/\026U\347\265YUC\247\304z\360}\322O\266\026\353\222\034\025i\016\235b\203\211\234@\253Es\234\032\rcI\034\260\343<\217\206.\003V\323\370\003|\177\245\262\253\033\310\005;\362/[\300\320:\0250\227\333Y\300&\\\251\362\\\354\354\314>\360\366\022\\\222\264xm6\230\177\327\350S\341\316N\344t\324\253!r\301\022\256\210\373j\207S\2036\361K\\\no\271\312rwK\371\t\270\256B\214";
+    PyObject *data = __Pyx_DecompressString(cstring, 378, 1);
     #define __Pyx_DecompressString_LZSS_UNUSED
     if (unlikely(!data)) __PYX_ERR(0, 1, __pyx_L1_error)
     const char* const bytes = __Pyx_PyBytes_AsString(data);
     #if !CYTHON_ASSUME_SAFE_MACROS
     if (likely(bytes)); else { Py_DECREF(data); __PYX_ERR(0, 1, __pyx_L1_error) }
     #endif
-    #elif (CYTHON_COMPRESS_STRINGS) > 0 && (CYTHON_COMPRESS_STRINGS) <= 90 /* compression: lzss (487 bytes) */
-static const char cstring[] = "\377?DELTAMA\377X_REFINE\376\000\003_TOLERA\377NCE__mai\367n__\005\000odul\335e\006\001nam\003\002py\277x_capi\032\001q\367ual\020\005test\377__cline_\3769\000traceba\377cksetdef\377aultint \377(double \377const *,\371 \000\r\020\rPy_ss\177ize_t)\000<\002\377struct _\375_\205\001t_5fcc\377qp_3ldl_\347LDLO\001\014\0236_t\377ypes_Prob~\000mr\rz\r\000k, \336\007\340\222\047\256 \230&\241\047\253\047*)\000?void (\362\037\360$\300\356 H\n\027\047\220\201B\326V\307\000me\337ets_e\317ait\357ies\000\316Afac\367tor\006\002unit\177_column\026\003\377solve_ma\343ny&\002\n\002\211#cha\001r\330a\000\005\000\r\205\204\001\204#\376a\301f\377scipy_6l\377inalg_11\377cython_b_las_d\000\047 \0471\200\216\002\307E\r\240\213\201\047\257\200(\221D\207\201\207,\375 \304\202V)\000dtrs\377m\000dsyrk\000\237dgemm\257\204\013\356\0343~\227\204\004lapack\232\204\003\000\314\204\t\274m\020<\360\027R4\245\2007\230\206\025\030n\370Xh\267T\332\201xdpotr\321f\273\204\001\002\002\n\001s\010\003s2\000\001\004";
-    PyObject *data = __Pyx_DecompressString_LZSS(cstring, 487, 2150);
+    #elif (CYTHON_COMPRESS_STRINGS) > 0 && (CYTHON_COMPRESS_STRINGS) <= 90 /* compression: lzss (504 bytes) */
+static const char cstring[] = "\377?DELTAMA\377X_REFINE\376\000\003_TOLERA\377NCE__mai\367n__\005\000odul\335e\006\001nam\003\002py\277x_capi\032\001q\367ual\020\005test\377__cline_\3769\000traceba\377cksetdef\377aultint \377(double \377const *,\371 \000\r\020\rPy_ss\177ize_t)\000<\002\377struct _\375_\205\001t_5fcc\377qp_3ldl_\347LDLO\001\014\0236_t\377ypes_Prob~\000mr\rz\r\000k, \336\007\340\222\047\256 \230&\241\047\253\047*)\000?void (\362\037\360$\300\356 H\n\027\047\220\201B\326V\307\000me\337ets_e\317ait\357ies\000\316Afac\367tor\006\002unit\177_column\026\003\377solve_ma\343ny&\002\n\002\211#cha\001r\330a\000\005\000\r\205\204\001\204#\376a\301f\377scipy_6l\377inalg_11\377cython_b_las_d\000\047 \0471\200\216\002\307E\r\240\213\201\047\257\200(\221D\207\201\207,\341 \304\202V\334M\374\202\225\246\200Zdtr\377sm\000dsyrk\277\000dgemm\001\002v\364\270\206\013\367\\3\240\206\004lapa\003ck\243\206\003\325\206\t\3224\336\206\025/\035\371W\000R4\245\2007\213\2005\305\2033\304\200R\325\201.1\210\254\212\004?dpotrf\301\204\001\002\002\032\n\001s\010\003s2\001\004";
+    PyObject *data = __Pyx_DecompressString_LZSS(cstring, 504, 2415);
     #define __Pyx_DecompressString_UNUSED
     if (unlikely(!data)) __PYX_ERR(0, 1, __pyx_L1_error)
     const char* const bytes = __Pyx_PyBytes_AsString(data);
     #if !CYTHON_ASSUME_SAFE_MACROS
     if (likely(bytes)); else { Py_DECREF(data); __PYX_ERR(0, 1, __pyx_L1_error) }
     #endif
-    #else /* compression: none (2150 bytes) */
-static const char bytes[] = "?DELTAMAX_REFINEREFINE_TOLERANCE__main____module____name____pyx_capi____qualname____test__cline_in_tracebacksetdefaultint (double const *, double const *, double const *, Py_ssize_t)\000int (struct __pyx_t_5fccqp_3ldl_LDL *, struct __pyx_t_5fccqp_6_types_Problem const *, double, double const *)\000int (struct __pyx_t_5fccqp_3ldl_LDL *, struct __pyx_t_5fccqp_6_types_Problem const *, double, double const *, Py_ssize_t const *, int, double *, double *, double *)\000void (struct __pyx_t_5fccqp_3ldl_LDL *, double *, int, double *)\000void (struct __pyx_t_5fccqp_3ldl_LDL *, struct __pyx_t_5fccqp_6_types_Problem const *, double, double const *, double const *, double *)\000meets_equalities\000ldl_factor\000ldl_unit_columns\000ldl_solve_many\000ldl_solvevoid (char *, char *, char *, char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *)\000void (char *, char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *)\000void (char *, char *, int *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *)\000dtrsm\000dsyrk\000dgemmvoid (char *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, int *)\000void (char *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, int *)\000void (char *, int *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, int *)\000void (char *, int *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, __pyx_t_5scipy_6linalg_13cyth""on_lapack_d *, int *)\000void (char *, int *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, int *)\000dpotrf\000dsytrf\000dpotrs\000dsytrs2\000dsytrs";
+    #else /* compression: none (2415 bytes) */
+static const char bytes[] = "?DELTAMAX_REFINEREFINE_TOLERANCE__main____module____name____pyx_capi____qualname____test__cline_in_tracebacksetdefaultint (double const *, double const *, double const *, Py_ssize_t)\000int (struct __pyx_t_5fccqp_3ldl_LDL *, struct __pyx_t_5fccqp_6_types_Problem const *, double, double const *)\000int (struct __pyx_t_5fccqp_3ldl_LDL *, struct __pyx_t_5fccqp_6_types_Problem const *, double, double const *, Py_ssize_t const *, int, double *, double *, double *)\000void (struct __pyx_t_5fccqp_3ldl_LDL *, double *, int, double *)\000void (struct __pyx_t_5fccqp_3ldl_LDL *, struct __pyx_t_5fccqp_6_types_Problem const *, double, double const *, double const *, double *)\000meets_equalities\000ldl_factor\000ldl_unit_columns\000ldl_solve_many\000ldl_solvevoid (char *, char *, char *, char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *)\000void (char *, char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *)\000void (char *, char *, int *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *)\000void (char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *)\000dtrsm\000dsyrk\000dgemm\000dgemvvoid (char *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, int *)\000void (char *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, int *)\000void (char *, int *, int *, __pyx_t""_5scipy_6linalg_13cython_lapack_d *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, int *)\000void (char *, int *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *)\000void (char *, int *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, int *)\000dpotrf\000dsytrf\000dpotrs\000dsytrs2\000dsytrs";
     PyObject *data = NULL;
     #define __Pyx_DecompressString_UNUSED
     #define __Pyx_DecompressString_LZSS_UNUSED

@@ -3,6 +3,7 @@
 /* BEGIN: Cython Metadata
 {
     "distutils": {
+        "depends": [],
         "extra_compile_args": [
             "-O3"
         ],
@@ -1267,6 +1268,7 @@ static int __Pyx_init_tpflags_variables(void) {
 #define __PYX_HAVE__fccqp__reduced
 #define __PYX_HAVE_API__fccqp__reduced
 /* Early includes */
+#include <math.h>
 #ifdef _OPENMP
 #include <omp.h>
 #endif /* _OPENMP */
@@ -1481,6 +1483,34 @@ static PyObject *__pyx_m = NULL;
 #endif
 static const char * const __pyx_cfilenm = __FILE__;
 
+/* Header.proto */
+#if !defined(CYTHON_CCOMPLEX)
+  #if defined(__cplusplus)
+    #define CYTHON_CCOMPLEX 1
+  #elif defined(_MSC_VER)
+    #define CYTHON_CCOMPLEX 0
+  #elif (defined(__ANDROID_MIN_SDK_VERSION__) && __ANDROID_MIN_SDK_VERSION__ < 26) || (defined(__ANDROID_API__) && __ANDROID_API__ < 26)
+    #define CYTHON_CCOMPLEX 0
+  #elif defined(__STDC_NO_COMPLEX__)
+    #define CYTHON_CCOMPLEX 0
+  #elif defined(_Complex_I) || (defined (__STDC_VERSION__) && __STDC_VERSION__ >= 201112L && !defined(__STDC_NO_COMPLEX__))
+    #define CYTHON_CCOMPLEX 1
+  #else
+    #define CYTHON_CCOMPLEX 0
+  #endif
+#endif
+#if CYTHON_CCOMPLEX
+  #ifdef __cplusplus
+    #include <complex>
+  #else
+    #include <complex.h>
+  #endif
+#endif
+#if CYTHON_CCOMPLEX && !defined(__cplusplus) && defined(__sun__) && defined(__GNUC__)
+  #undef _Complex_I
+  #define _Complex_I 1.0fj
+#endif
+
 /* #### Code section: filename_table ### */
 
 static const char* const __pyx_f[] = {
@@ -1625,7 +1655,49 @@ static const char* const __pyx_f[] = {
 #endif
 
 /* #### Code section: numeric_typedefs ### */
+
+/* "scipy/linalg/cython_blas.pxd":17
+ * # The original libraries should be linked directly.
+ * 
+ * ctypedef float s             # <<<<<<<<<<<<<<
+ * ctypedef double d
+ * ctypedef float complex c
+*/
+typedef float __pyx_t_5scipy_6linalg_11cython_blas_s;
+
+/* "scipy/linalg/cython_blas.pxd":18
+ * 
+ * ctypedef float s
+ * ctypedef double d             # <<<<<<<<<<<<<<
+ * ctypedef float complex c
+ * ctypedef double complex z
+*/
+typedef double __pyx_t_5scipy_6linalg_11cython_blas_d;
 /* #### Code section: complex_type_declarations ### */
+/* Declarations.proto */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+  #ifdef __cplusplus
+    typedef ::std::complex< float > __pyx_t_float_complex;
+  #else
+    typedef float _Complex __pyx_t_float_complex;
+  #endif
+#else
+    typedef struct { float real, imag; } __pyx_t_float_complex;
+#endif
+static CYTHON_INLINE __pyx_t_float_complex __pyx_t_float_complex_from_parts(float, float);
+
+/* Declarations.proto */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+  #ifdef __cplusplus
+    typedef ::std::complex< double > __pyx_t_double_complex;
+  #else
+    typedef double _Complex __pyx_t_double_complex;
+  #endif
+#else
+    typedef struct { double real, imag; } __pyx_t_double_complex;
+#endif
+static CYTHON_INLINE __pyx_t_double_complex __pyx_t_double_complex_from_parts(double, double);
+
 /* #### Code section: type_declarations ### */
 
 /*--- Type declarations ---*/
@@ -2053,6 +2125,104 @@ static void __pyx_insert_code_object(int code_line, __Pyx_CachedCodeObjectType* 
 static void __Pyx_AddTraceback(const char *funcname, int c_line,
                                int py_line, const char *filename);
 
+/* RealImag.proto */
+#if CYTHON_CCOMPLEX
+  #ifdef __cplusplus
+    #define __Pyx_CREAL(z) ((z).real())
+    #define __Pyx_CIMAG(z) ((z).imag())
+  #else
+    #define __Pyx_CREAL(z) (__real__(z))
+    #define __Pyx_CIMAG(z) (__imag__(z))
+  #endif
+#else
+    #define __Pyx_CREAL(z) ((z).real)
+    #define __Pyx_CIMAG(z) ((z).imag)
+#endif
+#if defined(__cplusplus) && CYTHON_CCOMPLEX\
+        && (defined(_WIN32) || defined(__clang__) || (defined(__GNUC__) && (__GNUC__ >= 5 || __GNUC__ == 4 && __GNUC_MINOR__ >= 4 )) || __cplusplus >= 201103)
+    #define __Pyx_SET_CREAL(z,x) ((z).real(x))
+    #define __Pyx_SET_CIMAG(z,y) ((z).imag(y))
+#else
+    #define __Pyx_SET_CREAL(z,x) __Pyx_CREAL(z) = (x)
+    #define __Pyx_SET_CIMAG(z,y) __Pyx_CIMAG(z) = (y)
+#endif
+
+/* Arithmetic.proto */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+    #define __Pyx_c_eq_float(a, b)   ((a)==(b))
+    #define __Pyx_c_sum_float(a, b)  ((a)+(b))
+    #define __Pyx_c_diff_float(a, b) ((a)-(b))
+    #define __Pyx_c_prod_float(a, b) ((a)*(b))
+    #define __Pyx_c_quot_float(a, b) ((a)/(b))
+    #define __Pyx_c_neg_float(a)     (-(a))
+  #ifdef __cplusplus
+    #define __Pyx_c_is_zero_float(z) ((z)==(float)0)
+    #define __Pyx_c_conj_float(z)    (::std::conj(z))
+    #if 1
+        #define __Pyx_c_abs_float(z)     (::std::abs(z))
+        #define __Pyx_c_pow_float(a, b)  (::std::pow(a, b))
+    #endif
+  #else
+    #define __Pyx_c_is_zero_float(z) ((z)==0)
+    #define __Pyx_c_conj_float(z)    (conjf(z))
+    #if 1
+        #define __Pyx_c_abs_float(z)     (cabsf(z))
+        #define __Pyx_c_pow_float(a, b)  (cpowf(a, b))
+    #endif
+ #endif
+#else
+    static CYTHON_INLINE int __Pyx_c_eq_float(__pyx_t_float_complex, __pyx_t_float_complex);
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_sum_float(__pyx_t_float_complex, __pyx_t_float_complex);
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_diff_float(__pyx_t_float_complex, __pyx_t_float_complex);
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_prod_float(__pyx_t_float_complex, __pyx_t_float_complex);
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_quot_float(__pyx_t_float_complex, __pyx_t_float_complex);
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_neg_float(__pyx_t_float_complex);
+    static CYTHON_INLINE int __Pyx_c_is_zero_float(__pyx_t_float_complex);
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_conj_float(__pyx_t_float_complex);
+    #if 1
+        static CYTHON_INLINE float __Pyx_c_abs_float(__pyx_t_float_complex);
+        static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_pow_float(__pyx_t_float_complex, __pyx_t_float_complex);
+    #endif
+#endif
+
+/* Arithmetic.proto */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+    #define __Pyx_c_eq_double(a, b)   ((a)==(b))
+    #define __Pyx_c_sum_double(a, b)  ((a)+(b))
+    #define __Pyx_c_diff_double(a, b) ((a)-(b))
+    #define __Pyx_c_prod_double(a, b) ((a)*(b))
+    #define __Pyx_c_quot_double(a, b) ((a)/(b))
+    #define __Pyx_c_neg_double(a)     (-(a))
+  #ifdef __cplusplus
+    #define __Pyx_c_is_zero_double(z) ((z)==(double)0)
+    #define __Pyx_c_conj_double(z)    (::std::conj(z))
+    #if 1
+        #define __Pyx_c_abs_double(z)     (::std::abs(z))
+        #define __Pyx_c_pow_double(a, b)  (::std::pow(a, b))
+    #endif
+  #else
+    #define __Pyx_c_is_zero_double(z) ((z)==0)
+    #define __Pyx_c_conj_double(z)    (conj(z))
+    #if 1
+        #define __Pyx_c_abs_double(z)     (cabs(z))
+        #define __Pyx_c_pow_double(a, b)  (cpow(a, b))
+    #endif
+ #endif
+#else
+    static CYTHON_INLINE int __Pyx_c_eq_double(__pyx_t_double_complex, __pyx_t_double_complex);
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_sum_double(__pyx_t_double_complex, __pyx_t_double_complex);
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_diff_double(__pyx_t_double_complex, __pyx_t_double_complex);
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_prod_double(__pyx_t_double_complex, __pyx_t_double_complex);
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_quot_double(__pyx_t_double_complex, __pyx_t_double_complex);
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_neg_double(__pyx_t_double_complex);
+    static CYTHON_INLINE int __Pyx_c_is_zero_double(__pyx_t_double_complex);
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_conj_double(__pyx_t_double_complex);
+    #if 1
+        static CYTHON_INLINE double __Pyx_c_abs_double(__pyx_t_double_complex);
+        static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_pow_double(__pyx_t_double_complex, __pyx_t_double_complex);
+    #endif
+#endif
+
 /* FormatTypeName.proto */
 #if CYTHON_COMPILING_IN_LIMITED_API && __PYX_LIMITED_VERSION_HEX >= 0x030d0000
 typedef PyObject *__Pyx_TypeName;
@@ -2227,6 +2397,17 @@ static int __Pyx_State_RemoveModule(void*);
 static void (*__pyx_f_5fccqp_3kkt_kkt_solve)(struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double const *, double *); /*proto*/
 static int (*__pyx_f_5fccqp_3kkt_kkt_unit_columns)(struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, Py_ssize_t const *, int, double *); /*proto*/
 
+/* Module declarations from "libc.math" */
+
+/* Module declarations from "scipy.linalg.cython_blas" */
+static void (*__pyx_f_5scipy_6linalg_11cython_blas_dgemv)(char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *); /*proto*/
+
+/* Module declarations from "fccqp._dense" */
+static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_copy(double const *, double *, Py_ssize_t); /*proto*/
+static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *, double, Py_ssize_t); /*proto*/
+static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec(double const *, double const *, double *, Py_ssize_t, Py_ssize_t); /*proto*/
+static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_colmatvec(double const *, int, double const *, double *, Py_ssize_t, Py_ssize_t, double); /*proto*/
+
 /* Module declarations from "fccqp.projections" */
 static void (*__pyx_f_5fccqp_11projections_proj_set)(double const *, double const *, double const *, struct __pyx_t_5fccqp_6_types_Cones, Py_ssize_t, double *); /*proto*/
 
@@ -2268,7 +2449,7 @@ namespace {
     PyObject *__pyx_empty_tuple;
     PyObject *__pyx_empty_bytes;
     PyObject *__pyx_empty_unicode;
-    PyObject *__pyx_string_tab[12];
+    PyObject *__pyx_string_tab[13];
 /* #### Code section: module_state_contents ### */
 /* CodeObjectCache.module_state_decls */
 struct __Pyx_CodeObjectCache __pyx_code_cache;
@@ -2312,7 +2493,8 @@ static __pyx_mstatetype * const __pyx_mstate_global = &__pyx_mstate_global_stati
 #define __pyx_n_u_setdefault __pyx_string_tab[8]
 #define __pyx_kp_b_int_struct___pyx_t_5fccqp_3kkt_K __pyx_string_tab[9]
 #define __pyx_kp_b_int_struct___pyx_t_5fccqp_7reduc __pyx_string_tab[10]
-#define __pyx_kp_b_void_double_const_double_const_d __pyx_string_tab[11]
+#define __pyx_kp_b_void_char_int_int___pyx_t_5scipy __pyx_string_tab[11]
+#define __pyx_kp_b_void_double_const_double_const_d __pyx_string_tab[12]
 /* #### Code section: module_state_clear ### */
 #if CYTHON_USE_MODULE_STATE
 static CYTHON_SMALL_CODE int __pyx_m_clear(PyObject *m) {
@@ -2327,7 +2509,7 @@ static CYTHON_SMALL_CODE int __pyx_m_clear(PyObject *m) {
   #if CYTHON_PEP489_MULTI_PHASE_INIT
   __Pyx_State_RemoveModule(NULL);
   #endif
-  for (int i=0; i<12; ++i) { Py_CLEAR(clear_module_state->__pyx_string_tab[i]); }
+  for (int i=0; i<13; ++i) { Py_CLEAR(clear_module_state->__pyx_string_tab[i]); }
 /* #### Code section: module_state_clear_contents ### */
 /* #### Code section: module_state_clear_end ### */
 return 0;
@@ -2344,7 +2526,7 @@ static CYTHON_SMALL_CODE int __pyx_m_traverse(PyObject *m, visitproc visit, void
   __Pyx_VISIT_CONST(traverse_module_state->__pyx_empty_tuple);
   __Pyx_VISIT_CONST(traverse_module_state->__pyx_empty_bytes);
   __Pyx_VISIT_CONST(traverse_module_state->__pyx_empty_unicode);
-  for (int i=0; i<12; ++i) { __Pyx_VISIT_CONST(traverse_module_state->__pyx_string_tab[i]); }
+  for (int i=0; i<13; ++i) { __Pyx_VISIT_CONST(traverse_module_state->__pyx_string_tab[i]); }
 /* #### Code section: module_state_traverse_contents ### */
 /* #### Code section: module_state_traverse_end ### */
 return 0;
@@ -2352,7 +2534,743 @@ return 0;
 #endif
 /* #### Code section: module_code ### */
 
-/* "fccqp/reduced.pyx":20
+/* "fccqp/_dense.pxd":16
+ * 
+ * 
+ * cdef inline double inf_norm(const double* v, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
+ *     cdef double out = 0.0
+ *     cdef Py_ssize_t i
+*/
+
+static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_v_v, Py_ssize_t __pyx_v_k) {
+  double __pyx_v_out;
+  Py_ssize_t __pyx_v_i;
+  double __pyx_r;
+  Py_ssize_t __pyx_t_1;
+  Py_ssize_t __pyx_t_2;
+  Py_ssize_t __pyx_t_3;
+  int __pyx_t_4;
+
+  /* "fccqp/_dense.pxd":17
+ * 
+ * cdef inline double inf_norm(const double* v, Py_ssize_t k) noexcept nogil:
+ *     cdef double out = 0.0             # <<<<<<<<<<<<<<
+ *     cdef Py_ssize_t i
+ *     for i in range(k):
+*/
+  __pyx_v_out = 0.0;
+
+  /* "fccqp/_dense.pxd":19
+ *     cdef double out = 0.0
+ *     cdef Py_ssize_t i
+ *     for i in range(k):             # <<<<<<<<<<<<<<
+ *         if fabs(v[i]) > out:
+ *             out = fabs(v[i])
+*/
+
+  __pyx_t_1 = __pyx_v_k;
+  __pyx_t_2 = __pyx_t_1;
+
+  for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
+    __pyx_v_i = __pyx_t_3;
+
+    /* "fccqp/_dense.pxd":20
+ *     cdef Py_ssize_t i
+ *     for i in range(k):
+ *         if fabs(v[i]) > out:             # <<<<<<<<<<<<<<
+ *             out = fabs(v[i])
+ *     return out
+*/
+    __pyx_t_4 = (fabs((__pyx_v_v[__pyx_v_i])) > __pyx_v_out);
+
+    if (__pyx_t_4) {
+
+
+      /* "fccqp/_dense.pxd":21
+ *     for i in range(k):
+ *         if fabs(v[i]) > out:
+ *             out = fabs(v[i])             # <<<<<<<<<<<<<<
+ *     return out
+ * 
+*/
+      __pyx_v_out = fabs((__pyx_v_v[__pyx_v_i]));
+
+      /* "fccqp/_dense.pxd":20
+ *     cdef Py_ssize_t i
+ *     for i in range(k):
+ *         if fabs(v[i]) > out:             # <<<<<<<<<<<<<<
+ *             out = fabs(v[i])
+ *     return out
+*/
+    }
+  }
+
+
+  /* "fccqp/_dense.pxd":22
+ *         if fabs(v[i]) > out:
+ *             out = fabs(v[i])
+ *     return out             # <<<<<<<<<<<<<<
+ * 
+ * 
+*/
+  {
+
+    __pyx_r = __pyx_v_out;
+  }
+  goto __pyx_L0;
+
+  /* "fccqp/_dense.pxd":16
+ * 
+ * 
+ * cdef inline double inf_norm(const double* v, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
+ *     cdef double out = 0.0
+ *     cdef Py_ssize_t i
+*/
+
+  /* function exit code */
+  __pyx_L0:;
+
+
+  return __pyx_r;
+}
+
+/* "fccqp/_dense.pxd":25
+ * 
+ * 
+ * cdef inline double dot(const double* a, const double* b, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
+ *     cdef double out = 0.0
+ *     cdef Py_ssize_t i
+*/
+
+static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, double const *__pyx_v_b, Py_ssize_t __pyx_v_k) {
+  double __pyx_v_out;
+  Py_ssize_t __pyx_v_i;
+  double __pyx_r;
+  Py_ssize_t __pyx_t_1;
+  Py_ssize_t __pyx_t_2;
+  Py_ssize_t __pyx_t_3;
+
+  /* "fccqp/_dense.pxd":26
+ * 
+ * cdef inline double dot(const double* a, const double* b, Py_ssize_t k) noexcept nogil:
+ *     cdef double out = 0.0             # <<<<<<<<<<<<<<
+ *     cdef Py_ssize_t i
+ *     for i in range(k):
+*/
+  __pyx_v_out = 0.0;
+
+  /* "fccqp/_dense.pxd":28
+ *     cdef double out = 0.0
+ *     cdef Py_ssize_t i
+ *     for i in range(k):             # <<<<<<<<<<<<<<
+ *         out += a[i] * b[i]
+ *     return out
+*/
+
+  __pyx_t_1 = __pyx_v_k;
+  __pyx_t_2 = __pyx_t_1;
+
+  for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
+    __pyx_v_i = __pyx_t_3;
+
+    /* "fccqp/_dense.pxd":29
+ *     cdef Py_ssize_t i
+ *     for i in range(k):
+ *         out += a[i] * b[i]             # <<<<<<<<<<<<<<
+ *     return out
+ * 
+*/
+    __pyx_v_out = (__pyx_v_out + ((__pyx_v_a[__pyx_v_i]) * (__pyx_v_b[__pyx_v_i])));
+  }
+
+
+  /* "fccqp/_dense.pxd":30
+ *     for i in range(k):
+ *         out += a[i] * b[i]
+ *     return out             # <<<<<<<<<<<<<<
+ * 
+ * 
+*/
+  {
+
+    __pyx_r = __pyx_v_out;
+  }
+  goto __pyx_L0;
+
+  /* "fccqp/_dense.pxd":25
+ * 
+ * 
+ * cdef inline double dot(const double* a, const double* b, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
+ *     cdef double out = 0.0
+ *     cdef Py_ssize_t i
+*/
+
+  /* function exit code */
+  __pyx_L0:;
+
+
+  return __pyx_r;
+}
+
+/* "fccqp/_dense.pxd":33
+ * 
+ * 
+ * cdef inline void copy(const double* src, double* dst, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
+ *     cdef Py_ssize_t i
+ *     for i in range(k):
+*/
+
+static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_copy(double const *__pyx_v_src, double *__pyx_v_dst, Py_ssize_t __pyx_v_k) {
+  Py_ssize_t __pyx_v_i;
+  Py_ssize_t __pyx_t_1;
+  Py_ssize_t __pyx_t_2;
+  Py_ssize_t __pyx_t_3;
+
+  /* "fccqp/_dense.pxd":35
+ * cdef inline void copy(const double* src, double* dst, Py_ssize_t k) noexcept nogil:
+ *     cdef Py_ssize_t i
+ *     for i in range(k):             # <<<<<<<<<<<<<<
+ *         dst[i] = src[i]
+ * 
+*/
+
+  __pyx_t_1 = __pyx_v_k;
+  __pyx_t_2 = __pyx_t_1;
+
+  for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
+    __pyx_v_i = __pyx_t_3;
+
+    /* "fccqp/_dense.pxd":36
+ *     cdef Py_ssize_t i
+ *     for i in range(k):
+ *         dst[i] = src[i]             # <<<<<<<<<<<<<<
+ * 
+ * 
+*/
+    (__pyx_v_dst[__pyx_v_i]) = (__pyx_v_src[__pyx_v_i]);
+  }
+
+
+  /* "fccqp/_dense.pxd":33
+ * 
+ * 
+ * cdef inline void copy(const double* src, double* dst, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
+ *     cdef Py_ssize_t i
+ *     for i in range(k):
+*/
+
+  /* function exit code */
+
+}
+
+/* "fccqp/_dense.pxd":39
+ * 
+ * 
+ * cdef inline void fill(double* dst, double value, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
+ *     cdef Py_ssize_t i
+ *     for i in range(k):
+*/
+
+static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *__pyx_v_dst, double __pyx_v_value, Py_ssize_t __pyx_v_k) {
+  Py_ssize_t __pyx_v_i;
+  Py_ssize_t __pyx_t_1;
+  Py_ssize_t __pyx_t_2;
+  Py_ssize_t __pyx_t_3;
+
+  /* "fccqp/_dense.pxd":41
+ * cdef inline void fill(double* dst, double value, Py_ssize_t k) noexcept nogil:
+ *     cdef Py_ssize_t i
+ *     for i in range(k):             # <<<<<<<<<<<<<<
+ *         dst[i] = value
+ * 
+*/
+
+  __pyx_t_1 = __pyx_v_k;
+  __pyx_t_2 = __pyx_t_1;
+
+  for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
+    __pyx_v_i = __pyx_t_3;
+
+    /* "fccqp/_dense.pxd":42
+ *     cdef Py_ssize_t i
+ *     for i in range(k):
+ *         dst[i] = value             # <<<<<<<<<<<<<<
+ * 
+ * 
+*/
+    (__pyx_v_dst[__pyx_v_i]) = __pyx_v_value;
+  }
+
+
+  /* "fccqp/_dense.pxd":39
+ * 
+ * 
+ * cdef inline void fill(double* dst, double value, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
+ *     cdef Py_ssize_t i
+ *     for i in range(k):
+*/
+
+  /* function exit code */
+
+}
+
+/* "fccqp/_dense.pxd":45
+ * 
+ * 
+ * cdef inline void matvec(const double* M, const double* x, double* out,             # <<<<<<<<<<<<<<
+ *                         Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
+ *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+*/
+
+static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec(double const *__pyx_v_M, double const *__pyx_v_x, double *__pyx_v_out, Py_ssize_t __pyx_v_rows, Py_ssize_t __pyx_v_cols) {
+  int __pyx_v_r;
+  int __pyx_v_c;
+  int __pyx_v_one;
+  double __pyx_v_alpha;
+  double __pyx_v_beta;
+  char __pyx_v_trans;
+  int __pyx_t_1;
+
+  /* "fccqp/_dense.pxd":48
+ *                         Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
+ *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1             # <<<<<<<<<<<<<<
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"T"
+*/
+  __pyx_v_r = ((int)__pyx_v_rows);
+  __pyx_v_c = ((int)__pyx_v_cols);
+  __pyx_v_one = 1;
+
+  /* "fccqp/_dense.pxd":49
+ *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0, beta = 0.0             # <<<<<<<<<<<<<<
+ *     cdef char trans = b"T"
+ *     if rows == 0:
+*/
+  __pyx_v_alpha = 1.0;
+  __pyx_v_beta = 0.0;
+
+  /* "fccqp/_dense.pxd":50
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"T"             # <<<<<<<<<<<<<<
+ *     if rows == 0:
+ *         return
+*/
+  __pyx_v_trans = 'T';
+
+  /* "fccqp/_dense.pxd":51
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"T"
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
+*/
+  __pyx_t_1 = (__pyx_v_rows == 0);
+
+  if (__pyx_t_1) {
+
+
+    /* "fccqp/_dense.pxd":52
+ *     cdef char trans = b"T"
+ *     if rows == 0:
+ *         return             # <<<<<<<<<<<<<<
+ *     if cols == 0:
+ *         fill(out, 0.0, rows)
+*/
+    {
+    }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":51
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"T"
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
+*/
+  }
+
+  /* "fccqp/_dense.pxd":53
+ *     if rows == 0:
+ *         return
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         fill(out, 0.0, rows)
+ *         return
+*/
+  __pyx_t_1 = (__pyx_v_cols == 0);
+
+  if (__pyx_t_1) {
+
+
+    /* "fccqp/_dense.pxd":54
+ *         return
+ *     if cols == 0:
+ *         fill(out, 0.0, rows)             # <<<<<<<<<<<<<<
+ *         return
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>x, &one, &beta, out, &one)
+*/
+    __pyx_f_5fccqp_6_dense_fill(__pyx_v_out, 0.0, __pyx_v_rows);
+
+    /* "fccqp/_dense.pxd":55
+ *     if cols == 0:
+ *         fill(out, 0.0, rows)
+ *         return             # <<<<<<<<<<<<<<
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>x, &one, &beta, out, &one)
+ * 
+*/
+    {
+    }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":53
+ *     if rows == 0:
+ *         return
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         fill(out, 0.0, rows)
+ *         return
+*/
+  }
+
+  /* "fccqp/_dense.pxd":56
+ *         fill(out, 0.0, rows)
+ *         return
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>x, &one, &beta, out, &one)             # <<<<<<<<<<<<<<
+ * 
+ * 
+*/
+  __pyx_f_5scipy_6linalg_11cython_blas_dgemv((&__pyx_v_trans), (&__pyx_v_c), (&__pyx_v_r), (&__pyx_v_alpha), ((double *)__pyx_v_M), (&__pyx_v_c), ((double *)__pyx_v_x), (&__pyx_v_one), (&__pyx_v_beta), __pyx_v_out, (&__pyx_v_one));
+
+  /* "fccqp/_dense.pxd":45
+ * 
+ * 
+ * cdef inline void matvec(const double* M, const double* x, double* out,             # <<<<<<<<<<<<<<
+ *                         Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
+ *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+*/
+
+  /* function exit code */
+  __pyx_L0:;
+
+
+
+
+
+
+}
+
+/* "fccqp/_dense.pxd":59
+ * 
+ * 
+ * cdef inline void matvec_t(const double* M, const double* y, double* out,             # <<<<<<<<<<<<<<
+ *                           Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
+ *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+*/
+
+static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec_t(double const *__pyx_v_M, double const *__pyx_v_y, double *__pyx_v_out, Py_ssize_t __pyx_v_rows, Py_ssize_t __pyx_v_cols) {
+  int __pyx_v_r;
+  int __pyx_v_c;
+  int __pyx_v_one;
+  double __pyx_v_alpha;
+  double __pyx_v_beta;
+  char __pyx_v_trans;
+  int __pyx_t_1;
+
+  /* "fccqp/_dense.pxd":62
+ *                           Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
+ *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1             # <<<<<<<<<<<<<<
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"N"
+*/
+  __pyx_v_r = ((int)__pyx_v_rows);
+  __pyx_v_c = ((int)__pyx_v_cols);
+  __pyx_v_one = 1;
+
+  /* "fccqp/_dense.pxd":63
+ *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0, beta = 0.0             # <<<<<<<<<<<<<<
+ *     cdef char trans = b"N"
+ *     if cols == 0:
+*/
+  __pyx_v_alpha = 1.0;
+  __pyx_v_beta = 0.0;
+
+  /* "fccqp/_dense.pxd":64
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"N"             # <<<<<<<<<<<<<<
+ *     if cols == 0:
+ *         return
+*/
+  __pyx_v_trans = 'N';
+
+  /* "fccqp/_dense.pxd":65
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"N"
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if rows == 0:
+*/
+  __pyx_t_1 = (__pyx_v_cols == 0);
+
+  if (__pyx_t_1) {
+
+
+    /* "fccqp/_dense.pxd":66
+ *     cdef char trans = b"N"
+ *     if cols == 0:
+ *         return             # <<<<<<<<<<<<<<
+ *     if rows == 0:
+ *         fill(out, 0.0, cols)
+*/
+    {
+    }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":65
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"N"
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if rows == 0:
+*/
+  }
+
+  /* "fccqp/_dense.pxd":67
+ *     if cols == 0:
+ *         return
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         fill(out, 0.0, cols)
+ *         return
+*/
+  __pyx_t_1 = (__pyx_v_rows == 0);
+
+  if (__pyx_t_1) {
+
+
+    /* "fccqp/_dense.pxd":68
+ *         return
+ *     if rows == 0:
+ *         fill(out, 0.0, cols)             # <<<<<<<<<<<<<<
+ *         return
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>y, &one, &beta, out, &one)
+*/
+    __pyx_f_5fccqp_6_dense_fill(__pyx_v_out, 0.0, __pyx_v_cols);
+
+    /* "fccqp/_dense.pxd":69
+ *     if rows == 0:
+ *         fill(out, 0.0, cols)
+ *         return             # <<<<<<<<<<<<<<
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>y, &one, &beta, out, &one)
+ * 
+*/
+    {
+    }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":67
+ *     if cols == 0:
+ *         return
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         fill(out, 0.0, cols)
+ *         return
+*/
+  }
+
+  /* "fccqp/_dense.pxd":70
+ *         fill(out, 0.0, cols)
+ *         return
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>y, &one, &beta, out, &one)             # <<<<<<<<<<<<<<
+ * 
+ * 
+*/
+  __pyx_f_5scipy_6linalg_11cython_blas_dgemv((&__pyx_v_trans), (&__pyx_v_c), (&__pyx_v_r), (&__pyx_v_alpha), ((double *)__pyx_v_M), (&__pyx_v_c), ((double *)__pyx_v_y), (&__pyx_v_one), (&__pyx_v_beta), __pyx_v_out, (&__pyx_v_one));
+
+  /* "fccqp/_dense.pxd":59
+ * 
+ * 
+ * cdef inline void matvec_t(const double* M, const double* y, double* out,             # <<<<<<<<<<<<<<
+ *                           Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
+ *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+*/
+
+  /* function exit code */
+  __pyx_L0:;
+
+
+
+
+
+
+}
+
+/* "fccqp/_dense.pxd":73
+ * 
+ * 
+ * cdef inline void colmatvec(const double* M, int ld, const double* x, double* out,             # <<<<<<<<<<<<<<
+ *                            Py_ssize_t rows, Py_ssize_t cols, double beta) noexcept nogil:
+ *     """``out = M x + beta out`` for a column-major ``rows x cols`` block ``M`` with
+*/
+
+static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_colmatvec(double const *__pyx_v_M, int __pyx_v_ld, double const *__pyx_v_x, double *__pyx_v_out, Py_ssize_t __pyx_v_rows, Py_ssize_t __pyx_v_cols, double __pyx_v_beta) {
+  int __pyx_v_r;
+  int __pyx_v_c;
+  int __pyx_v_one;
+  double __pyx_v_alpha;
+  char __pyx_v_trans;
+  int __pyx_t_1;
+
+  /* "fccqp/_dense.pxd":77
+ *     """``out = M x + beta out`` for a column-major ``rows x cols`` block ``M`` with
+ *     leading dimension ``ld`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1             # <<<<<<<<<<<<<<
+ *     cdef double alpha = 1.0
+ *     cdef char trans = b"N"
+*/
+  __pyx_v_r = ((int)__pyx_v_rows);
+  __pyx_v_c = ((int)__pyx_v_cols);
+  __pyx_v_one = 1;
+
+  /* "fccqp/_dense.pxd":78
+ *     leading dimension ``ld`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0             # <<<<<<<<<<<<<<
+ *     cdef char trans = b"N"
+ *     if rows == 0:
+*/
+  __pyx_v_alpha = 1.0;
+
+  /* "fccqp/_dense.pxd":79
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0
+ *     cdef char trans = b"N"             # <<<<<<<<<<<<<<
+ *     if rows == 0:
+ *         return
+*/
+  __pyx_v_trans = 'N';
+
+  /* "fccqp/_dense.pxd":80
+ *     cdef double alpha = 1.0
+ *     cdef char trans = b"N"
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
+*/
+  __pyx_t_1 = (__pyx_v_rows == 0);
+
+  if (__pyx_t_1) {
+
+
+    /* "fccqp/_dense.pxd":81
+ *     cdef char trans = b"N"
+ *     if rows == 0:
+ *         return             # <<<<<<<<<<<<<<
+ *     if cols == 0:
+ *         if beta == 0.0:
+*/
+    {
+    }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":80
+ *     cdef double alpha = 1.0
+ *     cdef char trans = b"N"
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
+*/
+  }
+
+  /* "fccqp/_dense.pxd":82
+ *     if rows == 0:
+ *         return
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         if beta == 0.0:
+ *             fill(out, 0.0, rows)
+*/
+  __pyx_t_1 = (__pyx_v_cols == 0);
+
+  if (__pyx_t_1) {
+
+
+    /* "fccqp/_dense.pxd":83
+ *         return
+ *     if cols == 0:
+ *         if beta == 0.0:             # <<<<<<<<<<<<<<
+ *             fill(out, 0.0, rows)
+ *         return
+*/
+    __pyx_t_1 = (__pyx_v_beta == 0.0);
+
+    if (__pyx_t_1) {
+
+
+      /* "fccqp/_dense.pxd":84
+ *     if cols == 0:
+ *         if beta == 0.0:
+ *             fill(out, 0.0, rows)             # <<<<<<<<<<<<<<
+ *         return
+ *     dgemv(&trans, &r, &c, &alpha, <double*>M, &ld, <double*>x, &one, &beta, out, &one)
+*/
+      __pyx_f_5fccqp_6_dense_fill(__pyx_v_out, 0.0, __pyx_v_rows);
+
+      /* "fccqp/_dense.pxd":83
+ *         return
+ *     if cols == 0:
+ *         if beta == 0.0:             # <<<<<<<<<<<<<<
+ *             fill(out, 0.0, rows)
+ *         return
+*/
+    }
+
+    /* "fccqp/_dense.pxd":85
+ *         if beta == 0.0:
+ *             fill(out, 0.0, rows)
+ *         return             # <<<<<<<<<<<<<<
+ *     dgemv(&trans, &r, &c, &alpha, <double*>M, &ld, <double*>x, &one, &beta, out, &one)
+*/
+    {
+    }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":82
+ *     if rows == 0:
+ *         return
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         if beta == 0.0:
+ *             fill(out, 0.0, rows)
+*/
+  }
+
+  /* "fccqp/_dense.pxd":86
+ *             fill(out, 0.0, rows)
+ *         return
+ *     dgemv(&trans, &r, &c, &alpha, <double*>M, &ld, <double*>x, &one, &beta, out, &one)             # <<<<<<<<<<<<<<
+*/
+  __pyx_f_5scipy_6linalg_11cython_blas_dgemv((&__pyx_v_trans), (&__pyx_v_r), (&__pyx_v_c), (&__pyx_v_alpha), ((double *)__pyx_v_M), (&__pyx_v_ld), ((double *)__pyx_v_x), (&__pyx_v_one), (&__pyx_v_beta), __pyx_v_out, (&__pyx_v_one));
+
+  /* "fccqp/_dense.pxd":73
+ * 
+ * 
+ * cdef inline void colmatvec(const double* M, int ld, const double* x, double* out,             # <<<<<<<<<<<<<<
+ *                            Py_ssize_t rows, Py_ssize_t cols, double beta) noexcept nogil:
+ *     """``out = M x + beta out`` for a column-major ``rows x cols`` block ``M`` with
+*/
+
+  /* function exit code */
+  __pyx_L0:;
+
+
+
+
+
+}
+
+/* "fccqp/reduced.pyx":21
  * 
  * 
  * cdef bint reduced_table(Reduced* r, KKT* k, const Problem* p, const double* rho_vec) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -2376,7 +3294,7 @@ static int __pyx_f_5fccqp_7reduced_reduced_table(struct __pyx_t_5fccqp_7reduced_
   Py_ssize_t __pyx_t_6;
   Py_ssize_t __pyx_t_7;
 
-  /* "fccqp/reduced.pyx":23
+  /* "fccqp/reduced.pyx":24
  *     """Tabulate ``W``, ``W_S`` and ``base`` with the factorization in ``k``; False when
  *     the columns missed the refinement tolerance."""
  *     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, N = n + m, i, j             # <<<<<<<<<<<<<<
@@ -2394,7 +3312,7 @@ static int __pyx_f_5fccqp_7reduced_reduced_table(struct __pyx_t_5fccqp_7reduced_
   __pyx_v_s = __pyx_t_1;
   __pyx_v_N = (__pyx_v_n + __pyx_v_m);
 
-  /* "fccqp/reduced.pyx":24
+  /* "fccqp/reduced.pyx":25
  *     the columns missed the refinement tolerance."""
  *     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, N = n + m, i, j
  *     if not kkt_unit_columns(k, p, rho_vec, p.constrained, <int>s, r.W):             # <<<<<<<<<<<<<<
@@ -2406,7 +3324,7 @@ static int __pyx_f_5fccqp_7reduced_reduced_table(struct __pyx_t_5fccqp_7reduced_
   if (__pyx_t_2) {
 
 
-    /* "fccqp/reduced.pyx":25
+    /* "fccqp/reduced.pyx":26
  *     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, N = n + m, i, j
  *     if not kkt_unit_columns(k, p, rho_vec, p.constrained, <int>s, r.W):
  *         return False             # <<<<<<<<<<<<<<
@@ -2419,7 +3337,7 @@ static int __pyx_f_5fccqp_7reduced_reduced_table(struct __pyx_t_5fccqp_7reduced_
     }
     goto __pyx_L0;
 
-    /* "fccqp/reduced.pyx":24
+    /* "fccqp/reduced.pyx":25
  *     the columns missed the refinement tolerance."""
  *     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, N = n + m, i, j
  *     if not kkt_unit_columns(k, p, rho_vec, p.constrained, <int>s, r.W):             # <<<<<<<<<<<<<<
@@ -2428,7 +3346,7 @@ static int __pyx_f_5fccqp_7reduced_reduced_table(struct __pyx_t_5fccqp_7reduced_
 */
   }
 
-  /* "fccqp/reduced.pyx":26
+  /* "fccqp/reduced.pyx":27
  *     if not kkt_unit_columns(k, p, rho_vec, p.constrained, <int>s, r.W):
  *         return False
  *     for j in range(s):             # <<<<<<<<<<<<<<
@@ -2442,7 +3360,7 @@ static int __pyx_f_5fccqp_7reduced_reduced_table(struct __pyx_t_5fccqp_7reduced_
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/reduced.pyx":27
+    /* "fccqp/reduced.pyx":28
  *         return False
  *     for j in range(s):
  *         for i in range(s):             # <<<<<<<<<<<<<<
@@ -2456,7 +3374,7 @@ static int __pyx_f_5fccqp_7reduced_reduced_table(struct __pyx_t_5fccqp_7reduced_
     for (__pyx_t_7 = 0; __pyx_t_7 < __pyx_t_6; __pyx_t_7+=1) {
       __pyx_v_i = __pyx_t_7;
 
-      /* "fccqp/reduced.pyx":28
+      /* "fccqp/reduced.pyx":29
  *     for j in range(s):
  *         for i in range(s):
  *             r.W_S[j * s + i] = r.W[p.constrained[j] + i * N]             # <<<<<<<<<<<<<<
@@ -2469,7 +3387,7 @@ static int __pyx_f_5fccqp_7reduced_reduced_table(struct __pyx_t_5fccqp_7reduced_
   }
 
 
-  /* "fccqp/reduced.pyx":29
+  /* "fccqp/reduced.pyx":30
  *         for i in range(s):
  *             r.W_S[j * s + i] = r.W[p.constrained[j] + i * N]
  *     for i in range(n):             # <<<<<<<<<<<<<<
@@ -2483,7 +3401,7 @@ static int __pyx_f_5fccqp_7reduced_reduced_table(struct __pyx_t_5fccqp_7reduced_
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/reduced.pyx":30
+    /* "fccqp/reduced.pyx":31
  *             r.W_S[j * s + i] = r.W[p.constrained[j] + i * N]
  *     for i in range(n):
  *         r.rhs[i] = -p.q[i]             # <<<<<<<<<<<<<<
@@ -2494,7 +3412,7 @@ static int __pyx_f_5fccqp_7reduced_reduced_table(struct __pyx_t_5fccqp_7reduced_
   }
 
 
-  /* "fccqp/reduced.pyx":31
+  /* "fccqp/reduced.pyx":32
  *     for i in range(n):
  *         r.rhs[i] = -p.q[i]
  *     for i in range(m):             # <<<<<<<<<<<<<<
@@ -2508,7 +3426,7 @@ static int __pyx_f_5fccqp_7reduced_reduced_table(struct __pyx_t_5fccqp_7reduced_
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/reduced.pyx":32
+    /* "fccqp/reduced.pyx":33
  *         r.rhs[i] = -p.q[i]
  *     for i in range(m):
  *         r.rhs[n + i] = p.b[i]             # <<<<<<<<<<<<<<
@@ -2519,7 +3437,7 @@ static int __pyx_f_5fccqp_7reduced_reduced_table(struct __pyx_t_5fccqp_7reduced_
   }
 
 
-  /* "fccqp/reduced.pyx":33
+  /* "fccqp/reduced.pyx":34
  *     for i in range(m):
  *         r.rhs[n + i] = p.b[i]
  *     kkt_solve(k, p, rho_vec, r.rhs, r.base)             # <<<<<<<<<<<<<<
@@ -2528,7 +3446,7 @@ static int __pyx_f_5fccqp_7reduced_reduced_table(struct __pyx_t_5fccqp_7reduced_
 */
   __pyx_f_5fccqp_3kkt_kkt_solve(__pyx_v_k, __pyx_v_p, __pyx_v_rho_vec, __pyx_v_r->rhs, __pyx_v_r->base);
 
-  /* "fccqp/reduced.pyx":34
+  /* "fccqp/reduced.pyx":35
  *         r.rhs[n + i] = p.b[i]
  *     kkt_solve(k, p, rho_vec, r.rhs, r.base)
  *     return True             # <<<<<<<<<<<<<<
@@ -2541,7 +3459,7 @@ static int __pyx_f_5fccqp_7reduced_reduced_table(struct __pyx_t_5fccqp_7reduced_
   }
   goto __pyx_L0;
 
-  /* "fccqp/reduced.pyx":20
+  /* "fccqp/reduced.pyx":21
  * 
  * 
  * cdef bint reduced_table(Reduced* r, KKT* k, const Problem* p, const double* rho_vec) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -2560,7 +3478,7 @@ static int __pyx_f_5fccqp_7reduced_reduced_table(struct __pyx_t_5fccqp_7reduced_
   return __pyx_r;
 }
 
-/* "fccqp/reduced.pyx":37
+/* "fccqp/reduced.pyx":38
  * 
  * 
  * cdef void reduced_start(Reduced* r, const Problem* p, Iterates* it) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -2574,7 +3492,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_start(struct __pyx_t_5fccqp_7reduced
   Py_ssize_t __pyx_t_2;
   Py_ssize_t __pyx_t_3;
 
-  /* "fccqp/reduced.pyx":40
+  /* "fccqp/reduced.pyx":41
  *     """Coordinates of the start: ``u = v = rho z - y`` (the first step is not relaxed)."""
  *     cdef Py_ssize_t j
  *     for j in range(p.s):             # <<<<<<<<<<<<<<
@@ -2588,7 +3506,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_start(struct __pyx_t_5fccqp_7reduced
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_j = __pyx_t_3;
 
-    /* "fccqp/reduced.pyx":41
+    /* "fccqp/reduced.pyx":42
  *     cdef Py_ssize_t j
  *     for j in range(p.s):
  *         r.v[j] = it.rho_vec[j] * it.z[j] - it.y[j]             # <<<<<<<<<<<<<<
@@ -2597,7 +3515,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_start(struct __pyx_t_5fccqp_7reduced
 */
     (__pyx_v_r->v[__pyx_v_j]) = (((__pyx_v_it->rho_vec[__pyx_v_j]) * (__pyx_v_it->z[__pyx_v_j])) - (__pyx_v_it->y[__pyx_v_j]));
 
-    /* "fccqp/reduced.pyx":42
+    /* "fccqp/reduced.pyx":43
  *     for j in range(p.s):
  *         r.v[j] = it.rho_vec[j] * it.z[j] - it.y[j]
  *         r.u[j] = r.v[j]             # <<<<<<<<<<<<<<
@@ -2606,7 +3524,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_start(struct __pyx_t_5fccqp_7reduced
 */
     (__pyx_v_r->u[__pyx_v_j]) = (__pyx_v_r->v[__pyx_v_j]);
 
-    /* "fccqp/reduced.pyx":43
+    /* "fccqp/reduced.pyx":44
  *         r.v[j] = it.rho_vec[j] * it.z[j] - it.y[j]
  *         r.u[j] = r.v[j]
  *         r.v_prev[j] = r.v[j]             # <<<<<<<<<<<<<<
@@ -2615,7 +3533,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_start(struct __pyx_t_5fccqp_7reduced
 */
     (__pyx_v_r->v_prev[__pyx_v_j]) = (__pyx_v_r->v[__pyx_v_j]);
 
-    /* "fccqp/reduced.pyx":44
+    /* "fccqp/reduced.pyx":45
  *         r.u[j] = r.v[j]
  *         r.v_prev[j] = r.v[j]
  *         r.u_prev[j] = r.u[j]             # <<<<<<<<<<<<<<
@@ -2626,7 +3544,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_start(struct __pyx_t_5fccqp_7reduced
   }
 
 
-  /* "fccqp/reduced.pyx":37
+  /* "fccqp/reduced.pyx":38
  * 
  * 
  * cdef void reduced_start(Reduced* r, const Problem* p, Iterates* it) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -2638,7 +3556,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_start(struct __pyx_t_5fccqp_7reduced
 
 }
 
-/* "fccqp/reduced.pyx":47
+/* "fccqp/reduced.pyx":48
  * 
  * 
  * cdef inline void _table_product(const Reduced* r, const double* c, double* out,             # <<<<<<<<<<<<<<
@@ -2647,86 +3565,17 @@ static void __pyx_f_5fccqp_7reduced_reduced_start(struct __pyx_t_5fccqp_7reduced
 */
 
 static CYTHON_INLINE void __pyx_f_5fccqp_7reduced__table_product(struct __pyx_t_5fccqp_7reduced_Reduced const *__pyx_v_r, double const *__pyx_v_c, double *__pyx_v_out, Py_ssize_t __pyx_v_s) {
-  Py_ssize_t __pyx_v_i;
-  Py_ssize_t __pyx_v_j;
-  double __pyx_v_acc;
-  double const *__pyx_v_row;
-  Py_ssize_t __pyx_t_1;
-  Py_ssize_t __pyx_t_2;
-  Py_ssize_t __pyx_t_3;
-  Py_ssize_t __pyx_t_4;
-  Py_ssize_t __pyx_t_5;
-  Py_ssize_t __pyx_t_6;
 
-  /* "fccqp/reduced.pyx":53
- *     cdef double acc
- *     cdef const double* row
- *     for i in range(s):             # <<<<<<<<<<<<<<
- *         row = r.W_S + i * s
- *         acc = 0.0
-*/
-
-  __pyx_t_1 = __pyx_v_s;
-  __pyx_t_2 = __pyx_t_1;
-
-  for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
-    __pyx_v_i = __pyx_t_3;
-
-    /* "fccqp/reduced.pyx":54
- *     cdef const double* row
- *     for i in range(s):
- *         row = r.W_S + i * s             # <<<<<<<<<<<<<<
- *         acc = 0.0
- *         for j in range(s):
-*/
-    __pyx_v_row = (__pyx_v_r->W_S + (__pyx_v_i * __pyx_v_s));
-
-    /* "fccqp/reduced.pyx":55
- *     for i in range(s):
- *         row = r.W_S + i * s
- *         acc = 0.0             # <<<<<<<<<<<<<<
- *         for j in range(s):
- *             acc += row[j] * c[j]
-*/
-    __pyx_v_acc = 0.0;
-
-    /* "fccqp/reduced.pyx":56
- *         row = r.W_S + i * s
- *         acc = 0.0
- *         for j in range(s):             # <<<<<<<<<<<<<<
- *             acc += row[j] * c[j]
- *         out[i] = acc
-*/
-
-    __pyx_t_4 = __pyx_v_s;
-    __pyx_t_5 = __pyx_t_4;
-
-    for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
-      __pyx_v_j = __pyx_t_6;
-
-      /* "fccqp/reduced.pyx":57
- *         acc = 0.0
- *         for j in range(s):
- *             acc += row[j] * c[j]             # <<<<<<<<<<<<<<
- *         out[i] = acc
- * 
-*/
-      __pyx_v_acc = (__pyx_v_acc + ((__pyx_v_row[__pyx_v_j]) * (__pyx_v_c[__pyx_v_j])));
-    }
-
-
-    /* "fccqp/reduced.pyx":58
- *         for j in range(s):
- *             acc += row[j] * c[j]
- *         out[i] = acc             # <<<<<<<<<<<<<<
+  /* "fccqp/reduced.pyx":51
+ *                                 Py_ssize_t s) noexcept nogil:
+ *     """``out = W_S c`` (row-major ``s x s``)."""
+ *     matvec(r.W_S, c, out, s, s)             # <<<<<<<<<<<<<<
  * 
  * 
 */
-    (__pyx_v_out[__pyx_v_i]) = __pyx_v_acc;
-  }
+  __pyx_f_5fccqp_6_dense_matvec(__pyx_v_r->W_S, __pyx_v_c, __pyx_v_out, __pyx_v_s, __pyx_v_s);
 
-
-  /* "fccqp/reduced.pyx":47
+  /* "fccqp/reduced.pyx":48
  * 
  * 
  * cdef inline void _table_product(const Reduced* r, const double* c, double* out,             # <<<<<<<<<<<<<<
@@ -2735,13 +3584,9 @@ static CYTHON_INLINE void __pyx_f_5fccqp_7reduced__table_product(struct __pyx_t_
 */
 
   /* function exit code */
-
-
-
-
 }
 
-/* "fccqp/reduced.pyx":61
+/* "fccqp/reduced.pyx":54
  * 
  * 
  * cdef void reduced_step(Reduced* r, const Problem* p, Iterates* it, double alpha,             # <<<<<<<<<<<<<<
@@ -2759,7 +3604,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_step(struct __pyx_t_5fccqp_7reduced_
   Py_ssize_t __pyx_t_4;
   Py_ssize_t __pyx_t_5;
 
-  /* "fccqp/reduced.pyx":64
+  /* "fccqp/reduced.pyx":57
  *                        bint relax_x) noexcept nogil:
  *     """One ADMM iteration with ``x = base + W u`` kept implicit through ``u``."""
  *     cdef Py_ssize_t s = p.s, j             # <<<<<<<<<<<<<<
@@ -2770,7 +3615,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_step(struct __pyx_t_5fccqp_7reduced_
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/reduced.pyx":65
+  /* "fccqp/reduced.pyx":58
  *     """One ADMM iteration with ``x = base + W u`` kept implicit through ``u``."""
  *     cdef Py_ssize_t s = p.s, j
  *     cdef double alpha_x = alpha if relax_x else 1.0             # <<<<<<<<<<<<<<
@@ -2786,7 +3631,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_step(struct __pyx_t_5fccqp_7reduced_
   }
   __pyx_v_alpha_x = __pyx_t_2;
 
-  /* "fccqp/reduced.pyx":66
+  /* "fccqp/reduced.pyx":59
  *     cdef Py_ssize_t s = p.s, j
  *     cdef double alpha_x = alpha if relax_x else 1.0
  *     for j in range(s):             # <<<<<<<<<<<<<<
@@ -2800,7 +3645,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_step(struct __pyx_t_5fccqp_7reduced_
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/reduced.pyx":67
+    /* "fccqp/reduced.pyx":60
  *     cdef double alpha_x = alpha if relax_x else 1.0
  *     for j in range(s):
  *         it.z_prev[j] = it.z[j]             # <<<<<<<<<<<<<<
@@ -2809,7 +3654,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_step(struct __pyx_t_5fccqp_7reduced_
 */
     (__pyx_v_it->z_prev[__pyx_v_j]) = (__pyx_v_it->z[__pyx_v_j]);
 
-    /* "fccqp/reduced.pyx":68
+    /* "fccqp/reduced.pyx":61
  *     for j in range(s):
  *         it.z_prev[j] = it.z[j]
  *         it.y_prev[j] = it.y[j]             # <<<<<<<<<<<<<<
@@ -2818,7 +3663,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_step(struct __pyx_t_5fccqp_7reduced_
 */
     (__pyx_v_it->y_prev[__pyx_v_j]) = (__pyx_v_it->y[__pyx_v_j]);
 
-    /* "fccqp/reduced.pyx":69
+    /* "fccqp/reduced.pyx":62
  *         it.z_prev[j] = it.z[j]
  *         it.y_prev[j] = it.y[j]
  *         r.v_prev[j] = r.v[j]             # <<<<<<<<<<<<<<
@@ -2827,7 +3672,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_step(struct __pyx_t_5fccqp_7reduced_
 */
     (__pyx_v_r->v_prev[__pyx_v_j]) = (__pyx_v_r->v[__pyx_v_j]);
 
-    /* "fccqp/reduced.pyx":70
+    /* "fccqp/reduced.pyx":63
  *         it.y_prev[j] = it.y[j]
  *         r.v_prev[j] = r.v[j]
  *         r.u_prev[j] = r.u[j]             # <<<<<<<<<<<<<<
@@ -2836,7 +3681,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_step(struct __pyx_t_5fccqp_7reduced_
 */
     (__pyx_v_r->u_prev[__pyx_v_j]) = (__pyx_v_r->u[__pyx_v_j]);
 
-    /* "fccqp/reduced.pyx":71
+    /* "fccqp/reduced.pyx":64
  *         r.v_prev[j] = r.v[j]
  *         r.u_prev[j] = r.u[j]
  *         r.v[j] = it.rho_vec[j] * it.z[j] - it.y[j]             # <<<<<<<<<<<<<<
@@ -2847,7 +3692,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_step(struct __pyx_t_5fccqp_7reduced_
   }
 
 
-  /* "fccqp/reduced.pyx":72
+  /* "fccqp/reduced.pyx":65
  *         r.u_prev[j] = r.u[j]
  *         r.v[j] = it.rho_vec[j] * it.z[j] - it.y[j]
  *     _table_product(r, r.v, r.xs, s)             # <<<<<<<<<<<<<<
@@ -2856,7 +3701,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_step(struct __pyx_t_5fccqp_7reduced_
 */
   __pyx_f_5fccqp_7reduced__table_product(__pyx_v_r, __pyx_v_r->v, __pyx_v_r->xs, __pyx_v_s);
 
-  /* "fccqp/reduced.pyx":73
+  /* "fccqp/reduced.pyx":66
  *         r.v[j] = it.rho_vec[j] * it.z[j] - it.y[j]
  *     _table_product(r, r.v, r.xs, s)
  *     for j in range(s):             # <<<<<<<<<<<<<<
@@ -2870,7 +3715,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_step(struct __pyx_t_5fccqp_7reduced_
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/reduced.pyx":74
+    /* "fccqp/reduced.pyx":67
  *     _table_product(r, r.v, r.xs, s)
  *     for j in range(s):
  *         it.relaxed[j] = alpha * (r.base[p.constrained[j]] + r.xs[j]) + (1.0 - alpha) * it.z_prev[j]             # <<<<<<<<<<<<<<
@@ -2879,7 +3724,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_step(struct __pyx_t_5fccqp_7reduced_
 */
     (__pyx_v_it->relaxed[__pyx_v_j]) = ((__pyx_v_alpha * ((__pyx_v_r->base[(__pyx_v_p->constrained[__pyx_v_j])]) + (__pyx_v_r->xs[__pyx_v_j]))) + ((1.0 - __pyx_v_alpha) * (__pyx_v_it->z_prev[__pyx_v_j])));
 
-    /* "fccqp/reduced.pyx":75
+    /* "fccqp/reduced.pyx":68
  *     for j in range(s):
  *         it.relaxed[j] = alpha * (r.base[p.constrained[j]] + r.xs[j]) + (1.0 - alpha) * it.z_prev[j]
  *         r.u[j] = alpha_x * r.v[j] + (1.0 - alpha_x) * r.u_prev[j]             # <<<<<<<<<<<<<<
@@ -2888,7 +3733,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_step(struct __pyx_t_5fccqp_7reduced_
 */
     (__pyx_v_r->u[__pyx_v_j]) = ((__pyx_v_alpha_x * (__pyx_v_r->v[__pyx_v_j])) + ((1.0 - __pyx_v_alpha_x) * (__pyx_v_r->u_prev[__pyx_v_j])));
 
-    /* "fccqp/reduced.pyx":76
+    /* "fccqp/reduced.pyx":69
  *         it.relaxed[j] = alpha * (r.base[p.constrained[j]] + r.xs[j]) + (1.0 - alpha) * it.z_prev[j]
  *         r.u[j] = alpha_x * r.v[j] + (1.0 - alpha_x) * r.u_prev[j]
  *         it.z[j] = it.relaxed[j] + it.y[j] / it.rho_vec[j]             # <<<<<<<<<<<<<<
@@ -2899,7 +3744,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_step(struct __pyx_t_5fccqp_7reduced_
   }
 
 
-  /* "fccqp/reduced.pyx":77
+  /* "fccqp/reduced.pyx":70
  *         r.u[j] = alpha_x * r.v[j] + (1.0 - alpha_x) * r.u_prev[j]
  *         it.z[j] = it.relaxed[j] + it.y[j] / it.rho_vec[j]
  *     proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)             # <<<<<<<<<<<<<<
@@ -2908,7 +3753,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_step(struct __pyx_t_5fccqp_7reduced_
 */
   __pyx_f_5fccqp_11projections_proj_set(__pyx_v_it->z, __pyx_v_p->lo, __pyx_v_p->hi, __pyx_v_p->cones, __pyx_v_s, __pyx_v_it->z);
 
-  /* "fccqp/reduced.pyx":78
+  /* "fccqp/reduced.pyx":71
  *         it.z[j] = it.relaxed[j] + it.y[j] / it.rho_vec[j]
  *     proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
  *     for j in range(s):             # <<<<<<<<<<<<<<
@@ -2922,7 +3767,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_step(struct __pyx_t_5fccqp_7reduced_
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/reduced.pyx":79
+    /* "fccqp/reduced.pyx":72
  *     proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
  *     for j in range(s):
  *         it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])             # <<<<<<<<<<<<<<
@@ -2935,7 +3780,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_step(struct __pyx_t_5fccqp_7reduced_
   }
 
 
-  /* "fccqp/reduced.pyx":61
+  /* "fccqp/reduced.pyx":54
  * 
  * 
  * cdef void reduced_step(Reduced* r, const Problem* p, Iterates* it, double alpha,             # <<<<<<<<<<<<<<
@@ -2949,7 +3794,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_step(struct __pyx_t_5fccqp_7reduced_
 
 }
 
-/* "fccqp/reduced.pyx":82
+/* "fccqp/reduced.pyx":75
  * 
  * 
  * cdef bint near_convergence(Reduced* r, const Problem* p, Iterates* it, double eps_p,             # <<<<<<<<<<<<<<
@@ -2968,7 +3813,7 @@ static int __pyx_f_5fccqp_7reduced_near_convergence(struct __pyx_t_5fccqp_7reduc
   double __pyx_t_4;
   int __pyx_t_5;
 
-  /* "fccqp/reduced.pyx":95
+  /* "fccqp/reduced.pyx":88
  *     cdef Py_ssize_t j, i
  *     cdef double x
  *     _table_product(r, r.u, r.xs, p.s)             # <<<<<<<<<<<<<<
@@ -2977,7 +3822,7 @@ static int __pyx_f_5fccqp_7reduced_near_convergence(struct __pyx_t_5fccqp_7reduc
 */
   __pyx_f_5fccqp_7reduced__table_product(__pyx_v_r, __pyx_v_r->u, __pyx_v_r->xs, __pyx_v_p->s);
 
-  /* "fccqp/reduced.pyx":96
+  /* "fccqp/reduced.pyx":89
  *     cdef double x
  *     _table_product(r, r.u, r.xs, p.s)
  *     for j in range(p.s):             # <<<<<<<<<<<<<<
@@ -2991,7 +3836,7 @@ static int __pyx_f_5fccqp_7reduced_near_convergence(struct __pyx_t_5fccqp_7reduc
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_j = __pyx_t_3;
 
-    /* "fccqp/reduced.pyx":97
+    /* "fccqp/reduced.pyx":90
  *     _table_product(r, r.u, r.xs, p.s)
  *     for j in range(p.s):
  *         i = p.constrained[j]             # <<<<<<<<<<<<<<
@@ -3000,7 +3845,7 @@ static int __pyx_f_5fccqp_7reduced_near_convergence(struct __pyx_t_5fccqp_7reduc
 */
     __pyx_v_i = (__pyx_v_p->constrained[__pyx_v_j]);
 
-    /* "fccqp/reduced.pyx":98
+    /* "fccqp/reduced.pyx":91
  *     for j in range(p.s):
  *         i = p.constrained[j]
  *         x = r.base[i] + r.xs[j]             # <<<<<<<<<<<<<<
@@ -3009,7 +3854,7 @@ static int __pyx_f_5fccqp_7reduced_near_convergence(struct __pyx_t_5fccqp_7reduc
 */
     __pyx_v_x = ((__pyx_v_r->base[__pyx_v_i]) + (__pyx_v_r->xs[__pyx_v_j]));
 
-    /* "fccqp/reduced.pyx":99
+    /* "fccqp/reduced.pyx":92
  *         i = p.constrained[j]
  *         x = r.base[i] + r.xs[j]
  *         if abs(x - it.z[j]) * p.D[i] > eps_p:             # <<<<<<<<<<<<<<
@@ -3023,7 +3868,7 @@ static int __pyx_f_5fccqp_7reduced_near_convergence(struct __pyx_t_5fccqp_7reduc
     if (__pyx_t_5) {
 
 
-      /* "fccqp/reduced.pyx":100
+      /* "fccqp/reduced.pyx":93
  *         x = r.base[i] + r.xs[j]
  *         if abs(x - it.z[j]) * p.D[i] > eps_p:
  *             return False             # <<<<<<<<<<<<<<
@@ -3036,7 +3881,7 @@ static int __pyx_f_5fccqp_7reduced_near_convergence(struct __pyx_t_5fccqp_7reduc
       }
       goto __pyx_L0;
 
-      /* "fccqp/reduced.pyx":99
+      /* "fccqp/reduced.pyx":92
  *         i = p.constrained[j]
  *         x = r.base[i] + r.xs[j]
  *         if abs(x - it.z[j]) * p.D[i] > eps_p:             # <<<<<<<<<<<<<<
@@ -3045,7 +3890,7 @@ static int __pyx_f_5fccqp_7reduced_near_convergence(struct __pyx_t_5fccqp_7reduc
 */
     }
 
-    /* "fccqp/reduced.pyx":101
+    /* "fccqp/reduced.pyx":94
  *         if abs(x - it.z[j]) * p.D[i] > eps_p:
  *             return False
  *         if abs(r.u[j] - it.rho_vec[j] * x + it.y[j]) > eps_d * p.c * p.D[i]:             # <<<<<<<<<<<<<<
@@ -3059,7 +3904,7 @@ static int __pyx_f_5fccqp_7reduced_near_convergence(struct __pyx_t_5fccqp_7reduc
     if (__pyx_t_5) {
 
 
-      /* "fccqp/reduced.pyx":102
+      /* "fccqp/reduced.pyx":95
  *             return False
  *         if abs(r.u[j] - it.rho_vec[j] * x + it.y[j]) > eps_d * p.c * p.D[i]:
  *             return False             # <<<<<<<<<<<<<<
@@ -3072,7 +3917,7 @@ static int __pyx_f_5fccqp_7reduced_near_convergence(struct __pyx_t_5fccqp_7reduc
       }
       goto __pyx_L0;
 
-      /* "fccqp/reduced.pyx":101
+      /* "fccqp/reduced.pyx":94
  *         if abs(x - it.z[j]) * p.D[i] > eps_p:
  *             return False
  *         if abs(r.u[j] - it.rho_vec[j] * x + it.y[j]) > eps_d * p.c * p.D[i]:             # <<<<<<<<<<<<<<
@@ -3083,7 +3928,7 @@ static int __pyx_f_5fccqp_7reduced_near_convergence(struct __pyx_t_5fccqp_7reduc
   }
 
 
-  /* "fccqp/reduced.pyx":103
+  /* "fccqp/reduced.pyx":96
  *         if abs(r.u[j] - it.rho_vec[j] * x + it.y[j]) > eps_d * p.c * p.D[i]:
  *             return False
  *     return True             # <<<<<<<<<<<<<<
@@ -3096,7 +3941,7 @@ static int __pyx_f_5fccqp_7reduced_near_convergence(struct __pyx_t_5fccqp_7reduc
   }
   goto __pyx_L0;
 
-  /* "fccqp/reduced.pyx":82
+  /* "fccqp/reduced.pyx":75
  * 
  * 
  * cdef bint near_convergence(Reduced* r, const Problem* p, Iterates* it, double eps_p,             # <<<<<<<<<<<<<<
@@ -3112,129 +3957,46 @@ static int __pyx_f_5fccqp_7reduced_near_convergence(struct __pyx_t_5fccqp_7reduc
   return __pyx_r;
 }
 
-/* "fccqp/reduced.pyx":106
+/* "fccqp/reduced.pyx":99
  * 
  * 
  * cdef inline void _combine(const Reduced* r, const double* c, double* out, Py_ssize_t first,             # <<<<<<<<<<<<<<
  *                           Py_ssize_t count, Py_ssize_t N, Py_ssize_t s) noexcept nogil:
- *     """``out = (base + W c)[first:first + count]`` (column by column: contiguous)."""
+ *     """``out = (base + W c)[first:first + count]``."""
 */
 
 static CYTHON_INLINE void __pyx_f_5fccqp_7reduced__combine(struct __pyx_t_5fccqp_7reduced_Reduced const *__pyx_v_r, double const *__pyx_v_c, double *__pyx_v_out, Py_ssize_t __pyx_v_first, Py_ssize_t __pyx_v_count, Py_ssize_t __pyx_v_N, Py_ssize_t __pyx_v_s) {
-  Py_ssize_t __pyx_v_i;
-  Py_ssize_t __pyx_v_j;
-  double const *__pyx_v_column;
-  double __pyx_v_cj;
-  Py_ssize_t __pyx_t_1;
-  Py_ssize_t __pyx_t_2;
-  Py_ssize_t __pyx_t_3;
-  Py_ssize_t __pyx_t_4;
-  Py_ssize_t __pyx_t_5;
-  Py_ssize_t __pyx_t_6;
-  Py_ssize_t __pyx_t_7;
 
-  /* "fccqp/reduced.pyx":112
- *     cdef const double* column
- *     cdef double cj
- *     for i in range(count):             # <<<<<<<<<<<<<<
- *         out[i] = r.base[first + i]
- *     for j in range(s):
-*/
-
-  __pyx_t_1 = __pyx_v_count;
-  __pyx_t_2 = __pyx_t_1;
-
-  for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
-    __pyx_v_i = __pyx_t_3;
-
-    /* "fccqp/reduced.pyx":113
- *     cdef double cj
- *     for i in range(count):
- *         out[i] = r.base[first + i]             # <<<<<<<<<<<<<<
- *     for j in range(s):
- *         column = r.W + j * N + first
-*/
-    (__pyx_v_out[__pyx_v_i]) = (__pyx_v_r->base[(__pyx_v_first + __pyx_v_i)]);
-  }
-
-
-  /* "fccqp/reduced.pyx":114
- *     for i in range(count):
- *         out[i] = r.base[first + i]
- *     for j in range(s):             # <<<<<<<<<<<<<<
- *         column = r.W + j * N + first
- *         cj = c[j]
-*/
-
-  __pyx_t_1 = __pyx_v_s;
-  __pyx_t_2 = __pyx_t_1;
-
-  for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
-    __pyx_v_j = __pyx_t_3;
-
-    /* "fccqp/reduced.pyx":115
- *         out[i] = r.base[first + i]
- *     for j in range(s):
- *         column = r.W + j * N + first             # <<<<<<<<<<<<<<
- *         cj = c[j]
- *         for i in range(count):
-*/
-    __pyx_v_column = ((__pyx_v_r->W + (__pyx_v_j * __pyx_v_N)) + __pyx_v_first);
-
-    /* "fccqp/reduced.pyx":116
- *     for j in range(s):
- *         column = r.W + j * N + first
- *         cj = c[j]             # <<<<<<<<<<<<<<
- *         for i in range(count):
- *             out[i] += column[i] * cj
-*/
-    __pyx_v_cj = (__pyx_v_c[__pyx_v_j]);
-
-    /* "fccqp/reduced.pyx":117
- *         column = r.W + j * N + first
- *         cj = c[j]
- *         for i in range(count):             # <<<<<<<<<<<<<<
- *             out[i] += column[i] * cj
+  /* "fccqp/reduced.pyx":102
+ *                           Py_ssize_t count, Py_ssize_t N, Py_ssize_t s) noexcept nogil:
+ *     """``out = (base + W c)[first:first + count]``."""
+ *     copy(r.base + first, out, count)             # <<<<<<<<<<<<<<
+ *     colmatvec(r.W + first, <int>N, c, out, count, s, 1.0)
  * 
 */
+  __pyx_f_5fccqp_6_dense_copy((__pyx_v_r->base + __pyx_v_first), __pyx_v_out, __pyx_v_count);
 
-    __pyx_t_4 = __pyx_v_count;
-    __pyx_t_5 = __pyx_t_4;
-
-    for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
-      __pyx_v_i = __pyx_t_6;
-
-      /* "fccqp/reduced.pyx":118
- *         cj = c[j]
- *         for i in range(count):
- *             out[i] += column[i] * cj             # <<<<<<<<<<<<<<
+  /* "fccqp/reduced.pyx":103
+ *     """``out = (base + W c)[first:first + count]``."""
+ *     copy(r.base + first, out, count)
+ *     colmatvec(r.W + first, <int>N, c, out, count, s, 1.0)             # <<<<<<<<<<<<<<
  * 
  * 
 */
+  __pyx_f_5fccqp_6_dense_colmatvec((__pyx_v_r->W + __pyx_v_first), ((int)__pyx_v_N), __pyx_v_c, __pyx_v_out, __pyx_v_count, __pyx_v_s, 1.0);
 
-      __pyx_t_7 = __pyx_v_i;
-      (__pyx_v_out[__pyx_t_7]) = ((__pyx_v_out[__pyx_t_7]) + ((__pyx_v_column[__pyx_v_i]) * __pyx_v_cj));
-    }
-
-  }
-
-
-  /* "fccqp/reduced.pyx":106
+  /* "fccqp/reduced.pyx":99
  * 
  * 
  * cdef inline void _combine(const Reduced* r, const double* c, double* out, Py_ssize_t first,             # <<<<<<<<<<<<<<
  *                           Py_ssize_t count, Py_ssize_t N, Py_ssize_t s) noexcept nogil:
- *     """``out = (base + W c)[first:first + count]`` (column by column: contiguous)."""
+ *     """``out = (base + W c)[first:first + count]``."""
 */
 
   /* function exit code */
-
-
-
-
 }
 
-/* "fccqp/reduced.pyx":121
+/* "fccqp/reduced.pyx":106
  * 
  * 
  * cdef void materialize(Reduced* r, const Problem* p, Iterates* it) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -3249,7 +4011,7 @@ static void __pyx_f_5fccqp_7reduced_materialize(struct __pyx_t_5fccqp_7reduced_R
   Py_ssize_t __pyx_v_s;
   Py_ssize_t __pyx_t_1;
 
-  /* "fccqp/reduced.pyx":123
+  /* "fccqp/reduced.pyx":108
  * cdef void materialize(Reduced* r, const Problem* p, Iterates* it) noexcept nogil:
  *     """Form ``x, nu`` and their previous values from ``base + W (u, v)``."""
  *     cdef Py_ssize_t n = p.n, m = p.m, N = n + m, s = p.s             # <<<<<<<<<<<<<<
@@ -3267,7 +4029,7 @@ static void __pyx_f_5fccqp_7reduced_materialize(struct __pyx_t_5fccqp_7reduced_R
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/reduced.pyx":124
+  /* "fccqp/reduced.pyx":109
  *     """Form ``x, nu`` and their previous values from ``base + W (u, v)``."""
  *     cdef Py_ssize_t n = p.n, m = p.m, N = n + m, s = p.s
  *     _combine(r, r.u, it.x, 0, n, N, s)             # <<<<<<<<<<<<<<
@@ -3276,7 +4038,7 @@ static void __pyx_f_5fccqp_7reduced_materialize(struct __pyx_t_5fccqp_7reduced_R
 */
   __pyx_f_5fccqp_7reduced__combine(__pyx_v_r, __pyx_v_r->u, __pyx_v_it->x, 0, __pyx_v_n, __pyx_v_N, __pyx_v_s);
 
-  /* "fccqp/reduced.pyx":125
+  /* "fccqp/reduced.pyx":110
  *     cdef Py_ssize_t n = p.n, m = p.m, N = n + m, s = p.s
  *     _combine(r, r.u, it.x, 0, n, N, s)
  *     _combine(r, r.u_prev, it.x_prev, 0, n, N, s)             # <<<<<<<<<<<<<<
@@ -3285,7 +4047,7 @@ static void __pyx_f_5fccqp_7reduced_materialize(struct __pyx_t_5fccqp_7reduced_R
 */
   __pyx_f_5fccqp_7reduced__combine(__pyx_v_r, __pyx_v_r->u_prev, __pyx_v_it->x_prev, 0, __pyx_v_n, __pyx_v_N, __pyx_v_s);
 
-  /* "fccqp/reduced.pyx":126
+  /* "fccqp/reduced.pyx":111
  *     _combine(r, r.u, it.x, 0, n, N, s)
  *     _combine(r, r.u_prev, it.x_prev, 0, n, N, s)
  *     _combine(r, r.v, it.nu, n, m, N, s)             # <<<<<<<<<<<<<<
@@ -3294,7 +4056,7 @@ static void __pyx_f_5fccqp_7reduced_materialize(struct __pyx_t_5fccqp_7reduced_R
 */
   __pyx_f_5fccqp_7reduced__combine(__pyx_v_r, __pyx_v_r->v, __pyx_v_it->nu, __pyx_v_n, __pyx_v_m, __pyx_v_N, __pyx_v_s);
 
-  /* "fccqp/reduced.pyx":127
+  /* "fccqp/reduced.pyx":112
  *     _combine(r, r.u_prev, it.x_prev, 0, n, N, s)
  *     _combine(r, r.v, it.nu, n, m, N, s)
  *     _combine(r, r.v_prev, it.nu_prev, n, m, N, s)             # <<<<<<<<<<<<<<
@@ -3303,7 +4065,7 @@ static void __pyx_f_5fccqp_7reduced_materialize(struct __pyx_t_5fccqp_7reduced_R
 */
   __pyx_f_5fccqp_7reduced__combine(__pyx_v_r, __pyx_v_r->v_prev, __pyx_v_it->nu_prev, __pyx_v_n, __pyx_v_m, __pyx_v_N, __pyx_v_s);
 
-  /* "fccqp/reduced.pyx":121
+  /* "fccqp/reduced.pyx":106
  * 
  * 
  * cdef void materialize(Reduced* r, const Problem* p, Iterates* it) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -3318,7 +4080,7 @@ static void __pyx_f_5fccqp_7reduced_materialize(struct __pyx_t_5fccqp_7reduced_R
 
 }
 
-/* "fccqp/reduced.pyx":130
+/* "fccqp/reduced.pyx":115
  * 
  * 
  * cdef inline void _shift(Reduced* r, const Problem* p, double* c, const double* old_rho,             # <<<<<<<<<<<<<<
@@ -3333,7 +4095,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_7reduced__shift(struct __pyx_t_5fccqp_7
   Py_ssize_t __pyx_t_3;
   Py_ssize_t __pyx_t_4;
 
-  /* "fccqp/reduced.pyx":134
+  /* "fccqp/reduced.pyx":119
  *     """``c += (R' - R) x_S(c)`` with ``x_S(c) = base_S + W_S c`` in the old table."""
  *     cdef Py_ssize_t j
  *     _table_product(r, c, r.xs, p.s)             # <<<<<<<<<<<<<<
@@ -3342,7 +4104,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_7reduced__shift(struct __pyx_t_5fccqp_7
 */
   __pyx_f_5fccqp_7reduced__table_product(__pyx_v_r, __pyx_v_c, __pyx_v_r->xs, __pyx_v_p->s);
 
-  /* "fccqp/reduced.pyx":135
+  /* "fccqp/reduced.pyx":120
  *     cdef Py_ssize_t j
  *     _table_product(r, c, r.xs, p.s)
  *     for j in range(p.s):             # <<<<<<<<<<<<<<
@@ -3356,7 +4118,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_7reduced__shift(struct __pyx_t_5fccqp_7
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_j = __pyx_t_3;
 
-    /* "fccqp/reduced.pyx":136
+    /* "fccqp/reduced.pyx":121
  *     _table_product(r, c, r.xs, p.s)
  *     for j in range(p.s):
  *         c[j] += (new_rho[j] - old_rho[j]) * (r.base[p.constrained[j]] + r.xs[j])             # <<<<<<<<<<<<<<
@@ -3369,7 +4131,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_7reduced__shift(struct __pyx_t_5fccqp_7
   }
 
 
-  /* "fccqp/reduced.pyx":130
+  /* "fccqp/reduced.pyx":115
  * 
  * 
  * cdef inline void _shift(Reduced* r, const Problem* p, double* c, const double* old_rho,             # <<<<<<<<<<<<<<
@@ -3381,7 +4143,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_7reduced__shift(struct __pyx_t_5fccqp_7
 
 }
 
-/* "fccqp/reduced.pyx":139
+/* "fccqp/reduced.pyx":124
  * 
  * 
  * cdef void reduced_rebase(Reduced* r, const Problem* p, const double* old_rho,             # <<<<<<<<<<<<<<
@@ -3391,7 +4153,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_7reduced__shift(struct __pyx_t_5fccqp_7
 
 static void __pyx_f_5fccqp_7reduced_reduced_rebase(struct __pyx_t_5fccqp_7reduced_Reduced *__pyx_v_r, struct __pyx_t_5fccqp_6_types_Problem const *__pyx_v_p, double const *__pyx_v_old_rho, double const *__pyx_v_new_rho) {
 
-  /* "fccqp/reduced.pyx":144
+  /* "fccqp/reduced.pyx":129
  *     so that the iterates they stand for (and the steps between them, which the
  *     infeasibility tests read) are unchanged. Call before refactoring."""
  *     _shift(r, p, r.u, old_rho, new_rho)             # <<<<<<<<<<<<<<
@@ -3400,7 +4162,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_rebase(struct __pyx_t_5fccqp_7reduce
 */
   __pyx_f_5fccqp_7reduced__shift(__pyx_v_r, __pyx_v_p, __pyx_v_r->u, __pyx_v_old_rho, __pyx_v_new_rho);
 
-  /* "fccqp/reduced.pyx":145
+  /* "fccqp/reduced.pyx":130
  *     infeasibility tests read) are unchanged. Call before refactoring."""
  *     _shift(r, p, r.u, old_rho, new_rho)
  *     _shift(r, p, r.u_prev, old_rho, new_rho)             # <<<<<<<<<<<<<<
@@ -3409,7 +4171,7 @@ static void __pyx_f_5fccqp_7reduced_reduced_rebase(struct __pyx_t_5fccqp_7reduce
 */
   __pyx_f_5fccqp_7reduced__shift(__pyx_v_r, __pyx_v_p, __pyx_v_r->u_prev, __pyx_v_old_rho, __pyx_v_new_rho);
 
-  /* "fccqp/reduced.pyx":146
+  /* "fccqp/reduced.pyx":131
  *     _shift(r, p, r.u, old_rho, new_rho)
  *     _shift(r, p, r.u_prev, old_rho, new_rho)
  *     _shift(r, p, r.v, old_rho, new_rho)             # <<<<<<<<<<<<<<
@@ -3417,14 +4179,14 @@ static void __pyx_f_5fccqp_7reduced_reduced_rebase(struct __pyx_t_5fccqp_7reduce
 */
   __pyx_f_5fccqp_7reduced__shift(__pyx_v_r, __pyx_v_p, __pyx_v_r->v, __pyx_v_old_rho, __pyx_v_new_rho);
 
-  /* "fccqp/reduced.pyx":147
+  /* "fccqp/reduced.pyx":132
  *     _shift(r, p, r.u_prev, old_rho, new_rho)
  *     _shift(r, p, r.v, old_rho, new_rho)
  *     _shift(r, p, r.v_prev, old_rho, new_rho)             # <<<<<<<<<<<<<<
 */
   __pyx_f_5fccqp_7reduced__shift(__pyx_v_r, __pyx_v_p, __pyx_v_r->v_prev, __pyx_v_old_rho, __pyx_v_new_rho);
 
-  /* "fccqp/reduced.pyx":139
+  /* "fccqp/reduced.pyx":124
  * 
  * 
  * cdef void reduced_rebase(Reduced* r, const Problem* p, const double* old_rho,             # <<<<<<<<<<<<<<
@@ -3545,6 +4307,26 @@ static int __Pyx_modinit_Function_import_code(__pyx_mstatetype *__pyx_mstate) {
     #endif
     const char * __pyx_import_name = __pyx_import_signature + 266;
     void (**const __pyx_import_pointers[])(void) = {(void (**)(void))&__pyx_f_5fccqp_3kkt_kkt_unit_columns, (void (**)(void))&__pyx_f_5fccqp_3kkt_kkt_solve, (void (**)(void)) NULL};
+    void (**const *__pyx_import_pointer)(void) = __pyx_import_pointers;
+    const char *__pyx_import_current_signature = __pyx_import_signature;
+    while (*__pyx_import_pointer) {
+      if (__Pyx_ImportFunction_3_3_1(__pyx_t_1, __pyx_import_name, *__pyx_import_pointer, __pyx_import_current_signature) < (0)) __PYX_ERR(0, 1, __pyx_L1_error)
+      ++__pyx_import_pointer;
+      __pyx_import_name = strchr(__pyx_import_name, '\0') + 1;
+      __pyx_import_signature = strchr(__pyx_import_signature, '\0') + 1;
+      if (*__pyx_import_signature != '\0') __pyx_import_current_signature = __pyx_import_signature;
+    }
+    __Pyx_DECREF(__pyx_t_1); __pyx_t_1 = 0;
+  }
+  {
+    __pyx_t_1 = PyImport_ImportModule("scipy.linalg.cython_blas"); if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 1, __pyx_L1_error)
+    __Pyx_GOTREF(__pyx_t_1);
+    const char * __pyx_import_signature = __Pyx_PyBytes_AsString(__pyx_mstate_global->__pyx_kp_b_void_char_int_int___pyx_t_5scipy);
+    #if !CYTHON_ASSUME_SAFE_MACROS
+    if (unlikely(!__pyx_import_signature)) __PYX_ERR(0, 1, __pyx_L1_error)
+    #endif
+    const char * __pyx_import_name = __pyx_import_signature + 259;
+    void (**const __pyx_import_pointers[])(void) = {(void (**)(void))&__pyx_f_5scipy_6linalg_11cython_blas_dgemv, (void (**)(void)) NULL};
     void (**const *__pyx_import_pointer)(void) = __pyx_import_pointers;
     const char *__pyx_import_current_signature = __pyx_import_signature;
     while (*__pyx_import_pointer) {
@@ -3930,30 +4712,30 @@ static int __Pyx_InitConstants(__pyx_mstatetype *__pyx_mstate) {
   CYTHON_UNUSED_VAR(__pyx_mstate);
   {
     const struct { const unsigned int length: 5; } str_length_index[] = {{1},{8},{10},{8},{12},{12},{8},{18},{10}};
-    const struct { const unsigned int length: 10; } bytes_length_index[] = {{292},{795},{121}};
+    const struct { const unsigned int length: 10; } bytes_length_index[] = {{292},{795},{264},{121}};
     #ifndef CYTHON_COMPRESS_STRINGS
       #define CYTHON_COMPRESS_STRINGS 90
     #endif
-    #if (CYTHON_COMPRESS_STRINGS) == 1 /* compression: zlib (297 bytes) */
-static const char cstring[] = "x\332\315T;O\3040\014\356O\351HOl\010\030\031\230\320-\047\304n\345\022\037\n\227\327%NE\371\365\270W\3651\320\252CAdq\3548\371>\307\217\047\000+\264\003^\326\253l\260\3359a\25724\237 E\320\355\376\222\205\351\355\204\211\000\244\321\016\201\357R\024\022\217B\236\023\222\302\223\310\206\264\243\362&Q\314\222\312\356\035\202\373\223\224\227\000w\3473\301~\377V\356n\313\237=\036\200\232\200\t\016\321\037\r\332Rz\227\250uW>\263a\324\017\r\244\244\277\020h\2641\362\340\270\253\212\332k\365\007Lft&\320bd\247\t\2447\331\272t5$oj\\\370\243\307\210*KT\360\332\311y\206\233\305P\025\233\360\231E[v\177!\214\202\313j\344\325\313\345\024n@l9\225\277\016\277\366_\252\342\2770\0313\304\025S\025=0\t\266\025\016E\344Rw5\306wt\022\207\343\310\023\"aa\371\215\250\205\341\256\035\216\022\211H\023\rC\027\351\312&[\031\300\263w\230\2463c\332\245!\372\017\340\361\365\r\210\230\330\370";
-    PyObject *data = __Pyx_DecompressString(cstring, 297, 1);
+    #if (CYTHON_COMPRESS_STRINGS) == 1 /* compression: zlib (343 bytes) */
+static const char cstring[] = "x\332\315TMO\3030\014\355O\351\221N\\&\3048r\340\204v\231\020w\313K\274-,\037]\342T\224_O\272\262\266\007VmR\207\310\305\261\343\330/\266\363\236\001\014*\013i\031\047\243\246fg\321\034eY\177\202\300R5\373CD}\2623\005\006\020ZY\202t\227=\nZ\243\330\007bI\033\214\232\225\345\374.\260\217\202\3636\016\303\343F\210C\t\017\373=\303r\371\236\317\356\363\337=\026\300uI\001V\336\2555\231\\8\033\270q\227.&C\257\257j\010A}\021poK\231;\307Y\221UN\311?@rFO\000\232\034\321*\006\341t46\034\r\301\351\212Fj\364\344IFA\022\336Zy\036\341do(\262I\360\234\3156\356\376\312\3441\215U\217\353$\307[8\001\260\361V\336<\375\245u)\262\377\202\244\357P\232\230\";%fL\266\314\022\3724\352\266\"\277%+\250;\366\211!\002e&\305\360\nu\372\265\335Q`\364<\320\250l_*v\350\177\276\364@t\370\202Pe\r\213\304B\250\2670\237\213\232w\316\302Zc\000y\235\347\325\241o\215\245\310\344\226L\325\326\341B\262\271\260\221/\316R\030r\347\220\255J\357> \321\3707n\3405\234";
+    PyObject *data = __Pyx_DecompressString(cstring, 343, 1);
     #define __Pyx_DecompressString_LZSS_UNUSED
     if (unlikely(!data)) __PYX_ERR(0, 1, __pyx_L1_error)
     const char* const bytes = __Pyx_PyBytes_AsString(data);
     #if !CYTHON_ASSUME_SAFE_MACROS
     if (likely(bytes)); else { Py_DECREF(data); __PYX_ERR(0, 1, __pyx_L1_error) }
     #endif
-    #elif (CYTHON_COMPRESS_STRINGS) > 0 && (CYTHON_COMPRESS_STRINGS) <= 90 /* compression: lzss (389 bytes) */
-static const char cstring[] = "\377?__main_}_\005\000odule\006\001\367nam\003\002pyx_\357capi\032\001qua\375l\020\005test__\277cline_9\000t\377raceback\377setdefau\377ltint (s\377truct __\376D\001t_5fccq\377p_3kkt_K\277KT *, \014\0236\377_types_P\377roblem c\357onst+\001dou\374\016\000\006\007Py_ssi\317ze_t\032\007w\000, \376\"\004*)\000void\360\047`\212\rw\007\352\001unit\377_columns}\000\373\001solve\2118\3777reducedc_R\002\003\2227\205\201F)\000KB|\243V\315[Itera\324`\000\334G\275E\245[\377\200\047\254\203&\327k\036^\360\200%\343)\000\257\204\032\306\200@\360\201/int\373)\000\243\204\005table\377\000near_co\377nvergenc\375e\026\006rebase\373\000m\343@riali}z\021\007start?\006\017step\260\206\003\276\205\024\366\206\026\260\207\033\177Cones, \252\207\007\376\233\207\tproj_se\001t";
-    PyObject *data = __Pyx_DecompressString_LZSS(cstring, 389, 1295);
+    #elif (CYTHON_COMPRESS_STRINGS) > 0 && (CYTHON_COMPRESS_STRINGS) <= 90 /* compression: lzss (461 bytes) */
+static const char cstring[] = "\377?__main_}_\005\000odule\006\001\367nam\003\002pyx_\357capi\032\001qua\375l\020\005test__\277cline_9\000t\377raceback\377setdefau\377ltint (s\377truct __\376D\001t_5fccq\377p_3kkt_K\277KT *, \014\0236\377_types_P\377roblem c\357onst+\001dou\374\016\000\006\007Py_ssi\317ze_t\032\007w\000, \376\"\004*)\000void\360\047`\212\rw\007\352\001unit\377_columns}\000\373\001solve\2118\3777reducedc_R\002\003\2227\205\201F)\000KB|\243V\315[Itera\324`\000\334G\275E\245[\377\200\047\254\203&\327k\036^\360\200%\343)\000\257\204\032\306\200@\360\201/int\373)\000\243\204\005table\377\000near_co\377nvergenc\375e\026\006rebase\373\000m\343@riali}z\021\007start?\006\357step\260\206\003cha9r\242\207\001\311\207\001*, \000\004\306\207\006\377scipy_6l\377inalg_11\377cython_b\037las_d\332\207\001\000\047*.\376,])\000dgemv\360\270\210\003\306\207\024\376\210\026\270\211\033Cone\347s, \262\211\007\243\211\tpro\037j_set";
+    PyObject *data = __Pyx_DecompressString_LZSS(cstring, 461, 1559);
     #define __Pyx_DecompressString_UNUSED
     if (unlikely(!data)) __PYX_ERR(0, 1, __pyx_L1_error)
     const char* const bytes = __Pyx_PyBytes_AsString(data);
     #if !CYTHON_ASSUME_SAFE_MACROS
     if (likely(bytes)); else { Py_DECREF(data); __PYX_ERR(0, 1, __pyx_L1_error) }
     #endif
-    #else /* compression: none (1295 bytes) */
-static const char bytes[] = "?__main____module____name____pyx_capi____qualname____test__cline_in_tracebacksetdefaultint (struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, Py_ssize_t const *, int, double *)\000void (struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double const *, double *)\000kkt_unit_columns\000kkt_solveint (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *)\000int (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *, double, double)\000void (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double const *)\000void (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *)\000\000void (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *, double, int)\000reduced_table\000near_convergence\000reduced_rebase\000materialize\000reduced_start\000reduced_stepvoid (double const *, double const *, double const *, struct __pyx_t_5fccqp_6_types_Cones, Py_ssize_t, double *)\000proj_set";
+    #else /* compression: none (1559 bytes) */
+static const char bytes[] = "?__main____module____name____pyx_capi____qualname____test__cline_in_tracebacksetdefaultint (struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, Py_ssize_t const *, int, double *)\000void (struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double const *, double *)\000kkt_unit_columns\000kkt_solveint (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_3kkt_KKT *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *)\000int (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *, double, double)\000void (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double const *)\000void (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *)\000\000void (struct __pyx_t_5fccqp_7reduced_Reduced *, struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates *, double, int)\000reduced_table\000near_convergence\000reduced_rebase\000materialize\000reduced_start\000reduced_stepvoid (char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *)\000dgemvvoid (double const *, double const *, double const *, struct __pyx_t_5fccqp_6_types_Cones, Py_ssize_t, double *)\000proj_set";
     PyObject *data = NULL;
     #define __Pyx_DecompressString_UNUSED
     #define __Pyx_DecompressString_LZSS_UNUSED
@@ -3971,7 +4753,7 @@ static const char bytes[] = "?__main____module____name____pyx_capi____qualname__
       stringtab[i] = string;
       pos += bytes_length;
     }
-    for (int i = 9; i < 12; i++) {
+    for (int i = 9; i < 13; i++) {
       Py_ssize_t bytes_length = bytes_length_index[i-9].length;
       PyObject *string = PyBytes_FromStringAndSize(bytes + pos, bytes_length);
       stringtab[i] = string;
@@ -3982,7 +4764,7 @@ static const char bytes[] = "?__main____module____name____pyx_capi____qualname__
       }
     }
     Py_XDECREF(data);
-    for (Py_ssize_t i = 0; i < 12; i++) {
+    for (Py_ssize_t i = 0; i < 13; i++) {
       if (unlikely(PyObject_Hash(stringtab[i]) == -1)) {
         __PYX_ERR(0, 1, __pyx_L1_error)
       }
@@ -3990,7 +4772,7 @@ static const char bytes[] = "?__main____module____name____pyx_capi____qualname__
     #if CYTHON_IMMORTAL_CONSTANTS
     {
       PyObject **table = stringtab + 9;
-      for (Py_ssize_t i=0; i<3; ++i) {
+      for (Py_ssize_t i=0; i<4; ++i) {
         #if PY_VERSION_HEX >= 0x030F0000
         PyUnstable_SetImmortal(table[i]);
         #elif CYTHON_COMPILING_IN_CPYTHON_FREETHREADING
@@ -4745,6 +5527,314 @@ bad:
     Py_XDECREF(py_code);
     Py_XDECREF(py_frame);
 }
+#endif
+
+/* Declarations */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+  #ifdef __cplusplus
+    static CYTHON_INLINE __pyx_t_float_complex __pyx_t_float_complex_from_parts(float x, float y) {
+      return ::std::complex< float >(x, y);
+    }
+  #else
+    static CYTHON_INLINE __pyx_t_float_complex __pyx_t_float_complex_from_parts(float x, float y) {
+      return x + y*(__pyx_t_float_complex)_Complex_I;
+    }
+  #endif
+#else
+    static CYTHON_INLINE __pyx_t_float_complex __pyx_t_float_complex_from_parts(float x, float y) {
+      __pyx_t_float_complex z;
+      z.real = x;
+      z.imag = y;
+      return z;
+    }
+#endif
+
+/* Arithmetic */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+#else
+    static CYTHON_INLINE int __Pyx_c_eq_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+       return (a.real == b.real) && (a.imag == b.imag);
+    }
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_sum_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+        __pyx_t_float_complex z;
+        z.real = a.real + b.real;
+        z.imag = a.imag + b.imag;
+        return z;
+    }
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_diff_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+        __pyx_t_float_complex z;
+        z.real = a.real - b.real;
+        z.imag = a.imag - b.imag;
+        return z;
+    }
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_prod_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+        __pyx_t_float_complex z;
+        z.real = a.real * b.real - a.imag * b.imag;
+        z.imag = a.real * b.imag + a.imag * b.real;
+        return z;
+    }
+    #if 1
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_quot_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+        if (b.imag == 0) {
+            return __pyx_t_float_complex_from_parts(a.real / b.real, a.imag / b.real);
+        } else if (fabsf(b.real) >= fabsf(b.imag)) {
+            if (b.real == 0 && b.imag == 0) {
+                return __pyx_t_float_complex_from_parts(a.real / b.real, a.imag / b.imag);
+            } else {
+                float r = b.imag / b.real;
+                float s = (float)(1.0) / (b.real + b.imag * r);
+                return __pyx_t_float_complex_from_parts(
+                    (a.real + a.imag * r) * s, (a.imag - a.real * r) * s);
+            }
+        } else {
+            float r = b.real / b.imag;
+            float s = (float)(1.0) / (b.imag + b.real * r);
+            return __pyx_t_float_complex_from_parts(
+                (a.real * r + a.imag) * s, (a.imag * r - a.real) * s);
+        }
+    }
+    #else
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_quot_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+        if (b.imag == 0) {
+            return __pyx_t_float_complex_from_parts(a.real / b.real, a.imag / b.real);
+        } else {
+            float denom = b.real * b.real + b.imag * b.imag;
+            return __pyx_t_float_complex_from_parts(
+                (a.real * b.real + a.imag * b.imag) / denom,
+                (a.imag * b.real - a.real * b.imag) / denom);
+        }
+    }
+    #endif
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_neg_float(__pyx_t_float_complex a) {
+        __pyx_t_float_complex z;
+        z.real = -a.real;
+        z.imag = -a.imag;
+        return z;
+    }
+    static CYTHON_INLINE int __Pyx_c_is_zero_float(__pyx_t_float_complex a) {
+       return (a.real == 0) && (a.imag == 0);
+    }
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_conj_float(__pyx_t_float_complex a) {
+        __pyx_t_float_complex z;
+        z.real =  a.real;
+        z.imag = -a.imag;
+        return z;
+    }
+    #if 1
+        static CYTHON_INLINE float __Pyx_c_abs_float(__pyx_t_float_complex z) {
+          #if !defined(HAVE_HYPOT) || defined(_MSC_VER)
+            return sqrtf(z.real*z.real + z.imag*z.imag);
+          #else
+            return hypotf(z.real, z.imag);
+          #endif
+        }
+        static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_pow_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+            __pyx_t_float_complex z;
+            float r, lnr, theta, z_r, z_theta;
+            if (b.imag == 0 && b.real == (int)b.real) {
+                if (b.real < 0) {
+                    float denom = a.real * a.real + a.imag * a.imag;
+                    a.real = a.real / denom;
+                    a.imag = -a.imag / denom;
+                    b.real = -b.real;
+                }
+                switch ((int)b.real) {
+                    case 0:
+                        z.real = 1;
+                        z.imag = 0;
+                        return z;
+                    case 1:
+                        return a;
+                    case 2:
+                        return __Pyx_c_prod_float(a, a);
+                    case 3:
+                        z = __Pyx_c_prod_float(a, a);
+                        return __Pyx_c_prod_float(z, a);
+                    case 4:
+                        z = __Pyx_c_prod_float(a, a);
+                        return __Pyx_c_prod_float(z, z);
+                }
+            }
+            if (a.imag == 0) {
+                if (a.real == 0) {
+                    return a;
+                } else if ((b.imag == 0) && (a.real >= 0)) {
+                    z.real = powf(a.real, b.real);
+                    z.imag = 0;
+                    return z;
+                } else if (a.real > 0) {
+                    r = a.real;
+                    theta = 0;
+                } else {
+                    r = -a.real;
+                    theta = atan2f(0.0, -1.0);
+                }
+            } else {
+                r = __Pyx_c_abs_float(a);
+                theta = atan2f(a.imag, a.real);
+            }
+            lnr = logf(r);
+            z_r = expf(lnr * b.real - theta * b.imag);
+            z_theta = theta * b.real + lnr * b.imag;
+            z.real = z_r * cosf(z_theta);
+            z.imag = z_r * sinf(z_theta);
+            return z;
+        }
+    #endif
+#endif
+
+/* Declarations */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+  #ifdef __cplusplus
+    static CYTHON_INLINE __pyx_t_double_complex __pyx_t_double_complex_from_parts(double x, double y) {
+      return ::std::complex< double >(x, y);
+    }
+  #else
+    static CYTHON_INLINE __pyx_t_double_complex __pyx_t_double_complex_from_parts(double x, double y) {
+      return x + y*(__pyx_t_double_complex)_Complex_I;
+    }
+  #endif
+#else
+    static CYTHON_INLINE __pyx_t_double_complex __pyx_t_double_complex_from_parts(double x, double y) {
+      __pyx_t_double_complex z;
+      z.real = x;
+      z.imag = y;
+      return z;
+    }
+#endif
+
+/* Arithmetic */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+#else
+    static CYTHON_INLINE int __Pyx_c_eq_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+       return (a.real == b.real) && (a.imag == b.imag);
+    }
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_sum_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+        __pyx_t_double_complex z;
+        z.real = a.real + b.real;
+        z.imag = a.imag + b.imag;
+        return z;
+    }
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_diff_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+        __pyx_t_double_complex z;
+        z.real = a.real - b.real;
+        z.imag = a.imag - b.imag;
+        return z;
+    }
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_prod_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+        __pyx_t_double_complex z;
+        z.real = a.real * b.real - a.imag * b.imag;
+        z.imag = a.real * b.imag + a.imag * b.real;
+        return z;
+    }
+    #if 1
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_quot_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+        if (b.imag == 0) {
+            return __pyx_t_double_complex_from_parts(a.real / b.real, a.imag / b.real);
+        } else if (fabs(b.real) >= fabs(b.imag)) {
+            if (b.real == 0 && b.imag == 0) {
+                return __pyx_t_double_complex_from_parts(a.real / b.real, a.imag / b.imag);
+            } else {
+                double r = b.imag / b.real;
+                double s = (double)(1.0) / (b.real + b.imag * r);
+                return __pyx_t_double_complex_from_parts(
+                    (a.real + a.imag * r) * s, (a.imag - a.real * r) * s);
+            }
+        } else {
+            double r = b.real / b.imag;
+            double s = (double)(1.0) / (b.imag + b.real * r);
+            return __pyx_t_double_complex_from_parts(
+                (a.real * r + a.imag) * s, (a.imag * r - a.real) * s);
+        }
+    }
+    #else
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_quot_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+        if (b.imag == 0) {
+            return __pyx_t_double_complex_from_parts(a.real / b.real, a.imag / b.real);
+        } else {
+            double denom = b.real * b.real + b.imag * b.imag;
+            return __pyx_t_double_complex_from_parts(
+                (a.real * b.real + a.imag * b.imag) / denom,
+                (a.imag * b.real - a.real * b.imag) / denom);
+        }
+    }
+    #endif
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_neg_double(__pyx_t_double_complex a) {
+        __pyx_t_double_complex z;
+        z.real = -a.real;
+        z.imag = -a.imag;
+        return z;
+    }
+    static CYTHON_INLINE int __Pyx_c_is_zero_double(__pyx_t_double_complex a) {
+       return (a.real == 0) && (a.imag == 0);
+    }
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_conj_double(__pyx_t_double_complex a) {
+        __pyx_t_double_complex z;
+        z.real =  a.real;
+        z.imag = -a.imag;
+        return z;
+    }
+    #if 1
+        static CYTHON_INLINE double __Pyx_c_abs_double(__pyx_t_double_complex z) {
+          #if !defined(HAVE_HYPOT) || defined(_MSC_VER)
+            return sqrt(z.real*z.real + z.imag*z.imag);
+          #else
+            return hypot(z.real, z.imag);
+          #endif
+        }
+        static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_pow_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+            __pyx_t_double_complex z;
+            double r, lnr, theta, z_r, z_theta;
+            if (b.imag == 0 && b.real == (int)b.real) {
+                if (b.real < 0) {
+                    double denom = a.real * a.real + a.imag * a.imag;
+                    a.real = a.real / denom;
+                    a.imag = -a.imag / denom;
+                    b.real = -b.real;
+                }
+                switch ((int)b.real) {
+                    case 0:
+                        z.real = 1;
+                        z.imag = 0;
+                        return z;
+                    case 1:
+                        return a;
+                    case 2:
+                        return __Pyx_c_prod_double(a, a);
+                    case 3:
+                        z = __Pyx_c_prod_double(a, a);
+                        return __Pyx_c_prod_double(z, a);
+                    case 4:
+                        z = __Pyx_c_prod_double(a, a);
+                        return __Pyx_c_prod_double(z, z);
+                }
+            }
+            if (a.imag == 0) {
+                if (a.real == 0) {
+                    return a;
+                } else if ((b.imag == 0) && (a.real >= 0)) {
+                    z.real = pow(a.real, b.real);
+                    z.imag = 0;
+                    return z;
+                } else if (a.real > 0) {
+                    r = a.real;
+                    theta = 0;
+                } else {
+                    r = -a.real;
+                    theta = atan2(0.0, -1.0);
+                }
+            } else {
+                r = __Pyx_c_abs_double(a);
+                theta = atan2(a.imag, a.real);
+            }
+            lnr = log(r);
+            z_r = exp(lnr * b.real - theta * b.imag);
+            z_theta = theta * b.real + lnr * b.imag;
+            z.real = z_r * cos(z_theta);
+            z.imag = z_r * sin(z_theta);
+            return z;
+        }
+    #endif
 #endif
 
 /* FormatTypeName */

@@ -12,6 +12,7 @@ the right-hand side ``(-q + E_S u, b)``. After a change of ``R`` the same ``x`` 
 coordinate ``u + (R' - R) x_S`` in the new table (:func:`reduced_rebase`).
 """
 
+from fccqp._dense cimport colmatvec, copy, matvec
 from fccqp._types cimport Iterates, Problem
 from fccqp.kkt cimport KKT, kkt_solve, kkt_unit_columns
 from fccqp.projections cimport proj_set
@@ -47,15 +48,7 @@ cdef void reduced_start(Reduced* r, const Problem* p, Iterates* it) noexcept nog
 cdef inline void _table_product(const Reduced* r, const double* c, double* out,
                                 Py_ssize_t s) noexcept nogil:
     """``out = W_S c`` (row-major ``s x s``)."""
-    cdef Py_ssize_t i, j
-    cdef double acc
-    cdef const double* row
-    for i in range(s):
-        row = r.W_S + i * s
-        acc = 0.0
-        for j in range(s):
-            acc += row[j] * c[j]
-        out[i] = acc
+    matvec(r.W_S, c, out, s, s)
 
 
 cdef void reduced_step(Reduced* r, const Problem* p, Iterates* it, double alpha,
@@ -105,17 +98,9 @@ cdef bint near_convergence(Reduced* r, const Problem* p, Iterates* it, double ep
 
 cdef inline void _combine(const Reduced* r, const double* c, double* out, Py_ssize_t first,
                           Py_ssize_t count, Py_ssize_t N, Py_ssize_t s) noexcept nogil:
-    """``out = (base + W c)[first:first + count]`` (column by column: contiguous)."""
-    cdef Py_ssize_t i, j
-    cdef const double* column
-    cdef double cj
-    for i in range(count):
-        out[i] = r.base[first + i]
-    for j in range(s):
-        column = r.W + j * N + first
-        cj = c[j]
-        for i in range(count):
-            out[i] += column[i] * cj
+    """``out = (base + W c)[first:first + count]``."""
+    copy(r.base + first, out, count)
+    colmatvec(r.W + first, <int>N, c, out, count, s, 1.0)
 
 
 cdef void materialize(Reduced* r, const Problem* p, Iterates* it) noexcept nogil:

@@ -2859,6 +2859,7 @@ static int __Pyx_State_RemoveModule(void*);
 
 /* Module declarations from "scipy.linalg.cython_blas" */
 static void (*__pyx_f_5scipy_6linalg_11cython_blas_dgemm)(char *, char *, int *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *); /*proto*/
+static void (*__pyx_f_5scipy_6linalg_11cython_blas_dgemv)(char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *); /*proto*/
 static void (*__pyx_f_5scipy_6linalg_11cython_blas_dsyrk)(char *, char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *); /*proto*/
 static void (*__pyx_f_5scipy_6linalg_11cython_blas_dtrsm)(char *, char *, char *, char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *); /*proto*/
 
@@ -2876,6 +2877,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_5_blas_cholesky_solve(double const *, i
 /* Module declarations from "libc.math" */
 
 /* Module declarations from "fccqp._dense" */
+static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *, double, Py_ssize_t); /*proto*/
 static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec(double const *, double const *, double *, Py_ssize_t, Py_ssize_t); /*proto*/
 static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec_t(double const *, double const *, double *, Py_ssize_t, Py_ssize_t); /*proto*/
 
@@ -3334,7 +3336,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_5_blas_cholesky_solve(double const *__p
 
 }
 
-/* "fccqp/_dense.pxd":14
+/* "fccqp/_dense.pxd":16
  * 
  * 
  * cdef inline double inf_norm(const double* v, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -3351,7 +3353,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
   Py_ssize_t __pyx_t_3;
   int __pyx_t_4;
 
-  /* "fccqp/_dense.pxd":15
+  /* "fccqp/_dense.pxd":17
  * 
  * cdef inline double inf_norm(const double* v, Py_ssize_t k) noexcept nogil:
  *     cdef double out = 0.0             # <<<<<<<<<<<<<<
@@ -3360,7 +3362,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
 */
   __pyx_v_out = 0.0;
 
-  /* "fccqp/_dense.pxd":17
+  /* "fccqp/_dense.pxd":19
  *     cdef double out = 0.0
  *     cdef Py_ssize_t i
  *     for i in range(k):             # <<<<<<<<<<<<<<
@@ -3374,7 +3376,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/_dense.pxd":18
+    /* "fccqp/_dense.pxd":20
  *     cdef Py_ssize_t i
  *     for i in range(k):
  *         if fabs(v[i]) > out:             # <<<<<<<<<<<<<<
@@ -3386,7 +3388,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
     if (__pyx_t_4) {
 
 
-      /* "fccqp/_dense.pxd":19
+      /* "fccqp/_dense.pxd":21
  *     for i in range(k):
  *         if fabs(v[i]) > out:
  *             out = fabs(v[i])             # <<<<<<<<<<<<<<
@@ -3395,7 +3397,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
 */
       __pyx_v_out = fabs((__pyx_v_v[__pyx_v_i]));
 
-      /* "fccqp/_dense.pxd":18
+      /* "fccqp/_dense.pxd":20
  *     cdef Py_ssize_t i
  *     for i in range(k):
  *         if fabs(v[i]) > out:             # <<<<<<<<<<<<<<
@@ -3406,7 +3408,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
   }
 
 
-  /* "fccqp/_dense.pxd":20
+  /* "fccqp/_dense.pxd":22
  *         if fabs(v[i]) > out:
  *             out = fabs(v[i])
  *     return out             # <<<<<<<<<<<<<<
@@ -3419,7 +3421,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
   }
   goto __pyx_L0;
 
-  /* "fccqp/_dense.pxd":14
+  /* "fccqp/_dense.pxd":16
  * 
  * 
  * cdef inline double inf_norm(const double* v, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -3434,7 +3436,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
   return __pyx_r;
 }
 
-/* "fccqp/_dense.pxd":23
+/* "fccqp/_dense.pxd":25
  * 
  * 
  * cdef inline double dot(const double* a, const double* b, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -3450,7 +3452,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
   Py_ssize_t __pyx_t_2;
   Py_ssize_t __pyx_t_3;
 
-  /* "fccqp/_dense.pxd":24
+  /* "fccqp/_dense.pxd":26
  * 
  * cdef inline double dot(const double* a, const double* b, Py_ssize_t k) noexcept nogil:
  *     cdef double out = 0.0             # <<<<<<<<<<<<<<
@@ -3459,7 +3461,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
 */
   __pyx_v_out = 0.0;
 
-  /* "fccqp/_dense.pxd":26
+  /* "fccqp/_dense.pxd":28
  *     cdef double out = 0.0
  *     cdef Py_ssize_t i
  *     for i in range(k):             # <<<<<<<<<<<<<<
@@ -3473,7 +3475,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/_dense.pxd":27
+    /* "fccqp/_dense.pxd":29
  *     cdef Py_ssize_t i
  *     for i in range(k):
  *         out += a[i] * b[i]             # <<<<<<<<<<<<<<
@@ -3484,7 +3486,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
   }
 
 
-  /* "fccqp/_dense.pxd":28
+  /* "fccqp/_dense.pxd":30
  *     for i in range(k):
  *         out += a[i] * b[i]
  *     return out             # <<<<<<<<<<<<<<
@@ -3497,7 +3499,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
   }
   goto __pyx_L0;
 
-  /* "fccqp/_dense.pxd":23
+  /* "fccqp/_dense.pxd":25
  * 
  * 
  * cdef inline double dot(const double* a, const double* b, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -3512,7 +3514,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
   return __pyx_r;
 }
 
-/* "fccqp/_dense.pxd":31
+/* "fccqp/_dense.pxd":33
  * 
  * 
  * cdef inline void copy(const double* src, double* dst, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -3526,7 +3528,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_copy(double const *__pyx_v_src,
   Py_ssize_t __pyx_t_2;
   Py_ssize_t __pyx_t_3;
 
-  /* "fccqp/_dense.pxd":33
+  /* "fccqp/_dense.pxd":35
  * cdef inline void copy(const double* src, double* dst, Py_ssize_t k) noexcept nogil:
  *     cdef Py_ssize_t i
  *     for i in range(k):             # <<<<<<<<<<<<<<
@@ -3540,7 +3542,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_copy(double const *__pyx_v_src,
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/_dense.pxd":34
+    /* "fccqp/_dense.pxd":36
  *     cdef Py_ssize_t i
  *     for i in range(k):
  *         dst[i] = src[i]             # <<<<<<<<<<<<<<
@@ -3551,7 +3553,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_copy(double const *__pyx_v_src,
   }
 
 
-  /* "fccqp/_dense.pxd":31
+  /* "fccqp/_dense.pxd":33
  * 
  * 
  * cdef inline void copy(const double* src, double* dst, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -3563,7 +3565,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_copy(double const *__pyx_v_src,
 
 }
 
-/* "fccqp/_dense.pxd":37
+/* "fccqp/_dense.pxd":39
  * 
  * 
  * cdef inline void fill(double* dst, double value, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -3577,7 +3579,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *__pyx_v_dst, doubl
   Py_ssize_t __pyx_t_2;
   Py_ssize_t __pyx_t_3;
 
-  /* "fccqp/_dense.pxd":39
+  /* "fccqp/_dense.pxd":41
  * cdef inline void fill(double* dst, double value, Py_ssize_t k) noexcept nogil:
  *     cdef Py_ssize_t i
  *     for i in range(k):             # <<<<<<<<<<<<<<
@@ -3591,7 +3593,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *__pyx_v_dst, doubl
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/_dense.pxd":40
+    /* "fccqp/_dense.pxd":42
  *     cdef Py_ssize_t i
  *     for i in range(k):
  *         dst[i] = value             # <<<<<<<<<<<<<<
@@ -3602,7 +3604,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *__pyx_v_dst, doubl
   }
 
 
-  /* "fccqp/_dense.pxd":37
+  /* "fccqp/_dense.pxd":39
  * 
  * 
  * cdef inline void fill(double* dst, double value, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -3614,222 +3616,456 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *__pyx_v_dst, doubl
 
 }
 
-/* "fccqp/_dense.pxd":43
+/* "fccqp/_dense.pxd":45
  * 
  * 
  * cdef inline void matvec(const double* M, const double* x, double* out,             # <<<<<<<<<<<<<<
  *                         Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
- *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M``."""
+ *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
 */
 
 static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec(double const *__pyx_v_M, double const *__pyx_v_x, double *__pyx_v_out, Py_ssize_t __pyx_v_rows, Py_ssize_t __pyx_v_cols) {
-  Py_ssize_t __pyx_v_i;
-  Py_ssize_t __pyx_v_j;
-  double __pyx_v_acc;
-  double const *__pyx_v_row;
-  Py_ssize_t __pyx_t_1;
-  Py_ssize_t __pyx_t_2;
-  Py_ssize_t __pyx_t_3;
-  Py_ssize_t __pyx_t_4;
-  Py_ssize_t __pyx_t_5;
-  Py_ssize_t __pyx_t_6;
+  int __pyx_v_r;
+  int __pyx_v_c;
+  int __pyx_v_one;
+  double __pyx_v_alpha;
+  double __pyx_v_beta;
+  char __pyx_v_trans;
+  int __pyx_t_1;
+
+  /* "fccqp/_dense.pxd":48
+ *                         Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
+ *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1             # <<<<<<<<<<<<<<
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"T"
+*/
+  __pyx_v_r = ((int)__pyx_v_rows);
+  __pyx_v_c = ((int)__pyx_v_cols);
+  __pyx_v_one = 1;
 
   /* "fccqp/_dense.pxd":49
- *     cdef double acc
- *     cdef const double* row
- *     for i in range(rows):             # <<<<<<<<<<<<<<
- *         row = M + i * cols
- *         acc = 0.0
+ *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0, beta = 0.0             # <<<<<<<<<<<<<<
+ *     cdef char trans = b"T"
+ *     if rows == 0:
 */
+  __pyx_v_alpha = 1.0;
+  __pyx_v_beta = 0.0;
 
-  __pyx_t_1 = __pyx_v_rows;
-  __pyx_t_2 = __pyx_t_1;
-
-  for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
-    __pyx_v_i = __pyx_t_3;
-
-    /* "fccqp/_dense.pxd":50
- *     cdef const double* row
- *     for i in range(rows):
- *         row = M + i * cols             # <<<<<<<<<<<<<<
- *         acc = 0.0
- *         for j in range(cols):
+  /* "fccqp/_dense.pxd":50
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"T"             # <<<<<<<<<<<<<<
+ *     if rows == 0:
+ *         return
 */
-    __pyx_v_row = (__pyx_v_M + (__pyx_v_i * __pyx_v_cols));
+  __pyx_v_trans = 'T';
 
-    /* "fccqp/_dense.pxd":51
- *     for i in range(rows):
- *         row = M + i * cols
- *         acc = 0.0             # <<<<<<<<<<<<<<
- *         for j in range(cols):
- *             acc += row[j] * x[j]
+  /* "fccqp/_dense.pxd":51
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"T"
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
 */
-    __pyx_v_acc = 0.0;
+  __pyx_t_1 = (__pyx_v_rows == 0);
+
+  if (__pyx_t_1) {
+
 
     /* "fccqp/_dense.pxd":52
- *         row = M + i * cols
- *         acc = 0.0
- *         for j in range(cols):             # <<<<<<<<<<<<<<
- *             acc += row[j] * x[j]
- *         out[i] = acc
+ *     cdef char trans = b"T"
+ *     if rows == 0:
+ *         return             # <<<<<<<<<<<<<<
+ *     if cols == 0:
+ *         fill(out, 0.0, rows)
 */
-
-    __pyx_t_4 = __pyx_v_cols;
-    __pyx_t_5 = __pyx_t_4;
-
-    for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
-      __pyx_v_j = __pyx_t_6;
-
-      /* "fccqp/_dense.pxd":53
- *         acc = 0.0
- *         for j in range(cols):
- *             acc += row[j] * x[j]             # <<<<<<<<<<<<<<
- *         out[i] = acc
- * 
-*/
-      __pyx_v_acc = (__pyx_v_acc + ((__pyx_v_row[__pyx_v_j]) * (__pyx_v_x[__pyx_v_j])));
+    {
     }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":51
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"T"
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
+*/
+  }
+
+  /* "fccqp/_dense.pxd":53
+ *     if rows == 0:
+ *         return
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         fill(out, 0.0, rows)
+ *         return
+*/
+  __pyx_t_1 = (__pyx_v_cols == 0);
+
+  if (__pyx_t_1) {
 
 
     /* "fccqp/_dense.pxd":54
- *         for j in range(cols):
- *             acc += row[j] * x[j]
- *         out[i] = acc             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
+ *         fill(out, 0.0, rows)             # <<<<<<<<<<<<<<
+ *         return
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>x, &one, &beta, out, &one)
+*/
+    __pyx_f_5fccqp_6_dense_fill(__pyx_v_out, 0.0, __pyx_v_rows);
+
+    /* "fccqp/_dense.pxd":55
+ *     if cols == 0:
+ *         fill(out, 0.0, rows)
+ *         return             # <<<<<<<<<<<<<<
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>x, &one, &beta, out, &one)
+ * 
+*/
+    {
+    }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":53
+ *     if rows == 0:
+ *         return
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         fill(out, 0.0, rows)
+ *         return
+*/
+  }
+
+  /* "fccqp/_dense.pxd":56
+ *         fill(out, 0.0, rows)
+ *         return
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>x, &one, &beta, out, &one)             # <<<<<<<<<<<<<<
  * 
  * 
 */
-    (__pyx_v_out[__pyx_v_i]) = __pyx_v_acc;
-  }
+  __pyx_f_5scipy_6linalg_11cython_blas_dgemv((&__pyx_v_trans), (&__pyx_v_c), (&__pyx_v_r), (&__pyx_v_alpha), ((double *)__pyx_v_M), (&__pyx_v_c), ((double *)__pyx_v_x), (&__pyx_v_one), (&__pyx_v_beta), __pyx_v_out, (&__pyx_v_one));
 
-
-  /* "fccqp/_dense.pxd":43
+  /* "fccqp/_dense.pxd":45
  * 
  * 
  * cdef inline void matvec(const double* M, const double* x, double* out,             # <<<<<<<<<<<<<<
  *                         Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
- *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M``."""
+ *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
 */
 
   /* function exit code */
+  __pyx_L0:;
+
+
 
 
 
 
 }
 
-/* "fccqp/_dense.pxd":57
+/* "fccqp/_dense.pxd":59
  * 
  * 
  * cdef inline void matvec_t(const double* M, const double* y, double* out,             # <<<<<<<<<<<<<<
  *                           Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
- *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (row by row, so that
+ *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
 */
 
 static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec_t(double const *__pyx_v_M, double const *__pyx_v_y, double *__pyx_v_out, Py_ssize_t __pyx_v_rows, Py_ssize_t __pyx_v_cols) {
-  Py_ssize_t __pyx_v_i;
-  Py_ssize_t __pyx_v_j;
-  double __pyx_v_yi;
-  double const *__pyx_v_row;
-  Py_ssize_t __pyx_t_1;
-  Py_ssize_t __pyx_t_2;
-  Py_ssize_t __pyx_t_3;
-  Py_ssize_t __pyx_t_4;
-  Py_ssize_t __pyx_t_5;
-  Py_ssize_t __pyx_t_6;
-  Py_ssize_t __pyx_t_7;
+  int __pyx_v_r;
+  int __pyx_v_c;
+  int __pyx_v_one;
+  double __pyx_v_alpha;
+  double __pyx_v_beta;
+  char __pyx_v_trans;
+  int __pyx_t_1;
+
+  /* "fccqp/_dense.pxd":62
+ *                           Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
+ *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1             # <<<<<<<<<<<<<<
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"N"
+*/
+  __pyx_v_r = ((int)__pyx_v_rows);
+  __pyx_v_c = ((int)__pyx_v_cols);
+  __pyx_v_one = 1;
+
+  /* "fccqp/_dense.pxd":63
+ *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0, beta = 0.0             # <<<<<<<<<<<<<<
+ *     cdef char trans = b"N"
+ *     if cols == 0:
+*/
+  __pyx_v_alpha = 1.0;
+  __pyx_v_beta = 0.0;
 
   /* "fccqp/_dense.pxd":64
- *     cdef double yi
- *     cdef const double* row
- *     for j in range(cols):             # <<<<<<<<<<<<<<
- *         out[j] = 0.0
- *     for i in range(rows):
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"N"             # <<<<<<<<<<<<<<
+ *     if cols == 0:
+ *         return
 */
+  __pyx_v_trans = 'N';
 
-  __pyx_t_1 = __pyx_v_cols;
-  __pyx_t_2 = __pyx_t_1;
+  /* "fccqp/_dense.pxd":65
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"N"
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if rows == 0:
+*/
+  __pyx_t_1 = (__pyx_v_cols == 0);
 
-  for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
-    __pyx_v_j = __pyx_t_3;
+  if (__pyx_t_1) {
+
+
+    /* "fccqp/_dense.pxd":66
+ *     cdef char trans = b"N"
+ *     if cols == 0:
+ *         return             # <<<<<<<<<<<<<<
+ *     if rows == 0:
+ *         fill(out, 0.0, cols)
+*/
+    {
+    }
+    goto __pyx_L0;
 
     /* "fccqp/_dense.pxd":65
- *     cdef const double* row
- *     for j in range(cols):
- *         out[j] = 0.0             # <<<<<<<<<<<<<<
- *     for i in range(rows):
- *         row = M + i * cols
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"N"
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if rows == 0:
 */
-    (__pyx_v_out[__pyx_v_j]) = 0.0;
   }
 
-
-  /* "fccqp/_dense.pxd":66
- *     for j in range(cols):
- *         out[j] = 0.0
- *     for i in range(rows):             # <<<<<<<<<<<<<<
- *         row = M + i * cols
- *         yi = y[i]
+  /* "fccqp/_dense.pxd":67
+ *     if cols == 0:
+ *         return
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         fill(out, 0.0, cols)
+ *         return
 */
+  __pyx_t_1 = (__pyx_v_rows == 0);
 
-  __pyx_t_1 = __pyx_v_rows;
-  __pyx_t_2 = __pyx_t_1;
+  if (__pyx_t_1) {
 
-  for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
-    __pyx_v_i = __pyx_t_3;
-
-    /* "fccqp/_dense.pxd":67
- *         out[j] = 0.0
- *     for i in range(rows):
- *         row = M + i * cols             # <<<<<<<<<<<<<<
- *         yi = y[i]
- *         for j in range(cols):
-*/
-    __pyx_v_row = (__pyx_v_M + (__pyx_v_i * __pyx_v_cols));
 
     /* "fccqp/_dense.pxd":68
- *     for i in range(rows):
- *         row = M + i * cols
- *         yi = y[i]             # <<<<<<<<<<<<<<
- *         for j in range(cols):
- *             out[j] += row[j] * yi
+ *         return
+ *     if rows == 0:
+ *         fill(out, 0.0, cols)             # <<<<<<<<<<<<<<
+ *         return
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>y, &one, &beta, out, &one)
 */
-    __pyx_v_yi = (__pyx_v_y[__pyx_v_i]);
+    __pyx_f_5fccqp_6_dense_fill(__pyx_v_out, 0.0, __pyx_v_cols);
 
     /* "fccqp/_dense.pxd":69
- *         row = M + i * cols
- *         yi = y[i]
- *         for j in range(cols):             # <<<<<<<<<<<<<<
- *             out[j] += row[j] * yi
+ *     if rows == 0:
+ *         fill(out, 0.0, cols)
+ *         return             # <<<<<<<<<<<<<<
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>y, &one, &beta, out, &one)
+ * 
 */
-
-    __pyx_t_4 = __pyx_v_cols;
-    __pyx_t_5 = __pyx_t_4;
-
-    for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
-      __pyx_v_j = __pyx_t_6;
-
-      /* "fccqp/_dense.pxd":70
- *         yi = y[i]
- *         for j in range(cols):
- *             out[j] += row[j] * yi             # <<<<<<<<<<<<<<
-*/
-
-      __pyx_t_7 = __pyx_v_j;
-      (__pyx_v_out[__pyx_t_7]) = ((__pyx_v_out[__pyx_t_7]) + ((__pyx_v_row[__pyx_v_j]) * __pyx_v_yi));
+    {
     }
+    goto __pyx_L0;
 
+    /* "fccqp/_dense.pxd":67
+ *     if cols == 0:
+ *         return
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         fill(out, 0.0, cols)
+ *         return
+*/
   }
 
+  /* "fccqp/_dense.pxd":70
+ *         fill(out, 0.0, cols)
+ *         return
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>y, &one, &beta, out, &one)             # <<<<<<<<<<<<<<
+ * 
+ * 
+*/
+  __pyx_f_5scipy_6linalg_11cython_blas_dgemv((&__pyx_v_trans), (&__pyx_v_c), (&__pyx_v_r), (&__pyx_v_alpha), ((double *)__pyx_v_M), (&__pyx_v_c), ((double *)__pyx_v_y), (&__pyx_v_one), (&__pyx_v_beta), __pyx_v_out, (&__pyx_v_one));
 
-  /* "fccqp/_dense.pxd":57
+  /* "fccqp/_dense.pxd":59
  * 
  * 
  * cdef inline void matvec_t(const double* M, const double* y, double* out,             # <<<<<<<<<<<<<<
  *                           Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
- *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (row by row, so that
+ *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
 */
 
   /* function exit code */
+  __pyx_L0:;
+
+
+
+
+
+
+}
+
+/* "fccqp/_dense.pxd":73
+ * 
+ * 
+ * cdef inline void colmatvec(const double* M, int ld, const double* x, double* out,             # <<<<<<<<<<<<<<
+ *                            Py_ssize_t rows, Py_ssize_t cols, double beta) noexcept nogil:
+ *     """``out = M x + beta out`` for a column-major ``rows x cols`` block ``M`` with
+*/
+
+static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_colmatvec(double const *__pyx_v_M, int __pyx_v_ld, double const *__pyx_v_x, double *__pyx_v_out, Py_ssize_t __pyx_v_rows, Py_ssize_t __pyx_v_cols, double __pyx_v_beta) {
+  int __pyx_v_r;
+  int __pyx_v_c;
+  int __pyx_v_one;
+  double __pyx_v_alpha;
+  char __pyx_v_trans;
+  int __pyx_t_1;
+
+  /* "fccqp/_dense.pxd":77
+ *     """``out = M x + beta out`` for a column-major ``rows x cols`` block ``M`` with
+ *     leading dimension ``ld`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1             # <<<<<<<<<<<<<<
+ *     cdef double alpha = 1.0
+ *     cdef char trans = b"N"
+*/
+  __pyx_v_r = ((int)__pyx_v_rows);
+  __pyx_v_c = ((int)__pyx_v_cols);
+  __pyx_v_one = 1;
+
+  /* "fccqp/_dense.pxd":78
+ *     leading dimension ``ld`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0             # <<<<<<<<<<<<<<
+ *     cdef char trans = b"N"
+ *     if rows == 0:
+*/
+  __pyx_v_alpha = 1.0;
+
+  /* "fccqp/_dense.pxd":79
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0
+ *     cdef char trans = b"N"             # <<<<<<<<<<<<<<
+ *     if rows == 0:
+ *         return
+*/
+  __pyx_v_trans = 'N';
+
+  /* "fccqp/_dense.pxd":80
+ *     cdef double alpha = 1.0
+ *     cdef char trans = b"N"
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
+*/
+  __pyx_t_1 = (__pyx_v_rows == 0);
+
+  if (__pyx_t_1) {
+
+
+    /* "fccqp/_dense.pxd":81
+ *     cdef char trans = b"N"
+ *     if rows == 0:
+ *         return             # <<<<<<<<<<<<<<
+ *     if cols == 0:
+ *         if beta == 0.0:
+*/
+    {
+    }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":80
+ *     cdef double alpha = 1.0
+ *     cdef char trans = b"N"
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
+*/
+  }
+
+  /* "fccqp/_dense.pxd":82
+ *     if rows == 0:
+ *         return
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         if beta == 0.0:
+ *             fill(out, 0.0, rows)
+*/
+  __pyx_t_1 = (__pyx_v_cols == 0);
+
+  if (__pyx_t_1) {
+
+
+    /* "fccqp/_dense.pxd":83
+ *         return
+ *     if cols == 0:
+ *         if beta == 0.0:             # <<<<<<<<<<<<<<
+ *             fill(out, 0.0, rows)
+ *         return
+*/
+    __pyx_t_1 = (__pyx_v_beta == 0.0);
+
+    if (__pyx_t_1) {
+
+
+      /* "fccqp/_dense.pxd":84
+ *     if cols == 0:
+ *         if beta == 0.0:
+ *             fill(out, 0.0, rows)             # <<<<<<<<<<<<<<
+ *         return
+ *     dgemv(&trans, &r, &c, &alpha, <double*>M, &ld, <double*>x, &one, &beta, out, &one)
+*/
+      __pyx_f_5fccqp_6_dense_fill(__pyx_v_out, 0.0, __pyx_v_rows);
+
+      /* "fccqp/_dense.pxd":83
+ *         return
+ *     if cols == 0:
+ *         if beta == 0.0:             # <<<<<<<<<<<<<<
+ *             fill(out, 0.0, rows)
+ *         return
+*/
+    }
+
+    /* "fccqp/_dense.pxd":85
+ *         if beta == 0.0:
+ *             fill(out, 0.0, rows)
+ *         return             # <<<<<<<<<<<<<<
+ *     dgemv(&trans, &r, &c, &alpha, <double*>M, &ld, <double*>x, &one, &beta, out, &one)
+*/
+    {
+    }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":82
+ *     if rows == 0:
+ *         return
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         if beta == 0.0:
+ *             fill(out, 0.0, rows)
+*/
+  }
+
+  /* "fccqp/_dense.pxd":86
+ *             fill(out, 0.0, rows)
+ *         return
+ *     dgemv(&trans, &r, &c, &alpha, <double*>M, &ld, <double*>x, &one, &beta, out, &one)             # <<<<<<<<<<<<<<
+*/
+  __pyx_f_5scipy_6linalg_11cython_blas_dgemv((&__pyx_v_trans), (&__pyx_v_r), (&__pyx_v_c), (&__pyx_v_alpha), ((double *)__pyx_v_M), (&__pyx_v_ld), ((double *)__pyx_v_x), (&__pyx_v_one), (&__pyx_v_beta), __pyx_v_out, (&__pyx_v_one));
+
+  /* "fccqp/_dense.pxd":73
+ * 
+ * 
+ * cdef inline void colmatvec(const double* M, int ld, const double* x, double* out,             # <<<<<<<<<<<<<<
+ *                            Py_ssize_t rows, Py_ssize_t cols, double beta) noexcept nogil:
+ *     """``out = M x + beta out`` for a column-major ``rows x cols`` block ``M`` with
+*/
+
+  /* function exit code */
+  __pyx_L0:;
+
 
 
 
@@ -5740,8 +5976,8 @@ static int __Pyx_modinit_Function_import_code(__pyx_mstatetype *__pyx_mstate) {
     #if !CYTHON_ASSUME_SAFE_MACROS
     if (unlikely(!__pyx_import_signature)) __PYX_ERR(0, 1, __pyx_L1_error)
     #endif
-    const char * __pyx_import_name = __pyx_import_signature + 684;
-    void (**const __pyx_import_pointers[])(void) = {(void (**)(void))&__pyx_f_5scipy_6linalg_11cython_blas_dtrsm, (void (**)(void))&__pyx_f_5scipy_6linalg_11cython_blas_dsyrk, (void (**)(void))&__pyx_f_5scipy_6linalg_11cython_blas_dgemm, (void (**)(void)) NULL};
+    const char * __pyx_import_name = __pyx_import_signature + 943;
+    void (**const __pyx_import_pointers[])(void) = {(void (**)(void))&__pyx_f_5scipy_6linalg_11cython_blas_dtrsm, (void (**)(void))&__pyx_f_5scipy_6linalg_11cython_blas_dsyrk, (void (**)(void))&__pyx_f_5scipy_6linalg_11cython_blas_dgemm, (void (**)(void))&__pyx_f_5scipy_6linalg_11cython_blas_dgemv, (void (**)(void)) NULL};
     void (**const *__pyx_import_pointer)(void) = __pyx_import_pointers;
     const char *__pyx_import_current_signature = __pyx_import_signature;
     while (*__pyx_import_pointer) {
@@ -6258,30 +6494,30 @@ static int __Pyx_InitConstants(__pyx_mstatetype *__pyx_mstate) {
   CYTHON_UNUSED_VAR(__pyx_mstate);
   {
     const struct { const unsigned int length: 5; } str_length_index[] = {{1},{19},{14},{20},{12},{8},{8},{10},{8},{12},{12},{8},{13},{6},{18},{5},{18},{11},{11},{5},{11},{11},{4},{4},{5},{1},{2},{5},{4},{8},{3},{10},{6}};
-    const struct { const unsigned int length: 10; } bytes_length_index[] = {{81},{523},{701},{229},{55}};
+    const struct { const unsigned int length: 10; } bytes_length_index[] = {{81},{523},{966},{229},{55}};
     #ifndef CYTHON_COMPRESS_STRINGS
       #define CYTHON_COMPRESS_STRINGS 90
     #endif
-    #if (CYTHON_COMPRESS_STRINGS) == 1 /* compression: zlib (518 bytes) */
-static const char cstring[] = "x\332\325T\315n\0231\020N\244\036\2208\301\035\021N\220\n\245j\253\366\212\370\351\tTB\201[\245\221c\317&V\275\266k\217\243lO\034s\354q\037\241G\216\034{\344\021z\344Q\230u\222\242J-\241H\251`%{~<;\33773\336}\021\203\334(\244<\366\033Q\216R\350\371jr\360r\377-|z\377n\217\225\327{\000\375j\302\353\215\226\004\3738\241\003,\000\204\265\216\004!\360S$+\033Y\nm\263t*\231|bE\231%\047\005)\274n\364\343$\314\302O\030\211\205\216 ]p\211\264E\021\251\362\274WVj\327\273t\307\201s\006\244a\025\030\205\202\2208\020\362H:+\231\206\345\305jd?G(\325\344\310U\365rU\205\021d\235=\301\340\212\200\250-yMXFk\275M\245\257\034\003\270\2400h;\364\316G$\205\205H\206\306\302$\214\034\337y\246\\\032\030\354d\224\316\372\363\3162\273_A\214\372\004\201\272\255\022\221\"`S\272&=O\310d\223\244\316\254;\004;\231/\354d\302\360\261\331\2334\327G\355BSa\204~p\014Z\336\304\242\333\272+\244\205\335m\215\235V\253\205\\\277\013\220e6\223\230\341\024B\222\013sCb ]\360\204\371B\3331N4U\363\223d5\261\323\244\322\306\271+:3\306Y%r$2\327\233d3\306_\342\262\224(\265\257`\227\277\na\206\260\271)+\0329\013\003#\"\250\333E\336:u~a1\211\377\200\357J*\373\347\006\262\322\216(\n\261l\251X\205\243\226\032bY^m\321\022\002\333\363\264Fx\376q_\341|m\307\377\254\305\277\311\372\367D\224w\024\212\231\210_\332?\326\356O\267\246\237O\237\234n\237\026\365\253Z\\\254\335\233\266\247\217\353\366E>9\254\037\326[\365\341\331\203\263\247_\037}\033\236\1778\037|o\377\004\372o\244\320";
-    PyObject *data = __Pyx_DecompressString(cstring, 518, 1);
+    #if (CYTHON_COMPRESS_STRINGS) == 1 /* compression: zlib (522 bytes) */
+static const char cstring[] = "x\332\345U=o\023A\020\265\245\024HT\320#L\005\216\220\243$JZ\304G*P0\001\272H\243\365\356\234\263\312\336\356fw\326\362\245\242t\351\362~BJJ\312\224\374\204\224\374\024\346\326v\020RL\024P,\020\047\335\316\354\354\334{of\356t\317b\220\033\205\224\047~#\312\243\024z\276\032\037<\337\177\r\037\336\276\331c\347\345\036@\277\032\363\375JK\202}\034\323\001\026\000\302ZG\202\020\370*\222\225\215-\205\266\331:\225L>\261\242\314\226AA\n\257\033\377$\t\263\210\023Fb\243#H\027\\\"mQD\252<\257\225\225\332\365.\303q\340\234\001i\330\005f\241 $\016\204<\226\316J\226a\371f7r\2343\224j0rU\275\\Ua\004YgO1\270\" jK^\023\226\321ZoS\351+\307\004.(\014\332\016\275\363\021Ia!\222\241\2210\t#\347w\236(\227\006\006;\231\245\263\376\264s\335\276_A\214\372\024\201\272\255\022\221\"`S\272&=\007d\261IRg\326\035\202\235\254\027v\262`x\337\254\r\314\325Y\273\320T\030\241\037\034\223\226\313Tt[\253bZ\354\273\255\221\323\352v)\327WAr\335\236E\314x\n!\311\205\371Fb ]\360\204\371\205\266#\034k\252\346\047\311j\342\240I\245\215\363Ptf\204\263J\344\221\310Z\227\331f\214?\314e)Qj_\301.\177\025\302\014asSVt\344,\014\214\210\240n\226yc\350\374\300b\022\377\200\336[\251\354\257\033\310\n;\362_\266@Q\210eK\305*\034\267\324\020\3132\257\243+;\263\014|{\016n\204\347?\330O\312\377\240\321\277@\375}!\312;\n\305\314\304O\355okw\047[\223\217\323G\323\355iQ\277\250\305\305\332\235I{\362\260n_\344\223\303\372~\275U\037\236\335;{\374\371\301\227\341\371\273\363\301\327\366w.\241\001t";
+    PyObject *data = __Pyx_DecompressString(cstring, 522, 1);
     #define __Pyx_DecompressString_LZSS_UNUSED
     if (unlikely(!data)) __PYX_ERR(0, 1, __pyx_L1_error)
     const char* const bytes = __Pyx_PyBytes_AsString(data);
     #if !CYTHON_ASSUME_SAFE_MACROS
     if (likely(bytes)); else { Py_DECREF(data); __PYX_ERR(0, 1, __pyx_L1_error) }
     #endif
-    #elif (CYTHON_COMPRESS_STRINGS) > 0 && (CYTHON_COMPRESS_STRINGS) <= 90 /* compression: lzss (665 bytes) */
-static const char cstring[] = "\377?src/fcc\377qp/schur\377.pyxRANK\337_TOLE\006\000CE\337__Pyx\001\000Di\377ct_NextR\377ef__anno\377tate____\357func\004\001mai\275n\003\002odul\025\002n\363am\035\002R\000_cap\275i*\001qual\020\005t\367est?\000is_c\377oroutine\337astyp\003\000yn\357cio.\016\006sbo_ol_cl\037\000_c\000\377tracebac_kconc\204\000n\210\0002\010\000s\025\000A\000dd@\001\321\002\375.\321\002flatno\377nzerofre\377eintpite\377msnnpnum\377pyonesor\377deringpo\377psetdefa\377ultvalue\375s-\000 (doub\367le a\002 *, \374\000\r\020\rPy_ssi\377ze_t)\000me\337ets_e\367\001it\371iJ\004\252\000uct _\335_\232!t_5\201B_5\306\202B_S\211Ac\001\020\0236_\276\242!s_Pro\222\000m\306~\025)\000\266\002\007`\210%)\000\277void (\201\200Y*\360\001a\310]\202\000\244Cfact\367or\000\261Ccert\373if\337@_conv\337exity\023\004un\377it_colum\373ns&\004solve\036\251#char\321a\000\005\000\r\360\376a\361`\000\004\252fscip\377y_6linal\377g_11cyth\377on_blas_\001d\241\204\001\000\047*.\216\002\347E\r\240\334\200,\354\264\200#\200\201\216, \304\202V)\000d\377trsm\000dsy\377rk\000dgemm\364\257\204\013\377|3\227\204\004lapa\003ck\232\204\003\314\204\t\274m\316\204#;\030\217\205\025\376g\037dpotrf\000\376\002\002s\200\001\340\004\013\210\3772\210U\220!\2203\220\377f\230B\230a\330\004\010\177\210\001\210\037\230\001\330\025\002\377\\\230\022\2302\230\\\250\377\021\250\047\260\035\270g\300\037Q\300b\310\001";
-    PyObject *data = __Pyx_DecompressString_LZSS(cstring, 665, 1882);
+    #elif (CYTHON_COMPRESS_STRINGS) > 0 && (CYTHON_COMPRESS_STRINGS) <= 90 /* compression: lzss (673 bytes) */
+static const char cstring[] = "\377?src/fcc\377qp/schur\377.pyxRANK\337_TOLE\006\000CE\337__Pyx\001\000Di\377ct_NextR\377ef__anno\377tate____\357func\004\001mai\275n\003\002odul\025\002n\363am\035\002R\000_cap\275i*\001qual\020\005t\367est?\000is_c\377oroutine\337astyp\003\000yn\357cio.\016\006sbo_ol_cl\037\000_c\000\377tracebac_kconc\204\000n\210\0002\010\000s\025\000A\000dd@\001\321\002\375.\321\002flatno\377nzerofre\377eintpite\377msnnpnum\377pyonesor\377deringpo\377psetdefa\377ultvalue\375s-\000 (doub\367le a\002 *, \374\000\r\020\rPy_ssi\377ze_t)\000me\337ets_e\367\001it\371iJ\004\252\000uct _\335_\232!t_5\201B_5\306\202B_S\211Ac\001\020\0236_\276\242!s_Pro\222\000m\306~\025)\000\266\002\007`\210%)\000\277void (\201\200Y*\360\001a\310]\202\000\244Cfact\367or\000\261Ccert\373if\337@_conv\337exity\023\004un\377it_colum\373ns&\004solve\036\251#char\321a\000\005\000\r\360\376a\361`\000\004\252fscip\377y_6linal\377g_11cyth\377on_blas_\001d\241\204\001\000\047*.\216\002\347E\r\240\334\200,\014\264\200#\200\201\216, \304\202V\334M\374\202\225\246\200Z\377dtrsm\000ds\377yrk\000dgem\245m\001\002v\270\206\013\210\206\0343\240\206\004l\037apack\243\206\003\325\206\t\263\2013\370;\030\230\207\025g\037dpotr\373f\000\002\002s\200\001\340\004\377\013\2102\210U\220!\220\3773\220f\230B\230a\330\377\004\010\210\001\210\037\230\001\375\330\025\002\\\230\022\2302\230\377\\\250\021\250\047\260\035\270\177g\300Q\300b\310\001";
+    PyObject *data = __Pyx_DecompressString_LZSS(cstring, 673, 2147);
     #define __Pyx_DecompressString_UNUSED
     if (unlikely(!data)) __PYX_ERR(0, 1, __pyx_L1_error)
     const char* const bytes = __Pyx_PyBytes_AsString(data);
     #if !CYTHON_ASSUME_SAFE_MACROS
     if (likely(bytes)); else { Py_DECREF(data); __PYX_ERR(0, 1, __pyx_L1_error) }
     #endif
-    #else /* compression: none (1882 bytes) */
-static const char bytes[] = "?src/fccqp/schur.pyxRANK_TOLERANCE__Pyx_PyDict_NextRef__annotate____func____main____module____name____pyx_capi____qualname____test___is_coroutineastypeasyncio.coroutinesbool_cline_in_tracebackconcatenateconstraineddtypefccqp.schurflatnonzerofreeintpitemsnnpnumpyonesorderingpopsetdefaultvaluesint (double const *, double const *, double const *, Py_ssize_t)\000meets_equalitiesint (struct __pyx_t_5fccqp_5schur_Schur *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *)\000int (struct __pyx_t_5fccqp_5schur_Schur *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double)\000void (struct __pyx_t_5fccqp_5schur_Schur *, struct __pyx_t_5fccqp_6_types_Problem const *, double *)\000void (struct __pyx_t_5fccqp_5schur_Schur *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double const *, double *)\000schur_factor\000schur_certifies_convexity\000schur_unit_columns\000schur_solvevoid (char *, char *, char *, char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *)\000void (char *, char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *)\000void (char *, char *, int *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *)\000dtrsm\000dsyrk\000dgemmvoid (char *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, int *)\000void (char *, int *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, int *)\000dpotrf\000dpotrs\200\001\340\004\013\2102\210U\220!\2203\220f\230B\230a\330\004\010\210\001\210\037\230\001\330\004\013\2102\210\\\230\022""\2302\230\\\250\021\250\047\260\035\270g\300Q\300b\310\001";
+    #else /* compression: none (2147 bytes) */
+static const char bytes[] = "?src/fccqp/schur.pyxRANK_TOLERANCE__Pyx_PyDict_NextRef__annotate____func____main____module____name____pyx_capi____qualname____test___is_coroutineastypeasyncio.coroutinesbool_cline_in_tracebackconcatenateconstraineddtypefccqp.schurflatnonzerofreeintpitemsnnpnumpyonesorderingpopsetdefaultvaluesint (double const *, double const *, double const *, Py_ssize_t)\000meets_equalitiesint (struct __pyx_t_5fccqp_5schur_Schur *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *)\000int (struct __pyx_t_5fccqp_5schur_Schur *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double)\000void (struct __pyx_t_5fccqp_5schur_Schur *, struct __pyx_t_5fccqp_6_types_Problem const *, double *)\000void (struct __pyx_t_5fccqp_5schur_Schur *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double const *, double *)\000schur_factor\000schur_certifies_convexity\000schur_unit_columns\000schur_solvevoid (char *, char *, char *, char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *)\000void (char *, char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *)\000void (char *, char *, int *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *)\000void (char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *)\000dtrsm\000dsyrk\000dgemm\000dgemvvoid (char *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, int *)\000void (char"" *, int *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, __pyx_t_5scipy_6linalg_13cython_lapack_d *, int *, int *)\000dpotrf\000dpotrs\200\001\340\004\013\2102\210U\220!\2203\220f\230B\230a\330\004\010\210\001\210\037\230\001\330\004\013\2102\210\\\230\022\2302\230\\\250\021\250\047\260\035\270g\300Q\300b\310\001";
     PyObject *data = NULL;
     #define __Pyx_DecompressString_UNUSED
     #define __Pyx_DecompressString_LZSS_UNUSED

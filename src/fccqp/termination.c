@@ -1483,6 +1483,34 @@ static PyObject *__pyx_m = NULL;
 #endif
 static const char * const __pyx_cfilenm = __FILE__;
 
+/* Header.proto */
+#if !defined(CYTHON_CCOMPLEX)
+  #if defined(__cplusplus)
+    #define CYTHON_CCOMPLEX 1
+  #elif defined(_MSC_VER)
+    #define CYTHON_CCOMPLEX 0
+  #elif (defined(__ANDROID_MIN_SDK_VERSION__) && __ANDROID_MIN_SDK_VERSION__ < 26) || (defined(__ANDROID_API__) && __ANDROID_API__ < 26)
+    #define CYTHON_CCOMPLEX 0
+  #elif defined(__STDC_NO_COMPLEX__)
+    #define CYTHON_CCOMPLEX 0
+  #elif defined(_Complex_I) || (defined (__STDC_VERSION__) && __STDC_VERSION__ >= 201112L && !defined(__STDC_NO_COMPLEX__))
+    #define CYTHON_CCOMPLEX 1
+  #else
+    #define CYTHON_CCOMPLEX 0
+  #endif
+#endif
+#if CYTHON_CCOMPLEX
+  #ifdef __cplusplus
+    #include <complex>
+  #else
+    #include <complex.h>
+  #endif
+#endif
+#if CYTHON_CCOMPLEX && !defined(__cplusplus) && defined(__sun__) && defined(__GNUC__)
+  #undef _Complex_I
+  #define _Complex_I 1.0fj
+#endif
+
 /* #### Code section: filename_table ### */
 
 static const char* const __pyx_f[] = {
@@ -1627,7 +1655,49 @@ static const char* const __pyx_f[] = {
 #endif
 
 /* #### Code section: numeric_typedefs ### */
+
+/* "scipy/linalg/cython_blas.pxd":17
+ * # The original libraries should be linked directly.
+ * 
+ * ctypedef float s             # <<<<<<<<<<<<<<
+ * ctypedef double d
+ * ctypedef float complex c
+*/
+typedef float __pyx_t_5scipy_6linalg_11cython_blas_s;
+
+/* "scipy/linalg/cython_blas.pxd":18
+ * 
+ * ctypedef float s
+ * ctypedef double d             # <<<<<<<<<<<<<<
+ * ctypedef float complex c
+ * ctypedef double complex z
+*/
+typedef double __pyx_t_5scipy_6linalg_11cython_blas_d;
 /* #### Code section: complex_type_declarations ### */
+/* Declarations.proto */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+  #ifdef __cplusplus
+    typedef ::std::complex< float > __pyx_t_float_complex;
+  #else
+    typedef float _Complex __pyx_t_float_complex;
+  #endif
+#else
+    typedef struct { float real, imag; } __pyx_t_float_complex;
+#endif
+static CYTHON_INLINE __pyx_t_float_complex __pyx_t_float_complex_from_parts(float, float);
+
+/* Declarations.proto */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+  #ifdef __cplusplus
+    typedef ::std::complex< double > __pyx_t_double_complex;
+  #else
+    typedef double _Complex __pyx_t_double_complex;
+  #endif
+#else
+    typedef struct { double real, imag; } __pyx_t_double_complex;
+#endif
+static CYTHON_INLINE __pyx_t_double_complex __pyx_t_double_complex_from_parts(double, double);
+
 /* #### Code section: type_declarations ### */
 
 /*--- Type declarations ---*/
@@ -1814,6 +1884,9 @@ static PyObject *__Pyx_ApiExport_GetApiDict(void);
 /* IncludeStringH.proto */
 #include <string.h>
 
+/* FunctionImport.proto */
+static int __Pyx_ImportFunction_3_3_1(PyObject *module, const char *funcname, void (**f)(void), const char *sig);
+
 /* dict_setdefault.proto (used by CLineInTraceback) */
 static CYTHON_INLINE PyObject *__Pyx_PyDict_SetDefault(PyObject *d, PyObject *key, PyObject *default_value);
 
@@ -1961,6 +2034,104 @@ static void __pyx_insert_code_object(int code_line, __Pyx_CachedCodeObjectType* 
 /* AddTraceback.proto */
 static void __Pyx_AddTraceback(const char *funcname, int c_line,
                                int py_line, const char *filename);
+
+/* RealImag.proto */
+#if CYTHON_CCOMPLEX
+  #ifdef __cplusplus
+    #define __Pyx_CREAL(z) ((z).real())
+    #define __Pyx_CIMAG(z) ((z).imag())
+  #else
+    #define __Pyx_CREAL(z) (__real__(z))
+    #define __Pyx_CIMAG(z) (__imag__(z))
+  #endif
+#else
+    #define __Pyx_CREAL(z) ((z).real)
+    #define __Pyx_CIMAG(z) ((z).imag)
+#endif
+#if defined(__cplusplus) && CYTHON_CCOMPLEX\
+        && (defined(_WIN32) || defined(__clang__) || (defined(__GNUC__) && (__GNUC__ >= 5 || __GNUC__ == 4 && __GNUC_MINOR__ >= 4 )) || __cplusplus >= 201103)
+    #define __Pyx_SET_CREAL(z,x) ((z).real(x))
+    #define __Pyx_SET_CIMAG(z,y) ((z).imag(y))
+#else
+    #define __Pyx_SET_CREAL(z,x) __Pyx_CREAL(z) = (x)
+    #define __Pyx_SET_CIMAG(z,y) __Pyx_CIMAG(z) = (y)
+#endif
+
+/* Arithmetic.proto */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+    #define __Pyx_c_eq_float(a, b)   ((a)==(b))
+    #define __Pyx_c_sum_float(a, b)  ((a)+(b))
+    #define __Pyx_c_diff_float(a, b) ((a)-(b))
+    #define __Pyx_c_prod_float(a, b) ((a)*(b))
+    #define __Pyx_c_quot_float(a, b) ((a)/(b))
+    #define __Pyx_c_neg_float(a)     (-(a))
+  #ifdef __cplusplus
+    #define __Pyx_c_is_zero_float(z) ((z)==(float)0)
+    #define __Pyx_c_conj_float(z)    (::std::conj(z))
+    #if 1
+        #define __Pyx_c_abs_float(z)     (::std::abs(z))
+        #define __Pyx_c_pow_float(a, b)  (::std::pow(a, b))
+    #endif
+  #else
+    #define __Pyx_c_is_zero_float(z) ((z)==0)
+    #define __Pyx_c_conj_float(z)    (conjf(z))
+    #if 1
+        #define __Pyx_c_abs_float(z)     (cabsf(z))
+        #define __Pyx_c_pow_float(a, b)  (cpowf(a, b))
+    #endif
+ #endif
+#else
+    static CYTHON_INLINE int __Pyx_c_eq_float(__pyx_t_float_complex, __pyx_t_float_complex);
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_sum_float(__pyx_t_float_complex, __pyx_t_float_complex);
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_diff_float(__pyx_t_float_complex, __pyx_t_float_complex);
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_prod_float(__pyx_t_float_complex, __pyx_t_float_complex);
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_quot_float(__pyx_t_float_complex, __pyx_t_float_complex);
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_neg_float(__pyx_t_float_complex);
+    static CYTHON_INLINE int __Pyx_c_is_zero_float(__pyx_t_float_complex);
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_conj_float(__pyx_t_float_complex);
+    #if 1
+        static CYTHON_INLINE float __Pyx_c_abs_float(__pyx_t_float_complex);
+        static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_pow_float(__pyx_t_float_complex, __pyx_t_float_complex);
+    #endif
+#endif
+
+/* Arithmetic.proto */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+    #define __Pyx_c_eq_double(a, b)   ((a)==(b))
+    #define __Pyx_c_sum_double(a, b)  ((a)+(b))
+    #define __Pyx_c_diff_double(a, b) ((a)-(b))
+    #define __Pyx_c_prod_double(a, b) ((a)*(b))
+    #define __Pyx_c_quot_double(a, b) ((a)/(b))
+    #define __Pyx_c_neg_double(a)     (-(a))
+  #ifdef __cplusplus
+    #define __Pyx_c_is_zero_double(z) ((z)==(double)0)
+    #define __Pyx_c_conj_double(z)    (::std::conj(z))
+    #if 1
+        #define __Pyx_c_abs_double(z)     (::std::abs(z))
+        #define __Pyx_c_pow_double(a, b)  (::std::pow(a, b))
+    #endif
+  #else
+    #define __Pyx_c_is_zero_double(z) ((z)==0)
+    #define __Pyx_c_conj_double(z)    (conj(z))
+    #if 1
+        #define __Pyx_c_abs_double(z)     (cabs(z))
+        #define __Pyx_c_pow_double(a, b)  (cpow(a, b))
+    #endif
+ #endif
+#else
+    static CYTHON_INLINE int __Pyx_c_eq_double(__pyx_t_double_complex, __pyx_t_double_complex);
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_sum_double(__pyx_t_double_complex, __pyx_t_double_complex);
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_diff_double(__pyx_t_double_complex, __pyx_t_double_complex);
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_prod_double(__pyx_t_double_complex, __pyx_t_double_complex);
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_quot_double(__pyx_t_double_complex, __pyx_t_double_complex);
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_neg_double(__pyx_t_double_complex);
+    static CYTHON_INLINE int __Pyx_c_is_zero_double(__pyx_t_double_complex);
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_conj_double(__pyx_t_double_complex);
+    #if 1
+        static CYTHON_INLINE double __Pyx_c_abs_double(__pyx_t_double_complex);
+        static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_pow_double(__pyx_t_double_complex, __pyx_t_double_complex);
+    #endif
+#endif
 
 /* FormatTypeName.proto */
 #if CYTHON_COMPILING_IN_LIMITED_API && __PYX_LIMITED_VERSION_HEX >= 0x030d0000
@@ -2130,7 +2301,11 @@ static int __Pyx_State_RemoveModule(void*);
 
 /* Module declarations from "libc.math" */
 
+/* Module declarations from "scipy.linalg.cython_blas" */
+static void (*__pyx_f_5scipy_6linalg_11cython_blas_dgemv)(char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *); /*proto*/
+
 /* Module declarations from "fccqp._dense" */
+static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *, double, Py_ssize_t); /*proto*/
 static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec(double const *, double const *, double *, Py_ssize_t, Py_ssize_t); /*proto*/
 static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec_t(double const *, double const *, double *, Py_ssize_t, Py_ssize_t); /*proto*/
 
@@ -2171,7 +2346,7 @@ namespace {
     PyObject *__pyx_empty_tuple;
     PyObject *__pyx_empty_bytes;
     PyObject *__pyx_empty_unicode;
-    PyObject *__pyx_string_tab[10];
+    PyObject *__pyx_string_tab[11];
 /* #### Code section: module_state_contents ### */
 /* CodeObjectCache.module_state_decls */
 struct __Pyx_CodeObjectCache __pyx_code_cache;
@@ -2214,6 +2389,7 @@ static __pyx_mstatetype * const __pyx_mstate_global = &__pyx_mstate_global_stati
 #define __pyx_n_u_cline_in_traceback __pyx_string_tab[7]
 #define __pyx_n_u_setdefault __pyx_string_tab[8]
 #define __pyx_kp_b_double_struct___pyx_t_5fccqp_6_t __pyx_string_tab[9]
+#define __pyx_kp_b_void_char_int_int___pyx_t_5scipy __pyx_string_tab[10]
 /* #### Code section: module_state_clear ### */
 #if CYTHON_USE_MODULE_STATE
 static CYTHON_SMALL_CODE int __pyx_m_clear(PyObject *m) {
@@ -2228,7 +2404,7 @@ static CYTHON_SMALL_CODE int __pyx_m_clear(PyObject *m) {
   #if CYTHON_PEP489_MULTI_PHASE_INIT
   __Pyx_State_RemoveModule(NULL);
   #endif
-  for (int i=0; i<10; ++i) { Py_CLEAR(clear_module_state->__pyx_string_tab[i]); }
+  for (int i=0; i<11; ++i) { Py_CLEAR(clear_module_state->__pyx_string_tab[i]); }
 /* #### Code section: module_state_clear_contents ### */
 /* #### Code section: module_state_clear_end ### */
 return 0;
@@ -2245,7 +2421,7 @@ static CYTHON_SMALL_CODE int __pyx_m_traverse(PyObject *m, visitproc visit, void
   __Pyx_VISIT_CONST(traverse_module_state->__pyx_empty_tuple);
   __Pyx_VISIT_CONST(traverse_module_state->__pyx_empty_bytes);
   __Pyx_VISIT_CONST(traverse_module_state->__pyx_empty_unicode);
-  for (int i=0; i<10; ++i) { __Pyx_VISIT_CONST(traverse_module_state->__pyx_string_tab[i]); }
+  for (int i=0; i<11; ++i) { __Pyx_VISIT_CONST(traverse_module_state->__pyx_string_tab[i]); }
 /* #### Code section: module_state_traverse_contents ### */
 /* #### Code section: module_state_traverse_end ### */
 return 0;
@@ -2253,7 +2429,7 @@ return 0;
 #endif
 /* #### Code section: module_code ### */
 
-/* "fccqp/_dense.pxd":14
+/* "fccqp/_dense.pxd":16
  * 
  * 
  * cdef inline double inf_norm(const double* v, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -2270,7 +2446,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
   Py_ssize_t __pyx_t_3;
   int __pyx_t_4;
 
-  /* "fccqp/_dense.pxd":15
+  /* "fccqp/_dense.pxd":17
  * 
  * cdef inline double inf_norm(const double* v, Py_ssize_t k) noexcept nogil:
  *     cdef double out = 0.0             # <<<<<<<<<<<<<<
@@ -2279,7 +2455,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
 */
   __pyx_v_out = 0.0;
 
-  /* "fccqp/_dense.pxd":17
+  /* "fccqp/_dense.pxd":19
  *     cdef double out = 0.0
  *     cdef Py_ssize_t i
  *     for i in range(k):             # <<<<<<<<<<<<<<
@@ -2293,7 +2469,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/_dense.pxd":18
+    /* "fccqp/_dense.pxd":20
  *     cdef Py_ssize_t i
  *     for i in range(k):
  *         if fabs(v[i]) > out:             # <<<<<<<<<<<<<<
@@ -2305,7 +2481,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
     if (__pyx_t_4) {
 
 
-      /* "fccqp/_dense.pxd":19
+      /* "fccqp/_dense.pxd":21
  *     for i in range(k):
  *         if fabs(v[i]) > out:
  *             out = fabs(v[i])             # <<<<<<<<<<<<<<
@@ -2314,7 +2490,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
 */
       __pyx_v_out = fabs((__pyx_v_v[__pyx_v_i]));
 
-      /* "fccqp/_dense.pxd":18
+      /* "fccqp/_dense.pxd":20
  *     cdef Py_ssize_t i
  *     for i in range(k):
  *         if fabs(v[i]) > out:             # <<<<<<<<<<<<<<
@@ -2325,7 +2501,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
   }
 
 
-  /* "fccqp/_dense.pxd":20
+  /* "fccqp/_dense.pxd":22
  *         if fabs(v[i]) > out:
  *             out = fabs(v[i])
  *     return out             # <<<<<<<<<<<<<<
@@ -2338,7 +2514,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
   }
   goto __pyx_L0;
 
-  /* "fccqp/_dense.pxd":14
+  /* "fccqp/_dense.pxd":16
  * 
  * 
  * cdef inline double inf_norm(const double* v, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -2353,7 +2529,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_inf_norm(double const *__pyx_
   return __pyx_r;
 }
 
-/* "fccqp/_dense.pxd":23
+/* "fccqp/_dense.pxd":25
  * 
  * 
  * cdef inline double dot(const double* a, const double* b, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -2369,7 +2545,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
   Py_ssize_t __pyx_t_2;
   Py_ssize_t __pyx_t_3;
 
-  /* "fccqp/_dense.pxd":24
+  /* "fccqp/_dense.pxd":26
  * 
  * cdef inline double dot(const double* a, const double* b, Py_ssize_t k) noexcept nogil:
  *     cdef double out = 0.0             # <<<<<<<<<<<<<<
@@ -2378,7 +2554,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
 */
   __pyx_v_out = 0.0;
 
-  /* "fccqp/_dense.pxd":26
+  /* "fccqp/_dense.pxd":28
  *     cdef double out = 0.0
  *     cdef Py_ssize_t i
  *     for i in range(k):             # <<<<<<<<<<<<<<
@@ -2392,7 +2568,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/_dense.pxd":27
+    /* "fccqp/_dense.pxd":29
  *     cdef Py_ssize_t i
  *     for i in range(k):
  *         out += a[i] * b[i]             # <<<<<<<<<<<<<<
@@ -2403,7 +2579,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
   }
 
 
-  /* "fccqp/_dense.pxd":28
+  /* "fccqp/_dense.pxd":30
  *     for i in range(k):
  *         out += a[i] * b[i]
  *     return out             # <<<<<<<<<<<<<<
@@ -2416,7 +2592,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
   }
   goto __pyx_L0;
 
-  /* "fccqp/_dense.pxd":23
+  /* "fccqp/_dense.pxd":25
  * 
  * 
  * cdef inline double dot(const double* a, const double* b, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -2431,7 +2607,7 @@ static CYTHON_INLINE double __pyx_f_5fccqp_6_dense_dot(double const *__pyx_v_a, 
   return __pyx_r;
 }
 
-/* "fccqp/_dense.pxd":31
+/* "fccqp/_dense.pxd":33
  * 
  * 
  * cdef inline void copy(const double* src, double* dst, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -2445,7 +2621,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_copy(double const *__pyx_v_src,
   Py_ssize_t __pyx_t_2;
   Py_ssize_t __pyx_t_3;
 
-  /* "fccqp/_dense.pxd":33
+  /* "fccqp/_dense.pxd":35
  * cdef inline void copy(const double* src, double* dst, Py_ssize_t k) noexcept nogil:
  *     cdef Py_ssize_t i
  *     for i in range(k):             # <<<<<<<<<<<<<<
@@ -2459,7 +2635,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_copy(double const *__pyx_v_src,
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/_dense.pxd":34
+    /* "fccqp/_dense.pxd":36
  *     cdef Py_ssize_t i
  *     for i in range(k):
  *         dst[i] = src[i]             # <<<<<<<<<<<<<<
@@ -2470,7 +2646,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_copy(double const *__pyx_v_src,
   }
 
 
-  /* "fccqp/_dense.pxd":31
+  /* "fccqp/_dense.pxd":33
  * 
  * 
  * cdef inline void copy(const double* src, double* dst, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -2482,7 +2658,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_copy(double const *__pyx_v_src,
 
 }
 
-/* "fccqp/_dense.pxd":37
+/* "fccqp/_dense.pxd":39
  * 
  * 
  * cdef inline void fill(double* dst, double value, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -2496,7 +2672,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *__pyx_v_dst, doubl
   Py_ssize_t __pyx_t_2;
   Py_ssize_t __pyx_t_3;
 
-  /* "fccqp/_dense.pxd":39
+  /* "fccqp/_dense.pxd":41
  * cdef inline void fill(double* dst, double value, Py_ssize_t k) noexcept nogil:
  *     cdef Py_ssize_t i
  *     for i in range(k):             # <<<<<<<<<<<<<<
@@ -2510,7 +2686,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *__pyx_v_dst, doubl
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/_dense.pxd":40
+    /* "fccqp/_dense.pxd":42
  *     cdef Py_ssize_t i
  *     for i in range(k):
  *         dst[i] = value             # <<<<<<<<<<<<<<
@@ -2521,7 +2697,7 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *__pyx_v_dst, doubl
   }
 
 
-  /* "fccqp/_dense.pxd":37
+  /* "fccqp/_dense.pxd":39
  * 
  * 
  * cdef inline void fill(double* dst, double value, Py_ssize_t k) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -2533,222 +2709,456 @@ static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_fill(double *__pyx_v_dst, doubl
 
 }
 
-/* "fccqp/_dense.pxd":43
+/* "fccqp/_dense.pxd":45
  * 
  * 
  * cdef inline void matvec(const double* M, const double* x, double* out,             # <<<<<<<<<<<<<<
  *                         Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
- *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M``."""
+ *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
 */
 
 static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec(double const *__pyx_v_M, double const *__pyx_v_x, double *__pyx_v_out, Py_ssize_t __pyx_v_rows, Py_ssize_t __pyx_v_cols) {
-  Py_ssize_t __pyx_v_i;
-  Py_ssize_t __pyx_v_j;
-  double __pyx_v_acc;
-  double const *__pyx_v_row;
-  Py_ssize_t __pyx_t_1;
-  Py_ssize_t __pyx_t_2;
-  Py_ssize_t __pyx_t_3;
-  Py_ssize_t __pyx_t_4;
-  Py_ssize_t __pyx_t_5;
-  Py_ssize_t __pyx_t_6;
+  int __pyx_v_r;
+  int __pyx_v_c;
+  int __pyx_v_one;
+  double __pyx_v_alpha;
+  double __pyx_v_beta;
+  char __pyx_v_trans;
+  int __pyx_t_1;
+
+  /* "fccqp/_dense.pxd":48
+ *                         Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
+ *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1             # <<<<<<<<<<<<<<
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"T"
+*/
+  __pyx_v_r = ((int)__pyx_v_rows);
+  __pyx_v_c = ((int)__pyx_v_cols);
+  __pyx_v_one = 1;
 
   /* "fccqp/_dense.pxd":49
- *     cdef double acc
- *     cdef const double* row
- *     for i in range(rows):             # <<<<<<<<<<<<<<
- *         row = M + i * cols
- *         acc = 0.0
+ *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0, beta = 0.0             # <<<<<<<<<<<<<<
+ *     cdef char trans = b"T"
+ *     if rows == 0:
 */
+  __pyx_v_alpha = 1.0;
+  __pyx_v_beta = 0.0;
 
-  __pyx_t_1 = __pyx_v_rows;
-  __pyx_t_2 = __pyx_t_1;
-
-  for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
-    __pyx_v_i = __pyx_t_3;
-
-    /* "fccqp/_dense.pxd":50
- *     cdef const double* row
- *     for i in range(rows):
- *         row = M + i * cols             # <<<<<<<<<<<<<<
- *         acc = 0.0
- *         for j in range(cols):
+  /* "fccqp/_dense.pxd":50
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"T"             # <<<<<<<<<<<<<<
+ *     if rows == 0:
+ *         return
 */
-    __pyx_v_row = (__pyx_v_M + (__pyx_v_i * __pyx_v_cols));
+  __pyx_v_trans = 'T';
 
-    /* "fccqp/_dense.pxd":51
- *     for i in range(rows):
- *         row = M + i * cols
- *         acc = 0.0             # <<<<<<<<<<<<<<
- *         for j in range(cols):
- *             acc += row[j] * x[j]
+  /* "fccqp/_dense.pxd":51
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"T"
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
 */
-    __pyx_v_acc = 0.0;
+  __pyx_t_1 = (__pyx_v_rows == 0);
+
+  if (__pyx_t_1) {
+
 
     /* "fccqp/_dense.pxd":52
- *         row = M + i * cols
- *         acc = 0.0
- *         for j in range(cols):             # <<<<<<<<<<<<<<
- *             acc += row[j] * x[j]
- *         out[i] = acc
+ *     cdef char trans = b"T"
+ *     if rows == 0:
+ *         return             # <<<<<<<<<<<<<<
+ *     if cols == 0:
+ *         fill(out, 0.0, rows)
 */
-
-    __pyx_t_4 = __pyx_v_cols;
-    __pyx_t_5 = __pyx_t_4;
-
-    for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
-      __pyx_v_j = __pyx_t_6;
-
-      /* "fccqp/_dense.pxd":53
- *         acc = 0.0
- *         for j in range(cols):
- *             acc += row[j] * x[j]             # <<<<<<<<<<<<<<
- *         out[i] = acc
- * 
-*/
-      __pyx_v_acc = (__pyx_v_acc + ((__pyx_v_row[__pyx_v_j]) * (__pyx_v_x[__pyx_v_j])));
+    {
     }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":51
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"T"
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
+*/
+  }
+
+  /* "fccqp/_dense.pxd":53
+ *     if rows == 0:
+ *         return
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         fill(out, 0.0, rows)
+ *         return
+*/
+  __pyx_t_1 = (__pyx_v_cols == 0);
+
+  if (__pyx_t_1) {
 
 
     /* "fccqp/_dense.pxd":54
- *         for j in range(cols):
- *             acc += row[j] * x[j]
- *         out[i] = acc             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
+ *         fill(out, 0.0, rows)             # <<<<<<<<<<<<<<
+ *         return
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>x, &one, &beta, out, &one)
+*/
+    __pyx_f_5fccqp_6_dense_fill(__pyx_v_out, 0.0, __pyx_v_rows);
+
+    /* "fccqp/_dense.pxd":55
+ *     if cols == 0:
+ *         fill(out, 0.0, rows)
+ *         return             # <<<<<<<<<<<<<<
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>x, &one, &beta, out, &one)
+ * 
+*/
+    {
+    }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":53
+ *     if rows == 0:
+ *         return
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         fill(out, 0.0, rows)
+ *         return
+*/
+  }
+
+  /* "fccqp/_dense.pxd":56
+ *         fill(out, 0.0, rows)
+ *         return
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>x, &one, &beta, out, &one)             # <<<<<<<<<<<<<<
  * 
  * 
 */
-    (__pyx_v_out[__pyx_v_i]) = __pyx_v_acc;
-  }
+  __pyx_f_5scipy_6linalg_11cython_blas_dgemv((&__pyx_v_trans), (&__pyx_v_c), (&__pyx_v_r), (&__pyx_v_alpha), ((double *)__pyx_v_M), (&__pyx_v_c), ((double *)__pyx_v_x), (&__pyx_v_one), (&__pyx_v_beta), __pyx_v_out, (&__pyx_v_one));
 
-
-  /* "fccqp/_dense.pxd":43
+  /* "fccqp/_dense.pxd":45
  * 
  * 
  * cdef inline void matvec(const double* M, const double* x, double* out,             # <<<<<<<<<<<<<<
  *                         Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
- *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M``."""
+ *     """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
 */
 
   /* function exit code */
+  __pyx_L0:;
+
+
 
 
 
 
 }
 
-/* "fccqp/_dense.pxd":57
+/* "fccqp/_dense.pxd":59
  * 
  * 
  * cdef inline void matvec_t(const double* M, const double* y, double* out,             # <<<<<<<<<<<<<<
  *                           Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
- *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (row by row, so that
+ *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
 */
 
 static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_matvec_t(double const *__pyx_v_M, double const *__pyx_v_y, double *__pyx_v_out, Py_ssize_t __pyx_v_rows, Py_ssize_t __pyx_v_cols) {
-  Py_ssize_t __pyx_v_i;
-  Py_ssize_t __pyx_v_j;
-  double __pyx_v_yi;
-  double const *__pyx_v_row;
-  Py_ssize_t __pyx_t_1;
-  Py_ssize_t __pyx_t_2;
-  Py_ssize_t __pyx_t_3;
-  Py_ssize_t __pyx_t_4;
-  Py_ssize_t __pyx_t_5;
-  Py_ssize_t __pyx_t_6;
-  Py_ssize_t __pyx_t_7;
+  int __pyx_v_r;
+  int __pyx_v_c;
+  int __pyx_v_one;
+  double __pyx_v_alpha;
+  double __pyx_v_beta;
+  char __pyx_v_trans;
+  int __pyx_t_1;
+
+  /* "fccqp/_dense.pxd":62
+ *                           Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
+ *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1             # <<<<<<<<<<<<<<
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"N"
+*/
+  __pyx_v_r = ((int)__pyx_v_rows);
+  __pyx_v_c = ((int)__pyx_v_cols);
+  __pyx_v_one = 1;
+
+  /* "fccqp/_dense.pxd":63
+ *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0, beta = 0.0             # <<<<<<<<<<<<<<
+ *     cdef char trans = b"N"
+ *     if cols == 0:
+*/
+  __pyx_v_alpha = 1.0;
+  __pyx_v_beta = 0.0;
 
   /* "fccqp/_dense.pxd":64
- *     cdef double yi
- *     cdef const double* row
- *     for j in range(cols):             # <<<<<<<<<<<<<<
- *         out[j] = 0.0
- *     for i in range(rows):
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"N"             # <<<<<<<<<<<<<<
+ *     if cols == 0:
+ *         return
 */
+  __pyx_v_trans = 'N';
 
-  __pyx_t_1 = __pyx_v_cols;
-  __pyx_t_2 = __pyx_t_1;
+  /* "fccqp/_dense.pxd":65
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"N"
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if rows == 0:
+*/
+  __pyx_t_1 = (__pyx_v_cols == 0);
 
-  for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
-    __pyx_v_j = __pyx_t_3;
+  if (__pyx_t_1) {
+
+
+    /* "fccqp/_dense.pxd":66
+ *     cdef char trans = b"N"
+ *     if cols == 0:
+ *         return             # <<<<<<<<<<<<<<
+ *     if rows == 0:
+ *         fill(out, 0.0, cols)
+*/
+    {
+    }
+    goto __pyx_L0;
 
     /* "fccqp/_dense.pxd":65
- *     cdef const double* row
- *     for j in range(cols):
- *         out[j] = 0.0             # <<<<<<<<<<<<<<
- *     for i in range(rows):
- *         row = M + i * cols
+ *     cdef double alpha = 1.0, beta = 0.0
+ *     cdef char trans = b"N"
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if rows == 0:
 */
-    (__pyx_v_out[__pyx_v_j]) = 0.0;
   }
 
-
-  /* "fccqp/_dense.pxd":66
- *     for j in range(cols):
- *         out[j] = 0.0
- *     for i in range(rows):             # <<<<<<<<<<<<<<
- *         row = M + i * cols
- *         yi = y[i]
+  /* "fccqp/_dense.pxd":67
+ *     if cols == 0:
+ *         return
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         fill(out, 0.0, cols)
+ *         return
 */
+  __pyx_t_1 = (__pyx_v_rows == 0);
 
-  __pyx_t_1 = __pyx_v_rows;
-  __pyx_t_2 = __pyx_t_1;
+  if (__pyx_t_1) {
 
-  for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
-    __pyx_v_i = __pyx_t_3;
-
-    /* "fccqp/_dense.pxd":67
- *         out[j] = 0.0
- *     for i in range(rows):
- *         row = M + i * cols             # <<<<<<<<<<<<<<
- *         yi = y[i]
- *         for j in range(cols):
-*/
-    __pyx_v_row = (__pyx_v_M + (__pyx_v_i * __pyx_v_cols));
 
     /* "fccqp/_dense.pxd":68
- *     for i in range(rows):
- *         row = M + i * cols
- *         yi = y[i]             # <<<<<<<<<<<<<<
- *         for j in range(cols):
- *             out[j] += row[j] * yi
+ *         return
+ *     if rows == 0:
+ *         fill(out, 0.0, cols)             # <<<<<<<<<<<<<<
+ *         return
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>y, &one, &beta, out, &one)
 */
-    __pyx_v_yi = (__pyx_v_y[__pyx_v_i]);
+    __pyx_f_5fccqp_6_dense_fill(__pyx_v_out, 0.0, __pyx_v_cols);
 
     /* "fccqp/_dense.pxd":69
- *         row = M + i * cols
- *         yi = y[i]
- *         for j in range(cols):             # <<<<<<<<<<<<<<
- *             out[j] += row[j] * yi
+ *     if rows == 0:
+ *         fill(out, 0.0, cols)
+ *         return             # <<<<<<<<<<<<<<
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>y, &one, &beta, out, &one)
+ * 
 */
-
-    __pyx_t_4 = __pyx_v_cols;
-    __pyx_t_5 = __pyx_t_4;
-
-    for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
-      __pyx_v_j = __pyx_t_6;
-
-      /* "fccqp/_dense.pxd":70
- *         yi = y[i]
- *         for j in range(cols):
- *             out[j] += row[j] * yi             # <<<<<<<<<<<<<<
-*/
-
-      __pyx_t_7 = __pyx_v_j;
-      (__pyx_v_out[__pyx_t_7]) = ((__pyx_v_out[__pyx_t_7]) + ((__pyx_v_row[__pyx_v_j]) * __pyx_v_yi));
+    {
     }
+    goto __pyx_L0;
 
+    /* "fccqp/_dense.pxd":67
+ *     if cols == 0:
+ *         return
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         fill(out, 0.0, cols)
+ *         return
+*/
   }
 
+  /* "fccqp/_dense.pxd":70
+ *         fill(out, 0.0, cols)
+ *         return
+ *     dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>y, &one, &beta, out, &one)             # <<<<<<<<<<<<<<
+ * 
+ * 
+*/
+  __pyx_f_5scipy_6linalg_11cython_blas_dgemv((&__pyx_v_trans), (&__pyx_v_c), (&__pyx_v_r), (&__pyx_v_alpha), ((double *)__pyx_v_M), (&__pyx_v_c), ((double *)__pyx_v_y), (&__pyx_v_one), (&__pyx_v_beta), __pyx_v_out, (&__pyx_v_one));
 
-  /* "fccqp/_dense.pxd":57
+  /* "fccqp/_dense.pxd":59
  * 
  * 
  * cdef inline void matvec_t(const double* M, const double* y, double* out,             # <<<<<<<<<<<<<<
  *                           Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
- *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (row by row, so that
+ *     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
 */
 
   /* function exit code */
+  __pyx_L0:;
+
+
+
+
+
+
+}
+
+/* "fccqp/_dense.pxd":73
+ * 
+ * 
+ * cdef inline void colmatvec(const double* M, int ld, const double* x, double* out,             # <<<<<<<<<<<<<<
+ *                            Py_ssize_t rows, Py_ssize_t cols, double beta) noexcept nogil:
+ *     """``out = M x + beta out`` for a column-major ``rows x cols`` block ``M`` with
+*/
+
+static CYTHON_INLINE void __pyx_f_5fccqp_6_dense_colmatvec(double const *__pyx_v_M, int __pyx_v_ld, double const *__pyx_v_x, double *__pyx_v_out, Py_ssize_t __pyx_v_rows, Py_ssize_t __pyx_v_cols, double __pyx_v_beta) {
+  int __pyx_v_r;
+  int __pyx_v_c;
+  int __pyx_v_one;
+  double __pyx_v_alpha;
+  char __pyx_v_trans;
+  int __pyx_t_1;
+
+  /* "fccqp/_dense.pxd":77
+ *     """``out = M x + beta out`` for a column-major ``rows x cols`` block ``M`` with
+ *     leading dimension ``ld`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1             # <<<<<<<<<<<<<<
+ *     cdef double alpha = 1.0
+ *     cdef char trans = b"N"
+*/
+  __pyx_v_r = ((int)__pyx_v_rows);
+  __pyx_v_c = ((int)__pyx_v_cols);
+  __pyx_v_one = 1;
+
+  /* "fccqp/_dense.pxd":78
+ *     leading dimension ``ld`` (``dgemv``)."""
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0             # <<<<<<<<<<<<<<
+ *     cdef char trans = b"N"
+ *     if rows == 0:
+*/
+  __pyx_v_alpha = 1.0;
+
+  /* "fccqp/_dense.pxd":79
+ *     cdef int r = <int>rows, c = <int>cols, one = 1
+ *     cdef double alpha = 1.0
+ *     cdef char trans = b"N"             # <<<<<<<<<<<<<<
+ *     if rows == 0:
+ *         return
+*/
+  __pyx_v_trans = 'N';
+
+  /* "fccqp/_dense.pxd":80
+ *     cdef double alpha = 1.0
+ *     cdef char trans = b"N"
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
+*/
+  __pyx_t_1 = (__pyx_v_rows == 0);
+
+  if (__pyx_t_1) {
+
+
+    /* "fccqp/_dense.pxd":81
+ *     cdef char trans = b"N"
+ *     if rows == 0:
+ *         return             # <<<<<<<<<<<<<<
+ *     if cols == 0:
+ *         if beta == 0.0:
+*/
+    {
+    }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":80
+ *     cdef double alpha = 1.0
+ *     cdef char trans = b"N"
+ *     if rows == 0:             # <<<<<<<<<<<<<<
+ *         return
+ *     if cols == 0:
+*/
+  }
+
+  /* "fccqp/_dense.pxd":82
+ *     if rows == 0:
+ *         return
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         if beta == 0.0:
+ *             fill(out, 0.0, rows)
+*/
+  __pyx_t_1 = (__pyx_v_cols == 0);
+
+  if (__pyx_t_1) {
+
+
+    /* "fccqp/_dense.pxd":83
+ *         return
+ *     if cols == 0:
+ *         if beta == 0.0:             # <<<<<<<<<<<<<<
+ *             fill(out, 0.0, rows)
+ *         return
+*/
+    __pyx_t_1 = (__pyx_v_beta == 0.0);
+
+    if (__pyx_t_1) {
+
+
+      /* "fccqp/_dense.pxd":84
+ *     if cols == 0:
+ *         if beta == 0.0:
+ *             fill(out, 0.0, rows)             # <<<<<<<<<<<<<<
+ *         return
+ *     dgemv(&trans, &r, &c, &alpha, <double*>M, &ld, <double*>x, &one, &beta, out, &one)
+*/
+      __pyx_f_5fccqp_6_dense_fill(__pyx_v_out, 0.0, __pyx_v_rows);
+
+      /* "fccqp/_dense.pxd":83
+ *         return
+ *     if cols == 0:
+ *         if beta == 0.0:             # <<<<<<<<<<<<<<
+ *             fill(out, 0.0, rows)
+ *         return
+*/
+    }
+
+    /* "fccqp/_dense.pxd":85
+ *         if beta == 0.0:
+ *             fill(out, 0.0, rows)
+ *         return             # <<<<<<<<<<<<<<
+ *     dgemv(&trans, &r, &c, &alpha, <double*>M, &ld, <double*>x, &one, &beta, out, &one)
+*/
+    {
+    }
+    goto __pyx_L0;
+
+    /* "fccqp/_dense.pxd":82
+ *     if rows == 0:
+ *         return
+ *     if cols == 0:             # <<<<<<<<<<<<<<
+ *         if beta == 0.0:
+ *             fill(out, 0.0, rows)
+*/
+  }
+
+  /* "fccqp/_dense.pxd":86
+ *             fill(out, 0.0, rows)
+ *         return
+ *     dgemv(&trans, &r, &c, &alpha, <double*>M, &ld, <double*>x, &one, &beta, out, &one)             # <<<<<<<<<<<<<<
+*/
+  __pyx_f_5scipy_6linalg_11cython_blas_dgemv((&__pyx_v_trans), (&__pyx_v_r), (&__pyx_v_c), (&__pyx_v_alpha), ((double *)__pyx_v_M), (&__pyx_v_ld), ((double *)__pyx_v_x), (&__pyx_v_one), (&__pyx_v_beta), __pyx_v_out, (&__pyx_v_one));
+
+  /* "fccqp/_dense.pxd":73
+ * 
+ * 
+ * cdef inline void colmatvec(const double* M, int ld, const double* x, double* out,             # <<<<<<<<<<<<<<
+ *                            Py_ssize_t rows, Py_ssize_t cols, double beta) noexcept nogil:
+ *     """``out = M x + beta out`` for a column-major ``rows x cols`` block ``M`` with
+*/
+
+  /* function exit code */
+  __pyx_L0:;
+
 
 
 
@@ -4050,11 +4460,39 @@ static int __Pyx_modinit_Variable_import_code(__pyx_mstatetype *__pyx_mstate) {
 
 static int __Pyx_modinit_Function_import_code(__pyx_mstatetype *__pyx_mstate) {
   __Pyx_RefNannyDeclarations
+  PyObject *__pyx_t_1 = NULL;
+  int __pyx_lineno = 0;
+  const char *__pyx_filename = NULL;
+  int __pyx_clineno = 0;
   CYTHON_UNUSED_VAR(__pyx_mstate);
   __Pyx_RefNannySetupContext("__Pyx_modinit_Function_import_code", 0);
   /*--- Function import code ---*/
+  {
+    __pyx_t_1 = PyImport_ImportModule("scipy.linalg.cython_blas"); if (unlikely(!__pyx_t_1)) __PYX_ERR(0, 1, __pyx_L1_error)
+    __Pyx_GOTREF(__pyx_t_1);
+    const char * __pyx_import_signature = __Pyx_PyBytes_AsString(__pyx_mstate_global->__pyx_kp_b_void_char_int_int___pyx_t_5scipy);
+    #if !CYTHON_ASSUME_SAFE_MACROS
+    if (unlikely(!__pyx_import_signature)) __PYX_ERR(0, 1, __pyx_L1_error)
+    #endif
+    const char * __pyx_import_name = __pyx_import_signature + 259;
+    void (**const __pyx_import_pointers[])(void) = {(void (**)(void))&__pyx_f_5scipy_6linalg_11cython_blas_dgemv, (void (**)(void)) NULL};
+    void (**const *__pyx_import_pointer)(void) = __pyx_import_pointers;
+    const char *__pyx_import_current_signature = __pyx_import_signature;
+    while (*__pyx_import_pointer) {
+      if (__Pyx_ImportFunction_3_3_1(__pyx_t_1, __pyx_import_name, *__pyx_import_pointer, __pyx_import_current_signature) < (0)) __PYX_ERR(0, 1, __pyx_L1_error)
+      ++__pyx_import_pointer;
+      __pyx_import_name = strchr(__pyx_import_name, '\0') + 1;
+      __pyx_import_signature = strchr(__pyx_import_signature, '\0') + 1;
+      if (*__pyx_import_signature != '\0') __pyx_import_current_signature = __pyx_import_signature;
+    }
+    __Pyx_DECREF(__pyx_t_1); __pyx_t_1 = 0;
+  }
   __Pyx_RefNannyFinishContext();
   return 0;
+  __pyx_L1_error:;
+  __Pyx_XDECREF(__pyx_t_1);
+  __Pyx_RefNannyFinishContext();
+  return -1;
 }
 
 #if CYTHON_PEP489_MULTI_PHASE_INIT
@@ -4333,7 +4771,7 @@ __Pyx_RefNannySetupContext("PyInit_termination", 0);
   /*--- Type init code ---*/
   (void)__Pyx_modinit_Type_import_code(__pyx_mstate);
   (void)__Pyx_modinit_Variable_import_code(__pyx_mstate);
-  (void)__Pyx_modinit_Function_import_code(__pyx_mstate);
+  if (unlikely((__Pyx_modinit_Function_import_code(__pyx_mstate) < 0))) __PYX_ERR(0, 1, __pyx_L1_error)
   if (__Pyx_InitAfterSharedUtility() < (0)) __PYX_ERR(0, 1, __pyx_L1_error)
   /*--- Execution code ---*/
 
@@ -4403,30 +4841,30 @@ static int __Pyx_InitConstants(__pyx_mstatetype *__pyx_mstate) {
   CYTHON_UNUSED_VAR(__pyx_mstate);
   {
     const struct { const unsigned int length: 5; } str_length_index[] = {{1},{8},{10},{8},{12},{12},{8},{18},{10}};
-    const struct { const unsigned int length: 9; } bytes_length_index[] = {{469}};
+    const struct { const unsigned int length: 9; } bytes_length_index[] = {{469},{264}};
     #ifndef CYTHON_COMPRESS_STRINGS
       #define CYTHON_COMPRESS_STRINGS 90
     #endif
-    #if (CYTHON_COMPRESS_STRINGS) == 1 /* compression: zlib (202 bytes) */
-static const char cstring[] = "x\332\255P\273\016\3020\014\354\247d\004\304\322\001Vf6\304\017XnbPD^M\234\252\375{\302\243\252T\036\022\022^|\266|g\373v\000\026\265\203\022\326\253l\350\206\034\332{\016C\017\022\203\276\3416\243\031\373L\211\001\244\321\216\240p9\242\244\006\345%\021+:a6\254|n\014\211E\342\230%\213\207\024\303\346$e\033`\013<\004Jp\210\276LY!\275K,Vk\361\244\315\353\325\262\322\216?\251\3255S\264\332!k\357\340HI\253rk\232\253\214\371\237Z\223f\347\265\372\371\335\357\343\373r\n\026\253_\355x\217~\373\250x\332\370\036R\016\301G\256\312\216\216\342\231T\345\010\243\031`j\304\221s\005\270[\315u";
-    PyObject *data = __Pyx_DecompressString(cstring, 202, 1);
+    #if (CYTHON_COMPRESS_STRINGS) == 1 /* compression: zlib (248 bytes) */
+static const char cstring[] = "x\332\265R\273n\3030\014\364\247xl\202.\031\232\265s\267\242?@\320\024\343\010\325+\022e\304\177_:\211k }\000\006Z-G\022\344\035y\3203\200G\033@\237\217\246:\236\242\200\376\202i<\003a\262S|\252\350\346\272p\021\000r60\350\254d$\356\220\336\013\213\341\003V\047&\326\316q\373P$W\222\366J%\360t :%\330\203\214\211\013\274\346\250]\276\245\030\212\264\333\307\3666v\237o7\215\r\362\023\333n\047\234\275\r(6\006x\343b\215\356Z\356Yf\374K\256\205s\210\326\254>\367\367\366\027]\005\325\352\257v|\037\255\273H=\355\342\031JM)fiTc\340\334\263i\002cv#,\205<\317\\o\244#\346Inrq\201O\325B6\215\260\327\277\201\256Wu\032\345\250\302\235\303\002f]\347j\352\377\336e\323\230\236\375\360\001B\361*\031";
+    PyObject *data = __Pyx_DecompressString(cstring, 248, 1);
     #define __Pyx_DecompressString_LZSS_UNUSED
     if (unlikely(!data)) __PYX_ERR(0, 1, __pyx_L1_error)
     const char* const bytes = __Pyx_PyBytes_AsString(data);
     #if !CYTHON_ASSUME_SAFE_MACROS
     if (likely(bytes)); else { Py_DECREF(data); __PYX_ERR(0, 1, __pyx_L1_error) }
     #endif
-    #elif (CYTHON_COMPRESS_STRINGS) > 0 && (CYTHON_COMPRESS_STRINGS) <= 90 /* compression: lzss (253 bytes) */
-static const char cstring[] = "\377?__main_}_\005\000odule\006\001\367nam\003\002pyx_\357capi\032\001qua\375l\020\005test__\277cline_9\000t\377raceback\377setdefau\377ltdouble\377 (struct\367 __G\001t_5f\377ccqp_6_t\377ypes_Pro\376#\000m const\317 *, 0\004\000\r*)\357\000int6\02511t\377erminati\377on_Resid\302\251\000sF\rV\005\000IJ\007voSid\276\200.\200;I\324\000a\350 \200\216.\237\047\251\047\272 \3263\2065\321 b\377ox_suppo\367rt\000\200@verg\377ed\000nearl\013y_\007\007r\312%";
-    PyObject *data = __Pyx_DecompressString_LZSS(cstring, 253, 556);
+    #elif (CYTHON_COMPRESS_STRINGS) > 0 && (CYTHON_COMPRESS_STRINGS) <= 90 /* compression: lzss (317 bytes) */
+static const char cstring[] = "\377?__main_}_\005\000odule\006\001\367nam\003\002pyx_\357capi\032\001qua\375l\020\005test__\277cline_9\000t\377raceback\377setdefau\377ltdouble\377 (struct\367 __G\001t_5f\377ccqp_6_t\377ypes_Pro\376#\000m const\317 *, 0\004\000\r*)\357\000int6\02511t\377erminati\377on_Resid\302\251\000sF\rV\005\000IJ\007voSid\276\200.\200;I\324\000a\350 \200\216.\237\047\251\047\272 \3263\2065\321 b\377ox_suppo\367rt\000\200@verg\377ed\000nearl\313y_\007\007r\312%\336\003ch\203ar\250A\216A\260@\000\004\331Fs\277cipy_6\231`a\377lg_11cyt\375h\224@blas_d\360\340A\000\047*.,])\000dg\007emv";
+    PyObject *data = __Pyx_DecompressString_LZSS(cstring, 317, 820);
     #define __Pyx_DecompressString_UNUSED
     if (unlikely(!data)) __PYX_ERR(0, 1, __pyx_L1_error)
     const char* const bytes = __Pyx_PyBytes_AsString(data);
     #if !CYTHON_ASSUME_SAFE_MACROS
     if (likely(bytes)); else { Py_DECREF(data); __PYX_ERR(0, 1, __pyx_L1_error) }
     #endif
-    #else /* compression: none (556 bytes) */
-static const char bytes[] = "?__main____module____name____pyx_capi____qualname____test__cline_in_tracebacksetdefaultdouble (struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double *)\000int (struct __pyx_t_5fccqp_11termination_Residuals const *, double, double)\000int (struct __pyx_t_5fccqp_11termination_Residuals const *, double, double, double)\000void (struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates const *, double *, double *, double *, struct __pyx_t_5fccqp_11termination_Residuals *)\000box_support\000converged\000nearly_converged\000residuals";
+    #else /* compression: none (820 bytes) */
+static const char bytes[] = "?__main____module____name____pyx_capi____qualname____test__cline_in_tracebacksetdefaultdouble (struct __pyx_t_5fccqp_6_types_Problem const *, double const *, double *)\000int (struct __pyx_t_5fccqp_11termination_Residuals const *, double, double)\000int (struct __pyx_t_5fccqp_11termination_Residuals const *, double, double, double)\000void (struct __pyx_t_5fccqp_6_types_Problem const *, struct __pyx_t_5fccqp_6_types_Iterates const *, double *, double *, double *, struct __pyx_t_5fccqp_11termination_Residuals *)\000box_support\000converged\000nearly_converged\000residualsvoid (char *, int *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *, __pyx_t_5scipy_6linalg_11cython_blas_d *, __pyx_t_5scipy_6linalg_11cython_blas_d *, int *)\000dgemv";
     PyObject *data = NULL;
     #define __Pyx_DecompressString_UNUSED
     #define __Pyx_DecompressString_LZSS_UNUSED
@@ -4444,7 +4882,7 @@ static const char bytes[] = "?__main____module____name____pyx_capi____qualname__
       stringtab[i] = string;
       pos += bytes_length;
     }
-    for (int i = 9; i < 10; i++) {
+    for (int i = 9; i < 11; i++) {
       Py_ssize_t bytes_length = bytes_length_index[i-9].length;
       PyObject *string = PyBytes_FromStringAndSize(bytes + pos, bytes_length);
       stringtab[i] = string;
@@ -4455,7 +4893,7 @@ static const char bytes[] = "?__main____module____name____pyx_capi____qualname__
       }
     }
     Py_XDECREF(data);
-    for (Py_ssize_t i = 0; i < 10; i++) {
+    for (Py_ssize_t i = 0; i < 11; i++) {
       if (unlikely(PyObject_Hash(stringtab[i]) == -1)) {
         __PYX_ERR(0, 1, __pyx_L1_error)
       }
@@ -4463,7 +4901,7 @@ static const char bytes[] = "?__main____module____name____pyx_capi____qualname__
     #if CYTHON_IMMORTAL_CONSTANTS
     {
       PyObject **table = stringtab + 9;
-      for (Py_ssize_t i=0; i<1; ++i) {
+      for (Py_ssize_t i=0; i<2; ++i) {
         #if PY_VERSION_HEX >= 0x030F0000
         PyUnstable_SetImmortal(table[i]);
         #elif CYTHON_COMPILING_IN_CPYTHON_FREETHREADING
@@ -4586,6 +5024,72 @@ bad:
     Py_XDECREF(d);
     return NULL;
 }
+
+/* PxdImportShared (used by FunctionImport) */
+#ifndef __PYX_HAVE_RT_ImportFromPxd_3_3_1
+#define __PYX_HAVE_RT_ImportFromPxd_3_3_1
+static int __Pyx_ImportFromPxd_3_3_1(PyObject *module, const char *name, void **p, const char *sig, const char *what, int optional) {
+    PyObject *d = 0;
+    PyObject *cobj = 0;
+    d = PyObject_GetAttrString(module, "__pyx_capi__");
+    if (!d)
+        goto bad;
+#if (defined(Py_LIMITED_API) && Py_LIMITED_API >= 0x030d0000) || (!defined(Py_LIMITED_API) && PY_VERSION_HEX >= 0x030d0000)
+    PyDict_GetItemStringRef(d, name, &cobj);
+#else
+    cobj = PyDict_GetItemString(d, name);
+    Py_XINCREF(cobj);
+#endif
+    if (!cobj) {
+        if (optional && !PyErr_Occurred()) {
+            PyErr_Clear();
+            *p = NULL;
+            goto allowed_failure;
+        } else {
+            PyErr_Format(PyExc_ImportError,
+                "%.200s does not export expected C %.8s %.200s",
+                    PyModule_GetName(module), what, name);
+            goto bad;
+        }
+    }
+    if (!PyCapsule_IsValid(cobj, sig)) {
+        PyErr_Format(PyExc_TypeError,
+            "C %.8s %.200s.%.200s has wrong signature (expected %.500s, got %.500s)",
+             what, PyModule_GetName(module), name, sig, PyCapsule_GetName(cobj));
+        goto bad;
+    }
+    *p = PyCapsule_GetPointer(cobj, sig);
+    if (!(*p))
+        goto bad;
+    Py_DECREF(cobj);
+allowed_failure:
+    Py_DECREF(d);
+    return 0;
+bad:
+    Py_XDECREF(d);
+    Py_XDECREF(cobj);
+    return -1;
+}
+#endif
+
+/* FunctionImport */
+#ifndef __PYX_HAVE_RT_ImportFunction_3_3_1
+#define __PYX_HAVE_RT_ImportFunction_3_3_1
+static int __Pyx_ImportFunction_3_3_1(PyObject *module, const char *funcname, void (**f)(void), const char *sig) {
+    if (*f) {
+        return 0; // already imported under a different name
+    }
+    union {
+        void (*fp)(void);
+        void *p;
+    } tmp;
+    int result = __Pyx_ImportFromPxd_3_3_1(module, funcname, &tmp.p, sig, "function", 0);
+    if (result == 0) {
+        *f = tmp.fp;
+    }
+    return result;
+}
+#endif
 
 /* dict_setdefault (used by CLineInTraceback) */
 static CYTHON_INLINE PyObject *__Pyx_PyDict_SetDefault(PyObject *d, PyObject *key, PyObject *default_value) {
@@ -5152,6 +5656,314 @@ bad:
     Py_XDECREF(py_code);
     Py_XDECREF(py_frame);
 }
+#endif
+
+/* Declarations */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+  #ifdef __cplusplus
+    static CYTHON_INLINE __pyx_t_float_complex __pyx_t_float_complex_from_parts(float x, float y) {
+      return ::std::complex< float >(x, y);
+    }
+  #else
+    static CYTHON_INLINE __pyx_t_float_complex __pyx_t_float_complex_from_parts(float x, float y) {
+      return x + y*(__pyx_t_float_complex)_Complex_I;
+    }
+  #endif
+#else
+    static CYTHON_INLINE __pyx_t_float_complex __pyx_t_float_complex_from_parts(float x, float y) {
+      __pyx_t_float_complex z;
+      z.real = x;
+      z.imag = y;
+      return z;
+    }
+#endif
+
+/* Arithmetic */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+#else
+    static CYTHON_INLINE int __Pyx_c_eq_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+       return (a.real == b.real) && (a.imag == b.imag);
+    }
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_sum_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+        __pyx_t_float_complex z;
+        z.real = a.real + b.real;
+        z.imag = a.imag + b.imag;
+        return z;
+    }
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_diff_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+        __pyx_t_float_complex z;
+        z.real = a.real - b.real;
+        z.imag = a.imag - b.imag;
+        return z;
+    }
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_prod_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+        __pyx_t_float_complex z;
+        z.real = a.real * b.real - a.imag * b.imag;
+        z.imag = a.real * b.imag + a.imag * b.real;
+        return z;
+    }
+    #if 1
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_quot_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+        if (b.imag == 0) {
+            return __pyx_t_float_complex_from_parts(a.real / b.real, a.imag / b.real);
+        } else if (fabsf(b.real) >= fabsf(b.imag)) {
+            if (b.real == 0 && b.imag == 0) {
+                return __pyx_t_float_complex_from_parts(a.real / b.real, a.imag / b.imag);
+            } else {
+                float r = b.imag / b.real;
+                float s = (float)(1.0) / (b.real + b.imag * r);
+                return __pyx_t_float_complex_from_parts(
+                    (a.real + a.imag * r) * s, (a.imag - a.real * r) * s);
+            }
+        } else {
+            float r = b.real / b.imag;
+            float s = (float)(1.0) / (b.imag + b.real * r);
+            return __pyx_t_float_complex_from_parts(
+                (a.real * r + a.imag) * s, (a.imag * r - a.real) * s);
+        }
+    }
+    #else
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_quot_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+        if (b.imag == 0) {
+            return __pyx_t_float_complex_from_parts(a.real / b.real, a.imag / b.real);
+        } else {
+            float denom = b.real * b.real + b.imag * b.imag;
+            return __pyx_t_float_complex_from_parts(
+                (a.real * b.real + a.imag * b.imag) / denom,
+                (a.imag * b.real - a.real * b.imag) / denom);
+        }
+    }
+    #endif
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_neg_float(__pyx_t_float_complex a) {
+        __pyx_t_float_complex z;
+        z.real = -a.real;
+        z.imag = -a.imag;
+        return z;
+    }
+    static CYTHON_INLINE int __Pyx_c_is_zero_float(__pyx_t_float_complex a) {
+       return (a.real == 0) && (a.imag == 0);
+    }
+    static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_conj_float(__pyx_t_float_complex a) {
+        __pyx_t_float_complex z;
+        z.real =  a.real;
+        z.imag = -a.imag;
+        return z;
+    }
+    #if 1
+        static CYTHON_INLINE float __Pyx_c_abs_float(__pyx_t_float_complex z) {
+          #if !defined(HAVE_HYPOT) || defined(_MSC_VER)
+            return sqrtf(z.real*z.real + z.imag*z.imag);
+          #else
+            return hypotf(z.real, z.imag);
+          #endif
+        }
+        static CYTHON_INLINE __pyx_t_float_complex __Pyx_c_pow_float(__pyx_t_float_complex a, __pyx_t_float_complex b) {
+            __pyx_t_float_complex z;
+            float r, lnr, theta, z_r, z_theta;
+            if (b.imag == 0 && b.real == (int)b.real) {
+                if (b.real < 0) {
+                    float denom = a.real * a.real + a.imag * a.imag;
+                    a.real = a.real / denom;
+                    a.imag = -a.imag / denom;
+                    b.real = -b.real;
+                }
+                switch ((int)b.real) {
+                    case 0:
+                        z.real = 1;
+                        z.imag = 0;
+                        return z;
+                    case 1:
+                        return a;
+                    case 2:
+                        return __Pyx_c_prod_float(a, a);
+                    case 3:
+                        z = __Pyx_c_prod_float(a, a);
+                        return __Pyx_c_prod_float(z, a);
+                    case 4:
+                        z = __Pyx_c_prod_float(a, a);
+                        return __Pyx_c_prod_float(z, z);
+                }
+            }
+            if (a.imag == 0) {
+                if (a.real == 0) {
+                    return a;
+                } else if ((b.imag == 0) && (a.real >= 0)) {
+                    z.real = powf(a.real, b.real);
+                    z.imag = 0;
+                    return z;
+                } else if (a.real > 0) {
+                    r = a.real;
+                    theta = 0;
+                } else {
+                    r = -a.real;
+                    theta = atan2f(0.0, -1.0);
+                }
+            } else {
+                r = __Pyx_c_abs_float(a);
+                theta = atan2f(a.imag, a.real);
+            }
+            lnr = logf(r);
+            z_r = expf(lnr * b.real - theta * b.imag);
+            z_theta = theta * b.real + lnr * b.imag;
+            z.real = z_r * cosf(z_theta);
+            z.imag = z_r * sinf(z_theta);
+            return z;
+        }
+    #endif
+#endif
+
+/* Declarations */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+  #ifdef __cplusplus
+    static CYTHON_INLINE __pyx_t_double_complex __pyx_t_double_complex_from_parts(double x, double y) {
+      return ::std::complex< double >(x, y);
+    }
+  #else
+    static CYTHON_INLINE __pyx_t_double_complex __pyx_t_double_complex_from_parts(double x, double y) {
+      return x + y*(__pyx_t_double_complex)_Complex_I;
+    }
+  #endif
+#else
+    static CYTHON_INLINE __pyx_t_double_complex __pyx_t_double_complex_from_parts(double x, double y) {
+      __pyx_t_double_complex z;
+      z.real = x;
+      z.imag = y;
+      return z;
+    }
+#endif
+
+/* Arithmetic */
+#if CYTHON_CCOMPLEX && (1) && (!0 || __cplusplus)
+#else
+    static CYTHON_INLINE int __Pyx_c_eq_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+       return (a.real == b.real) && (a.imag == b.imag);
+    }
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_sum_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+        __pyx_t_double_complex z;
+        z.real = a.real + b.real;
+        z.imag = a.imag + b.imag;
+        return z;
+    }
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_diff_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+        __pyx_t_double_complex z;
+        z.real = a.real - b.real;
+        z.imag = a.imag - b.imag;
+        return z;
+    }
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_prod_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+        __pyx_t_double_complex z;
+        z.real = a.real * b.real - a.imag * b.imag;
+        z.imag = a.real * b.imag + a.imag * b.real;
+        return z;
+    }
+    #if 1
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_quot_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+        if (b.imag == 0) {
+            return __pyx_t_double_complex_from_parts(a.real / b.real, a.imag / b.real);
+        } else if (fabs(b.real) >= fabs(b.imag)) {
+            if (b.real == 0 && b.imag == 0) {
+                return __pyx_t_double_complex_from_parts(a.real / b.real, a.imag / b.imag);
+            } else {
+                double r = b.imag / b.real;
+                double s = (double)(1.0) / (b.real + b.imag * r);
+                return __pyx_t_double_complex_from_parts(
+                    (a.real + a.imag * r) * s, (a.imag - a.real * r) * s);
+            }
+        } else {
+            double r = b.real / b.imag;
+            double s = (double)(1.0) / (b.imag + b.real * r);
+            return __pyx_t_double_complex_from_parts(
+                (a.real * r + a.imag) * s, (a.imag * r - a.real) * s);
+        }
+    }
+    #else
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_quot_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+        if (b.imag == 0) {
+            return __pyx_t_double_complex_from_parts(a.real / b.real, a.imag / b.real);
+        } else {
+            double denom = b.real * b.real + b.imag * b.imag;
+            return __pyx_t_double_complex_from_parts(
+                (a.real * b.real + a.imag * b.imag) / denom,
+                (a.imag * b.real - a.real * b.imag) / denom);
+        }
+    }
+    #endif
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_neg_double(__pyx_t_double_complex a) {
+        __pyx_t_double_complex z;
+        z.real = -a.real;
+        z.imag = -a.imag;
+        return z;
+    }
+    static CYTHON_INLINE int __Pyx_c_is_zero_double(__pyx_t_double_complex a) {
+       return (a.real == 0) && (a.imag == 0);
+    }
+    static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_conj_double(__pyx_t_double_complex a) {
+        __pyx_t_double_complex z;
+        z.real =  a.real;
+        z.imag = -a.imag;
+        return z;
+    }
+    #if 1
+        static CYTHON_INLINE double __Pyx_c_abs_double(__pyx_t_double_complex z) {
+          #if !defined(HAVE_HYPOT) || defined(_MSC_VER)
+            return sqrt(z.real*z.real + z.imag*z.imag);
+          #else
+            return hypot(z.real, z.imag);
+          #endif
+        }
+        static CYTHON_INLINE __pyx_t_double_complex __Pyx_c_pow_double(__pyx_t_double_complex a, __pyx_t_double_complex b) {
+            __pyx_t_double_complex z;
+            double r, lnr, theta, z_r, z_theta;
+            if (b.imag == 0 && b.real == (int)b.real) {
+                if (b.real < 0) {
+                    double denom = a.real * a.real + a.imag * a.imag;
+                    a.real = a.real / denom;
+                    a.imag = -a.imag / denom;
+                    b.real = -b.real;
+                }
+                switch ((int)b.real) {
+                    case 0:
+                        z.real = 1;
+                        z.imag = 0;
+                        return z;
+                    case 1:
+                        return a;
+                    case 2:
+                        return __Pyx_c_prod_double(a, a);
+                    case 3:
+                        z = __Pyx_c_prod_double(a, a);
+                        return __Pyx_c_prod_double(z, a);
+                    case 4:
+                        z = __Pyx_c_prod_double(a, a);
+                        return __Pyx_c_prod_double(z, z);
+                }
+            }
+            if (a.imag == 0) {
+                if (a.real == 0) {
+                    return a;
+                } else if ((b.imag == 0) && (a.real >= 0)) {
+                    z.real = pow(a.real, b.real);
+                    z.imag = 0;
+                    return z;
+                } else if (a.real > 0) {
+                    r = a.real;
+                    theta = 0;
+                } else {
+                    r = -a.real;
+                    theta = atan2(0.0, -1.0);
+                }
+            } else {
+                r = __Pyx_c_abs_double(a);
+                theta = atan2(a.imag, a.real);
+            }
+            lnr = log(r);
+            z_r = exp(lnr * b.real - theta * b.imag);
+            z_theta = theta * b.real + lnr * b.imag;
+            z.real = z_r * cos(z_theta);
+            z.imag = z_r * sin(z_theta);
+            return z;
+        }
+    #endif
 #endif
 
 /* FormatTypeName */
