@@ -9,11 +9,11 @@ against Clarabel. Some of these wait for the compiled core's fixes (items 1-8, 1
 from __future__ import annotations
 
 import re
-import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
+import tomllib
 
 import fccqp
 from fccqp import FrictionCone, SecondOrderCone, Status
@@ -103,7 +103,8 @@ BASE = Problem.of(*random_problem(22, n=10, m=3, n_cones=1, n_box=3))
 
 def _extreme(change: str) -> tuple[Problem, dict, dict]:
     """The base problem with one of item 2's or item 6's extreme changes."""
-    data, settings, guess = dict(zip("P q A b lb ub cones".split(), BASE.args())), {}, {}
+    names = "P q A b lb ub cones".split()
+    data, settings, guess = dict(zip(names, BASE.args(), strict=True)), {}, {}
     if change in ("q", "b"):
         data[change] = data[change] * 1e300
     elif change == "P":

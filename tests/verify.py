@@ -343,6 +343,46 @@ def check_solution(problem: Problem, result: fccqp.Result,
     return report
 
 
+def from_qpsolvers(problem, solution) -> tuple[Problem, fccqp.Result]:
+    """A qpsolvers problem and fccqp's ``Solution`` of it, in fccqp's slack form.
+
+    Re-derived here from qpsolvers' definitions, not taken from the backend: with
+    ``s = G x`` the problem is ``[A 0; G -I] [x; s] = [b; 0]``, ``[lb; -inf] <= [x; s]
+    <= [ub; h]``, and qpsolvers' duals give ``y_ext = [y; z]``, ``z_ext = [z_box; z]``
+    (stationarity in ``s`` reads ``-y_G + z_s = 0``). The ``Result`` carries the
+    status and claimed residuals from ``solution.extras``.
+    """
+    P, q, G, h, A, b, lb, ub = (None if v is None else
+                                np.asarray(v.toarray() if sp.issparse(v) else v, float)
+                                for v in problem.unpack())
+    n = q.shape[0]
+    G = np.zeros((0, n)) if G is None else G.reshape(-1, n)
+    h = np.zeros(0) if h is None else h.reshape(-1)
+    A = np.zeros((0, n)) if A is None else A.reshape(-1, n)
+    b = np.zeros(0) if b is None else b.reshape(-1)
+    k = G.shape[0]
+    P_ext = np.zeros((n + k, n + k))
+    P_ext[:n, :n] = P
+    A_ext = np.block([[A, np.zeros((A.shape[0], k))], [G, -np.eye(k)]])
+    lb_ext = np.concatenate([np.full(n, -np.inf) if lb is None else lb, np.full(k, -np.inf)])
+    ub_ext = np.concatenate([np.full(n, np.inf) if ub is None else ub, h])
+    ext = Problem.of(P_ext, np.concatenate([q, np.zeros(k)]), A_ext,
+                     np.concatenate([b, np.zeros(k)]), lb_ext, ub_ext)
+    extras = solution.extras
+    present = solution.x is not None
+    z_box = solution.z_box if present and solution.z_box.size else np.zeros(n)
+    result = fccqp.Result(
+        x=np.concatenate([solution.x, G @ solution.x]) if present else np.zeros(n + k),
+        y=np.concatenate([solution.y, solution.z]) if present else np.zeros(0),
+        z=np.concatenate([z_box, solution.z]) if present else np.zeros(0),
+        status=extras["status"], obj=solution.obj, iterations=extras["iterations"],
+        prim_res=extras["prim_res"], dual_res=extras["dual_res"],
+        setup_time=extras["setup_time"], solve_time=extras["solve_time"], rho=extras["rho"],
+        factorizations=extras["factorizations"], certificate=extras.get("certificate"),
+    )
+    return ext, result
+
+
 def verify_solution(problem: Problem | Sequence, result: fccqp.Result,
                     tolerances: Tolerances | None = None) -> Report:
     """Assert that ``result`` keeps the promises of its status for ``problem``.

@@ -191,9 +191,10 @@ def fccqp_solve_problem(
         ``P x + q + A'y + G'z + z_box = 0`` with ``z >= 0`` exactly; absent constraint
         blocks give empty arrays. When the budget runs out, or on
         ``Status.NUMERICAL_ERROR``, ``x, y, z, z_box`` hold the last (finite) iterate
-        and ``found`` is False; on infeasibility they are None. ``extras`` holds the fccqp ``status``,
-        ``iterations``, ``prim_res``, ``dual_res`` (of the slack form), ``setup_time``,
-        ``solve_time``, ``rho`` and ``factorizations``.
+        and ``found`` is False; on infeasibility they are None. ``extras`` holds the
+        fccqp ``status``, ``iterations``, ``prim_res``, ``dual_res`` (of the slack
+        form), ``setup_time``, ``solve_time``, ``rho``, ``factorizations`` and
+        ``certificate`` (of the slack form, see ``fccqp.Result``).
 
     Raises
     ------
@@ -243,6 +244,7 @@ def fccqp_solve_problem(
         "solve_time": result.solve_time,
         "rho": result.rho,
         "factorizations": result.factorizations,
+        "certificate": result.certificate,
     }
     solution.build_time = solve_start - build_start
     solution.solve_time = solve_end - solve_start
