@@ -20,6 +20,7 @@ from benchmarks.cvxpy_overhead import WbcQP, cvxpy_problem, linear_costs, wbc_qp
 import fccqp
 from fccqp_cvxpy import FCCQP, FCCQPSolver
 from fccqp_cvxpy.translation import Translation
+from verify import Problem, Tolerances, verify_solution
 
 TIGHT = {"eps_abs": 1e-8, "eps_rel": 1e-8, "max_iter": 100_000}
 TIGHTER = {**TIGHT, "eps_abs": 1e-10, "eps_rel": 1e-10}
@@ -29,6 +30,14 @@ primal sensitive to the objective: at the default 1e-8 gap Clarabel's own torque
 off by 3e-4."""
 RTOL = 2e-5
 """Agreement required with Clarabel, relative to the largest reference entry (or 1)."""
+
+
+def _verify(problem: cp.Problem, options: dict | None = None) -> None:
+    """fccqp's result keeps its status's promise on the translated problem."""
+    stats = problem.solver_stats.extra_stats
+    t = stats["translation"]
+    translated = Problem.of(t.P, t.q, t.A, t.b, t.lb, t.ub, t.cones)
+    verify_solution(translated, stats["result"], Tolerances.of(**(options or {})))
 
 
 def _values(problem: cp.Problem) -> dict[str, object]:
@@ -52,6 +61,7 @@ def _compare(
     expected = _values(problem)
     problem.solve(solver=FCCQP, **(options or TIGHT))
     assert problem.status == cp.OPTIMAL
+    _verify(problem, options or TIGHT)
     got = _values(problem)
     assert got.keys() == expected.keys()
     for key, reference in expected.items():
@@ -241,6 +251,7 @@ def test_soc_with_offset_uses_slacks() -> None:
 
 def _status(problem: cp.Problem) -> str:
     problem.solve(solver=FCCQP)
+    _verify(problem)
     return problem.status
 
 

@@ -15,6 +15,7 @@ from qpsolvers import ParamError, Problem, problems, solve_problem, solve_qp
 
 import fccqp
 from fccqp.qpsolvers_backend import fccqp_solve_qp, register
+from verify import Tolerances, from_qpsolvers, verify_solution
 
 TIGHT = dict(eps_abs=1e-9, eps_rel=1e-9, max_iter=100_000)
 DEFAULT_EPS = fccqp.Settings().eps_abs
@@ -112,6 +113,7 @@ def test_reference_problems(getter, settings, eps):
     problem, ref = reference(getter)
     solution = solve_problem(problem, solver="fccqp", **settings)
     assert solution.found, solution.extras
+    verify_solution(*from_qpsolvers(problem, solution), Tolerances.of(**settings))
     scale = magnitude(problem, ref)
     # fccqp stops on eps_abs + eps_rel * scale for the slack form; qpsolvers' own
     # residuals of the translated duals are within a small factor of its own.
@@ -206,6 +208,7 @@ def test_dual_signs_follow_qpsolvers(constraints, c, x, duals):
     problem = Problem(np.eye(2), -np.asarray(c), **constraints)
     solution = solve_problem(problem, solver="fccqp", **TIGHT)
     assert solution.found
+    verify_solution(*from_qpsolvers(problem, solution), Tolerances.of(**TIGHT))
     assert_close(solution.x, x, 1e-7, "x")
     for name, value in duals.items():
         assert_close(getattr(solution, name), np.asarray(value), 1e-7, name)
@@ -323,9 +326,11 @@ def test_invalid_setting_value_raises_param_error():
 )
 def test_infeasible_problem_is_not_found(constraints):
     P, q = np.eye(2), np.ones(2)
-    solution = solve_problem(Problem(P, q, **constraints), solver="fccqp")
+    problem = Problem(P, q, **constraints)
+    solution = solve_problem(problem, solver="fccqp")
     assert solution.found is False
     assert solution.extras["status"] is fccqp.Status.PRIMAL_INFEASIBLE
+    verify_solution(*from_qpsolvers(problem, solution))
     assert solution.x is None and solution.z is None
     assert solve_qp(P, q, **constraints, solver="fccqp") is None
 
@@ -342,7 +347,7 @@ P2, Q2, G2, H2 = np.eye(2), np.ones(2), np.array([[1.0, 1.0]]), np.array([1.0])
         (dict(G=np.array([[1.0, np.nan]])), ValueError, "G contains NaN"),
         (dict(h=np.array([np.nan])), ValueError, "h contains NaN"),
         (dict(h=np.array([-np.inf])), ValueError, "h\\[0\\] is -inf"),
-        (dict(G=[["a", "b"]]), TypeError, "G and h must be numeric"),
+        (dict(G=[["a", "b"]]), TypeError, "G must be numeric"),
         (dict(q=np.ones(3)), ValueError, "q must have 2 entries"),
         (dict(P=np.array([[1.0, np.nan], [np.nan, 1.0]])), ValueError, "P contains NaN"),
         (dict(lb=np.array([1.0, 0.0]), ub=np.zeros(2)), ValueError, "lb > ub at index 0"),
@@ -377,9 +382,9 @@ def test_verbose_prints_the_iteration_log(capsys):
 def test_registered_once_in_qpsolvers_lists():
     assert register() is True
     assert register() is True
-    for names in (qpsolvers.available_solvers, qpsolvers.dense_solvers):
+    for names in (qpsolvers.available_solvers, qpsolvers.dense_solvers,
+                  qpsolvers.sparse_solvers):
         assert names.count("fccqp") == 1
-    assert "fccqp" not in qpsolvers.sparse_solvers  # it densifies, like ECOS
     assert qpsolvers.solvers.solve_function["fccqp"].__name__ == "fccqp_solve_problem"
 
 

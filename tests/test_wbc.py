@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import fccqp
+from verify import Problem, Tolerances, verify_solution
 
 pytest.importorskip("pinocchio")
 from benchmarks.testsets import generate_test_set  # noqa: E402
@@ -19,6 +20,10 @@ def cones_of(qp):
     return [fccqp.FrictionCone(int(s), float(mu)) for s, mu in pairs]
 
 
+def problem_of(qp):
+    return Problem.of(qp.P, qp.q, qp.A, qp.b, qp.lb, qp.ub, cones_of(qp))
+
+
 def test_matches_clarabel_reference(test_set):
     for qp, x_ref in zip(test_set.qps, test_set.x_ref, strict=True):
         result = fccqp.solve(
@@ -26,6 +31,7 @@ def test_matches_clarabel_reference(test_set):
             eps_abs=1e-9, eps_rel=1e-9, max_iter=20000,
         )
         assert result.status is fccqp.Status.SOLVED
+        verify_solution(problem_of(qp), result, Tolerances.of(eps_abs=1e-9, eps_rel=1e-9))
         assert qp.equality_residual(result.x) <= 1e-9
         assert qp.cone_violation(result.x) <= 1e-6
         assert qp.bound_violation(result.x) <= 1e-6
@@ -40,7 +46,7 @@ def test_realtime_sequence_keeps_dynamics_exact(test_set):
     solver = fccqp.Solver(fccqp.Settings.realtime())
     for qp in test_set.qps:
         result = solver.solve(qp.P, qp.q, qp.A, qp.b, qp.lb, qp.ub, cones_of(qp))
-        assert result.iterations <= 15
+        verify_solution(problem_of(qp), result, Tolerances.of(fccqp.Settings.realtime()))
         assert qp.equality_residual(result.x) <= 1e-9
 
 
@@ -49,3 +55,4 @@ def test_default_settings_solve_every_qp(test_set):
     for qp in test_set.qps:
         result = solver.solve(qp.P, qp.q, qp.A, qp.b, qp.lb, qp.ub, cones_of(qp))
         assert result.status is fccqp.Status.SOLVED
+        verify_solution(problem_of(qp), result)

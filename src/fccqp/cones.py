@@ -15,7 +15,7 @@ normals.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from functools import cached_property, lru_cache
 
@@ -108,20 +108,27 @@ class ConeArrays:
 
 
 def _integer(value: object, what: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
         raise TypeError(f"{what} must be an integer, got {value!r}")
     return int(value)
 
 
 def _check_friction(cone: FrictionCone, index: int) -> np.ndarray:
     mu = cone.mu
-    if isinstance(mu, bool) or not isinstance(mu, (int, float, np.integer, np.floating)):
-        raise TypeError(f"cones[{index}].mu must be a number, got {mu!r}")
+    if isinstance(mu, (bool, np.bool_)) or not isinstance(
+        mu, (int, float, np.integer, np.floating)
+    ):
+        raise TypeError(f"cones[{index}].mu must be a real number, got {mu!r}")
     if not math.isfinite(mu) or mu <= 0:
         raise ValueError(f"cones[{index}].mu must be finite and > 0, got {mu}")
     if cone.normal is None:
         return np.array([0.0, 0.0, 1.0])
-    normal = np.asarray(cone.normal, dtype=float)
+    normal = np.asarray(cone.normal)
+    if normal.dtype.kind not in "iuf":
+        raise TypeError(
+            f"cones[{index}].normal must be 3 real numbers, got {cone.normal!r}"
+        )
+    normal = normal.astype(np.float64)
     if normal.shape != (3,):
         raise ValueError(f"cones[{index}].normal must have 3 entries, got shape {normal.shape}")
     if not np.all(np.isfinite(normal)):
@@ -132,31 +139,51 @@ def _check_friction(cone: FrictionCone, index: int) -> np.ndarray:
     return normal / norm
 
 
+def _signature(cone: object) -> tuple:
+    """The types behind a cone's value: part of the memo key, because specs that
+    compare equal may differ in validity (``0.5 + 0j == 0.5``, ``2.0 == 2``)."""
+    if isinstance(cone, FrictionCone):
+        normal = cone.normal
+        kinds = tuple(map(type, normal)) if isinstance(normal, tuple) else type(normal)
+        return type(cone), type(cone.start), type(cone.mu), kinds
+    if isinstance(cone, SecondOrderCone):
+        return type(cone), type(cone.start), type(cone.dim)
+    return (type(cone),)
+
+
 def flatten_cones(cones: Sequence[Cone], n: int) -> ConeArrays:
     """Validate cone specs for an ``n``-vector and return them as flat arrays.
 
-    Results are memoized for hashable inputs: a control loop passes the same cones
-    every tick.
+    Results are memoized for hashable inputs, keyed on the specs and the types of
+    their fields (see :func:`_signature`): a control loop passes the same cones every
+    tick, and a spec that only compares equal to a valid one is still validated.
 
     Raises
     ------
     TypeError
-        If an entry is not a :class:`FrictionCone` or :class:`SecondOrderCone`.
+        If ``cones`` is not a sequence of cones, an entry is not a
+        :class:`FrictionCone` or :class:`SecondOrderCone`, or a field has the wrong type.
     ValueError
         If a block leaves ``[0, n)``, overlaps another block, a second-order cone has
         ``dim < 2``, or a friction cone has a bad ``mu`` or normal.
     """
     if isinstance(cones, (FrictionCone, SecondOrderCone)):
         cones = (cones,)
+    elif isinstance(cones, (str, bytes)) or not isinstance(cones, Iterable):
+        raise TypeError(
+            f"cones must be a sequence of FrictionCone or SecondOrderCone, got {cones!r}"
+        )
+    cones = tuple(cones)
+    key = tuple((cone, _signature(cone)) for cone in cones)
     try:
-        return _flatten_cached(tuple(cones), n)
+        return _flatten_cached(key, n)
     except TypeError:  # unhashable field, e.g. a numpy normal: validate uncached
         return _flatten(cones, n)
 
 
 @lru_cache(maxsize=64)
-def _flatten_cached(cones: tuple[Cone, ...], n: int) -> ConeArrays:
-    return _flatten(cones, n)
+def _flatten_cached(key: tuple[tuple[Cone, tuple], ...], n: int) -> ConeArrays:
+    return _flatten([cone for cone, _ in key], n)
 
 
 def _flatten(cones: Sequence[Cone], n: int) -> ConeArrays:
@@ -169,21 +196,22 @@ def _flatten(cones: Sequence[Cone], n: int) -> ConeArrays:
     for i, cone in enumerate(cones):
         if isinstance(cone, FrictionCone):
             normal[i] = _check_friction(cone, i)
-            kind[i], dim[i], mu[i] = FRICTION, 3, float(cone.mu)
+            kind[i], size, mu[i] = FRICTION, 3, float(cone.mu)
         elif isinstance(cone, SecondOrderCone):
             kind[i] = SECOND_ORDER
-            dim[i] = _integer(cone.dim, f"cones[{i}].dim")
-            if dim[i] < 2:
-                raise ValueError(f"cones[{i}].dim must be >= 2, got {dim[i]}")
+            size = _integer(cone.dim, f"cones[{i}].dim")
+            if size < 2:
+                raise ValueError(f"cones[{i}].dim must be >= 2, got {size}")
         else:
             raise TypeError(
                 f"cones[{i}] must be a FrictionCone or SecondOrderCone, got {type(cone).__name__}"
             )
-        offset[i] = _integer(cone.start, f"cones[{i}].start")
-        if offset[i] < 0 or offset[i] + dim[i] > n:
+        start = _integer(cone.start, f"cones[{i}].start")
+        if start < 0 or start + size > n:  # Python ints: no overflow before the check
             raise ValueError(
-                f"cones[{i}] covers x[{offset[i]}:{offset[i] + dim[i]}], outside x of length {n}"
+                f"cones[{i}] covers x[{start}:{start + size}], outside x of length {n}"
             )
+        offset[i], dim[i] = start, size
     order = np.argsort(offset, kind="stable")
     for a, b in zip(order[:-1], order[1:], strict=True):
         if offset[a] + dim[a] > offset[b]:

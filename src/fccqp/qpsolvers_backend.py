@@ -16,16 +16,20 @@ factorization cost with its cube.
 
 Duals. fccqp returns ``(y_ext, z_ext)`` with ``P_ext v + q_ext + A_ext' y_ext +
 z_ext = 0``. Its rows for ``s`` read ``-y_G + z_s = 0``, so the multiplier of
-``G x <= h`` is ``z = z_s``, the box multiplier of the slack: it comes from the
-projection onto ``s <= h``, hence is exactly ``>= 0`` and exactly zero on inactive
-rows. Its rows for ``x`` then give qpsolvers' convention
+``G x <= h`` is ``z = z_s``, the box multiplier of the slack. It comes from the
+projection onto ``s <= h``, so it is zero on inactive rows and non-negative up to
+rounding in the unscaling (values like ``-4.8e-18`` occur); the backend clips it at
+0, so the returned ``z`` is exactly ``>= 0``. Its rows for ``x`` then give qpsolvers' convention
 ``P x + q + A'y + G'z + z_box = 0`` with ``y = y_A`` and ``z_box = z_x``
 (negative at an active lower bound, positive at an active upper bound).
 
 fccqp is a dense solver, meant for 30-300 variables: sparse ``P``, ``G``, ``A``
 (``scipy.sparse`` matrices or arrays, ``csc_array`` included) are accepted and
-densified. It is therefore registered in ``qpsolvers.dense_solvers`` only, as
-qpsolvers does for ECOS, which also densifies.
+densified, so it is listed in both ``qpsolvers.dense_solvers`` and
+``qpsolvers.sparse_solvers`` (as ProxQP and PIQP are). Before densifying, the size
+of the slack form's KKT matrix, ``n + m_A + 2 m_G`` rows, is checked against
+:data:`MAX_KKT_ROWS`: a larger problem raises ``ValueError`` rather than running
+out of memory.
 
 Registration. qpsolvers has no plugin mechanism: :func:`register` adds "fccqp" to
 its module-level registry, which ``import fccqp`` calls. Importing qpsolvers takes
@@ -60,6 +64,11 @@ if TYPE_CHECKING:
 SOLVER_NAME = "fccqp"
 """Name of the solver in qpsolvers' registry."""
 
+MAX_KKT_ROWS = 5000
+"""Largest dense KKT matrix the backend builds: ``n + m_A + 2 m_G`` rows. At this
+size the matrix takes 200 MB and one factorization about 4e10 flops (seconds), ten
+times the 500 rows the dense backend is meant for."""
+
 
 def _settings(verbose: bool, kwargs: dict[str, object]) -> Settings:
     """Map qpsolvers keyword arguments onto :class:`fccqp.Settings`.
@@ -75,15 +84,38 @@ def _settings(verbose: bool, kwargs: dict[str, object]) -> Settings:
         raise ParamError(f"fccqp: {exn}") from exn
 
 
+def _check_size(problem: Problem) -> None:
+    """Refuse, before densifying anything, a slack form above :data:`MAX_KKT_ROWS`."""
+    def rows(M: object) -> int:
+        shape = getattr(M, "shape", None) or np.shape(M)
+        return 0 if M is None else shape[0] if len(shape) == 2 else 1
+
+    n, m_A, m_G = rows(problem.P), rows(problem.A), rows(problem.G)
+    rows = n + m_A + 2 * m_G
+    if rows > MAX_KKT_ROWS:
+        raise ValueError(
+            f"fccqp is a dense solver: this problem (n = {n}, {m_A} rows of A, {m_G} rows "
+            f"of G) needs a {rows} x {rows} KKT matrix, above the limit of {MAX_KKT_ROWS} "
+            f"rows (fccqp.qpsolvers_backend.MAX_KKT_ROWS); use a sparse solver"
+        )
+
+
+def _real_array(value: object, name: str) -> np.ndarray:
+    """``value`` as a float64 array; complex or non-numeric input is a ``TypeError``."""
+    if sp.issparse(value):
+        value = value.toarray()
+    if np.iscomplexobj(value):
+        raise TypeError(f"{name} must be real, got complex entries")
+    try:
+        return np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError) as exn:
+        raise TypeError(f"{name} must be numeric: {exn}") from exn
+
+
 def _inequalities(G: object, h: object, n: int) -> tuple[np.ndarray, np.ndarray]:
     """Check ``G x <= h`` and return it dense; errors name ``G`` or ``h``."""
-    if sp.issparse(G):
-        G = G.toarray()
-    try:
-        G = np.asarray(G, dtype=np.float64)
-        h = np.asarray(h, dtype=np.float64).reshape(-1)
-    except (TypeError, ValueError) as exn:
-        raise TypeError(f"G and h must be numeric: {exn}") from exn
+    G = _real_array(G, "G")
+    h = _real_array(h, "h").reshape(-1)
     if G.ndim != 2 or G.shape[1] != n:
         raise ValueError(f"G must have {n} columns (the size of P), got shape {G.shape}")
     if h.shape[0] != G.shape[0]:
@@ -118,6 +150,8 @@ def _with_slacks(data: ProblemData, G: np.ndarray, h: np.ndarray) -> tuple[np.nd
 
 
 def _initial_guess(initvals: object, n: int) -> np.ndarray:
+    if np.iscomplexobj(initvals):
+        raise TypeError("initvals must be real, got complex entries")
     try:
         guess = np.asarray(initvals, dtype=np.float64).reshape(-1)
     except (TypeError, ValueError) as exn:
@@ -154,11 +188,13 @@ def fccqp_solve_problem(
     -------
     qpsolvers.Solution
         ``found`` is True only for ``Status.SOLVED``. Duals follow qpsolvers:
-        ``P x + q + A'y + G'z + z_box = 0`` with ``z >= 0``; absent constraint blocks
-        give empty arrays. When the budget runs out ``x, y, z, z_box`` hold the last
-        iterate; on infeasibility they are None. ``extras`` holds the fccqp ``status``,
-        ``iterations``, ``prim_res``, ``dual_res`` (of the slack form), ``setup_time``,
-        ``solve_time``, ``rho`` and ``factorizations``.
+        ``P x + q + A'y + G'z + z_box = 0`` with ``z >= 0`` exactly; absent constraint
+        blocks give empty arrays. When the budget runs out, or on
+        ``Status.NUMERICAL_ERROR``, ``x, y, z, z_box`` hold the last (finite) iterate
+        and ``found`` is False; on infeasibility they are None. ``extras`` holds the
+        fccqp ``status``, ``iterations``, ``prim_res``, ``dual_res`` (of the slack
+        form), ``setup_time``, ``solve_time``, ``rho``, ``factorizations`` and
+        ``certificate`` (of the slack form, see ``fccqp.Result``).
 
     Raises
     ------
@@ -166,8 +202,9 @@ def fccqp_solve_problem(
         On an unknown keyword or an invalid setting value, naming it.
     ValueError, TypeError
         On malformed problem data, naming the argument (``P``, ``q``, ``G``, ``h``,
-        ``A``, ``b``, ``lb``, ``ub``, ``initvals``), or when ``P`` is not positive
-        semidefinite.
+        ``A``, ``b``, ``lb``, ``ub``, ``initvals``; complex entries included), when
+        ``P`` is not convex on the null space of ``A``, or when the slack form's KKT
+        matrix would exceed :data:`MAX_KKT_ROWS` rows.
     """
     from qpsolvers import Solution
 
@@ -178,6 +215,7 @@ def fccqp_solve_problem(
 
     build_start = time.perf_counter()
     problem.check_constraints()
+    _check_size(problem)
     settings = _settings(verbose, kwargs)
     P, q, G, h, A, b, lb, ub = problem.unpack()
     data = validate(P, q, A, b, lb, ub)
@@ -206,6 +244,7 @@ def fccqp_solve_problem(
         "solve_time": result.solve_time,
         "rho": result.rho,
         "factorizations": result.factorizations,
+        "certificate": result.certificate,
     }
     solution.build_time = solve_start - build_start
     solution.solve_time = solve_end - solve_start
@@ -215,7 +254,7 @@ def fccqp_solve_problem(
     solution.obj = result.obj
     solution.x = result.x[:n]
     solution.y = result.y[:m_A]
-    solution.z = result.z[n:] if m_G else np.empty(0)
+    solution.z = np.maximum(result.z[n:], 0.0) if m_G else np.empty(0)
     solution.z_box = result.z[:n] if lb is not None or ub is not None else np.empty(0)
     return solution
 
@@ -254,14 +293,14 @@ def _add_to_registry() -> bool:
     """Put fccqp in qpsolvers' registry, mutating its lists and dict in place.
 
     ``qpsolvers.solve_problem`` looks solvers up in ``solve_function``; the lists
-    ``available_solvers`` and ``dense_solvers`` are what users and qpsolvers'
-    messages consult. Other modules hold these same objects, hence in place.
+    ``available_solvers``, ``dense_solvers`` and ``sparse_solvers`` are what users and
+    qpsolvers' messages consult. Other modules hold these same objects, hence in place.
     """
     try:
         from qpsolvers import solvers
     except ImportError:
         return False
-    for names in (solvers.available_solvers, solvers.dense_solvers):
+    for names in (solvers.available_solvers, solvers.dense_solvers, solvers.sparse_solvers):
         if SOLVER_NAME not in names:
             names.append(SOLVER_NAME)
     solvers.solve_function[SOLVER_NAME] = fccqp_solve_problem

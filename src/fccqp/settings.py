@@ -4,7 +4,64 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import numbers
 from dataclasses import dataclass
+
+import numpy as np
+
+INT_MAX = 2**31 - 1
+"""Largest iteration count or interval: what a compiled 32-bit counter holds."""
+MAX_SCALING = 100
+"""Most Ruiz passes: equilibration settles within 10-25, more only costs setup time."""
+MAX_ANDERSON_MEMORY = 100
+"""Most Anderson memory: each step solves a least-squares problem of this size."""
+
+_REAL_RANGES = {
+    # name: (low, high, low excluded, high excluded)
+    "rho": (0.0, math.inf, True, True),
+    "sigma": (0.0, math.inf, True, True),
+    "alpha": (0.0, 2.0, True, True),
+    "eps_abs": (0.0, math.inf, False, True),
+    "eps_rel": (0.0, math.inf, False, True),
+    "eps_prim_inf": (0.0, math.inf, True, True),
+    "eps_dual_inf": (0.0, math.inf, True, True),
+    "time_limit": (0.0, math.inf, True, False),
+    "adaptive_rho_tolerance": (1.0, math.inf, True, True),
+}
+"""Real settings and their allowed interval; ``inf`` is allowed only for ``time_limit``."""
+_INTEGER_RANGES = {
+    "max_iter": (1, INT_MAX),
+    "check_termination": (1, INT_MAX),
+    "adaptive_rho_interval": (1, INT_MAX),
+    "anderson_memory": (0, MAX_ANDERSON_MEMORY),
+    "scaling": (0, MAX_SCALING),
+}
+"""Integer settings and their allowed closed interval."""
+_BOOLEANS = ("adaptive_rho", "restore_feasibility", "warm_start", "verbose")
+
+
+def _real(name: str, value: object, low: float, high: float, low_open: bool,
+          high_open: bool) -> float:
+    """``value`` as a float in the interval, or an error naming the setting."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise TypeError(f"setting {name} must be a real number, got {value!r}")
+    value = float(value)
+    below = value <= low if low_open else value < low
+    above = value >= high if high_open else value > high
+    if math.isnan(value) or below or above:
+        interval = f"{'(' if low_open else '['}{low:g}, {high:g}{')' if high_open else ']'}"
+        raise ValueError(f"setting {name} must lie in {interval}, got {value}")
+    return value
+
+
+def _integer(name: str, value: object, low: int, high: int) -> int:
+    """``value`` as an int in ``[low, high]``, or an error naming the setting."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"setting {name} must be an integer, got {value!r}")
+    value = int(value)
+    if not low <= value <= high:
+        raise ValueError(f"setting {name} must lie in [{low}, {high}], got {value}")
+    return value
 
 
 @dataclass(frozen=True)
@@ -12,7 +69,11 @@ class Settings:
     """Settings of the ADMM solver; every field has a default.
 
     Names follow OSQP where the meaning is the same. Tolerances apply to the
-    unscaled problem, in the infinity norm.
+    unscaled problem, in the infinity norm. Construction checks every field: a value
+    of the wrong type (``None``, a string, a complex number, a bool for a number)
+    raises ``TypeError`` and one outside its range ``ValueError``, both naming the
+    setting. Reals must be finite (``time_limit`` may be ``inf``); integers are
+    bounded by :data:`INT_MAX`, :data:`MAX_SCALING` and :data:`MAX_ANDERSON_MEMORY`.
     """
 
     rho: float = 0.1
@@ -30,7 +91,8 @@ class Settings:
     eps_dual_inf: float = 1e-6
     """Tolerance of the dual infeasibility certificate."""
     max_iter: int = 4000
-    """Iteration budget; when it runs out the current iterate is returned."""
+    """Iteration budget, at most :data:`INT_MAX`; when it runs out the current iterate
+    is returned."""
     time_limit: float = math.inf
     """Wall-clock budget of one solve in seconds (setup included); ``inf`` for none."""
     check_termination: int = 1
@@ -43,9 +105,10 @@ class Settings:
     adaptive_rho_tolerance: float = 5.0
     """Refactor only when rho would change by more than this factor."""
     anderson_memory: int = 10
-    """Anderson acceleration memory (0 disables); safeguarded, see fccqp.admm._anderson."""
+    """Anderson acceleration memory (0 disables, at most :data:`MAX_ANDERSON_MEMORY`);
+    safeguarded, see fccqp.admm._anderson."""
     scaling: int = 10
-    """Ruiz equilibration iterations (0 disables scaling)."""
+    """Ruiz equilibration iterations (0 disables scaling, at most :data:`MAX_SCALING`)."""
     restore_feasibility: bool = True
     """Return a point in the box and the cones: the violating entries are pinned at
     their projection and the others respond through the KKT system, keeping
@@ -63,45 +126,25 @@ class Settings:
     """Print one line per residual check."""
 
     def __post_init__(self) -> None:
-        positive = ("rho", "sigma", "eps_prim_inf", "eps_dual_inf", "time_limit")
-        for name in positive:
+        """Check every field's type and range, naming the field; store plain ``float``
+        / ``int`` / ``bool`` values so that equal settings hash equal."""
+        for name, (low, high, low_open, high_open) in _REAL_RANGES.items():
+            object.__setattr__(self, name, _real(name, getattr(self, name), low, high,
+                                                 low_open, high_open))
+        for name, (low, high) in _INTEGER_RANGES.items():
+            object.__setattr__(self, name, _integer(name, getattr(self, name), low, high))
+        for name in _BOOLEANS:
             value = getattr(self, name)
-            if not isinstance(value, (int, float)) or isinstance(value, bool) or math.isnan(value):
-                raise TypeError(f"setting {name} must be a number, got {value!r}")
-            if value <= 0 or (name != "time_limit" and not math.isfinite(value)):
-                raise ValueError(f"setting {name} must be finite and > 0, got {value}")
-        for name in ("eps_abs", "eps_rel"):
-            value = getattr(self, name)
-            if not isinstance(value, (int, float)) or isinstance(value, bool):
-                raise TypeError(f"setting {name} must be a number, got {value!r}")
-            if not (0 <= value < math.inf):
-                raise ValueError(f"setting {name} must be finite and >= 0, got {value}")
+            if not isinstance(value, (bool, np.bool_)):
+                raise TypeError(f"setting {name} must be a bool, got {value!r}")
+            object.__setattr__(self, name, bool(value))
         if self.eps_abs == 0 and self.eps_rel == 0:
             raise ValueError("settings eps_abs and eps_rel cannot both be 0")
-        if not (0 < self.alpha < 2):
-            raise ValueError(f"setting alpha must lie in (0, 2), got {self.alpha}")
-        if not (self.adaptive_rho_tolerance > 1):
-            raise ValueError(
-                f"setting adaptive_rho_tolerance must be > 1, got {self.adaptive_rho_tolerance}"
-            )
-        integers = (
-            "max_iter", "check_termination", "adaptive_rho_interval", "scaling", "anderson_memory"
-        )
-        for name in integers:
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int):
-                raise TypeError(f"setting {name} must be an integer, got {value!r}")
-            minimum = 0 if name in ("scaling", "anderson_memory") else 1
-            if value < minimum:
-                raise ValueError(f"setting {name} must be >= {minimum}, got {value}")
         backends = ("auto", "schur_reduced", "ldl_reduced", "ldl_full")
         if self.kkt_backend not in backends:
             raise ValueError(
                 f"setting kkt_backend must be one of {', '.join(backends)}, got {self.kkt_backend!r}"
             )
-        for name in ("adaptive_rho", "restore_feasibility", "warm_start", "verbose"):
-            if not isinstance(getattr(self, name), bool):
-                raise TypeError(f"setting {name} must be a bool, got {getattr(self, name)!r}")
 
     def replace(self, **overrides: object) -> Settings:
         """Return a copy with some fields changed; unknown names raise ``ValueError``."""

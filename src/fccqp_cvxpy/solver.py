@@ -35,8 +35,9 @@ STATUS_MAP = {
     fccqp.Status.TIME_LIMIT_REACHED: s.USER_LIMIT,
     fccqp.Status.PRIMAL_INFEASIBLE: s.INFEASIBLE,
     fccqp.Status.DUAL_INFEASIBLE: s.UNBOUNDED,
+    fccqp.Status.NUMERICAL_ERROR: s.SOLVER_ERROR,
 }
-"""fccqp status -> CVXPY status; anything else (or a non-finite iterate) is SOLVER_ERROR."""
+"""fccqp status -> CVXPY status; a non-finite point with a solved status is SOLVER_ERROR."""
 
 CITATION = """@misc{acosta2024fccqp,
   title = {{FCCQP}: A Whole Body Control {QP} Solver with Full Friction Cones},
@@ -97,6 +98,8 @@ class FCCQPSolver(ConicSolver):
 
     MIP_CAPABLE = False
     REQUIRES_CONSTR = False
+    BOUNDED_VARIABLES = True
+    """CVXPY passes variable bounds as arrays, which become fccqp's box directly."""
     SUPPORTED_CONSTRAINTS = [*ConicSolver.SUPPORTED_CONSTRAINTS, SOC]
 
     def __init__(self, settings: fccqp.Settings | None = None, **overrides: Any) -> None:
@@ -184,6 +187,7 @@ class FCCQPSolver(ConicSolver):
         translation = translate(
             data.get(s.P), data[s.C], data[s.A], data[s.B],
             ConeDims(dims.zero, dims.nonneg, tuple(dims.soc)),
+            data.get(s.LOWER_BOUNDS), data.get(s.UPPER_BOUNDS),
         )
         translate_time = time.perf_counter() - start
         cached = solver_cache.get(self.name()) if solver_cache is not None else None
@@ -201,7 +205,7 @@ class FCCQPSolver(ConicSolver):
     def invert(self, solution: RawSolution, inverse_data: Any) -> Solution:
         """Map fccqp's result back to CVXPY's variables, duals, status and stats."""
         result = solution.result
-        status = STATUS_MAP.get(result.status, s.SOLVER_ERROR)
+        status = STATUS_MAP[result.status]
         finite = np.isfinite(result.x).all() and np.isfinite(result.y).all()
         if status in s.SOLUTION_PRESENT and not (finite and np.isfinite(result.z).all()):
             status = s.SOLVER_ERROR

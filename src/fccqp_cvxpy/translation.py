@@ -17,6 +17,10 @@ themselves. :func:`translate` therefore maps each CVXPY row group as follows.
 
 Zero rows
     Kept as equalities ``A_i x = b_i``. Their CVXPY dual is fccqp's ``y_i``.
+Variable bounds (``BOUNDED_VARIABLES``)
+    CVXPY passes ``cp.Variable(bounds=...)`` and ``nonneg=True`` as per-column
+    ``lower``/``upper`` arrays; they become fccqp's box as they are. Columns with a
+    finite variable bound are not mapped into native cones.
 Nonnegative rows that are a simple bound
     A row with a single nonzero ``a`` in column ``j`` says ``a x_j <= b_i``: an upper
     bound ``b_i / a`` if ``a > 0``, a lower bound if ``a < 0``. Several bounds on one
@@ -212,7 +216,8 @@ def _merge_bounds(
 
 
 def translate(
-    P: sp.sparray | None, c: np.ndarray, A: sp.sparray, b: np.ndarray, dims: ConeDims
+    P: sp.sparray | None, c: np.ndarray, A: sp.sparray, b: np.ndarray, dims: ConeDims,
+    lower: np.ndarray | None = None, upper: np.ndarray | None = None,
 ) -> Translation:
     """Translate CVXPY's ``min 1/2 x'Px + c'x, A x + s = b, s in K`` to fccqp's form.
 
@@ -228,6 +233,12 @@ def translate(
         Right-hand side.
     dims : ConeDims
         Sizes of the cone blocks.
+    lower, upper : (n,) arrays, optional
+        Variable bounds CVXPY passes to solvers with ``BOUNDED_VARIABLES``
+        (``cp.Variable(bounds=...)``, ``nonneg=True``); ``None`` for none. They join
+        the box directly; a column with a finite variable bound is never part of a
+        native cone (fccqp allows no bound on a cone entry), so such a block gets
+        slacks.
 
     Returns
     -------
@@ -242,6 +253,9 @@ def translate(
     A.eliminate_zeros()
     A.sort_indices()
     counts, cols, vals = _single_entries(A)
+    var_lb = np.full(n, -np.inf) if lower is None else np.asarray(lower, np.float64).reshape(-1)
+    var_ub = np.full(n, np.inf) if upper is None else np.asarray(upper, np.float64).reshape(-1)
+    var_bounded = np.isfinite(var_lb) | np.isfinite(var_ub)
 
     used = np.zeros(n, dtype=bool)
     mapped: list[_MappedCone] = []
@@ -250,7 +264,7 @@ def translate(
     for dim in dims.soc:
         rows = np.arange(offset, offset + dim)
         offset += dim
-        block = _mappable_cone(rows, counts, cols, vals, b, used)
+        block = _mappable_cone(rows, counts, cols, vals, b, used | var_bounded)
         if block is None:
             slack_soc.append(rows)
         else:
@@ -260,9 +274,15 @@ def translate(
     nonneg = np.arange(dims.zero, dims.zero + dims.nonneg)
     simple = nonneg[(counts[nonneg] == 1) & ~used[cols[nonneg]]]
     lb_x, ub_x, lower_row, upper_row = _merge_bounds(simple, cols[simple], vals[simple], b, n)
-    crossed = lb_x > ub_x
+    # Bound rows that cross each other or the variable bounds stay general rows.
+    crossed = np.maximum(lb_x, var_lb) > np.minimum(ub_x, var_ub)
     lb_x[crossed], ub_x[crossed] = -np.inf, np.inf
     lower_row[crossed] = upper_row[crossed] = -1
+    # A strictly tighter variable bound replaces the row's (its dual is not CVXPY's to
+    # report); on a tie the row keeps it, so that the row's dual is returned.
+    lower_row[var_lb > lb_x] = -1
+    upper_row[var_ub < ub_x] = -1
+    lb_x, ub_x = np.maximum(lb_x, var_lb), np.minimum(ub_x, var_ub)
     simple = simple[~crossed[cols[simple]]]
     slack_nonneg = np.setdiff1d(nonneg, simple, assume_unique=True)
 
