@@ -253,7 +253,10 @@ def _check_point(problem: Problem, result: fccqp.Result, tol: Tolerances, report
     primal_scale = max(1.0, _inf(b), _inf(Ax))
     report.add("equality", primal["equality"], equality_bound(problem, x, tol))
     report.add("box", primal["box"], tol.bound(max(1.0, _inf(x)), looser))
-    report.add("cone", primal["cone"], tol.bound(max(1.0, _inf(x)), looser))
+    # the tolerance is on the entrywise (infinity-norm) distance, which the Euclidean
+    # distance of a block of d entries exceeds by at most sqrt(d)
+    widest = max((blk.stop - blk.start for blk, _, _ in problem.blocks()), default=1)
+    report.add("cone", primal["cone"] / np.sqrt(widest), tol.bound(max(1.0, _inf(x)), looser))
 
     dual_scale = max(1.0, _inf(q), _inf(Px))
     stationarity = _inf(Px + q + A.T @ y + z)
@@ -284,7 +287,8 @@ def _check_primal_certificate(problem: Problem, result: fccqp.Result, tol: Toler
                               report: Report) -> None:
     m, cert = problem.b.shape[0], result.certificate
     dy, dz = cert[:m], cert[m:]
-    terms = max(_inf(problem.A.T @ dy), _inf(dz))
+    # "~ 0" relative to the terms that must cancel (|A|'|dy| + |dz|), as formulation.md says
+    terms = _inf(np.abs(problem.A).T @ np.abs(dy) + np.abs(dz))
     report.add("certificate size", 0.0 if terms > 0 else 1.0, 0.0)
     if not terms > 0:
         return
@@ -307,10 +311,13 @@ def _check_dual_certificate(problem: Problem, result: fccqp.Result, tol: Toleran
     if not size > 0:
         return
     dx = dx / size
-    P_norm, A_norm = max(_inf(problem.P), 1e-300), max(_inf(problem.A), 1e-300)
-    report.add("P dx ~ 0 (relative)", _inf(problem.P @ dx) / P_norm, tol.certificate)
-    report.add("A dx ~ 0 (relative)", _inf(problem.A @ dx) / A_norm, tol.certificate)
-    report.add("q'dx < 0 (relative)", float(problem.q @ dx) / max(_inf(problem.q), 1e-300),
+    # "~ 0" and "< 0" relative to the terms of each sum, as formulation.md says
+    P_terms = max(_inf(np.abs(problem.P) @ np.abs(dx)), 1e-300)
+    A_terms = max(_inf(np.abs(problem.A) @ np.abs(dx)), 1e-300)
+    report.add("P dx ~ 0 (relative)", _inf(problem.P @ dx) / P_terms, tol.certificate)
+    report.add("A dx ~ 0 (relative)", _inf(problem.A @ dx) / A_terms, tol.certificate)
+    report.add("q'dx < 0 (relative)",
+               float(problem.q @ dx) / max(float(np.abs(problem.q) @ np.abs(dx)), 1e-300),
                -tol.certificate)
     recession = np.where(np.isfinite(problem.lb), np.maximum(-dx, 0), 0) + np.where(
         np.isfinite(problem.ub), np.maximum(dx, 0), 0)

@@ -24716,7 +24716,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
  *         if (cold or s == 0) and converged(r, o.eps_abs, o.eps_rel) and not unbounded_start:
  *             self._finish_run(run, _SOLVED, 0)             # <<<<<<<<<<<<<<
  *             return
- *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer
+ *         if (cold or s == 0) and r.prim > o.eps_abs + o.eps_rel * r.prim_scale and \
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_finish_run(__pyx_v_self, __pyx_v_run, __pyx_e_5fccqp_4admm__SOLVED, 0);
 
@@ -24724,8 +24724,8 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
  *         if (cold or s == 0) and converged(r, o.eps_abs, o.eps_rel) and not unbounded_start:
  *             self._finish_run(run, _SOLVED, 0)
  *             return             # <<<<<<<<<<<<<<
- *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer
- *             if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():
+ *         if (cold or s == 0) and r.prim > o.eps_abs + o.eps_rel * r.prim_scale and \
+ *                 self._inconsistent():
 */
     {
     }
@@ -24743,87 +24743,75 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   /* "fccqp/admm.pyx":469
  *             self._finish_run(run, _SOLVED, 0)
  *             return
- *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer             # <<<<<<<<<<<<<<
- *             if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():
- *                 status = _PRIMAL_INFEASIBLE
+ *         if (cold or s == 0) and r.prim > o.eps_abs + o.eps_rel * r.prim_scale and \             # <<<<<<<<<<<<<<
+ *                 self._inconsistent():
+ *             # tested on the penalty-free start: with rho in the KKT matrix (up to 1e9 on
 */
-  __pyx_t_3 = (__pyx_v_s == 0);
+  if (!__pyx_v_cold) {
+  } else {
+    goto __pyx_L17_next_and;
+  }
+  __pyx_t_4 = (__pyx_v_s == 0);
 
-  if (__pyx_t_3) {
+  if (__pyx_t_4) {
 
-
-    /* "fccqp/admm.pyx":470
- *             return
- *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer
- *             if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():             # <<<<<<<<<<<<<<
- *                 status = _PRIMAL_INFEASIBLE
- *             else:
-*/
-    __pyx_t_4 = (__pyx_v_r->prim > (__pyx_v_o->eps_abs + (__pyx_v_o->eps_rel * __pyx_v_r->prim_scale)));
-
-    if (__pyx_t_4) {
-
-    } else {
-
-      __pyx_t_3 = __pyx_t_4;
-
-      goto __pyx_L17_bool_binop_done;
-    }
-    __pyx_t_4 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_inconsistent(__pyx_v_self);
-
+  } else {
 
     __pyx_t_3 = __pyx_t_4;
 
-    __pyx_L17_bool_binop_done:;
-    if (__pyx_t_3) {
+    goto __pyx_L16_bool_binop_done;
+  }
+  __pyx_L17_next_and:;
+  __pyx_t_4 = (__pyx_v_r->prim > (__pyx_v_o->eps_abs + (__pyx_v_o->eps_rel * __pyx_v_r->prim_scale)));
 
+  if (__pyx_t_4) {
 
-      /* "fccqp/admm.pyx":471
- *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer
- *             if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():
- *                 status = _PRIMAL_INFEASIBLE             # <<<<<<<<<<<<<<
- *             else:
- *                 status = self._classify(0, False, start_time)
-*/
-      __pyx_v_status = __pyx_e_5fccqp_4admm__PRIMAL_INFEASIBLE;
+  } else {
 
-      /* "fccqp/admm.pyx":470
+    __pyx_t_3 = __pyx_t_4;
+
+    goto __pyx_L16_bool_binop_done;
+  }
+
+  /* "fccqp/admm.pyx":470
  *             return
- *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer
- *             if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():             # <<<<<<<<<<<<<<
- *                 status = _PRIMAL_INFEASIBLE
- *             else:
+ *         if (cold or s == 0) and r.prim > o.eps_abs + o.eps_rel * r.prim_scale and \
+ *                 self._inconsistent():             # <<<<<<<<<<<<<<
+ *             # tested on the penalty-free start: with rho in the KKT matrix (up to 1e9 on
+ *             # fixed entries) the regularization's trace in A'r can hide the certificate
 */
-      goto __pyx_L16;
-    }
+  __pyx_t_4 = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_inconsistent(__pyx_v_self);
+
+
+  __pyx_t_3 = __pyx_t_4;
+
+  __pyx_L16_bool_binop_done:;
+
+  /* "fccqp/admm.pyx":469
+ *             self._finish_run(run, _SOLVED, 0)
+ *             return
+ *         if (cold or s == 0) and r.prim > o.eps_abs + o.eps_rel * r.prim_scale and \             # <<<<<<<<<<<<<<
+ *                 self._inconsistent():
+ *             # tested on the penalty-free start: with rho in the KKT matrix (up to 1e9 on
+*/
+  if (__pyx_t_3) {
+
 
     /* "fccqp/admm.pyx":473
- *                 status = _PRIMAL_INFEASIBLE
- *             else:
- *                 status = self._classify(0, False, start_time)             # <<<<<<<<<<<<<<
- *             self._finish_run(run, status, 0)
+ *             # tested on the penalty-free start: with rho in the KKT matrix (up to 1e9 on
+ *             # fixed entries) the regularization's trace in A'r can hide the certificate
+ *             self._finish_run(run, _PRIMAL_INFEASIBLE, 0)             # <<<<<<<<<<<<<<
  *             return
+ *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer
 */
-    /*else*/ {
-      __pyx_v_status = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_classify(__pyx_v_self, 0, 0, __pyx_v_start_time);
-    }
-    __pyx_L16:;
+    ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_finish_run(__pyx_v_self, __pyx_v_run, __pyx_e_5fccqp_4admm__PRIMAL_INFEASIBLE, 0);
 
     /* "fccqp/admm.pyx":474
- *             else:
- *                 status = self._classify(0, False, start_time)
- *             self._finish_run(run, status, 0)             # <<<<<<<<<<<<<<
- *             return
- *         for j in range(s):
-*/
-    ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_finish_run(__pyx_v_self, __pyx_v_run, __pyx_v_status, 0);
-
-    /* "fccqp/admm.pyx":475
- *                 status = self._classify(0, False, start_time)
- *             self._finish_run(run, status, 0)
+ *             # fixed entries) the regularization's trace in A'r can hide the certificate
+ *             self._finish_run(run, _PRIMAL_INFEASIBLE, 0)
  *             return             # <<<<<<<<<<<<<<
- *         for j in range(s):
- *             it.rho_vec[j] = run.rho * self.rho_scale[j]
+ *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer
+ *             self._finish_run(run, self._classify(0, False, start_time), 0)
 */
     {
     }
@@ -24832,14 +24820,55 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     /* "fccqp/admm.pyx":469
  *             self._finish_run(run, _SOLVED, 0)
  *             return
- *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer             # <<<<<<<<<<<<<<
- *             if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():
- *                 status = _PRIMAL_INFEASIBLE
+ *         if (cold or s == 0) and r.prim > o.eps_abs + o.eps_rel * r.prim_scale and \             # <<<<<<<<<<<<<<
+ *                 self._inconsistent():
+ *             # tested on the penalty-free start: with rho in the KKT matrix (up to 1e9 on
 */
   }
 
-  /* "fccqp/admm.pyx":476
- *             self._finish_run(run, status, 0)
+  /* "fccqp/admm.pyx":475
+ *             self._finish_run(run, _PRIMAL_INFEASIBLE, 0)
+ *             return
+ *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer             # <<<<<<<<<<<<<<
+ *             self._finish_run(run, self._classify(0, False, start_time), 0)
+ *             return
+*/
+  __pyx_t_3 = (__pyx_v_s == 0);
+
+  if (__pyx_t_3) {
+
+
+    /* "fccqp/admm.pyx":476
+ *             return
+ *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer
+ *             self._finish_run(run, self._classify(0, False, start_time), 0)             # <<<<<<<<<<<<<<
+ *             return
+ *         for j in range(s):
+*/
+    ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_finish_run(__pyx_v_self, __pyx_v_run, ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_classify(__pyx_v_self, 0, 0, __pyx_v_start_time), 0);
+
+    /* "fccqp/admm.pyx":477
+ *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer
+ *             self._finish_run(run, self._classify(0, False, start_time), 0)
+ *             return             # <<<<<<<<<<<<<<
+ *         for j in range(s):
+ *             it.rho_vec[j] = run.rho * self.rho_scale[j]
+*/
+    {
+    }
+    goto __pyx_L0;
+
+    /* "fccqp/admm.pyx":475
+ *             self._finish_run(run, _PRIMAL_INFEASIBLE, 0)
+ *             return
+ *         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer             # <<<<<<<<<<<<<<
+ *             self._finish_run(run, self._classify(0, False, start_time), 0)
+ *             return
+*/
+  }
+
+  /* "fccqp/admm.pyx":478
+ *             self._finish_run(run, self._classify(0, False, start_time), 0)
  *             return
  *         for j in range(s):             # <<<<<<<<<<<<<<
  *             it.rho_vec[j] = run.rho * self.rho_scale[j]
@@ -24852,7 +24881,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
     __pyx_v_j = __pyx_t_6;
 
-    /* "fccqp/admm.pyx":477
+    /* "fccqp/admm.pyx":479
  *             return
  *         for j in range(s):
  *             it.rho_vec[j] = run.rho * self.rho_scale[j]             # <<<<<<<<<<<<<<
@@ -24863,7 +24892,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   }
 
 
-  /* "fccqp/admm.pyx":478
+  /* "fccqp/admm.pyx":480
  *         for j in range(s):
  *             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *         if self.factored_rho != run.rho or cold:             # <<<<<<<<<<<<<<
@@ -24878,15 +24907,15 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
     __pyx_t_3 = __pyx_t_4;
 
-    goto __pyx_L22_bool_binop_done;
+    goto __pyx_L24_bool_binop_done;
   }
 
   __pyx_t_3 = __pyx_v_cold;
-  __pyx_L22_bool_binop_done:;
+  __pyx_L24_bool_binop_done:;
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":479
+    /* "fccqp/admm.pyx":481
  *             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *         if self.factored_rho != run.rho or cold:
  *             code = self._factor(run, self._budget(0))             # <<<<<<<<<<<<<<
@@ -24895,7 +24924,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_code = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_factor(__pyx_v_self, __pyx_v_run, ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_budget(__pyx_v_self, 0));
 
-    /* "fccqp/admm.pyx":480
+    /* "fccqp/admm.pyx":482
  *         if self.factored_rho != run.rho or cold:
  *             code = self._factor(run, self._budget(0))
  *             if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -24907,7 +24936,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     if (__pyx_t_3) {
 
 
-      /* "fccqp/admm.pyx":481
+      /* "fccqp/admm.pyx":483
  *             code = self._factor(run, self._budget(0))
  *             if code != FACTORED:
  *                 run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR             # <<<<<<<<<<<<<<
@@ -24926,7 +24955,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
       __pyx_v_run->status = __pyx_t_7;
 
-      /* "fccqp/admm.pyx":482
+      /* "fccqp/admm.pyx":484
  *             if code != FACTORED:
  *                 run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR
  *                 return             # <<<<<<<<<<<<<<
@@ -24937,7 +24966,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
       }
       goto __pyx_L0;
 
-      /* "fccqp/admm.pyx":480
+      /* "fccqp/admm.pyx":482
  *         if self.factored_rho != run.rho or cold:
  *             code = self._factor(run, self._budget(0))
  *             if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -24946,7 +24975,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     }
 
-    /* "fccqp/admm.pyx":478
+    /* "fccqp/admm.pyx":480
  *         for j in range(s):
  *             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *         if self.factored_rho != run.rho or cold:             # <<<<<<<<<<<<<<
@@ -24955,7 +24984,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":483
+  /* "fccqp/admm.pyx":485
  *                 run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR
  *                 return
  *         reduced = self.form != LDL_FULL             # <<<<<<<<<<<<<<
@@ -24964,7 +24993,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_reduced = (__pyx_v_self->form != __pyx_e_5fccqp_3kkt_LDL_FULL);
 
-  /* "fccqp/admm.pyx":484
+  /* "fccqp/admm.pyx":486
  *                 return
  *         reduced = self.form != LDL_FULL
  *         if reduced:             # <<<<<<<<<<<<<<
@@ -24973,7 +25002,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   if (__pyx_v_reduced) {
 
-    /* "fccqp/admm.pyx":485
+    /* "fccqp/admm.pyx":487
  *         reduced = self.form != LDL_FULL
  *         if reduced:
  *             self._reduced_base()             # <<<<<<<<<<<<<<
@@ -24982,7 +25011,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_reduced_base(__pyx_v_self);
 
-    /* "fccqp/admm.pyx":486
+    /* "fccqp/admm.pyx":488
  *         if reduced:
  *             self._reduced_base()
  *             reduced_start(&self.red, p, it)             # <<<<<<<<<<<<<<
@@ -24991,7 +25020,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_f_5fccqp_7reduced_reduced_start((&__pyx_v_self->red), __pyx_v_p, __pyx_v_it);
 
-    /* "fccqp/admm.pyx":484
+    /* "fccqp/admm.pyx":486
  *                 return
  *         reduced = self.form != LDL_FULL
  *         if reduced:             # <<<<<<<<<<<<<<
@@ -25000,7 +25029,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":487
+  /* "fccqp/admm.pyx":489
  *             self._reduced_base()
  *             reduced_start(&self.red, p, it)
  *         eps_p = o.eps_abs + o.eps_rel * r.prim_scale             # <<<<<<<<<<<<<<
@@ -25009,7 +25038,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_eps_p = (__pyx_v_o->eps_abs + (__pyx_v_o->eps_rel * __pyx_v_r->prim_scale));
 
-  /* "fccqp/admm.pyx":488
+  /* "fccqp/admm.pyx":490
  *             reduced_start(&self.red, p, it)
  *         eps_p = o.eps_abs + o.eps_rel * r.prim_scale
  *         eps_d = o.eps_abs + o.eps_rel * r.dual_scale             # <<<<<<<<<<<<<<
@@ -25018,7 +25047,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_eps_d = (__pyx_v_o->eps_abs + (__pyx_v_o->eps_rel * __pyx_v_r->dual_scale));
 
-  /* "fccqp/admm.pyx":489
+  /* "fccqp/admm.pyx":491
  *         eps_p = o.eps_abs + o.eps_rel * r.prim_scale
  *         eps_d = o.eps_abs + o.eps_rel * r.dual_scale
  *         anderson_reset(&self.aa, False)             # <<<<<<<<<<<<<<
@@ -25027,7 +25056,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_f_5fccqp_8anderson_anderson_reset((&__pyx_v_self->aa), 0);
 
-  /* "fccqp/admm.pyx":490
+  /* "fccqp/admm.pyx":492
  *         eps_d = o.eps_abs + o.eps_rel * r.dual_scale
  *         anderson_reset(&self.aa, False)
  *         fresh = True  # the next step starts a run of KKT solutions: do not relax x             # <<<<<<<<<<<<<<
@@ -25036,7 +25065,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_fresh = 1;
 
-  /* "fccqp/admm.pyx":491
+  /* "fccqp/admm.pyx":493
  *         anderson_reset(&self.aa, False)
  *         fresh = True  # the next step starts a run of KKT solutions: do not relax x
  *         while status == _RUNNING:             # <<<<<<<<<<<<<<
@@ -25049,7 +25078,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
     if (!__pyx_t_3) break;
 
-    /* "fccqp/admm.pyx":492
+    /* "fccqp/admm.pyx":494
  *         fresh = True  # the next step starts a run of KKT solutions: do not relax x
  *         while status == _RUNNING:
  *             iteration += 1             # <<<<<<<<<<<<<<
@@ -25058,7 +25087,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_iteration = (__pyx_v_iteration + 1);
 
-    /* "fccqp/admm.pyx":493
+    /* "fccqp/admm.pyx":495
  *         while status == _RUNNING:
  *             iteration += 1
  *             if reduced:             # <<<<<<<<<<<<<<
@@ -25067,7 +25096,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     if (__pyx_v_reduced) {
 
-      /* "fccqp/admm.pyx":494
+      /* "fccqp/admm.pyx":496
  *             iteration += 1
  *             if reduced:
  *                 reduced_step(&self.red, p, it, o.alpha, not fresh)             # <<<<<<<<<<<<<<
@@ -25076,17 +25105,17 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_f_5fccqp_7reduced_reduced_step((&__pyx_v_self->red), __pyx_v_p, __pyx_v_it, __pyx_v_o->alpha, (!__pyx_v_fresh));
 
-      /* "fccqp/admm.pyx":493
+      /* "fccqp/admm.pyx":495
  *         while status == _RUNNING:
  *             iteration += 1
  *             if reduced:             # <<<<<<<<<<<<<<
  *                 reduced_step(&self.red, p, it, o.alpha, not fresh)
  *             else:
 */
-      goto __pyx_L28;
+      goto __pyx_L30;
     }
 
-    /* "fccqp/admm.pyx":496
+    /* "fccqp/admm.pyx":498
  *                 reduced_step(&self.red, p, it, o.alpha, not fresh)
  *             else:
  *                 self._full_step(not fresh)             # <<<<<<<<<<<<<<
@@ -25096,9 +25125,9 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     /*else*/ {
       ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_full_step(__pyx_v_self, (!__pyx_v_fresh));
     }
-    __pyx_L28:;
+    __pyx_L30:;
 
-    /* "fccqp/admm.pyx":497
+    /* "fccqp/admm.pyx":499
  *             else:
  *                 self._full_step(not fresh)
  *             fresh = False             # <<<<<<<<<<<<<<
@@ -25107,7 +25136,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_fresh = 0;
 
-    /* "fccqp/admm.pyx":498
+    /* "fccqp/admm.pyx":500
  *                 self._full_step(not fresh)
  *             fresh = False
  *             last = iteration >= o.max_iter or (timed and fccqp_now() - start_time >= o.time_limit)             # <<<<<<<<<<<<<<
@@ -25122,23 +25151,23 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
       __pyx_t_3 = __pyx_t_4;
 
-      goto __pyx_L29_bool_binop_done;
+      goto __pyx_L31_bool_binop_done;
     }
     if (__pyx_v_timed) {
     } else {
 
       __pyx_t_3 = __pyx_v_timed;
-      goto __pyx_L29_bool_binop_done;
+      goto __pyx_L31_bool_binop_done;
     }
     __pyx_t_4 = ((fccqp_now() - __pyx_v_start_time) >= __pyx_v_o->time_limit);
 
 
     __pyx_t_3 = __pyx_t_4;
 
-    __pyx_L29_bool_binop_done:;
+    __pyx_L31_bool_binop_done:;
     __pyx_v_last = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":499
+    /* "fccqp/admm.pyx":501
  *             fresh = False
  *             last = iteration >= o.max_iter or (timed and fccqp_now() - start_time >= o.time_limit)
  *             periodic = iteration % o.adaptive_rho_interval == 0             # <<<<<<<<<<<<<<
@@ -25147,7 +25176,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_periodic = ((__pyx_v_iteration % __pyx_v_o->adaptive_rho_interval) == 0);
 
-    /* "fccqp/admm.pyx":500
+    /* "fccqp/admm.pyx":502
  *             last = iteration >= o.max_iter or (timed and fccqp_now() - start_time >= o.time_limit)
  *             periodic = iteration % o.adaptive_rho_interval == 0
  *             adapt = o.adaptive_rho and periodic             # <<<<<<<<<<<<<<
@@ -25158,14 +25187,14 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     } else {
 
       __pyx_t_3 = __pyx_v_o->adaptive_rho;
-      goto __pyx_L32_bool_binop_done;
+      goto __pyx_L34_bool_binop_done;
     }
 
     __pyx_t_3 = __pyx_v_periodic;
-    __pyx_L32_bool_binop_done:;
+    __pyx_L34_bool_binop_done:;
     __pyx_v_adapt = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":501
+    /* "fccqp/admm.pyx":503
  *             periodic = iteration % o.adaptive_rho_interval == 0
  *             adapt = o.adaptive_rho and periodic
  *             check = iteration % o.check_termination == 0 or last or adapt             # <<<<<<<<<<<<<<
@@ -25180,20 +25209,20 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
       __pyx_t_3 = __pyx_t_4;
 
-      goto __pyx_L34_bool_binop_done;
+      goto __pyx_L36_bool_binop_done;
     }
     if (!__pyx_v_last) {
     } else {
 
       __pyx_t_3 = __pyx_v_last;
-      goto __pyx_L34_bool_binop_done;
+      goto __pyx_L36_bool_binop_done;
     }
 
     __pyx_t_3 = __pyx_v_adapt;
-    __pyx_L34_bool_binop_done:;
+    __pyx_L36_bool_binop_done:;
     __pyx_v_check = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":502
+    /* "fccqp/admm.pyx":504
  *             adapt = o.adaptive_rho and periodic
  *             check = iteration % o.check_termination == 0 or last or adapt
  *             if check and reduced and not (last or periodic):             # <<<<<<<<<<<<<<
@@ -25204,34 +25233,34 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     } else {
 
       __pyx_t_3 = __pyx_v_check;
-      goto __pyx_L38_bool_binop_done;
+      goto __pyx_L40_bool_binop_done;
     }
     if (__pyx_v_reduced) {
     } else {
 
       __pyx_t_3 = __pyx_v_reduced;
-      goto __pyx_L38_bool_binop_done;
+      goto __pyx_L40_bool_binop_done;
     }
     if (!__pyx_v_last) {
     } else {
 
       __pyx_t_4 = __pyx_v_last;
-      goto __pyx_L41_bool_binop_done;
+      goto __pyx_L43_bool_binop_done;
     }
 
     __pyx_t_4 = __pyx_v_periodic;
-    __pyx_L41_bool_binop_done:;
+    __pyx_L43_bool_binop_done:;
     __pyx_t_8 = (!__pyx_t_4);
 
 
 
     __pyx_t_3 = __pyx_t_8;
 
-    __pyx_L38_bool_binop_done:;
+    __pyx_L40_bool_binop_done:;
     if (__pyx_t_3) {
 
 
-      /* "fccqp/admm.pyx":505
+      /* "fccqp/admm.pyx":507
  *                 # a scheduled full check (and with it infeasibility detection) still runs
  *                 # every adaptive_rho_interval iterations
  *                 check = near_convergence(&self.red, p, it, eps_p, eps_d)             # <<<<<<<<<<<<<<
@@ -25240,7 +25269,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_v_check = __pyx_f_5fccqp_7reduced_near_convergence((&__pyx_v_self->red), __pyx_v_p, __pyx_v_it, __pyx_v_eps_p, __pyx_v_eps_d);
 
-      /* "fccqp/admm.pyx":502
+      /* "fccqp/admm.pyx":504
  *             adapt = o.adaptive_rho and periodic
  *             check = iteration % o.check_termination == 0 or last or adapt
  *             if check and reduced and not (last or periodic):             # <<<<<<<<<<<<<<
@@ -25249,7 +25278,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     }
 
-    /* "fccqp/admm.pyx":506
+    /* "fccqp/admm.pyx":508
  *                 # every adaptive_rho_interval iterations
  *                 check = near_convergence(&self.red, p, it, eps_p, eps_d)
  *             if check:             # <<<<<<<<<<<<<<
@@ -25258,7 +25287,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     if (__pyx_v_check) {
 
-      /* "fccqp/admm.pyx":507
+      /* "fccqp/admm.pyx":509
  *                 check = near_convergence(&self.red, p, it, eps_p, eps_d)
  *             if check:
  *                 if reduced:             # <<<<<<<<<<<<<<
@@ -25267,7 +25296,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       if (__pyx_v_reduced) {
 
-        /* "fccqp/admm.pyx":508
+        /* "fccqp/admm.pyx":510
  *             if check:
  *                 if reduced:
  *                     materialize(&self.red, p, it)             # <<<<<<<<<<<<<<
@@ -25276,7 +25305,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
         __pyx_f_5fccqp_7reduced_materialize((&__pyx_v_self->red), __pyx_v_p, __pyx_v_it);
 
-        /* "fccqp/admm.pyx":507
+        /* "fccqp/admm.pyx":509
  *                 check = near_convergence(&self.red, p, it, eps_p, eps_d)
  *             if check:
  *                 if reduced:             # <<<<<<<<<<<<<<
@@ -25285,7 +25314,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       }
 
-      /* "fccqp/admm.pyx":509
+      /* "fccqp/admm.pyx":511
  *                 if reduced:
  *                     materialize(&self.red, p, it)
  *                 self._residuals()             # <<<<<<<<<<<<<<
@@ -25294,7 +25323,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_residuals(__pyx_v_self);
 
-      /* "fccqp/admm.pyx":510
+      /* "fccqp/admm.pyx":512
  *                     materialize(&self.red, p, it)
  *                 self._residuals()
  *                 eps_p = o.eps_abs + o.eps_rel * r.prim_scale             # <<<<<<<<<<<<<<
@@ -25303,7 +25332,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_v_eps_p = (__pyx_v_o->eps_abs + (__pyx_v_o->eps_rel * __pyx_v_r->prim_scale));
 
-      /* "fccqp/admm.pyx":511
+      /* "fccqp/admm.pyx":513
  *                 self._residuals()
  *                 eps_p = o.eps_abs + o.eps_rel * r.prim_scale
  *                 eps_d = o.eps_abs + o.eps_rel * r.dual_scale             # <<<<<<<<<<<<<<
@@ -25312,7 +25341,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_v_eps_d = (__pyx_v_o->eps_abs + (__pyx_v_o->eps_rel * __pyx_v_r->dual_scale));
 
-      /* "fccqp/admm.pyx":512
+      /* "fccqp/admm.pyx":514
  *                 eps_p = o.eps_abs + o.eps_rel * r.prim_scale
  *                 eps_d = o.eps_abs + o.eps_rel * r.dual_scale
  *                 if iteration % _LOG_INTERVAL == 0:             # <<<<<<<<<<<<<<
@@ -25324,7 +25353,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
       if (__pyx_t_3) {
 
 
-        /* "fccqp/admm.pyx":513
+        /* "fccqp/admm.pyx":515
  *                 eps_d = o.eps_abs + o.eps_rel * r.dual_scale
  *                 if iteration % _LOG_INTERVAL == 0:
  *                     self._log(iteration, run.rho)             # <<<<<<<<<<<<<<
@@ -25333,7 +25362,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
         ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_log(__pyx_v_self, __pyx_v_iteration, __pyx_v_run->rho);
 
-        /* "fccqp/admm.pyx":512
+        /* "fccqp/admm.pyx":514
  *                 eps_p = o.eps_abs + o.eps_rel * r.prim_scale
  *                 eps_d = o.eps_abs + o.eps_rel * r.dual_scale
  *                 if iteration % _LOG_INTERVAL == 0:             # <<<<<<<<<<<<<<
@@ -25342,7 +25371,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       }
 
-      /* "fccqp/admm.pyx":514
+      /* "fccqp/admm.pyx":516
  *                 if iteration % _LOG_INTERVAL == 0:
  *                     self._log(iteration, run.rho)
  *                 status = self._check(iteration, last, start_time)             # <<<<<<<<<<<<<<
@@ -25351,7 +25380,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_v_status = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_check(__pyx_v_self, __pyx_v_iteration, __pyx_v_last, __pyx_v_start_time);
 
-      /* "fccqp/admm.pyx":515
+      /* "fccqp/admm.pyx":517
  *                     self._log(iteration, run.rho)
  *                 status = self._check(iteration, last, start_time)
  *                 if status == _RUNNING and adapt:             # <<<<<<<<<<<<<<
@@ -25366,15 +25395,15 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
         __pyx_t_3 = __pyx_t_8;
 
-        goto __pyx_L47_bool_binop_done;
+        goto __pyx_L49_bool_binop_done;
       }
 
       __pyx_t_3 = __pyx_v_adapt;
-      __pyx_L47_bool_binop_done:;
+      __pyx_L49_bool_binop_done:;
       if (__pyx_t_3) {
 
 
-        /* "fccqp/admm.pyx":516
+        /* "fccqp/admm.pyx":518
  *                 status = self._check(iteration, last, start_time)
  *                 if status == _RUNNING and adapt:
  *                     new_rho = self._new_rho(run.rho)             # <<<<<<<<<<<<<<
@@ -25383,7 +25412,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
         __pyx_v_new_rho = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new_rho(__pyx_v_self, __pyx_v_run->rho);
 
-        /* "fccqp/admm.pyx":517
+        /* "fccqp/admm.pyx":519
  *                 if status == _RUNNING and adapt:
  *                     new_rho = self._new_rho(run.rho)
  *                     if new_rho != run.rho:             # <<<<<<<<<<<<<<
@@ -25395,7 +25424,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
         if (__pyx_t_3) {
 
 
-          /* "fccqp/admm.pyx":518
+          /* "fccqp/admm.pyx":520
  *                     new_rho = self._new_rho(run.rho)
  *                     if new_rho != run.rho:
  *                         if reduced:             # <<<<<<<<<<<<<<
@@ -25404,7 +25433,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           if (__pyx_v_reduced) {
 
-            /* "fccqp/admm.pyx":519
+            /* "fccqp/admm.pyx":521
  *                     if new_rho != run.rho:
  *                         if reduced:
  *                             for j in range(s):             # <<<<<<<<<<<<<<
@@ -25418,7 +25447,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
             for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
               __pyx_v_j = __pyx_t_6;
 
-              /* "fccqp/admm.pyx":520
+              /* "fccqp/admm.pyx":522
  *                         if reduced:
  *                             for j in range(s):
  *                                 self.vec_s[j] = new_rho * self.rho_scale[j]             # <<<<<<<<<<<<<<
@@ -25429,7 +25458,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
             }
 
 
-            /* "fccqp/admm.pyx":521
+            /* "fccqp/admm.pyx":523
  *                             for j in range(s):
  *                                 self.vec_s[j] = new_rho * self.rho_scale[j]
  *                             reduced_rebase(&self.red, p, it.rho_vec, self.vec_s)             # <<<<<<<<<<<<<<
@@ -25438,7 +25467,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
             __pyx_f_5fccqp_7reduced_reduced_rebase((&__pyx_v_self->red), __pyx_v_p, __pyx_v_it->rho_vec, __pyx_v_self->vec_s);
 
-            /* "fccqp/admm.pyx":518
+            /* "fccqp/admm.pyx":520
  *                     new_rho = self._new_rho(run.rho)
  *                     if new_rho != run.rho:
  *                         if reduced:             # <<<<<<<<<<<<<<
@@ -25447,7 +25476,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           }
 
-          /* "fccqp/admm.pyx":522
+          /* "fccqp/admm.pyx":524
  *                                 self.vec_s[j] = new_rho * self.rho_scale[j]
  *                             reduced_rebase(&self.red, p, it.rho_vec, self.vec_s)
  *                         run.rho = new_rho             # <<<<<<<<<<<<<<
@@ -25456,7 +25485,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           __pyx_v_run->rho = __pyx_v_new_rho;
 
-          /* "fccqp/admm.pyx":523
+          /* "fccqp/admm.pyx":525
  *                             reduced_rebase(&self.red, p, it.rho_vec, self.vec_s)
  *                         run.rho = new_rho
  *                         for j in range(s):             # <<<<<<<<<<<<<<
@@ -25470,7 +25499,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
           for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
             __pyx_v_j = __pyx_t_6;
 
-            /* "fccqp/admm.pyx":524
+            /* "fccqp/admm.pyx":526
  *                         run.rho = new_rho
  *                         for j in range(s):
  *                             it.rho_vec[j] = run.rho * self.rho_scale[j]             # <<<<<<<<<<<<<<
@@ -25481,7 +25510,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
           }
 
 
-          /* "fccqp/admm.pyx":525
+          /* "fccqp/admm.pyx":527
  *                         for j in range(s):
  *                             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *                         code = self._factor(run, self._budget(iteration))             # <<<<<<<<<<<<<<
@@ -25490,7 +25519,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           __pyx_v_code = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_factor(__pyx_v_self, __pyx_v_run, ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_budget(__pyx_v_self, __pyx_v_iteration));
 
-          /* "fccqp/admm.pyx":526
+          /* "fccqp/admm.pyx":528
  *                             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *                         code = self._factor(run, self._budget(iteration))
  *                         if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -25502,7 +25531,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
           if (__pyx_t_3) {
 
 
-            /* "fccqp/admm.pyx":527
+            /* "fccqp/admm.pyx":529
  *                         code = self._factor(run, self._budget(iteration))
  *                         if code != FACTORED:
  *                             run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR             # <<<<<<<<<<<<<<
@@ -25521,7 +25550,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
             __pyx_v_run->status = __pyx_t_7;
 
-            /* "fccqp/admm.pyx":528
+            /* "fccqp/admm.pyx":530
  *                         if code != FACTORED:
  *                             run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR
  *                             return             # <<<<<<<<<<<<<<
@@ -25532,7 +25561,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
             }
             goto __pyx_L0;
 
-            /* "fccqp/admm.pyx":526
+            /* "fccqp/admm.pyx":528
  *                             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *                         code = self._factor(run, self._budget(iteration))
  *                         if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -25541,7 +25570,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           }
 
-          /* "fccqp/admm.pyx":529
+          /* "fccqp/admm.pyx":531
  *                             run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR
  *                             return
  *                         reduced = self.form != LDL_FULL             # <<<<<<<<<<<<<<
@@ -25550,7 +25579,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           __pyx_v_reduced = (__pyx_v_self->form != __pyx_e_5fccqp_3kkt_LDL_FULL);
 
-          /* "fccqp/admm.pyx":530
+          /* "fccqp/admm.pyx":532
  *                             return
  *                         reduced = self.form != LDL_FULL
  *                         if reduced:             # <<<<<<<<<<<<<<
@@ -25559,7 +25588,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           if (__pyx_v_reduced) {
 
-            /* "fccqp/admm.pyx":531
+            /* "fccqp/admm.pyx":533
  *                         reduced = self.form != LDL_FULL
  *                         if reduced:
  *                             self._reduced_base()             # <<<<<<<<<<<<<<
@@ -25568,7 +25597,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
             ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_reduced_base(__pyx_v_self);
 
-            /* "fccqp/admm.pyx":530
+            /* "fccqp/admm.pyx":532
  *                             return
  *                         reduced = self.form != LDL_FULL
  *                         if reduced:             # <<<<<<<<<<<<<<
@@ -25577,7 +25606,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           }
 
-          /* "fccqp/admm.pyx":532
+          /* "fccqp/admm.pyx":534
  *                         if reduced:
  *                             self._reduced_base()
  *                         fresh = True             # <<<<<<<<<<<<<<
@@ -25586,7 +25615,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           __pyx_v_fresh = 1;
 
-          /* "fccqp/admm.pyx":533
+          /* "fccqp/admm.pyx":535
  *                             self._reduced_base()
  *                         fresh = True
  *                         anderson_reset(&self.aa, True)             # <<<<<<<<<<<<<<
@@ -25595,7 +25624,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           __pyx_f_5fccqp_8anderson_anderson_reset((&__pyx_v_self->aa), 1);
 
-          /* "fccqp/admm.pyx":517
+          /* "fccqp/admm.pyx":519
  *                 if status == _RUNNING and adapt:
  *                     new_rho = self._new_rho(run.rho)
  *                     if new_rho != run.rho:             # <<<<<<<<<<<<<<
@@ -25604,7 +25633,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
         }
 
-        /* "fccqp/admm.pyx":515
+        /* "fccqp/admm.pyx":517
  *                     self._log(iteration, run.rho)
  *                 status = self._check(iteration, last, start_time)
  *                 if status == _RUNNING and adapt:             # <<<<<<<<<<<<<<
@@ -25613,7 +25642,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       }
 
-      /* "fccqp/admm.pyx":506
+      /* "fccqp/admm.pyx":508
  *                 # every adaptive_rho_interval iterations
  *                 check = near_convergence(&self.red, p, it, eps_p, eps_d)
  *             if check:             # <<<<<<<<<<<<<<
@@ -25622,7 +25651,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     }
 
-    /* "fccqp/admm.pyx":534
+    /* "fccqp/admm.pyx":536
  *                         fresh = True
  *                         anderson_reset(&self.aa, True)
  *             if status == _RUNNING and o.anderson_memory > 0:             # <<<<<<<<<<<<<<
@@ -25637,18 +25666,18 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
       __pyx_t_3 = __pyx_t_8;
 
-      goto __pyx_L58_bool_binop_done;
+      goto __pyx_L60_bool_binop_done;
     }
     __pyx_t_8 = (__pyx_v_o->anderson_memory > 0);
 
 
     __pyx_t_3 = __pyx_t_8;
 
-    __pyx_L58_bool_binop_done:;
+    __pyx_L60_bool_binop_done:;
     if (__pyx_t_3) {
 
 
-      /* "fccqp/admm.pyx":535
+      /* "fccqp/admm.pyx":537
  *                         anderson_reset(&self.aa, True)
  *             if status == _RUNNING and o.anderson_memory > 0:
  *                 anderson_step(&self.aa, it, s)             # <<<<<<<<<<<<<<
@@ -25657,7 +25686,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_f_5fccqp_8anderson_anderson_step((&__pyx_v_self->aa), __pyx_v_it, __pyx_v_s);
 
-      /* "fccqp/admm.pyx":534
+      /* "fccqp/admm.pyx":536
  *                         fresh = True
  *                         anderson_reset(&self.aa, True)
  *             if status == _RUNNING and o.anderson_memory > 0:             # <<<<<<<<<<<<<<
@@ -25667,7 +25696,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     }
   }
 
-  /* "fccqp/admm.pyx":536
+  /* "fccqp/admm.pyx":538
  *             if status == _RUNNING and o.anderson_memory > 0:
  *                 anderson_step(&self.aa, it, s)
  *         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:             # <<<<<<<<<<<<<<
@@ -25678,7 +25707,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   } else {
 
     __pyx_t_3 = __pyx_v_o->restore_feasibility;
-    goto __pyx_L61_bool_binop_done;
+    goto __pyx_L63_bool_binop_done;
   }
   __pyx_t_8 = (__pyx_e_5fccqp_4admm__SOLVED <= __pyx_v_status);
   if (__pyx_t_8) {
@@ -25687,11 +25716,11 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
   __pyx_t_3 = __pyx_t_8;
 
-  __pyx_L61_bool_binop_done:;
+  __pyx_L63_bool_binop_done:;
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":537
+    /* "fccqp/admm.pyx":539
  *                 anderson_step(&self.aa, it, s)
  *         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
  *             status = self._keep_restored(status, iteration, reduced, start_time)             # <<<<<<<<<<<<<<
@@ -25700,17 +25729,17 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_status = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_keep_restored(__pyx_v_self, __pyx_v_status, __pyx_v_iteration, __pyx_v_reduced, __pyx_v_start_time);
 
-    /* "fccqp/admm.pyx":536
+    /* "fccqp/admm.pyx":538
  *             if status == _RUNNING and o.anderson_memory > 0:
  *                 anderson_step(&self.aa, it, s)
  *         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:             # <<<<<<<<<<<<<<
  *             status = self._keep_restored(status, iteration, reduced, start_time)
  *         elif reduced and status != _NUMERICAL_ERROR:
 */
-    goto __pyx_L60;
+    goto __pyx_L62;
   }
 
-  /* "fccqp/admm.pyx":538
+  /* "fccqp/admm.pyx":540
  *         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
  *             status = self._keep_restored(status, iteration, reduced, start_time)
  *         elif reduced and status != _NUMERICAL_ERROR:             # <<<<<<<<<<<<<<
@@ -25721,18 +25750,18 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   } else {
 
     __pyx_t_3 = __pyx_v_reduced;
-    goto __pyx_L63_bool_binop_done;
+    goto __pyx_L65_bool_binop_done;
   }
   __pyx_t_8 = (__pyx_v_status != __pyx_e_5fccqp_4admm__NUMERICAL_ERROR);
 
 
   __pyx_t_3 = __pyx_t_8;
 
-  __pyx_L63_bool_binop_done:;
+  __pyx_L65_bool_binop_done:;
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":539
+    /* "fccqp/admm.pyx":541
  *             status = self._keep_restored(status, iteration, reduced, start_time)
  *         elif reduced and status != _NUMERICAL_ERROR:
  *             self._restore_equalities()   # certificates are already in cert             # <<<<<<<<<<<<<<
@@ -25741,7 +25770,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_restore_equalities(__pyx_v_self);
 
-    /* "fccqp/admm.pyx":538
+    /* "fccqp/admm.pyx":540
  *         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
  *             status = self._keep_restored(status, iteration, reduced, start_time)
  *         elif reduced and status != _NUMERICAL_ERROR:             # <<<<<<<<<<<<<<
@@ -25749,9 +25778,9 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
  *         self._finish_run(run, status, iteration)
 */
   }
-  __pyx_L60:;
+  __pyx_L62:;
 
-  /* "fccqp/admm.pyx":540
+  /* "fccqp/admm.pyx":542
  *         elif reduced and status != _NUMERICAL_ERROR:
  *             self._restore_equalities()   # certificates are already in cert
  *         self._finish_run(run, status, iteration)             # <<<<<<<<<<<<<<
@@ -25792,7 +25821,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
 }
 
-/* "fccqp/admm.pyx":542
+/* "fccqp/admm.pyx":544
  *         self._finish_run(run, status, iteration)
  * 
  *     cdef int _check(self, long iteration, bint last, double start_time) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -25813,7 +25842,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   Py_ssize_t __pyx_t_4;
   int __pyx_t_5;
 
-  /* "fccqp/admm.pyx":544
+  /* "fccqp/admm.pyx":546
  *     cdef int _check(self, long iteration, bint last, double start_time) noexcept nogil:
  *         """Termination and infeasibility tests after the residuals of ``iteration``."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -25822,7 +25851,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":545
+  /* "fccqp/admm.pyx":547
  *         """Termination and infeasibility tests after the residuals of ``iteration``."""
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -25831,7 +25860,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":546
+  /* "fccqp/admm.pyx":548
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Options* o = &self.opt             # <<<<<<<<<<<<<<
@@ -25840,7 +25869,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   __pyx_v_o = (&__pyx_v_self->opt);
 
-  /* "fccqp/admm.pyx":547
+  /* "fccqp/admm.pyx":549
  *         cdef Iterates* it = &self.it
  *         cdef Options* o = &self.opt
  *         cdef Residuals* r = &self.res             # <<<<<<<<<<<<<<
@@ -25849,7 +25878,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   __pyx_v_r = (&__pyx_v_self->res);
 
-  /* "fccqp/admm.pyx":549
+  /* "fccqp/admm.pyx":551
  *         cdef Residuals* r = &self.res
  *         cdef Py_ssize_t i
  *         if not r.finite:             # <<<<<<<<<<<<<<
@@ -25861,7 +25890,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":550
+    /* "fccqp/admm.pyx":552
  *         cdef Py_ssize_t i
  *         if not r.finite:
  *             return _NUMERICAL_ERROR             # <<<<<<<<<<<<<<
@@ -25874,7 +25903,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":549
+    /* "fccqp/admm.pyx":551
  *         cdef Residuals* r = &self.res
  *         cdef Py_ssize_t i
  *         if not r.finite:             # <<<<<<<<<<<<<<
@@ -25883,7 +25912,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":551
+  /* "fccqp/admm.pyx":553
  *         if not r.finite:
  *             return _NUMERICAL_ERROR
  *         if converged(r, o.eps_abs, o.eps_rel):             # <<<<<<<<<<<<<<
@@ -25895,7 +25924,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":552
+    /* "fccqp/admm.pyx":554
  *             return _NUMERICAL_ERROR
  *         if converged(r, o.eps_abs, o.eps_rel):
  *             return _SOLVED             # <<<<<<<<<<<<<<
@@ -25908,7 +25937,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":551
+    /* "fccqp/admm.pyx":553
  *         if not r.finite:
  *             return _NUMERICAL_ERROR
  *         if converged(r, o.eps_abs, o.eps_rel):             # <<<<<<<<<<<<<<
@@ -25917,7 +25946,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":553
+  /* "fccqp/admm.pyx":555
  *         if converged(r, o.eps_abs, o.eps_rel):
  *             return _SOLVED
  *         if primal_infeasible(p, it, o.eps_prim_inf, self.vec_m, self.vec_s, self.vec_n,             # <<<<<<<<<<<<<<
@@ -25929,7 +25958,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":555
+    /* "fccqp/admm.pyx":557
  *         if primal_infeasible(p, it, o.eps_prim_inf, self.vec_m, self.vec_s, self.vec_n,
  *                              self.vec_n2):
  *             fill(self.cert, 0.0, p.n + p.m)             # <<<<<<<<<<<<<<
@@ -25938,7 +25967,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
     __pyx_f_5fccqp_6_dense_fill(__pyx_v_self->cert, 0.0, (__pyx_v_p->n + __pyx_v_p->m));
 
-    /* "fccqp/admm.pyx":556
+    /* "fccqp/admm.pyx":558
  *                              self.vec_n2):
  *             fill(self.cert, 0.0, p.n + p.m)
  *             for i in range(p.m):   # in the user's units (the common factor 1/c dropped)             # <<<<<<<<<<<<<<
@@ -25952,7 +25981,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
       __pyx_v_i = __pyx_t_4;
 
-      /* "fccqp/admm.pyx":557
+      /* "fccqp/admm.pyx":559
  *             fill(self.cert, 0.0, p.n + p.m)
  *             for i in range(p.m):   # in the user's units (the common factor 1/c dropped)
  *                 self.cert[i] = self.vec_m[i] * p.E[i]             # <<<<<<<<<<<<<<
@@ -25963,7 +25992,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
 
 
-    /* "fccqp/admm.pyx":558
+    /* "fccqp/admm.pyx":560
  *             for i in range(p.m):   # in the user's units (the common factor 1/c dropped)
  *                 self.cert[i] = self.vec_m[i] * p.E[i]
  *             for i in range(p.s):             # <<<<<<<<<<<<<<
@@ -25977,7 +26006,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
       __pyx_v_i = __pyx_t_4;
 
-      /* "fccqp/admm.pyx":559
+      /* "fccqp/admm.pyx":561
  *                 self.cert[i] = self.vec_m[i] * p.E[i]
  *             for i in range(p.s):
  *                 self.cert[p.m + p.constrained[i]] = self.vec_s[i] / p.D[p.constrained[i]]             # <<<<<<<<<<<<<<
@@ -25988,7 +26017,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
 
 
-    /* "fccqp/admm.pyx":560
+    /* "fccqp/admm.pyx":562
  *             for i in range(p.s):
  *                 self.cert[p.m + p.constrained[i]] = self.vec_s[i] / p.D[p.constrained[i]]
  *             return _PRIMAL_INFEASIBLE             # <<<<<<<<<<<<<<
@@ -26001,7 +26030,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":553
+    /* "fccqp/admm.pyx":555
  *         if converged(r, o.eps_abs, o.eps_rel):
  *             return _SOLVED
  *         if primal_infeasible(p, it, o.eps_prim_inf, self.vec_m, self.vec_s, self.vec_n,             # <<<<<<<<<<<<<<
@@ -26010,7 +26039,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":561
+  /* "fccqp/admm.pyx":563
  *                 self.cert[p.m + p.constrained[i]] = self.vec_s[i] / p.D[p.constrained[i]]
  *             return _PRIMAL_INFEASIBLE
  *         if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():             # <<<<<<<<<<<<<<
@@ -26036,7 +26065,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":562
+    /* "fccqp/admm.pyx":564
  *             return _PRIMAL_INFEASIBLE
  *         if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():
  *             return _PRIMAL_INFEASIBLE             # <<<<<<<<<<<<<<
@@ -26049,7 +26078,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":561
+    /* "fccqp/admm.pyx":563
  *                 self.cert[p.m + p.constrained[i]] = self.vec_s[i] / p.D[p.constrained[i]]
  *             return _PRIMAL_INFEASIBLE
  *         if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():             # <<<<<<<<<<<<<<
@@ -26058,7 +26087,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":563
+  /* "fccqp/admm.pyx":565
  *         if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():
  *             return _PRIMAL_INFEASIBLE
  *         for i in range(p.n):             # <<<<<<<<<<<<<<
@@ -26072,7 +26101,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":564
+    /* "fccqp/admm.pyx":566
  *             return _PRIMAL_INFEASIBLE
  *         for i in range(p.n):
  *             self.direction[i] = it.x[i] - it.x_prev[i]             # <<<<<<<<<<<<<<
@@ -26083,7 +26112,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   }
 
 
-  /* "fccqp/admm.pyx":565
+  /* "fccqp/admm.pyx":567
  *         for i in range(p.n):
  *             self.direction[i] = it.x[i] - it.x_prev[i]
  *         if self._unbounded():             # <<<<<<<<<<<<<<
@@ -26095,7 +26124,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":566
+    /* "fccqp/admm.pyx":568
  *             self.direction[i] = it.x[i] - it.x_prev[i]
  *         if self._unbounded():
  *             return _DUAL_INFEASIBLE             # <<<<<<<<<<<<<<
@@ -26108,7 +26137,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":565
+    /* "fccqp/admm.pyx":567
  *         for i in range(p.n):
  *             self.direction[i] = it.x[i] - it.x_prev[i]
  *         if self._unbounded():             # <<<<<<<<<<<<<<
@@ -26117,7 +26146,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":567
+  /* "fccqp/admm.pyx":569
  *         if self._unbounded():
  *             return _DUAL_INFEASIBLE
  *         if last:             # <<<<<<<<<<<<<<
@@ -26126,7 +26155,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   if (__pyx_v_last) {
 
-    /* "fccqp/admm.pyx":568
+    /* "fccqp/admm.pyx":570
  *             return _DUAL_INFEASIBLE
  *         if last:
  *             return self._classify(iteration, True, start_time)             # <<<<<<<<<<<<<<
@@ -26139,7 +26168,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":567
+    /* "fccqp/admm.pyx":569
  *         if self._unbounded():
  *             return _DUAL_INFEASIBLE
  *         if last:             # <<<<<<<<<<<<<<
@@ -26148,7 +26177,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":569
+  /* "fccqp/admm.pyx":571
  *         if last:
  *             return self._classify(iteration, True, start_time)
  *         return _RUNNING             # <<<<<<<<<<<<<<
@@ -26161,7 +26190,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":542
+  /* "fccqp/admm.pyx":544
  *         self._finish_run(run, status, iteration)
  * 
  *     cdef int _check(self, long iteration, bint last, double start_time) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26179,7 +26208,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":571
+/* "fccqp/admm.pyx":573
  *         return _RUNNING
  * 
  *     cdef bint _inconsistent(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26196,7 +26225,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   Py_ssize_t __pyx_t_3;
   Py_ssize_t __pyx_t_4;
 
-  /* "fccqp/admm.pyx":574
+  /* "fccqp/admm.pyx":576
  *         """The equality certificate; on success ``cert`` holds ``(-E r, 0)``, ``r = b_s - A_s
  *         x_s``: ``A'y ~ 0`` and ``b'y < 0`` in the user's units."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -26205,7 +26234,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":576
+  /* "fccqp/admm.pyx":578
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i
  *         if not equality_inconsistent(p, &self.it, self.opt.eps_prim_inf, self.vec_m,             # <<<<<<<<<<<<<<
@@ -26217,7 +26246,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":578
+    /* "fccqp/admm.pyx":580
  *         if not equality_inconsistent(p, &self.it, self.opt.eps_prim_inf, self.vec_m,
  *                                      self.vec_n, self.vec_n2):
  *             return False             # <<<<<<<<<<<<<<
@@ -26230,7 +26259,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":576
+    /* "fccqp/admm.pyx":578
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i
  *         if not equality_inconsistent(p, &self.it, self.opt.eps_prim_inf, self.vec_m,             # <<<<<<<<<<<<<<
@@ -26239,7 +26268,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
 */
   }
 
-  /* "fccqp/admm.pyx":579
+  /* "fccqp/admm.pyx":581
  *                                      self.vec_n, self.vec_n2):
  *             return False
  *         fill(self.cert, 0.0, p.n + p.m)             # <<<<<<<<<<<<<<
@@ -26248,7 +26277,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_self->cert, 0.0, (__pyx_v_p->n + __pyx_v_p->m));
 
-  /* "fccqp/admm.pyx":580
+  /* "fccqp/admm.pyx":582
  *             return False
  *         fill(self.cert, 0.0, p.n + p.m)
  *         for i in range(p.m):             # <<<<<<<<<<<<<<
@@ -26262,7 +26291,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":581
+    /* "fccqp/admm.pyx":583
  *         fill(self.cert, 0.0, p.n + p.m)
  *         for i in range(p.m):
  *             self.cert[i] = -self.vec_m[i] * p.E[i]             # <<<<<<<<<<<<<<
@@ -26273,7 +26302,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   }
 
 
-  /* "fccqp/admm.pyx":582
+  /* "fccqp/admm.pyx":584
  *         for i in range(p.m):
  *             self.cert[i] = -self.vec_m[i] * p.E[i]
  *         return True             # <<<<<<<<<<<<<<
@@ -26286,7 +26315,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":571
+  /* "fccqp/admm.pyx":573
  *         return _RUNNING
  * 
  *     cdef bint _inconsistent(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26301,7 +26330,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":584
+/* "fccqp/admm.pyx":586
  *         return True
  * 
  *     cdef bint _unbounded(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26318,7 +26347,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   Py_ssize_t __pyx_t_3;
   Py_ssize_t __pyx_t_4;
 
-  /* "fccqp/admm.pyx":586
+  /* "fccqp/admm.pyx":588
  *     cdef bint _unbounded(self) noexcept nogil:
  *         """The dual certificate for ``direction``; on success ``cert`` holds it, unscaled."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -26327,7 +26356,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":588
+  /* "fccqp/admm.pyx":590
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i
  *         if not dual_infeasible(p, self.direction, self.opt.eps_dual_inf, self.vec_n,             # <<<<<<<<<<<<<<
@@ -26339,7 +26368,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":590
+    /* "fccqp/admm.pyx":592
  *         if not dual_infeasible(p, self.direction, self.opt.eps_dual_inf, self.vec_n,
  *                                self.vec_n2, self.vec_s2):
  *             return False             # <<<<<<<<<<<<<<
@@ -26352,7 +26381,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":588
+    /* "fccqp/admm.pyx":590
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i
  *         if not dual_infeasible(p, self.direction, self.opt.eps_dual_inf, self.vec_n,             # <<<<<<<<<<<<<<
@@ -26361,7 +26390,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
 */
   }
 
-  /* "fccqp/admm.pyx":591
+  /* "fccqp/admm.pyx":593
  *                                self.vec_n2, self.vec_s2):
  *             return False
  *         for i in range(p.n):             # <<<<<<<<<<<<<<
@@ -26375,7 +26404,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":592
+    /* "fccqp/admm.pyx":594
  *             return False
  *         for i in range(p.n):
  *             self.cert[i] = self.direction[i] * p.D[i]             # <<<<<<<<<<<<<<
@@ -26386,7 +26415,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   }
 
 
-  /* "fccqp/admm.pyx":593
+  /* "fccqp/admm.pyx":595
  *         for i in range(p.n):
  *             self.cert[i] = self.direction[i] * p.D[i]
  *         return True             # <<<<<<<<<<<<<<
@@ -26399,7 +26428,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":584
+  /* "fccqp/admm.pyx":586
  *         return True
  * 
  *     cdef bint _unbounded(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26414,7 +26443,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":595
+/* "fccqp/admm.pyx":597
  *         return True
  * 
  *     cdef int _classify(self, long iteration, bint stopped, double start_time) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26428,7 +26457,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   int __pyx_t_1;
   int __pyx_t_2;
 
-  /* "fccqp/admm.pyx":598
+  /* "fccqp/admm.pyx":600
  *         """Status of an iterate from its residuals alone: solved, inaccurate (within
  *         ``INACCURATE_FACTOR`` of the tolerances), or the budget that ran out."""
  *         cdef Residuals* r = &self.res             # <<<<<<<<<<<<<<
@@ -26437,7 +26466,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_r = (&__pyx_v_self->res);
 
-  /* "fccqp/admm.pyx":599
+  /* "fccqp/admm.pyx":601
  *         ``INACCURATE_FACTOR`` of the tolerances), or the budget that ran out."""
  *         cdef Residuals* r = &self.res
  *         if not r.finite:             # <<<<<<<<<<<<<<
@@ -26449,7 +26478,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":600
+    /* "fccqp/admm.pyx":602
  *         cdef Residuals* r = &self.res
  *         if not r.finite:
  *             return _NUMERICAL_ERROR             # <<<<<<<<<<<<<<
@@ -26462,7 +26491,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":599
+    /* "fccqp/admm.pyx":601
  *         ``INACCURATE_FACTOR`` of the tolerances), or the budget that ran out."""
  *         cdef Residuals* r = &self.res
  *         if not r.finite:             # <<<<<<<<<<<<<<
@@ -26471,7 +26500,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":601
+  /* "fccqp/admm.pyx":603
  *         if not r.finite:
  *             return _NUMERICAL_ERROR
  *         if converged(r, self.opt.eps_abs, self.opt.eps_rel):             # <<<<<<<<<<<<<<
@@ -26483,7 +26512,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":602
+    /* "fccqp/admm.pyx":604
  *             return _NUMERICAL_ERROR
  *         if converged(r, self.opt.eps_abs, self.opt.eps_rel):
  *             return _SOLVED             # <<<<<<<<<<<<<<
@@ -26496,7 +26525,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":601
+    /* "fccqp/admm.pyx":603
  *         if not r.finite:
  *             return _NUMERICAL_ERROR
  *         if converged(r, self.opt.eps_abs, self.opt.eps_rel):             # <<<<<<<<<<<<<<
@@ -26505,7 +26534,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":603
+  /* "fccqp/admm.pyx":605
  *         if converged(r, self.opt.eps_abs, self.opt.eps_rel):
  *             return _SOLVED
  *         if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):             # <<<<<<<<<<<<<<
@@ -26517,7 +26546,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":604
+    /* "fccqp/admm.pyx":606
  *             return _SOLVED
  *         if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *             return _INACCURATE             # <<<<<<<<<<<<<<
@@ -26530,7 +26559,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":603
+    /* "fccqp/admm.pyx":605
  *         if converged(r, self.opt.eps_abs, self.opt.eps_rel):
  *             return _SOLVED
  *         if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):             # <<<<<<<<<<<<<<
@@ -26539,7 +26568,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":605
+  /* "fccqp/admm.pyx":607
  *         if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *             return _INACCURATE
  *         if iteration >= self.opt.max_iter or not stopped:             # <<<<<<<<<<<<<<
@@ -26565,7 +26594,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":606
+    /* "fccqp/admm.pyx":608
  *             return _INACCURATE
  *         if iteration >= self.opt.max_iter or not stopped:
  *             return _MAX_ITER             # <<<<<<<<<<<<<<
@@ -26578,7 +26607,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":605
+    /* "fccqp/admm.pyx":607
  *         if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *             return _INACCURATE
  *         if iteration >= self.opt.max_iter or not stopped:             # <<<<<<<<<<<<<<
@@ -26587,7 +26616,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":607
+  /* "fccqp/admm.pyx":609
  *         if iteration >= self.opt.max_iter or not stopped:
  *             return _MAX_ITER
  *         return _TIME_LIMIT             # <<<<<<<<<<<<<<
@@ -26600,7 +26629,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":595
+  /* "fccqp/admm.pyx":597
  *         return True
  * 
  *     cdef int _classify(self, long iteration, bint stopped, double start_time) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26614,7 +26643,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":609
+/* "fccqp/admm.pyx":611
  *         return _TIME_LIMIT
  * 
  *     cdef void _full_step(self, bint relax_x) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26639,7 +26668,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   Py_ssize_t __pyx_t_4;
   Py_ssize_t __pyx_t_5;
 
-  /* "fccqp/admm.pyx":611
+  /* "fccqp/admm.pyx":613
  *     cdef void _full_step(self, bint relax_x) noexcept nogil:
  *         """One ADMM iteration with a KKT solve (update_x, update_z, update_y)."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -26648,7 +26677,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":612
+  /* "fccqp/admm.pyx":614
  *         """One ADMM iteration with a KKT solve (update_x, update_z, update_y)."""
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -26657,7 +26686,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":613
+  /* "fccqp/admm.pyx":615
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j             # <<<<<<<<<<<<<<
@@ -26674,7 +26703,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":614
+  /* "fccqp/admm.pyx":616
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         cdef double alpha = self.opt.alpha, alpha_x = alpha if relax_x else 1.0             # <<<<<<<<<<<<<<
@@ -26693,7 +26722,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
   __pyx_v_alpha_x = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":615
+  /* "fccqp/admm.pyx":617
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         cdef double alpha = self.opt.alpha, alpha_x = alpha if relax_x else 1.0
  *         cdef double sigma = self.opt.sigma             # <<<<<<<<<<<<<<
@@ -26704,7 +26733,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 
   __pyx_v_sigma = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":616
+  /* "fccqp/admm.pyx":618
  *         cdef double alpha = self.opt.alpha, alpha_x = alpha if relax_x else 1.0
  *         cdef double sigma = self.opt.sigma
  *         copy(it.x, it.x_prev, n)             # <<<<<<<<<<<<<<
@@ -26713,7 +26742,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->x, __pyx_v_it->x_prev, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":617
+  /* "fccqp/admm.pyx":619
  *         cdef double sigma = self.opt.sigma
  *         copy(it.x, it.x_prev, n)
  *         copy(it.nu, it.nu_prev, m)             # <<<<<<<<<<<<<<
@@ -26722,7 +26751,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->nu, __pyx_v_it->nu_prev, __pyx_v_m);
 
-  /* "fccqp/admm.pyx":618
+  /* "fccqp/admm.pyx":620
  *         copy(it.x, it.x_prev, n)
  *         copy(it.nu, it.nu_prev, m)
  *         copy(it.z, it.z_prev, s)             # <<<<<<<<<<<<<<
@@ -26731,7 +26760,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->z, __pyx_v_it->z_prev, __pyx_v_s);
 
-  /* "fccqp/admm.pyx":619
+  /* "fccqp/admm.pyx":621
  *         copy(it.nu, it.nu_prev, m)
  *         copy(it.z, it.z_prev, s)
  *         copy(it.y, it.y_prev, s)             # <<<<<<<<<<<<<<
@@ -26740,7 +26769,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->y, __pyx_v_it->y_prev, __pyx_v_s);
 
-  /* "fccqp/admm.pyx":620
+  /* "fccqp/admm.pyx":622
  *         copy(it.z, it.z_prev, s)
  *         copy(it.y, it.y_prev, s)
  *         for i in range(n):             # <<<<<<<<<<<<<<
@@ -26754,7 +26783,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":621
+    /* "fccqp/admm.pyx":623
  *         copy(it.y, it.y_prev, s)
  *         for i in range(n):
  *             self.rhs[i] = sigma * it.x[i] - p.q[i]             # <<<<<<<<<<<<<<
@@ -26765,7 +26794,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":622
+  /* "fccqp/admm.pyx":624
  *         for i in range(n):
  *             self.rhs[i] = sigma * it.x[i] - p.q[i]
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -26779,7 +26808,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":623
+    /* "fccqp/admm.pyx":625
  *             self.rhs[i] = sigma * it.x[i] - p.q[i]
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i]             # <<<<<<<<<<<<<<
@@ -26790,7 +26819,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":624
+  /* "fccqp/admm.pyx":626
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i]
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -26804,7 +26833,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":625
+    /* "fccqp/admm.pyx":627
  *             self.rhs[n + i] = p.b[i]
  *         for j in range(s):
  *             self.rhs[p.constrained[j]] += it.rho_vec[j] * it.z[j] - it.y[j]             # <<<<<<<<<<<<<<
@@ -26817,7 +26846,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":626
+  /* "fccqp/admm.pyx":628
  *         for j in range(s):
  *             self.rhs[p.constrained[j]] += it.rho_vec[j] * it.z[j] - it.y[j]
  *         kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)             # <<<<<<<<<<<<<<
@@ -26826,7 +26855,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_3kkt_kkt_solve((&__pyx_v_self->kkt), __pyx_v_p, __pyx_v_it->rho_vec, __pyx_v_self->rhs, __pyx_v_self->sol);
 
-  /* "fccqp/admm.pyx":627
+  /* "fccqp/admm.pyx":629
  *             self.rhs[p.constrained[j]] += it.rho_vec[j] * it.z[j] - it.y[j]
  *         kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -26840,7 +26869,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":628
+    /* "fccqp/admm.pyx":630
  *         kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
  *         for j in range(s):
  *             it.relaxed[j] = alpha * self.sol[p.constrained[j]] + (1.0 - alpha) * it.z_prev[j]             # <<<<<<<<<<<<<<
@@ -26851,7 +26880,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":629
+  /* "fccqp/admm.pyx":631
  *         for j in range(s):
  *             it.relaxed[j] = alpha * self.sol[p.constrained[j]] + (1.0 - alpha) * it.z_prev[j]
  *         for i in range(n):             # <<<<<<<<<<<<<<
@@ -26865,7 +26894,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":630
+    /* "fccqp/admm.pyx":632
  *             it.relaxed[j] = alpha * self.sol[p.constrained[j]] + (1.0 - alpha) * it.z_prev[j]
  *         for i in range(n):
  *             it.x[i] = alpha_x * self.sol[i] + (1.0 - alpha_x) * it.x_prev[i]             # <<<<<<<<<<<<<<
@@ -26876,7 +26905,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":631
+  /* "fccqp/admm.pyx":633
  *         for i in range(n):
  *             it.x[i] = alpha_x * self.sol[i] + (1.0 - alpha_x) * it.x_prev[i]
  *         copy(self.sol + n, it.nu, m)             # <<<<<<<<<<<<<<
@@ -26885,7 +26914,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_6_dense_copy((__pyx_v_self->sol + __pyx_v_n), __pyx_v_it->nu, __pyx_v_m);
 
-  /* "fccqp/admm.pyx":632
+  /* "fccqp/admm.pyx":634
  *             it.x[i] = alpha_x * self.sol[i] + (1.0 - alpha_x) * it.x_prev[i]
  *         copy(self.sol + n, it.nu, m)
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -26899,7 +26928,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":633
+    /* "fccqp/admm.pyx":635
  *         copy(self.sol + n, it.nu, m)
  *         for j in range(s):
  *             it.z[j] = it.relaxed[j] + it.y[j] / it.rho_vec[j]             # <<<<<<<<<<<<<<
@@ -26910,7 +26939,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":634
+  /* "fccqp/admm.pyx":636
  *         for j in range(s):
  *             it.z[j] = it.relaxed[j] + it.y[j] / it.rho_vec[j]
  *         proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)             # <<<<<<<<<<<<<<
@@ -26919,7 +26948,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_11projections_proj_set(__pyx_v_it->z, __pyx_v_p->lo, __pyx_v_p->hi, __pyx_v_p->cones, __pyx_v_s, __pyx_v_it->z);
 
-  /* "fccqp/admm.pyx":635
+  /* "fccqp/admm.pyx":637
  *             it.z[j] = it.relaxed[j] + it.y[j] / it.rho_vec[j]
  *         proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -26933,7 +26962,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":636
+    /* "fccqp/admm.pyx":638
  *         proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
  *         for j in range(s):
  *             it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])             # <<<<<<<<<<<<<<
@@ -26946,7 +26975,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":609
+  /* "fccqp/admm.pyx":611
  *         return _TIME_LIMIT
  * 
  *     cdef void _full_step(self, bint relax_x) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26967,7 +26996,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 
 }
 
-/* "fccqp/admm.pyx":638
+/* "fccqp/admm.pyx":640
  *             it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])
  * 
  *     cdef double _new_rho(self, double rho) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26989,7 +27018,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   double __pyx_t_6;
   int __pyx_t_7;
 
-  /* "fccqp/admm.pyx":641
+  /* "fccqp/admm.pyx":643
  *         """OSQP's rule: rho *= sqrt(relative primal / relative dual residual), clipped;
  *         unchanged unless it moves by more than ``adaptive_rho_tolerance``."""
  *         cdef Residuals* r = &self.res             # <<<<<<<<<<<<<<
@@ -26998,7 +27027,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
 */
   __pyx_v_r = (&__pyx_v_self->res);
 
-  /* "fccqp/admm.pyx":642
+  /* "fccqp/admm.pyx":644
  *         unchanged unless it moves by more than ``adaptive_rho_tolerance``."""
  *         cdef Residuals* r = &self.res
  *         cdef double ratio = (r.prim_s / max(r.prim_scale_s, 1e-30)) / max(             # <<<<<<<<<<<<<<
@@ -27022,7 +27051,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
 
   __pyx_t_1 = 1e-30;
 
-  /* "fccqp/admm.pyx":643
+  /* "fccqp/admm.pyx":645
  *         cdef Residuals* r = &self.res
  *         cdef double ratio = (r.prim_s / max(r.prim_scale_s, 1e-30)) / max(
  *             r.dual_s / max(r.dual_scale_s, 1e-30), 1e-30)             # <<<<<<<<<<<<<<
@@ -27057,7 +27086,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":642
+  /* "fccqp/admm.pyx":644
  *         unchanged unless it moves by more than ``adaptive_rho_tolerance``."""
  *         cdef Residuals* r = &self.res
  *         cdef double ratio = (r.prim_s / max(r.prim_scale_s, 1e-30)) / max(             # <<<<<<<<<<<<<<
@@ -27068,7 +27097,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
 
 
 
-  /* "fccqp/admm.pyx":644
+  /* "fccqp/admm.pyx":646
  *         cdef double ratio = (r.prim_s / max(r.prim_scale_s, 1e-30)) / max(
  *             r.dual_s / max(r.dual_scale_s, 1e-30), 1e-30)
  *         cdef double new_rho = min(max(rho * sqrt(ratio), _RHO_MIN), _RHO_MAX)             # <<<<<<<<<<<<<<
@@ -27107,7 +27136,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   __pyx_v_new_rho = __pyx_t_2;
 
 
-  /* "fccqp/admm.pyx":645
+  /* "fccqp/admm.pyx":647
  *             r.dual_s / max(r.dual_scale_s, 1e-30), 1e-30)
  *         cdef double new_rho = min(max(rho * sqrt(ratio), _RHO_MIN), _RHO_MAX)
  *         cdef double tolerance = self.opt.adaptive_rho_tolerance             # <<<<<<<<<<<<<<
@@ -27118,7 +27147,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
 
   __pyx_v_tolerance = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":646
+  /* "fccqp/admm.pyx":648
  *         cdef double new_rho = min(max(rho * sqrt(ratio), _RHO_MIN), _RHO_MAX)
  *         cdef double tolerance = self.opt.adaptive_rho_tolerance
  *         if new_rho > rho * tolerance or new_rho < rho / tolerance:             # <<<<<<<<<<<<<<
@@ -27144,7 +27173,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   if (__pyx_t_4) {
 
 
-    /* "fccqp/admm.pyx":647
+    /* "fccqp/admm.pyx":649
  *         cdef double tolerance = self.opt.adaptive_rho_tolerance
  *         if new_rho > rho * tolerance or new_rho < rho / tolerance:
  *             return new_rho             # <<<<<<<<<<<<<<
@@ -27157,7 +27186,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":646
+    /* "fccqp/admm.pyx":648
  *         cdef double new_rho = min(max(rho * sqrt(ratio), _RHO_MIN), _RHO_MAX)
  *         cdef double tolerance = self.opt.adaptive_rho_tolerance
  *         if new_rho > rho * tolerance or new_rho < rho / tolerance:             # <<<<<<<<<<<<<<
@@ -27166,7 +27195,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
 */
   }
 
-  /* "fccqp/admm.pyx":648
+  /* "fccqp/admm.pyx":650
  *         if new_rho > rho * tolerance or new_rho < rho / tolerance:
  *             return new_rho
  *         return rho             # <<<<<<<<<<<<<<
@@ -27179,7 +27208,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":638
+  /* "fccqp/admm.pyx":640
  *             it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])
  * 
  *     cdef double _new_rho(self, double rho) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27196,7 +27225,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":652
+/* "fccqp/admm.pyx":654
  *     # -------------------------------------------------------- factorizations
  * 
  *     cdef long _budget(self, long iteration) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27209,7 +27238,7 @@ static long __pyx_f_5fccqp_4admm_9Workspace__budget(struct __pyx_obj_5fccqp_4adm
   long __pyx_r;
   Py_ssize_t __pyx_t_1;
 
-  /* "fccqp/admm.pyx":655
+  /* "fccqp/admm.pyx":657
  *         """Solves the reduced form's table can save: the iterations left, plus, when the
  *         result will be restored, the columns the restoration would otherwise compute."""
  *         cdef long restoring = self.prob.s if self.opt.restore_feasibility else 0             # <<<<<<<<<<<<<<
@@ -27225,7 +27254,7 @@ static long __pyx_f_5fccqp_4admm_9Workspace__budget(struct __pyx_obj_5fccqp_4adm
   }
   __pyx_v_restoring = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":656
+  /* "fccqp/admm.pyx":658
  *         result will be restored, the columns the restoration would otherwise compute."""
  *         cdef long restoring = self.prob.s if self.opt.restore_feasibility else 0
  *         return self.opt.max_iter - iteration + restoring             # <<<<<<<<<<<<<<
@@ -27238,7 +27267,7 @@ static long __pyx_f_5fccqp_4admm_9Workspace__budget(struct __pyx_obj_5fccqp_4adm
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":652
+  /* "fccqp/admm.pyx":654
  *     # -------------------------------------------------------- factorizations
  * 
  *     cdef long _budget(self, long iteration) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27252,7 +27281,7 @@ static long __pyx_f_5fccqp_4admm_9Workspace__budget(struct __pyx_obj_5fccqp_4adm
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":658
+/* "fccqp/admm.pyx":660
  *         return self.opt.max_iter - iteration + restoring
  * 
  *     cdef int _certify(self, bint schur_factored) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27265,7 +27294,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
   int __pyx_r;
   int __pyx_t_1;
 
-  /* "fccqp/admm.pyx":661
+  /* "fccqp/admm.pyx":663
  *         """Establish convexity for the current matrices (see :func:`fccqp.kkt.kkt_convexity`);
  *         ``schur_factored`` says that the Schur backend has just factored them."""
  *         cdef int code = kkt_convexity(&self.kkt, &self.prob, self.opt.sigma, self.it.rho_vec,             # <<<<<<<<<<<<<<
@@ -27274,7 +27303,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
 */
   __pyx_v_code = __pyx_f_5fccqp_3kkt_kkt_convexity((&__pyx_v_self->kkt), (&__pyx_v_self->prob), __pyx_v_self->opt.sigma, __pyx_v_self->it.rho_vec, __pyx_v_schur_factored);
 
-  /* "fccqp/admm.pyx":663
+  /* "fccqp/admm.pyx":665
  *         cdef int code = kkt_convexity(&self.kkt, &self.prob, self.opt.sigma, self.it.rho_vec,
  *                                       schur_factored)
  *         if code == FACTORED:             # <<<<<<<<<<<<<<
@@ -27286,7 +27315,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":664
+    /* "fccqp/admm.pyx":666
  *                                       schur_factored)
  *         if code == FACTORED:
  *             self.certified = True             # <<<<<<<<<<<<<<
@@ -27295,7 +27324,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_v_self->certified = 1;
 
-    /* "fccqp/admm.pyx":663
+    /* "fccqp/admm.pyx":665
  *         cdef int code = kkt_convexity(&self.kkt, &self.prob, self.opt.sigma, self.it.rho_vec,
  *                                       schur_factored)
  *         if code == FACTORED:             # <<<<<<<<<<<<<<
@@ -27304,7 +27333,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
 */
   }
 
-  /* "fccqp/admm.pyx":665
+  /* "fccqp/admm.pyx":667
  *         if code == FACTORED:
  *             self.certified = True
  *         return code             # <<<<<<<<<<<<<<
@@ -27317,7 +27346,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":658
+  /* "fccqp/admm.pyx":660
  *         return self.opt.max_iter - iteration + restoring
  * 
  *     cdef int _certify(self, bint schur_factored) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27331,7 +27360,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":667
+/* "fccqp/admm.pyx":669
  *         return code
  * 
  *     cdef int _factor(self, Run* run, long budget) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27354,7 +27383,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   long __pyx_t_6;
   double __pyx_t_7;
 
-  /* "fccqp/admm.pyx":674
+  /* "fccqp/admm.pyx":676
  *         matrices are new. Returns FACTORED, NOT_CONVEX, or UNAVAILABLE (numerical
  *         breakdown); records the form and the rho it factored."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -27363,7 +27392,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":675
+  /* "fccqp/admm.pyx":677
  *         breakdown); records the form and the rho it factored."""
  *         cdef Problem* p = &self.prob
  *         cdef int backend, code, first = self.opt.backend             # <<<<<<<<<<<<<<
@@ -27374,7 +27403,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 
   __pyx_v_first = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":677
+  /* "fccqp/admm.pyx":679
  *         cdef int backend, code, first = self.opt.backend
  *         cdef bint reduced_pays
  *         if first == AUTO:             # <<<<<<<<<<<<<<
@@ -27386,7 +27415,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   if (__pyx_t_2) {
 
 
-    /* "fccqp/admm.pyx":678
+    /* "fccqp/admm.pyx":680
  *         cdef bint reduced_pays
  *         if first == AUTO:
  *             reduced_pays = 2 * p.s <= p.n + p.m and _REDUCED_COST * p.s <= budget             # <<<<<<<<<<<<<<
@@ -27411,7 +27440,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     __pyx_L4_bool_binop_done:;
     __pyx_v_reduced_pays = __pyx_t_2;
 
-    /* "fccqp/admm.pyx":679
+    /* "fccqp/admm.pyx":681
  *         if first == AUTO:
  *             reduced_pays = 2 * p.s <= p.n + p.m and _REDUCED_COST * p.s <= budget
  *             first = SCHUR_REDUCED if reduced_pays else LDL_FULL             # <<<<<<<<<<<<<<
@@ -27427,7 +27456,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     }
     __pyx_v_first = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":677
+    /* "fccqp/admm.pyx":679
  *         cdef int backend, code, first = self.opt.backend
  *         cdef bint reduced_pays
  *         if first == AUTO:             # <<<<<<<<<<<<<<
@@ -27436,7 +27465,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
   }
 
-  /* "fccqp/admm.pyx":680
+  /* "fccqp/admm.pyx":682
  *             reduced_pays = 2 * p.s <= p.n + p.m and _REDUCED_COST * p.s <= budget
  *             first = SCHUR_REDUCED if reduced_pays else LDL_FULL
  *         for backend in range(first, LDL_FULL + 1):             # <<<<<<<<<<<<<<
@@ -27450,7 +27479,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   for (__pyx_t_1 = __pyx_v_first; __pyx_t_1 < __pyx_t_6; __pyx_t_1+=1) {
     __pyx_v_backend = __pyx_t_1;
 
-    /* "fccqp/admm.pyx":681
+    /* "fccqp/admm.pyx":683
  *             first = SCHUR_REDUCED if reduced_pays else LDL_FULL
  *         for backend in range(first, LDL_FULL + 1):
  *             if not self.certified and backend != SCHUR_REDUCED:             # <<<<<<<<<<<<<<
@@ -27476,7 +27505,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":683
+      /* "fccqp/admm.pyx":685
  *             if not self.certified and backend != SCHUR_REDUCED:
  *                 # certify first: the certificate overwrites an LDL' factorization
  *                 code = self._certify(False)             # <<<<<<<<<<<<<<
@@ -27485,7 +27514,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       __pyx_v_code = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_certify(__pyx_v_self, 0);
 
-      /* "fccqp/admm.pyx":684
+      /* "fccqp/admm.pyx":686
  *                 # certify first: the certificate overwrites an LDL' factorization
  *                 code = self._certify(False)
  *                 run.factorizations += 1             # <<<<<<<<<<<<<<
@@ -27494,7 +27523,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       __pyx_v_run->factorizations = (__pyx_v_run->factorizations + 1);
 
-      /* "fccqp/admm.pyx":685
+      /* "fccqp/admm.pyx":687
  *                 code = self._certify(False)
  *                 run.factorizations += 1
  *                 if code == NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -27506,7 +27535,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
       if (__pyx_t_2) {
 
 
-        /* "fccqp/admm.pyx":686
+        /* "fccqp/admm.pyx":688
  *                 run.factorizations += 1
  *                 if code == NOT_CONVEX:
  *                     return NOT_CONVEX             # <<<<<<<<<<<<<<
@@ -27519,7 +27548,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
         }
         goto __pyx_L0;
 
-        /* "fccqp/admm.pyx":685
+        /* "fccqp/admm.pyx":687
  *                 code = self._certify(False)
  *                 run.factorizations += 1
  *                 if code == NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -27528,7 +27557,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       }
 
-      /* "fccqp/admm.pyx":681
+      /* "fccqp/admm.pyx":683
  *             first = SCHUR_REDUCED if reduced_pays else LDL_FULL
  *         for backend in range(first, LDL_FULL + 1):
  *             if not self.certified and backend != SCHUR_REDUCED:             # <<<<<<<<<<<<<<
@@ -27537,7 +27566,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     }
 
-    /* "fccqp/admm.pyx":688
+    /* "fccqp/admm.pyx":690
  *                     return NOT_CONVEX
  *             code = kkt_factor(&self.kkt, p, backend,
  *                               self.opt.sigma if backend == LDL_FULL else 0.0, self.it.rho_vec)             # <<<<<<<<<<<<<<
@@ -27555,7 +27584,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     }
 
 
-    /* "fccqp/admm.pyx":687
+    /* "fccqp/admm.pyx":689
  *                 if code == NOT_CONVEX:
  *                     return NOT_CONVEX
  *             code = kkt_factor(&self.kkt, p, backend,             # <<<<<<<<<<<<<<
@@ -27565,7 +27594,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     __pyx_v_code = __pyx_f_5fccqp_3kkt_kkt_factor((&__pyx_v_self->kkt), __pyx_v_p, __pyx_v_backend, __pyx_t_7, __pyx_v_self->it.rho_vec);
 
 
-    /* "fccqp/admm.pyx":689
+    /* "fccqp/admm.pyx":691
  *             code = kkt_factor(&self.kkt, p, backend,
  *                               self.opt.sigma if backend == LDL_FULL else 0.0, self.it.rho_vec)
  *             run.factorizations += 1             # <<<<<<<<<<<<<<
@@ -27574,7 +27603,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_v_run->factorizations = (__pyx_v_run->factorizations + 1);
 
-    /* "fccqp/admm.pyx":690
+    /* "fccqp/admm.pyx":692
  *                               self.opt.sigma if backend == LDL_FULL else 0.0, self.it.rho_vec)
  *             run.factorizations += 1
  *             if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -27586,7 +27615,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":691
+      /* "fccqp/admm.pyx":693
  *             run.factorizations += 1
  *             if code != FACTORED:
  *                 if backend == LDL_FULL:             # <<<<<<<<<<<<<<
@@ -27598,7 +27627,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
       if (__pyx_t_2) {
 
 
-        /* "fccqp/admm.pyx":692
+        /* "fccqp/admm.pyx":694
  *             if code != FACTORED:
  *                 if backend == LDL_FULL:
  *                     return UNAVAILABLE             # <<<<<<<<<<<<<<
@@ -27611,7 +27640,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
         }
         goto __pyx_L0;
 
-        /* "fccqp/admm.pyx":691
+        /* "fccqp/admm.pyx":693
  *             run.factorizations += 1
  *             if code != FACTORED:
  *                 if backend == LDL_FULL:             # <<<<<<<<<<<<<<
@@ -27620,7 +27649,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       }
 
-      /* "fccqp/admm.pyx":693
+      /* "fccqp/admm.pyx":695
  *                 if backend == LDL_FULL:
  *                     return UNAVAILABLE
  *                 continue             # <<<<<<<<<<<<<<
@@ -27629,7 +27658,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       goto __pyx_L6_continue;
 
-      /* "fccqp/admm.pyx":690
+      /* "fccqp/admm.pyx":692
  *                               self.opt.sigma if backend == LDL_FULL else 0.0, self.it.rho_vec)
  *             run.factorizations += 1
  *             if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -27638,7 +27667,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     }
 
-    /* "fccqp/admm.pyx":694
+    /* "fccqp/admm.pyx":696
  *                     return UNAVAILABLE
  *                 continue
  *             if not self.certified and self._certify(True) == NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -27664,7 +27693,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":695
+      /* "fccqp/admm.pyx":697
  *                 continue
  *             if not self.certified and self._certify(True) == NOT_CONVEX:
  *                 return NOT_CONVEX             # <<<<<<<<<<<<<<
@@ -27677,7 +27706,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
       }
       goto __pyx_L0;
 
-      /* "fccqp/admm.pyx":694
+      /* "fccqp/admm.pyx":696
  *                     return UNAVAILABLE
  *                 continue
  *             if not self.certified and self._certify(True) == NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -27686,7 +27715,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     }
 
-    /* "fccqp/admm.pyx":696
+    /* "fccqp/admm.pyx":698
  *             if not self.certified and self._certify(True) == NOT_CONVEX:
  *                 return NOT_CONVEX
  *             if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,             # <<<<<<<<<<<<<<
@@ -27704,7 +27733,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
       goto __pyx_L18_bool_binop_done;
     }
 
-    /* "fccqp/admm.pyx":697
+    /* "fccqp/admm.pyx":699
  *                 return NOT_CONVEX
  *             if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,
  *                                                          self.it.rho_vec):             # <<<<<<<<<<<<<<
@@ -27718,7 +27747,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 
     __pyx_L18_bool_binop_done:;
 
-    /* "fccqp/admm.pyx":696
+    /* "fccqp/admm.pyx":698
  *             if not self.certified and self._certify(True) == NOT_CONVEX:
  *                 return NOT_CONVEX
  *             if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,             # <<<<<<<<<<<<<<
@@ -27728,7 +27757,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":698
+      /* "fccqp/admm.pyx":700
  *             if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,
  *                                                          self.it.rho_vec):
  *                 continue             # <<<<<<<<<<<<<<
@@ -27737,7 +27766,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       goto __pyx_L6_continue;
 
-      /* "fccqp/admm.pyx":696
+      /* "fccqp/admm.pyx":698
  *             if not self.certified and self._certify(True) == NOT_CONVEX:
  *                 return NOT_CONVEX
  *             if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,             # <<<<<<<<<<<<<<
@@ -27746,7 +27775,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     }
 
-    /* "fccqp/admm.pyx":699
+    /* "fccqp/admm.pyx":701
  *                                                          self.it.rho_vec):
  *                 continue
  *             self.form = backend             # <<<<<<<<<<<<<<
@@ -27755,7 +27784,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_v_self->form = __pyx_v_backend;
 
-    /* "fccqp/admm.pyx":700
+    /* "fccqp/admm.pyx":702
  *                 continue
  *             self.form = backend
  *             run.backend = backend             # <<<<<<<<<<<<<<
@@ -27764,7 +27793,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_v_run->backend = __pyx_v_backend;
 
-    /* "fccqp/admm.pyx":701
+    /* "fccqp/admm.pyx":703
  *             self.form = backend
  *             run.backend = backend
  *             self.factored_rho = run.rho             # <<<<<<<<<<<<<<
@@ -27775,7 +27804,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 
     __pyx_v_self->factored_rho = __pyx_t_7;
 
-    /* "fccqp/admm.pyx":702
+    /* "fccqp/admm.pyx":704
  *             run.backend = backend
  *             self.factored_rho = run.rho
  *             return FACTORED             # <<<<<<<<<<<<<<
@@ -27791,7 +27820,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   }
 
 
-  /* "fccqp/admm.pyx":703
+  /* "fccqp/admm.pyx":705
  *             self.factored_rho = run.rho
  *             return FACTORED
  *         return UNAVAILABLE             # <<<<<<<<<<<<<<
@@ -27804,7 +27833,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":667
+  /* "fccqp/admm.pyx":669
  *         return code
  * 
  *     cdef int _factor(self, Run* run, long budget) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27822,7 +27851,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":705
+/* "fccqp/admm.pyx":707
  *         return UNAVAILABLE
  * 
  *     cdef void _reduced_base(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27837,7 +27866,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
   Py_ssize_t __pyx_t_2;
   Py_ssize_t __pyx_t_3;
 
-  /* "fccqp/admm.pyx":708
+  /* "fccqp/admm.pyx":710
  *         """``base``: the x-update's response to ``(-q, b)`` alone (q and b change every
  *         solve; the table only with the factorization)."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -27846,7 +27875,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":710
+  /* "fccqp/admm.pyx":712
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i
  *         for i in range(p.n):             # <<<<<<<<<<<<<<
@@ -27860,7 +27889,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":711
+    /* "fccqp/admm.pyx":713
  *         cdef Py_ssize_t i
  *         for i in range(p.n):
  *             self.rhs[i] = -p.q[i]             # <<<<<<<<<<<<<<
@@ -27871,7 +27900,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
   }
 
 
-  /* "fccqp/admm.pyx":712
+  /* "fccqp/admm.pyx":714
  *         for i in range(p.n):
  *             self.rhs[i] = -p.q[i]
  *         for i in range(p.m):             # <<<<<<<<<<<<<<
@@ -27885,7 +27914,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":713
+    /* "fccqp/admm.pyx":715
  *             self.rhs[i] = -p.q[i]
  *         for i in range(p.m):
  *             self.rhs[p.n + i] = p.b[i]             # <<<<<<<<<<<<<<
@@ -27896,7 +27925,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
   }
 
 
-  /* "fccqp/admm.pyx":714
+  /* "fccqp/admm.pyx":716
  *         for i in range(p.m):
  *             self.rhs[p.n + i] = p.b[i]
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.red.base)             # <<<<<<<<<<<<<<
@@ -27905,7 +27934,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_3kkt_kkt_solve((&__pyx_v_self->kkt), __pyx_v_p, __pyx_v_self->it.rho_vec, __pyx_v_self->rhs, __pyx_v_self->red.base);
 
-  /* "fccqp/admm.pyx":705
+  /* "fccqp/admm.pyx":707
  *         return UNAVAILABLE
  * 
  *     cdef void _reduced_base(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27918,7 +27947,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
 
 }
 
-/* "fccqp/admm.pyx":716
+/* "fccqp/admm.pyx":718
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.red.base)
  * 
  *     cdef int _equality_start(self, bint* unbounded) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27947,7 +27976,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   double __pyx_t_9;
   double __pyx_t_10;
 
-  /* "fccqp/admm.pyx":727
+  /* "fccqp/admm.pyx":729
  *         candidate certificate) and the start falls back to the origin.
  *         """
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -27956,7 +27985,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":728
+  /* "fccqp/admm.pyx":730
  *         """
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -27965,7 +27994,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":729
+  /* "fccqp/admm.pyx":731
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, i, step             # <<<<<<<<<<<<<<
@@ -27979,7 +28008,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 
   __pyx_v_m = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":730
+  /* "fccqp/admm.pyx":732
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, i, step
  *         cdef double sigma = self.opt.sigma             # <<<<<<<<<<<<<<
@@ -27990,7 +28019,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 
   __pyx_v_sigma = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":731
+  /* "fccqp/admm.pyx":733
  *         cdef Py_ssize_t n = p.n, m = p.m, i, step
  *         cdef double sigma = self.opt.sigma
  *         fill(it.rho_vec, 0.0, p.s)             # <<<<<<<<<<<<<<
@@ -27999,7 +28028,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_it->rho_vec, 0.0, __pyx_v_p->s);
 
-  /* "fccqp/admm.pyx":732
+  /* "fccqp/admm.pyx":734
  *         cdef double sigma = self.opt.sigma
  *         fill(it.rho_vec, 0.0, p.s)
  *         self.factored_rho = -1.0  # the KKT matrix now holds no rho factorization             # <<<<<<<<<<<<<<
@@ -28008,7 +28037,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_self->factored_rho = -1.0;
 
-  /* "fccqp/admm.pyx":733
+  /* "fccqp/admm.pyx":735
  *         fill(it.rho_vec, 0.0, p.s)
  *         self.factored_rho = -1.0  # the KKT matrix now holds no rho factorization
  *         self.form = LDL_FULL             # <<<<<<<<<<<<<<
@@ -28017,7 +28046,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_self->form = __pyx_e_5fccqp_3kkt_LDL_FULL;
 
-  /* "fccqp/admm.pyx":734
+  /* "fccqp/admm.pyx":736
  *         self.factored_rho = -1.0  # the KKT matrix now holds no rho factorization
  *         self.form = LDL_FULL
  *         cdef int code = kkt_factor(&self.kkt, p, LDL_FULL, sigma, it.rho_vec)             # <<<<<<<<<<<<<<
@@ -28026,7 +28055,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_code = __pyx_f_5fccqp_3kkt_kkt_factor((&__pyx_v_self->kkt), __pyx_v_p, __pyx_e_5fccqp_3kkt_LDL_FULL, __pyx_v_sigma, __pyx_v_it->rho_vec);
 
-  /* "fccqp/admm.pyx":735
+  /* "fccqp/admm.pyx":737
  *         self.form = LDL_FULL
  *         cdef int code = kkt_factor(&self.kkt, p, LDL_FULL, sigma, it.rho_vec)
  *         if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -28038,7 +28067,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":736
+    /* "fccqp/admm.pyx":738
  *         cdef int code = kkt_factor(&self.kkt, p, LDL_FULL, sigma, it.rho_vec)
  *         if code != FACTORED:
  *             return NOT_CONVEX             # <<<<<<<<<<<<<<
@@ -28051,7 +28080,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":735
+    /* "fccqp/admm.pyx":737
  *         self.form = LDL_FULL
  *         cdef int code = kkt_factor(&self.kkt, p, LDL_FULL, sigma, it.rho_vec)
  *         if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -28060,7 +28089,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   }
 
-  /* "fccqp/admm.pyx":737
+  /* "fccqp/admm.pyx":739
  *         if code != FACTORED:
  *             return NOT_CONVEX
  *         self.certified = True             # <<<<<<<<<<<<<<
@@ -28069,7 +28098,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_self->certified = 1;
 
-  /* "fccqp/admm.pyx":738
+  /* "fccqp/admm.pyx":740
  *             return NOT_CONVEX
  *         self.certified = True
  *         fill(it.x, 0.0, n)             # <<<<<<<<<<<<<<
@@ -28078,7 +28107,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_it->x, 0.0, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":739
+  /* "fccqp/admm.pyx":741
  *         self.certified = True
  *         fill(it.x, 0.0, n)
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -28092,7 +28121,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   for (__pyx_t_5 = 0; __pyx_t_5 < __pyx_t_4; __pyx_t_5+=1) {
     __pyx_v_i = __pyx_t_5;
 
-    /* "fccqp/admm.pyx":740
+    /* "fccqp/admm.pyx":742
  *         fill(it.x, 0.0, n)
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i]             # <<<<<<<<<<<<<<
@@ -28103,7 +28132,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   }
 
 
-  /* "fccqp/admm.pyx":741
+  /* "fccqp/admm.pyx":743
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i]
  *         for step in range(_EQUALITY_START_STEPS):             # <<<<<<<<<<<<<<
@@ -28117,7 +28146,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   for (__pyx_t_1 = 0; __pyx_t_1 < __pyx_t_7; __pyx_t_1+=1) {
     __pyx_v_step = __pyx_t_1;
 
-    /* "fccqp/admm.pyx":742
+    /* "fccqp/admm.pyx":744
  *             self.rhs[n + i] = p.b[i]
  *         for step in range(_EQUALITY_START_STEPS):
  *             for i in range(n):             # <<<<<<<<<<<<<<
@@ -28131,7 +28160,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
     for (__pyx_t_8 = 0; __pyx_t_8 < __pyx_t_5; __pyx_t_8+=1) {
       __pyx_v_i = __pyx_t_8;
 
-      /* "fccqp/admm.pyx":743
+      /* "fccqp/admm.pyx":745
  *         for step in range(_EQUALITY_START_STEPS):
  *             for i in range(n):
  *                 self.rhs[i] = sigma * it.x[i] - p.q[i]             # <<<<<<<<<<<<<<
@@ -28142,7 +28171,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
     }
 
 
-    /* "fccqp/admm.pyx":744
+    /* "fccqp/admm.pyx":746
  *             for i in range(n):
  *                 self.rhs[i] = sigma * it.x[i] - p.q[i]
  *             kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)             # <<<<<<<<<<<<<<
@@ -28151,7 +28180,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
     __pyx_f_5fccqp_3kkt_kkt_solve((&__pyx_v_self->kkt), __pyx_v_p, __pyx_v_it->rho_vec, __pyx_v_self->rhs, __pyx_v_self->sol);
 
-    /* "fccqp/admm.pyx":745
+    /* "fccqp/admm.pyx":747
  *                 self.rhs[i] = sigma * it.x[i] - p.q[i]
  *             kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
  *             copy(self.sol, it.x, n)             # <<<<<<<<<<<<<<
@@ -28162,7 +28191,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   }
 
 
-  /* "fccqp/admm.pyx":746
+  /* "fccqp/admm.pyx":748
  *             kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
  *             copy(self.sol, it.x, n)
  *         copy(self.sol + n, it.nu, m)             # <<<<<<<<<<<<<<
@@ -28171,7 +28200,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_copy((__pyx_v_self->sol + __pyx_v_n), __pyx_v_it->nu, __pyx_v_m);
 
-  /* "fccqp/admm.pyx":748
+  /* "fccqp/admm.pyx":750
  *         copy(self.sol + n, it.nu, m)
  *         unbounded[0] = sigma * inf_norm(it.x, n) > _EQUALITY_START_LIMIT * max(
  *             1.0, inf_norm(p.q, n))             # <<<<<<<<<<<<<<
@@ -28193,7 +28222,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   }
 
 
-  /* "fccqp/admm.pyx":747
+  /* "fccqp/admm.pyx":749
  *             copy(self.sol, it.x, n)
  *         copy(self.sol + n, it.nu, m)
  *         unbounded[0] = sigma * inf_norm(it.x, n) > _EQUALITY_START_LIMIT * max(             # <<<<<<<<<<<<<<
@@ -28203,7 +28232,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   (__pyx_v_unbounded[0]) = ((__pyx_v_sigma * __pyx_f_5fccqp_6_dense_inf_norm(__pyx_v_it->x, __pyx_v_n)) > (__pyx_v_5fccqp_4admm__EQUALITY_START_LIMIT * __pyx_t_10));
 
 
-  /* "fccqp/admm.pyx":749
+  /* "fccqp/admm.pyx":751
  *         unbounded[0] = sigma * inf_norm(it.x, n) > _EQUALITY_START_LIMIT * max(
  *             1.0, inf_norm(p.q, n))
  *         if unbounded[0]:             # <<<<<<<<<<<<<<
@@ -28212,7 +28241,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   if ((__pyx_v_unbounded[0])) {
 
-    /* "fccqp/admm.pyx":750
+    /* "fccqp/admm.pyx":752
  *             1.0, inf_norm(p.q, n))
  *         if unbounded[0]:
  *             copy(it.x, self.direction, n)             # <<<<<<<<<<<<<<
@@ -28221,7 +28250,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->x, __pyx_v_self->direction, __pyx_v_n);
 
-    /* "fccqp/admm.pyx":751
+    /* "fccqp/admm.pyx":753
  *         if unbounded[0]:
  *             copy(it.x, self.direction, n)
  *             fill(it.x, 0.0, n)             # <<<<<<<<<<<<<<
@@ -28230,7 +28259,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
     __pyx_f_5fccqp_6_dense_fill(__pyx_v_it->x, 0.0, __pyx_v_n);
 
-    /* "fccqp/admm.pyx":752
+    /* "fccqp/admm.pyx":754
  *             copy(it.x, self.direction, n)
  *             fill(it.x, 0.0, n)
  *             fill(it.nu, 0.0, m)             # <<<<<<<<<<<<<<
@@ -28239,7 +28268,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
     __pyx_f_5fccqp_6_dense_fill(__pyx_v_it->nu, 0.0, __pyx_v_m);
 
-    /* "fccqp/admm.pyx":749
+    /* "fccqp/admm.pyx":751
  *         unbounded[0] = sigma * inf_norm(it.x, n) > _EQUALITY_START_LIMIT * max(
  *             1.0, inf_norm(p.q, n))
  *         if unbounded[0]:             # <<<<<<<<<<<<<<
@@ -28248,7 +28277,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   }
 
-  /* "fccqp/admm.pyx":753
+  /* "fccqp/admm.pyx":755
  *             fill(it.x, 0.0, n)
  *             fill(it.nu, 0.0, m)
  *         for i in range(p.s):             # <<<<<<<<<<<<<<
@@ -28262,7 +28291,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   for (__pyx_t_5 = 0; __pyx_t_5 < __pyx_t_4; __pyx_t_5+=1) {
     __pyx_v_i = __pyx_t_5;
 
-    /* "fccqp/admm.pyx":754
+    /* "fccqp/admm.pyx":756
  *             fill(it.nu, 0.0, m)
  *         for i in range(p.s):
  *             it.z[i] = it.x[p.constrained[i]]             # <<<<<<<<<<<<<<
@@ -28273,7 +28302,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   }
 
 
-  /* "fccqp/admm.pyx":755
+  /* "fccqp/admm.pyx":757
  *         for i in range(p.s):
  *             it.z[i] = it.x[p.constrained[i]]
  *         proj_set(it.z, p.lo, p.hi, p.cones, p.s, it.z)             # <<<<<<<<<<<<<<
@@ -28282,7 +28311,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_11projections_proj_set(__pyx_v_it->z, __pyx_v_p->lo, __pyx_v_p->hi, __pyx_v_p->cones, __pyx_v_p->s, __pyx_v_it->z);
 
-  /* "fccqp/admm.pyx":756
+  /* "fccqp/admm.pyx":758
  *             it.z[i] = it.x[p.constrained[i]]
  *         proj_set(it.z, p.lo, p.hi, p.cones, p.s, it.z)
  *         fill(it.y, 0.0, p.s)             # <<<<<<<<<<<<<<
@@ -28291,7 +28320,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_it->y, 0.0, __pyx_v_p->s);
 
-  /* "fccqp/admm.pyx":757
+  /* "fccqp/admm.pyx":759
  *         proj_set(it.z, p.lo, p.hi, p.cones, p.s, it.z)
  *         fill(it.y, 0.0, p.s)
  *         copy(it.x, it.x_prev, n)             # <<<<<<<<<<<<<<
@@ -28300,7 +28329,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->x, __pyx_v_it->x_prev, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":758
+  /* "fccqp/admm.pyx":760
  *         fill(it.y, 0.0, p.s)
  *         copy(it.x, it.x_prev, n)
  *         copy(it.nu, it.nu_prev, m)             # <<<<<<<<<<<<<<
@@ -28309,7 +28338,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->nu, __pyx_v_it->nu_prev, __pyx_v_m);
 
-  /* "fccqp/admm.pyx":759
+  /* "fccqp/admm.pyx":761
  *         copy(it.x, it.x_prev, n)
  *         copy(it.nu, it.nu_prev, m)
  *         copy(it.y, it.y_prev, p.s)             # <<<<<<<<<<<<<<
@@ -28318,7 +28347,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->y, __pyx_v_it->y_prev, __pyx_v_p->s);
 
-  /* "fccqp/admm.pyx":760
+  /* "fccqp/admm.pyx":762
  *         copy(it.nu, it.nu_prev, m)
  *         copy(it.y, it.y_prev, p.s)
  *         return FACTORED             # <<<<<<<<<<<<<<
@@ -28331,7 +28360,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":716
+  /* "fccqp/admm.pyx":718
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.red.base)
  * 
  *     cdef int _equality_start(self, bint* unbounded) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28352,7 +28381,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":762
+/* "fccqp/admm.pyx":764
  *         return FACTORED
  * 
  *     cdef void _restore_equalities(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28371,7 +28400,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   Py_ssize_t __pyx_t_4;
   Py_ssize_t __pyx_t_5;
 
-  /* "fccqp/admm.pyx":766
+  /* "fccqp/admm.pyx":768
  *         the reduced form, a restoration) accumulates in ``A x = b``: one refined KKT
  *         solve for ``(0, b - A x)`` with the current factorization."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -28380,7 +28409,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":767
+  /* "fccqp/admm.pyx":769
  *         solve for ``(0, b - A x)`` with the current factorization."""
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m, i             # <<<<<<<<<<<<<<
@@ -28394,7 +28423,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 
   __pyx_v_m = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":768
+  /* "fccqp/admm.pyx":770
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m, i
  *         if m == 0:             # <<<<<<<<<<<<<<
@@ -28406,7 +28435,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   if (__pyx_t_2) {
 
 
-    /* "fccqp/admm.pyx":769
+    /* "fccqp/admm.pyx":771
  *         cdef Py_ssize_t n = p.n, m = p.m, i
  *         if m == 0:
  *             return             # <<<<<<<<<<<<<<
@@ -28417,7 +28446,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":768
+    /* "fccqp/admm.pyx":770
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m, i
  *         if m == 0:             # <<<<<<<<<<<<<<
@@ -28426,7 +28455,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 */
   }
 
-  /* "fccqp/admm.pyx":770
+  /* "fccqp/admm.pyx":772
  *         if m == 0:
  *             return
  *         fill(self.rhs, 0.0, n)             # <<<<<<<<<<<<<<
@@ -28435,7 +28464,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_self->rhs, 0.0, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":771
+  /* "fccqp/admm.pyx":773
  *             return
  *         fill(self.rhs, 0.0, n)
  *         matvec(p.A, self.it.x, self.rhs + n, m, n)             # <<<<<<<<<<<<<<
@@ -28444,7 +28473,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 */
   __pyx_f_5fccqp_6_dense_matvec(__pyx_v_p->A, __pyx_v_self->it.x, (__pyx_v_self->rhs + __pyx_v_n), __pyx_v_m, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":772
+  /* "fccqp/admm.pyx":774
  *         fill(self.rhs, 0.0, n)
  *         matvec(p.A, self.it.x, self.rhs + n, m, n)
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -28458,7 +28487,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":773
+    /* "fccqp/admm.pyx":775
  *         matvec(p.A, self.it.x, self.rhs + n, m, n)
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i] - self.rhs[n + i]             # <<<<<<<<<<<<<<
@@ -28469,7 +28498,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   }
 
 
-  /* "fccqp/admm.pyx":774
+  /* "fccqp/admm.pyx":776
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i] - self.rhs[n + i]
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.sol)             # <<<<<<<<<<<<<<
@@ -28478,7 +28507,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 */
   __pyx_f_5fccqp_3kkt_kkt_solve((&__pyx_v_self->kkt), __pyx_v_p, __pyx_v_self->it.rho_vec, __pyx_v_self->rhs, __pyx_v_self->sol);
 
-  /* "fccqp/admm.pyx":775
+  /* "fccqp/admm.pyx":777
  *             self.rhs[n + i] = p.b[i] - self.rhs[n + i]
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.sol)
  *         for i in range(n):             # <<<<<<<<<<<<<<
@@ -28492,7 +28521,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":776
+    /* "fccqp/admm.pyx":778
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.sol)
  *         for i in range(n):
  *             self.it.x[i] += self.sol[i]             # <<<<<<<<<<<<<<
@@ -28505,7 +28534,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   }
 
 
-  /* "fccqp/admm.pyx":777
+  /* "fccqp/admm.pyx":779
  *         for i in range(n):
  *             self.it.x[i] += self.sol[i]
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -28519,7 +28548,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":778
+    /* "fccqp/admm.pyx":780
  *             self.it.x[i] += self.sol[i]
  *         for i in range(m):
  *             self.it.nu[i] += self.sol[n + i]             # <<<<<<<<<<<<<<
@@ -28532,7 +28561,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   }
 
 
-  /* "fccqp/admm.pyx":762
+  /* "fccqp/admm.pyx":764
  *         return FACTORED
  * 
  *     cdef void _restore_equalities(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28548,7 +28577,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 
 }
 
-/* "fccqp/admm.pyx":780
+/* "fccqp/admm.pyx":782
  *             self.it.nu[i] += self.sol[n + i]
  * 
  *     cdef int _keep_restored(self, int status, long iteration, bint reduced,             # <<<<<<<<<<<<<<
@@ -28574,7 +28603,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
   double __pyx_t_7;
   int __pyx_t_8;
 
-  /* "fccqp/admm.pyx":792
+  /* "fccqp/admm.pyx":794
  *         either case.
  *         """
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -28583,7 +28612,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":793
+  /* "fccqp/admm.pyx":795
  *         """
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -28592,7 +28621,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":794
+  /* "fccqp/admm.pyx":796
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j             # <<<<<<<<<<<<<<
@@ -28609,7 +28638,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":796
+  /* "fccqp/admm.pyx":798
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j
  *         cdef int new_status
  *         copy(it.x, self.saved, n)             # <<<<<<<<<<<<<<
@@ -28618,7 +28647,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->x, __pyx_v_self->saved, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":797
+  /* "fccqp/admm.pyx":799
  *         cdef int new_status
  *         copy(it.x, self.saved, n)
  *         copy(it.nu, self.saved + n, m)             # <<<<<<<<<<<<<<
@@ -28627,7 +28656,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->nu, (__pyx_v_self->saved + __pyx_v_n), __pyx_v_m);
 
-  /* "fccqp/admm.pyx":798
+  /* "fccqp/admm.pyx":800
  *         copy(it.x, self.saved, n)
  *         copy(it.nu, self.saved + n, m)
  *         copy(it.z, self.saved + n + m, s)             # <<<<<<<<<<<<<<
@@ -28636,7 +28665,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->z, ((__pyx_v_self->saved + __pyx_v_n) + __pyx_v_m), __pyx_v_s);
 
-  /* "fccqp/admm.pyx":799
+  /* "fccqp/admm.pyx":801
  *         copy(it.nu, self.saved + n, m)
  *         copy(it.z, self.saved + n + m, s)
  *         if restore(&self.rest, &self.kkt, &self.red, reduced, p, it):             # <<<<<<<<<<<<<<
@@ -28648,7 +28677,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
   if (__pyx_t_2) {
 
 
-    /* "fccqp/admm.pyx":800
+    /* "fccqp/admm.pyx":802
  *         copy(it.z, self.saved + n + m, s)
  *         if restore(&self.rest, &self.kkt, &self.red, reduced, p, it):
  *             self._restore_equalities()             # <<<<<<<<<<<<<<
@@ -28657,7 +28686,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_restore_equalities(__pyx_v_self);
 
-    /* "fccqp/admm.pyx":801
+    /* "fccqp/admm.pyx":803
  *         if restore(&self.rest, &self.kkt, &self.red, reduced, p, it):
  *             self._restore_equalities()
  *             for j in range(s):             # <<<<<<<<<<<<<<
@@ -28671,7 +28700,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
     for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
       __pyx_v_j = __pyx_t_4;
 
-      /* "fccqp/admm.pyx":802
+      /* "fccqp/admm.pyx":804
  *             self._restore_equalities()
  *             for j in range(s):
  *                 it.z[j] = it.x[p.constrained[j]]             # <<<<<<<<<<<<<<
@@ -28682,7 +28711,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
     }
 
 
-    /* "fccqp/admm.pyx":803
+    /* "fccqp/admm.pyx":805
  *             for j in range(s):
  *                 it.z[j] = it.x[p.constrained[j]]
  *             proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)             # <<<<<<<<<<<<<<
@@ -28691,7 +28720,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     __pyx_f_5fccqp_11projections_proj_set(__pyx_v_it->z, __pyx_v_p->lo, __pyx_v_p->hi, __pyx_v_p->cones, __pyx_v_s, __pyx_v_it->z);
 
-    /* "fccqp/admm.pyx":804
+    /* "fccqp/admm.pyx":806
  *                 it.z[j] = it.x[p.constrained[j]]
  *             proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
  *             self._residuals()             # <<<<<<<<<<<<<<
@@ -28700,7 +28729,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_residuals(__pyx_v_self);
 
-    /* "fccqp/admm.pyx":805
+    /* "fccqp/admm.pyx":807
  *             proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
  *             self._residuals()
  *             new_status = self._classify(iteration, True, start_time)             # <<<<<<<<<<<<<<
@@ -28709,7 +28738,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     __pyx_v_new_status = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_classify(__pyx_v_self, __pyx_v_iteration, 1, __pyx_v_start_time);
 
-    /* "fccqp/admm.pyx":806
+    /* "fccqp/admm.pyx":808
  *             self._residuals()
  *             new_status = self._classify(iteration, True, start_time)
  *             if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)             # <<<<<<<<<<<<<<
@@ -28742,7 +28771,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
       goto __pyx_L7_bool_binop_done;
     }
 
-    /* "fccqp/admm.pyx":807
+    /* "fccqp/admm.pyx":809
  *             new_status = self._classify(iteration, True, start_time)
  *             if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)
  *                     and (status != _SOLVED or new_status == _SOLVED)):             # <<<<<<<<<<<<<<
@@ -28766,7 +28795,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 
     __pyx_L7_bool_binop_done:;
 
-    /* "fccqp/admm.pyx":806
+    /* "fccqp/admm.pyx":808
  *             self._residuals()
  *             new_status = self._classify(iteration, True, start_time)
  *             if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)             # <<<<<<<<<<<<<<
@@ -28776,7 +28805,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":808
+      /* "fccqp/admm.pyx":810
  *             if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)
  *                     and (status != _SOLVED or new_status == _SOLVED)):
  *                 return new_status             # <<<<<<<<<<<<<<
@@ -28789,7 +28818,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
       }
       goto __pyx_L0;
 
-      /* "fccqp/admm.pyx":806
+      /* "fccqp/admm.pyx":808
  *             self._residuals()
  *             new_status = self._classify(iteration, True, start_time)
  *             if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)             # <<<<<<<<<<<<<<
@@ -28798,7 +28827,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     }
 
-    /* "fccqp/admm.pyx":799
+    /* "fccqp/admm.pyx":801
  *         copy(it.nu, self.saved + n, m)
  *         copy(it.z, self.saved + n + m, s)
  *         if restore(&self.rest, &self.kkt, &self.red, reduced, p, it):             # <<<<<<<<<<<<<<
@@ -28807,7 +28836,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   }
 
-  /* "fccqp/admm.pyx":809
+  /* "fccqp/admm.pyx":811
  *                     and (status != _SOLVED or new_status == _SOLVED)):
  *                 return new_status
  *         copy(self.saved, it.x, n)             # <<<<<<<<<<<<<<
@@ -28816,7 +28845,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_self->saved, __pyx_v_it->x, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":810
+  /* "fccqp/admm.pyx":812
  *                 return new_status
  *         copy(self.saved, it.x, n)
  *         copy(self.saved + n, it.nu, m)             # <<<<<<<<<<<<<<
@@ -28825,7 +28854,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy((__pyx_v_self->saved + __pyx_v_n), __pyx_v_it->nu, __pyx_v_m);
 
-  /* "fccqp/admm.pyx":811
+  /* "fccqp/admm.pyx":813
  *         copy(self.saved, it.x, n)
  *         copy(self.saved + n, it.nu, m)
  *         copy(self.saved + n + m, it.z, s)             # <<<<<<<<<<<<<<
@@ -28834,7 +28863,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy(((__pyx_v_self->saved + __pyx_v_n) + __pyx_v_m), __pyx_v_it->z, __pyx_v_s);
 
-  /* "fccqp/admm.pyx":812
+  /* "fccqp/admm.pyx":814
  *         copy(self.saved + n, it.nu, m)
  *         copy(self.saved + n + m, it.z, s)
  *         if reduced:             # <<<<<<<<<<<<<<
@@ -28843,7 +28872,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   if (__pyx_v_reduced) {
 
-    /* "fccqp/admm.pyx":813
+    /* "fccqp/admm.pyx":815
  *         copy(self.saved + n + m, it.z, s)
  *         if reduced:
  *             self._restore_equalities()             # <<<<<<<<<<<<<<
@@ -28852,7 +28881,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_restore_equalities(__pyx_v_self);
 
-    /* "fccqp/admm.pyx":812
+    /* "fccqp/admm.pyx":814
  *         copy(self.saved + n, it.nu, m)
  *         copy(self.saved + n + m, it.z, s)
  *         if reduced:             # <<<<<<<<<<<<<<
@@ -28861,7 +28890,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   }
 
-  /* "fccqp/admm.pyx":814
+  /* "fccqp/admm.pyx":816
  *         if reduced:
  *             self._restore_equalities()
  *         return status             # <<<<<<<<<<<<<<
@@ -28874,7 +28903,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":780
+  /* "fccqp/admm.pyx":782
  *             self.it.nu[i] += self.sol[n + i]
  * 
  *     cdef int _keep_restored(self, int status, long iteration, bint reduced,             # <<<<<<<<<<<<<<
@@ -28894,7 +28923,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":818
+/* "fccqp/admm.pyx":820
  *     # ------------------------------------------------------------- bookkeeping
  * 
  *     cdef void _residuals(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28904,7 +28933,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 
 static void __pyx_f_5fccqp_4admm_9Workspace__residuals(struct __pyx_obj_5fccqp_4admm_Workspace *__pyx_v_self) {
 
-  /* "fccqp/admm.pyx":819
+  /* "fccqp/admm.pyx":821
  * 
  *     cdef void _residuals(self) noexcept nogil:
  *         residuals(&self.prob, &self.it, self.vec_m, self.vec_n, self.vec_n2, &self.res)             # <<<<<<<<<<<<<<
@@ -28913,7 +28942,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__residuals(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_11termination_residuals((&__pyx_v_self->prob), (&__pyx_v_self->it), __pyx_v_self->vec_m, __pyx_v_self->vec_n, __pyx_v_self->vec_n2, (&__pyx_v_self->res));
 
-  /* "fccqp/admm.pyx":818
+  /* "fccqp/admm.pyx":820
  *     # ------------------------------------------------------------- bookkeeping
  * 
  *     cdef void _residuals(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28924,7 +28953,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__residuals(struct __pyx_obj_5fccqp_4
   /* function exit code */
 }
 
-/* "fccqp/admm.pyx":821
+/* "fccqp/admm.pyx":823
  *         residuals(&self.prob, &self.it, self.vec_m, self.vec_n, self.vec_n2, &self.res)
  * 
  *     cdef void _log(self, long iteration, double rho) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28941,7 +28970,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
   double __pyx_t_5;
   double __pyx_t_6;
 
-  /* "fccqp/admm.pyx":823
+  /* "fccqp/admm.pyx":825
  *     cdef void _log(self, long iteration, double rho) noexcept nogil:
  *         cdef double* row
  *         if self.log_count < self.log_rows:             # <<<<<<<<<<<<<<
@@ -28953,7 +28982,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":824
+    /* "fccqp/admm.pyx":826
  *         cdef double* row
  *         if self.log_count < self.log_rows:
  *             row = self.log + 5 * self.log_count             # <<<<<<<<<<<<<<
@@ -28962,7 +28991,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
 */
     __pyx_v_row = (__pyx_v_self->log + (5 * __pyx_v_self->log_count));
 
-    /* "fccqp/admm.pyx":826
+    /* "fccqp/admm.pyx":828
  *             row = self.log + 5 * self.log_count
  *             row[0], row[1], row[2], row[3], row[4] = (
  *                 iteration, self.res.prim, self.res.dual, self.res.gap, rho)             # <<<<<<<<<<<<<<
@@ -28980,7 +29009,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
     __pyx_t_6 = __pyx_v_rho;
 
 
-    /* "fccqp/admm.pyx":825
+    /* "fccqp/admm.pyx":827
  *         if self.log_count < self.log_rows:
  *             row = self.log + 5 * self.log_count
  *             row[0], row[1], row[2], row[3], row[4] = (             # <<<<<<<<<<<<<<
@@ -28998,7 +29027,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
     (__pyx_v_row[4]) = __pyx_t_6;
 
 
-    /* "fccqp/admm.pyx":827
+    /* "fccqp/admm.pyx":829
  *             row[0], row[1], row[2], row[3], row[4] = (
  *                 iteration, self.res.prim, self.res.dual, self.res.gap, rho)
  *             self.log_count += 1             # <<<<<<<<<<<<<<
@@ -29007,7 +29036,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
 */
     __pyx_v_self->log_count = (__pyx_v_self->log_count + 1);
 
-    /* "fccqp/admm.pyx":823
+    /* "fccqp/admm.pyx":825
  *     cdef void _log(self, long iteration, double rho) noexcept nogil:
  *         cdef double* row
  *         if self.log_count < self.log_rows:             # <<<<<<<<<<<<<<
@@ -29016,7 +29045,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
 */
   }
 
-  /* "fccqp/admm.pyx":821
+  /* "fccqp/admm.pyx":823
  *         residuals(&self.prob, &self.it, self.vec_m, self.vec_n, self.vec_n2, &self.res)
  * 
  *     cdef void _log(self, long iteration, double rho) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -29028,7 +29057,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
 
 }
 
-/* "fccqp/admm.pyx":829
+/* "fccqp/admm.pyx":831
  *             self.log_count += 1
  * 
  *     cdef void _finish_run(self, Run* run, int status, long iteration) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -29039,7 +29068,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
 static void __pyx_f_5fccqp_4admm_9Workspace__finish_run(struct __pyx_obj_5fccqp_4admm_Workspace *__pyx_v_self, struct __pyx_t_5fccqp_4admm_Run *__pyx_v_run, int __pyx_v_status, long __pyx_v_iteration) {
   int __pyx_t_1;
 
-  /* "fccqp/admm.pyx":830
+  /* "fccqp/admm.pyx":832
  * 
  *     cdef void _finish_run(self, Run* run, int status, long iteration) noexcept nogil:
  *         run.status = status             # <<<<<<<<<<<<<<
@@ -29048,7 +29077,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish_run(struct __pyx_obj_5fccqp_
 */
   __pyx_v_run->status = __pyx_v_status;
 
-  /* "fccqp/admm.pyx":831
+  /* "fccqp/admm.pyx":833
  *     cdef void _finish_run(self, Run* run, int status, long iteration) noexcept nogil:
  *         run.status = status
  *         run.iterations = iteration             # <<<<<<<<<<<<<<
@@ -29057,7 +29086,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish_run(struct __pyx_obj_5fccqp_
 */
   __pyx_v_run->iterations = __pyx_v_iteration;
 
-  /* "fccqp/admm.pyx":832
+  /* "fccqp/admm.pyx":834
  *         run.status = status
  *         run.iterations = iteration
  *         run.backend = self.form             # <<<<<<<<<<<<<<
@@ -29068,7 +29097,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish_run(struct __pyx_obj_5fccqp_
 
   __pyx_v_run->backend = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":829
+  /* "fccqp/admm.pyx":831
  *             self.log_count += 1
  * 
  *     cdef void _finish_run(self, Run* run, int status, long iteration) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -29079,7 +29108,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish_run(struct __pyx_obj_5fccqp_
   /* function exit code */
 }
 
-/* "fccqp/admm.pyx":834
+/* "fccqp/admm.pyx":836
  *         run.backend = self.form
  * 
  *     cdef void _finish(self, Run* run, double* x, double* y, double* z,             # <<<<<<<<<<<<<<
@@ -29099,7 +29128,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
   int __pyx_t_4;
   double __pyx_t_5;
 
-  /* "fccqp/admm.pyx":839
+  /* "fccqp/admm.pyx":841
  *         user's units from the returned point alone (the primal one as the distance of
  *         ``x_S`` to C), settle the status on them and keep the point for a warm start."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -29108,7 +29137,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":840
+  /* "fccqp/admm.pyx":842
  *         ``x_S`` to C), settle the status on them and keep the point for a warm start."""
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -29117,7 +29146,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":841
+  /* "fccqp/admm.pyx":843
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j             # <<<<<<<<<<<<<<
@@ -29134,7 +29163,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":842
+  /* "fccqp/admm.pyx":844
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)             # <<<<<<<<<<<<<<
@@ -29143,7 +29172,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   __pyx_f_5fccqp_7scaling_unscale(__pyx_v_it->x, __pyx_v_it->nu, __pyx_v_it->y, __pyx_v_p->D, __pyx_v_p->E, __pyx_v_p->c, __pyx_v_n, __pyx_v_m, __pyx_v_s, __pyx_v_p->constrained, __pyx_v_x, __pyx_v_y, __pyx_v_z);
 
-  /* "fccqp/admm.pyx":843
+  /* "fccqp/admm.pyx":845
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)
  *         if run.status == _PRIMAL_INFEASIBLE or run.status == _DUAL_INFEASIBLE:             # <<<<<<<<<<<<<<
@@ -29154,7 +29183,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     case __pyx_e_5fccqp_4admm__PRIMAL_INFEASIBLE:
     case __pyx_e_5fccqp_4admm__DUAL_INFEASIBLE:
 
-    /* "fccqp/admm.pyx":844
+    /* "fccqp/admm.pyx":846
  *         unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)
  *         if run.status == _PRIMAL_INFEASIBLE or run.status == _DUAL_INFEASIBLE:
  *             copy(self.cert, cert, n + m)             # <<<<<<<<<<<<<<
@@ -29163,7 +29192,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_self->cert, __pyx_v_cert, (__pyx_v_n + __pyx_v_m));
 
-    /* "fccqp/admm.pyx":843
+    /* "fccqp/admm.pyx":845
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)
  *         if run.status == _PRIMAL_INFEASIBLE or run.status == _DUAL_INFEASIBLE:             # <<<<<<<<<<<<<<
@@ -29174,7 +29203,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     default: break;
   }
 
-  /* "fccqp/admm.pyx":845
+  /* "fccqp/admm.pyx":847
  *         if run.status == _PRIMAL_INFEASIBLE or run.status == _DUAL_INFEASIBLE:
  *             copy(self.cert, cert, n + m)
  *         self._user_residuals(x, y, z)             # <<<<<<<<<<<<<<
@@ -29183,7 +29212,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_user_residuals(__pyx_v_self, __pyx_v_x, __pyx_v_y, __pyx_v_z);
 
-  /* "fccqp/admm.pyx":846
+  /* "fccqp/admm.pyx":848
  *             copy(self.cert, cert, n + m)
  *         self._user_residuals(x, y, z)
  *         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):             # <<<<<<<<<<<<<<
@@ -29196,7 +29225,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     case __pyx_e_5fccqp_4admm__MAX_ITER:
     case __pyx_e_5fccqp_4admm__TIME_LIMIT:
 
-    /* "fccqp/admm.pyx":847
+    /* "fccqp/admm.pyx":849
  *         self._user_residuals(x, y, z)
  *         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):
  *             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):             # <<<<<<<<<<<<<<
@@ -29208,7 +29237,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":848
+      /* "fccqp/admm.pyx":850
  *         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):
  *             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):
  *                 run.status = _SOLVED             # <<<<<<<<<<<<<<
@@ -29217,7 +29246,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
       __pyx_v_run->status = __pyx_e_5fccqp_4admm__SOLVED;
 
-      /* "fccqp/admm.pyx":847
+      /* "fccqp/admm.pyx":849
  *         self._user_residuals(x, y, z)
  *         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):
  *             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):             # <<<<<<<<<<<<<<
@@ -29227,7 +29256,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
       goto __pyx_L3;
     }
 
-    /* "fccqp/admm.pyx":849
+    /* "fccqp/admm.pyx":851
  *             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):
  *                 run.status = _SOLVED
  *             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):             # <<<<<<<<<<<<<<
@@ -29239,7 +29268,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":850
+      /* "fccqp/admm.pyx":852
  *                 run.status = _SOLVED
  *             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *                 run.status = _INACCURATE             # <<<<<<<<<<<<<<
@@ -29248,7 +29277,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
       __pyx_v_run->status = __pyx_e_5fccqp_4admm__INACCURATE;
 
-      /* "fccqp/admm.pyx":849
+      /* "fccqp/admm.pyx":851
  *             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):
  *                 run.status = _SOLVED
  *             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):             # <<<<<<<<<<<<<<
@@ -29258,7 +29287,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
       goto __pyx_L3;
     }
 
-    /* "fccqp/admm.pyx":851
+    /* "fccqp/admm.pyx":853
  *             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *                 run.status = _INACCURATE
  *             elif run.status in (_SOLVED, _INACCURATE):             # <<<<<<<<<<<<<<
@@ -29280,7 +29309,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     if (__pyx_t_3) {
 
 
-      /* "fccqp/admm.pyx":852
+      /* "fccqp/admm.pyx":854
  *                 run.status = _INACCURATE
  *             elif run.status in (_SOLVED, _INACCURATE):
  *                 run.status = _NUMERICAL_ERROR   # the scaled test passed, the point does not             # <<<<<<<<<<<<<<
@@ -29289,7 +29318,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
       __pyx_v_run->status = __pyx_e_5fccqp_4admm__NUMERICAL_ERROR;
 
-      /* "fccqp/admm.pyx":851
+      /* "fccqp/admm.pyx":853
  *             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *                 run.status = _INACCURATE
  *             elif run.status in (_SOLVED, _INACCURATE):             # <<<<<<<<<<<<<<
@@ -29299,7 +29328,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     }
     __pyx_L3:;
 
-    /* "fccqp/admm.pyx":846
+    /* "fccqp/admm.pyx":848
  *             copy(self.cert, cert, n + m)
  *         self._user_residuals(x, y, z)
  *         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):             # <<<<<<<<<<<<<<
@@ -29310,7 +29339,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     default: break;
   }
 
-  /* "fccqp/admm.pyx":853
+  /* "fccqp/admm.pyx":855
  *             elif run.status in (_SOLVED, _INACCURATE):
  *                 run.status = _NUMERICAL_ERROR   # the scaled test passed, the point does not
  *         if not self.res.finite:             # <<<<<<<<<<<<<<
@@ -29322,7 +29351,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":854
+    /* "fccqp/admm.pyx":856
  *                 run.status = _NUMERICAL_ERROR   # the scaled test passed, the point does not
  *         if not self.res.finite:
  *             run.status = _NUMERICAL_ERROR             # <<<<<<<<<<<<<<
@@ -29331,7 +29360,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_v_run->status = __pyx_e_5fccqp_4admm__NUMERICAL_ERROR;
 
-    /* "fccqp/admm.pyx":853
+    /* "fccqp/admm.pyx":855
  *             elif run.status in (_SOLVED, _INACCURATE):
  *                 run.status = _NUMERICAL_ERROR   # the scaled test passed, the point does not
  *         if not self.res.finite:             # <<<<<<<<<<<<<<
@@ -29340,7 +29369,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   }
 
-  /* "fccqp/admm.pyx":855
+  /* "fccqp/admm.pyx":857
  *         if not self.res.finite:
  *             run.status = _NUMERICAL_ERROR
  *         self.has_previous = self.res.finite and run.status not in (             # <<<<<<<<<<<<<<
@@ -29354,7 +29383,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     goto __pyx_L5_bool_binop_done;
   }
 
-  /* "fccqp/admm.pyx":856
+  /* "fccqp/admm.pyx":858
  *             run.status = _NUMERICAL_ERROR
  *         self.has_previous = self.res.finite and run.status not in (
  *             _PRIMAL_INFEASIBLE, _DUAL_INFEASIBLE)             # <<<<<<<<<<<<<<
@@ -29365,7 +29394,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     case __pyx_e_5fccqp_4admm__PRIMAL_INFEASIBLE:
     case __pyx_e_5fccqp_4admm__DUAL_INFEASIBLE:
 
-    /* "fccqp/admm.pyx":855
+    /* "fccqp/admm.pyx":857
  *         if not self.res.finite:
  *             run.status = _NUMERICAL_ERROR
  *         self.has_previous = self.res.finite and run.status not in (             # <<<<<<<<<<<<<<
@@ -29387,7 +29416,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
   __pyx_L5_bool_binop_done:;
   __pyx_v_self->has_previous = __pyx_t_3;
 
-  /* "fccqp/admm.pyx":857
+  /* "fccqp/admm.pyx":859
  *         self.has_previous = self.res.finite and run.status not in (
  *             _PRIMAL_INFEASIBLE, _DUAL_INFEASIBLE)
  *         if self.has_previous:             # <<<<<<<<<<<<<<
@@ -29396,7 +29425,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   if (__pyx_v_self->has_previous) {
 
-    /* "fccqp/admm.pyx":858
+    /* "fccqp/admm.pyx":860
  *             _PRIMAL_INFEASIBLE, _DUAL_INFEASIBLE)
  *         if self.has_previous:
  *             copy(x, self.prev_x, n)             # <<<<<<<<<<<<<<
@@ -29405,7 +29434,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_x, __pyx_v_self->prev_x, __pyx_v_n);
 
-    /* "fccqp/admm.pyx":859
+    /* "fccqp/admm.pyx":861
  *         if self.has_previous:
  *             copy(x, self.prev_x, n)
  *             copy(y, self.prev_y, m)             # <<<<<<<<<<<<<<
@@ -29414,7 +29443,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_y, __pyx_v_self->prev_y, __pyx_v_m);
 
-    /* "fccqp/admm.pyx":860
+    /* "fccqp/admm.pyx":862
  *             copy(x, self.prev_x, n)
  *             copy(y, self.prev_y, m)
  *             copy(z, self.prev_z, n)             # <<<<<<<<<<<<<<
@@ -29423,7 +29452,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_z, __pyx_v_self->prev_z, __pyx_v_n);
 
-    /* "fccqp/admm.pyx":861
+    /* "fccqp/admm.pyx":863
  *             copy(y, self.prev_y, m)
  *             copy(z, self.prev_z, n)
  *             self.prev_rho = run.rho             # <<<<<<<<<<<<<<
@@ -29434,7 +29463,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 
     __pyx_v_self->prev_rho = __pyx_t_5;
 
-    /* "fccqp/admm.pyx":857
+    /* "fccqp/admm.pyx":859
  *         self.has_previous = self.res.finite and run.status not in (
  *             _PRIMAL_INFEASIBLE, _DUAL_INFEASIBLE)
  *         if self.has_previous:             # <<<<<<<<<<<<<<
@@ -29443,7 +29472,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   }
 
-  /* "fccqp/admm.pyx":834
+  /* "fccqp/admm.pyx":836
  *         run.backend = self.form
  * 
  *     cdef void _finish(self, Run* run, double* x, double* y, double* z,             # <<<<<<<<<<<<<<
@@ -29459,7 +29488,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 
 }
 
-/* "fccqp/admm.pyx":863
+/* "fccqp/admm.pyx":865
  *             self.prev_rho = run.rho
  * 
  *     cdef void _user_residuals(self, const double* x, const double* y,             # <<<<<<<<<<<<<<
@@ -29497,7 +29526,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   int __pyx_t_9;
   double __pyx_t_10;
 
-  /* "fccqp/admm.pyx":867
+  /* "fccqp/admm.pyx":869
  *         """:mod:`fccqp.termination`'s residuals of the returned ``(x, y, z)`` on the user's
  *         data, with ``dist(x_S, C)`` as the primal part off the equalities."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -29506,7 +29535,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":868
+  /* "fccqp/admm.pyx":870
  *         data, with ``dist(x_S, C)`` as the primal part off the equalities."""
  *         cdef Problem* p = &self.prob
  *         cdef Residuals* r = &self.res             # <<<<<<<<<<<<<<
@@ -29515,7 +29544,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_v_r = (&__pyx_v_self->res);
 
-  /* "fccqp/admm.pyx":869
+  /* "fccqp/admm.pyx":871
  *         cdef Problem* p = &self.prob
  *         cdef Residuals* r = &self.res
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j             # <<<<<<<<<<<<<<
@@ -29532,7 +29561,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":870
+  /* "fccqp/admm.pyx":872
  *         cdef Residuals* r = &self.res
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         cdef double* Ax = self.vec_m             # <<<<<<<<<<<<<<
@@ -29543,7 +29572,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 
   __pyx_v_Ax = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":871
+  /* "fccqp/admm.pyx":873
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         cdef double* Ax = self.vec_m
  *         cdef double* grad = self.vec_n             # <<<<<<<<<<<<<<
@@ -29554,7 +29583,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 
   __pyx_v_grad = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":872
+  /* "fccqp/admm.pyx":874
  *         cdef double* Ax = self.vec_m
  *         cdef double* grad = self.vec_n
  *         cdef double* ATy = self.vec_n2             # <<<<<<<<<<<<<<
@@ -29565,7 +29594,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 
   __pyx_v_ATy = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":873
+  /* "fccqp/admm.pyx":875
  *         cdef double* grad = self.vec_n
  *         cdef double* ATy = self.vec_n2
  *         cdef double* proj = self.vec_s             # <<<<<<<<<<<<<<
@@ -29576,7 +29605,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 
   __pyx_v_proj = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":874
+  /* "fccqp/admm.pyx":876
  *         cdef double* ATy = self.vec_n2
  *         cdef double* proj = self.vec_s
  *         cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, terms = 0.0, total = 0.0             # <<<<<<<<<<<<<<
@@ -29590,7 +29619,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   __pyx_v_terms = 0.0;
   __pyx_v_total = 0.0;
 
-  /* "fccqp/admm.pyx":876
+  /* "fccqp/admm.pyx":878
  *         cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, terms = 0.0, total = 0.0
  *         cdef double value
  *         matvec(self.A_user, x, Ax, m, n)             # <<<<<<<<<<<<<<
@@ -29599,7 +29628,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_f_5fccqp_6_dense_matvec(__pyx_v_self->A_user, __pyx_v_x, __pyx_v_Ax, __pyx_v_m, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":877
+  /* "fccqp/admm.pyx":879
  *         cdef double value
  *         matvec(self.A_user, x, Ax, m, n)
  *         matvec_t(self.A_user, y, ATy, m, n)             # <<<<<<<<<<<<<<
@@ -29608,7 +29637,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_f_5fccqp_6_dense_matvec_t(__pyx_v_self->A_user, __pyx_v_y, __pyx_v_ATy, __pyx_v_m, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":878
+  /* "fccqp/admm.pyx":880
  *         matvec(self.A_user, x, Ax, m, n)
  *         matvec_t(self.A_user, y, ATy, m, n)
  *         matvec(self.P_user, x, grad, n, n)             # <<<<<<<<<<<<<<
@@ -29617,7 +29646,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_f_5fccqp_6_dense_matvec(__pyx_v_self->P_user, __pyx_v_x, __pyx_v_grad, __pyx_v_n, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":879
+  /* "fccqp/admm.pyx":881
  *         matvec_t(self.A_user, y, ATy, m, n)
  *         matvec(self.P_user, x, grad, n, n)
  *         r.prim = r.prim_scale = 0.0             # <<<<<<<<<<<<<<
@@ -29627,7 +29656,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   __pyx_v_r->prim = 0.0;
   __pyx_v_r->prim_scale = 0.0;
 
-  /* "fccqp/admm.pyx":880
+  /* "fccqp/admm.pyx":882
  *         matvec(self.P_user, x, grad, n, n)
  *         r.prim = r.prim_scale = 0.0
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -29641,7 +29670,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":881
+    /* "fccqp/admm.pyx":883
  *         r.prim = r.prim_scale = 0.0
  *         for i in range(m):
  *             r.prim = max(r.prim, fabs(Ax[i] - self.b_user[i]))             # <<<<<<<<<<<<<<
@@ -29665,7 +29694,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->prim = __pyx_t_7;
 
 
-    /* "fccqp/admm.pyx":882
+    /* "fccqp/admm.pyx":884
  *         for i in range(m):
  *             r.prim = max(r.prim, fabs(Ax[i] - self.b_user[i]))
  *             r.prim_scale = max(r.prim_scale, max(fabs(Ax[i]), fabs(self.b_user[i])))             # <<<<<<<<<<<<<<
@@ -29704,7 +29733,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->prim_scale = __pyx_t_5;
 
 
-    /* "fccqp/admm.pyx":883
+    /* "fccqp/admm.pyx":885
  *             r.prim = max(r.prim, fabs(Ax[i] - self.b_user[i]))
  *             r.prim_scale = max(r.prim_scale, max(fabs(Ax[i]), fabs(self.b_user[i])))
  *             by += self.b_user[i] * y[i]             # <<<<<<<<<<<<<<
@@ -29713,7 +29742,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_by = (__pyx_v_by + ((__pyx_v_self->b_user[__pyx_v_i]) * (__pyx_v_y[__pyx_v_i])));
 
-    /* "fccqp/admm.pyx":884
+    /* "fccqp/admm.pyx":886
  *             r.prim_scale = max(r.prim_scale, max(fabs(Ax[i]), fabs(self.b_user[i])))
  *             by += self.b_user[i] * y[i]
  *             terms += fabs(self.b_user[i] * y[i])             # <<<<<<<<<<<<<<
@@ -29724,7 +29753,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":885
+  /* "fccqp/admm.pyx":887
  *             by += self.b_user[i] * y[i]
  *             terms += fabs(self.b_user[i] * y[i])
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -29738,7 +29767,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":886
+    /* "fccqp/admm.pyx":888
  *             terms += fabs(self.b_user[i] * y[i])
  *         for j in range(s):
  *             i = p.constrained[j]             # <<<<<<<<<<<<<<
@@ -29747,7 +29776,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_i = (__pyx_v_p->constrained[__pyx_v_j]);
 
-    /* "fccqp/admm.pyx":887
+    /* "fccqp/admm.pyx":889
  *         for j in range(s):
  *             i = p.constrained[j]
  *             value = x[i]             # <<<<<<<<<<<<<<
@@ -29756,7 +29785,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_value = (__pyx_v_x[__pyx_v_i]);
 
-    /* "fccqp/admm.pyx":888
+    /* "fccqp/admm.pyx":890
  *             i = p.constrained[j]
  *             value = x[i]
  *             if value < self.lb_user[i]:             # <<<<<<<<<<<<<<
@@ -29768,7 +29797,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     if (__pyx_t_8) {
 
 
-      /* "fccqp/admm.pyx":889
+      /* "fccqp/admm.pyx":891
  *             value = x[i]
  *             if value < self.lb_user[i]:
  *                 value = self.lb_user[i]             # <<<<<<<<<<<<<<
@@ -29777,7 +29806,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
       __pyx_v_value = (__pyx_v_self->lb_user[__pyx_v_i]);
 
-      /* "fccqp/admm.pyx":888
+      /* "fccqp/admm.pyx":890
  *             i = p.constrained[j]
  *             value = x[i]
  *             if value < self.lb_user[i]:             # <<<<<<<<<<<<<<
@@ -29786,7 +29815,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     }
 
-    /* "fccqp/admm.pyx":890
+    /* "fccqp/admm.pyx":892
  *             if value < self.lb_user[i]:
  *                 value = self.lb_user[i]
  *             if value > self.ub_user[i]:             # <<<<<<<<<<<<<<
@@ -29798,7 +29827,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     if (__pyx_t_8) {
 
 
-      /* "fccqp/admm.pyx":891
+      /* "fccqp/admm.pyx":893
  *                 value = self.lb_user[i]
  *             if value > self.ub_user[i]:
  *                 value = self.ub_user[i]             # <<<<<<<<<<<<<<
@@ -29807,7 +29836,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
       __pyx_v_value = (__pyx_v_self->ub_user[__pyx_v_i]);
 
-      /* "fccqp/admm.pyx":890
+      /* "fccqp/admm.pyx":892
  *             if value < self.lb_user[i]:
  *                 value = self.lb_user[i]
  *             if value > self.ub_user[i]:             # <<<<<<<<<<<<<<
@@ -29816,7 +29845,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     }
 
-    /* "fccqp/admm.pyx":892
+    /* "fccqp/admm.pyx":894
  *             if value > self.ub_user[i]:
  *                 value = self.ub_user[i]
  *             proj[j] = value             # <<<<<<<<<<<<<<
@@ -29827,7 +29856,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":893
+  /* "fccqp/admm.pyx":895
  *                 value = self.ub_user[i]
  *             proj[j] = value
  *         for j in range(p.cones.count):   # cone blocks are contiguous in x too             # <<<<<<<<<<<<<<
@@ -29841,7 +29870,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":894
+    /* "fccqp/admm.pyx":896
  *             proj[j] = value
  *         for j in range(p.cones.count):   # cone blocks are contiguous in x too
  *             i = p.cones.offset[j]             # <<<<<<<<<<<<<<
@@ -29850,7 +29879,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_i = (__pyx_v_p->cones.offset[__pyx_v_j]);
 
-    /* "fccqp/admm.pyx":895
+    /* "fccqp/admm.pyx":897
  *         for j in range(p.cones.count):   # cone blocks are contiguous in x too
  *             i = p.cones.offset[j]
  *             proj_block(x + p.constrained[i], p.cones.kind[j], p.cones.dim[j], p.cones.mu[j],             # <<<<<<<<<<<<<<
@@ -29861,7 +29890,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":897
+  /* "fccqp/admm.pyx":899
  *             proj_block(x + p.constrained[i], p.cones.kind[j], p.cones.dim[j], p.cones.mu[j],
  *                        p.cones.normal + 3 * j, proj + i)
  *         r.dual_scale = 0.0             # <<<<<<<<<<<<<<
@@ -29870,7 +29899,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_v_r->dual_scale = 0.0;
 
-  /* "fccqp/admm.pyx":898
+  /* "fccqp/admm.pyx":900
  *                        p.cones.normal + 3 * j, proj + i)
  *         r.dual_scale = 0.0
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -29884,7 +29913,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":899
+    /* "fccqp/admm.pyx":901
  *         r.dual_scale = 0.0
  *         for j in range(s):
  *             i = p.constrained[j]             # <<<<<<<<<<<<<<
@@ -29893,7 +29922,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_i = (__pyx_v_p->constrained[__pyx_v_j]);
 
-    /* "fccqp/admm.pyx":900
+    /* "fccqp/admm.pyx":902
  *         for j in range(s):
  *             i = p.constrained[j]
  *             r.prim = max(r.prim, fabs(x[i] - proj[j]))             # <<<<<<<<<<<<<<
@@ -29917,7 +29946,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->prim = __pyx_t_6;
 
 
-    /* "fccqp/admm.pyx":901
+    /* "fccqp/admm.pyx":903
  *             i = p.constrained[j]
  *             r.prim = max(r.prim, fabs(x[i] - proj[j]))
  *             r.prim_scale = max(r.prim_scale, fabs(x[i]))             # <<<<<<<<<<<<<<
@@ -29941,7 +29970,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->prim_scale = __pyx_t_7;
 
 
-    /* "fccqp/admm.pyx":902
+    /* "fccqp/admm.pyx":904
  *             r.prim = max(r.prim, fabs(x[i] - proj[j]))
  *             r.prim_scale = max(r.prim_scale, fabs(x[i]))
  *             if z[i] > 0.0 and isfinite(self.ub_user[i]):             # <<<<<<<<<<<<<<
@@ -29967,7 +29996,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     if (__pyx_t_8) {
 
 
-      /* "fccqp/admm.pyx":903
+      /* "fccqp/admm.pyx":905
  *             r.prim_scale = max(r.prim_scale, fabs(x[i]))
  *             if z[i] > 0.0 and isfinite(self.ub_user[i]):
  *                 support += self.ub_user[i] * z[i]             # <<<<<<<<<<<<<<
@@ -29976,7 +30005,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
       __pyx_v_support = (__pyx_v_support + ((__pyx_v_self->ub_user[__pyx_v_i]) * (__pyx_v_z[__pyx_v_i])));
 
-      /* "fccqp/admm.pyx":904
+      /* "fccqp/admm.pyx":906
  *             if z[i] > 0.0 and isfinite(self.ub_user[i]):
  *                 support += self.ub_user[i] * z[i]
  *                 terms += fabs(self.ub_user[i] * z[i])             # <<<<<<<<<<<<<<
@@ -29985,7 +30014,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
       __pyx_v_terms = (__pyx_v_terms + fabs(((__pyx_v_self->ub_user[__pyx_v_i]) * (__pyx_v_z[__pyx_v_i]))));
 
-      /* "fccqp/admm.pyx":902
+      /* "fccqp/admm.pyx":904
  *             r.prim = max(r.prim, fabs(x[i] - proj[j]))
  *             r.prim_scale = max(r.prim_scale, fabs(x[i]))
  *             if z[i] > 0.0 and isfinite(self.ub_user[i]):             # <<<<<<<<<<<<<<
@@ -29995,7 +30024,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
       goto __pyx_L13;
     }
 
-    /* "fccqp/admm.pyx":905
+    /* "fccqp/admm.pyx":907
  *                 support += self.ub_user[i] * z[i]
  *                 terms += fabs(self.ub_user[i] * z[i])
  *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):             # <<<<<<<<<<<<<<
@@ -30021,7 +30050,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     if (__pyx_t_8) {
 
 
-      /* "fccqp/admm.pyx":906
+      /* "fccqp/admm.pyx":908
  *                 terms += fabs(self.ub_user[i] * z[i])
  *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):
  *                 support += self.lb_user[i] * z[i]             # <<<<<<<<<<<<<<
@@ -30030,7 +30059,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
       __pyx_v_support = (__pyx_v_support + ((__pyx_v_self->lb_user[__pyx_v_i]) * (__pyx_v_z[__pyx_v_i])));
 
-      /* "fccqp/admm.pyx":907
+      /* "fccqp/admm.pyx":909
  *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):
  *                 support += self.lb_user[i] * z[i]
  *                 terms += fabs(self.lb_user[i] * z[i])             # <<<<<<<<<<<<<<
@@ -30039,7 +30068,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
       __pyx_v_terms = (__pyx_v_terms + fabs(((__pyx_v_self->lb_user[__pyx_v_i]) * (__pyx_v_z[__pyx_v_i]))));
 
-      /* "fccqp/admm.pyx":905
+      /* "fccqp/admm.pyx":907
  *                 support += self.ub_user[i] * z[i]
  *                 terms += fabs(self.ub_user[i] * z[i])
  *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):             # <<<<<<<<<<<<<<
@@ -30051,7 +30080,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":908
+  /* "fccqp/admm.pyx":910
  *                 support += self.lb_user[i] * z[i]
  *                 terms += fabs(self.lb_user[i] * z[i])
  *         r.dual = 0.0             # <<<<<<<<<<<<<<
@@ -30060,7 +30089,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_v_r->dual = 0.0;
 
-  /* "fccqp/admm.pyx":909
+  /* "fccqp/admm.pyx":911
  *                 terms += fabs(self.lb_user[i] * z[i])
  *         r.dual = 0.0
  *         for i in range(n):             # <<<<<<<<<<<<<<
@@ -30074,7 +30103,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":910
+    /* "fccqp/admm.pyx":912
  *         r.dual = 0.0
  *         for i in range(n):
  *             xPx += x[i] * grad[i]             # <<<<<<<<<<<<<<
@@ -30083,7 +30112,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_xPx = (__pyx_v_xPx + ((__pyx_v_x[__pyx_v_i]) * (__pyx_v_grad[__pyx_v_i])));
 
-    /* "fccqp/admm.pyx":911
+    /* "fccqp/admm.pyx":913
  *         for i in range(n):
  *             xPx += x[i] * grad[i]
  *             qx += self.q_user[i] * x[i]             # <<<<<<<<<<<<<<
@@ -30092,7 +30121,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_qx = (__pyx_v_qx + ((__pyx_v_self->q_user[__pyx_v_i]) * (__pyx_v_x[__pyx_v_i])));
 
-    /* "fccqp/admm.pyx":912
+    /* "fccqp/admm.pyx":914
  *             xPx += x[i] * grad[i]
  *             qx += self.q_user[i] * x[i]
  *             r.dual_scale = max(r.dual_scale, max(fabs(grad[i]), fabs(self.q_user[i])))             # <<<<<<<<<<<<<<
@@ -30131,7 +30160,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->dual_scale = __pyx_t_6;
 
 
-    /* "fccqp/admm.pyx":913
+    /* "fccqp/admm.pyx":915
  *             qx += self.q_user[i] * x[i]
  *             r.dual_scale = max(r.dual_scale, max(fabs(grad[i]), fabs(self.q_user[i])))
  *             value = grad[i] + self.q_user[i] + ATy[i] + z[i]             # <<<<<<<<<<<<<<
@@ -30140,7 +30169,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_value = ((((__pyx_v_grad[__pyx_v_i]) + (__pyx_v_self->q_user[__pyx_v_i])) + (__pyx_v_ATy[__pyx_v_i])) + (__pyx_v_z[__pyx_v_i]));
 
-    /* "fccqp/admm.pyx":914
+    /* "fccqp/admm.pyx":916
  *             r.dual_scale = max(r.dual_scale, max(fabs(grad[i]), fabs(self.q_user[i])))
  *             value = grad[i] + self.q_user[i] + ATy[i] + z[i]
  *             r.dual = max(r.dual, fabs(value))             # <<<<<<<<<<<<<<
@@ -30164,7 +30193,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->dual = __pyx_t_5;
 
 
-    /* "fccqp/admm.pyx":915
+    /* "fccqp/admm.pyx":917
  *             value = grad[i] + self.q_user[i] + ATy[i] + z[i]
  *             r.dual = max(r.dual, fabs(value))
  *             total += fabs(value) + fabs(x[i]) + fabs(z[i])             # <<<<<<<<<<<<<<
@@ -30175,7 +30204,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":916
+  /* "fccqp/admm.pyx":918
  *             r.dual = max(r.dual, fabs(value))
  *             total += fabs(value) + fabs(x[i]) + fabs(z[i])
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -30189,7 +30218,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":917
+    /* "fccqp/admm.pyx":919
  *             total += fabs(value) + fabs(x[i]) + fabs(z[i])
  *         for i in range(m):
  *             total += fabs(y[i])             # <<<<<<<<<<<<<<
@@ -30200,7 +30229,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":918
+  /* "fccqp/admm.pyx":920
  *         for i in range(m):
  *             total += fabs(y[i])
  *         r.gap = fabs(xPx + qx + by + support)             # <<<<<<<<<<<<<<
@@ -30209,7 +30238,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_v_r->gap = fabs((((__pyx_v_xPx + __pyx_v_qx) + __pyx_v_by) + __pyx_v_support));
 
-  /* "fccqp/admm.pyx":919
+  /* "fccqp/admm.pyx":921
  *             total += fabs(y[i])
  *         r.gap = fabs(xPx + qx + by + support)
  *         r.gap_scale = max(max(fabs(xPx), fabs(qx)), terms)             # <<<<<<<<<<<<<<
@@ -30248,7 +30277,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   __pyx_v_r->gap_scale = __pyx_t_10;
 
 
-  /* "fccqp/admm.pyx":920
+  /* "fccqp/admm.pyx":922
  *         r.gap = fabs(xPx + qx + by + support)
  *         r.gap_scale = max(max(fabs(xPx), fabs(qx)), terms)
  *         r.finite = isfinite(total) and isfinite(r.gap) and isfinite(r.prim)             # <<<<<<<<<<<<<<
@@ -30282,7 +30311,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   __pyx_L22_bool_binop_done:;
   __pyx_v_r->finite = __pyx_t_8;
 
-  /* "fccqp/admm.pyx":863
+  /* "fccqp/admm.pyx":865
  *             self.prev_rho = run.rho
  * 
  *     cdef void _user_residuals(self, const double* x, const double* y,             # <<<<<<<<<<<<<<

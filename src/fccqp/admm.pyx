@@ -466,12 +466,14 @@ cdef class Workspace:
         if (cold or s == 0) and converged(r, o.eps_abs, o.eps_rel) and not unbounded_start:
             self._finish_run(run, _SOLVED, 0)
             return
+        if (cold or s == 0) and r.prim > o.eps_abs + o.eps_rel * r.prim_scale and \
+                self._inconsistent():
+            # tested on the penalty-free start: with rho in the KKT matrix (up to 1e9 on
+            # fixed entries) the regularization's trace in A'r can hide the certificate
+            self._finish_run(run, _PRIMAL_INFEASIBLE, 0)
+            return
         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer
-            if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():
-                status = _PRIMAL_INFEASIBLE
-            else:
-                status = self._classify(0, False, start_time)
-            self._finish_run(run, status, 0)
+            self._finish_run(run, self._classify(0, False, start_time), 0)
             return
         for j in range(s):
             it.rho_vec[j] = run.rho * self.rho_scale[j]

@@ -2290,10 +2290,10 @@ static PyObject *__Pyx_Object_VectorcallMethodKwds(PyObject *name, PyObject *con
 #endif
 
 /* CIntToPy.proto */
-static CYTHON_INLINE PyObject* __Pyx_PyLong_From_int(int value);
+static CYTHON_INLINE PyObject* __Pyx_PyLong_From_long(long value);
 
 /* CIntToPy.proto */
-static CYTHON_INLINE PyObject* __Pyx_PyLong_From_long(long value);
+static CYTHON_INLINE PyObject* __Pyx_PyLong_From_int(int value);
 
 /* FormatTypeName.proto */
 #if CYTHON_COMPILING_IN_LIMITED_API && __PYX_LIMITED_VERSION_HEX >= 0x030d0000
@@ -2447,6 +2447,7 @@ static double __pyx_v_5fccqp_3ldl__REFINE_TOLERANCE;
 static void __pyx_f_5fccqp_3ldl_ldl_solve_many(struct __pyx_t_5fccqp_3ldl_LDL *, double *, int, double *); /*proto*/
 static int __pyx_f_5fccqp_3ldl_meets_equalities(double const *, double const *, double const *, Py_ssize_t); /*proto*/
 static void __pyx_f_5fccqp_3ldl__solve_one(struct __pyx_t_5fccqp_3ldl_LDL *, double *); /*proto*/
+static void __pyx_f_5fccqp_3ldl__refine_regularized(struct __pyx_t_5fccqp_3ldl_LDL *, struct __pyx_t_5fccqp_6_types_Problem const *, double, double const *, double const *, double *); /*proto*/
 static int __pyx_f_5fccqp_3ldl__in_null_space(double const *, struct __pyx_t_5fccqp_6_types_Problem const *, double const *, int, int); /*proto*/
 /* #### Code section: typeinfo ### */
 /* #### Code section: before_global_var ### */
@@ -4373,9 +4374,233 @@ static int __pyx_f_5fccqp_3ldl_meets_equalities(double const *__pyx_v_Ax, double
 /* "fccqp/ldl.pyx":112
  * 
  * 
+ * cdef void _refine_regularized(LDL* f, const Problem* p, double sigma, const double* rho_vec,             # <<<<<<<<<<<<<<
+ *                              const double* rhs, double* sol) noexcept nogil:
+ *     """Two refinement steps against the factored matrix itself (with ``-delta I``): the
+*/
+
+static void __pyx_f_5fccqp_3ldl__refine_regularized(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_v_f, struct __pyx_t_5fccqp_6_types_Problem const *__pyx_v_p, double __pyx_v_sigma, double const *__pyx_v_rho_vec, double const *__pyx_v_rhs, double *__pyx_v_sol) {
+  Py_ssize_t __pyx_v_n;
+  Py_ssize_t __pyx_v_m;
+  Py_ssize_t __pyx_v_i;
+  Py_ssize_t __pyx_v_k;
+  CYTHON_UNUSED Py_ssize_t __pyx_v_step;
+  double *__pyx_v_res;
+  Py_ssize_t __pyx_t_1;
+  double *__pyx_t_2;
+  Py_ssize_t __pyx_t_3;
+  Py_ssize_t __pyx_t_4;
+  Py_ssize_t __pyx_t_5;
+  Py_ssize_t __pyx_t_6;
+
+  /* "fccqp/ldl.pyx":117
+ *     factorization of a matrix with entries 1 and 1e-13 loses digits that refinement
+ *     recovers."""
+ *     cdef Py_ssize_t n = p.n, m = p.m, i, k, step             # <<<<<<<<<<<<<<
+ *     cdef double* res = f.residual
+ *     for step in range(2):
+*/
+  __pyx_t_1 = __pyx_v_p->n;
+
+  __pyx_v_n = __pyx_t_1;
+  __pyx_t_1 = __pyx_v_p->m;
+
+  __pyx_v_m = __pyx_t_1;
+
+  /* "fccqp/ldl.pyx":118
+ *     recovers."""
+ *     cdef Py_ssize_t n = p.n, m = p.m, i, k, step
+ *     cdef double* res = f.residual             # <<<<<<<<<<<<<<
+ *     for step in range(2):
+ *         matvec(p.P, sol, res, n, n)
+*/
+  __pyx_t_2 = __pyx_v_f->residual;
+
+  __pyx_v_res = __pyx_t_2;
+
+  /* "fccqp/ldl.pyx":119
+ *     cdef Py_ssize_t n = p.n, m = p.m, i, k, step
+ *     cdef double* res = f.residual
+ *     for step in range(2):             # <<<<<<<<<<<<<<
+ *         matvec(p.P, sol, res, n, n)
+ *         matvec_t(p.A, sol + n, f.ATnu, m, n)
+*/
+  for (__pyx_t_1 = 0; __pyx_t_1 < 2; __pyx_t_1+=1) {
+    __pyx_v_step = __pyx_t_1;
+
+    /* "fccqp/ldl.pyx":120
+ *     cdef double* res = f.residual
+ *     for step in range(2):
+ *         matvec(p.P, sol, res, n, n)             # <<<<<<<<<<<<<<
+ *         matvec_t(p.A, sol + n, f.ATnu, m, n)
+ *         for i in range(n):
+*/
+    __pyx_f_5fccqp_6_dense_matvec(__pyx_v_p->P, __pyx_v_sol, __pyx_v_res, __pyx_v_n, __pyx_v_n);
+
+    /* "fccqp/ldl.pyx":121
+ *     for step in range(2):
+ *         matvec(p.P, sol, res, n, n)
+ *         matvec_t(p.A, sol + n, f.ATnu, m, n)             # <<<<<<<<<<<<<<
+ *         for i in range(n):
+ *             res[i] = rhs[i] - res[i] - sigma * sol[i] - f.ATnu[i]
+*/
+    __pyx_f_5fccqp_6_dense_matvec_t(__pyx_v_p->A, (__pyx_v_sol + __pyx_v_n), __pyx_v_f->ATnu, __pyx_v_m, __pyx_v_n);
+
+    /* "fccqp/ldl.pyx":122
+ *         matvec(p.P, sol, res, n, n)
+ *         matvec_t(p.A, sol + n, f.ATnu, m, n)
+ *         for i in range(n):             # <<<<<<<<<<<<<<
+ *             res[i] = rhs[i] - res[i] - sigma * sol[i] - f.ATnu[i]
+ *         for k in range(p.s):
+*/
+
+    __pyx_t_3 = __pyx_v_n;
+    __pyx_t_4 = __pyx_t_3;
+
+    for (__pyx_t_5 = 0; __pyx_t_5 < __pyx_t_4; __pyx_t_5+=1) {
+      __pyx_v_i = __pyx_t_5;
+
+      /* "fccqp/ldl.pyx":123
+ *         matvec_t(p.A, sol + n, f.ATnu, m, n)
+ *         for i in range(n):
+ *             res[i] = rhs[i] - res[i] - sigma * sol[i] - f.ATnu[i]             # <<<<<<<<<<<<<<
+ *         for k in range(p.s):
+ *             i = p.constrained[k]
+*/
+      (__pyx_v_res[__pyx_v_i]) = ((((__pyx_v_rhs[__pyx_v_i]) - (__pyx_v_res[__pyx_v_i])) - (__pyx_v_sigma * (__pyx_v_sol[__pyx_v_i]))) - (__pyx_v_f->ATnu[__pyx_v_i]));
+    }
+
+
+    /* "fccqp/ldl.pyx":124
+ *         for i in range(n):
+ *             res[i] = rhs[i] - res[i] - sigma * sol[i] - f.ATnu[i]
+ *         for k in range(p.s):             # <<<<<<<<<<<<<<
+ *             i = p.constrained[k]
+ *             res[i] -= rho_vec[k] * sol[i]
+*/
+
+    __pyx_t_3 = __pyx_v_p->s;
+    __pyx_t_4 = __pyx_t_3;
+
+    for (__pyx_t_5 = 0; __pyx_t_5 < __pyx_t_4; __pyx_t_5+=1) {
+      __pyx_v_k = __pyx_t_5;
+
+      /* "fccqp/ldl.pyx":125
+ *             res[i] = rhs[i] - res[i] - sigma * sol[i] - f.ATnu[i]
+ *         for k in range(p.s):
+ *             i = p.constrained[k]             # <<<<<<<<<<<<<<
+ *             res[i] -= rho_vec[k] * sol[i]
+ *         matvec(p.A, sol, f.Ax, m, n)
+*/
+      __pyx_v_i = (__pyx_v_p->constrained[__pyx_v_k]);
+
+      /* "fccqp/ldl.pyx":126
+ *         for k in range(p.s):
+ *             i = p.constrained[k]
+ *             res[i] -= rho_vec[k] * sol[i]             # <<<<<<<<<<<<<<
+ *         matvec(p.A, sol, f.Ax, m, n)
+ *         for i in range(m):
+*/
+
+      __pyx_t_6 = __pyx_v_i;
+      (__pyx_v_res[__pyx_t_6]) = ((__pyx_v_res[__pyx_t_6]) - ((__pyx_v_rho_vec[__pyx_v_k]) * (__pyx_v_sol[__pyx_v_i])));
+    }
+
+
+    /* "fccqp/ldl.pyx":127
+ *             i = p.constrained[k]
+ *             res[i] -= rho_vec[k] * sol[i]
+ *         matvec(p.A, sol, f.Ax, m, n)             # <<<<<<<<<<<<<<
+ *         for i in range(m):
+ *             res[n + i] = rhs[n + i] - f.Ax[i] + _DELTA * sol[n + i]
+*/
+    __pyx_f_5fccqp_6_dense_matvec(__pyx_v_p->A, __pyx_v_sol, __pyx_v_f->Ax, __pyx_v_m, __pyx_v_n);
+
+    /* "fccqp/ldl.pyx":128
+ *             res[i] -= rho_vec[k] * sol[i]
+ *         matvec(p.A, sol, f.Ax, m, n)
+ *         for i in range(m):             # <<<<<<<<<<<<<<
+ *             res[n + i] = rhs[n + i] - f.Ax[i] + _DELTA * sol[n + i]
+ *         _solve_one(f, res)
+*/
+
+    __pyx_t_3 = __pyx_v_m;
+    __pyx_t_4 = __pyx_t_3;
+
+    for (__pyx_t_5 = 0; __pyx_t_5 < __pyx_t_4; __pyx_t_5+=1) {
+      __pyx_v_i = __pyx_t_5;
+
+      /* "fccqp/ldl.pyx":129
+ *         matvec(p.A, sol, f.Ax, m, n)
+ *         for i in range(m):
+ *             res[n + i] = rhs[n + i] - f.Ax[i] + _DELTA * sol[n + i]             # <<<<<<<<<<<<<<
+ *         _solve_one(f, res)
+ *         for i in range(n + m):
+*/
+      (__pyx_v_res[(__pyx_v_n + __pyx_v_i)]) = (((__pyx_v_rhs[(__pyx_v_n + __pyx_v_i)]) - (__pyx_v_f->Ax[__pyx_v_i])) + (__pyx_v_5fccqp_3ldl__DELTA * (__pyx_v_sol[(__pyx_v_n + __pyx_v_i)])));
+    }
+
+
+    /* "fccqp/ldl.pyx":130
+ *         for i in range(m):
+ *             res[n + i] = rhs[n + i] - f.Ax[i] + _DELTA * sol[n + i]
+ *         _solve_one(f, res)             # <<<<<<<<<<<<<<
+ *         for i in range(n + m):
+ *             sol[i] += res[i]
+*/
+    __pyx_f_5fccqp_3ldl__solve_one(__pyx_v_f, __pyx_v_res);
+
+    /* "fccqp/ldl.pyx":131
+ *             res[n + i] = rhs[n + i] - f.Ax[i] + _DELTA * sol[n + i]
+ *         _solve_one(f, res)
+ *         for i in range(n + m):             # <<<<<<<<<<<<<<
+ *             sol[i] += res[i]
+ * 
+*/
+
+    __pyx_t_3 = (__pyx_v_n + __pyx_v_m);
+    __pyx_t_4 = __pyx_t_3;
+
+    for (__pyx_t_5 = 0; __pyx_t_5 < __pyx_t_4; __pyx_t_5+=1) {
+      __pyx_v_i = __pyx_t_5;
+
+      /* "fccqp/ldl.pyx":132
+ *         _solve_one(f, res)
+ *         for i in range(n + m):
+ *             sol[i] += res[i]             # <<<<<<<<<<<<<<
+ * 
+ * 
+*/
+
+      __pyx_t_6 = __pyx_v_i;
+      (__pyx_v_sol[__pyx_t_6]) = ((__pyx_v_sol[__pyx_t_6]) + (__pyx_v_res[__pyx_v_i]));
+    }
+
+  }
+
+  /* "fccqp/ldl.pyx":112
+ * 
+ * 
+ * cdef void _refine_regularized(LDL* f, const Problem* p, double sigma, const double* rho_vec,             # <<<<<<<<<<<<<<
+ *                              const double* rhs, double* sol) noexcept nogil:
+ *     """Two refinement steps against the factored matrix itself (with ``-delta I``): the
+*/
+
+  /* function exit code */
+
+
+
+
+
+
+}
+
+/* "fccqp/ldl.pyx":135
+ * 
+ * 
  * cdef void ldl_solve(LDL* f, const Problem* p, double sigma, const double* rho_vec,             # <<<<<<<<<<<<<<
  *                     const double* rhs, double* sol) noexcept nogil:
- *     """Solve the unregularized KKT system for ``rhs`` into ``sol`` (they may not alias)."""
+ *     """Solve the unregularized KKT system for ``rhs`` into ``sol`` (they may not alias).
 */
 
 static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_v_f, struct __pyx_t_5fccqp_6_types_Problem const *__pyx_v_p, double __pyx_v_sigma, double const *__pyx_v_rho_vec, double const *__pyx_v_rhs, double *__pyx_v_sol) {
@@ -4383,21 +4608,26 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
   Py_ssize_t __pyx_v_m;
   Py_ssize_t __pyx_v_i;
   Py_ssize_t __pyx_v_k;
-  CYTHON_UNUSED Py_ssize_t __pyx_v_r;
+  Py_ssize_t __pyx_v_r;
   double *__pyx_v_res;
+  double __pyx_v_error;
+  double __pyx_v_last_error;
   Py_ssize_t __pyx_t_1;
   Py_ssize_t __pyx_t_2;
   Py_ssize_t __pyx_t_3;
   int __pyx_t_4;
   double *__pyx_t_5;
-  int __pyx_t_6;
-  int __pyx_t_7;
+  long __pyx_t_6;
+  long __pyx_t_7;
   Py_ssize_t __pyx_t_8;
-  Py_ssize_t __pyx_t_9;
+  double __pyx_t_9;
+  double __pyx_t_10;
+  double __pyx_t_11;
+  Py_ssize_t __pyx_t_12;
 
-  /* "fccqp/ldl.pyx":115
- *                     const double* rhs, double* sol) noexcept nogil:
- *     """Solve the unregularized KKT system for ``rhs`` into ``sol`` (they may not alias)."""
+  /* "fccqp/ldl.pyx":143
+ *     ``delta``) is returned rather than one drifting with the singular system.
+ *     """
  *     cdef Py_ssize_t n = p.n, m = p.m, i, k, r             # <<<<<<<<<<<<<<
  *     for i in range(n + m):
  *         sol[i] = rhs[i]
@@ -4409,8 +4639,8 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
 
   __pyx_v_m = __pyx_t_1;
 
-  /* "fccqp/ldl.pyx":116
- *     """Solve the unregularized KKT system for ``rhs`` into ``sol`` (they may not alias)."""
+  /* "fccqp/ldl.pyx":144
+ *     """
  *     cdef Py_ssize_t n = p.n, m = p.m, i, k, r
  *     for i in range(n + m):             # <<<<<<<<<<<<<<
  *         sol[i] = rhs[i]
@@ -4423,7 +4653,7 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/ldl.pyx":117
+    /* "fccqp/ldl.pyx":145
  *     cdef Py_ssize_t n = p.n, m = p.m, i, k, r
  *     for i in range(n + m):
  *         sol[i] = rhs[i]             # <<<<<<<<<<<<<<
@@ -4434,7 +4664,7 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
   }
 
 
-  /* "fccqp/ldl.pyx":118
+  /* "fccqp/ldl.pyx":146
  *     for i in range(n + m):
  *         sol[i] = rhs[i]
  *     _solve_one(f, sol)             # <<<<<<<<<<<<<<
@@ -4443,7 +4673,7 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
 */
   __pyx_f_5fccqp_3ldl__solve_one(__pyx_v_f, __pyx_v_sol);
 
-  /* "fccqp/ldl.pyx":119
+  /* "fccqp/ldl.pyx":147
  *         sol[i] = rhs[i]
  *     _solve_one(f, sol)
  *     if m == 0:             # <<<<<<<<<<<<<<
@@ -4455,18 +4685,18 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
   if (__pyx_t_4) {
 
 
-    /* "fccqp/ldl.pyx":120
+    /* "fccqp/ldl.pyx":148
  *     _solve_one(f, sol)
  *     if m == 0:
  *         return             # <<<<<<<<<<<<<<
  *     cdef double* res = f.residual
- *     for r in range(_MAX_REFINE):
+ *     cdef double error, last_error = INFINITY
 */
     {
     }
     goto __pyx_L0;
 
-    /* "fccqp/ldl.pyx":119
+    /* "fccqp/ldl.pyx":147
  *         sol[i] = rhs[i]
  *     _solve_one(f, sol)
  *     if m == 0:             # <<<<<<<<<<<<<<
@@ -4475,55 +4705,243 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
 */
   }
 
-  /* "fccqp/ldl.pyx":121
+  /* "fccqp/ldl.pyx":149
  *     if m == 0:
  *         return
  *     cdef double* res = f.residual             # <<<<<<<<<<<<<<
- *     for r in range(_MAX_REFINE):
- *         matvec(p.A, sol, f.Ax, m, n)
+ *     cdef double error, last_error = INFINITY
+ *     for r in range(_MAX_REFINE + 1):
 */
   __pyx_t_5 = __pyx_v_f->residual;
 
   __pyx_v_res = __pyx_t_5;
 
-  /* "fccqp/ldl.pyx":122
+  /* "fccqp/ldl.pyx":150
  *         return
  *     cdef double* res = f.residual
- *     for r in range(_MAX_REFINE):             # <<<<<<<<<<<<<<
+ *     cdef double error, last_error = INFINITY             # <<<<<<<<<<<<<<
+ *     for r in range(_MAX_REFINE + 1):
+ *         matvec(p.A, sol, f.Ax, m, n)
+*/
+  __pyx_v_last_error = INFINITY;
+
+  /* "fccqp/ldl.pyx":151
+ *     cdef double* res = f.residual
+ *     cdef double error, last_error = INFINITY
+ *     for r in range(_MAX_REFINE + 1):             # <<<<<<<<<<<<<<
  *         matvec(p.A, sol, f.Ax, m, n)
  *         if meets_equalities(f.Ax, rhs + n, p.E, m):
 */
 
-  __pyx_t_6 = __pyx_v_5fccqp_3ldl__MAX_REFINE;
+  __pyx_t_6 = (__pyx_v_5fccqp_3ldl__MAX_REFINE + 1);
   __pyx_t_7 = __pyx_t_6;
 
   for (__pyx_t_1 = 0; __pyx_t_1 < __pyx_t_7; __pyx_t_1+=1) {
     __pyx_v_r = __pyx_t_1;
 
-    /* "fccqp/ldl.pyx":123
- *     cdef double* res = f.residual
- *     for r in range(_MAX_REFINE):
+    /* "fccqp/ldl.pyx":152
+ *     cdef double error, last_error = INFINITY
+ *     for r in range(_MAX_REFINE + 1):
  *         matvec(p.A, sol, f.Ax, m, n)             # <<<<<<<<<<<<<<
  *         if meets_equalities(f.Ax, rhs + n, p.E, m):
  *             return
 */
     __pyx_f_5fccqp_6_dense_matvec(__pyx_v_p->A, __pyx_v_sol, __pyx_v_f->Ax, __pyx_v_m, __pyx_v_n);
 
-    /* "fccqp/ldl.pyx":124
- *     for r in range(_MAX_REFINE):
+    /* "fccqp/ldl.pyx":153
+ *     for r in range(_MAX_REFINE + 1):
  *         matvec(p.A, sol, f.Ax, m, n)
  *         if meets_equalities(f.Ax, rhs + n, p.E, m):             # <<<<<<<<<<<<<<
  *             return
- *         matvec(p.P, sol, res, n, n)
+ *         error = 0.0
 */
     __pyx_t_4 = __pyx_f_5fccqp_3ldl_meets_equalities(__pyx_v_f->Ax, (__pyx_v_rhs + __pyx_v_n), __pyx_v_p->E, __pyx_v_m);
 
     if (__pyx_t_4) {
 
 
-      /* "fccqp/ldl.pyx":125
+      /* "fccqp/ldl.pyx":154
  *         matvec(p.A, sol, f.Ax, m, n)
  *         if meets_equalities(f.Ax, rhs + n, p.E, m):
+ *             return             # <<<<<<<<<<<<<<
+ *         error = 0.0
+ *         for i in range(m):
+*/
+      {
+      }
+      goto __pyx_L0;
+
+      /* "fccqp/ldl.pyx":153
+ *     for r in range(_MAX_REFINE + 1):
+ *         matvec(p.A, sol, f.Ax, m, n)
+ *         if meets_equalities(f.Ax, rhs + n, p.E, m):             # <<<<<<<<<<<<<<
+ *             return
+ *         error = 0.0
+*/
+    }
+
+    /* "fccqp/ldl.pyx":155
+ *         if meets_equalities(f.Ax, rhs + n, p.E, m):
+ *             return
+ *         error = 0.0             # <<<<<<<<<<<<<<
+ *         for i in range(m):
+ *             error = max(error, fabs(rhs[n + i] - f.Ax[i]) / p.E[i])
+*/
+    __pyx_v_error = 0.0;
+
+    /* "fccqp/ldl.pyx":156
+ *             return
+ *         error = 0.0
+ *         for i in range(m):             # <<<<<<<<<<<<<<
+ *             error = max(error, fabs(rhs[n + i] - f.Ax[i]) / p.E[i])
+ *         if error >= 0.5 * last_error:
+*/
+
+    __pyx_t_2 = __pyx_v_m;
+    __pyx_t_3 = __pyx_t_2;
+
+    for (__pyx_t_8 = 0; __pyx_t_8 < __pyx_t_3; __pyx_t_8+=1) {
+      __pyx_v_i = __pyx_t_8;
+
+      /* "fccqp/ldl.pyx":157
+ *         error = 0.0
+ *         for i in range(m):
+ *             error = max(error, fabs(rhs[n + i] - f.Ax[i]) / p.E[i])             # <<<<<<<<<<<<<<
+ *         if error >= 0.5 * last_error:
+ *             # no progress: A x = b has no solution (inconsistent rows), and refining
+*/
+
+      __pyx_t_9 = (fabs(((__pyx_v_rhs[(__pyx_v_n + __pyx_v_i)]) - (__pyx_v_f->Ax[__pyx_v_i]))) / (__pyx_v_p->E[__pyx_v_i]));
+
+      __pyx_t_10 = __pyx_v_error;
+      __pyx_t_4 = (__pyx_t_9 > __pyx_t_10);
+
+      if (__pyx_t_4) {
+
+        __pyx_t_11 = __pyx_t_9;
+      } else {
+
+        __pyx_t_11 = __pyx_t_10;
+      }
+
+      __pyx_v_error = __pyx_t_11;
+
+    }
+
+
+    /* "fccqp/ldl.pyx":158
+ *         for i in range(m):
+ *             error = max(error, fabs(rhs[n + i] - f.Ax[i]) / p.E[i])
+ *         if error >= 0.5 * last_error:             # <<<<<<<<<<<<<<
+ *             # no progress: A x = b has no solution (inconsistent rows), and refining
+ *             # against the singular system would only inflate nu; undo the last step and
+*/
+    __pyx_t_4 = (__pyx_v_error >= (0.5 * __pyx_v_last_error));
+
+    if (__pyx_t_4) {
+
+
+      /* "fccqp/ldl.pyx":163
+ *             # refine against the regularized matrix instead, whose least-squares x is
+ *             # what the equality certificate reads
+ *             if r > 0:             # <<<<<<<<<<<<<<
+ *                 for i in range(n + m):
+ *                     sol[i] -= res[i]
+*/
+      __pyx_t_4 = (__pyx_v_r > 0);
+
+      if (__pyx_t_4) {
+
+
+        /* "fccqp/ldl.pyx":164
+ *             # what the equality certificate reads
+ *             if r > 0:
+ *                 for i in range(n + m):             # <<<<<<<<<<<<<<
+ *                     sol[i] -= res[i]
+ *             _refine_regularized(f, p, sigma, rho_vec, rhs, sol)
+*/
+
+        __pyx_t_2 = (__pyx_v_n + __pyx_v_m);
+        __pyx_t_3 = __pyx_t_2;
+
+        for (__pyx_t_8 = 0; __pyx_t_8 < __pyx_t_3; __pyx_t_8+=1) {
+          __pyx_v_i = __pyx_t_8;
+
+          /* "fccqp/ldl.pyx":165
+ *             if r > 0:
+ *                 for i in range(n + m):
+ *                     sol[i] -= res[i]             # <<<<<<<<<<<<<<
+ *             _refine_regularized(f, p, sigma, rho_vec, rhs, sol)
+ *             return
+*/
+
+          __pyx_t_12 = __pyx_v_i;
+          (__pyx_v_sol[__pyx_t_12]) = ((__pyx_v_sol[__pyx_t_12]) - (__pyx_v_res[__pyx_v_i]));
+        }
+
+
+        /* "fccqp/ldl.pyx":163
+ *             # refine against the regularized matrix instead, whose least-squares x is
+ *             # what the equality certificate reads
+ *             if r > 0:             # <<<<<<<<<<<<<<
+ *                 for i in range(n + m):
+ *                     sol[i] -= res[i]
+*/
+      }
+
+      /* "fccqp/ldl.pyx":166
+ *                 for i in range(n + m):
+ *                     sol[i] -= res[i]
+ *             _refine_regularized(f, p, sigma, rho_vec, rhs, sol)             # <<<<<<<<<<<<<<
+ *             return
+ *         last_error = error
+*/
+      __pyx_f_5fccqp_3ldl__refine_regularized(__pyx_v_f, __pyx_v_p, __pyx_v_sigma, __pyx_v_rho_vec, __pyx_v_rhs, __pyx_v_sol);
+
+      /* "fccqp/ldl.pyx":167
+ *                     sol[i] -= res[i]
+ *             _refine_regularized(f, p, sigma, rho_vec, rhs, sol)
+ *             return             # <<<<<<<<<<<<<<
+ *         last_error = error
+ *         if r == _MAX_REFINE:
+*/
+      {
+      }
+      goto __pyx_L0;
+
+      /* "fccqp/ldl.pyx":158
+ *         for i in range(m):
+ *             error = max(error, fabs(rhs[n + i] - f.Ax[i]) / p.E[i])
+ *         if error >= 0.5 * last_error:             # <<<<<<<<<<<<<<
+ *             # no progress: A x = b has no solution (inconsistent rows), and refining
+ *             # against the singular system would only inflate nu; undo the last step and
+*/
+    }
+
+    /* "fccqp/ldl.pyx":168
+ *             _refine_regularized(f, p, sigma, rho_vec, rhs, sol)
+ *             return
+ *         last_error = error             # <<<<<<<<<<<<<<
+ *         if r == _MAX_REFINE:
+ *             return
+*/
+    __pyx_v_last_error = __pyx_v_error;
+
+    /* "fccqp/ldl.pyx":169
+ *             return
+ *         last_error = error
+ *         if r == _MAX_REFINE:             # <<<<<<<<<<<<<<
+ *             return
+ *         matvec(p.P, sol, res, n, n)
+*/
+    __pyx_t_4 = (__pyx_v_r == __pyx_v_5fccqp_3ldl__MAX_REFINE);
+
+    if (__pyx_t_4) {
+
+
+      /* "fccqp/ldl.pyx":170
+ *         last_error = error
+ *         if r == _MAX_REFINE:
  *             return             # <<<<<<<<<<<<<<
  *         matvec(p.P, sol, res, n, n)
  *         matvec_t(p.A, sol + n, f.ATnu, m, n)
@@ -4532,17 +4950,17 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
       }
       goto __pyx_L0;
 
-      /* "fccqp/ldl.pyx":124
- *     for r in range(_MAX_REFINE):
- *         matvec(p.A, sol, f.Ax, m, n)
- *         if meets_equalities(f.Ax, rhs + n, p.E, m):             # <<<<<<<<<<<<<<
+      /* "fccqp/ldl.pyx":169
+ *             return
+ *         last_error = error
+ *         if r == _MAX_REFINE:             # <<<<<<<<<<<<<<
  *             return
  *         matvec(p.P, sol, res, n, n)
 */
     }
 
-    /* "fccqp/ldl.pyx":126
- *         if meets_equalities(f.Ax, rhs + n, p.E, m):
+    /* "fccqp/ldl.pyx":171
+ *         if r == _MAX_REFINE:
  *             return
  *         matvec(p.P, sol, res, n, n)             # <<<<<<<<<<<<<<
  *         matvec_t(p.A, sol + n, f.ATnu, m, n)
@@ -4550,7 +4968,7 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
 */
     __pyx_f_5fccqp_6_dense_matvec(__pyx_v_p->P, __pyx_v_sol, __pyx_v_res, __pyx_v_n, __pyx_v_n);
 
-    /* "fccqp/ldl.pyx":127
+    /* "fccqp/ldl.pyx":172
  *             return
  *         matvec(p.P, sol, res, n, n)
  *         matvec_t(p.A, sol + n, f.ATnu, m, n)             # <<<<<<<<<<<<<<
@@ -4559,7 +4977,7 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
 */
     __pyx_f_5fccqp_6_dense_matvec_t(__pyx_v_p->A, (__pyx_v_sol + __pyx_v_n), __pyx_v_f->ATnu, __pyx_v_m, __pyx_v_n);
 
-    /* "fccqp/ldl.pyx":128
+    /* "fccqp/ldl.pyx":173
  *         matvec(p.P, sol, res, n, n)
  *         matvec_t(p.A, sol + n, f.ATnu, m, n)
  *         for i in range(n):             # <<<<<<<<<<<<<<
@@ -4573,7 +4991,7 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
     for (__pyx_t_8 = 0; __pyx_t_8 < __pyx_t_3; __pyx_t_8+=1) {
       __pyx_v_i = __pyx_t_8;
 
-      /* "fccqp/ldl.pyx":129
+      /* "fccqp/ldl.pyx":174
  *         matvec_t(p.A, sol + n, f.ATnu, m, n)
  *         for i in range(n):
  *             res[i] = rhs[i] - res[i] - sigma * sol[i] - f.ATnu[i]             # <<<<<<<<<<<<<<
@@ -4584,7 +5002,7 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
     }
 
 
-    /* "fccqp/ldl.pyx":130
+    /* "fccqp/ldl.pyx":175
  *         for i in range(n):
  *             res[i] = rhs[i] - res[i] - sigma * sol[i] - f.ATnu[i]
  *         for k in range(p.s):             # <<<<<<<<<<<<<<
@@ -4598,7 +5016,7 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
     for (__pyx_t_8 = 0; __pyx_t_8 < __pyx_t_3; __pyx_t_8+=1) {
       __pyx_v_k = __pyx_t_8;
 
-      /* "fccqp/ldl.pyx":131
+      /* "fccqp/ldl.pyx":176
  *             res[i] = rhs[i] - res[i] - sigma * sol[i] - f.ATnu[i]
  *         for k in range(p.s):
  *             i = p.constrained[k]             # <<<<<<<<<<<<<<
@@ -4607,7 +5025,7 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
 */
       __pyx_v_i = (__pyx_v_p->constrained[__pyx_v_k]);
 
-      /* "fccqp/ldl.pyx":132
+      /* "fccqp/ldl.pyx":177
  *         for k in range(p.s):
  *             i = p.constrained[k]
  *             res[i] -= rho_vec[k] * sol[i]             # <<<<<<<<<<<<<<
@@ -4615,12 +5033,12 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
  *             res[n + i] = rhs[n + i] - f.Ax[i]
 */
 
-      __pyx_t_9 = __pyx_v_i;
-      (__pyx_v_res[__pyx_t_9]) = ((__pyx_v_res[__pyx_t_9]) - ((__pyx_v_rho_vec[__pyx_v_k]) * (__pyx_v_sol[__pyx_v_i])));
+      __pyx_t_12 = __pyx_v_i;
+      (__pyx_v_res[__pyx_t_12]) = ((__pyx_v_res[__pyx_t_12]) - ((__pyx_v_rho_vec[__pyx_v_k]) * (__pyx_v_sol[__pyx_v_i])));
     }
 
 
-    /* "fccqp/ldl.pyx":133
+    /* "fccqp/ldl.pyx":178
  *             i = p.constrained[k]
  *             res[i] -= rho_vec[k] * sol[i]
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -4634,7 +5052,7 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
     for (__pyx_t_8 = 0; __pyx_t_8 < __pyx_t_3; __pyx_t_8+=1) {
       __pyx_v_i = __pyx_t_8;
 
-      /* "fccqp/ldl.pyx":134
+      /* "fccqp/ldl.pyx":179
  *             res[i] -= rho_vec[k] * sol[i]
  *         for i in range(m):
  *             res[n + i] = rhs[n + i] - f.Ax[i]             # <<<<<<<<<<<<<<
@@ -4645,7 +5063,7 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
     }
 
 
-    /* "fccqp/ldl.pyx":135
+    /* "fccqp/ldl.pyx":180
  *         for i in range(m):
  *             res[n + i] = rhs[n + i] - f.Ax[i]
  *         _solve_one(f, res)             # <<<<<<<<<<<<<<
@@ -4654,7 +5072,7 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
 */
     __pyx_f_5fccqp_3ldl__solve_one(__pyx_v_f, __pyx_v_res);
 
-    /* "fccqp/ldl.pyx":136
+    /* "fccqp/ldl.pyx":181
  *             res[n + i] = rhs[n + i] - f.Ax[i]
  *         _solve_one(f, res)
  *         for i in range(n + m):             # <<<<<<<<<<<<<<
@@ -4668,7 +5086,7 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
     for (__pyx_t_8 = 0; __pyx_t_8 < __pyx_t_3; __pyx_t_8+=1) {
       __pyx_v_i = __pyx_t_8;
 
-      /* "fccqp/ldl.pyx":137
+      /* "fccqp/ldl.pyx":182
  *         _solve_one(f, res)
  *         for i in range(n + m):
  *             sol[i] += res[i]             # <<<<<<<<<<<<<<
@@ -4676,19 +5094,19 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
  * 
 */
 
-      __pyx_t_9 = __pyx_v_i;
-      (__pyx_v_sol[__pyx_t_9]) = ((__pyx_v_sol[__pyx_t_9]) + (__pyx_v_res[__pyx_v_i]));
+      __pyx_t_12 = __pyx_v_i;
+      (__pyx_v_sol[__pyx_t_12]) = ((__pyx_v_sol[__pyx_t_12]) + (__pyx_v_res[__pyx_v_i]));
     }
 
   }
 
 
-  /* "fccqp/ldl.pyx":112
+  /* "fccqp/ldl.pyx":135
  * 
  * 
  * cdef void ldl_solve(LDL* f, const Problem* p, double sigma, const double* rho_vec,             # <<<<<<<<<<<<<<
  *                     const double* rhs, double* sol) noexcept nogil:
- *     """Solve the unregularized KKT system for ``rhs`` into ``sol`` (they may not alias)."""
+ *     """Solve the unregularized KKT system for ``rhs`` into ``sol`` (they may not alias).
 */
 
   /* function exit code */
@@ -4699,9 +5117,11 @@ static void __pyx_f_5fccqp_3ldl_ldl_solve(struct __pyx_t_5fccqp_3ldl_LDL *__pyx_
 
 
 
+
+
 }
 
-/* "fccqp/ldl.pyx":140
+/* "fccqp/ldl.pyx":185
  * 
  * 
  * cdef bint _in_null_space(const double* AW, const Problem* p, const double* W, int N,             # <<<<<<<<<<<<<<
@@ -4730,7 +5150,7 @@ static int __pyx_f_5fccqp_3ldl__in_null_space(double const *__pyx_v_AW, struct _
   double __pyx_t_9;
   int __pyx_t_10;
 
-  /* "fccqp/ldl.pyx":144
+  /* "fccqp/ldl.pyx":189
  *     """:func:`meets_equalities` for columns ``W_x`` that should satisfy ``A W_x = 0``,
  *     given ``AW = A W_x`` (``m x count``, Fortran)."""
  *     cdef Py_ssize_t i, j, n = p.n, m = p.m             # <<<<<<<<<<<<<<
@@ -4744,7 +5164,7 @@ static int __pyx_f_5fccqp_3ldl__in_null_space(double const *__pyx_v_AW, struct _
 
   __pyx_v_m = __pyx_t_1;
 
-  /* "fccqp/ldl.pyx":145
+  /* "fccqp/ldl.pyx":190
  *     given ``AW = A W_x`` (``m x count``, Fortran)."""
  *     cdef Py_ssize_t i, j, n = p.n, m = p.m
  *     cdef double error = 0.0, a_max = 0.0, w_max = 0.0, e_min = 1e300             # <<<<<<<<<<<<<<
@@ -4756,7 +5176,7 @@ static int __pyx_f_5fccqp_3ldl__in_null_space(double const *__pyx_v_AW, struct _
   __pyx_v_w_max = 0.0;
   __pyx_v_e_min = 1e300;
 
-  /* "fccqp/ldl.pyx":146
+  /* "fccqp/ldl.pyx":191
  *     cdef Py_ssize_t i, j, n = p.n, m = p.m
  *     cdef double error = 0.0, a_max = 0.0, w_max = 0.0, e_min = 1e300
  *     for j in range(count):             # <<<<<<<<<<<<<<
@@ -4770,7 +5190,7 @@ static int __pyx_f_5fccqp_3ldl__in_null_space(double const *__pyx_v_AW, struct _
   for (__pyx_t_1 = 0; __pyx_t_1 < __pyx_t_3; __pyx_t_1+=1) {
     __pyx_v_j = __pyx_t_1;
 
-    /* "fccqp/ldl.pyx":147
+    /* "fccqp/ldl.pyx":192
  *     cdef double error = 0.0, a_max = 0.0, w_max = 0.0, e_min = 1e300
  *     for j in range(count):
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -4784,7 +5204,7 @@ static int __pyx_f_5fccqp_3ldl__in_null_space(double const *__pyx_v_AW, struct _
     for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
       __pyx_v_i = __pyx_t_6;
 
-      /* "fccqp/ldl.pyx":148
+      /* "fccqp/ldl.pyx":193
  *     for j in range(count):
  *         for i in range(m):
  *             error = max(error, fabs(AW[i + j * m]) / p.E[i])             # <<<<<<<<<<<<<<
@@ -4810,7 +5230,7 @@ static int __pyx_f_5fccqp_3ldl__in_null_space(double const *__pyx_v_AW, struct _
     }
 
 
-    /* "fccqp/ldl.pyx":149
+    /* "fccqp/ldl.pyx":194
  *         for i in range(m):
  *             error = max(error, fabs(AW[i + j * m]) / p.E[i])
  *         for i in range(n):             # <<<<<<<<<<<<<<
@@ -4824,7 +5244,7 @@ static int __pyx_f_5fccqp_3ldl__in_null_space(double const *__pyx_v_AW, struct _
     for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
       __pyx_v_i = __pyx_t_6;
 
-      /* "fccqp/ldl.pyx":150
+      /* "fccqp/ldl.pyx":195
  *             error = max(error, fabs(AW[i + j * m]) / p.E[i])
  *         for i in range(n):
  *             w_max = max(w_max, fabs(W[i + j * N]))             # <<<<<<<<<<<<<<
@@ -4852,7 +5272,7 @@ static int __pyx_f_5fccqp_3ldl__in_null_space(double const *__pyx_v_AW, struct _
   }
 
 
-  /* "fccqp/ldl.pyx":151
+  /* "fccqp/ldl.pyx":196
  *         for i in range(n):
  *             w_max = max(w_max, fabs(W[i + j * N]))
  *     for i in range(m * n):             # <<<<<<<<<<<<<<
@@ -4866,7 +5286,7 @@ static int __pyx_f_5fccqp_3ldl__in_null_space(double const *__pyx_v_AW, struct _
   for (__pyx_t_5 = 0; __pyx_t_5 < __pyx_t_4; __pyx_t_5+=1) {
     __pyx_v_i = __pyx_t_5;
 
-    /* "fccqp/ldl.pyx":152
+    /* "fccqp/ldl.pyx":197
  *             w_max = max(w_max, fabs(W[i + j * N]))
  *     for i in range(m * n):
  *         a_max = max(a_max, fabs(p.A[i]))             # <<<<<<<<<<<<<<
@@ -4892,7 +5312,7 @@ static int __pyx_f_5fccqp_3ldl__in_null_space(double const *__pyx_v_AW, struct _
   }
 
 
-  /* "fccqp/ldl.pyx":153
+  /* "fccqp/ldl.pyx":198
  *     for i in range(m * n):
  *         a_max = max(a_max, fabs(p.A[i]))
  *     for i in range(m):             # <<<<<<<<<<<<<<
@@ -4906,7 +5326,7 @@ static int __pyx_f_5fccqp_3ldl__in_null_space(double const *__pyx_v_AW, struct _
   for (__pyx_t_5 = 0; __pyx_t_5 < __pyx_t_4; __pyx_t_5+=1) {
     __pyx_v_i = __pyx_t_5;
 
-    /* "fccqp/ldl.pyx":154
+    /* "fccqp/ldl.pyx":199
  *         a_max = max(a_max, fabs(p.A[i]))
  *     for i in range(m):
  *         e_min = min(e_min, p.E[i])             # <<<<<<<<<<<<<<
@@ -4932,7 +5352,7 @@ static int __pyx_f_5fccqp_3ldl__in_null_space(double const *__pyx_v_AW, struct _
   }
 
 
-  /* "fccqp/ldl.pyx":155
+  /* "fccqp/ldl.pyx":200
  *     for i in range(m):
  *         e_min = min(e_min, p.E[i])
  *     return error <= _REFINE_TOLERANCE * max(1.0, a_max * w_max / e_min)             # <<<<<<<<<<<<<<
@@ -4960,7 +5380,7 @@ static int __pyx_f_5fccqp_3ldl__in_null_space(double const *__pyx_v_AW, struct _
 
   goto __pyx_L0;
 
-  /* "fccqp/ldl.pyx":140
+  /* "fccqp/ldl.pyx":185
  * 
  * 
  * cdef bint _in_null_space(const double* AW, const Problem* p, const double* W, int N,             # <<<<<<<<<<<<<<
@@ -4981,7 +5401,7 @@ static int __pyx_f_5fccqp_3ldl__in_null_space(double const *__pyx_v_AW, struct _
   return __pyx_r;
 }
 
-/* "fccqp/ldl.pyx":158
+/* "fccqp/ldl.pyx":203
  * 
  * 
  * cdef bint ldl_unit_columns(LDL* f, const Problem* p, double sigma, const double* rho_vec,             # <<<<<<<<<<<<<<
@@ -5012,7 +5432,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
   Py_ssize_t __pyx_t_12;
   Py_ssize_t __pyx_t_13;
 
-  /* "fccqp/ldl.pyx":164
+  /* "fccqp/ldl.pyx":209
  *     in ``entries``, refined like :func:`ldl_solve`; ``R`` is scratch of ``W``'s size and
  *     ``work`` of ``N``. False when the equality part misses ``REFINE_TOLERANCE``."""
  *     cdef int n = <int>p.n, m = <int>p.m, N = f.N, i, j, k, r             # <<<<<<<<<<<<<<
@@ -5025,7 +5445,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
 
   __pyx_v_N = __pyx_t_1;
 
-  /* "fccqp/ldl.pyx":165
+  /* "fccqp/ldl.pyx":210
  *     ``work`` of ``N``. False when the equality part misses ``REFINE_TOLERANCE``."""
  *     cdef int n = <int>p.n, m = <int>p.m, N = f.N, i, j, k, r
  *     for j in range(count):             # <<<<<<<<<<<<<<
@@ -5039,7 +5459,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_j = __pyx_t_3;
 
-    /* "fccqp/ldl.pyx":166
+    /* "fccqp/ldl.pyx":211
  *     cdef int n = <int>p.n, m = <int>p.m, N = f.N, i, j, k, r
  *     for j in range(count):
  *         for i in range(N):             # <<<<<<<<<<<<<<
@@ -5053,7 +5473,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
     for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
       __pyx_v_i = __pyx_t_6;
 
-      /* "fccqp/ldl.pyx":167
+      /* "fccqp/ldl.pyx":212
  *     for j in range(count):
  *         for i in range(N):
  *             W[i + j * N] = 0.0             # <<<<<<<<<<<<<<
@@ -5064,7 +5484,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
     }
 
 
-    /* "fccqp/ldl.pyx":168
+    /* "fccqp/ldl.pyx":213
  *         for i in range(N):
  *             W[i + j * N] = 0.0
  *         W[entries[j] + j * N] = 1.0             # <<<<<<<<<<<<<<
@@ -5075,7 +5495,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
   }
 
 
-  /* "fccqp/ldl.pyx":169
+  /* "fccqp/ldl.pyx":214
  *             W[i + j * N] = 0.0
  *         W[entries[j] + j * N] = 1.0
  *     ldl_solve_many(f, W, count, work)             # <<<<<<<<<<<<<<
@@ -5084,7 +5504,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
 */
   __pyx_f_5fccqp_3ldl_ldl_solve_many(__pyx_v_f, __pyx_v_W, __pyx_v_count, __pyx_v_work);
 
-  /* "fccqp/ldl.pyx":170
+  /* "fccqp/ldl.pyx":215
  *         W[entries[j] + j * N] = 1.0
  *     ldl_solve_many(f, W, count, work)
  *     if m == 0:             # <<<<<<<<<<<<<<
@@ -5096,7 +5516,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
   if (__pyx_t_7) {
 
 
-    /* "fccqp/ldl.pyx":171
+    /* "fccqp/ldl.pyx":216
  *     ldl_solve_many(f, W, count, work)
  *     if m == 0:
  *         return True             # <<<<<<<<<<<<<<
@@ -5109,7 +5529,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
     }
     goto __pyx_L0;
 
-    /* "fccqp/ldl.pyx":170
+    /* "fccqp/ldl.pyx":215
  *         W[entries[j] + j * N] = 1.0
  *     ldl_solve_many(f, W, count, work)
  *     if m == 0:             # <<<<<<<<<<<<<<
@@ -5118,7 +5538,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
 */
   }
 
-  /* "fccqp/ldl.pyx":172
+  /* "fccqp/ldl.pyx":217
  *     if m == 0:
  *         return True
  *     for r in range(_MAX_REFINE + 1):             # <<<<<<<<<<<<<<
@@ -5132,7 +5552,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
   for (__pyx_t_1 = 0; __pyx_t_1 < __pyx_t_9; __pyx_t_1+=1) {
     __pyx_v_r = __pyx_t_1;
 
-    /* "fccqp/ldl.pyx":174
+    /* "fccqp/ldl.pyx":219
  *     for r in range(_MAX_REFINE + 1):
  *         # R_nu = A W_x (m x count, stored in the first m rows of R's columns of length m)
  *         gemm(b"T", b"N", m, count, n, 1.0, p.A, n, W, N, 0.0, R, m)             # <<<<<<<<<<<<<<
@@ -5141,7 +5561,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
 */
     __pyx_f_5fccqp_5_blas_gemm('T', 'N', __pyx_v_m, __pyx_v_count, __pyx_v_n, 1.0, __pyx_v_p->A, __pyx_v_n, __pyx_v_W, __pyx_v_N, 0.0, __pyx_v_R, __pyx_v_m);
 
-    /* "fccqp/ldl.pyx":175
+    /* "fccqp/ldl.pyx":220
  *         # R_nu = A W_x (m x count, stored in the first m rows of R's columns of length m)
  *         gemm(b"T", b"N", m, count, n, 1.0, p.A, n, W, N, 0.0, R, m)
  *         if _in_null_space(R, p, W, N, count):             # <<<<<<<<<<<<<<
@@ -5153,7 +5573,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
     if (__pyx_t_7) {
 
 
-      /* "fccqp/ldl.pyx":176
+      /* "fccqp/ldl.pyx":221
  *         gemm(b"T", b"N", m, count, n, 1.0, p.A, n, W, N, 0.0, R, m)
  *         if _in_null_space(R, p, W, N, count):
  *             return True             # <<<<<<<<<<<<<<
@@ -5166,7 +5586,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
       }
       goto __pyx_L0;
 
-      /* "fccqp/ldl.pyx":175
+      /* "fccqp/ldl.pyx":220
  *         # R_nu = A W_x (m x count, stored in the first m rows of R's columns of length m)
  *         gemm(b"T", b"N", m, count, n, 1.0, p.A, n, W, N, 0.0, R, m)
  *         if _in_null_space(R, p, W, N, count):             # <<<<<<<<<<<<<<
@@ -5175,7 +5595,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
 */
     }
 
-    /* "fccqp/ldl.pyx":177
+    /* "fccqp/ldl.pyx":222
  *         if _in_null_space(R, p, W, N, count):
  *             return True
  *         for j in range(count - 1, -1, -1):  # -A W_x to rows n.. (back to front: no overlap)             # <<<<<<<<<<<<<<
@@ -5185,7 +5605,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
     for (__pyx_t_2 = (__pyx_v_count - 1); __pyx_t_2 > -1; __pyx_t_2-=1) {
       __pyx_v_j = __pyx_t_2;
 
-      /* "fccqp/ldl.pyx":178
+      /* "fccqp/ldl.pyx":223
  *             return True
  *         for j in range(count - 1, -1, -1):  # -A W_x to rows n.. (back to front: no overlap)
  *             for i in range(m - 1, -1, -1):             # <<<<<<<<<<<<<<
@@ -5195,7 +5615,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
       for (__pyx_t_3 = (__pyx_v_m - 1); __pyx_t_3 > -1; __pyx_t_3-=1) {
         __pyx_v_i = __pyx_t_3;
 
-        /* "fccqp/ldl.pyx":179
+        /* "fccqp/ldl.pyx":224
  *         for j in range(count - 1, -1, -1):  # -A W_x to rows n.. (back to front: no overlap)
  *             for i in range(m - 1, -1, -1):
  *                 R[n + i + j * N] = -R[i + j * m]             # <<<<<<<<<<<<<<
@@ -5206,7 +5626,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
       }
     }
 
-    /* "fccqp/ldl.pyx":181
+    /* "fccqp/ldl.pyx":226
  *                 R[n + i + j * N] = -R[i + j * m]
  *         # R_x = e - (P + sigma I) W_x - A' W_nu - R W_x
  *         gemm(b"N", b"N", n, count, n, -1.0, p.P, n, W, N, 0.0, R, N)             # <<<<<<<<<<<<<<
@@ -5215,7 +5635,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
 */
     __pyx_f_5fccqp_5_blas_gemm('N', 'N', __pyx_v_n, __pyx_v_count, __pyx_v_n, -1.0, __pyx_v_p->P, __pyx_v_n, __pyx_v_W, __pyx_v_N, 0.0, __pyx_v_R, __pyx_v_N);
 
-    /* "fccqp/ldl.pyx":182
+    /* "fccqp/ldl.pyx":227
  *         # R_x = e - (P + sigma I) W_x - A' W_nu - R W_x
  *         gemm(b"N", b"N", n, count, n, -1.0, p.P, n, W, N, 0.0, R, N)
  *         gemm(b"N", b"N", n, count, m, -1.0, p.A, n, W + n, N, 1.0, R, N)             # <<<<<<<<<<<<<<
@@ -5224,7 +5644,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
 */
     __pyx_f_5fccqp_5_blas_gemm('N', 'N', __pyx_v_n, __pyx_v_count, __pyx_v_m, -1.0, __pyx_v_p->A, __pyx_v_n, (__pyx_v_W + __pyx_v_n), __pyx_v_N, 1.0, __pyx_v_R, __pyx_v_N);
 
-    /* "fccqp/ldl.pyx":183
+    /* "fccqp/ldl.pyx":228
  *         gemm(b"N", b"N", n, count, n, -1.0, p.P, n, W, N, 0.0, R, N)
  *         gemm(b"N", b"N", n, count, m, -1.0, p.A, n, W + n, N, 1.0, R, N)
  *         for j in range(count):             # <<<<<<<<<<<<<<
@@ -5238,7 +5658,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
     for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
       __pyx_v_j = __pyx_t_4;
 
-      /* "fccqp/ldl.pyx":184
+      /* "fccqp/ldl.pyx":229
  *         gemm(b"N", b"N", n, count, m, -1.0, p.A, n, W + n, N, 1.0, R, N)
  *         for j in range(count):
  *             for i in range(n):             # <<<<<<<<<<<<<<
@@ -5252,7 +5672,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
       for (__pyx_t_10 = 0; __pyx_t_10 < __pyx_t_6; __pyx_t_10+=1) {
         __pyx_v_i = __pyx_t_10;
 
-        /* "fccqp/ldl.pyx":185
+        /* "fccqp/ldl.pyx":230
  *         for j in range(count):
  *             for i in range(n):
  *                 R[i + j * N] -= sigma * W[i + j * N]             # <<<<<<<<<<<<<<
@@ -5265,7 +5685,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
       }
 
 
-      /* "fccqp/ldl.pyx":186
+      /* "fccqp/ldl.pyx":231
  *             for i in range(n):
  *                 R[i + j * N] -= sigma * W[i + j * N]
  *             for k in range(p.s):             # <<<<<<<<<<<<<<
@@ -5279,7 +5699,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
       for (__pyx_t_5 = 0; __pyx_t_5 < __pyx_t_13; __pyx_t_5+=1) {
         __pyx_v_k = __pyx_t_5;
 
-        /* "fccqp/ldl.pyx":187
+        /* "fccqp/ldl.pyx":232
  *                 R[i + j * N] -= sigma * W[i + j * N]
  *             for k in range(p.s):
  *                 i = <int>p.constrained[k]             # <<<<<<<<<<<<<<
@@ -5288,7 +5708,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
 */
         __pyx_v_i = ((int)(__pyx_v_p->constrained[__pyx_v_k]));
 
-        /* "fccqp/ldl.pyx":188
+        /* "fccqp/ldl.pyx":233
  *             for k in range(p.s):
  *                 i = <int>p.constrained[k]
  *                 R[i + j * N] -= rho_vec[k] * W[i + j * N]             # <<<<<<<<<<<<<<
@@ -5301,7 +5721,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
       }
 
 
-      /* "fccqp/ldl.pyx":189
+      /* "fccqp/ldl.pyx":234
  *                 i = <int>p.constrained[k]
  *                 R[i + j * N] -= rho_vec[k] * W[i + j * N]
  *             R[entries[j] + j * N] += 1.0             # <<<<<<<<<<<<<<
@@ -5314,7 +5734,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
     }
 
 
-    /* "fccqp/ldl.pyx":190
+    /* "fccqp/ldl.pyx":235
  *                 R[i + j * N] -= rho_vec[k] * W[i + j * N]
  *             R[entries[j] + j * N] += 1.0
  *         ldl_solve_many(f, R, count, work)             # <<<<<<<<<<<<<<
@@ -5323,7 +5743,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
 */
     __pyx_f_5fccqp_3ldl_ldl_solve_many(__pyx_v_f, __pyx_v_R, __pyx_v_count, __pyx_v_work);
 
-    /* "fccqp/ldl.pyx":191
+    /* "fccqp/ldl.pyx":236
  *             R[entries[j] + j * N] += 1.0
  *         ldl_solve_many(f, R, count, work)
  *         for i in range(N * count):             # <<<<<<<<<<<<<<
@@ -5337,7 +5757,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
     for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
       __pyx_v_i = __pyx_t_4;
 
-      /* "fccqp/ldl.pyx":192
+      /* "fccqp/ldl.pyx":237
  *         ldl_solve_many(f, R, count, work)
  *         for i in range(N * count):
  *             W[i] += R[i]             # <<<<<<<<<<<<<<
@@ -5351,7 +5771,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
   }
 
 
-  /* "fccqp/ldl.pyx":193
+  /* "fccqp/ldl.pyx":238
  *         for i in range(N * count):
  *             W[i] += R[i]
  *     return False             # <<<<<<<<<<<<<<
@@ -5362,7 +5782,7 @@ static int __pyx_f_5fccqp_3ldl_ldl_unit_columns(struct __pyx_t_5fccqp_3ldl_LDL *
   }
   goto __pyx_L0;
 
-  /* "fccqp/ldl.pyx":158
+  /* "fccqp/ldl.pyx":203
  * 
  * 
  * cdef bint ldl_unit_columns(LDL* f, const Problem* p, double sigma, const double* rho_vec,             # <<<<<<<<<<<<<<
@@ -7662,85 +8082,6 @@ static PyObject *__Pyx_Object_VectorcallMethodKwds(PyObject *name, PyObject *con
 #endif
 
 /* CIntToPy */
-static CYTHON_INLINE PyObject* __Pyx_PyLong_From_int(int value) {
-#ifdef __Pyx_HAS_GCC_DIAGNOSTIC
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wconversion"
-#endif
-    const int neg_one = (int) -1, const_zero = (int) 0;
-#ifdef __Pyx_HAS_GCC_DIAGNOSTIC
-#pragma GCC diagnostic pop
-#endif
-    const int is_unsigned = neg_one > const_zero;
-    if (is_unsigned) {
-        if (sizeof(int) < sizeof(long)) {
-            return PyLong_FromLong((long) value);
-        } else if (sizeof(int) <= sizeof(unsigned long)) {
-            return PyLong_FromUnsignedLong((unsigned long) value);
-#if !CYTHON_COMPILING_IN_PYPY
-        } else if (sizeof(int) <= sizeof(unsigned PY_LONG_LONG)) {
-            return PyLong_FromUnsignedLongLong((unsigned PY_LONG_LONG) value);
-#endif
-        }
-    } else {
-        if (sizeof(int) <= sizeof(long)) {
-            return PyLong_FromLong((long) value);
-        } else if (sizeof(int) <= sizeof(PY_LONG_LONG)) {
-            return PyLong_FromLongLong((PY_LONG_LONG) value);
-        }
-    }
-    {
-        unsigned char *bytes = (unsigned char *)&value;
-#if !CYTHON_COMPILING_IN_LIMITED_API && PY_VERSION_HEX >= 0x030d00A4
-        if (is_unsigned) {
-            return PyLong_FromUnsignedNativeBytes(bytes, sizeof(value), -1);
-        } else {
-            return PyLong_FromNativeBytes(bytes, sizeof(value), -1);
-        }
-#elif !CYTHON_COMPILING_IN_LIMITED_API && PY_VERSION_HEX < 0x030d0000
-        int one = 1; int little = (int)*(unsigned char *)&one;
-        return _PyLong_FromByteArray(bytes, sizeof(int),
-                                     little, !is_unsigned);
-#else
-        int one = 1; int little = (int)*(unsigned char *)&one;
-        PyObject *result = NULL, *kwds = NULL;
-        PyObject *py_bytes = NULL, *order_str = NULL, *from_bytes_str = NULL;;
-        py_bytes = PyBytes_FromStringAndSize((char*)bytes, sizeof(int));
-        if (!py_bytes) goto limited_bad;
-        from_bytes_str = PyUnicode_FromStringAndSize("from_bytes", 10);
-        if (!from_bytes_str) goto limited_bad;
-        order_str = PyUnicode_FromString(little ? "little" : "big");
-        if (!order_str) goto limited_bad;
-        {
-            PyObject *args[] = { (PyObject*)&PyLong_Type, py_bytes, order_str, Py_True };
-            if (!is_unsigned) {
-                PyObject *signed_str = PyUnicode_FromStringAndSize("signed", 6);
-                if (!signed_str) goto limited_bad;
-#if CYTHON_VECTORCALL
-                kwds = PyTuple_Pack(1, signed_str);
-#else
-                {
-                    PyObject *keys[] = {signed_str};
-                    PyObject *values[] = {Py_True};
-                    kwds = __Pyx_MakeKwargDict(keys, values, 1);
-                }
-#endif
-                Py_DECREF(signed_str);
-                if (unlikely(!kwds)) goto limited_bad;
-            }
-            result = __Pyx_Object_VectorcallMethodKwds(from_bytes_str, args, 3 | __Pyx_PY_VECTORCALL_ARGUMENTS_OFFSET, kwds);
-        }
-        limited_bad:
-        Py_XDECREF(kwds);
-        Py_XDECREF(order_str);
-        Py_XDECREF(py_bytes);
-        Py_XDECREF(from_bytes_str);
-        return result;
-#endif
-    }
-}
-
-/* CIntToPy */
 static CYTHON_INLINE PyObject* __Pyx_PyLong_From_long(long value) {
 #ifdef __Pyx_HAS_GCC_DIAGNOSTIC
 #pragma GCC diagnostic push
@@ -7785,6 +8126,85 @@ static CYTHON_INLINE PyObject* __Pyx_PyLong_From_long(long value) {
         PyObject *result = NULL, *kwds = NULL;
         PyObject *py_bytes = NULL, *order_str = NULL, *from_bytes_str = NULL;;
         py_bytes = PyBytes_FromStringAndSize((char*)bytes, sizeof(long));
+        if (!py_bytes) goto limited_bad;
+        from_bytes_str = PyUnicode_FromStringAndSize("from_bytes", 10);
+        if (!from_bytes_str) goto limited_bad;
+        order_str = PyUnicode_FromString(little ? "little" : "big");
+        if (!order_str) goto limited_bad;
+        {
+            PyObject *args[] = { (PyObject*)&PyLong_Type, py_bytes, order_str, Py_True };
+            if (!is_unsigned) {
+                PyObject *signed_str = PyUnicode_FromStringAndSize("signed", 6);
+                if (!signed_str) goto limited_bad;
+#if CYTHON_VECTORCALL
+                kwds = PyTuple_Pack(1, signed_str);
+#else
+                {
+                    PyObject *keys[] = {signed_str};
+                    PyObject *values[] = {Py_True};
+                    kwds = __Pyx_MakeKwargDict(keys, values, 1);
+                }
+#endif
+                Py_DECREF(signed_str);
+                if (unlikely(!kwds)) goto limited_bad;
+            }
+            result = __Pyx_Object_VectorcallMethodKwds(from_bytes_str, args, 3 | __Pyx_PY_VECTORCALL_ARGUMENTS_OFFSET, kwds);
+        }
+        limited_bad:
+        Py_XDECREF(kwds);
+        Py_XDECREF(order_str);
+        Py_XDECREF(py_bytes);
+        Py_XDECREF(from_bytes_str);
+        return result;
+#endif
+    }
+}
+
+/* CIntToPy */
+static CYTHON_INLINE PyObject* __Pyx_PyLong_From_int(int value) {
+#ifdef __Pyx_HAS_GCC_DIAGNOSTIC
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wconversion"
+#endif
+    const int neg_one = (int) -1, const_zero = (int) 0;
+#ifdef __Pyx_HAS_GCC_DIAGNOSTIC
+#pragma GCC diagnostic pop
+#endif
+    const int is_unsigned = neg_one > const_zero;
+    if (is_unsigned) {
+        if (sizeof(int) < sizeof(long)) {
+            return PyLong_FromLong((long) value);
+        } else if (sizeof(int) <= sizeof(unsigned long)) {
+            return PyLong_FromUnsignedLong((unsigned long) value);
+#if !CYTHON_COMPILING_IN_PYPY
+        } else if (sizeof(int) <= sizeof(unsigned PY_LONG_LONG)) {
+            return PyLong_FromUnsignedLongLong((unsigned PY_LONG_LONG) value);
+#endif
+        }
+    } else {
+        if (sizeof(int) <= sizeof(long)) {
+            return PyLong_FromLong((long) value);
+        } else if (sizeof(int) <= sizeof(PY_LONG_LONG)) {
+            return PyLong_FromLongLong((PY_LONG_LONG) value);
+        }
+    }
+    {
+        unsigned char *bytes = (unsigned char *)&value;
+#if !CYTHON_COMPILING_IN_LIMITED_API && PY_VERSION_HEX >= 0x030d00A4
+        if (is_unsigned) {
+            return PyLong_FromUnsignedNativeBytes(bytes, sizeof(value), -1);
+        } else {
+            return PyLong_FromNativeBytes(bytes, sizeof(value), -1);
+        }
+#elif !CYTHON_COMPILING_IN_LIMITED_API && PY_VERSION_HEX < 0x030d0000
+        int one = 1; int little = (int)*(unsigned char *)&one;
+        return _PyLong_FromByteArray(bytes, sizeof(int),
+                                     little, !is_unsigned);
+#else
+        int one = 1; int little = (int)*(unsigned char *)&one;
+        PyObject *result = NULL, *kwds = NULL;
+        PyObject *py_bytes = NULL, *order_str = NULL, *from_bytes_str = NULL;;
+        py_bytes = PyBytes_FromStringAndSize((char*)bytes, sizeof(int));
         if (!py_bytes) goto limited_bad;
         from_bytes_str = PyUnicode_FromStringAndSize("from_bytes", 10);
         if (!from_bytes_str) goto limited_bad;

@@ -20,7 +20,7 @@ right-hand side (refined); :func:`ldl_solve_many` for several, unrefined (level-
 ``dsytrs2``); callers refine those.
 """
 
-from libc.math cimport fabs
+from libc.math cimport INFINITY, fabs
 
 from scipy.linalg.cython_lapack cimport dsytrf, dsytrs, dsytrs2
 
@@ -109,9 +109,37 @@ cdef bint meets_equalities(const double* Ax, const double* b, const double* row_
     return error <= _REFINE_TOLERANCE * max(1.0, size)
 
 
+cdef void _refine_regularized(LDL* f, const Problem* p, double sigma, const double* rho_vec,
+                             const double* rhs, double* sol) noexcept nogil:
+    """Two refinement steps against the factored matrix itself (with ``-delta I``): the
+    factorization of a matrix with entries 1 and 1e-13 loses digits that refinement
+    recovers."""
+    cdef Py_ssize_t n = p.n, m = p.m, i, k, step
+    cdef double* res = f.residual
+    for step in range(2):
+        matvec(p.P, sol, res, n, n)
+        matvec_t(p.A, sol + n, f.ATnu, m, n)
+        for i in range(n):
+            res[i] = rhs[i] - res[i] - sigma * sol[i] - f.ATnu[i]
+        for k in range(p.s):
+            i = p.constrained[k]
+            res[i] -= rho_vec[k] * sol[i]
+        matvec(p.A, sol, f.Ax, m, n)
+        for i in range(m):
+            res[n + i] = rhs[n + i] - f.Ax[i] + _DELTA * sol[n + i]
+        _solve_one(f, res)
+        for i in range(n + m):
+            sol[i] += res[i]
+
+
 cdef void ldl_solve(LDL* f, const Problem* p, double sigma, const double* rho_vec,
                     const double* rhs, double* sol) noexcept nogil:
-    """Solve the unregularized KKT system for ``rhs`` into ``sol`` (they may not alias)."""
+    """Solve the unregularized KKT system for ``rhs`` into ``sol`` (they may not alias).
+
+    Refinement stops when a step does not halve the equality error: then ``A x = b``
+    has no solution, and the regularized solution (the least-squares ``x`` up to
+    ``delta``) is returned rather than one drifting with the singular system.
+    """
     cdef Py_ssize_t n = p.n, m = p.m, i, k, r
     for i in range(n + m):
         sol[i] = rhs[i]
@@ -119,9 +147,26 @@ cdef void ldl_solve(LDL* f, const Problem* p, double sigma, const double* rho_ve
     if m == 0:
         return
     cdef double* res = f.residual
-    for r in range(_MAX_REFINE):
+    cdef double error, last_error = INFINITY
+    for r in range(_MAX_REFINE + 1):
         matvec(p.A, sol, f.Ax, m, n)
         if meets_equalities(f.Ax, rhs + n, p.E, m):
+            return
+        error = 0.0
+        for i in range(m):
+            error = max(error, fabs(rhs[n + i] - f.Ax[i]) / p.E[i])
+        if error >= 0.5 * last_error:
+            # no progress: A x = b has no solution (inconsistent rows), and refining
+            # against the singular system would only inflate nu; undo the last step and
+            # refine against the regularized matrix instead, whose least-squares x is
+            # what the equality certificate reads
+            if r > 0:
+                for i in range(n + m):
+                    sol[i] -= res[i]
+            _refine_regularized(f, p, sigma, rho_vec, rhs, sol)
+            return
+        last_error = error
+        if r == _MAX_REFINE:
             return
         matvec(p.P, sol, res, n, n)
         matvec_t(p.A, sol + n, f.ATnu, m, n)
