@@ -42,6 +42,7 @@ __all__ = [
     "DEFAULT_SOLVERS",
     "LoadResult",
     "blas_info",
+    "busy_cpus",
     "cpu_load",
     "main",
     "measure",
@@ -76,6 +77,31 @@ def cpu_load(count: int, max_seconds: float = 600.0) -> Iterator[list[subprocess
             p.wait()
 
 
+def busy_cpus(interval: float = 0.5) -> float | None:
+    """How many CPUs other processes kept busy over ``interval`` s (None without /proc/stat).
+
+    This process sleeps meanwhile, so the figure is the load of the rest of the machine:
+    an "unloaded" round is only unloaded if this is close to 0.
+    """
+
+    def read() -> tuple[int, int] | None:
+        try:
+            with open("/proc/stat") as fh:
+                fields = [int(v) for v in fh.readline().split()[1:]]
+        except (OSError, ValueError):
+            return None
+        idle = fields[3] + (fields[4] if len(fields) > 4 else 0)
+        return sum(fields), idle
+
+    a = read()
+    time.sleep(interval)
+    b = read()
+    if a is None or b is None or b[0] == a[0]:
+        return None
+    total, idle = b[0] - a[0], b[1] - a[1]
+    return (total - idle) / total * (os.cpu_count() or 1)
+
+
 def blas_info() -> list[dict]:
     """What threadpoolctl reports about the loaded BLAS/OpenMP libraries (may be empty)."""
     try:
@@ -93,8 +119,8 @@ class LoadResult:
     loaded: dict[str, list[float]] = field(default_factory=dict)
     solved: dict[str, list[bool]] = field(default_factory=dict)
     skipped: dict[str, str] = field(default_factory=dict)
-    loadavg: list[float] = field(default_factory=list)
-    """1-minute load average at the start of each unloaded round (empty where unknown)."""
+    busy: list[float] = field(default_factory=list)
+    """CPUs busy with other processes just before each unloaded round (Linux only)."""
 
     def median(self, name: str, loaded: bool) -> float:
         """Median solve time of ``name`` (s)."""
@@ -214,8 +240,10 @@ def measure(
     for r in range(rounds):
         loaded = r % 2 == 1
         order = found[r % len(found) :] + found[: r % len(found)] if found else []
-        if not loaded and hasattr(os, "getloadavg"):
-            result.loadavg.append(os.getloadavg()[0])
+        if not loaded:
+            busy = busy_cpus()
+            if busy is not None:
+                result.busy.append(busy)
         with cpu_load(load if loaded else 0, max_seconds):
             for n in order:
                 times, solved = _pass(adapters[n], prepared[n], test_set.sequence)
@@ -238,10 +266,12 @@ def format_table(result: LoadResult, load: int) -> str:
             f"{n:16s} {result.median(n, False) * 1e6:12.0f} {result.median(n, True) * 1e6:10.0f} "
             f"{p90 * 1e6:11.0f} {result.ratio(n):6.2f} {solved:7.1%}"
         )
-    if result.loadavg:
-        worst = max(result.loadavg)
-        note = "" if worst < 0.5 else "  WARNING: the machine was not idle in unloaded rounds"
-        lines.append(f"1-min load average before unloaded rounds: max {worst:.2f}{note}")
+    if result.busy:
+        worst = max(result.busy)
+        note = "" if worst < 0.3 else "  WARNING: other processes were running"
+        lines.append(
+            f"CPUs busy with other processes before unloaded rounds: max {worst:.2f}{note}"
+        )
     for n, why in result.skipped.items():
         lines.append(f"{n:16s} skipped: {why}")
     lines.append(
