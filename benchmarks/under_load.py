@@ -311,14 +311,12 @@ def main(argv: Sequence[str] | None = None) -> None:
     result = measure(
         test_set, args.solvers, rounds=args.rounds, load=args.load, max_seconds=args.max_seconds
     )
-    print(
-        f"{args.robot}, {len(test_set)} QPs ({MIX}, seed {args.seed}), {args.rounds} rounds, "
-        "library thread defaults"
-    )
+    env = {k: v for k, v in os.environ.items() if k.endswith("_NUM_THREADS")}
+    threads = f"thread variables set: {env}" if env else "library thread defaults"
+    head = f"{args.robot}, {len(test_set)} QPs ({MIX}, seed {args.seed}), {args.rounds} rounds"
+    print(f"{head}, {threads}")
     print(format_table(result, args.load))
     print(format_blas(blas_info()))
-    env = {k: v for k, v in os.environ.items() if k.endswith("_NUM_THREADS")}
-    print(f"thread variables: {env or 'none set'}")
 
 
 if __name__ == "__main__":
