@@ -15,7 +15,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from benchmarks.harness import baseline, run_variants
+from benchmarks.baseline import baseline
+from benchmarks.harness import run_variants
 from benchmarks.report import RunInfo, write_outputs
 from benchmarks.robots import ROBOTS
 from benchmarks.scenarios import SCENARIOS

@@ -24,11 +24,11 @@ from dataclasses import asdict
 import numpy as np
 from tqdm import tqdm
 
+from benchmarks.adapters import Adapter, SolveOutcome
 from benchmarks.metrics import qp_metrics
-from benchmarks.solvers import Adapter, SolveOutcome, kkt_factorization_time
 from benchmarks.testsets import TestSet
 
-__all__ = ["WARMUP_QPS", "baseline", "run_variants"]
+__all__ = ["WARMUP_QPS", "run_variants"]
 
 WARMUP_QPS = 5
 """QPs solved (and discarded) by each variant before timing."""
@@ -44,16 +44,6 @@ def _one_pass(adapter: Adapter, data: Sequence[object], sequence: np.ndarray) ->
             previous = seq
         out.append(adapter.solve(item))
     return out
-
-
-def baseline(test_set: TestSet, repeats: int) -> list[tuple[float, float]]:
-    """Per QP: median ``dsytrf`` time of the KKT matrix and its equality residual."""
-    gc.collect()
-    gc.disable()
-    try:
-        return [kkt_factorization_time(qp, max(repeats, 3)) for qp in test_set.qps]
-    finally:
-        gc.enable()
 
 
 def run_variants(
