@@ -66,7 +66,7 @@ def run_variants(
     kkt
         Output of :func:`baseline` for the set, copied into each row.
     progress
-        Show a tqdm bar.
+        Show tqdm bars for the preparation, the warm-up and the timed passes.
 
     Returns
     -------
@@ -74,15 +74,24 @@ def run_variants(
         One row per variant and QP (variants in the given order), the columns of
         ``results.csv``.
     """
-    data = [[adapter.prepare(qp) for qp in test_set.qps] for adapter in adapters]
+    robot = test_set.robot
+    data = [
+        [adapter.prepare(qp) for qp in test_set.qps]
+        for adapter in tqdm(adapters, desc=f"{robot}: preparing inputs", leave=False,
+                            disable=not progress)
+    ]
     n_qps = len(test_set.qps)
     warm = min(WARMUP_QPS, n_qps)
-    for adapter, prepared in zip(adapters, data, strict=True):
+    bar = tqdm(adapters, desc=f"{robot}: warm-up (a first run compiles fccqp, 1-3 min)",
+               leave=False, disable=not progress)
+    for adapter, prepared in zip(bar, data, strict=True):
+        bar.set_postfix_str(adapter.name)
         _one_pass(adapter, prepared[:warm], test_set.sequence[:warm])
     times = np.zeros((len(adapters), repeats, n_qps))
     first: list[list[SolveOutcome]] = [[] for _ in adapters]
     bar = tqdm(
-        total=repeats * n_qps * len(adapters), desc=f"{test_set.robot}", leave=False,
+        total=repeats * n_qps * len(adapters), desc=f"{robot}: timing {repeats} passes",
+        leave=False,
         disable=not progress,
     )
     for r in range(repeats):
