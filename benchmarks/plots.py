@@ -59,6 +59,9 @@ REFERENCE_NOTE = "reference = Clarabel at 1e-9"
 _TORQUE_PLOTTED = ("fccqp-realtime", "fccqp-default", "daqp-pyr4", "osqp-pyr4", "proxqp-pyr8")
 _WP_FLOOR = 1e-4
 """Lowest torque error drawn in the work-precision plot (% of limit); smaller ones sit on it."""
+_LINES = {"realtime": "-.", "8 facets": "--"}
+"""Line style of the settings that share a solver's colour in the sequence figures
+(solid for the default; qpsolvers variants dotted)."""
 _DPI = 80
 _LEGEND = {"loc": "upper left", "bbox_to_anchor": (1.01, 1.0), "fontsize": 7, "frameon": False}
 
@@ -67,7 +70,7 @@ def _style(variant: str) -> dict[str, object]:
     """Colour, marker, line style and fill of a variant (hollow when it sees a pyramid)."""
     v = VARIANTS[variant]
     colour, marker = STYLE[v.family]
-    line = ":" if not v.direct else ("--" if v.setting == "8 facets" else "-")
+    line = ":" if not v.direct else _LINES.get(v.setting, "-")
     return {"color": colour, "marker": marker, "ls": line,
             "mfc": colour if v.exact_cones else "none"}
 
