@@ -215,8 +215,8 @@ class QuadprogAdapter(Adapter):
 class PiqpAdapter(Adapter):
     """PIQP's dense backend on the 4-facet inner pyramid; setup + solve timed, cold.
 
-    ``tol`` sets ``eps_abs`` and ``eps_rel`` (PIQP's defaults, 1e-8 and 1e-9, when
-    ``None``).
+    ``tol`` sets ``eps_abs`` and ``eps_rel = tol / 10``, the ratio of PIQP's defaults
+    (1e-8 and 1e-9, kept when ``None``).
     """
 
     def __init__(self, name: str, tol: float | None = None) -> None:
@@ -237,7 +237,8 @@ class PiqpAdapter(Adapter):
         solver = self._piqp.DenseSolver()
         solver.settings.verbose = False
         if self._tol is not None:
-            solver.settings.eps_abs = solver.settings.eps_rel = self._tol
+            solver.settings.eps_abs = self._tol
+            solver.settings.eps_rel = self._tol / 10
         solver.setup(*data)
         status = solver.solve()
         elapsed = time.perf_counter() - start

@@ -86,14 +86,19 @@ def _fccqp(name: str, setting: str, sweep: bool, overrides: dict, realtime: bool
 
 def _tolerances(name: str, family: str, exact: bool, module: str,
                 make: Callable[[str, float | None], Adapter], knob: str,
-                default: float, loose: float, tight: float) -> list[Variant]:
-    """A peer at its default tolerance and at a looser and a tighter one."""
+                tolerances: tuple[float, float, float], start: str) -> list[Variant]:
+    """A peer at its default tolerance and at a looser and a tighter one.
+
+    ``tolerances`` are (default, loose, tight); ``start`` says how it starts a solve.
+    """
     cones = "exact cones" if exact else "4-facet inner pyramid"
-    out = [Variant(name, family, "default", exact, True, False, module,
-                   lambda v: make(v, None), f"{family} defaults ({knob} {default:g}), {cones}")]
+    default, loose, tight = tolerances
+    out = [Variant(name, family, "default", exact, True, False, module, lambda v: make(v, None),
+                   f"{family} defaults ({knob} {default:.0e}), {cones}, {start}")]
     for label, tol in (("loose", loose), ("tight", tight)):
         out.append(Variant(f"{name}-{label}", family, label, exact, True, True, module,
-                           lambda v, tol=tol: make(v, tol), f"{family}, {knob} {tol:g}, {cones}"))
+                           lambda v, tol=tol: make(v, tol),
+                           f"{family}, {knob} {tol:.0e}, {cones}, {start}"))
     return out
 
 
@@ -114,24 +119,30 @@ _LIST: list[Variant] = [
         for it in (30, 60)
     ],
     *_tolerances("clarabel", "clarabel", True, "clarabel", ClarabelAdapter,
-                 "tol_gap_abs = tol_gap_rel = tol_feas", 1e-8, 1e-5, 1e-10),
+                 "tol_gap_abs = tol_gap_rel = tol_feas", (1e-8, 1e-5, 1e-10),
+                 "cold (no warm start)"),
     *_tolerances("qoco", "qoco", True, "qoco", QocoAdapter, "abstol = reltol",
-                 1e-7, 1e-4, 1e-9),
-    *_tolerances("scs", "scs", True, "scs", ScsAdapter, "eps_abs = eps_rel", 1e-4, 1e-3, 1e-5),
+                 (1e-7, 1e-4, 1e-9), "cold (no warm start in its Python API)"),
+    *_tolerances("scs", "scs", True, "scs", ScsAdapter, "eps_abs = eps_rel", (1e-4, 1e-3, 1e-5),
+                 "warm (previous x, y, s)"),
     *_tolerances("daqp-pyr4", "daqp", False, "daqp", DaqpAdapter, "primal_tol",
-                 1e-6, 1e-4, 1e-9),
+                 (1e-6, 1e-4, 1e-9), "warm (previous multipliers)"),
     Variant("quadprog-pyr4", "quadprog", "default", False, True, False, "quadprog",
             QuadprogAdapter, "quadprog (no settings), 4-facet inner pyramid, cold"),
-    *_tolerances("piqp-pyr4", "piqp", False, "piqp", PiqpAdapter, "eps_abs = eps_rel",
-                 1e-8, 1e-5, 1e-10),
+    *_tolerances("piqp-pyr4", "piqp", False, "piqp", PiqpAdapter,
+                 "eps_abs (eps_rel = eps_abs / 10)",
+                 (1e-8, 1e-5, 1e-10), "cold (no warm start)"),
     *_tolerances("proxqp-pyr4", "proxqp", False, "proxsuite",
-                 lambda v, eps: ProxqpAdapter(v, 4, eps), "eps_abs", 1e-5, 1e-3, 1e-8),
+                 lambda v, eps: ProxqpAdapter(v, 4, eps), "eps_abs", (1e-5, 1e-3, 1e-8),
+                 "warm (update)"),
     Variant("proxqp-pyr8", "proxqp", "8 facets", False, True, False, "proxsuite",
-            lambda v: ProxqpAdapter(v, 8), "proxqp defaults, 8-facet inner pyramid, warm"),
+            lambda v: ProxqpAdapter(v, 8), "proxqp defaults, 8-facet inner pyramid, warm (update)"),
     *_tolerances("osqp-pyr4", "osqp", False, "osqp", lambda v, eps: OsqpAdapter(v, 4, eps),
-                 "eps_abs = eps_rel", 1e-3, 1e-2, 1e-5),
+                 "eps_abs = eps_rel", (1e-3, 1e-2, 1e-5),
+                 "warm (warm_start x, y)"),
     Variant("osqp-pyr8", "osqp", "8 facets", False, True, False, "osqp",
-            lambda v: OsqpAdapter(v, 8), "osqp defaults, 8-facet inner pyramid, warm"),
+            lambda v: OsqpAdapter(v, 8),
+            "osqp defaults, 8-facet inner pyramid, warm (warm_start x, y)"),
     *[
         Variant(f"qpsolvers:{s}", s, "via qpsolvers", False, False, False, "qpsolvers",
                 lambda v, s=s: QpsolversAdapter(v, s),
