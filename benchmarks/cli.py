@@ -15,7 +15,6 @@ import shlex
 import sys
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 from threadpoolctl import threadpool_limits
@@ -25,35 +24,18 @@ from benchmarks.baseline import baseline
 from benchmarks.cache import DEFAULT_CACHE, cached_test_set
 from benchmarks.harness import run_variants
 from benchmarks.machine import blas_info, load_average
+from benchmarks.presets import PRESETS
 from benchmarks.report import RunInfo, write_outputs
 from benchmarks.robots import ROBOTS
 from benchmarks.scenarios import SCENARIOS
 from benchmarks.solvers import VARIANTS, available_variants, make_adapter
 from benchmarks.testsets import MIX
 
-__all__ = ["DEFAULT_OUT", "PRESETS", "Preset", "build_parser", "main"]
+__all__ = ["DEFAULT_OUT", "build_parser", "main"]
 
 DEFAULT_OUT = Path(__file__).resolve().parent / "out"
 """Default parent folder of the outputs (ignored by git; the committed reports under
 ``benchmarks/results/`` are only written when ``--out`` names them)."""
-
-
-@dataclass(frozen=True)
-class Preset:
-    """Sizes of a run: QPs per robot, ticks per sequence, timing passes."""
-
-    n_qps: int
-    seq_len: int
-    repeats: int
-
-
-PRESETS: dict[str, Preset] = {
-    # 4 sequences of 15 ticks: one of each scenario of the mix; every variant, the settings
-    # sweeps included, in under 2 minutes on 2 cores once fccqp is compiled.
-    "quick": Preset(n_qps=60, seq_len=15, repeats=3),
-    # 4 sequences of 100 ticks (the generator's default length).
-    "full": Preset(n_qps=400, seq_len=100, repeats=10),
-}
 
 
 def _choice_list(kind: str, known: Sequence[str]):

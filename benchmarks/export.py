@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.cache import DEFAULT_CACHE, cached_test_set
+from benchmarks.presets import PRESETS
 from benchmarks.robots import ROBOTS
 from benchmarks.testsets import MIX, TestSet
 
@@ -118,8 +119,11 @@ def build_parser() -> argparse.ArgumentParser:
                         help="folder of the qpbenchmark test set (created)")
     parser.add_argument("--robots", nargs="+", choices=list(ROBOTS), default=list(ROBOTS),
                         metavar="ROBOT", help=f"robots (default all: {', '.join(ROBOTS)})")
-    parser.add_argument("--n-qps", type=int, default=80, help="QPs per robot (default 80)")
-    parser.add_argument("--seq-len", type=int, default=20, help="ticks per sequence (default 20)")
+    quick = PRESETS["quick"]
+    parser.add_argument("--n-qps", type=int, default=quick.n_qps,
+                        help=f"QPs per robot (default {quick.n_qps}, the quick preset's)")
+    parser.add_argument("--seq-len", type=int, default=quick.seq_len,
+                        help=f"ticks per sequence (default {quick.seq_len})")
     parser.add_argument("--seed", type=int, default=0, help="test-set seed (default 0)")
     parser.add_argument("--cache", type=Path, default=DEFAULT_CACHE,
                         help="folder of cached test sets (default benchmarks/.cache)")

@@ -75,6 +75,26 @@ def _style(variant: str) -> dict[str, object]:
             "mfc": colour if v.exact_cones else "none"}
 
 
+_TOLERANCE_ORDER = ("loose", "eps 1e-03", "eps 1e-04", "default", "eps 1e-06", "eps 1e-07",
+                    "tight")
+_BUDGET_ORDER = ("realtime", "realtime, 30 it", "realtime, 60 it")
+
+
+def _curve(variant: str) -> tuple[str, int] | None:
+    """Which line of the work-precision plot a variant lies on, and its place on it.
+
+    A solver's tolerance sweep (loose, default, tight; fccqp's eps values) is one line
+    from loose to tight, fccqp's iteration budgets another; other points stand alone.
+    """
+    v = VARIANTS[variant]
+    if not v.direct:
+        return None
+    for name, order in (("tolerance", _TOLERANCE_ORDER), ("budget", _BUDGET_ORDER)):
+        if v.setting in order:
+            return name, order.index(v.setting)
+    return None
+
+
 def _label(variant: str) -> str:
     v = VARIANTS[variant]
     return variant if v.exact_cones else f"{variant} (pyramid)"
@@ -177,10 +197,10 @@ def plot_sequence(ts: TestSet, rows: Sequence[dict[str, object]], out: Path) -> 
 def plot_work_precision(ts: TestSet, rows: Sequence[dict[str, object]], out: Path) -> str:
     """Median solve time (x) against p95 torque error in % of the joint limit (y).
 
-    One point per variant, labelled with its setting; the points of one solver are
-    joined in order of time. A QP the solver does not report solved counts as an
-    infinite error, so a variant with more than 5 % of such QPs has an infinite p95
-    and is drawn as a cross on the top edge. Returns the file name.
+    One point per variant, labelled with its setting; a solver's tolerance sweep is
+    joined from loose to tight (see :func:`_curve`). A QP the solver does not report
+    solved counts as an infinite error, so a variant with more than 5 % of such QPs has
+    an infinite p95 and is drawn as a cross on the top edge. Returns the file name.
     """
     solvers = list(dict.fromkeys(str(r["solver"]) for r in rows))
     points: dict[str, tuple[float, float]] = {}
@@ -192,7 +212,7 @@ def plot_work_precision(ts: TestSet, rows: Sequence[dict[str, object]], out: Pat
 
     fig, ax = plt.subplots(figsize=(9.5, 5.5))
     edge = blended_transform_factory(ax.transData, ax.transAxes)
-    families: dict[tuple[str, bool], list[tuple[float, float]]] = {}
+    curves: dict[tuple[str, str], list[tuple[int, float, float]]] = {}
     for s, (x, y) in points.items():
         v = VARIANTS[s]
         setting = v.setting
@@ -204,15 +224,16 @@ def plot_work_precision(ts: TestSet, rows: Sequence[dict[str, object]], out: Pat
                     mfc=style["mfc"])
             ax.annotate(setting, (x, y_drawn), xytext=(4, 3), textcoords="offset points",
                         fontsize=6, color=colour)
-            families.setdefault((v.family, v.direct), []).append((x, y_drawn))
+            curve = _curve(s)
+            if curve is not None:
+                curves.setdefault((v.family, curve[0]), []).append((curve[1], x, y_drawn))
         else:
             ax.plot(x, 1.0, "x", color=colour, ms=8, mew=2, transform=edge, clip_on=False)
             ax.annotate(setting, (x, 1.0), xycoords=edge, xytext=(4, -9),
                         textcoords="offset points", fontsize=6, color=colour)
-    for (family, direct), pts in families.items():
+    for (family, _), pts in curves.items():
         pts.sort()
-        ax.plot(*zip(*pts, strict=True), color=STYLE[family][0], lw=0.8,
-                ls="-" if direct else ":")
+        ax.plot([p[1] for p in pts], [p[2] for p in pts], color=STYLE[family][0], lw=0.8)
     for family, (colour, marker) in STYLE.items():
         if any(VARIANTS[s].family == family for s in solvers):
             exact = any(VARIANTS[s].exact_cones for s in solvers if VARIANTS[s].family == family)
