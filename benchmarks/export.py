@@ -79,7 +79,7 @@ class WbcPyramidQpbenchmark(TestSet):
         data = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
         for fname in sorted(os.listdir(data)):
             if fname.endswith(".npz"):
-                yield Problem.load(os.path.join(data, fname), name=fname[:-4])
+                yield Problem.load(os.path.join(data, fname))  # named after the file
 '''
 
 
