@@ -82,7 +82,7 @@ def run_variants(
     ]
     n_qps = len(test_set.qps)
     warm = min(WARMUP_QPS, n_qps)
-    bar = tqdm(adapters, desc=f"{robot}: warm-up (a first run compiles fccqp, 1-3 min)",
+    bar = tqdm(adapters, desc=f"{robot}: warm-up (a first run compiles fccqp: 2-4 min)",
                leave=False, disable=not progress)
     for adapter, prepared in zip(bar, data, strict=True):
         bar.set_postfix_str(adapter.name)
