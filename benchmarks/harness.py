@@ -3,14 +3,16 @@
 A pass is one variant solving the whole set; passes never interleave per QP, so caches
 and warm-start state belong to one solver at a time:
 
-1. every QP is prepared (:meth:`~benchmarks.solvers.Adapter.prepare`) before timing;
+1. every QP is prepared (:meth:`~benchmarks.adapters.Adapter.prepare`) before timing;
 2. warm-up: each variant solves the first few QPs and is reset, so that JIT
    compilation (fccqp's numba kernels) and first-call costs are not timed;
 3. ``repeats`` rounds; in each, every variant makes one pass over the set in
    controller-loop order, resetting the warm start at each sequence boundary, with
    the garbage collector off. Rotating the variants round by round (instead of
    running each variant's passes back to back) spreads the drifts of a shared
-   machine's speed, which last minutes, over all variants alike.
+   machine's speed, which last minutes, over all variants alike. Objects that exist
+   before the first round are frozen out of the garbage collector (``gc.freeze``), so
+   the collection before each pass costs little.
    A pass is deterministic, so the per-QP time reported is the median over the passes
    and the solution is the one of the first pass.
 """
@@ -64,7 +66,7 @@ def run_variants(
     repeats
         Rounds of passes; the time per QP is the median over a variant's passes.
     kkt
-        Output of :func:`baseline` for the set, copied into each row.
+        Output of :func:`benchmarks.baseline.baseline` for the set, copied into each row.
     progress
         Show tqdm bars for the preparation, the warm-up and the timed passes.
 
