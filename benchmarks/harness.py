@@ -3,14 +3,16 @@
 A pass is one variant solving the whole set; passes never interleave per QP, so caches
 and warm-start state belong to one solver at a time:
 
-1. every QP is prepared (:meth:`~benchmarks.solvers.Adapter.prepare`) before timing;
+1. every QP is prepared (:meth:`~benchmarks.adapters.Adapter.prepare`) before timing;
 2. warm-up: each variant solves the first few QPs and is reset, so that JIT
    compilation (fccqp's numba kernels) and first-call costs are not timed;
 3. ``repeats`` rounds; in each, every variant makes one pass over the set in
    controller-loop order, resetting the warm start at each sequence boundary, with
    the garbage collector off. Rotating the variants round by round (instead of
    running each variant's passes back to back) spreads the drifts of a shared
-   machine's speed, which last minutes, over all variants alike.
+   machine's speed, which last minutes, over all variants alike. Objects that exist
+   before the first round are frozen out of the garbage collector (``gc.freeze``), so
+   the collection before each pass costs little.
    A pass is deterministic, so the per-QP time reported is the median over the passes
    and the solution is the one of the first pass.
 """
@@ -24,11 +26,11 @@ from dataclasses import asdict
 import numpy as np
 from tqdm import tqdm
 
+from benchmarks.adapters import Adapter, SolveOutcome
 from benchmarks.metrics import qp_metrics
-from benchmarks.solvers import Adapter, SolveOutcome, kkt_factorization_time
 from benchmarks.testsets import TestSet
 
-__all__ = ["WARMUP_QPS", "baseline", "run_variants"]
+__all__ = ["WARMUP_QPS", "run_variants"]
 
 WARMUP_QPS = 5
 """QPs solved (and discarded) by each variant before timing."""
@@ -44,16 +46,6 @@ def _one_pass(adapter: Adapter, data: Sequence[object], sequence: np.ndarray) ->
             previous = seq
         out.append(adapter.solve(item))
     return out
-
-
-def baseline(test_set: TestSet, repeats: int) -> list[tuple[float, float]]:
-    """Per QP: median ``dsytrf`` time of the KKT matrix and its equality residual."""
-    gc.collect()
-    gc.disable()
-    try:
-        return [kkt_factorization_time(qp, max(repeats, 3)) for qp in test_set.qps]
-    finally:
-        gc.enable()
 
 
 def run_variants(
@@ -74,9 +66,9 @@ def run_variants(
     repeats
         Rounds of passes; the time per QP is the median over a variant's passes.
     kkt
-        Output of :func:`baseline` for the set, copied into each row.
+        Output of :func:`benchmarks.baseline.baseline` for the set, copied into each row.
     progress
-        Show a tqdm bar.
+        Show tqdm bars for the preparation, the warm-up and the timed passes.
 
     Returns
     -------
@@ -84,15 +76,44 @@ def run_variants(
         One row per variant and QP (variants in the given order), the columns of
         ``results.csv``.
     """
-    data = [[adapter.prepare(qp) for qp in test_set.qps] for adapter in adapters]
+    robot = test_set.robot
+    data = [
+        [adapter.prepare(qp) for qp in test_set.qps]
+        for adapter in tqdm(adapters, desc=f"{robot}: preparing inputs", leave=False,
+                            disable=not progress)
+    ]
     n_qps = len(test_set.qps)
     warm = min(WARMUP_QPS, n_qps)
-    for adapter, prepared in zip(adapters, data, strict=True):
+    bar = tqdm(adapters, desc=f"{robot}: warm-up (a first run compiles fccqp: 2-4 min)",
+               leave=False, disable=not progress)
+    for adapter, prepared in zip(bar, data, strict=True):
+        bar.set_postfix_str(adapter.name)
         _one_pass(adapter, prepared[:warm], test_set.sequence[:warm])
+    # Freeze what exists now (prepared data, models): the collection before each pass then
+    # walks only new objects (without this, 40 % of a run went into gc.collect).
+    gc.collect()
+    gc.freeze()
+    try:
+        return _timed_rounds(adapters, data, test_set, repeats, kkt, progress)
+    finally:
+        gc.unfreeze()
+
+
+def _timed_rounds(
+    adapters: Sequence[Adapter],
+    data: Sequence[Sequence[object]],
+    test_set: TestSet,
+    repeats: int,
+    kkt: Sequence[tuple[float, float]],
+    progress: bool,
+) -> list[dict[str, object]]:
+    """``repeats`` rounds of one pass per adapter, rotating; the rows of every QP."""
+    robot, n_qps = test_set.robot, len(test_set.qps)
     times = np.zeros((len(adapters), repeats, n_qps))
     first: list[list[SolveOutcome]] = [[] for _ in adapters]
     bar = tqdm(
-        total=repeats * n_qps * len(adapters), desc=f"{test_set.robot}", leave=False,
+        total=repeats * n_qps * len(adapters), desc=f"{robot}: timing {repeats} passes",
+        leave=False,
         disable=not progress,
     )
     for r in range(repeats):

@@ -22,12 +22,16 @@ import numpy as np
 from benchmarks.wbc_qp import WbcQP
 
 __all__ = [
+    "DEADLINES",
     "SHIFT",
     "TOLERANCE",
+    "TORQUE_LIMIT_SHARE",
     "QPMetrics",
     "Summary",
+    "deadline_share",
     "qp_metrics",
     "shifted_geometric_mean",
+    "solved_torque_errors",
     "summarize",
 ]
 
@@ -36,6 +40,12 @@ TOLERANCE = 1e-3
 
 SHIFT = 10.0
 """Shift of the shifted geometric mean of times, in seconds (qpbenchmark's value)."""
+
+DEADLINES = (250e-6, 500e-6, 1e-3)
+"""Time budgets (s) of the deadline view."""
+
+TORQUE_LIMIT_SHARE = 0.05
+"""Largest torque error, as a fraction of the joint's limit, of a usable answer."""
 
 
 @dataclass(frozen=True)
@@ -127,6 +137,8 @@ class Summary:
     but suboptimal); ``reported_rate`` is how often the solver itself reports success.
     ``shm_time`` counts unreported solves as ``time_limit``; the ratios compare medians
     with the fastest variant of the set and with one ``dsytrf`` of the KKT matrix.
+    ``p95_torque_error_rel`` judges every returned point; ``p95_solved_torque_error_rel``
+    counts a QP the solver did not report solved as an infinite error.
     """
 
     solver: str
@@ -148,6 +160,34 @@ class Summary:
     p95_torque_error: float
     max_torque_error: float
     p95_torque_error_rel: float
+    p95_solved_torque_error_rel: float
+
+
+def solved_torque_errors(rows: Sequence[dict[str, object]]) -> np.ndarray:
+    """``torque_error_rel`` of each row, infinite where the solver did not report success.
+
+    The work-precision view counts an unsolved QP as a failure whatever point came back.
+    """
+    return np.array(
+        [float(r["torque_error_rel"]) if r["reported"] else np.inf for r in rows], dtype=float
+    )
+
+
+def deadline_share(rows: Sequence[dict[str, object]], budget: float) -> float:
+    """Share of ``rows`` (one solver) answered within ``budget`` seconds, and usefully.
+
+    A QP counts when the solve took at most ``budget``, the solver reports success, the
+    point is feasible for the exact cones (:attr:`QPMetrics.feasible`) and its largest
+    torque error is below :data:`TORQUE_LIMIT_SHARE` of the joint's limit.
+    """
+    ok = [
+        float(r["time"]) <= budget
+        and bool(r["reported"])
+        and bool(r["feasible"])
+        and float(r["torque_error_rel"]) < TORQUE_LIMIT_SHARE
+        for r in rows
+    ]
+    return float(np.mean(ok)) if ok else float("nan")
 
 
 def summarize(
@@ -203,6 +243,12 @@ def summarize(
                 p95_torque_error=float(np.percentile(du, 95)),
                 max_torque_error=float(np.max(du)),
                 p95_torque_error_rel=float(np.percentile(column(s, "torque_error_rel"), 95)),
+                p95_solved_torque_error_rel=float(
+                    np.percentile(
+                        solved_torque_errors([r for r in rows if r["solver"] == s]), 95,
+                        method="higher",  # no interpolation with an infinite neighbour
+                    )
+                ),
             )
         )
     return out

@@ -24,8 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 
 import fccqp
+from benchmarks.exact_solvers import fccqp_arguments
 from benchmarks.robots import ROBOTS
-from benchmarks.solvers import fccqp_arguments
 from benchmarks.testsets import TestSet, generate_test_set
 
 

@@ -1,11 +1,10 @@
-"""Write the benchmark's outputs: ``results.csv``, ``report.md`` and PNG plots.
+"""Write the benchmark's outputs: ``results.csv``, ``report.md`` and the PNG figures.
 
-The report states the machine and library versions, how it was produced, what each
-test set holds, one table per set, and a targets section that checks the goals of
-issue 5 and says MET or MISSED with the numbers. Plots follow the paper's Figure 1:
-solve time along one sequence per solver (top), one joint's torque along that
-sequence from fccqp, the reference and the pyramid solvers (bottom); plus the
-distribution of solve times per solver.
+The report states how it was produced (the exact command), the machine (CPU, BLAS
+library and threads, load average at start and end), the library versions, what each
+test set holds, one table per set of the solvers' default settings, the work-precision
+figure and the deadline view of every variant, and a targets section that says MET or
+MISSED with the numbers. The figures are drawn by :mod:`benchmarks.plots`.
 """
 
 from __future__ import annotations
@@ -13,37 +12,42 @@ from __future__ import annotations
 import csv
 import os
 import platform
-import subprocess
 from collections.abc import Sequence
 from dataclasses import dataclass
-from importlib import metadata
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+from benchmarks.machine import cpu_model, git_revision, version
+from benchmarks.metrics import (
+    DEADLINES,
+    SHIFT,
+    TOLERANCE,
+    TORQUE_LIMIT_SHARE,
+    Summary,
+    deadline_share,
+    summarize,
+)
+from benchmarks.plots import REFERENCE_NOTE, plot_distribution, plot_sequence, plot_work_precision
+from benchmarks.solvers import VARIANTS
+from benchmarks.testsets import TestSet, active_fraction
 
-from benchmarks.metrics import SHIFT, TOLERANCE, Summary, summarize  # noqa: E402
-from benchmarks.solvers import VARIANTS  # noqa: E402
-from benchmarks.testsets import TestSet, active_flags, active_fraction  # noqa: E402
+__all__ = ["TORQUE_TARGET", "RunInfo", "write_csv", "write_outputs"]
 
-__all__ = ["TORQUE_TARGET", "RunInfo", "write_outputs"]
-
-TORQUE_TARGET = 0.05
+TORQUE_TARGET = TORQUE_LIMIT_SHARE
 """Target on fccqp-realtime's torque error: p95 over QPs of ``max_j |du_j| / u_max_j``."""
 
 EQUALITY_FACTOR = 10.0
 """An equality residual is at factorization accuracy when within this factor of
 (plus 1e-12) the residual of a direct ``dsytrf``/``dsytrs`` solve of the KKT system."""
 
-_SPEED_TARGETS = (("proxqp-pyr4", 4.0), ("osqp-pyr4", 10.0), ("clarabel", 10.0))
-_PYRAMID_PLOTTED = ("proxqp-pyr4", "osqp-pyr4", "proxqp-pyr8", "osqp-pyr8")
+_PROJECT_TARGETS = (("proxqp-pyr4", 4.0), ("osqp-pyr4", 10.0), ("clarabel", 10.0))
+"""fccqp-realtime's speed goals: median at most 1/factor of these peers' medians."""
 _CSV_SKIP = ("u",)
 _LIBRARIES = (
-    "numpy", "scipy", "numba", "fccqp", "clarabel", "proxsuite", "osqp", "qpsolvers",
-    "pin", "example-robot-data", "matplotlib",
+    "numpy", "scipy", "numba", "fccqp", "clarabel", "qoco", "scs", "daqp", "quadprog", "piqp",
+    "proxsuite", "osqp", "qpsolvers", "pin", "example-robot-data", "matplotlib",
+    "threadpoolctl",
 )
 
 
@@ -63,6 +67,12 @@ class RunInfo:
         Seed of the test sets.
     skipped
         Variants requested but not installed.
+    blas
+        threadpoolctl's description of each thread pool, one line each.
+    blas_threads
+        Thread limit applied to those pools while timing (``None``: not limited).
+    load_start, load_end
+        1-minute load average when the run started and when the timing ended.
     """
 
     command: str
@@ -70,40 +80,10 @@ class RunInfo:
     repeats: int
     seed: int
     skipped: tuple[str, ...] = ()
-
-
-def _cpu_model() -> str:
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
-
-
-def _version(package: str) -> str:
-    try:
-        return metadata.version(package)
-    except metadata.PackageNotFoundError:
-        return "not installed"
-
-
-def _git_revision() -> str:
-    """Commit of the working tree, with ``+ local changes in src/`` when it is dirty."""
-    root = Path(__file__).resolve().parent.parent
-    try:
-        head = subprocess.run(
-            ["git", "rev-parse", "--short", "HEAD"], cwd=root, capture_output=True, text=True,
-            check=True,
-        ).stdout.strip()
-        dirty = subprocess.run(
-            ["git", "status", "--porcelain", "--", "src"], cwd=root, capture_output=True,
-            text=True, check=True,
-        ).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
-    return f"{head} + local changes in src/" if dirty else head
+    blas: tuple[str, ...] = ()
+    blas_threads: int | None = None
+    load_start: float = float("nan")
+    load_end: float = float("nan")
 
 
 def _us(seconds: float) -> str:
@@ -128,90 +108,6 @@ def write_csv(rows: Sequence[dict[str, object]], path: Path) -> None:
             writer.writerow(
                 {k: (f"{v:.4g}" if isinstance(v, float) else v) for k, v in row.items()}
             )
-
-
-def _plotted_sequence(ts: TestSet) -> int:
-    """The sequence with the largest share of active QPs (then the longest)."""
-    best, key = int(ts.sequence[0]), (-1.0, 0)
-    for seq in dict.fromkeys(ts.sequence.tolist()):
-        idx = np.flatnonzero(ts.sequence == seq)
-        share = np.mean([any(active_flags(ts.qps[i], ts.x_ref[i])) for i in idx])
-        if (share, idx.size) > key:
-            best, key = int(seq), (float(share), idx.size)
-    return best
-
-
-def _plotted_joint(ts: TestSet, idx: np.ndarray) -> int:
-    """The joint whose reference torque comes closest to its limit along ``idx``."""
-    u = ts.qps[0].layout["u"]
-    usage = np.max([np.abs(ts.x_ref[i][u]) / ts.qps[i].ub[u] for i in idx], axis=0)
-    return int(np.argmax(usage))
-
-
-def plot_sequence(ts: TestSet, rows: Sequence[dict[str, object]], out: Path) -> tuple[str, str]:
-    """Figure 1 of the paper for one robot: times (top) and a torque (bottom).
-
-    The time plot shows the direct-API variants and the dsytrf baseline (the qpsolvers
-    variants are in the distribution plot).
-    """
-    seq = _plotted_sequence(ts)
-    idx = np.flatnonzero(ts.sequence == seq)
-    t_ms = (idx - idx[0]) * ts.dt * 1e3
-    solvers = list(dict.fromkeys(str(r["solver"]) for r in rows))
-    by = {(str(r["solver"]), int(r["qp"])): r for r in rows}
-    fig, ax = plt.subplots(figsize=(8, 4))
-    ax.set_prop_cycle(color=plt.get_cmap("tab10").colors)
-    for s in solvers:
-        if not s.startswith("qpsolvers:"):
-            ax.plot(t_ms, [1e6 * float(by[s, i]["time"]) for i in idx], label=s, lw=1)
-    kkt = [1e6 * float(by[solvers[0], i]["dsytrf_time"]) for i in idx]
-    ax.plot(t_ms, kkt, "k--", lw=1, label="one dsytrf (baseline)")
-    ax.set_yscale("log")
-    ax.set_xlabel("time along the sequence [ms]")
-    ax.set_ylabel("solve time [us]")
-    ax.set_title(f"{ts.robot}: solve time along sequence {seq} ({ts.scenario} set)")
-    ax.legend(fontsize=7, ncol=2)
-    fig.tight_layout()
-    times_png = f"times_{ts.robot}.png"
-    fig.savefig(out / times_png, dpi=80)
-    plt.close(fig)
-
-    joint = _plotted_joint(ts, idx)
-    u = ts.qps[0].layout["u"]
-    fig, ax = plt.subplots(figsize=(8, 3.5))
-    ax.plot(t_ms, [ts.x_ref[i][u][joint] for i in idx], "k-", lw=2.5, label="reference")
-    for s in ("fccqp-realtime", *_PYRAMID_PLOTTED):
-        if (s, int(idx[0])) in by:
-            ax.plot(t_ms, [by[s, i]["u"][joint] for i in idx], lw=1.2, label=s)
-    limit = ts.qps[idx[0]].ub[u][joint]
-    for sign in (-1, 1):
-        ax.axhline(sign * limit, color="gray", ls=":", lw=1)
-    ax.set_xlabel("time along the sequence [ms]")
-    ax.set_ylabel(f"torque of joint {joint} [Nm]")
-    ax.set_title(f"{ts.robot}: joint {joint} torque (dotted: limit)")
-    ax.legend(fontsize=7, ncol=3)
-    fig.tight_layout()
-    torque_png = f"torque_{ts.robot}.png"
-    fig.savefig(out / torque_png, dpi=80)
-    plt.close(fig)
-    return times_png, torque_png
-
-
-def plot_distribution(sets: Sequence[tuple[TestSet, list[dict[str, object]]]], out: Path) -> str:
-    """Box plots of per-QP solve times, one panel per test set, log scale."""
-    fig, axes = plt.subplots(len(sets), 1, figsize=(9, 2.8 * len(sets)), squeeze=False)
-    for ax, (ts, rows) in zip(axes[:, 0], sets, strict=True):
-        solvers = list(dict.fromkeys(str(r["solver"]) for r in rows))
-        data = [[1e6 * float(r["time"]) for r in rows if r["solver"] == s] for s in solvers]
-        ax.boxplot(data, orientation="horizontal", whis=(5, 95), flierprops={"ms": 2})
-        ax.set_yticks(range(1, len(solvers) + 1), solvers, fontsize=7)
-        ax.set_xscale("log")
-        ax.set_title(f"{ts.robot} / {ts.scenario}: solve time [us] (whiskers 5-95 %)", fontsize=9)
-    fig.tight_layout()
-    name = "time_distribution.png"
-    fig.savefig(out / name, dpi=80)
-    plt.close(fig)
-    return name
 
 
 def _set_description(ts: TestSet) -> str:
@@ -252,32 +148,54 @@ def _table(summaries: Sequence[Summary]) -> str:
     return "\n".join(lines)
 
 
+def _fastest_peer(summaries: Sequence[Summary], exact: bool) -> Summary | None:
+    """The fastest (median) peer of a cone class at its default setting, direct API."""
+    peers = [
+        x for x in summaries
+        if VARIANTS[x.solver].family != "fccqp" and VARIANTS[x.solver].direct
+        and not VARIANTS[x.solver].sweep and VARIANTS[x.solver].exact_cones == exact
+    ]
+    return min(peers, key=lambda x: x.median_time, default=None)
+
+
+def _verdict(ok: bool) -> str:
+    return "**MET**" if ok else "**MISSED**"
+
+
+def _speed_row(robot: str, mine: Summary, peer: Summary, factor: float, what: str) -> str:
+    ratio = mine.median_time / peer.median_time
+    return (
+        f"| {robot} | {mine.solver} median <= {'' if factor == 1 else f'1/{factor:g} of '}"
+        f"{what} | {_us(mine.median_time)} us vs {peer.solver} {_us(peer.median_time)} us "
+        f"(reported solved {_pct(peer.reported_rate)} %): ratio {ratio:.2f} "
+        f"(target <= {1 / factor:.2f}) | {_verdict(ratio <= 1 / factor)} |"
+    )
+
+
 def _targets(
     ts: TestSet, rows: Sequence[dict[str, object]], summaries: Sequence[Summary]
 ) -> list[str]:
     """Rows of the targets table for one test set: ``| robot | target | numbers | verdict |``."""
     by = {s.solver: s for s in summaries}
     out = []
-
-    def verdict(ok: bool) -> str:
-        return "**MET**" if ok else "**MISSED**"
-
-    rt = by.get("fccqp-realtime")
-    for peer, factor in _SPEED_TARGETS:
-        if rt is None or peer not in by:
+    for name in ("fccqp-realtime", "fccqp-default"):
+        if name not in by:
             continue
-        ratio = rt.median_time / by[peer].median_time
-        out.append(
-            f"| {ts.robot} | fccqp-realtime median <= 1/{factor:g} of {peer} "
-            f"| {_us(rt.median_time)} us vs {_us(by[peer].median_time)} us: "
-            f"ratio {ratio:.2f} (target <= {1 / factor:.2f}) | {verdict(ratio <= 1 / factor)} |"
-        )
+        for exact, what in ((True, "the fastest exact-cone peer"),
+                            (False, "the fastest pyramid peer")):
+            peer = _fastest_peer(summaries, exact)
+            if peer is not None:
+                out.append(_speed_row(ts.robot, by[name], peer, 1.0, what))
+    rt = by.get("fccqp-realtime")
+    for peer, factor in _PROJECT_TARGETS:
+        if rt is not None and peer in by:
+            out.append(_speed_row(ts.robot, rt, by[peer], factor, peer))
     if "fccqp-default" in by:
         d = by["fccqp-default"]
         out.append(
             f"| {ts.robot} | fccqp-default solves every QP to tolerance "
             f"| success {_pct(d.success_rate)} % ({round(d.success_rate * d.n)}/{d.n}); "
-            f"reported solved {_pct(d.reported_rate)} % | {verdict(d.success_rate == 1.0)} |"
+            f"reported solved {_pct(d.reported_rate)} % | {_verdict(d.success_rate == 1.0)} |"
         )
     for name in ("fccqp-realtime", "fccqp-default"):
         mine = [r for r in rows if r["solver"] == name]
@@ -289,16 +207,70 @@ def _targets(
         out.append(
             f"| {ts.robot} | {name} equality residual at factorization accuracy "
             f"| max {_g(eq.max())} (direct KKT solve: max {_g(ref.max())}); "
-            f"{ok.sum()}/{ok.size} QPs within {EQUALITY_FACTOR:g}x + 1e-12 | {verdict(ok.all())} |"
+            f"{ok.sum()}/{ok.size} QPs within {EQUALITY_FACTOR:g}x + 1e-12 | {_verdict(ok.all())} |"
         )
     if rt is not None:
+        met = rt.p95_torque_error_rel <= TORQUE_TARGET
         out.append(
             f"| {ts.robot} | fccqp-realtime torque error p95 <= {100 * TORQUE_TARGET:g} % of "
             f"the joint limit | p95 {100 * rt.p95_torque_error_rel:.1f} % "
             f"(median / p95 / max {_g(rt.median_torque_error)} / {_g(rt.p95_torque_error)} / "
-            f"{_g(rt.max_torque_error)} Nm) | {verdict(rt.p95_torque_error_rel <= TORQUE_TARGET)} |"
+            f"{_g(rt.max_torque_error)} Nm) | {_verdict(met)} |"
         )
     return out
+
+
+def _sweep_table(rows: Sequence[dict[str, object]], summaries: Sequence[Summary]) -> str:
+    """Every variant: the work-precision numbers and the deadline shares."""
+    budgets = " | ".join(f"<= {_us(b)} us %" for b in DEADLINES)
+    lines = [
+        f"| variant | cones | setting | median us | p95 torque err. / limit (solved) "
+        f"| reported % | {budgets} |",
+        "|---|---|---|---|---|---|" + "---|" * len(DEADLINES),
+    ]
+    for s in summaries:
+        v = VARIANTS[s.solver]
+        mine = [r for r in rows if r["solver"] == s.solver]
+        err = s.p95_solved_torque_error_rel
+        err_text = f"{100 * err:.2g} %" if np.isfinite(err) else "failed"
+        shares = " | ".join(_pct(deadline_share(mine, b)) for b in DEADLINES)
+        lines.append(
+            f"| {s.solver} | {'exact' if v.exact_cones else 'pyramid'} | {v.setting} "
+            f"| {_us(s.median_time)} | {err_text} "
+            f"| {_pct(s.reported_rate)} | {shares} |"
+        )
+    return "\n".join(lines)
+
+
+def _machine(info: RunInfo) -> list[str]:
+    cores = os.cpu_count() or 1
+    lines = [
+        "## Machine and versions",
+        "",
+        "| item | value |",
+        "|---|---|",
+        f"| CPU | {cpu_model()} |",
+        f"| cores | {cores} |",
+        f"| load average (1 min) at start / end of timing | {info.load_start:.2f} / "
+        f"{info.load_end:.2f} |",
+        *[f"| BLAS / OpenMP pool | {pool} |" for pool in info.blas],
+        f"| BLAS threads while timing | "
+        f"{'not limited' if info.blas_threads is None else info.blas_threads} "
+        "(threadpoolctl `threadpool_limits`) |",
+        f"| fccqp revision | {git_revision()} |",
+        f"| python | {platform.python_version()} ({platform.system()} {platform.release()}) |",
+        *[f"| {lib} | {version(lib)} |" for lib in _LIBRARIES],
+        "",
+    ]
+    if max(info.load_start, info.load_end) > cores:
+        lines += [
+            f"**Warning: the load average ({max(info.load_start, info.load_end):.1f}) exceeded "
+            f"the {cores} cores during this run: other processes competed for the CPU, so "
+            "absolute times are inflated and noisier than usual; compare ratios within the "
+            "run.**",
+            "",
+        ]
+    return lines
 
 
 def _header(info: RunInfo, variants: Sequence[str]) -> list[str]:
@@ -308,51 +280,74 @@ def _header(info: RunInfo, variants: Sequence[str]) -> list[str]:
         f"Produced by `{info.command}` (preset `{info.preset}`, seed {info.seed}, "
         f"{info.repeats} timing passes per QP, median reported).",
         "",
-        "## Machine and versions",
-        "",
-        "| item | value |",
-        "|---|---|",
-        f"| CPU | {_cpu_model()} |",
-        f"| cores | {os.cpu_count()} |",
-        f"| fccqp revision | {_git_revision()} |",
-        f"| python | {platform.python_version()} ({platform.system()} {platform.release()}) |",
-        *[f"| {lib} | {_version(lib)} |" for lib in _LIBRARIES],
-        "",
+        *_machine(info),
         "## Variants",
         "",
-        "| variant | what |",
-        "|---|---|",
-        *[f"| {v} | {VARIANTS[v][2]} |" for v in variants],
-        "| dsytrf (baseline) | one LAPACK `dsytrf` of `[[P + 1e-6 I, A'], [A, 0]]`, no solve |",
+        "A variant is one solver at one setting. *exact* solvers see the exact friction "
+        "cones; *pyramid* solvers see an inner (inscribed) pyramid of 4 or 8 facets, whose "
+        "answers are cone-feasible but restricted. *loose* and *tight* variants run a "
+        "peer at a looser and a tighter tolerance than its default; the fccqp sweep varies "
+        "its tolerance and the real-time preset's iteration budget.",
+        "",
+        "| variant | solver | cones | setting | what |",
+        "|---|---|---|---|---|",
+        *[
+            f"| {v} | {VARIANTS[v].family} | {'exact' if VARIANTS[v].exact_cones else 'pyramid'} "
+            f"| {VARIANTS[v].setting} | {VARIANTS[v].description} |"
+            for v in variants
+        ],
+        "| dsytrf (floor) | LAPACK | - | - | one `dsytrf` of `[[P + 1e-6 I, A'], [A, 0]]`, "
+        "no solve |",
         "",
     ]
     if info.skipped:
         lines += [f"Skipped (not installed): {', '.join(info.skipped)}.", ""]
     lines += [
-        "## Method",
+        "## Method and definitions",
         "",
         "- Data conversion (sparse matrices, pyramid rows, cone lists) happens before timing;"
-        " the timer (`time.perf_counter`) surrounds the solver's own Python call. Clarabel"
-        " has no update for new matrices, so its construction is timed with its solve; OSQP"
-        " is set up for each QP (setup timed) and warm started with `warm_start(x, y)`;"
-        " ProxQP's dense model is `update`d and warm started within a sequence.",
-        "- A pass is one solver solving the whole set in controller-loop order, restarting"
+        " the timer (`time.perf_counter`) surrounds the solver's own Python call, including"
+        " the setup of solvers that cannot update their matrices (Clarabel, QOCO, SCS, OSQP,"
+        " PIQP). Warm starts within a sequence: fccqp (its state), ProxQP (`update` + warm"
+        " start), OSQP (`warm_start(x, y)`), SCS (previous `x, y, s`), DAQP (previous"
+        " multipliers); the others solve every QP cold.",
+        "- A pass is one variant solving the whole set in controller-loop order, restarting"
         " warm starts at each sequence boundary; passes never interleave per QP. Each"
-        " solver first solves a few QPs untimed (warm-up: numba compilation and first-call"
-        " costs are excluded). Passes rotate through the solvers round by round, so drifts"
-        " of the shared machine's speed reach every solver alike. The garbage collector is"
+        " variant first solves a few QPs untimed (warm-up: numba compilation and first-call"
+        " costs are excluded). Passes rotate through the variants round by round, so drifts"
+        " of the shared machine's speed reach every variant alike. The garbage collector is"
         " off during timed passes. Read medians.",
-        "- Every solution is judged on the exact-cone problem against Clarabel's reference"
-        " at 1e-9 (also for pyramid solvers). **success** (qpbenchmark's convention): the"
-        f" solver reports success and the equality residual, exact-cone violation and bound"
-        f" violation are within {TOLERANCE:g} relative to `1 + ||b||`, `1 + max ||f_ref||`"
-        f" and `1 + max u_max`, and the objective gap `|f - f_ref| / max(1, |f_ref|)` is"
-        f" within {TOLERANCE:g}. **feasible** drops the objective check (a pyramid answer is"
-        " feasible but restricted). **reported**: the solver's own status says solved.",
-        f"- shm ratio: shifted geometric mean of times (shift {SHIFT:g} s, qpbenchmark's"
-        " convention; at these sub-millisecond times it is close to the arithmetic mean),"
-        " counting a solve that is not reported solved as the controller period, divided by"
-        " the best variant's. Ratios to the fastest variant and to dsytrf use medians.",
+        f"- Every solution is judged on the exact-cone problem against the reference"
+        f" ({REFERENCE_NOTE}), also for pyramid solvers. **success %** (qpbenchmark's"
+        f" convention): share of QPs where the solver reports success and the equality"
+        f" residual, exact-cone violation and bound violation are within {TOLERANCE:g}"
+        f" relative to `1 + ||b||`, `1 + max ||f_ref||` and `1 + max u_max`, and the"
+        f" objective gap `|f - f_ref| / max(1, |f_ref|)` is within {TOLERANCE:g}."
+        " **feasible %** drops the objective check (a pyramid answer is feasible but"
+        " restricted). **reported %**: the solver's own status says solved (fccqp: `SOLVED`"
+        " only; anything else counts as not solved).",
+        "- **median us / p95 us**: median and 95th percentile over QPs of the per-QP time"
+        " (itself the median over passes), in microseconds.",
+        f"- **shm ratio**: the shifted geometric mean (shm) of times, `exp(mean(log(t + s)))"
+        f" - s` with shift `s` = {SHIFT:g} s as in qpbenchmark (at these sub-millisecond"
+        " times it is close to the arithmetic mean), counting a solve not reported solved"
+        " as the controller period (2 ms), divided by the smallest shm of the table."
+        " **median / fastest**: median divided by the smallest median of the table."
+        " **median / dsytrf**: median divided by the median time of one `dsytrf` of the"
+        " QP's KKT matrix (the floor). **median iter**: median of the iterations the solver"
+        " reports (`-` when it reports none).",
+        "- **max eq. res.**: largest `||A x - b||_inf`; **max cone viol.**: largest"
+        " exact-cone violation `max(0, ||f_t|| - mu f_n)` in newtons; **median obj. gap**:"
+        " median objective gap as above.",
+        "- **torque err.**: per QP, the largest joint torque error `max_j |u_j - u_ref_j|`"
+        " in Nm, and **/ limit** the same as a fraction of each joint's torque limit,"
+        " `max_j |u_j - u_ref_j| / u_max_j`: median, p95 and max over QPs.",
+        f"- **Work-precision**: per variant, median time against the p95 over QPs of the"
+        f" torque error / limit, counting a QP the solver does not report solved as an"
+        f" infinite error (**(solved)** in the tables; `failed` when more than 5 % of the"
+        f" QPs are not solved). **Deadline view** (`<= B us %`): share of QPs solved within"
+        f" the budget `B`, reported solved, feasible on the exact cones and with torque"
+        f" error under {100 * TORQUE_LIMIT_SHARE:g} % of the limit.",
         "",
     ]
     return lines
@@ -384,28 +379,41 @@ def write_outputs(
     body: list[str] = []
     for ts, rows in sets:
         summaries = summarize(rows, time_limit=ts.dt)
-        target_rows += _targets(ts, rows, summaries)
+        defaults = summarize([r for r in rows if not VARIANTS[str(r["solver"])].sweep], ts.dt)
+        target_rows += _targets(ts, rows, defaults)
         times_png, torque_png = plot_sequence(ts, rows, out)
+        wp_png = plot_work_precision(ts, rows, out)
         kkt = np.median([float(r["dsytrf_time"]) for r in rows])
         body += [
             f"### {ts.robot} / {ts.scenario}",
             "",
             _set_description(ts) + f". Median dsytrf of the KKT matrix: {_us(kkt)} us.",
             "",
-            _table(summaries),
+            "Default settings:",
+            "",
+            _table(defaults),
             "",
             f"![solve time along a sequence]({times_png})",
             "",
             f"![torque along a sequence]({torque_png})",
             "",
+            "Every variant (work precision and deadline view):",
+            "",
+            _sweep_table(rows, summaries),
+            "",
+            f"![work precision]({wp_png})",
+            "",
         ]
     dist_png = plot_distribution(sets, out)
     lines += [
-        "## Targets (issue 5)",
+        "## Targets",
         "",
-        "Speed targets compare medians of the same run; peers run at their own defaults.",
-        f"Torque target (stated here): p95 over QPs of the largest joint torque error, as a"
-        f" fraction of that joint's limit, at most {100 * TORQUE_TARGET:g} %.",
+        "Speed targets compare medians of the same run; peers run at their own defaults."
+        " The fastest peer of a class is the one with the smallest median among the direct-API"
+        " peers at their default settings that see the exact cones (exact-cone peer) or a"
+        " pyramid (pyramid peer).",
+        f"Torque target: p95 over QPs of the largest joint torque error, as a fraction of"
+        f" that joint's limit, at most {100 * TORQUE_TARGET:g} %.",
         "",
         "| robot | target | numbers | verdict |",
         "|---|---|---|---|",

@@ -18,7 +18,15 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-__all__ = ["ROBOTS", "Foot", "LoadedRobot", "RobotConfig", "data_dir", "load_robot"]
+__all__ = [
+    "ROBOTS",
+    "Foot",
+    "LoadedRobot",
+    "RobotConfig",
+    "actuated_joint_names",
+    "data_dir",
+    "load_robot",
+]
 
 
 @dataclass(frozen=True)
@@ -221,3 +229,19 @@ def load_robot(name: str) -> LoadedRobot:
         if hand >= model.nframes:
             raise KeyError(f"{name}: no frame {cfg.hand_frame!r}")
     return LoadedRobot(cfg, model, q0, contact_frames, foot_frames, hand)
+
+
+def actuated_joint_names(robot: LoadedRobot) -> list[str]:
+    """Names of the actuated joints in the order of the torque block ``u`` (URDF names).
+
+    Torque ``u_j`` drives velocity ``6 + j`` (after the free flyer), so a joint's name
+    is the one whose velocity index that is.
+    """
+    model = robot.model
+    names = [""] * (model.nv - 6)
+    for jid in range(1, model.njoints):
+        joint = model.joints[jid]
+        for k in range(joint.nv):
+            if joint.idx_v + k >= 6:
+                names[joint.idx_v + k - 6] = model.names[jid]
+    return names

@@ -18,6 +18,7 @@ from benchmarks.scenarios import SCENARIOS, make_sequence, rollout
 from benchmarks.wbc_qp import WbcQP
 
 __all__ = [
+    "GENERATOR_VERSION",
     "LAYOUT_NAMES",
     "MIX",
     "TestSet",
@@ -27,6 +28,11 @@ __all__ = [
     "load",
     "save",
 ]
+
+GENERATOR_VERSION = 1
+"""Version of the generator's output: bump it with any change to ``robots``, ``wbc_qp``,
+``scenarios`` or this module that changes the generated QPs or references, so that cached
+test sets (:mod:`benchmarks.cache`) are generated anew."""
 
 MIX = "mix"
 """Scenario name of the default mix: sequence ``j`` runs ``SCENARIOS[j % 4]``."""
@@ -52,6 +58,9 @@ class TestSet:
     sequence
         Index of the sequence each QP belongs to: a new index is where a controller
         (and a warm start) would restart from rest.
+    generator_version
+        :data:`GENERATOR_VERSION` of the code that generated the set (0 for files
+        written before the version existed).
     """
 
     __test__ = False  # not a pytest test class
@@ -63,6 +72,7 @@ class TestSet:
     qps: list[WbcQP]
     x_ref: list[np.ndarray]
     sequence: np.ndarray
+    generator_version: int = 0
 
     def __len__(self) -> int:
         return len(self.qps)
@@ -124,7 +134,7 @@ def generate_test_set(
         j += 1
     if bar is not None:
         bar.close()
-    return TestSet(robot, scenario, seed, dt, qps, xs, np.array(seq))
+    return TestSet(robot, scenario, seed, dt, qps, xs, np.array(seq), GENERATOR_VERSION)
 
 
 def active_flags(qp: WbcQP, x: np.ndarray, rtol: float = 1e-6) -> tuple[bool, bool]:
@@ -159,7 +169,8 @@ def active_fraction(test_set: TestSet, rtol: float = 1e-6) -> float:
 def save(test_set: TestSet, path: str | Path) -> None:
     """Write ``test_set`` to one compressed ``.npz`` (format in docs/benchmarks-generator.md).
 
-    Keys: ``robot``, ``scenario`` (str), ``seed``, ``dt``, ``n_qps``, ``sequence``, and
+    Keys: ``robot``, ``scenario`` (str), ``seed``, ``dt``, ``n_qps``, ``sequence``,
+    ``generator_version``, and
     per QP ``i``: ``qp{i}_P``, ``_q``, ``_A``, ``_b``, ``_lb``, ``_ub``, ``_cone_starts``,
     ``_mus``, ``_normals``, ``_nv``, ``_layout`` (5 x 2 ``[start, stop]`` in the order of
     :data:`LAYOUT_NAMES`) and ``_x_ref``.
@@ -171,6 +182,7 @@ def save(test_set: TestSet, path: str | Path) -> None:
         "dt": np.array(test_set.dt),
         "n_qps": np.array(len(test_set)),
         "sequence": np.asarray(test_set.sequence),
+        "generator_version": np.array(test_set.generator_version),
     }
     for i, (qp, x) in enumerate(zip(test_set.qps, test_set.x_ref, strict=True)):
         for name in _QP_ARRAYS:
@@ -203,4 +215,5 @@ def load(path: str | Path) -> TestSet:
             qps,
             xs,
             z["sequence"],
+            int(z["generator_version"]) if "generator_version" in z else 0,
         )

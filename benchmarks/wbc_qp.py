@@ -51,6 +51,11 @@ _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 _LOCAL = pin.ReferenceFrame.LOCAL
 
 
+_FLAT_FRAME = (np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0]))
+for _axis in _FLAT_FRAME:
+    _axis.flags.writeable = False
+
+
 def tangent_basis(normal: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Orthonormal frame ``(t1, t2, n)`` with ``n`` the unit normal.
 
@@ -58,6 +63,8 @@ def tangent_basis(normal: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray
     world axes and the pyramids below are the usual axis-aligned ones.
     """
     n = np.asarray(normal, dtype=float)
+    if n[0] == 0.0 and n[1] == 0.0 and n[2] > 0.0:  # flat ground: the same frame, faster
+        return _FLAT_FRAME
     n = n / np.linalg.norm(n)
     a = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
     t1 = a - (a @ n) * n

@@ -19,15 +19,16 @@ N_QPS = 6
 def run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A tiny run: solo12, 6 QPs in two sequences, one timing pass, every solver."""
     out = tmp_path_factory.mktemp("bench")
+    cache = tmp_path_factory.mktemp("cache")
     argv = ["--robots", "solo12", "--n-qps", str(N_QPS), "--seq-len", "3", "--repeats", "1",
-            "--out", str(out), "--no-progress"]
+            "--out", str(out), "--cache", str(cache), "--no-progress"]
     main(argv)
     return out
 
 
 def test_outputs_exist_and_are_not_empty(run: Path) -> None:
     names = ["report.md", "results.csv", "times_solo12.png", "torque_solo12.png",
-             "time_distribution.png"]
+             "work_precision_solo12.png", "time_distribution.png"]
     for name in names:
         assert (run / name).stat().st_size > 0, name
 
@@ -49,6 +50,9 @@ def test_report_names_every_solver_and_the_targets(run: Path) -> None:
     for name in installed:
         assert f"| {name} |" in text
     assert "## Targets" in text and ("MET" in text or "MISSED" in text)
+    assert "fastest exact-cone peer" in text and "fastest pyramid peer" in text
+    assert "BLAS" in text and "load average" in text
+    assert "issue" not in text.lower()  # readers have not seen the issue tracker
 
 
 def test_reference_against_itself_has_zero_errors() -> None:
