@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from fccqp.anderson import solve_small_spd_py as _solve_small_spd
 
 

@@ -2,17 +2,17 @@
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
-from hypothesis import strategies as st
-from hypothesis.extra.numpy import arrays
-
-from fccqp.cones import FRICTION, SECOND_ORDER
 from fccqp.projections import (
     project_cone_block,
     project_constraint_set,
     project_friction_cone,
     project_second_order_cone,
 )
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from fccqp.cones import FRICTION, SECOND_ORDER
 
 finite = st.floats(-1e3, 1e3, allow_nan=False, allow_infinity=False)
 mus = st.floats(1e-3, 1e3)

@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from fccqp.projections import project_constraint_set
 from fccqp.scaling import MAX_NORM, MIN_NORM
 from fccqp.scaling import equilibrate_py as equilibrate

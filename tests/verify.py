@@ -383,7 +383,9 @@ def from_qpsolvers(problem, solution) -> tuple[Problem, fccqp.Result]:
         y=np.concatenate([solution.y, solution.z]) if present else np.zeros(0),
         z=np.concatenate([z_box, solution.z]) if present else np.zeros(0),
         status=extras["status"], obj=solution.obj, iterations=extras["iterations"],
-        prim_res=extras["prim_res"], dual_res=extras["dual_res"],
+        # no residual claim: qpsolvers' z stands for both the slack rows' multiplier and
+        # the slack bound's, which agree only at the optimum (see the docstring)
+        prim_res=np.inf, dual_res=np.inf,
         setup_time=extras["setup_time"], solve_time=extras["solve_time"], rho=extras["rho"],
         factorizations=extras["factorizations"], certificate=extras.get("certificate"),
     )

@@ -25052,7 +25052,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
  *         eps_d = o.eps_abs + o.eps_rel * r.dual_scale
  *         anderson_reset(&self.aa, False)             # <<<<<<<<<<<<<<
  *         fresh = True  # the next step starts a run of KKT solutions: do not relax x
- *         while status == _RUNNING:
+ *         if timed and fccqp_now() - start_time >= o.time_limit:
 */
   __pyx_f_5fccqp_8anderson_anderson_reset((&__pyx_v_self->aa), 0);
 
@@ -25060,14 +25060,54 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
  *         eps_d = o.eps_abs + o.eps_rel * r.dual_scale
  *         anderson_reset(&self.aa, False)
  *         fresh = True  # the next step starts a run of KKT solutions: do not relax x             # <<<<<<<<<<<<<<
- *         while status == _RUNNING:
- *             iteration += 1
+ *         if timed and fccqp_now() - start_time >= o.time_limit:
+ *             status = self._classify(0, True, start_time)   # the setup spent the budget
 */
   __pyx_v_fresh = 1;
 
   /* "fccqp/admm.pyx":493
  *         anderson_reset(&self.aa, False)
  *         fresh = True  # the next step starts a run of KKT solutions: do not relax x
+ *         if timed and fccqp_now() - start_time >= o.time_limit:             # <<<<<<<<<<<<<<
+ *             status = self._classify(0, True, start_time)   # the setup spent the budget
+ *         while status == _RUNNING:
+*/
+  if (__pyx_v_timed) {
+  } else {
+
+    __pyx_t_3 = __pyx_v_timed;
+    goto __pyx_L29_bool_binop_done;
+  }
+  __pyx_t_4 = ((fccqp_now() - __pyx_v_start_time) >= __pyx_v_o->time_limit);
+
+
+  __pyx_t_3 = __pyx_t_4;
+
+  __pyx_L29_bool_binop_done:;
+  if (__pyx_t_3) {
+
+
+    /* "fccqp/admm.pyx":494
+ *         fresh = True  # the next step starts a run of KKT solutions: do not relax x
+ *         if timed and fccqp_now() - start_time >= o.time_limit:
+ *             status = self._classify(0, True, start_time)   # the setup spent the budget             # <<<<<<<<<<<<<<
+ *         while status == _RUNNING:
+ *             iteration += 1
+*/
+    __pyx_v_status = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_classify(__pyx_v_self, 0, 1, __pyx_v_start_time);
+
+    /* "fccqp/admm.pyx":493
+ *         anderson_reset(&self.aa, False)
+ *         fresh = True  # the next step starts a run of KKT solutions: do not relax x
+ *         if timed and fccqp_now() - start_time >= o.time_limit:             # <<<<<<<<<<<<<<
+ *             status = self._classify(0, True, start_time)   # the setup spent the budget
+ *         while status == _RUNNING:
+*/
+  }
+
+  /* "fccqp/admm.pyx":495
+ *         if timed and fccqp_now() - start_time >= o.time_limit:
+ *             status = self._classify(0, True, start_time)   # the setup spent the budget
  *         while status == _RUNNING:             # <<<<<<<<<<<<<<
  *             iteration += 1
  *             if reduced:
@@ -25078,8 +25118,8 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
     if (!__pyx_t_3) break;
 
-    /* "fccqp/admm.pyx":494
- *         fresh = True  # the next step starts a run of KKT solutions: do not relax x
+    /* "fccqp/admm.pyx":496
+ *             status = self._classify(0, True, start_time)   # the setup spent the budget
  *         while status == _RUNNING:
  *             iteration += 1             # <<<<<<<<<<<<<<
  *             if reduced:
@@ -25087,7 +25127,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_iteration = (__pyx_v_iteration + 1);
 
-    /* "fccqp/admm.pyx":495
+    /* "fccqp/admm.pyx":497
  *         while status == _RUNNING:
  *             iteration += 1
  *             if reduced:             # <<<<<<<<<<<<<<
@@ -25096,7 +25136,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     if (__pyx_v_reduced) {
 
-      /* "fccqp/admm.pyx":496
+      /* "fccqp/admm.pyx":498
  *             iteration += 1
  *             if reduced:
  *                 reduced_step(&self.red, p, it, o.alpha, not fresh)             # <<<<<<<<<<<<<<
@@ -25105,17 +25145,17 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_f_5fccqp_7reduced_reduced_step((&__pyx_v_self->red), __pyx_v_p, __pyx_v_it, __pyx_v_o->alpha, (!__pyx_v_fresh));
 
-      /* "fccqp/admm.pyx":495
+      /* "fccqp/admm.pyx":497
  *         while status == _RUNNING:
  *             iteration += 1
  *             if reduced:             # <<<<<<<<<<<<<<
  *                 reduced_step(&self.red, p, it, o.alpha, not fresh)
  *             else:
 */
-      goto __pyx_L30;
+      goto __pyx_L33;
     }
 
-    /* "fccqp/admm.pyx":498
+    /* "fccqp/admm.pyx":500
  *                 reduced_step(&self.red, p, it, o.alpha, not fresh)
  *             else:
  *                 self._full_step(not fresh)             # <<<<<<<<<<<<<<
@@ -25125,9 +25165,9 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     /*else*/ {
       ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_full_step(__pyx_v_self, (!__pyx_v_fresh));
     }
-    __pyx_L30:;
+    __pyx_L33:;
 
-    /* "fccqp/admm.pyx":499
+    /* "fccqp/admm.pyx":501
  *             else:
  *                 self._full_step(not fresh)
  *             fresh = False             # <<<<<<<<<<<<<<
@@ -25136,7 +25176,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_fresh = 0;
 
-    /* "fccqp/admm.pyx":500
+    /* "fccqp/admm.pyx":502
  *                 self._full_step(not fresh)
  *             fresh = False
  *             last = iteration >= o.max_iter or (timed and fccqp_now() - start_time >= o.time_limit)             # <<<<<<<<<<<<<<
@@ -25151,23 +25191,23 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
       __pyx_t_3 = __pyx_t_4;
 
-      goto __pyx_L31_bool_binop_done;
+      goto __pyx_L34_bool_binop_done;
     }
     if (__pyx_v_timed) {
     } else {
 
       __pyx_t_3 = __pyx_v_timed;
-      goto __pyx_L31_bool_binop_done;
+      goto __pyx_L34_bool_binop_done;
     }
     __pyx_t_4 = ((fccqp_now() - __pyx_v_start_time) >= __pyx_v_o->time_limit);
 
 
     __pyx_t_3 = __pyx_t_4;
 
-    __pyx_L31_bool_binop_done:;
+    __pyx_L34_bool_binop_done:;
     __pyx_v_last = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":501
+    /* "fccqp/admm.pyx":503
  *             fresh = False
  *             last = iteration >= o.max_iter or (timed and fccqp_now() - start_time >= o.time_limit)
  *             periodic = iteration % o.adaptive_rho_interval == 0             # <<<<<<<<<<<<<<
@@ -25176,7 +25216,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_periodic = ((__pyx_v_iteration % __pyx_v_o->adaptive_rho_interval) == 0);
 
-    /* "fccqp/admm.pyx":502
+    /* "fccqp/admm.pyx":504
  *             last = iteration >= o.max_iter or (timed and fccqp_now() - start_time >= o.time_limit)
  *             periodic = iteration % o.adaptive_rho_interval == 0
  *             adapt = o.adaptive_rho and periodic             # <<<<<<<<<<<<<<
@@ -25187,14 +25227,14 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     } else {
 
       __pyx_t_3 = __pyx_v_o->adaptive_rho;
-      goto __pyx_L34_bool_binop_done;
+      goto __pyx_L37_bool_binop_done;
     }
 
     __pyx_t_3 = __pyx_v_periodic;
-    __pyx_L34_bool_binop_done:;
+    __pyx_L37_bool_binop_done:;
     __pyx_v_adapt = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":503
+    /* "fccqp/admm.pyx":505
  *             periodic = iteration % o.adaptive_rho_interval == 0
  *             adapt = o.adaptive_rho and periodic
  *             check = iteration % o.check_termination == 0 or last or adapt             # <<<<<<<<<<<<<<
@@ -25209,20 +25249,20 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
       __pyx_t_3 = __pyx_t_4;
 
-      goto __pyx_L36_bool_binop_done;
+      goto __pyx_L39_bool_binop_done;
     }
     if (!__pyx_v_last) {
     } else {
 
       __pyx_t_3 = __pyx_v_last;
-      goto __pyx_L36_bool_binop_done;
+      goto __pyx_L39_bool_binop_done;
     }
 
     __pyx_t_3 = __pyx_v_adapt;
-    __pyx_L36_bool_binop_done:;
+    __pyx_L39_bool_binop_done:;
     __pyx_v_check = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":504
+    /* "fccqp/admm.pyx":506
  *             adapt = o.adaptive_rho and periodic
  *             check = iteration % o.check_termination == 0 or last or adapt
  *             if check and reduced and not (last or periodic):             # <<<<<<<<<<<<<<
@@ -25233,34 +25273,34 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     } else {
 
       __pyx_t_3 = __pyx_v_check;
-      goto __pyx_L40_bool_binop_done;
+      goto __pyx_L43_bool_binop_done;
     }
     if (__pyx_v_reduced) {
     } else {
 
       __pyx_t_3 = __pyx_v_reduced;
-      goto __pyx_L40_bool_binop_done;
+      goto __pyx_L43_bool_binop_done;
     }
     if (!__pyx_v_last) {
     } else {
 
       __pyx_t_4 = __pyx_v_last;
-      goto __pyx_L43_bool_binop_done;
+      goto __pyx_L46_bool_binop_done;
     }
 
     __pyx_t_4 = __pyx_v_periodic;
-    __pyx_L43_bool_binop_done:;
+    __pyx_L46_bool_binop_done:;
     __pyx_t_8 = (!__pyx_t_4);
 
 
 
     __pyx_t_3 = __pyx_t_8;
 
-    __pyx_L40_bool_binop_done:;
+    __pyx_L43_bool_binop_done:;
     if (__pyx_t_3) {
 
 
-      /* "fccqp/admm.pyx":507
+      /* "fccqp/admm.pyx":509
  *                 # a scheduled full check (and with it infeasibility detection) still runs
  *                 # every adaptive_rho_interval iterations
  *                 check = near_convergence(&self.red, p, it, eps_p, eps_d)             # <<<<<<<<<<<<<<
@@ -25269,7 +25309,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_v_check = __pyx_f_5fccqp_7reduced_near_convergence((&__pyx_v_self->red), __pyx_v_p, __pyx_v_it, __pyx_v_eps_p, __pyx_v_eps_d);
 
-      /* "fccqp/admm.pyx":504
+      /* "fccqp/admm.pyx":506
  *             adapt = o.adaptive_rho and periodic
  *             check = iteration % o.check_termination == 0 or last or adapt
  *             if check and reduced and not (last or periodic):             # <<<<<<<<<<<<<<
@@ -25278,7 +25318,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     }
 
-    /* "fccqp/admm.pyx":508
+    /* "fccqp/admm.pyx":510
  *                 # every adaptive_rho_interval iterations
  *                 check = near_convergence(&self.red, p, it, eps_p, eps_d)
  *             if check:             # <<<<<<<<<<<<<<
@@ -25287,7 +25327,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     if (__pyx_v_check) {
 
-      /* "fccqp/admm.pyx":509
+      /* "fccqp/admm.pyx":511
  *                 check = near_convergence(&self.red, p, it, eps_p, eps_d)
  *             if check:
  *                 if reduced:             # <<<<<<<<<<<<<<
@@ -25296,7 +25336,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       if (__pyx_v_reduced) {
 
-        /* "fccqp/admm.pyx":510
+        /* "fccqp/admm.pyx":512
  *             if check:
  *                 if reduced:
  *                     materialize(&self.red, p, it)             # <<<<<<<<<<<<<<
@@ -25305,7 +25345,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
         __pyx_f_5fccqp_7reduced_materialize((&__pyx_v_self->red), __pyx_v_p, __pyx_v_it);
 
-        /* "fccqp/admm.pyx":509
+        /* "fccqp/admm.pyx":511
  *                 check = near_convergence(&self.red, p, it, eps_p, eps_d)
  *             if check:
  *                 if reduced:             # <<<<<<<<<<<<<<
@@ -25314,7 +25354,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       }
 
-      /* "fccqp/admm.pyx":511
+      /* "fccqp/admm.pyx":513
  *                 if reduced:
  *                     materialize(&self.red, p, it)
  *                 self._residuals()             # <<<<<<<<<<<<<<
@@ -25323,7 +25363,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_residuals(__pyx_v_self);
 
-      /* "fccqp/admm.pyx":512
+      /* "fccqp/admm.pyx":514
  *                     materialize(&self.red, p, it)
  *                 self._residuals()
  *                 eps_p = o.eps_abs + o.eps_rel * r.prim_scale             # <<<<<<<<<<<<<<
@@ -25332,7 +25372,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_v_eps_p = (__pyx_v_o->eps_abs + (__pyx_v_o->eps_rel * __pyx_v_r->prim_scale));
 
-      /* "fccqp/admm.pyx":513
+      /* "fccqp/admm.pyx":515
  *                 self._residuals()
  *                 eps_p = o.eps_abs + o.eps_rel * r.prim_scale
  *                 eps_d = o.eps_abs + o.eps_rel * r.dual_scale             # <<<<<<<<<<<<<<
@@ -25341,7 +25381,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_v_eps_d = (__pyx_v_o->eps_abs + (__pyx_v_o->eps_rel * __pyx_v_r->dual_scale));
 
-      /* "fccqp/admm.pyx":514
+      /* "fccqp/admm.pyx":516
  *                 eps_p = o.eps_abs + o.eps_rel * r.prim_scale
  *                 eps_d = o.eps_abs + o.eps_rel * r.dual_scale
  *                 if iteration % _LOG_INTERVAL == 0:             # <<<<<<<<<<<<<<
@@ -25353,7 +25393,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
       if (__pyx_t_3) {
 
 
-        /* "fccqp/admm.pyx":515
+        /* "fccqp/admm.pyx":517
  *                 eps_d = o.eps_abs + o.eps_rel * r.dual_scale
  *                 if iteration % _LOG_INTERVAL == 0:
  *                     self._log(iteration, run.rho)             # <<<<<<<<<<<<<<
@@ -25362,7 +25402,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
         ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_log(__pyx_v_self, __pyx_v_iteration, __pyx_v_run->rho);
 
-        /* "fccqp/admm.pyx":514
+        /* "fccqp/admm.pyx":516
  *                 eps_p = o.eps_abs + o.eps_rel * r.prim_scale
  *                 eps_d = o.eps_abs + o.eps_rel * r.dual_scale
  *                 if iteration % _LOG_INTERVAL == 0:             # <<<<<<<<<<<<<<
@@ -25371,7 +25411,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       }
 
-      /* "fccqp/admm.pyx":516
+      /* "fccqp/admm.pyx":518
  *                 if iteration % _LOG_INTERVAL == 0:
  *                     self._log(iteration, run.rho)
  *                 status = self._check(iteration, last, start_time)             # <<<<<<<<<<<<<<
@@ -25380,7 +25420,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_v_status = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_check(__pyx_v_self, __pyx_v_iteration, __pyx_v_last, __pyx_v_start_time);
 
-      /* "fccqp/admm.pyx":517
+      /* "fccqp/admm.pyx":519
  *                     self._log(iteration, run.rho)
  *                 status = self._check(iteration, last, start_time)
  *                 if status == _RUNNING and adapt:             # <<<<<<<<<<<<<<
@@ -25395,15 +25435,15 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
         __pyx_t_3 = __pyx_t_8;
 
-        goto __pyx_L49_bool_binop_done;
+        goto __pyx_L52_bool_binop_done;
       }
 
       __pyx_t_3 = __pyx_v_adapt;
-      __pyx_L49_bool_binop_done:;
+      __pyx_L52_bool_binop_done:;
       if (__pyx_t_3) {
 
 
-        /* "fccqp/admm.pyx":518
+        /* "fccqp/admm.pyx":520
  *                 status = self._check(iteration, last, start_time)
  *                 if status == _RUNNING and adapt:
  *                     new_rho = self._new_rho(run.rho)             # <<<<<<<<<<<<<<
@@ -25412,7 +25452,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
         __pyx_v_new_rho = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_new_rho(__pyx_v_self, __pyx_v_run->rho);
 
-        /* "fccqp/admm.pyx":519
+        /* "fccqp/admm.pyx":521
  *                 if status == _RUNNING and adapt:
  *                     new_rho = self._new_rho(run.rho)
  *                     if new_rho != run.rho:             # <<<<<<<<<<<<<<
@@ -25424,7 +25464,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
         if (__pyx_t_3) {
 
 
-          /* "fccqp/admm.pyx":520
+          /* "fccqp/admm.pyx":522
  *                     new_rho = self._new_rho(run.rho)
  *                     if new_rho != run.rho:
  *                         if reduced:             # <<<<<<<<<<<<<<
@@ -25433,7 +25473,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           if (__pyx_v_reduced) {
 
-            /* "fccqp/admm.pyx":521
+            /* "fccqp/admm.pyx":523
  *                     if new_rho != run.rho:
  *                         if reduced:
  *                             for j in range(s):             # <<<<<<<<<<<<<<
@@ -25447,7 +25487,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
             for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
               __pyx_v_j = __pyx_t_6;
 
-              /* "fccqp/admm.pyx":522
+              /* "fccqp/admm.pyx":524
  *                         if reduced:
  *                             for j in range(s):
  *                                 self.vec_s[j] = new_rho * self.rho_scale[j]             # <<<<<<<<<<<<<<
@@ -25458,7 +25498,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
             }
 
 
-            /* "fccqp/admm.pyx":523
+            /* "fccqp/admm.pyx":525
  *                             for j in range(s):
  *                                 self.vec_s[j] = new_rho * self.rho_scale[j]
  *                             reduced_rebase(&self.red, p, it.rho_vec, self.vec_s)             # <<<<<<<<<<<<<<
@@ -25467,7 +25507,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
             __pyx_f_5fccqp_7reduced_reduced_rebase((&__pyx_v_self->red), __pyx_v_p, __pyx_v_it->rho_vec, __pyx_v_self->vec_s);
 
-            /* "fccqp/admm.pyx":520
+            /* "fccqp/admm.pyx":522
  *                     new_rho = self._new_rho(run.rho)
  *                     if new_rho != run.rho:
  *                         if reduced:             # <<<<<<<<<<<<<<
@@ -25476,7 +25516,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           }
 
-          /* "fccqp/admm.pyx":524
+          /* "fccqp/admm.pyx":526
  *                                 self.vec_s[j] = new_rho * self.rho_scale[j]
  *                             reduced_rebase(&self.red, p, it.rho_vec, self.vec_s)
  *                         run.rho = new_rho             # <<<<<<<<<<<<<<
@@ -25485,7 +25525,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           __pyx_v_run->rho = __pyx_v_new_rho;
 
-          /* "fccqp/admm.pyx":525
+          /* "fccqp/admm.pyx":527
  *                             reduced_rebase(&self.red, p, it.rho_vec, self.vec_s)
  *                         run.rho = new_rho
  *                         for j in range(s):             # <<<<<<<<<<<<<<
@@ -25499,7 +25539,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
           for (__pyx_t_6 = 0; __pyx_t_6 < __pyx_t_5; __pyx_t_6+=1) {
             __pyx_v_j = __pyx_t_6;
 
-            /* "fccqp/admm.pyx":526
+            /* "fccqp/admm.pyx":528
  *                         run.rho = new_rho
  *                         for j in range(s):
  *                             it.rho_vec[j] = run.rho * self.rho_scale[j]             # <<<<<<<<<<<<<<
@@ -25510,7 +25550,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
           }
 
 
-          /* "fccqp/admm.pyx":527
+          /* "fccqp/admm.pyx":529
  *                         for j in range(s):
  *                             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *                         code = self._factor(run, self._budget(iteration))             # <<<<<<<<<<<<<<
@@ -25519,7 +25559,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           __pyx_v_code = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_factor(__pyx_v_self, __pyx_v_run, ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_budget(__pyx_v_self, __pyx_v_iteration));
 
-          /* "fccqp/admm.pyx":528
+          /* "fccqp/admm.pyx":530
  *                             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *                         code = self._factor(run, self._budget(iteration))
  *                         if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -25531,7 +25571,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
           if (__pyx_t_3) {
 
 
-            /* "fccqp/admm.pyx":529
+            /* "fccqp/admm.pyx":531
  *                         code = self._factor(run, self._budget(iteration))
  *                         if code != FACTORED:
  *                             run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR             # <<<<<<<<<<<<<<
@@ -25550,7 +25590,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
             __pyx_v_run->status = __pyx_t_7;
 
-            /* "fccqp/admm.pyx":530
+            /* "fccqp/admm.pyx":532
  *                         if code != FACTORED:
  *                             run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR
  *                             return             # <<<<<<<<<<<<<<
@@ -25561,7 +25601,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
             }
             goto __pyx_L0;
 
-            /* "fccqp/admm.pyx":528
+            /* "fccqp/admm.pyx":530
  *                             it.rho_vec[j] = run.rho * self.rho_scale[j]
  *                         code = self._factor(run, self._budget(iteration))
  *                         if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -25570,7 +25610,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           }
 
-          /* "fccqp/admm.pyx":531
+          /* "fccqp/admm.pyx":533
  *                             run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR
  *                             return
  *                         reduced = self.form != LDL_FULL             # <<<<<<<<<<<<<<
@@ -25579,7 +25619,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           __pyx_v_reduced = (__pyx_v_self->form != __pyx_e_5fccqp_3kkt_LDL_FULL);
 
-          /* "fccqp/admm.pyx":532
+          /* "fccqp/admm.pyx":534
  *                             return
  *                         reduced = self.form != LDL_FULL
  *                         if reduced:             # <<<<<<<<<<<<<<
@@ -25588,7 +25628,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           if (__pyx_v_reduced) {
 
-            /* "fccqp/admm.pyx":533
+            /* "fccqp/admm.pyx":535
  *                         reduced = self.form != LDL_FULL
  *                         if reduced:
  *                             self._reduced_base()             # <<<<<<<<<<<<<<
@@ -25597,7 +25637,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
             ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_reduced_base(__pyx_v_self);
 
-            /* "fccqp/admm.pyx":532
+            /* "fccqp/admm.pyx":534
  *                             return
  *                         reduced = self.form != LDL_FULL
  *                         if reduced:             # <<<<<<<<<<<<<<
@@ -25606,7 +25646,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           }
 
-          /* "fccqp/admm.pyx":534
+          /* "fccqp/admm.pyx":536
  *                         if reduced:
  *                             self._reduced_base()
  *                         fresh = True             # <<<<<<<<<<<<<<
@@ -25615,7 +25655,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           __pyx_v_fresh = 1;
 
-          /* "fccqp/admm.pyx":535
+          /* "fccqp/admm.pyx":537
  *                             self._reduced_base()
  *                         fresh = True
  *                         anderson_reset(&self.aa, True)             # <<<<<<<<<<<<<<
@@ -25624,7 +25664,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
           __pyx_f_5fccqp_8anderson_anderson_reset((&__pyx_v_self->aa), 1);
 
-          /* "fccqp/admm.pyx":519
+          /* "fccqp/admm.pyx":521
  *                 if status == _RUNNING and adapt:
  *                     new_rho = self._new_rho(run.rho)
  *                     if new_rho != run.rho:             # <<<<<<<<<<<<<<
@@ -25633,7 +25673,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
         }
 
-        /* "fccqp/admm.pyx":517
+        /* "fccqp/admm.pyx":519
  *                     self._log(iteration, run.rho)
  *                 status = self._check(iteration, last, start_time)
  *                 if status == _RUNNING and adapt:             # <<<<<<<<<<<<<<
@@ -25642,7 +25682,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       }
 
-      /* "fccqp/admm.pyx":508
+      /* "fccqp/admm.pyx":510
  *                 # every adaptive_rho_interval iterations
  *                 check = near_convergence(&self.red, p, it, eps_p, eps_d)
  *             if check:             # <<<<<<<<<<<<<<
@@ -25651,7 +25691,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     }
 
-    /* "fccqp/admm.pyx":536
+    /* "fccqp/admm.pyx":538
  *                         fresh = True
  *                         anderson_reset(&self.aa, True)
  *             if status == _RUNNING and o.anderson_memory > 0:             # <<<<<<<<<<<<<<
@@ -25666,18 +25706,18 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
       __pyx_t_3 = __pyx_t_8;
 
-      goto __pyx_L60_bool_binop_done;
+      goto __pyx_L63_bool_binop_done;
     }
     __pyx_t_8 = (__pyx_v_o->anderson_memory > 0);
 
 
     __pyx_t_3 = __pyx_t_8;
 
-    __pyx_L60_bool_binop_done:;
+    __pyx_L63_bool_binop_done:;
     if (__pyx_t_3) {
 
 
-      /* "fccqp/admm.pyx":537
+      /* "fccqp/admm.pyx":539
  *                         anderson_reset(&self.aa, True)
  *             if status == _RUNNING and o.anderson_memory > 0:
  *                 anderson_step(&self.aa, it, s)             # <<<<<<<<<<<<<<
@@ -25686,7 +25726,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
       __pyx_f_5fccqp_8anderson_anderson_step((&__pyx_v_self->aa), __pyx_v_it, __pyx_v_s);
 
-      /* "fccqp/admm.pyx":536
+      /* "fccqp/admm.pyx":538
  *                         fresh = True
  *                         anderson_reset(&self.aa, True)
  *             if status == _RUNNING and o.anderson_memory > 0:             # <<<<<<<<<<<<<<
@@ -25696,7 +25736,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
     }
   }
 
-  /* "fccqp/admm.pyx":538
+  /* "fccqp/admm.pyx":540
  *             if status == _RUNNING and o.anderson_memory > 0:
  *                 anderson_step(&self.aa, it, s)
  *         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:             # <<<<<<<<<<<<<<
@@ -25707,7 +25747,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   } else {
 
     __pyx_t_3 = __pyx_v_o->restore_feasibility;
-    goto __pyx_L63_bool_binop_done;
+    goto __pyx_L66_bool_binop_done;
   }
   __pyx_t_8 = (__pyx_e_5fccqp_4admm__SOLVED <= __pyx_v_status);
   if (__pyx_t_8) {
@@ -25716,11 +25756,11 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
   __pyx_t_3 = __pyx_t_8;
 
-  __pyx_L63_bool_binop_done:;
+  __pyx_L66_bool_binop_done:;
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":539
+    /* "fccqp/admm.pyx":541
  *                 anderson_step(&self.aa, it, s)
  *         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
  *             status = self._keep_restored(status, iteration, reduced, start_time)             # <<<<<<<<<<<<<<
@@ -25729,17 +25769,17 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     __pyx_v_status = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_keep_restored(__pyx_v_self, __pyx_v_status, __pyx_v_iteration, __pyx_v_reduced, __pyx_v_start_time);
 
-    /* "fccqp/admm.pyx":538
+    /* "fccqp/admm.pyx":540
  *             if status == _RUNNING and o.anderson_memory > 0:
  *                 anderson_step(&self.aa, it, s)
  *         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:             # <<<<<<<<<<<<<<
  *             status = self._keep_restored(status, iteration, reduced, start_time)
  *         elif reduced and status != _NUMERICAL_ERROR:
 */
-    goto __pyx_L62;
+    goto __pyx_L65;
   }
 
-  /* "fccqp/admm.pyx":540
+  /* "fccqp/admm.pyx":542
  *         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
  *             status = self._keep_restored(status, iteration, reduced, start_time)
  *         elif reduced and status != _NUMERICAL_ERROR:             # <<<<<<<<<<<<<<
@@ -25750,18 +25790,18 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
   } else {
 
     __pyx_t_3 = __pyx_v_reduced;
-    goto __pyx_L65_bool_binop_done;
+    goto __pyx_L68_bool_binop_done;
   }
   __pyx_t_8 = (__pyx_v_status != __pyx_e_5fccqp_4admm__NUMERICAL_ERROR);
 
 
   __pyx_t_3 = __pyx_t_8;
 
-  __pyx_L65_bool_binop_done:;
+  __pyx_L68_bool_binop_done:;
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":541
+    /* "fccqp/admm.pyx":543
  *             status = self._keep_restored(status, iteration, reduced, start_time)
  *         elif reduced and status != _NUMERICAL_ERROR:
  *             self._restore_equalities()   # certificates are already in cert             # <<<<<<<<<<<<<<
@@ -25770,7 +25810,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_restore_equalities(__pyx_v_self);
 
-    /* "fccqp/admm.pyx":540
+    /* "fccqp/admm.pyx":542
  *         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
  *             status = self._keep_restored(status, iteration, reduced, start_time)
  *         elif reduced and status != _NUMERICAL_ERROR:             # <<<<<<<<<<<<<<
@@ -25778,9 +25818,9 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
  *         self._finish_run(run, status, iteration)
 */
   }
-  __pyx_L62:;
+  __pyx_L65:;
 
-  /* "fccqp/admm.pyx":542
+  /* "fccqp/admm.pyx":544
  *         elif reduced and status != _NUMERICAL_ERROR:
  *             self._restore_equalities()   # certificates are already in cert
  *         self._finish_run(run, status, iteration)             # <<<<<<<<<<<<<<
@@ -25821,7 +25861,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__iterate(struct __pyx_obj_5fccqp_4ad
 
 }
 
-/* "fccqp/admm.pyx":544
+/* "fccqp/admm.pyx":546
  *         self._finish_run(run, status, iteration)
  * 
  *     cdef int _check(self, long iteration, bint last, double start_time) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -25842,7 +25882,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   Py_ssize_t __pyx_t_4;
   int __pyx_t_5;
 
-  /* "fccqp/admm.pyx":546
+  /* "fccqp/admm.pyx":548
  *     cdef int _check(self, long iteration, bint last, double start_time) noexcept nogil:
  *         """Termination and infeasibility tests after the residuals of ``iteration``."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -25851,7 +25891,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":547
+  /* "fccqp/admm.pyx":549
  *         """Termination and infeasibility tests after the residuals of ``iteration``."""
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -25860,7 +25900,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":548
+  /* "fccqp/admm.pyx":550
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Options* o = &self.opt             # <<<<<<<<<<<<<<
@@ -25869,7 +25909,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   __pyx_v_o = (&__pyx_v_self->opt);
 
-  /* "fccqp/admm.pyx":549
+  /* "fccqp/admm.pyx":551
  *         cdef Iterates* it = &self.it
  *         cdef Options* o = &self.opt
  *         cdef Residuals* r = &self.res             # <<<<<<<<<<<<<<
@@ -25878,7 +25918,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   __pyx_v_r = (&__pyx_v_self->res);
 
-  /* "fccqp/admm.pyx":551
+  /* "fccqp/admm.pyx":553
  *         cdef Residuals* r = &self.res
  *         cdef Py_ssize_t i
  *         if not r.finite:             # <<<<<<<<<<<<<<
@@ -25890,7 +25930,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":552
+    /* "fccqp/admm.pyx":554
  *         cdef Py_ssize_t i
  *         if not r.finite:
  *             return _NUMERICAL_ERROR             # <<<<<<<<<<<<<<
@@ -25903,7 +25943,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":551
+    /* "fccqp/admm.pyx":553
  *         cdef Residuals* r = &self.res
  *         cdef Py_ssize_t i
  *         if not r.finite:             # <<<<<<<<<<<<<<
@@ -25912,7 +25952,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":553
+  /* "fccqp/admm.pyx":555
  *         if not r.finite:
  *             return _NUMERICAL_ERROR
  *         if converged(r, o.eps_abs, o.eps_rel):             # <<<<<<<<<<<<<<
@@ -25924,7 +25964,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":554
+    /* "fccqp/admm.pyx":556
  *             return _NUMERICAL_ERROR
  *         if converged(r, o.eps_abs, o.eps_rel):
  *             return _SOLVED             # <<<<<<<<<<<<<<
@@ -25937,7 +25977,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":553
+    /* "fccqp/admm.pyx":555
  *         if not r.finite:
  *             return _NUMERICAL_ERROR
  *         if converged(r, o.eps_abs, o.eps_rel):             # <<<<<<<<<<<<<<
@@ -25946,7 +25986,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":555
+  /* "fccqp/admm.pyx":557
  *         if converged(r, o.eps_abs, o.eps_rel):
  *             return _SOLVED
  *         if primal_infeasible(p, it, o.eps_prim_inf, self.vec_m, self.vec_s, self.vec_n,             # <<<<<<<<<<<<<<
@@ -25958,7 +25998,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":557
+    /* "fccqp/admm.pyx":559
  *         if primal_infeasible(p, it, o.eps_prim_inf, self.vec_m, self.vec_s, self.vec_n,
  *                              self.vec_n2):
  *             fill(self.cert, 0.0, p.n + p.m)             # <<<<<<<<<<<<<<
@@ -25967,7 +26007,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
     __pyx_f_5fccqp_6_dense_fill(__pyx_v_self->cert, 0.0, (__pyx_v_p->n + __pyx_v_p->m));
 
-    /* "fccqp/admm.pyx":558
+    /* "fccqp/admm.pyx":560
  *                              self.vec_n2):
  *             fill(self.cert, 0.0, p.n + p.m)
  *             for i in range(p.m):   # in the user's units (the common factor 1/c dropped)             # <<<<<<<<<<<<<<
@@ -25981,7 +26021,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
       __pyx_v_i = __pyx_t_4;
 
-      /* "fccqp/admm.pyx":559
+      /* "fccqp/admm.pyx":561
  *             fill(self.cert, 0.0, p.n + p.m)
  *             for i in range(p.m):   # in the user's units (the common factor 1/c dropped)
  *                 self.cert[i] = self.vec_m[i] * p.E[i]             # <<<<<<<<<<<<<<
@@ -25992,7 +26032,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
 
 
-    /* "fccqp/admm.pyx":560
+    /* "fccqp/admm.pyx":562
  *             for i in range(p.m):   # in the user's units (the common factor 1/c dropped)
  *                 self.cert[i] = self.vec_m[i] * p.E[i]
  *             for i in range(p.s):             # <<<<<<<<<<<<<<
@@ -26006,7 +26046,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
       __pyx_v_i = __pyx_t_4;
 
-      /* "fccqp/admm.pyx":561
+      /* "fccqp/admm.pyx":563
  *                 self.cert[i] = self.vec_m[i] * p.E[i]
  *             for i in range(p.s):
  *                 self.cert[p.m + p.constrained[i]] = self.vec_s[i] / p.D[p.constrained[i]]             # <<<<<<<<<<<<<<
@@ -26017,7 +26057,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
 
 
-    /* "fccqp/admm.pyx":562
+    /* "fccqp/admm.pyx":564
  *             for i in range(p.s):
  *                 self.cert[p.m + p.constrained[i]] = self.vec_s[i] / p.D[p.constrained[i]]
  *             return _PRIMAL_INFEASIBLE             # <<<<<<<<<<<<<<
@@ -26030,7 +26070,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":555
+    /* "fccqp/admm.pyx":557
  *         if converged(r, o.eps_abs, o.eps_rel):
  *             return _SOLVED
  *         if primal_infeasible(p, it, o.eps_prim_inf, self.vec_m, self.vec_s, self.vec_n,             # <<<<<<<<<<<<<<
@@ -26039,7 +26079,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":563
+  /* "fccqp/admm.pyx":565
  *                 self.cert[p.m + p.constrained[i]] = self.vec_s[i] / p.D[p.constrained[i]]
  *             return _PRIMAL_INFEASIBLE
  *         if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():             # <<<<<<<<<<<<<<
@@ -26065,7 +26105,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":564
+    /* "fccqp/admm.pyx":566
  *             return _PRIMAL_INFEASIBLE
  *         if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():
  *             return _PRIMAL_INFEASIBLE             # <<<<<<<<<<<<<<
@@ -26078,7 +26118,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":563
+    /* "fccqp/admm.pyx":565
  *                 self.cert[p.m + p.constrained[i]] = self.vec_s[i] / p.D[p.constrained[i]]
  *             return _PRIMAL_INFEASIBLE
  *         if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():             # <<<<<<<<<<<<<<
@@ -26087,7 +26127,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":565
+  /* "fccqp/admm.pyx":567
  *         if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():
  *             return _PRIMAL_INFEASIBLE
  *         for i in range(p.n):             # <<<<<<<<<<<<<<
@@ -26101,7 +26141,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":566
+    /* "fccqp/admm.pyx":568
  *             return _PRIMAL_INFEASIBLE
  *         for i in range(p.n):
  *             self.direction[i] = it.x[i] - it.x_prev[i]             # <<<<<<<<<<<<<<
@@ -26112,7 +26152,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   }
 
 
-  /* "fccqp/admm.pyx":567
+  /* "fccqp/admm.pyx":569
  *         for i in range(p.n):
  *             self.direction[i] = it.x[i] - it.x_prev[i]
  *         if self._unbounded():             # <<<<<<<<<<<<<<
@@ -26124,7 +26164,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":568
+    /* "fccqp/admm.pyx":570
  *             self.direction[i] = it.x[i] - it.x_prev[i]
  *         if self._unbounded():
  *             return _DUAL_INFEASIBLE             # <<<<<<<<<<<<<<
@@ -26137,7 +26177,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":567
+    /* "fccqp/admm.pyx":569
  *         for i in range(p.n):
  *             self.direction[i] = it.x[i] - it.x_prev[i]
  *         if self._unbounded():             # <<<<<<<<<<<<<<
@@ -26146,7 +26186,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":569
+  /* "fccqp/admm.pyx":571
  *         if self._unbounded():
  *             return _DUAL_INFEASIBLE
  *         if last:             # <<<<<<<<<<<<<<
@@ -26155,7 +26195,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   if (__pyx_v_last) {
 
-    /* "fccqp/admm.pyx":570
+    /* "fccqp/admm.pyx":572
  *             return _DUAL_INFEASIBLE
  *         if last:
  *             return self._classify(iteration, True, start_time)             # <<<<<<<<<<<<<<
@@ -26168,7 +26208,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":569
+    /* "fccqp/admm.pyx":571
  *         if self._unbounded():
  *             return _DUAL_INFEASIBLE
  *         if last:             # <<<<<<<<<<<<<<
@@ -26177,7 +26217,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
 */
   }
 
-  /* "fccqp/admm.pyx":571
+  /* "fccqp/admm.pyx":573
  *         if last:
  *             return self._classify(iteration, True, start_time)
  *         return _RUNNING             # <<<<<<<<<<<<<<
@@ -26190,7 +26230,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":544
+  /* "fccqp/admm.pyx":546
  *         self._finish_run(run, status, iteration)
  * 
  *     cdef int _check(self, long iteration, bint last, double start_time) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26208,7 +26248,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__check(struct __pyx_obj_5fccqp_4admm_
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":573
+/* "fccqp/admm.pyx":575
  *         return _RUNNING
  * 
  *     cdef bint _inconsistent(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26225,7 +26265,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   Py_ssize_t __pyx_t_3;
   Py_ssize_t __pyx_t_4;
 
-  /* "fccqp/admm.pyx":576
+  /* "fccqp/admm.pyx":578
  *         """The equality certificate; on success ``cert`` holds ``(-E r, 0)``, ``r = b_s - A_s
  *         x_s``: ``A'y ~ 0`` and ``b'y < 0`` in the user's units."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -26234,7 +26274,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":578
+  /* "fccqp/admm.pyx":580
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i
  *         if not equality_inconsistent(p, &self.it, self.opt.eps_prim_inf, self.vec_m,             # <<<<<<<<<<<<<<
@@ -26246,7 +26286,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":580
+    /* "fccqp/admm.pyx":582
  *         if not equality_inconsistent(p, &self.it, self.opt.eps_prim_inf, self.vec_m,
  *                                      self.vec_n, self.vec_n2):
  *             return False             # <<<<<<<<<<<<<<
@@ -26259,7 +26299,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":578
+    /* "fccqp/admm.pyx":580
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i
  *         if not equality_inconsistent(p, &self.it, self.opt.eps_prim_inf, self.vec_m,             # <<<<<<<<<<<<<<
@@ -26268,7 +26308,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
 */
   }
 
-  /* "fccqp/admm.pyx":581
+  /* "fccqp/admm.pyx":583
  *                                      self.vec_n, self.vec_n2):
  *             return False
  *         fill(self.cert, 0.0, p.n + p.m)             # <<<<<<<<<<<<<<
@@ -26277,7 +26317,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_self->cert, 0.0, (__pyx_v_p->n + __pyx_v_p->m));
 
-  /* "fccqp/admm.pyx":582
+  /* "fccqp/admm.pyx":584
  *             return False
  *         fill(self.cert, 0.0, p.n + p.m)
  *         for i in range(p.m):             # <<<<<<<<<<<<<<
@@ -26291,7 +26331,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":583
+    /* "fccqp/admm.pyx":585
  *         fill(self.cert, 0.0, p.n + p.m)
  *         for i in range(p.m):
  *             self.cert[i] = -self.vec_m[i] * p.E[i]             # <<<<<<<<<<<<<<
@@ -26302,7 +26342,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   }
 
 
-  /* "fccqp/admm.pyx":584
+  /* "fccqp/admm.pyx":586
  *         for i in range(p.m):
  *             self.cert[i] = -self.vec_m[i] * p.E[i]
  *         return True             # <<<<<<<<<<<<<<
@@ -26315,7 +26355,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":573
+  /* "fccqp/admm.pyx":575
  *         return _RUNNING
  * 
  *     cdef bint _inconsistent(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26330,7 +26370,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__inconsistent(struct __pyx_obj_5fccqp
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":586
+/* "fccqp/admm.pyx":588
  *         return True
  * 
  *     cdef bint _unbounded(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26347,7 +26387,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   Py_ssize_t __pyx_t_3;
   Py_ssize_t __pyx_t_4;
 
-  /* "fccqp/admm.pyx":588
+  /* "fccqp/admm.pyx":590
  *     cdef bint _unbounded(self) noexcept nogil:
  *         """The dual certificate for ``direction``; on success ``cert`` holds it, unscaled."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -26356,7 +26396,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":590
+  /* "fccqp/admm.pyx":592
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i
  *         if not dual_infeasible(p, self.direction, self.opt.eps_dual_inf, self.vec_n,             # <<<<<<<<<<<<<<
@@ -26368,7 +26408,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":592
+    /* "fccqp/admm.pyx":594
  *         if not dual_infeasible(p, self.direction, self.opt.eps_dual_inf, self.vec_n,
  *                                self.vec_n2, self.vec_s2):
  *             return False             # <<<<<<<<<<<<<<
@@ -26381,7 +26421,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":590
+    /* "fccqp/admm.pyx":592
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i
  *         if not dual_infeasible(p, self.direction, self.opt.eps_dual_inf, self.vec_n,             # <<<<<<<<<<<<<<
@@ -26390,7 +26430,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
 */
   }
 
-  /* "fccqp/admm.pyx":593
+  /* "fccqp/admm.pyx":595
  *                                self.vec_n2, self.vec_s2):
  *             return False
  *         for i in range(p.n):             # <<<<<<<<<<<<<<
@@ -26404,7 +26444,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":594
+    /* "fccqp/admm.pyx":596
  *             return False
  *         for i in range(p.n):
  *             self.cert[i] = self.direction[i] * p.D[i]             # <<<<<<<<<<<<<<
@@ -26415,7 +26455,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   }
 
 
-  /* "fccqp/admm.pyx":595
+  /* "fccqp/admm.pyx":597
  *         for i in range(p.n):
  *             self.cert[i] = self.direction[i] * p.D[i]
  *         return True             # <<<<<<<<<<<<<<
@@ -26428,7 +26468,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":586
+  /* "fccqp/admm.pyx":588
  *         return True
  * 
  *     cdef bint _unbounded(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26443,7 +26483,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__unbounded(struct __pyx_obj_5fccqp_4a
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":597
+/* "fccqp/admm.pyx":599
  *         return True
  * 
  *     cdef int _classify(self, long iteration, bint stopped, double start_time) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26457,7 +26497,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   int __pyx_t_1;
   int __pyx_t_2;
 
-  /* "fccqp/admm.pyx":600
+  /* "fccqp/admm.pyx":602
  *         """Status of an iterate from its residuals alone: solved, inaccurate (within
  *         ``INACCURATE_FACTOR`` of the tolerances), or the budget that ran out."""
  *         cdef Residuals* r = &self.res             # <<<<<<<<<<<<<<
@@ -26466,7 +26506,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
 */
   __pyx_v_r = (&__pyx_v_self->res);
 
-  /* "fccqp/admm.pyx":601
+  /* "fccqp/admm.pyx":603
  *         ``INACCURATE_FACTOR`` of the tolerances), or the budget that ran out."""
  *         cdef Residuals* r = &self.res
  *         if not r.finite:             # <<<<<<<<<<<<<<
@@ -26478,7 +26518,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":602
+    /* "fccqp/admm.pyx":604
  *         cdef Residuals* r = &self.res
  *         if not r.finite:
  *             return _NUMERICAL_ERROR             # <<<<<<<<<<<<<<
@@ -26491,7 +26531,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":601
+    /* "fccqp/admm.pyx":603
  *         ``INACCURATE_FACTOR`` of the tolerances), or the budget that ran out."""
  *         cdef Residuals* r = &self.res
  *         if not r.finite:             # <<<<<<<<<<<<<<
@@ -26500,7 +26540,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":603
+  /* "fccqp/admm.pyx":605
  *         if not r.finite:
  *             return _NUMERICAL_ERROR
  *         if converged(r, self.opt.eps_abs, self.opt.eps_rel):             # <<<<<<<<<<<<<<
@@ -26512,7 +26552,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":604
+    /* "fccqp/admm.pyx":606
  *             return _NUMERICAL_ERROR
  *         if converged(r, self.opt.eps_abs, self.opt.eps_rel):
  *             return _SOLVED             # <<<<<<<<<<<<<<
@@ -26525,7 +26565,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":603
+    /* "fccqp/admm.pyx":605
  *         if not r.finite:
  *             return _NUMERICAL_ERROR
  *         if converged(r, self.opt.eps_abs, self.opt.eps_rel):             # <<<<<<<<<<<<<<
@@ -26534,7 +26574,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":605
+  /* "fccqp/admm.pyx":607
  *         if converged(r, self.opt.eps_abs, self.opt.eps_rel):
  *             return _SOLVED
  *         if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):             # <<<<<<<<<<<<<<
@@ -26546,7 +26586,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":606
+    /* "fccqp/admm.pyx":608
  *             return _SOLVED
  *         if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *             return _INACCURATE             # <<<<<<<<<<<<<<
@@ -26559,7 +26599,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":605
+    /* "fccqp/admm.pyx":607
  *         if converged(r, self.opt.eps_abs, self.opt.eps_rel):
  *             return _SOLVED
  *         if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):             # <<<<<<<<<<<<<<
@@ -26568,7 +26608,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":607
+  /* "fccqp/admm.pyx":609
  *         if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *             return _INACCURATE
  *         if iteration >= self.opt.max_iter or not stopped:             # <<<<<<<<<<<<<<
@@ -26594,7 +26634,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":608
+    /* "fccqp/admm.pyx":610
  *             return _INACCURATE
  *         if iteration >= self.opt.max_iter or not stopped:
  *             return _MAX_ITER             # <<<<<<<<<<<<<<
@@ -26607,7 +26647,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":607
+    /* "fccqp/admm.pyx":609
  *         if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *             return _INACCURATE
  *         if iteration >= self.opt.max_iter or not stopped:             # <<<<<<<<<<<<<<
@@ -26616,7 +26656,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
 */
   }
 
-  /* "fccqp/admm.pyx":609
+  /* "fccqp/admm.pyx":611
  *         if iteration >= self.opt.max_iter or not stopped:
  *             return _MAX_ITER
  *         return _TIME_LIMIT             # <<<<<<<<<<<<<<
@@ -26629,7 +26669,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":597
+  /* "fccqp/admm.pyx":599
  *         return True
  * 
  *     cdef int _classify(self, long iteration, bint stopped, double start_time) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26643,7 +26683,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__classify(struct __pyx_obj_5fccqp_4ad
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":611
+/* "fccqp/admm.pyx":613
  *         return _TIME_LIMIT
  * 
  *     cdef void _full_step(self, bint relax_x) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26668,7 +26708,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   Py_ssize_t __pyx_t_4;
   Py_ssize_t __pyx_t_5;
 
-  /* "fccqp/admm.pyx":613
+  /* "fccqp/admm.pyx":615
  *     cdef void _full_step(self, bint relax_x) noexcept nogil:
  *         """One ADMM iteration with a KKT solve (update_x, update_z, update_y)."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -26677,7 +26717,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":614
+  /* "fccqp/admm.pyx":616
  *         """One ADMM iteration with a KKT solve (update_x, update_z, update_y)."""
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -26686,7 +26726,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":615
+  /* "fccqp/admm.pyx":617
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j             # <<<<<<<<<<<<<<
@@ -26703,7 +26743,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":616
+  /* "fccqp/admm.pyx":618
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         cdef double alpha = self.opt.alpha, alpha_x = alpha if relax_x else 1.0             # <<<<<<<<<<<<<<
@@ -26722,7 +26762,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
   __pyx_v_alpha_x = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":617
+  /* "fccqp/admm.pyx":619
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         cdef double alpha = self.opt.alpha, alpha_x = alpha if relax_x else 1.0
  *         cdef double sigma = self.opt.sigma             # <<<<<<<<<<<<<<
@@ -26733,7 +26773,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 
   __pyx_v_sigma = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":618
+  /* "fccqp/admm.pyx":620
  *         cdef double alpha = self.opt.alpha, alpha_x = alpha if relax_x else 1.0
  *         cdef double sigma = self.opt.sigma
  *         copy(it.x, it.x_prev, n)             # <<<<<<<<<<<<<<
@@ -26742,7 +26782,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->x, __pyx_v_it->x_prev, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":619
+  /* "fccqp/admm.pyx":621
  *         cdef double sigma = self.opt.sigma
  *         copy(it.x, it.x_prev, n)
  *         copy(it.nu, it.nu_prev, m)             # <<<<<<<<<<<<<<
@@ -26751,7 +26791,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->nu, __pyx_v_it->nu_prev, __pyx_v_m);
 
-  /* "fccqp/admm.pyx":620
+  /* "fccqp/admm.pyx":622
  *         copy(it.x, it.x_prev, n)
  *         copy(it.nu, it.nu_prev, m)
  *         copy(it.z, it.z_prev, s)             # <<<<<<<<<<<<<<
@@ -26760,7 +26800,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->z, __pyx_v_it->z_prev, __pyx_v_s);
 
-  /* "fccqp/admm.pyx":621
+  /* "fccqp/admm.pyx":623
  *         copy(it.nu, it.nu_prev, m)
  *         copy(it.z, it.z_prev, s)
  *         copy(it.y, it.y_prev, s)             # <<<<<<<<<<<<<<
@@ -26769,7 +26809,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->y, __pyx_v_it->y_prev, __pyx_v_s);
 
-  /* "fccqp/admm.pyx":622
+  /* "fccqp/admm.pyx":624
  *         copy(it.z, it.z_prev, s)
  *         copy(it.y, it.y_prev, s)
  *         for i in range(n):             # <<<<<<<<<<<<<<
@@ -26783,7 +26823,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":623
+    /* "fccqp/admm.pyx":625
  *         copy(it.y, it.y_prev, s)
  *         for i in range(n):
  *             self.rhs[i] = sigma * it.x[i] - p.q[i]             # <<<<<<<<<<<<<<
@@ -26794,7 +26834,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":624
+  /* "fccqp/admm.pyx":626
  *         for i in range(n):
  *             self.rhs[i] = sigma * it.x[i] - p.q[i]
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -26808,7 +26848,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":625
+    /* "fccqp/admm.pyx":627
  *             self.rhs[i] = sigma * it.x[i] - p.q[i]
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i]             # <<<<<<<<<<<<<<
@@ -26819,7 +26859,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":626
+  /* "fccqp/admm.pyx":628
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i]
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -26833,7 +26873,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":627
+    /* "fccqp/admm.pyx":629
  *             self.rhs[n + i] = p.b[i]
  *         for j in range(s):
  *             self.rhs[p.constrained[j]] += it.rho_vec[j] * it.z[j] - it.y[j]             # <<<<<<<<<<<<<<
@@ -26846,7 +26886,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":628
+  /* "fccqp/admm.pyx":630
  *         for j in range(s):
  *             self.rhs[p.constrained[j]] += it.rho_vec[j] * it.z[j] - it.y[j]
  *         kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)             # <<<<<<<<<<<<<<
@@ -26855,7 +26895,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_3kkt_kkt_solve((&__pyx_v_self->kkt), __pyx_v_p, __pyx_v_it->rho_vec, __pyx_v_self->rhs, __pyx_v_self->sol);
 
-  /* "fccqp/admm.pyx":629
+  /* "fccqp/admm.pyx":631
  *             self.rhs[p.constrained[j]] += it.rho_vec[j] * it.z[j] - it.y[j]
  *         kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -26869,7 +26909,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":630
+    /* "fccqp/admm.pyx":632
  *         kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
  *         for j in range(s):
  *             it.relaxed[j] = alpha * self.sol[p.constrained[j]] + (1.0 - alpha) * it.z_prev[j]             # <<<<<<<<<<<<<<
@@ -26880,7 +26920,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":631
+  /* "fccqp/admm.pyx":633
  *         for j in range(s):
  *             it.relaxed[j] = alpha * self.sol[p.constrained[j]] + (1.0 - alpha) * it.z_prev[j]
  *         for i in range(n):             # <<<<<<<<<<<<<<
@@ -26894,7 +26934,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":632
+    /* "fccqp/admm.pyx":634
  *             it.relaxed[j] = alpha * self.sol[p.constrained[j]] + (1.0 - alpha) * it.z_prev[j]
  *         for i in range(n):
  *             it.x[i] = alpha_x * self.sol[i] + (1.0 - alpha_x) * it.x_prev[i]             # <<<<<<<<<<<<<<
@@ -26905,7 +26945,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":633
+  /* "fccqp/admm.pyx":635
  *         for i in range(n):
  *             it.x[i] = alpha_x * self.sol[i] + (1.0 - alpha_x) * it.x_prev[i]
  *         copy(self.sol + n, it.nu, m)             # <<<<<<<<<<<<<<
@@ -26914,7 +26954,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_6_dense_copy((__pyx_v_self->sol + __pyx_v_n), __pyx_v_it->nu, __pyx_v_m);
 
-  /* "fccqp/admm.pyx":634
+  /* "fccqp/admm.pyx":636
  *             it.x[i] = alpha_x * self.sol[i] + (1.0 - alpha_x) * it.x_prev[i]
  *         copy(self.sol + n, it.nu, m)
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -26928,7 +26968,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":635
+    /* "fccqp/admm.pyx":637
  *         copy(self.sol + n, it.nu, m)
  *         for j in range(s):
  *             it.z[j] = it.relaxed[j] + it.y[j] / it.rho_vec[j]             # <<<<<<<<<<<<<<
@@ -26939,7 +26979,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":636
+  /* "fccqp/admm.pyx":638
  *         for j in range(s):
  *             it.z[j] = it.relaxed[j] + it.y[j] / it.rho_vec[j]
  *         proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)             # <<<<<<<<<<<<<<
@@ -26948,7 +26988,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_11projections_proj_set(__pyx_v_it->z, __pyx_v_p->lo, __pyx_v_p->hi, __pyx_v_p->cones, __pyx_v_s, __pyx_v_it->z);
 
-  /* "fccqp/admm.pyx":637
+  /* "fccqp/admm.pyx":639
  *             it.z[j] = it.relaxed[j] + it.y[j] / it.rho_vec[j]
  *         proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -26962,7 +27002,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":638
+    /* "fccqp/admm.pyx":640
  *         proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
  *         for j in range(s):
  *             it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])             # <<<<<<<<<<<<<<
@@ -26975,7 +27015,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":611
+  /* "fccqp/admm.pyx":613
  *         return _TIME_LIMIT
  * 
  *     cdef void _full_step(self, bint relax_x) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -26996,7 +27036,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__full_step(struct __pyx_obj_5fccqp_4
 
 }
 
-/* "fccqp/admm.pyx":640
+/* "fccqp/admm.pyx":642
  *             it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])
  * 
  *     cdef double _new_rho(self, double rho) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27018,7 +27058,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   double __pyx_t_6;
   int __pyx_t_7;
 
-  /* "fccqp/admm.pyx":643
+  /* "fccqp/admm.pyx":645
  *         """OSQP's rule: rho *= sqrt(relative primal / relative dual residual), clipped;
  *         unchanged unless it moves by more than ``adaptive_rho_tolerance``."""
  *         cdef Residuals* r = &self.res             # <<<<<<<<<<<<<<
@@ -27027,7 +27067,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
 */
   __pyx_v_r = (&__pyx_v_self->res);
 
-  /* "fccqp/admm.pyx":644
+  /* "fccqp/admm.pyx":646
  *         unchanged unless it moves by more than ``adaptive_rho_tolerance``."""
  *         cdef Residuals* r = &self.res
  *         cdef double ratio = (r.prim_s / max(r.prim_scale_s, 1e-30)) / max(             # <<<<<<<<<<<<<<
@@ -27051,7 +27091,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
 
   __pyx_t_1 = 1e-30;
 
-  /* "fccqp/admm.pyx":645
+  /* "fccqp/admm.pyx":647
  *         cdef Residuals* r = &self.res
  *         cdef double ratio = (r.prim_s / max(r.prim_scale_s, 1e-30)) / max(
  *             r.dual_s / max(r.dual_scale_s, 1e-30), 1e-30)             # <<<<<<<<<<<<<<
@@ -27086,7 +27126,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   }
 
 
-  /* "fccqp/admm.pyx":644
+  /* "fccqp/admm.pyx":646
  *         unchanged unless it moves by more than ``adaptive_rho_tolerance``."""
  *         cdef Residuals* r = &self.res
  *         cdef double ratio = (r.prim_s / max(r.prim_scale_s, 1e-30)) / max(             # <<<<<<<<<<<<<<
@@ -27097,7 +27137,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
 
 
 
-  /* "fccqp/admm.pyx":646
+  /* "fccqp/admm.pyx":648
  *         cdef double ratio = (r.prim_s / max(r.prim_scale_s, 1e-30)) / max(
  *             r.dual_s / max(r.dual_scale_s, 1e-30), 1e-30)
  *         cdef double new_rho = min(max(rho * sqrt(ratio), _RHO_MIN), _RHO_MAX)             # <<<<<<<<<<<<<<
@@ -27136,7 +27176,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   __pyx_v_new_rho = __pyx_t_2;
 
 
-  /* "fccqp/admm.pyx":647
+  /* "fccqp/admm.pyx":649
  *             r.dual_s / max(r.dual_scale_s, 1e-30), 1e-30)
  *         cdef double new_rho = min(max(rho * sqrt(ratio), _RHO_MIN), _RHO_MAX)
  *         cdef double tolerance = self.opt.adaptive_rho_tolerance             # <<<<<<<<<<<<<<
@@ -27147,7 +27187,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
 
   __pyx_v_tolerance = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":648
+  /* "fccqp/admm.pyx":650
  *         cdef double new_rho = min(max(rho * sqrt(ratio), _RHO_MIN), _RHO_MAX)
  *         cdef double tolerance = self.opt.adaptive_rho_tolerance
  *         if new_rho > rho * tolerance or new_rho < rho / tolerance:             # <<<<<<<<<<<<<<
@@ -27173,7 +27213,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   if (__pyx_t_4) {
 
 
-    /* "fccqp/admm.pyx":649
+    /* "fccqp/admm.pyx":651
  *         cdef double tolerance = self.opt.adaptive_rho_tolerance
  *         if new_rho > rho * tolerance or new_rho < rho / tolerance:
  *             return new_rho             # <<<<<<<<<<<<<<
@@ -27186,7 +27226,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":648
+    /* "fccqp/admm.pyx":650
  *         cdef double new_rho = min(max(rho * sqrt(ratio), _RHO_MIN), _RHO_MAX)
  *         cdef double tolerance = self.opt.adaptive_rho_tolerance
  *         if new_rho > rho * tolerance or new_rho < rho / tolerance:             # <<<<<<<<<<<<<<
@@ -27195,7 +27235,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
 */
   }
 
-  /* "fccqp/admm.pyx":650
+  /* "fccqp/admm.pyx":652
  *         if new_rho > rho * tolerance or new_rho < rho / tolerance:
  *             return new_rho
  *         return rho             # <<<<<<<<<<<<<<
@@ -27208,7 +27248,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":640
+  /* "fccqp/admm.pyx":642
  *             it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])
  * 
  *     cdef double _new_rho(self, double rho) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27225,7 +27265,7 @@ static double __pyx_f_5fccqp_4admm_9Workspace__new_rho(struct __pyx_obj_5fccqp_4
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":654
+/* "fccqp/admm.pyx":656
  *     # -------------------------------------------------------- factorizations
  * 
  *     cdef long _budget(self, long iteration) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27238,7 +27278,7 @@ static long __pyx_f_5fccqp_4admm_9Workspace__budget(struct __pyx_obj_5fccqp_4adm
   long __pyx_r;
   Py_ssize_t __pyx_t_1;
 
-  /* "fccqp/admm.pyx":657
+  /* "fccqp/admm.pyx":659
  *         """Solves the reduced form's table can save: the iterations left, plus, when the
  *         result will be restored, the columns the restoration would otherwise compute."""
  *         cdef long restoring = self.prob.s if self.opt.restore_feasibility else 0             # <<<<<<<<<<<<<<
@@ -27254,7 +27294,7 @@ static long __pyx_f_5fccqp_4admm_9Workspace__budget(struct __pyx_obj_5fccqp_4adm
   }
   __pyx_v_restoring = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":658
+  /* "fccqp/admm.pyx":660
  *         result will be restored, the columns the restoration would otherwise compute."""
  *         cdef long restoring = self.prob.s if self.opt.restore_feasibility else 0
  *         return self.opt.max_iter - iteration + restoring             # <<<<<<<<<<<<<<
@@ -27267,7 +27307,7 @@ static long __pyx_f_5fccqp_4admm_9Workspace__budget(struct __pyx_obj_5fccqp_4adm
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":654
+  /* "fccqp/admm.pyx":656
  *     # -------------------------------------------------------- factorizations
  * 
  *     cdef long _budget(self, long iteration) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27281,7 +27321,7 @@ static long __pyx_f_5fccqp_4admm_9Workspace__budget(struct __pyx_obj_5fccqp_4adm
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":660
+/* "fccqp/admm.pyx":662
  *         return self.opt.max_iter - iteration + restoring
  * 
  *     cdef int _certify(self, bint schur_factored) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27294,7 +27334,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
   int __pyx_r;
   int __pyx_t_1;
 
-  /* "fccqp/admm.pyx":663
+  /* "fccqp/admm.pyx":665
  *         """Establish convexity for the current matrices (see :func:`fccqp.kkt.kkt_convexity`);
  *         ``schur_factored`` says that the Schur backend has just factored them."""
  *         cdef int code = kkt_convexity(&self.kkt, &self.prob, self.opt.sigma, self.it.rho_vec,             # <<<<<<<<<<<<<<
@@ -27303,7 +27343,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
 */
   __pyx_v_code = __pyx_f_5fccqp_3kkt_kkt_convexity((&__pyx_v_self->kkt), (&__pyx_v_self->prob), __pyx_v_self->opt.sigma, __pyx_v_self->it.rho_vec, __pyx_v_schur_factored);
 
-  /* "fccqp/admm.pyx":665
+  /* "fccqp/admm.pyx":667
  *         cdef int code = kkt_convexity(&self.kkt, &self.prob, self.opt.sigma, self.it.rho_vec,
  *                                       schur_factored)
  *         if code == FACTORED:             # <<<<<<<<<<<<<<
@@ -27315,7 +27355,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":666
+    /* "fccqp/admm.pyx":668
  *                                       schur_factored)
  *         if code == FACTORED:
  *             self.certified = True             # <<<<<<<<<<<<<<
@@ -27324,7 +27364,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_v_self->certified = 1;
 
-    /* "fccqp/admm.pyx":665
+    /* "fccqp/admm.pyx":667
  *         cdef int code = kkt_convexity(&self.kkt, &self.prob, self.opt.sigma, self.it.rho_vec,
  *                                       schur_factored)
  *         if code == FACTORED:             # <<<<<<<<<<<<<<
@@ -27333,7 +27373,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
 */
   }
 
-  /* "fccqp/admm.pyx":667
+  /* "fccqp/admm.pyx":669
  *         if code == FACTORED:
  *             self.certified = True
  *         return code             # <<<<<<<<<<<<<<
@@ -27346,7 +27386,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":660
+  /* "fccqp/admm.pyx":662
  *         return self.opt.max_iter - iteration + restoring
  * 
  *     cdef int _certify(self, bint schur_factored) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27360,7 +27400,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__certify(struct __pyx_obj_5fccqp_4adm
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":669
+/* "fccqp/admm.pyx":671
  *         return code
  * 
  *     cdef int _factor(self, Run* run, long budget) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27383,7 +27423,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   long __pyx_t_6;
   double __pyx_t_7;
 
-  /* "fccqp/admm.pyx":676
+  /* "fccqp/admm.pyx":678
  *         matrices are new. Returns FACTORED, NOT_CONVEX, or UNAVAILABLE (numerical
  *         breakdown); records the form and the rho it factored."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -27392,7 +27432,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":677
+  /* "fccqp/admm.pyx":679
  *         breakdown); records the form and the rho it factored."""
  *         cdef Problem* p = &self.prob
  *         cdef int backend, code, first = self.opt.backend             # <<<<<<<<<<<<<<
@@ -27403,7 +27443,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 
   __pyx_v_first = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":679
+  /* "fccqp/admm.pyx":681
  *         cdef int backend, code, first = self.opt.backend
  *         cdef bint reduced_pays
  *         if first == AUTO:             # <<<<<<<<<<<<<<
@@ -27415,7 +27455,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   if (__pyx_t_2) {
 
 
-    /* "fccqp/admm.pyx":680
+    /* "fccqp/admm.pyx":682
  *         cdef bint reduced_pays
  *         if first == AUTO:
  *             reduced_pays = 2 * p.s <= p.n + p.m and _REDUCED_COST * p.s <= budget             # <<<<<<<<<<<<<<
@@ -27440,7 +27480,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     __pyx_L4_bool_binop_done:;
     __pyx_v_reduced_pays = __pyx_t_2;
 
-    /* "fccqp/admm.pyx":681
+    /* "fccqp/admm.pyx":683
  *         if first == AUTO:
  *             reduced_pays = 2 * p.s <= p.n + p.m and _REDUCED_COST * p.s <= budget
  *             first = SCHUR_REDUCED if reduced_pays else LDL_FULL             # <<<<<<<<<<<<<<
@@ -27456,7 +27496,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     }
     __pyx_v_first = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":679
+    /* "fccqp/admm.pyx":681
  *         cdef int backend, code, first = self.opt.backend
  *         cdef bint reduced_pays
  *         if first == AUTO:             # <<<<<<<<<<<<<<
@@ -27465,7 +27505,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
   }
 
-  /* "fccqp/admm.pyx":682
+  /* "fccqp/admm.pyx":684
  *             reduced_pays = 2 * p.s <= p.n + p.m and _REDUCED_COST * p.s <= budget
  *             first = SCHUR_REDUCED if reduced_pays else LDL_FULL
  *         for backend in range(first, LDL_FULL + 1):             # <<<<<<<<<<<<<<
@@ -27479,7 +27519,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   for (__pyx_t_1 = __pyx_v_first; __pyx_t_1 < __pyx_t_6; __pyx_t_1+=1) {
     __pyx_v_backend = __pyx_t_1;
 
-    /* "fccqp/admm.pyx":683
+    /* "fccqp/admm.pyx":685
  *             first = SCHUR_REDUCED if reduced_pays else LDL_FULL
  *         for backend in range(first, LDL_FULL + 1):
  *             if not self.certified and backend != SCHUR_REDUCED:             # <<<<<<<<<<<<<<
@@ -27505,7 +27545,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":685
+      /* "fccqp/admm.pyx":687
  *             if not self.certified and backend != SCHUR_REDUCED:
  *                 # certify first: the certificate overwrites an LDL' factorization
  *                 code = self._certify(False)             # <<<<<<<<<<<<<<
@@ -27514,7 +27554,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       __pyx_v_code = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_certify(__pyx_v_self, 0);
 
-      /* "fccqp/admm.pyx":686
+      /* "fccqp/admm.pyx":688
  *                 # certify first: the certificate overwrites an LDL' factorization
  *                 code = self._certify(False)
  *                 run.factorizations += 1             # <<<<<<<<<<<<<<
@@ -27523,7 +27563,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       __pyx_v_run->factorizations = (__pyx_v_run->factorizations + 1);
 
-      /* "fccqp/admm.pyx":687
+      /* "fccqp/admm.pyx":689
  *                 code = self._certify(False)
  *                 run.factorizations += 1
  *                 if code == NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -27535,7 +27575,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
       if (__pyx_t_2) {
 
 
-        /* "fccqp/admm.pyx":688
+        /* "fccqp/admm.pyx":690
  *                 run.factorizations += 1
  *                 if code == NOT_CONVEX:
  *                     return NOT_CONVEX             # <<<<<<<<<<<<<<
@@ -27548,7 +27588,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
         }
         goto __pyx_L0;
 
-        /* "fccqp/admm.pyx":687
+        /* "fccqp/admm.pyx":689
  *                 code = self._certify(False)
  *                 run.factorizations += 1
  *                 if code == NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -27557,7 +27597,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       }
 
-      /* "fccqp/admm.pyx":683
+      /* "fccqp/admm.pyx":685
  *             first = SCHUR_REDUCED if reduced_pays else LDL_FULL
  *         for backend in range(first, LDL_FULL + 1):
  *             if not self.certified and backend != SCHUR_REDUCED:             # <<<<<<<<<<<<<<
@@ -27566,7 +27606,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     }
 
-    /* "fccqp/admm.pyx":690
+    /* "fccqp/admm.pyx":692
  *                     return NOT_CONVEX
  *             code = kkt_factor(&self.kkt, p, backend,
  *                               self.opt.sigma if backend == LDL_FULL else 0.0, self.it.rho_vec)             # <<<<<<<<<<<<<<
@@ -27584,7 +27624,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     }
 
 
-    /* "fccqp/admm.pyx":689
+    /* "fccqp/admm.pyx":691
  *                 if code == NOT_CONVEX:
  *                     return NOT_CONVEX
  *             code = kkt_factor(&self.kkt, p, backend,             # <<<<<<<<<<<<<<
@@ -27594,7 +27634,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     __pyx_v_code = __pyx_f_5fccqp_3kkt_kkt_factor((&__pyx_v_self->kkt), __pyx_v_p, __pyx_v_backend, __pyx_t_7, __pyx_v_self->it.rho_vec);
 
 
-    /* "fccqp/admm.pyx":691
+    /* "fccqp/admm.pyx":693
  *             code = kkt_factor(&self.kkt, p, backend,
  *                               self.opt.sigma if backend == LDL_FULL else 0.0, self.it.rho_vec)
  *             run.factorizations += 1             # <<<<<<<<<<<<<<
@@ -27603,7 +27643,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_v_run->factorizations = (__pyx_v_run->factorizations + 1);
 
-    /* "fccqp/admm.pyx":692
+    /* "fccqp/admm.pyx":694
  *                               self.opt.sigma if backend == LDL_FULL else 0.0, self.it.rho_vec)
  *             run.factorizations += 1
  *             if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -27615,7 +27655,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":693
+      /* "fccqp/admm.pyx":695
  *             run.factorizations += 1
  *             if code != FACTORED:
  *                 if backend == LDL_FULL:             # <<<<<<<<<<<<<<
@@ -27627,7 +27667,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
       if (__pyx_t_2) {
 
 
-        /* "fccqp/admm.pyx":694
+        /* "fccqp/admm.pyx":696
  *             if code != FACTORED:
  *                 if backend == LDL_FULL:
  *                     return UNAVAILABLE             # <<<<<<<<<<<<<<
@@ -27640,7 +27680,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
         }
         goto __pyx_L0;
 
-        /* "fccqp/admm.pyx":693
+        /* "fccqp/admm.pyx":695
  *             run.factorizations += 1
  *             if code != FACTORED:
  *                 if backend == LDL_FULL:             # <<<<<<<<<<<<<<
@@ -27649,7 +27689,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       }
 
-      /* "fccqp/admm.pyx":695
+      /* "fccqp/admm.pyx":697
  *                 if backend == LDL_FULL:
  *                     return UNAVAILABLE
  *                 continue             # <<<<<<<<<<<<<<
@@ -27658,7 +27698,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       goto __pyx_L6_continue;
 
-      /* "fccqp/admm.pyx":692
+      /* "fccqp/admm.pyx":694
  *                               self.opt.sigma if backend == LDL_FULL else 0.0, self.it.rho_vec)
  *             run.factorizations += 1
  *             if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -27667,7 +27707,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     }
 
-    /* "fccqp/admm.pyx":696
+    /* "fccqp/admm.pyx":698
  *                     return UNAVAILABLE
  *                 continue
  *             if not self.certified and self._certify(True) == NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -27693,7 +27733,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":697
+      /* "fccqp/admm.pyx":699
  *                 continue
  *             if not self.certified and self._certify(True) == NOT_CONVEX:
  *                 return NOT_CONVEX             # <<<<<<<<<<<<<<
@@ -27706,7 +27746,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
       }
       goto __pyx_L0;
 
-      /* "fccqp/admm.pyx":696
+      /* "fccqp/admm.pyx":698
  *                     return UNAVAILABLE
  *                 continue
  *             if not self.certified and self._certify(True) == NOT_CONVEX:             # <<<<<<<<<<<<<<
@@ -27715,7 +27755,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     }
 
-    /* "fccqp/admm.pyx":698
+    /* "fccqp/admm.pyx":700
  *             if not self.certified and self._certify(True) == NOT_CONVEX:
  *                 return NOT_CONVEX
  *             if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,             # <<<<<<<<<<<<<<
@@ -27733,7 +27773,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
       goto __pyx_L18_bool_binop_done;
     }
 
-    /* "fccqp/admm.pyx":699
+    /* "fccqp/admm.pyx":701
  *                 return NOT_CONVEX
  *             if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,
  *                                                          self.it.rho_vec):             # <<<<<<<<<<<<<<
@@ -27747,7 +27787,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 
     __pyx_L18_bool_binop_done:;
 
-    /* "fccqp/admm.pyx":698
+    /* "fccqp/admm.pyx":700
  *             if not self.certified and self._certify(True) == NOT_CONVEX:
  *                 return NOT_CONVEX
  *             if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,             # <<<<<<<<<<<<<<
@@ -27757,7 +27797,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":700
+      /* "fccqp/admm.pyx":702
  *             if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,
  *                                                          self.it.rho_vec):
  *                 continue             # <<<<<<<<<<<<<<
@@ -27766,7 +27806,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
       goto __pyx_L6_continue;
 
-      /* "fccqp/admm.pyx":698
+      /* "fccqp/admm.pyx":700
  *             if not self.certified and self._certify(True) == NOT_CONVEX:
  *                 return NOT_CONVEX
  *             if backend != LDL_FULL and not reduced_table(&self.red, &self.kkt, p,             # <<<<<<<<<<<<<<
@@ -27775,7 +27815,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     }
 
-    /* "fccqp/admm.pyx":701
+    /* "fccqp/admm.pyx":703
  *                                                          self.it.rho_vec):
  *                 continue
  *             self.form = backend             # <<<<<<<<<<<<<<
@@ -27784,7 +27824,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_v_self->form = __pyx_v_backend;
 
-    /* "fccqp/admm.pyx":702
+    /* "fccqp/admm.pyx":704
  *                 continue
  *             self.form = backend
  *             run.backend = backend             # <<<<<<<<<<<<<<
@@ -27793,7 +27833,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 */
     __pyx_v_run->backend = __pyx_v_backend;
 
-    /* "fccqp/admm.pyx":703
+    /* "fccqp/admm.pyx":705
  *             self.form = backend
  *             run.backend = backend
  *             self.factored_rho = run.rho             # <<<<<<<<<<<<<<
@@ -27804,7 +27844,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
 
     __pyx_v_self->factored_rho = __pyx_t_7;
 
-    /* "fccqp/admm.pyx":704
+    /* "fccqp/admm.pyx":706
  *             run.backend = backend
  *             self.factored_rho = run.rho
  *             return FACTORED             # <<<<<<<<<<<<<<
@@ -27820,7 +27860,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   }
 
 
-  /* "fccqp/admm.pyx":705
+  /* "fccqp/admm.pyx":707
  *             self.factored_rho = run.rho
  *             return FACTORED
  *         return UNAVAILABLE             # <<<<<<<<<<<<<<
@@ -27833,7 +27873,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":669
+  /* "fccqp/admm.pyx":671
  *         return code
  * 
  *     cdef int _factor(self, Run* run, long budget) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27851,7 +27891,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__factor(struct __pyx_obj_5fccqp_4admm
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":707
+/* "fccqp/admm.pyx":709
  *         return UNAVAILABLE
  * 
  *     cdef void _reduced_base(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27866,7 +27906,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
   Py_ssize_t __pyx_t_2;
   Py_ssize_t __pyx_t_3;
 
-  /* "fccqp/admm.pyx":710
+  /* "fccqp/admm.pyx":712
  *         """``base``: the x-update's response to ``(-q, b)`` alone (q and b change every
  *         solve; the table only with the factorization)."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -27875,7 +27915,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":712
+  /* "fccqp/admm.pyx":714
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t i
  *         for i in range(p.n):             # <<<<<<<<<<<<<<
@@ -27889,7 +27929,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":713
+    /* "fccqp/admm.pyx":715
  *         cdef Py_ssize_t i
  *         for i in range(p.n):
  *             self.rhs[i] = -p.q[i]             # <<<<<<<<<<<<<<
@@ -27900,7 +27940,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
   }
 
 
-  /* "fccqp/admm.pyx":714
+  /* "fccqp/admm.pyx":716
  *         for i in range(p.n):
  *             self.rhs[i] = -p.q[i]
  *         for i in range(p.m):             # <<<<<<<<<<<<<<
@@ -27914,7 +27954,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
   for (__pyx_t_3 = 0; __pyx_t_3 < __pyx_t_2; __pyx_t_3+=1) {
     __pyx_v_i = __pyx_t_3;
 
-    /* "fccqp/admm.pyx":715
+    /* "fccqp/admm.pyx":717
  *             self.rhs[i] = -p.q[i]
  *         for i in range(p.m):
  *             self.rhs[p.n + i] = p.b[i]             # <<<<<<<<<<<<<<
@@ -27925,7 +27965,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
   }
 
 
-  /* "fccqp/admm.pyx":716
+  /* "fccqp/admm.pyx":718
  *         for i in range(p.m):
  *             self.rhs[p.n + i] = p.b[i]
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.red.base)             # <<<<<<<<<<<<<<
@@ -27934,7 +27974,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_3kkt_kkt_solve((&__pyx_v_self->kkt), __pyx_v_p, __pyx_v_self->it.rho_vec, __pyx_v_self->rhs, __pyx_v_self->red.base);
 
-  /* "fccqp/admm.pyx":707
+  /* "fccqp/admm.pyx":709
  *         return UNAVAILABLE
  * 
  *     cdef void _reduced_base(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27947,7 +27987,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__reduced_base(struct __pyx_obj_5fccq
 
 }
 
-/* "fccqp/admm.pyx":718
+/* "fccqp/admm.pyx":720
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.red.base)
  * 
  *     cdef int _equality_start(self, bint* unbounded) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -27976,7 +28016,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   double __pyx_t_9;
   double __pyx_t_10;
 
-  /* "fccqp/admm.pyx":729
+  /* "fccqp/admm.pyx":731
  *         candidate certificate) and the start falls back to the origin.
  *         """
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -27985,7 +28025,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":730
+  /* "fccqp/admm.pyx":732
  *         """
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -27994,7 +28034,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":731
+  /* "fccqp/admm.pyx":733
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, i, step             # <<<<<<<<<<<<<<
@@ -28008,7 +28048,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 
   __pyx_v_m = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":732
+  /* "fccqp/admm.pyx":734
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, i, step
  *         cdef double sigma = self.opt.sigma             # <<<<<<<<<<<<<<
@@ -28019,7 +28059,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 
   __pyx_v_sigma = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":733
+  /* "fccqp/admm.pyx":735
  *         cdef Py_ssize_t n = p.n, m = p.m, i, step
  *         cdef double sigma = self.opt.sigma
  *         fill(it.rho_vec, 0.0, p.s)             # <<<<<<<<<<<<<<
@@ -28028,7 +28068,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_it->rho_vec, 0.0, __pyx_v_p->s);
 
-  /* "fccqp/admm.pyx":734
+  /* "fccqp/admm.pyx":736
  *         cdef double sigma = self.opt.sigma
  *         fill(it.rho_vec, 0.0, p.s)
  *         self.factored_rho = -1.0  # the KKT matrix now holds no rho factorization             # <<<<<<<<<<<<<<
@@ -28037,7 +28077,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_self->factored_rho = -1.0;
 
-  /* "fccqp/admm.pyx":735
+  /* "fccqp/admm.pyx":737
  *         fill(it.rho_vec, 0.0, p.s)
  *         self.factored_rho = -1.0  # the KKT matrix now holds no rho factorization
  *         self.form = LDL_FULL             # <<<<<<<<<<<<<<
@@ -28046,7 +28086,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_self->form = __pyx_e_5fccqp_3kkt_LDL_FULL;
 
-  /* "fccqp/admm.pyx":736
+  /* "fccqp/admm.pyx":738
  *         self.factored_rho = -1.0  # the KKT matrix now holds no rho factorization
  *         self.form = LDL_FULL
  *         cdef int code = kkt_factor(&self.kkt, p, LDL_FULL, sigma, it.rho_vec)             # <<<<<<<<<<<<<<
@@ -28055,7 +28095,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_code = __pyx_f_5fccqp_3kkt_kkt_factor((&__pyx_v_self->kkt), __pyx_v_p, __pyx_e_5fccqp_3kkt_LDL_FULL, __pyx_v_sigma, __pyx_v_it->rho_vec);
 
-  /* "fccqp/admm.pyx":737
+  /* "fccqp/admm.pyx":739
  *         self.form = LDL_FULL
  *         cdef int code = kkt_factor(&self.kkt, p, LDL_FULL, sigma, it.rho_vec)
  *         if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -28067,7 +28107,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":738
+    /* "fccqp/admm.pyx":740
  *         cdef int code = kkt_factor(&self.kkt, p, LDL_FULL, sigma, it.rho_vec)
  *         if code != FACTORED:
  *             return NOT_CONVEX             # <<<<<<<<<<<<<<
@@ -28080,7 +28120,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":737
+    /* "fccqp/admm.pyx":739
  *         self.form = LDL_FULL
  *         cdef int code = kkt_factor(&self.kkt, p, LDL_FULL, sigma, it.rho_vec)
  *         if code != FACTORED:             # <<<<<<<<<<<<<<
@@ -28089,7 +28129,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   }
 
-  /* "fccqp/admm.pyx":739
+  /* "fccqp/admm.pyx":741
  *         if code != FACTORED:
  *             return NOT_CONVEX
  *         self.certified = True             # <<<<<<<<<<<<<<
@@ -28098,7 +28138,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_v_self->certified = 1;
 
-  /* "fccqp/admm.pyx":740
+  /* "fccqp/admm.pyx":742
  *             return NOT_CONVEX
  *         self.certified = True
  *         fill(it.x, 0.0, n)             # <<<<<<<<<<<<<<
@@ -28107,7 +28147,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_it->x, 0.0, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":741
+  /* "fccqp/admm.pyx":743
  *         self.certified = True
  *         fill(it.x, 0.0, n)
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -28121,7 +28161,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   for (__pyx_t_5 = 0; __pyx_t_5 < __pyx_t_4; __pyx_t_5+=1) {
     __pyx_v_i = __pyx_t_5;
 
-    /* "fccqp/admm.pyx":742
+    /* "fccqp/admm.pyx":744
  *         fill(it.x, 0.0, n)
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i]             # <<<<<<<<<<<<<<
@@ -28132,7 +28172,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   }
 
 
-  /* "fccqp/admm.pyx":743
+  /* "fccqp/admm.pyx":745
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i]
  *         for step in range(_EQUALITY_START_STEPS):             # <<<<<<<<<<<<<<
@@ -28146,7 +28186,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   for (__pyx_t_1 = 0; __pyx_t_1 < __pyx_t_7; __pyx_t_1+=1) {
     __pyx_v_step = __pyx_t_1;
 
-    /* "fccqp/admm.pyx":744
+    /* "fccqp/admm.pyx":746
  *             self.rhs[n + i] = p.b[i]
  *         for step in range(_EQUALITY_START_STEPS):
  *             for i in range(n):             # <<<<<<<<<<<<<<
@@ -28160,7 +28200,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
     for (__pyx_t_8 = 0; __pyx_t_8 < __pyx_t_5; __pyx_t_8+=1) {
       __pyx_v_i = __pyx_t_8;
 
-      /* "fccqp/admm.pyx":745
+      /* "fccqp/admm.pyx":747
  *         for step in range(_EQUALITY_START_STEPS):
  *             for i in range(n):
  *                 self.rhs[i] = sigma * it.x[i] - p.q[i]             # <<<<<<<<<<<<<<
@@ -28171,7 +28211,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
     }
 
 
-    /* "fccqp/admm.pyx":746
+    /* "fccqp/admm.pyx":748
  *             for i in range(n):
  *                 self.rhs[i] = sigma * it.x[i] - p.q[i]
  *             kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)             # <<<<<<<<<<<<<<
@@ -28180,7 +28220,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
     __pyx_f_5fccqp_3kkt_kkt_solve((&__pyx_v_self->kkt), __pyx_v_p, __pyx_v_it->rho_vec, __pyx_v_self->rhs, __pyx_v_self->sol);
 
-    /* "fccqp/admm.pyx":747
+    /* "fccqp/admm.pyx":749
  *                 self.rhs[i] = sigma * it.x[i] - p.q[i]
  *             kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
  *             copy(self.sol, it.x, n)             # <<<<<<<<<<<<<<
@@ -28191,7 +28231,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   }
 
 
-  /* "fccqp/admm.pyx":748
+  /* "fccqp/admm.pyx":750
  *             kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
  *             copy(self.sol, it.x, n)
  *         copy(self.sol + n, it.nu, m)             # <<<<<<<<<<<<<<
@@ -28200,7 +28240,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_copy((__pyx_v_self->sol + __pyx_v_n), __pyx_v_it->nu, __pyx_v_m);
 
-  /* "fccqp/admm.pyx":750
+  /* "fccqp/admm.pyx":752
  *         copy(self.sol + n, it.nu, m)
  *         unbounded[0] = sigma * inf_norm(it.x, n) > _EQUALITY_START_LIMIT * max(
  *             1.0, inf_norm(p.q, n))             # <<<<<<<<<<<<<<
@@ -28222,7 +28262,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   }
 
 
-  /* "fccqp/admm.pyx":749
+  /* "fccqp/admm.pyx":751
  *             copy(self.sol, it.x, n)
  *         copy(self.sol + n, it.nu, m)
  *         unbounded[0] = sigma * inf_norm(it.x, n) > _EQUALITY_START_LIMIT * max(             # <<<<<<<<<<<<<<
@@ -28232,7 +28272,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   (__pyx_v_unbounded[0]) = ((__pyx_v_sigma * __pyx_f_5fccqp_6_dense_inf_norm(__pyx_v_it->x, __pyx_v_n)) > (__pyx_v_5fccqp_4admm__EQUALITY_START_LIMIT * __pyx_t_10));
 
 
-  /* "fccqp/admm.pyx":751
+  /* "fccqp/admm.pyx":753
  *         unbounded[0] = sigma * inf_norm(it.x, n) > _EQUALITY_START_LIMIT * max(
  *             1.0, inf_norm(p.q, n))
  *         if unbounded[0]:             # <<<<<<<<<<<<<<
@@ -28241,7 +28281,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   if ((__pyx_v_unbounded[0])) {
 
-    /* "fccqp/admm.pyx":752
+    /* "fccqp/admm.pyx":754
  *             1.0, inf_norm(p.q, n))
  *         if unbounded[0]:
  *             copy(it.x, self.direction, n)             # <<<<<<<<<<<<<<
@@ -28250,7 +28290,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->x, __pyx_v_self->direction, __pyx_v_n);
 
-    /* "fccqp/admm.pyx":753
+    /* "fccqp/admm.pyx":755
  *         if unbounded[0]:
  *             copy(it.x, self.direction, n)
  *             fill(it.x, 0.0, n)             # <<<<<<<<<<<<<<
@@ -28259,7 +28299,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
     __pyx_f_5fccqp_6_dense_fill(__pyx_v_it->x, 0.0, __pyx_v_n);
 
-    /* "fccqp/admm.pyx":754
+    /* "fccqp/admm.pyx":756
  *             copy(it.x, self.direction, n)
  *             fill(it.x, 0.0, n)
  *             fill(it.nu, 0.0, m)             # <<<<<<<<<<<<<<
@@ -28268,7 +28308,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
     __pyx_f_5fccqp_6_dense_fill(__pyx_v_it->nu, 0.0, __pyx_v_m);
 
-    /* "fccqp/admm.pyx":751
+    /* "fccqp/admm.pyx":753
  *         unbounded[0] = sigma * inf_norm(it.x, n) > _EQUALITY_START_LIMIT * max(
  *             1.0, inf_norm(p.q, n))
  *         if unbounded[0]:             # <<<<<<<<<<<<<<
@@ -28277,7 +28317,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   }
 
-  /* "fccqp/admm.pyx":755
+  /* "fccqp/admm.pyx":757
  *             fill(it.x, 0.0, n)
  *             fill(it.nu, 0.0, m)
  *         for i in range(p.s):             # <<<<<<<<<<<<<<
@@ -28291,7 +28331,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   for (__pyx_t_5 = 0; __pyx_t_5 < __pyx_t_4; __pyx_t_5+=1) {
     __pyx_v_i = __pyx_t_5;
 
-    /* "fccqp/admm.pyx":756
+    /* "fccqp/admm.pyx":758
  *             fill(it.nu, 0.0, m)
  *         for i in range(p.s):
  *             it.z[i] = it.x[p.constrained[i]]             # <<<<<<<<<<<<<<
@@ -28302,7 +28342,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   }
 
 
-  /* "fccqp/admm.pyx":757
+  /* "fccqp/admm.pyx":759
  *         for i in range(p.s):
  *             it.z[i] = it.x[p.constrained[i]]
  *         proj_set(it.z, p.lo, p.hi, p.cones, p.s, it.z)             # <<<<<<<<<<<<<<
@@ -28311,7 +28351,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_11projections_proj_set(__pyx_v_it->z, __pyx_v_p->lo, __pyx_v_p->hi, __pyx_v_p->cones, __pyx_v_p->s, __pyx_v_it->z);
 
-  /* "fccqp/admm.pyx":758
+  /* "fccqp/admm.pyx":760
  *             it.z[i] = it.x[p.constrained[i]]
  *         proj_set(it.z, p.lo, p.hi, p.cones, p.s, it.z)
  *         fill(it.y, 0.0, p.s)             # <<<<<<<<<<<<<<
@@ -28320,7 +28360,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_it->y, 0.0, __pyx_v_p->s);
 
-  /* "fccqp/admm.pyx":759
+  /* "fccqp/admm.pyx":761
  *         proj_set(it.z, p.lo, p.hi, p.cones, p.s, it.z)
  *         fill(it.y, 0.0, p.s)
  *         copy(it.x, it.x_prev, n)             # <<<<<<<<<<<<<<
@@ -28329,7 +28369,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->x, __pyx_v_it->x_prev, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":760
+  /* "fccqp/admm.pyx":762
  *         fill(it.y, 0.0, p.s)
  *         copy(it.x, it.x_prev, n)
  *         copy(it.nu, it.nu_prev, m)             # <<<<<<<<<<<<<<
@@ -28338,7 +28378,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->nu, __pyx_v_it->nu_prev, __pyx_v_m);
 
-  /* "fccqp/admm.pyx":761
+  /* "fccqp/admm.pyx":763
  *         copy(it.x, it.x_prev, n)
  *         copy(it.nu, it.nu_prev, m)
  *         copy(it.y, it.y_prev, p.s)             # <<<<<<<<<<<<<<
@@ -28347,7 +28387,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->y, __pyx_v_it->y_prev, __pyx_v_p->s);
 
-  /* "fccqp/admm.pyx":762
+  /* "fccqp/admm.pyx":764
  *         copy(it.nu, it.nu_prev, m)
  *         copy(it.y, it.y_prev, p.s)
  *         return FACTORED             # <<<<<<<<<<<<<<
@@ -28360,7 +28400,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":718
+  /* "fccqp/admm.pyx":720
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.red.base)
  * 
  *     cdef int _equality_start(self, bint* unbounded) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28381,7 +28421,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__equality_start(struct __pyx_obj_5fcc
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":764
+/* "fccqp/admm.pyx":766
  *         return FACTORED
  * 
  *     cdef void _restore_equalities(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28400,7 +28440,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   Py_ssize_t __pyx_t_4;
   Py_ssize_t __pyx_t_5;
 
-  /* "fccqp/admm.pyx":768
+  /* "fccqp/admm.pyx":770
  *         the reduced form, a restoration) accumulates in ``A x = b``: one refined KKT
  *         solve for ``(0, b - A x)`` with the current factorization."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -28409,7 +28449,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":769
+  /* "fccqp/admm.pyx":771
  *         solve for ``(0, b - A x)`` with the current factorization."""
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m, i             # <<<<<<<<<<<<<<
@@ -28423,7 +28463,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 
   __pyx_v_m = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":770
+  /* "fccqp/admm.pyx":772
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m, i
  *         if m == 0:             # <<<<<<<<<<<<<<
@@ -28435,7 +28475,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   if (__pyx_t_2) {
 
 
-    /* "fccqp/admm.pyx":771
+    /* "fccqp/admm.pyx":773
  *         cdef Py_ssize_t n = p.n, m = p.m, i
  *         if m == 0:
  *             return             # <<<<<<<<<<<<<<
@@ -28446,7 +28486,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
     }
     goto __pyx_L0;
 
-    /* "fccqp/admm.pyx":770
+    /* "fccqp/admm.pyx":772
  *         cdef Problem* p = &self.prob
  *         cdef Py_ssize_t n = p.n, m = p.m, i
  *         if m == 0:             # <<<<<<<<<<<<<<
@@ -28455,7 +28495,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 */
   }
 
-  /* "fccqp/admm.pyx":772
+  /* "fccqp/admm.pyx":774
  *         if m == 0:
  *             return
  *         fill(self.rhs, 0.0, n)             # <<<<<<<<<<<<<<
@@ -28464,7 +28504,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 */
   __pyx_f_5fccqp_6_dense_fill(__pyx_v_self->rhs, 0.0, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":773
+  /* "fccqp/admm.pyx":775
  *             return
  *         fill(self.rhs, 0.0, n)
  *         matvec(p.A, self.it.x, self.rhs + n, m, n)             # <<<<<<<<<<<<<<
@@ -28473,7 +28513,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 */
   __pyx_f_5fccqp_6_dense_matvec(__pyx_v_p->A, __pyx_v_self->it.x, (__pyx_v_self->rhs + __pyx_v_n), __pyx_v_m, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":774
+  /* "fccqp/admm.pyx":776
  *         fill(self.rhs, 0.0, n)
  *         matvec(p.A, self.it.x, self.rhs + n, m, n)
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -28487,7 +28527,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":775
+    /* "fccqp/admm.pyx":777
  *         matvec(p.A, self.it.x, self.rhs + n, m, n)
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i] - self.rhs[n + i]             # <<<<<<<<<<<<<<
@@ -28498,7 +28538,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   }
 
 
-  /* "fccqp/admm.pyx":776
+  /* "fccqp/admm.pyx":778
  *         for i in range(m):
  *             self.rhs[n + i] = p.b[i] - self.rhs[n + i]
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.sol)             # <<<<<<<<<<<<<<
@@ -28507,7 +28547,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 */
   __pyx_f_5fccqp_3kkt_kkt_solve((&__pyx_v_self->kkt), __pyx_v_p, __pyx_v_self->it.rho_vec, __pyx_v_self->rhs, __pyx_v_self->sol);
 
-  /* "fccqp/admm.pyx":777
+  /* "fccqp/admm.pyx":779
  *             self.rhs[n + i] = p.b[i] - self.rhs[n + i]
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.sol)
  *         for i in range(n):             # <<<<<<<<<<<<<<
@@ -28521,7 +28561,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":778
+    /* "fccqp/admm.pyx":780
  *         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.sol)
  *         for i in range(n):
  *             self.it.x[i] += self.sol[i]             # <<<<<<<<<<<<<<
@@ -28534,7 +28574,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   }
 
 
-  /* "fccqp/admm.pyx":779
+  /* "fccqp/admm.pyx":781
  *         for i in range(n):
  *             self.it.x[i] += self.sol[i]
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -28548,7 +28588,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":780
+    /* "fccqp/admm.pyx":782
  *             self.it.x[i] += self.sol[i]
  *         for i in range(m):
  *             self.it.nu[i] += self.sol[n + i]             # <<<<<<<<<<<<<<
@@ -28561,7 +28601,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
   }
 
 
-  /* "fccqp/admm.pyx":764
+  /* "fccqp/admm.pyx":766
  *         return FACTORED
  * 
  *     cdef void _restore_equalities(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28577,7 +28617,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__restore_equalities(struct __pyx_obj
 
 }
 
-/* "fccqp/admm.pyx":782
+/* "fccqp/admm.pyx":784
  *             self.it.nu[i] += self.sol[n + i]
  * 
  *     cdef int _keep_restored(self, int status, long iteration, bint reduced,             # <<<<<<<<<<<<<<
@@ -28603,7 +28643,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
   double __pyx_t_7;
   int __pyx_t_8;
 
-  /* "fccqp/admm.pyx":794
+  /* "fccqp/admm.pyx":796
  *         either case.
  *         """
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -28612,7 +28652,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":795
+  /* "fccqp/admm.pyx":797
  *         """
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -28621,7 +28661,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":796
+  /* "fccqp/admm.pyx":798
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j             # <<<<<<<<<<<<<<
@@ -28638,7 +28678,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":798
+  /* "fccqp/admm.pyx":800
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j
  *         cdef int new_status
  *         copy(it.x, self.saved, n)             # <<<<<<<<<<<<<<
@@ -28647,7 +28687,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->x, __pyx_v_self->saved, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":799
+  /* "fccqp/admm.pyx":801
  *         cdef int new_status
  *         copy(it.x, self.saved, n)
  *         copy(it.nu, self.saved + n, m)             # <<<<<<<<<<<<<<
@@ -28656,7 +28696,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->nu, (__pyx_v_self->saved + __pyx_v_n), __pyx_v_m);
 
-  /* "fccqp/admm.pyx":800
+  /* "fccqp/admm.pyx":802
  *         copy(it.x, self.saved, n)
  *         copy(it.nu, self.saved + n, m)
  *         copy(it.z, self.saved + n + m, s)             # <<<<<<<<<<<<<<
@@ -28665,7 +28705,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_it->z, ((__pyx_v_self->saved + __pyx_v_n) + __pyx_v_m), __pyx_v_s);
 
-  /* "fccqp/admm.pyx":801
+  /* "fccqp/admm.pyx":803
  *         copy(it.nu, self.saved + n, m)
  *         copy(it.z, self.saved + n + m, s)
  *         if restore(&self.rest, &self.kkt, &self.red, reduced, p, it):             # <<<<<<<<<<<<<<
@@ -28677,7 +28717,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
   if (__pyx_t_2) {
 
 
-    /* "fccqp/admm.pyx":802
+    /* "fccqp/admm.pyx":804
  *         copy(it.z, self.saved + n + m, s)
  *         if restore(&self.rest, &self.kkt, &self.red, reduced, p, it):
  *             self._restore_equalities()             # <<<<<<<<<<<<<<
@@ -28686,7 +28726,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_restore_equalities(__pyx_v_self);
 
-    /* "fccqp/admm.pyx":803
+    /* "fccqp/admm.pyx":805
  *         if restore(&self.rest, &self.kkt, &self.red, reduced, p, it):
  *             self._restore_equalities()
  *             for j in range(s):             # <<<<<<<<<<<<<<
@@ -28700,7 +28740,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
     for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
       __pyx_v_j = __pyx_t_4;
 
-      /* "fccqp/admm.pyx":804
+      /* "fccqp/admm.pyx":806
  *             self._restore_equalities()
  *             for j in range(s):
  *                 it.z[j] = it.x[p.constrained[j]]             # <<<<<<<<<<<<<<
@@ -28711,7 +28751,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
     }
 
 
-    /* "fccqp/admm.pyx":805
+    /* "fccqp/admm.pyx":807
  *             for j in range(s):
  *                 it.z[j] = it.x[p.constrained[j]]
  *             proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)             # <<<<<<<<<<<<<<
@@ -28720,7 +28760,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     __pyx_f_5fccqp_11projections_proj_set(__pyx_v_it->z, __pyx_v_p->lo, __pyx_v_p->hi, __pyx_v_p->cones, __pyx_v_s, __pyx_v_it->z);
 
-    /* "fccqp/admm.pyx":806
+    /* "fccqp/admm.pyx":808
  *                 it.z[j] = it.x[p.constrained[j]]
  *             proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
  *             self._residuals()             # <<<<<<<<<<<<<<
@@ -28729,7 +28769,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_residuals(__pyx_v_self);
 
-    /* "fccqp/admm.pyx":807
+    /* "fccqp/admm.pyx":809
  *             proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
  *             self._residuals()
  *             new_status = self._classify(iteration, True, start_time)             # <<<<<<<<<<<<<<
@@ -28738,7 +28778,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     __pyx_v_new_status = ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_classify(__pyx_v_self, __pyx_v_iteration, 1, __pyx_v_start_time);
 
-    /* "fccqp/admm.pyx":808
+    /* "fccqp/admm.pyx":810
  *             self._residuals()
  *             new_status = self._classify(iteration, True, start_time)
  *             if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)             # <<<<<<<<<<<<<<
@@ -28771,7 +28811,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
       goto __pyx_L7_bool_binop_done;
     }
 
-    /* "fccqp/admm.pyx":809
+    /* "fccqp/admm.pyx":811
  *             new_status = self._classify(iteration, True, start_time)
  *             if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)
  *                     and (status != _SOLVED or new_status == _SOLVED)):             # <<<<<<<<<<<<<<
@@ -28795,7 +28835,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 
     __pyx_L7_bool_binop_done:;
 
-    /* "fccqp/admm.pyx":808
+    /* "fccqp/admm.pyx":810
  *             self._residuals()
  *             new_status = self._classify(iteration, True, start_time)
  *             if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)             # <<<<<<<<<<<<<<
@@ -28805,7 +28845,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":810
+      /* "fccqp/admm.pyx":812
  *             if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)
  *                     and (status != _SOLVED or new_status == _SOLVED)):
  *                 return new_status             # <<<<<<<<<<<<<<
@@ -28818,7 +28858,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
       }
       goto __pyx_L0;
 
-      /* "fccqp/admm.pyx":808
+      /* "fccqp/admm.pyx":810
  *             self._residuals()
  *             new_status = self._classify(iteration, True, start_time)
  *             if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)             # <<<<<<<<<<<<<<
@@ -28827,7 +28867,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     }
 
-    /* "fccqp/admm.pyx":801
+    /* "fccqp/admm.pyx":803
  *         copy(it.nu, self.saved + n, m)
  *         copy(it.z, self.saved + n + m, s)
  *         if restore(&self.rest, &self.kkt, &self.red, reduced, p, it):             # <<<<<<<<<<<<<<
@@ -28836,7 +28876,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   }
 
-  /* "fccqp/admm.pyx":811
+  /* "fccqp/admm.pyx":813
  *                     and (status != _SOLVED or new_status == _SOLVED)):
  *                 return new_status
  *         copy(self.saved, it.x, n)             # <<<<<<<<<<<<<<
@@ -28845,7 +28885,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy(__pyx_v_self->saved, __pyx_v_it->x, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":812
+  /* "fccqp/admm.pyx":814
  *                 return new_status
  *         copy(self.saved, it.x, n)
  *         copy(self.saved + n, it.nu, m)             # <<<<<<<<<<<<<<
@@ -28854,7 +28894,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy((__pyx_v_self->saved + __pyx_v_n), __pyx_v_it->nu, __pyx_v_m);
 
-  /* "fccqp/admm.pyx":813
+  /* "fccqp/admm.pyx":815
  *         copy(self.saved, it.x, n)
  *         copy(self.saved + n, it.nu, m)
  *         copy(self.saved + n + m, it.z, s)             # <<<<<<<<<<<<<<
@@ -28863,7 +28903,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   __pyx_f_5fccqp_6_dense_copy(((__pyx_v_self->saved + __pyx_v_n) + __pyx_v_m), __pyx_v_it->z, __pyx_v_s);
 
-  /* "fccqp/admm.pyx":814
+  /* "fccqp/admm.pyx":816
  *         copy(self.saved + n, it.nu, m)
  *         copy(self.saved + n + m, it.z, s)
  *         if reduced:             # <<<<<<<<<<<<<<
@@ -28872,7 +28912,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   if (__pyx_v_reduced) {
 
-    /* "fccqp/admm.pyx":815
+    /* "fccqp/admm.pyx":817
  *         copy(self.saved + n + m, it.z, s)
  *         if reduced:
  *             self._restore_equalities()             # <<<<<<<<<<<<<<
@@ -28881,7 +28921,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
     ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_restore_equalities(__pyx_v_self);
 
-    /* "fccqp/admm.pyx":814
+    /* "fccqp/admm.pyx":816
  *         copy(self.saved + n, it.nu, m)
  *         copy(self.saved + n + m, it.z, s)
  *         if reduced:             # <<<<<<<<<<<<<<
@@ -28890,7 +28930,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 */
   }
 
-  /* "fccqp/admm.pyx":816
+  /* "fccqp/admm.pyx":818
  *         if reduced:
  *             self._restore_equalities()
  *         return status             # <<<<<<<<<<<<<<
@@ -28903,7 +28943,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
   }
   goto __pyx_L0;
 
-  /* "fccqp/admm.pyx":782
+  /* "fccqp/admm.pyx":784
  *             self.it.nu[i] += self.sol[n + i]
  * 
  *     cdef int _keep_restored(self, int status, long iteration, bint reduced,             # <<<<<<<<<<<<<<
@@ -28923,7 +28963,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
   return __pyx_r;
 }
 
-/* "fccqp/admm.pyx":820
+/* "fccqp/admm.pyx":822
  *     # ------------------------------------------------------------- bookkeeping
  * 
  *     cdef void _residuals(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28933,7 +28973,7 @@ static int __pyx_f_5fccqp_4admm_9Workspace__keep_restored(struct __pyx_obj_5fccq
 
 static void __pyx_f_5fccqp_4admm_9Workspace__residuals(struct __pyx_obj_5fccqp_4admm_Workspace *__pyx_v_self) {
 
-  /* "fccqp/admm.pyx":821
+  /* "fccqp/admm.pyx":823
  * 
  *     cdef void _residuals(self) noexcept nogil:
  *         residuals(&self.prob, &self.it, self.vec_m, self.vec_n, self.vec_n2, &self.res)             # <<<<<<<<<<<<<<
@@ -28942,7 +28982,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__residuals(struct __pyx_obj_5fccqp_4
 */
   __pyx_f_5fccqp_11termination_residuals((&__pyx_v_self->prob), (&__pyx_v_self->it), __pyx_v_self->vec_m, __pyx_v_self->vec_n, __pyx_v_self->vec_n2, (&__pyx_v_self->res));
 
-  /* "fccqp/admm.pyx":820
+  /* "fccqp/admm.pyx":822
  *     # ------------------------------------------------------------- bookkeeping
  * 
  *     cdef void _residuals(self) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28953,7 +28993,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__residuals(struct __pyx_obj_5fccqp_4
   /* function exit code */
 }
 
-/* "fccqp/admm.pyx":823
+/* "fccqp/admm.pyx":825
  *         residuals(&self.prob, &self.it, self.vec_m, self.vec_n, self.vec_n2, &self.res)
  * 
  *     cdef void _log(self, long iteration, double rho) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -28970,7 +29010,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
   double __pyx_t_5;
   double __pyx_t_6;
 
-  /* "fccqp/admm.pyx":825
+  /* "fccqp/admm.pyx":827
  *     cdef void _log(self, long iteration, double rho) noexcept nogil:
  *         cdef double* row
  *         if self.log_count < self.log_rows:             # <<<<<<<<<<<<<<
@@ -28982,7 +29022,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
   if (__pyx_t_1) {
 
 
-    /* "fccqp/admm.pyx":826
+    /* "fccqp/admm.pyx":828
  *         cdef double* row
  *         if self.log_count < self.log_rows:
  *             row = self.log + 5 * self.log_count             # <<<<<<<<<<<<<<
@@ -28991,7 +29031,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
 */
     __pyx_v_row = (__pyx_v_self->log + (5 * __pyx_v_self->log_count));
 
-    /* "fccqp/admm.pyx":828
+    /* "fccqp/admm.pyx":830
  *             row = self.log + 5 * self.log_count
  *             row[0], row[1], row[2], row[3], row[4] = (
  *                 iteration, self.res.prim, self.res.dual, self.res.gap, rho)             # <<<<<<<<<<<<<<
@@ -29009,7 +29049,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
     __pyx_t_6 = __pyx_v_rho;
 
 
-    /* "fccqp/admm.pyx":827
+    /* "fccqp/admm.pyx":829
  *         if self.log_count < self.log_rows:
  *             row = self.log + 5 * self.log_count
  *             row[0], row[1], row[2], row[3], row[4] = (             # <<<<<<<<<<<<<<
@@ -29027,7 +29067,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
     (__pyx_v_row[4]) = __pyx_t_6;
 
 
-    /* "fccqp/admm.pyx":829
+    /* "fccqp/admm.pyx":831
  *             row[0], row[1], row[2], row[3], row[4] = (
  *                 iteration, self.res.prim, self.res.dual, self.res.gap, rho)
  *             self.log_count += 1             # <<<<<<<<<<<<<<
@@ -29036,7 +29076,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
 */
     __pyx_v_self->log_count = (__pyx_v_self->log_count + 1);
 
-    /* "fccqp/admm.pyx":825
+    /* "fccqp/admm.pyx":827
  *     cdef void _log(self, long iteration, double rho) noexcept nogil:
  *         cdef double* row
  *         if self.log_count < self.log_rows:             # <<<<<<<<<<<<<<
@@ -29045,7 +29085,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
 */
   }
 
-  /* "fccqp/admm.pyx":823
+  /* "fccqp/admm.pyx":825
  *         residuals(&self.prob, &self.it, self.vec_m, self.vec_n, self.vec_n2, &self.res)
  * 
  *     cdef void _log(self, long iteration, double rho) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -29057,7 +29097,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
 
 }
 
-/* "fccqp/admm.pyx":831
+/* "fccqp/admm.pyx":833
  *             self.log_count += 1
  * 
  *     cdef void _finish_run(self, Run* run, int status, long iteration) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -29068,7 +29108,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__log(struct __pyx_obj_5fccqp_4admm_W
 static void __pyx_f_5fccqp_4admm_9Workspace__finish_run(struct __pyx_obj_5fccqp_4admm_Workspace *__pyx_v_self, struct __pyx_t_5fccqp_4admm_Run *__pyx_v_run, int __pyx_v_status, long __pyx_v_iteration) {
   int __pyx_t_1;
 
-  /* "fccqp/admm.pyx":832
+  /* "fccqp/admm.pyx":834
  * 
  *     cdef void _finish_run(self, Run* run, int status, long iteration) noexcept nogil:
  *         run.status = status             # <<<<<<<<<<<<<<
@@ -29077,7 +29117,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish_run(struct __pyx_obj_5fccqp_
 */
   __pyx_v_run->status = __pyx_v_status;
 
-  /* "fccqp/admm.pyx":833
+  /* "fccqp/admm.pyx":835
  *     cdef void _finish_run(self, Run* run, int status, long iteration) noexcept nogil:
  *         run.status = status
  *         run.iterations = iteration             # <<<<<<<<<<<<<<
@@ -29086,7 +29126,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish_run(struct __pyx_obj_5fccqp_
 */
   __pyx_v_run->iterations = __pyx_v_iteration;
 
-  /* "fccqp/admm.pyx":834
+  /* "fccqp/admm.pyx":836
  *         run.status = status
  *         run.iterations = iteration
  *         run.backend = self.form             # <<<<<<<<<<<<<<
@@ -29097,7 +29137,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish_run(struct __pyx_obj_5fccqp_
 
   __pyx_v_run->backend = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":831
+  /* "fccqp/admm.pyx":833
  *             self.log_count += 1
  * 
  *     cdef void _finish_run(self, Run* run, int status, long iteration) noexcept nogil:             # <<<<<<<<<<<<<<
@@ -29108,7 +29148,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish_run(struct __pyx_obj_5fccqp_
   /* function exit code */
 }
 
-/* "fccqp/admm.pyx":836
+/* "fccqp/admm.pyx":838
  *         run.backend = self.form
  * 
  *     cdef void _finish(self, Run* run, double* x, double* y, double* z,             # <<<<<<<<<<<<<<
@@ -29128,7 +29168,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
   int __pyx_t_4;
   double __pyx_t_5;
 
-  /* "fccqp/admm.pyx":841
+  /* "fccqp/admm.pyx":843
  *         user's units from the returned point alone (the primal one as the distance of
  *         ``x_S`` to C), settle the status on them and keep the point for a warm start."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -29137,7 +29177,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":842
+  /* "fccqp/admm.pyx":844
  *         ``x_S`` to C), settle the status on them and keep the point for a warm start."""
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it             # <<<<<<<<<<<<<<
@@ -29146,7 +29186,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   __pyx_v_it = (&__pyx_v_self->it);
 
-  /* "fccqp/admm.pyx":843
+  /* "fccqp/admm.pyx":845
  *         cdef Problem* p = &self.prob
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j             # <<<<<<<<<<<<<<
@@ -29163,7 +29203,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":844
+  /* "fccqp/admm.pyx":846
  *         cdef Iterates* it = &self.it
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)             # <<<<<<<<<<<<<<
@@ -29172,7 +29212,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   __pyx_f_5fccqp_7scaling_unscale(__pyx_v_it->x, __pyx_v_it->nu, __pyx_v_it->y, __pyx_v_p->D, __pyx_v_p->E, __pyx_v_p->c, __pyx_v_n, __pyx_v_m, __pyx_v_s, __pyx_v_p->constrained, __pyx_v_x, __pyx_v_y, __pyx_v_z);
 
-  /* "fccqp/admm.pyx":845
+  /* "fccqp/admm.pyx":847
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)
  *         if run.status == _PRIMAL_INFEASIBLE or run.status == _DUAL_INFEASIBLE:             # <<<<<<<<<<<<<<
@@ -29183,7 +29223,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     case __pyx_e_5fccqp_4admm__PRIMAL_INFEASIBLE:
     case __pyx_e_5fccqp_4admm__DUAL_INFEASIBLE:
 
-    /* "fccqp/admm.pyx":846
+    /* "fccqp/admm.pyx":848
  *         unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)
  *         if run.status == _PRIMAL_INFEASIBLE or run.status == _DUAL_INFEASIBLE:
  *             copy(self.cert, cert, n + m)             # <<<<<<<<<<<<<<
@@ -29192,7 +29232,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_self->cert, __pyx_v_cert, (__pyx_v_n + __pyx_v_m));
 
-    /* "fccqp/admm.pyx":845
+    /* "fccqp/admm.pyx":847
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)
  *         if run.status == _PRIMAL_INFEASIBLE or run.status == _DUAL_INFEASIBLE:             # <<<<<<<<<<<<<<
@@ -29203,7 +29243,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     default: break;
   }
 
-  /* "fccqp/admm.pyx":847
+  /* "fccqp/admm.pyx":849
  *         if run.status == _PRIMAL_INFEASIBLE or run.status == _DUAL_INFEASIBLE:
  *             copy(self.cert, cert, n + m)
  *         self._user_residuals(x, y, z)             # <<<<<<<<<<<<<<
@@ -29212,7 +29252,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   ((struct __pyx_vtabstruct_5fccqp_4admm_Workspace *)__pyx_v_self->__pyx_vtab)->_user_residuals(__pyx_v_self, __pyx_v_x, __pyx_v_y, __pyx_v_z);
 
-  /* "fccqp/admm.pyx":848
+  /* "fccqp/admm.pyx":850
  *             copy(self.cert, cert, n + m)
  *         self._user_residuals(x, y, z)
  *         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):             # <<<<<<<<<<<<<<
@@ -29225,7 +29265,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     case __pyx_e_5fccqp_4admm__MAX_ITER:
     case __pyx_e_5fccqp_4admm__TIME_LIMIT:
 
-    /* "fccqp/admm.pyx":849
+    /* "fccqp/admm.pyx":851
  *         self._user_residuals(x, y, z)
  *         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):
  *             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):             # <<<<<<<<<<<<<<
@@ -29237,7 +29277,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":850
+      /* "fccqp/admm.pyx":852
  *         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):
  *             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):
  *                 run.status = _SOLVED             # <<<<<<<<<<<<<<
@@ -29246,7 +29286,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
       __pyx_v_run->status = __pyx_e_5fccqp_4admm__SOLVED;
 
-      /* "fccqp/admm.pyx":849
+      /* "fccqp/admm.pyx":851
  *         self._user_residuals(x, y, z)
  *         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):
  *             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):             # <<<<<<<<<<<<<<
@@ -29256,7 +29296,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
       goto __pyx_L3;
     }
 
-    /* "fccqp/admm.pyx":851
+    /* "fccqp/admm.pyx":853
  *             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):
  *                 run.status = _SOLVED
  *             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):             # <<<<<<<<<<<<<<
@@ -29268,7 +29308,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     if (__pyx_t_2) {
 
 
-      /* "fccqp/admm.pyx":852
+      /* "fccqp/admm.pyx":854
  *                 run.status = _SOLVED
  *             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *                 run.status = _INACCURATE             # <<<<<<<<<<<<<<
@@ -29277,7 +29317,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
       __pyx_v_run->status = __pyx_e_5fccqp_4admm__INACCURATE;
 
-      /* "fccqp/admm.pyx":851
+      /* "fccqp/admm.pyx":853
  *             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):
  *                 run.status = _SOLVED
  *             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):             # <<<<<<<<<<<<<<
@@ -29287,7 +29327,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
       goto __pyx_L3;
     }
 
-    /* "fccqp/admm.pyx":853
+    /* "fccqp/admm.pyx":855
  *             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *                 run.status = _INACCURATE
  *             elif run.status in (_SOLVED, _INACCURATE):             # <<<<<<<<<<<<<<
@@ -29309,7 +29349,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     if (__pyx_t_3) {
 
 
-      /* "fccqp/admm.pyx":854
+      /* "fccqp/admm.pyx":856
  *                 run.status = _INACCURATE
  *             elif run.status in (_SOLVED, _INACCURATE):
  *                 run.status = _NUMERICAL_ERROR   # the scaled test passed, the point does not             # <<<<<<<<<<<<<<
@@ -29318,7 +29358,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
       __pyx_v_run->status = __pyx_e_5fccqp_4admm__NUMERICAL_ERROR;
 
-      /* "fccqp/admm.pyx":853
+      /* "fccqp/admm.pyx":855
  *             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
  *                 run.status = _INACCURATE
  *             elif run.status in (_SOLVED, _INACCURATE):             # <<<<<<<<<<<<<<
@@ -29328,7 +29368,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     }
     __pyx_L3:;
 
-    /* "fccqp/admm.pyx":848
+    /* "fccqp/admm.pyx":850
  *             copy(self.cert, cert, n + m)
  *         self._user_residuals(x, y, z)
  *         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):             # <<<<<<<<<<<<<<
@@ -29339,7 +29379,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     default: break;
   }
 
-  /* "fccqp/admm.pyx":855
+  /* "fccqp/admm.pyx":857
  *             elif run.status in (_SOLVED, _INACCURATE):
  *                 run.status = _NUMERICAL_ERROR   # the scaled test passed, the point does not
  *         if not self.res.finite:             # <<<<<<<<<<<<<<
@@ -29351,7 +29391,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
   if (__pyx_t_3) {
 
 
-    /* "fccqp/admm.pyx":856
+    /* "fccqp/admm.pyx":858
  *                 run.status = _NUMERICAL_ERROR   # the scaled test passed, the point does not
  *         if not self.res.finite:
  *             run.status = _NUMERICAL_ERROR             # <<<<<<<<<<<<<<
@@ -29360,7 +29400,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_v_run->status = __pyx_e_5fccqp_4admm__NUMERICAL_ERROR;
 
-    /* "fccqp/admm.pyx":855
+    /* "fccqp/admm.pyx":857
  *             elif run.status in (_SOLVED, _INACCURATE):
  *                 run.status = _NUMERICAL_ERROR   # the scaled test passed, the point does not
  *         if not self.res.finite:             # <<<<<<<<<<<<<<
@@ -29369,7 +29409,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   }
 
-  /* "fccqp/admm.pyx":857
+  /* "fccqp/admm.pyx":859
  *         if not self.res.finite:
  *             run.status = _NUMERICAL_ERROR
  *         self.has_previous = self.res.finite and run.status not in (             # <<<<<<<<<<<<<<
@@ -29383,7 +29423,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     goto __pyx_L5_bool_binop_done;
   }
 
-  /* "fccqp/admm.pyx":858
+  /* "fccqp/admm.pyx":860
  *             run.status = _NUMERICAL_ERROR
  *         self.has_previous = self.res.finite and run.status not in (
  *             _PRIMAL_INFEASIBLE, _DUAL_INFEASIBLE)             # <<<<<<<<<<<<<<
@@ -29394,7 +29434,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
     case __pyx_e_5fccqp_4admm__PRIMAL_INFEASIBLE:
     case __pyx_e_5fccqp_4admm__DUAL_INFEASIBLE:
 
-    /* "fccqp/admm.pyx":857
+    /* "fccqp/admm.pyx":859
  *         if not self.res.finite:
  *             run.status = _NUMERICAL_ERROR
  *         self.has_previous = self.res.finite and run.status not in (             # <<<<<<<<<<<<<<
@@ -29416,7 +29456,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
   __pyx_L5_bool_binop_done:;
   __pyx_v_self->has_previous = __pyx_t_3;
 
-  /* "fccqp/admm.pyx":859
+  /* "fccqp/admm.pyx":861
  *         self.has_previous = self.res.finite and run.status not in (
  *             _PRIMAL_INFEASIBLE, _DUAL_INFEASIBLE)
  *         if self.has_previous:             # <<<<<<<<<<<<<<
@@ -29425,7 +29465,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   if (__pyx_v_self->has_previous) {
 
-    /* "fccqp/admm.pyx":860
+    /* "fccqp/admm.pyx":862
  *             _PRIMAL_INFEASIBLE, _DUAL_INFEASIBLE)
  *         if self.has_previous:
  *             copy(x, self.prev_x, n)             # <<<<<<<<<<<<<<
@@ -29434,7 +29474,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_x, __pyx_v_self->prev_x, __pyx_v_n);
 
-    /* "fccqp/admm.pyx":861
+    /* "fccqp/admm.pyx":863
  *         if self.has_previous:
  *             copy(x, self.prev_x, n)
  *             copy(y, self.prev_y, m)             # <<<<<<<<<<<<<<
@@ -29443,7 +29483,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_y, __pyx_v_self->prev_y, __pyx_v_m);
 
-    /* "fccqp/admm.pyx":862
+    /* "fccqp/admm.pyx":864
  *             copy(x, self.prev_x, n)
  *             copy(y, self.prev_y, m)
  *             copy(z, self.prev_z, n)             # <<<<<<<<<<<<<<
@@ -29452,7 +29492,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
     __pyx_f_5fccqp_6_dense_copy(__pyx_v_z, __pyx_v_self->prev_z, __pyx_v_n);
 
-    /* "fccqp/admm.pyx":863
+    /* "fccqp/admm.pyx":865
  *             copy(y, self.prev_y, m)
  *             copy(z, self.prev_z, n)
  *             self.prev_rho = run.rho             # <<<<<<<<<<<<<<
@@ -29463,7 +29503,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 
     __pyx_v_self->prev_rho = __pyx_t_5;
 
-    /* "fccqp/admm.pyx":859
+    /* "fccqp/admm.pyx":861
  *         self.has_previous = self.res.finite and run.status not in (
  *             _PRIMAL_INFEASIBLE, _DUAL_INFEASIBLE)
  *         if self.has_previous:             # <<<<<<<<<<<<<<
@@ -29472,7 +29512,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 */
   }
 
-  /* "fccqp/admm.pyx":836
+  /* "fccqp/admm.pyx":838
  *         run.backend = self.form
  * 
  *     cdef void _finish(self, Run* run, double* x, double* y, double* z,             # <<<<<<<<<<<<<<
@@ -29488,7 +29528,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__finish(struct __pyx_obj_5fccqp_4adm
 
 }
 
-/* "fccqp/admm.pyx":865
+/* "fccqp/admm.pyx":867
  *             self.prev_rho = run.rho
  * 
  *     cdef void _user_residuals(self, const double* x, const double* y,             # <<<<<<<<<<<<<<
@@ -29526,7 +29566,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   int __pyx_t_9;
   double __pyx_t_10;
 
-  /* "fccqp/admm.pyx":869
+  /* "fccqp/admm.pyx":871
  *         """:mod:`fccqp.termination`'s residuals of the returned ``(x, y, z)`` on the user's
  *         data, with ``dist(x_S, C)`` as the primal part off the equalities."""
  *         cdef Problem* p = &self.prob             # <<<<<<<<<<<<<<
@@ -29535,7 +29575,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_v_p = (&__pyx_v_self->prob);
 
-  /* "fccqp/admm.pyx":870
+  /* "fccqp/admm.pyx":872
  *         data, with ``dist(x_S, C)`` as the primal part off the equalities."""
  *         cdef Problem* p = &self.prob
  *         cdef Residuals* r = &self.res             # <<<<<<<<<<<<<<
@@ -29544,7 +29584,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_v_r = (&__pyx_v_self->res);
 
-  /* "fccqp/admm.pyx":871
+  /* "fccqp/admm.pyx":873
  *         cdef Problem* p = &self.prob
  *         cdef Residuals* r = &self.res
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j             # <<<<<<<<<<<<<<
@@ -29561,7 +29601,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 
   __pyx_v_s = __pyx_t_1;
 
-  /* "fccqp/admm.pyx":872
+  /* "fccqp/admm.pyx":874
  *         cdef Residuals* r = &self.res
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         cdef double* Ax = self.vec_m             # <<<<<<<<<<<<<<
@@ -29572,7 +29612,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 
   __pyx_v_Ax = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":873
+  /* "fccqp/admm.pyx":875
  *         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
  *         cdef double* Ax = self.vec_m
  *         cdef double* grad = self.vec_n             # <<<<<<<<<<<<<<
@@ -29583,7 +29623,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 
   __pyx_v_grad = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":874
+  /* "fccqp/admm.pyx":876
  *         cdef double* Ax = self.vec_m
  *         cdef double* grad = self.vec_n
  *         cdef double* ATy = self.vec_n2             # <<<<<<<<<<<<<<
@@ -29594,7 +29634,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 
   __pyx_v_ATy = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":875
+  /* "fccqp/admm.pyx":877
  *         cdef double* grad = self.vec_n
  *         cdef double* ATy = self.vec_n2
  *         cdef double* proj = self.vec_s             # <<<<<<<<<<<<<<
@@ -29605,7 +29645,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 
   __pyx_v_proj = __pyx_t_2;
 
-  /* "fccqp/admm.pyx":876
+  /* "fccqp/admm.pyx":878
  *         cdef double* ATy = self.vec_n2
  *         cdef double* proj = self.vec_s
  *         cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, terms = 0.0, total = 0.0             # <<<<<<<<<<<<<<
@@ -29619,7 +29659,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   __pyx_v_terms = 0.0;
   __pyx_v_total = 0.0;
 
-  /* "fccqp/admm.pyx":878
+  /* "fccqp/admm.pyx":880
  *         cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, terms = 0.0, total = 0.0
  *         cdef double value
  *         matvec(self.A_user, x, Ax, m, n)             # <<<<<<<<<<<<<<
@@ -29628,7 +29668,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_f_5fccqp_6_dense_matvec(__pyx_v_self->A_user, __pyx_v_x, __pyx_v_Ax, __pyx_v_m, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":879
+  /* "fccqp/admm.pyx":881
  *         cdef double value
  *         matvec(self.A_user, x, Ax, m, n)
  *         matvec_t(self.A_user, y, ATy, m, n)             # <<<<<<<<<<<<<<
@@ -29637,7 +29677,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_f_5fccqp_6_dense_matvec_t(__pyx_v_self->A_user, __pyx_v_y, __pyx_v_ATy, __pyx_v_m, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":880
+  /* "fccqp/admm.pyx":882
  *         matvec(self.A_user, x, Ax, m, n)
  *         matvec_t(self.A_user, y, ATy, m, n)
  *         matvec(self.P_user, x, grad, n, n)             # <<<<<<<<<<<<<<
@@ -29646,7 +29686,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_f_5fccqp_6_dense_matvec(__pyx_v_self->P_user, __pyx_v_x, __pyx_v_grad, __pyx_v_n, __pyx_v_n);
 
-  /* "fccqp/admm.pyx":881
+  /* "fccqp/admm.pyx":883
  *         matvec_t(self.A_user, y, ATy, m, n)
  *         matvec(self.P_user, x, grad, n, n)
  *         r.prim = r.prim_scale = 0.0             # <<<<<<<<<<<<<<
@@ -29656,7 +29696,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   __pyx_v_r->prim = 0.0;
   __pyx_v_r->prim_scale = 0.0;
 
-  /* "fccqp/admm.pyx":882
+  /* "fccqp/admm.pyx":884
  *         matvec(self.P_user, x, grad, n, n)
  *         r.prim = r.prim_scale = 0.0
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -29670,7 +29710,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":883
+    /* "fccqp/admm.pyx":885
  *         r.prim = r.prim_scale = 0.0
  *         for i in range(m):
  *             r.prim = max(r.prim, fabs(Ax[i] - self.b_user[i]))             # <<<<<<<<<<<<<<
@@ -29694,7 +29734,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->prim = __pyx_t_7;
 
 
-    /* "fccqp/admm.pyx":884
+    /* "fccqp/admm.pyx":886
  *         for i in range(m):
  *             r.prim = max(r.prim, fabs(Ax[i] - self.b_user[i]))
  *             r.prim_scale = max(r.prim_scale, max(fabs(Ax[i]), fabs(self.b_user[i])))             # <<<<<<<<<<<<<<
@@ -29733,7 +29773,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->prim_scale = __pyx_t_5;
 
 
-    /* "fccqp/admm.pyx":885
+    /* "fccqp/admm.pyx":887
  *             r.prim = max(r.prim, fabs(Ax[i] - self.b_user[i]))
  *             r.prim_scale = max(r.prim_scale, max(fabs(Ax[i]), fabs(self.b_user[i])))
  *             by += self.b_user[i] * y[i]             # <<<<<<<<<<<<<<
@@ -29742,7 +29782,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_by = (__pyx_v_by + ((__pyx_v_self->b_user[__pyx_v_i]) * (__pyx_v_y[__pyx_v_i])));
 
-    /* "fccqp/admm.pyx":886
+    /* "fccqp/admm.pyx":888
  *             r.prim_scale = max(r.prim_scale, max(fabs(Ax[i]), fabs(self.b_user[i])))
  *             by += self.b_user[i] * y[i]
  *             terms += fabs(self.b_user[i] * y[i])             # <<<<<<<<<<<<<<
@@ -29753,7 +29793,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":887
+  /* "fccqp/admm.pyx":889
  *             by += self.b_user[i] * y[i]
  *             terms += fabs(self.b_user[i] * y[i])
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -29767,7 +29807,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":888
+    /* "fccqp/admm.pyx":890
  *             terms += fabs(self.b_user[i] * y[i])
  *         for j in range(s):
  *             i = p.constrained[j]             # <<<<<<<<<<<<<<
@@ -29776,7 +29816,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_i = (__pyx_v_p->constrained[__pyx_v_j]);
 
-    /* "fccqp/admm.pyx":889
+    /* "fccqp/admm.pyx":891
  *         for j in range(s):
  *             i = p.constrained[j]
  *             value = x[i]             # <<<<<<<<<<<<<<
@@ -29785,7 +29825,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_value = (__pyx_v_x[__pyx_v_i]);
 
-    /* "fccqp/admm.pyx":890
+    /* "fccqp/admm.pyx":892
  *             i = p.constrained[j]
  *             value = x[i]
  *             if value < self.lb_user[i]:             # <<<<<<<<<<<<<<
@@ -29797,7 +29837,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     if (__pyx_t_8) {
 
 
-      /* "fccqp/admm.pyx":891
+      /* "fccqp/admm.pyx":893
  *             value = x[i]
  *             if value < self.lb_user[i]:
  *                 value = self.lb_user[i]             # <<<<<<<<<<<<<<
@@ -29806,7 +29846,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
       __pyx_v_value = (__pyx_v_self->lb_user[__pyx_v_i]);
 
-      /* "fccqp/admm.pyx":890
+      /* "fccqp/admm.pyx":892
  *             i = p.constrained[j]
  *             value = x[i]
  *             if value < self.lb_user[i]:             # <<<<<<<<<<<<<<
@@ -29815,7 +29855,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     }
 
-    /* "fccqp/admm.pyx":892
+    /* "fccqp/admm.pyx":894
  *             if value < self.lb_user[i]:
  *                 value = self.lb_user[i]
  *             if value > self.ub_user[i]:             # <<<<<<<<<<<<<<
@@ -29827,7 +29867,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     if (__pyx_t_8) {
 
 
-      /* "fccqp/admm.pyx":893
+      /* "fccqp/admm.pyx":895
  *                 value = self.lb_user[i]
  *             if value > self.ub_user[i]:
  *                 value = self.ub_user[i]             # <<<<<<<<<<<<<<
@@ -29836,7 +29876,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
       __pyx_v_value = (__pyx_v_self->ub_user[__pyx_v_i]);
 
-      /* "fccqp/admm.pyx":892
+      /* "fccqp/admm.pyx":894
  *             if value < self.lb_user[i]:
  *                 value = self.lb_user[i]
  *             if value > self.ub_user[i]:             # <<<<<<<<<<<<<<
@@ -29845,7 +29885,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     }
 
-    /* "fccqp/admm.pyx":894
+    /* "fccqp/admm.pyx":896
  *             if value > self.ub_user[i]:
  *                 value = self.ub_user[i]
  *             proj[j] = value             # <<<<<<<<<<<<<<
@@ -29856,7 +29896,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":895
+  /* "fccqp/admm.pyx":897
  *                 value = self.ub_user[i]
  *             proj[j] = value
  *         for j in range(p.cones.count):   # cone blocks are contiguous in x too             # <<<<<<<<<<<<<<
@@ -29870,7 +29910,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":896
+    /* "fccqp/admm.pyx":898
  *             proj[j] = value
  *         for j in range(p.cones.count):   # cone blocks are contiguous in x too
  *             i = p.cones.offset[j]             # <<<<<<<<<<<<<<
@@ -29879,7 +29919,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_i = (__pyx_v_p->cones.offset[__pyx_v_j]);
 
-    /* "fccqp/admm.pyx":897
+    /* "fccqp/admm.pyx":899
  *         for j in range(p.cones.count):   # cone blocks are contiguous in x too
  *             i = p.cones.offset[j]
  *             proj_block(x + p.constrained[i], p.cones.kind[j], p.cones.dim[j], p.cones.mu[j],             # <<<<<<<<<<<<<<
@@ -29890,7 +29930,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":899
+  /* "fccqp/admm.pyx":901
  *             proj_block(x + p.constrained[i], p.cones.kind[j], p.cones.dim[j], p.cones.mu[j],
  *                        p.cones.normal + 3 * j, proj + i)
  *         r.dual_scale = 0.0             # <<<<<<<<<<<<<<
@@ -29899,7 +29939,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_v_r->dual_scale = 0.0;
 
-  /* "fccqp/admm.pyx":900
+  /* "fccqp/admm.pyx":902
  *                        p.cones.normal + 3 * j, proj + i)
  *         r.dual_scale = 0.0
  *         for j in range(s):             # <<<<<<<<<<<<<<
@@ -29913,7 +29953,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_j = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":901
+    /* "fccqp/admm.pyx":903
  *         r.dual_scale = 0.0
  *         for j in range(s):
  *             i = p.constrained[j]             # <<<<<<<<<<<<<<
@@ -29922,7 +29962,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_i = (__pyx_v_p->constrained[__pyx_v_j]);
 
-    /* "fccqp/admm.pyx":902
+    /* "fccqp/admm.pyx":904
  *         for j in range(s):
  *             i = p.constrained[j]
  *             r.prim = max(r.prim, fabs(x[i] - proj[j]))             # <<<<<<<<<<<<<<
@@ -29946,7 +29986,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->prim = __pyx_t_6;
 
 
-    /* "fccqp/admm.pyx":903
+    /* "fccqp/admm.pyx":905
  *             i = p.constrained[j]
  *             r.prim = max(r.prim, fabs(x[i] - proj[j]))
  *             r.prim_scale = max(r.prim_scale, fabs(x[i]))             # <<<<<<<<<<<<<<
@@ -29970,7 +30010,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->prim_scale = __pyx_t_7;
 
 
-    /* "fccqp/admm.pyx":904
+    /* "fccqp/admm.pyx":906
  *             r.prim = max(r.prim, fabs(x[i] - proj[j]))
  *             r.prim_scale = max(r.prim_scale, fabs(x[i]))
  *             if z[i] > 0.0 and isfinite(self.ub_user[i]):             # <<<<<<<<<<<<<<
@@ -29996,7 +30036,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     if (__pyx_t_8) {
 
 
-      /* "fccqp/admm.pyx":905
+      /* "fccqp/admm.pyx":907
  *             r.prim_scale = max(r.prim_scale, fabs(x[i]))
  *             if z[i] > 0.0 and isfinite(self.ub_user[i]):
  *                 support += self.ub_user[i] * z[i]             # <<<<<<<<<<<<<<
@@ -30005,7 +30045,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
       __pyx_v_support = (__pyx_v_support + ((__pyx_v_self->ub_user[__pyx_v_i]) * (__pyx_v_z[__pyx_v_i])));
 
-      /* "fccqp/admm.pyx":906
+      /* "fccqp/admm.pyx":908
  *             if z[i] > 0.0 and isfinite(self.ub_user[i]):
  *                 support += self.ub_user[i] * z[i]
  *                 terms += fabs(self.ub_user[i] * z[i])             # <<<<<<<<<<<<<<
@@ -30014,7 +30054,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
       __pyx_v_terms = (__pyx_v_terms + fabs(((__pyx_v_self->ub_user[__pyx_v_i]) * (__pyx_v_z[__pyx_v_i]))));
 
-      /* "fccqp/admm.pyx":904
+      /* "fccqp/admm.pyx":906
  *             r.prim = max(r.prim, fabs(x[i] - proj[j]))
  *             r.prim_scale = max(r.prim_scale, fabs(x[i]))
  *             if z[i] > 0.0 and isfinite(self.ub_user[i]):             # <<<<<<<<<<<<<<
@@ -30024,7 +30064,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
       goto __pyx_L13;
     }
 
-    /* "fccqp/admm.pyx":907
+    /* "fccqp/admm.pyx":909
  *                 support += self.ub_user[i] * z[i]
  *                 terms += fabs(self.ub_user[i] * z[i])
  *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):             # <<<<<<<<<<<<<<
@@ -30050,7 +30090,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     if (__pyx_t_8) {
 
 
-      /* "fccqp/admm.pyx":908
+      /* "fccqp/admm.pyx":910
  *                 terms += fabs(self.ub_user[i] * z[i])
  *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):
  *                 support += self.lb_user[i] * z[i]             # <<<<<<<<<<<<<<
@@ -30059,7 +30099,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
       __pyx_v_support = (__pyx_v_support + ((__pyx_v_self->lb_user[__pyx_v_i]) * (__pyx_v_z[__pyx_v_i])));
 
-      /* "fccqp/admm.pyx":909
+      /* "fccqp/admm.pyx":911
  *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):
  *                 support += self.lb_user[i] * z[i]
  *                 terms += fabs(self.lb_user[i] * z[i])             # <<<<<<<<<<<<<<
@@ -30068,7 +30108,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
       __pyx_v_terms = (__pyx_v_terms + fabs(((__pyx_v_self->lb_user[__pyx_v_i]) * (__pyx_v_z[__pyx_v_i]))));
 
-      /* "fccqp/admm.pyx":907
+      /* "fccqp/admm.pyx":909
  *                 support += self.ub_user[i] * z[i]
  *                 terms += fabs(self.ub_user[i] * z[i])
  *             elif z[i] < 0.0 and isfinite(self.lb_user[i]):             # <<<<<<<<<<<<<<
@@ -30080,7 +30120,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":910
+  /* "fccqp/admm.pyx":912
  *                 support += self.lb_user[i] * z[i]
  *                 terms += fabs(self.lb_user[i] * z[i])
  *         r.dual = 0.0             # <<<<<<<<<<<<<<
@@ -30089,7 +30129,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_v_r->dual = 0.0;
 
-  /* "fccqp/admm.pyx":911
+  /* "fccqp/admm.pyx":913
  *                 terms += fabs(self.lb_user[i] * z[i])
  *         r.dual = 0.0
  *         for i in range(n):             # <<<<<<<<<<<<<<
@@ -30103,7 +30143,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":912
+    /* "fccqp/admm.pyx":914
  *         r.dual = 0.0
  *         for i in range(n):
  *             xPx += x[i] * grad[i]             # <<<<<<<<<<<<<<
@@ -30112,7 +30152,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_xPx = (__pyx_v_xPx + ((__pyx_v_x[__pyx_v_i]) * (__pyx_v_grad[__pyx_v_i])));
 
-    /* "fccqp/admm.pyx":913
+    /* "fccqp/admm.pyx":915
  *         for i in range(n):
  *             xPx += x[i] * grad[i]
  *             qx += self.q_user[i] * x[i]             # <<<<<<<<<<<<<<
@@ -30121,7 +30161,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_qx = (__pyx_v_qx + ((__pyx_v_self->q_user[__pyx_v_i]) * (__pyx_v_x[__pyx_v_i])));
 
-    /* "fccqp/admm.pyx":914
+    /* "fccqp/admm.pyx":916
  *             xPx += x[i] * grad[i]
  *             qx += self.q_user[i] * x[i]
  *             r.dual_scale = max(r.dual_scale, max(fabs(grad[i]), fabs(self.q_user[i])))             # <<<<<<<<<<<<<<
@@ -30160,7 +30200,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->dual_scale = __pyx_t_6;
 
 
-    /* "fccqp/admm.pyx":915
+    /* "fccqp/admm.pyx":917
  *             qx += self.q_user[i] * x[i]
  *             r.dual_scale = max(r.dual_scale, max(fabs(grad[i]), fabs(self.q_user[i])))
  *             value = grad[i] + self.q_user[i] + ATy[i] + z[i]             # <<<<<<<<<<<<<<
@@ -30169,7 +30209,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
     __pyx_v_value = ((((__pyx_v_grad[__pyx_v_i]) + (__pyx_v_self->q_user[__pyx_v_i])) + (__pyx_v_ATy[__pyx_v_i])) + (__pyx_v_z[__pyx_v_i]));
 
-    /* "fccqp/admm.pyx":916
+    /* "fccqp/admm.pyx":918
  *             r.dual_scale = max(r.dual_scale, max(fabs(grad[i]), fabs(self.q_user[i])))
  *             value = grad[i] + self.q_user[i] + ATy[i] + z[i]
  *             r.dual = max(r.dual, fabs(value))             # <<<<<<<<<<<<<<
@@ -30193,7 +30233,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
     __pyx_v_r->dual = __pyx_t_5;
 
 
-    /* "fccqp/admm.pyx":917
+    /* "fccqp/admm.pyx":919
  *             value = grad[i] + self.q_user[i] + ATy[i] + z[i]
  *             r.dual = max(r.dual, fabs(value))
  *             total += fabs(value) + fabs(x[i]) + fabs(z[i])             # <<<<<<<<<<<<<<
@@ -30204,7 +30244,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":918
+  /* "fccqp/admm.pyx":920
  *             r.dual = max(r.dual, fabs(value))
  *             total += fabs(value) + fabs(x[i]) + fabs(z[i])
  *         for i in range(m):             # <<<<<<<<<<<<<<
@@ -30218,7 +30258,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   for (__pyx_t_4 = 0; __pyx_t_4 < __pyx_t_3; __pyx_t_4+=1) {
     __pyx_v_i = __pyx_t_4;
 
-    /* "fccqp/admm.pyx":919
+    /* "fccqp/admm.pyx":921
  *             total += fabs(value) + fabs(x[i]) + fabs(z[i])
  *         for i in range(m):
  *             total += fabs(y[i])             # <<<<<<<<<<<<<<
@@ -30229,7 +30269,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   }
 
 
-  /* "fccqp/admm.pyx":920
+  /* "fccqp/admm.pyx":922
  *         for i in range(m):
  *             total += fabs(y[i])
  *         r.gap = fabs(xPx + qx + by + support)             # <<<<<<<<<<<<<<
@@ -30238,7 +30278,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
 */
   __pyx_v_r->gap = fabs((((__pyx_v_xPx + __pyx_v_qx) + __pyx_v_by) + __pyx_v_support));
 
-  /* "fccqp/admm.pyx":921
+  /* "fccqp/admm.pyx":923
  *             total += fabs(y[i])
  *         r.gap = fabs(xPx + qx + by + support)
  *         r.gap_scale = max(max(fabs(xPx), fabs(qx)), terms)             # <<<<<<<<<<<<<<
@@ -30277,7 +30317,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   __pyx_v_r->gap_scale = __pyx_t_10;
 
 
-  /* "fccqp/admm.pyx":922
+  /* "fccqp/admm.pyx":924
  *         r.gap = fabs(xPx + qx + by + support)
  *         r.gap_scale = max(max(fabs(xPx), fabs(qx)), terms)
  *         r.finite = isfinite(total) and isfinite(r.gap) and isfinite(r.prim)             # <<<<<<<<<<<<<<
@@ -30311,7 +30351,7 @@ static void __pyx_f_5fccqp_4admm_9Workspace__user_residuals(struct __pyx_obj_5fc
   __pyx_L22_bool_binop_done:;
   __pyx_v_r->finite = __pyx_t_8;
 
-  /* "fccqp/admm.pyx":865
+  /* "fccqp/admm.pyx":867
  *             self.prev_rho = run.rho
  * 
  *     cdef void _user_residuals(self, const double* x, const double* y,             # <<<<<<<<<<<<<<

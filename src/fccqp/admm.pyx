@@ -490,6 +490,8 @@ cdef class Workspace:
         eps_d = o.eps_abs + o.eps_rel * r.dual_scale
         anderson_reset(&self.aa, False)
         fresh = True  # the next step starts a run of KKT solutions: do not relax x
+        if timed and fccqp_now() - start_time >= o.time_limit:
+            status = self._classify(0, True, start_time)   # the setup spent the budget
         while status == _RUNNING:
             iteration += 1
             if reduced:

@@ -143,7 +143,8 @@ class Settings:
         backends = ("auto", "schur_reduced", "ldl_reduced", "ldl_full")
         if self.kkt_backend not in backends:
             raise ValueError(
-                f"setting kkt_backend must be one of {', '.join(backends)}, got {self.kkt_backend!r}"
+                f"setting kkt_backend must be one of {', '.join(backends)}, "
+                f"got {self.kkt_backend!r}"
             )
 
     def replace(self, **overrides: object) -> Settings:
