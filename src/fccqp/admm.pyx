@@ -188,6 +188,7 @@ cdef class Workspace:
     cdef Py_ssize_t* block_start
     cdef Py_ssize_t log_rows, log_count
     cdef double prev_rho, factored_rho, setup_time
+    cdef double clock[6]
     cdef bint has_previous, has_matrices, certified, scaled_once
     cdef int form
     cdef object _keep
@@ -324,6 +325,14 @@ cdef class Workspace:
         return self.found.code, self.found.argument, self.found.index, self.found.value
 
     @property
+    def phase_times(self):
+        """Seconds of the last solve's phases inside the compiled call: validation scan,
+        scaling, start and factorization, iterations, restoration and unscaling (a
+        phase the solve skipped shows 0)."""
+        cdef int i
+        return tuple(max(self.clock[i + 1] - self.clock[i], 0.0) for i in range(5))
+
+    @property
     def log_lines(self):
         """Rows ``(iteration, prim, dual, gap, rho)`` of the last solve's log."""
         cdef Py_ssize_t i, j
@@ -338,8 +347,9 @@ cdef class Workspace:
         ``x0`` (None or a float64 vector) overrides the warm start; ``warm`` asks for a
         start from the previous solution (when there is one). ``cert_out`` (``m + n``
         entries) receives an infeasibility certificate. Returns ``(code, iterations, rho,
-        prim, dual, gap, factorizations, setup_time, backend)``; code ``BAD_DATA`` (see
-        :attr:`finding`) and ``NOT_CONVEX_CODE`` leave the previous solution untouched.
+        prim, dual, gap, objective, factorizations, setup_time, backend)``; code
+        ``BAD_DATA`` (see :attr:`finding`) and ``NOT_CONVEX_CODE`` leave the previous
+        solution untouched.
         """
         cdef Problem* p = &self.prob
         cdef Py_ssize_t n = p.n, m = p.m
@@ -350,6 +360,7 @@ cdef class Workspace:
         if x0 is not None:
             guess = x0
             x0_ptr = &guess[0]
+        self.clock[0] = fccqp_now()
         with nogil:
             self.found = scan_and_copy(
                 &P[0, 0], &q[0], &A[0, 0] if m else NULL, &b[0] if m else NULL, &lb[0], &ub[0],
@@ -357,7 +368,7 @@ cdef class Workspace:
                 self.ub_user, &same)
         if self.found.code != SCAN_OK:
             self.has_matrices = False
-            return BAD_DATA, 0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, ""
+            return BAD_DATA, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, ""
         enter()   # single-threaded BLAS for this solve (see fccqp.blas_threads)
         try:
             with nogil:
@@ -365,14 +376,15 @@ cdef class Workspace:
                 if run.status != _NOT_CONVEX:
                     self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0],
                                  &cert_out[0])
+                self.clock[5] = fccqp_now()
         finally:
             leave()
         if run.status == _NOT_CONVEX:
             self.has_matrices = self.has_previous = self.certified = False
-            return NOT_CONVEX_CODE, 0, 0.0, 0.0, 0.0, 0.0, run.factorizations, 0.0, ""
+            return NOT_CONVEX_CODE, 0, 0.0, 0.0, 0.0, 0.0, 0.0, run.factorizations, 0.0, ""
         r = &self.res
-        return (run.status, run.iterations, run.rho, r.prim, r.dual, r.gap, run.factorizations,
-                run.setup_time, BACKEND_NAMES[run.backend])
+        return (run.status, run.iterations, run.rho, r.prim, r.dual, r.gap, r.objective,
+                run.factorizations, run.setup_time, BACKEND_NAMES[run.backend])
 
     # ----------------------------------------------------------------- one solve
 
@@ -385,7 +397,9 @@ cdef class Workspace:
         if not same_matrices:
             self.certified = False
         self.has_matrices = True
+        self.clock[1] = fccqp_now()
         self._scale(reuse)
+        self.clock[2] = fccqp_now()
         self.log_count = 0
         run.rho = self.prev_rho if warm else self.opt.rho
         if x0 != NULL:
@@ -482,6 +496,7 @@ cdef class Workspace:
             if code != FACTORED:
                 run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR
                 return
+        self.clock[3] = fccqp_now()
         reduced = self.form != LDL_FULL
         if reduced:
             self._reduced_base()
@@ -537,6 +552,7 @@ cdef class Workspace:
                         anderson_reset(&self.aa, True)
             if status == _RUNNING and o.anderson_memory > 0:
                 anderson_step(&self.aa, it, s)
+        self.clock[4] = fccqp_now()
         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
             status = self._keep_restored(status, iteration, reduced, start_time)
         elif reduced and status != _NUMERICAL_ERROR:
@@ -919,6 +935,7 @@ cdef class Workspace:
             total += fabs(value) + fabs(x[i]) + fabs(z[i])
         for i in range(m):
             total += fabs(y[i])
+        r.objective = 0.5 * xPx + qx
         r.gap = fabs(xPx + qx + by + support)
         r.gap_scale = max(max(fabs(xPx), fabs(qx)), terms)
         r.finite = isfinite(total) and isfinite(r.gap) and isfinite(r.prim)

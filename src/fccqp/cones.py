@@ -102,6 +102,15 @@ class ConeArrays:
         blocks = zip(self.offset, self.dim, strict=True)
         return np.concatenate([np.arange(o, o + d) for o, d in blocks])
 
+    def same_blocks(self, other: ConeArrays) -> bool:
+        """Same kinds, offsets and sizes as ``other`` (friction coefficients and normals
+        may differ)."""
+        return self is other or (
+            self.kind.tobytes() == other.kind.tobytes()
+            and self.offset.tobytes() == other.offset.tobytes()
+            and self.dim.tobytes() == other.dim.tobytes()
+        )
+
     def relocated(self, offset: np.ndarray) -> ConeArrays:
         """The same cones with new block offsets."""
         return ConeArrays(self.kind, offset.astype(np.int64), self.dim, self.mu, self.normal)

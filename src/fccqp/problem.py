@@ -135,23 +135,25 @@ def structure(
 
     Raises ``ValueError`` when an entry of a cone block has a finite bound.
     """
+    from fccqp.validation import structure_scan
+
     flat = flatten_cones(cones, n)
-    bounded = (lb > -INFINITE_BOUND) | (ub < INFINITE_BOUND)
-    if flat.count:
-        members = flat.members
-        if bounded[members].any():
-            i = int(members[np.flatnonzero(bounded[members])[0]])
-            raise ValueError(
-                f"x[{i}] is in a cone block and has a finite bound (lb[{i}] = {lb[i]}, "
-                f"ub[{i}] = {ub[i]}); cone entries must have infinite bounds"
-            )
-        is_constrained = bounded.copy()
-        is_constrained[members] = True
-    else:
-        is_constrained = bounded
-    constrained = np.flatnonzero(is_constrained)
-    fixed = lb[constrained] == ub[constrained]
-    return constrained, fixed, flat.relocated(np.searchsorted(constrained, flat.offset))
+    constrained, fixed = np.empty(n, np.intp), np.empty(n, np.uint8)
+    relocated = np.empty(flat.count, np.intp)
+    count, _, member = structure_scan(lb, ub, flat.offset, flat.dim, constrained, fixed,
+                                      relocated, 0)
+    check_cone_bounds(member, lb, ub)
+    return constrained[:count], fixed[:count].astype(bool), flat.relocated(relocated)
+
+
+def check_cone_bounds(member: int, lb: np.ndarray, ub: np.ndarray) -> None:
+    """Raise for ``member``, the first cone entry with a finite bound (-1: none)."""
+    if member >= 0:
+        raise ValueError(
+            f"x[{member}] is in a cone block and has a finite bound (lb[{member}] = "
+            f"{lb[member]}, ub[{member}] = {ub[member]}); cone entries must have infinite "
+            "bounds"
+        )
 
 
 def validate(

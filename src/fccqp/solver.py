@@ -14,8 +14,9 @@ from collections.abc import Sequence
 import numpy as np
 
 from fccqp import admm, schur
-from fccqp.cones import Cone, ConeArrays
-from fccqp.problem import MAX_ENTRY, convert, raise_finding, structure
+from fccqp.cones import Cone, ConeArrays, flatten_cones
+from fccqp.problem import MAX_ENTRY, check_cone_bounds, convert, raise_finding
+from fccqp.validation import structure_scan
 from fccqp.result import Result
 from fccqp.settings import Settings
 from fccqp.status import Status
@@ -36,23 +37,35 @@ iterations, the first and the last)."""
 
 
 class _Structure:
-    """What a workspace was allocated for: sizes, constrained and fixed entries, cones."""
+    """What a workspace was allocated for, kept up to date in place by
+    :func:`fccqp.validation.structure_scan`: the constrained entries, the fixed ones
+    and the cone blocks' offsets among them, for ``n`` variables and ``m`` rows."""
 
-    __slots__ = ("key", "cones")
+    __slots__ = ("n", "m", "count", "constrained", "fixed", "relocated", "cones")
 
-    def __init__(self, n: int, m: int, constrained: np.ndarray, fixed: np.ndarray,
-                 cones: ConeArrays) -> None:
-        self.key = (n, m, constrained.tobytes(), fixed.tobytes(), cones.offset.tobytes(),
-                    cones.dim.tobytes(), cones.kind.tobytes())
-        self.cones = cones
+    def __init__(self, n: int, m: int, cones: ConeArrays) -> None:
+        self.n, self.m, self.count, self.cones = n, m, 0, cones
+        self.constrained, self.fixed = np.empty(n, np.intp), np.empty(n, np.uint8)
+        self.relocated = np.empty(cones.count, np.intp)
 
+    def update(self, lb: np.ndarray, ub: np.ndarray) -> bool:
+        """Scan the bounds; True when the constrained or fixed entries changed."""
+        count, changed, member = structure_scan(
+            lb, ub, self.cones.offset, self.cones.dim, self.constrained, self.fixed,
+            self.relocated, self.count)
+        check_cone_bounds(member, lb, ub)
+        self.count = count
+        return changed
 
-def _workspace(n: int, m: int, constrained: np.ndarray, fixed: np.ndarray, cones: ConeArrays,
-               settings: Settings) -> admm.Workspace:
-    cone_arrays = (cones.kind, cones.offset, cones.dim, cones.mu, cones.normal)
-    log_rows = LOG_ROWS if settings.verbose else 0
-    return admm.Workspace(n, m, constrained, cone_arrays, fixed,
-                          schur.ordering(n, constrained), settings, log_rows)
+    def workspace(self, settings: Settings) -> admm.Workspace:
+        """A workspace for this structure."""
+        constrained = self.constrained[: self.count].copy()
+        cones = self.cones
+        cone_arrays = (cones.kind, self.relocated.copy(), cones.dim, cones.mu, cones.normal)
+        log_rows = LOG_ROWS if settings.verbose else 0
+        return admm.Workspace(self.n, self.m, constrained, cone_arrays,
+                              self.fixed[: self.count].astype(bool),
+                              schur.ordering(self.n, constrained), settings, log_rows)
 
 
 class Solver:
@@ -129,20 +142,24 @@ class Solver:
         settings = self.settings
         P, q, A, b, lb, ub = convert(P, q, A, b, lb, ub)
         n, m = P.shape[0], A.shape[0]
-        constrained, fixed, flat = structure(lb, ub, cones, n)
+        flat = flatten_cones(cones, n)   # memoized: the same object for the same cones
         guess = None if x0 is None else _initial_guess(x0, n)
-        current = _Structure(n, m, constrained, fixed, flat)
-        w = self._workspace
-        if w is None or self._structure.key != current.key:
-            w = _workspace(n, m, constrained, fixed, flat, settings)
-            self._workspace = w
-        elif self._structure.cones is not flat:
-            w.update_cones(flat.mu, flat.normal)
-        self._structure = current
+        w, structure = self._workspace, self._structure
+        if w is None or (structure.n, structure.m) != (n, m) or not flat.same_blocks(
+                structure.cones):
+            structure = self._structure = _Structure(n, m, flat)
+            structure.update(lb, ub)
+            w = self._workspace = structure.workspace(settings)
+        else:
+            if structure.update(lb, ub):
+                w = self._workspace = structure.workspace(settings)
+            elif flat is not structure.cones:
+                w.update_cones(flat.mu, flat.normal)
+            structure.cones = flat
         x, y, z, certificate = np.empty(n), np.empty(m), np.empty(n), np.empty(n + m)
-        (code, iterations, rho, prim, dual, gap, factorizations, setup_time, backend) = w.solve(
-            P, q, A, b, lb, ub, guess, settings.warm_start, start, x, y, z, certificate
-        )
+        (code, iterations, rho, prim, dual, gap, obj, factorizations, setup_time,
+         backend) = w.solve(P, q, A, b, lb, ub, guess, settings.warm_start, start, x, y, z,
+                            certificate)
         if code == admm.BAD_DATA:
             raise_finding(w.finding, lb, ub)
         if code == admm.NOT_CONVEX_CODE:
@@ -159,13 +176,12 @@ class Solver:
             certificate_out = certificate[:n]
         else:
             certificate_out = None
-        obj = float(x @ (0.5 * (P @ x) + q)) if np.isfinite(x).all() else float("nan")
         result = Result(
-            x=x, y=y, z=z, status=status, obj=obj, iterations=int(iterations),
-            prim_res=float(prim), dual_res=float(dual), setup_time=float(setup_time),
-            solve_time=time.perf_counter() - start, rho=float(rho),
-            factorizations=int(factorizations), certificate=certificate_out,
-            gap=float("nan") if status.is_infeasible() else float(gap), backend=backend,
+            x=x, y=y, z=z, status=status, obj=obj, iterations=iterations,
+            prim_res=prim, dual_res=dual, setup_time=setup_time,
+            solve_time=time.perf_counter() - start, rho=rho,
+            factorizations=factorizations, certificate=certificate_out,
+            gap=float("nan") if status.is_infeasible() else gap, backend=backend,
         )
         if settings.verbose:
             _print_log(w.log_lines, result)

@@ -5,6 +5,7 @@ cdef struct Residuals:
     # Residuals of an iterate in the user's units, the scales of their relative
     # tolerances, and the scaled values that rho adaptation balances.
     double prim, dual, gap
+    double objective            # 1/2 x'Px + q'x (set for the returned point)
     double prim_scale, dual_scale, gap_scale
     double prim_s, dual_s, prim_scale_s, dual_scale_s
     bint finite
