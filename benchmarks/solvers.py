@@ -78,8 +78,8 @@ def _fccqp(name: str, setting: str, sweep: bool, overrides: dict, realtime: bool
     def factory(variant: str) -> Adapter:
         import fccqp
 
-        base = fccqp.Settings.realtime() if realtime else fccqp.Settings()
-        return FccqpAdapter(variant, base.replace(**overrides))
+        make = fccqp.Settings.realtime if realtime else fccqp.Settings
+        return FccqpAdapter(variant, make(**overrides))
 
     return Variant(name, "fccqp", setting, True, True, sweep, "fccqp", factory, description)
 

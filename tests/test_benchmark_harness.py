@@ -98,3 +98,12 @@ def test_bad_arguments_exit_with_clear_messages(
         main(argv)
     assert exc.value.code == 2
     assert message in capsys.readouterr().err
+
+
+def test_no_sweep_keeps_only_default_settings(tmp_path: Path) -> None:
+    argv = ["--robots", "solo12", "--n-qps", "2", "--seq-len", "2", "--repeats", "1",
+            "--solvers", "fccqp-default", "fccqp-eps1e-3", "clarabel-loose", "--no-sweep",
+            "--out", str(tmp_path / "out"), "--cache", str(tmp_path / "cache"), "--no-progress"]
+    main(argv)
+    with open(tmp_path / "out" / "results.csv") as fh:
+        assert {r["solver"] for r in csv.DictReader(fh)} == {"fccqp-default"}
