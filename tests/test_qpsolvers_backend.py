@@ -402,13 +402,14 @@ def test_import_fccqp_first_then_qpsolvers():
         """
         import sys
         import fccqp
-        from fccqp.qpsolvers_backend import _RegisterOnImport
+        from fccqp._import_hooks import _AfterImport
         assert "qpsolvers" not in sys.modules
         import qpsolvers
         from importlib.machinery import SourceFileLoader
         assert isinstance(qpsolvers.__loader__, SourceFileLoader)
         assert isinstance(qpsolvers.__spec__.loader, SourceFileLoader)
-        assert not any(isinstance(f, _RegisterOnImport) for f in sys.meta_path)
+        assert not any(isinstance(f, _AfterImport) and f.name == "qpsolvers"
+                       for f in sys.meta_path)
         import numpy as np
         one = np.ones((1, 1))
         x = qpsolvers.solve_qp(2 * one, -2 * one[0], one, 0.5 * one[0], solver="fccqp")
@@ -424,8 +425,8 @@ def test_import_qpsolvers_first_then_fccqp():
         import sys
         import qpsolvers
         import fccqp
-        from fccqp.qpsolvers_backend import _RegisterOnImport
-        assert not any(isinstance(f, _RegisterOnImport) for f in sys.meta_path)
+        from fccqp._import_hooks import _AfterImport
+        assert not any(isinstance(f, _AfterImport) for f in sys.meta_path)
         print(qpsolvers.available_solvers.count("fccqp"))
         """
     )

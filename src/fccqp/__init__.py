@@ -3,8 +3,8 @@
 Solves ``min 1/2 x'Px + q'x  s.t.  A x = b, lb <= x <= ub, x[block_k] in K_k`` with the
 equalities exact at every iterate and the box and cones handled by projections.
 
-``Solver`` and ``solve`` load the numba kernels (numba, scipy.linalg and the compiled
-code cache) on first access, so that ``import fccqp`` stays cheap.
+``Solver`` and ``solve`` load the compiled core (and scipy's LAPACK tables) on first
+access, so that ``import fccqp`` stays cheap.
 """
 
 from fccqp.cones import FrictionCone, SecondOrderCone
@@ -29,6 +29,9 @@ _LAZY = ("Solver", "solve")
 
 def __getattr__(name: str) -> object:
     if name in _LAZY:
+        from fccqp._scipy_lapack import preload
+
+        preload()
         from fccqp import solver
 
         return getattr(solver, name)

@@ -16,7 +16,7 @@ single-threaded too (the count is process-wide). Where no OpenBLAS setter is fou
 (another BLAS, Windows), nothing is changed: :data:`GUARD` says which.
 """
 
-import scipy.linalg.cython_lapack as _lapack
+import importlib
 
 cdef extern from *:
     """
@@ -51,7 +51,9 @@ _NAMES = (
 
 def _load():
     global _set, _get
-    path = _lapack.__file__.encode()
+    # import_module, not "import scipy.linalg.cython_lapack": the attribute walk of the
+    # latter would import all of scipy.linalg (see fccqp._scipy_lapack)
+    path = importlib.import_module("scipy.linalg.cython_lapack").__file__.encode()
     for setter, getter in _NAMES:
         _set = <set_threads_t>fccqp_find_symbol(path, setter)
         _get = <get_threads_t>fccqp_find_symbol(path, getter)

@@ -41,22 +41,20 @@ updates it right after ``import qpsolvers`` finishes, then removes itself.
 
 from __future__ import annotations
 
-import importlib.abc
 import importlib.util
 import sys
 import time
-from collections.abc import Sequence
-from types import ModuleType
 from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.sparse as sp
 
+from fccqp._import_hooks import after_import
+from fccqp.problem import issparse
 from fccqp.settings import Settings
 
 if TYPE_CHECKING:
-    from importlib.machinery import ModuleSpec
 
+    import scipy.sparse as sp
     from qpsolvers import Problem, Solution
 
     from fccqp.problem import ProblemData
@@ -102,7 +100,7 @@ def _check_size(problem: Problem) -> None:
 
 def _real_array(value: object, name: str) -> np.ndarray:
     """``value`` as a float64 array; complex or non-numeric input is a ``TypeError``."""
-    if sp.issparse(value):
+    if issparse(value):
         value = value.toarray()
     if np.iscomplexobj(value):
         raise TypeError(f"{name} must be real, got complex entries")
@@ -307,51 +305,6 @@ def _add_to_registry() -> bool:
     return True
 
 
-class _RegisteringLoader(importlib.abc.Loader):
-    """Runs qpsolvers' own loader, then registers fccqp and retires the hook."""
-
-    def __init__(self, loader: importlib.abc.Loader, hook: _RegisterOnImport) -> None:
-        self._loader = loader
-        self._hook = hook
-
-    def create_module(self, spec: ModuleSpec) -> ModuleType | None:
-        return self._loader.create_module(spec)
-
-    def exec_module(self, module: ModuleType) -> None:
-        # Hand the module its real loader before its code runs, so nothing
-        # (submodule imports, importlib.resources, inspect) ever sees this wrapper.
-        module.__loader__ = self._loader
-        module.__spec__.loader = self._loader
-        self._loader.exec_module(module)
-        if self._hook in sys.meta_path:
-            sys.meta_path.remove(self._hook)
-        _add_to_registry()
-
-
-class _RegisterOnImport(importlib.abc.MetaPathFinder):
-    """Meta-path finder that registers fccqp once ``import qpsolvers`` completes.
-
-    It finds nothing itself: for the name ``qpsolvers`` it asks the other finders
-    and wraps the loader they return; every other name goes straight past it.
-    """
-
-    def find_spec(
-        self, fullname: str, path: Sequence[str] | None, target: ModuleType | None = None
-    ) -> ModuleSpec | None:
-        if fullname != "qpsolvers":
-            return None
-        for finder in sys.meta_path:
-            find = getattr(finder, "find_spec", None)
-            if finder is self or find is None:
-                continue
-            spec = find(fullname, path, target)
-            if spec is not None:
-                if spec.loader is not None and hasattr(spec.loader, "exec_module"):
-                    spec.loader = _RegisteringLoader(spec.loader, self)
-                return spec
-        return None
-
-
 def register() -> bool:
     """Make ``solver="fccqp"`` available in qpsolvers, without importing it.
 
@@ -364,10 +317,7 @@ def register() -> bool:
     bool
         False, having done nothing, when qpsolvers is not installed.
     """
-    if "qpsolvers" in sys.modules:
-        return _add_to_registry()
-    if importlib.util.find_spec("qpsolvers") is None:
+    if "qpsolvers" not in sys.modules and importlib.util.find_spec("qpsolvers") is None:
         return False
-    if not any(isinstance(finder, _RegisterOnImport) for finder in sys.meta_path):
-        sys.meta_path.insert(0, _RegisterOnImport())
+    after_import("qpsolvers", lambda module: _add_to_registry())
     return True

@@ -16,10 +16,10 @@ import numpy as np
 from fccqp import admm, schur
 from fccqp.cones import Cone, ConeArrays, flatten_cones
 from fccqp.problem import MAX_ENTRY, check_cone_bounds, convert, raise_finding
-from fccqp.validation import structure_scan
 from fccqp.result import Result
 from fccqp.settings import Settings
 from fccqp.status import Status
+from fccqp.validation import structure_scan
 
 STATUS_BY_CODE = {
     admm.SOLVED: Status.SOLVED,
