@@ -41,12 +41,13 @@ class _Structure:
     :func:`fccqp.validation.structure_scan`: the constrained entries, the fixed ones
     and the cone blocks' offsets among them, for ``n`` variables and ``m`` rows."""
 
-    __slots__ = ("n", "m", "count", "constrained", "fixed", "relocated", "cones")
+    __slots__ = ("n", "m", "count", "constrained", "fixed", "relocated", "cones", "certificate")
 
     def __init__(self, n: int, m: int, cones: ConeArrays) -> None:
         self.n, self.m, self.count, self.cones = n, m, 0, cones
         self.constrained, self.fixed = np.empty(n, np.intp), np.empty(n, np.uint8)
         self.relocated = np.empty(cones.count, np.intp)
+        self.certificate = np.empty(n + m)  # copied into the Result only when infeasible
 
     def update(self, lb: np.ndarray, ub: np.ndarray) -> bool:
         """Scan the bounds; True when the constrained or fixed entries changed."""
@@ -156,7 +157,7 @@ class Solver:
             elif flat is not structure.cones:
                 w.update_cones(flat.mu, flat.normal)
             structure.cones = flat
-        x, y, z, certificate = np.empty(n), np.empty(m), np.empty(n), np.empty(n + m)
+        x, y, z, certificate = np.empty(n), np.empty(m), np.empty(n), structure.certificate
         (code, iterations, rho, prim, dual, gap, obj, factorizations, setup_time,
          backend) = w.solve(P, q, A, b, lb, ub, guess, settings.warm_start, start, x, y, z,
                             certificate)
@@ -171,9 +172,9 @@ class Solver:
             )
         status = STATUS_BY_CODE[code]
         if status is Status.PRIMAL_INFEASIBLE:
-            certificate_out = certificate
+            certificate_out = certificate.copy()
         elif status is Status.DUAL_INFEASIBLE:
-            certificate_out = certificate[:n]
+            certificate_out = certificate[:n].copy()
         else:
             certificate_out = None
         result = Result(
