@@ -148,7 +148,7 @@ def main() -> None:
     qp = wbc_qp()
     settings = fccqp.Settings()
     problem, _ = cvxpy_problem(qp)
-    problem.solve(solver=FCCQP(settings))  # compile numba kernels and CVXPY's chain
+    problem.solve(solver=FCCQP(settings))  # first-call costs: CVXPY's solve chain
     translation = problem.solver_stats.extra_stats["translation"]
     print(f"WBC QP: {qp.q.shape[0]} variables, {qp.b.shape[0]} equalities, "
           f"{qp.contacts} contacts; via CVXPY: {translation.num_slacks} slacks, "

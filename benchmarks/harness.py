@@ -5,7 +5,7 @@ and warm-start state belong to one solver at a time:
 
 1. every QP is prepared (:meth:`~benchmarks.adapters.Adapter.prepare`) before timing;
 2. warm-up: each variant solves the first few QPs and is reset, so that JIT
-   compilation (fccqp's numba kernels) and first-call costs are not timed;
+   first-call costs (loading extension modules, caches) are not timed;
 3. ``repeats`` rounds; in each, every variant makes one pass over the set in
    controller-loop order, resetting the warm start at each sequence boundary, with
    the garbage collector off. Rotating the variants round by round (instead of
@@ -84,7 +84,7 @@ def run_variants(
     ]
     n_qps = len(test_set.qps)
     warm = min(WARMUP_QPS, n_qps)
-    bar = tqdm(adapters, desc=f"{robot}: warm-up (a first run compiles fccqp: 2-4 min)",
+    bar = tqdm(adapters, desc=f"{robot}: warm-up (first calls, untimed)",
                leave=False, disable=not progress)
     for adapter, prepared in zip(bar, data, strict=True):
         bar.set_postfix_str(adapter.name)

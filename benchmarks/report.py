@@ -45,7 +45,7 @@ _PROJECT_TARGETS = (("proxqp-pyr4", 4.0), ("osqp-pyr4", 10.0), ("clarabel", 10.0
 """fccqp-realtime's speed goals: median at most 1/factor of these peers' medians."""
 _CSV_SKIP = ("u",)
 _LIBRARIES = (
-    "numpy", "scipy", "numba", "fccqp", "clarabel", "qoco", "scs", "daqp", "quadprog", "piqp",
+    "numpy", "scipy", "cython", "fccqp", "clarabel", "qoco", "scs", "daqp", "quadprog", "piqp",
     "proxsuite", "osqp", "qpsolvers", "pin", "example-robot-data", "matplotlib",
     "threadpoolctl",
 )
@@ -313,7 +313,7 @@ def _header(info: RunInfo, variants: Sequence[str]) -> list[str]:
         " multipliers); the others solve every QP cold.",
         "- A pass is one variant solving the whole set in controller-loop order, restarting"
         " warm starts at each sequence boundary; passes never interleave per QP. Each"
-        " variant first solves a few QPs untimed (warm-up: numba compilation and first-call"
+        " variant first solves a few QPs untimed (warm-up: loading extension modules and first-call"
         " costs are excluded). Passes rotate through the variants round by round, so drifts"
         " of the shared machine's speed reach every variant alike. The garbage collector is"
         " off during timed passes. Read medians.",

@@ -213,9 +213,6 @@ def test_item7_inconsistent_rows_with_a_fixed_entry_are_certified():
     assert result.iterations <= ITERATIONS_TO_CERTIFY
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "open: lp_4 (x <= 0 and x >= 1) ends at MAX_ITER_REACHED, never a wrong claim, but "
-    "uncertified: with rho at its maximum the dual step's certificate does not settle"))
 def test_item7_cvxpy_lp_4_is_certified():
     """Item 7: CVXPY's standard lp_4 (sum(x), x <= 0, x >= 1) returned user_limit."""
     cp = pytest.importorskip("cvxpy")

@@ -111,6 +111,10 @@ RESTORED_EQUALITY = 1e-7
 """A restored point is kept only if its primal residual is below this times its scale:
 otherwise the other entries could not absorb the pinning. Refinement aims at 1e-13, but
 an ill-conditioned ``W_TT`` (condition 1e8 on solo12) costs digits."""
+STALL_FACTOR, STALLS = 1e3, 2
+"""Anderson acceleration stops for the rest of a run when, at ``STALLS`` scheduled checks
+in a row, the primal residual is above ``STALL_FACTOR`` times its tolerance and not half
+of what it was at the previous scheduled check (see _iterate)."""
 LOG_INTERVAL = 25
 """With ``verbose``, the log keeps one line every this many iterations (as OSQP)."""
 cdef double _INACCURATE_FACTOR = INACCURATE_FACTOR
@@ -120,6 +124,8 @@ cdef double _EQUALITY_START_LIMIT = EQUALITY_START_LIMIT
 cdef double _RESTORED_EQUALITY = RESTORED_EQUALITY
 cdef long _EQUALITY_START_STEPS = EQUALITY_START_STEPS
 cdef long _LOG_INTERVAL = LOG_INTERVAL
+cdef double _STALL_FACTOR = STALL_FACTOR
+cdef int _STALLS = STALLS
 
 
 cdef struct Options:
@@ -462,8 +468,9 @@ cdef class Workspace:
         cdef long iteration = 0
         cdef int status = _RUNNING, code
         cdef bint unbounded_start = False, timed = isfinite(o.time_limit)
-        cdef bint reduced, fresh, last, periodic, adapt, check
-        cdef double eps_p, eps_d, new_rho
+        cdef bint reduced, fresh, last, periodic, adapt, check, accelerate
+        cdef double eps_p, eps_d, new_rho, periodic_prim
+        cdef int stalls
         run.factorizations = 0
         run.backend = self.form
         if cold or s == 0:
@@ -504,6 +511,9 @@ cdef class Workspace:
         eps_p = o.eps_abs + o.eps_rel * r.prim_scale
         eps_d = o.eps_abs + o.eps_rel * r.dual_scale
         anderson_reset(&self.aa, False)
+        accelerate = o.anderson_memory > 0
+        periodic_prim = INFINITY
+        stalls = 0
         fresh = True  # the next step starts a run of KKT solutions: do not relax x
         if timed and fccqp_now() - start_time >= o.time_limit:
             status = self._classify(0, True, start_time)   # the setup spent the budget
@@ -531,6 +541,17 @@ cdef class Workspace:
                 if iteration % _LOG_INTERVAL == 0:
                     self._log(iteration, run.rho)
                 status = self._check(iteration, last, start_time)
+                if status == _RUNNING and periodic and accelerate:
+                    # a primal residual that does not halve between two scheduled checks
+                    # far from tolerance is how infeasibility looks; Anderson's
+                    # extrapolated points there hide the steady step that certifies it
+                    # (CVXPY's lp_4 ran 4000 iterations uncertified), so plain ADMM runs on
+                    if r.prim > _STALL_FACTOR * eps_p and r.prim > 0.5 * periodic_prim:
+                        stalls += 1
+                    else:
+                        stalls = 0
+                    accelerate = stalls < _STALLS
+                    periodic_prim = r.prim
                 if status == _RUNNING and adapt:
                     new_rho = self._new_rho(run.rho)
                     if new_rho != run.rho:
@@ -550,7 +571,7 @@ cdef class Workspace:
                             self._reduced_base()
                         fresh = True
                         anderson_reset(&self.aa, True)
-            if status == _RUNNING and o.anderson_memory > 0:
+            if status == _RUNNING and accelerate:
                 anderson_step(&self.aa, it, s)
         self.clock[4] = fccqp_now()
         if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
