@@ -487,7 +487,7 @@ cdef class Workspace:
         if (cold or s == 0) and converged(r, o.eps_abs, o.eps_rel) and not unbounded_start:
             self._finish_run(run, _SOLVED, 0)
             return
-        if (cold or s == 0) and r.prim > o.eps_abs + o.eps_rel * r.prim_scale and \
+        if (cold or s == 0) and r.prim_eq > o.eps_abs + o.eps_rel * r.prim_eq_scale and \
                 self._inconsistent():
             # tested on the penalty-free start: with rho in the KKT matrix (up to 1e9 on
             # fixed entries) the regularization's trace in A'r can hide the certificate
@@ -508,7 +508,7 @@ cdef class Workspace:
         if reduced:
             self._reduced_base()
             reduced_start(&self.red, p, it)
-        eps_p = o.eps_abs + o.eps_rel * r.prim_scale
+        eps_p = o.eps_abs + o.eps_rel * r.prim_set_scale   # the gate tests x_S - z
         eps_d = o.eps_abs + o.eps_rel * r.dual_scale
         anderson_reset(&self.aa, False)
         accelerate = o.anderson_memory > 0
@@ -536,7 +536,7 @@ cdef class Workspace:
                 if reduced:
                     materialize(&self.red, p, it)
                 self._residuals()
-                eps_p = o.eps_abs + o.eps_rel * r.prim_scale
+                eps_p = o.eps_abs + o.eps_rel * r.prim_set_scale
                 eps_d = o.eps_abs + o.eps_rel * r.dual_scale
                 if iteration % _LOG_INTERVAL == 0:
                     self._log(iteration, run.rho)
@@ -546,7 +546,8 @@ cdef class Workspace:
                     # far from tolerance is how infeasibility looks; Anderson's
                     # extrapolated points there hide the steady step that certifies it
                     # (CVXPY's lp_4 ran 4000 iterations uncertified), so plain ADMM runs on
-                    if r.prim > _STALL_FACTOR * eps_p and r.prim > 0.5 * periodic_prim:
+                    if (r.prim > _STALL_FACTOR * (o.eps_abs + o.eps_rel * r.prim_scale)
+                            and r.prim > 0.5 * periodic_prim):
                         stalls += 1
                     else:
                         stalls = 0
@@ -599,7 +600,7 @@ cdef class Workspace:
             for i in range(p.s):
                 self.cert[p.m + p.constrained[i]] = self.vec_s[i] / p.D[p.constrained[i]]
             return _PRIMAL_INFEASIBLE
-        if r.prim > o.eps_abs + o.eps_rel * r.prim_scale and self._inconsistent():
+        if r.prim_eq > o.eps_abs + o.eps_rel * r.prim_eq_scale and self._inconsistent():
             return _PRIMAL_INFEASIBLE
         for i in range(p.n):
             self.direction[i] = it.x[i] - it.x_prev[i]
@@ -917,10 +918,10 @@ cdef class Workspace:
         matvec(self.A_user, x, Ax, m, n)
         matvec_t(self.A_user, y, ATy, m, n)
         matvec(self.P_user, x, grad, n, n)
-        r.prim = r.prim_scale = 0.0
+        r.prim_eq = r.prim_eq_scale = r.prim_set = r.prim_set_scale = 0.0
         for i in range(m):
-            r.prim = max(r.prim, fabs(Ax[i] - self.b_user[i]))
-            r.prim_scale = max(r.prim_scale, max(fabs(Ax[i]), fabs(self.b_user[i])))
+            r.prim_eq = max(r.prim_eq, fabs(Ax[i] - self.b_user[i]))
+            r.prim_eq_scale = max(r.prim_eq_scale, max(fabs(Ax[i]), fabs(self.b_user[i])))
             by += self.b_user[i] * y[i]
             terms += fabs(self.b_user[i] * y[i])
         for j in range(s):
@@ -938,8 +939,8 @@ cdef class Workspace:
         r.dual_scale = 0.0
         for j in range(s):
             i = p.constrained[j]
-            r.prim = max(r.prim, fabs(x[i] - proj[j]))
-            r.prim_scale = max(r.prim_scale, fabs(x[i]))
+            r.prim_set = max(r.prim_set, fabs(x[i] - proj[j]))
+            r.prim_set_scale = max(r.prim_set_scale, fabs(x[i]))
             if z[i] > 0.0 and isfinite(self.ub_user[i]):
                 support += self.ub_user[i] * z[i]
                 terms += fabs(self.ub_user[i] * z[i])
@@ -959,5 +960,7 @@ cdef class Workspace:
         r.objective = 0.5 * xPx + qx
         r.gap = fabs(xPx + qx + by + support)
         r.gap_scale = max(max(fabs(xPx), fabs(qx)), terms)
+        r.prim = max(r.prim_eq, r.prim_set)
+        r.prim_scale = max(r.prim_eq_scale, r.prim_set_scale)
         r.finite = isfinite(total) and isfinite(r.gap) and isfinite(r.prim)
 

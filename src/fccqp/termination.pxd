@@ -4,9 +4,11 @@ from fccqp._types cimport Iterates, Problem
 cdef struct Residuals:
     # Residuals of an iterate in the user's units, the scales of their relative
     # tolerances, and the scaled values that rho adaptation balances.
-    double prim, dual, gap
+    double prim, dual, gap      # prim = max(prim_eq, prim_set), the reported value
     double objective            # 1/2 x'Px + q'x (set for the returned point)
-    double prim_scale, dual_scale, gap_scale
+    double prim_eq, prim_set    # ||A x - b|| and the distance of x_S to C (or to w)
+    double prim_eq_scale, prim_set_scale
+    double prim_scale, dual_scale, gap_scale   # prim_scale: the larger of the two
     double prim_s, dual_s, prim_scale_s, dual_scale_s
     bint finite
 

@@ -3,13 +3,14 @@
 
 For the user's problem and an iterate ``(x, y, z)`` with slack ``w`` in ``C``:
 
-    prim = max(||A x - b||, ||x_S - w||)            <= eps_abs + eps_rel * prim_scale
+    ||A x - b||                                      <= eps_abs + eps_rel * max(||A x||, ||b||)
+    ||x_S - w||                                      <= eps_abs + eps_rel * max(||x_S||, ||w||)
     dual = ||P x + q + A'y + z||                     <= eps_abs + eps_rel * dual_scale
     gap  = |x'Px + q'x + b'y + sigma_C(z)|           <= eps_abs + eps_rel * gap_scale
 
-(infinity norms). The scales come from the data and the primal point only:
-``prim_scale = max(||b||, ||A x||, ||x_S||, ||w||)`` and ``dual_scale = max(||q||, ||P
-x||)``: neither grows with the multipliers, which diverge on an infeasible problem (a
+(infinity norms); the primal residual reported is the larger of the first two, each
+judged in its own units (rows of ``A``, entries of ``x``). The scales come from the
+data and the primal point only: ``dual_scale = max(||q||, ||P x||)``, neither grows with the multipliers, which diverge on an infeasible problem (a
 dual scale that included them let a dual residual of 486 pass against multipliers of
 3.6e8). The gap's scale is the size of its terms, as in PIQP (``|x'Px|``, ``|q'x|``, and the sum
 of the magnitudes of the products in ``b'y + sigma_C(z)``): on an infeasible problem
@@ -52,15 +53,16 @@ cdef void residuals(const Problem* p, const Iterates* it, double* Ax, double* AT
     """Fill ``r`` for the iterate ``it`` (``Ax``, ``ATnu``, ``Px``: scratch of sizes m, n, n)."""
     cdef Py_ssize_t n = p.n, m = p.m, i, j
     cdef double c = p.c, value, scale, xPx, qx, bnu, support, terms, total = 0.0
-    r.prim = r.prim_scale = r.prim_s = r.prim_scale_s = 0.0
+    r.prim_eq = r.prim_eq_scale = r.prim_set = r.prim_set_scale = 0.0
+    r.prim_s = r.prim_scale_s = 0.0
     matvec(p.A, it.x, Ax, m, n)
     matvec_t(p.A, it.nu, ATnu, m, n)
     matvec(p.P, it.x, Px, n, n)
     for i in range(m):
         value = fabs(Ax[i] - p.b[i])
         scale = max(fabs(Ax[i]), fabs(p.b[i]))
-        r.prim = max(r.prim, value / p.E[i])
-        r.prim_scale = max(r.prim_scale, scale / p.E[i])
+        r.prim_eq = max(r.prim_eq, value / p.E[i])
+        r.prim_eq_scale = max(r.prim_eq_scale, scale / p.E[i])
         r.prim_s = max(r.prim_s, value)
         r.prim_scale_s = max(r.prim_scale_s, scale)
         total += value
@@ -68,11 +70,13 @@ cdef void residuals(const Problem* p, const Iterates* it, double* Ax, double* AT
         i = p.constrained[j]
         value = fabs(it.x[i] - it.z[j])
         scale = max(fabs(it.x[i]), fabs(it.z[j]))
-        r.prim = max(r.prim, value * p.D[i])
-        r.prim_scale = max(r.prim_scale, scale * p.D[i])
+        r.prim_set = max(r.prim_set, value * p.D[i])
+        r.prim_set_scale = max(r.prim_set_scale, scale * p.D[i])
         r.prim_s = max(r.prim_s, value)
         r.prim_scale_s = max(r.prim_scale_s, scale)
         total += value + fabs(it.y[j])
+    r.prim = max(r.prim_eq, r.prim_set)
+    r.prim_scale = max(r.prim_eq_scale, r.prim_set_scale)
     r.dual = r.dual_scale = r.dual_s = r.dual_scale_s = 0.0
     xPx = qx = 0.0
     for i in range(n):
@@ -111,6 +115,7 @@ cdef bint nearly_converged(const Residuals* r, double eps_abs, double eps_rel,
                            double factor) noexcept nogil:
     """:func:`converged` with tolerances multiplied by ``factor``."""
     return (r.finite
-            and r.prim <= factor * (eps_abs + eps_rel * r.prim_scale)
+            and r.prim_eq <= factor * (eps_abs + eps_rel * r.prim_eq_scale)
+            and r.prim_set <= factor * (eps_abs + eps_rel * r.prim_set_scale)
             and r.dual <= factor * (eps_abs + eps_rel * r.dual_scale)
             and r.gap <= factor * (eps_abs + eps_rel * r.gap_scale))
