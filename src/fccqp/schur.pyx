@@ -23,7 +23,7 @@ rank-deficient ``A``. Solves are refined like :func:`fccqp.ldl.ldl_solve`.
 
 import numpy as np
 
-from fccqp._blas cimport cholesky, cholesky_solve, gemm, syrk_t, trsm
+from fccqp._blas cimport cholesky, cholesky_solve, cholesky_solve_vector, gemm, syrk_t, trsm
 from fccqp._dense cimport matvec, matvec_t
 from fccqp._types cimport Problem
 from fccqp.ldl cimport meets_equalities
@@ -103,7 +103,7 @@ cdef void _h_solve(Schur* f, double* v, Py_ssize_t n) noexcept nogil:
     cdef Py_ssize_t i
     for i in range(n):
         f.perm[i] = v[f.order[i]]
-    cholesky_solve(f.L, <int>n, <int>n, f.perm, 1, <int>n)
+    cholesky_solve_vector(f.L, <int>n, <int>n, f.perm)
     for i in range(n):
         v[f.order[i]] = f.perm[i]
 
@@ -120,7 +120,7 @@ cdef void _solve(Schur* f, const Problem* p, const double* rhs_x, const double* 
     matvec(p.A, x, nu, m, n)
     for i in range(m):
         nu[i] -= rhs_nu[i]
-    cholesky_solve(f.LS, <int>m, <int>m, nu, 1, <int>m)
+    cholesky_solve_vector(f.LS, <int>m, <int>m, nu)
     matvec_t(p.A, nu, f.ATnu, m, n)
     _h_solve(f, f.ATnu, n)
     for i in range(n):
