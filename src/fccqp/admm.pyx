@@ -38,6 +38,7 @@ from fccqp.anderson cimport Anderson, anderson_reset, anderson_step
 from fccqp.certificates cimport dual_infeasible, equality_inconsistent, primal_infeasible
 from fccqp.kkt cimport (AUTO, FACTORED, KKT, LDL_FULL, LDL_REDUCED, NOT_CONVEX, SCHUR_REDUCED,
                         UNAVAILABLE, kkt_convexity, kkt_factor, kkt_solve)
+from fccqp.polish cimport Polish, multiplier_violation, polish
 from fccqp.projections cimport proj_block, proj_set
 from fccqp.reduced cimport (Reduced, materialize, near_convergence, reduced_rebase,
                             reduced_start, reduced_step, reduced_table)
@@ -111,6 +112,10 @@ RESTORED_EQUALITY = 1e-7
 """A restored point is kept only if its primal residual is below this times its scale:
 otherwise the other entries could not absorb the pinning. Refinement aims at 1e-13, but
 an ill-conditioned ``W_TT`` (condition 1e8 on solo12) costs digits."""
+POLISH_EXACT = 1e-3
+"""A polished residual counts as no worse than ADMM's when it is below this times its
+tolerance (rounding of an exact solve), and its multipliers may miss their cones by
+this times the dual tolerance."""
 LOG_INTERVAL = 25
 """With ``verbose``, the log keeps one line every this many iterations (as OSQP)."""
 cdef double _INACCURATE_FACTOR = INACCURATE_FACTOR
@@ -118,6 +123,7 @@ cdef double _REDUCED_COST = REDUCED_COST
 cdef double _RHO_MIN = RHO_MIN, _RHO_MAX = RHO_MAX
 cdef double _EQUALITY_START_LIMIT = EQUALITY_START_LIMIT
 cdef double _RESTORED_EQUALITY = RESTORED_EQUALITY
+cdef double _POLISH_EXACT = POLISH_EXACT
 cdef long _EQUALITY_START_STEPS = EQUALITY_START_STEPS
 cdef long _LOG_INTERVAL = LOG_INTERVAL
 
@@ -126,8 +132,8 @@ cdef struct Options:
     # Settings of fccqp.Settings the kernels read.
     double rho, sigma, alpha, eps_abs, eps_rel, eps_prim_inf, eps_dual_inf
     double time_limit, adaptive_rho_tolerance
-    long max_iter, check_termination, adaptive_rho_interval, scaling
-    bint adaptive_rho, restore_feasibility
+    long max_iter, check_termination, adaptive_rho_interval, scaling, polish_refine_iter
+    bint adaptive_rho, restore_feasibility, polish
     int backend, anderson_memory
 
 
@@ -139,6 +145,7 @@ cdef struct Run:
     int factorizations
     double setup_time
     int backend
+    bint polished
 
 
 cdef class Workspace:
@@ -157,6 +164,7 @@ cdef class Workspace:
     cdef Reduced red
     cdef Anderson aa
     cdef Restoration rest
+    cdef Polish pol
     cdef Options opt
     cdef Residuals res
     cdef Finding found
@@ -185,6 +193,9 @@ cdef class Workspace:
     cdef double* prev_x
     cdef double* prev_y
     cdef double* prev_z
+    cdef double* user_x
+    cdef double* user_y
+    cdef double* user_z
     cdef Py_ssize_t* block_start
     cdef Py_ssize_t log_rows, log_count
     cdef double prev_rho, factored_rho, setup_time
@@ -281,6 +292,18 @@ cdef class Workspace:
         rs.positions, rs.entries = <Py_ssize_t*>self._new_int(s), <Py_ssize_t*>self._new_int(s)
         rs.W_T, rs.gram, rs.step = self._new(N * s), self._new(s * s), self._new(s)
         rs.start, rs.point = self._new(N), self._new(N)
+        pol = &self.pol
+        pol.active = <char*>self._new(s)
+        pol.index, pol.free = <Py_ssize_t*>self._new_int(n), <Py_ssize_t*>self._new_int(n)
+        pol.boundary = <Py_ssize_t*>self._new_int(s)
+        pol.g, pol.lam = self._new(s), self._new(s)
+        pol.K, pol.ipiv = self._new((N + s) * (N + s)), <int*>self._new_int(N + s)
+        pol.lwork = <int>(64 * (N + s))
+        pol.work = self._new(64 * (N + s))
+        pol.rhs, pol.step = self._new(N + s), self._new(N + s)
+        pol.x, pol.nu, pol.y = self._new(n), self._new(m), self._new(s)
+        pol.grad, pol.ATnu, pol.Ax = self._new(n), self._new(n), self._new(m)
+        self.user_x, self.user_y, self.user_z = self._new(n), self._new(m), self._new(n)
         self.log_rows = log_rows
         self.log = self._new(5 * log_rows)
         o = &self.opt
@@ -292,6 +315,7 @@ cdef class Workspace:
         o.max_iter, o.check_termination = settings.max_iter, settings.check_termination
         o.adaptive_rho_interval, o.scaling = settings.adaptive_rho_interval, settings.scaling
         o.adaptive_rho, o.restore_feasibility = settings.adaptive_rho, settings.restore_feasibility
+        o.polish, o.polish_refine_iter = settings.polish, settings.polish_refine_iter
         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
         self.has_previous = self.has_matrices = self.certified = self.scaled_once = False
         self.factored_rho = -1.0
@@ -347,7 +371,7 @@ cdef class Workspace:
         ``x0`` (None or a float64 vector) overrides the warm start; ``warm`` asks for a
         start from the previous solution (when there is one). ``cert_out`` (``m + n``
         entries) receives an infeasibility certificate. Returns ``(code, iterations, rho,
-        prim, dual, gap, objective, factorizations, setup_time, backend)``; code
+        prim, dual, gap, objective, factorizations, setup_time, backend, polished)``; code
         ``BAD_DATA`` (see :attr:`finding`) and ``NOT_CONVEX_CODE`` leave the previous
         solution untouched.
         """
@@ -368,7 +392,7 @@ cdef class Workspace:
                 self.ub_user, &same)
         if self.found.code != SCAN_OK:
             self.has_matrices = False
-            return BAD_DATA, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, ""
+            return BAD_DATA, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, "", False
         enter()   # single-threaded BLAS for this solve (see fccqp.blas_threads)
         try:
             with nogil:
@@ -381,10 +405,11 @@ cdef class Workspace:
             leave()
         if run.status == _NOT_CONVEX:
             self.has_matrices = self.has_previous = self.certified = False
-            return NOT_CONVEX_CODE, 0, 0.0, 0.0, 0.0, 0.0, 0.0, run.factorizations, 0.0, ""
+            return (NOT_CONVEX_CODE, 0, 0.0, 0.0, 0.0, 0.0, 0.0, run.factorizations, 0.0, "",
+                    False)
         r = &self.res
         return (run.status, run.iterations, run.rho, r.prim, r.dual, r.gap, r.objective,
-                run.factorizations, run.setup_time, BACKEND_NAMES[run.backend])
+                run.factorizations, run.setup_time, BACKEND_NAMES[run.backend], run.polished)
 
     # ----------------------------------------------------------------- one solve
 
@@ -466,6 +491,7 @@ cdef class Workspace:
         cdef double eps_p, eps_d, new_rho
         run.factorizations = 0
         run.backend = self.form
+        run.polished = False
         if cold or s == 0:
             code = self._equality_start(&unbounded_start)
             run.factorizations += 1
@@ -553,7 +579,10 @@ cdef class Workspace:
             if status == _RUNNING and o.anderson_memory > 0:
                 anderson_step(&self.aa, it, s)
         self.clock[4] = fccqp_now()
-        if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
+        if o.polish and _SOLVED <= status <= _TIME_LIMIT and self._keep_polished(
+                &status, run, iteration, start_time):
+            run.polished = True   # feasible to the tolerance: nothing to restore
+        elif o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
             status = self._keep_restored(status, iteration, reduced, start_time)
         elif reduced and status != _NUMERICAL_ERROR:
             self._restore_equalities()   # certificates are already in cert
@@ -832,6 +861,58 @@ cdef class Workspace:
         if reduced:
             self._restore_equalities()
         return status
+
+    cdef bint _keep_polished(self, int* status, Run* run, long iteration,
+                             double start_time) noexcept nogil:
+        """Replace the final iterate by its polished version (see :mod:`fccqp.polish`)
+        when that passes a KKT check on the user's problem; True if it did.
+
+        The polished point is accepted only when, in the user's units, it is primal
+        feasible within the tolerance (box and exact cones), its multipliers lie in the
+        normal cones its active set needs (:func:`fccqp.polish.multiplier_violation`,
+        within ``POLISH_EXACT`` of the dual tolerance) and its primal and dual
+        residuals and gap are each no worse than the ADMM point's (or below
+        ``POLISH_EXACT`` times their tolerance). Otherwise the iterate and its
+        residuals are left as they were. On acceptance the status is the polished
+        point's when that is solved or inaccurate.
+        """
+        cdef Problem* p = &self.prob
+        cdef Iterates* it = &self.it
+        cdef Options* o = &self.opt
+        cdef Residuals* r = &self.res
+        cdef Residuals before = self.res, plain
+        cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j
+        cdef double tol_p, tol_d, tol_g
+        cdef int new_status
+        if not polish(&self.pol, p, it, o.polish_refine_iter, &run.factorizations):
+            return False
+        unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, self.user_x,
+                self.user_y, self.user_z)
+        self._user_residuals(self.user_x, self.user_y, self.user_z)
+        plain = self.res
+        unscale(self.pol.x, self.pol.nu, self.pol.y, p.D, p.E, p.c, n, m, s, p.constrained,
+                self.user_x, self.user_y, self.user_z)
+        self._user_residuals(self.user_x, self.user_y, self.user_z)
+        tol_p = o.eps_abs + o.eps_rel * r.prim_scale
+        tol_d = o.eps_abs + o.eps_rel * r.dual_scale
+        tol_g = o.eps_abs + o.eps_rel * r.gap_scale
+        if not (r.finite and r.prim <= tol_p
+                and multiplier_violation(&self.pol, p, self.user_z) <= _POLISH_EXACT * tol_d
+                and (r.prim <= plain.prim or r.prim <= _POLISH_EXACT * tol_p)
+                and (r.dual <= plain.dual or r.dual <= _POLISH_EXACT * tol_d)
+                and (r.gap <= plain.gap or r.gap <= _POLISH_EXACT * tol_g)):
+            self.res = before
+            return False
+        copy(self.pol.x, it.x, n)
+        copy(self.pol.nu, it.nu, m)
+        copy(self.pol.y, it.y, s)
+        for j in range(s):
+            it.z[j] = it.x[p.constrained[j]]
+        proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
+        new_status = self._classify(iteration, True, start_time)
+        if new_status == _SOLVED or new_status == _INACCURATE:
+            status[0] = new_status
+        return True
 
     # ------------------------------------------------------------- bookkeeping
 

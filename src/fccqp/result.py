@@ -56,3 +56,7 @@ class Result:
     """Duality gap ``|x'Px + q'x + b'y + sigma_C(z)|`` of the returned point, ``sigma_C``
     the support function of the box and cones (see docs/formulation.md); NaN when the
     status is an infeasibility certificate."""
+    polished: bool = False
+    """True when the returned point is the polished one (``Settings.polish``): the
+    exact solution of the QP on the guessed active set, which passed the KKT check on
+    the user's problem; False when polishing was off, failed or was rejected."""

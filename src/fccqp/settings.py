@@ -15,6 +15,9 @@ MAX_SCALING = 100
 """Most Ruiz passes: equilibration settles within 10-25, more only costs setup time."""
 MAX_ANDERSON_MEMORY = 100
 """Most Anderson memory: each step solves a least-squares problem of this size."""
+MAX_POLISH_REFINE_ITER = 100
+"""Most re-linearizations of polishing: each costs one factorization; Newton's method
+on the cones' tangent planes converges in 1-3 when the active set is right."""
 
 _REAL_RANGES = {
     # name: (low, high, low excluded, high excluded)
@@ -35,9 +38,10 @@ _INTEGER_RANGES = {
     "adaptive_rho_interval": (1, INT_MAX),
     "anderson_memory": (0, MAX_ANDERSON_MEMORY),
     "scaling": (0, MAX_SCALING),
+    "polish_refine_iter": (0, MAX_POLISH_REFINE_ITER),
 }
 """Integer settings and their allowed closed interval."""
-_BOOLEANS = ("adaptive_rho", "restore_feasibility", "warm_start", "verbose")
+_BOOLEANS = ("adaptive_rho", "restore_feasibility", "polish", "warm_start", "verbose")
 
 
 def _real(name: str, value: object, low: float, high: float, low_open: bool,
@@ -73,7 +77,8 @@ class Settings:
     of the wrong type (``None``, a string, a complex number, a bool for a number)
     raises ``TypeError`` and one outside its range ``ValueError``, both naming the
     setting. Reals must be finite (``time_limit`` may be ``inf``); integers are
-    bounded by :data:`INT_MAX`, :data:`MAX_SCALING` and :data:`MAX_ANDERSON_MEMORY`.
+    bounded by :data:`INT_MAX`, :data:`MAX_SCALING`, :data:`MAX_ANDERSON_MEMORY` and
+    :data:`MAX_POLISH_REFINE_ITER`.
     """
 
     rho: float = 0.1
@@ -113,6 +118,14 @@ class Settings:
     """Return a point in the box and the cones: the violating entries are pinned at
     their projection and the others respond through the KKT system, keeping
     ``A x = b``; see :mod:`fccqp.restoration`."""
+    polish: bool = False
+    """After ADMM (solved or stopped by a budget), solve the equality-constrained QP on
+    the active set its iterate suggests (box entries at a bound, cone blocks at the apex
+    or on a tangent plane) and return that point when it passes a KKT check on the
+    user's problem; ``Result.polished`` says whether it did. See :mod:`fccqp.polish`."""
+    polish_refine_iter: int = 3
+    """Re-linearizations of the boundary cones' tangent planes in polishing (Newton
+    steps, one factorization each; at most :data:`MAX_POLISH_REFINE_ITER`)."""
     kkt_backend: str = "auto"
     """Linear-system backend of the x-update: ``"schur_reduced"`` (Cholesky of ``P + R``
     and of ``A (P + R)^-1 A'``, reduced iteration), ``"ldl_reduced"`` (LDL', reduced

@@ -16,10 +16,10 @@ import numpy as np
 from fccqp import admm, schur
 from fccqp.cones import Cone, ConeArrays, flatten_cones
 from fccqp.problem import MAX_ENTRY, check_cone_bounds, convert, raise_finding
-from fccqp.validation import structure_scan
 from fccqp.result import Result
 from fccqp.settings import Settings
 from fccqp.status import Status
+from fccqp.validation import structure_scan
 
 STATUS_BY_CODE = {
     admm.SOLVED: Status.SOLVED,
@@ -158,8 +158,8 @@ class Solver:
             structure.cones = flat
         x, y, z, certificate = np.empty(n), np.empty(m), np.empty(n), np.empty(n + m)
         (code, iterations, rho, prim, dual, gap, obj, factorizations, setup_time,
-         backend) = w.solve(P, q, A, b, lb, ub, guess, settings.warm_start, start, x, y, z,
-                            certificate)
+         backend, polished) = w.solve(P, q, A, b, lb, ub, guess, settings.warm_start, start,
+                                      x, y, z, certificate)
         if code == admm.BAD_DATA:
             raise_finding(w.finding, lb, ub)
         if code == admm.NOT_CONVEX_CODE:
@@ -182,6 +182,7 @@ class Solver:
             solve_time=time.perf_counter() - start, rho=rho,
             factorizations=factorizations, certificate=certificate_out,
             gap=float("nan") if status.is_infeasible() else gap, backend=backend,
+            polished=polished,
         )
         if settings.verbose:
             _print_log(w.log_lines, result)

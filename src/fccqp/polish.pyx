@@ -1,0 +1,366 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""Polishing: the exact solution of the QP on the active set that ADMM's iterate suggests.
+
+ADMM reaches high accuracy only slowly where the cost is flat; but its iterate usually
+knows which constraints bind long before it has converged. Polishing (after OSQP's
+``polish.c``, extended to the cones) guesses the active set from the slack ``z`` and
+the multiplier ``y`` of the scaled problem and solves the equality-constrained QP on
+it. The guess is Moreau's decomposition of ``v = z + y`` (OSQP's rule ``z_j - lo_j <
+-y_j`` for a box entry reads ``v_j < lo_j``):
+
+- a box entry is held at ``lo`` when ``v_j < lo_j``, at ``hi`` when ``v_j > hi_j``
+  (always when ``lo == hi``), free otherwise;
+- a cone block is held at the apex (all its entries 0) when ``v`` lies in the polar
+  cone: ``z ~ 0`` and ``y`` inside the polar; it is on the boundary when ``v`` is in
+  neither the cone nor its polar (``z`` on the boundary away from the apex, ``y`` a
+  positive multiple of the outward normal there); it is free when ``v`` lies in the cone.
+
+A boundary block contributes one linear equality, its tangent plane ``g'x_block = 0``,
+which passes through the origin because the cone functions ``phi(f) = ||f - (n'f)n|| -
+mu n'f`` (friction) and ``phi(t, w) = ||w|| - t`` (second order) are positively
+homogeneous: ``g'f = phi(f)`` for ``g`` their gradient at ``f``. Held entries are
+eliminated, so the KKT system of the polished QP
+
+    [ P_FF + delta I   A_F'        G'        ] [x_F]   [-q_F - P_F,H x_H]
+    [ A_F              -delta I              ] [nu ] = [ b - A_H x_H    ]
+    [ G                            -delta I  ] [lam]   [ 0              ]
+
+has the free entries ``F`` of ``x``, the equality multipliers and one multiplier per
+boundary block as unknowns (``G`` holds the unit normals ``g``). It is factored with
+Bunch-Kaufman ``dsytrf`` and refined against the unregularized matrix, as
+:mod:`fccqp.ldl` does. Each boundary block's plane is then re-linearized at the new
+``x_block`` (Newton's method on ``phi(x_block) = 0``, quadratically convergent when the
+guess is right) and the system re-solved, ``newton_steps`` times at most or until
+``|phi| <= NEWTON_TOLERANCE ||x_block||``.
+
+Multipliers, in the sign convention of docs/formulation.md (``P x + q + A'nu + y = 0``,
+``y`` in the normal cone of the set): a held entry's is minus the gradient of the
+Lagrangian there, a boundary block's is ``lam g`` (in the polar cone when ``lam >=
+0``), a free entry's is 0. Whether the guess was right is decided by the caller, on the
+user's problem (:func:`multiplier_violation` and the residuals of
+:mod:`fccqp.admm`); nothing here tells a wrong guess from a right one.
+"""
+
+from libc.math cimport INFINITY, fabs, isfinite, sqrt
+
+from scipy.linalg.cython_lapack cimport dsytrf, dsytrs
+
+from fccqp._dense cimport copy, inf_norm, matvec, matvec_t
+from fccqp._types cimport FRICTION, Cones, Iterates, Problem
+from fccqp.projections cimport proj_block
+
+DELTA = 1e-12
+"""Regularization of both diagonal blocks of the polishing KKT matrix (scaled problem):
+it exists for dependent rows and a cost that is flat on the free entries; refinement
+against the unregularized matrix removes it."""
+MAX_REFINE = 5
+"""Most refinement steps per solve."""
+REFINE_TOLERANCE = 1e-14
+"""Refine while the KKT residual exceeds this times ``max(1, ||q||, ||b||)`` (scaled)."""
+NEWTON_TOLERANCE = 1e-13
+"""Stop re-linearizing when every boundary block has ``|phi| <= this * ||x_block||``."""
+cdef double _DELTA = DELTA
+cdef int _MAX_REFINE = MAX_REFINE
+cdef double _REFINE_TOLERANCE = REFINE_TOLERANCE
+cdef double _NEWTON_TOLERANCE = NEWTON_TOLERANCE
+
+
+cdef inline double _axis(const double* v, Py_ssize_t kind, Py_ssize_t dim, double mu,
+                         const double* normal, double* across) noexcept nogil:
+    """Split a cone block ``v`` into its part along the cone's axis (returned) and the
+    norm of the rest (``across``), with the axis scaled so that the cone reads
+    ``across <= slope * axis`` (slope ``mu`` for friction, 1 for second order)."""
+    cdef double along, t, total = 0.0
+    cdef Py_ssize_t i
+    if kind == FRICTION:
+        along = normal[0] * v[0] + normal[1] * v[1] + normal[2] * v[2]
+        for i in range(3):
+            t = v[i] - along * normal[i]
+            total += t * t
+    else:
+        along = v[0]
+        for i in range(1, dim):
+            total += v[i] * v[i]
+    across[0] = sqrt(total)
+    return along
+
+
+cdef inline double _slope(Py_ssize_t kind, double mu) noexcept nogil:
+    return mu if kind == FRICTION else 1.0
+
+
+cdef bint _plane(const double* v, Py_ssize_t kind, Py_ssize_t dim, double mu,
+                 const double* normal, double* g, double* phi) noexcept nogil:
+    """Unit gradient ``g`` of the cone function at ``v`` and its value ``phi``; False
+    (``g`` untouched) where the gradient does not exist (``v`` on the axis)."""
+    cdef double across, slope = _slope(kind, mu)
+    cdef double along = _axis(v, kind, dim, mu, normal, &across)
+    cdef double unit = 1.0 / sqrt(1.0 + slope * slope)
+    cdef Py_ssize_t i
+    phi[0] = across - slope * along
+    if not across > 0.0:
+        return False
+    if kind == FRICTION:
+        for i in range(3):
+            g[i] = ((v[i] - along * normal[i]) / across - slope * normal[i]) * unit
+    else:
+        g[0] = -unit
+        for i in range(1, dim):
+            g[i] = v[i] / across * unit
+    return True
+
+
+cdef Py_ssize_t _guess(Polish* w, const Problem* p, const Iterates* it) noexcept nogil:
+    """Fill ``active``, the boundary blocks' planes ``g`` and multipliers ``lam`` (the
+    component of ``y`` along ``g``) and the list ``boundary``; return its length."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t j, k, o, d, nb = 0
+    cdef double v, along, across, slope, phi, lam
+    cdef char code
+    for j in range(p.s):
+        v = it.z[j] + it.y[j]
+        if p.lo[j] == p.hi[j]:
+            w.active[j] = FIXED
+        elif v < p.lo[j]:
+            w.active[j] = LOWER
+        elif v > p.hi[j]:
+            w.active[j] = UPPER
+        else:
+            w.active[j] = FREE
+    for k in range(c.count):
+        o, d = c.offset[k], c.dim[k]
+        for j in range(o, o + d):
+            w.g[j] = it.z[j] + it.y[j]
+        slope = _slope(c.kind[k], c.mu[k])
+        along = _axis(w.g + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
+        if across <= slope * along:
+            code = FREE
+        elif slope * across <= -along:
+            code = APEX
+        else:   # across > 0 here, so the plane exists
+            code = BOUNDARY
+            _plane(w.g + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.g + o, &phi)
+            lam = 0.0
+            for j in range(o, o + d):
+                lam += it.y[j] * w.g[j]
+            w.lam[nb] = lam
+            w.boundary[nb] = k
+            nb += 1
+        for j in range(o, o + d):
+            w.active[j] = code
+    return nb
+
+
+cdef Py_ssize_t _unknowns(Polish* w, const Problem* p, const Iterates* it) noexcept nogil:
+    """Start from the iterate with the held entries at their values; number the free
+    entries (``index``, ``free``) and return how many there are."""
+    cdef Py_ssize_t n = p.n, i, j, nf = 0
+    cdef char code
+    copy(it.x, w.x, n)
+    copy(it.nu, w.nu, p.m)
+    for i in range(n):
+        w.index[i] = 0
+    for j in range(p.s):
+        code = w.active[j]
+        i = p.constrained[j]
+        if code == LOWER or code == FIXED:
+            w.x[i] = p.lo[j]
+        elif code == UPPER:
+            w.x[i] = p.hi[j]
+        elif code == APEX:
+            w.x[i] = 0.0
+        else:
+            continue
+        w.index[i] = -1
+    for i in range(n):
+        if w.index[i] == 0:
+            w.index[i] = nf
+            w.free[nf] = i
+            nf += 1
+    return nf
+
+
+cdef void _assemble(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) noexcept nogil:
+    """Lower triangle of the regularized KKT matrix of the polished QP into ``K``."""
+    cdef Py_ssize_t n = p.n, m = p.m, N = nf + m + nb, r, col, i, j, k, o, start, jc
+    cdef double* K = w.K
+    for col in range(N):
+        for r in range(col, N):
+            K[r + col * N] = 0.0
+    for col in range(nf):
+        jc = w.free[col]
+        for r in range(col, nf):
+            K[r + col * N] = p.P[w.free[r] * n + jc]
+        K[col + col * N] += _DELTA
+        for i in range(m):
+            K[nf + i + col * N] = p.A[i * n + jc]
+    for k in range(nb):
+        o = p.cones.offset[w.boundary[k]]
+        start = p.constrained[o]
+        for j in range(p.cones.dim[w.boundary[k]]):
+            K[nf + m + k + w.index[start + j] * N] = w.g[o + j]
+    for r in range(nf, N):
+        K[r + r * N] = -_DELTA
+
+
+cdef double _residual(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) noexcept nogil:
+    """KKT residual of the current ``(x, nu, lam)`` against the unregularized matrix into
+    ``rhs``; returns its infinity norm. Leaves the Lagrangian's gradient without the
+    planes' terms in ``grad`` (minus the multipliers of the held entries)."""
+    cdef Py_ssize_t n = p.n, m = p.m, i, j, k, o, start, cone
+    cdef double value
+    matvec(p.P, w.x, w.grad, n, n)
+    matvec_t(p.A, w.nu, w.ATnu, m, n)
+    for i in range(n):
+        w.grad[i] += p.q[i] + w.ATnu[i]
+    for i in range(nf):
+        w.rhs[i] = -w.grad[w.free[i]]
+    for k in range(nb):
+        cone = w.boundary[k]
+        o = p.cones.offset[cone]
+        start = p.constrained[o]
+        value = 0.0
+        for j in range(p.cones.dim[cone]):
+            w.rhs[w.index[start + j]] -= w.lam[k] * w.g[o + j]
+            value += w.g[o + j] * w.x[start + j]
+        w.rhs[nf + m + k] = -value
+    matvec(p.A, w.x, w.Ax, m, n)
+    for i in range(m):
+        w.rhs[nf + i] = p.b[i] - w.Ax[i]
+    return inf_norm(w.rhs, nf + m + nb)
+
+
+cdef void _apply(Polish* w, Py_ssize_t nf, Py_ssize_t m, Py_ssize_t nb,
+                 double sign) noexcept nogil:
+    """Add ``sign`` times ``step`` to the unknowns."""
+    cdef Py_ssize_t i
+    for i in range(nf):
+        w.x[w.free[i]] += sign * w.step[i]
+    for i in range(m):
+        w.nu[i] += sign * w.step[nf + i]
+    for i in range(nb):
+        w.lam[i] += sign * w.step[nf + m + i]
+
+
+cdef void _solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
+                 double scale) noexcept nogil:
+    """Correct ``(x, nu, lam)`` to the solution of the factored system: residual
+    corrections against the unregularized matrix until the residual is below
+    ``REFINE_TOLERANCE * scale``, stops halving (a singular system), or ``MAX_REFINE``
+    corrections after the first; a correction that makes it grow is undone."""
+    cdef char uplo = b"L"
+    cdef int size = <int>(nf + p.m + nb), one = 1, info = 0
+    cdef double norm, last = INFINITY
+    cdef int r
+    for r in range(_MAX_REFINE + 2):
+        norm = _residual(w, p, nf, nb)
+        if norm > last:
+            _apply(w, nf, p.m, nb, -1.0)
+            return
+        if norm <= _REFINE_TOLERANCE * scale or norm > 0.5 * last or r == _MAX_REFINE + 1:
+            return
+        last = norm
+        copy(w.rhs, w.step, size)
+        dsytrs(&uplo, &size, &one, w.K, &size, w.ipiv, w.step, &size, &info)
+        _apply(w, nf, p.m, nb, 1.0)
+
+
+cdef bint _relinearize(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
+    """Move each boundary block's plane to the tangent plane at the current
+    ``x_block``, unless every block already meets ``NEWTON_TOLERANCE``: then return
+    False and keep the planes, with which ``(x, lam)`` were solved. A block on the axis
+    (``x_block = 0`` on its plane: the apex) keeps its plane."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t k, j, cone, o, start, d
+    cdef double phi, size
+    cdef bint converged = True
+    for k in range(nb):   # the new planes go to step, which is free until the next solve
+        cone = w.boundary[k]
+        o, d = c.offset[cone], c.dim[cone]
+        start = p.constrained[o]
+        size = 0.0
+        for j in range(d):
+            size += w.x[start + j] * w.x[start + j]
+            w.step[o + j] = w.g[o + j]
+        _plane(w.x + start, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, w.step + o, &phi)
+        if fabs(phi) > _NEWTON_TOLERANCE * sqrt(size):
+            converged = False
+    if converged:
+        return False
+    copy(w.step, w.g, p.s)
+    return True
+
+
+cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_steps,
+                 int* factorizations) noexcept nogil:
+    """Polish the iterate ``it`` into ``w.x``, ``w.nu``, ``w.y`` (scaled problem) and
+    leave the guess in ``w.active``; ``factorizations`` counts the ``dsytrf`` calls.
+
+    False when a factorization breaks down or the result is not finite; otherwise the
+    caller judges the point.
+    """
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, nb, nf, j, k, o, cone
+    cdef char uplo = b"L"
+    cdef int size, info = 0
+    cdef long step
+    cdef char code
+    cdef double total = 0.0
+    cdef double scale = max(1.0, max(inf_norm(p.q, n), inf_norm(p.b, m)))
+    nb = _guess(w, p, it)
+    nf = _unknowns(w, p, it)
+    size = <int>(nf + m + nb)
+    for step in range(newton_steps + 1):
+        if step > 0 and not _relinearize(w, p, nb):
+            break
+        _assemble(w, p, nf, nb)
+        dsytrf(&uplo, &size, w.K, &size, w.ipiv, w.work, &w.lwork, &info)
+        factorizations[0] += 1
+        if info != 0:
+            return False
+        _solve(w, p, nf, nb, scale)
+    _residual(w, p, nf, nb)   # grad: the held entries' multipliers, negated
+    for j in range(s):
+        code = w.active[j]
+        w.y[j] = 0.0 if code == FREE or code == BOUNDARY else -w.grad[p.constrained[j]]
+    for k in range(nb):
+        cone = w.boundary[k]
+        o = p.cones.offset[cone]
+        for j in range(o, o + p.cones.dim[cone]):
+            w.y[j] = w.lam[k] * w.g[j]
+    for j in range(n):
+        total += w.x[j]
+    for j in range(m):
+        total += w.nu[j]
+    for j in range(s):
+        total += w.y[j]
+    return isfinite(total)
+
+
+cdef double multiplier_violation(Polish* w, const Problem* p, const double* z) noexcept nogil:
+    """How far the multipliers ``z`` (user's units, one per entry of ``x``) of the
+    polished point are from the normal cone its guess needs: the wrong-signed part of a
+    held box entry's (``z <= 0`` at a lower bound, ``>= 0`` at an upper one, either on
+    ``lo == hi``) and, on held or boundary cone blocks, the distance of ``z_block`` to
+    the polar cone (``-z_block`` must lie in the dual cone). The scaling is constant on a
+    cone block, so the cones are those of the scaled problem."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t j, k, o, d, start
+    cdef double worst = 0.0, distance
+    cdef char code
+    for j in range(p.s):
+        code = w.active[j]
+        if code == LOWER:
+            worst = max(worst, z[p.constrained[j]])
+        elif code == UPPER:
+            worst = max(worst, -z[p.constrained[j]])
+    for k in range(c.count):
+        o, d = c.offset[k], c.dim[k]
+        if w.active[o] == FREE:
+            continue
+        start = p.constrained[o]
+        proj_block(z + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
+        distance = 0.0   # ||P_K(z)||: the distance of z to the polar (Moreau)
+        for j in range(d):
+            distance += w.step[j] * w.step[j]
+        worst = max(worst, sqrt(distance))
+    return worst
