@@ -296,7 +296,7 @@ cdef class Workspace:
         pol.active = <char*>self._new(s)
         pol.index, pol.free = <Py_ssize_t*>self._new_int(n), <Py_ssize_t*>self._new_int(n)
         pol.boundary = <Py_ssize_t*>self._new_int(s)
-        pol.g, pol.lam = self._new(s), self._new(s)
+        pol.g, pol.lam, pol.hess = self._new(s), self._new(s), self._new(s * s)
         pol.K, pol.ipiv = self._new((N + s) * (N + s)), <int*>self._new_int(N + s)
         pol.lwork = <int>(64 * (N + s))
         pol.work = self._new(64 * (N + s))

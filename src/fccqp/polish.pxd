@@ -17,6 +17,7 @@ cdef struct Polish:
     Py_ssize_t* free        # n: the entries that are unknowns, ascending
     Py_ssize_t* boundary    # s: the cone blocks on their boundary
     double* g               # s: unit normal of each boundary block's tangent plane
+    double* hess            # s x s: a boundary block's curvature term at hess + offset * s
     double* K               # N x N, Fortran order; the factor after dsytrf
     int* ipiv               # N
     double* work            # lwork entries, for dsytrf
