@@ -69,12 +69,20 @@ MAX_REFINE = 5
 """Most refinement steps per solve."""
 REFINE_TOLERANCE = 1e-14
 """Refine while the KKT residual exceeds this times ``max(1, ||q||, ||b||)`` (scaled)."""
+GUESS_PASSES = 4
+"""Most active sets solved per polish: the first from ADMM's iterate, each next one
+corrected from the previous polished point (a primal-dual active-set step)."""
+ACTIVE_TOLERANCE = 1e-12
+"""A free entry or block joins the active set when it violates by more than this
+(relative to the bound, or to ``||x_block||``)."""
 NEWTON_TOLERANCE = 1e-13
 """Stop re-linearizing when every boundary block has ``|phi| <= this * ||x_block||``."""
 cdef double _DELTA = DELTA
 cdef int _MAX_REFINE = MAX_REFINE
 cdef double _REFINE_TOLERANCE = REFINE_TOLERANCE
 cdef double _NEWTON_TOLERANCE = NEWTON_TOLERANCE
+cdef int _GUESS_PASSES = GUESS_PASSES
+cdef double _ACTIVE_TOLERANCE = ACTIVE_TOLERANCE
 
 
 cdef inline double _axis(const double* v, Py_ssize_t kind, Py_ssize_t dim, double mu,
@@ -161,28 +169,35 @@ cdef void _linearize(Polish* w, const Problem* p, Py_ssize_t k, const double* v)
                w.hess + o * p.s)
 
 
-cdef Py_ssize_t _guess(Polish* w, const Problem* p, const Iterates* it) noexcept nogil:
-    """Fill ``active``, the list ``boundary`` and each boundary block's multiplier
-    ``lam`` (the component of ``y`` along the plane's normal), plane and curvature at
-    the projection of ``z + y`` onto the cone; return the number of boundary blocks."""
+cdef Py_ssize_t _guess(Polish* w, const Problem* p, const double* z, const double* y,
+                       Py_ssize_t* changed) noexcept nogil:
+    """Fill ``active`` from the slack ``z`` and multiplier ``y``, the list ``boundary``
+    and each boundary block's multiplier ``lam`` (the component of ``y`` along the
+    plane's normal), plane and curvature at the projection of ``z + y`` onto the cone;
+    return the number of boundary blocks and count in ``changed`` the constrained
+    entries whose code changed."""
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t j, k, o, d, nb = 0
     cdef double v, along, across, slope, phi, lam
     cdef char code
+    changed[0] = 0
     for j in range(p.s):
-        v = it.z[j] + it.y[j]
+        v = z[j] + y[j]
         if p.lo[j] == p.hi[j]:
-            w.active[j] = FIXED
+            code = FIXED
         elif v < p.lo[j]:
-            w.active[j] = LOWER
+            code = LOWER
         elif v > p.hi[j]:
-            w.active[j] = UPPER
+            code = UPPER
         else:
-            w.active[j] = FREE
+            code = FREE
+        if not p.in_cone[j]:
+            changed[0] += code != w.active[j]
+            w.active[j] = code
     for k in range(c.count):
         o, d = c.offset[k], c.dim[k]
         for j in range(o, o + d):
-            w.g[j] = it.z[j] + it.y[j]
+            w.g[j] = z[j] + y[j]
         slope = _slope(c.kind[k], c.mu[k])
         along = _axis(w.g + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
         if across <= slope * along:
@@ -195,23 +210,85 @@ cdef Py_ssize_t _guess(Polish* w, const Problem* p, const Iterates* it) noexcept
             _plane(w.step, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.g + o, &phi)
             lam = 0.0
             for j in range(o, o + d):
-                lam += it.y[j] * w.g[j]
+                lam += y[j] * w.g[j]
             w.lam[nb] = lam
             w.boundary[nb] = k
             _linearize(w, p, nb, w.step)
             nb += 1
         for j in range(o, o + d):
+            changed[0] += code != w.active[j]
             w.active[j] = code
     return nb
 
 
-cdef Py_ssize_t _unknowns(Polish* w, const Problem* p, const Iterates* it) noexcept nogil:
-    """Start from the iterate with the held entries at their values; number the free
-    entries (``index``, ``free``) and return how many there are."""
+cdef Py_ssize_t _renew(Polish* w, const Problem* p, Py_ssize_t* changed) noexcept nogil:
+    """Correct the guess from the polished point: release held entries and boundary
+    blocks whose multiplier has the wrong sign, hold free entries that violate their
+    bound, and put free blocks that left their cone on the boundary (or the apex, if
+    ``x_block`` lies in the polar); an apex block whose multiplier left the polar is
+    reclassified from that multiplier as in :func:`_guess`. Returns the number of
+    boundary blocks (planes and curvature at ``x_block``, or at the projection for a
+    new one) and counts the changed entries in ``changed``."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t j, k, o, d, start, nb = 0, old = 0
+    cdef double value, size, along, across, slope, lam
+    cdef char code, before
+    changed[0] = 0
+    for j in range(p.s):
+        if p.in_cone[j]:
+            continue
+        code = before = w.active[j]
+        value = w.x[p.constrained[j]]
+        if code == LOWER and w.y[j] > 0.0 or code == UPPER and w.y[j] < 0.0:
+            code = FREE
+        elif code == FREE and value < p.lo[j] - _ACTIVE_TOLERANCE * max(1.0, fabs(p.lo[j])):
+            code = LOWER
+        elif code == FREE and value > p.hi[j] + _ACTIVE_TOLERANCE * max(1.0, fabs(p.hi[j])):
+            code = UPPER
+        changed[0] += code != before
+        w.active[j] = code
+    copy(w.lam, w.rhs, c.count)   # the old boundary multipliers, by old position
+    for k in range(c.count):
+        o, d = c.offset[k], c.dim[k]
+        start = p.constrained[o]
+        code = before = w.active[o]
+        lam = 0.0
+        slope = _slope(c.kind[k], c.mu[k])
+        if before == BOUNDARY:
+            lam = w.rhs[old]
+            old += 1
+            if lam < 0.0:
+                code = FREE
+            copy(w.x + start, w.step, d)
+        elif before == FREE:
+            size = 0.0
+            for j in range(d):
+                size += w.x[start + j] * w.x[start + j]
+            along = _axis(w.x + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
+            if across - slope * along > _ACTIVE_TOLERANCE * sqrt(size):
+                code = APEX if slope * across <= -along else BOUNDARY
+                proj_block(w.x + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
+        else:   # APEX: keep while y stays in the polar
+            along = _axis(w.y + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
+            if slope * across > -along:
+                code = FREE if across <= slope * along else BOUNDARY
+                proj_block(w.y + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
+        for j in range(o, o + d):
+            changed[0] += code != before
+            w.active[j] = code
+        if code == BOUNDARY:
+            w.lam[nb] = lam
+            w.boundary[nb] = k
+            _linearize(w, p, nb, w.step)
+            nb += 1
+    return nb
+
+
+cdef Py_ssize_t _unknowns(Polish* w, const Problem* p) noexcept nogil:
+    """Put the held entries of ``x`` at their values; number the free entries
+    (``index``, ``free``) and return how many there are."""
     cdef Py_ssize_t n = p.n, i, j, nf = 0
     cdef char code
-    copy(it.x, w.x, n)
-    copy(it.nu, w.nu, p.m)
     for i in range(n):
         w.index[i] = 0
     for j in range(p.s):
@@ -351,44 +428,79 @@ cdef bint _relinearize(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogi
     return True
 
 
-cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_steps,
-                 int* factorizations) noexcept nogil:
-    """Polish the iterate ``it`` into ``w.x``, ``w.nu``, ``w.y`` (scaled problem) and
-    leave the guess in ``w.active``; ``factorizations`` counts the ``dsytrf`` calls.
-
-    False when a factorization breaks down or the result is not finite; otherwise the
-    caller judges the point.
-    """
-    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, nb, nf, j, k, o, cone
+cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
+                       double scale, int* factorizations) noexcept nogil:
+    """Assemble and factor the KKT matrix of the current active set and planes, and
+    solve it from the current point; False when the factorization breaks down."""
     cdef char uplo = b"L"
-    cdef int size, info = 0
-    cdef long step
+    cdef int size = <int>(nf + p.m + nb), info = 0
+    _assemble(w, p, nf, nb)
+    dsytrf(&uplo, &size, w.K, &size, w.ipiv, w.work, &w.lwork, &info)
+    factorizations[0] += 1
+    if info != 0:
+        return False
+    _solve(w, p, nf, nb, scale)
+    return True
+
+
+cdef void _multipliers(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) noexcept nogil:
+    """``y`` of the current point: minus the Lagrangian's gradient on held entries,
+    ``lam g(x)`` on boundary blocks (stationary to second order in the last Newton
+    step), 0 elsewhere."""
+    cdef Py_ssize_t j, k, o, cone
     cdef char code
-    cdef double total = 0.0, phi
-    cdef double scale = max(1.0, max(inf_norm(p.q, n), inf_norm(p.b, m)))
-    nb = _guess(w, p, it)
-    nf = _unknowns(w, p, it)
-    size = <int>(nf + m + nb)
-    for step in range(newton_steps + 1):
-        if step > 0 and not _relinearize(w, p, nb):
-            break
-        _assemble(w, p, nf, nb)
-        dsytrf(&uplo, &size, w.K, &size, w.ipiv, w.work, &w.lwork, &info)
-        factorizations[0] += 1
-        if info != 0:
-            return False
-        _solve(w, p, nf, nb, scale)
+    cdef double phi
     _residual(w, p, nf, nb)   # grad: the held entries' multipliers, negated
-    for j in range(s):
+    for j in range(p.s):
         code = w.active[j]
         w.y[j] = 0.0 if code == FREE or code == BOUNDARY else -w.grad[p.constrained[j]]
-    for k in range(nb):   # lam g(x): stationary to second order in the last Newton step
+    for k in range(nb):
         cone = w.boundary[k]
         o = p.cones.offset[cone]
         _plane(w.x + p.constrained[o], p.cones.kind[cone], p.cones.dim[cone], p.cones.mu[cone],
                p.cones.normal + 3 * cone, w.g + o, &phi)
         for j in range(o, o + p.cones.dim[cone]):
             w.y[j] = w.lam[k] * w.g[j]
+
+
+cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_steps,
+                 int* factorizations) noexcept nogil:
+    """Polish the iterate ``it`` into ``w.x``, ``w.nu``, ``w.y`` (scaled problem) and
+    leave the final guess in ``w.active``; ``factorizations`` counts the ``dsytrf``
+    calls.
+
+    Each guess is solved once (one Newton step, curvature included) and corrected from
+    the polished point (:func:`_renew`, a primal-dual active-set step), until the guess
+    stops changing or ``GUESS_PASSES`` guesses were solved. On a settled guess the
+    boundary planes are then re-linearized up to ``newton_steps`` times. False when a
+    factorization breaks down or the result is not finite; otherwise the caller judges
+    the point.
+    """
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, nb, nf = 0, j, changed
+    cdef long guess, step
+    cdef double total = 0.0
+    cdef double scale = max(1.0, max(inf_norm(p.q, n), inf_norm(p.b, m)))
+    copy(it.x, w.x, n)
+    copy(it.nu, w.nu, m)
+    for j in range(s):
+        w.active[j] = FREE
+    nb = _guess(w, p, it.z, it.y, &changed)
+    for guess in range(_GUESS_PASSES):
+        if guess > 0:
+            nb = _renew(w, p, &changed)
+            if changed == 0:
+                break
+        nf = _unknowns(w, p)
+        if not _factor_solve(w, p, nf, nb, scale, factorizations):
+            return False
+        _multipliers(w, p, nf, nb)
+    if changed == 0:
+        for step in range(newton_steps):
+            if not _relinearize(w, p, nb):
+                break
+            if not _factor_solve(w, p, nf, nb, scale, factorizations):
+                return False
+        _multipliers(w, p, nf, nb)
     for j in range(n):
         total += w.x[j]
     for j in range(m):
