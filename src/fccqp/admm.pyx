@@ -580,7 +580,7 @@ cdef class Workspace:
                 anderson_step(&self.aa, it, s)
         self.clock[4] = fccqp_now()
         if o.polish and _SOLVED <= status <= _TIME_LIMIT and self._keep_polished(
-                &status, run, iteration, start_time):
+                &status, iteration, start_time):
             run.polished = True   # feasible to the tolerance: nothing to restore
         elif o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
             status = self._keep_restored(status, iteration, reduced, start_time)
@@ -862,8 +862,7 @@ cdef class Workspace:
             self._restore_equalities()
         return status
 
-    cdef bint _keep_polished(self, int* status, Run* run, long iteration,
-                             double start_time) noexcept nogil:
+    cdef bint _keep_polished(self, int* status, long iteration, double start_time) noexcept nogil:
         """Replace the final iterate by its polished version (see :mod:`fccqp.polish`)
         when that passes a KKT check on the user's problem; True if it did.
 
@@ -883,8 +882,8 @@ cdef class Workspace:
         cdef Residuals before = self.res, plain
         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j
         cdef double tol_p, tol_d, tol_g
-        cdef int new_status
-        if not polish(&self.pol, p, it, o.polish_refine_iter, &run.factorizations):
+        cdef int new_status, factorizations = 0   # of polishing's own matrix: not counted
+        if not polish(&self.pol, p, it, o.polish_refine_iter, &factorizations):
             return False
         unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, self.user_x,
                 self.user_y, self.user_z)

@@ -47,7 +47,9 @@ class Result:
     rho: float
     """Final rho (scaled problem)."""
     factorizations: int
-    """KKT factorizations performed during the call."""
+    """Factorizations of the x-update's KKT matrix performed during the call (0 when a
+    warm solve reused it); polishing's factorizations of its own, smaller system are
+    not counted."""
     certificate: np.ndarray | None = None
     """Infeasibility certificate, see the class docstring."""
     backend: str = ""
