@@ -126,7 +126,7 @@ class Settings:
     On by default: on the WBC sets (go2, talos_reduced; 200 warm QPs each) it polished
     92 % and 84 % of the solves, cut go2's p95 torque error against the Clarabel
     reference from 15 to 0.7 Nm and talos' worst relative objective gap from 1.1e-3 to
-    2.6e-5, for 1.2-1.45x the median time (docs/performance.md)."""
+    2.6e-5, for 1.5x (go2) and 1.8x (talos) the median time (docs/performance.md)."""
     polish_refine_iter: int = 10
     """Most re-linearizations of the boundary cones' tangent planes in polishing (Newton
     steps, one factorization each, taken only until the cone function is met to 1e-13;
@@ -189,9 +189,9 @@ class Settings:
         error by -28 % to +16 % across the four robots and cost 12 % of the solve time.
         Ruiz scaling runs 4 passes instead of 10: 20 us less per solve, p95 torque error
         within -9 % to +11 % of 10 passes. Polishing is off: after 15 iterations the
-        active set is often wrong, and on talos_reduced polishing raised the share
-        solved only from 17 % to 40 % at 3.6x the median time (go2: 51 % to 90 % at
-        1.9x), beyond what a control loop can spend.
+        active set is often wrong: on talos_reduced polishing raised the share solved
+        only from 17 % to 40 %, at 4x the median time, and left the worst objective gap
+        at 69 (go2: 51 % to 90 % solved, gap 0.13 to 1.1e-3, at 1.5x the time).
         """
         preset = cls(
             max_iter=15, eps_abs=1e-4, eps_rel=1e-4, warm_start=True, check_termination=5,
