@@ -113,9 +113,17 @@ def test_degenerate_problems_stay_correct(shape):
         verify_solution(problem, result)
 
 
-def test_nothing_to_polish_and_infeasible_problems():
-    P, q = np.eye(3), np.ones(3)
-    assert not fccqp.solve(P, q, polish=True).polished   # no constraint: solved at once
+def test_solves_ended_at_the_start_are_polished_and_infeasible_ones_not():
+    # the cold start's equality-constrained QP carries sigma's bias; polishing removes it
+    P, q = np.diag([1.0, 1e-6, 1e-6]), np.ones(3)
+    plain = fccqp.solve(P, q, polish=False)
+    result = fccqp.solve(P, q, polish=True)
+    assert plain.iterations == result.iterations == 0 and result.polished
+    np.testing.assert_allclose(result.x, -q / np.diag(P), rtol=1e-12)
+    assert np.abs(plain.x + q / np.diag(P)).max() > 1e-6
+    problem = random_problem(0, n_box=0, n_cones=1)   # cone inactive at the start's point
+    result = fccqp.solve(*problem)
+    verify_solution(problem, result)
     P, q, A, b, lb, ub, cones = random_problem(0, n_cones=0)
     lb[5:8], ub[5:8] = 1.0, 2.0
     A = np.vstack([A, np.eye(30)[5]])
