@@ -124,9 +124,9 @@ class Settings:
     or on a tangent plane) and return that point when it passes a KKT check on the
     user's problem; ``Result.polished`` says whether it did. See :mod:`fccqp.polish`.
     On by default: on the WBC sets (go2, talos_reduced; 200 warm QPs each) it polished
-    92 % and 84 % of the solves, cut go2's p95 torque error against the Clarabel
-    reference from 15 to 0.7 Nm and talos' worst relative objective gap from 1.1e-3 to
-    2.6e-5, for 1.5x (go2) and 1.8x (talos) the median time (docs/performance.md)."""
+    99 % of the solves, cut the p95 torque error against the Clarabel reference from 15
+    and 31 Nm to 0.009 and 0.008 Nm and the worst relative objective gap from 4e-5 and
+    1.1e-3 to 9e-9 and 4e-7, for 1.5x and 1.4x the median time (docs/performance.md)."""
     polish_refine_iter: int = 10
     """Most re-linearizations of the boundary cones' tangent planes in polishing (Newton
     steps, one factorization each, taken only until the cone function is met to 1e-13;
@@ -191,7 +191,7 @@ class Settings:
         within -9 % to +11 % of 10 passes. Polishing is off: after 15 iterations the
         active set is often wrong: on talos_reduced polishing raised the share solved
         only from 17 % to 40 %, at 4x the median time, and left the worst objective gap
-        at 69 (go2: 51 % to 90 % solved, gap 0.13 to 1.1e-3, at 1.5x the time).
+        at 69 (go2: 51 % to 90 % solved, gap 0.13 to 1.1e-3, at 1.3x the time).
         """
         preset = cls(
             max_iter=15, eps_abs=1e-4, eps_rel=1e-4, warm_start=True, check_termination=5,
