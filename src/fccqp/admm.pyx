@@ -358,8 +358,9 @@ cdef class Workspace:
     @property
     def phase_times(self):
         """Seconds of the last solve's phases inside the compiled call: validation scan,
-        scaling, start and factorization, iterations, restoration and unscaling (a
-        phase the solve skipped shows 0)."""
+        scaling, start and factorization, iterations (with the polishing tried where
+        ADMM converges before its budget), the final polishing or restoration and the
+        unscaling (a phase the solve skipped shows 0)."""
         cdef int i
         return tuple(max(self.clock[i + 1] - self.clock[i], 0.0) for i in range(5))
 
