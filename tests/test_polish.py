@@ -148,3 +148,23 @@ def test_polish_is_on_by_default_and_off_in_the_realtime_preset():
 def test_polish_settings_are_validated(name, value, error):
     with pytest.raises(error, match=name):
         fccqp.Settings(**{name: value})
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_polished_answers_pass_the_independent_check(seed):
+    # random shapes: boxes, friction and second-order cones, dependent rows, flat costs
+    rng = np.random.default_rng(seed)
+    n_cones, n_box, soc_dim = int(rng.integers(0, 4)), int(rng.integers(0, 8)), 0
+    if rng.random() < 0.3:
+        soc_dim = int(rng.integers(2, 5))
+    m = int(rng.integers(0, 6))
+    problem = random_problem(
+        seed, n=3 * n_cones + soc_dim + n_box + int(rng.integers(5, 30)), m=m,
+        n_cones=n_cones, n_box=n_box, soc_dim=soc_dim,
+        duplicate_rows=min(2, m) if rng.random() < 0.3 else 0,
+        psd_rank=int(rng.integers(1, 5)) if rng.random() < 0.3 else None)
+    for settings in (dict(), dict(max_iter=int(rng.integers(1, 40)))):
+        result = fccqp.solve(*problem, **settings)
+        verify_solution(problem, result)
+        if result.polished and not settings:   # a budget-stopped one may stay inaccurate
+            assert result.status is Status.SOLVED
