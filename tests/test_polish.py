@@ -113,6 +113,13 @@ def test_degenerate_problems_stay_correct(shape):
         verify_solution(problem, result)
 
 
+def test_every_entry_held_leaves_nothing_to_solve():
+    result = fccqp.solve(np.eye(2), np.array([10.0, -10.0]), lb=-np.ones(2), ub=np.ones(2))
+    assert result.polished and result.status is Status.SOLVED
+    np.testing.assert_array_equal(result.x, [-1.0, 1.0])
+    np.testing.assert_allclose(result.z, [-9.0, 9.0], rtol=1e-14)
+
+
 def test_solves_ended_at_the_start_are_polished_and_infeasible_ones_not():
     # the cold start's equality-constrained QP carries sigma's bias; polishing removes it
     P, q = np.diag([1.0, 1e-6, 1e-6]), np.ones(3)

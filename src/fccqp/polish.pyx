@@ -437,6 +437,8 @@ cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t n
     solve it from the current point; False when the factorization breaks down."""
     cdef char uplo = b"L"
     cdef int size = <int>(nf + p.m + nb), info = 0
+    if size == 0:   # every entry held, no rows: nothing to solve
+        return True
     _assemble(w, p, nf, nb)
     dsytrf(&uplo, &size, w.K, &size, w.ipiv, w.work, &w.lwork, &info)
     factorizations[0] += 1
