@@ -604,12 +604,11 @@ cdef class Workspace:
         if (not run.polished and o.polish and _SOLVED <= status <= _TIME_LIMIT
                 and polished_at != iteration):
             run.polished = self._keep_polished(&status, iteration, start_time)
-        if run.polished:
-            pass   # feasible to the tolerance: nothing to restore
-        elif o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
-            status = self._keep_restored(status, iteration, reduced, start_time)
-        elif reduced and status != _NUMERICAL_ERROR:
-            self._restore_equalities()   # certificates are already in cert
+        if not run.polished:   # a polished point is feasible already: nothing to restore
+            if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
+                status = self._keep_restored(status, iteration, reduced, start_time)
+            elif reduced and status != _NUMERICAL_ERROR:
+                self._restore_equalities()   # certificates are already in cert
         self._finish_run(run, status, iteration)
 
     cdef int _check(self, long iteration, bint last, double start_time) noexcept nogil:
