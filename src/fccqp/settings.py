@@ -126,7 +126,7 @@ class Settings:
     On by default: on the WBC sets (go2, talos_reduced; 200 warm QPs each) it polished
     99 % of the solves, cut the p95 torque error against the Clarabel reference from 15
     and 31 Nm to 0.009 and 0.008 Nm and the worst relative objective gap from 4e-5 and
-    1.1e-3 to 9e-9 and 4e-7, for 1.5x and 1.4x the median time (docs/performance.md)."""
+    1.1e-3 to 9e-9 and 4e-7, for 1.5-1.65x the median time (docs/performance.md)."""
     polish_refine_iter: int = 10
     """Most re-linearizations of the boundary cones' tangent planes in polishing (Newton
     steps, one factorization each, taken only until the cone function is met to 1e-13;
@@ -191,7 +191,7 @@ class Settings:
         within -9 % to +11 % of 10 passes. Polishing is off: after 15 iterations the
         active set is often wrong: on talos_reduced polishing raised the share solved
         only from 17 % to 40 %, at 4x the median time, and left the worst objective gap
-        at 69 (go2: 51 % to 90 % solved, gap 0.13 to 1.1e-3, at 1.3x the time).
+        at 69 (go2: 51 % to 90 % solved, gap 0.13 to 1.1e-3, at 1.3-2.1x the time).
         """
         preset = cls(
             max_iter=15, eps_abs=1e-4, eps_rel=1e-4, warm_start=True, check_termination=5,
