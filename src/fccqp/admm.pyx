@@ -38,6 +38,7 @@ from fccqp.anderson cimport Anderson, anderson_reset, anderson_step
 from fccqp.certificates cimport dual_infeasible, equality_inconsistent, primal_infeasible
 from fccqp.kkt cimport (AUTO, FACTORED, KKT, LDL_FULL, LDL_REDUCED, NOT_CONVEX, SCHUR_REDUCED,
                         UNAVAILABLE, kkt_convexity, kkt_factor, kkt_solve)
+from fccqp.polish cimport Polish, multiplier_violation, polish
 from fccqp.projections cimport proj_block, proj_set
 from fccqp.reduced cimport (Reduced, materialize, near_convergence, reduced_rebase,
                             reduced_start, reduced_step, reduced_table)
@@ -115,6 +116,15 @@ STALL_FACTOR, STALLS = 1e3, 2
 """Anderson acceleration stops for the rest of a run when, at ``STALLS`` scheduled checks
 in a row, the primal residual is above ``STALL_FACTOR`` times its tolerance and not half
 of what it was at the previous scheduled check (see _iterate)."""
+POLISH_RETRIES = 2
+"""When ADMM converges but its polished point is rejected, ADMM goes on with 10x tighter
+tolerances and polishes again, at most this many times (the budgets still apply): on
+talos' hardest controller sequence, 13 of 22 cold solves polished at eps 1e-5, 17 at
+1e-6, 21 at 1e-7."""
+POLISH_EXACT = 1e-3
+"""A polished residual counts as no worse than ADMM's when it is below this times its
+tolerance (rounding of an exact solve), and its multipliers may miss their cones by
+this times the dual tolerance."""
 LOG_INTERVAL = 25
 """With ``verbose``, the log keeps one line every this many iterations (as OSQP)."""
 cdef double _INACCURATE_FACTOR = INACCURATE_FACTOR
@@ -122,6 +132,8 @@ cdef double _REDUCED_COST = REDUCED_COST
 cdef double _RHO_MIN = RHO_MIN, _RHO_MAX = RHO_MAX
 cdef double _EQUALITY_START_LIMIT = EQUALITY_START_LIMIT
 cdef double _RESTORED_EQUALITY = RESTORED_EQUALITY
+cdef double _POLISH_EXACT = POLISH_EXACT
+cdef int _POLISH_RETRIES = POLISH_RETRIES
 cdef long _EQUALITY_START_STEPS = EQUALITY_START_STEPS
 cdef long _LOG_INTERVAL = LOG_INTERVAL
 cdef double _STALL_FACTOR = STALL_FACTOR
@@ -132,8 +144,8 @@ cdef struct Options:
     # Settings of fccqp.Settings the kernels read.
     double rho, sigma, alpha, eps_abs, eps_rel, eps_prim_inf, eps_dual_inf
     double time_limit, adaptive_rho_tolerance
-    long max_iter, check_termination, adaptive_rho_interval, scaling
-    bint adaptive_rho, restore_feasibility
+    long max_iter, check_termination, adaptive_rho_interval, scaling, polish_refine_iter
+    bint adaptive_rho, restore_feasibility, polish
     int backend, anderson_memory
 
 
@@ -145,6 +157,7 @@ cdef struct Run:
     int factorizations
     double setup_time
     int backend
+    bint polished
 
 
 cdef class Workspace:
@@ -163,6 +176,7 @@ cdef class Workspace:
     cdef Reduced red
     cdef Anderson aa
     cdef Restoration rest
+    cdef Polish pol
     cdef Options opt
     cdef Residuals res
     cdef Finding found
@@ -191,9 +205,13 @@ cdef class Workspace:
     cdef double* prev_x
     cdef double* prev_y
     cdef double* prev_z
+    cdef double* user_x
+    cdef double* user_y
+    cdef double* user_z
     cdef Py_ssize_t* block_start
     cdef Py_ssize_t log_rows, log_count
     cdef double prev_rho, factored_rho, setup_time
+    cdef double tighten   # factor on the tolerances of the run (see POLISH_RETRIES)
     cdef double clock[6]
     cdef bint has_previous, has_matrices, certified, scaled_once
     cdef int form
@@ -287,6 +305,18 @@ cdef class Workspace:
         rs.positions, rs.entries = <Py_ssize_t*>self._new_int(s), <Py_ssize_t*>self._new_int(s)
         rs.W_T, rs.gram, rs.step = self._new(N * s), self._new(s * s), self._new(s)
         rs.start, rs.point = self._new(N), self._new(N)
+        pol = &self.pol
+        pol.active = <char*>self._new(s)
+        pol.index, pol.free = <Py_ssize_t*>self._new_int(n), <Py_ssize_t*>self._new_int(n)
+        pol.boundary = <Py_ssize_t*>self._new_int(s)
+        pol.g, pol.lam, pol.hess = self._new(s), self._new(s), self._new(s * s)
+        pol.K, pol.ipiv = self._new((N + s) * (N + s)), <int*>self._new_int(N + s)
+        pol.lwork = <int>(64 * (N + s))
+        pol.work = self._new(64 * (N + s))
+        pol.rhs, pol.step = self._new(N + s), self._new(N + s)
+        pol.x, pol.nu, pol.y = self._new(n), self._new(m), self._new(s)
+        pol.grad, pol.ATnu, pol.Ax = self._new(n), self._new(n), self._new(m)
+        self.user_x, self.user_y, self.user_z = self._new(n), self._new(m), self._new(n)
         self.log_rows = log_rows
         self.log = self._new(5 * log_rows)
         o = &self.opt
@@ -298,6 +328,7 @@ cdef class Workspace:
         o.max_iter, o.check_termination = settings.max_iter, settings.check_termination
         o.adaptive_rho_interval, o.scaling = settings.adaptive_rho_interval, settings.scaling
         o.adaptive_rho, o.restore_feasibility = settings.adaptive_rho, settings.restore_feasibility
+        o.polish, o.polish_refine_iter = settings.polish, settings.polish_refine_iter
         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
         self.has_previous = self.has_matrices = self.certified = self.scaled_once = False
         self.factored_rho = -1.0
@@ -333,8 +364,9 @@ cdef class Workspace:
     @property
     def phase_times(self):
         """Seconds of the last solve's phases inside the compiled call: validation scan,
-        scaling, start and factorization, iterations, restoration and unscaling (a
-        phase the solve skipped shows 0)."""
+        scaling, start and factorization, iterations (with the polishing tried where
+        ADMM converges before its budget), the final polishing or restoration and the
+        unscaling (a phase the solve skipped shows 0)."""
         cdef int i
         return tuple(max(self.clock[i + 1] - self.clock[i], 0.0) for i in range(5))
 
@@ -353,7 +385,7 @@ cdef class Workspace:
         ``x0`` (None or a float64 vector) overrides the warm start; ``warm`` asks for a
         start from the previous solution (when there is one). ``cert_out`` (``m + n``
         entries) receives an infeasibility certificate. Returns ``(code, iterations, rho,
-        prim, dual, gap, objective, factorizations, setup_time, backend)``; code
+        prim, dual, gap, objective, factorizations, setup_time, backend, polished)``; code
         ``BAD_DATA`` (see :attr:`finding`) and ``NOT_CONVEX_CODE`` leave the previous
         solution untouched.
         """
@@ -374,7 +406,7 @@ cdef class Workspace:
                 self.ub_user, &same)
         if self.found.code != SCAN_OK:
             self.has_matrices = False
-            return BAD_DATA, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, ""
+            return BAD_DATA, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, "", False
         enter()   # single-threaded BLAS for this solve (see fccqp.blas_threads)
         try:
             with nogil:
@@ -387,10 +419,11 @@ cdef class Workspace:
             leave()
         if run.status == _NOT_CONVEX:
             self.has_matrices = self.has_previous = self.certified = False
-            return NOT_CONVEX_CODE, 0, 0.0, 0.0, 0.0, 0.0, 0.0, run.factorizations, 0.0, ""
+            return (NOT_CONVEX_CODE, 0, 0.0, 0.0, 0.0, 0.0, 0.0, run.factorizations, 0.0, "",
+                    False)
         r = &self.res
         return (run.status, run.iterations, run.rho, r.prim, r.dual, r.gap, r.objective,
-                run.factorizations, run.setup_time, BACKEND_NAMES[run.backend])
+                run.factorizations, run.setup_time, BACKEND_NAMES[run.backend], run.polished)
 
     # ----------------------------------------------------------------- one solve
 
@@ -465,14 +498,16 @@ cdef class Workspace:
         cdef Options* o = &self.opt
         cdef Residuals* r = &self.res
         cdef Py_ssize_t s = p.s, j
-        cdef long iteration = 0
-        cdef int status = _RUNNING, code
+        cdef long iteration = 0, polished_at = -1
+        cdef int status = _RUNNING, code, retries = 0
         cdef bint unbounded_start = False, timed = isfinite(o.time_limit)
         cdef bint reduced, fresh, last, periodic, adapt, check, accelerate
         cdef double eps_p, eps_d, new_rho, periodic_prim
         cdef int stalls
         run.factorizations = 0
         run.backend = self.form
+        run.polished = False
+        self.tighten = 1.0
         if cold or s == 0:
             code = self._equality_start(&unbounded_start)
             run.factorizations += 1
@@ -485,7 +520,10 @@ cdef class Workspace:
             self._finish_run(run, _DUAL_INFEASIBLE, 0)
             return
         if (cold or s == 0) and converged(r, o.eps_abs, o.eps_rel) and not unbounded_start:
-            self._finish_run(run, _SOLVED, 0)
+            status = _SOLVED
+            if o.polish:   # the start carries sigma's bias where the cost is flat
+                run.polished = self._keep_polished(&status, 0, start_time)
+            self._finish_run(run, status, 0)
             return
         if (cold or s == 0) and r.prim_eq > o.eps_abs + o.eps_rel * r.prim_eq_scale and \
                 self._inconsistent():
@@ -494,7 +532,10 @@ cdef class Workspace:
             self._finish_run(run, _PRIMAL_INFEASIBLE, 0)
             return
         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer
-            self._finish_run(run, self._classify(0, False, start_time), 0)
+            status = self._classify(0, False, start_time)
+            if o.polish and _SOLVED <= status <= _TIME_LIMIT:
+                run.polished = self._keep_polished(&status, 0, start_time)
+            self._finish_run(run, status, 0)
             return
         for j in range(s):
             it.rho_vec[j] = run.rho * self.rho_scale[j]
@@ -536,11 +577,18 @@ cdef class Workspace:
                 if reduced:
                     materialize(&self.red, p, it)
                 self._residuals()
-                eps_p = o.eps_abs + o.eps_rel * r.prim_set_scale
-                eps_d = o.eps_abs + o.eps_rel * r.dual_scale
+                eps_p = self.tighten * (o.eps_abs + o.eps_rel * r.prim_set_scale)
+                eps_d = self.tighten * (o.eps_abs + o.eps_rel * r.dual_scale)
                 if iteration % _LOG_INTERVAL == 0:
                     self._log(iteration, run.rho)
                 status = self._check(iteration, last, start_time)
+                if status == _SOLVED and o.polish and not last and retries < _POLISH_RETRIES:
+                    polished_at = iteration
+                    run.polished = self._keep_polished(&status, iteration, start_time)
+                    if not run.polished:   # go on, closer to the active set
+                        retries += 1
+                        self.tighten *= 0.1
+                        status = _RUNNING
                 if status == _RUNNING and periodic and accelerate:
                     # a primal residual that does not halve between two scheduled checks
                     # far from tolerance is how infeasibility looks; Anderson's
@@ -575,10 +623,14 @@ cdef class Workspace:
             if status == _RUNNING and accelerate:
                 anderson_step(&self.aa, it, s)
         self.clock[4] = fccqp_now()
-        if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
-            status = self._keep_restored(status, iteration, reduced, start_time)
-        elif reduced and status != _NUMERICAL_ERROR:
-            self._restore_equalities()   # certificates are already in cert
+        if (not run.polished and o.polish and _SOLVED <= status <= _TIME_LIMIT
+                and polished_at != iteration):
+            run.polished = self._keep_polished(&status, iteration, start_time)
+        if not run.polished:   # a polished point is feasible already: nothing to restore
+            if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
+                status = self._keep_restored(status, iteration, reduced, start_time)
+            elif reduced and status != _NUMERICAL_ERROR:
+                self._restore_equalities()   # certificates are already in cert
         self._finish_run(run, status, iteration)
 
     cdef int _check(self, long iteration, bint last, double start_time) noexcept nogil:
@@ -590,7 +642,7 @@ cdef class Workspace:
         cdef Py_ssize_t i
         if not r.finite:
             return _NUMERICAL_ERROR
-        if converged(r, o.eps_abs, o.eps_rel):
+        if converged(r, self.tighten * o.eps_abs, self.tighten * o.eps_rel):
             return _SOLVED
         if primal_infeasible(p, it, o.eps_prim_inf, self.vec_m, self.vec_s, self.vec_n,
                              self.vec_n2):
@@ -854,6 +906,59 @@ cdef class Workspace:
         if reduced:
             self._restore_equalities()
         return status
+
+    cdef bint _keep_polished(self, int* status, long iteration, double start_time) noexcept nogil:
+        """Replace the final iterate by its polished version (see :mod:`fccqp.polish`)
+        when that passes a KKT check on the user's problem; True if it did.
+
+        The polished point is accepted only when, in the user's units, it is primal
+        feasible within the tolerance (box and exact cones), its multipliers lie in the
+        normal cones its active set needs (:func:`fccqp.polish.multiplier_violation`,
+        within ``POLISH_EXACT`` of the dual tolerance) and its primal and dual
+        residuals and gap are each no worse than the ADMM point's (or below
+        ``POLISH_EXACT`` times their tolerance). Otherwise the iterate and its
+        residuals are left as they were. On acceptance the status is the polished
+        point's when that is solved or inaccurate.
+        """
+        cdef Problem* p = &self.prob
+        cdef Iterates* it = &self.it
+        cdef Options* o = &self.opt
+        cdef Residuals* r = &self.res
+        cdef Residuals before = self.res, plain
+        cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j
+        cdef double tol_p, tol_d, tol_g
+        cdef int new_status, factorizations = 0   # of polishing's own matrix: not counted
+        if not polish(&self.pol, p, it, o.polish_refine_iter, &factorizations):
+            return False
+        unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, self.user_x,
+                self.user_y, self.user_z)
+        self._user_residuals(self.user_x, self.user_y, self.user_z)
+        plain = self.res
+        unscale(self.pol.x, self.pol.nu, self.pol.y, p.D, p.E, p.c, n, m, s, p.constrained,
+                self.user_x, self.user_y, self.user_z)
+        self._user_residuals(self.user_x, self.user_y, self.user_z)
+        tol_p = o.eps_abs + o.eps_rel * r.prim_scale
+        tol_d = o.eps_abs + o.eps_rel * r.dual_scale
+        tol_g = o.eps_abs + o.eps_rel * r.gap_scale
+        if not (r.finite
+                and r.prim_eq <= o.eps_abs + o.eps_rel * r.prim_eq_scale
+                and r.prim_set <= o.eps_abs + o.eps_rel * r.prim_set_scale
+                and multiplier_violation(&self.pol, p, self.user_z) <= _POLISH_EXACT * tol_d
+                and (r.prim <= plain.prim or r.prim <= _POLISH_EXACT * tol_p)
+                and (r.dual <= plain.dual or r.dual <= _POLISH_EXACT * tol_d)
+                and (r.gap <= plain.gap or r.gap <= _POLISH_EXACT * tol_g)):
+            self.res = before
+            return False
+        copy(self.pol.x, it.x, n)
+        copy(self.pol.nu, it.nu, m)
+        copy(self.pol.y, it.y, s)
+        for j in range(s):
+            it.z[j] = it.x[p.constrained[j]]
+        proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
+        new_status = self._classify(iteration, True, start_time)
+        if new_status == _SOLVED or new_status == _INACCURATE:
+            status[0] = new_status
+        return True
 
     # ------------------------------------------------------------- bookkeeping
 

@@ -47,7 +47,9 @@ class Result:
     rho: float
     """Final rho (scaled problem)."""
     factorizations: int
-    """KKT factorizations performed during the call."""
+    """Factorizations of the x-update's KKT matrix performed during the call (0 when a
+    warm solve reused it); polishing's factorizations of its own, smaller system are
+    not counted."""
     certificate: np.ndarray | None = None
     """Infeasibility certificate, see the class docstring."""
     backend: str = ""
@@ -56,3 +58,7 @@ class Result:
     """Duality gap ``|x'Px + q'x + b'y + sigma_C(z)|`` of the returned point, ``sigma_C``
     the support function of the box and cones (see docs/formulation.md); NaN when the
     status is an infeasibility certificate."""
+    polished: bool = False
+    """True when the returned point is the polished one (``Settings.polish``): the
+    exact solution of the QP on the guessed active set, which passed the KKT check on
+    the user's problem; False when polishing was off, failed or was rejected."""

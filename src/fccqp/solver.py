@@ -159,8 +159,8 @@ class Solver:
             structure.cones = flat
         x, y, z, certificate = np.empty(n), np.empty(m), np.empty(n), structure.certificate
         (code, iterations, rho, prim, dual, gap, obj, factorizations, setup_time,
-         backend) = w.solve(P, q, A, b, lb, ub, guess, settings.warm_start, start, x, y, z,
-                            certificate)
+         backend, polished) = w.solve(P, q, A, b, lb, ub, guess, settings.warm_start, start,
+                                      x, y, z, certificate)
         if code == admm.BAD_DATA:
             raise_finding(w.finding, lb, ub)
         if code == admm.NOT_CONVEX_CODE:
@@ -183,6 +183,7 @@ class Solver:
             solve_time=time.perf_counter() - start, rho=rho,
             factorizations=factorizations, certificate=certificate_out,
             gap=float("nan") if status.is_infeasible() else gap, backend=backend,
+            polished=polished,
         )
         if settings.verbose:
             _print_log(w.log_lines, result)

@@ -1,0 +1,37 @@
+# cython: language_level=3
+from fccqp._types cimport Iterates, Problem
+
+cdef enum:
+    # Active-set codes of a constrained entry (Polish.active).
+    FREE = 0        # no constraint imposed
+    LOWER = 1       # box entry held at its lower bound
+    UPPER = 2       # box entry held at its upper bound
+    FIXED = 3       # box entry with lo == hi: held there, its multiplier of either sign
+    APEX = 4        # entry of a cone block held at the apex (the block is 0)
+    BOUNDARY = 5    # entry of a cone block on the cone's tangent plane
+
+cdef struct Polish:
+    # Scratch of the polishing step; N = n + m + s bounds the size of its KKT system.
+    char* active            # s: the guess, one code per constrained entry
+    Py_ssize_t* index       # n: position of x_i among the unknowns, -1 when held fixed
+    Py_ssize_t* free        # n: the entries that are unknowns, ascending
+    Py_ssize_t* boundary    # s: the cone blocks on their boundary
+    double* g               # s: unit normal of each boundary block's tangent plane
+    double* hess            # s x s: a boundary block's curvature term at hess + offset * s
+    double* K               # N x N, Fortran order; the factor after dsytrf
+    int* ipiv               # N
+    double* work            # lwork entries, for dsytrf
+    int lwork
+    double* rhs             # N: residual of the current solution
+    double* step            # N: correction solved from rhs
+    double* lam             # s: multiplier of each boundary block's tangent plane
+    double* x               # n: the polished point (scaled problem)
+    double* nu              # m: its equality multipliers
+    double* y               # s: its constraint multipliers
+    double* grad            # n: scratch, the gradient of the Lagrangian
+    double* ATnu            # n: scratch
+    double* Ax              # m: scratch
+
+cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_steps,
+                 int* factorizations) noexcept nogil
+cdef double multiplier_violation(Polish* w, const Problem* p, const double* z) noexcept nogil

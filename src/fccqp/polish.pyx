@@ -1,0 +1,551 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""Polishing: the exact solution of the QP on the active set that ADMM's iterate suggests.
+
+ADMM reaches high accuracy only slowly where the cost is flat; but its iterate usually
+knows which constraints bind long before it has converged. Polishing (after OSQP's
+``polish.c``, extended to the cones) guesses the active set from the slack ``z`` and
+the multiplier ``y`` of the scaled problem and solves the equality-constrained QP on
+it. The guess is Moreau's decomposition of ``v = z + y`` (OSQP's rule ``z_j - lo_j <
+-y_j`` for a box entry reads ``v_j < lo_j``):
+
+- a box entry is held at ``lo`` when ``v_j < lo_j``, at ``hi`` when ``v_j > hi_j``
+  (always when ``lo == hi``), free otherwise;
+- a cone block is held at the apex (all its entries 0) when ``v`` lies in the polar
+  cone: ``z ~ 0`` and ``y`` inside the polar; it is on the boundary when ``v`` is in
+  neither the cone nor its polar (``z`` on the boundary away from the apex, ``y`` a
+  positive multiple of the outward normal there); it is free when ``v`` lies in the cone.
+
+A boundary block contributes one linear equality, its tangent plane ``g'x_block = 0``,
+which passes through the origin because the cone functions ``phi(f) = ||f - (n'f)n|| -
+mu n'f`` (friction) and ``phi(t, w) = ||w|| - t`` (second order) are positively
+homogeneous: ``g'f = phi(f)`` for ``g`` their gradient at ``f``. Held entries are
+eliminated, so the KKT system of the polished QP
+
+    [ P_FF + delta I   A_F'        G'        ] [x_F]   [-q_F - P_F,H x_H]
+    [ A_F              -delta I              ] [nu ] = [ b - A_H x_H    ]
+    [ G                            -delta I  ] [lam]   [ 0              ]
+
+has the free entries ``F`` of ``x``, the equality multipliers and one multiplier per
+boundary block as unknowns (``G`` holds the unit normals ``g``). It is factored with
+Bunch-Kaufman ``dsytrf`` and refined against the unregularized matrix, as
+:mod:`fccqp.ldl` does. Each boundary block's plane is then re-linearized at the new
+``x_block`` and the system re-solved, ``newton_steps`` times at most or until ``|phi|
+<= NEWTON_TOLERANCE ||x_block||``: Newton's method (SQP) on the KKT conditions of the
+QP on the active manifold, quadratically convergent when the guess is right.
+
+Newton needs the curvature of the constraint: the Hessian of the Lagrangian adds
+``lam H`` on each boundary block, ``H`` the Hessian of the cone function times the
+normalization of ``g`` (for friction ``(I - nn' - ee') / ||t||``, ``e`` the unit
+tangential direction; for second order ``(I - ee') / ||w||`` on ``w``). Homogeneity
+makes ``H x_k = 0`` at the linearization point, so the Newton step is the same
+equality-constrained QP with ``P + lam H`` on the block. Without that term the
+iteration is a fixed point that diverges where ``P`` is flat on the forces and the
+multipliers are large, as in whole-body control (measured on random problems: the
+cone violation grew from 1e-7 to 2e-5 in one re-linearization).
+
+Multipliers, in the sign convention of docs/formulation.md (``P x + q + A'nu + y = 0``,
+``y`` in the normal cone of the set): a held entry's is minus the gradient of the
+Lagrangian there, a boundary block's is ``lam g`` with ``g`` the normal at the final
+``x_block`` (in the polar cone when ``lam >= 0``; to first order ``lam g(x) = lam g_k +
+lam H x``, so the curvature term of the last step is accounted for and stationarity
+holds to second order), a free entry's is 0. Whether the guess was right is decided by
+the caller, on the user's problem (:func:`multiplier_violation` and the residuals of
+:mod:`fccqp.admm`); nothing here tells a wrong guess from a right one.
+"""
+
+from libc.math cimport INFINITY, fabs, isfinite, sqrt
+
+from scipy.linalg.cython_lapack cimport dsytrf, dsytrs
+
+from fccqp._dense cimport copy, inf_norm, matvec, matvec_t
+from fccqp._types cimport FRICTION, Cones, Iterates, Problem
+from fccqp.projections cimport proj_block
+
+DELTA = 1e-12
+"""Regularization of both diagonal blocks of the polishing KKT matrix (scaled problem):
+it exists for dependent rows and a cost that is flat on the free entries; refinement
+against the unregularized matrix removes it."""
+MAX_REFINE = 5
+"""Most refinement steps per solve."""
+REFINE_TOLERANCE = 1e-14
+"""Refine while the KKT residual exceeds this times ``max(1, ||q||, ||b||)`` (scaled)."""
+GUESS_PASSES = 6
+"""Most active sets solved per polish: the first from ADMM's iterate, each next one
+corrected from the previous polished point (:func:`_renew`). On the WBC sets more did
+not help: 8 and 16 polished the same share as 4."""
+ACTIVE_TOLERANCE = 1e-12
+"""A free entry or block joins the active set when it violates by more than this
+(relative to the bound, or to ``||x_block||``)."""
+NEWTON_TOLERANCE = 1e-13
+"""Stop re-linearizing when every boundary block has ``|phi| <= this * ||x_block||``."""
+cdef double _DELTA = DELTA
+cdef int _MAX_REFINE = MAX_REFINE
+cdef double _REFINE_TOLERANCE = REFINE_TOLERANCE
+cdef double _NEWTON_TOLERANCE = NEWTON_TOLERANCE
+cdef int _GUESS_PASSES = GUESS_PASSES
+cdef double _ACTIVE_TOLERANCE = ACTIVE_TOLERANCE
+
+
+cdef inline double _axis(const double* v, Py_ssize_t kind, Py_ssize_t dim, double mu,
+                         const double* normal, double* across) noexcept nogil:
+    """Split a cone block ``v`` into its part along the cone's axis (returned) and the
+    norm of the rest (``across``), with the axis scaled so that the cone reads
+    ``across <= slope * axis`` (slope ``mu`` for friction, 1 for second order)."""
+    cdef double along, t, total = 0.0
+    cdef Py_ssize_t i
+    if kind == FRICTION:
+        along = normal[0] * v[0] + normal[1] * v[1] + normal[2] * v[2]
+        for i in range(3):
+            t = v[i] - along * normal[i]
+            total += t * t
+    else:
+        along = v[0]
+        for i in range(1, dim):
+            total += v[i] * v[i]
+    across[0] = sqrt(total)
+    return along
+
+
+cdef inline double _slope(Py_ssize_t kind, double mu) noexcept nogil:
+    return mu if kind == FRICTION else 1.0
+
+
+cdef bint _plane(const double* v, Py_ssize_t kind, Py_ssize_t dim, double mu,
+                 const double* normal, double* g, double* phi) noexcept nogil:
+    """Unit gradient ``g`` of the cone function at ``v`` and its value ``phi``; False
+    (``g`` untouched) where the gradient does not exist (``v`` on the axis)."""
+    cdef double across, slope = _slope(kind, mu)
+    cdef double along = _axis(v, kind, dim, mu, normal, &across)
+    cdef double unit = 1.0 / sqrt(1.0 + slope * slope)
+    cdef Py_ssize_t i
+    phi[0] = across - slope * along
+    if not across > 0.0:
+        return False
+    if kind == FRICTION:
+        for i in range(3):
+            g[i] = ((v[i] - along * normal[i]) / across - slope * normal[i]) * unit
+    else:
+        g[0] = -unit
+        for i in range(1, dim):
+            g[i] = v[i] / across * unit
+    return True
+
+
+cdef void _curvature(const double* v, Py_ssize_t kind, Py_ssize_t dim, double mu,
+                     const double* normal, double weight, double* H) noexcept nogil:
+    """``H`` (``dim x dim``, symmetric) = ``weight`` times the Hessian of the cone
+    function at ``v`` divided by ``sqrt(1 + slope^2)`` (the normalization of ``g``);
+    0 on the axis, where the Hessian does not exist."""
+    cdef double across, along = _axis(v, kind, dim, mu, normal, &across)
+    cdef double slope = _slope(kind, mu), scale, ea, eb
+    cdef Py_ssize_t a, b
+    for a in range(dim * dim):
+        H[a] = 0.0
+    if not across > 0.0:
+        return
+    scale = weight / (sqrt(1.0 + slope * slope) * across)
+    if kind == FRICTION:
+        for a in range(3):
+            ea = (v[a] - along * normal[a]) / across
+            for b in range(3):
+                eb = (v[b] - along * normal[b]) / across
+                H[a * 3 + b] = scale * ((1.0 if a == b else 0.0) - normal[a] * normal[b]
+                                        - ea * eb)
+    else:
+        for a in range(1, dim):
+            for b in range(1, dim):
+                H[a * dim + b] = scale * ((1.0 if a == b else 0.0)
+                                          - v[a] * v[b] / (across * across))
+
+
+cdef void _linearize(Polish* w, const Problem* p, Py_ssize_t k, const double* v) noexcept nogil:
+    """Plane ``g`` and curvature ``hess`` of boundary block ``k`` (of ``boundary``) at
+    ``v``, with its current multiplier; a block whose ``v`` is on the axis keeps its plane
+    and gets no curvature."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t cone = w.boundary[k], o = c.offset[cone], d = c.dim[cone]
+    cdef double phi
+    _plane(v, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, w.g + o, &phi)
+    _curvature(v, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, w.lam[k],
+               w.hess + o * p.s)
+
+
+cdef Py_ssize_t _guess(Polish* w, const Problem* p, const double* z, const double* y,
+                       Py_ssize_t* changed) noexcept nogil:
+    """Fill ``active`` from the slack ``z`` and multiplier ``y``, the list ``boundary``
+    and each boundary block's multiplier ``lam`` (the component of ``y`` along the
+    plane's normal), plane and curvature at the projection of ``z + y`` onto the cone;
+    return the number of boundary blocks and count in ``changed`` the constrained
+    entries whose code changed."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t j, k, o, d, nb = 0
+    cdef double v, along, across, slope, phi, lam
+    cdef char code
+    changed[0] = 0
+    for j in range(p.s):
+        v = z[j] + y[j]
+        if p.lo[j] == p.hi[j]:
+            code = FIXED
+        elif v < p.lo[j]:
+            code = LOWER
+        elif v > p.hi[j]:
+            code = UPPER
+        else:
+            code = FREE
+        if not p.in_cone[j]:
+            changed[0] += code != w.active[j]
+            w.active[j] = code
+    for k in range(c.count):
+        o, d = c.offset[k], c.dim[k]
+        for j in range(o, o + d):
+            w.g[j] = z[j] + y[j]
+        slope = _slope(c.kind[k], c.mu[k])
+        along = _axis(w.g + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
+        if across <= slope * along:
+            code = FREE
+        elif slope * across <= -along:
+            code = APEX
+        else:   # across > 0 here, so the plane exists
+            code = BOUNDARY
+            proj_block(w.g + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
+            _plane(w.step, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.g + o, &phi)
+            lam = 0.0
+            for j in range(o, o + d):
+                lam += y[j] * w.g[j]
+            w.lam[nb] = lam
+            w.boundary[nb] = k
+            _linearize(w, p, nb, w.step)
+            nb += 1
+        for j in range(o, o + d):
+            changed[0] += code != w.active[j]
+            w.active[j] = code
+    return nb
+
+
+cdef Py_ssize_t _renew(Polish* w, const Problem* p, bint adding,
+                       Py_ssize_t* changed) noexcept nogil:
+    """Correct the guess from the polished point. With ``adding``, hold free entries
+    that violate their bound and put free blocks that left their cone on the boundary
+    (or at the apex, if ``x_block`` lies in the polar); otherwise release held entries
+    and boundary blocks whose multiplier has the wrong sign, and reclassify an apex
+    block whose multiplier left the polar from that multiplier as in :func:`_guess`.
+    Returns the number of boundary blocks (planes and curvature at ``x_block``, or at
+    the projection for a new one) and counts the changed entries in ``changed``."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t j, k, o, d, start, nb = 0, old = 0
+    cdef double value, size, along, across, slope, lam
+    cdef char code, before
+    changed[0] = 0
+    for j in range(p.s):
+        if p.in_cone[j]:
+            continue
+        code = before = w.active[j]
+        value = w.x[p.constrained[j]]
+        if not adding and (code == LOWER and w.y[j] > 0.0 or code == UPPER and w.y[j] < 0.0):
+            code = FREE
+        elif adding and code == FREE:
+            if value < p.lo[j] - _ACTIVE_TOLERANCE * max(1.0, fabs(p.lo[j])):
+                code = LOWER
+            elif value > p.hi[j] + _ACTIVE_TOLERANCE * max(1.0, fabs(p.hi[j])):
+                code = UPPER
+        changed[0] += code != before
+        w.active[j] = code
+    copy(w.lam, w.rhs, c.count)   # the old boundary multipliers, by old position
+    for k in range(c.count):
+        o, d = c.offset[k], c.dim[k]
+        start = p.constrained[o]
+        code = before = w.active[o]
+        lam = 0.0
+        slope = _slope(c.kind[k], c.mu[k])
+        if before == BOUNDARY:
+            lam = w.rhs[old]
+            old += 1
+            if not adding and lam < 0.0:
+                code = FREE
+            copy(w.x + start, w.step, d)
+        elif before == FREE and adding:
+            size = 0.0
+            for j in range(d):
+                size += w.x[start + j] * w.x[start + j]
+            along = _axis(w.x + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
+            if across - slope * along > _ACTIVE_TOLERANCE * sqrt(size):
+                code = APEX if slope * across <= -along else BOUNDARY
+                proj_block(w.x + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
+        elif before == APEX and not adding:   # keep while y stays in the polar
+            along = _axis(w.y + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
+            if slope * across > -along:
+                code = FREE if across <= slope * along else BOUNDARY
+                proj_block(w.y + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
+        for j in range(o, o + d):
+            changed[0] += code != before
+            w.active[j] = code
+        if code == BOUNDARY:
+            w.lam[nb] = lam
+            w.boundary[nb] = k
+            _linearize(w, p, nb, w.step)
+            nb += 1
+    return nb
+
+
+cdef Py_ssize_t _unknowns(Polish* w, const Problem* p) noexcept nogil:
+    """Put the held entries of ``x`` at their values; number the free entries
+    (``index``, ``free``) and return how many there are."""
+    cdef Py_ssize_t n = p.n, i, j, nf = 0
+    cdef char code
+    for i in range(n):
+        w.index[i] = 0
+    for j in range(p.s):
+        code = w.active[j]
+        i = p.constrained[j]
+        if code == LOWER or code == FIXED:
+            w.x[i] = p.lo[j]
+        elif code == UPPER:
+            w.x[i] = p.hi[j]
+        elif code == APEX:
+            w.x[i] = 0.0
+        else:
+            continue
+        w.index[i] = -1
+    for i in range(n):
+        if w.index[i] == 0:
+            w.index[i] = nf
+            w.free[nf] = i
+            nf += 1
+    return nf
+
+
+cdef void _assemble(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) noexcept nogil:
+    """Lower triangle of the regularized KKT matrix of the polished QP into ``K``."""
+    cdef Py_ssize_t n = p.n, m = p.m, N = nf + m + nb, r, col, i, j, k, o, d, start, jc
+    cdef double* K = w.K
+    for col in range(N):
+        for r in range(col, N):
+            K[r + col * N] = 0.0
+    for col in range(nf):
+        jc = w.free[col]
+        for r in range(col, nf):
+            K[r + col * N] = p.P[w.free[r] * n + jc]
+        K[col + col * N] += _DELTA
+        for i in range(m):
+            K[nf + i + col * N] = p.A[i * n + jc]
+    for k in range(nb):
+        o, d = p.cones.offset[w.boundary[k]], p.cones.dim[w.boundary[k]]
+        start = p.constrained[o]
+        for j in range(d):
+            K[nf + m + k + w.index[start + j] * N] = w.g[o + j]
+            for i in range(j, d):   # entries of a block are consecutive unknowns
+                K[w.index[start + i] + w.index[start + j] * N] += w.hess[o * p.s + i * d + j]
+    for r in range(nf, N):
+        K[r + r * N] = -_DELTA
+
+
+cdef double _residual(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) noexcept nogil:
+    """Residual of the current ``(x, nu, lam)`` in the unregularized system (with the
+    curvature terms) into ``rhs``; returns its infinity norm. Leaves the gradient of the
+    Lagrangian without the boundary blocks' terms in ``grad`` (there it is minus the
+    multipliers of the held entries)."""
+    cdef Py_ssize_t n = p.n, m = p.m, i, j, k, o, d, start, cone
+    cdef double value, curved
+    matvec(p.P, w.x, w.grad, n, n)
+    matvec_t(p.A, w.nu, w.ATnu, m, n)
+    for i in range(n):
+        w.grad[i] += p.q[i] + w.ATnu[i]
+    for i in range(nf):
+        w.rhs[i] = -w.grad[w.free[i]]
+    for k in range(nb):
+        cone = w.boundary[k]
+        o = p.cones.offset[cone]
+        start = p.constrained[o]
+        d = p.cones.dim[cone]
+        value = 0.0
+        for j in range(d):
+            curved = 0.0
+            for i in range(d):
+                curved += w.hess[o * p.s + j * d + i] * w.x[start + i]
+            w.rhs[w.index[start + j]] -= w.lam[k] * w.g[o + j] + curved
+            value += w.g[o + j] * w.x[start + j]
+        w.rhs[nf + m + k] = -value
+    matvec(p.A, w.x, w.Ax, m, n)
+    for i in range(m):
+        w.rhs[nf + i] = p.b[i] - w.Ax[i]
+    return inf_norm(w.rhs, nf + m + nb)
+
+
+cdef void _apply(Polish* w, Py_ssize_t nf, Py_ssize_t m, Py_ssize_t nb,
+                 double sign) noexcept nogil:
+    """Add ``sign`` times ``step`` to the unknowns."""
+    cdef Py_ssize_t i
+    for i in range(nf):
+        w.x[w.free[i]] += sign * w.step[i]
+    for i in range(m):
+        w.nu[i] += sign * w.step[nf + i]
+    for i in range(nb):
+        w.lam[i] += sign * w.step[nf + m + i]
+
+
+cdef void _solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
+                 double scale) noexcept nogil:
+    """Correct ``(x, nu, lam)`` to the solution of the factored system: residual
+    corrections against the unregularized matrix until the residual is below
+    ``REFINE_TOLERANCE * scale``, stops halving (a singular system), or ``MAX_REFINE``
+    corrections after the first; a correction that makes it grow is undone."""
+    cdef char uplo = b"L"
+    cdef int size = <int>(nf + p.m + nb), one = 1, info = 0
+    cdef double norm, last = INFINITY
+    cdef int r
+    for r in range(_MAX_REFINE + 2):
+        norm = _residual(w, p, nf, nb)
+        if norm > last:
+            _apply(w, nf, p.m, nb, -1.0)
+            return
+        if norm <= _REFINE_TOLERANCE * scale or norm > 0.5 * last or r == _MAX_REFINE + 1:
+            return
+        last = norm
+        copy(w.rhs, w.step, size)
+        dsytrs(&uplo, &size, &one, w.K, &size, w.ipiv, w.step, &size, &info)
+        _apply(w, nf, p.m, nb, 1.0)
+
+
+cdef bint _relinearize(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
+    """Move each boundary block's plane and curvature to the current ``x_block``,
+    unless every block already meets ``NEWTON_TOLERANCE``: then return False and keep
+    the planes, with which ``(x, lam)`` were solved."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t k, j, cone, start, d
+    cdef double across, along, size
+    cdef bint converged = True
+    for k in range(nb):
+        cone = w.boundary[k]
+        d = c.dim[cone]
+        start = p.constrained[c.offset[cone]]
+        size = 0.0
+        for j in range(d):
+            size += w.x[start + j] * w.x[start + j]
+        along = _axis(w.x + start, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, &across)
+        if fabs(across - _slope(c.kind[cone], c.mu[cone]) * along) > _NEWTON_TOLERANCE * sqrt(size):
+            converged = False
+    if converged:
+        return False
+    for k in range(nb):
+        _linearize(w, p, k, w.x + p.constrained[c.offset[w.boundary[k]]])
+    return True
+
+
+cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
+                       double scale, int* factorizations) noexcept nogil:
+    """Assemble and factor the KKT matrix of the current active set and planes, and
+    solve it from the current point; False when the factorization breaks down."""
+    cdef char uplo = b"L"
+    cdef int size = <int>(nf + p.m + nb), info = 0
+    if size == 0:   # every entry held, no rows: nothing to solve
+        return True
+    _assemble(w, p, nf, nb)
+    dsytrf(&uplo, &size, w.K, &size, w.ipiv, w.work, &w.lwork, &info)
+    factorizations[0] += 1
+    if info != 0:
+        return False
+    _solve(w, p, nf, nb, scale)
+    return True
+
+
+cdef void _multipliers(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) noexcept nogil:
+    """``y`` of the current point: minus the Lagrangian's gradient on held entries,
+    ``lam g(x)`` on boundary blocks (stationary to second order in the last Newton
+    step), 0 elsewhere."""
+    cdef Py_ssize_t j, k, o, cone
+    cdef char code
+    cdef double phi
+    _residual(w, p, nf, nb)   # grad: the held entries' multipliers, negated
+    for j in range(p.s):
+        code = w.active[j]
+        w.y[j] = 0.0 if code == FREE or code == BOUNDARY else -w.grad[p.constrained[j]]
+    for k in range(nb):
+        cone = w.boundary[k]
+        o = p.cones.offset[cone]
+        _plane(w.x + p.constrained[o], p.cones.kind[cone], p.cones.dim[cone], p.cones.mu[cone],
+               p.cones.normal + 3 * cone, w.g + o, &phi)
+        for j in range(o, o + p.cones.dim[cone]):
+            w.y[j] = w.lam[k] * w.g[j]
+
+
+cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_steps,
+                 int* factorizations) noexcept nogil:
+    """Polish the iterate ``it`` into ``w.x``, ``w.nu``, ``w.y`` (scaled problem) and
+    leave the final guess in ``w.active``; ``factorizations`` counts the ``dsytrf``
+    calls.
+
+    Each guess is solved once (one Newton step, curvature included) and corrected from
+    the polished point (:func:`_renew`), until the guess stops changing or
+    ``GUESS_PASSES`` guesses were solved. A correction first only adds the violated
+    constraints; wrong-signed multipliers are released only from a point that violates
+    nothing. Changing both at once (a plain primal-dual active-set step) was measured
+    to diverge on whole-body control, where the cost is flat on the torques and forces:
+    releasing a bound and a cone together sent free torques to 1e3. On a settled guess the
+    boundary planes are then re-linearized up to ``newton_steps`` times. False when a
+    factorization breaks down or the result is not finite; otherwise the caller judges
+    the point.
+    """
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, nb, nf = 0, j, changed
+    cdef long guess, step
+    cdef double total = 0.0
+    cdef double scale = max(1.0, max(inf_norm(p.q, n), inf_norm(p.b, m)))
+    copy(it.x, w.x, n)
+    copy(it.nu, w.nu, m)
+    for j in range(s):
+        w.active[j] = FREE
+    nb = _guess(w, p, it.z, it.y, &changed)
+    for guess in range(_GUESS_PASSES):
+        if guess > 0:
+            nb = _renew(w, p, True, &changed)
+            if changed == 0:
+                nb = _renew(w, p, False, &changed)
+            if changed == 0:
+                break
+        nf = _unknowns(w, p)
+        if not _factor_solve(w, p, nf, nb, scale, factorizations):
+            return False
+        _multipliers(w, p, nf, nb)
+    if changed == 0:
+        for step in range(newton_steps):
+            if not _relinearize(w, p, nb):
+                break
+            if not _factor_solve(w, p, nf, nb, scale, factorizations):
+                return False
+        _multipliers(w, p, nf, nb)
+    for j in range(n):
+        total += w.x[j]
+    for j in range(m):
+        total += w.nu[j]
+    for j in range(s):
+        total += w.y[j]
+    return isfinite(total)
+
+
+cdef double multiplier_violation(Polish* w, const Problem* p, const double* z) noexcept nogil:
+    """How far the multipliers ``z`` (user's units, one per entry of ``x``) of the
+    polished point are from the normal cone its guess needs: the wrong-signed part of a
+    held box entry's (``z <= 0`` at a lower bound, ``>= 0`` at an upper one, either on
+    ``lo == hi``) and, on held or boundary cone blocks, the distance of ``z_block`` to
+    the polar cone (``-z_block`` must lie in the dual cone). The scaling is constant on a
+    cone block, so the cones are those of the scaled problem."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t j, k, o, d, start
+    cdef double worst = 0.0, distance
+    cdef char code
+    for j in range(p.s):
+        code = w.active[j]
+        if code == LOWER:
+            worst = max(worst, z[p.constrained[j]])
+        elif code == UPPER:
+            worst = max(worst, -z[p.constrained[j]])
+    for k in range(c.count):
+        o, d = c.offset[k], c.dim[k]
+        if w.active[o] == FREE:
+            continue
+        start = p.constrained[o]
+        proj_block(z + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
+        distance = 0.0   # ||P_K(z)||: the distance of z to the polar (Moreau)
+        for j in range(d):
+            distance += w.step[j] * w.step[j]
+        worst = max(worst, sqrt(distance))
+    return worst

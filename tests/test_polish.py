@@ -1,0 +1,177 @@
+"""Polishing: the exact solution on ADMM's active set, returned only when it is better."""
+
+import numpy as np
+import pytest
+
+import fccqp
+from fccqp import Status
+from problems import random_problem
+from reference import clarabel_solve
+from verify import Problem, Tolerances, check_solution, verify_solution
+
+BACKENDS = ("schur_reduced", "ldl_reduced", "ldl_full")
+EXACT = Tolerances(eps_abs=1e-10, eps_rel=1e-10, factor=1.0)
+"""The KKT conditions to 1e-10: what a polished answer meets and ADMM at 1e-5 does not."""
+
+
+def _cone_problem(seed):
+    """Friction cones (and a second-order cone on odd seeds) on their boundary and at
+    the apex, and torque-like boxes at their bounds."""
+    return random_problem(seed, n=40, m=6, n_cones=5, n_box=8, soc_dim=4 if seed % 2 else 0)
+
+
+def _block_kinds(problem, x):
+    """How many cone blocks of ``x`` are at the apex and on the boundary."""
+    apex = boundary = 0
+    for block, mu, normal in Problem.of(*problem).blocks():
+        f = x[block]
+        along = normal @ f
+        across = np.linalg.norm(f - along * normal)
+        if np.linalg.norm(f) < 1e-9:
+            apex += 1
+        elif abs(across - mu * along) < 1e-9 * np.linalg.norm(f):
+            boundary += 1
+    return apex, boundary
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("seed", range(4))
+def test_polished_answer_is_exact(seed, backend):
+    problem = P, q, A, b, lb, ub, cones = _cone_problem(seed)
+    plain = fccqp.solve(*problem, kkt_backend=backend, polish=False)
+    result = fccqp.solve(*problem, kkt_backend=backend, polish=True)
+    assert result.polished and not plain.polished
+    assert result.status is plain.status is Status.SOLVED
+    verify_solution(problem, result)
+    verify_solution(problem, plain)
+    # the active set the test is about: boxes at a bound, cones at the apex and boundary
+    box = np.isfinite(lb)
+    assert np.count_nonzero(np.abs(result.z[box]) > 1e-6) >= 5
+    apex, boundary = _block_kinds(problem, result.x)
+    assert boundary >= 2 and apex + boundary >= 4
+    # KKT to 1e-10 on the user's problem; ADMM alone stops at its 1e-5 tolerance
+    assert check_solution(Problem.of(*problem), result, EXACT).passed
+    assert not check_solution(Problem.of(*problem), plain, EXACT).passed
+    assert max(result.prim_res, result.dual_res, result.gap) <= 1e-10
+    # Clarabel at 1e-12 agrees on the objective to its own accuracy; its x is itself
+    # only good to about 1e-6 here (it moves towards ours as its tolerance tightens)
+    reference = clarabel_solve(*problem, tol=1e-12)
+    assert abs(result.obj - reference.obj) <= 1e-10 * abs(reference.obj)
+    assert abs(plain.obj - reference.obj) > 1e-7 * abs(reference.obj)
+    assert np.abs(result.x - reference.x).max() <= 1e-5
+    assert np.abs(plain.x - reference.x).max() > 2e-5
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("seed", [0, 3])
+def test_wrong_guess_keeps_the_admm_point(seed, backend):
+    # two iterations of ADMM do not know the active set: the polished point fails the
+    # check and the (restored) ADMM point is returned unchanged
+    problem = _cone_problem(seed)
+    settings = dict(max_iter=2, kkt_backend=backend)
+    kept = fccqp.solve(*problem, polish=True, **settings)
+    plain = fccqp.solve(*problem, polish=False, **settings)
+    assert not kept.polished
+    assert kept.status is plain.status is Status.MAX_ITER_REACHED
+    for name in ("x", "y", "z"):
+        np.testing.assert_array_equal(getattr(kept, name), getattr(plain, name))
+    assert kept.solve_time > 0
+    verify_solution(problem, kept)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_budget_stopped_solve_is_polished_to_solved(backend):
+    problem = _cone_problem(1)
+    plain = fccqp.solve(*problem, max_iter=15, kkt_backend=backend, polish=False)
+    result = fccqp.solve(*problem, max_iter=15, kkt_backend=backend, polish=True)
+    assert plain.status is Status.MAX_ITER_REACHED
+    assert result.polished and result.status is Status.SOLVED
+    verify_solution(problem, result)
+    assert check_solution(Problem.of(*problem), result, EXACT).passed
+
+
+def test_warm_solver_polishes_a_sequence():
+    P, q, A, b, lb, ub, cones = _cone_problem(2)
+    solver = fccqp.Solver(polish=True)
+    rng = np.random.default_rng(0)
+    for _ in range(5):
+        q_k = q + 0.05 * rng.standard_normal(q.shape)
+        result = solver.solve(P, q_k, A, b, lb, ub, cones)
+        problem = (P, q_k, A, b, lb, ub, cones)
+        assert result.polished and result.status is Status.SOLVED
+        verify_solution(problem, result)
+        assert check_solution(Problem.of(*problem), result, EXACT).passed
+
+
+@pytest.mark.parametrize("shape", [dict(duplicate_rows=3), dict(psd_rank=5), dict(n_cones=0),
+                                   dict(soc_dim=5)])
+def test_degenerate_problems_stay_correct(shape):
+    problem = random_problem(1, **shape)
+    for refine in (0, 3):
+        result = fccqp.solve(*problem, polish=True, polish_refine_iter=refine)
+        assert result.status is Status.SOLVED
+        verify_solution(problem, result)
+
+
+def test_every_entry_held_leaves_nothing_to_solve():
+    result = fccqp.solve(np.eye(2), np.array([10.0, -10.0]), lb=-np.ones(2), ub=np.ones(2))
+    assert result.polished and result.status is Status.SOLVED
+    np.testing.assert_array_equal(result.x, [-1.0, 1.0])
+    np.testing.assert_allclose(result.z, [-9.0, 9.0], rtol=1e-14)
+
+
+def test_solves_ended_at_the_start_are_polished_and_infeasible_ones_not():
+    # the cold start's equality-constrained QP carries sigma's bias; polishing removes it
+    P, q = np.diag([1.0, 1e-6, 1e-6]), np.ones(3)
+    plain = fccqp.solve(P, q, polish=False)
+    result = fccqp.solve(P, q, polish=True)
+    assert plain.iterations == result.iterations == 0 and result.polished
+    np.testing.assert_allclose(result.x, -q / np.diag(P), rtol=1e-12)
+    assert np.abs(plain.x + q / np.diag(P)).max() > 1e-6
+    problem = random_problem(0, n_box=0, n_cones=1)   # cone inactive at the start's point
+    result = fccqp.solve(*problem)
+    verify_solution(problem, result)
+    P, q, A, b, lb, ub, cones = random_problem(0, n_cones=0)
+    lb[5:8], ub[5:8] = 1.0, 2.0
+    A = np.vstack([A, np.eye(30)[5]])
+    b = np.append(b, -1.0)  # x5 = -1 against lb 1
+    result = fccqp.solve(P, q, A, b, lb, ub, cones, polish=True)
+    assert result.status is Status.PRIMAL_INFEASIBLE and not result.polished
+    verify_solution((P, q, A, b, lb, ub, cones), result)
+
+
+def test_polish_is_on_by_default_and_off_in_the_realtime_preset():
+    assert fccqp.Settings().polish is True
+    assert fccqp.Settings.realtime().polish is False
+    assert fccqp.solve(*_cone_problem(0)).polished is True
+    assert fccqp.solve(*_cone_problem(0), polish=False).polished is False
+
+
+@pytest.mark.parametrize(("name", "value", "error"), [
+    ("polish", 1, TypeError), ("polish", None, TypeError),
+    ("polish_refine_iter", -1, ValueError), ("polish_refine_iter", 101, ValueError),
+    ("polish_refine_iter", 1.5, TypeError), ("polish_refine_iter", True, TypeError),
+])
+def test_polish_settings_are_validated(name, value, error):
+    with pytest.raises(error, match=name):
+        fccqp.Settings(**{name: value})
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_polished_answers_pass_the_independent_check(seed):
+    # random shapes: boxes, friction and second-order cones, dependent rows, flat costs
+    rng = np.random.default_rng(seed)
+    n_cones, n_box, soc_dim = int(rng.integers(0, 4)), int(rng.integers(0, 8)), 0
+    if rng.random() < 0.3:
+        soc_dim = int(rng.integers(2, 5))
+    m = int(rng.integers(0, 6))
+    problem = random_problem(
+        seed, n=3 * n_cones + soc_dim + n_box + int(rng.integers(5, 30)), m=m,
+        n_cones=n_cones, n_box=n_box, soc_dim=soc_dim,
+        duplicate_rows=min(2, m) if rng.random() < 0.3 else 0,
+        psd_rank=int(rng.integers(1, 5)) if rng.random() < 0.3 else None)
+    for settings in (dict(), dict(max_iter=int(rng.integers(1, 40)))):
+        result = fccqp.solve(*problem, **settings)
+        verify_solution(problem, result)
+        if result.polished and not settings:   # a budget-stopped one may stay inaccurate
+            assert result.status is Status.SOLVED
