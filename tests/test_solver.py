@@ -263,3 +263,20 @@ def test_verbose_prints_log(capsys):
     fccqp.solve(*random_problem(14), verbose=True)
     out = capsys.readouterr().out
     assert "prim_res" in out and "status: solved" in out
+
+
+def test_changing_friction_coefficients_leave_other_problems_alone():
+    """One warm solver alternating between two friction coefficients on the same blocks,
+    and fresh solves in between: every answer is that of its own problem. (The
+    workspace once kept the memoized cone arrays themselves, so updating its friction
+    coefficients rewrote those of every later solve with the other cones.)"""
+    P, q, A, b, lb, ub, _ = random_problem(0, n_cones=0)
+    problems = [
+        (P, q, A, b, lb, ub, [FrictionCone(6, mu), FrictionCone(9, mu)]) for mu in (0.3, 0.9)
+    ]
+    expected = [fccqp.solve(*problem).x for problem in problems]
+    solver = fccqp.Solver()
+    for _ in range(3):
+        for problem, x in zip(problems, expected, strict=True):
+            np.testing.assert_allclose(solver.solve(*problem).x, x, atol=1e-6)
+            np.testing.assert_allclose(fccqp.solve(*problem).x, x, atol=1e-6)

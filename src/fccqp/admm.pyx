@@ -227,13 +227,15 @@ cdef class Workspace:
         cdef Py_ssize_t k, j
         self._arrays = []
         kind, offset, dim, mu, normal = cones
-        self._keep = (np.ascontiguousarray(constrained, dtype=np.intp),
-                      np.ascontiguousarray(kind, dtype=np.intp),
-                      np.ascontiguousarray(offset, dtype=np.intp),
-                      np.ascontiguousarray(dim, dtype=np.intp),
-                      np.ascontiguousarray(mu, dtype=np.float64),
-                      np.ascontiguousarray(normal, dtype=np.float64).reshape(-1),
-                      np.ascontiguousarray(order, dtype=np.intp),
+        # private copies: update_cones writes into them, and the caller's arrays may be
+        # shared (fccqp.cones memoizes one ConeArrays per distinct set of cones)
+        self._keep = (np.array(constrained, dtype=np.intp),
+                      np.array(kind, dtype=np.intp),
+                      np.array(offset, dtype=np.intp),
+                      np.array(dim, dtype=np.intp),
+                      np.array(mu, dtype=np.float64),
+                      np.array(normal, dtype=np.float64).reshape(-1),
+                      np.array(order, dtype=np.intp),
                       np.zeros(max(len(kind), 1), dtype=np.intp))
         cdef Py_ssize_t[::1] c_view = self._keep[0], kind_v = self._keep[1]
         cdef Py_ssize_t[::1] offset_v = self._keep[2], dim_v = self._keep[3]

@@ -228,4 +228,6 @@ def _flatten(cones: Sequence[Cone], n: int) -> ConeArrays:
                 f"cones[{a}] (x[{offset[a]}:{offset[a] + dim[a]}]) overlaps "
                 f"cones[{b}] (x[{offset[b]}:{offset[b] + dim[b]}])"
             )
+    for array in (kind, offset, dim, mu, normal):
+        array.flags.writeable = False  # memoized and shared: nobody may write into it
     return ConeArrays(kind, offset, dim, mu, normal)
