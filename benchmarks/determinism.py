@@ -44,6 +44,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks import testsets
+from benchmarks.exact_solvers import fccqp_arguments
 from benchmarks.testsets import MIX, TestSet
 
 __all__ = [
@@ -53,7 +54,6 @@ __all__ = [
     "digest",
     "first_difference",
     "main",
-    "problem_arguments",
     "run_sequence",
 ]
 
@@ -70,20 +70,6 @@ def _settings(name: str):
     import fccqp
 
     return fccqp.Settings.realtime() if name == "realtime" else fccqp.Settings()
-
-
-def problem_arguments(qp) -> tuple:
-    """``(P, q, A, b, lb, ub, cones)`` of a :class:`~benchmarks.wbc_qp.WbcQP` for fccqp."""
-    import fccqp
-
-    flat = np.array([0.0, 0.0, 1.0])
-    cones = tuple(
-        fccqp.FrictionCone(
-            int(s), float(mu), None if np.allclose(n, flat) else tuple(map(float, n))
-        )
-        for s, mu, n in zip(qp.cone_starts, qp.mus, qp.normals, strict=True)
-    )
-    return (qp.P, qp.q, qp.A, qp.b, qp.lb, qp.ub, cones)
 
 
 Record = tuple[bytes, bytes, bytes, int, str]
@@ -105,7 +91,7 @@ def run_sequence(test_set: TestSet, settings: str) -> list[Record]:
     import fccqp
 
     solver = fccqp.Solver(_settings(settings))
-    args = [problem_arguments(qp) for qp in test_set.qps]
+    args = [fccqp_arguments(qp) for qp in test_set.qps]
     records, previous = [], None
     for a, seq in zip(args, test_set.sequence, strict=True):
         if previous is not None and seq != previous:
@@ -183,7 +169,7 @@ def allocations(test_set: TestSet, settings: str, top: int = 5) -> Allocations:
     import fccqp
 
     solver = fccqp.Solver(_settings(settings))
-    args = [problem_arguments(qp) for qp in test_set.qps]
+    args = [fccqp_arguments(qp) for qp in test_set.qps]
     previous = None
 
     def solve(i: int):

@@ -109,27 +109,36 @@ cdef bint meets_equalities(const double* Ax, const double* b, const double* row_
     return error <= _REFINE_TOLERANCE * max(1.0, size)
 
 
+cdef void _refine_step(LDL* f, const Problem* p, double sigma, const double* rho_vec,
+                       const double* rhs, double* sol, double delta) noexcept nogil:
+    """One refinement step against the KKT matrix with ``-delta I`` as its (2, 2) block:
+    0 for the true system, ``DELTA`` for the factored one. Needs ``f.Ax = A x`` on entry;
+    leaves the correction in ``f.residual``."""
+    cdef Py_ssize_t n = p.n, m = p.m, i, k
+    cdef double* res = f.residual
+    matvec(p.P, sol, res, n, n)
+    matvec_t(p.A, sol + n, f.ATnu, m, n)
+    for i in range(n):
+        res[i] = rhs[i] - res[i] - sigma * sol[i] - f.ATnu[i]
+    for k in range(p.s):
+        i = p.constrained[k]
+        res[i] -= rho_vec[k] * sol[i]
+    for i in range(m):
+        res[n + i] = rhs[n + i] - f.Ax[i] + delta * sol[n + i]
+    _solve_one(f, res)
+    for i in range(n + m):
+        sol[i] += res[i]
+
+
 cdef void _refine_regularized(LDL* f, const Problem* p, double sigma, const double* rho_vec,
                              const double* rhs, double* sol) noexcept nogil:
     """Two refinement steps against the factored matrix itself (with ``-delta I``): the
     factorization of a matrix with entries 1 and 1e-13 loses digits that refinement
     recovers."""
-    cdef Py_ssize_t n = p.n, m = p.m, i, k, step
-    cdef double* res = f.residual
+    cdef int step
     for step in range(2):
-        matvec(p.P, sol, res, n, n)
-        matvec_t(p.A, sol + n, f.ATnu, m, n)
-        for i in range(n):
-            res[i] = rhs[i] - res[i] - sigma * sol[i] - f.ATnu[i]
-        for k in range(p.s):
-            i = p.constrained[k]
-            res[i] -= rho_vec[k] * sol[i]
-        matvec(p.A, sol, f.Ax, m, n)
-        for i in range(m):
-            res[n + i] = rhs[n + i] - f.Ax[i] + _DELTA * sol[n + i]
-        _solve_one(f, res)
-        for i in range(n + m):
-            sol[i] += res[i]
+        matvec(p.A, sol, f.Ax, p.m, p.n)
+        _refine_step(f, p, sigma, rho_vec, rhs, sol, _DELTA)
 
 
 cdef void ldl_solve(LDL* f, const Problem* p, double sigma, const double* rho_vec,
@@ -168,18 +177,7 @@ cdef void ldl_solve(LDL* f, const Problem* p, double sigma, const double* rho_ve
         last_error = error
         if r == _MAX_REFINE:
             return
-        matvec(p.P, sol, res, n, n)
-        matvec_t(p.A, sol + n, f.ATnu, m, n)
-        for i in range(n):
-            res[i] = rhs[i] - res[i] - sigma * sol[i] - f.ATnu[i]
-        for k in range(p.s):
-            i = p.constrained[k]
-            res[i] -= rho_vec[k] * sol[i]
-        for i in range(m):
-            res[n + i] = rhs[n + i] - f.Ax[i]
-        _solve_one(f, res)
-        for i in range(n + m):
-            sol[i] += res[i]
+        _refine_step(f, p, sigma, rho_vec, rhs, sol, 0.0)
 
 
 cdef bint _in_null_space(const double* AW, const Problem* p, const double* W, int N,
