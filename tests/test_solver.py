@@ -9,7 +9,7 @@ import fccqp
 from fccqp import FrictionCone, SecondOrderCone, Status
 from problems import random_problem
 from reference import clarabel_solve
-from verify import Tolerances, verify_solution
+from verify import Problem, Tolerances, verify_solution
 
 TIGHT = dict(eps_abs=1e-8, eps_rel=1e-8, max_iter=20000)
 TIGHT_TOLERANCES = Tolerances.of(**TIGHT)
@@ -280,3 +280,15 @@ def test_changing_friction_coefficients_leave_other_problems_alone():
         for problem, x in zip(problems, expected, strict=True):
             np.testing.assert_allclose(solver.solve(*problem).x, x, atol=1e-6)
             np.testing.assert_allclose(fccqp.solve(*problem).x, x, atol=1e-6)
+
+
+def test_feasible_problem_with_dependent_rows_is_not_certified_infeasible():
+    """A fuzz case: the dual step drifted along the null space of A' (duplicated rows)
+    with b'dy at the size of what its residual explains, and passed for a certificate
+    of a feasible problem. A certificate must separate by more than (A'dy + dz)'x."""
+    problem = random_problem(593544, n=18, m=2, n_cones=2, n_box=6, duplicate_rows=2,
+                             psd_rank=2)
+    assert clarabel_solve(*problem).status == "solved"
+    result = fccqp.solve(*problem, eps_abs=1e-7, eps_rel=1e-7)
+    assert result.status is Status.SOLVED
+    verify_solution(Problem.of(*problem), result, Tolerances.of(eps_abs=1e-7, eps_rel=1e-7))
