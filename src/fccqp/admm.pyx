@@ -987,7 +987,7 @@ cdef class Workspace:
         ``x_S`` to C), settle the status on them and keep the point for a warm start."""
         cdef Problem* p = &self.prob
         cdef Iterates* it = &self.it
-        cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
+        cdef Py_ssize_t n = p.n, m = p.m, s = p.s
         unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)
         if run.status == _PRIMAL_INFEASIBLE or run.status == _DUAL_INFEASIBLE:
             copy(self.cert, cert, n + m)

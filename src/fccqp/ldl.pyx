@@ -149,7 +149,7 @@ cdef void ldl_solve(LDL* f, const Problem* p, double sigma, const double* rho_ve
     has no solution, and the regularized solution (the least-squares ``x`` up to
     ``delta``) is returned rather than one drifting with the singular system.
     """
-    cdef Py_ssize_t n = p.n, m = p.m, i, k, r
+    cdef Py_ssize_t n = p.n, m = p.m, i, r
     for i in range(n + m):
         sol[i] = rhs[i]
     _solve_one(f, sol)
