@@ -24,6 +24,21 @@ from fccqp._types cimport Iterates, Problem
 from fccqp.projections cimport proj_block
 
 
+cdef inline void _transpose_product(const Problem* p, const double* v, double* out,
+                                    double* terms) noexcept nogil:
+    """``out = A'v`` and ``terms = |A|'|v|``, the size of the products each entry sums."""
+    cdef Py_ssize_t n = p.n, i, j
+    cdef double value
+    for j in range(n):
+        out[j] = 0.0
+        terms[j] = 0.0
+    for i in range(p.m):
+        for j in range(n):
+            value = p.A[i * n + j] * v[i]
+            out[j] += value
+            terms[j] += fabs(value)
+
+
 cdef bint primal_infeasible(const Problem* p, const Iterates* it, double eps, double* d_nu,
                             double* d_y, double* lhs, double* terms) noexcept nogil:
     """Test ``(nu - nu_prev, y - y_prev)``; ``d_nu`` (m), ``d_y`` (s), ``lhs`` and ``terms``
@@ -59,14 +74,7 @@ cdef bint primal_infeasible(const Problem* p, const Iterates* it, double eps, do
         size += fabs(p.b[i] * d_nu[i])
     if not (support < -eps * size) or not isfinite(support):
         return False
-    for i in range(n):
-        lhs[i] = 0.0
-        terms[i] = 0.0
-    for i in range(m):
-        for j in range(n):
-            value = p.A[i * n + j] * d_nu[i]
-            lhs[j] += value
-            terms[j] += fabs(value)
+    _transpose_product(p, d_nu, lhs, terms)
     for j in range(s):
         i = p.constrained[j]
         lhs[i] += d_y[j]
@@ -97,14 +105,7 @@ cdef bint equality_inconsistent(const Problem* p, const Iterates* it, double eps
         size += fabs(p.b[i] * value)
     if not (br > eps * size) or not isfinite(br):
         return False
-    for j in range(n):
-        ATr[j] = 0.0
-        terms[j] = 0.0
-    for i in range(m):
-        for j in range(n):
-            value = p.A[i * n + j] * r[i]
-            ATr[j] += value
-            terms[j] += fabs(value)
+    _transpose_product(p, r, ATr, terms)
     for j in range(n):
         lhs_max = max(lhs_max, fabs(ATr[j]) / p.D[j])
         terms_max = max(terms_max, terms[j] / p.D[j])
