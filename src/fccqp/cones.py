@@ -7,7 +7,7 @@ A cone constrains a contiguous block ``x[start:start + dim]``:
   ``(fx, fy, fz)`` with the normal force last, as in the paper).
 - :class:`SecondOrderCone` -- ``{(t, v) : ||v|| <= t}`` of any dimension ``>= 2``.
 
-The numba kernels never see these objects: :func:`flatten_cones` turns them into
+The compiled kernels never see these objects: :func:`flatten_cones` turns them into
 :class:`ConeArrays`, plain arrays of kinds, offsets, sizes, friction coefficients and
 normals.
 """
@@ -75,7 +75,7 @@ Cone = FrictionCone | SecondOrderCone
 
 @dataclass(frozen=True)
 class ConeArrays:
-    """Flat description of cone blocks for the numba kernels.
+    """Flat description of cone blocks for the compiled kernels.
 
     All arrays have one entry per cone, ``normal`` one row per cone (unused rows of
     second-order cones hold zeros). ``offset`` indexes the vector the cone acts on,

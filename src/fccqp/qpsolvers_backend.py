@@ -49,15 +49,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from fccqp._import_hooks import after_import
-from fccqp.problem import issparse
+from fccqp.problem import ProblemData, issparse, validate
 from fccqp.settings import Settings
 
 if TYPE_CHECKING:
-
     import scipy.sparse as sp
     from qpsolvers import Problem, Solution
 
-    from fccqp.problem import ProblemData
 
 SOLVER_NAME = "fccqp"
 """Name of the solver in qpsolvers' registry."""
@@ -206,10 +204,10 @@ def fccqp_solve_problem(
     """
     from qpsolvers import Solution
 
-    # Imported here, not at module level: `import fccqp` registers this backend and
-    # must not pay for numba (see fccqp/__init__.py).
-    from fccqp.problem import validate
-    from fccqp.solver import Solver
+    # Through the package, not at module level: `import fccqp` registers this backend
+    # and must not load the compiled core, which fccqp.Solver loads on first access
+    # (with scipy's LAPACK tables, see fccqp/__init__.py).
+    from fccqp import Solver
 
     build_start = time.perf_counter()
     problem.check_constraints()
