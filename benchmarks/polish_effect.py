@@ -41,13 +41,15 @@ class Effect:
     objective_gap_max: float
 
 
-def solve_sequence(test_set: TestSet, arguments: list, settings: fccqp.Settings):
-    """Solve the set in order with one warm solver; the results and each call's time."""
+def solve_sequence(test_set: TestSet, arguments: list, settings: fccqp.Settings,
+                   cold: bool = False):
+    """Solve the set in order with one solver, warm along each sequence (``cold``: reset
+    before every QP); the results and each call's time."""
     solver = fccqp.Solver(settings)
     results, times = [], []
     previous = None
     for args, sequence in zip(arguments, test_set.sequence, strict=True):
-        if sequence != previous:
+        if cold or sequence != previous:
             solver.reset()
             previous = sequence
         start = time.perf_counter()

@@ -18,13 +18,13 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import time
 from dataclasses import dataclass
 
 import numpy as np
 
 import fccqp
 from benchmarks.exact_solvers import fccqp_arguments
+from benchmarks.polish_effect import solve_sequence
 from benchmarks.robots import ROBOTS
 from benchmarks.testsets import TestSet, generate_test_set
 
@@ -40,21 +40,6 @@ class Quality:
     torque_error_p95: float
     cost_excess_p95: float
     solved: float
-
-
-def _solve_all(test_set: TestSet, arguments: list, restore: bool, cold: bool):
-    """Solve the set in order; return the results and the time of each call."""
-    solver = fccqp.Solver(fccqp.Settings.realtime(restore_feasibility=restore))
-    results, times = [], []
-    previous_sequence = None
-    for args, sequence in zip(arguments, test_set.sequence, strict=True):
-        if cold or sequence != previous_sequence:
-            solver.reset()
-            previous_sequence = sequence
-        start = time.perf_counter()
-        results.append(solver.solve(*args))
-        times.append(time.perf_counter() - start)
-    return results, times
 
 
 def _quality(test_set: TestSet, results: list) -> Quality:
@@ -102,7 +87,9 @@ def main() -> None:
             quality = {}
             for _ in range(options.passes):
                 for restore in (True, False):
-                    results, times = _solve_all(test_set, arguments, restore, cold)
+                    results, times = solve_sequence(
+                        test_set, arguments,
+                        fccqp.Settings.realtime(restore_feasibility=restore), cold)
                     medians[restore].append(statistics.median(times))
                     quality[restore] = _quality(test_set, results)
             for restore in (True, False):
