@@ -606,22 +606,12 @@ cdef class Workspace:
                 if status == _RUNNING and adapt:
                     new_rho = self._new_rho(run.rho)
                     if new_rho != run.rho:
-                        if reduced:
-                            for j in range(s):
-                                self.vec_s[j] = new_rho * self.rho_scale[j]
-                            reduced_rebase(&self.red, p, it.rho_vec, self.vec_s)
-                        run.rho = new_rho
-                        for j in range(s):
-                            it.rho_vec[j] = run.rho * self.rho_scale[j]
-                        code = self._factor(run, self._budget(iteration))
+                        code = self._change_rho(run, new_rho, iteration, reduced)
                         if code != FACTORED:
                             run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR
                             return
                         reduced = self.form != LDL_FULL
-                        if reduced:
-                            self._reduced_base()
                         fresh = True
-                        anderson_reset(&self.aa, True)
             if status == _RUNNING and accelerate:
                 anderson_step(&self.aa, it, s)
         self.clock[4] = fccqp_now()
@@ -634,6 +624,29 @@ cdef class Workspace:
             elif reduced and status != _NUMERICAL_ERROR:
                 self._restore_equalities()   # certificates are already in cert
         self._finish_run(run, status, iteration)
+
+    cdef int _change_rho(self, Run* run, double new_rho, long iteration,
+                         bint reduced) noexcept nogil:
+        """Refactor for ``new_rho``: carry the reduced form's coordinates into the new
+        table (before the old one is gone), factor, recompute ``base``, forget
+        Anderson's memory. Returns :func:`_factor`'s code."""
+        cdef Problem* p = &self.prob
+        cdef Iterates* it = &self.it
+        cdef Py_ssize_t j
+        cdef int code
+        if reduced:
+            for j in range(p.s):
+                self.vec_s[j] = new_rho * self.rho_scale[j]
+            reduced_rebase(&self.red, p, it.rho_vec, self.vec_s)
+        run.rho = new_rho
+        for j in range(p.s):
+            it.rho_vec[j] = new_rho * self.rho_scale[j]
+        code = self._factor(run, self._budget(iteration))
+        if code == FACTORED:
+            if self.form != LDL_FULL:
+                self._reduced_base()
+            anderson_reset(&self.aa, True)
+        return code
 
     cdef int _check(self, long iteration, bint last, double start_time) noexcept nogil:
         """Termination and infeasibility tests after the residuals of ``iteration``."""
