@@ -214,6 +214,7 @@ cdef class Workspace:
     cdef double tighten   # factor on the tolerances of the run (see POLISH_RETRIES)
     cdef double clock[6]
     cdef bint has_previous, has_matrices, certified, scaled_once
+    cdef bint table_ready   # the reduced table and base hold for this solve's data and rho
     cdef int form
     cdef object _keep
 
@@ -318,6 +319,9 @@ cdef class Workspace:
         pol.rhs, pol.step = self._new(N + s), self._new(N + s)
         pol.x, pol.nu, pol.y = self._new(n), self._new(m), self._new(s)
         pol.grad, pol.ATnu, pol.Ax = self._new(n), self._new(n), self._new(m)
+        pol.T, pol.tpiv = self._new(4 * s * s), <int*>self._new_int(2 * s)
+        pol.tr, pol.du = self._new(2 * s), self._new(2 * s)
+        pol.full, pol.dfull = self._new(N), self._new(N)
         self.user_x, self.user_y, self.user_z = self._new(n), self._new(m), self._new(n)
         self.log_rows = log_rows
         self.log = self._new(5 * log_rows)
@@ -510,6 +514,7 @@ cdef class Workspace:
         run.backend = self.form
         run.polished = False
         self.tighten = 1.0
+        self.table_ready = False   # base is for the previous q, b
         if cold or s == 0:
             code = self._equality_start(&unbounded_start)
             run.factorizations += 1
@@ -546,10 +551,18 @@ cdef class Workspace:
             if code != FACTORED:
                 run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR
                 return
-        self.clock[3] = fccqp_now()
         reduced = self.form != LDL_FULL
         if reduced:
             self._reduced_base()
+        if not cold and o.polish and self._keep_polished(&status, 0, start_time, True):
+            # a warm start carries the previous solution's active set: when it still
+            # holds, the polished point is the answer and ADMM need not run at all
+            run.polished = True
+            self.clock[3] = self.clock[4] = fccqp_now()
+            self._finish_run(run, _SOLVED, 0)
+            return
+        self.clock[3] = fccqp_now()
+        if reduced:
             reduced_start(&self.red, p, it)
         eps_p = o.eps_abs + o.eps_rel * r.prim_set_scale   # the gate tests x_S - z
         eps_d = o.eps_abs + o.eps_rel * r.dual_scale
@@ -783,6 +796,7 @@ cdef class Workspace:
         cdef Problem* p = &self.prob
         cdef int backend, code, first = self.opt.backend
         cdef bint reduced_pays
+        self.table_ready = False
         if first == AUTO:
             reduced_pays = 2 * p.s <= p.n + p.m and _REDUCED_COST * p.s <= budget
             first = SCHUR_REDUCED if reduced_pays else LDL_FULL
@@ -821,6 +835,7 @@ cdef class Workspace:
         for i in range(p.m):
             self.rhs[p.n + i] = p.b[i]
         kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.red.base)
+        self.table_ready = True
 
     cdef int _equality_start(self, bint* unbounded) noexcept nogil:
         """Paper's cold start: ``x`` solves the QP with equalities only, ``z = P_C(x_S)``,
@@ -840,6 +855,7 @@ cdef class Workspace:
         fill(it.rho_vec, 0.0, p.s)
         self.factored_rho = -1.0  # the KKT matrix now holds no rho factorization
         self.form = LDL_FULL
+        self.table_ready = False
         cdef int code = kkt_factor(&self.kkt, p, LDL_FULL, sigma, it.rho_vec)
         if code != FACTORED:
             return NOT_CONVEX
@@ -922,7 +938,8 @@ cdef class Workspace:
             self._restore_equalities()
         return status
 
-    cdef bint _keep_polished(self, int* status, long iteration, double start_time) noexcept nogil:
+    cdef bint _keep_polished(self, int* status, long iteration, double start_time,
+                            bint solved_only=False) noexcept nogil:
         """Replace the final iterate by its polished version (see :mod:`fccqp.polish`)
         when that passes a KKT check on the user's problem; True if it did.
 
@@ -943,7 +960,8 @@ cdef class Workspace:
         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j
         cdef double tol_p, tol_d, tol_g
         cdef int new_status, factorizations = 0   # of polishing's own matrix: not counted
-        if not polish(&self.pol, p, it, o.polish_refine_iter, &factorizations):
+        if not polish(&self.pol, p, it, o.polish_refine_iter, &factorizations,
+                      &self.red if self.table_ready else NULL, &self.kkt, it.rho_vec):
             return False
         unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, self.user_x,
                 self.user_y, self.user_z)
@@ -961,7 +979,8 @@ cdef class Workspace:
                 and multiplier_violation(&self.pol, p, self.user_z) <= _POLISH_EXACT * tol_d
                 and (r.prim <= plain.prim or r.prim <= _POLISH_EXACT * tol_p)
                 and (r.dual <= plain.dual or r.dual <= _POLISH_EXACT * tol_d)
-                and (r.gap <= plain.gap or r.gap <= _POLISH_EXACT * tol_g)):
+                and (r.gap <= plain.gap or r.gap <= _POLISH_EXACT * tol_g)
+                and not (solved_only and self._classify(iteration, True, start_time) != _SOLVED)):
             self.res = before
             return False
         copy(self.pol.x, it.x, n)

@@ -1,5 +1,7 @@
 # cython: language_level=3
 from fccqp._types cimport Iterates, Problem
+from fccqp.kkt cimport KKT
+from fccqp.reduced cimport Reduced
 
 cdef enum:
     # Active-set codes of a constrained entry (Polish.active).
@@ -31,7 +33,15 @@ cdef struct Polish:
     double* grad            # n: scratch, the gradient of the Lagrangian
     double* ATnu            # n: scratch
     double* Ax              # m: scratch
+    # the solve in the reduced form's coordinates (fccqp.polish_table)
+    double* T               # (2 s)^2, Fortran order: its matrix, the LU factor after dgetrf
+    int* tpiv               # 2 s
+    double* tr              # 2 s: residual of the constraints' conditions, then solution
+    double* du              # 2 s: the last correction (du, dlam)
+    double* full            # n + m: residual of the KKT conditions
+    double* dfull           # n + m: the last correction (dx, dnu)
 
 cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_steps,
-                 int* factorizations) noexcept nogil
+                 int* factorizations, const Reduced* table, KKT* kkt,
+                 const double* rho_vec) noexcept nogil
 cdef double multiplier_violation(Polish* w, const Problem* p, const double* z) noexcept nogil

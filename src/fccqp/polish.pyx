@@ -59,7 +59,10 @@ from scipy.linalg.cython_lapack cimport dsytrf, dsytrs
 
 from fccqp._dense cimport copy, inf_norm, matvec, matvec_t
 from fccqp._types cimport FRICTION, Cones, Iterates, Problem
+from fccqp.kkt cimport KKT
+from fccqp.polish_table cimport table_factor_solve
 from fccqp.projections cimport proj_block
+from fccqp.reduced cimport Reduced
 
 DELTA = 1e-12
 """Regularization of both diagonal blocks of the polishing KKT matrix (scaled problem):
@@ -448,6 +451,19 @@ cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t n
     return True
 
 
+cdef bint _solve_guess(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
+                      double scale, int* factorizations, const Reduced* table, KKT* kkt,
+                      const double* rho_vec, bint* tabled) noexcept nogil:
+    """Solve the polished QP of the current guess in the reduced form's coordinates
+    while ``tabled`` (:mod:`fccqp.polish_table`), else with its own KKT matrix; a
+    singular system in the table's coordinates ends ``tabled`` for this polish."""
+    if tabled[0]:
+        if table_factor_solve(w, p, table, kkt, rho_vec, nb, scale):
+            return True
+        tabled[0] = False
+    return _factor_solve(w, p, nf, nb, scale, factorizations)
+
+
 cdef void _multipliers(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) noexcept nogil:
     """``y`` of the current point: minus the Lagrangian's gradient on held entries,
     ``lam g(x)`` on boundary blocks (stationary to second order in the last Newton
@@ -469,7 +485,8 @@ cdef void _multipliers(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
 
 
 cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_steps,
-                 int* factorizations) noexcept nogil:
+                 int* factorizations, const Reduced* table, KKT* kkt,
+                 const double* rho_vec) noexcept nogil:
     """Polish the iterate ``it`` into ``w.x``, ``w.nu``, ``w.y`` (scaled problem) and
     leave the final guess in ``w.active``; ``factorizations`` counts the ``dsytrf``
     calls.
@@ -489,8 +506,10 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     cdef long guess, step
     cdef double total = 0.0
     cdef double scale = max(1.0, max(inf_norm(p.q, n), inf_norm(p.b, m)))
+    cdef bint tabled = table != NULL
     copy(it.x, w.x, n)
     copy(it.nu, w.nu, m)
+    copy(it.y, w.y, s)
     for j in range(s):
         w.active[j] = FREE
     nb = _guess(w, p, it.z, it.y, &changed)
@@ -502,14 +521,14 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
             if changed == 0:
                 break
         nf = _unknowns(w, p)
-        if not _factor_solve(w, p, nf, nb, scale, factorizations):
+        if not _solve_guess(w, p, nf, nb, scale, factorizations, table, kkt, rho_vec, &tabled):
             return False
         _multipliers(w, p, nf, nb)
     if changed == 0:
         for step in range(newton_steps):
             if not _relinearize(w, p, nb):
                 break
-            if not _factor_solve(w, p, nf, nb, scale, factorizations):
+            if not _solve_guess(w, p, nf, nb, scale, factorizations, table, kkt, rho_vec, &tabled):
                 return False
         _multipliers(w, p, nf, nb)
     for j in range(n):

@@ -1,0 +1,216 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""Solve the polished QP of one active set in the reduced form's coordinates.
+
+The reduced iteration keeps a table of the x-update's KKT inverse on the constrained
+entries (:mod:`fccqp.reduced`): ``(x, nu) = base + W u`` solves
+
+    [ P + R   A' ] [x ]   [-q + E_S u]
+    [ A       0  ] [nu] = [ b        ]
+
+so every such point satisfies ``A x = b`` and stationarity ``P x + q + A'nu + E_S y =
+0`` with ``y = R x_S - u``. The polished QP (:mod:`fccqp.polish`) only adds conditions
+on the constrained entries, one per entry plus one per boundary cone block:
+
+- a held entry sits at its value: ``x_j = h_j``;
+- a free entry has no multiplier: ``y_j = 0``;
+- a boundary block ``J`` has ``y_J = lam g + H x_J`` (its plane's normal ``g``, the
+  curvature ``H`` of the Newton step) and lies on the plane: ``g'x_J = 0``.
+
+In the coordinates ``(u, lam)`` that is a square system of ``s + nb`` equations, built
+from the ``s x s`` table ``W_S`` in ``O(s^2)`` and factored with LU (``dgetrf``) in
+``O(s^3)``: no new factorization of the ``(n + m)``-sized KKT matrix, which is what
+the polishing of :mod:`fccqp.polish` pays for every active set and every Newton step
+(on go2, 84 rows and ``s = 24``: a warm polish cost 220 us there, mostly ``dsytrf``).
+The system is solved as corrections of the current point against the residual of the
+polished QP's full, unregularized KKT conditions (each correction one refined KKT
+solve with the factorization ADMM already has, one combination with ``W`` and one
+``dgetrs``), so the table's rounding errors are refined away.
+
+The system is singular exactly when the polished QP's solution or its multipliers are
+not unique (a cost flat on the free entries, active constraints that depend on each
+other); then :func:`table_factor_solve` reports a breakdown and the caller polishes
+with the regularized KKT matrix instead.
+"""
+
+from libc.math cimport INFINITY, fabs
+
+from scipy.linalg.cython_lapack cimport dgetf2, dgetrs
+
+from fccqp._dense cimport colmatvec, fill, inf_norm, matvec, matvec_t
+from fccqp._types cimport Problem
+from fccqp.kkt cimport KKT, kkt_solve
+from fccqp.polish cimport APEX, BOUNDARY, FIXED, FREE, LOWER, UPPER, Polish
+from fccqp.reduced cimport Reduced
+
+PIVOT_RATIO = 1e-13
+"""The LU factor counts as singular when its smallest pivot is below this times its
+largest (the polished QP's solution is then not unique: the caller regularizes)."""
+MAX_REFINE = 5
+"""Most corrections after the first solve."""
+REFINE_TOLERANCE = 1e-14
+"""Refine while the residual exceeds this times ``max(1, ||q||, ||b||)`` (scaled)."""
+cdef double _PIVOT_RATIO = PIVOT_RATIO
+cdef int _MAX_REFINE = MAX_REFINE
+cdef double _REFINE_TOLERANCE = REFINE_TOLERANCE
+
+
+cdef inline double _held_value(const Problem* p, Py_ssize_t j, char code) noexcept nogil:
+    if code == UPPER:
+        return p.hi[j]
+    if code == APEX:
+        return 0.0
+    return p.lo[j]   # LOWER and FIXED
+
+
+cdef inline bint _held(char code) noexcept nogil:
+    return code == LOWER or code == UPPER or code == FIXED or code == APEX
+
+
+cdef void _assemble(Polish* w, const Problem* p, const Reduced* t, const double* rho,
+                    Py_ssize_t nb) noexcept nogil:
+    """The system's matrix ``T`` (column-major, ``s + nb`` square) in the unknowns
+    ``(du, dlam)``; ``dx_S = d0_S + W_S du`` and ``dy = R dx_S - du``."""
+    cdef Py_ssize_t s = p.s, S2 = s + nb, j, l, k, o, d, a, b, cone
+    cdef double* T = w.T
+    cdef const double* WS = t.W_S
+    cdef const double* H
+    cdef double value
+    cdef char code
+    for j in range(S2 * S2):
+        T[j] = 0.0
+    for j in range(s):
+        code = w.active[j]
+        if _held(code):
+            for l in range(s):
+                T[j + l * S2] = WS[j * s + l]
+            continue
+        for l in range(s):
+            T[j + l * S2] = rho[j] * WS[j * s + l]
+        T[j + j * S2] -= 1.0
+    for k in range(nb):
+        cone = w.boundary[k]
+        o, d = p.cones.offset[cone], p.cones.dim[cone]
+        H = w.hess + o * s
+        for a in range(d):
+            j = o + a
+            for l in range(s):
+                value = 0.0
+                for b in range(d):
+                    value += H[a * d + b] * WS[(o + b) * s + l]
+                T[j + l * S2] -= value
+                T[s + k + l * S2] += w.g[j] * WS[j * s + l]
+            T[j + (s + k) * S2] = -w.g[j]
+
+
+cdef double _residual(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
+    """Residual of ``(x, nu, y, lam)`` in the polished QP's conditions: the KKT part
+    ``(-(P x + q + A'nu + E_S y), b - A x)`` into ``full``, the constraints' part into
+    ``tr``; returns the infinity norm of both."""
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j, k, o, d, a, b, start, cone
+    cdef double value, curved
+    cdef const double* H
+    cdef char code
+    matvec(p.P, w.x, w.grad, n, n)
+    matvec_t(p.A, w.nu, w.ATnu, m, n)
+    for i in range(n):
+        w.full[i] = -(w.grad[i] + p.q[i] + w.ATnu[i])
+    for j in range(s):
+        w.full[p.constrained[j]] -= w.y[j]
+    matvec(p.A, w.x, w.Ax, m, n)
+    for i in range(m):
+        w.full[n + i] = p.b[i] - w.Ax[i]
+    for j in range(s):
+        code = w.active[j]
+        if _held(code):
+            w.tr[j] = _held_value(p, j, code) - w.x[p.constrained[j]]
+        else:
+            w.tr[j] = -w.y[j]
+    for k in range(nb):
+        cone = w.boundary[k]
+        o, d = p.cones.offset[cone], p.cones.dim[cone]
+        start = p.constrained[o]
+        H = w.hess + o * s
+        value = 0.0
+        for a in range(d):
+            curved = 0.0
+            for b in range(d):
+                curved += H[a * d + b] * w.x[start + b]
+            w.tr[o + a] += w.lam[k] * w.g[o + a] + curved
+            value += w.g[o + a] * w.x[start + a]
+        w.tr[s + k] = -value
+    return max(inf_norm(w.full, n + m), inf_norm(w.tr, s + nb))
+
+
+cdef void _correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
+                   const double* rho, Py_ssize_t nb, double sign, double tiny) noexcept nogil:
+    """Solve for the correction of the residual in ``full``/``tr`` into ``dfull``
+    (``dx, dnu``) and ``du`` (``du, dlam``) and add ``sign`` times it; with ``sign ==
+    -1`` undo the last one, which ``dfull`` and ``du`` still hold. A KKT part of the
+    residual below ``tiny`` counts as 0 (Newton steps: only the planes moved), which
+    saves the KKT solve."""
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, N = n + m, i, j, k, o, d, a, b, start, cone
+    cdef int size = <int>(s + nb), one = 1, info = 0
+    cdef char trans = b"N"
+    cdef const double* H
+    cdef double value
+    cdef char code
+    if sign > 0.0:
+        if inf_norm(w.full, N) <= tiny:   # the KKT part holds already (Newton steps)
+            fill(w.dfull, 0.0, N)
+        else:
+            kkt_solve(kkt, p, rho, w.full, w.dfull)   # d0 = K_R^-1 (r1, r2)
+        for j in range(s):
+            code = w.active[j]
+            value = w.dfull[p.constrained[j]]
+            w.tr[j] -= value if _held(code) else rho[j] * value
+        for k in range(nb):
+            cone = w.boundary[k]
+            o, d = p.cones.offset[cone], p.cones.dim[cone]
+            start = p.constrained[o]
+            H = w.hess + o * s
+            for a in range(d):
+                for b in range(d):
+                    w.tr[o + a] += H[a * d + b] * w.dfull[start + b]
+                w.tr[s + k] -= w.g[o + a] * w.dfull[start + a]
+        dgetrs(&trans, &size, &one, w.T, &size, w.tpiv, w.tr, &size, &info)
+        for j in range(s + nb):
+            w.du[j] = w.tr[j]
+        colmatvec(t.W, <int>N, w.du, w.dfull, N, s, 1.0)   # dx = d0 + W du
+    for i in range(n):
+        w.x[i] += sign * w.dfull[i]
+    for i in range(m):
+        w.nu[i] += sign * w.dfull[n + i]
+    for j in range(s):   # dy = R dx_S - du
+        w.y[j] += sign * (rho[j] * w.dfull[p.constrained[j]] - w.du[j])
+    for k in range(nb):
+        w.lam[k] += sign * w.du[s + k]
+
+
+cdef bint table_factor_solve(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
+                             const double* rho, Py_ssize_t nb, double scale) noexcept nogil:
+    """Factor the system of the current active set and planes and solve it from the
+    current point, refined until the residual is below ``REFINE_TOLERANCE * scale`` or
+    stops halving; False when the system is singular (see the module's docstring)."""
+    cdef int size = <int>(p.s + nb), info = 0, r
+    cdef Py_ssize_t i
+    cdef double norm, last = INFINITY, big = 0.0, small = INFINITY, pivot
+    _assemble(w, p, t, rho, nb)
+    dgetf2(&size, &size, w.T, &size, w.tpiv, &info)
+    if info != 0:
+        return False
+    for i in range(size):
+        pivot = fabs(w.T[i + i * size])
+        big = max(big, pivot)
+        small = min(small, pivot)
+    if not small > _PIVOT_RATIO * big:
+        return False
+    for r in range(_MAX_REFINE + 2):
+        norm = _residual(w, p, nb)
+        if norm > last:
+            _correct(w, p, t, kkt, rho, nb, -1.0, 0.0)
+            return True
+        if norm <= _REFINE_TOLERANCE * scale or norm > 0.5 * last or r == _MAX_REFINE + 1:
+            return True
+        last = norm
+        _correct(w, p, t, kkt, rho, nb, 1.0, _REFINE_TOLERANCE * scale)
+    return True
