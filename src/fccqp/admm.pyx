@@ -127,6 +127,18 @@ tolerance (rounding of an exact solve), and its multipliers may miss their cones
 this times the dual tolerance."""
 LOG_INTERVAL = 25
 """With ``verbose``, the log keeps one line every this many iterations (as OSQP)."""
+POLISH_GATE = 1e3
+"""A run stopped by a budget is polished only when its residuals are within this factor
+of the tolerances: farther out the iterate's active set is mostly wrong (talos'
+realtime sequences, stopped after 0-30 iterations: 6 guesses changing 14-33 entries
+each, 1 ms, never accepted), and the time is better spent iterating."""
+cdef double _POLISH_GATE = POLISH_GATE
+RESERVE_DECAY = 0.5
+"""Under a time limit the iterations stop when the time left is what the final step
+(polish or restoration, and unscaling) took lately: the largest of its last durations,
+each older one weighted by this factor more (so one slow solve is forgotten within a
+few). At most half the budget is reserved."""
+cdef double _RESERVE_DECAY = RESERVE_DECAY
 cdef double _INACCURATE_FACTOR = INACCURATE_FACTOR
 cdef double _REDUCED_COST = REDUCED_COST
 cdef double _RHO_MIN = RHO_MIN, _RHO_MAX = RHO_MAX
@@ -211,10 +223,13 @@ cdef class Workspace:
     cdef Py_ssize_t* block_start
     cdef Py_ssize_t log_rows, log_count
     cdef double prev_rho, factored_rho, setup_time
+    cdef double final_reserve   # seconds the final polish or restoration took lately
     cdef double tighten   # factor on the tolerances of the run (see POLISH_RETRIES)
     cdef double clock[6]
     cdef bint has_previous, has_matrices, certified, scaled_once
     cdef bint table_ready   # the reduced table and base hold for this solve's data and rho
+    cdef bint iterated      # the last solve ran the iterations (and then its final step)
+    cdef bint prev_polished, start_polished   # the previous solution was polished; this solve starts from it
     cdef int form
     cdef object _keep
 
@@ -337,7 +352,9 @@ cdef class Workspace:
         o.polish, o.polish_refine_iter = settings.polish, settings.polish_refine_iter
         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
         self.has_previous = self.has_matrices = self.certified = self.scaled_once = False
+        self.prev_polished = self.start_polished = False
         self.factored_rho = -1.0
+        self.final_reserve = 0.0
 
     cdef double* _new(self, Py_ssize_t size):
         """A zeroed array of ``size`` doubles (at least one) that lives with ``self``."""
@@ -421,6 +438,9 @@ cdef class Workspace:
                     self._finish(&run, &x_out[0], &y_out[0] if m else NULL, &z_out[0],
                                  &cert_out[0])
                 self.clock[5] = fccqp_now()
+                if self.iterated:   # learn what the final step after the iterations costs
+                    self.final_reserve = max(_RESERVE_DECAY * self.final_reserve,
+                                             self.clock[5] - self.clock[4])
         finally:
             leave()
         if run.status == _NOT_CONVEX:
@@ -449,7 +469,8 @@ cdef class Workspace:
         run.rho = self.prev_rho if warm else self.opt.rho
         if x0 != NULL:
             self._start_from_guess(x0)
-        elif warm:
+        self.start_polished = x0 == NULL and warm and self.prev_polished
+        if x0 == NULL and warm:
             scale_start(self.prev_x, self.prev_y, self.prev_z, self.prev_rho, p.D, p.E, p.c,
                         p.n, p.m, p.s, p.constrained, p.lo, p.hi, p.cones, self.it.x,
                         self.it.nu, self.it.y, self.it.z)
@@ -507,6 +528,8 @@ cdef class Workspace:
         cdef long iteration = 0, polished_at = -1
         cdef int status = _RUNNING, code, retries = 0
         cdef bint unbounded_start = False, timed = isfinite(o.time_limit)
+        # the iterations stop early enough for the final polish or restoration to fit
+        cdef double deadline = o.time_limit - min(self.final_reserve, 0.5 * o.time_limit)
         cdef bint reduced, fresh, last, periodic, adapt, check, accelerate
         cdef double eps_p, eps_d, new_rho, periodic_prim
         cdef int stalls
@@ -515,6 +538,8 @@ cdef class Workspace:
         run.polished = False
         self.tighten = 1.0
         self.table_ready = False   # base is for the previous q, b
+        self.iterated = False
+        self.clock[3] = self.clock[4] = fccqp_now()   # phases skipped show 0
         if cold or s == 0:
             code = self._equality_start(&unbounded_start)
             run.factorizations += 1
@@ -554,9 +579,9 @@ cdef class Workspace:
         reduced = self.form != LDL_FULL
         if reduced:
             self._reduced_base()
-        if not cold and o.polish and self._keep_polished(&status, 0, start_time, True):
-            # a warm start carries the previous solution's active set: when it still
-            # holds, the polished point is the answer and ADMM need not run at all
+        if self.start_polished and o.polish and self._keep_polished(&status, 0, start_time, True):
+            # a warm start from a polished solution carries its active set: when that
+            # still holds, the polished point is the answer and ADMM need not run at all
             run.polished = True
             self.clock[3] = self.clock[4] = fccqp_now()
             self._finish_run(run, _SOLVED, 0)
@@ -571,7 +596,7 @@ cdef class Workspace:
         periodic_prim = INFINITY
         stalls = 0
         fresh = True  # the next step starts a run of KKT solutions: do not relax x
-        if timed and fccqp_now() - start_time >= o.time_limit:
+        if timed and fccqp_now() - start_time >= deadline:
             status = self._classify(0, True, start_time)   # the setup spent the budget
         while status == _RUNNING:
             iteration += 1
@@ -580,7 +605,7 @@ cdef class Workspace:
             else:
                 self._full_step(not fresh)
             fresh = False
-            last = iteration >= o.max_iter or (timed and fccqp_now() - start_time >= o.time_limit)
+            last = iteration >= o.max_iter or (timed and fccqp_now() - start_time >= deadline)
             periodic = iteration % o.adaptive_rho_interval == 0
             adapt = o.adaptive_rho and periodic
             check = iteration % o.check_termination == 0 or last or adapt
@@ -628,8 +653,10 @@ cdef class Workspace:
             if status == _RUNNING and accelerate:
                 anderson_step(&self.aa, it, s)
         self.clock[4] = fccqp_now()
+        self.iterated = True
         if (not run.polished and o.polish and _SOLVED <= status <= _TIME_LIMIT
-                and polished_at != iteration):
+                and polished_at != iteration
+                and nearly_converged(r, o.eps_abs, o.eps_rel, _POLISH_GATE)):
             run.polished = self._keep_polished(&status, iteration, start_time)
         if not run.polished:   # a polished point is feasible already: nothing to restore
             if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
@@ -1040,6 +1067,7 @@ cdef class Workspace:
             copy(y, self.prev_y, m)
             copy(z, self.prev_z, n)
             self.prev_rho = run.rho
+        self.prev_polished = self.has_previous and run.polished
 
     cdef void _user_residuals(self, const double* x, const double* y,
                               const double* z) noexcept nogil:

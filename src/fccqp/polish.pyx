@@ -60,7 +60,7 @@ from scipy.linalg.cython_lapack cimport dsytrf, dsytrs
 from fccqp._dense cimport copy, inf_norm, matvec, matvec_t
 from fccqp._types cimport FRICTION, Cones, Iterates, Problem
 from fccqp.kkt cimport KKT
-from fccqp.polish_table cimport table_factor_solve
+from fccqp.polish_table cimport table_factor, table_solve
 from fccqp.projections cimport proj_block
 from fccqp.reduced cimport Reduced
 
@@ -81,6 +81,11 @@ ACTIVE_TOLERANCE = 1e-12
 (relative to the bound, or to ``||x_block||``)."""
 NEWTON_TOLERANCE = 1e-13
 """Stop re-linearizing when every boundary block has ``|phi| <= this * ||x_block||``."""
+CHORD_RATE = 0.25
+"""In the table's coordinates a Newton step reuses the last LU factor (a chord step)
+while the cones' miss ``|phi| / ||x_block||`` keeps shrinking by this factor per step,
+and refactors at the current planes otherwise."""
+cdef double _CHORD_RATE = CHORD_RATE
 cdef double _DELTA = DELTA
 cdef int _MAX_REFINE = MAX_REFINE
 cdef double _REFINE_TOLERANCE = REFINE_TOLERANCE
@@ -409,14 +414,17 @@ cdef void _solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
         _apply(w, nf, p.m, nb, 1.0)
 
 
-cdef bint _relinearize(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
+cdef bint _relinearize(Polish* w, const Problem* p, Py_ssize_t nb,
+                       double* worst) noexcept nogil:
     """Move each boundary block's plane and curvature to the current ``x_block``,
     unless every block already meets ``NEWTON_TOLERANCE``: then return False and keep
-    the planes, with which ``(x, lam)`` were solved."""
+    the planes, with which ``(x, lam)`` were solved. ``worst`` receives the largest
+    ``|phi| / ||x_block||``."""
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t k, j, cone, start, d
-    cdef double across, along, size
+    cdef double across, along, size, miss
     cdef bint converged = True
+    worst[0] = 0.0
     for k in range(nb):
         cone = w.boundary[k]
         d = c.dim[cone]
@@ -425,8 +433,10 @@ cdef bint _relinearize(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogi
         for j in range(d):
             size += w.x[start + j] * w.x[start + j]
         along = _axis(w.x + start, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, &across)
-        if fabs(across - _slope(c.kind[cone], c.mu[cone]) * along) > _NEWTON_TOLERANCE * sqrt(size):
+        miss = fabs(across - _slope(c.kind[cone], c.mu[cone]) * along)
+        if miss > _NEWTON_TOLERANCE * sqrt(size):
             converged = False
+            worst[0] = max(worst[0], miss / sqrt(size))
     if converged:
         return False
     for k in range(nb):
@@ -458,7 +468,8 @@ cdef bint _solve_guess(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
     while ``tabled`` (:mod:`fccqp.polish_table`), else with its own KKT matrix; a
     singular system in the table's coordinates ends ``tabled`` for this polish."""
     if tabled[0]:
-        if table_factor_solve(w, p, table, kkt, rho_vec, nb, scale):
+        if table_factor(w, p, table, rho_vec, nb):
+            table_solve(w, p, table, kkt, rho_vec, nb, scale)
             return True
         tabled[0] = False
     return _factor_solve(w, p, nf, nb, scale, factorizations)
@@ -507,6 +518,9 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     cdef double total = 0.0
     cdef double scale = max(1.0, max(inf_norm(p.q, n), inf_norm(p.b, m)))
     cdef bint tabled = table != NULL
+    w.kkt_floor = 0.0
+    cdef double miss, last_miss = INFINITY
+    cdef bint refactored = False
     copy(it.x, w.x, n)
     copy(it.nu, w.nu, m)
     copy(it.y, w.y, s)
@@ -526,10 +540,15 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         _multipliers(w, p, nf, nb)
     if changed == 0:
         for step in range(newton_steps):
-            if not _relinearize(w, p, nb):
-                break
-            if not _solve_guess(w, p, nf, nb, scale, factorizations, table, kkt, rho_vec, &tabled):
+            if not _relinearize(w, p, nb, &miss) or (refactored and miss >= last_miss):
+                break   # converged, or at the floor that rounding leaves
+            refactored = not (tabled and miss <= _CHORD_RATE * last_miss)
+            if not refactored:
+                table_solve(w, p, table, kkt, rho_vec, nb, scale)   # a chord step
+            elif not _solve_guess(w, p, nf, nb, scale, factorizations, table, kkt, rho_vec,
+                                  &tabled):
                 return False
+            last_miss = miss
         _multipliers(w, p, nf, nb)
     for j in range(n):
         total += w.x[j]

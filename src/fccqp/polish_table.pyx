@@ -49,6 +49,15 @@ MAX_REFINE = 5
 """Most corrections after the first solve."""
 REFINE_TOLERANCE = 1e-14
 """Refine while the residual exceeds this times ``max(1, ||q||, ||b||)`` (scaled)."""
+MINOR_PART = 1e-2
+"""A correction skips the KKT solve when the KKT conditions' residual is below this
+times the constraints' (after a Newton step only the planes moved): the next correction
+takes it up if it matters."""
+FLOOR_FACTOR = 2.0
+"""See :func:`_correct`: a KKT solve is worth it only when the KKT part grew this much
+above the residual the last one left."""
+cdef double _MINOR_PART = MINOR_PART
+cdef double _FLOOR_FACTOR = FLOOR_FACTOR
 cdef double _PIVOT_RATIO = PIVOT_RATIO
 cdef int _MAX_REFINE = MAX_REFINE
 cdef double _REFINE_TOLERANCE = REFINE_TOLERANCE
@@ -138,7 +147,8 @@ cdef double _residual(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil
             w.tr[o + a] += w.lam[k] * w.g[o + a] + curved
             value += w.g[o + a] * w.x[start + a]
         w.tr[s + k] = -value
-    return max(inf_norm(w.full, n + m), inf_norm(w.tr, s + nb))
+    w.kkt_norm = inf_norm(w.full, n + m)
+    return max(w.kkt_norm, inf_norm(w.tr, s + nb))
 
 
 cdef void _correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
@@ -146,8 +156,9 @@ cdef void _correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
     """Solve for the correction of the residual in ``full``/``tr`` into ``dfull``
     (``dx, dnu``) and ``du`` (``du, dlam``) and add ``sign`` times it; with ``sign ==
     -1`` undo the last one, which ``dfull`` and ``du`` still hold. A KKT part of the
-    residual below ``tiny`` counts as 0 (Newton steps: only the planes moved), which
-    saves the KKT solve."""
+    residual below ``tiny``, below ``MINOR_PART`` times the constraints' part, or within
+    ``FLOOR_FACTOR`` of what the last KKT solve left (its rounding floor) counts as 0
+    for this correction, which saves the KKT solve."""
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, N = n + m, i, j, k, o, d, a, b, start, cone
     cdef int size = <int>(s + nb), one = 1, info = 0
     cdef char trans = b"N"
@@ -155,10 +166,12 @@ cdef void _correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
     cdef double value
     cdef char code
     if sign > 0.0:
-        if inf_norm(w.full, N) <= tiny:   # the KKT part holds already (Newton steps)
-            fill(w.dfull, 0.0, N)
-        else:
+        w.kkt_solved = w.kkt_norm > max(tiny, _MINOR_PART * inf_norm(w.tr, s + nb),
+                                        _FLOOR_FACTOR * w.kkt_floor)
+        if w.kkt_solved:
             kkt_solve(kkt, p, rho, w.full, w.dfull)   # d0 = K_R^-1 (r1, r2)
+        else:   # the KKT part holds already, is minor, or is at its rounding floor
+            fill(w.dfull, 0.0, N)
         for j in range(s):
             code = w.active[j]
             value = w.dfull[p.constrained[j]]
@@ -186,14 +199,13 @@ cdef void _correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
         w.lam[k] += sign * w.du[s + k]
 
 
-cdef bint table_factor_solve(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
-                             const double* rho, Py_ssize_t nb, double scale) noexcept nogil:
-    """Factor the system of the current active set and planes and solve it from the
-    current point, refined until the residual is below ``REFINE_TOLERANCE * scale`` or
-    stops halving; False when the system is singular (see the module's docstring)."""
-    cdef int size = <int>(p.s + nb), info = 0, r
+cdef bint table_factor(Polish* w, const Problem* p, const Reduced* t, const double* rho,
+                       Py_ssize_t nb) noexcept nogil:
+    """Assemble and LU-factor the system of the current active set and planes; False
+    when it is singular (see the module's docstring)."""
+    cdef int size = <int>(p.s + nb), info = 0
     cdef Py_ssize_t i
-    cdef double norm, last = INFINITY, big = 0.0, small = INFINITY, pivot
+    cdef double big = 0.0, small = INFINITY, pivot
     _assemble(w, p, t, rho, nb)
     dgetf2(&size, &size, w.T, &size, w.tpiv, &info)
     if info != 0:
@@ -202,15 +214,27 @@ cdef bint table_factor_solve(Polish* w, const Problem* p, const Reduced* t, KKT*
         pivot = fabs(w.T[i + i * size])
         big = max(big, pivot)
         small = min(small, pivot)
-    if not small > _PIVOT_RATIO * big:
-        return False
+    return small > _PIVOT_RATIO * big
+
+
+cdef void table_solve(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
+                      const double* rho, Py_ssize_t nb, double scale) noexcept nogil:
+    """Correct the current point with the last factor until the residual is below
+    ``REFINE_TOLERANCE * scale`` or stops halving (a correction that makes it grow is
+    undone). With the factor of the current planes this solves the polished QP; after
+    the planes moved (:func:`fccqp.polish._relinearize`) it is a chord step of Newton's
+    method, the Jacobian of the earlier planes standing in for the current one."""
+    cdef double norm, last = INFINITY
+    cdef int r
+    w.kkt_solved = False
     for r in range(_MAX_REFINE + 2):
         norm = _residual(w, p, nb)
+        if w.kkt_solved:
+            w.kkt_floor = w.kkt_norm
         if norm > last:
             _correct(w, p, t, kkt, rho, nb, -1.0, 0.0)
-            return True
+            return
         if norm <= _REFINE_TOLERANCE * scale or norm > 0.5 * last or r == _MAX_REFINE + 1:
-            return True
+            return
         last = norm
         _correct(w, p, t, kkt, rho, nb, 1.0, _REFINE_TOLERANCE * scale)
-    return True

@@ -19,6 +19,9 @@ MAX_POLISH_REFINE_ITER = 100
 """Most re-linearizations of polishing: each costs one factorization; Newton's method
 on the cones' tangent planes converges in 1-3 when the active set is right."""
 
+REALTIME_BUDGET = 1e-3
+"""Default budget of :meth:`Settings.realtime` in seconds: one tick of a 1 kHz loop."""
+
 _REAL_RANGES = {
     # name: (low, high, low excluded, high excluded)
     "rho": (0.0, math.inf, True, True),
@@ -176,25 +179,21 @@ class Settings:
         return dataclasses.replace(self, **overrides)
 
     @classmethod
-    def realtime(cls, **overrides: object) -> Settings:
-        """Preset for control loops: warm start, a 15-iteration budget, loose tolerance.
+    def realtime(cls, budget: float = REALTIME_BUDGET, **overrides: object) -> Settings:
+        """Preset for control loops: a time budget per solve, warm start, polishing.
 
-        The paper ran 15 iterations at ``rho = 5e-5`` and ``eps = 1e-4`` on Cassie.
-        Here rho applies to the scaled problem and only to constrained entries; a sweep
-        over ``rho`` in 0.1-10 on the whole-body-control test sets in ``benchmarks/``
-        found no value better than the default 0.1 on every robot (see
-        ``docs/performance.md``). Residuals are checked every 5 iterations (each check
-        costs about half a KKT solve), so a solve ends after 5, 10 or 15 iterations.
-        Anderson acceleration is off: within 15 iterations it changed the p95 torque
-        error by -28 % to +16 % across the four robots and cost 12 % of the solve time.
-        Ruiz scaling runs 4 passes instead of 10: 20 us less per solve, p95 torque error
-        within -9 % to +11 % of 10 passes. Polishing is off: after 15 iterations the
-        active set is often wrong: on talos_reduced polishing raised the share solved
-        only from 17 % to 40 %, at 4x the median time, and left the worst objective gap
-        at 69 (go2: 51 % to 90 % solved, gap 0.13 to 1.1e-3, at 1.3-2.1x the time).
+        A controller has a deadline, not an iteration count: each solve returns within
+        ``budget`` seconds (setup included; see :attr:`time_limit`) the best point it
+        found, with ``A x = b`` exact. A warm start from a polished solution first
+        polishes the previous active set (one small LU, no iteration): in a control loop
+        that is the answer most ticks. Otherwise ADMM runs, polishing when it meets the
+        tolerance, and stops early enough to polish or restore within the budget.
+        Tolerances 1e-4 (the paper's) and 4 Ruiz passes instead of 10 (20 us less per
+        solve). The default budget, :data:`REALTIME_BUDGET`, is a 1 kHz control tick;
+        the figures per robot are in docs/performance.md.
         """
         preset = cls(
-            max_iter=15, eps_abs=1e-4, eps_rel=1e-4, warm_start=True, check_termination=5,
-            anderson_memory=0, scaling=4, polish=False,
+            time_limit=budget, eps_abs=1e-4, eps_rel=1e-4, warm_start=True, scaling=4,
+            polish=True,
         )
         return preset.replace(**overrides)
