@@ -1,8 +1,9 @@
 """Independent reference solutions for the tests.
 
 :func:`clarabel_solve` solves the same problem with Clarabel (an interior-point
-solver with exact second-order cones) at tight tolerance. Checks of a returned point
-live in :mod:`verify`.
+solver with exact second-order cones) at tight tolerance, on :func:`clarabel_form`:
+the problem in Clarabel's conic form, which also maps Clarabel's duals back to fccqp's
+convention. Checks of a returned point live in :mod:`verify`.
 """
 
 from __future__ import annotations
@@ -31,8 +32,42 @@ def tangent_basis(normal: np.ndarray) -> np.ndarray:
     return np.vstack([t1, np.cross(normal, t1)])
 
 
-def clarabel_solve(P, q, A=None, b=None, lb=None, ub=None, cones=(), tol=1e-10) -> Reference:
-    """Solve the fccqp problem with Clarabel; return its status and solution."""
+@dataclass(frozen=True)
+class ClarabelForm:
+    """An fccqp problem as Clarabel's ``min 1/2 x'Px + q'x  s.t.  A x + s = b, s in K``.
+
+    The rows of ``A`` are the equalities (zero cone), then one row per finite bound
+    (``-x_i + s = -lb_i``, ``x_i + s = ub_i``, nonnegative cone), then each cone block
+    as ``-B x + s = 0`` with ``s`` in a second-order cone (``B`` the identity on a
+    second-order block, ``[mu n'; tangent basis]`` on a friction block).
+    """
+
+    P: sp.csc_matrix
+    """Upper triangle of ``P``."""
+    q: np.ndarray
+    A: sp.csc_matrix
+    b: np.ndarray
+    cones: list
+    """Clarabel's cone list, in row order."""
+    equalities: int
+    """Number of equality rows, which come first."""
+
+    def duals(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Clarabel's dual ``z`` as fccqp's ``(y, z)``.
+
+        Clarabel's stationarity ``P x + q + A'z = 0`` is fccqp's ``P x + q + A_eq'y +
+        z_fccqp = 0`` with ``y`` the equality rows' part and ``z_fccqp`` the other rows'
+        part mapped back through their ``A`` rows; a lower bound row (``-e_i``) then gives
+        ``z_i <= 0``, an upper one ``z_i >= 0``, and on a cone block ``-z_block = B'z_c``
+        lies in the dual cone because ``z_c`` lies in the (self-dual) second-order cone.
+        """
+        z = np.asarray(z, float)
+        m = self.equalities
+        return z[:m].copy(), np.asarray(self.A[m:].T @ z[m:]).reshape(-1)
+
+
+def clarabel_form(P, q, A=None, b=None, lb=None, ub=None, cones=()) -> ClarabelForm:
+    """The fccqp problem in Clarabel's form (see :class:`ClarabelForm`)."""
     P = np.asarray(P, float)
     n = P.shape[0]
     rows, rhs, kinds = [], [], []
@@ -40,6 +75,7 @@ def clarabel_solve(P, q, A=None, b=None, lb=None, ub=None, cones=(), tol=1e-10) 
         rows.append(np.asarray(A, float))
         rhs.append(np.asarray(b, float))
         kinds.append(clarabel.ZeroConeT(np.shape(A)[0]))
+    equalities = sum(r.shape[0] for r in rows)
     eye = np.eye(n)
     box_rows, box_rhs = [], []
     for i in range(n):
@@ -68,14 +104,19 @@ def clarabel_solve(P, q, A=None, b=None, lb=None, ub=None, cones=(), tol=1e-10) 
         kinds.append(clarabel.SecondOrderConeT(int(d)))
     if not rows:
         rows, rhs = [np.zeros((0, n))], [np.zeros(0)]
+    return ClarabelForm(sp.csc_matrix(np.triu(P)), np.asarray(q, float),
+                        sp.csc_matrix(np.vstack(rows)), np.concatenate(rhs), kinds, equalities)
+
+
+def clarabel_solve(P, q, A=None, b=None, lb=None, ub=None, cones=(), tol=1e-10) -> Reference:
+    """Solve the fccqp problem with Clarabel; return its status and solution."""
+    P = np.asarray(P, float)
+    form = clarabel_form(P, q, A, b, lb, ub, cones)
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = tol
     settings.tol_ktratio = 1e-8
-    solver = clarabel.DefaultSolver(
-        sp.csc_matrix(np.triu(P)), np.asarray(q, float), sp.csc_matrix(np.vstack(rows)),
-        np.concatenate(rhs), kinds, settings,
-    )
+    solver = clarabel.DefaultSolver(form.P, form.q, form.A, form.b, form.cones, settings)
     sol = solver.solve()
     status = str(sol.status)
     if status in ("Solved", "AlmostSolved"):
