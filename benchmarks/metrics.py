@@ -156,6 +156,7 @@ class Summary:
     max_equality_residual: float
     max_cone_violation: float
     median_objective_gap: float
+    max_objective_gap: float
     median_torque_error: float
     p95_torque_error: float
     max_torque_error: float
@@ -239,6 +240,7 @@ def summarize(
                 max_equality_residual=float(np.max(column(s, "equality_residual"))),
                 max_cone_violation=float(np.max(column(s, "cone_violation"))),
                 median_objective_gap=float(np.median(column(s, "objective_gap"))),
+                max_objective_gap=float(np.max(column(s, "objective_gap"))),
                 median_torque_error=float(np.median(du)),
                 p95_torque_error=float(np.percentile(du, 95)),
                 max_torque_error=float(np.max(du)),

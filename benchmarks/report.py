@@ -37,6 +37,13 @@ __all__ = ["TORQUE_TARGET", "RunInfo", "write_csv", "write_outputs"]
 TORQUE_TARGET = TORQUE_LIMIT_SHARE
 """Target on fccqp-realtime's torque error: p95 over QPs of ``max_j |du_j| / u_max_j``."""
 
+REALTIME_SUCCESS = 0.95
+"""Target on fccqp-realtime's success rate (issue 13)."""
+REALTIME_GAP = 1e-3
+"""Target on fccqp-realtime's worst relative objective gap (issue 13)."""
+REALTIME_POLISH_COST = 1.3
+"""Target on fccqp-realtime's median against the preset without polishing (issue 13)."""
+
 EQUALITY_FACTOR = 10.0
 """An equality residual is at factorization accuracy when within this factor of
 (plus 1e-12) the residual of a direct ``dsytrf``/``dsytrs`` solve of the KKT system."""
@@ -172,6 +179,26 @@ def _speed_row(robot: str, mine: Summary, peer: Summary, factor: float, what: st
     )
 
 
+def _realtime_quality_rows(robot: str, rt: Summary, plain: Summary | None) -> list[str]:
+    """Issue 13's targets on the realtime preset: success, worst objective gap, and the
+    time against the same preset without polishing (when that variant ran)."""
+    rows = [
+        f"| {robot} | fccqp-realtime success >= {100 * REALTIME_SUCCESS:g} % "
+        f"| {_pct(rt.success_rate)} % (reported solved {_pct(rt.reported_rate)} %) "
+        f"| {_verdict(rt.success_rate >= REALTIME_SUCCESS)} |",
+        f"| {robot} | fccqp-realtime worst relative objective gap <= {REALTIME_GAP:g} "
+        f"| {_g(rt.max_objective_gap)} | {_verdict(rt.max_objective_gap <= REALTIME_GAP)} |",
+    ]
+    if plain is not None:
+        ratio = rt.median_time / plain.median_time
+        rows.append(
+            f"| {robot} | fccqp-realtime median <= {REALTIME_POLISH_COST:g}x without polishing "
+            f"| {_us(rt.median_time)} us / {_us(plain.median_time)} us = {ratio:.2f} "
+            f"| {_verdict(ratio <= REALTIME_POLISH_COST)} |"
+        )
+    return rows
+
+
 def _targets(
     ts: TestSet, rows: Sequence[dict[str, object]], summaries: Sequence[Summary]
 ) -> list[str]:
@@ -210,6 +237,7 @@ def _targets(
             f"{ok.sum()}/{ok.size} QPs within {EQUALITY_FACTOR:g}x + 1e-12 | {_verdict(ok.all())} |"
         )
     if rt is not None:
+        out.extend(_realtime_quality_rows(ts.robot, rt, by.get("fccqp-realtime-nopolish")))
         met = rt.p95_torque_error_rel <= TORQUE_TARGET
         out.append(
             f"| {ts.robot} | fccqp-realtime torque error p95 <= {100 * TORQUE_TARGET:g} % of "

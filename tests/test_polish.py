@@ -140,11 +140,56 @@ def test_solves_ended_at_the_start_are_polished_and_infeasible_ones_not():
     verify_solution((P, q, A, b, lb, ub, cones), result)
 
 
-def test_polish_is_on_by_default_and_off_in_the_realtime_preset():
+def test_polish_is_on_in_both_presets():
     assert fccqp.Settings().polish is True
-    assert fccqp.Settings.realtime().polish is False
+    assert fccqp.Settings.realtime().polish is True
     assert fccqp.solve(*_cone_problem(0)).polished is True
     assert fccqp.solve(*_cone_problem(0), polish=False).polished is False
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_table_and_full_polish_agree(seed):
+    """The reduced backends polish in the table's coordinates (fccqp.polish_table),
+    the full one with its own KKT matrix: the same active set gives the same point."""
+    problem = _cone_problem(seed)
+    table = fccqp.solve(*problem, kkt_backend="schur_reduced")
+    full = fccqp.solve(*problem, kkt_backend="ldl_full")
+    assert table.backend == "schur_reduced" and full.backend == "ldl_full"
+    assert table.polished and full.polished
+    for result in (table, full):
+        assert check_solution(Problem.of(*problem), result, EXACT).passed
+    assert np.abs(table.x - full.x).max() <= 1e-8 * max(1.0, np.abs(full.x).max())
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_warm_solve_polishes_the_previous_active_set_without_iterating(backend):
+    """A control loop's next tick: the data moves a little, the active set stays, so
+    the warm solve's first polish is the answer (0 iterations), as exact as a cold
+    solve's."""
+    P, q, A, b, lb, ub, cones = _cone_problem(1)
+    solver = fccqp.Solver(fccqp.Settings(kkt_backend=backend))
+    assert solver.solve(P, q, A, b, lb, ub, cones).polished
+    rng = np.random.default_rng(0)
+    moved = (P, q + 1e-4 * rng.standard_normal(q.size), A, b, lb, ub, cones)
+    warm = solver.solve(*moved)
+    cold = fccqp.solve(*moved, kkt_backend=backend)
+    assert warm.status is Status.SOLVED and warm.polished and warm.iterations == 0
+    assert check_solution(Problem.of(*moved), warm, EXACT).passed
+    assert abs(warm.obj - cold.obj) <= 1e-10 * abs(cold.obj)
+
+
+def test_warm_solve_iterates_when_the_active_set_changed():
+    """A warm start whose active set no longer holds is rejected by the KKT check:
+    ADMM runs and the answer is still verified."""
+    P, q, A, b, lb, ub, cones = _cone_problem(2)
+    solver = fccqp.Solver()
+    assert solver.solve(P, q, A, b, lb, ub, cones).polished
+    moved = (P, -q, A, b, lb, ub, cones)
+    result = solver.solve(*moved)
+    assert result.iterations > 0
+    verify_solution(moved, result)
+    reference = clarabel_solve(*moved, tol=1e-12)
+    assert abs(result.obj - reference.obj) <= 1e-6 * abs(reference.obj)
 
 
 @pytest.mark.parametrize(("name", "value", "error"), [

@@ -228,6 +228,18 @@ def test_inaccurate_status_within_ten_times_tolerance():
     assert np.abs(result.x - exact.x).max() < 1e-2
 
 
+def test_realtime_preset_is_a_time_budget():
+    assert fccqp.Settings.realtime().time_limit == fccqp.settings.REALTIME_BUDGET
+    preset = fccqp.Settings.realtime(2e-3, eps_abs=1e-5)
+    assert preset.time_limit == 2e-3 and preset.eps_abs == 1e-5 and preset.polish
+    assert fccqp.Settings.realtime(math.inf).time_limit == math.inf
+    for bad in (0.0, -1e-3, math.nan):
+        with pytest.raises(ValueError, match="budget"):
+            fccqp.Settings.realtime(bad)
+    with pytest.raises(TypeError, match="budget"):
+        fccqp.Settings.realtime("1 ms")
+
+
 def test_realtime_preset_keeps_its_status_promise():
     settings = fccqp.Settings.realtime()
     problem = random_problem(2)

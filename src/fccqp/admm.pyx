@@ -462,6 +462,7 @@ cdef class Workspace:
         if not same_matrices:
             self.certified = False
         self.has_matrices = True
+        self.start_polished = x0 == NULL and warm and self.prev_polished
         self.clock[1] = fccqp_now()
         self._scale(reuse)
         self.clock[2] = fccqp_now()
@@ -469,7 +470,6 @@ cdef class Workspace:
         run.rho = self.prev_rho if warm else self.opt.rho
         if x0 != NULL:
             self._start_from_guess(x0)
-        self.start_polished = x0 == NULL and warm and self.prev_polished
         if x0 == NULL and warm:
             scale_start(self.prev_x, self.prev_y, self.prev_z, self.prev_rho, p.D, p.E, p.c,
                         p.n, p.m, p.s, p.constrained, p.lo, p.hi, p.cones, self.it.x,

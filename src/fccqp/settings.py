@@ -192,6 +192,7 @@ class Settings:
         solve). The default budget, :data:`REALTIME_BUDGET`, is a 1 kHz control tick;
         the figures per robot are in docs/performance.md.
         """
+        budget = _real("budget", budget, 0.0, math.inf, True, False)
         preset = cls(
             time_limit=budget, eps_abs=1e-4, eps_rel=1e-4, warm_start=True, scaling=4,
             polish=True,
