@@ -60,7 +60,7 @@ from scipy.linalg.cython_lapack cimport dsytrf, dsytrs
 from fccqp._dense cimport copy, inf_norm, matvec, matvec_t
 from fccqp._types cimport FRICTION, Cones, Iterates, Problem
 from fccqp.kkt cimport KKT
-from fccqp.polish_table cimport table_factor, table_solve
+from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.projections cimport proj_block
 from fccqp.reduced cimport Reduced
 
@@ -82,9 +82,9 @@ ACTIVE_TOLERANCE = 1e-12
 NEWTON_TOLERANCE = 1e-13
 """Stop re-linearizing when every boundary block has ``|phi| <= this * ||x_block||``."""
 CHORD_RATE = 0.25
-"""In the table's coordinates a Newton step reuses the last LU factor (a chord step)
-while the cones' miss ``|phi| / ||x_block||`` keeps shrinking by this factor per step,
-and refactors at the current planes otherwise."""
+"""A Newton step reuses the last factorization (a chord step: the Jacobian of earlier
+planes) while the cones' miss ``|phi| / ||x_block||`` keeps shrinking by this factor
+per step, and refactors at the current planes otherwise."""
 cdef double _CHORD_RATE = CHORD_RATE
 cdef double _DELTA = DELTA
 cdef int _MAX_REFINE = MAX_REFINE
@@ -414,6 +414,18 @@ cdef void _solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
         _apply(w, nf, p.m, nb, 1.0)
 
 
+cdef void _correct_once(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) noexcept nogil:
+    """One correction of the current point with the factor in ``K`` (a chord step)."""
+    cdef char uplo = b"L"
+    cdef int size = <int>(nf + p.m + nb), one = 1, info = 0
+    if size == 0:
+        return
+    _residual(w, p, nf, nb)
+    copy(w.rhs, w.step, size)
+    dsytrs(&uplo, &size, &one, w.K, &size, w.ipiv, w.step, &size, &info)
+    _apply(w, nf, p.m, nb, 1.0)
+
+
 cdef bint _relinearize(Polish* w, const Problem* p, Py_ssize_t nb,
                        double* worst) noexcept nogil:
     """Move each boundary block's plane and curvature to the current ``x_block``,
@@ -500,7 +512,9 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
                  const double* rho_vec) noexcept nogil:
     """Polish the iterate ``it`` into ``w.x``, ``w.nu``, ``w.y`` (scaled problem) and
     leave the final guess in ``w.active``; ``factorizations`` counts the ``dsytrf``
-    calls.
+    calls. With ``table`` (the reduced form's, current for ``rho_vec`` and ``kkt``'s
+    factorization) each guess is solved in its coordinates (:mod:`fccqp.polish_table`),
+    else, or where that system is singular, with the guess's own KKT matrix.
 
     Each guess is solved once (one Newton step, curvature included) and corrected from
     the polished point (:func:`_renew`), until the guess stops changing or
@@ -509,9 +523,10 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     nothing. Changing both at once (a plain primal-dual active-set step) was measured
     to diverge on whole-body control, where the cost is flat on the torques and forces:
     releasing a bound and a cone together sent free torques to 1e3. On a settled guess the
-    boundary planes are then re-linearized up to ``newton_steps`` times. False when a
-    factorization breaks down or the result is not finite; otherwise the caller judges
-    the point.
+    boundary planes are then re-linearized up to ``newton_steps`` times (chord steps
+    while they converge fast, see ``CHORD_RATE``), stopping early at the floor rounding
+    leaves. False when a factorization breaks down or the result is not finite;
+    otherwise the caller judges the point.
     """
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, nb, nf = 0, j, changed
     cdef long guess, step
@@ -542,13 +557,21 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         for step in range(newton_steps):
             if not _relinearize(w, p, nb, &miss) or (refactored and miss >= last_miss):
                 break   # converged, or at the floor that rounding leaves
-            refactored = not (tabled and miss <= _CHORD_RATE * last_miss)
-            if not refactored:
-                table_solve(w, p, table, kkt, rho_vec, nb, scale)   # a chord step
+            refactored = miss > _CHORD_RATE * last_miss
+            if not refactored:   # a chord step: one correction, the last factor, the current planes
+                if tabled:
+                    table_correct(w, p, table, kkt, rho_vec, nb, scale)
+                else:
+                    _correct_once(w, p, nf, nb)
             elif not _solve_guess(w, p, nf, nb, scale, factorizations, table, kkt, rho_vec,
                                   &tabled):
                 return False
             last_miss = miss
+        if not refactored:   # refine the last chord step's point
+            if tabled:
+                table_solve(w, p, table, kkt, rho_vec, nb, scale)
+            else:
+                _solve(w, p, nf, nb, scale)
         _multipliers(w, p, nf, nb)
     for j in range(n):
         total += w.x[j]

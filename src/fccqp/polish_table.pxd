@@ -8,3 +8,5 @@ cdef bint table_factor(Polish* w, const Problem* p, const Reduced* t, const doub
                        Py_ssize_t nb) noexcept nogil
 cdef void table_solve(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
                       const double* rho, Py_ssize_t nb, double scale) noexcept nogil
+cdef void table_correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
+                        const double* rho, Py_ssize_t nb, double scale) noexcept nogil

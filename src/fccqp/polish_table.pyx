@@ -238,3 +238,11 @@ cdef void table_solve(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
             return
         last = norm
         _correct(w, p, t, kkt, rho, nb, 1.0, _REFINE_TOLERANCE * scale)
+
+
+cdef void table_correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
+                        const double* rho, Py_ssize_t nb, double scale) noexcept nogil:
+    """One correction of the current point with the last factor (a chord step)."""
+    w.kkt_solved = False
+    _residual(w, p, nb)
+    _correct(w, p, t, kkt, rho, nb, 1.0, _REFINE_TOLERANCE * scale)
