@@ -16,8 +16,8 @@ MAX_SCALING = 100
 MAX_ANDERSON_MEMORY = 100
 """Most Anderson memory: each step solves a least-squares problem of this size."""
 MAX_POLISH_REFINE_ITER = 100
-"""Most re-linearizations of polishing: each costs one factorization; Newton's method
-on the cones' tangent planes converges in 1-3 when the active set is right."""
+"""Most re-linearizations of polishing: Newton's method on the cones' tangent planes
+converges in 1-3 when the active set is right."""
 
 REALTIME_BUDGET = 1e-3
 """Default budget of :meth:`Settings.realtime` in seconds: one tick of a 1 kHz loop."""
@@ -129,13 +129,15 @@ class Settings:
     On by default: on the WBC sets (go2, talos_reduced; 200 warm QPs each) it polished
     99 % of the solves, cut the p95 torque error against the Clarabel reference from 15
     and 31 Nm to 0.009 and 0.008 Nm and the worst relative objective gap from 4e-5 and
-    1.1e-3 to 9e-9 and 4e-7, for 1.5-1.65x the median time (docs/performance.md)."""
+    1.1e-3 to 9e-9 and 4e-7 (docs/performance.md has its current cost). A warm start
+    from a polished solution polishes its active set first, before any iteration."""
     polish_refine_iter: int = 10
     """Most re-linearizations of the boundary cones' tangent planes in polishing (Newton
-    steps, one factorization each, taken only until the cone function is met to 1e-13;
-    at most :data:`MAX_POLISH_REFINE_ITER`). From ADMM's point Newton sometimes needs
-    about 8 on whole-body control (small contact forces); on go2 10 instead of 3 raised
-    the polished share from 91 % to 92 % for 0.2 more factorizations per solve."""
+    steps, taken only until the cone function is met to 1e-13 or stops improving; a
+    step reuses the last factorization while the steps converge fast; at most
+    :data:`MAX_POLISH_REFINE_ITER`). From ADMM's point Newton sometimes needs about 8
+    on whole-body control (small contact forces); on go2 10 instead of 3 raised the
+    polished share from 91 % to 92 % for 0.2 more factorizations per solve."""
     kkt_backend: str = "auto"
     """Linear-system backend of the x-update: ``"schur_reduced"`` (Cholesky of ``P + R``
     and of ``A (P + R)^-1 A'``, reduced iteration), ``"ldl_reduced"`` (LDL', reduced
