@@ -156,7 +156,7 @@ cdef struct Options:
     # Settings of fccqp.Settings the kernels read.
     double rho, sigma, alpha, eps_abs, eps_rel, eps_prim_inf, eps_dual_inf
     double time_limit, adaptive_rho_tolerance
-    long max_iter, check_termination, adaptive_rho_interval, scaling, polish_refine_iter
+    long max_iter, min_iter, check_termination, adaptive_rho_interval, scaling, polish_refine_iter
     bint adaptive_rho, restore_feasibility, polish
     int backend, anderson_memory
 
@@ -347,6 +347,7 @@ cdef class Workspace:
         o.time_limit = settings.time_limit
         o.adaptive_rho_tolerance = settings.adaptive_rho_tolerance
         o.max_iter, o.check_termination = settings.max_iter, settings.check_termination
+        o.min_iter = settings.min_iter
         o.adaptive_rho_interval, o.scaling = settings.adaptive_rho_interval, settings.scaling
         o.adaptive_rho, o.restore_feasibility = settings.adaptive_rho, settings.restore_feasibility
         o.polish, o.polish_refine_iter = settings.polish, settings.polish_refine_iter
@@ -591,7 +592,7 @@ cdef class Workspace:
         periodic_prim = INFINITY
         stalls = 0
         fresh = True  # the next step starts a run of KKT solutions: do not relax x
-        if timed and fccqp_now() - start_time >= deadline:
+        if timed and o.min_iter == 0 and fccqp_now() - start_time >= deadline:
             status = self._classify(0, True, start_time)   # the setup spent the budget
         while status == _RUNNING:
             iteration += 1
@@ -600,7 +601,8 @@ cdef class Workspace:
             else:
                 self._full_step(not fresh)
             fresh = False
-            last = iteration >= o.max_iter or (timed and fccqp_now() - start_time >= deadline)
+            last = iteration >= o.max_iter or (timed and iteration >= o.min_iter
+                                               and fccqp_now() - start_time >= deadline)
             periodic = iteration % o.adaptive_rho_interval == 0
             adapt = o.adaptive_rho and periodic
             check = iteration % o.check_termination == 0 or last or adapt
