@@ -200,10 +200,15 @@ def _realtime_quality_rows(robot: str, rt: Summary, plain: Summary | None) -> li
 
 
 def _targets(
-    ts: TestSet, rows: Sequence[dict[str, object]], summaries: Sequence[Summary]
+    ts: TestSet, rows: Sequence[dict[str, object]], summaries: Sequence[Summary],
+    every: Sequence[Summary] = (),
 ) -> list[str]:
-    """Rows of the targets table for one test set: ``| robot | target | numbers | verdict |``."""
+    """Rows of the targets table for one test set: ``| robot | target | numbers | verdict |``.
+
+    ``summaries`` are the variants at their defaults, ``every`` all variants (for the
+    realtime preset without polishing, a sweep variant)."""
     by = {s.solver: s for s in summaries}
+    plain = {s.solver: s for s in every}.get("fccqp-realtime-nopolish")
     out = []
     for name in ("fccqp-realtime", "fccqp-default"):
         if name not in by:
@@ -237,7 +242,7 @@ def _targets(
             f"{ok.sum()}/{ok.size} QPs within {EQUALITY_FACTOR:g}x + 1e-12 | {_verdict(ok.all())} |"
         )
     if rt is not None:
-        out.extend(_realtime_quality_rows(ts.robot, rt, by.get("fccqp-realtime-nopolish")))
+        out.extend(_realtime_quality_rows(ts.robot, rt, plain))
         met = rt.p95_torque_error_rel <= TORQUE_TARGET
         out.append(
             f"| {ts.robot} | fccqp-realtime torque error p95 <= {100 * TORQUE_TARGET:g} % of "
@@ -408,7 +413,7 @@ def write_outputs(
     for ts, rows in sets:
         summaries = summarize(rows, time_limit=ts.dt)
         defaults = summarize([r for r in rows if not VARIANTS[str(r["solver"])].sweep], ts.dt)
-        target_rows += _targets(ts, rows, defaults)
+        target_rows += _targets(ts, rows, defaults, summaries)
         times_png, torque_png = plot_sequence(ts, rows, out)
         wp_png = plot_work_precision(ts, rows, out)
         kkt = np.median([float(r["dsytrf_time"]) for r in rows])

@@ -378,3 +378,19 @@ def test_docs_example_runs(capsys: pytest.CaptureFixture[str]) -> None:
     code = re.search(r"```python\n(.*?)```", page, re.S).group(1)
     exec(compile(code, "docs/cvxpy.md", "exec"), {})
     assert capsys.readouterr().out.startswith("optimal")
+
+
+def _standard_tests():
+    """CVXPY's own conformance tests that apply to fccqp (no integers, no SDP)."""
+    helpers = pytest.importorskip("cvxpy.tests.solver_test_helpers")
+    for group in (helpers.StandardTestLPs, helpers.StandardTestQPs, helpers.StandardTestSOCPs):
+        for name in sorted(vars(group)):
+            if name.startswith("test_") and not name.startswith("test_mi_") and name != "test_lp_7":
+                yield pytest.param(getattr(group, name), id=f"{group.__name__}.{name}")
+
+
+@pytest.mark.parametrize("check", list(_standard_tests()))
+def test_cvxpy_standard_tests_pass_at_default_settings(check):
+    """CVXPY's StandardTestLPs/QPs/SOCPs, as CVXPY runs them for its own solvers (lp_7
+    needs the sdpap package for its reference)."""
+    check(solver=FCCQP())

@@ -130,6 +130,15 @@ class FCCQPSolver(ConicSolver):
         """Import fccqp (CVXPY calls this to check the solver is installed)."""
         import fccqp  # noqa: F401
 
+    def apply(self, problem):
+        """CVXPY's conic data, with ``n_eq`` and ``n_ineq`` (the zero and nonnegative
+        cone rows) as CVXPY's QP solvers report them: its conformance test of
+        ``BOUNDED_VARIABLES`` reads ``n_ineq`` to check that bounds did not become rows."""
+        data, inverse_data = super().apply(problem)
+        dims = data[s.DIMS]
+        data["n_eq"], data["n_ineq"] = dims.zero, dims.nonneg
+        return data, inverse_data
+
     def supports_quad_obj(self) -> bool:
         """fccqp takes the quadratic objective directly, so CVXPY keeps ``P``."""
         return True
