@@ -81,6 +81,11 @@ ACTIVE_TOLERANCE = 1e-12
 (relative to the bound, or to ``||x_block||``)."""
 NEWTON_TOLERANCE = 1e-13
 """Stop re-linearizing when every boundary block has ``|phi| <= this * ||x_block||``."""
+MISS_FLOOR = 1e-11
+"""Newton also stops when a fresh factorization did not reduce a miss already below
+this: the floor rounding leaves (talos: 1.8e-13, for all 10 steps). Farther out a
+Newton step may grow the miss before it converges, so it goes on there."""
+cdef double _MISS_FLOOR = MISS_FLOOR
 CHORD_RATE = 0.25
 """A Newton step reuses the last factorization (a chord step: the Jacobian of earlier
 planes) while the cones' miss ``|phi| / ||x_block||`` keeps shrinking by this factor
@@ -555,7 +560,8 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         _multipliers(w, p, nf, nb)
     if changed == 0:
         for step in range(newton_steps):
-            if not _relinearize(w, p, nb, &miss) or (refactored and miss >= last_miss):
+            if not _relinearize(w, p, nb, &miss) or (
+                    refactored and miss >= last_miss and miss <= _MISS_FLOOR):
                 break   # converged, or at the floor that rounding leaves
             refactored = miss > _CHORD_RATE * last_miss
             if not refactored:   # a chord step: one correction, the last factor, the current planes

@@ -22,7 +22,7 @@ from libc.math cimport exp, fabs, log, sqrt
 from fccqp._types cimport Cones
 from fccqp.projections cimport proj_set
 
-MIN_NORM = 1e-4
+MIN_NORM = 1e-8
 """Column norms below this are treated as 1 (a column of zeros is left alone)."""
 MAX_NORM = 1e4
 """Column norms are capped here, bounding one pass's scale change to 100x."""
