@@ -37,7 +37,7 @@ def problems(draw) -> Problem:
     n_free = draw(st.integers(0 if n_friction + soc_dim + n_box else 1, 3))
     n = 3 * n_friction + soc_dim + n_box + n_free
     m = draw(st.integers(0, max(0, n - 1)))
-    duplicates = draw(st.integers(0, min(m, 2)))
+    duplicates = draw(st.integers(0, min(m // 2, 2)))  # copies of existing rows
     rank = draw(st.integers(0, n))
     p_decade, q_decade, a_decades = (draw(st.integers(-6, 6)) for _ in range(3))
     shift_b = draw(st.booleans())
