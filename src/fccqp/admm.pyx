@@ -127,6 +127,14 @@ tolerance (rounding of an exact solve), and its multipliers may miss their cones
 this times the dual tolerance."""
 LOG_INTERVAL = 25
 """With ``verbose``, the log keeps one line every this many iterations (as OSQP)."""
+EQUALITY_SLACK = 10.0
+EQUALITY_EXACT = 1e-13
+"""A polished point keeps ``A x = b`` as ADMM's iterates do, at factorization accuracy:
+within ``EQUALITY_SLACK`` times the ADMM point's residual, or below ``EQUALITY_EXACT``
+times ``max(||A x||, ||b||)``. (The tolerance alone let a polished point with ``A x - b``
+at 2e-9 of its terms pass as SOLVED in a random test.)"""
+cdef double _EQUALITY_SLACK = EQUALITY_SLACK
+cdef double _EQUALITY_EXACT = EQUALITY_EXACT
 POLISH_GATE = 1e3
 """A run under a time limit is polished at its end only when its residuals are within
 this factor of the tolerances: farther out the iterate's active set is mostly wrong
@@ -1024,6 +1032,8 @@ cdef class Workspace:
                 and r.prim_eq <= o.eps_abs + o.eps_rel * r.prim_eq_scale
                 and r.prim_set <= o.eps_abs + o.eps_rel * r.prim_set_scale
                 and multiplier_violation(&self.pol, p, self.user_z) <= _POLISH_EXACT * tol_d
+                and r.prim_eq <= max(_EQUALITY_SLACK * plain.prim_eq,
+                                     _EQUALITY_EXACT * r.prim_eq_scale)
                 and (r.prim <= plain.prim or r.prim <= _POLISH_EXACT * tol_p)
                 and (r.dual <= plain.dual or r.dual <= _POLISH_EXACT * tol_d)
                 and (r.gap <= plain.gap or r.gap <= _POLISH_EXACT * tol_g)
