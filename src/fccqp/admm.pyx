@@ -106,8 +106,8 @@ EQUALITY_START_STEPS = 3
 """Proximal steps of the cold start's equality-constrained QP (see _equality_start)."""
 EQUALITY_START_LIMIT = 1e-3
 """The cold start's equality-constrained QP counts as unbounded when sigma * ||x_eq||
-exceeds this * max(1, ||q||): its solution is then an (unbounded) direction, tested as
-a dual infeasibility certificate, and the start falls back to the origin."""
+exceeds this * max(1, ||q||): its last proximal step is then an (unbounded) direction,
+tested as a dual infeasibility certificate, and the start falls back onto A x = b."""
 RESTORED_EQUALITY = 1e-7
 """A restored point is kept only if its primal residual is below this times its scale:
 otherwise the other entries could not absorb the pinning. Refinement aims at 1e-13, but
@@ -900,8 +900,17 @@ cdef class Workspace:
         inertia certifies convexity; a few proximal steps (``x_{j+1} = argmin f +
         sigma/2 ||x - x_j||^2`` on the same factorization) remove sigma's bias, so that
         an optimum with no active constraint is recognised at once. When the solution
-        is huge the equality-constrained QP is unbounded: ``direction`` keeps it (a
-        candidate certificate) and the start falls back to the origin.
+        is huge the equality-constrained QP is unbounded: ``direction`` keeps the last
+        proximal step (a candidate certificate) and the start falls back to the point
+        of ``A x = b`` with the least ``x'(P + sigma I) x``.
+
+        The step, not the solution, is the direction: along a ray ``d`` (``P d = 0``,
+        ``A d = 0``) each step adds the same multiple of ``d``, while the solution also
+        carries its bounded part and ``A x = b``, so that ``P x`` and ``A x`` are up to
+        ``1e-6`` of their terms (the suite's unbounded problems: 2e-7 to 9e-7 after
+        three steps), the certificate test's own tolerance; in the step they are
+        rounding (1e-16), the bounded part shrinking by ``sigma / (lambda + sigma)``
+        per step.
         """
         cdef Problem* p = &self.prob
         cdef Iterates* it = &self.it
@@ -922,13 +931,18 @@ cdef class Workspace:
             for i in range(n):
                 self.rhs[i] = sigma * it.x[i] - p.q[i]
             kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
+            for i in range(n):
+                self.direction[i] = self.sol[i] - it.x[i]
             copy(self.sol, it.x, n)
         copy(self.sol + n, it.nu, m)
         unbounded[0] = sigma * inf_norm(it.x, n) > _EQUALITY_START_LIMIT * max(
             1.0, inf_norm(p.q, n))
         if unbounded[0]:
-            copy(it.x, self.direction, n)
-            fill(it.x, 0.0, n)
+            # min 1/2 x'(P + sigma I) x subject to A x = b: bounded, and A x = b holds
+            # for whatever status the run ends with
+            fill(self.rhs, 0.0, n)
+            kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
+            copy(self.sol, it.x, n)
             fill(it.nu, 0.0, m)
         for i in range(p.s):
             it.z[i] = it.x[p.constrained[i]]

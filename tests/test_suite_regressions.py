@@ -1,0 +1,47 @@
+"""Reproducers the general-QP suite found (benchmarks/general_suite, issue 13).
+
+Each test rebuilds the suite's own problem with ``build(family, member)``, solves it at
+the suite's settings (eps 1e-6) and judges the answer with :func:`verify.verify_solution`.
+"""
+
+from __future__ import annotations
+
+import pytest
+from benchmarks.general_suite.families import build
+
+import fccqp
+from fccqp import Status
+from verify import Tolerances, equality_bound, primal_violations, verify_solution
+
+EPS = {"eps_abs": 1e-6, "eps_rel": 1e-6}
+
+
+def _equality_holds(problem, result) -> bool:
+    """``A x = b`` to factorization accuracy, which formulation.md promises whatever the
+    status (verify_solution checks it only where the status carries no other promise)."""
+    violation = primal_violations(problem, result.x)["equality"]
+    return violation <= equality_bound(problem, result.x, Tolerances())
+
+
+@pytest.mark.parametrize("member", [8, 28])
+def test_unbounded_without_constrained_entries_is_certified(member):
+    """dual_infeasible[8] and [28]: a ray with P d = 0, A d = 0, q'd < 0 and no box or
+    cone. The cold start's unbounded solution was tested as the certificate, but it
+    carries A x = b and its bounded part (P x, A x at 1e-7 of their terms, the test's
+    own tolerance): MAX_ITER_REACHED after 0 iterations, with x = 0 breaking A x = b."""
+    problem = build("dual_infeasible", member).problem
+    result = fccqp.solve(*problem.args(), **EPS)
+    verify_solution(problem, result, Tolerances.of(**EPS))
+    assert result.status is Status.DUAL_INFEASIBLE
+    assert _equality_holds(problem, result)
+
+
+def test_uncertified_unbounded_start_satisfies_the_equalities():
+    """With a certificate tolerance far below rounding (eps_dual_inf = 1e-300) no
+    direction passes, and dual_infeasible[28] ends without a certificate: the point
+    returned must still satisfy A x = b (it was the origin, |A x - b| = 4.96)."""
+    problem = build("dual_infeasible", 28).problem
+    result = fccqp.solve(*problem.args(), eps_dual_inf=1e-300, **EPS)
+    assert result.status is Status.MAX_ITER_REACHED
+    verify_solution(problem, result, Tolerances.of(**EPS))
+    assert _equality_holds(problem, result)
