@@ -45,3 +45,16 @@ def test_uncertified_unbounded_start_satisfies_the_equalities():
     assert result.status is Status.MAX_ITER_REACHED
     verify_solution(problem, result, Tolerances.of(**EPS))
     assert _equality_holds(problem, result)
+
+
+@pytest.mark.parametrize("member", [10, 18, 19, 22, 28, 42, 44, 48])
+def test_narrow_boxes_far_from_the_origin_are_solved(member):
+    """large_multipliers: every entry boxed to a width of 1e-4..1e-2 about a point of
+    size 1, multipliers up to 3e8. Rho adaptation judged the primal residual against
+    |x| instead of the box width, kept rho 1e3 times too small, and ADMM ended at
+    MAX_ITER_REACHED after 4000 iterations with an iterate whose active set polishing
+    could not recover (moved to the origin, 8 of 9 solved in 140-1800 iterations)."""
+    problem = build("large_multipliers", member).problem
+    result = fccqp.solve(*problem.args(), **EPS)
+    verify_solution(problem, result, Tolerances.of(**EPS))
+    assert result.status is Status.SOLVED

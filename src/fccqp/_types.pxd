@@ -33,6 +33,7 @@ cdef struct Problem:
     const char* in_cone         # s flags: the constrained entry belongs to a cone block
     double* lo                  # bounds of x_S (s entries, +-inf where absent)
     double* hi
+    double* span                # m: range of each row's A x over the box (termination.row_spans)
     Cones cones
     double* D                   # x = D x_scaled
     double* E                   # equality rows were multiplied by E

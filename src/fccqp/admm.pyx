@@ -44,7 +44,7 @@ from fccqp.reduced cimport (Reduced, materialize, near_convergence, reduced_reba
                             reduced_start, reduced_step, reduced_table)
 from fccqp.restoration cimport Restoration, restore
 from fccqp.scaling cimport equilibrate, scale_start, unscale
-from fccqp.termination cimport Residuals, converged, nearly_converged, residuals
+from fccqp.termination cimport Residuals, converged, nearly_converged, residuals, row_spans
 from fccqp.validation cimport SCAN_OK, Finding, scan_and_copy
 
 cdef extern from *:
@@ -284,6 +284,7 @@ cdef class Workspace:
         p.in_cone = in_cone
         p.P, p.q, p.A, p.b = self._new(n * n), self._new(n), self._new(m * n), self._new(m)
         p.lo, p.hi, p.D, p.E = self._new(s), self._new(s), self._new(n), self._new(m)
+        p.span = self._new(m)
         p.c = 1.0
         self.P_user, self.q_user = self._new(n * n), self._new(n)
         self.A_user, self.b_user = self._new(m * n), self._new(m)
@@ -493,7 +494,8 @@ cdef class Workspace:
 
     cdef void _scale(self, bint reuse) noexcept nogil:
         """Equilibrate the user's data into the scaled problem, or, with ``reuse``, apply
-        the scaling of the unchanged matrices to the new vectors only."""
+        the scaling of the unchanged matrices to the new vectors only; then the rows'
+        spans over the (new) box."""
         cdef Problem* p = &self.prob
         cdef Py_ssize_t n = p.n, m = p.m, i, j
         if not reuse:
@@ -514,6 +516,7 @@ cdef class Workspace:
             i = p.constrained[j]
             p.lo[j] = self.lb_user[i] / p.D[i]
             p.hi[j] = self.ub_user[i] / p.D[i]
+        row_spans(p, self.d_scratch)
 
     cdef void _start_from_guess(self, const double* x0) noexcept nogil:
         """Primal guess ``x0`` (user's units), duals zero, slack its projection."""
