@@ -135,6 +135,11 @@ times ``max(||A x||, ||b||)``. (The tolerance alone let a polished point with ``
 at 2e-9 of its terms pass as SOLVED in a random test.)"""
 cdef double _EQUALITY_SLACK = EQUALITY_SLACK
 cdef double _EQUALITY_EXACT = EQUALITY_EXACT
+EQUALITY_MISSED = 1e-9
+"""The equality-constrained cold start meets ``A x = b`` to factorization accuracy
+(1e-14 of ``max(||A x||, ||b||)`` or better) unless the rows are inconsistent or
+numerically dependent; beyond this the "auto" backend takes the full form."""
+cdef double _EQUALITY_MISSED = EQUALITY_MISSED
 POLISH_GATE = 1e3
 """A run under a time limit is polished at its end only when its residuals are within
 this factor of the tolerances: farther out the iterate's active set is mostly wrong
@@ -240,6 +245,7 @@ cdef class Workspace:
     cdef bint table_ready   # the reduced table and base hold for this solve's data and rho
     cdef bint iterated      # the last solve ran the iterations (and then its final step)
     cdef bint prev_polished, start_polished   # the previous solution was polished; this solve starts from it
+    cdef bint equalities_missed   # the last cold start did not meet A x = b
     cdef int form
     cdef object _keep
 
@@ -364,7 +370,7 @@ cdef class Workspace:
         o.polish, o.polish_refine_iter = settings.polish, settings.polish_refine_iter
         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
         self.has_previous = self.has_matrices = self.certified = self.scaled_once = False
-        self.prev_polished = self.start_polished = False
+        self.prev_polished = self.start_polished = self.equalities_missed = False
         self.factored_rho = -1.0
         self.final_reserve = 0.0
 
@@ -571,8 +577,10 @@ cdef class Workspace:
                 run.polished = self._keep_polished(&status, 0, start_time)
             self._finish_run(run, status, 0)
             return
-        if (cold or s == 0) and r.prim_eq > o.eps_abs + o.eps_rel * r.prim_eq_scale and \
-                self._inconsistent():
+        if cold or s == 0:   # not at factorization accuracy: inconsistent or dependent rows
+            self.equalities_missed = r.prim_eq > _EQUALITY_MISSED * max(r.prim_eq_scale, 1.0)
+        if ((cold or s == 0) and r.prim_eq > o.eps_abs + o.eps_rel * r.prim_eq_scale
+                and self._inconsistent()):
             # tested on the penalty-free start: with rho in the KKT matrix (up to 1e9 on
             # fixed entries) the regularization's trace in A'r can hide the certificate
             self._finish_run(run, _PRIMAL_INFEASIBLE, 0)
@@ -856,7 +864,12 @@ cdef class Workspace:
         cdef bint reduced_pays
         self.table_ready = False
         if first == AUTO:
-            reduced_pays = 2 * p.s <= p.n + p.m and _REDUCED_COST * p.s <= budget
+            # rows the equality-constrained start could not meet (inconsistent, or
+            # numerically dependent) go to the full form: its regularized solves give
+            # least-squares iterates, on which the equality certificate is tested
+            # (a random test: the reduced form ran 4000 iterations uncertified)
+            reduced_pays = (2 * p.s <= p.n + p.m and _REDUCED_COST * p.s <= budget
+                            and not self.equalities_missed)
             first = SCHUR_REDUCED if reduced_pays else LDL_FULL
         for backend in range(first, LDL_FULL + 1):
             if not self.certified and backend != SCHUR_REDUCED:
