@@ -104,7 +104,7 @@ def _tolerances(name: str, family: str, exact: bool, module: str,
 
 _LIST: list[Variant] = [
     _fccqp("fccqp-realtime", "realtime", False, {}, True,
-           "fccqp, Settings.realtime() (1 ms budget, polishing, eps 1e-4), exact cones, warm"),
+           "fccqp, Settings.realtime() (2 ms budget, polishing, eps 1e-4), exact cones, warm"),
     _fccqp("fccqp-realtime-nopolish", "realtime, no polish", True, {"polish": False}, True,
            "fccqp, Settings.realtime(polish=False), exact cones, warm"),
     _fccqp("fccqp-default", "default", False, {}, False,
@@ -118,7 +118,7 @@ _LIST: list[Variant] = [
     *[
         _fccqp(f"fccqp-realtime-{ms:g}ms", f"realtime, {ms:g} ms", True, {"budget": ms * 1e-3},
                True, f"fccqp, Settings.realtime(budget={ms * 1e-3:g}), exact cones, warm")
-        for ms in (0.5, 2, 3)
+        for ms in (0.5, 1, 3)
     ],
     *_tolerances("clarabel", "clarabel", True, "clarabel", ClarabelAdapter,
                  "tol_gap_abs = tol_gap_rel = tol_feas", (1e-8, 1e-5, 1e-10),

@@ -14,7 +14,7 @@ from benchmarks.metrics import qp_metrics
 from benchmarks.solvers import VARIANTS, make_adapter
 from benchmarks.testsets import generate_test_set
 
-EXACT = ["fccqp-default", "fccqp-realtime-2ms", "clarabel", "qoco", "scs-tight"]
+EXACT = ["fccqp-default", "fccqp-realtime-1ms", "clarabel", "qoco", "scs-tight"]
 PYRAMID = ["daqp-pyr4", "quadprog-pyr4", "piqp-pyr4", "proxqp-pyr4", "osqp-pyr4-tight"]
 
 
