@@ -1,4 +1,4 @@
-"""What the real-time preset returns after its 15-iteration budget, warm and cold.
+"""What the real-time preset returns within its time budget, warm and cold.
 
 Run ``python -m benchmarks.realtime_quality [--robots R ...] [--qps N] [--passes K]``.
 For each robot it generates the default test set (``mix`` of the four scenarios,
