@@ -488,7 +488,7 @@ cdef class Workspace:
         run.rho = self.prev_rho if warm else self.opt.rho
         if x0 != NULL:
             self._start_from_guess(x0)
-        if x0 == NULL and warm:
+        elif warm:
             scale_start(self.prev_x, self.prev_y, self.prev_z, self.prev_rho, p.D, p.E, p.c,
                         p.n, p.m, p.s, p.constrained, p.lo, p.hi, p.cones, self.it.x,
                         self.it.nu, self.it.y, self.it.z)
@@ -1031,11 +1031,13 @@ cdef class Workspace:
         The polished point is accepted only when, in the user's units, it is primal
         feasible within the tolerance (box and exact cones), its multipliers lie in the
         normal cones its active set needs (:func:`fccqp.polish.multiplier_violation`,
-        within ``POLISH_EXACT`` of the dual tolerance) and its primal and dual
-        residuals and gap are each no worse than the ADMM point's (or below
-        ``POLISH_EXACT`` times their tolerance). Otherwise the iterate and its
-        residuals are left as they were. On acceptance the status is the polished
-        point's when that is solved or inaccurate.
+        within ``POLISH_EXACT`` of the dual tolerance), it keeps ``A x = b`` at
+        factorization accuracy (``EQUALITY_SLACK``, ``EQUALITY_EXACT``) and its primal
+        and dual residuals and gap are each no worse than the ADMM point's (or below
+        ``POLISH_EXACT`` times their tolerance); with ``solved_only`` (the warm polish)
+        it must also be solved. Otherwise the iterate and its residuals are left as
+        they were. On acceptance the status is the polished point's when that is
+        solved or inaccurate.
         """
         cdef Problem* p = &self.prob
         cdef Iterates* it = &self.it

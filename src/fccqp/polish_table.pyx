@@ -17,8 +17,9 @@ on the constrained entries, one per entry plus one per boundary cone block:
   curvature ``H`` of the Newton step) and lies on the plane: ``g'x_J = 0``.
 
 In the coordinates ``(u, lam)`` that is a square system of ``s + nb`` equations, built
-from the ``s x s`` table ``W_S`` in ``O(s^2)`` and factored with LU (``dgetrf``) in
-``O(s^3)``: no new factorization of the ``(n + m)``-sized KKT matrix, which is what
+from the ``s x s`` table ``W_S`` in ``O(s^2)`` and factored with LU (``dgetf2``; at
+these sizes OpenBLAS's blocked ``dgetrf`` costs the same, 58k instructions for go2's 28
+rows) in ``O(s^3)``: no new factorization of the ``(n + m)``-sized KKT matrix, which is what
 the polishing of :mod:`fccqp.polish` pays for every active set and every Newton step
 (on go2, 84 rows and ``s = 24``: a warm polish cost 220 us there, mostly ``dsytrf``).
 The system is solved as corrections of the current point against the residual of the
@@ -39,7 +40,7 @@ from scipy.linalg.cython_lapack cimport dgetf2, dgetrs
 from fccqp._dense cimport colmatvec, fill, inf_norm, matvec, matvec_t
 from fccqp._types cimport Problem
 from fccqp.kkt cimport KKT, kkt_solve
-from fccqp.polish cimport APEX, BOUNDARY, FIXED, FREE, LOWER, UPPER, Polish
+from fccqp.polish cimport APEX, FIXED, LOWER, UPPER, Polish
 from fccqp.reduced cimport Reduced
 
 PIVOT_RATIO = 1e-13
