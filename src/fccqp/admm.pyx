@@ -1129,7 +1129,7 @@ cdef class Workspace:
             copy(y, self.prev_y, m)
             copy(z, self.prev_z, n)
             self.prev_rho = run.rho
-        self.prev_polished = self.has_previous and run.polished
+        self.prev_polished = self.has_previous and (run.polished or run.status == _SOLVED)
 
     cdef void _user_residuals(self, const double* x, const double* y,
                               const double* z) noexcept nogil:

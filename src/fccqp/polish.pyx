@@ -461,6 +461,39 @@ cdef bint _relinearize(Polish* w, const Problem* p, Py_ssize_t nb,
     return True
 
 
+cdef Py_ssize_t _drop_far_side(Polish* w, const Problem* p, Py_ssize_t nb,
+                               Py_ssize_t* changed) noexcept nogil:
+    """Hold at the apex every boundary block whose ``x_block`` lies on the far side of it
+    (``n'x_block <= 0``: the tangent plane through the origin also holds the opposite
+    ray, and a polished QP that pulls a contact ends there); return the number of
+    boundary blocks left, compacted in order with their multipliers, and count the
+    changed entries in ``changed``.
+
+    Newton's re-linearization cannot leave that side: each new plane is tangent along
+    the projection of a point outside the cone, and on talos' whole-body control the
+    miss stayed at 1.1-1.2 for all ten steps (a fresh factorization each) in one of five
+    polishes. The apex is the active set such a block asks for (no force); the next
+    guess pass releases it again if its multiplier leaves the polar cone."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t k, j, cone, o, d, kept = 0
+    cdef double across, along
+    changed[0] = 0
+    for k in range(nb):
+        cone = w.boundary[k]
+        o, d = c.offset[cone], c.dim[cone]
+        along = _axis(w.x + p.constrained[o], c.kind[cone], d, c.mu[cone], c.normal + 3 * cone,
+                      &across)
+        if along <= 0.0:
+            for j in range(o, o + d):
+                w.active[j] = APEX
+            changed[0] += d
+            continue
+        w.boundary[kept] = cone
+        w.lam[kept] = w.lam[k]
+        kept += 1
+    return kept
+
+
 cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
                        double scale, int* factorizations) noexcept nogil:
     """Assemble and factor the KKT matrix of the current active set and planes, and
@@ -530,11 +563,13 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     releasing a bound and a cone together sent free torques to 1e3. On a settled guess the
     boundary planes are then re-linearized up to ``newton_steps`` times (chord steps
     while they converge fast, see ``CHORD_RATE``), stopping early at the floor rounding
-    leaves. False when a factorization breaks down or the result is not finite;
-    otherwise the caller judges the point.
+    leaves. A boundary block that a solve puts past the apex (:func:`_drop_far_side`)
+    is held at the apex instead and the corrected guess solved, within the same
+    ``GUESS_PASSES``. False when a factorization breaks down or the result is not
+    finite; otherwise the caller judges the point.
     """
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, nb, nf = 0, j, changed
-    cdef long guess, step
+    cdef long passes = 0, step
     cdef double total = 0.0
     cdef double scale = max(1.0, max(inf_norm(p.q, n), inf_norm(p.b, m)))
     cdef bint tabled = table != NULL
@@ -547,18 +582,23 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     for j in range(s):
         w.active[j] = FREE
     nb = _guess(w, p, it.z, it.y, &changed)
-    for guess in range(_GUESS_PASSES):
-        if guess > 0:
-            nb = _renew(w, p, True, &changed)
-            if changed == 0:
-                nb = _renew(w, p, False, &changed)
-            if changed == 0:
-                break
+    while True:
         nf = _unknowns(w, p)
         if not _solve_guess(w, p, nf, nb, scale, factorizations, table, kkt, rho_vec, &tabled):
             return False
         _multipliers(w, p, nf, nb)
-    if changed == 0:
+        passes += 1
+        if passes == _GUESS_PASSES:
+            break   # not settled: the caller's check judges this guess's point
+        nb = _renew(w, p, True, &changed)
+        if changed == 0:
+            nb = _renew(w, p, False, &changed)
+        if changed == 0:
+            nb = _drop_far_side(w, p, nb, &changed)
+        if changed != 0:
+            continue
+        last_miss = INFINITY
+        refactored = False
         for step in range(newton_steps):
             if not _relinearize(w, p, nb, &miss) or (
                     refactored and miss >= last_miss and miss <= _MISS_FLOOR):
@@ -573,12 +613,18 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
                                   &tabled):
                 return False
             last_miss = miss
+            nb = _drop_far_side(w, p, nb, &changed)
+            if changed != 0:
+                break
+        if changed != 0:
+            continue   # a block went past its apex: solve the corrected guess
         if not refactored:   # refine the last chord step's point
             if tabled:
                 table_solve(w, p, table, kkt, rho_vec, nb, scale)
             else:
                 _solve(w, p, nf, nb, scale)
         _multipliers(w, p, nf, nb)
+        break
     for j in range(n):
         total += w.x[j]
     for j in range(m):

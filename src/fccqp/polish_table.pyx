@@ -17,9 +17,10 @@ on the constrained entries, one per entry plus one per boundary cone block:
   curvature ``H`` of the Newton step) and lies on the plane: ``g'x_J = 0``.
 
 In the coordinates ``(u, lam)`` that is a square system of ``s + nb`` equations, built
-from the ``s x s`` table ``W_S`` in ``O(s^2)`` and factored with LU (``dgetf2``; at
-these sizes OpenBLAS's blocked ``dgetrf`` costs the same, 59k instructions for go2's 28
-rows, and a plain right-looking loop with partial pivoting measured 77k) in ``O(s^3)``: no new factorization of the ``(n + m)``-sized KKT matrix, which is what
+from the ``s x s`` table ``W_S`` in ``O(s^2)`` and factored with LU in ``O(s^3)``
+(LAPACK's ``dgetrf``: on go2's 28 rows it costs what the unblocked ``dgetf2`` does,
+59k instructions, on talos' 64 rows a third less, and a plain right-looking loop with
+partial pivoting measured 77k on 28): no new factorization of the ``(n + m)``-sized KKT matrix, which is what
 the polishing of :mod:`fccqp.polish` pays for every active set and every Newton step
 (on go2, 84 rows and ``s = 24``: a warm polish cost 220 us there, mostly ``dsytrf``).
 The system is solved as corrections of the current point against the residual of the
@@ -35,7 +36,7 @@ with the regularized KKT matrix instead.
 
 from libc.math cimport INFINITY, fabs
 
-from scipy.linalg.cython_lapack cimport dgetf2, dgetrs
+from scipy.linalg.cython_lapack cimport dgetrf, dgetrs
 
 from fccqp._dense cimport colmatvec, fill, inf_norm, matvec, matvec_t
 from fccqp._types cimport Problem
@@ -208,7 +209,7 @@ cdef bint table_factor(Polish* w, const Problem* p, const Reduced* t, const doub
     cdef Py_ssize_t i
     cdef double big = 0.0, small = INFINITY, pivot
     _assemble(w, p, t, rho, nb)
-    dgetf2(&size, &size, w.T, &size, w.tpiv, &info)
+    dgetrf(&size, &size, w.T, &size, w.tpiv, &info)
     if info != 0:
         return False
     for i in range(size):
