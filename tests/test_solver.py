@@ -206,7 +206,7 @@ def test_lp_solution_matches_clarabel():
 
 
 def test_budget_statuses():
-    problem = random_problem(11, psd_rank=10)   # without polishing, which solves it from 2 iterations
+    problem = random_problem(11, psd_rank=10)   # polishing solves it from 2 iterations
     result = fccqp.solve(*problem, max_iter=2, eps_abs=1e-12, eps_rel=0.0, polish=False)
     assert result.status is Status.MAX_ITER_REACHED
     result = fccqp.solve(*problem, time_limit=1e-9, eps_abs=1e-12, eps_rel=0.0, polish=False)
