@@ -28,6 +28,8 @@ cdef int kkt_factor(KKT* k, const Problem* p, int backend, double sigma,
                     const double* rho_vec) noexcept nogil
 cdef void kkt_solve(KKT* k, const Problem* p, const double* rho_vec, const double* rhs,
                     double* sol) noexcept nogil
+cdef void kkt_solve_once(KKT* k, const Problem* p, const double* rho_vec, const double* rhs,
+                         double* sol) noexcept nogil
 cdef bint kkt_unit_columns(KKT* k, const Problem* p, const double* rho_vec,
                            const Py_ssize_t* entries, int count, double* W) noexcept nogil
 cdef int kkt_convexity(KKT* k, const Problem* p, double sigma, const double* rho_vec,

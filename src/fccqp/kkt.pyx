@@ -7,7 +7,7 @@ Every backend solves the KKT system of the x-update,
     [ A                 0  ] [nu] = [b],      R = diag(rho on constrained entries),
 
 through four calls: :func:`kkt_factor` (for given P, A, sigma, rho), :func:`kkt_solve`
-(one refined right-hand side), :func:`kkt_unit_columns` (responses to unit right-hand
+(one refined right-hand side; :func:`kkt_solve_once` for callers that refine), :func:`kkt_unit_columns` (responses to unit right-hand
 sides on chosen entries, the reduced form's table and the restoration's columns) and
 :func:`kkt_convexity` (is the QP convex?). The backends are :mod:`fccqp.schur`
 (Cholesky, needs ``P + R`` positive definite and ``A`` of full row rank; the reduced
@@ -17,7 +17,8 @@ the reduced forms.
 
 from fccqp._types cimport Problem
 from fccqp.ldl cimport ldl_factor, ldl_solve, ldl_unit_columns
-from fccqp.schur cimport schur_certifies_convexity, schur_factor, schur_solve, schur_unit_columns
+from fccqp.schur cimport (schur_certifies_convexity, schur_factor, schur_solve, schur_solve_once,
+                         schur_unit_columns)
 
 
 cdef int kkt_factor(KKT* k, const Problem* p, int backend, double sigma,
@@ -40,6 +41,18 @@ cdef void kkt_solve(KKT* k, const Problem* p, const double* rho_vec, const doubl
     """Solve for ``rhs`` into ``sol`` with the backend factored last, refined."""
     if k.backend == SCHUR_REDUCED:
         schur_solve(&k.schur, p, rho_vec, rhs, sol)
+    else:
+        ldl_solve(&k.ldl, p, k.sigma, rho_vec, rhs, sol)
+
+
+cdef void kkt_solve_once(KKT* k, const Problem* p, const double* rho_vec, const double* rhs,
+                         double* sol) noexcept nogil:
+    """:func:`kkt_solve` for a caller that refines against its own residual: the Schur
+    backend's factorization is of the system itself, and one unrefined solve is then
+    enough (on talos' warm polish the refinement had doubled the cost of each of its
+    KKT solves); the LDL' backend, regularized by ``delta``, still refines."""
+    if k.backend == SCHUR_REDUCED:
+        schur_solve_once(&k.schur, p, rhs, sol)
     else:
         ldl_solve(&k.ldl, p, k.sigma, rho_vec, rhs, sol)
 

@@ -40,7 +40,7 @@ from scipy.linalg.cython_lapack cimport dgetrf, dgetrs
 
 from fccqp._dense cimport colmatvec, fill, inf_norm, matvec, matvec_t
 from fccqp._types cimport Problem
-from fccqp.kkt cimport KKT, kkt_solve
+from fccqp.kkt cimport KKT, kkt_solve_once
 from fccqp.polish cimport APEX, FIXED, LOWER, UPPER, Polish
 from fccqp.reduced cimport Reduced
 
@@ -171,7 +171,7 @@ cdef void _correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
         w.kkt_solved = w.kkt_norm > max(tiny, _MINOR_PART * inf_norm(w.tr, s + nb),
                                         _FLOOR_FACTOR * w.kkt_floor)
         if w.kkt_solved:
-            kkt_solve(kkt, p, rho, w.full, w.dfull)   # d0 = K_R^-1 (r1, r2)
+            kkt_solve_once(kkt, p, rho, w.full, w.dfull)   # d0 = K_R^-1 (r1, r2)
         else:   # the KKT part holds already, is minor, or is at its rounding floor
             fill(w.dfull, 0.0, N)
         for j in range(s):

@@ -21,6 +21,8 @@ cdef struct Schur:
 cdef bint schur_factor(Schur* f, const Problem* p, const double* rho_vec) noexcept nogil
 cdef bint schur_certifies_convexity(Schur* f, const Problem* p, const double* rho_vec,
                                     double sigma) noexcept nogil
+cdef void schur_solve_once(Schur* f, const Problem* p, const double* rhs,
+                           double* sol) noexcept nogil
 cdef void schur_solve(Schur* f, const Problem* p, const double* rho_vec, const double* rhs,
                       double* sol) noexcept nogil
 cdef void schur_unit_columns(Schur* f, const Problem* p, double* W) noexcept nogil

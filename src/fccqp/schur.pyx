@@ -127,6 +127,13 @@ cdef void _solve(Schur* f, const Problem* p, const double* rhs_x, const double* 
         x[i] -= f.ATnu[i]
 
 
+cdef void schur_solve_once(Schur* f, const Problem* p, const double* rhs,
+                           double* sol) noexcept nogil:
+    """Solve for ``rhs = (f, g)`` into ``sol = (x, nu)`` without refinement: for callers
+    that refine against their own residual (no aliasing)."""
+    _solve(f, p, rhs, rhs + p.n, sol, sol + p.n)
+
+
 cdef void schur_solve(Schur* f, const Problem* p, const double* rho_vec, const double* rhs,
                       double* sol) noexcept nogil:
     """Solve for ``rhs = (f, g)`` into ``sol = (x, nu)``, refined (no aliasing)."""
