@@ -333,6 +333,7 @@ cdef class Workspace:
         aa.dg, aa.df = self._new(memory * 2 * s), self._new(memory * 2 * s)
         aa.g, aa.f, aa.g_new, aa.f_new = self._new(2 * s), self._new(2 * s), self._new(2 * s), self._new(2 * s)
         aa.plain, aa.gram, aa.gamma = self._new(2 * s + 1), self._new(memory * memory), self._new(memory)
+        aa.products = self._new(memory * memory)
         anderson_reset(aa, False)
         rs = &self.rest
         rs.pinned = <char*>self._new(s)

@@ -11,6 +11,7 @@ cdef struct Anderson:
     double* g_new           # 2s scratch
     double* f_new           # 2s scratch
     double* plain           # 2s + 1: T of the last accelerated point, and its |f|
+    double* products        # capacity x capacity: products[i, l] = df_i'df_l of stored slots
     double* gram            # capacity x capacity scratch
     double* gamma           # capacity scratch
     long stored             # pairs stored so far

@@ -102,6 +102,13 @@ cdef void anderson_step(Anderson* a, Iterates* it, Py_ssize_t s) noexcept nogil:
             a.dg[slot * two_s + j] = g[j] - a.g[j]
             a.df[slot * two_s + j] = f[j] - a.f[j]
         a.stored += 1
+        # only the new slot's products change: O(capacity s) instead of O(capacity^2 s)
+        for l in range(min(a.stored, <long>cap)):
+            acc = 0.0
+            for j in range(two_s):
+                acc += a.df[slot * two_s + j] * a.df[l * two_s + j]
+            a.products[slot * cap + l] = acc
+            a.products[l * cap + slot] = acc
     for j in range(two_s):
         a.g[j] = g[j]
         a.f[j] = f[j]
@@ -113,12 +120,8 @@ cdef void anderson_step(Anderson* a, Iterates* it, Py_ssize_t s) noexcept nogil:
         return
     ridge = 0.0
     for i in range(stored):
-        for l in range(i + 1):
-            acc = 0.0
-            for j in range(two_s):
-                acc += a.df[i * two_s + j] * a.df[l * two_s + j]
-            a.gram[i * stored + l] = acc
-            a.gram[l * stored + i] = acc
+        for l in range(stored):
+            a.gram[i * stored + l] = a.products[i * cap + l]
         ridge = max(ridge, a.gram[i * stored + i])
         acc = 0.0
         for j in range(two_s):
