@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from functools import cached_property, lru_cache
+from functools import cached_property
 
 import numpy as np
 
@@ -148,23 +148,26 @@ def _check_friction(cone: FrictionCone, index: int) -> np.ndarray:
     return normal / norm
 
 
-def _signature(cone: object) -> tuple:
-    """The types behind a cone's value: part of the memo key, because specs that
-    compare equal may differ in validity (``0.5 + 0j == 0.5``, ``2.0 == 2``)."""
+def _key(cone: object) -> tuple:
+    """A cone's values and the types behind them, as a memo key of plain values (hashed
+    in C, unlike the dataclass): the types are part of it because specs that compare
+    equal may differ in validity (``0.5 + 0j == 0.5``, ``2.0 == 2``)."""
+    kind = type(cone)
     if isinstance(cone, FrictionCone):
-        normal = cone.normal
-        kinds = tuple(map(type, normal)) if isinstance(normal, tuple) else type(normal)
-        return type(cone), type(cone.start), type(cone.mu), kinds
+        start, mu, normal = cone.start, cone.mu, cone.normal
+        kinds = tuple(map(type, normal)) if type(normal) is tuple else type(normal)
+        return kind, start, type(start), mu, type(mu), normal, kinds
     if isinstance(cone, SecondOrderCone):
-        return type(cone), type(cone.start), type(cone.dim)
-    return (type(cone),)
+        start, dim = cone.start, cone.dim
+        return kind, start, type(start), dim, type(dim)
+    return kind, cone
 
 
 def flatten_cones(cones: Sequence[Cone], n: int) -> ConeArrays:
     """Validate cone specs for an ``n``-vector and return them as flat arrays.
 
-    Results are memoized for hashable inputs, keyed on the specs and the types of
-    their fields (see :func:`_signature`): a control loop passes the same cones every
+    Results are memoized for hashable inputs, keyed on the specs' values and the types
+    of their fields (see :func:`_key`): a control loop passes the same cones every
     tick, and a spec that only compares equal to a valid one is still validated.
 
     Raises
@@ -183,16 +186,22 @@ def flatten_cones(cones: Sequence[Cone], n: int) -> ConeArrays:
             f"cones must be a sequence of FrictionCone or SecondOrderCone, got {cones!r}"
         )
     cones = tuple(cones)
-    key = tuple((cone, _signature(cone)) for cone in cones)
     try:
-        return _flatten_cached(key, n)
+        key = (n, *map(_key, cones))
+        flat = _MEMO.get(key)
     except TypeError:  # unhashable field, e.g. a numpy normal: validate uncached
         return _flatten(cones, n)
+    if flat is None:
+        flat = _flatten(cones, n)
+        if len(_MEMO) >= MEMO_SIZE:
+            _MEMO.clear()
+        _MEMO[key] = flat
+    return flat
 
 
-@lru_cache(maxsize=64)
-def _flatten_cached(key: tuple[tuple[Cone, tuple], ...], n: int) -> ConeArrays:
-    return _flatten([cone for cone, _ in key], n)
+MEMO_SIZE = 64
+"""Most cone lists :func:`flatten_cones` remembers (all are forgotten when full)."""
+_MEMO: dict[tuple, ConeArrays] = {}
 
 
 def _flatten(cones: Sequence[Cone], n: int) -> ConeArrays:

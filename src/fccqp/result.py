@@ -62,3 +62,13 @@ class Result:
     """True when the returned point is the polished one (``Settings.polish``): the
     exact solution of the QP on the guessed active set, which passed the KKT check on
     the user's problem; False when polishing was off, failed or was rejected."""
+
+    @classmethod
+    def _of(cls, fields: dict[str, object]) -> Result:
+        """A result with every field given in ``fields``, without the frozen
+        dataclass's ``__init__``, which sets each field through ``object.__setattr__``:
+        34k instructions per solve against 11k (callgrind), a quarter of the Python
+        layer of a go2 solve."""
+        result = object.__new__(cls)
+        result.__dict__.update(fields)
+        return result

@@ -177,14 +177,14 @@ class Solver:
             certificate_out = certificate[:n].copy()
         else:
             certificate_out = None
-        result = Result(
-            x=x, y=y, z=z, status=status, obj=obj, iterations=iterations,
-            prim_res=prim, dual_res=dual, setup_time=setup_time,
-            solve_time=time.perf_counter() - start, rho=rho,
-            factorizations=factorizations, certificate=certificate_out,
-            gap=float("nan") if status.is_infeasible() else gap, backend=backend,
-            polished=polished,
-        )
+        result = Result._of({
+            "x": x, "y": y, "z": z, "status": status, "obj": obj, "iterations": iterations,
+            "prim_res": prim, "dual_res": dual, "setup_time": setup_time,
+            "solve_time": time.perf_counter() - start, "rho": rho,
+            "factorizations": factorizations, "certificate": certificate_out,
+            "backend": backend, "gap": float("nan") if status.is_infeasible() else gap,
+            "polished": polished,
+        })
         if settings.verbose:
             _print_log(w.log_lines, result)
         return result
