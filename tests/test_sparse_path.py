@@ -14,7 +14,7 @@ import pytest
 import scipy.sparse as sp
 
 import fccqp
-from fccqp import FrictionCone, SecondOrderCone, Status
+from fccqp import FrictionCone, SecondOrderCone, Status, scaling, sparse_problem
 from fccqp.settings import MAX_DENSE_KKT_ROWS
 from problems import random_problem
 from reference import clarabel_solve
@@ -29,6 +29,24 @@ def sparse_args(problem):
     """The problem with ``P`` and ``A`` as CSC matrices."""
     P, q, A, b, lb, ub, cones = problem
     return sp.csc_matrix(P), q, sp.csc_matrix(A), b, lb, ub, cones
+
+
+def test_equilibration_is_the_dense_kernels():
+    """``sparse_problem.equilibrate`` computes the dense kernel's scaling (Ruiz passes with
+    the cone blocks kept uniform, cost normalization) to rounding."""
+    P, q, A, b, lb, ub, cones = random_problem(4, soc_dim=4)
+    scaled = sparse_problem.equilibrate(sparse_problem.convert(P, q, A, b, lb, ub, cones), 10)
+    P_d, q_d, A_d, b_d = P.copy(), q.copy(), A.copy(), b.copy()
+    D, E = np.empty(P.shape[0]), np.empty(A.shape[0])
+    starts = np.array([cone.start for cone in cones], dtype=np.intp)
+    dims = np.array([cone.dim for cone in cones], dtype=np.intp)
+    c = scaling.equilibrate_py(P_d, q_d, A_d, b_d, starts, dims, 10, D, E)
+    np.testing.assert_allclose(scaled.D, D, rtol=1e-14)
+    np.testing.assert_allclose(scaled.E, E, rtol=1e-14)
+    assert scaled.c == pytest.approx(c, rel=1e-14)
+    np.testing.assert_allclose(scaled.P.toarray(), P_d, atol=1e-14)
+    np.testing.assert_allclose(scaled.A.toarray(), A_d, atol=1e-14)
+    np.testing.assert_allclose(scaled.q, q_d, atol=1e-14)
 
 
 @pytest.mark.parametrize("seed", range(6))

@@ -233,18 +233,19 @@ def _inverse_sqrt_norm(norm: np.ndarray) -> np.ndarray:
                     1.0 / np.sqrt(np.clip(norm, MIN_NORM, MAX_NORM)))
 
 
-def _column_max(M: sp.csc_matrix) -> np.ndarray:
-    """Largest magnitude of each column of ``M`` (0 for an empty column)."""
-    if M.nnz == 0:
-        return np.zeros(M.shape[1])
-    return np.asarray(abs(M).max(axis=0).todense()).reshape(-1)
-
-
-def _row_max(M: sp.csc_matrix) -> np.ndarray:
-    """Largest magnitude of each row of ``M`` (0 for an empty row)."""
-    if M.nnz == 0:
-        return np.zeros(M.shape[0])
-    return np.asarray(abs(M).max(axis=1).todense()).reshape(-1)
+def _column_max(M: sp.csc_matrix, row_weight: np.ndarray | None = None) -> np.ndarray:
+    """Largest ``|M_ij| w_i`` of each column ``j`` of the CSC matrix ``M`` (0 for an empty
+    column), ``w`` the ``row_weight`` (ones by default): one pass over the stored
+    entries, no product of matrices."""
+    values = np.abs(M.data)
+    if row_weight is not None:
+        values = values * row_weight[M.indices]
+    counts = np.diff(M.indptr)
+    out = np.zeros(M.shape[1])
+    filled = counts > 0
+    if filled.any():
+        out[filled] = np.maximum.reduceat(values, M.indptr[:-1][filled])
+    return out
 
 
 def equilibrate(data: SparseData, passes: int, previous: Scaled | None = None) -> Scaled:
@@ -257,13 +258,13 @@ def equilibrate(data: SparseData, passes: int, previous: Scaled | None = None) -
     if previous is not None:
         return _assemble(data, previous.P, previous.A, previous.D, previous.E, previous.c)
     P, A = data.P, data.A
+    A_rows = A.T.tocsc()   # the rows of A as columns
     D, E = np.ones(data.n), np.ones(data.m)
     starts = data.constrained[data.cones.offset]
     for _ in range(passes):
-        Ds, Es = sp.diags(D), sp.diags(E)
-        P_now, A_now = Ds @ P @ Ds, Es @ A @ Ds
-        d = _inverse_sqrt_norm(np.maximum(_column_max(P_now), _column_max(A_now)))
-        e = _inverse_sqrt_norm(_row_max(A_now))
+        # the norms of the current D P D and E A D, read off the original entries
+        d = _inverse_sqrt_norm(D * np.maximum(_column_max(P, D), _column_max(A, E)))
+        e = _inverse_sqrt_norm(E * _column_max(A_rows, D))
         for start, dim in zip(starts, data.cones.dim, strict=True):
             block = slice(start, start + dim)
             d[block] = np.exp(np.mean(np.log(d[block])))
