@@ -142,7 +142,8 @@ class Settings:
     restore_feasibility: bool = True
     """Return a point in the box and the cones: the violating entries are pinned at
     their projection and the others respond through the KKT system, keeping
-    ``A x = b``; see :mod:`fccqp.restoration`."""
+    ``A x = b``; see :mod:`fccqp.restoration`. The dense path only: it has no effect on
+    the sparse path (:mod:`fccqp.sparse_admm`)."""
     polish: bool = True
     """After ADMM (solved or stopped by a budget), solve the equality-constrained QP on
     the active set its iterate suggests (box entries at a bound, cone blocks at the apex

@@ -240,7 +240,8 @@ class SparseWorkspace:
             self.final_reserve = max(RESERVE_DECAY * self.final_reserve,
                                      time.perf_counter() - run.iterations_end)
         keep = outcome.residuals.finite and not outcome.status.is_infeasible()
-        self.previous = (outcome.x, outcome.y, outcome.z) if keep else None
+        # copies: the Result hands the arrays to the caller, who may write into them
+        self.previous = (outcome.x.copy(), outcome.y.copy(), outcome.z.copy()) if keep else None
         self.previous_rho = outcome.rho
         self.previous_polished = keep and outcome.polished
         return outcome
@@ -265,6 +266,7 @@ class _Run:
         self.certificate: np.ndarray | None = None
         self.log: list[tuple[float, ...]] = []
         self.iterated = False
+        self.iteration = 0   # iterations taken so far
         self.iterations_end = 0.0
         self.res = Residuals()
 
@@ -301,8 +303,8 @@ class _Run:
         if negative > self.p.m:
             raise NotConvexError(
                 "the QP is not convex: P has negative curvature on the null space of A "
-                f"(the KKT matrix has {negative} negative pivots, more than the "
-                f"{self.p.m} rows of A)")
+                f"(P is not positive semidefinite: the KKT matrix has {negative} negative "
+                f"pivots, more than the {self.p.m} rows of A)")
         return negative
 
     def _equality_start(self) -> bool:
@@ -518,9 +520,9 @@ class _Run:
                 if polished:
                     return Status.SOLVED, 0, True
             return self._loop(start, timed, deadline)
-        except FactorizationError:
+        except FactorizationError:   # a zero pivot: not quasi-definite (overflow, say)
             self.w.factored_rho = None
-            return Status.NUMERICAL_ERROR, 0, False
+            return Status.NUMERICAL_ERROR, self.iteration, False
 
     def _loop(self, start: float, timed: bool, deadline: float) -> tuple[Status, int, bool]:
         """ADMM iterations until a status; then the final polish."""
@@ -535,6 +537,7 @@ class _Run:
             status = self._classify(0, True)   # the setup spent the budget
         while status is None:
             iteration += 1
+            self.iteration = iteration
             self._step(not fresh)
             fresh = False
             last = iteration >= o.max_iter or (
