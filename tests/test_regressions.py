@@ -478,20 +478,22 @@ def test_item17_inequality_multipliers_are_exactly_nonnegative():
         assert (solution.z >= 0).all(), getter.__name__
 
 
-def test_item17_listed_as_sparse_and_large_sparse_input_is_refused():
+def test_item17_listed_as_sparse_and_large_sparse_input_is_solved():
     """Item 17: fccqp takes scipy.sparse input, so it is a sparse solver too; a problem
-    beyond the dense backend's limit raises a ValueError naming its size."""
+    beyond the dense core's limit (it used to raise a ValueError naming its size) now
+    takes the sparse path, without being densified."""
     qpsolvers = pytest.importorskip("qpsolvers")
     import scipy.sparse as sp
 
-    from fccqp.qpsolvers_backend import MAX_KKT_ROWS
+    from fccqp.settings import MAX_DENSE_KKT_ROWS
 
     assert "fccqp" in qpsolvers.sparse_solvers and "fccqp" in qpsolvers.dense_solvers
-    n = MAX_KKT_ROWS
+    n = MAX_DENSE_KKT_ROWS
     G = sp.eye(n, format="csc")
-    with pytest.raises(ValueError, match=rf"{3 * n} x {3 * n}.*{MAX_KKT_ROWS}"):
-        qpsolvers.solve_qp(sp.eye(n, format="csc"), np.ones(n), G, np.ones(n),
-                           solver="fccqp")
+    solution = qpsolvers.solve_problem(
+        qpsolvers.Problem(sp.eye(n, format="csc"), np.ones(n), G, np.ones(n)), solver="fccqp")
+    assert solution.found and solution.extras["backend"] == "sparse"
+    np.testing.assert_allclose(solution.x, -np.ones(n), atol=1e-9)
 
 
 # item 18 --------------------------------------------------------------------------

@@ -23,13 +23,13 @@ rounding in the unscaling (values like ``-4.8e-18`` occur); the backend clips it
 ``P x + q + A'y + G'z + z_box = 0`` with ``y = y_A`` and ``z_box = z_x``
 (negative at an active lower bound, positive at an active upper bound).
 
-fccqp is a dense solver, meant for 30-300 variables: sparse ``P``, ``G``, ``A``
+fccqp's core is dense, meant for 30-300 variables: sparse ``P``, ``G``, ``A``
 (``scipy.sparse`` matrices or arrays, ``csc_array`` included) are accepted and
-densified, so it is listed in both ``qpsolvers.dense_solvers`` and
-``qpsolvers.sparse_solvers`` (as ProxQP and PIQP are). Before densifying, the size
-of the slack form's KKT matrix, ``n + m_A + 2 m_G`` rows, is checked against
-:data:`MAX_KKT_ROWS`: a larger problem raises ``ValueError`` rather than running
-out of memory.
+densified. Before densifying, the size of the slack form's KKT matrix, ``n + m_A + 2
+m_G`` rows, is checked against :data:`fccqp.settings.MAX_DENSE_KKT_ROWS`: a larger
+problem (or any, with ``kkt_backend="sparse"``) keeps its matrices sparse, builds the
+slack form sparse and takes fccqp's sparse path (:mod:`fccqp.sparse_admm`). So fccqp
+is listed in both ``qpsolvers.dense_solvers`` and ``qpsolvers.sparse_solvers``.
 
 Registration. qpsolvers has no plugin mechanism: :func:`register` adds "fccqp" to
 its module-level registry, which ``import fccqp`` calls. Importing qpsolvers takes
@@ -49,8 +49,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from fccqp._import_hooks import after_import
-from fccqp.problem import ProblemData, issparse, validate
-from fccqp.settings import Settings
+from fccqp.problem import issparse, validate
+from fccqp.settings import MAX_DENSE_KKT_ROWS, Settings
 
 if TYPE_CHECKING:
     import scipy.sparse as sp
@@ -59,11 +59,6 @@ if TYPE_CHECKING:
 
 SOLVER_NAME = "fccqp"
 """Name of the solver in qpsolvers' registry."""
-
-MAX_KKT_ROWS = 5000
-"""Largest dense KKT matrix the backend builds: ``n + m_A + 2 m_G`` rows. At this
-size the matrix takes 200 MB and one factorization about 4e10 flops (seconds), ten
-times the 500 rows the dense backend is meant for."""
 
 
 def _settings(verbose: bool, kwargs: dict[str, object]) -> Settings:
@@ -80,20 +75,15 @@ def _settings(verbose: bool, kwargs: dict[str, object]) -> Settings:
         raise ParamError(f"fccqp: {exn}") from exn
 
 
-def _check_size(problem: Problem) -> None:
-    """Refuse, before densifying anything, a slack form above :data:`MAX_KKT_ROWS`."""
+def _kkt_rows(problem: Problem) -> int:
+    """Rows of the slack form's KKT matrix, ``n + m_A + 2 m_G``, from the shapes alone."""
     def rows(M: object) -> int:
+        if M is None:
+            return 0
         shape = getattr(M, "shape", None) or np.shape(M)
-        return 0 if M is None else shape[0] if len(shape) == 2 else 1
+        return shape[0] if len(shape) == 2 else 1
 
-    n, m_A, m_G = rows(problem.P), rows(problem.A), rows(problem.G)
-    rows = n + m_A + 2 * m_G
-    if rows > MAX_KKT_ROWS:
-        raise ValueError(
-            f"fccqp is a dense solver: this problem (n = {n}, {m_A} rows of A, {m_G} rows "
-            f"of G) needs a {rows} x {rows} KKT matrix, above the limit of {MAX_KKT_ROWS} "
-            f"rows (fccqp.qpsolvers_backend.MAX_KKT_ROWS); use a sparse solver"
-        )
+    return rows(problem.P) + rows(problem.A) + 2 * rows(problem.G)
 
 
 def _real_array(value: object, name: str) -> np.ndarray:
@@ -108,15 +98,27 @@ def _real_array(value: object, name: str) -> np.ndarray:
         raise TypeError(f"{name} must be numeric: {exn}") from exn
 
 
-def _inequalities(G: object, h: object, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Check ``G x <= h`` and return it dense; errors name ``G`` or ``h``."""
-    G = _real_array(G, "G")
+def _inequalities(G: object, h: object, n: int,
+                  sparse: bool = False) -> tuple[np.ndarray | sp.csc_matrix, np.ndarray]:
+    """Check ``G x <= h`` and return it dense (CSC with ``sparse``); errors name ``G``
+    or ``h``."""
+    if sparse:
+        import scipy.sparse as sp
+
+        if np.iscomplexobj(G) or (issparse(G) and G.dtype.kind == "c"):
+            raise TypeError("G must be real, got complex entries")
+        G = sp.csc_matrix(G, dtype=np.float64) if issparse(G) else sp.csc_matrix(
+            _real_array(G, "G"))
+        values = G.data
+    else:
+        G = _real_array(G, "G")
+        values = G
     h = _real_array(h, "h").reshape(-1)
     if G.ndim != 2 or G.shape[1] != n:
         raise ValueError(f"G must have {n} columns (the size of P), got shape {G.shape}")
     if h.shape[0] != G.shape[0]:
         raise ValueError(f"G has {G.shape[0]} rows but h has {h.shape[0]} entries")
-    if not np.isfinite(G).all():
+    if not np.isfinite(values).all():
         raise ValueError("G contains NaN or inf")
     if np.isnan(h).any():
         raise ValueError("h contains NaN")
@@ -126,15 +128,25 @@ def _inequalities(G: object, h: object, n: int) -> tuple[np.ndarray, np.ndarray]
     return G, h
 
 
-def _with_slacks(data: ProblemData, G: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Return ``(P, q, A, b, lb, ub)`` over ``[x; s]`` with ``G x - s = 0``, ``s <= h``."""
+def _with_slacks(data: object, G: np.ndarray | sp.csc_matrix,
+                 h: np.ndarray) -> tuple[object, ...]:
+    """Return ``(P, q, A, b, lb, ub)`` over ``[x; s]`` with ``G x - s = 0``, ``s <= h``;
+    the matrices are dense for dense ``data`` (:class:`fccqp.problem.ProblemData`) and
+    CSC for sparse ``data`` (:class:`fccqp.sparse_problem.SparseData`)."""
     n, m, k = data.n, data.m, G.shape[0]
-    P = np.zeros((n + k, n + k))
-    P[:n, :n] = data.P
-    A = np.zeros((m + k, n + k))
-    A[:m, :n] = data.A
-    A[m:, :n] = G
-    A[m:, n:] = -np.eye(k)
+    if issparse(data.P):
+        import scipy.sparse as sp
+
+        P = sp.block_diag([data.P, sp.csc_matrix((k, k))], format="csc")
+        A = sp.vstack([sp.hstack([data.A, sp.csc_matrix((m, k))]),
+                       sp.hstack([G, -sp.eye(k)])], format="csc")
+    else:
+        P = np.zeros((n + k, n + k))
+        P[:n, :n] = data.P
+        A = np.zeros((m + k, n + k))
+        A[:m, :n] = data.A
+        A[m:, :n] = G
+        A[m:, n:] = -np.eye(k)
     return (
         P,
         np.concatenate([data.q, np.zeros(k)]),
@@ -170,7 +182,10 @@ def fccqp_solve_problem(
     problem : qpsolvers.Problem
         ``min 1/2 x'Px + q'x  s.t.  G x <= h, A x = b, lb <= x <= ub``. ``P`` must be
         symmetric positive semidefinite; matrices may be dense or ``scipy.sparse``
-        (densified). Inequalities become slack variables (see the module docstring).
+        (densified, unless the slack form's KKT matrix exceeds
+        :data:`fccqp.settings.MAX_DENSE_KKT_ROWS` rows or ``kkt_backend="sparse"``:
+        then the problem takes the sparse path). Inequalities become slack variables
+        (see the module docstring).
     initvals : (n,) array_like, optional
         Primal initial guess ``x0``; the slacks start at ``G x0``. Without it the
         solve starts cold.
@@ -189,7 +204,8 @@ def fccqp_solve_problem(
         ``Status.NUMERICAL_ERROR``, ``x, y, z, z_box`` hold the last (finite) iterate
         and ``found`` is False; on infeasibility they are None. ``extras`` holds the
         fccqp ``status``, ``iterations``, ``prim_res``, ``dual_res`` (of the slack
-        form), ``setup_time``, ``solve_time``, ``rho``, ``factorizations`` and
+        form), ``setup_time``, ``solve_time``, ``rho``, ``factorizations``,
+        ``backend`` (the KKT backend that ran, ``"sparse"`` on the sparse path) and
         ``certificate`` (of the slack form, see ``fccqp.Result``).
 
     Raises
@@ -198,9 +214,8 @@ def fccqp_solve_problem(
         On an unknown keyword or an invalid setting value, naming it.
     ValueError, TypeError
         On malformed problem data, naming the argument (``P``, ``q``, ``G``, ``h``,
-        ``A``, ``b``, ``lb``, ``ub``, ``initvals``; complex entries included), when
-        ``P`` is not convex on the null space of ``A``, or when the slack form's KKT
-        matrix would exceed :data:`MAX_KKT_ROWS` rows.
+        ``A``, ``b``, ``lb``, ``ub``, ``initvals``; complex entries included), or when
+        ``P`` is not convex on the null space of ``A``.
     """
     from qpsolvers import Solution
 
@@ -211,16 +226,21 @@ def fccqp_solve_problem(
 
     build_start = time.perf_counter()
     problem.check_constraints()
-    _check_size(problem)
     settings = _settings(verbose, kwargs)
     P, q, G, h, A, b, lb, ub = problem.unpack()
-    data = validate(P, q, A, b, lb, ub)
+    sparse = settings.kkt_backend == "sparse" or _kkt_rows(problem) > MAX_DENSE_KKT_ROWS
+    if sparse:   # never densified: the slack form is built sparse, for the sparse path
+        from fccqp.sparse_problem import convert
+
+        data = convert(P, q, A, b, lb, ub)
+    else:
+        data = validate(P, q, A, b, lb, ub)
     x0 = None if initvals is None else _initial_guess(initvals, data.n)
     if G is None:
         args = (data.P, data.q, data.A, data.b, data.lb, data.ub)
         m_G = 0
     else:
-        G, h = _inequalities(G, h, data.n)
+        G, h = _inequalities(G, h, data.n, sparse)
         args = _with_slacks(data, G, h)
         m_G = G.shape[0]
         if x0 is not None:
@@ -240,6 +260,7 @@ def fccqp_solve_problem(
         "solve_time": result.solve_time,
         "rho": result.rho,
         "factorizations": result.factorizations,
+        "backend": result.backend,
         "certificate": result.certificate,
     }
     solution.build_time = solve_start - build_start

@@ -19,6 +19,14 @@ MAX_POLISH_REFINE_ITER = 100
 """Most re-linearizations of polishing: Newton's method on the cones' tangent planes
 converges in 1-3 when the active set is right."""
 
+MAX_DENSE_KKT_ROWS = 5000
+"""Largest KKT matrix (``n + m`` rows) that the dense core factors. At this size the
+dense matrix takes 200 MB and one factorization about 4e10 flops (seconds), ten times
+the 500 rows the dense core is meant for; a larger problem takes the sparse path
+(``kkt_backend="sparse"``, :mod:`fccqp.sparse_admm`), whatever ``kkt_backend`` says."""
+KKT_BACKENDS = ("auto", "schur_reduced", "ldl_reduced", "ldl_full", "sparse")
+"""The values of ``Settings.kkt_backend``."""
+
 REALTIME_BUDGET = 2e-3
 """Default budget of :meth:`Settings.realtime` in seconds. Measured on the full benchmark
 (budgets 0.5, 1, 2, 3 ms; share solved on solo12 / anymal_c / go2 / talos_reduced): 98 /
@@ -134,7 +142,8 @@ class Settings:
     restore_feasibility: bool = True
     """Return a point in the box and the cones: the violating entries are pinned at
     their projection and the others respond through the KKT system, keeping
-    ``A x = b``; see :mod:`fccqp.restoration`."""
+    ``A x = b``; see :mod:`fccqp.restoration`. The dense path only: it has no effect on
+    the sparse path (:mod:`fccqp.sparse_admm`)."""
     polish: bool = True
     """After ADMM (solved or stopped by a budget), solve the equality-constrained QP on
     the active set its iterate suggests (box entries at a bound, cone blocks at the apex
@@ -155,10 +164,13 @@ class Settings:
     kkt_backend: str = "auto"
     """Linear-system backend of the x-update: ``"schur_reduced"`` (Cholesky of ``P + R``
     and of ``A (P + R)^-1 A'``, reduced iteration), ``"ldl_reduced"`` (LDL', reduced
-    iteration), ``"ldl_full"`` (LDL', one KKT solve per iteration) or ``"auto"`` (the
-    first of these that applies and pays; see docs/algorithm.md). A forced backend
-    that cannot factor the matrix falls back to the next one in that order;
-    ``Result.backend`` says which ran."""
+    iteration), ``"ldl_full"`` (LDL', one KKT solve per iteration), ``"sparse"`` (the
+    sparse path: ``scipy.sparse`` data and a sparse LDL' from ``qdldl``, one KKT solve
+    per iteration, :mod:`fccqp.sparse_admm`) or ``"auto"`` (the first of the dense ones
+    that applies and pays; see docs/algorithm.md). A forced dense backend that cannot
+    factor the matrix falls back to the next one in that order; a problem whose KKT
+    matrix has more than :data:`MAX_DENSE_KKT_ROWS` rows takes the sparse path whatever
+    this says. ``Result.backend`` says which ran."""
     warm_start: bool = True
     """Start from the previous solution (used by :class:`fccqp.Solver`)."""
     verbose: bool = False
@@ -179,10 +191,9 @@ class Settings:
             object.__setattr__(self, name, bool(value))
         if self.eps_abs == 0 and self.eps_rel == 0:
             raise ValueError("settings eps_abs and eps_rel cannot both be 0")
-        backends = ("auto", "schur_reduced", "ldl_reduced", "ldl_full")
-        if self.kkt_backend not in backends:
+        if self.kkt_backend not in KKT_BACKENDS:
             raise ValueError(
-                f"setting kkt_backend must be one of {', '.join(backends)}, "
+                f"setting kkt_backend must be one of {', '.join(KKT_BACKENDS)}, "
                 f"got {self.kkt_backend!r}"
             )
 

@@ -3,7 +3,10 @@
 Everything numeric happens in one compiled call per solve,
 :meth:`fccqp.admm.Workspace.solve`; this module converts the arguments, decides
 whether the previous solve's workspace fits the new problem's structure, and builds
-the :class:`~fccqp.result.Result`.
+the :class:`~fccqp.result.Result`. Problems whose KKT matrix exceeds
+:data:`fccqp.settings.MAX_DENSE_KKT_ROWS` rows, and every problem with
+``kkt_backend="sparse"``, go to the sparse path (:mod:`fccqp.sparse_admm`) instead,
+before anything is densified.
 """
 
 from __future__ import annotations
@@ -17,7 +20,7 @@ from fccqp import admm, schur
 from fccqp.cones import Cone, ConeArrays, flatten_cones
 from fccqp.problem import MAX_ENTRY, check_cone_bounds, convert, raise_finding
 from fccqp.result import Result
-from fccqp.settings import Settings
+from fccqp.settings import MAX_DENSE_KKT_ROWS, Settings
 from fccqp.status import Status
 from fccqp.validation import structure_scan
 
@@ -91,11 +94,14 @@ class Solver:
         self.settings = (settings or Settings()).replace(**overrides)
         self._structure: _Structure | None = None
         self._workspace: admm.Workspace | None = None
+        self._sparse = None   # the sparse path's workspace, made on its first problem
 
     def reset(self) -> None:
         """Forget the previous solve: the next one starts cold."""
         if self._workspace is not None:
             self._workspace.forget()
+        if self._sparse is not None:
+            self._sparse.forget()
 
     def solve(
         self,
@@ -114,8 +120,9 @@ class Solver:
         Parameters
         ----------
         P : (n, n) array_like or scipy.sparse matrix
-            Symmetric cost matrix (densified if sparse); the QP must be convex on the
-            null space of ``A`` (see docs/formulation.md).
+            Symmetric cost matrix (densified if sparse, unless the problem takes the
+            sparse path); the QP must be convex on the null space of ``A`` (see
+            docs/formulation.md).
         q : (n,) array_like
             Linear cost.
         A, b : (m, n) and (m,) array_like, optional
@@ -132,15 +139,22 @@ class Solver:
         -------
         Result
             Only ``Status.SOLVED`` means that the returned point meets the tolerances.
+            ``Result.backend`` is ``"sparse"`` when the problem took the sparse path:
+            ``settings.kkt_backend == "sparse"``, or a KKT matrix (``n + m`` rows) above
+            :data:`fccqp.settings.MAX_DENSE_KKT_ROWS`.
 
         Raises
         ------
         ValueError, TypeError
             On malformed input, naming the argument, and when the QP is not convex
             (detected from the inertia of the KKT matrix).
+        ImportError
+            When the problem takes the sparse path and ``qdldl`` is not installed.
         """
         start = time.perf_counter()
         settings = self.settings
+        if settings.kkt_backend == "sparse" or _rows(P) + _rows(A) > MAX_DENSE_KKT_ROWS:
+            return self._solve_sparse(P, q, A, b, lb, ub, cones, x0, start)
         P, q, A, b, lb, ub = convert(P, q, A, b, lb, ub)
         n, m = P.shape[0], A.shape[0]
         flat = flatten_cones(cones, n)   # memoized: the same object for the same cones
@@ -188,6 +202,45 @@ class Solver:
         if settings.verbose:
             _print_log(w.log_lines, result)
         return result
+
+
+    def _solve_sparse(self, P: object, q: object, A: object, b: object, lb: object,
+                      ub: object, cones: Sequence[Cone], x0: object,
+                      start: float) -> Result:
+        """The sparse path (:mod:`fccqp.sparse_admm`): the same arguments and Result."""
+        from fccqp import sparse_admm, sparse_problem
+
+        settings = self.settings
+        data = sparse_problem.convert(P, q, A, b, lb, ub, cones)
+        guess = None if x0 is None else _initial_guess(x0, data.n)
+        if self._sparse is None:
+            self._sparse = sparse_admm.SparseWorkspace(settings)
+        out = self._sparse.solve(data, guess, start)
+        status = out.status
+        result = Result(
+            x=out.x, y=out.y, z=out.z, status=status, obj=out.residuals.objective,
+            iterations=out.iterations, prim_res=out.residuals.prim,
+            dual_res=out.residuals.dual, setup_time=out.setup_time,
+            solve_time=time.perf_counter() - start, rho=out.rho,
+            factorizations=out.factorizations, certificate=out.certificate,
+            gap=float("nan") if status.is_infeasible() else out.residuals.gap,
+            backend=sparse_admm.BACKEND, polished=out.polished,
+        )
+        if settings.verbose:
+            _print_log(out.log, result)
+        return result
+
+
+def _rows(matrix: object) -> int:
+    """Rows of a matrix argument, read from its shape without converting it (0 for
+    ``None`` or anything without a 2-D shape, which conversion then reports)."""
+    if matrix is None:
+        return 0
+    try:
+        shape = matrix.shape if hasattr(matrix, "shape") else np.shape(matrix)
+    except (TypeError, ValueError):
+        return 0
+    return int(shape[0]) if len(shape) == 2 else 0
 
 
 def _initial_guess(x0: object, n: int) -> np.ndarray:

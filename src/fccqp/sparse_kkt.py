@@ -1,0 +1,168 @@
+"""Sparse quasi-definite LDL' backend of the x-update, through ``qdldl``.
+
+The x-update solves, for a right-hand side ``(r, b)``,
+
+    [ P + sigma I + R   A' ] [x ]   [r]
+    [ A                 0  ] [nu] = [b],      R = diag(rho on constrained entries),
+
+as the dense ``ldl_full`` backend (:mod:`fccqp.ldl`) does: the zero block is replaced
+by ``-delta I``, which makes the matrix quasi-definite (``P + sigma I + R`` is positive
+definite on a convex problem), so an LDL' factorization exists in any symmetric
+order, rank-deficient ``A`` included; ``qdldl`` factors it in its fill-reducing (AMD)
+order, without pivoting. Each solve is refined against the unregularized matrix until
+``A x = b`` holds to ``REFINE_TOLERANCE`` of its terms in the user's units; when a
+step stops halving that error, ``A x = b`` has no solution and the regularized
+(least-squares) solution is returned, refined against the factored matrix itself,
+which the equality certificate reads.
+
+``delta`` is larger than the dense backend's ``1e-13``: without pivoting, a row of
+``A`` eliminated before its variables has the pivot ``-delta`` and adds ``A_i'A_i /
+delta`` to the rest, so the rounding of the factorization grows like ``1 / delta``.
+At ``DELTA = 1e-9`` (scaled problem) refinement still reaches ``1e-13`` in one or two
+steps on well-posed rows.
+
+Inertia. By Sylvester's law the signs of the pivots ``d`` are the inertia of the
+factored matrix: without ``R``, more than ``m`` negative pivots means that ``P +
+sigma I`` has negative curvature on the null space of ``A`` (the QP is not convex).
+
+Contract (as in :mod:`fccqp.kkt`): :class:`SparseKKT` is built once per structure
+from the scaled ``(P, A)``; :meth:`SparseKKT.factor` for given ``sigma`` and penalties
+(a new numeric factorization on the same pattern); :meth:`SparseKKT.solve` for one
+right-hand side, refined.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+DELTA = 1e-9
+"""Quasi-definite regularization of the (2, 2) block (scaled problem)."""
+MAX_REFINE = 5
+"""Most refinement steps per solve."""
+REFINE_TOLERANCE = 1e-13
+"""Refine while ``||A x - b||`` (user's units) exceeds this times ``max(1, ||b||,
+|| |A| |x| ||)``, the size of the terms of ``A x``: the rounding of ``A x`` itself is
+``eps |A| |x|``, and on long rows (a row of 15000 ones in qpsolvers' sparse
+least-squares test) that floor lies above ``1e-13 max(||b||, ||A x||)``, which the
+dense backend's test uses (:data:`fccqp.ldl.REFINE_TOLERANCE`)."""
+REGULARIZED_STEPS = 2
+"""Refinement steps against the factored matrix when ``A x = b`` has no solution."""
+
+
+class FactorizationError(Exception):
+    """``qdldl`` met a zero pivot (the matrix is not quasi-definite: a non-convex ``P``
+    whose curvature cancels ``sigma`` exactly, or overflow)."""
+
+
+class SparseKKT:
+    """The x-update's KKT matrix on a fixed pattern, and its ``qdldl`` factorization.
+
+    Parameters
+    ----------
+    P, A : scipy.sparse.csc_matrix
+        The scaled problem's ``P`` (both triangles) and ``A``.
+    constrained : (s,) int array
+        The entries of ``x`` that carry a penalty.
+    E : (m,) array
+        Row scaling of ``A``: the refinement's stopping test divides row ``i`` of
+        ``A x - b`` by ``E_i`` (the user's units).
+    """
+
+    def __init__(self, P: sp.csc_matrix, A: sp.csc_matrix, constrained: np.ndarray,
+                 E: np.ndarray) -> None:
+        try:   # loaded when the sparse path first runs
+            import qdldl
+        except ImportError as exn:
+            raise ImportError(
+                "fccqp's sparse path (a KKT matrix above fccqp.settings.MAX_DENSE_KKT_ROWS "
+                "rows, or kkt_backend='sparse') needs the qdldl package: pip install qdldl"
+            ) from exn
+        self._qdldl = qdldl
+        self.P, self.A, self.E = P, A, E
+        self.abs_A = abs(A).tocsc()
+        self.AT = A.T.tocsc()
+        n, m = P.shape[0], A.shape[0]
+        self.n, self.m = n, m
+        self.constrained = constrained
+        # the upper triangle with every diagonal entry stored, zero or not, so that the
+        # pattern stays the same whatever sigma and rho are
+        upper = sp.triu(P, format="coo")
+        At = A.tocoo()
+        diagonal = np.arange(n + m)
+        rows = np.concatenate([upper.row, At.col, diagonal])
+        cols = np.concatenate([upper.col, n + At.row, diagonal])
+        values = np.concatenate([upper.data, At.data, np.zeros(n + m)])
+        K = sp.csc_matrix((values, (rows, cols)), shape=(n + m, n + m))
+        K.sort_indices()
+        coo = K.tocoo()
+        self._K = K
+        self._values = K.data.copy()
+        self._diagonal = np.flatnonzero(coo.row == coo.col)   # column order
+        self._solver = None
+        self.penalty = np.zeros(n)   # sigma + rho on each entry of x, set by factor
+
+    def factor(self, sigma: float, rho_vec: np.ndarray) -> int:
+        """Factor for ``sigma`` (on every entry of ``x``) and the penalties ``rho_vec`` on
+        the constrained entries; return the number of negative pivots.
+
+        Raises :class:`FactorizationError` when ``qdldl`` meets a zero pivot.
+        """
+        n = self.n
+        diagonal = self._values[self._diagonal]
+        diagonal[:n] += sigma
+        diagonal[self.constrained] += rho_vec
+        diagonal[n:] = -DELTA
+        K = self._K
+        K.data[:] = self._values
+        K.data[self._diagonal] = diagonal
+        try:
+            if self._solver is None:
+                self._solver = self._qdldl.Solver(K, upper=True)
+            else:
+                self._solver.update(K, upper=True)
+        except RuntimeError as exn:   # qdldl's report of a zero pivot
+            self._solver = None
+            raise FactorizationError(str(exn)) from exn
+        self.penalty = np.full(n, sigma)
+        self.penalty[self.constrained] += rho_vec
+        _, d, _ = self._solver.factors()
+        return int(np.count_nonzero(d < 0))
+
+    def _residual(self, rhs: np.ndarray, sol: np.ndarray, Ax: np.ndarray,
+                  delta: float) -> np.ndarray:
+        """``rhs - K sol`` for the matrix with ``-delta I`` as its (2, 2) block."""
+        n = self.n
+        x, nu = sol[:n], sol[n:]
+        top = rhs[:n] - self.P @ x - self.penalty * x - self.AT @ nu
+        return np.concatenate([top, rhs[n:] - Ax + delta * nu])
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        """Solve the unregularized system for ``rhs`` (refined, see the module docstring)."""
+        sol = self._solver.solve(rhs)
+        if self.m == 0:
+            return sol
+        n, E = self.n, self.E
+        b = rhs[n:]
+        last_error, step = np.inf, None
+        for r in range(MAX_REFINE + 1):
+            Ax = self.A @ sol[:n]
+            error = float(np.max(np.abs(b - Ax) / E))
+            size = float(np.max(np.maximum(np.abs(b), self.abs_A @ np.abs(sol[:n])) / E))
+            if error <= REFINE_TOLERANCE * max(1.0, size):
+                return sol
+            if error >= 0.5 * last_error:
+                # no progress: A x = b has no solution; undo the last step and refine
+                # against the regularized matrix, whose least-squares x the equality
+                # certificate reads
+                sol = sol - step
+                for _ in range(REGULARIZED_STEPS):
+                    sol = sol + self._solver.solve(
+                        self._residual(rhs, sol, self.A @ sol[:n], DELTA))
+                return sol
+            last_error = error
+            if r == MAX_REFINE:
+                return sol
+            step = self._solver.solve(self._residual(rhs, sol, Ax, 0.0))
+            sol = sol + step
+        return sol

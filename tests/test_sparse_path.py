@@ -1,0 +1,344 @@
+"""The sparse path (``fccqp.sparse_admm``): forced on small problems, and taken on its own
+by problems whose KKT matrix exceeds ``MAX_DENSE_KKT_ROWS``.
+
+Its answers are checked against Clarabel at tight tolerance and against the dense
+path, its statuses with ``verify_solution`` (which recomputes everything from the
+data), and its certificates likewise; above the limit, through ``fccqp.solve`` and
+through qpsolvers with ``scipy.sparse`` matrices.
+"""
+
+import sys
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+import fccqp
+from fccqp import FrictionCone, SecondOrderCone, Status, scaling, sparse_problem
+from fccqp.settings import MAX_DENSE_KKT_ROWS
+from problems import random_problem
+from reference import clarabel_solve
+from verify import Tolerances, from_qpsolvers, verify_solution
+
+SPARSE = dict(kkt_backend="sparse")
+TIGHT = dict(eps_abs=1e-8, eps_rel=1e-8, max_iter=20000)
+TIGHT_TOLERANCES = Tolerances.of(**TIGHT)
+
+
+def sparse_args(problem):
+    """The problem with ``P`` and ``A`` as CSC matrices."""
+    P, q, A, b, lb, ub, cones = problem
+    return sp.csc_matrix(P), q, sp.csc_matrix(A), b, lb, ub, cones
+
+
+def test_equilibration_is_the_dense_kernels():
+    """``sparse_problem.equilibrate`` computes the dense kernel's scaling (Ruiz passes with
+    the cone blocks kept uniform, cost normalization) to rounding."""
+    P, q, A, b, lb, ub, cones = random_problem(4, soc_dim=4)
+    scaled = sparse_problem.equilibrate(sparse_problem.convert(P, q, A, b, lb, ub, cones), 10)
+    P_d, q_d, A_d, b_d = P.copy(), q.copy(), A.copy(), b.copy()
+    D, E = np.empty(P.shape[0]), np.empty(A.shape[0])
+    starts = np.array([cone.start for cone in cones], dtype=np.intp)
+    dims = np.array([cone.dim for cone in cones], dtype=np.intp)
+    c = scaling.equilibrate_py(P_d, q_d, A_d, b_d, starts, dims, 10, D, E)
+    np.testing.assert_allclose(scaled.D, D, rtol=1e-14)
+    np.testing.assert_allclose(scaled.E, E, rtol=1e-14)
+    assert scaled.c == pytest.approx(c, rel=1e-14)
+    np.testing.assert_allclose(scaled.P.toarray(), P_d, atol=1e-14)
+    np.testing.assert_allclose(scaled.A.toarray(), A_d, atol=1e-14)
+    np.testing.assert_allclose(scaled.q, q_d, atol=1e-14)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_matches_clarabel_and_the_dense_path(seed):
+    """Friction cones (tilted normals included), a second-order cone on odd seeds, a box
+    and equalities, at tight tolerance."""
+    problem = random_problem(seed, soc_dim=4 if seed % 2 else 0)
+    reference = clarabel_solve(*problem)
+    result = fccqp.solve(*sparse_args(problem), **SPARSE, **TIGHT)
+    assert result.status is Status.SOLVED and result.backend == "sparse"
+    np.testing.assert_allclose(result.x, reference.x, atol=1e-4)
+    assert result.obj - reference.obj <= 1e-7 * (1 + abs(reference.obj))
+    verify_solution(problem, result, TIGHT_TOLERANCES)
+    dense = fccqp.solve(*problem, **TIGHT)
+    np.testing.assert_allclose(result.x, dense.x, atol=1e-6)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_default_settings_reach_tolerance_and_report_true_residuals(seed):
+    problem = random_problem(seed, psd_rank=10, n=40, m=10, n_cones=4, n_box=8)
+    reference = clarabel_solve(*problem)
+    result = fccqp.solve(*problem, **SPARSE)
+    assert result.status is Status.SOLVED
+    verify_solution(problem, result, Tolerances(factor=1.0))
+    assert abs(result.obj - reference.obj) <= 1e-3 * (1 + abs(reference.obj))
+
+
+def test_polishing_gives_the_exact_optimum():
+    """The README's example: the friction cone binds; the polished point is exact."""
+    P = np.diag([1.0, 1.0, 1e-3, 1e-3, 1e-3])
+    q = np.array([-8.0, 0.0, 0.0, 0.0, 0.0])
+    A = np.array([[1.0, 0, -1, 0, 0], [0, 1, 0, -1, 0], [0, 0, 0, 0, 1]])
+    b = np.array([0.0, 0.0, 10.0])
+    lb, ub = np.array([-6, -6] + [-np.inf] * 3), np.array([6, 6] + [np.inf] * 3)
+    cones = [FrictionCone(start=2, mu=0.5)]
+    result = fccqp.solve(P, q, A, b, lb, ub, cones, **SPARSE)
+    assert result.status is Status.SOLVED and result.polished
+    np.testing.assert_allclose(result.x, [5.0, 0.0, 5.0, 0.0, 10.0], atol=1e-9)
+    verify_solution((P, q, A, b, lb, ub, cones), result, Tolerances(factor=1.0))
+    plain = fccqp.solve(P, q, A, b, lb, ub, cones, polish=False, **SPARSE)
+    assert plain.status is Status.SOLVED and not plain.polished
+
+
+def test_rank_deficient_equalities():
+    problem = random_problem(3, duplicate_rows=3)
+    reference = clarabel_solve(*problem)
+    result = fccqp.solve(*problem, **SPARSE, **TIGHT)
+    assert result.status is Status.SOLVED
+    np.testing.assert_allclose(result.x, reference.x, atol=1e-5)
+    verify_solution(problem, result, TIGHT_TOLERANCES)
+
+
+@pytest.mark.parametrize("budget", [1, 2, 5, 20])
+def test_equalities_exact_at_every_budget(budget):
+    problem = random_problem(5, psd_rank=10)
+    result = fccqp.solve(*problem, max_iter=budget, eps_abs=1e-12, eps_rel=0.0, **SPARSE)
+    assert result.status in (Status.MAX_ITER_REACHED, Status.SOLVED_INACCURATE, Status.SOLVED)
+    verify_solution(problem, result)   # A x = b to factorization accuracy, whatever the status
+
+
+def test_budget_statuses():
+    problem = random_problem(11, psd_rank=10)
+    result = fccqp.solve(*problem, max_iter=2, eps_abs=1e-12, eps_rel=0.0, **SPARSE)
+    assert result.status is Status.MAX_ITER_REACHED
+    result = fccqp.solve(*problem, time_limit=1e-9, eps_abs=1e-12, eps_rel=0.0, **SPARSE)
+    assert result.status is Status.TIME_LIMIT_REACHED
+    verify_solution(problem, result)
+
+
+def test_box_infeasible():
+    problem = (np.eye(3), np.zeros(3), np.ones((1, 3)), [10.0], -np.ones(3), np.ones(3), ())
+    result = fccqp.solve(*problem, **SPARSE)
+    assert result.status is Status.PRIMAL_INFEASIBLE and np.isnan(result.gap)
+    assert clarabel_solve(*problem).status == "primal_infeasible"
+    verify_solution(problem, result)
+
+
+def test_box_infeasible_through_many_rows():
+    """A chain of equalities that pushes the last entry out of its box."""
+    n = 40
+    A = sp.diags([np.ones(n - 1), -np.ones(n - 1)], [0, 1], shape=(n - 1, n)).tocsc()
+    b = np.full(n - 1, 0.1)   # x_i = x_{i+1} + 0.1, so x_0 = x_{n-1} + 3.9
+    lb, ub = -np.ones(n), np.ones(n)
+    problem = (np.eye(n), np.zeros(n), A, b, lb, ub, ())
+    result = fccqp.solve(sp.eye(n, format="csc"), np.zeros(n), A, b, lb, ub, **SPARSE)
+    assert result.status is Status.PRIMAL_INFEASIBLE
+    verify_solution(problem, result)
+
+
+def test_cone_infeasible():
+    """The normal force must be negative: impossible inside a friction cone."""
+    cones = [FrictionCone(0, 0.5)]
+    problem = (np.eye(3), np.zeros(3), np.array([[0.0, 0.0, 1.0]]), [-1.0], None, None, cones)
+    result = fccqp.solve(*problem, **SPARSE)
+    assert result.status is Status.PRIMAL_INFEASIBLE
+    verify_solution(problem, result)
+
+
+def test_inconsistent_equalities():
+    problem = (np.eye(2), np.zeros(2), np.array([[1.0, 1.0], [2.0, 2.0]]), [1.0, 3.0],
+               [-5, -5], [5, 5], ())
+    result = fccqp.solve(*problem, **SPARSE)
+    assert result.status is Status.PRIMAL_INFEASIBLE
+    verify_solution(problem, result)
+
+
+def test_unbounded_lp():
+    problem = (np.zeros((3, 3)), np.array([-1.0, 0.0, 0.0]), np.array([[0.0, 1.0, 1.0]]),
+               [1.0], [0, 0, 0], [np.inf, 1, 1], ())
+    result = fccqp.solve(*problem, **SPARSE)
+    assert result.status is Status.DUAL_INFEASIBLE
+    verify_solution(problem, result)
+    assert result.certificate[0] > 0
+
+
+def test_unbounded_along_cone():
+    cones = [SecondOrderCone(0, 3)]
+    problem = (np.zeros((3, 3)), np.array([0.0, 0.0, -1.0]), None, None, None, None, cones)
+    result = fccqp.solve(*problem, **SPARSE)
+    assert result.status is Status.DUAL_INFEASIBLE
+    verify_solution(problem, result)
+
+
+def test_lp_matches_clarabel():
+    rng = np.random.default_rng(3)
+    n = 12
+    A = rng.standard_normal((4, n))
+    problem = (np.zeros((n, n)), rng.uniform(0.1, 1, n), A, A @ rng.uniform(0.1, 1, n),
+               np.zeros(n), np.full(n, 2.0), ())
+    reference = clarabel_solve(*problem)
+    result = fccqp.solve(*problem, **SPARSE, **TIGHT)
+    assert result.status is Status.SOLVED
+    verify_solution(problem, result, TIGHT_TOLERANCES)
+    assert abs(result.obj - reference.obj) <= 1e-6 * (1 + abs(reference.obj))
+
+
+def test_nonconvex_objective_is_rejected():
+    with pytest.raises(ValueError, match="not convex"):
+        fccqp.solve(np.diag([1.0, -2.0, 1.0]), np.zeros(3), lb=-np.ones(3), ub=np.ones(3),
+                    **SPARSE)
+    # negative curvature that the equality removes is convex (docs/formulation.md)
+    result = fccqp.solve(np.diag([-1.0, 1.0]), np.zeros(2), np.array([[1.0, 0.0]]), [1.0],
+                         [-5, -5], [5, 5], **SPARSE)
+    assert result.status is Status.SOLVED
+
+
+@pytest.mark.parametrize("args, error, message", [
+    ((sp.csc_matrix(np.array([[1.0, 1.0], [0.0, 1.0]])), np.zeros(2)), ValueError,
+     "P must be symmetric"),
+    ((sp.csc_matrix((2, 3)), np.zeros(2)), ValueError, "P must be square"),
+    ((sp.eye(2, format="csc"), np.zeros(3)), ValueError, "q must have 2 entries"),
+    ((sp.eye(2, format="csc") * 1j, np.zeros(2)), TypeError, "P must be real"),
+    ((sp.eye(2, format="csc"), np.zeros(2), sp.csc_matrix(np.array([[np.nan, 1.0]])), [1.0]),
+     ValueError, "A contains NaN or inf"),
+    ((sp.eye(2, format="csc"), np.zeros(2), sp.csc_matrix(np.ones((1, 3))), [1.0]),
+     ValueError, "A must have 2 columns"),
+    ((sp.eye(2, format="csc"), np.zeros(2), sp.csc_matrix(np.ones((1, 2))), [1.0, 2.0]),
+     ValueError, "b must have 1 entries"),
+    ((sp.eye(2, format="csc"), np.zeros(2), None, None, [1.0, 0.0], [0.0, 1.0]), ValueError,
+     "lb > ub at index 0"),
+    ((sp.eye(2, format="csc"), [0.0, np.inf]), ValueError, "q contains NaN or inf"),
+])
+def test_bad_input_names_the_argument(args, error, message):
+    with pytest.raises(error, match=message):
+        fccqp.solve(*args, **SPARSE)
+
+
+def test_cone_entry_with_a_bound_is_rejected():
+    with pytest.raises(ValueError, match="cone block and has a finite bound"):
+        fccqp.solve(sp.eye(3, format="csc"), np.zeros(3), lb=[0.0, -np.inf, -np.inf],
+                    cones=[FrictionCone(0, 0.5)], **SPARSE)
+
+
+def test_warm_solver_reuses_the_factorization_and_the_solution():
+    problem = random_problem(1, n_box=6)
+    solver = fccqp.Solver(adaptive_rho=False, **SPARSE)
+    first = solver.solve(*problem)
+    again = solver.solve(*problem)
+    assert first.status is again.status is Status.SOLVED
+    assert again.factorizations == 0 and again.backend == "sparse"
+    assert again.iterations <= first.iterations
+    P, q, A, b, lb, ub, cones = problem
+    moved = solver.solve(P, q + 0.01, A, b, lb, ub, cones)
+    assert moved.factorizations == 0 and moved.status is Status.SOLVED
+    verify_solution((P, q + 0.01, A, b, lb, ub, cones), moved)
+    changed = solver.solve(1.01 * P, q, A, b, lb, ub, cones)
+    assert changed.factorizations >= 1 and changed.status is Status.SOLVED
+    verify_solution((1.01 * P, q, A, b, lb, ub, cones), changed)
+    solver.reset()
+    assert solver.solve(*problem).iterations == first.iterations
+
+
+def test_x0_initial_guess():
+    problem = random_problem(10)
+    reference = clarabel_solve(*problem)
+    result = fccqp.Solver(**SPARSE).solve(*problem, x0=reference.x)
+    assert result.status is Status.SOLVED
+    verify_solution(problem, result)
+
+
+def test_verbose_prints_log(capsys):
+    fccqp.solve(*random_problem(14), verbose=True, **SPARSE)
+    out = capsys.readouterr().out
+    assert "prim_res" in out and "status: solved" in out and "sparse backend" in out
+
+
+def test_settings_name_the_sparse_backend():
+    assert fccqp.Settings(kkt_backend="sparse").kkt_backend == "sparse"
+    with pytest.raises(ValueError, match="ldl_full, sparse"):
+        fccqp.Settings(kkt_backend="qdldl")
+
+
+def test_missing_qdldl_is_a_clear_import_error(monkeypatch):
+    monkeypatch.setitem(sys.modules, "qdldl", None)
+    with pytest.raises(ImportError, match="pip install qdldl"):
+        fccqp.solve(np.eye(2), np.zeros(2), lb=[0, 0], ub=[1, 1], **SPARSE)
+
+
+def large_problem(n: int, seed: int = 0):
+    """A separable QP with a coupling row and a friction cone: ``n`` variables, a
+    tridiagonal ``P``, two equalities, a box on most entries."""
+    rng = np.random.default_rng(seed)
+    main = rng.uniform(1.0, 2.0, n)
+    P = sp.diags([main, -0.25 * np.ones(n - 1), -0.25 * np.ones(n - 1)], [0, 1, -1],
+                 format="csc")
+    q = rng.standard_normal(n)
+    A = sp.csc_matrix(np.vstack([np.ones(n), np.r_[np.zeros(n - 1), 1.0]]))
+    b = np.array([1.0, 2.0])
+    lb, ub = np.full(n, -0.5), np.full(n, 0.5)
+    lb[-3:], ub[-3:] = -np.inf, np.inf   # the cone's entries
+    return P, q, A, b, lb, ub, [FrictionCone(n - 3, 0.4)]
+
+
+def clarabel_sparse(P, q, A, b, lb, ub, cones):
+    """Clarabel at tight tolerance on a sparse problem with friction cones about the z
+    axis (``reference.clarabel_form`` builds dense matrices, too large here)."""
+    clarabel = pytest.importorskip("clarabel")
+    n = q.shape[0]
+    eye = sp.eye(n, format="csr")
+    low, high = np.flatnonzero(np.isfinite(lb)), np.flatnonzero(np.isfinite(ub))
+    rows = [A, -eye[low], eye[high]]
+    kinds = [clarabel.ZeroConeT(A.shape[0]), clarabel.NonnegativeConeT(len(low) + len(high))]
+    for cone in cones:
+        f = cone.start
+        rows.append(-sp.csr_matrix(([cone.mu, 1.0, 1.0], ([0, 1, 2], [f + 2, f, f + 1])),
+                                   shape=(3, n)))
+        kinds.append(clarabel.SecondOrderConeT(3))
+    rhs = np.concatenate([b, -lb[low], ub[high], np.zeros(3 * len(cones))])
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = 1e-10
+    solution = clarabel.DefaultSolver(sp.triu(P, format="csc"), q,
+                                      sp.vstack(rows, format="csc"), rhs, kinds,
+                                      settings).solve()
+    assert str(solution.status) == "Solved"
+    x = np.array(solution.x)
+    return x, float(0.5 * x @ (P @ x) + q @ x)
+
+
+def test_problem_above_the_limit_takes_the_sparse_path():
+    n = MAX_DENSE_KKT_ROWS
+    problem = P, q, A, b, lb, ub, cones = large_problem(n)
+    result = fccqp.solve(*problem)
+    assert result.status is Status.SOLVED and result.backend == "sparse"
+    x, obj = clarabel_sparse(*problem)
+    assert abs(result.obj - obj) <= 1e-8 * (1 + abs(obj))
+    np.testing.assert_allclose(result.x, x, atol=1e-5)
+    assert np.abs(A @ result.x - b).max() <= 1e-12 * n
+
+
+def test_qpsolvers_sparse_problem_above_the_limit():
+    """qpsolvers' sparse least-squares problem (as ``solve_ls`` poses it without
+    conversion), whose slack form has 5101 KKT rows: solved with scipy.sparse input,
+    meeting the KKT conditions (recomputed by ``verify_solution``) and qpsolvers' own
+    checks, at Clarabel's objective (tight tolerance) or better."""
+    qpsolvers = pytest.importorskip("qpsolvers")
+    from qpsolvers.problems import get_sparse_least_squares
+
+    R, s, G, h, A, b, _, _ = get_sparse_least_squares(1700)
+    P, q = (R.T @ R).tocsc(), -(s @ R)
+    problem = qpsolvers.Problem(P, q, G, h, A, b)
+    assert P.shape[0] + A.shape[0] + 2 * G.shape[0] > MAX_DENSE_KKT_ROWS
+    solution = qpsolvers.solve_problem(problem, solver="fccqp")
+    assert solution.found and solution.extras["backend"] == "sparse"
+    assert solution.is_optimal(1e-5 * max(1.0, np.abs(q).max()))
+    verify_solution(*from_qpsolvers(problem, solution))
+    reference = qpsolvers.solve_problem(problem, solver="clarabel", tol_gap_abs=1e-10,
+                                        tol_gap_rel=1e-10, tol_feas=1e-10)
+    assert solution.obj - reference.obj <= 1e-12 * abs(reference.obj)
+    # P = I: the optimum is unique, but at an objective of 1e8 Clarabel's tolerance
+    # leaves entries up to 3e-3 inside constraints that fccqp's polished point holds
+    # exactly (x[915] + x[916] <= 1 with x[915] = 0, against 5.6e-4 for Clarabel)
+    np.testing.assert_allclose(solution.x, reference.x, atol=1e-2)
+    x = qpsolvers.solve_qp(P, q, G, h, A, b, solver="fccqp")
+    np.testing.assert_array_equal(x, solution.x)
