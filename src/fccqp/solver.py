@@ -217,15 +217,16 @@ class Solver:
             self._sparse = sparse_admm.SparseWorkspace(settings)
         out = self._sparse.solve(data, guess, start)
         status = out.status
-        result = Result(
-            x=out.x, y=out.y, z=out.z, status=status, obj=out.residuals.objective,
-            iterations=out.iterations, prim_res=out.residuals.prim,
-            dual_res=out.residuals.dual, setup_time=out.setup_time,
-            solve_time=time.perf_counter() - start, rho=out.rho,
-            factorizations=out.factorizations, certificate=out.certificate,
-            gap=float("nan") if status.is_infeasible() else out.residuals.gap,
-            backend=sparse_admm.BACKEND, polished=out.polished,
-        )
+        result = Result._of({
+            "x": out.x, "y": out.y, "z": out.z, "status": status,
+            "obj": out.residuals.objective, "iterations": out.iterations,
+            "prim_res": out.residuals.prim, "dual_res": out.residuals.dual,
+            "setup_time": out.setup_time, "solve_time": time.perf_counter() - start,
+            "rho": out.rho, "factorizations": out.factorizations,
+            "certificate": out.certificate, "backend": sparse_admm.BACKEND,
+            "gap": float("nan") if status.is_infeasible() else out.residuals.gap,
+            "polished": out.polished,
+        })
         if settings.verbose:
             _print_log(out.log, result)
         return result
