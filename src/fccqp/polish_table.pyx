@@ -18,9 +18,7 @@ on the constrained entries, one per entry plus one per boundary cone block:
 
 In the coordinates ``(u, lam)`` that is a square system of ``s + nb`` equations, built
 from the ``s x s`` table ``W_S`` in ``O(s^2)`` and factored with LU in ``O(s^3)``
-(LAPACK's ``dgetrf``: on go2's 28 rows it costs what the unblocked ``dgetf2`` does,
-59k instructions, on talos' 64 rows a third less, and a plain right-looking loop with
-partial pivoting measured 77k on 28): no new factorization of the ``(n + m)``-sized KKT matrix, which is what
+(a vectorized loop up to ``LU_LOOP_ROWS``, LAPACK's ``dgetrf`` above): no new factorization of the ``(n + m)``-sized KKT matrix, which is what
 the polishing of :mod:`fccqp.polish` pays for every active set and every Newton step
 (on go2, 84 rows and ``s = 24``: a warm polish cost 220 us there, mostly ``dsytrf``).
 The system is solved as corrections of the current point against the residual of the
@@ -44,6 +42,13 @@ from fccqp.kkt cimport KKT, kkt_solve_once
 from fccqp.polish cimport APEX, FIXED, LOWER, UPPER, Polish
 from fccqp.reduced cimport Reduced
 
+LU_LOOP_ROWS = 40
+"""Systems up to this size are LU-factored by the loop of :func:`_lu`, larger ones by
+LAPACK's ``dgetrf``. Measured per factorization (callgrind, the WBC sets): on go2's
+28 rows the loop takes 40k instructions against ``dgetrf``'s 59k (its blocked,
+recursive kernels cost their call overhead there), on talos' 64 rows about 350k against
+248k (its 4-wide kernels win)."""
+cdef int _LU_LOOP_ROWS = LU_LOOP_ROWS
 PIVOT_RATIO = 1e-13
 """The LU factor counts as singular when its smallest pivot is below this times its
 largest (the polished QP's solution is then not unique: the caller regularizes)."""
@@ -201,6 +206,43 @@ cdef void _correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
         w.lam[k] += sign * w.du[s + k]
 
 
+cdef bint _lu(double* T, int n, int* piv) noexcept nogil:
+    """LU with partial pivoting of the column-major ``n x n`` matrix ``T`` in place,
+    pivots 1-based as LAPACK's ``dgetrf`` leaves them for ``dgetrs``; False at a zero
+    pivot. Right-looking, one column at a time: the update of a column is a contiguous
+    axpy, which the compiler vectorizes (see ``LU_LOOP_ROWS`` for where it is used)."""
+    cdef int k, i, j, best
+    cdef double largest, value, inverse, factor
+    cdef double* pivot_column
+    cdef double* column
+    for k in range(n):
+        pivot_column = T + k * n
+        best = k
+        largest = fabs(pivot_column[k])
+        for i in range(k + 1, n):
+            if fabs(pivot_column[i]) > largest:
+                largest = fabs(pivot_column[i])
+                best = i
+        piv[k] = best + 1
+        if largest == 0.0:
+            return False
+        if best != k:
+            for j in range(n):
+                value = T[k + j * n]
+                T[k + j * n] = T[best + j * n]
+                T[best + j * n] = value
+        inverse = 1.0 / pivot_column[k]
+        for i in range(k + 1, n):
+            pivot_column[i] *= inverse
+        for j in range(k + 1, n):
+            column = T + j * n
+            factor = column[k]
+            if factor != 0.0:
+                for i in range(k + 1, n):
+                    column[i] -= factor * pivot_column[i]
+    return True
+
+
 cdef bint table_factor(Polish* w, const Problem* p, const Reduced* t, const double* rho,
                        Py_ssize_t nb) noexcept nogil:
     """Assemble and LU-factor the system of the current active set and planes; False
@@ -209,9 +251,13 @@ cdef bint table_factor(Polish* w, const Problem* p, const Reduced* t, const doub
     cdef Py_ssize_t i
     cdef double big = 0.0, small = INFINITY, pivot
     _assemble(w, p, t, rho, nb)
-    dgetrf(&size, &size, w.T, &size, w.tpiv, &info)
-    if info != 0:
-        return False
+    if size <= _LU_LOOP_ROWS:
+        if not _lu(w.T, size, w.tpiv):
+            return False
+    else:
+        dgetrf(&size, &size, w.T, &size, w.tpiv, &info)
+        if info != 0:
+            return False
     for i in range(size):
         pivot = fabs(w.T[i + i * size])
         big = max(big, pivot)
