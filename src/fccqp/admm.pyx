@@ -244,7 +244,7 @@ cdef class Workspace:
     cdef bint has_previous, has_matrices, certified, scaled_once
     cdef bint table_ready   # the reduced table and base hold for this solve's data and rho
     cdef bint iterated      # the last solve ran the iterations (and then its final step)
-    cdef bint from_previous   # this solve starts from the previous solution (warm, no x0)
+    cdef bint prev_polished, from_polished   # the previous solution was polished; this solve starts from it
     cdef bint equalities_missed   # the last cold start did not meet A x = b
     cdef int form
     cdef object _keep
@@ -371,7 +371,7 @@ cdef class Workspace:
         o.polish, o.polish_refine_iter = settings.polish, settings.polish_refine_iter
         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
         self.has_previous = self.has_matrices = self.certified = self.scaled_once = False
-        self.from_previous = self.equalities_missed = False
+        self.prev_polished = self.from_polished = self.equalities_missed = False
         self.factored_rho = -1.0
         self.final_reserve = 0.0
 
@@ -481,7 +481,7 @@ cdef class Workspace:
         if not same_matrices:
             self.certified = False
         self.has_matrices = True
-        self.from_previous = x0 == NULL and warm
+        self.from_polished = x0 == NULL and warm and self.prev_polished
         self.clock[1] = fccqp_now()
         self._scale(reuse)
         self.clock[2] = fccqp_now()
@@ -602,7 +602,7 @@ cdef class Workspace:
         reduced = self.form != LDL_FULL
         if reduced:
             self._reduced_base()
-        if self.from_previous and o.polish and self._warm_polish(run, start_time):
+        if self.from_polished and o.polish and self._warm_polish(run, start_time):
             return
         self.clock[3] = fccqp_now()
         if reduced:
@@ -685,9 +685,9 @@ cdef class Workspace:
         self._finish_run(run, status, iteration)
 
     cdef bint _warm_polish(self, Run* run, double start_time) noexcept nogil:
-        """Polish the warm start (the previous data's solution) before any iteration;
-        True, and the run finished SOLVED, when the point passes :func:`_keep_polished`'s
-        check and is solved.
+        """Polish the warm start (a polished solution of the previous data) before any
+        iteration; True, and the run finished SOLVED, when the point passes
+        :func:`_keep_polished`'s check and is solved.
 
         In a control loop the active set mostly survives a tick, and then this is the
         whole solve after the factorization: no iteration (go2: 90 % of the ticks). With
@@ -696,10 +696,12 @@ cdef class Workspace:
         (which saves ADMM's factorization and table when it succeeds): no cheaper
         (1.9M against 1.78M instructions per go2 tick, callgrind), since that matrix
         needs its own ``dsytrf`` and refinement, and dearer when the guess fails. Tried
-        from every previous solution, not only from polished ones: after a tick that
-        stopped unpolished (a budget), the next one polishes more often (talos, the
-        realtime preset capped at 15 / 30 iterations: 32 -> 36 % / 61 -> 66 % of the
-        ticks solved without iterating), the same elsewhere.
+        and not kept: polishing from every previous solution, or with 1 or 2 guesses from
+        an unpolished one. Capped at 15 / 30 iterations talos' ticks polish more often
+        (32 -> 36 %, 61 -> 66 % end here), but under the realtime preset's 2 ms budget a
+        failed polish after a budget-stopped tick takes the time the next ADMM run needs:
+        talos solved 37 % of the ticks (every solution) against 82 %, and 58-87 % (one
+        guess) against 77-93 % (polished only) in four alternating runs.
         """
         cdef int status = _RUNNING
         if not self._keep_polished(&status, 0, start_time, True):
@@ -1134,6 +1136,7 @@ cdef class Workspace:
             copy(y, self.prev_y, m)
             copy(z, self.prev_z, n)
             self.prev_rho = run.rho
+        self.prev_polished = self.has_previous and run.polished
 
     cdef void _user_residuals(self, const double* x, const double* y,
                               const double* z) noexcept nogil:

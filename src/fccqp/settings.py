@@ -153,7 +153,7 @@ class Settings:
     99 % of the solves, cut the p95 torque error against the Clarabel reference from 15
     and 31 Nm to 0.009 and 0.008 Nm and the worst relative objective gap from 4e-5 and
     1.1e-3 to 9e-9 and 4e-7 (docs/performance.md has its current cost). A warm start
-    from the previous solution polishes its active set first, before any iteration."""
+    from a polished solution polishes its active set first, before any iteration."""
     polish_refine_iter: int = 10
     """Most re-linearizations of the boundary cones' tangent planes in polishing (Newton
     steps, taken only until the cone function is met to 1e-13 or stops improving; a
@@ -211,8 +211,8 @@ class Settings:
 
         A controller has a deadline, not an iteration count: each solve returns within
         ``budget`` seconds (setup included; see :attr:`time_limit`) the best point it
-        found, with ``A x = b`` exact. A warm start from the previous solution first
-        polishes its active set (one small LU, no iteration): in a control loop
+        found, with ``A x = b`` exact. A warm start from a polished solution first
+        polishes the previous active set (one small LU, no iteration): in a control loop
         that is the answer most ticks. Otherwise ADMM runs, polishing when it meets the
         tolerance, and stops early enough to polish or restore within the budget, but
         not before :data:`REALTIME_MIN_ITER` iterations (a budget shorter than the setup

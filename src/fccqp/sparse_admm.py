@@ -188,6 +188,7 @@ class SparseWorkspace:
         self.certified = False
         self.previous: tuple[np.ndarray, ...] | None = None   # (x, y, z) of the last solve
         self.previous_rho = settings.rho
+        self.previous_polished = False
         self.final_reserve = 0.0
 
     def forget(self) -> None:
@@ -224,7 +225,7 @@ class SparseWorkspace:
         self.key, self.scaled = key, scaled
         warm = settings.warm_start and self.previous is not None and x0 is None
         run = _Run(self, data, scaled, self.previous_rho if warm else settings.rho,
-                   warm)
+                   warm and self.previous_polished)
         if x0 is not None:
             run.start_from_guess(x0)
         elif warm:
@@ -242,6 +243,7 @@ class SparseWorkspace:
         # copies: the Result hands the arrays to the caller, who may write into them
         self.previous = (outcome.x.copy(), outcome.y.copy(), outcome.z.copy()) if keep else None
         self.previous_rho = outcome.rho
+        self.previous_polished = keep and outcome.polished
         return outcome
 
 
@@ -249,7 +251,7 @@ class _Run:
     """One solve on the sparse path: the scaled iterate and the loop over it."""
 
     def __init__(self, workspace: SparseWorkspace, data: SparseData, scaled: Scaled,
-                 rho: float, from_previous: bool) -> None:
+                 rho: float, from_polished: bool) -> None:
         self.w, self.data, self.p = workspace, data, scaled
         self.o = workspace.settings
         p = scaled
@@ -258,7 +260,7 @@ class _Run:
         self.rho_vec = rho * self.rho_scale
         self.x, self.nu = np.zeros(p.n), np.zeros(p.m)
         self.z, self.y = np.zeros(p.s), np.zeros(p.s)
-        self.from_previous = from_previous   # warm polish first, as the dense core does
+        self.from_polished = from_polished   # warm polish first, as the dense core does
         self.factorizations = 0
         self.tighten = 1.0
         self.certificate: np.ndarray | None = None
@@ -513,7 +515,7 @@ class _Run:
                 return status, 0, False
             if self.w.factored_rho != self.rho or cold:
                 self._factor_rho()
-            if self.from_previous and o.polish:
+            if self.from_polished and o.polish:
                 polished, status = self._keep_polished(Status.SOLVED, 0, solved_only=True)
                 if polished:
                     return Status.SOLVED, 0, True
