@@ -63,7 +63,7 @@ def test_polished_answer_is_exact(seed, backend):
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
-@pytest.mark.parametrize("seed", [3, 4])
+@pytest.mark.parametrize("seed", [3, 5])
 def test_wrong_guess_keeps_the_admm_point(seed, backend):
     # two iterations of ADMM do not know the active set: the polished point fails the
     # check and the (restored) ADMM point is returned unchanged
