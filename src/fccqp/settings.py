@@ -222,8 +222,8 @@ class Settings:
         tolerance, and stops early enough to polish or restore within the budget, but
         not before :data:`REALTIME_MIN_ITER` iterations (a budget shorter than the setup
         plus those is overrun rather than wasted: the next tick starts from there).
-        Tolerances 1e-4 (the paper's). The default budget, :data:`REALTIME_BUDGET`, is 2 ms; the figures per
-        robot and budget are in docs/performance.md.
+        Tolerances 1e-4 (the paper's). The default budget, :data:`REALTIME_BUDGET`, is
+        2 ms; the figures per robot and budget are in docs/performance.md.
         """
         budget = _real("budget", budget, 0.0, math.inf, True, False)
         preset = cls(
