@@ -44,7 +44,8 @@ from fccqp.reduced cimport (Reduced, materialize, near_convergence, reduced_reba
                             reduced_start, reduced_step, reduced_table)
 from fccqp.restoration cimport Restoration, restore
 from fccqp.scaling cimport equilibrate, scale_start, unscale
-from fccqp.termination cimport Residuals, converged, nearly_converged, residuals, row_spans
+from fccqp.termination cimport (Residuals, converged, gap_scale, nearly_converged, residuals,
+                               row_spans)
 from fccqp.validation cimport SCAN_OK, Finding, scan_and_copy
 
 cdef extern from *:
@@ -571,19 +572,18 @@ cdef class Workspace:
         if unbounded_start and self._unbounded():
             self._finish_run(run, _DUAL_INFEASIBLE, 0)
             return
+        if cold or s == 0:   # not at factorization accuracy: inconsistent or dependent rows
+            self.equalities_missed = r.prim_eq > _EQUALITY_MISSED * max(r.prim_eq_scale, 1.0)
+            if self._missed() and self._inconsistent():
+                # tested on the penalty-free start: with rho in the KKT matrix (up to 1e9
+                # on fixed entries) the regularization's trace in A'r can hide it
+                self._finish_run(run, _PRIMAL_INFEASIBLE, 0)
+                return
         if (cold or s == 0) and converged(r, o.eps_abs, o.eps_rel) and not unbounded_start:
             status = _SOLVED
             if o.polish:   # the start carries sigma's bias where the cost is flat
                 run.polished = self._keep_polished(&status, 0, start_time)
             self._finish_run(run, status, 0)
-            return
-        if cold or s == 0:   # not at factorization accuracy: inconsistent or dependent rows
-            self.equalities_missed = r.prim_eq > _EQUALITY_MISSED * max(r.prim_eq_scale, 1.0)
-        if ((cold or s == 0) and r.prim_eq > o.eps_abs + o.eps_rel * r.prim_eq_scale
-                and self._inconsistent()):
-            # tested on the penalty-free start: with rho in the KKT matrix (up to 1e9 on
-            # fixed entries) the regularization's trace in A'r can hide the certificate
-            self._finish_run(run, _PRIMAL_INFEASIBLE, 0)
             return
         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer
             status = self._classify(0, False, start_time)
@@ -736,6 +736,8 @@ cdef class Workspace:
         cdef Py_ssize_t i
         if not r.finite:
             return _NUMERICAL_ERROR
+        if self._missed() and self._inconsistent():
+            return _PRIMAL_INFEASIBLE   # A x = b has no solution: no point can be SOLVED
         if converged(r, self.tighten * o.eps_abs, self.tighten * o.eps_rel):
             return _SOLVED
         if primal_infeasible(p, it, o.eps_prim_inf, self.vec_m, self.vec_s, self.vec_n,
@@ -746,8 +748,6 @@ cdef class Workspace:
             for i in range(p.s):
                 self.cert[p.m + p.constrained[i]] = self.vec_s[i] / p.D[p.constrained[i]]
             return _PRIMAL_INFEASIBLE
-        if r.prim_eq > o.eps_abs + o.eps_rel * r.prim_eq_scale and self._inconsistent():
-            return _PRIMAL_INFEASIBLE
         for i in range(p.n):
             self.direction[i] = it.x[i] - it.x_prev[i]
         if self._unbounded():
@@ -755,6 +755,14 @@ cdef class Workspace:
         if last:
             return self._classify(iteration, True, start_time)
         return _RUNNING
+
+    cdef bint _missed(self) noexcept nogil:
+        """The last residuals miss ``A x = b`` beyond factorization accuracy
+        (``EQUALITY_MISSED`` of their scale): only then can the equality certificate
+        hold. Not the tolerance: rows inconsistent by less than ``eps_rel`` of the
+        largest row (a duplicated row of size 2 off by 0.65 among rows of 3e6) are no
+        more solvable, and were left uncertified for 4000 iterations."""
+        return self.res.prim_eq > _EQUALITY_MISSED * self.res.prim_eq_scale
 
     cdef bint _inconsistent(self) noexcept nogil:
         """The equality certificate; on success ``cert`` holds ``(-E r, 0)``, ``r = b_s - A_s
@@ -1188,7 +1196,7 @@ cdef class Workspace:
             total += fabs(y[i])
         r.objective = 0.5 * xPx + qx
         r.gap = fabs(xPx + qx + by + support)
-        r.gap_scale = max(max(fabs(xPx), fabs(qx)), terms)
+        r.gap_scale = gap_scale(xPx, qx, terms)
         r.prim = max(r.prim_eq, r.prim_set)
         r.prim_scale = max(r.prim_eq_scale, r.prim_set_scale)
         r.finite = isfinite(total) and isfinite(r.gap) and isfinite(r.prim)
