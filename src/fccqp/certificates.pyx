@@ -116,27 +116,42 @@ cdef bint primal_infeasible(const Problem* p, const Iterates* it, double eps, do
             and _DOMINANCE * lhs_max * size <= -support * terms_max)
 
 
-cdef bint equality_inconsistent(const Problem* p, const Iterates* it, double eps, double* r,
-                                double* ATr, double* terms) noexcept nogil:
-    """Test ``r = b - A x`` (``r``: m scratch; ``ATr``, ``terms``: n scratch)."""
-    cdef Py_ssize_t n = p.n, m = p.m, i, j
-    cdef double value, br = 0.0, size = 0.0, lhs_max = 0.0, terms_max = 0.0
-    if m == 0:
-        return False
-    for i in range(m):
+cdef int equality_inconsistent(const Problem* p, const Iterates* it, double eps, double* r,
+                               double* ATr, double* terms) noexcept nogil:
+    """:func:`equality_direction` for ``r = b - A x`` (``r``: m, filled; ``ATr``,
+    ``terms``: n scratch)."""
+    cdef Py_ssize_t n = p.n, i, j
+    cdef double value
+    for i in range(p.m):
         value = p.b[i]
         for j in range(n):
             value -= p.A[i * n + j] * it.x[j]
         r[i] = value
-        br += p.b[i] * value
-        size += fabs(p.b[i] * value)
+    return equality_direction(p, r, eps, ATr, terms)
+
+
+cdef int equality_direction(const Problem* p, const double* r, double eps, double* ATr,
+                            double* terms) noexcept nogil:
+    """Test ``r`` (m) for ``A'r ~ 0`` and ``b'r > 0``: ``CERTIFIED``, or ``SEPARATED``
+    when only the dominance of the separation over the residual is missing (a
+    cleaner ``r`` may pass, see :meth:`fccqp.admm.Workspace._inconsistent`), else
+    ``REJECTED`` (``ATr``, ``terms``: n scratch)."""
+    cdef Py_ssize_t n = p.n, i, j
+    cdef double br = 0.0, size = 0.0, lhs_max = 0.0, terms_max = 0.0
+    if p.m == 0:
+        return REJECTED
+    for i in range(p.m):
+        br += p.b[i] * r[i]
+        size += fabs(p.b[i] * r[i])
     if not (br > _SEPARATION_FLOOR * size) or not isfinite(br):
-        return False
+        return REJECTED
     _transpose_product(p, r, ATr, terms)
     for j in range(n):
         lhs_max = max(lhs_max, fabs(ATr[j]) / p.D[j])
         terms_max = max(terms_max, terms[j] / p.D[j])
-    return lhs_max <= eps * terms_max and _DOMINANCE * lhs_max * size <= br * terms_max
+    if not lhs_max <= eps * terms_max:
+        return REJECTED
+    return CERTIFIED if _DOMINANCE * lhs_max * size <= br * terms_max else SEPARATED
 
 
 cdef inline bint _near_zero(const double* M, const double* dx, Py_ssize_t rows,
