@@ -680,7 +680,7 @@ cdef class Workspace:
         if not run.polished:   # a polished point is feasible already: nothing to restore
             if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
                 status = self._keep_restored(status, iteration, reduced, start_time)
-            elif reduced and status != _NUMERICAL_ERROR:
+            elif (reduced or self._missed()) and status != _NUMERICAL_ERROR:
                 self._restore_equalities()   # certificates are already in cert
         self._finish_run(run, status, iteration)
 
@@ -775,11 +775,13 @@ cdef class Workspace:
         when ``A x = b`` has no solution, but it carries the regularization's trace:
         ``A'r = -delta A'nu``, which is large against ``r`` itself when the rows are
         inconsistent by little (``rho = 2.6e-9`` against ``delta = 5.9e-8`` on a random
-        problem). With ``clean``, an ``r`` that misses only the dominance test is cleaned
-        by one step of inverse iteration: the regularized solve for ``(0, r)`` returns
-        ``nu`` with ``-delta nu`` equal to the part of ``r`` in the null space of ``A'``
-        and the rest shrunk by ``delta / lambda`` (``lambda`` the eigenvalues of ``A H^-1
-        A'`` off that null space): that problem's ``rho`` fell to 3e-16."""
+        problem), or when a row is so small that ``delta`` outweighs it (rows of norm
+        1e-9, ``r`` all on such a row, ``rho = 1``). With ``clean``, an ``r`` that
+        separates but is not certified is cleaned by one step of inverse iteration: the
+        regularized solve for ``(0, r)`` returns ``nu`` with ``-delta nu`` equal to the
+        part of ``r`` in the null space of ``A'`` and the rest shrunk by ``delta /
+        lambda`` (``lambda`` the eigenvalues of ``A H^-1 A'`` off that null space): the
+        first problem's ``rho`` fell to 3e-16."""
         cdef Problem* p = &self.prob
         cdef Py_ssize_t n = p.n, m = p.m, i
         cdef double* r = self.vec_m
@@ -1002,7 +1004,10 @@ cdef class Workspace:
     cdef void _restore_equalities(self) noexcept nogil:
         """Remove the rounding that a combination of KKT solutions (``x = base + W u`` in
         the reduced form, a restoration) accumulates in ``A x = b``: one refined KKT
-        solve for ``(0, b - A x)`` with the current factorization."""
+        solve for ``(0, b - A x)`` with the current factorization. The full form needs
+        it only when its iterate misses ``A x = b`` beyond factorization accuracy
+        (:meth:`_missed`): diverging iterates of an infeasible problem (``|x| = 4e6``,
+        rho 2.4e5) left a 3.5e-7 relative error in their KKT solves' ``A x = b``."""
         cdef Problem* p = &self.prob
         cdef Py_ssize_t n = p.n, m = p.m, i
         if m == 0:
@@ -1033,6 +1038,7 @@ cdef class Workspace:
         cdef Iterates* it = &self.it
         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j
         cdef int new_status
+        cdef bint missed = self._missed()
         copy(it.x, self.saved, n)
         copy(it.nu, self.saved + n, m)
         copy(it.z, self.saved + n + m, s)
@@ -1049,7 +1055,7 @@ cdef class Workspace:
         copy(self.saved, it.x, n)
         copy(self.saved + n, it.nu, m)
         copy(self.saved + n + m, it.z, s)
-        if reduced:
+        if reduced or missed:
             self._restore_equalities()
         return status
 

@@ -7,7 +7,7 @@ cdef enum:
     # Outcomes of the equality certificate's tests.
     REJECTED = 0
     CERTIFIED = 1
-    SEPARATED = 2   # b'r > 0 and A'r ~ 0, but the separation does not dominate the residual
+    SEPARATED = 2   # b'r > 0, but A'r is not small enough against it
 
 cdef int equality_inconsistent(const Problem* p, const Iterates* it, double eps, double* r,
                                double* ATr, double* terms) noexcept nogil

@@ -132,10 +132,10 @@ cdef int equality_inconsistent(const Problem* p, const Iterates* it, double eps,
 
 cdef int equality_direction(const Problem* p, const double* r, double eps, double* ATr,
                             double* terms) noexcept nogil:
-    """Test ``r`` (m) for ``A'r ~ 0`` and ``b'r > 0``: ``CERTIFIED``, or ``SEPARATED``
-    when only the dominance of the separation over the residual is missing (a
-    cleaner ``r`` may pass, see :meth:`fccqp.admm.Workspace._inconsistent`), else
-    ``REJECTED`` (``ATr``, ``terms``: n scratch)."""
+    """Test ``r`` (m) for ``A'r ~ 0`` and ``b'r > 0``: ``CERTIFIED``, ``SEPARATED`` when
+    ``b'r`` separates but ``A'r`` is not small enough against it (a cleaner ``r`` may
+    pass, see :meth:`fccqp.admm.Workspace._inconsistent`), else ``REJECTED`` (``ATr``,
+    ``terms``: n scratch)."""
     cdef Py_ssize_t n = p.n, i, j
     cdef double br = 0.0, size = 0.0, lhs_max = 0.0, terms_max = 0.0
     if p.m == 0:
@@ -149,9 +149,9 @@ cdef int equality_direction(const Problem* p, const double* r, double eps, doubl
     for j in range(n):
         lhs_max = max(lhs_max, fabs(ATr[j]) / p.D[j])
         terms_max = max(terms_max, terms[j] / p.D[j])
-    if not lhs_max <= eps * terms_max:
-        return REJECTED
-    return CERTIFIED if _DOMINANCE * lhs_max * size <= br * terms_max else SEPARATED
+    if lhs_max <= eps * terms_max and _DOMINANCE * lhs_max * size <= br * terms_max:
+        return CERTIFIED
+    return SEPARATED
 
 
 cdef inline bint _near_zero(const double* M, const double* dx, Py_ssize_t rows,
