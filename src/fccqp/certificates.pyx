@@ -15,7 +15,7 @@ of its terms. For the primal and equality certificates (Farkas) it must hold by 
 than rounding, ``delta < -SEPARATION_FLOOR``, and by more than the residual of the
 "``~ 0``" part could explain, ``|delta| >= DOMINANCE * rho``, as Clarabel and SCS ask
 (``||A'y|| <= eps_infeas |b'y|``, with ``eps_infeas`` 1e-8 and 1e-7 in their normalized
-units; OSQP asks ``b'dy + sigma_C(dy) < 0`` alone). No fixed margin in ``eps`` is asked:
+units; OSQP asks ``b'dy + sigma_C(dz) < 0`` alone). No fixed margin in ``eps`` is asked:
 the separation of the best certificate is a property of the data (a duplicated row
 whose right-hand side is off by ``1.5e-6`` of its terms allows no certificate with
 more), and such a problem has no other honest status: fccqp keeps ``A x = b``, which
@@ -45,7 +45,8 @@ DOMINANCE = 100.0
 residual: a feasible ``x`` would need products with the certificate this many times
 larger than ``b``'s to explain the separation away. Nearly dependent but consistent
 rows give certificates whose two are alike (``rho = 9e-7`` against ``delta = 1.1e-6`` in
-a fuzz case), truly inconsistent ones separate by 1e4 or more times their residual."""
+a fuzz case); the certificates of 397 infeasible problems of a random property run
+separate by 120 times their residual or more (98 % of them by 1e4 or more)."""
 cdef double _SEPARATION_FLOOR = SEPARATION_FLOOR
 cdef double _DOMINANCE = DOMINANCE
 
