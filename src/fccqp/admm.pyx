@@ -1103,9 +1103,10 @@ cdef class Workspace:
                 and r.prim_eq <= o.eps_abs + o.eps_rel * r.prim_eq_scale
                 and r.prim_set <= o.eps_abs + o.eps_rel * r.prim_set_scale
                 and multiplier_violation(&self.pol, p, self.user_z) <= _POLISH_EXACT * tol_d
-                and r.prim_eq <= min(max(_EQUALITY_SLACK * plain.prim_eq,
-                                         _EQUALITY_EXACT * r.prim_eq_scale),
-                                     _EQUALITY_MISSED * self._row_terms(self.user_x))
+                # at EQUALITY_EXACT of max(|A x|, |b|) it is below EQUALITY_MISSED of |A||x|
+                and (r.prim_eq <= _EQUALITY_EXACT * r.prim_eq_scale
+                     or (r.prim_eq <= _EQUALITY_SLACK * plain.prim_eq
+                         and r.prim_eq <= _EQUALITY_MISSED * self._row_terms(self.user_x)))
                 and (r.prim <= plain.prim or r.prim <= _POLISH_EXACT * tol_p)
                 and (r.dual <= plain.dual or r.dual <= _POLISH_EXACT * tol_d)
                 and (r.gap <= plain.gap or r.gap <= _POLISH_EXACT * tol_g)
