@@ -15,7 +15,8 @@ depends on the status, following the guarantees of docs/formulation.md:
 - ``MAX_ITER_REACHED``, ``TIME_LIMIT_REACHED``: ``A x = b`` to factorization accuracy;
 - ``PRIMAL_INFEASIBLE``: the certificate ``(dy, dz)`` has ``A'dy + dz ~ 0`` and
   ``b'dy + sigma_C(dz) < 0``, with ``sigma_C(dz)`` finite (``dz`` of the right sign on
-  the box, ``-dz_block`` in the dual cones);
+  the box, ``-dz_block`` in the dual cones), the separation beyond rounding and beyond
+  what the residual of ``A'dy + dz ~ 0`` could explain (see below);
 - ``DUAL_INFEASIBLE``: the certificate ``dx`` has ``P dx ~ 0``, ``A dx ~ 0``,
   ``q'dx < 0`` and lies in the recession cone of the box and cones;
 - ``NUMERICAL_ERROR``: nothing is promised.
@@ -26,6 +27,26 @@ never from the multipliers: an iterate with multipliers of 1e8 must not make its
 residuals look small (issue 11, item 1). Certificate conditions are relative to the
 size of their own terms, so they are invariant to scaling the certificate, the rows
 of ``A`` or the objective.
+
+The primal certificate's separation. By Farkas, ``(dy, dz)`` proves that no ``x`` has
+``A x = b`` and ``x`` in C when ``A'dy + dz = 0`` and ``b'dy + sigma_C(dz) < 0``; with a
+residual ``res = A'dy + dz``, any feasible ``x`` has ``b'dy + sigma_C(dz) >= res'x``, so
+the separation must be large against what the residual can explain. It is judged by
+``delta = (b'dy + sigma_C(dz)) / size`` (``size`` the magnitude of its terms) against
+``rho = ||res|| / ||terms of res||``: ``delta < -max(separation, dominance * rho)``. A
+feasible ``x`` would need products with the certificate ``dominance`` times larger
+than ``b``'s to explain such a separation; ``separation`` (1e-10) stays far above the
+rounding of the sum (``1e-16`` of its terms, times its cancellation). A fixed margin
+in ``eps_prim_inf`` (this checker asked ``delta < -10 eps_prim_inf`` before) is not a
+property of a proof: none of the anchors asks it (OSQP: ``u'dy+ + l'dy- < 0``; SCS:
+``b'y < -1e-9`` and ``||A'y|| <= 1e-7 |b'y|``; Clarabel: ``b'z < -1e-8`` and ``||A'z||
+<= 1e-8 |b'z|``), and it rejected every certificate of problems that are infeasible by
+less: a duplicated row whose right-hand side is off by ``1.5e-6`` of its terms allows
+no certificate with ``|delta|`` above ``1.5e-6`` (Clarabel: infeasible), while no other
+status could pass either (``A x = b`` has no solution). The dominance test is what the
+margin stood in for: a feasible problem with nearly dependent rows once passed the
+solver's old test with ``rho = 9e-7`` and ``delta = -1.1e-6``, which ``dominance = 10``
+rejects.
 """
 
 from __future__ import annotations
@@ -111,7 +132,9 @@ class Tolerances:
     ``eps_abs``, ``eps_rel`` are the solver's; a check passes within ``factor`` times
     ``eps_abs + eps_rel * scale`` (the solver measures the same quantities, but its
     scales may differ by small factors). ``certificate`` bounds the relative
-    violations of an infeasibility certificate; ``equality`` the relative error of
+    violations of an infeasibility certificate (and the relative margin of the dual
+    one's ``q'dx < 0``); ``separation`` and ``dominance`` the primal certificate's
+    separation (see the module docstring); ``equality`` the relative error of
     ``A x = b`` that "factorization accuracy" allows.
     """
 
@@ -119,6 +142,8 @@ class Tolerances:
     eps_rel: float = 1e-5
     factor: float = 10.0
     certificate: float = 1e-5
+    separation: float = 1e-10
+    dominance: float = 10.0
     equality: float = 1e-9
 
     @classmethod
@@ -128,7 +153,8 @@ class Tolerances:
             **{k: v for k, v in overrides.items() if k in fccqp.Settings.__dataclass_fields__}
         )
         certificate = 10 * max(s.eps_prim_inf, s.eps_dual_inf)
-        own = {k: v for k, v in overrides.items() if k in ("factor", "equality", "certificate")}
+        own = {k: v for k, v in overrides.items()
+               if k in ("factor", "equality", "certificate", "separation", "dominance")}
         return cls(**{"eps_abs": s.eps_abs, "eps_rel": s.eps_rel,
                       "certificate": certificate, **own})
 
@@ -277,10 +303,15 @@ def _check_point(problem: Problem, result: fccqp.Result, tol: Tolerances, report
     # same quantity; prim_res bounds the entrywise box and cone violation.
     slack = 1e-9 * dual_scale
     report.add("claimed dual_res", stationarity, result.dual_res * (1 + 1e-6) + slack)
-    violation = max(primal["equality"], primal["box"], primal["cone"] / np.sqrt(3))
-    # A x itself is computed to eps |A||x|: a claim may differ from this recomputation
-    # by that much (|A||x| = 3e8 against |b| = 4 in a random problem)
-    rounding = 1e-12 * _inf(np.abs(A) @ np.abs(x))
+    # a block's Euclidean distance exceeds its entrywise one by at most sqrt(its size)
+    entrywise = max((cone_distance(x[blk], mu, nrm) / np.sqrt(blk.stop - blk.start)
+                     for blk, mu, nrm in problem.blocks()), default=0.0)
+    violation = max(primal["equality"], primal["box"], entrywise)
+    # A x itself is computed to eps |A||x|, and a cone distance at x to eps |x|: a claim
+    # may differ from this recomputation by that much (|A||x| = 3e8 against |b| = 4 in
+    # a random problem; polished blocks of size 1e8 on a cone's boundary, 3e-9 from it
+    # recomputed, 0 claimed)
+    rounding = 1e-12 * max(_inf(np.abs(A) @ np.abs(x)), _inf(x))
     report.add("claimed prim_res", violation,
                result.prim_res * (1 + 1e-6) + 1e-9 * primal_scale + rounding)
     if np.isfinite(result.gap):
@@ -296,15 +327,17 @@ def _check_primal_certificate(problem: Problem, result: fccqp.Result, tol: Toler
     report.add("certificate size", 0.0 if terms > 0 else 1.0, 0.0)
     if not terms > 0:
         return
-    report.add("A'dy + dz ~ 0 (relative)", _inf(problem.A.T @ dy + dz) / terms, tol.certificate)
+    residual = _inf(problem.A.T @ dy + dz) / terms
+    report.add("A'dy + dz ~ 0 (relative)", residual, tol.certificate)
     support, sign, dual_cone = _multiplier_conditions(problem, dz)
     report.add("dz sign on the box (relative)", sign / terms, tol.certificate)
     report.add("-dz in the dual cones (relative)", dual_cone / terms, tol.certificate)
     by = float(problem.b @ dy)
     size = max(abs(by), abs(support), np.abs(problem.b) @ np.abs(dy))
-    # b'dy + sigma_C(dz) must be negative, by more than rounding of its own terms
+    # b'dy + sigma_C(dz) must be negative beyond rounding of its own terms and beyond
+    # what the residual explains (the module docstring)
     report.add("b'dy + sigma(dz) < 0 (relative)", (by + support) / max(size, 1e-300),
-               -tol.certificate)
+               -max(tol.separation, tol.dominance * residual))
 
 
 def _check_dual_certificate(problem: Problem, result: fccqp.Result, tol: Tolerances,

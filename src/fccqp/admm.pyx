@@ -35,7 +35,8 @@ from fccqp._dense cimport copy, fill, inf_norm, matvec, matvec_t
 from fccqp._types cimport Cones, Iterates, Problem
 from fccqp.blas_threads cimport enter, leave
 from fccqp.anderson cimport Anderson, anderson_reset, anderson_step
-from fccqp.certificates cimport dual_infeasible, equality_inconsistent, primal_infeasible
+from fccqp.certificates cimport (CERTIFIED, SEPARATED, dual_infeasible, equality_direction,
+                                 equality_inconsistent, primal_infeasible)
 from fccqp.kkt cimport (AUTO, FACTORED, KKT, LDL_FULL, LDL_REDUCED, NOT_CONVEX, SCHUR_REDUCED,
                         UNAVAILABLE, kkt_convexity, kkt_factor, kkt_solve)
 from fccqp.polish cimport Polish, multiplier_violation, polish
@@ -44,7 +45,8 @@ from fccqp.reduced cimport (Reduced, materialize, near_convergence, reduced_reba
                             reduced_start, reduced_step, reduced_table)
 from fccqp.restoration cimport Restoration, restore
 from fccqp.scaling cimport equilibrate, scale_start, unscale
-from fccqp.termination cimport Residuals, converged, nearly_converged, residuals, row_spans
+from fccqp.termination cimport (Residuals, converged, gap_scale, nearly_converged, residuals,
+                               row_spans)
 from fccqp.validation cimport SCAN_OK, Finding, scan_and_copy
 
 cdef extern from *:
@@ -131,8 +133,11 @@ EQUALITY_SLACK = 10.0
 EQUALITY_EXACT = 1e-13
 """A polished point keeps ``A x = b`` as ADMM's iterates do, at factorization accuracy:
 within ``EQUALITY_SLACK`` times the ADMM point's residual, or below ``EQUALITY_EXACT``
-times ``max(||A x||, ||b||)``. (The tolerance alone let a polished point with ``A x - b``
-at 2e-9 of its terms pass as SOLVED in a random test.)"""
+times ``max(||A x||, ||b||)``, and never beyond ``EQUALITY_MISSED`` times the largest
+row of ``|A| |x|``. (The tolerance alone let a polished point with ``A x - b`` at 2e-9
+of its terms pass as SOLVED in a random test; the slack alone one at 8e-9 where the
+ADMM point, a reduced form's combination ``base + W u`` with a wild ``u`` before its
+final correction, missed by 1e-9.)"""
 cdef double _EQUALITY_SLACK = EQUALITY_SLACK
 cdef double _EQUALITY_EXACT = EQUALITY_EXACT
 EQUALITY_MISSED = 1e-9
@@ -572,19 +577,18 @@ cdef class Workspace:
         if unbounded_start and self._unbounded():
             self._finish_run(run, _DUAL_INFEASIBLE, 0)
             return
+        if cold or s == 0:   # not at factorization accuracy: inconsistent or dependent rows
+            self.equalities_missed = r.prim_eq > _EQUALITY_MISSED * max(r.prim_eq_scale, 1.0)
+            if self._missed() and self._inconsistent(True):
+                # tested on the penalty-free start: with rho in the KKT matrix (up to 1e9
+                # on fixed entries) the regularization's trace in A'r can hide it
+                self._finish_run(run, _PRIMAL_INFEASIBLE, 0)
+                return
         if (cold or s == 0) and converged(r, o.eps_abs, o.eps_rel) and not unbounded_start:
             status = _SOLVED
             if o.polish:   # the start carries sigma's bias where the cost is flat
                 run.polished = self._keep_polished(&status, 0, start_time)
             self._finish_run(run, status, 0)
-            return
-        if cold or s == 0:   # not at factorization accuracy: inconsistent or dependent rows
-            self.equalities_missed = r.prim_eq > _EQUALITY_MISSED * max(r.prim_eq_scale, 1.0)
-        if ((cold or s == 0) and r.prim_eq > o.eps_abs + o.eps_rel * r.prim_eq_scale
-                and self._inconsistent()):
-            # tested on the penalty-free start: with rho in the KKT matrix (up to 1e9 on
-            # fixed entries) the regularization's trace in A'r can hide the certificate
-            self._finish_run(run, _PRIMAL_INFEASIBLE, 0)
             return
         if s == 0:  # nothing to iterate: the equality-constrained QP was the answer
             status = self._classify(0, False, start_time)
@@ -680,7 +684,7 @@ cdef class Workspace:
         if not run.polished:   # a polished point is feasible already: nothing to restore
             if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
                 status = self._keep_restored(status, iteration, reduced, start_time)
-            elif reduced and status != _NUMERICAL_ERROR:
+            elif (reduced or self._missed()) and status != _NUMERICAL_ERROR:
                 self._restore_equalities()   # certificates are already in cert
         self._finish_run(run, status, iteration)
 
@@ -743,6 +747,10 @@ cdef class Workspace:
         cdef Py_ssize_t i
         if not r.finite:
             return _NUMERICAL_ERROR
+        if self._missed() and self._inconsistent(iteration % o.adaptive_rho_interval == 0):
+            # A x = b has no solution: no point can be SOLVED (cleaned on the schedule
+            # of rho adaptation, a KKT solve each time)
+            return _PRIMAL_INFEASIBLE
         if converged(r, self.tighten * o.eps_abs, self.tighten * o.eps_rel):
             return _SOLVED
         if primal_infeasible(p, it, o.eps_prim_inf, self.vec_m, self.vec_s, self.vec_n,
@@ -753,8 +761,6 @@ cdef class Workspace:
             for i in range(p.s):
                 self.cert[p.m + p.constrained[i]] = self.vec_s[i] / p.D[p.constrained[i]]
             return _PRIMAL_INFEASIBLE
-        if r.prim_eq > o.eps_abs + o.eps_rel * r.prim_eq_scale and self._inconsistent():
-            return _PRIMAL_INFEASIBLE
         for i in range(p.n):
             self.direction[i] = it.x[i] - it.x_prev[i]
         if self._unbounded():
@@ -763,17 +769,46 @@ cdef class Workspace:
             return self._classify(iteration, True, start_time)
         return _RUNNING
 
-    cdef bint _inconsistent(self) noexcept nogil:
-        """The equality certificate; on success ``cert`` holds ``(-E r, 0)``, ``r = b_s - A_s
-        x_s``: ``A'y ~ 0`` and ``b'y < 0`` in the user's units."""
+    cdef bint _missed(self) noexcept nogil:
+        """The last residuals miss ``A x = b`` beyond factorization accuracy
+        (``EQUALITY_MISSED`` of their scale): only then can the equality certificate
+        hold. Not the tolerance: rows inconsistent by less than ``eps_rel`` of the
+        largest row (a duplicated row of size 2 off by 0.65 among rows of 3e6) are no
+        more solvable, and were left uncertified for 4000 iterations."""
+        return self.res.prim_eq > _EQUALITY_MISSED * self.res.prim_eq_scale
+
+    cdef bint _inconsistent(self, bint clean) noexcept nogil:
+        """The equality certificate; on success ``cert`` holds ``(-E r, 0)``: ``A'y ~ 0`` and
+        ``b'y < 0`` in the user's units.
+
+        ``r = b_s - A_s x_s`` of a regularized KKT solution is the least-squares residual
+        when ``A x = b`` has no solution, but it carries the regularization's trace:
+        ``A'r = -delta A'nu``, which is large against ``r`` itself when the rows are
+        inconsistent by little (``rho = 2.6e-9`` against ``delta = 5.9e-8`` on a random
+        problem), or when a row is so small that ``delta`` outweighs it (rows of norm
+        1e-9, ``r`` all on such a row, ``rho = 1``). With ``clean``, an ``r`` that
+        separates but is not certified is cleaned by one step of inverse iteration: the
+        regularized solve for ``(0, r)`` returns ``nu`` with ``-delta nu`` equal to the
+        part of ``r`` in the null space of ``A'`` and the rest shrunk by ``delta /
+        lambda`` (``lambda`` the eigenvalues of ``A H^-1 A'`` off that null space): the
+        first problem's ``rho`` fell to 1e-17, the second's to 7e-17."""
         cdef Problem* p = &self.prob
-        cdef Py_ssize_t i
-        if not equality_inconsistent(p, &self.it, self.opt.eps_prim_inf, self.vec_m,
-                                     self.vec_n, self.vec_n2):
+        cdef Py_ssize_t n = p.n, m = p.m, i
+        cdef double* r = self.vec_m
+        cdef int code = equality_inconsistent(p, &self.it, self.opt.eps_prim_inf, r,
+                                              self.vec_n, self.vec_n2)
+        if code == SEPARATED and clean:
+            fill(self.rhs, 0.0, n)
+            copy(r, self.rhs + n, m)
+            kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.sol)
+            for i in range(m):
+                r[i] = -self.sol[n + i]
+            code = equality_direction(p, r, self.opt.eps_prim_inf, self.vec_n, self.vec_n2)
+        if code != CERTIFIED:
             return False
-        fill(self.cert, 0.0, p.n + p.m)
-        for i in range(p.m):
-            self.cert[i] = -self.vec_m[i] * p.E[i]
+        fill(self.cert, 0.0, n + m)
+        for i in range(m):
+            self.cert[i] = -r[i] * p.E[i]
         return True
 
     cdef bint _unbounded(self) noexcept nogil:
@@ -979,7 +1014,10 @@ cdef class Workspace:
     cdef void _restore_equalities(self) noexcept nogil:
         """Remove the rounding that a combination of KKT solutions (``x = base + W u`` in
         the reduced form, a restoration) accumulates in ``A x = b``: one refined KKT
-        solve for ``(0, b - A x)`` with the current factorization."""
+        solve for ``(0, b - A x)`` with the current factorization. The full form needs
+        it only when its iterate misses ``A x = b`` beyond factorization accuracy
+        (:meth:`_missed`): diverging iterates of an infeasible problem (``|x| = 4e6``,
+        rho 2.4e5) left a 3.5e-7 relative error in their KKT solves' ``A x = b``."""
         cdef Problem* p = &self.prob
         cdef Py_ssize_t n = p.n, m = p.m, i
         if m == 0:
@@ -1010,6 +1048,7 @@ cdef class Workspace:
         cdef Iterates* it = &self.it
         cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j
         cdef int new_status
+        cdef bint missed = self._missed()
         copy(it.x, self.saved, n)
         copy(it.nu, self.saved + n, m)
         copy(it.z, self.saved + n + m, s)
@@ -1026,7 +1065,7 @@ cdef class Workspace:
         copy(self.saved, it.x, n)
         copy(self.saved + n, it.nu, m)
         copy(self.saved + n + m, it.z, s)
-        if reduced:
+        if reduced or missed:
             self._restore_equalities()
         return status
 
@@ -1071,8 +1110,10 @@ cdef class Workspace:
                 and r.prim_eq <= o.eps_abs + o.eps_rel * r.prim_eq_scale
                 and r.prim_set <= o.eps_abs + o.eps_rel * r.prim_set_scale
                 and multiplier_violation(&self.pol, p, self.user_z) <= _POLISH_EXACT * tol_d
-                and r.prim_eq <= max(_EQUALITY_SLACK * plain.prim_eq,
-                                     _EQUALITY_EXACT * r.prim_eq_scale)
+                # at EQUALITY_EXACT of max(|A x|, |b|) it is below EQUALITY_MISSED of |A||x|
+                and (r.prim_eq <= _EQUALITY_EXACT * r.prim_eq_scale
+                     or (r.prim_eq <= _EQUALITY_SLACK * plain.prim_eq
+                         and r.prim_eq <= _EQUALITY_MISSED * self._row_terms(self.user_x)))
                 and (r.prim <= plain.prim or r.prim <= _POLISH_EXACT * tol_p)
                 and (r.dual <= plain.dual or r.dual <= _POLISH_EXACT * tol_d)
                 and (r.gap <= plain.gap or r.gap <= _POLISH_EXACT * tol_g)
@@ -1089,6 +1130,19 @@ cdef class Workspace:
         if new_status == _SOLVED or new_status == _INACCURATE:
             status[0] = new_status
         return True
+
+    cdef double _row_terms(self, const double* x) noexcept nogil:
+        """``max_i sum_j |A_ij x_j|`` on the user's data: the size of the terms whose
+        rounding ``A x = b`` carries at factorization accuracy."""
+        cdef Problem* p = &self.prob
+        cdef Py_ssize_t n = p.n, i, j
+        cdef double largest = 0.0, row
+        for i in range(p.m):
+            row = 0.0
+            for j in range(n):
+                row += fabs(self.A_user[i * n + j] * x[j])
+            largest = max(largest, row)
+        return largest
 
     # ------------------------------------------------------------- bookkeeping
 
@@ -1195,7 +1249,7 @@ cdef class Workspace:
             total += fabs(y[i])
         r.objective = 0.5 * xPx + qx
         r.gap = fabs(xPx + qx + by + support)
-        r.gap_scale = max(max(fabs(xPx), fabs(qx)), terms)
+        r.gap_scale = gap_scale(xPx, qx, terms)
         r.prim = max(r.prim_eq, r.prim_set)
         r.prim_scale = max(r.prim_eq_scale, r.prim_set_scale)
         r.finite = isfinite(total) and isfinite(r.gap) and isfinite(r.prim)

@@ -3,7 +3,15 @@ from fccqp._types cimport Iterates, Problem
 
 cdef bint primal_infeasible(const Problem* p, const Iterates* it, double eps, double* d_nu,
                             double* d_y, double* lhs, double* terms) noexcept nogil
-cdef bint equality_inconsistent(const Problem* p, const Iterates* it, double eps, double* r,
-                                double* ATr, double* terms) noexcept nogil
+cdef enum:
+    # Outcomes of the equality certificate's tests.
+    REJECTED = 0
+    CERTIFIED = 1
+    SEPARATED = 2   # b'r > 0, but A'r is not small enough against it
+
+cdef int equality_inconsistent(const Problem* p, const Iterates* it, double eps, double* r,
+                               double* ATr, double* terms) noexcept nogil
+cdef int equality_direction(const Problem* p, const double* r, double eps, double* ATr,
+                            double* terms) noexcept nogil
 cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double* Pdx,
                           double* terms, double* block) noexcept nogil

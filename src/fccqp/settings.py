@@ -112,7 +112,8 @@ class Settings:
     eps_rel: float = 1e-5
     """Relative tolerance on primal and dual residuals."""
     eps_prim_inf: float = 1e-6
-    """Tolerance of the primal infeasibility certificate."""
+    """Tolerance of the primal infeasibility certificate: the residual of ``A'dy + dz ~ 0``
+    relative to its terms (the separation ``b'dy + sigma_C(dz) < 0`` must dominate it)."""
     eps_dual_inf: float = 1e-6
     """Tolerance of the dual infeasibility certificate."""
     max_iter: int = 4000

@@ -17,5 +17,6 @@ cdef void residuals(const Problem* p, const Iterates* it, double* Ax, double* AT
 cdef bint converged(const Residuals* r, double eps_abs, double eps_rel) noexcept nogil
 cdef bint nearly_converged(const Residuals* r, double eps_abs, double eps_rel,
                            double factor) noexcept nogil
+cdef double gap_scale(double xPx, double qx, double terms) noexcept nogil
 cdef void row_spans(Problem* p, double* width) noexcept nogil
 cdef double box_support(const Problem* p, const double* y, double* terms) noexcept nogil
