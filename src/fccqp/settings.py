@@ -142,10 +142,10 @@ class Settings:
     """Ruiz equilibration passes (0 disables scaling, at most :data:`MAX_SCALING`). Four
     rather than OSQP's 10: on the general-QP suite at eps 1e-6 (``python -m
     benchmarks.general_suite``) both solve 543 of 543 problems (542 with 10 before
-    Anderson's weight cap), on
-    the WBC sets at default settings both solved and polished 100 % with the same worst
-    gap and torque error (talos: 66 against 55 mean iterations, go2: 12 against 29), and
-    each pass costs 50k instructions on go2, 270k on talos (6-20 % of a warm tick)."""
+    Anderson's weight cap), on the WBC sets at default settings both solved and polished
+    100 % with the same worst gap and torque error (talos: 66 against 55 mean
+    iterations, go2: 12 against 29), and each pass costs 50k instructions on go2, 270k
+    on talos (6-20 % of a warm tick)."""
     restore_feasibility: bool = True
     """Return a point in the box and the cones: the violating entries are pinned at
     their projection and the others respond through the KKT system, keeping
