@@ -7,9 +7,10 @@ Every backend solves the KKT system of the x-update,
     [ A                 0  ] [nu] = [b],      R = diag(rho on constrained entries),
 
 through four calls: :func:`kkt_factor` (for given P, A, sigma, rho), :func:`kkt_solve`
-(one refined right-hand side; :func:`kkt_solve_once` for callers that refine), :func:`kkt_unit_columns` (responses to unit right-hand
-sides on chosen entries, the reduced form's table and the restoration's columns) and
-:func:`kkt_convexity` (is the QP convex?). The backends are :mod:`fccqp.schur`
+(one refined right-hand side; :func:`kkt_solve_once` for callers that refine),
+:func:`kkt_unit_columns` (responses to unit right-hand sides on chosen entries, the
+reduced form's table and the restoration's columns) and :func:`kkt_convexity` (is the
+QP convex?). The backends are :mod:`fccqp.schur`
 (Cholesky, needs ``P + R`` positive definite and ``A`` of full row rank; the reduced
 form only) and :mod:`fccqp.ldl` (quasi-definite LDL', any ``A``). ``sigma`` is 0 in
 the reduced forms.

@@ -18,13 +18,15 @@ on the constrained entries, one per entry plus one per boundary cone block:
 
 In the coordinates ``(u, lam)`` that is a square system of ``s + nb`` equations, built
 from the ``s x s`` table ``W_S`` in ``O(s^2)`` and factored with LU in ``O(s^3)``
-(a vectorized loop up to ``LU_LOOP_ROWS``, LAPACK's ``dgetrf`` above): no new factorization of the ``(n + m)``-sized KKT matrix, which is what
-the polishing of :mod:`fccqp.polish` pays for every active set and every Newton step
+(a vectorized loop up to ``LU_LOOP_ROWS``, LAPACK's ``dgetrf`` above): no new
+factorization of the ``(n + m)``-sized KKT matrix, which is what the polishing of
+:mod:`fccqp.polish` pays for every active set and every Newton step
 (on go2, 84 rows and ``s = 24``: a warm polish cost 220 us there, mostly ``dsytrf``).
 The system is solved as corrections of the current point against the residual of the
-polished QP's full, unregularized KKT conditions (each correction one refined KKT
-solve with the factorization ADMM already has, one combination with ``W`` and one
-``dgetrs``), so the table's rounding errors are refined away.
+polished QP's full, unregularized KKT conditions (each correction one KKT solve with
+the factorization ADMM already has, unrefined with the Schur backend since this loop
+refines, one combination with ``W`` and one ``dgetrs``), so the table's rounding errors
+are refined away.
 
 The system is singular exactly when the polished QP's solution or its multipliers are
 not unique (a cost flat on the free entries, active constraints that depend on each
