@@ -25,8 +25,22 @@ MAX_ENTRY = 1e20
 """Largest magnitude accepted in ``P, q, A, b, x0`` (see :mod:`fccqp.validation`)."""
 
 
+class Sizes:
+    """``n`` and ``m`` of a problem that has the vectors ``q`` (cost) and ``b`` (rows)."""
+
+    @property
+    def n(self) -> int:
+        """Number of variables."""
+        return int(self.q.shape[0])
+
+    @property
+    def m(self) -> int:
+        """Number of equality rows."""
+        return int(self.b.shape[0])
+
+
 @dataclass(frozen=True)
-class ProblemData:
+class ProblemData(Sizes):
     """A converted problem ``min 1/2 x'Px + q'x  s.t.  Ax = b, lb <= x <= ub, cones``.
 
     All arrays are dense, float64 and C-contiguous (their numbers are checked by the
@@ -44,16 +58,6 @@ class ProblemData:
     cones: ConeArrays
     constrained: np.ndarray
     fixed: np.ndarray
-
-    @property
-    def n(self) -> int:
-        """Number of variables."""
-        return int(self.q.shape[0])
-
-    @property
-    def m(self) -> int:
-        """Number of equality rows."""
-        return int(self.b.shape[0])
 
 
 def issparse(value: object) -> bool:

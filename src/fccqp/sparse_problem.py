@@ -19,14 +19,14 @@ import scipy.sparse as sp
 
 from fccqp import problem as dense_problem
 from fccqp.cones import Cone, ConeArrays
-from fccqp.problem import INFINITE_BOUND, MAX_ENTRY, raise_finding, structure, vector
+from fccqp.problem import INFINITE_BOUND, MAX_ENTRY, Sizes, raise_finding, structure, vector
 from fccqp.projections import project_constraint_set
 from fccqp.scaling import MAX_NORM, MIN_COST_NORM, MIN_NORM
 from fccqp.validation import SYMMETRY_TOLERANCE
 
 
 @dataclass(frozen=True)
-class SparseData:
+class SparseData(Sizes):
     """``min 1/2 x'Px + q'x  s.t.  A x = b, lb <= x <= ub, x[block] in cone``, sparse.
 
     ``P`` (both triangles, symmetrized) and ``A`` are CSC float64 matrices, the vectors
@@ -45,16 +45,6 @@ class SparseData:
     cones: ConeArrays
     constrained: np.ndarray
     fixed: np.ndarray
-
-    @property
-    def n(self) -> int:
-        """Number of variables."""
-        return int(self.q.shape[0])
-
-    @property
-    def m(self) -> int:
-        """Number of equality rows."""
-        return int(self.b.shape[0])
 
 
 def _sparse_matrix(value: object, name: str) -> sp.csc_matrix:
@@ -163,7 +153,7 @@ def convert(
 
 
 @dataclass(frozen=True)
-class Scaled:
+class Scaled(Sizes):
     """The equilibrated problem ``P_s = c D P D``, ``q_s = c D q``, ``A_s = E A D``,
     ``b_s = E b``, bounds of ``x_S`` divided by ``D_S`` (see :mod:`fccqp.scaling`), with
     what the iteration, the checks and polishing read from it: the structure of the
@@ -195,16 +185,6 @@ class Scaled:
     span: np.ndarray
     """Range of each row's ``A x`` over the box (infinite where a row meets an entry
     without two finite bounds)."""
-
-    @property
-    def n(self) -> int:
-        """Number of variables."""
-        return int(self.q.shape[0])
-
-    @property
-    def m(self) -> int:
-        """Number of equality rows."""
-        return int(self.b.shape[0])
 
     @property
     def s(self) -> int:
