@@ -11,7 +11,7 @@ its finding into the message.
 from __future__ import annotations
 
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -110,14 +110,16 @@ def vector(value: object, name: str, n: int) -> np.ndarray:
 
 def convert(
     P: object, q: object, A: object = None, b: object = None, lb: object = None,
-    ub: object = None,
-) -> tuple[np.ndarray, ...]:
-    """Check types and shapes; return ``(P, q, A, b, lb, ub)`` as float64 arrays.
+    ub: object = None, *, matrix: Callable[[object, str], object] = dense_matrix,
+) -> tuple:
+    """Check types and shapes; return ``(P, q, A, b, lb, ub)``, the vectors as float64
+    arrays and ``P``, ``A`` through ``matrix`` (:func:`dense_matrix`; the sparse path
+    passes its CSC conversion).
 
     ``A, b`` default to zero rows and ``lb, ub`` to infinities. No copy is made of an
     argument that is already a contiguous float64 array of the right shape.
     """
-    P = dense_matrix(P, "P")
+    P = matrix(P, "P")
     if P.shape[0] != P.shape[1]:
         raise ValueError(f"P must be square, got shape {P.shape}")
     n = P.shape[0]
@@ -128,11 +130,10 @@ def convert(
         raise ValueError("A and b must be given together")
     if A is None:
         A, b = np.zeros((0, n)), np.zeros(0)
-    else:
-        A = dense_matrix(A, "A")
-        if A.shape[1] != n:
-            raise ValueError(f"A must have {n} columns (the size of P), got shape {A.shape}")
-        b = vector(b, "b", A.shape[0])
+    A = matrix(A, "A")
+    if A.shape[1] != n:
+        raise ValueError(f"A must have {n} columns (the size of P), got shape {A.shape}")
+    b = vector(b, "b", A.shape[0])
     lb = np.full(n, -np.inf) if lb is None else vector(lb, "lb", n)
     ub = np.full(n, np.inf) if ub is None else vector(ub, "ub", n)
     return P, q, A, b, lb, ub

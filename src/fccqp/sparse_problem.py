@@ -19,7 +19,7 @@ import scipy.sparse as sp
 
 from fccqp import problem as dense_problem
 from fccqp.cones import Cone, ConeArrays
-from fccqp.problem import INFINITE_BOUND, MAX_ENTRY, Sizes, raise_finding, structure, vector
+from fccqp.problem import INFINITE_BOUND, MAX_ENTRY, Sizes, raise_finding, structure
 from fccqp.projections import project_constraint_set
 from fccqp.scaling import MAX_NORM, MIN_COST_NORM, MIN_NORM
 from fccqp.validation import SYMMETRY_TOLERANCE
@@ -120,24 +120,10 @@ def convert(
     replaced by ``(P + P') / 2`` when its asymmetry is below
     ``SYMMETRY_TOLERANCE`` times its largest entry, and rejected above.
     """
-    P = _sparse_matrix(P, "P")
-    if P.shape[0] != P.shape[1]:
-        raise ValueError(f"P must be square, got shape {P.shape}")
+    P, q, A, b, lb, ub = dense_problem.convert(P, q, A, b, lb, ub, matrix=_sparse_matrix)
+    # private copies: the caller may refill its arrays before the next solve
+    q, b, lb, ub = (np.array(v) for v in (q, b, lb, ub))
     n = P.shape[0]
-    if n == 0:
-        raise ValueError("P must have at least one row (the problem has no variables)")
-    q = np.array(vector(q, "q", n))
-    if (A is None) != (b is None):
-        raise ValueError("A and b must be given together")
-    if A is None:
-        A, b = sp.csc_matrix((0, n)), np.zeros(0)
-    else:
-        A = _sparse_matrix(A, "A")
-        if A.shape[1] != n:
-            raise ValueError(f"A must have {n} columns (the size of P), got shape {A.shape}")
-        b = np.array(vector(b, "b", A.shape[0]))
-    lb = np.full(n, -np.inf) if lb is None else np.array(vector(lb, "lb", n))
-    ub = np.full(n, np.inf) if ub is None else np.array(vector(ub, "ub", n))
     _finite_entries(P, -1, "P")
     asymmetry = abs(P - P.T).max() if P.nnz else 0.0
     if asymmetry > SYMMETRY_TOLERANCE * abs(P).max():
