@@ -3,9 +3,11 @@
 import numpy as np
 import pytest
 from fccqp.projections import project_constraint_set
-from fccqp.scaling import MAX_NORM, MIN_NORM
+from fccqp.scaling import MAX_NORM, MIN_NORM, RESCALE_DRIFT
 from fccqp.scaling import equilibrate_py as equilibrate
+from fccqp.scaling import rescale_py as rescale
 from fccqp.scaling import scale_start_py as scale_start
+from fccqp.scaling import scaled_norms_py as scaled_norms
 from fccqp.scaling import unscale_py as unscale
 
 
@@ -24,11 +26,16 @@ def _ruiz(P, q, A, blocks, iterations):
         for start, dim in blocks:
             d[start : start + dim] = np.exp(np.log(d[start : start + dim]).mean())
         D, E = D * d, E * e
+    return D, E, _cost_normalization(D, P, q)
+
+
+def _cost_normalization(D, P, q):
+    """``c`` of the cost of ``P, q`` under the column scaling ``D``."""
     P_s = D[:, None] * P * D[None, :]
     mean_col = np.abs(P_s).max(axis=1).mean()
     q_norm = np.abs(D * q).max()
     size = max(mean_col if mean_col >= MIN_NORM else 1.0, q_norm if q_norm >= MIN_NORM else 1.0)
-    return D, E, 1.0 / min(size, MAX_NORM)
+    return 1.0 / min(size, MAX_NORM)
 
 
 @pytest.mark.parametrize(("seed", "n", "m"), [(0, 9, 4), (1, 13, 6), (2, 31, 12), (3, 5, 0)])
@@ -82,3 +89,54 @@ def test_warm_start_and_unscaling_are_inverse():
     np.testing.assert_allclose(x2, x, rtol=1e-14)
     np.testing.assert_allclose(y2, y, rtol=1e-14)
     np.testing.assert_allclose(z2, z, rtol=1e-14)
+
+
+def _equilibrated(P, q, A, b, iterations=4):
+    n, m = P.shape[0], A.shape[0]
+    P_s, q_s, A_s, b_s = P.copy(), q.copy(), A.copy(), b.copy()
+    D, E = np.empty(n), np.empty(m)
+    none = np.array([], dtype=np.intp)
+    c = equilibrate(P_s, q_s, A_s, b_s, none, none, iterations, D, E)
+    return D, E, c, scaled_norms(P_s, A_s, c)
+
+
+def test_rescale_applies_an_earlier_scaling_and_normalizes_the_cost_anew():
+    rng = np.random.default_rng(4)
+    n, m = 12, 5
+    G = rng.standard_normal((n, n)) * np.logspace(-2, 2, n)
+    P, A = G @ G.T, rng.standard_normal((m, n)) * np.logspace(1, -1, m)[:, None]
+    q, b = rng.standard_normal(n), rng.standard_normal(m)
+    D, E, c, reference = _equilibrated(P, q, A, b)
+    # the next tick: matrices 2 % off, a cost 8x larger
+    P2 = P * (1 + 0.02 * rng.standard_normal((n, n)))
+    P2 = (P2 + P2.T) / 2
+    A2, q2 = A * (1 + 0.02 * rng.standard_normal((m, n))), 8 * q
+    kept, P_s, q_s, A_s, b_s, c2 = rescale(P2, q2, A2, b, D, E, reference)
+    assert kept
+    assert c2 == pytest.approx(_cost_normalization(D, P2, q2), rel=1e-12)
+    np.testing.assert_allclose(P_s, c2 * D[:, None] * P2 * D[None, :], rtol=1e-12)
+    np.testing.assert_allclose(q_s, c2 * D * q2, rtol=1e-12)
+    np.testing.assert_allclose(A_s, E[:, None] * A2 * D[None, :], rtol=1e-12)
+    np.testing.assert_allclose(b_s, E * b, rtol=1e-12)
+    np.testing.assert_allclose(scaled_norms(P_s, A_s, c2), scaled_norms(
+        c2 * D[:, None] * P2 * D[None, :], E[:, None] * A2 * D[None, :], c2), rtol=1e-12)
+
+
+@pytest.mark.parametrize("where", ["P column", "A row"])
+def test_rescale_refuses_data_that_moved_beyond_the_drift(where):
+    rng = np.random.default_rng(5)
+    n, m = 10, 4
+    G = rng.standard_normal((n, n))
+    P, A = G @ G.T + np.eye(n), rng.standard_normal((m, n))
+    q, b = rng.standard_normal(n), rng.standard_normal(m)
+    D, E, _, reference = _equilibrated(P, q, A, b)
+    factor = 1.5 * RESCALE_DRIFT   # beyond the drift even after the cost's normalization
+    P2, A2 = P.copy(), A.copy()
+    if where == "P column":
+        P2[:, 3] *= factor
+        P2[3, :] *= factor
+        A2[:, 3] *= factor
+    else:
+        A2[2] *= factor
+    assert not rescale(P2, q, A2, b, D, E, reference)[0]
+    assert rescale(P, q, A, b, D, E, reference)[0]

@@ -97,6 +97,24 @@ def test_warm_start_cuts_iterations_on_nearby_problems():
     assert sum(warm_iterations[1:]) < 0.6 * sum(cold[1:])
 
 
+@pytest.mark.parametrize("factor", [1.02, 1e3])
+def test_warm_start_on_changed_matrices_matches_a_cold_solve(factor):
+    # a warm start keeps the previous equilibration while the new data's norms stay
+    # near what it gave (fccqp.scaling.rescale) and equilibrates anew past that
+    P, q, A, b, lb, ub, cones = random_problem(10, n=40, m=10, n_cones=4, n_box=8)
+    solver = fccqp.Solver(**TIGHT)
+    solver.solve(P, q, A, b, lb, ub, cones)
+    scale = np.ones(P.shape[0])
+    scale[-10:] = factor   # free entries: their bounds stay as they are
+    P2, A2 = scale[:, None] * P * scale[None, :], A * scale[None, :]
+    problem = (P2 + P2.T) / 2, q * scale, A2, b, lb, ub, cones
+    warm = solver.solve(*problem)
+    reference = clarabel_solve(*problem)
+    assert warm.status is Status.SOLVED
+    assert abs(warm.obj - reference.obj) <= 1e-6 * (1 + abs(reference.obj))
+    verify_solution(problem, warm, TIGHT_TOLERANCES)
+
+
 def test_reuses_factorization_when_matrices_unchanged():
     P, q, A, b, lb, ub, cones = random_problem(9)
     solver = fccqp.Solver(adaptive_rho=False)

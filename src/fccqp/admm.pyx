@@ -44,7 +44,7 @@ from fccqp.projections cimport proj_block, proj_set
 from fccqp.reduced cimport (Reduced, materialize, near_convergence, reduced_rebase,
                             reduced_start, reduced_step, reduced_table)
 from fccqp.restoration cimport Restoration, restore
-from fccqp.scaling cimport equilibrate, scale_start, unscale
+from fccqp.scaling cimport equilibrate, rescale, scale_start, scaled_norms, unscale
 from fccqp.termination cimport (Residuals, converged, gap_scale, nearly_converged, residuals,
                                row_spans)
 from fccqp.validation cimport SCAN_OK, Finding, scan_and_copy
@@ -222,6 +222,8 @@ cdef class Workspace:
     cdef double* rho_scale
     cdef double* d_scratch
     cdef double* e_scratch
+    cdef double* scale_reference   # norms of the scaled matrices at the last equilibration
+    cdef double* scale_norms
     cdef double* rhs
     cdef double* sol
     cdef double* vec_n
@@ -304,6 +306,7 @@ cdef class Workspace:
         for k in range(s):
             self.rho_scale[k] = FIXED_RHO_SCALE if fixed[k] else 1.0
         self.d_scratch, self.e_scratch = self._new(n), self._new(m)
+        self.scale_reference, self.scale_norms = self._new(N), self._new(N)
         it = &self.it
         it.x, it.nu, it.z, it.y = self._new(n), self._new(m), self._new(s), self._new(s)
         it.x_prev, it.nu_prev = self._new(n), self._new(m)
@@ -488,7 +491,7 @@ cdef class Workspace:
         self.has_matrices = True
         self.from_polished = x0 == NULL and warm and self.prev_polished
         self.clock[1] = fccqp_now()
-        self._scale(reuse)
+        self._scale(reuse, warm)
         self.clock[2] = fccqp_now()
         self.log_count = 0
         run.rho = self.prev_rho if warm else self.opt.rho
@@ -504,13 +507,21 @@ cdef class Workspace:
         self._iterate(&run, x0 == NULL and not warm, start_time)
         return run
 
-    cdef void _scale(self, bint reuse) noexcept nogil:
-        """Equilibrate the user's data into the scaled problem, or, with ``reuse``, apply
-        the scaling of the unchanged matrices to the new vectors only; then the rows'
-        spans over the (new) box."""
+    cdef void _scale(self, bint reuse, bint warm) noexcept nogil:
+        """Equilibrate the user's data into the scaled problem; with ``reuse`` (unchanged
+        matrices) apply the scaling to the new vectors only, and with ``warm`` (a start
+        from the previous solution) scale the new data with the previous equilibration
+        (:func:`fccqp.scaling.rescale`); then the rows' spans over the (new) box."""
         cdef Problem* p = &self.prob
         cdef Py_ssize_t n = p.n, m = p.m, i, j
-        if not reuse:
+        if reuse:
+            for i in range(n):
+                p.q[i] = p.c * p.D[i] * self.q_user[i]
+            for i in range(m):
+                p.b[i] = p.E[i] * self.b_user[i]
+        elif not (warm and self.scaled_once and rescale(
+                self.P_user, self.q_user, self.A_user, self.b_user, n, m, p.D, p.E,
+                self.scale_reference, self.scale_norms, p.P, p.q, p.A, p.b, &p.c)):
             copy(self.P_user, p.P, n * n)
             copy(self.A_user, p.A, m * n)
             copy(self.q_user, p.q, n)
@@ -518,12 +529,8 @@ cdef class Workspace:
             p.c = equilibrate(p.P, p.q, p.A, p.b, n, m, self.block_start, p.cones.dim,
                               p.cones.count, self.opt.scaling, p.D, p.E, self.d_scratch,
                               self.e_scratch)
+            scaled_norms(p.P, p.A, n, m, p.c, self.scale_reference)
             self.scaled_once = True
-        else:
-            for i in range(n):
-                p.q[i] = p.c * p.D[i] * self.q_user[i]
-            for i in range(m):
-                p.b[i] = p.E[i] * self.b_user[i]
         for j in range(p.s):
             i = p.constrained[j]
             p.lo[j] = self.lb_user[i] / p.D[i]
