@@ -34,6 +34,62 @@ def test_backend_matches_clarabel(backend, seed):
     assert np.abs(A @ result.x - b).max() <= 1e-9 * (1 + np.abs(b).max())
 
 
+def _block_diagonal(problem, coupled_constrained=False, flat_free=False):
+    """``problem`` with the cost of whole-body control's shape: dense on the first
+    free entries, diagonal on the other free ones and on every constrained entry (the
+    Schur backend's diagonal tail); ``coupled_constrained`` couples a boxed entry to a
+    free one, ``flat_free`` gives a diagonal free entry no curvature."""
+    P, q, A, b, lb, ub, cones = problem
+    n = P.shape[0]
+    constrained = np.isfinite(lb) | np.isfinite(ub)
+    for cone in cones:
+        constrained[cone.start:cone.start + cone.dim] = True
+    free = np.flatnonzero(~constrained)
+    dense = free[:6]
+    P2 = np.diag(np.linspace(0.5, 2.0, n))
+    P2[np.ix_(dense, dense)] = P[np.ix_(dense, dense)] + np.eye(6)
+    if coupled_constrained:
+        boxed = np.flatnonzero(np.isfinite(lb) & ~np.isin(np.arange(n), dense))[0]
+        P2[boxed, dense[0]] = P2[dense[0], boxed] = 0.3
+    if flat_free:
+        P2[free[-1], free[-1]] = 0.0
+    return P2, q, A, b, lb, ub, cones
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("shape", ["diagonal tail", "coupled constrained", "flat free"])
+def test_backend_matches_clarabel_on_block_diagonal_costs(backend, shape):
+    problem = _block_diagonal(random_problem(4, n_box=6), shape == "coupled constrained",
+                              shape == "flat free")
+    result = fccqp.solve(*problem, kkt_backend=backend, eps_abs=1e-8, eps_rel=1e-8)
+    assert result.status is Status.SOLVED
+    if backend != "schur_reduced" or shape != "flat free":
+        assert result.backend == backend
+    else:   # H = P + R is singular on the flat entry: LDL' takes over
+        assert result.backend in ("ldl_reduced", "ldl_full")
+    reference = clarabel_solve(*problem)
+    np.testing.assert_allclose(result.x, reference.x, atol=1e-5 * (1 + np.abs(reference.x).max()))
+    A, b = problem[2:4]
+    assert np.abs(A @ result.x - b).max() <= 1e-9 * (1 + np.abs(b).max())
+
+
+@pytest.mark.parametrize("entry", ["free", "boxed"])
+def test_negative_curvature_on_the_diagonal_tail_is_rejected(entry):
+    P, q, A, b, lb, ub, cones = _block_diagonal(random_problem(4, n_box=6))
+    constrained = np.isfinite(lb) | np.isfinite(ub)
+    for cone in cones:
+        constrained[cone.start:cone.start + cone.dim] = True
+    i = np.flatnonzero(np.isfinite(lb) if entry == "boxed" else ~constrained)[-1]
+    null = np.linalg.svd(A)[2][A.shape[0]:].T
+    P[i, i] = 0.0
+    # the curvature that makes the cost concave on the null space of A, doubled
+    curvature = np.linalg.eigvalsh(null.T @ P @ null)[0] / (null[i] @ null[i])
+    P[i, i] = -2.0 * max(curvature, 1e-3)
+    assert np.linalg.eigvalsh(null.T @ P @ null)[0] < 0
+    with pytest.raises(ValueError, match="not convex"):
+        fccqp.Solver(kkt_backend="schur_reduced").solve(P, q, A, b, lb, ub, cones)
+
+
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_warm_solver_reuses_every_backend(backend):
     problem = random_problem(1, n_box=6)

@@ -327,7 +327,10 @@ cdef class Workspace:
         kk.ldl.Ax, kk.ldl.ATnu = self._new(m), self._new(n)
         kk.schur.n, kk.schur.m = <int>n, <int>m
         kk.schur.L, kk.schur.LS, kk.schur.Y = self._new(n * n), self._new(m * m), self._new(n * m)
-        kk.schur.order = &order_v[0]
+        kk.schur.base_order = &order_v[0]
+        kk.schur.order = <Py_ssize_t*>self._new_int(n)
+        kk.schur.coupled = <char*>self._new(n)
+        kk.schur.dense = <int>n
         kk.schur.perm, kk.schur.dx, kk.schur.r = self._new(n), self._new(n), self._new(n)
         kk.schur.ATnu, kk.schur.dnu, kk.schur.Ax = self._new(n), self._new(m), self._new(m)
         kk.schur.X, kk.schur.Wnu, kk.schur.M = self._new(n * s), self._new(m * s), self._new(s * s)

@@ -7,7 +7,10 @@ cdef struct Schur:
     double* L            # n x n, Fortran
     double* LS           # m x m, Fortran
     double* Y            # n x m, Fortran: L^-1 A' (rows in order)
-    const Py_ssize_t* order   # free entries first, the s constrained entries last
+    const Py_ssize_t* base_order   # free entries first, the s constrained entries last
+    Py_ssize_t* order    # base_order with the diagonal free entries moved behind the others
+    int dense            # rows of the dense leading block of L; a diagonal tail follows
+    char* coupled        # n scratch: which rows of P have entries off the diagonal
     double* perm         # n scratch
     double* dx           # n scratch
     double* r            # n scratch

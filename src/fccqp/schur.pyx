@@ -15,6 +15,14 @@ and the reduced form's table (:func:`schur_unit_columns`) skips the leading rows
 the leading block of ``L`` is the Cholesky factor of ``P`` on the free entries, which
 makes a convexity certificate cheap (:func:`schur_certifies_convexity`).
 
+Where ``P`` is diagonal on the constrained entries and on some free ones (no entry
+off its diagonal in their rows: the torques and forces of whole-body control), those
+free entries go after the other free ones in ``order`` and ``H`` is block diagonal, a
+dense leading block of ``dense`` rows and a diagonal tail: Cholesky, the triangular
+solves and the table's columns then work on the leading block only, and the tail is a
+division. On talos (``n, m, s`` = 124, 68, 56, a dense block of 38) the factorization
+and the table take half the multiply-adds of the dense way.
+
 ``S`` is positive definite exactly when ``A`` has full row rank; when either
 factorization fails (or loses a pivot to cancellation, see ``RANK_TOLERANCE``) the
 caller falls back to the quasi-definite LDL' backend of :mod:`fccqp.ldl`, which handles
@@ -22,6 +30,8 @@ rank-deficient ``A``. Solves are refined like :func:`fccqp.ldl.ldl_solve`.
 """
 
 import numpy as np
+
+from libc.math cimport sqrt
 
 from fccqp._blas cimport cholesky, cholesky_solve, cholesky_solve_vector, gemm, syrk_t, trsm
 from fccqp._dense cimport matvec, matvec_t
@@ -42,27 +52,66 @@ def ordering(n, constrained):
     return np.concatenate((np.flatnonzero(free), constrained)).astype(np.intp)
 
 
+cdef void _order(Schur* f, const Problem* p) noexcept nogil:
+    """Put the free entries whose row of ``P`` is diagonal after the other free ones and
+    set ``dense``: the rows before the diagonal tail, ``n`` when some constrained entry is
+    coupled (then ``order`` keeps the base order's free entries and nothing is diagonal).
+    ``order`` is rebuilt from ``base_order``, so it depends only on this ``P``."""
+    cdef Py_ssize_t n = p.n, s = p.s, first = n - s, i, j, k, lead = 0
+    cdef char* coupled = f.coupled
+    for i in range(n):
+        coupled[i] = 0
+        for j in range(n):
+            if j != i and p.P[i * n + j] != 0.0:
+                coupled[i] = 1
+                break
+    for k in range(s):
+        if coupled[p.constrained[k]]:
+            for i in range(n):
+                f.order[i] = f.base_order[i]
+            f.dense = <int>n
+            return
+    for k in range(first):
+        if coupled[f.base_order[k]]:
+            f.order[lead] = f.base_order[k]
+            lead += 1
+    f.dense = <int>lead
+    for k in range(first):
+        if not coupled[f.base_order[k]]:
+            f.order[lead] = f.base_order[k]
+            lead += 1
+    for k in range(first, n):
+        f.order[k] = f.base_order[k]
+
+
 cdef bint schur_factor(Schur* f, const Problem* p, const double* rho_vec) noexcept nogil:
     """Factor ``H = P + R`` (rows in ``order``) into ``L`` and ``S`` into ``LS``;
     ``Y := L^-1 A'``. False when ``H`` or ``S`` is not (numerically) positive definite."""
     cdef int n = <int>p.n, m = <int>p.m, s = <int>p.s, first = n - s, i, j
+    cdef int k
     cdef Py_ssize_t column
     cdef double largest = 0.0
+    _order(f, p)
+    k = f.dense
     for j in range(n):
         column = f.order[j]
         for i in range(j, n):
             f.L[i + j * n] = p.P[f.order[i] * n + column]
     for j in range(s):
         f.L[first + j + (first + j) * n] += rho_vec[j]
-    if not cholesky(f.L, n, n):
+    if k > 0 and not cholesky(f.L, k, n):
         return False
+    for j in range(k, n):   # the diagonal tail: L there is zero off the diagonal
+        if not f.L[j + j * n] > 0.0:
+            return False
+        f.L[j + j * n] = sqrt(f.L[j + j * n])
     if m == 0:
         return True
     for j in range(n):
         column = f.order[j]
         for i in range(m):
             f.Y[j + i * n] = p.A[i * n + column]
-    trsm(b"L", b"N", n, m, f.L, n, f.Y, n)
+    _lower_solve(f, n, m, f.Y, n)
     syrk_t(m, n, f.Y, n, f.LS, m)
     for i in range(m):
         largest = max(largest, f.LS[i + i * m])
@@ -72,6 +121,27 @@ cdef bint schur_factor(Schur* f, const Problem* p, const double* rho_vec) noexce
         if f.LS[i + i * m] * f.LS[i + i * m] <= _RANK_TOLERANCE * largest:
             return False
     return True
+
+
+cdef void _lower_solve(Schur* f, int n, int columns, double* B, int ldb) noexcept nogil:
+    """``B := L^-1 B`` (``n x columns``, column-major): ``dtrsm`` on the dense block, a
+    division on the diagonal tail."""
+    cdef int k = f.dense, i, j
+    if k > 0:
+        trsm(b"L", b"N", k, columns, f.L, n, B, ldb)
+    for j in range(columns):
+        for i in range(k, n):
+            B[i + j * ldb] /= f.L[i + i * n]
+
+
+cdef void _upper_solve(Schur* f, int n, int columns, double* B, int ldb) noexcept nogil:
+    """``B := L'^-1 B``, as :func:`_lower_solve`."""
+    cdef int k = f.dense, i, j
+    if k > 0:
+        trsm(b"L", b"T", k, columns, f.L, n, B, ldb)
+    for j in range(columns):
+        for i in range(k, n):
+            B[i + j * ldb] /= f.L[i + i * n]
 
 
 cdef bint schur_certifies_convexity(Schur* f, const Problem* p, const double* rho_vec,
@@ -88,6 +158,11 @@ cdef bint schur_certifies_convexity(Schur* f, const Problem* p, const double* rh
     cdef int n = <int>p.n, s = <int>p.s, first = n - s, i, j, k
     cdef double acc
     cdef const double* L22 = f.L + first + first * n
+    if f.dense <= first:   # L22 is diagonal
+        for j in range(s):
+            if not L22[j + j * n] * L22[j + j * n] + sigma - rho_vec[j] > 0.0:
+                return False
+        return True
     for j in range(s):
         for i in range(j, s):
             acc = 0.0
@@ -100,10 +175,15 @@ cdef bint schur_certifies_convexity(Schur* f, const Problem* p, const double* rh
 
 cdef void _h_solve(Schur* f, double* v, Py_ssize_t n) noexcept nogil:
     """``v := H^-1 v`` in place, ``v`` in the user's order of ``x``."""
-    cdef Py_ssize_t i
+    cdef Py_ssize_t i, k = f.dense
+    cdef double d
     for i in range(n):
         f.perm[i] = v[f.order[i]]
-    cholesky_solve_vector(f.L, <int>n, <int>n, f.perm)
+    if k > 0:
+        cholesky_solve_vector(f.L, <int>k, <int>n, f.perm)
+    for i in range(k, n):
+        d = f.L[i + i * n]
+        f.perm[i] /= d * d
     for i in range(n):
         v[f.order[i]] = f.perm[i]
 
@@ -173,16 +253,25 @@ cdef void schur_unit_columns(Schur* f, const Problem* p, double* W) noexcept nog
     """
     cdef int n = <int>p.n, m = <int>p.m, s = <int>p.s, first = n - s, N = n + m, i, j
     cdef double* X = f.X
+    cdef double d
     for i in range(n * s):
         X[i] = 0.0
-    for j in range(s):
-        X[first + j + j * n] = 1.0
-    trsm(b"L", b"N", s, s, f.L + first + first * n, n, X + first, n)
+    if f.dense <= first:   # L22 is diagonal, and so is Z's block
+        for j in range(s):
+            d = 1.0 / f.L[first + j + (first + j) * n]
+            X[first + j + j * n] = d
+            for i in range(m):
+                f.Wnu[i + j * m] = f.Y[first + j + i * n] * d
+    else:
+        for j in range(s):
+            X[first + j + j * n] = 1.0
+        trsm(b"L", b"N", s, s, f.L + first + first * n, n, X + first, n)
+        if m > 0:
+            gemm(b"T", b"N", m, s, s, 1.0, f.Y + first, n, X + first, n, 0.0, f.Wnu, m)
     if m > 0:
-        gemm(b"T", b"N", m, s, s, 1.0, f.Y + first, n, X + first, n, 0.0, f.Wnu, m)
         cholesky_solve(f.LS, m, m, f.Wnu, s, m)
         gemm(b"N", b"N", n, s, m, -1.0, f.Y, n, f.Wnu, m, 1.0, X, n)
-    trsm(b"L", b"T", n, s, f.L, n, X, n)
+    _upper_solve(f, n, s, X, n)
     for j in range(s):
         for i in range(n):
             W[f.order[i] + j * N] = X[i + j * n]
