@@ -174,8 +174,9 @@ cdef bint rescale(const double* P, const double* q, const double* A, const doubl
                   Py_ssize_t n, Py_ssize_t m, const double* D, const double* E,
                   const double* reference, double* norms, double* P_s, double* q_s,
                   double* A_s, double* b_s, double* c) noexcept nogil:
-    """Scale new data with the ``D, E`` of an earlier equilibration, in one pass, and
-    normalize its cost into ``c`` (:func:`equilibrate`'s last step); False when a column
+    """Scale new data with the ``D, E`` of an earlier equilibration and normalize its
+    cost into ``c`` as :func:`equilibrate` does (two passes over ``P``, one over ``A``,
+    the norms found on the way); False when a column
     or row norm of the result (:func:`scaled_norms`, into ``norms``) left the factor
     ``RESCALE_DRIFT`` around ``reference``, the norms that equilibration gave its own
     data: then the data moved too far for it and the caller equilibrates.
@@ -188,18 +189,34 @@ cdef bint rescale(const double* P, const double* q, const double* A, const doubl
     are 0.22M of a 1.76M-instruction tick (callgrind).
     """
     cdef Py_ssize_t i, j
-    cdef double di
-    for i in range(n):
+    cdef double di, value, row, mean_col = 0.0, q_norm = 0.0, size
+    for i in range(n):   # D P D's rows (its columns: it is symmetric) and the cost's size
         di = D[i]
+        row = 0.0
+        for j in range(n):
+            row = max(row, fabs(P[i * n + j]) * D[j])
+        norms[i] = row * di
+        mean_col += norms[i]
+        q_s[i] = q[i] * di
+        q_norm = max(q_norm, fabs(q_s[i]))
+    mean_col /= n
+    size = max(mean_col if mean_col >= _MIN_COST_NORM else 1.0,
+               q_norm if q_norm >= _MIN_COST_NORM else 1.0)
+    c[0] = 1.0 / min(size, _MAX_NORM)   # as _normalize_cost finds it
+    for i in range(n):
+        di = c[0] * D[i]
         for j in range(n):
             P_s[i * n + j] = P[i * n + j] * di * D[j]
-        q_s[i] = q[i] * di
+        q_s[i] *= c[0]
     for i in range(m):
+        row = 0.0
         for j in range(n):
-            A_s[i * n + j] = A[i * n + j] * E[i] * D[j]
+            value = A[i * n + j] * E[i] * D[j]
+            A_s[i * n + j] = value
+            norms[j] = max(norms[j], fabs(value))
+            row = max(row, fabs(value))
+        norms[n + i] = row
         b_s[i] = b[i] * E[i]
-    c[0] = _normalize_cost(P_s, q_s, n, norms)
-    scaled_norms(P_s, A_s, n, m, c[0], norms)
     for i in range(n + m):
         if not (norms[i] <= _RESCALE_DRIFT * reference[i]
                 and reference[i] <= _RESCALE_DRIFT * norms[i]):
