@@ -115,6 +115,32 @@ def test_warm_start_on_changed_matrices_matches_a_cold_solve(factor):
     verify_solution(problem, warm, TIGHT_TOLERANCES)
 
 
+def test_a_solver_follows_bounds_that_change_structure():
+    # the workspace checks each solve's bounds against the structure it was made for
+    P, q, A, b, lb, ub, cones = random_problem(11, n=40, m=10, n_cones=4, n_box=8)
+    free = np.flatnonzero(~np.isfinite(lb) & ~np.isfinite(ub))
+    free = free[free >= 12 + 8]   # after the four cones and the boxes
+    boxed = np.flatnonzero(np.isfinite(lb))
+    solver = fccqp.Solver(**TIGHT)
+    lb2, ub2 = lb.copy(), ub.copy()
+    lb2[free[0]], ub2[free[0]] = -0.1, 0.1          # a free entry gets a box
+    lb3, ub3 = lb.copy(), ub.copy()
+    lb3[boxed[0]] = ub3[boxed[0]] = 0.5 * (lb[boxed[0]] + ub[boxed[0]])   # a box is fixed
+    for bounds in ((lb, ub), (lb2, ub2), (lb3, ub3), (lb, ub)):
+        problem = P, q, A, b, *bounds, cones
+        result = solver.solve(*problem)
+        assert result.status is Status.SOLVED
+        assert abs(result.obj - clarabel_solve(*problem).obj) <= 1e-6 * (1 + abs(result.obj))
+        verify_solution(problem, result, TIGHT_TOLERANCES)
+    bad_lb = lb.copy()
+    bad_lb[cones[0].start] = -1.0
+    with pytest.raises(ValueError, match=rf"x\[{cones[0].start}\] is in a cone block"):
+        solver.solve(P, q, A, b, bad_lb, ub, cones)
+    again = solver.solve(P, q, A, b, lb, ub, cones)   # the solver is still sound
+    assert again.status is Status.SOLVED
+    verify_solution((P, q, A, b, lb, ub, cones), again, TIGHT_TOLERANCES)
+
+
 def test_reuses_factorization_when_matrices_unchanged():
     P, q, A, b, lb, ub, cones = random_problem(9)
     solver = fccqp.Solver(adaptive_rho=False)

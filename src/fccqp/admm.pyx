@@ -77,6 +77,15 @@ NOT_CONVEX_CODE = -1
 """The KKT inertia shows that the QP is not convex."""
 BAD_DATA = -2
 """The validation scan found bad numbers (see ``Workspace.finding``)."""
+STRUCTURE_CHANGED = -3
+"""The bounds no longer have the structure the workspace was made for (another set of
+constrained or fixed entries, or a bound on a cone entry): the caller rescans them
+(:func:`fccqp.validation.structure_scan`) and makes a new workspace."""
+cdef enum:
+    _FREE_ENTRY = 0
+    _BOXED_ENTRY = 1
+    _FIXED_ENTRY = 2
+    _CONE_ENTRY = 3
 cdef enum:
     _RUNNING = 0
     _SOLVED = 1
@@ -243,6 +252,7 @@ cdef class Workspace:
     cdef double* user_y
     cdef double* user_z
     cdef Py_ssize_t* block_start
+    cdef char* entry_kind   # n: _FREE_ENTRY, ... as the bounds were at allocation
     cdef Py_ssize_t log_rows, log_count
     cdef double prev_rho, factored_rho, setup_time
     cdef double final_reserve   # seconds the final polish or restoration took lately
@@ -305,6 +315,10 @@ cdef class Workspace:
         self.rho_scale = self._new(s)
         for k in range(s):
             self.rho_scale[k] = FIXED_RHO_SCALE if fixed[k] else 1.0
+        self.entry_kind = <char*>self._new(n)
+        for k in range(s):
+            self.entry_kind[c_view[k]] = (_CONE_ENTRY if in_cone[k] else
+                                          _FIXED_ENTRY if fixed[k] else _BOXED_ENTRY)
         self.d_scratch, self.e_scratch = self._new(n), self._new(m)
         self.scale_reference, self.scale_norms = self._new(N), self._new(N)
         it = &self.it
@@ -460,6 +474,9 @@ cdef class Workspace:
         if self.found.code != SCAN_OK:
             self.has_matrices = False
             return BAD_DATA, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, "", False
+        if not self._same_structure():
+            self.has_matrices = False
+            return STRUCTURE_CHANGED, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, "", False
         enter()   # single-threaded BLAS for this solve (see fccqp.blas_threads)
         try:
             with nogil:
@@ -480,6 +497,23 @@ cdef class Workspace:
         r = &self.res
         return (run.status, run.iterations, run.rho, r.prim, r.dual, r.gap, r.objective,
                 run.factorizations, run.setup_time, BACKEND_NAMES[run.backend], run.polished)
+
+    cdef bint _same_structure(self) noexcept nogil:
+        """Whether the new bounds (in ``lb_user``, ``ub_user``) bound, fix and leave free
+        the entries they did at allocation, with no bound on a cone entry: one pass
+        here instead of a separate call per solve (the control-loop case)."""
+        cdef Py_ssize_t i
+        cdef double lo, hi
+        cdef char kind
+        for i in range(self.prob.n):
+            lo, hi = self.lb_user[i], self.ub_user[i]
+            if lo == -INFINITY and hi == INFINITY:
+                kind = _CONE_ENTRY if self.entry_kind[i] == _CONE_ENTRY else _FREE_ENTRY
+            else:
+                kind = _FIXED_ENTRY if lo == hi else _BOXED_ENTRY
+            if kind != self.entry_kind[i]:
+                return False
+        return True
 
     # ----------------------------------------------------------------- one solve
 

@@ -42,7 +42,9 @@ iterations, the first and the last)."""
 class _Structure:
     """What a workspace was allocated for, kept up to date in place by
     :func:`fccqp.validation.structure_scan`: the constrained entries, the fixed ones
-    and the cone blocks' offsets among them, for ``n`` variables and ``m`` rows."""
+    and the cone blocks' offsets among them, for ``n`` variables and ``m`` rows. The
+    workspace checks the bounds against it in every solve and asks for a rescan
+    (``admm.STRUCTURE_CHANGED``) when they moved."""
 
     __slots__ = ("n", "m", "count", "constrained", "fixed", "relocated", "cones", "certificate")
 
@@ -165,16 +167,19 @@ class Solver:
             structure = self._structure = _Structure(n, m, flat)
             structure.update(lb, ub)
             w = self._workspace = structure.workspace(settings)
-        else:
-            if structure.update(lb, ub):
-                w = self._workspace = structure.workspace(settings)
-            elif flat is not structure.cones:
-                w.update_cones(flat.mu, flat.normal)
-            structure.cones = flat
+        elif flat is not structure.cones:
+            w.update_cones(flat.mu, flat.normal)
+        structure.cones = flat
         x, y, z, certificate = np.empty(n), np.empty(m), np.empty(n), structure.certificate
+        out = w.solve(P, q, A, b, lb, ub, guess, settings.warm_start, start, x, y, z,
+                      certificate)
+        if out[0] == admm.STRUCTURE_CHANGED:   # the workspace's own scan of the bounds
+            structure.update(lb, ub)
+            w = self._workspace = structure.workspace(settings)
+            out = w.solve(P, q, A, b, lb, ub, guess, settings.warm_start, start, x, y, z,
+                          certificate)
         (code, iterations, rho, prim, dual, gap, obj, factorizations, setup_time,
-         backend, polished) = w.solve(P, q, A, b, lb, ub, guess, settings.warm_start, start,
-                                      x, y, z, certificate)
+         backend, polished) = out
         if code == admm.BAD_DATA:
             raise_finding(w.finding, lb, ub)
         if code == admm.NOT_CONVEX_CODE:
