@@ -13,7 +13,8 @@ from setuptools import Extension, setup
 MODULES = sorted(path.stem for path in Path("src/fccqp").glob("*.pyx"))
 
 extensions = [
-    Extension(f"fccqp.{name}", [f"src/fccqp/{name}.pyx"], extra_compile_args=["-O3"])
+    Extension(f"fccqp.{name}", [f"src/fccqp/{name}.pyx"], include_dirs=["src/fccqp"],
+              extra_compile_args=["-O3"])
     for name in MODULES
 ]
 

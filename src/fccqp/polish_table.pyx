@@ -44,12 +44,14 @@ from fccqp.kkt cimport KKT, kkt_solve_once
 from fccqp.polish cimport APEX, FIXED, LOWER, UPPER, Polish
 from fccqp.reduced cimport Reduced
 
-LU_LOOP_ROWS = 40
-"""Systems up to this size are LU-factored by the loop of :func:`_lu`, larger ones by
-LAPACK's ``dgetrf``. Measured per factorization (callgrind, the WBC sets): on go2's
-28 rows the loop takes 40k instructions against ``dgetrf``'s 59k (its blocked,
-recursive kernels cost their call overhead there), on talos' 64 rows about 350k against
-248k (its 4-wide kernels win)."""
+LU_LOOP_ROWS = 64
+"""Systems up to this size are LU-factored by the loop ``fccqp_lu`` (fccqp_kernels.h,
+built for AVX2 + FMA beside the baseline), larger ones by LAPACK's ``dgetrf``. Measured
+per tick (callgrind, the WBC sets, AVX2 copy): go2's 28 rows took 40k instructions in
+the baseline loop against ``dgetrf``'s 59k, 30k with AVX2; on talos, whose systems
+reach 64 rows, the AVX2 loop cut a tick from 8.15M to 7.81M instructions against
+``dgetrf`` (the baseline loop had lost there, 350k against 248k per factorization).
+Larger systems were not measured: ``dgetrf``'s blocked kernels gain with the size."""
 cdef int _LU_LOOP_ROWS = LU_LOOP_ROWS
 PIVOT_RATIO = 1e-13
 """The LU factor counts as singular when its smallest pivot is below this times its
@@ -208,41 +210,10 @@ cdef void _correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
         w.lam[k] += sign * w.du[s + k]
 
 
-cdef bint _lu(double* T, int n, int* piv) noexcept nogil:
-    """LU with partial pivoting of the column-major ``n x n`` matrix ``T`` in place,
-    pivots 1-based as LAPACK's ``dgetrf`` leaves them for ``dgetrs``; False at a zero
-    pivot. Right-looking, one column at a time: the update of a column is a contiguous
-    axpy, which the compiler vectorizes (see ``LU_LOOP_ROWS`` for where it is used)."""
-    cdef int k, i, j, best
-    cdef double largest, value, inverse, factor
-    cdef double* pivot_column
-    cdef double* column
-    for k in range(n):
-        pivot_column = T + k * n
-        best = k
-        largest = fabs(pivot_column[k])
-        for i in range(k + 1, n):
-            if fabs(pivot_column[i]) > largest:
-                largest = fabs(pivot_column[i])
-                best = i
-        piv[k] = best + 1
-        if largest == 0.0:
-            return False
-        if best != k:
-            for j in range(n):
-                value = T[k + j * n]
-                T[k + j * n] = T[best + j * n]
-                T[best + j * n] = value
-        inverse = 1.0 / pivot_column[k]
-        for i in range(k + 1, n):
-            pivot_column[i] *= inverse
-        for j in range(k + 1, n):
-            column = T + j * n
-            factor = column[k]
-            if factor != 0.0:
-                for i in range(k + 1, n):
-                    column[i] -= factor * pivot_column[i]
-    return True
+# LU with partial pivoting in place, LAPACK's pivots: the loop LU_LOOP_ROWS speaks of,
+# in C so that it can be built for AVX2 beside the baseline (see fccqp_kernels.h)
+cdef extern from "fccqp_kernels.h" nogil:
+    int fccqp_lu(double* T, int n, int* piv)
 
 
 cdef bint table_factor(Polish* w, const Problem* p, const Reduced* t, const double* rho,
@@ -254,7 +225,7 @@ cdef bint table_factor(Polish* w, const Problem* p, const Reduced* t, const doub
     cdef double big = 0.0, small = INFINITY, pivot
     _assemble(w, p, t, rho, nb)
     if size <= _LU_LOOP_ROWS:
-        if not _lu(w.T, size, w.tpiv):
+        if not fccqp_lu(w.T, size, w.tpiv):
             return False
     else:
         dgetrf(&size, &size, w.T, &size, w.tpiv, &info)
