@@ -93,10 +93,13 @@ cdef bint schur_factor(Schur* f, const Problem* p, const double* rho_vec) noexce
     cdef double largest = 0.0
     _order(f, p)
     k = f.dense
-    for j in range(n):
+    for j in range(k):   # the dense block's lower triangle; below it L is never read
         column = f.order[j]
-        for i in range(j, n):
+        for i in range(j, k):
             f.L[i + j * n] = p.P[f.order[i] * n + column]
+    for j in range(k, n):
+        column = f.order[j]
+        f.L[j + j * n] = p.P[column * n + column]
     for j in range(s):
         f.L[first + j + (first + j) * n] += rho_vec[j]
     if k > 0 and not cholesky(f.L, k, n):
