@@ -1,7 +1,8 @@
 /* Small dense kernels compiled twice, for AVX2 + FMA and for the baseline x86-64 (SSE2),
  * the copy picked at load time by the CPU (GCC / clang target_clones, an ifunc): the
  * rest of the core is built for the baseline, so that a wheel runs on every x86-64.
- * Elsewhere (other compilers, other architectures) there is one baseline copy.
+ * Elsewhere (other compilers, other C libraries, other architectures) there is one
+ * baseline copy.
  *
  * fccqp_lu: LU with partial pivoting of a column-major n x n matrix in place, pivots
  * 1-based as LAPACK's dgetrf leaves them for dgetrs; returns 0 at a zero pivot, else 1.
@@ -12,7 +13,8 @@
 
 #include <math.h>
 
-#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
+/* ifuncs need glibc (math.h above defines __GLIBC__ there); musl gets one copy */
+#if defined(__x86_64__) && defined(__GLIBC__) && (defined(__GNUC__) || defined(__clang__))
 #define FCCQP_CLONES __attribute__((target_clones("arch=haswell", "default")))
 #else
 #define FCCQP_CLONES
