@@ -176,10 +176,10 @@ cdef bint rescale(const double* P, const double* q, const double* A, const doubl
                   double* A_s, double* b_s, double* c) noexcept nogil:
     """Scale new data with the ``D, E`` of an earlier equilibration and normalize its
     cost into ``c`` as :func:`equilibrate` does (two passes over ``P``, one over ``A``,
-    the norms found on the way); False when a column
-    or row norm of the result (:func:`scaled_norms`, into ``norms``) left the factor
-    ``RESCALE_DRIFT`` around ``reference``, the norms that equilibration gave its own
-    data: then the data moved too far for it and the caller equilibrates.
+    the norms found on the way); False when a column or row norm of the result (as
+    :func:`scaled_norms` reads them, into ``norms``) left the factor ``RESCALE_DRIFT``
+    around ``reference``, the norms that equilibration gave its own data: then the data
+    moved too far for it and the caller equilibrates.
 
     In a control loop the matrices change a little every tick, and the ``D, E`` of an
     earlier tick scale this tick's data about as well (on the WBC sets the largest

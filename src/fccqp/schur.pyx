@@ -104,7 +104,7 @@ cdef bint schur_factor(Schur* f, const Problem* p, const double* rho_vec) noexce
         f.L[first + j + (first + j) * n] += rho_vec[j]
     if k > 0 and not cholesky(f.L, k, n):
         return False
-    for j in range(k, n):   # the diagonal tail: L there is zero off the diagonal
+    for j in range(k, n):   # the diagonal tail (off its diagonal L is never read)
         if not f.L[j + j * n] > 0.0:
             return False
         f.L[j + j * n] = sqrt(f.L[j + j * n])
