@@ -114,7 +114,7 @@ cdef bint schur_factor(Schur* f, const Problem* p, const double* rho_vec) noexce
         column = f.order[j]
         for i in range(m):
             f.Y[j + i * n] = p.A[i * n + column]
-    _lower_solve(f, n, m, f.Y, n)
+    _triangular_solve(f, b"N", n, m, f.Y, n)
     syrk_t(m, n, f.Y, n, f.LS, m)
     for i in range(m):
         largest = max(largest, f.LS[i + i * m])
@@ -126,22 +126,13 @@ cdef bint schur_factor(Schur* f, const Problem* p, const double* rho_vec) noexce
     return True
 
 
-cdef void _lower_solve(Schur* f, int n, int columns, double* B, int ldb) noexcept nogil:
-    """``B := L^-1 B`` (``n x columns``, column-major): ``dtrsm`` on the dense block, a
-    division on the diagonal tail."""
+cdef void _triangular_solve(Schur* f, char trans, int n, int columns, double* B,
+                            int ldb) noexcept nogil:
+    """``B := L^-1 B`` (``trans`` ``N``) or ``L'^-1 B`` (``T``), ``B`` ``n x columns``
+    column-major: ``dtrsm`` on the dense block, a division on the diagonal tail."""
     cdef int k = f.dense, i, j
     if k > 0:
-        trsm(b"L", b"N", k, columns, f.L, n, B, ldb)
-    for j in range(columns):
-        for i in range(k, n):
-            B[i + j * ldb] /= f.L[i + i * n]
-
-
-cdef void _upper_solve(Schur* f, int n, int columns, double* B, int ldb) noexcept nogil:
-    """``B := L'^-1 B``, as :func:`_lower_solve`."""
-    cdef int k = f.dense, i, j
-    if k > 0:
-        trsm(b"L", b"T", k, columns, f.L, n, B, ldb)
+        trsm(b"L", trans, k, columns, f.L, n, B, ldb)
     for j in range(columns):
         for i in range(k, n):
             B[i + j * ldb] /= f.L[i + i * n]
@@ -274,7 +265,7 @@ cdef void schur_unit_columns(Schur* f, const Problem* p, double* W) noexcept nog
     if m > 0:
         cholesky_solve(f.LS, m, m, f.Wnu, s, m)
         gemm(b"N", b"N", n, s, m, -1.0, f.Y, n, f.Wnu, m, 1.0, X, n)
-    _upper_solve(f, n, s, X, n)
+    _triangular_solve(f, b"T", n, s, X, n)
     for j in range(s):
         for i in range(n):
             W[f.order[i] + j * N] = X[i + j * n]
