@@ -139,6 +139,13 @@ def test_a_solver_follows_bounds_that_change_structure():
     again = solver.solve(P, q, A, b, lb, ub, cones)   # the solver is still sound
     assert again.status is Status.SOLVED
     verify_solution((P, q, A, b, lb, ub, cones), again, TIGHT_TOLERANCES)
+    # a fixed value beyond INFINITE_BOUND: the workspace reads the structure as the
+    # structure scan does (a bound, fixed), so the next solves reuse it
+    lb4, ub4 = lb.copy(), ub.copy()
+    lb4[free[1]] = ub4[free[1]] = 1e21
+    capped = fccqp.Solver(max_iter=30)
+    for _ in range(2):
+        assert isinstance(capped.solve(P, q, A, b, lb4, ub4, cones).status, Status)
 
 
 def test_reuses_factorization_when_matrices_unchanged():

@@ -48,6 +48,7 @@ from fccqp.scaling cimport equilibrate, rescale, scale_start, scaled_norms, unsc
 from fccqp.termination cimport (Residuals, converged, gap_scale, nearly_converged, residuals,
                                row_spans)
 from fccqp.validation cimport SCAN_OK, Finding, scan_and_copy
+from fccqp.validation import INFINITE_BOUND
 
 cdef extern from *:
     """
@@ -148,6 +149,7 @@ of its terms pass as SOLVED in a random test; the slack alone one at 8e-9 where 
 ADMM point, a reduced form's combination ``base + W u`` with a wild ``u`` before its
 final correction, missed by 1e-9.)"""
 cdef double _EQUALITY_SLACK = EQUALITY_SLACK
+cdef double _INFINITE_BOUND = INFINITE_BOUND
 cdef double _EQUALITY_EXACT = EQUALITY_EXACT
 EQUALITY_MISSED = 1e-9
 """The equality-constrained cold start meets ``A x = b`` to factorization accuracy
@@ -474,7 +476,7 @@ cdef class Workspace:
         if self.found.code != SCAN_OK:
             self.has_matrices = False
             return BAD_DATA, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, "", False
-        if not self._same_structure():
+        if not self._same_structure(&lb[0], &ub[0]):
             self.has_matrices = False
             return STRUCTURE_CHANGED, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, "", False
         enter()   # single-threaded BLAS for this solve (see fccqp.blas_threads)
@@ -498,19 +500,18 @@ cdef class Workspace:
         return (run.status, run.iterations, run.rho, r.prim, r.dual, r.gap, r.objective,
                 run.factorizations, run.setup_time, BACKEND_NAMES[run.backend], run.polished)
 
-    cdef bint _same_structure(self) noexcept nogil:
-        """Whether the new bounds (in ``lb_user``, ``ub_user``) bound, fix and leave free
-        the entries they did at allocation, with no bound on a cone entry: one pass
-        here instead of a separate call per solve (the control-loop case)."""
+    cdef bint _same_structure(self, const double* lb, const double* ub) noexcept nogil:
+        """Whether the user's new bounds bound, fix and leave free the entries they did at
+        allocation, with no bound on a cone entry, by the rules of
+        :func:`fccqp.validation.structure_scan`: one pass here instead of a separate
+        call per solve (the control-loop case)."""
         cdef Py_ssize_t i
-        cdef double lo, hi
         cdef char kind
         for i in range(self.prob.n):
-            lo, hi = self.lb_user[i], self.ub_user[i]
-            if lo == -INFINITY and hi == INFINITY:
-                kind = _CONE_ENTRY if self.entry_kind[i] == _CONE_ENTRY else _FREE_ENTRY
+            if lb[i] > -_INFINITE_BOUND or ub[i] < _INFINITE_BOUND:
+                kind = _FIXED_ENTRY if lb[i] == ub[i] else _BOXED_ENTRY
             else:
-                kind = _FIXED_ENTRY if lo == hi else _BOXED_ENTRY
+                kind = _CONE_ENTRY if self.entry_kind[i] == _CONE_ENTRY else _FREE_ENTRY
             if kind != self.entry_kind[i]:
                 return False
         return True
