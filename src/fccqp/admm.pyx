@@ -47,8 +47,8 @@ from fccqp.restoration cimport Restoration, restore
 from fccqp.scaling cimport equilibrate, rescale, scale_start, scaled_norms, unscale
 from fccqp.termination cimport (Residuals, converged, gap_scale, nearly_converged, residuals,
                                row_spans)
-from fccqp.validation cimport SCAN_OK, Finding, scan_and_copy
-from fccqp.validation import INFINITE_BOUND
+from fccqp.validation cimport (BOUNDED, FIXED_BOUND, SCAN_OK, UNBOUNDED, Finding, bound_kind,
+                               scan_and_copy)
 
 cdef extern from *:
     """
@@ -83,10 +83,7 @@ STRUCTURE_CHANGED = -3
 constrained or fixed entries, or a bound on a cone entry): the caller rescans them
 (:func:`fccqp.validation.structure_scan`) and makes a new workspace."""
 cdef enum:
-    _FREE_ENTRY = 0
-    _BOXED_ENTRY = 1
-    _FIXED_ENTRY = 2
-    _CONE_ENTRY = 3
+    _CONE_ENTRY = 3   # beside fccqp.validation's bound_kind codes
 cdef enum:
     _RUNNING = 0
     _SOLVED = 1
@@ -149,7 +146,6 @@ of its terms pass as SOLVED in a random test; the slack alone one at 8e-9 where 
 ADMM point, a reduced form's combination ``base + W u`` with a wild ``u`` before its
 final correction, missed by 1e-9.)"""
 cdef double _EQUALITY_SLACK = EQUALITY_SLACK
-cdef double _INFINITE_BOUND = INFINITE_BOUND
 cdef double _EQUALITY_EXACT = EQUALITY_EXACT
 EQUALITY_MISSED = 1e-9
 """The equality-constrained cold start meets ``A x = b`` to factorization accuracy
@@ -254,7 +250,7 @@ cdef class Workspace:
     cdef double* user_y
     cdef double* user_z
     cdef Py_ssize_t* block_start
-    cdef char* entry_kind   # n: _FREE_ENTRY, ... as the bounds were at allocation
+    cdef char* entry_kind   # n: bound_kind of the bounds at allocation, or _CONE_ENTRY
     cdef Py_ssize_t log_rows, log_count
     cdef double prev_rho, factored_rho, setup_time
     cdef double final_reserve   # seconds the final polish or restoration took lately
@@ -320,7 +316,7 @@ cdef class Workspace:
         self.entry_kind = <char*>self._new(n)
         for k in range(s):
             self.entry_kind[c_view[k]] = (_CONE_ENTRY if in_cone[k] else
-                                          _FIXED_ENTRY if fixed[k] else _BOXED_ENTRY)
+                                          FIXED_BOUND if fixed[k] else BOUNDED)
         self.d_scratch, self.e_scratch = self._new(n), self._new(m)
         self.scale_reference, self.scale_norms = self._new(N), self._new(N)
         it = &self.it
@@ -502,16 +498,15 @@ cdef class Workspace:
 
     cdef bint _same_structure(self, const double* lb, const double* ub) noexcept nogil:
         """Whether the user's new bounds bound, fix and leave free the entries they did at
-        allocation, with no bound on a cone entry, by the rules of
-        :func:`fccqp.validation.structure_scan`: one pass here instead of a separate
-        call per solve (the control-loop case)."""
+        allocation, with no bound on a cone entry (:func:`fccqp.validation.bound_kind`,
+        the rule of ``structure_scan``): one pass here instead of a separate call per
+        solve (the control-loop case)."""
         cdef Py_ssize_t i
-        cdef char kind
+        cdef int kind
         for i in range(self.prob.n):
-            if lb[i] > -_INFINITE_BOUND or ub[i] < _INFINITE_BOUND:
-                kind = _FIXED_ENTRY if lb[i] == ub[i] else _BOXED_ENTRY
-            else:
-                kind = _CONE_ENTRY if self.entry_kind[i] == _CONE_ENTRY else _FREE_ENTRY
+            kind = bound_kind(lb[i], ub[i])
+            if kind == UNBOUNDED and self.entry_kind[i] == _CONE_ENTRY:
+                continue
             if kind != self.entry_kind[i]:
                 return False
         return True

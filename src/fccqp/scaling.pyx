@@ -125,12 +125,20 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
     return _normalize_cost(P, q, n, d)
 
 
+cdef inline double _cost_scale(double mean_col, double q_norm) noexcept nogil:
+    """``c = 1 / size`` of a cost whose ``P`` has mean column norm ``mean_col`` and whose
+    ``q`` has norm ``q_norm``: the larger of the two, each counted only above
+    ``MIN_COST_NORM``, at most ``MAX_NORM``."""
+    cdef double size = max(mean_col if mean_col >= _MIN_COST_NORM else 1.0,
+                           q_norm if q_norm >= _MIN_COST_NORM else 1.0)
+    return 1.0 / min(size, _MAX_NORM)
+
+
 cdef double _normalize_cost(double* P, double* q, Py_ssize_t n, double* ones) noexcept nogil:
-    """Multiply the (scaled) cost by ``c = 1 / size`` and return ``c``; ``size`` is the
-    larger of the mean column norm of ``P`` and ``||q||``, each counted only above
-    ``MIN_COST_NORM``. ``ones`` is scratch of size ``n``."""
+    """Multiply the (scaled) cost by :func:`_cost_scale`'s ``c`` and return it; ``ones``
+    is scratch of size ``n``."""
     cdef Py_ssize_t i
-    cdef double mean_col = 0.0, q_norm = 0.0, size, c
+    cdef double mean_col = 0.0, q_norm = 0.0, c
     for i in range(n):
         ones[i] = 1.0
     for i in range(n):
@@ -138,9 +146,7 @@ cdef double _normalize_cost(double* P, double* q, Py_ssize_t n, double* ones) no
     mean_col /= n
     for i in range(n):
         q_norm = max(q_norm, fabs(q[i]))
-    size = max(mean_col if mean_col >= _MIN_COST_NORM else 1.0,
-               q_norm if q_norm >= _MIN_COST_NORM else 1.0)
-    c = 1.0 / min(size, _MAX_NORM)
+    c = _cost_scale(mean_col, q_norm)
     for i in range(n * n):
         P[i] *= c
     for i in range(n):
@@ -189,7 +195,7 @@ cdef bint rescale(const double* P, const double* q, const double* A, const doubl
     are 0.22M of a 1.76M-instruction tick (callgrind).
     """
     cdef Py_ssize_t i, j
-    cdef double di, value, row, mean_col = 0.0, q_norm = 0.0, size
+    cdef double di, value, row, mean_col = 0.0, q_norm = 0.0
     for i in range(n):   # D P D's rows (its columns: it is symmetric) and the cost's size
         di = D[i]
         row = 0.0
@@ -199,10 +205,7 @@ cdef bint rescale(const double* P, const double* q, const double* A, const doubl
         mean_col += norms[i]
         q_s[i] = q[i] * di
         q_norm = max(q_norm, fabs(q_s[i]))
-    mean_col /= n
-    size = max(mean_col if mean_col >= _MIN_COST_NORM else 1.0,
-               q_norm if q_norm >= _MIN_COST_NORM else 1.0)
-    c[0] = 1.0 / min(size, _MAX_NORM)   # as _normalize_cost finds it
+    c[0] = _cost_scale(mean_col / n, q_norm)
     for i in range(n):
         di = c[0] * D[i]
         for j in range(n):

@@ -11,6 +11,12 @@ cdef enum:
     INFINITE_SIDE = 6
     TOO_LARGE = 7       # an entry beyond MAX_ENTRY
 
+cdef enum:
+    # Codes of bound_kind.
+    UNBOUNDED = 0
+    BOUNDED = 1
+    FIXED_BOUND = 2
+
 cdef struct Finding:
     int code
     int argument        # q, A, b, lb, ub numbered 0-4; -1 for P
@@ -21,3 +27,4 @@ cdef Finding scan_and_copy(const double* P, const double* q, const double* A, co
                            const double* lb, const double* ub, Py_ssize_t n, Py_ssize_t m,
                            double* P_out, double* q_out, double* A_out, double* b_out,
                            double* lb_out, double* ub_out, bint* same_matrices) noexcept nogil
+cdef int bound_kind(double lb, double ub) noexcept nogil

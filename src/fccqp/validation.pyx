@@ -126,6 +126,15 @@ cdef Finding scan_and_copy(const double* P, const double* q, const double* A, co
     return _found(SCAN_OK, -1, -1, 0.0)
 
 
+cdef int bound_kind(double lb, double ub) noexcept nogil:
+    """How the bounds ``lb, ub`` of one entry constrain it: ``UNBOUNDED`` (both beyond
+    ``INFINITE_BOUND``), ``FIXED_BOUND`` (``lb == ub``) or ``BOUNDED``. The one rule for
+    :func:`structure_scan` and the workspace's check of each solve's bounds."""
+    if lb > -_INFINITE_BOUND or ub < _INFINITE_BOUND:
+        return FIXED_BOUND if lb == ub else BOUNDED
+    return UNBOUNDED
+
+
 def structure_scan(const double[::1] lb, const double[::1] ub, const Py_ssize_t[::1] offset,
                    const Py_ssize_t[::1] dim, Py_ssize_t[::1] constrained,
                    unsigned char[::1] fixed, Py_ssize_t[::1] relocated, Py_ssize_t count):
@@ -140,8 +149,9 @@ def structure_scan(const double[::1] lb, const double[::1] ub, const Py_ssize_t[
     case, where the structure rarely changes, costs a microsecond.
     """
     cdef Py_ssize_t n = lb.shape[0], blocks = offset.shape[0], i, k, j = 0, member = -1
-    cdef bint changed = False, bounded, in_cone
+    cdef bint changed = False, in_cone
     cdef unsigned char is_fixed
+    cdef int kind
     for i in range(n):
         in_cone = False
         for k in range(blocks):
@@ -152,11 +162,11 @@ def structure_scan(const double[::1] lb, const double[::1] ub, const Py_ssize_t[
                         changed = True
                         relocated[k] = j
                 break
-        bounded = lb[i] > -_INFINITE_BOUND or ub[i] < _INFINITE_BOUND
-        if in_cone and bounded and member < 0:
+        kind = bound_kind(lb[i], ub[i])
+        if in_cone and kind != UNBOUNDED and member < 0:
             member = i
-        if in_cone or bounded:
-            is_fixed = lb[i] == ub[i]
+        if in_cone or kind != UNBOUNDED:
+            is_fixed = kind == FIXED_BOUND
             if j >= count or constrained[j] != i or fixed[j] != is_fixed:
                 changed = True
                 constrained[j] = i
