@@ -21,6 +21,8 @@ from functools import cached_property
 
 import numpy as np
 
+from fccqp.fast_checks import cone_key
+
 FRICTION = 0
 """Kind code of a friction cone in :class:`ConeArrays`."""
 SECOND_ORDER = 1
@@ -148,27 +150,13 @@ def _check_friction(cone: FrictionCone, index: int) -> np.ndarray:
     return normal / norm
 
 
-def _key(cone: object) -> tuple:
-    """A cone's values and the types behind them, as a memo key of plain values (hashed
-    in C, unlike the dataclass): the types are part of it because specs that compare
-    equal may differ in validity (``0.5 + 0j == 0.5``, ``2.0 == 2``)."""
-    kind = type(cone)
-    if isinstance(cone, FrictionCone):
-        start, mu, normal = cone.start, cone.mu, cone.normal
-        kinds = tuple(map(type, normal)) if type(normal) is tuple else type(normal)
-        return kind, start, type(start), mu, type(mu), normal, kinds
-    if isinstance(cone, SecondOrderCone):
-        start, dim = cone.start, cone.dim
-        return kind, start, type(start), dim, type(dim)
-    return kind, cone
-
-
 def flatten_cones(cones: Sequence[Cone], n: int) -> ConeArrays:
     """Validate cone specs for an ``n``-vector and return them as flat arrays.
 
     Results are memoized for hashable inputs, keyed on the specs' values and the types
-    of their fields (see :func:`_key`): a control loop passes the same cones every
-    tick, and a spec that only compares equal to a valid one is still validated.
+    of their fields (:func:`fccqp.fast_checks.cone_key`): a control loop passes the
+    same cones every tick, and a spec that only compares equal to a valid one is still
+    validated.
 
     Raises
     ------
@@ -179,16 +167,16 @@ def flatten_cones(cones: Sequence[Cone], n: int) -> ConeArrays:
         If a block leaves ``[0, n)``, overlaps another block, a second-order cone has
         ``dim < 2``, or a friction cone has a bad ``mu`` or normal.
     """
-    if isinstance(cones, (FrictionCone, SecondOrderCone)):
-        cones = (cones,)
-    elif isinstance(cones, (str, bytes)) or not isinstance(cones, Iterable):
-        raise TypeError(
-            f"cones must be a sequence of FrictionCone or SecondOrderCone, got {cones!r}"
-        )
-    cones = tuple(cones)
+    if type(cones) is not tuple:   # a tuple, the control loop's case, needs no checks
+        if isinstance(cones, (FrictionCone, SecondOrderCone)):
+            cones = (cones,)
+        elif isinstance(cones, (str, bytes)) or not isinstance(cones, Iterable):
+            raise TypeError(
+                f"cones must be a sequence of FrictionCone or SecondOrderCone, got {cones!r}"
+            )
+        cones = tuple(cones)
     try:
-        key = (n, *map(_key, cones))
-        flat = _MEMO.get(key)
+        flat = _MEMO.get(key := cone_key(cones, n))
     except TypeError:  # unhashable field, e.g. a numpy normal: validate uncached
         return _flatten(cones, n)
     if flat is None:

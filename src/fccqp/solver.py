@@ -11,6 +11,7 @@ before anything is densified.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Sequence
 
@@ -18,6 +19,7 @@ import numpy as np
 
 from fccqp import admm, schur
 from fccqp.cones import Cone, ConeArrays, flatten_cones
+from fccqp.fast_checks import dense_arguments
 from fccqp.problem import MAX_ENTRY, check_cone_bounds, convert, raise_finding
 from fccqp.result import Result
 from fccqp.settings import MAX_DENSE_KKT_ROWS, Settings
@@ -155,13 +157,18 @@ class Solver:
         """
         start = time.perf_counter()
         settings = self.settings
-        if settings.kkt_backend == "sparse" or _rows(P) + _rows(A) > MAX_DENSE_KKT_ROWS:
-            return self._solve_sparse(P, q, A, b, lb, ub, cones, x0, start)
-        P, q, A, b, lb, ub = convert(P, q, A, b, lb, ub)
-        n, m = P.shape[0], A.shape[0]
+        w, structure = self._workspace, self._structure
+        sparse = settings.kkt_backend == "sparse"
+        if w is not None and not sparse and dense_arguments(P, q, A, b, lb, ub, structure.n,
+                                                            structure.m):
+            n, m = structure.n, structure.m   # the control loop: the arrays fit as they are
+        else:
+            if sparse or _rows(P) + _rows(A) > MAX_DENSE_KKT_ROWS:
+                return self._solve_sparse(P, q, A, b, lb, ub, cones, x0, start)
+            P, q, A, b, lb, ub = convert(P, q, A, b, lb, ub)
+            n, m = P.shape[0], A.shape[0]
         flat = flatten_cones(cones, n)   # memoized: the same object for the same cones
         guess = None if x0 is None else _initial_guess(x0, n)
-        w, structure = self._workspace, self._structure
         if w is None or (structure.n, structure.m) != (n, m) or not flat.same_blocks(
                 structure.cones):
             structure = self._structure = _Structure(n, m, flat)
@@ -201,7 +208,7 @@ class Solver:
             "prim_res": prim, "dual_res": dual, "setup_time": setup_time,
             "solve_time": time.perf_counter() - start, "rho": rho,
             "factorizations": factorizations, "certificate": certificate_out,
-            "backend": backend, "gap": float("nan") if status.is_infeasible() else gap,
+            "backend": backend, "gap": gap if certificate_out is None else math.nan,
             "polished": polished,
         })
         if settings.verbose:
