@@ -409,7 +409,7 @@ def test_item15_verbose_log_is_sparse_and_ends_with_the_returned_residual(capsys
     the last) and return the last logged residual."""
     problem = random_problem(5, n=40, m=10, n_cones=4, n_box=8)
     result = fccqp.solve(*problem, verbose=True, eps_abs=1e-12, eps_rel=1e-12, max_iter=20000,
-                         anderson_memory=0, alpha=1.0)
+                         anderson_memory=0, alpha=1.0, polish=False)
     rows = LOG_ROW.findall(capsys.readouterr().out)
     assert result.iterations >= 100, "the test needs a long enough run"
     assert len(rows) <= result.iterations / 25 + 3

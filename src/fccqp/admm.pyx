@@ -39,7 +39,7 @@ from fccqp.certificates cimport (CERTIFIED, SEPARATED, dual_infeasible, equality
                                  equality_inconsistent, primal_infeasible)
 from fccqp.kkt cimport (AUTO, FACTORED, KKT, LDL_FULL, LDL_REDUCED, NOT_CONVEX, SCHUR_REDUCED,
                         UNAVAILABLE, kkt_convexity, kkt_factor, kkt_solve)
-from fccqp.polish cimport Polish, multiplier_violation, polish
+from fccqp.polish cimport Polish, guess_changes, multiplier_violation, polish
 from fccqp.projections cimport proj_block, proj_set
 from fccqp.reduced cimport (Reduced, materialize, near_convergence, reduced_rebase,
                             reduced_start, reduced_step, reduced_table)
@@ -160,6 +160,18 @@ entries each, 1 ms, never accepted), and the time is better spent iterating. Wit
 time limit the polish is tried whatever the residuals: after 4000 iterations on a
 degenerate LP it is what finds the answer (2 of the general suite's 60)."""
 cdef double _POLISH_GATE = POLISH_GATE
+EARLY_POLISH_GATE = 1e3
+EARLY_POLISH_TRIES = 3
+"""ADMM converges slowly along the weakly determined directions of whole-body control's
+costs (torque and force weights of 1e-4 to 1e-6) long after its active set has settled.
+So at a scheduled check (every ``adaptive_rho_interval`` iterations) whose residuals are
+within ``EARLY_POLISH_GATE`` of the tolerances, the run polishes early when the active
+set ADMM's iterate points to (:func:`fccqp.polish.guess_changes`) is the one of the
+previous scheduled check and was not polished yet; it ends there when the polished
+point passes the KKT check and is solved. At most ``EARLY_POLISH_TRIES`` such attempts
+per solve."""
+cdef double _EARLY_POLISH_GATE = EARLY_POLISH_GATE
+cdef int _EARLY_POLISH_TRIES = EARLY_POLISH_TRIES
 RESERVE_DECAY = 0.5
 """Under a time limit the iterations stop when the time left is what the final step
 (polish or restoration, and unscaling) took lately: the largest of its last durations,
@@ -238,6 +250,8 @@ cdef class Workspace:
     cdef double* vec_n3
     cdef double* vec_s
     cdef double* vec_s2
+    cdef double* guess_point   # s scratch of guess_changes
+    cdef char* guess_codes     # s: the active set ADMM's iterate pointed to at the last check
     cdef double* vec_m
     cdef double* direction
     cdef double* cert
@@ -328,6 +342,7 @@ cdef class Workspace:
         cdef Py_ssize_t wide = max(n, m)
         self.vec_n, self.vec_n2, self.vec_n3 = self._new(wide), self._new(wide), self._new(wide)
         self.vec_s, self.vec_s2, self.vec_m = self._new(s), self._new(s), self._new(m)
+        self.guess_point, self.guess_codes = self._new(s), <char*>self._new(s)
         self.direction, self.saved, self.cert = self._new(n), self._new(N + s), self._new(N)
         self.prev_x, self.prev_y, self.prev_z = self._new(n), self._new(m), self._new(n)
         kk = &self.kkt
@@ -592,7 +607,8 @@ cdef class Workspace:
         cdef Residuals* r = &self.res
         cdef Py_ssize_t s = p.s, j
         cdef long iteration = 0, polished_at = -1
-        cdef int status = _RUNNING, code, retries = 0
+        cdef int status = _RUNNING, code, retries = 0, early_tries = 0
+        cdef bint guess_polished = False, first_check = True
         cdef bint unbounded_start = False, timed = isfinite(o.time_limit)
         # the iterations stop early enough for the final polish or restoration to fit
         cdef double deadline = o.time_limit - min(self.final_reserve, 0.5 * o.time_limit)
@@ -692,6 +708,19 @@ cdef class Workspace:
                         retries += 1
                         self.tighten *= 0.1
                         status = _RUNNING
+                if (status == _RUNNING and periodic and o.polish and not last
+                        and early_tries < _EARLY_POLISH_TRIES):
+                    if (guess_changes(p, it.z, it.y, self.guess_point, self.guess_codes) != 0
+                            or first_check):
+                        guess_polished = first_check = False   # polish it once it settles
+                    elif not guess_polished and nearly_converged(r, o.eps_abs, o.eps_rel,
+                                                                 _EARLY_POLISH_GATE) and (
+                            not timed or fccqp_now() - start_time + 2.0 * self.final_reserve
+                            <= deadline):
+                        guess_polished = True
+                        early_tries += 1
+                        polished_at = iteration
+                        run.polished = self._keep_polished(&status, iteration, start_time, True)
                 if status == _RUNNING and periodic and accelerate:
                     # a primal residual that does not halve between two scheduled checks
                     # far from tolerance is how infeasibility looks; Anderson's

@@ -47,4 +47,6 @@ cdef struct Polish:
 cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_steps,
                  int* factorizations, const Reduced* table, KKT* kkt,
                  const double* rho_vec) noexcept nogil
+cdef Py_ssize_t guess_changes(const Problem* p, const double* z, const double* y,
+                              double* point, char* codes) noexcept nogil
 cdef double multiplier_violation(Polish* w, const Problem* p, const double* z) noexcept nogil

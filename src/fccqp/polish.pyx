@@ -183,6 +183,52 @@ cdef void _linearize(Polish* w, const Problem* p, Py_ssize_t k, const double* v)
                w.hess + o * p.s)
 
 
+cdef inline char _box_code(const Problem* p, Py_ssize_t j, double v) noexcept nogil:
+    """The guess for box entry ``j`` from ``v = z_j + y_j``, the point before projection."""
+    if p.lo[j] == p.hi[j]:
+        return FIXED
+    if v < p.lo[j]:
+        return LOWER
+    if v > p.hi[j]:
+        return UPPER
+    return FREE
+
+
+cdef inline char _cone_code(const Cones* c, Py_ssize_t k, const double* v) noexcept nogil:
+    """The guess for cone block ``k`` from ``v = z_J + y_J``: FREE inside the cone, APEX
+    in its polar, BOUNDARY otherwise."""
+    cdef double across, slope = _slope(c.kind[k], c.mu[k])
+    cdef double along = _axis(v, c.kind[k], c.dim[k], c.mu[k], c.normal + 3 * k, &across)
+    if across <= slope * along:
+        return FREE
+    if slope * across <= -along:
+        return APEX
+    return BOUNDARY   # across > 0 here, so the plane exists
+
+
+cdef Py_ssize_t guess_changes(const Problem* p, const double* z, const double* y,
+                              double* point, char* codes) noexcept nogil:
+    """Classify every constrained entry as :func:`_guess` would from ``z, y`` into
+    ``codes`` (``point``: ``s`` scratch) and return how many codes changed: the iteration
+    asks it whether ADMM's active set has settled before it polishes early."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t j, k, o, changed = 0
+    cdef char code
+    for j in range(p.s):
+        point[j] = z[j] + y[j]
+        if not p.in_cone[j]:
+            code = _box_code(p, j, point[j])
+            changed += code != codes[j]
+            codes[j] = code
+    for k in range(c.count):
+        o = c.offset[k]
+        code = _cone_code(c, k, point + o)
+        for j in range(o, o + c.dim[k]):
+            changed += code != codes[j]
+            codes[j] = code
+    return changed
+
+
 cdef Py_ssize_t _guess(Polish* w, const Problem* p, const double* z, const double* y,
                        Py_ssize_t* changed) noexcept nogil:
     """Fill ``active`` from the slack ``z`` and multiplier ``y``, the list ``boundary``
@@ -192,34 +238,20 @@ cdef Py_ssize_t _guess(Polish* w, const Problem* p, const double* z, const doubl
     entries whose code changed."""
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t j, k, o, d, nb = 0
-    cdef double v, along, across, slope, phi, lam
+    cdef double phi, lam
     cdef char code
     changed[0] = 0
     for j in range(p.s):
-        v = z[j] + y[j]
-        if p.lo[j] == p.hi[j]:
-            code = FIXED
-        elif v < p.lo[j]:
-            code = LOWER
-        elif v > p.hi[j]:
-            code = UPPER
-        else:
-            code = FREE
         if not p.in_cone[j]:
+            code = _box_code(p, j, z[j] + y[j])
             changed[0] += code != w.active[j]
             w.active[j] = code
     for k in range(c.count):
         o, d = c.offset[k], c.dim[k]
         for j in range(o, o + d):
             w.g[j] = z[j] + y[j]
-        slope = _slope(c.kind[k], c.mu[k])
-        along = _axis(w.g + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
-        if across <= slope * along:
-            code = FREE
-        elif slope * across <= -along:
-            code = APEX
-        else:   # across > 0 here, so the plane exists
-            code = BOUNDARY
+        code = _cone_code(c, k, w.g + o)
+        if code == BOUNDARY:
             proj_block(w.g + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
             _plane(w.step, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.g + o, &phi)
             lam = 0.0
