@@ -160,7 +160,7 @@ entries each, 1 ms, never accepted), and the time is better spent iterating. Wit
 time limit the polish is tried whatever the residuals: after 4000 iterations on a
 degenerate LP it is what finds the answer (2 of the general suite's 60)."""
 cdef double _POLISH_GATE = POLISH_GATE
-EARLY_POLISH_GATE = 1e3
+EARLY_POLISH_GATE = 1e2
 EARLY_POLISH_TRIES = 3
 """ADMM converges slowly along the weakly determined directions of whole-body control's
 costs (torque and force weights of 1e-4 to 1e-6) long after its active set has settled.
@@ -169,7 +169,9 @@ within ``EARLY_POLISH_GATE`` of the tolerances, the run polishes early when the 
 set ADMM's iterate points to (:func:`fccqp.polish.guess_changes`) is the one of the
 previous scheduled check and was not polished yet; it ends there when the polished
 point passes the KKT check and is solved. At most ``EARLY_POLISH_TRIES`` such attempts
-per solve."""
+per solve. Measured on talos' first 100 ticks at default settings (callgrind): 9.07M
+instructions per tick without, 6.99M with a gate of 1e2, 7.41M with 1e3, 7.96M with 1e4;
+mean iterations 63 -> 25 over all 200 ticks, the worst gap unchanged."""
 cdef double _EARLY_POLISH_GATE = EARLY_POLISH_GATE
 cdef int _EARLY_POLISH_TRIES = EARLY_POLISH_TRIES
 RESERVE_DECAY = 0.5
