@@ -494,30 +494,15 @@ cdef class Workspace:
         """
         cdef Py_ssize_t n = self.prob.n, m = self.prob.m
         cdef Py_buffer views[11]
-        cdef int held = 0, i
+        cdef Py_ssize_t rows[11]
+        cdef Py_ssize_t columns[11]
+        cdef int held = 0, count = 10 if x0 is None else 11, i
+        cdef tuple arrays = (P, q, A, b, lb, ub, x_out, y_out, z_out, cert_out, x0)
+        rows[:] = [n, n, m, m, n, n, n, m, n, n + m, n]
+        columns[:] = [n, -1, n, -1, -1, -1, -1, -1, -1, -1, -1]   # -1: a vector
         try:
-            _hold(P, &views[0], n, n, False)
-            held += 1
-            _hold(q, &views[1], n, -1, False)
-            held += 1
-            _hold(A, &views[2], m, n, False)
-            held += 1
-            _hold(b, &views[3], m, -1, False)
-            held += 1
-            _hold(lb, &views[4], n, -1, False)
-            held += 1
-            _hold(ub, &views[5], n, -1, False)
-            held += 1
-            _hold(x_out, &views[6], n, -1, True)
-            held += 1
-            _hold(y_out, &views[7], m, -1, True)
-            held += 1
-            _hold(z_out, &views[8], n, -1, True)
-            held += 1
-            _hold(cert_out, &views[9], n + m, -1, True)
-            held += 1
-            if x0 is not None:
-                _hold(x0, &views[10], n, -1, False)
+            for i in range(count):   # the outputs, 6 to 9, are written
+                _hold(arrays[i], &views[i], rows[i], columns[i], 6 <= i <= 9)
                 held += 1
             return self._run(<const double*>views[0].buf, <const double*>views[1].buf,
                              <const double*>views[2].buf, <const double*>views[3].buf,
