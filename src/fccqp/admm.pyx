@@ -174,9 +174,10 @@ point passes the KKT check and is solved. At most ``EARLY_POLISH_TRIES`` such at
 per solve, and none under a time limit: on talos at the realtime preset's 2 ms a failed
 polish of its 64-row systems takes the time the next iterations need (success 87-89 %
 against 96 % when every settled guess was tried; with a rule that tried only while
-twice the final step's reserve fit, 94.5 % against 95.3 % over nine alternating runs). Measured on talos' first 100 ticks at default settings (callgrind): 9.07M
-instructions per tick without, 6.99M with a gate of 1e2, 7.41M with 1e3, 7.96M with 1e4;
-mean iterations 63 -> 25 over all 200 ticks, the worst gap unchanged."""
+twice the final step's reserve fit, 94.5 % against 95.2 % over nine alternating runs).
+Measured on talos' first 100 ticks at default settings (callgrind): 9.07M instructions
+per tick without, 6.99M with a gate of 1e2, 7.41M with 1e3, 7.96M with 1e4; mean
+iterations 63 -> 25 over all 200 ticks, the worst gap unchanged."""
 cdef double _EARLY_POLISH_GATE = EARLY_POLISH_GATE
 cdef int _EARLY_POLISH_TRIES = EARLY_POLISH_TRIES
 RESERVE_DECAY = 0.5

@@ -161,8 +161,8 @@ class Settings:
     and 31 Nm to 0.009 and 0.008 Nm and the worst relative objective gap from 4e-5 and
     1.1e-3 to 9e-9 and 4e-7 (docs/performance.md has its current cost). A warm start
     from a polished solution polishes its active set first, before any iteration, and
-    a run polishes early once the active set its iterate points to has settled
-    (``fccqp.admm.EARLY_POLISH_GATE``)."""
+    without a time limit a run polishes early once the active set its iterate points
+    to has settled (``fccqp.admm.EARLY_POLISH_GATE``)."""
     polish_refine_iter: int = 10
     """Most re-linearizations of the boundary cones' tangent planes in polishing (Newton
     steps, taken only until the cone function is met to 1e-13 or stops improving; a
