@@ -121,6 +121,9 @@ def test_dense_arguments_recognizes_only_contiguous_float64_of_the_shapes():
     assert not dense_arguments(M, v.reshape(3, 1), Z, z, v, v, 3, 1)
     assert not dense_arguments(M, v, Z, z, None, v, 3, 1)
     assert not dense_arguments(M.tolist(), v, Z, z, v, v, 3, 1)
+    assert not dense_arguments(memoryview(M), v, Z, z, v, v, 3, 1)   # a buffer, no array
+    subclass = type("Subclass", (np.ndarray,), {})
+    assert not dense_arguments(M.view(subclass), v, Z, z, v, v, 3, 1)
     assert not dense_arguments(M, v, Z, z, v, v.astype(np.int64), 3, 1)
 
 

@@ -15,15 +15,20 @@ argument.
 
 from cpython.buffer cimport PyBUF_C_CONTIGUOUS, PyBUF_FORMAT, PyBuffer_Release, PyObject_GetBuffer
 
+from numpy import ndarray
+
 cdef object _FRICTION = None
 cdef object _SECOND_ORDER = None
 
 
 cdef bint _is_dense(object value, int ndim, Py_ssize_t rows, Py_ssize_t columns):
-    """Whether ``value`` exposes a C-contiguous buffer of native float64 with ``ndim``
-    dimensions of ``rows`` (and ``columns``) entries."""
+    """Whether ``value`` is a numpy array (not a subclass, as :func:`fccqp.problem.convert`
+    passes through) with a C-contiguous buffer of native float64 of ``ndim`` dimensions
+    of ``rows`` (and ``columns``) entries."""
     cdef Py_buffer view
     cdef bint dense
+    if type(value) is not ndarray:
+        return False
     try:
         PyObject_GetBuffer(value, &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT)
     except (TypeError, ValueError, BufferError):   # no buffer, or not a contiguous one
