@@ -493,8 +493,8 @@ cdef class Workspace:
         ``NOT_CONVEX_CODE`` leave the previous solution untouched.
 
         The arrays are read through their buffers, held for the call: typed memoryview
-        arguments made a memoryview object for each of the eleven, 31k of a go2 tick's
-        1.13M instructions (callgrind).
+        arguments made a memoryview object for each of the eleven, and holding the
+        buffers instead saved 9k of a go2 tick's 1.13M instructions (callgrind).
         """
         cdef Py_ssize_t n = self.prob.n, m = self.prob.m
         cdef Py_buffer views[11]

@@ -5,12 +5,12 @@ A controller calls :meth:`fccqp.Solver.solve` with the same kinds of arguments e
 tick: six contiguous float64 arrays of the workspace's sizes and a list of cone specs
 like the last one. :func:`dense_arguments` recognizes the arrays from their buffers
 without converting them, and :func:`cone_key` builds :func:`fccqp.cones.flatten_cones`'
-memo key; both are what :func:`fccqp.problem.convert` and :func:`fccqp.cones._key`
-decide, without the interpreter's per-attribute work. After the compiled solve the
-interpreter runs from cold caches, and there the two Python versions took 6.7 us and
-8.0 us of a 150 us go2 tick (in flow, medians of interleaved rounds). Anything they do
-not recognize takes the Python path, which converts or raises the error that names the
-argument.
+memo key; both decide what :func:`fccqp.problem.convert`'s fast path and the memo's key
+function in Python did, without the interpreter's per-attribute work. After the compiled
+solve the interpreter runs from cold caches, and there the two Python versions took 6.7
+us and 8.0 us of a 150 us go2 tick (in flow, medians of interleaved rounds). Anything
+they do not recognize takes the Python path, which converts or raises the error that
+names the argument.
 """
 
 from cpython.buffer cimport PyBUF_C_CONTIGUOUS, PyBUF_FORMAT, PyBuffer_Release, PyObject_GetBuffer
