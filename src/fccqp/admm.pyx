@@ -29,8 +29,7 @@ without allocating and without the GIL.
 
 import numpy as np
 
-from cpython.buffer cimport (PyBUF_C_CONTIGUOUS, PyBUF_FORMAT, PyBUF_WRITABLE, PyBuffer_Release,
-                            PyObject_GetBuffer)
+from cpython.buffer cimport PyBuffer_Release
 from libc.math cimport INFINITY, fabs, isfinite, sqrt
 
 from fccqp._dense cimport copy, fill, inf_norm, matvec, matvec_t
@@ -39,6 +38,7 @@ from fccqp.blas_threads cimport enter, leave
 from fccqp.anderson cimport Anderson, anderson_reset, anderson_step
 from fccqp.certificates cimport (CERTIFIED, SEPARATED, dual_infeasible, equality_direction,
                                  equality_inconsistent, primal_infeasible)
+from fccqp.fast_checks cimport hold_float64
 from fccqp.kkt cimport (AUTO, FACTORED, KKT, LDL_FULL, LDL_REDUCED, NOT_CONVEX, SCHUR_REDUCED,
                         UNAVAILABLE, kkt_convexity, kkt_factor, kkt_solve)
 from fccqp.polish cimport Polish, guess_changes, multiplier_violation, polish
@@ -217,21 +217,6 @@ cdef struct Run:
     double setup_time
     int backend
     bint polished
-
-
-cdef int _hold(object array, Py_buffer* view, Py_ssize_t rows, Py_ssize_t columns,
-               bint writable) except -1:
-    """Hold ``array``'s buffer in ``view``: C-contiguous float64 of ``rows`` entries (a
-    matrix of ``rows x columns`` when ``columns >= 0``), writable if asked. An array
-    the caller did not prepare is a bug of the caller's, not the user's."""
-    PyObject_GetBuffer(array, view,
-                       PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (PyBUF_WRITABLE if writable else 0))
-    if (view.itemsize != 8 or view.format == NULL or view.format[0] != b"d"
-            or view.format[1] != 0 or view.ndim != (1 if columns < 0 else 2)
-            or view.shape[0] != rows or (columns >= 0 and view.shape[1] != columns)):
-        PyBuffer_Release(view)
-        raise ValueError(f"expected a C-contiguous float64 array of {rows} rows")
-    return 0
 
 
 cdef class Workspace:
@@ -506,7 +491,8 @@ cdef class Workspace:
         columns[:] = [n, -1, n, -1, -1, -1, -1, -1, -1, -1, -1]   # -1: a vector
         try:
             for i in range(count):   # the outputs, 6 to 9, are written
-                _hold(arrays[i], &views[i], rows[i], columns[i], 6 <= i <= 9)
+                if not hold_float64(arrays[i], &views[i], rows[i], columns[i], 6 <= i <= 9):
+                    raise ValueError(f"expected a C-contiguous float64 array of {rows[i]} rows")
                 held += 1
             return self._run(<const double*>views[0].buf, <const double*>views[1].buf,
                              <const double*>views[2].buf, <const double*>views[3].buf,

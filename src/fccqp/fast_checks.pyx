@@ -13,7 +13,8 @@ they do not recognize takes the Python path, which converts or raises the error 
 names the argument.
 """
 
-from cpython.buffer cimport PyBUF_C_CONTIGUOUS, PyBUF_FORMAT, PyBuffer_Release, PyObject_GetBuffer
+from cpython.buffer cimport (PyBUF_C_CONTIGUOUS, PyBUF_FORMAT, PyBUF_WRITABLE, PyBuffer_Release,
+                            PyObject_GetBuffer)
 
 from numpy import ndarray
 
@@ -21,31 +22,44 @@ cdef object _FRICTION = None
 cdef object _SECOND_ORDER = None
 
 
-cdef bint _is_dense(object value, int ndim, Py_ssize_t rows, Py_ssize_t columns):
+cdef bint hold_float64(object array, Py_buffer* view, Py_ssize_t rows, Py_ssize_t columns,
+                       bint writable) except -1:
+    """Hold ``array``'s C-contiguous buffer (writable if asked) in ``view`` and return True
+    when it is native float64 of ``rows`` entries, a ``rows x columns`` matrix when
+    ``columns >= 0``; otherwise release it and return False. Raises where ``array`` has
+    no such buffer (``TypeError``, ``BufferError``). The one rule for
+    :func:`dense_arguments` and the buffers ``fccqp.admm.Workspace.solve`` holds."""
+    PyObject_GetBuffer(array, view,
+                       PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (PyBUF_WRITABLE if writable else 0))
+    if (view.itemsize == 8 and view.format != NULL and view.format[0] == b"d"
+            and view.format[1] == 0 and view.ndim == (1 if columns < 0 else 2)
+            and view.shape[0] == rows and (columns < 0 or view.shape[1] == columns)):
+        return True
+    PyBuffer_Release(view)
+    return False
+
+
+cdef bint _is_dense(object value, Py_ssize_t rows, Py_ssize_t columns):
     """Whether ``value`` is a numpy array (not a subclass, as :func:`fccqp.problem.convert`
-    passes through) with a C-contiguous buffer of native float64 of ``ndim`` dimensions
-    of ``rows`` (and ``columns``) entries."""
+    passes through) that :func:`hold_float64` accepts."""
     cdef Py_buffer view
-    cdef bint dense
     if type(value) is not ndarray:
         return False
     try:
-        PyObject_GetBuffer(value, &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT)
+        if not hold_float64(value, &view, rows, columns, False):
+            return False
     except (TypeError, ValueError, BufferError):   # no buffer, or not a contiguous one
         return False
-    dense = (view.ndim == ndim and view.itemsize == 8 and view.format != NULL
-             and view.format[0] == b"d" and view.format[1] == 0 and view.shape[0] == rows
-             and (ndim == 1 or view.shape[1] == columns))
     PyBuffer_Release(&view)
-    return dense
+    return True
 
 
 def dense_arguments(P, q, A, b, lb, ub, Py_ssize_t n, Py_ssize_t m):
     """True when ``P, q, A, b, lb, ub`` are C-contiguous float64 arrays of the shapes
     ``(n, n), (n,), (m, n), (m,), (n,), (n,)``: what :func:`fccqp.problem.convert`
     would return unchanged. Their numbers are checked by the solve."""
-    return (_is_dense(P, 2, n, n) and _is_dense(q, 1, n, 0) and _is_dense(A, 2, m, n)
-            and _is_dense(b, 1, m, 0) and _is_dense(lb, 1, n, 0) and _is_dense(ub, 1, n, 0))
+    return (_is_dense(P, n, n) and _is_dense(q, n, -1) and _is_dense(A, m, n)
+            and _is_dense(b, m, -1) and _is_dense(lb, n, -1) and _is_dense(ub, n, -1))
 
 
 cdef tuple _one_key(object cone):
