@@ -25,11 +25,12 @@ cdef inline void trsm(char side, char trans, int m, int n, const double* L, int 
     dtrsm(&side, &lower, &trans, &non_unit, &m, &n, &one, <double*>L, &ldl, B, &ldb)
 
 
-cdef inline void syrk_t(int n, int k, const double* a, int lda, double* c, int ldc) noexcept nogil:
-    """Lower triangle of ``C = A' A`` (``A`` is ``k x n``)."""
+cdef inline void syrk_t(int n, int k, const double* a, int lda, double beta, double* c,
+                        int ldc) noexcept nogil:
+    """Lower triangle of ``C = A' A + beta C`` (``A`` is ``k x n``)."""
     cdef char lower = b"L", trans = b"T"
-    cdef double one = 1.0, zero = 0.0
-    dsyrk(&lower, &trans, &n, &k, &one, <double*>a, &lda, &zero, c, &ldc)
+    cdef double one = 1.0
+    dsyrk(&lower, &trans, &n, &k, &one, <double*>a, &lda, &beta, c, &ldc)
 
 
 cdef inline bint cholesky(double* M, int n, int ld) noexcept nogil:

@@ -41,7 +41,7 @@ from fccqp.certificates cimport (CERTIFIED, SEPARATED, dual_infeasible, equality
 from fccqp.fast_checks cimport hold_float64
 from fccqp.kkt cimport (AUTO, FACTORED, KKT, LDL_FULL, LDL_REDUCED, NOT_CONVEX, SCHUR_REDUCED,
                         UNAVAILABLE, kkt_convexity, kkt_factor, kkt_solve)
-from fccqp.polish cimport Polish, guess_changes, multiplier_violation, polish
+from fccqp.polish cimport Polish, guess_changes, multiplier_violation, polish, polish_prepare
 from fccqp.projections cimport proj_block, proj_set
 from fccqp.reduced cimport (Reduced, materialize, near_convergence, reduced_rebase,
                             reduced_start, reduced_step, reduced_table)
@@ -401,6 +401,13 @@ cdef class Workspace:
         pol.T, pol.tpiv = self._new(4 * s * s), <int*>self._new_int(2 * s)
         pol.tr, pol.du = self._new(2 * s), self._new(2 * s)
         pol.full, pol.dfull = self._new(N), self._new(N)
+        ps = &pol.schur
+        ps.ready = False
+        ps.order, ps.coupled = <Py_ssize_t*>self._new_int(n), <char*>self._new(n)
+        ps.L, ps.root, ps.Y = self._new(n * n), self._new(n), self._new(n * (m + s))
+        ps.SU, ps.S = self._new(m * m), self._new((m + s) * (m + s))
+        ps.block, ps.g = self._new(s * s), self._new(s)
+        ps.t, ps.t2, ps.u = self._new(n), self._new(n), self._new(m + s)
         self.user_x, self.user_y, self.user_z = self._new(n), self._new(m), self._new(n)
         self.log_rows = log_rows
         self.log = self._new(5 * log_rows)
@@ -645,7 +652,7 @@ cdef class Workspace:
         cdef bint unbounded_start = False, timed = isfinite(o.time_limit)
         # the iterations stop early enough for the final polish or restoration to fit
         cdef double deadline = o.time_limit - min(self.final_reserve, 0.5 * o.time_limit)
-        cdef bint reduced, fresh, last, periodic, adapt, check, accelerate
+        cdef bint reduced, fresh, last, periodic, adapt, check, accelerate, warm_polish
         cdef double eps_p, eps_d, new_rho, periodic_prim
         cdef int stalls
         run.factorizations = 0
@@ -653,6 +660,7 @@ cdef class Workspace:
         run.polished = False
         self.tighten = 1.0
         self.table_ready = False   # base is for the previous q, b
+        self.pol.schur.ready = False   # set up for the previous P, A
         self.iterated = False
         self.clock[3] = self.clock[4] = fccqp_now()   # phases skipped show 0
         if cold or s == 0:
@@ -687,7 +695,13 @@ cdef class Workspace:
             return
         for j in range(s):
             it.rho_vec[j] = run.rho * self.rho_scale[j]
+        warm_polish = self.from_polished and o.polish
         if self.factored_rho != run.rho or cold:
+            if warm_polish and polish_prepare(&self.pol, p):
+                # polish before ADMM's factorization, which it does not need
+                if self._warm_polish(run, start_time):
+                    return
+                warm_polish = False   # the same guesses would fail again
             code = self._factor(run, self._budget(0))
             if code != FACTORED:
                 run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR
@@ -695,7 +709,7 @@ cdef class Workspace:
         reduced = self.form != LDL_FULL
         if reduced:
             self._reduced_base()
-        if self.from_polished and o.polish and self._warm_polish(run, start_time):
+        if warm_polish and self._warm_polish(run, start_time):
             return
         self.clock[3] = fccqp_now()
         if reduced:

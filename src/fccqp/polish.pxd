@@ -1,6 +1,7 @@
 # cython: language_level=3
 from fccqp._types cimport Iterates, Problem
 from fccqp.kkt cimport KKT
+from fccqp.polish_schur cimport PolishSchur
 from fccqp.reduced cimport Reduced
 
 cdef enum:
@@ -22,6 +23,8 @@ cdef struct Polish:
     double* hess            # s x s: a boundary block's curvature term at hess + offset * s
     double* K               # N x N, Fortran order; the factor after dsytrf
     int* ipiv               # N
+    PolishSchur schur       # the Schur-complement solve where P's structure allows it
+    bint structured         # the current guess is factored in schur, not in K
     double* work            # lwork entries, for dsytrf
     int lwork
     double* rhs             # N: residual of the current solution
@@ -47,6 +50,7 @@ cdef struct Polish:
 cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_steps,
                  int* factorizations, const Reduced* table, KKT* kkt,
                  const double* rho_vec) noexcept nogil
+cdef bint polish_prepare(Polish* w, const Problem* p) noexcept nogil
 cdef Py_ssize_t guess_changes(const Problem* p, const double* z, const double* y,
                               double* point, char* codes) noexcept nogil
 cdef double multiplier_violation(Polish* w, const Problem* p, const double* z) noexcept nogil

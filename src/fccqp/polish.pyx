@@ -60,6 +60,7 @@ from scipy.linalg.cython_lapack cimport dsytrf, dsytrs
 from fccqp._dense cimport copy, inf_norm, matvec, matvec_t
 from fccqp._types cimport FRICTION, Cones, Iterates, Problem
 from fccqp.kkt cimport KKT
+from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup, polish_schur_solve
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.projections cimport proj_block
 from fccqp.reduced cimport Reduced
@@ -434,8 +435,6 @@ cdef void _solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
     corrections against the unregularized matrix until the residual is below
     ``REFINE_TOLERANCE * scale``, stops halving (a singular system), or ``MAX_REFINE``
     corrections after the first; a correction that makes it grow is undone."""
-    cdef char uplo = b"L"
-    cdef int size = <int>(nf + p.m + nb), one = 1, info = 0
     cdef double norm, last = INFINITY
     cdef int r
     for r in range(_MAX_REFINE + 2):
@@ -446,20 +445,27 @@ cdef void _solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
         if norm <= _REFINE_TOLERANCE * scale or norm > 0.5 * last or r == _MAX_REFINE + 1:
             return
         last = norm
-        copy(w.rhs, w.step, size)
-        dsytrs(&uplo, &size, &one, w.K, &size, w.ipiv, w.step, &size, &info)
+        _factored_solve(w, p, nf, nb)
         _apply(w, nf, p.m, nb, 1.0)
 
 
-cdef void _correct_once(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) noexcept nogil:
-    """One correction of the current point with the factor in ``K`` (a chord step)."""
+cdef void _factored_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) noexcept nogil:
+    """``step`` := the current factorization's solution for ``rhs``."""
     cdef char uplo = b"L"
     cdef int size = <int>(nf + p.m + nb), one = 1, info = 0
-    if size == 0:
+    copy(w.rhs, w.step, size)
+    if w.structured:
+        polish_schur_solve(&w.schur, p, w.free, nf, w.index, w.boundary, nb, w.step)
+    else:
+        dsytrs(&uplo, &size, &one, w.K, &size, w.ipiv, w.step, &size, &info)
+
+
+cdef void _correct_once(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) noexcept nogil:
+    """One correction of the current point with the last factorization (a chord step)."""
+    if nf + p.m + nb == 0:
         return
     _residual(w, p, nf, nb)
-    copy(w.rhs, w.step, size)
-    dsytrs(&uplo, &size, &one, w.K, &size, w.ipiv, w.step, &size, &info)
+    _factored_solve(w, p, nf, nb)
     _apply(w, nf, p.m, nb, 1.0)
 
 
@@ -528,15 +534,22 @@ cdef Py_ssize_t _drop_far_side(Polish* w, const Problem* p, Py_ssize_t nb,
 
 cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
                        double scale, int* factorizations) noexcept nogil:
-    """Assemble and factor the KKT matrix of the current active set and planes, and
-    solve it from the current point; False when the factorization breaks down."""
+    """Factor the KKT matrix of the current active set and planes (by Schur complement
+    where :mod:`fccqp.polish_schur` was set up for this problem and applies, else
+    assembled for ``dsytrf``) and solve it from the current point; False when the
+    factorization breaks down."""
     cdef char uplo = b"L"
     cdef int size = <int>(nf + p.m + nb), info = 0
     if size == 0:   # every entry held, no rows: nothing to solve
         return True
+    w.structured = w.schur.ready and polish_schur_factor(&w.schur, p, w.index, w.boundary, nb,
+                                                         w.g, w.hess, _DELTA)
+    factorizations[0] += 1
+    if w.structured:
+        _solve(w, p, nf, nb, scale)
+        return True
     _assemble(w, p, nf, nb)
     dsytrf(&uplo, &size, w.K, &size, w.ipiv, w.work, &w.lwork, &info)
-    factorizations[0] += 1
     if info != 0:
         return False
     _solve(w, p, nf, nb, scale)
@@ -575,6 +588,12 @@ cdef void _multipliers(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
                p.cones.normal + 3 * cone, w.g + o, &phi)
         for j in range(o, o + p.cones.dim[cone]):
             w.y[j] = w.lam[k] * w.g[j]
+
+
+cdef bint polish_prepare(Polish* w, const Problem* p) noexcept nogil:
+    """Set up the Schur-complement solve of :mod:`fccqp.polish_schur` for this solve's
+    ``P`` and ``A``; True when it applies, and then polishing needs no table."""
+    return polish_schur_setup(&w.schur, p, _DELTA)
 
 
 cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_steps,

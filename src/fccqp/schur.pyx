@@ -115,7 +115,7 @@ cdef bint schur_factor(Schur* f, const Problem* p, const double* rho_vec) noexce
         for i in range(m):
             f.Y[j + i * n] = p.A[i * n + column]
     _triangular_solve(f, b"N", n, m, f.Y, n)
-    syrk_t(m, n, f.Y, n, f.LS, m)
+    syrk_t(m, n, f.Y, n, 0.0, f.LS, m)
     for i in range(m):
         largest = max(largest, f.LS[i + i * m])
     if not cholesky(f.LS, m, m):

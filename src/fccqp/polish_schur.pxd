@@ -1,0 +1,30 @@
+# cython: language_level=3
+from fccqp._types cimport Problem
+
+cdef struct PolishSchur:
+    # The polished QP's KKT system by Schur complement where P's structure allows it
+    # (see polish_schur.pyx); set up once per solve, factored once per guess.
+    bint ready              # set up for the current scaled P and A
+    int dense               # leading rows of the unconstrained entries that P couples
+    Py_ssize_t unconstrained    # entries without a bound or a cone (n - s)
+    Py_ssize_t* order       # n: the unconstrained entries, coupled ones first
+    char* coupled           # n: P has an entry off the diagonal in this row
+    double* L               # n x n (leading dense x dense used): Cholesky of P_DD + delta I
+    double* root            # n: sqrt(P_ii + delta) of the entries P does not couple
+    double* Y               # n x (m + s), column-major: L^-1 C' by rows of H's blocks
+    double* SU              # m x m: the unconstrained entries' part of S, + delta I
+    double* S               # (m + s)^2: S of the last factored guess, then its Cholesky
+    double* block           # s x s: a boundary block's Cholesky factor at block + offset * s
+    double* g               # s: the planes S was factored with (a chord step reuses them)
+    double* t               # n scratch
+    double* t2              # n scratch
+    double* u               # m + s scratch
+    int size                # m + nb of the last factored guess
+
+cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noexcept nogil
+cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
+                              const Py_ssize_t* boundary, Py_ssize_t nb, const double* g,
+                              const double* hess, double delta) noexcept nogil
+cdef void polish_schur_solve(PolishSchur* f, const Problem* p, const Py_ssize_t* free,
+                             Py_ssize_t nf, const Py_ssize_t* index, const Py_ssize_t* boundary,
+                             Py_ssize_t nb, double* v) noexcept nogil
