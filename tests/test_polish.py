@@ -220,3 +220,58 @@ def test_polished_answers_pass_the_independent_check(seed):
         verify_solution(problem, result)
         if result.polished and not settings:   # a budget-stopped one may stay inaccurate
             assert result.status is Status.SOLVED
+
+
+def _block_structured(problem, couple=False):
+    """``problem`` with ``P`` as whole-body control has it: dense on the unconstrained
+    entries, diagonal (weights from 1e-6 to 1) on the boxed and cone entries; with
+    ``couple``, one constrained entry keeps a coupling."""
+    P, q, A, b, lb, ub, cones = problem
+    n = q.size
+    constrained = np.isfinite(lb) | np.isfinite(ub)
+    for cone in cones:
+        constrained[cone.start:cone.start + getattr(cone, "dim", 3)] = True
+    P = P.copy()
+    weights = np.geomspace(1e-6, 1.0, constrained.sum())
+    P[constrained, :] = 0.0
+    P[:, constrained] = 0.0
+    P[np.flatnonzero(constrained), np.flatnonzero(constrained)] = weights
+    if couple:
+        first, free = np.flatnonzero(constrained)[0], np.flatnonzero(~constrained)[0]
+        P[first, free] = P[free, first] = 0.5 * np.sqrt(weights[0] * P[free, free])
+    assert np.linalg.eigvalsh(P).min() > 0.0
+    return P, q, A, b, lb, ub, cones
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_warm_polish_with_new_matrices_skips_admm_factorization(seed):
+    """Where ``P`` is diagonal on the constrained entries (whole-body control's torques
+    and forces), the warm polish of a tick whose matrices moved solves its KKT system by
+    Schur complement (fccqp.polish_schur) before any ADMM factorization: none is made,
+    and the answer is as exact as a cold solve's."""
+    problem = _block_structured(_cone_problem(seed))
+    P, q, A, b, lb, ub, cones = problem
+    solver = fccqp.Solver(fccqp.Settings.realtime(float("inf")))
+    assert solver.solve(*problem).polished
+    rng = np.random.default_rng(seed)
+    moved = (P * (1.0 + 1e-3 * np.eye(q.size)), q + 1e-4 * rng.standard_normal(q.size),
+             A, b, lb, ub, cones)
+    warm = solver.solve(*moved)
+    assert warm.status is Status.SOLVED and warm.polished
+    assert warm.iterations == 0 and warm.factorizations == 0
+    assert check_solution(Problem.of(*moved), warm, EXACT).passed
+    reference = clarabel_solve(*moved, tol=1e-12)
+    assert abs(warm.obj - reference.obj) <= 1e-8 * max(1.0, abs(reference.obj))
+
+
+def test_warm_polish_factors_where_p_couples_a_constrained_entry():
+    """A coupled constrained entry leaves the Schur complement out: the tick factors as
+    before, and its answer is still exact."""
+    problem = _block_structured(_cone_problem(1), couple=True)
+    P, q, A, b, lb, ub, cones = problem
+    solver = fccqp.Solver(fccqp.Settings.realtime(float("inf")))
+    assert solver.solve(*problem).polished
+    moved = (P * (1.0 + 1e-3 * np.eye(q.size)), q, A, b, lb, ub, cones)
+    warm = solver.solve(*moved)
+    assert warm.status is Status.SOLVED and warm.polished and warm.factorizations >= 1
+    assert check_solution(Problem.of(*moved), warm, EXACT).passed

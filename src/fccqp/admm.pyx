@@ -401,6 +401,7 @@ cdef class Workspace:
         pol.T, pol.tpiv = self._new(4 * s * s), <int*>self._new_int(2 * s)
         pol.tr, pol.du = self._new(2 * s), self._new(2 * s)
         pol.full, pol.dfull = self._new(N), self._new(N)
+        pol.schur_only = pol.schur_failed = False
         ps = &pol.schur
         ps.ready = False
         ps.order, ps.coupled = <Py_ssize_t*>self._new_int(n), <char*>self._new(n)
@@ -652,7 +653,7 @@ cdef class Workspace:
         cdef bint unbounded_start = False, timed = isfinite(o.time_limit)
         # the iterations stop early enough for the final polish or restoration to fit
         cdef double deadline = o.time_limit - min(self.final_reserve, 0.5 * o.time_limit)
-        cdef bint reduced, fresh, last, periodic, adapt, check, accelerate, warm_polish
+        cdef bint reduced, fresh, last, periodic, adapt, check, accelerate, warm_polish, polished
         cdef double eps_p, eps_d, new_rho, periodic_prim
         cdef int stalls
         run.factorizations = 0
@@ -699,9 +700,14 @@ cdef class Workspace:
         if self.factored_rho != run.rho or cold:
             if warm_polish and polish_prepare(&self.pol, p):
                 # polish before ADMM's factorization, which it does not need
-                if self._warm_polish(run, start_time):
+                self.pol.schur_only = True
+                polished = self._warm_polish(run, start_time)
+                self.pol.schur_only = False
+                if polished:
                     return
-                warm_polish = False   # the same guesses would fail again
+                # a guess that failed the check would fail again; one that the Schur
+                # complement could not solve goes to the table
+                warm_polish = self.pol.schur_failed
             code = self._factor(run, self._budget(0))
             if code != FACTORED:
                 run.status = _NOT_CONVEX if code == NOT_CONVEX else _NUMERICAL_ERROR

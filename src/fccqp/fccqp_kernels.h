@@ -10,6 +10,12 @@
  * factored one column at a time (rows swapped in full), then each trailing column gets
  * the panel's four updates in one pass, which loads and stores it once instead of four
  * times (callgrind, talos' 64-row systems: see polish_table.LU_LOOP_ROWS).
+ *
+ * fccqp_cholesky: Cholesky factor L L' of the lower triangle of a column-major n x n
+ * matrix (leading dimension ld) in place; returns 0 at a pivot that is not positive.
+ * Right-looking in panels of FCCQP_LU_PANEL columns like fccqp_lu. For the polish's
+ * Schur complements (go2: 34 rows) dpotrf took 26k instructions a call, most of it in
+ * its recursion's dtrsm / dsyrk set-up (callgrind; see polish_schur).
  */
 #ifndef FCCQP_KERNELS_H
 #define FCCQP_KERNELS_H
@@ -93,6 +99,48 @@ static int fccqp_lu(double *T, int n, int *piv)
                         for (int i = end; i < n; i++)
                             column[i] -= u * l[i];
                     }
+                }
+            }
+        }
+    }
+    return 1;
+}
+
+FCCQP_CLONES
+static int fccqp_cholesky(double *M, int n, int ld)
+{
+    for (int k0 = 0; k0 < n; k0 += FCCQP_LU_PANEL) {
+        int end = k0 + FCCQP_LU_PANEL < n ? k0 + FCCQP_LU_PANEL : n;
+        for (int k = k0; k < end; k++) {   /* the panel, one column at a time */
+            double *pivot_column = M + (long)k * ld;
+            double pivot = pivot_column[k];
+            if (!(pivot > 0.0))
+                return 0;
+            pivot = sqrt(pivot);
+            pivot_column[k] = pivot;
+            double inverse = 1.0 / pivot;
+            for (int i = k + 1; i < n; i++)
+                pivot_column[i] *= inverse;
+            for (int j = k + 1; j < end; j++) {
+                double *column = M + (long)j * ld;
+                double factor = pivot_column[j];
+                for (int i = j; i < n; i++)
+                    column[i] -= factor * pivot_column[i];
+            }
+        }
+        const double *l0 = M + (long)k0 * ld;
+        for (int j = end; j < n; j++) {   /* the trailing columns: the panel's updates */
+            double *column = M + (long)j * ld;
+            if (end - k0 == FCCQP_LU_PANEL) {
+                fccqp_rank4_update(column, l0, l0 + ld, l0 + 2 * (long)ld, l0 + 3 * (long)ld,
+                                   l0[j], l0[ld + j], l0[2 * (long)ld + j],
+                                   l0[3 * (long)ld + j], j, n);
+            } else {
+                for (int b = k0; b < end; b++) {
+                    const double *l = M + (long)b * ld;
+                    double factor = l[j];
+                    for (int i = j; i < n; i++)
+                        column[i] -= factor * l[i];
                 }
             }
         }

@@ -25,6 +25,8 @@ cdef struct Polish:
     int* ipiv               # N
     PolishSchur schur       # the Schur-complement solve where P's structure allows it
     bint structured         # the current guess is factored in schur, not in K
+    bint schur_only         # fail rather than assemble for dsytrf where schur does not apply
+    bint schur_failed       # the last polish failed so
     double* work            # lwork entries, for dsytrf
     int lwork
     double* rhs             # N: residual of the current solution
@@ -34,6 +36,7 @@ cdef struct Polish:
     double* nu              # m: its equality multipliers
     double* y               # s: its constraint multipliers
     double* grad            # n: scratch, the gradient of the Lagrangian
+    bint grad_current       # grad is that of the current (x, nu): _multipliers reuses it
     double* ATnu            # n: scratch
     double* Ax              # m: scratch
     # the solve in the reduced form's coordinates (fccqp.polish_table)

@@ -338,6 +338,7 @@ cdef Py_ssize_t _unknowns(Polish* w, const Problem* p) noexcept nogil:
     (``index``, ``free``) and return how many there are."""
     cdef Py_ssize_t n = p.n, i, j, nf = 0
     cdef char code
+    w.grad_current = False
     for i in range(n):
         w.index[i] = 0
     for j in range(p.s):
@@ -414,6 +415,7 @@ cdef double _residual(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb)
     matvec(p.A, w.x, w.Ax, m, n)
     for i in range(m):
         w.rhs[nf + i] = p.b[i] - w.Ax[i]
+    w.grad_current = True
     return inf_norm(w.rhs, nf + m + nb)
 
 
@@ -421,6 +423,7 @@ cdef void _apply(Polish* w, Py_ssize_t nf, Py_ssize_t m, Py_ssize_t nb,
                  double sign) noexcept nogil:
     """Add ``sign`` times ``step`` to the unknowns."""
     cdef Py_ssize_t i
+    w.grad_current = False
     for i in range(nf):
         w.x[w.free[i]] += sign * w.step[i]
     for i in range(m):
@@ -548,6 +551,9 @@ cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t n
     if w.structured:
         _solve(w, p, nf, nb, scale)
         return True
+    if w.schur_only:
+        w.schur_failed = True
+        return False
     _assemble(w, p, nf, nb)
     dsytrf(&uplo, &size, w.K, &size, w.ipiv, w.work, &w.lwork, &info)
     if info != 0:
@@ -562,6 +568,7 @@ cdef bint _solve_guess(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
     """Solve the polished QP of the current guess in the reduced form's coordinates
     while ``tabled`` (:mod:`fccqp.polish_table`), else with its own KKT matrix; a
     singular system in the table's coordinates ends ``tabled`` for this polish."""
+    w.grad_current = False
     if tabled[0]:
         if table_factor(w, p, table, rho_vec, nb):
             table_solve(w, p, table, kkt, rho_vec, nb, scale)
@@ -577,7 +584,8 @@ cdef void _multipliers(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
     cdef Py_ssize_t j, k, o, cone
     cdef char code
     cdef double phi
-    _residual(w, p, nf, nb)   # grad: the held entries' multipliers, negated
+    if not w.grad_current:   # a solve's last residual is often the point's
+        _residual(w, p, nf, nb)   # grad: the held entries' multipliers, negated
     for j in range(p.s):
         code = w.active[j]
         w.y[j] = 0.0 if code == FREE or code == BOUNDARY else -w.grad[p.constrained[j]]
@@ -630,6 +638,8 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     copy(it.x, w.x, n)
     copy(it.nu, w.nu, m)
     copy(it.y, w.y, s)
+    w.grad_current = False
+    w.schur_failed = False
     for j in range(s):
         w.active[j] = FREE
     nb = _guess(w, p, it.z, it.y, &changed)
@@ -658,6 +668,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
             if not refactored:   # a chord step: one correction, the last factor, the current planes
                 if tabled:
                     table_correct(w, p, table, kkt, rho_vec, nb, scale)
+                    w.grad_current = False
                 else:
                     _correct_once(w, p, nf, nb)
             elif not _solve_guess(w, p, nf, nb, scale, factorizations, table, kkt, rho_vec,
@@ -672,6 +683,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         if not refactored:   # refine the last chord step's point
             if tabled:
                 table_solve(w, p, table, kkt, rho_vec, nb, scale)
+                w.grad_current = False
             else:
                 _solve(w, p, nf, nb, scale)
         _multipliers(w, p, nf, nb)
