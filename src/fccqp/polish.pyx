@@ -73,6 +73,12 @@ MAX_REFINE = 5
 """Most refinement steps per solve."""
 REFINE_TOLERANCE = 1e-14
 """Refine while the KKT residual exceeds this times ``max(1, ||q||, ||b||)`` (scaled)."""
+GUESS_TOLERANCE = 1e-10
+"""A guess's first solve, which the guess corrections and Newton steps move on from, is
+refined only to this (same scale); the point returned is refined to ``REFINE_TOLERANCE``.
+With the Schur complement (:mod:`fccqp.polish_schur`) the first solve leaves about
+2e-12 on whole-body control, and refining it to 1e-14 took a second KKT solve and
+residual that the next chord step repeats."""
 GUESS_PASSES = 6
 """Most active sets solved per polish: the first from ADMM's iterate, each next one
 corrected from the previous polished point (:func:`_renew`). On the WBC sets more did
@@ -95,6 +101,7 @@ cdef double _CHORD_RATE = CHORD_RATE
 cdef double _DELTA = DELTA
 cdef int _MAX_REFINE = MAX_REFINE
 cdef double _REFINE_TOLERANCE = REFINE_TOLERANCE
+cdef double _GUESS_TOLERANCE = GUESS_TOLERANCE
 cdef double _NEWTON_TOLERANCE = NEWTON_TOLERANCE
 cdef int _GUESS_PASSES = GUESS_PASSES
 cdef double _ACTIVE_TOLERANCE = ACTIVE_TOLERANCE
@@ -433,11 +440,11 @@ cdef void _apply(Polish* w, Py_ssize_t nf, Py_ssize_t m, Py_ssize_t nb,
 
 
 cdef void _solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
-                 double scale) noexcept nogil:
+                 double tolerance) noexcept nogil:
     """Correct ``(x, nu, lam)`` to the solution of the factored system: residual
     corrections against the unregularized matrix until the residual is below
-    ``REFINE_TOLERANCE * scale``, stops halving (a singular system), or ``MAX_REFINE``
-    corrections after the first; a correction that makes it grow is undone."""
+    ``tolerance``, stops halving (a singular system), or ``MAX_REFINE`` corrections
+    after the first; a correction that makes it grow is undone."""
     cdef double norm, last = INFINITY
     cdef int r
     for r in range(_MAX_REFINE + 2):
@@ -445,7 +452,7 @@ cdef void _solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
         if norm > last:
             _apply(w, nf, p.m, nb, -1.0)
             return
-        if norm <= _REFINE_TOLERANCE * scale or norm > 0.5 * last or r == _MAX_REFINE + 1:
+        if norm <= tolerance or norm > 0.5 * last or r == _MAX_REFINE + 1:
             return
         last = norm
         _factored_solve(w, p, nf, nb)
@@ -536,11 +543,11 @@ cdef Py_ssize_t _drop_far_side(Polish* w, const Problem* p, Py_ssize_t nb,
 
 
 cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
-                       double scale, int* factorizations) noexcept nogil:
+                       double tolerance, int* factorizations) noexcept nogil:
     """Factor the KKT matrix of the current active set and planes (by Schur complement
     where :mod:`fccqp.polish_schur` was set up for this problem and applies, else
-    assembled for ``dsytrf``) and solve it from the current point; False when the
-    factorization breaks down."""
+    assembled for ``dsytrf``) and solve it from the current point to ``tolerance``;
+    False when the factorization breaks down."""
     cdef char uplo = b"L"
     cdef int size = <int>(nf + p.m + nb), info = 0
     if size == 0:   # every entry held, no rows: nothing to solve
@@ -549,7 +556,7 @@ cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t n
                                                          w.g, w.hess, _DELTA)
     factorizations[0] += 1
     if w.structured:
-        _solve(w, p, nf, nb, scale)
+        _solve(w, p, nf, nb, tolerance)
         return True
     if w.schur_only:
         w.schur_failed = True
@@ -558,23 +565,25 @@ cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t n
     dsytrf(&uplo, &size, w.K, &size, w.ipiv, w.work, &w.lwork, &info)
     if info != 0:
         return False
-    _solve(w, p, nf, nb, scale)
+    _solve(w, p, nf, nb, tolerance)
     return True
 
 
 cdef bint _solve_guess(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
                       double scale, int* factorizations, const Reduced* table, KKT* kkt,
-                      const double* rho_vec, bint* tabled) noexcept nogil:
+                      const double* rho_vec, bint* tabled, bint first) noexcept nogil:
     """Solve the polished QP of the current guess in the reduced form's coordinates
-    while ``tabled`` (:mod:`fccqp.polish_table`), else with its own KKT matrix; a
-    singular system in the table's coordinates ends ``tabled`` for this polish."""
+    while ``tabled`` (:mod:`fccqp.polish_table`), else with its own KKT matrix (refined
+    to ``GUESS_TOLERANCE`` on a guess's ``first`` solve); a singular system in the
+    table's coordinates ends ``tabled`` for this polish."""
     w.grad_current = False
     if tabled[0]:
         if table_factor(w, p, table, rho_vec, nb):
             table_solve(w, p, table, kkt, rho_vec, nb, scale)
             return True
         tabled[0] = False
-    return _factor_solve(w, p, nf, nb, scale, factorizations)
+    return _factor_solve(w, p, nf, nb, (_GUESS_TOLERANCE if first else _REFINE_TOLERANCE) * scale,
+                         factorizations)
 
 
 cdef void _multipliers(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) noexcept nogil:
@@ -645,12 +654,16 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     nb = _guess(w, p, it.z, it.y, &changed)
     while True:
         nf = _unknowns(w, p)
-        if not _solve_guess(w, p, nf, nb, scale, factorizations, table, kkt, rho_vec, &tabled):
+        if not _solve_guess(w, p, nf, nb, scale, factorizations, table, kkt, rho_vec, &tabled,
+                            True):
             return False
         _multipliers(w, p, nf, nb)
         passes += 1
-        if passes == _GUESS_PASSES:
-            break   # not settled: the caller's check judges this guess's point
+        if passes == _GUESS_PASSES:   # not settled: the caller's check judges this point
+            if not tabled:
+                _solve(w, p, nf, nb, _REFINE_TOLERANCE * scale)
+                _multipliers(w, p, nf, nb)
+            break
         nb = _renew(w, p, True, &changed)
         if changed == 0:
             nb = _renew(w, p, False, &changed)
@@ -672,7 +685,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
                 else:
                     _correct_once(w, p, nf, nb)
             elif not _solve_guess(w, p, nf, nb, scale, factorizations, table, kkt, rho_vec,
-                                  &tabled):
+                                  &tabled, False):
                 return False
             last_miss = miss
             nb = _drop_far_side(w, p, nb, &changed)
@@ -680,12 +693,12 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
                 break
         if changed != 0:
             continue   # a block went past its apex: solve the corrected guess
-        if not refactored:   # refine the last chord step's point
+        if not refactored:   # refine the last chord step's (or the first solve's) point
             if tabled:
                 table_solve(w, p, table, kkt, rho_vec, nb, scale)
                 w.grad_current = False
             else:
-                _solve(w, p, nf, nb, scale)
+                _solve(w, p, nf, nb, _REFINE_TOLERANCE * scale)
         _multipliers(w, p, nf, nb)
         break
     for j in range(n):
