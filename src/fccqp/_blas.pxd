@@ -49,24 +49,39 @@ cdef inline void cholesky_solve(const double* L, int n, int ld, double* B, int c
     dpotrs(&lower, &n, &columns, <double*>L, &ld, B, &ldb, &info)
 
 
-cdef inline void cholesky_solve_vector(const double* L, int n, int ld, double* b) noexcept nogil:
-    """``b := (L L')^-1 b`` for one vector: forward then backward substitution on the
-    column-major lower factor ``L``. A loop, not ``dpotrs``: for one right-hand side at
-    n = 54 (go2's ``H``) ``dpotrs`` went through two ``dtrsm`` calls whose set-up cost
-    more than the 3k multiply-adds (callgrind: the single-vector solves were a third of
-    the Schur backend's instructions)."""
+cdef inline void forward_substitution(const double* L, int n, int ld, double* b) noexcept nogil:
+    """``b := L^-1 b`` for the column-major lower triangle ``L``, column by column (each
+    an update of contiguous entries)."""
     cdef int i, k
     cdef double value
     cdef const double* column
-    for k in range(n):          # L y = b, column by column (contiguous)
+    for k in range(n):
         value = b[k] / L[k + k * ld]
         b[k] = value
         column = L + k * ld
         for i in range(k + 1, n):
             b[i] -= column[i] * value
-    for k in range(n - 1, -1, -1):   # L' x = y, a dot product per row of L'
+
+
+cdef inline void backward_substitution(const double* L, int n, int ld, double* b) noexcept nogil:
+    """``b := L'^-1 b`` for the column-major lower triangle ``L``, a dot product per row
+    of ``L'``."""
+    cdef int i, k
+    cdef double value
+    cdef const double* column
+    for k in range(n - 1, -1, -1):
         column = L + k * ld
         value = b[k]
         for i in range(k + 1, n):
             value -= column[i] * b[i]
         b[k] = value / column[k]
+
+
+cdef inline void cholesky_solve_vector(const double* L, int n, int ld, double* b) noexcept nogil:
+    """``b := (L L')^-1 b`` for one vector: forward then backward substitution on the
+    column-major lower factor ``L``. Loops, not ``dpotrs``: for one right-hand side at
+    n = 54 (go2's ``H``) ``dpotrs`` went through two ``dtrsm`` calls whose set-up cost
+    more than the 3k multiply-adds (callgrind: the single-vector solves were a third of
+    the Schur backend's instructions)."""
+    forward_substitution(L, n, ld, b)
+    backward_substitution(L, n, ld, b)

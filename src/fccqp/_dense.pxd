@@ -45,7 +45,8 @@ cdef inline void fill(double* dst, double value, Py_ssize_t k) noexcept nogil:
 
 
 cdef extern from "fccqp_kernels.h" nogil:
-    void fccqp_matvec_t(const double* M, const double* y, double* out, int rows, int cols)
+    void fccqp_matvec_t(const double* M, int ld, const double* y, double* out, int rows,
+                        int cols)
 
 
 cdef inline void matvec(const double* M, const double* x, double* out,
@@ -65,7 +66,7 @@ cdef inline void matvec(const double* M, const double* x, double* out,
 cdef inline void matvec_t(const double* M, const double* y, double* out,
                           Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
     """``out = M' y`` for a row-major ``rows x cols`` matrix ``M`` (``fccqp_kernels.h``)."""
-    fccqp_matvec_t(M, y, out, <int>rows, <int>cols)
+    fccqp_matvec_t(M, <int>cols, y, out, <int>rows, <int>cols)
 
 
 cdef inline void colmatvec(const double* M, int ld, const double* x, double* out,

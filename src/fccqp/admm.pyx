@@ -407,7 +407,9 @@ cdef class Workspace:
         ps.order, ps.coupled = <Py_ssize_t*>self._new_int(n), <char*>self._new(n)
         ps.L, ps.root, ps.Y = self._new(n * n), self._new(n), self._new(n * (m + s))
         ps.SU, ps.S = self._new(m * m), self._new((m + s) * (m + s))
-        ps.block, ps.g = self._new(s * s), self._new(s)
+        ps.block = self._new(s * s)
+        ps.rowvar, ps.block_row = <Py_ssize_t*>self._new_int(n), <Py_ssize_t*>self._new_int(s)
+        ps.inv_root = self._new(n)
         ps.t, ps.t2, ps.u = self._new(n), self._new(n), self._new(m + s)
         self.user_x, self.user_y, self.user_z = self._new(n), self._new(m), self._new(n)
         self.log_rows = log_rows

@@ -17,8 +17,9 @@
  * Schur complements (go2: 34 rows) dpotrf took 26k instructions a call, most of it in
  * its recursion's dtrsm / dsyrk set-up (callgrind; see polish_schur).
  *
- * fccqp_matvec_t: out = M' y for a row-major rows x cols M (out aliases neither
- * input, as BLAS requires): four scaled rows of M added to out per pass, a loop over
+ * fccqp_matvec_t: out = M' y for a row-major rows x cols M with leading dimension ld
+ * (out aliases neither input, as BLAS requires): four scaled rows of M added to out per
+ * pass, a loop over
  * contiguous entries that vectorizes without reassociating a sum. 2.1k instructions a
  * call against dgemv's 2.8k on go2's A' y and P y (callgrind); M x stays with dgemv,
  * whose dot-product kernel took 3.2k against 3.7k for a loop in four explicit lanes.
@@ -156,21 +157,20 @@ static int fccqp_cholesky(double *M, int n, int ld)
 
 
 FCCQP_CLONES
-static void fccqp_matvec_t(const double *restrict M, const double *restrict y,
+static void fccqp_matvec_t(const double *restrict M, int ld, const double *restrict y,
                            double *restrict out, int rows, int cols)
 {
     for (int j = 0; j < cols; j++)
         out[j] = 0.0;
     int i = 0;
     for (; i + 4 <= rows; i += 4) {
-        const double *r0 = M + (long)i * cols, *r1 = r0 + cols, *r2 = r1 + cols;
-        const double *r3 = r2 + cols;
+        const double *r0 = M + (long)i * ld, *r1 = r0 + ld, *r2 = r1 + ld, *r3 = r2 + ld;
         double y0 = y[i], y1 = y[i + 1], y2 = y[i + 2], y3 = y[i + 3];
         for (int j = 0; j < cols; j++)
             out[j] += (y0 * r0[j] + y1 * r1[j]) + (y2 * r2[j] + y3 * r3[j]);
     }
     for (; i < rows; i++) {
-        const double *r0 = M + (long)i * cols;
+        const double *r0 = M + (long)i * ld;
         double y0 = y[i];
         for (int j = 0; j < cols; j++)
             out[j] += y0 * r0[j];

@@ -11,11 +11,15 @@ cdef struct PolishSchur:
     char* coupled           # n: P has an entry off the diagonal in this row
     double* L               # n x n (leading dense x dense used): Cholesky of P_DD + delta I
     double* root            # n: sqrt(P_ii + delta) of the entries P does not couple
-    double* Y               # n x (m + s), column-major: L^-1 C' by rows of H's blocks
+    double* Y               # n x (m + s), column-major: L^-1 C', a row per free entry
+    Py_ssize_t* rowvar      # n: the entry of x of each row of Y
+    double* inv_root        # n: 1 / root of Y's diagonal rows (dense <= row < diag_end)
+    Py_ssize_t* block_row   # s: the first row of Y of each boundary block
+    int diag_end            # rows of Y before the boundary blocks'
+    int rows                # rows of Y: the free entries of the factored guess
     double* SU              # m x m: the unconstrained entries' part of S, + delta I
     double* S               # (m + s)^2: S of the last factored guess, then its Cholesky
     double* block           # s x s: a boundary block's Cholesky factor at block + offset * s
-    double* g               # s: the planes S was factored with (a chord step reuses them)
     double* t               # n scratch
     double* t2              # n scratch
     double* u               # m + s scratch
@@ -25,6 +29,5 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
 cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
                               const Py_ssize_t* boundary, Py_ssize_t nb, const double* g,
                               const double* hess, double delta) noexcept nogil
-cdef void polish_schur_solve(PolishSchur* f, const Problem* p, const Py_ssize_t* free,
-                             Py_ssize_t nf, const Py_ssize_t* index, const Py_ssize_t* boundary,
-                             Py_ssize_t nb, double* v) noexcept nogil
+cdef void polish_schur_solve(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
+                             const Py_ssize_t* boundary, Py_ssize_t nb, double* v) noexcept nogil

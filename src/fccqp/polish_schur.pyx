@@ -34,8 +34,10 @@ False and the caller assembles the matrix for ``dsytrf``.
 
 from libc.math cimport sqrt
 
-from fccqp._blas cimport cholesky_solve_vector, syrk_t, trsm
-from fccqp._dense cimport matvec, matvec_t
+from scipy.linalg.cython_blas cimport dgemv
+
+from fccqp._blas cimport (backward_substitution, cholesky_solve_vector, forward_substitution,
+                          syrk_t, trsm)
 from fccqp._types cimport Problem
 
 PIVOT_TOLERANCE = 1e-12
@@ -51,6 +53,8 @@ cdef double _RANK_TOLERANCE = RANK_TOLERANCE
 
 cdef extern from "fccqp_kernels.h" nogil:
     int fccqp_cholesky(double* M, int n, int ld)
+    void fccqp_matvec_t(const double* M, int ld, const double* y, double* out, int rows,
+                        int cols)
 
 
 cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noexcept nogil:
@@ -92,6 +96,9 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
         f.coupled[p.constrained[j]] = 0
     k = <int>lead
     f.dense, f.unconstrained = k, rest
+    for r in range(rest):
+        f.rowvar[r] = f.order[r]
+        f.inv_root[r] = 1.0 / f.root[f.order[r]] if r >= k else 0.0
     for c in range(k):
         for r in range(c, k):
             f.L[r + c * n] = p.P[f.order[r] * n + f.order[c]]
@@ -139,75 +146,100 @@ cdef bint _small_cholesky(double* B, Py_ssize_t d) noexcept nogil:
     return True
 
 
+cdef inline bint _diagonal_row(PolishSchur* f, const Problem* p, Py_ssize_t i, Py_ssize_t row,
+                               Py_ssize_t size) noexcept nogil:
+    """Row ``row`` of ``Y`` for free entry ``i``, a diagonal entry of ``H``: ``C``'s
+    column ``i`` (no plane) divided by ``sqrt(P_ii + delta)``; False when ``P_ii`` is
+    too small for that."""
+    cdef Py_ssize_t c, n = p.n, m = p.m
+    cdef double inverse
+    if f.root[i] == 0.0:
+        return False
+    inverse = 1.0 / f.root[i]
+    for c in range(m):
+        f.Y[row + c * n] = p.A[c * n + i] * inverse
+    for c in range(m, size):
+        f.Y[row + c * n] = 0.0
+    f.rowvar[row] = i
+    f.inv_root[row] = inverse
+    return True
+
+
 cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
                               const Py_ssize_t* boundary, Py_ssize_t nb, const double* g,
                               const double* hess, double delta) noexcept nogil:
     """Factor ``S`` of the guess whose held entries have ``index`` -1 and whose boundary
     blocks are ``boundary[:nb]`` (ascending), with planes ``g`` and curvature ``hess`` as
-    :mod:`fccqp.polish` keeps them. False where the Schur complement does not apply."""
+    :mod:`fccqp.polish` keeps them, and keep ``Y = L^-1 C'`` for the solves. ``Y``'s
+    rows: the unconstrained entries (from the set-up), the free box entries and free
+    cone blocks (a diagonal entry of ``H`` each), then the boundary blocks. False where
+    the Schur complement does not apply."""
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, size = m + nb, i, j, r, c, k, o, d
-    cdef Py_ssize_t start, rows = 0, kb = 0, a
+    cdef Py_ssize_t start, row = f.unconstrained, kb, a
     cdef double* S = f.S
-    cdef double* Z = f.Y + f.unconstrained
+    cdef double* Y = f.Y
     cdef double* B
     cdef double largest = 0.0, value
+    for c in range(m, size):   # the unconstrained entries have no plane
+        for r in range(f.unconstrained):
+            Y[r + c * n] = 0.0
+    for j in range(s):   # free box entries and free cone blocks: divided by sqrt(P_ii)
+        if not p.in_cone[j] and index[p.constrained[j]] >= 0:
+            if not _diagonal_row(f, p, p.constrained[j], row, size):
+                return False
+            row += 1
+    kb = 0
+    for k in range(p.cones.count):
+        start = p.constrained[p.cones.offset[k]]
+        if index[start] < 0:
+            continue   # at the apex: held
+        if kb < nb and boundary[kb] == k:
+            kb += 1    # on the boundary: below
+            continue
+        for a in range(p.cones.dim[k]):
+            if not _diagonal_row(f, p, start + a, row, size):
+                return False
+            row += 1
+    if kb != nb:
+        return False   # a boundary block that is held: not a guess this solves
+    f.diag_end = <int>row
+    for kb in range(nb):   # boundary blocks: diag(P) + curvature, a Cholesky of d rows
+        k = boundary[kb]
+        o, d = p.cones.offset[k], p.cones.dim[k]
+        start = p.constrained[o]
+        B = f.block + o * s
+        for c in range(d):
+            if f.root[start + c] == 0.0:
+                return False
+            for r in range(c, d):
+                B[r + c * d] = hess[o * s + r * d + c]
+            B[c + c * d] += f.root[start + c] * f.root[start + c]
+        if not _small_cholesky(B, d):
+            return False
+        f.block_row[kb] = row
+        for a in range(d):
+            f.rowvar[row + a] = start + a
+            for c in range(m):
+                Y[row + a + c * n] = p.A[c * n + start + a]
+            for c in range(m, size):
+                Y[row + a + c * n] = 0.0
+            Y[row + a + (m + kb) * n] = g[o + a]
+        for c in range(size):   # Y_block := B^-1 Y_block (forward substitution)
+            for a in range(d):
+                value = Y[row + a + c * n]
+                for r in range(a):
+                    value -= B[a + r * d] * Y[row + r + c * n]
+                Y[row + a + c * n] = value / B[a + a * d]
+        row += d
+    f.rows = <int>row
     for c in range(size):
         for r in range(c, size):
             S[r + c * size] = f.SU[r + c * m] if r < m else 0.0
         if c >= m:
             S[c + c * size] = delta
-    for j in range(s):   # free box entries: a diagonal entry of H each
-        if p.in_cone[j]:
-            continue
-        i = p.constrained[j]
-        if index[i] < 0:
-            continue
-        if f.root[i] == 0.0:
-            return False
-        for c in range(m):
-            Z[rows + c * n] = p.A[c * n + i] / f.root[i]
-        for c in range(m, size):
-            Z[rows + c * n] = 0.0
-        rows += 1
-    for k in range(p.cones.count):
-        o, d = p.cones.offset[k], p.cones.dim[k]
-        start = p.constrained[o]
-        if index[start] < 0:
-            continue   # at the apex: held
-        for a in range(d):
-            if f.root[start + a] == 0.0:
-                return False
-            for c in range(m):
-                Z[rows + a + c * n] = p.A[c * n + start + a]
-            for c in range(m, size):
-                Z[rows + a + c * n] = 0.0
-        if kb < nb and boundary[kb] == k:   # diag(P) + curvature: a Cholesky of d rows
-            B = f.block + o * s
-            for c in range(d):
-                for r in range(c, d):
-                    B[r + c * d] = hess[o * s + r * d + c]
-                B[c + c * d] += f.root[start + c] * f.root[start + c]
-            if not _small_cholesky(B, d):
-                return False
-            for a in range(d):
-                f.g[o + a] = g[o + a]
-                Z[rows + a + (m + kb) * n] = g[o + a]
-            for c in range(size):   # Z_block := B^-1 Z_block (forward substitution)
-                for a in range(d):
-                    value = Z[rows + a + c * n]
-                    for r in range(a):
-                        value -= B[a + r * d] * Z[rows + r + c * n]
-                    Z[rows + a + c * n] = value / B[a + a * d]
-            kb += 1
-        else:
-            for a in range(d):
-                for c in range(m):
-                    Z[rows + a + c * n] /= f.root[start + a]
-        rows += d
-    if kb != nb:
-        return False   # a boundary block that is held: not a guess this solves
-    if rows > 0:
-        syrk_t(<int>size, <int>rows, Z, <int>n, 1.0, S, <int>size)
+    if row > f.unconstrained:
+        syrk_t(<int>size, <int>(row - f.unconstrained), Y + f.unconstrained, <int>n, 1.0, S,
+               <int>size)
     for c in range(size):
         largest = max(largest, S[c + c * size])
     if size > 0 and not fccqp_cholesky(S, <int>size, <int>size):
@@ -219,93 +251,71 @@ cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t
     return True
 
 
-cdef void _h_solve(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
-                   const Py_ssize_t* boundary, Py_ssize_t nb, double* t) noexcept nogil:
-    """``t := H^-1 t`` on the free entries (``t`` in the order of ``x``; held entries
-    are left alone)."""
-    cdef Py_ssize_t n = p.n, s = p.s, r, j, i, k, o, d, start, a, kb = 0
-    cdef int dense = f.dense
+cdef void _forward(PolishSchur* f, const Problem* p, const Py_ssize_t* boundary,
+                   Py_ssize_t nb, double* w) noexcept nogil:
+    """``w := L^-1 w``, ``w`` in the order of ``Y``'s rows."""
+    cdef Py_ssize_t r, a, b, kb, d, o, row
     cdef double* B
     cdef double value
-    for r in range(dense):
-        f.t2[r] = t[f.order[r]]
-    if dense > 0:
-        cholesky_solve_vector(f.L, dense, <int>n, f.t2)
-    for r in range(dense):
-        t[f.order[r]] = f.t2[r]
-    for r in range(dense, f.unconstrained):
-        i = f.order[r]
-        t[i] /= f.root[i] * f.root[i]
-    for j in range(s):
-        if p.in_cone[j]:
-            continue
-        i = p.constrained[j]
-        if index[i] >= 0:
-            t[i] /= f.root[i] * f.root[i]
-    for k in range(p.cones.count):
-        o, d = p.cones.offset[k], p.cones.dim[k]
-        start = p.constrained[o]
-        if index[start] < 0:
-            continue
-        if kb < nb and boundary[kb] == k:
-            B = f.block + o * s
-            for a in range(d):   # B B' t = rhs: forward, then backward substitution
-                value = t[start + a]
-                for r in range(a):
-                    value -= B[a + r * d] * t[start + r]
-                t[start + a] = value / B[a + a * d]
-            for a in range(d - 1, -1, -1):
-                value = t[start + a]
-                for r in range(a + 1, d):
-                    value -= B[r + a * d] * t[start + r]
-                t[start + a] = value / B[a + a * d]
-            kb += 1
-        else:
-            for a in range(d):
-                t[start + a] /= f.root[start + a] * f.root[start + a]
+    if f.dense > 0:
+        forward_substitution(f.L, f.dense, <int>p.n, w)
+    for r in range(f.dense, f.diag_end):
+        w[r] *= f.inv_root[r]
+    for kb in range(nb):
+        o, d = p.cones.offset[boundary[kb]], p.cones.dim[boundary[kb]]
+        B, row = f.block + o * p.s, f.block_row[kb]
+        for a in range(d):
+            value = w[row + a]
+            for b in range(a):
+                value -= B[a + b * d] * w[row + b]
+            w[row + a] = value / B[a + a * d]
 
 
-cdef void polish_schur_solve(PolishSchur* f, const Problem* p, const Py_ssize_t* free,
-                             Py_ssize_t nf, const Py_ssize_t* index, const Py_ssize_t* boundary,
-                             Py_ssize_t nb, double* v) noexcept nogil:
+cdef void _backward(PolishSchur* f, const Problem* p, const Py_ssize_t* boundary,
+                    Py_ssize_t nb, double* w) noexcept nogil:
+    """``w := L'^-1 w``, ``w`` in the order of ``Y``'s rows."""
+    cdef Py_ssize_t r, a, b, kb, d, o, row
+    cdef double* B
+    cdef double value
+    for kb in range(nb):
+        o, d = p.cones.offset[boundary[kb]], p.cones.dim[boundary[kb]]
+        B, row = f.block + o * p.s, f.block_row[kb]
+        for a in range(d - 1, -1, -1):
+            value = w[row + a]
+            for b in range(a + 1, d):
+                value -= B[b + a * d] * w[row + b]
+            w[row + a] = value / B[a + a * d]
+    for r in range(f.dense, f.diag_end):
+        w[r] *= f.inv_root[r]
+    if f.dense > 0:
+        backward_substitution(f.L, f.dense, <int>p.n, w)
+
+
+cdef void polish_schur_solve(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
+                             const Py_ssize_t* boundary, Py_ssize_t nb, double* v) noexcept nogil:
     """``v := M^-1 v`` for the factored guess (its planes and curvature, also after
     they moved: a chord step), ``v = [x_F; nu; lam]`` as :mod:`fccqp.polish` lays out
-    its unknowns (``free[:nf]``, the rows, the planes)."""
-    cdef const double* g = f.g
-    cdef Py_ssize_t n = p.n, m = p.m, i, kb, a, o, start
-    cdef int size = f.size
-    cdef double* t = f.t
+    its unknowns (free entries by ``index``, the rows, the planes):
+    ``w = L^-1 r_x``, ``u = S^-1 (Y'w - r_c)``, ``x_F = L'^-1 (w - Y u)``."""
+    cdef Py_ssize_t n = p.n, r, c, nf = f.rows
+    cdef int rows = f.rows, size = f.size, one = 1, ld = <int>p.n
+    cdef double* w = f.t
     cdef double* u = f.u
-    cdef double value
-    for i in range(n):
-        t[i] = 0.0
-    for i in range(nf):
-        t[free[i]] = v[i]
-    _h_solve(f, p, index, boundary, nb, t)
-    matvec(p.A, t, u, m, n)
-    for i in range(m):
-        u[i] -= v[nf + i]
-    for kb in range(nb):
-        o = p.cones.offset[boundary[kb]]
-        start = p.constrained[o]
-        value = 0.0
-        for a in range(p.cones.dim[boundary[kb]]):
-            value += g[o + a] * t[start + a]
-        u[m + kb] = value - v[nf + m + kb]
+    cdef double alpha = 1.0, zero = 0.0
+    cdef char trans = b"T"
+    for r in range(rows):
+        w[r] = v[index[f.rowvar[r]]]
+    _forward(f, p, boundary, nb, w)
     if size > 0:
+        dgemv(&trans, &rows, &size, &alpha, f.Y, &ld, w, &one, &zero, u, &one)
+        for c in range(size):
+            u[c] -= v[nf + c]
         cholesky_solve_vector(f.S, size, size, u)
-    matvec_t(p.A, u, f.t2, m, n)
-    for i in range(n):
-        t[i] = 0.0
-    for i in range(nf):
-        t[free[i]] = v[i] - f.t2[free[i]]
-    for kb in range(nb):
-        o = p.cones.offset[boundary[kb]]
-        start = p.constrained[o]
-        for a in range(p.cones.dim[boundary[kb]]):
-            t[start + a] -= g[o + a] * u[m + kb]
-    _h_solve(f, p, index, boundary, nb, t)
-    for i in range(nf):
-        v[i] = t[free[i]]
-    for i in range(m + nb):
-        v[nf + i] = u[i]
+        fccqp_matvec_t(f.Y, <int>n, u, f.t2, size, rows)   # Y u: columns of Y
+        for r in range(rows):
+            w[r] -= f.t2[r]
+    _backward(f, p, boundary, nb, w)
+    for r in range(rows):
+        v[index[f.rowvar[r]]] = w[r]
+    for c in range(size):
+        v[nf + c] = u[c]
