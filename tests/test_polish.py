@@ -227,7 +227,6 @@ def _block_structured(problem, couple=False):
     entries, diagonal (weights from 1e-6 to 1) on the boxed and cone entries; with
     ``couple``, one constrained entry keeps a coupling."""
     P, q, A, b, lb, ub, cones = problem
-    n = q.size
     constrained = np.isfinite(lb) | np.isfinite(ub)
     for cone in cones:
         constrained[cone.start:cone.start + getattr(cone, "dim", 3)] = True

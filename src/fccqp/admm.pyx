@@ -816,12 +816,13 @@ cdef class Workspace:
         :func:`_keep_polished`'s check and is solved.
 
         In a control loop the active set mostly survives a tick, and then this is the
-        whole solve after the factorization: no iteration (go2: 90 % of the ticks). With
-        the reduced form it costs one small LU in the table's coordinates. Measured
-        against polishing before the factorization, with the polish's own KKT matrix
-        (which saves ADMM's factorization and table when it succeeds): no cheaper
-        (1.9M against 1.78M instructions per go2 tick, callgrind), since that matrix
-        needs its own ``dsytrf`` and refinement, and dearer when the guess fails. Tried
+        whole solve: no iteration (go2: 91 % of the ticks). Where ``P`` is diagonal on the
+        constrained entries (whole-body control) it runs before ADMM's factorization, its
+        systems solved by Schur complement on ``P``'s blocks (:mod:`fccqp.polish_schur`),
+        and a success skips that factorization and the reduced table; otherwise it runs
+        after them in the table's coordinates (one small LU a guess). The polished QP's
+        own KKT matrix by ``dsytrf`` instead was no cheaper than the table (1.9M against
+        1.78M instructions per go2 tick, callgrind) and dearer when the guess fails. Tried
         and not kept: polishing from every previous solution, or with 1 or 2 guesses from
         an unpolished one. Capped at 15 / 30 iterations talos' ticks polish more often
         (32 -> 36 %, 61 -> 66 % end here), but under the realtime preset's 2 ms budget a

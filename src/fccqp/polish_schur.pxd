@@ -8,7 +8,7 @@ cdef struct PolishSchur:
     int dense               # leading rows of the unconstrained entries that P couples
     Py_ssize_t unconstrained    # entries without a bound or a cone (n - s)
     Py_ssize_t* order       # n: the unconstrained entries, coupled ones first
-    char* coupled           # n: P has an entry off the diagonal in this row
+    char* coupled           # n: set-up scratch (1: P couples the entry, 2: constrained)
     double* L               # n x n (leading dense x dense used): Cholesky of P_DD + delta I
     double* root            # n: sqrt(P_ii + delta) of the entries P does not couple
     double* Y               # n x (m + s), column-major: L^-1 C', a row per free entry

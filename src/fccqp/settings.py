@@ -221,8 +221,8 @@ class Settings:
         A controller has a deadline, not an iteration count: each solve returns within
         ``budget`` seconds (setup included; see :attr:`time_limit`) the best point it
         found, with ``A x = b`` exact. A warm start from a polished solution first
-        polishes the previous active set (one small LU, no iteration): in a control loop
-        that is the answer most ticks. Otherwise ADMM runs, polishing when it meets the
+        polishes the previous active set (no iteration; on whole-body control not even
+        ADMM's factorization): in a control loop that is the answer most ticks. Otherwise ADMM runs, polishing when it meets the
         tolerance, and stops early enough to polish or restore within the budget, but
         not before :data:`REALTIME_MIN_ITER` iterations (a budget shorter than the setup
         plus those is overrun rather than wasted: the next tick starts from there).
