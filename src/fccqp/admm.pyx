@@ -282,6 +282,7 @@ cdef class Workspace:
     cdef bint table_ready   # the reduced table and base hold for this solve's data and rho
     cdef bint iterated      # the last solve ran the iterations (and then its final step)
     cdef bint prev_polished, from_polished   # the previous solution was polished; this solve starts from it
+    cdef bint user_current   # user_x, user_y, user_z and res are the returned point's
     cdef bint equalities_missed   # the last cold start did not meet A x = b
     cdef int form
     cdef object _keep
@@ -428,6 +429,7 @@ cdef class Workspace:
         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
         self.has_previous = self.has_matrices = self.certified = self.scaled_once = False
         self.prev_polished = self.from_polished = self.equalities_missed = False
+        self.user_current = False
         self.factored_rho = -1.0
         self.final_reserve = 0.0
 
@@ -581,6 +583,7 @@ cdef class Workspace:
             self.certified = False
         self.has_matrices = True
         self.from_polished = x0 == NULL and warm and self.prev_polished
+        self.user_current = False
         self.clock[1] = fccqp_now()
         self._scale(reuse, warm)
         self.clock[2] = fccqp_now()
@@ -834,6 +837,7 @@ cdef class Workspace:
         if not self._keep_polished(&status, 0, start_time, True):
             return False
         run.polished = True
+        self.user_current = True   # _keep_polished left them so
         self.clock[3] = self.clock[4] = fccqp_now()
         self._finish_run(run, _SOLVED, 0)
         return True
@@ -1293,10 +1297,16 @@ cdef class Workspace:
         cdef Problem* p = &self.prob
         cdef Iterates* it = &self.it
         cdef Py_ssize_t n = p.n, m = p.m, s = p.s
-        unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)
-        if run.status == _PRIMAL_INFEASIBLE or run.status == _DUAL_INFEASIBLE:
-            copy(self.cert, cert, n + m)
-        self._user_residuals(x, y, z)
+        if self.user_current:   # a warm polish's point: unscaled and measured already
+            copy(self.user_x, x, n)
+            if m:
+                copy(self.user_y, y, m)
+            copy(self.user_z, z, n)
+        else:
+            unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)
+            if run.status == _PRIMAL_INFEASIBLE or run.status == _DUAL_INFEASIBLE:
+                copy(self.cert, cert, n + m)
+            self._user_residuals(x, y, z)
         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):
             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):
                 run.status = _SOLVED

@@ -119,7 +119,7 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
         for r in range(rest):
             f.Y[r + c * n] = p.A[c * n + f.order[r]]
         for r in range(k, rest):
-            f.Y[r + c * n] /= f.root[f.order[r]]
+            f.Y[r + c * n] *= f.inv_root[r]
     if m > 0:
         if k > 0:
             trsm(b"L", b"N", k, <int>m, f.L, <int>n, f.Y, <int>n)
