@@ -29,11 +29,12 @@ KKT_BACKENDS = ("auto", "schur_reduced", "ldl_reduced", "ldl_full", "sparse")
 
 REALTIME_BUDGET = 2e-3
 """Default budget of :meth:`Settings.realtime` in seconds. Measured on the full benchmark
-(budgets 0.5, 1, 2, 3 ms; share solved on solo12 / anymal_c / go2 / talos_reduced): 98 /
-88 / 99 / 34 %, 100 / 100 / 100 / 35 %, 100 / 100 / 100 / 84 %, 100 / 100 / 100 / 91 %.
-The quadrupeds need 1 ms (their median solve is 0.2-0.26 ms, and the budget rarely
-binds), the humanoid more than its 1 ms setup and warm polish; 2 ms is the end of a
-control tick's usual range, 3 ms (pass ``budget=3e-3``) serves the humanoid best."""
+at 9f0fb22 (budgets 0.5, 1, 2, 3 ms; share solved on solo12 / anymal_c / go2 /
+talos_reduced): 100 / 100 / 100 / 58.5 %, 100 / 100 / 100 / 89.8 %, 100 / 100 / 100 /
+99.0 %, 100 / 100 / 100 / 99.8 %. The quadrupeds need 0.5 ms (their median solve is
+65-72 us there, and the budget rarely binds); the humanoid's ticks whose active set
+changed need more than 1 ms. 2 ms is the end of a control tick's usual range; 3 ms
+(pass ``budget=3e-3``) serves the humanoid best."""
 REALTIME_MIN_ITER = 15
 """Iterations :meth:`Settings.realtime` runs whatever the budget: the paper's real-time
 count, so that each tick of a loop whose budget its setup spends still progresses."""
@@ -222,10 +223,11 @@ class Settings:
         ``budget`` seconds (setup included; see :attr:`time_limit`) the best point it
         found, with ``A x = b`` exact. A warm start from a polished solution first
         polishes the previous active set (no iteration; on whole-body control not even
-        ADMM's factorization): in a control loop that is the answer most ticks. Otherwise ADMM runs, polishing when it meets the
-        tolerance, and stops early enough to polish or restore within the budget, but
-        not before :data:`REALTIME_MIN_ITER` iterations (a budget shorter than the setup
-        plus those is overrun rather than wasted: the next tick starts from there).
+        ADMM's factorization): in a control loop that is the answer most ticks.
+        Otherwise ADMM runs, polishing when it meets the tolerance, and stops early
+        enough to polish or restore within the budget, but not before
+        :data:`REALTIME_MIN_ITER` iterations (a budget shorter than the setup plus those
+        is overrun rather than wasted: the next tick starts from there).
         Tolerances 1e-4 (the paper's). The default budget, :data:`REALTIME_BUDGET`, is
         2 ms; the figures per robot and budget are in docs/performance.md.
         """
