@@ -180,7 +180,7 @@ cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t
     rows: the unconstrained entries (from the set-up), the free box entries and free
     cone blocks (a diagonal entry of ``H`` each), then the boundary blocks. False where
     the Schur complement does not apply."""
-    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, size = m + nb, i, j, r, c, k, o, d
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, size = m + nb, j, r, c, k, o, d
     cdef Py_ssize_t start, row = f.unconstrained, kb, a
     cdef double* S = f.S
     cdef double* Y = f.Y
