@@ -19,10 +19,10 @@
  *
  * fccqp_matvec_t: out = M' y for a row-major rows x cols M with leading dimension ld
  * (out aliases neither input, as BLAS requires): four scaled rows of M added to out per
- * pass, a loop over
- * contiguous entries that vectorizes without reassociating a sum. 2.1k instructions a
- * call against dgemv's 2.8k on go2's A' y and P y (callgrind); M x stays with dgemv,
- * whose dot-product kernel took 3.2k against 3.7k for a loop in four explicit lanes.
+ * pass, a loop over contiguous entries that vectorizes without reassociating a sum.
+ * 2.1k instructions a call against dgemv's 2.8k on go2's A' y and P y (callgrind); M x
+ * stays with dgemv, whose dot-product kernel took 3.2k against 3.7k for a loop in four
+ * explicit lanes. fccqp_cholesky also factors polish_schur's d x d cone blocks.
  */
 #ifndef FCCQP_KERNELS_H
 #define FCCQP_KERNELS_H

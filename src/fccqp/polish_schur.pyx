@@ -47,6 +47,7 @@ from scipy.linalg.cython_blas cimport dgemv
 from fccqp._blas cimport (backward_substitution, cholesky_solve_vector, forward_substitution,
                           syrk_t, trsm)
 from fccqp._types cimport Problem
+from fccqp.schur cimport mark_coupled
 
 PIVOT_TOLERANCE = 1e-12
 """A diagonal entry of ``P`` (or pivot of its dense block) below this times ``P``'s
@@ -73,13 +74,9 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
     cdef double largest = 0.0, pivot
     cdef int k
     f.ready = False
+    mark_coupled(p.P, n, f.coupled)
     for i in range(n):
         largest = max(largest, p.P[i * n + i])
-        f.coupled[i] = 0
-        for j in range(n):
-            if j != i and p.P[i * n + j] != 0.0:
-                f.coupled[i] = 1
-                break
     if not largest > 0.0:
         return False
     for j in range(s):
@@ -130,28 +127,6 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
     return True
 
 
-cdef bint _small_cholesky(double* B, Py_ssize_t d) noexcept nogil:
-    """Cholesky factor of the ``d x d`` lower triangle of ``B`` in place; False if not
-    positive definite. A loop, not ``dpotrf``, which took about 830 instructions a call
-    for a friction cone's 3 rows (callgrind, go2), several times the loop's work."""
-    cdef Py_ssize_t i, j, k
-    cdef double value, pivot
-    for j in range(d):
-        value = B[j + j * d]
-        for k in range(j):
-            value -= B[j + k * d] * B[j + k * d]
-        if not value > 0.0:
-            return False
-        pivot = sqrt(value)
-        B[j + j * d] = pivot
-        for i in range(j + 1, d):
-            value = B[i + j * d]
-            for k in range(j):
-                value -= B[i + k * d] * B[j + k * d]
-            B[i + j * d] = value / pivot
-    return True
-
-
 cdef inline bint _diagonal_row(PolishSchur* f, const Problem* p, Py_ssize_t i, Py_ssize_t row,
                                Py_ssize_t size) noexcept nogil:
     """Row ``row`` of ``Y`` for free entry ``i``, a diagonal entry of ``H``: ``C``'s
@@ -185,7 +160,7 @@ cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t
     cdef double* S = f.S
     cdef double* Y = f.Y
     cdef double* B
-    cdef double largest = 0.0, value
+    cdef double largest = 0.0
     for c in range(m, size):   # the unconstrained entries have no plane
         for r in range(f.unconstrained):
             Y[r + c * n] = 0.0
@@ -220,7 +195,7 @@ cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t
             for r in range(c, d):
                 B[r + c * d] = hess[o * s + r * d + c]
             B[c + c * d] += f.root[start + c] * f.root[start + c]
-        if not _small_cholesky(B, d):
+        if not fccqp_cholesky(B, <int>d, <int>d):
             return False
         f.block_row[kb] = row
         for a in range(d):
@@ -230,12 +205,8 @@ cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t
             for c in range(m, size):
                 Y[row + a + c * n] = 0.0
             Y[row + a + (m + kb) * n] = g[o + a]
-        for c in range(size):   # Y_block := B^-1 Y_block (forward substitution)
-            for a in range(d):
-                value = Y[row + a + c * n]
-                for r in range(a):
-                    value -= B[a + r * d] * Y[row + r + c * n]
-                Y[row + a + c * n] = value / B[a + a * d]
+        for c in range(size):   # Y_block := B^-1 Y_block
+            forward_substitution(B, <int>d, <int>d, Y + row + c * n)
         row += d
     f.rows = <int>row
     for c in range(size):
@@ -260,37 +231,23 @@ cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t
 cdef void _forward(PolishSchur* f, const Problem* p, const Py_ssize_t* boundary,
                    Py_ssize_t nb, double* w) noexcept nogil:
     """``w := L^-1 w``, ``w`` in the order of ``Y``'s rows."""
-    cdef Py_ssize_t r, a, b, kb, d, o, row
-    cdef double* B
-    cdef double value
+    cdef Py_ssize_t r, kb, d, o
     if f.dense > 0:
         forward_substitution(f.L, f.dense, <int>p.n, w)
     for r in range(f.dense, f.diag_end):
         w[r] *= f.inv_root[r]
     for kb in range(nb):
         o, d = p.cones.offset[boundary[kb]], p.cones.dim[boundary[kb]]
-        B, row = f.block + o * p.s, f.block_row[kb]
-        for a in range(d):
-            value = w[row + a]
-            for b in range(a):
-                value -= B[a + b * d] * w[row + b]
-            w[row + a] = value / B[a + a * d]
+        forward_substitution(f.block + o * p.s, <int>d, <int>d, w + f.block_row[kb])
 
 
 cdef void _backward(PolishSchur* f, const Problem* p, const Py_ssize_t* boundary,
                     Py_ssize_t nb, double* w) noexcept nogil:
     """``w := L'^-1 w``, ``w`` in the order of ``Y``'s rows."""
-    cdef Py_ssize_t r, a, b, kb, d, o, row
-    cdef double* B
-    cdef double value
+    cdef Py_ssize_t r, kb, d, o
     for kb in range(nb):
         o, d = p.cones.offset[boundary[kb]], p.cones.dim[boundary[kb]]
-        B, row = f.block + o * p.s, f.block_row[kb]
-        for a in range(d - 1, -1, -1):
-            value = w[row + a]
-            for b in range(a + 1, d):
-                value -= B[b + a * d] * w[row + b]
-            w[row + a] = value / B[a + a * d]
+        backward_substitution(f.block + o * p.s, <int>d, <int>d, w + f.block_row[kb])
     for r in range(f.dense, f.diag_end):
         w[r] *= f.inv_root[r]
     if f.dense > 0:

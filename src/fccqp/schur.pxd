@@ -21,6 +21,7 @@ cdef struct Schur:
     double* Wnu          # m x s scratch (unit columns)
     double* M            # s x s scratch (convexity test)
 
+cdef void mark_coupled(const double* P, Py_ssize_t n, char* coupled) noexcept nogil
 cdef bint schur_factor(Schur* f, const Problem* p, const double* rho_vec) noexcept nogil
 cdef bint schur_certifies_convexity(Schur* f, const Problem* p, const double* rho_vec,
                                     double sigma) noexcept nogil

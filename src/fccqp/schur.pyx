@@ -52,19 +52,25 @@ def ordering(n, constrained):
     return np.concatenate((np.flatnonzero(free), constrained)).astype(np.intp)
 
 
+cdef void mark_coupled(const double* P, Py_ssize_t n, char* coupled) noexcept nogil:
+    """``coupled[i]`` = 1 where row ``i`` of ``P`` has an entry off its diagonal, else 0."""
+    cdef Py_ssize_t i, j
+    for i in range(n):
+        coupled[i] = 0
+        for j in range(n):
+            if j != i and P[i * n + j] != 0.0:
+                coupled[i] = 1
+                break
+
+
 cdef void _order(Schur* f, const Problem* p) noexcept nogil:
     """Put the free entries whose row of ``P`` is diagonal after the other free ones and
     set ``dense``: the rows before the diagonal tail, ``n`` when some constrained entry is
     coupled (then ``order`` keeps the base order's free entries and nothing is diagonal).
     ``order`` is rebuilt from ``base_order``, so it depends only on this ``P``."""
-    cdef Py_ssize_t n = p.n, s = p.s, first = n - s, i, j, k, lead = 0
+    cdef Py_ssize_t n = p.n, s = p.s, first = n - s, i, k, lead = 0
     cdef char* coupled = f.coupled
-    for i in range(n):
-        coupled[i] = 0
-        for j in range(n):
-            if j != i and p.P[i * n + j] != 0.0:
-                coupled[i] = 1
-                break
+    mark_coupled(p.P, n, coupled)
     for k in range(s):
         if coupled[p.constrained[k]]:
             for i in range(n):
