@@ -170,3 +170,47 @@ def test_rounding_asymmetry_is_accepted():
 
 def test_time_limit_infinity_is_default():
     assert fccqp.Settings().time_limit == np.inf
+
+
+@pytest.mark.parametrize("n", [1, 3, 4, 5, 9])
+def test_the_compiled_scan_sees_every_entry(n):
+    """The workspace's scan of ``P`` and ``A`` (fccqp_kernels.h: four entries a step,
+    then a remainder) finds a bad entry wherever it sits, and a change of any one pair
+    of ``P`` or entry of ``A`` makes the solve use the new matrices."""
+    rng = np.random.default_rng(n)
+    M = rng.standard_normal((n, n))
+    P0, q0 = M @ M.T + np.eye(n), rng.standard_normal(n)
+    A0, b0 = rng.standard_normal((1, n)), rng.standard_normal(1)
+    solver = fccqp.Solver(eps_abs=1e-9, eps_rel=1e-9)
+    solver.solve(P0, q0, A0, b0)
+
+    def solved(Pk, Ak):
+        reference = fccqp.solve(Pk, q0, Ak, b0, eps_abs=1e-9, eps_rel=1e-9).x
+        np.testing.assert_allclose(solver.solve(Pk, q0, Ak, b0).x, reference, atol=1e-7)
+
+    for i in range(n):
+        for j in range(n):
+            for value, message in [(np.nan, "P contains NaN or inf"),
+                                   (np.inf, "P contains NaN or inf"),
+                                   (1e21, "P has an entry of magnitude 1e\\+21")]:
+                bad = P0.copy()
+                bad[i, j] = bad[j, i] = value
+                with pytest.raises(ValueError, match=message):
+                    solver.solve(bad, q0, A0, b0)
+            if j >= i:
+                changed = P0.copy()
+                changed[i, j] = changed[j, i] = P0[i, j] + 0.5 * (1 + (i == j))
+                solved(changed, A0)
+        for value in (np.nan, -np.inf):
+            bad = A0.copy()
+            bad[0, i] = value
+            with pytest.raises(ValueError, match="A contains NaN or inf"):
+                solver.solve(P0, q0, bad, b0)
+        changed = A0.copy()
+        changed[0, i] += 1.0
+        solved(P0, changed)
+    asymmetric = P0.copy()
+    asymmetric[n - 1, 0] += 1e-3
+    if n > 1:
+        with pytest.raises(ValueError, match="P must be symmetric"):
+            solver.solve(asymmetric, q0, A0, b0)

@@ -22,6 +22,11 @@ from libc.math cimport exp, fabs, log, sqrt
 from fccqp._types cimport Cones
 from fccqp.projections cimport proj_set
 
+cdef extern from "fccqp_kernels.h" nogil:
+    void fccqp_scale_rows(const double* M, int rows, int cols, const double* left,
+                          const double* right, double* out, double* row_max,
+                          double* column_max)
+
 MIN_NORM = 1e-8
 """Column norms below this are treated as 1 (a column of zeros is left alone). OSQP
 uses 1e-4; that left an equality row of size 1e-7 unscaled, and ADMM then did not
@@ -194,31 +199,22 @@ cdef bint rescale(const double* P, const double* q, const double* A, const doubl
     (8x between two solo12 ticks), so ``c`` is found anew. On go2 the four Ruiz passes
     are 0.22M of a 1.76M-instruction tick (callgrind).
     """
-    cdef Py_ssize_t i, j
-    cdef double di, value, row, mean_col = 0.0, q_norm = 0.0
-    for i in range(n):   # D P D's rows (its columns: it is symmetric) and the cost's size
-        di = D[i]
-        row = 0.0
-        for j in range(n):
-            row = max(row, fabs(P[i * n + j]) * D[j])
-        norms[i] = row * di
+    cdef Py_ssize_t i
+    cdef double mean_col = 0.0, q_norm = 0.0
+    # D P D and its rows' norms (its columns': it is symmetric), then the cost's size
+    fccqp_scale_rows(P, <int>n, <int>n, D, D, P_s, norms, NULL)
+    for i in range(n):
         mean_col += norms[i]
-        q_s[i] = q[i] * di
+        q_s[i] = q[i] * D[i]
         q_norm = max(q_norm, fabs(q_s[i]))
     c[0] = _cost_scale(mean_col / n, q_norm)
+    for i in range(n * n):
+        P_s[i] *= c[0]
     for i in range(n):
-        di = c[0] * D[i]
-        for j in range(n):
-            P_s[i * n + j] = P[i * n + j] * di * D[j]
         q_s[i] *= c[0]
+    if m:   # E A D, its rows' norms and its columns' beside D P D's
+        fccqp_scale_rows(A, <int>m, <int>n, E, D, A_s, norms + n, norms)
     for i in range(m):
-        row = 0.0
-        for j in range(n):
-            value = A[i * n + j] * E[i] * D[j]
-            A_s[i * n + j] = value
-            norms[j] = max(norms[j], fabs(value))
-            row = max(row, fabs(value))
-        norms[n + i] = row
         b_s[i] = b[i] * E[i]
     for i in range(n + m):
         if not (norms[i] <= _RESCALE_DRIFT * reference[i]

@@ -57,6 +57,10 @@ from libc.math cimport INFINITY, fabs, isfinite
 from fccqp._dense cimport matvec, matvec_t
 from fccqp._types cimport Iterates, Problem
 
+cdef extern from "fccqp_kernels.h" nogil:
+    void fccqp_row_spans(const double* A, int rows, int cols, const double* width,
+                         double* span)
+
 GAP_TERMS_CAP = 10.0
 """The multiplier terms widen the gap's scale to at most this multiple of
 ``max(|x'Px|, |q'x|)`` (see the module docstring)."""
@@ -65,20 +69,15 @@ cdef double _GAP_TERMS_CAP = GAP_TERMS_CAP
 
 cdef void row_spans(Problem* p, double* width) noexcept nogil:
     """``span``: for each row ``i``, ``sum_j |A_ij| (hi_j - lo_j)``, the range of ``(A x)_i``
-    over the box (infinite where the row meets an entry without two finite bounds);
-    ``width`` (n) is scratch."""
-    cdef Py_ssize_t n = p.n, i, j
-    cdef double a
+    over the box (infinite where the row meets an entry without two finite bounds), by
+    ``fccqp_row_spans`` (fccqp_kernels.h); ``width`` (n) is scratch."""
+    cdef Py_ssize_t n = p.n, j
     for j in range(n):
         width[j] = INFINITY
     for j in range(p.s):
         width[p.constrained[j]] = p.hi[j] - p.lo[j]
-    for i in range(p.m):
-        p.span[i] = 0.0
-        for j in range(n):
-            a = p.A[i * n + j]
-            if a != 0.0:
-                p.span[i] += fabs(a) * width[j]
+    if p.m:
+        fccqp_row_spans(p.A, <int>p.m, <int>n, width, p.span)
 
 
 cdef inline double _capped(double size, double span) noexcept nogil:

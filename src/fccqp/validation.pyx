@@ -13,6 +13,10 @@ The shape and type half lives in :mod:`fccqp.problem`.
 
 from libc.math cimport INFINITY, fabs, isfinite, isnan
 
+cdef extern from "fccqp_kernels.h" nogil:
+    void fccqp_symmetric_copy(const double* P, int n, double* out, double* found)
+    void fccqp_checked_copy(const double* v, long k, double* out, double* found)
+
 SYMMETRY_TOLERANCE = 1e-10
 """Relative asymmetry of ``P`` above which it is rejected rather than symmetrized."""
 MAX_ENTRY = 1e20
@@ -63,41 +67,25 @@ cdef Finding scan_and_copy(const double* P, const double* q, const double* A, co
     """Check and copy; ``same_matrices`` becomes False as soon as ``P`` or ``A`` differs
     from what ``P_out``, ``A_out`` held.
 
-    ``P`` is read a pair ``(i, j), (j, i)`` at a time (the upper triangle), ``A`` in one
-    pass that does not branch on the data; what went wrong is looked up only when
-    something did. The pass over ``A`` then vectorizes: on talos (``n, m`` = 124, 68) the
-    scan went from 0.48M to 0.42M instructions per solve (callgrind); the strided half of
-    the pairs keeps the loop over ``P`` scalar.
+    ``P`` goes through ``fccqp_symmetric_copy`` (four pairs ``(i, j), (j, i)`` of the
+    upper triangle a step) and ``A`` through ``fccqp_checked_copy`` (fccqp_kernels.h),
+    passes that do not branch on the data; what went wrong is looked up only when
+    something did.
     """
-    cdef Py_ssize_t i, j
-    cdef double v, t, value, scale = 0.0, asymmetry = 0.0
-    cdef bint same = same_matrices[0], bad = False, differs = False
+    cdef Py_ssize_t i
+    cdef double found[4]   # largest entry, asymmetry, NaN if not finite, changes
+    cdef bint same = same_matrices[0], bad, differs
     cdef Finding f
-    for i in range(n):
-        v = P[i * n + i]
-        bad |= not isfinite(v)
-        scale = max(scale, fabs(v))
-        differs |= P_out[i * n + i] != v
-        P_out[i * n + i] = v
-        for j in range(i + 1, n):
-            v, t = P[i * n + j], P[j * n + i]
-            bad |= not isfinite(v - t)   # NaN or infinite where either is
-            scale = max(scale, max(fabs(v), fabs(t)))
-            asymmetry = max(asymmetry, fabs(v - t))
-            value = 0.5 * (v + t)
-            differs |= (P_out[i * n + j] != value) | (P_out[j * n + i] != value)
-            P_out[i * n + j] = value
-            P_out[j * n + i] = value
-    if bad or scale > _MAX_ENTRY:
+    fccqp_symmetric_copy(P, <int>n, P_out, found)
+    bad = not (found[2] == 0.0)
+    differs = not (found[3] == 0.0)
+    if bad or found[0] > _MAX_ENTRY:
         return _first_bad_entry(P, n)
-    if asymmetry > _SYMMETRY_TOLERANCE * scale:
-        return _found(P_ASYMMETRIC, -1, -1, asymmetry)
-    for i in range(m * n):
-        v = A[i]
-        bad |= not (fabs(v) <= _MAX_ENTRY)   # NaN, infinite or too large
-        differs |= A_out[i] != v
-        A_out[i] = v
-    if bad:
+    if found[1] > _SYMMETRY_TOLERANCE * found[0]:
+        return _found(P_ASYMMETRIC, -1, -1, found[1])
+    fccqp_checked_copy(A, m * n, A_out, found)
+    differs |= not (found[3] == 0.0)
+    if not (found[2] == 0.0) or found[0] > _MAX_ENTRY:
         for i in range(m * n):
             if not isfinite(A[i]):
                 return _found(NOT_FINITE, 1, i // n, A[i])
