@@ -22,7 +22,8 @@
  * pass, a loop over contiguous entries that vectorizes without reassociating a sum.
  * 2.1k instructions a call against dgemv's 2.8k on go2's A' y and P y (callgrind); M x
  * stays with dgemv, whose dot-product kernel took 3.2k against 3.7k for a loop in four
- * explicit lanes. fccqp_cholesky also factors polish_schur's d x d cone blocks. *
+ * explicit lanes. fccqp_cholesky also factors polish_schur's d x d cone blocks.
+ *
  * fccqp_symmetric_copy, fccqp_checked_copy, fccqp_scale_rows and fccqp_row_spans: the
  * per-solve passes over P and A of the validation scan, the rescaling and the rows'
  * spans. They keep running maxima or skip zeros, which GCC does not vectorize (a float
