@@ -29,8 +29,10 @@
  * spans. They keep running maxima or skip zeros, which GCC does not vectorize (a float
  * max is not associative once NaN is allowed, not without -ffast-math), so they are
  * written in four lanes (fccqp_v4). Per go2 solve (callgrind, 200 ticks of
- * Settings.realtime(inf)): the scan went from 82k to 27k instructions, the rescaling
- * from 62k to 31k and the spans from 14k to 6k.
+ * Settings.realtime(inf)): the scan went from 82k to 42k instructions and the rescaling
+ * from 62k to 48k; in wall time (one process each, passes alternated, Zen) the
+ * rescaling and spans from 11.5 to 5.7 us; the scan, which is the first read of the
+ * caller's arrays, stayed at 10-11 us.
  */
 #ifndef FCCQP_KERNELS_H
 #define FCCQP_KERNELS_H
@@ -38,85 +40,169 @@
 #include <math.h>
 #include <string.h>
 
-/* ifuncs need glibc (math.h above defines __GLIBC__ there); musl gets one copy */
-#if defined(__x86_64__) && defined(__GLIBC__) && (defined(__GNUC__) || defined(__clang__))
-#define FCCQP_CLONES __attribute__((target_clones("arch=haswell", "default")))
+/* ifuncs need glibc (math.h above defines __GLIBC__ there); musl gets one copy. The AVX2
+ * copy is picked by the CPU's features: x86-64-v3 (AVX2, FMA) where GCC 12+ dispatches on
+ * it, AVX2 alone otherwise. Not "arch=haswell", which GCC dispatches on the CPU model:
+ * every other CPU (Zen, Skylake and later) ran the baseline copy, and callgrind, which
+ * reports a Haswell, measured the other one. */
+#if defined(__x86_64__) && defined(__GLIBC__) && defined(__GNUC__) && !defined(__clang__) \
+    && __GNUC__ >= 12
+#define FCCQP_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
+#elif defined(__x86_64__) && defined(__GLIBC__) && (defined(__GNUC__) || defined(__clang__))
+#define FCCQP_CLONES __attribute__((target_clones("avx2", "default")))
 #else
 #define FCCQP_CLONES
 #endif
 
 #define FCCQP_LU_PANEL 4
 
-/* Four lanes of doubles: GCC / clang vector extensions, one AVX2 register in the haswell
- * clone and two SSE2 registers in the baseline; elsewhere a struct the helpers loop over.
- * fccqp_max4(acc, x) skips a NaN x (the passes detect NaN by a sum instead). */
+/* Four lanes of doubles for the per-solve passes (fccqp_symmetric_copy and the three
+ * after it). With GCC / clang two vectors of two (vector extensions): the width SSE2 and
+ * NEON have, so that the baseline build needs no clone; four lanes in one 32-byte vector
+ * were 30 % faster in an AVX2 clone but 4x slower in the baseline, where GCC lowers
+ * their comparisons to scalars. Elsewhere a struct the helpers loop over. The running
+ * maxima use maxpd where there is SSE2 (one instruction; a compare and a blend else), and
+ * fccqp_max4(acc, x) skips a NaN x: the passes flag NaN with a comparison instead. Flags
+ * are lane masks, or-ed and read once at the end. */
 #if defined(__GNUC__) || defined(__clang__)
-#if !defined(__clang__)   /* the helpers are inlined: no vector crosses a call */
-#pragma GCC diagnostic ignored "-Wpsabi"
-#endif
-typedef double fccqp_v4 __attribute__((vector_size(32)));
-typedef long long fccqp_mask4 __attribute__((vector_size(32)));
-#define FCCQP_LANE(v, k) ((v)[k])
-static inline fccqp_v4 fccqp_splat4(double x) { return (fccqp_v4){x, x, x, x}; }
-static inline fccqp_v4 fccqp_set4(double a, double b, double c, double d)
+/* forced: inside a large caller GCC stopped inlining them (3x the instructions) */
+#define FCCQP_LANE_OP static inline __attribute__((always_inline))
+typedef double fccqp_v2 __attribute__((vector_size(16)));
+typedef long long fccqp_m2 __attribute__((vector_size(16)));
+typedef struct { fccqp_v2 lo, hi; } fccqp_v4;
+typedef struct { fccqp_m2 lo, hi; } fccqp_flags4;
+#define FCCQP_LANE(v, k) ((k) < 2 ? (v).lo[(k) & 1] : (v).hi[(k) & 1])
+#if defined(__SSE2__)
+#include <emmintrin.h>
+FCCQP_LANE_OP fccqp_v2 fccqp_max2(fccqp_v2 acc, fccqp_v2 x)
 {
-    return (fccqp_v4){a, b, c, d};
-}
-static inline fccqp_v4 fccqp_add4(fccqp_v4 a, fccqp_v4 b) { return a + b; }
-static inline fccqp_v4 fccqp_sub4(fccqp_v4 a, fccqp_v4 b) { return a - b; }
-static inline fccqp_v4 fccqp_mul4(fccqp_v4 a, fccqp_v4 b) { return a * b; }
-static inline fccqp_v4 fccqp_abs4(fccqp_v4 a)
-{
-    return (fccqp_v4)((fccqp_mask4)a & (fccqp_mask4){0x7fffffffffffffffLL, 0x7fffffffffffffffLL,
-                                                     0x7fffffffffffffffLL, 0x7fffffffffffffffLL});
-}
-static inline fccqp_v4 fccqp_max4(fccqp_v4 acc, fccqp_v4 x)
-{
-    fccqp_mask4 larger = x > acc;
-    return (fccqp_v4)(((fccqp_mask4)x & larger) | ((fccqp_mask4)acc & ~larger));
-}
-static inline fccqp_v4 fccqp_where_nonzero4(fccqp_v4 a, fccqp_v4 x)   /* a != 0 ? x : 0 */
-{
-    return (fccqp_v4)((fccqp_mask4)x & (a != (fccqp_v4){0.0, 0.0, 0.0, 0.0}));
+    return (fccqp_v2)_mm_max_pd((__m128d)x, (__m128d)acc);   /* x > acc ? x : acc */
 }
 #else
+FCCQP_LANE_OP fccqp_v2 fccqp_max2(fccqp_v2 acc, fccqp_v2 x)
+{
+    fccqp_m2 larger = x > acc;
+    return (fccqp_v2)(((fccqp_m2)x & larger) | ((fccqp_m2)acc & ~larger));
+}
+#endif
+FCCQP_LANE_OP fccqp_v2 fccqp_abs2(fccqp_v2 a)
+{
+    return (fccqp_v2)((fccqp_m2)a & (fccqp_m2){0x7fffffffffffffffLL, 0x7fffffffffffffffLL});
+}
+FCCQP_LANE_OP fccqp_v4 fccqp_load4(const double *p)
+{
+    fccqp_v4 v;
+    memcpy(&v.lo, p, sizeof v.lo);
+    memcpy(&v.hi, p + 2, sizeof v.hi);
+    return v;
+}
+FCCQP_LANE_OP void fccqp_store4(double *p, fccqp_v4 v)
+{
+    memcpy(p, &v.lo, sizeof v.lo);
+    memcpy(p + 2, &v.hi, sizeof v.hi);
+}
+FCCQP_LANE_OP fccqp_v4 fccqp_splat4(double x)
+{
+    fccqp_v4 r = {{x, x}, {x, x}};
+    return r;
+}
+FCCQP_LANE_OP fccqp_v4 fccqp_set4(double a, double b, double c, double d)
+{
+    fccqp_v4 r = {{a, b}, {c, d}};
+    return r;
+}
+#define FCCQP_HALVES(lo_value, hi_value) \
+    fccqp_v4 r = {lo_value, hi_value};   \
+    return r;
+FCCQP_LANE_OP fccqp_v4 fccqp_add4(fccqp_v4 a, fccqp_v4 b) { FCCQP_HALVES(a.lo + b.lo, a.hi + b.hi) }
+FCCQP_LANE_OP fccqp_v4 fccqp_sub4(fccqp_v4 a, fccqp_v4 b) { FCCQP_HALVES(a.lo - b.lo, a.hi - b.hi) }
+FCCQP_LANE_OP fccqp_v4 fccqp_mul4(fccqp_v4 a, fccqp_v4 b) { FCCQP_HALVES(a.lo * b.lo, a.hi * b.hi) }
+FCCQP_LANE_OP fccqp_v4 fccqp_abs4(fccqp_v4 a) { FCCQP_HALVES(fccqp_abs2(a.lo), fccqp_abs2(a.hi)) }
+FCCQP_LANE_OP fccqp_v4 fccqp_max4(fccqp_v4 acc, fccqp_v4 x)
+{
+    FCCQP_HALVES(fccqp_max2(acc.lo, x.lo), fccqp_max2(acc.hi, x.hi))
+}
+FCCQP_LANE_OP fccqp_v4 fccqp_where_nonzero4(fccqp_v4 a, fccqp_v4 x)   /* a != 0 ? x : 0 */
+{
+    fccqp_v2 zero = {0.0, 0.0};
+    FCCQP_HALVES((fccqp_v2)((fccqp_m2)x.lo & (a.lo != zero)),
+                 (fccqp_v2)((fccqp_m2)x.hi & (a.hi != zero)))
+}
+FCCQP_LANE_OP fccqp_flags4 fccqp_no_flags4(void)
+{
+    fccqp_flags4 f = {{0, 0}, {0, 0}};
+    return f;
+}
+FCCQP_LANE_OP fccqp_flags4 fccqp_flag_unequal4(fccqp_flags4 f, fccqp_v4 a, fccqp_v4 b)
+{
+    f.lo |= a.lo != b.lo;
+    f.hi |= a.hi != b.hi;
+    return f;
+}
+FCCQP_LANE_OP fccqp_flags4 fccqp_flag_beyond4(fccqp_flags4 f, fccqp_v4 a, double limit)
+{   /* flags a lane where not a <= limit: beyond it, or NaN */
+    fccqp_v2 l = {limit, limit};
+    f.lo |= ~(a.lo <= l);
+    f.hi |= ~(a.hi <= l);
+    return f;
+}
+FCCQP_LANE_OP int fccqp_any4(fccqp_flags4 f)
+{
+    fccqp_m2 both = f.lo | f.hi;
+    return (both[0] | both[1]) != 0;
+}
+#else
+#define FCCQP_LANE_OP static inline
 typedef struct { double lane[4]; } fccqp_v4;
+typedef struct { int lane[4]; } fccqp_flags4;
 #define FCCQP_LANE(v, k) ((v).lane[k])
-#define FCCQP_LANEWISE(expression) \
-    fccqp_v4 r; for (int k = 0; k < 4; k++) r.lane[k] = (expression); return r;
-static inline fccqp_v4 fccqp_splat4(double x) { FCCQP_LANEWISE(x) }
-static inline fccqp_v4 fccqp_set4(double a, double b, double c, double d)
+#define FCCQP_LANEWISE(type, expression) \
+    type r; for (int k = 0; k < 4; k++) r.lane[k] = (expression); return r;
+FCCQP_LANE_OP fccqp_v4 fccqp_load4(const double *p) { FCCQP_LANEWISE(fccqp_v4, p[k]) }
+FCCQP_LANE_OP void fccqp_store4(double *p, fccqp_v4 v)
+{
+    for (int k = 0; k < 4; k++)
+        p[k] = v.lane[k];
+}
+FCCQP_LANE_OP fccqp_v4 fccqp_splat4(double x) { FCCQP_LANEWISE(fccqp_v4, x) }
+FCCQP_LANE_OP fccqp_v4 fccqp_set4(double a, double b, double c, double d)
 {
     fccqp_v4 r = {{a, b, c, d}};
     return r;
 }
-static inline fccqp_v4 fccqp_add4(fccqp_v4 a, fccqp_v4 b) { FCCQP_LANEWISE(a.lane[k] + b.lane[k]) }
-static inline fccqp_v4 fccqp_sub4(fccqp_v4 a, fccqp_v4 b) { FCCQP_LANEWISE(a.lane[k] - b.lane[k]) }
-static inline fccqp_v4 fccqp_mul4(fccqp_v4 a, fccqp_v4 b) { FCCQP_LANEWISE(a.lane[k] * b.lane[k]) }
-static inline fccqp_v4 fccqp_abs4(fccqp_v4 a) { FCCQP_LANEWISE(fabs(a.lane[k])) }
-static inline fccqp_v4 fccqp_max4(fccqp_v4 acc, fccqp_v4 x)
+FCCQP_LANE_OP fccqp_v4 fccqp_add4(fccqp_v4 a, fccqp_v4 b) { FCCQP_LANEWISE(fccqp_v4, a.lane[k] + b.lane[k]) }
+FCCQP_LANE_OP fccqp_v4 fccqp_sub4(fccqp_v4 a, fccqp_v4 b) { FCCQP_LANEWISE(fccqp_v4, a.lane[k] - b.lane[k]) }
+FCCQP_LANE_OP fccqp_v4 fccqp_mul4(fccqp_v4 a, fccqp_v4 b) { FCCQP_LANEWISE(fccqp_v4, a.lane[k] * b.lane[k]) }
+FCCQP_LANE_OP fccqp_v4 fccqp_abs4(fccqp_v4 a) { FCCQP_LANEWISE(fccqp_v4, fabs(a.lane[k])) }
+FCCQP_LANE_OP fccqp_v4 fccqp_max4(fccqp_v4 acc, fccqp_v4 x)
 {
-    FCCQP_LANEWISE(x.lane[k] > acc.lane[k] ? x.lane[k] : acc.lane[k])
+    FCCQP_LANEWISE(fccqp_v4, x.lane[k] > acc.lane[k] ? x.lane[k] : acc.lane[k])
 }
-static inline fccqp_v4 fccqp_where_nonzero4(fccqp_v4 a, fccqp_v4 x)
+FCCQP_LANE_OP fccqp_v4 fccqp_where_nonzero4(fccqp_v4 a, fccqp_v4 x)
 {
-    FCCQP_LANEWISE(a.lane[k] != 0.0 ? x.lane[k] : 0.0)
+    FCCQP_LANEWISE(fccqp_v4, a.lane[k] != 0.0 ? x.lane[k] : 0.0)
+}
+FCCQP_LANE_OP fccqp_flags4 fccqp_no_flags4(void) { FCCQP_LANEWISE(fccqp_flags4, 0) }
+FCCQP_LANE_OP fccqp_flags4 fccqp_flag_unequal4(fccqp_flags4 f, fccqp_v4 a, fccqp_v4 b)
+{
+    FCCQP_LANEWISE(fccqp_flags4, f.lane[k] | (a.lane[k] != b.lane[k]))
+}
+FCCQP_LANE_OP fccqp_flags4 fccqp_flag_beyond4(fccqp_flags4 f, fccqp_v4 a, double limit)
+{
+    FCCQP_LANEWISE(fccqp_flags4, f.lane[k] | !(a.lane[k] <= limit))
+}
+FCCQP_LANE_OP int fccqp_any4(fccqp_flags4 f)
+{
+    return (f.lane[0] | f.lane[1] | f.lane[2] | f.lane[3]) != 0;
 }
 #endif
-static inline fccqp_v4 fccqp_load4(const double *p)
-{
-    fccqp_v4 v;
-    memcpy(&v, p, sizeof v);
-    return v;
-}
-static inline void fccqp_store4(double *p, fccqp_v4 v) { memcpy(p, &v, sizeof v); }
-static inline double fccqp_largest4(fccqp_v4 v, double x)   /* max(x, lanes of v) */
+FCCQP_LANE_OP double fccqp_largest4(fccqp_v4 v, double x)   /* max(x, lanes of v) */
 {
     for (int k = 0; k < 4; k++)
         x = FCCQP_LANE(v, k) > x ? FCCQP_LANE(v, k) : x;
     return x;
 }
-static inline double fccqp_sum4(fccqp_v4 v)
+FCCQP_LANE_OP double fccqp_sum4(fccqp_v4 v)
 {
     return (FCCQP_LANE(v, 0) + FCCQP_LANE(v, 1)) + (FCCQP_LANE(v, 2) + FCCQP_LANE(v, 3));
 }
@@ -260,26 +346,32 @@ static void fccqp_matvec_t(const double *restrict M, int ld, const double *restr
     }
 }
 
+/* What fccqp_symmetric_copy and fccqp_checked_copy found: bits of their result */
+#define FCCQP_NOT_FINITE 1   /* an entry NaN or infinite (symmetric copy), or beyond the limit */
+#define FCCQP_CHANGED 2      /* out did not hold the result already */
+
 /* out = (P + P') / 2 for a row-major n x n P, a pair (i, j), (j, i) at a time over the
- * upper triangle, four pairs to a step. found[0]: the largest |entry|; found[1]: the
- * largest |P_ij - P_ji|; found[2]: 0 when every pair is finite, else NaN (0 times each
- * pair's difference, summed: NaN once an entry is NaN or infinite); found[3]: 0 when out
- * already held the result, else not (the summed |changes|; out is symmetric on entry,
- * as this pass leaves it, so its upper triangle is compared). */
-FCCQP_CLONES
-static void fccqp_symmetric_copy(const double *restrict P, int n, double *restrict out,
-                                 double found[4])
+ * upper triangle, four pairs to a step; sizes[0] becomes the largest |entry| and
+ * sizes[1] the largest |P_ij - P_ji|. A pair is flagged FCCQP_NOT_FINITE when its
+ * difference is not finite (an entry NaN or infinite, or both beyond 1e308). out is
+ * symmetric on entry, as this pass leaves it, so FCCQP_CHANGED compares its upper
+ * triangle. */
+static int fccqp_symmetric_copy(const double *restrict P, int n, double *restrict out,
+                                double sizes[2])
 {
-    fccqp_v4 zero = fccqp_splat4(0.0), half = fccqp_splat4(0.5);
-    fccqp_v4 largest = zero, asymmetry = zero, poison = zero, changes = zero;
-    double largest_1 = 0.0, asymmetry_1 = 0.0, poison_1 = 0.0, changes_1 = 0.0;
+    fccqp_v4 half = fccqp_splat4(0.5), largest = fccqp_splat4(0.0), asymmetry = largest;
+    fccqp_flags4 not_finite = fccqp_no_flags4(), changed = not_finite;
+    double largest_1 = 0.0, asymmetry_1 = 0.0;
+    int found = 0;
     for (int i = 0; i < n; i++) {
         const double *row = P + (long)i * n;
         double *out_row = out + (long)i * n;
         double v = row[i];
+        if (!(fabs(v) <= 1.7976931348623157e308))
+            found |= FCCQP_NOT_FINITE;
         largest_1 = fabs(v) > largest_1 ? fabs(v) : largest_1;
-        poison_1 += 0.0 * v;
-        changes_1 += fabs(out_row[i] - v);
+        if (out_row[i] != v)
+            found |= FCCQP_CHANGED;
         out_row[i] = v;
         int j = i + 1;
         for (; j + 4 <= n; j += 4) {
@@ -287,13 +379,12 @@ static void fccqp_symmetric_copy(const double *restrict P, int n, double *restri
             fccqp_v4 upper = fccqp_load4(row + j);
             fccqp_v4 lower = fccqp_set4(column[0], column[n], column[2 * (long)n],
                                         column[3 * (long)n]);
-            fccqp_v4 difference = fccqp_sub4(upper, lower);
+            fccqp_v4 difference = fccqp_abs4(fccqp_sub4(upper, lower));
             fccqp_v4 value = fccqp_mul4(half, fccqp_add4(upper, lower));
-            poison = fccqp_add4(poison, fccqp_mul4(zero, difference));
+            not_finite = fccqp_flag_beyond4(not_finite, difference, 1.7976931348623157e308);
             largest = fccqp_max4(fccqp_max4(largest, fccqp_abs4(upper)), fccqp_abs4(lower));
-            asymmetry = fccqp_max4(asymmetry, fccqp_abs4(difference));
-            changes = fccqp_add4(changes, fccqp_abs4(fccqp_sub4(fccqp_load4(out_row + j),
-                                                                value)));
+            asymmetry = fccqp_max4(asymmetry, difference);
+            changed = fccqp_flag_unequal4(changed, fccqp_load4(out_row + j), value);
             fccqp_store4(out_row + j, value);
             double *mirror = out + (long)j * n + i;
             mirror[0] = FCCQP_LANE(value, 0);
@@ -303,25 +394,52 @@ static void fccqp_symmetric_copy(const double *restrict P, int n, double *restri
         }
         for (; j < n; j++) {
             double u = row[j], l = P[(long)j * n + i], value = 0.5 * (u + l);
+            double difference = fabs(u - l);
+            if (!(difference <= 1.7976931348623157e308))
+                found |= FCCQP_NOT_FINITE;
             largest_1 = fabs(u) > largest_1 ? fabs(u) : largest_1;
             largest_1 = fabs(l) > largest_1 ? fabs(l) : largest_1;
-            asymmetry_1 = fabs(u - l) > asymmetry_1 ? fabs(u - l) : asymmetry_1;
-            poison_1 += 0.0 * (u - l);
-            changes_1 += fabs(out_row[j] - value);
+            asymmetry_1 = difference > asymmetry_1 ? difference : asymmetry_1;
+            if (out_row[j] != value)
+                found |= FCCQP_CHANGED;
             out_row[j] = value;
             out[(long)j * n + i] = value;
         }
     }
-    found[0] = fccqp_largest4(largest, largest_1);
-    found[1] = fccqp_largest4(asymmetry, asymmetry_1);
-    found[2] = fccqp_sum4(poison) + poison_1;
-    found[3] = fccqp_sum4(changes) + changes_1;
+    sizes[0] = fccqp_largest4(largest, largest_1);
+    sizes[1] = fccqp_largest4(asymmetry, asymmetry_1);
+    return found | (fccqp_any4(not_finite) ? FCCQP_NOT_FINITE : 0)
+           | (fccqp_any4(changed) ? FCCQP_CHANGED : 0);
+}
+
+/* out = v for k entries; FCCQP_NOT_FINITE where an entry is not within [-limit, limit]
+ * (NaN, infinite or too large), FCCQP_CHANGED where out did not hold v */
+static int fccqp_checked_copy(const double *restrict v, long k, double limit,
+                              double *restrict out)
+{
+    fccqp_flags4 beyond = fccqp_no_flags4(), changed = beyond;
+    int found = 0;
+    long i = 0;
+    for (; i + 4 <= k; i += 4) {
+        fccqp_v4 value = fccqp_load4(v + i);
+        beyond = fccqp_flag_beyond4(beyond, fccqp_abs4(value), limit);
+        changed = fccqp_flag_unequal4(changed, fccqp_load4(out + i), value);
+        fccqp_store4(out + i, value);
+    }
+    for (; i < k; i++) {
+        if (!(fabs(v[i]) <= limit))
+            found |= FCCQP_NOT_FINITE;
+        if (out[i] != v[i])
+            found |= FCCQP_CHANGED;
+        out[i] = v[i];
+    }
+    return found | (fccqp_any4(beyond) ? FCCQP_NOT_FINITE : 0)
+           | (fccqp_any4(changed) ? FCCQP_CHANGED : 0);
 }
 
 /* out = diag(left) M diag(right) for a row-major rows x cols M (out aliases nothing);
  * row_max[i] = max_j |out_ij|, and where column_max is not NULL column_max[j] becomes
  * max(column_max[j], max_i |out_ij|). M, left and right are finite. */
-FCCQP_CLONES
 static void fccqp_scale_rows(const double *restrict M, int rows, int cols,
                              const double *restrict left, const double *restrict right,
                              double *restrict out, double *restrict row_max,
@@ -353,37 +471,8 @@ static void fccqp_scale_rows(const double *restrict M, int rows, int cols,
     }
 }
 
-/* out = v for k entries; found as fccqp_symmetric_copy leaves it: the largest |entry|,
- * found[1] = 0, found[2] NaN unless every entry is finite, found[3] 0 when out held v */
-FCCQP_CLONES
-static void fccqp_checked_copy(const double *restrict v, long k, double *restrict out,
-                               double found[4])
-{
-    fccqp_v4 zero = fccqp_splat4(0.0), largest = zero, poison = zero, changes = zero;
-    double largest_1 = 0.0, poison_1 = 0.0, changes_1 = 0.0;
-    long i = 0;
-    for (; i + 4 <= k; i += 4) {
-        fccqp_v4 value = fccqp_load4(v + i);
-        largest = fccqp_max4(largest, fccqp_abs4(value));
-        poison = fccqp_add4(poison, fccqp_mul4(zero, value));
-        changes = fccqp_add4(changes, fccqp_abs4(fccqp_sub4(fccqp_load4(out + i), value)));
-        fccqp_store4(out + i, value);
-    }
-    for (; i < k; i++) {
-        largest_1 = fabs(v[i]) > largest_1 ? fabs(v[i]) : largest_1;
-        poison_1 += 0.0 * v[i];
-        changes_1 += fabs(out[i] - v[i]);
-        out[i] = v[i];
-    }
-    found[0] = fccqp_largest4(largest, largest_1);
-    found[1] = 0.0;
-    found[2] = fccqp_sum4(poison) + poison_1;
-    found[3] = fccqp_sum4(changes) + changes_1;
-}
-
 /* span[i] = sum_j |A_ij| width_j over the entries with A_ij != 0 for a row-major rows x
  * cols A (a zero entry adds nothing even where the width is infinite) */
-FCCQP_CLONES
 static void fccqp_row_spans(const double *restrict A, int rows, int cols,
                             const double *restrict width, double *restrict span)
 {

@@ -14,8 +14,9 @@ The shape and type half lives in :mod:`fccqp.problem`.
 from libc.math cimport INFINITY, fabs, isfinite, isnan
 
 cdef extern from "fccqp_kernels.h" nogil:
-    void fccqp_symmetric_copy(const double* P, int n, double* out, double* found)
-    void fccqp_checked_copy(const double* v, long k, double* out, double* found)
+    int FCCQP_NOT_FINITE, FCCQP_CHANGED
+    int fccqp_symmetric_copy(const double* P, int n, double* out, double* sizes)
+    int fccqp_checked_copy(const double* v, long k, double limit, double* out)
 
 SYMMETRY_TOLERANCE = 1e-10
 """Relative asymmetry of ``P`` above which it is rejected rather than symmetrized."""
@@ -73,19 +74,18 @@ cdef Finding scan_and_copy(const double* P, const double* q, const double* A, co
     something did.
     """
     cdef Py_ssize_t i
-    cdef double found[4]   # largest entry, asymmetry, NaN if not finite, changes
-    cdef bint same = same_matrices[0], bad, differs
+    cdef double sizes[2]   # the largest entry and asymmetry of P
+    cdef bint same = same_matrices[0], differs
+    cdef int found = fccqp_symmetric_copy(P, <int>n, P_out, sizes)
     cdef Finding f
-    fccqp_symmetric_copy(P, <int>n, P_out, found)
-    bad = not (found[2] == 0.0)
-    differs = not (found[3] == 0.0)
-    if bad or found[0] > _MAX_ENTRY:
+    if found & FCCQP_NOT_FINITE or sizes[0] > _MAX_ENTRY:
         return _first_bad_entry(P, n)
-    if found[1] > _SYMMETRY_TOLERANCE * found[0]:
-        return _found(P_ASYMMETRIC, -1, -1, found[1])
-    fccqp_checked_copy(A, m * n, A_out, found)
-    differs |= not (found[3] == 0.0)
-    if not (found[2] == 0.0) or found[0] > _MAX_ENTRY:
+    if sizes[1] > _SYMMETRY_TOLERANCE * sizes[0]:
+        return _found(P_ASYMMETRIC, -1, -1, sizes[1])
+    differs = found & FCCQP_CHANGED
+    found = fccqp_checked_copy(A, m * n, _MAX_ENTRY, A_out)
+    differs |= found & FCCQP_CHANGED
+    if found & FCCQP_NOT_FINITE:   # NaN, infinite or too large
         for i in range(m * n):
             if not isfinite(A[i]):
                 return _found(NOT_FINITE, 1, i // n, A[i])
