@@ -345,6 +345,33 @@ def test_changing_friction_coefficients_leave_other_problems_alone():
             np.testing.assert_allclose(fccqp.solve(*problem).x, x, atol=1e-6)
 
 
+def test_cone_specs_rebuilt_every_tick_are_read_anew():
+    """A control loop passes a new tuple of equal specs each tick, which the solver
+    recognizes without flattening them again (fccqp.fast_checks.same_cones); a changed
+    coefficient or normal, a normal given as a numpy array and changed in place, and an
+    int where a float was must all be seen."""
+    P, q, A, b, lb, ub, _ = random_problem(1, n_cones=0)
+    tilted = (0.0, 0.6, 0.8)
+    normal = np.array([0.0, 0.0, 1.0])
+    ticks = [
+        (FrictionCone(6, 0.3), FrictionCone(9, 0.3)),
+        (FrictionCone(6, 0.3), FrictionCone(9, 0.3)),
+        (FrictionCone(6, 0.9), FrictionCone(9, 0.3)),
+        (FrictionCone(6, 0.9), FrictionCone(9, 0.3, tilted)),
+        (FrictionCone(6, 0.9, normal), FrictionCone(9, 0.3, tilted)),
+        (FrictionCone(6, 1), FrictionCone(9, 0.3, tilted)),
+        (FrictionCone(6, 1.0), SecondOrderCone(9, 3)),
+    ]
+    solver = fccqp.Solver()
+    for k, cones in enumerate(ticks[:5] + [None] + ticks[5:]):
+        if cones is None:   # the last tick's normal array, changed in place
+            normal[:] = tilted
+            cones = ticks[4]
+        expected = fccqp.solve(P, q, A, b, lb, ub, cones).x
+        np.testing.assert_allclose(solver.solve(P, q, A, b, lb, ub, cones).x, expected,
+                                   atol=1e-6, err_msg=f"tick {k}")
+
+
 def test_feasible_problem_with_dependent_rows_is_not_certified_infeasible():
     """A fuzz case: the dual step drifted along the null space of A' (duplicated rows)
     with b'dy at the size of what its residual explains, and passed for a certificate

@@ -4,8 +4,9 @@
 A controller calls :meth:`fccqp.Solver.solve` with the same kinds of arguments every
 tick: six contiguous float64 arrays of the workspace's sizes and a list of cone specs
 like the last one. :func:`dense_arguments` recognizes the arrays from their buffers
-without converting them, and :func:`cone_key` builds :func:`fccqp.cones.flatten_cones`'
-memo key; both decide what :func:`fccqp.problem.convert`'s fast path and the memo's key
+without converting them, :func:`cone_key` builds :func:`fccqp.cones.flatten_cones`'
+memo key and :func:`same_cones` tells when the specs are those of the last solve; they
+decide what :func:`fccqp.problem.convert`'s fast path and the memo's key
 function in Python did, without the interpreter's per-attribute work. After the compiled
 solve the interpreter runs from cold caches, and there the two Python versions took 6.7
 us and 8.0 us of a 150 us go2 tick (in flow, medians of interleaved rounds). Anything
@@ -89,3 +90,50 @@ def cone_key(tuple cones, Py_ssize_t n):
     for cone in cones:
         key.append(_one_key(cone))
     return tuple(key)
+
+
+cdef inline bint _same_number(object a, object b):
+    """Equal ints or equal floats (anything else, such as a numpy value that may change in
+    place, is not recognized)."""
+    return ((type(a) is float and type(b) is float) or (type(a) is int and type(b) is int)) \
+        and a == b
+
+
+cdef bint _same_normal(object a, object b):
+    if a is None or b is None:
+        return a is None and b is None
+    if type(a) is not tuple or type(b) is not tuple or len(<tuple>a) != len(<tuple>b):
+        return False
+    for u, v in zip(<tuple>a, <tuple>b):
+        if not _same_number(u, v):
+            return False
+    return True
+
+
+def same_cones(cones, previous):
+    """Whether the tuple ``cones`` holds specs of the same kinds and the same int and
+    float values as the tuple ``previous`` (the last solve's, already validated): then
+    its :func:`fccqp.cones.flatten_cones` is the last one, with no key to build and hash
+    (a control loop rebuilds equal specs every tick; 3-5 us of a go2 tick in flow).
+    False when unsure."""
+    global _FRICTION, _SECOND_ORDER
+    if type(cones) is not tuple or type(previous) is not tuple:
+        return False
+    if len(<tuple>cones) != len(<tuple>previous):
+        return False
+    if _FRICTION is None:
+        from fccqp.cones import FrictionCone, SecondOrderCone
+        _FRICTION, _SECOND_ORDER = FrictionCone, SecondOrderCone
+    for a, b in zip(<tuple>cones, <tuple>previous):
+        if type(a) is not type(b):
+            return False
+        if type(a) is _FRICTION:
+            if not (_same_number(a.start, b.start) and _same_number(a.mu, b.mu)
+                    and _same_normal(a.normal, b.normal)):
+                return False
+        elif type(a) is _SECOND_ORDER:
+            if not (_same_number(a.start, b.start) and _same_number(a.dim, b.dim)):
+                return False
+        else:
+            return False
+    return True

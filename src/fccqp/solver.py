@@ -19,7 +19,7 @@ import numpy as np
 
 from fccqp import admm, schur
 from fccqp.cones import Cone, ConeArrays, flatten_cones
-from fccqp.fast_checks import dense_arguments
+from fccqp.fast_checks import dense_arguments, same_cones
 from fccqp.problem import MAX_ENTRY, check_cone_bounds, convert, raise_finding
 from fccqp.result import Result
 from fccqp.settings import MAX_DENSE_KKT_ROWS, Settings
@@ -99,6 +99,7 @@ class Solver:
         self._structure: _Structure | None = None
         self._workspace: admm.Workspace | None = None
         self._sparse = None   # the sparse path's workspace, made on its first problem
+        self._cones: object = None   # the cones argument of the last dense solve
 
     def reset(self) -> None:
         """Forget the previous solve: the next one starts cold."""
@@ -167,7 +168,11 @@ class Solver:
                 return self._solve_sparse(P, q, A, b, lb, ub, cones, x0, start)
             P, q, A, b, lb, ub = convert(P, q, A, b, lb, ub)
             n, m = P.shape[0], A.shape[0]
-        flat = flatten_cones(cones, n)   # memoized: the same object for the same cones
+        if structure is not None and structure.n == n and same_cones(cones, self._cones):
+            flat = structure.cones   # the last solve's specs, rebuilt
+        else:
+            flat = flatten_cones(cones, n)   # memoized: the same object for the same cones
+        self._cones = cones
         guess = None if x0 is None else _initial_guess(x0, n)
         if w is None or (structure.n, structure.m) != (n, m) or not flat.same_blocks(
                 structure.cones):
