@@ -38,7 +38,7 @@ from fccqp.blas_threads cimport enter, leave
 from fccqp.anderson cimport Anderson, anderson_reset, anderson_step
 from fccqp.certificates cimport (CERTIFIED, SEPARATED, dual_infeasible, equality_direction,
                                  equality_inconsistent, primal_infeasible)
-from fccqp.fast_checks cimport hold_float64
+from fccqp.fast_checks cimport hold_dense, hold_float64
 from fccqp.kkt cimport (AUTO, FACTORED, KKT, LDL_FULL, LDL_REDUCED, NOT_CONVEX, SCHUR_REDUCED,
                         UNAVAILABLE, kkt_convexity, kkt_factor, kkt_solve)
 from fccqp.polish cimport Polish, guess_changes, multiplier_violation, polish, polish_prepare
@@ -84,6 +84,9 @@ STRUCTURE_CHANGED = -3
 """The bounds no longer have the structure the workspace was made for (another set of
 constrained or fixed entries, or a bound on a cone entry): the caller rescans them
 (:func:`fccqp.validation.structure_scan`) and makes a new workspace."""
+NOT_DENSE = -4
+"""An input array is not a C-contiguous float64 numpy array of the workspace's shape
+(:meth:`Workspace.solve` with ``checked=False``): the caller converts the arguments."""
 cdef enum:
     _CONE_ENTRY = 3   # beside fccqp.validation's bound_kind codes
 cdef enum:
@@ -477,13 +480,15 @@ cdef class Workspace:
         return [tuple(self.log[5 * i + j] for j in range(5)) for i in range(self.log_count)]
 
     def solve(self, P, q, A, b, lb, ub, x0, bint warm, double start_time, x_out, y_out,
-              z_out, cert_out):
+              z_out, cert_out, bint checked=True):
         """Validate, scale, run ADMM and unscale into ``x_out``, ``y_out``, ``z_out``.
 
         ``P, q, A, b, lb, ub`` are C-contiguous float64 arrays of the workspace's shapes
         (as :func:`fccqp.problem.convert` or :func:`fccqp.fast_checks.dense_arguments`
-        leave them); ``x0`` (None or a float64 vector) overrides the warm start;
-        ``warm`` asks for a start from the previous solution (when there is one).
+        leave them); with ``checked=False`` they are the caller's arguments as they came,
+        and the code is ``NOT_DENSE`` when one is not such an array. ``x0`` (None or a
+        float64 vector) overrides the warm start; ``warm`` asks for a start from the
+        previous solution (when there is one).
         ``cert_out`` (``m + n`` entries) receives an infeasibility certificate. Returns
         ``(code, iterations, rho, prim, dual, gap, objective, factorizations, setup_time,
         backend, polished)``; code ``BAD_DATA`` (see :attr:`finding`) and
@@ -503,7 +508,10 @@ cdef class Workspace:
         columns[:] = [n, -1, n, -1, -1, -1, -1, -1, -1, -1, -1]   # -1: a vector
         try:
             for i in range(count):   # the outputs, 6 to 9, are written
-                if not hold_float64(arrays[i], &views[i], rows[i], columns[i], 6 <= i <= 9):
+                if i < 6 and not checked:
+                    if not hold_dense(arrays[i], &views[i], rows[i], columns[i]):
+                        return (NOT_DENSE, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, "", False)
+                elif not hold_float64(arrays[i], &views[i], rows[i], columns[i], 6 <= i <= 9):
                     raise ValueError(f"expected a C-contiguous float64 array of {rows[i]} rows")
                 held += 1
             return self._run(<const double*>views[0].buf, <const double*>views[1].buf,

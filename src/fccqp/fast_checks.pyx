@@ -40,16 +40,21 @@ cdef bint hold_float64(object array, Py_buffer* view, Py_ssize_t rows, Py_ssize_
     return False
 
 
-cdef bint _is_dense(object value, Py_ssize_t rows, Py_ssize_t columns):
-    """Whether ``value`` is a numpy array (not a subclass, as :func:`fccqp.problem.convert`
-    passes through) that :func:`hold_float64` accepts."""
-    cdef Py_buffer view
+cdef bint hold_dense(object value, Py_buffer* view, Py_ssize_t rows, Py_ssize_t columns):
+    """Hold the buffer of ``value`` in ``view`` and return True when it is a numpy array
+    (not a subclass, as :func:`fccqp.problem.convert` passes through) that
+    :func:`hold_float64` accepts; False, holding nothing, otherwise."""
     if type(value) is not ndarray:
         return False
     try:
-        if not hold_float64(value, &view, rows, columns, False):
-            return False
+        return hold_float64(value, view, rows, columns, False)
     except (TypeError, ValueError, BufferError):   # no buffer, or not a contiguous one
+        return False
+
+
+cdef bint _is_dense(object value, Py_ssize_t rows, Py_ssize_t columns):
+    cdef Py_buffer view
+    if not hold_dense(value, &view, rows, columns):
         return False
     PyBuffer_Release(&view)
     return True

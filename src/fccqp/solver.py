@@ -160,18 +160,22 @@ class Solver:
         settings = self.settings
         w, structure = self._workspace, self._structure
         sparse = settings.kkt_backend == "sparse"
+        if w is not None and x0 is None and not sparse and same_cones(cones, self._cones):
+            # the control loop: the caller's arrays as they came, checked by the solve
+            x, y, z = np.empty(structure.n), np.empty(structure.m), np.empty(structure.n)
+            out = w.solve(P, q, A, b, lb, ub, None, settings.warm_start, start, x, y, z,
+                          structure.certificate, False)
+            if out[0] != admm.NOT_DENSE:
+                return self._result(out, P, q, A, b, lb, ub, None, start, x, y, z)
         if w is not None and not sparse and dense_arguments(P, q, A, b, lb, ub, structure.n,
                                                             structure.m):
-            n, m = structure.n, structure.m   # the control loop: the arrays fit as they are
+            n, m = structure.n, structure.m   # the arrays fit as they are
         else:
             if sparse or _rows(P) + _rows(A) > MAX_DENSE_KKT_ROWS:
                 return self._solve_sparse(P, q, A, b, lb, ub, cones, x0, start)
             P, q, A, b, lb, ub = convert(P, q, A, b, lb, ub)
             n, m = P.shape[0], A.shape[0]
-        if structure is not None and structure.n == n and same_cones(cones, self._cones):
-            flat = structure.cones   # the last solve's specs, rebuilt
-        else:
-            flat = flatten_cones(cones, n)   # memoized: the same object for the same cones
+        flat = flatten_cones(cones, n)   # memoized: the same object for the same cones
         self._cones = cones
         guess = None if x0 is None else _initial_guess(x0, n)
         if w is None or (structure.n, structure.m) != (n, m) or not flat.same_blocks(
@@ -182,9 +186,20 @@ class Solver:
         elif flat is not structure.cones:
             w.update_cones(flat.mu, flat.normal)
         structure.cones = flat
-        x, y, z, certificate = np.empty(n), np.empty(m), np.empty(n), structure.certificate
+        x, y, z = np.empty(n), np.empty(m), np.empty(n)
         out = w.solve(P, q, A, b, lb, ub, guess, settings.warm_start, start, x, y, z,
-                      certificate)
+                      structure.certificate)
+        return self._result(out, P, q, A, b, lb, ub, guess, start, x, y, z)
+
+    def _result(self, out: tuple, P: np.ndarray, q: np.ndarray, A: np.ndarray,
+                b: np.ndarray, lb: np.ndarray, ub: np.ndarray, guess: np.ndarray | None,
+                start: float, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> Result:
+        """The :class:`Result` of the dense solve that returned ``out`` into ``x, y, z``
+        (after a new workspace and a second solve when the bounds changed its
+        structure), or the error it found."""
+        settings = self.settings
+        w, structure = self._workspace, self._structure
+        n, certificate = structure.n, structure.certificate
         if out[0] == admm.STRUCTURE_CHANGED:   # the workspace's own scan of the bounds
             structure.update(lb, ub)
             w = self._workspace = structure.workspace(settings)
