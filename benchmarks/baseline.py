@@ -8,16 +8,14 @@ residual an exact-equality solver can reach on the QP ("factorization accuracy")
 
 from __future__ import annotations
 
-import gc
 import time
 
 import numpy as np
 from scipy.linalg import lapack
 
 from benchmarks.testsets import TestSet
-from benchmarks.wbc_qp import WbcQP
 
-__all__ = ["KKT_REGULARIZATION", "baseline", "kkt_factorization_time"]
+__all__ = ["KKT_REGULARIZATION", "KktFloor"]
 
 KKT_REGULARIZATION = 1e-6
 """Diagonal added to ``P`` in the baseline KKT matrix (fccqp's default ``sigma``)."""
@@ -25,35 +23,48 @@ KKT_REGULARIZATION = 1e-6
 _LWORK_PER_ROW = 64
 """dsytrf work size per row (its block size): scipy's default work size is unblocked."""
 
+REPEATS_PER_QP = 3
+"""Back-to-back ``dsytrf`` of one QP in a pass; the pass keeps their median."""
 
-def kkt_factorization_time(qp: WbcQP, repeats: int) -> tuple[float, float]:
-    """Median time of one ``dsytrf`` of ``[[P + 1e-6 I, A'], [A, 0]]`` and its accuracy.
 
-    The second value is ``||A x - b||_inf`` of the equality-constrained minimizer solved
-    with that factorization (``dsytrs``), NaN when the factorization fails.
+class KktFloor:
+    """The floor of a test set: each QP's KKT matrix ``[[P + 1e-6 I, A'], [A, 0]]``.
+
+    :meth:`time_pass` factors every matrix once per QP (the median of
+    ``REPEATS_PER_QP`` back-to-back ``dsytrf``); the harness runs it in its rotation of
+    passes, beside the solvers' passes, so that the machine's speed drifts reach the
+    floor as they reach the solvers (timed before them, on its own, the floor of one
+    run differed by 1.25x from that of another for the same QPs). ``residuals`` holds,
+    per QP, ``||A x - b||_inf`` of the equality-constrained minimizer solved with that
+    factorization (``dsytrs``), NaN where the factorization fails.
     """
-    n, m = qp.n, qp.A.shape[0]
-    K = np.zeros((n + m, n + m), order="F")
-    K[:n, :n] = qp.P + KKT_REGULARIZATION * np.eye(n)
-    K[n:, :n] = qp.A
-    K[:n, n:] = qp.A.T
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        lu, ipiv, info = lapack.dsytrf(K, lower=1, lwork=_LWORK_PER_ROW * (n + m))
-        times.append(time.perf_counter() - start)
-    if info != 0:
-        return float(np.median(times)), float("nan")
-    rhs = np.concatenate([-qp.q, qp.b])
-    sol, _ = lapack.dsytrs(lu, ipiv, rhs, lower=1)
-    return float(np.median(times)), qp.equality_residual(sol[:n])
 
+    def __init__(self, test_set: TestSet) -> None:
+        self._systems: list[tuple[np.ndarray, int]] = []
+        self.residuals: list[float] = []
+        for qp in test_set.qps:
+            n, m = qp.n, qp.A.shape[0]
+            K = np.zeros((n + m, n + m), order="F")
+            K[:n, :n] = qp.P + KKT_REGULARIZATION * np.eye(n)
+            K[n:, :n] = qp.A
+            K[:n, n:] = qp.A.T
+            lwork = _LWORK_PER_ROW * (n + m)
+            self._systems.append((K, lwork))
+            lu, ipiv, info = lapack.dsytrf(K, lower=1, lwork=lwork)
+            if info != 0:
+                self.residuals.append(float("nan"))
+                continue
+            sol, _ = lapack.dsytrs(lu, ipiv, np.concatenate([-qp.q, qp.b]), lower=1)
+            self.residuals.append(qp.equality_residual(sol[:n]))
 
-def baseline(test_set: TestSet, repeats: int) -> list[tuple[float, float]]:
-    """Per QP of ``test_set``: median ``dsytrf`` time and its equality residual."""
-    gc.collect()
-    gc.disable()
-    try:
-        return [kkt_factorization_time(qp, max(repeats, 3)) for qp in test_set.qps]
-    finally:
-        gc.enable()
+    def time_pass(self) -> list[float]:
+        """Seconds of one ``dsytrf`` per QP (the median of ``REPEATS_PER_QP``)."""
+        times = []
+        for K, lwork in self._systems:
+            repeats = []
+            for _ in range(REPEATS_PER_QP):
+                start = time.perf_counter()
+                lapack.dsytrf(K, lower=1, lwork=lwork)
+                repeats.append(time.perf_counter() - start)
+            times.append(float(np.median(repeats)))
+        return times

@@ -14,7 +14,9 @@ and warm-start state belong to one solver at a time:
    before the first round are frozen out of the garbage collector (``gc.freeze``), so
    the collection before each pass costs little.
    A pass is deterministic, so the per-QP time reported is the median over the passes
-   and the solution is the one of the first pass.
+   and the solution is the one of the first pass. Each round ends with a pass of the
+   floor (:class:`benchmarks.baseline.KktFloor`: one ``dsytrf`` per QP), timed the same
+   way.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ import numpy as np
 from tqdm import tqdm
 
 from benchmarks.adapters import Adapter, SolveOutcome
+from benchmarks.baseline import KktFloor
 from benchmarks.metrics import qp_metrics
 from benchmarks.testsets import TestSet
 
@@ -52,7 +55,7 @@ def run_variants(
     adapters: Sequence[Adapter],
     test_set: TestSet,
     repeats: int,
-    kkt: Sequence[tuple[float, float]],
+    floor: KktFloor,
     progress: bool = True,
 ) -> list[dict[str, object]]:
     """Time every adapter on every QP of ``test_set`` and judge its solutions.
@@ -65,8 +68,9 @@ def run_variants(
         The QPs, with reference solutions and sequence indices.
     repeats
         Rounds of passes; the time per QP is the median over a variant's passes.
-    kkt
-        Output of :func:`benchmarks.baseline.baseline` for the set, copied into each row.
+    floor
+        The set's KKT factorization floor, timed in each round; its median per QP and
+        its equality residual go into each row.
     progress
         Show tqdm bars for the preparation, the warm-up and the timed passes.
 
@@ -94,7 +98,7 @@ def run_variants(
     gc.collect()
     gc.freeze()
     try:
-        return _timed_rounds(adapters, data, test_set, repeats, kkt, progress)
+        return _timed_rounds(adapters, data, test_set, repeats, floor, progress)
     finally:
         gc.unfreeze()
 
@@ -104,12 +108,14 @@ def _timed_rounds(
     data: Sequence[Sequence[object]],
     test_set: TestSet,
     repeats: int,
-    kkt: Sequence[tuple[float, float]],
+    floor: KktFloor,
     progress: bool,
 ) -> list[dict[str, object]]:
-    """``repeats`` rounds of one pass per adapter, rotating; the rows of every QP."""
+    """``repeats`` rounds of one pass per adapter and one of the floor, rotating; the
+    rows of every QP."""
     robot, n_qps = test_set.robot, len(test_set.qps)
     times = np.zeros((len(adapters), repeats, n_qps))
+    floor_times = np.zeros((repeats, n_qps))
     first: list[list[SolveOutcome]] = [[] for _ in adapters]
     bar = tqdm(
         total=repeats * n_qps * len(adapters), desc=f"{robot}: timing {repeats} passes",
@@ -127,7 +133,14 @@ def _timed_rounds(
             times[k, r] = [o.time for o in outcomes]
             first[k] = first[k] or outcomes
             bar.update(n_qps)
+        gc.collect()
+        gc.disable()
+        try:
+            floor_times[r] = floor.time_pass()
+        finally:
+            gc.enable()
     bar.close()
+    kkt = [(float(np.median(floor_times[:, i])), floor.residuals[i]) for i in range(n_qps)]
     rows = []
     for k, adapter in enumerate(adapters):
         rows += _rows(adapter, test_set, times[k], first[k], kkt)
