@@ -23,6 +23,14 @@ cdef object _FRICTION = None
 cdef object _SECOND_ORDER = None
 
 
+cdef inline void _load_kinds():
+    """Look the cone classes up once: fccqp.cones imports this module."""
+    global _FRICTION, _SECOND_ORDER
+    if _FRICTION is None:
+        from fccqp.cones import FrictionCone, SecondOrderCone
+        _FRICTION, _SECOND_ORDER = FrictionCone, SecondOrderCone
+
+
 cdef bint hold_float64(object array, Py_buffer* view, Py_ssize_t rows, Py_ssize_t columns,
                        bint writable) except -1:
     """Hold ``array``'s C-contiguous buffer (writable if asked) in ``view`` and return True
@@ -53,6 +61,7 @@ cdef bint hold_dense(object value, Py_buffer* view, Py_ssize_t rows, Py_ssize_t 
 
 
 cdef bint _is_dense(object value, Py_ssize_t rows, Py_ssize_t columns):
+    """Whether :func:`hold_dense` would hold ``value`` (nothing stays held)."""
     cdef Py_buffer view
     if not hold_dense(value, &view, rows, columns):
         return False
@@ -87,10 +96,7 @@ def cone_key(tuple cones, Py_ssize_t n):
     A spec's key holds its values and the types behind them, since specs that compare
     equal may differ in validity (``0.5 + 0j == 0.5``, ``2.0 == 2``). Hashing the key
     raises ``TypeError`` for an unhashable field (a numpy normal)."""
-    global _FRICTION, _SECOND_ORDER
-    if _FRICTION is None:   # fccqp.cones imports this module: look its classes up once
-        from fccqp.cones import FrictionCone, SecondOrderCone
-        _FRICTION, _SECOND_ORDER = FrictionCone, SecondOrderCone
+    _load_kinds()
     cdef list key = [n]
     for cone in cones:
         key.append(_one_key(cone))
@@ -121,14 +127,11 @@ def same_cones(cones, previous):
     its :func:`fccqp.cones.flatten_cones` is the last one, with no key to build and hash
     (a control loop rebuilds equal specs every tick; 3-5 us of a go2 tick in flow).
     False when unsure."""
-    global _FRICTION, _SECOND_ORDER
     if type(cones) is not tuple or type(previous) is not tuple:
         return False
     if len(<tuple>cones) != len(<tuple>previous):
         return False
-    if _FRICTION is None:
-        from fccqp.cones import FrictionCone, SecondOrderCone
-        _FRICTION, _SECOND_ORDER = FrictionCone, SecondOrderCone
+    _load_kinds()
     for a, b in zip(<tuple>cones, <tuple>previous):
         if type(a) is not type(b):
             return False
