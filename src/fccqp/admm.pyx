@@ -29,6 +29,9 @@ without allocating and without the GIL.
 
 import numpy as np
 
+from fccqp.result import Result
+from fccqp.status import Status
+
 from cpython.buffer cimport PyBuffer_Release
 from libc.math cimport INFINITY, fabs, isfinite, sqrt
 
@@ -87,6 +90,16 @@ constrained or fixed entries, or a bound on a cone entry): the caller rescans th
 NOT_DENSE = -4
 """An input array is not a C-contiguous float64 numpy array of the workspace's shape
 (:meth:`Workspace.solve` with ``checked=False``): the caller converts the arguments."""
+STATUS_BY_CODE = {
+    SOLVED: Status.SOLVED,
+    SOLVED_INACCURATE: Status.SOLVED_INACCURATE,
+    MAX_ITER: Status.MAX_ITER_REACHED,
+    TIME_LIMIT: Status.TIME_LIMIT_REACHED,
+    PRIMAL_INFEASIBLE: Status.PRIMAL_INFEASIBLE,
+    DUAL_INFEASIBLE: Status.DUAL_INFEASIBLE,
+    NUMERICAL_ERROR: Status.NUMERICAL_ERROR,
+}
+"""The run codes as statuses: the only place they meet."""
 cdef enum:
     _CONE_ENTRY = 3   # beside fccqp.validation's bound_kind codes
 cdef enum:
@@ -100,6 +113,7 @@ cdef enum:
     _NUMERICAL_ERROR = 7
     _NOT_CONVEX = -1
     _BAD_DATA = -2
+    _STRUCTURE_CHANGED = -3
 
 BACKENDS = {"schur_reduced": SCHUR_REDUCED, "ldl_reduced": LDL_REDUCED, "ldl_full": LDL_FULL,
             "auto": AUTO}
@@ -479,30 +493,37 @@ cdef class Workspace:
         cdef Py_ssize_t i, j
         return [tuple(self.log[5 * i + j] for j in range(5)) for i in range(self.log_count)]
 
-    def solve(self, P, q, A, b, lb, ub, x0, bint warm, double start_time, x_out, y_out,
-              z_out, cert_out, bint checked=True):
-        """Validate, scale, run ADMM and unscale into ``x_out``, ``y_out``, ``z_out``.
+    def solve(self, P, q, A, b, lb, ub, x0, bint warm, double start_time, cert_out,
+              bint checked=True):
+        """Validate, scale, run ADMM and unscale; return the :class:`fccqp.Result`, or
+        the code of what the caller must do instead.
 
         ``P, q, A, b, lb, ub`` are C-contiguous float64 arrays of the workspace's shapes
         (as :func:`fccqp.problem.convert` or :func:`fccqp.fast_checks.dense_arguments`
         leave them); with ``checked=False`` they are the caller's arguments as they came,
         and the code is ``NOT_DENSE`` when one is not such an array. ``x0`` (None or a
         float64 vector) overrides the warm start; ``warm`` asks for a start from the
-        previous solution (when there is one).
-        ``cert_out`` (``m + n`` entries) receives an infeasibility certificate. Returns
-        ``(code, iterations, rho, prim, dual, gap, objective, factorizations, setup_time,
-        backend, polished)``; code ``BAD_DATA`` (see :attr:`finding`) and
-        ``NOT_CONVEX_CODE`` leave the previous solution untouched.
+        previous solution (when there is one); ``start_time`` is the call's start on the
+        clock of ``time.perf_counter``. ``cert_out`` (``m + n`` entries) receives an
+        infeasibility certificate, which the result copies. The other codes are
+        ``STRUCTURE_CHANGED``, ``BAD_DATA`` (see :attr:`finding`) and
+        ``NOT_CONVEX_CODE``; the last two leave the previous solution untouched.
 
         The arrays are read through their buffers, held for the call: typed memoryview
         arguments made a memoryview object for each of the eleven, and holding the
-        buffers instead saved 9k of a go2 tick's 1.13M instructions (callgrind).
+        buffers instead saved 9k of a go2 tick's 1.13M instructions (callgrind). The
+        result is built here, not in Python from a tuple of the run's figures: the
+        interpreter runs from cold caches after the compiled solve, and there that took
+        7-10 us of a 100 us go2 or solo12 tick (in flow); built here, a go2 tick
+        counts 7k fewer instructions of 706k (callgrind).
         """
         cdef Py_ssize_t n = self.prob.n, m = self.prob.m
         cdef Py_buffer views[11]
         cdef Py_ssize_t rows[11]
         cdef Py_ssize_t columns[11]
-        cdef int held = 0, count = 10 if x0 is None else 11, i
+        cdef int held = 0, count = 10 if x0 is None else 11, i, code
+        cdef Run run
+        x_out, y_out, z_out = np.empty(n), np.empty(m), np.empty(n)
         cdef tuple arrays = (P, q, A, b, lb, ub, x_out, y_out, z_out, cert_out, x0)
         rows[:] = [n, n, m, m, n, n, n, m, n, n + m, n]
         columns[:] = [n, -1, n, -1, -1, -1, -1, -1, -1, -1, -1]   # -1: a vector
@@ -510,25 +531,48 @@ cdef class Workspace:
             for i in range(count):   # the outputs, 6 to 9, are written
                 if i < 6 and not checked:
                     if not hold_dense(arrays[i], &views[i], rows[i], columns[i]):
-                        return (NOT_DENSE, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, "", False)
+                        return NOT_DENSE
                 elif not hold_float64(arrays[i], &views[i], rows[i], columns[i], 6 <= i <= 9):
                     raise ValueError(f"expected a C-contiguous float64 array of {rows[i]} rows")
                 held += 1
-            return self._run(<const double*>views[0].buf, <const double*>views[1].buf,
+            code = self._run(<const double*>views[0].buf, <const double*>views[1].buf,
                              <const double*>views[2].buf, <const double*>views[3].buf,
                              <const double*>views[4].buf, <const double*>views[5].buf,
                              <const double*>views[10].buf if x0 is not None else NULL, warm,
                              start_time, <double*>views[6].buf, <double*>views[7].buf,
-                             <double*>views[8].buf, <double*>views[9].buf)
+                             <double*>views[8].buf, <double*>views[9].buf, &run)
         finally:
             for i in range(held):
                 PyBuffer_Release(&views[i])
+        if code < _SOLVED:
+            return code
+        return self._result(&run, x_out, y_out, z_out, cert_out, start_time)
 
-    cdef tuple _run(self, const double* P, const double* q, const double* A, const double* b,
-                    const double* lb, const double* ub, const double* x0, bint warm,
-                    double start_time, double* x_out, double* y_out, double* z_out,
-                    double* cert_out):
-        """:meth:`solve` on the held buffers."""
+    cdef object _result(self, const Run* run, x, y, z, cert_out, double start_time):
+        """The :class:`fccqp.Result` of a finished run (see ``Result.gap`` and
+        ``Result.certificate`` for the infeasible statuses)."""
+        cdef Residuals* r = &self.res
+        certificate = None
+        if run.status == _PRIMAL_INFEASIBLE:
+            certificate = cert_out.copy()
+        elif run.status == _DUAL_INFEASIBLE:
+            certificate = cert_out[:self.prob.n].copy()
+        return Result._of({
+            "x": x, "y": y, "z": z, "status": STATUS_BY_CODE[run.status],
+            "obj": r.objective, "iterations": run.iterations, "prim_res": r.prim,
+            "dual_res": r.dual, "setup_time": run.setup_time,
+            "solve_time": fccqp_now() - start_time, "rho": run.rho,
+            "factorizations": run.factorizations, "certificate": certificate,
+            "backend": BACKEND_NAMES[run.backend],
+            "gap": r.gap if certificate is None else float("nan"), "polished": run.polished,
+        })
+
+    cdef int _run(self, const double* P, const double* q, const double* A, const double* b,
+                  const double* lb, const double* ub, const double* x0, bint warm,
+                  double start_time, double* x_out, double* y_out, double* z_out,
+                  double* cert_out, Run* out) except -9:
+        """:meth:`solve` on the held buffers: the run's status, with ``out`` filled, or
+        one of the codes below ``SOLVED``."""
         cdef Problem* p = &self.prob
         cdef Py_ssize_t n = p.n, m = p.m
         cdef bint same = self.has_matrices
@@ -540,10 +584,10 @@ cdef class Workspace:
                 self.q_user, self.A_user, self.b_user, self.lb_user, self.ub_user, &same)
         if self.found.code != SCAN_OK:
             self.has_matrices = False
-            return BAD_DATA, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, "", False
+            return _BAD_DATA
         if not self._same_structure(lb, ub):
             self.has_matrices = False
-            return STRUCTURE_CHANGED, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0.0, "", False
+            return _STRUCTURE_CHANGED
         enter()   # single-threaded BLAS for this solve (see fccqp.blas_threads)
         try:
             with nogil:
@@ -558,11 +602,9 @@ cdef class Workspace:
             leave()
         if run.status == _NOT_CONVEX:
             self.has_matrices = self.has_previous = self.certified = False
-            return (NOT_CONVEX_CODE, 0, 0.0, 0.0, 0.0, 0.0, 0.0, run.factorizations, 0.0, "",
-                    False)
-        r = &self.res
-        return (run.status, run.iterations, run.rho, r.prim, r.dual, r.gap, r.objective,
-                run.factorizations, run.setup_time, BACKEND_NAMES[run.backend], run.polished)
+            return _NOT_CONVEX
+        out[0] = run
+        return run.status
 
     cdef bint _same_structure(self, const double* lb, const double* ub) noexcept nogil:
         """Whether the user's new bounds bound, fix and leave free the entries they did at

@@ -11,7 +11,6 @@ before anything is densified.
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Sequence
 
@@ -23,19 +22,8 @@ from fccqp.fast_checks import dense_arguments, same_cones
 from fccqp.problem import MAX_ENTRY, check_cone_bounds, convert, raise_finding
 from fccqp.result import Result
 from fccqp.settings import MAX_DENSE_KKT_ROWS, Settings
-from fccqp.status import Status
 from fccqp.validation import structure_scan
 
-STATUS_BY_CODE = {
-    admm.SOLVED: Status.SOLVED,
-    admm.SOLVED_INACCURATE: Status.SOLVED_INACCURATE,
-    admm.MAX_ITER: Status.MAX_ITER_REACHED,
-    admm.TIME_LIMIT: Status.TIME_LIMIT_REACHED,
-    admm.PRIMAL_INFEASIBLE: Status.PRIMAL_INFEASIBLE,
-    admm.DUAL_INFEASIBLE: Status.DUAL_INFEASIBLE,
-    admm.NUMERICAL_ERROR: Status.NUMERICAL_ERROR,
-}
-"""The kernel's run codes as statuses: the only place they meet."""
 LOG_ROWS = 1024
 """Most lines of the verbose log kept per solve (one every ``admm.LOG_INTERVAL``
 iterations, the first and the last)."""
@@ -162,11 +150,12 @@ class Solver:
         sparse = settings.kkt_backend == "sparse"
         if w is not None and x0 is None and not sparse and same_cones(cones, self._cones):
             # the control loop: the caller's arrays as they came, checked by the solve
-            x, y, z = np.empty(structure.n), np.empty(structure.m), np.empty(structure.n)
-            out = w.solve(P, q, A, b, lb, ub, None, settings.warm_start, start, x, y, z,
+            out = w.solve(P, q, A, b, lb, ub, None, settings.warm_start, start,
                           structure.certificate, False)
-            if out[0] != admm.NOT_DENSE:
-                return self._result(out, P, q, A, b, lb, ub, None, start, x, y, z)
+            if type(out) is Result and not settings.verbose:
+                return out
+            if type(out) is Result or out != admm.NOT_DENSE:
+                return self._result(out, P, q, A, b, lb, ub, None, start)
         if w is not None and not sparse and dense_arguments(P, q, A, b, lb, ub, structure.n,
                                                             structure.m):
             n, m = structure.n, structure.m   # the arrays fit as they are
@@ -186,54 +175,35 @@ class Solver:
         elif flat is not structure.cones:
             w.update_cones(flat.mu, flat.normal)
         structure.cones = flat
-        x, y, z = np.empty(n), np.empty(m), np.empty(n)
-        out = w.solve(P, q, A, b, lb, ub, guess, settings.warm_start, start, x, y, z,
+        out = w.solve(P, q, A, b, lb, ub, guess, settings.warm_start, start,
                       structure.certificate)
-        return self._result(out, P, q, A, b, lb, ub, guess, start, x, y, z)
+        return self._result(out, P, q, A, b, lb, ub, guess, start)
 
-    def _result(self, out: tuple, P: np.ndarray, q: np.ndarray, A: np.ndarray,
+    def _result(self, out: Result | int, P: np.ndarray, q: np.ndarray, A: np.ndarray,
                 b: np.ndarray, lb: np.ndarray, ub: np.ndarray, guess: np.ndarray | None,
-                start: float, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> Result:
-        """The :class:`Result` of the dense solve that returned ``out`` into ``x, y, z``
-        (after a new workspace and a second solve when the bounds changed its
-        structure), or the error it found."""
+                start: float) -> Result:
+        """The :class:`Result` of the dense solve that returned ``out``: ``out`` itself,
+        after a new workspace and a second solve when the bounds changed its structure,
+        or the error the code says it found."""
         settings = self.settings
         w, structure = self._workspace, self._structure
-        n, certificate = structure.n, structure.certificate
-        if out[0] == admm.STRUCTURE_CHANGED:   # the workspace's own scan of the bounds
+        if type(out) is int and out == admm.STRUCTURE_CHANGED:   # the workspace's own scan
             structure.update(lb, ub)
             w = self._workspace = structure.workspace(settings)
-            out = w.solve(P, q, A, b, lb, ub, guess, settings.warm_start, start, x, y, z,
-                          certificate)
-        (code, iterations, rho, prim, dual, gap, obj, factorizations, setup_time,
-         backend, polished) = out
-        if code == admm.BAD_DATA:
+            out = w.solve(P, q, A, b, lb, ub, guess, settings.warm_start, start,
+                          structure.certificate)
+        if type(out) is int and out == admm.BAD_DATA:
             raise_finding(w.finding, lb, ub)
-        if code == admm.NOT_CONVEX_CODE:
+        if type(out) is int:   # NOT_CONVEX_CODE, the only code left
             self._workspace = self._structure = None
             raise ValueError(
                 "the QP is not convex: P has negative curvature on the null space of A "
                 f"(P is not positive semidefinite: its smallest eigenvalue is "
                 f"{np.linalg.eigvalsh((P + P.T) / 2)[0]:.3g})"
             )
-        status = STATUS_BY_CODE[code]
-        if status is Status.PRIMAL_INFEASIBLE:
-            certificate_out = certificate.copy()
-        elif status is Status.DUAL_INFEASIBLE:
-            certificate_out = certificate[:n].copy()
-        else:
-            certificate_out = None
-        result = Result._of({
-            "x": x, "y": y, "z": z, "status": status, "obj": obj, "iterations": iterations,
-            "prim_res": prim, "dual_res": dual, "setup_time": setup_time,
-            "solve_time": time.perf_counter() - start, "rho": rho,
-            "factorizations": factorizations, "certificate": certificate_out,
-            "backend": backend, "gap": gap if certificate_out is None else math.nan,
-            "polished": polished,
-        })
         if settings.verbose:
-            _print_log(w.log_lines, result)
-        return result
+            _print_log(w.log_lines, out)
+        return out
 
 
     def _solve_sparse(self, P: object, q: object, A: object, b: object, lb: object,
