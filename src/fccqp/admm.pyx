@@ -415,6 +415,7 @@ cdef class Workspace:
         pol.work = self._new(64 * (N + s))
         pol.rhs, pol.step = self._new(N + s), self._new(N + s)
         pol.x, pol.nu, pol.y = self._new(n), self._new(m), self._new(s)
+        pol.x_prev, pol.nu_prev = self._new(n), self._new(m)
         pol.grad, pol.ATnu, pol.Ax = self._new(n), self._new(n), self._new(m)
         pol.T, pol.tpiv = self._new(4 * s * s), <int*>self._new_int(2 * s)
         pol.tr, pol.du = self._new(2 * s), self._new(2 * s)

@@ -79,13 +79,14 @@ refined only to this (same scale); the point returned is refined to ``REFINE_TOL
 With the Schur complement (:mod:`fccqp.polish_schur`) the first solve leaves about
 2e-12 on whole-body control, and refining it to 1e-14 took a second KKT solve and
 residual that the next chord step repeats."""
-GUESS_PASSES = 6
+GUESS_PASSES = 8
 """Most active sets solved per polish: the first from ADMM's iterate, each next one
-corrected from the previous polished point (:func:`_renew`). With one release per pass
-(see :func:`polish`), 4, 6, 8 and 12 passes ended 81.5, 83.5, 84 and 84 % of talos'
-ticks and 92, 93, 93 and 94.5 % of go2's without an iteration
-(``Settings.realtime(math.inf)``, 200 ticks each); a polish that does not settle spends
-them all, and on talos almost none of those that reached the cap was accepted."""
+corrected from the previous polished point or step (:func:`_renew`). With the steps of
+:func:`polish`, 6, 8 and 10 passes ended 88, 89 and 90.5 % of talos' ticks and 92.5, 93
+and 93.5 % of go2's without an iteration (``Settings.realtime(math.inf)``, 200 ticks
+each), at 4.72M, 4.92M and 5.20M instructions per talos tick and 701k, 700k and 725k
+per go2 tick (callgrind); with 6 a polish that had not settled was accepted within the
+realtime preset's tolerance at a gap of 2.5e-4 (1.1e-4 with 8, 6e-10 with 10)."""
 ACTIVE_TOLERANCE = 1e-12
 """A free entry or block joins the active set when it violates by more than this
 (relative to the bound, or to ``||x_block||``)."""
@@ -322,11 +323,89 @@ cdef Py_ssize_t _most_wrong(Polish* w, const Problem* p) noexcept nogil:
     return most
 
 
-cdef Py_ssize_t _renew(Polish* w, const Problem* p, bint adding,
+cdef bint _inside(const double* v, Py_ssize_t kind, Py_ssize_t dim, double mu,
+                  const double* normal) noexcept nogil:
+    """Whether the block ``v`` lies in its cone to ``ACTIVE_TOLERANCE`` (the rule by
+    which :func:`_renew` adds a free block that left it)."""
+    cdef double across, size = 0.0
+    cdef Py_ssize_t j
+    cdef double along = _axis(v, kind, dim, mu, normal, &across)
+    for j in range(dim):
+        size += v[j] * v[j]
+    return across - _slope(kind, mu) * along <= _ACTIVE_TOLERANCE * sqrt(size)
+
+
+cdef double _cone_step(const double* x0, const double* x1, Py_ssize_t kind, Py_ssize_t dim,
+                       double mu, const double* normal, double* point) noexcept nogil:
+    """The largest ``t`` in ``[0, 1]`` with ``x0 + t (x1 - x0)`` in the cone, to
+    ``2^-40`` by bisection (``point``: ``dim`` scratch): 1 when ``x1`` is inside (the
+    cone is convex), 0 when ``x0`` is not."""
+    cdef double low = 0.0, high = 1.0, middle
+    cdef Py_ssize_t halving, j
+    if _inside(x1, kind, dim, mu, normal):
+        return 1.0
+    if not _inside(x0, kind, dim, mu, normal):
+        return 0.0
+    for halving in range(40):
+        middle = 0.5 * (low + high)
+        for j in range(dim):
+            point[j] = x0[j] + middle * (x1[j] - x0[j])
+        if _inside(point, kind, dim, mu, normal):
+            low = middle
+        else:
+            high = middle
+    return low
+
+
+cdef double _step(Polish* w, const Problem* p, Py_ssize_t* blocking) noexcept nogil:
+    """The largest ``t`` in ``[0, 1]`` such that ``x_prev + t (x - x_prev)`` keeps every
+    free box entry within its bounds, every free cone block in its cone and every
+    boundary block on the near side of its apex; ``blocking`` receives the constraint
+    that stops it first (an entry ``j < s``, or ``s`` plus a cone's index), -1 when none
+    does and ``t`` is 1."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t j, k, o, d, i, start
+    cdef double t = 1.0, stop, x0, x1, along0, along1, across
+    blocking[0] = -1
+    for j in range(p.s):
+        if p.in_cone[j] or w.active[j] != FREE:
+            continue
+        i = p.constrained[j]
+        x0, x1 = w.x_prev[i], w.x[i]
+        stop = 1.0
+        if x1 < p.lo[j] and x1 < x0:
+            stop = max(0.0, (p.lo[j] - x0) / (x1 - x0))
+        elif x1 > p.hi[j] and x1 > x0:
+            stop = max(0.0, (p.hi[j] - x0) / (x1 - x0))
+        if stop < t:
+            t, blocking[0] = stop, j
+    for k in range(c.count):
+        o, d = c.offset[k], c.dim[k]
+        start = p.constrained[o]
+        if w.active[o] == FREE:
+            stop = _cone_step(w.x_prev + start, w.x + start, c.kind[k], d, c.mu[k],
+                              c.normal + 3 * k, w.step)
+        elif w.active[o] == BOUNDARY:   # its tangent plane also holds the far ray
+            along0 = _axis(w.x_prev + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
+            along1 = _axis(w.x + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
+            stop = 1.0
+            if along1 <= 0.0:
+                stop = max(0.0, along0 / (along0 - along1)) if along0 > along1 else 0.0
+        else:
+            continue
+        if stop < t:
+            t, blocking[0] = stop, p.s + k
+    return t
+
+
+cdef Py_ssize_t _renew(Polish* w, const Problem* p, bint adding, Py_ssize_t blocking,
                        Py_ssize_t* changed) noexcept nogil:
     """Correct the guess from the polished point. With ``adding``, hold free entries
     that violate their bound and put free blocks that left their cone on the boundary
-    (or at the apex, if ``x_block`` lies in the polar); otherwise release the one held
+    (or at the apex, if ``x_block`` lies in the polar), and hold the ``blocking``
+    constraint of a step (:func:`_step`; -1 for none) where the step left it: a box
+    entry at its nearer bound, a free block on the boundary, a boundary block at the
+    apex; otherwise release the one held
     entry or block whose multiplier is the most wrong (:func:`_most_wrong`): a held entry
     or a boundary block becomes free, an apex block is reclassified from its multiplier
     as in :func:`_guess`.
@@ -345,6 +424,8 @@ cdef Py_ssize_t _renew(Polish* w, const Problem* p, bint adding,
         value = w.x[p.constrained[j]]
         if j == released:
             code = FREE
+        elif adding and code == FREE and j == blocking:
+            code = LOWER if fabs(value - p.lo[j]) <= fabs(value - p.hi[j]) else UPPER
         elif adding and code == FREE:
             if value < p.lo[j] - _ACTIVE_TOLERANCE * max(1.0, fabs(p.lo[j])):
                 code = LOWER
@@ -364,14 +445,16 @@ cdef Py_ssize_t _renew(Polish* w, const Problem* p, bint adding,
             old += 1
             if released == p.s + k:
                 code = FREE
+            elif blocking == p.s + k:
+                code = APEX
             copy(w.x + start, w.step, d)
         elif before == FREE and adding:
             size = 0.0
             for j in range(d):
                 size += w.x[start + j] * w.x[start + j]
             along = _axis(w.x + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
-            if across - slope * along > _ACTIVE_TOLERANCE * sqrt(size):
-                code = APEX if slope * across <= -along else BOUNDARY
+            if across - slope * along > _ACTIVE_TOLERANCE * sqrt(size) or blocking == p.s + k:
+                code = APEX if slope * across <= -along or size == 0.0 else BOUNDARY
                 proj_block(w.x + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
         elif released == p.s + k:   # an apex block whose y left the polar
             along = _axis(w.y + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
@@ -682,7 +765,15 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     cycled on talos' contact switches (32 entries released, 17 held again the next
     pass); one at a time, 83.5 % of talos' ticks ended in the warm polish, without an
     iteration, instead of 80.5 %, and 93 % of go2's instead of 91.5 %
-    (``Settings.realtime(math.inf)``, 200 ticks each). On a settled guess the boundary
+    (``Settings.realtime(math.inf)``, 200 ticks each). Once a pass's point violates
+    nothing, each next pass is a step of a primal active-set method: from that point
+    toward the new guess's solution only as far as the first free constraint allows
+    (:func:`_step`), which is then held, and a release only from a full step. The
+    polished QP of a wrong guess lies far out where the cost is flat on the forces, and
+    jumping there swung talos' contact forces by hundreds of newtons from pass to pass
+    (a block flipping between apex and boundary); with the steps, 88 instead of 83.5 %
+    of talos' ticks ended in the warm polish and a tick took 4.72M instead of 5.96M
+    instructions (six passes each). On a settled guess the boundary
     planes are then re-linearized up to ``newton_steps`` times (chord steps while they
     converge fast, see ``CHORD_RATE``), stopping early at the floor rounding leaves. A boundary block that a solve puts past the apex (:func:`_drop_far_side`)
     is held at the apex instead and the corrected guess solved, within the same
@@ -697,6 +788,9 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     w.kkt_floor = 0.0
     cdef double miss, rate, last_miss = INFINITY
     cdef bint refactored = False
+    cdef bint feasible = False   # a pass's point violated nothing: from then on, steps
+    cdef Py_ssize_t blocking
+    cdef double t
     copy(it.x, w.x, n)
     copy(it.nu, w.nu, m)
     copy(it.y, w.y, s)
@@ -707,6 +801,9 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     nb = _guess(w, p, it.z, it.y, &changed)
     while True:
         nf = _unknowns(w, p)
+        if feasible:
+            copy(w.x, w.x_prev, n)
+            copy(w.nu, w.nu_prev, m)
         if not _solve_guess(w, p, nf, nb, scale, factorizations, table, kkt, rho_vec, &tabled,
                             True):
             return False
@@ -717,9 +814,20 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
                 _solve(w, p, nf, nb, _REFINE_TOLERANCE * scale)
                 _multipliers(w, p, nf, nb)
             break
-        nb = _renew(w, p, True, &changed)
+        if feasible:
+            t = _step(w, p, &blocking)
+            if blocking >= 0:   # stop where the first constraint does, and hold it
+                for j in range(n):
+                    w.x[j] = w.x_prev[j] + t * (w.x[j] - w.x_prev[j])
+                for j in range(m):
+                    w.nu[j] = w.nu_prev[j] + t * (w.nu[j] - w.nu_prev[j])
+                w.grad_current = False
+                nb = _renew(w, p, True, blocking, &changed)
+                continue
+        nb = _renew(w, p, True, -1, &changed)
         if changed == 0:
-            nb = _renew(w, p, False, &changed)
+            feasible = True
+            nb = _renew(w, p, False, -1, &changed)
         if changed == 0:
             nb = _drop_far_side(w, p, nb, &changed)
         if changed != 0:
