@@ -32,7 +32,7 @@ REALTIME_BUDGET = 2e-3
 at 9f0fb22 (budgets 0.5, 1, 2, 3 ms; share solved on solo12 / anymal_c / go2 /
 talos_reduced): 100 / 100 / 100 / 58.5 %, 100 / 100 / 100 / 89.8 %, 100 / 100 / 100 /
 99.0 %, 100 / 100 / 100 / 99.8 % (at f956755, on a slower machine state: talos 42.5,
-68.2, 97.3, 98.8 %; at ca223da 46.0, 75.0, 96.5, 99.5 %, the quadrupeds 98.8-99.8 % at
+68.2, 97.3, 98.8 %; at 2a7b277 58.5, 84.0, 96.2, 99.8 %, the quadrupeds 99.5-100 % at
 0.5 ms and 100 % from 1 ms). The quadrupeds need 0.5 to 1 ms (their median solve is
 65-106 us, and the budget rarely binds); the humanoid's ticks whose active set
 changed need more than 1 ms. 2 ms is the end of a control tick's usual range; 3 ms
