@@ -33,10 +33,10 @@ cdef struct Polish:
     double* step            # N: correction solved from rhs
     double* lam             # s: multiplier of each boundary block's tangent plane
     double* x               # n: the polished point (scaled problem)
-    double* x_prev          # n: the point a step starts from (see polish)
-    double* nu_prev         # m: its equality multipliers
     double* nu              # m: its equality multipliers
     double* y               # s: its constraint multipliers
+    double* x_prev          # n: the point a step starts from (see polish)
+    double* nu_prev         # m: its equality multipliers
     double* grad            # n: scratch, the gradient of the Lagrangian
     bint grad_current       # grad is that of the current (x, nu): _multipliers reuses it
     double* ATnu            # n: scratch

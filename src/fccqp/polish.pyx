@@ -405,11 +405,9 @@ cdef Py_ssize_t _renew(Polish* w, const Problem* p, bint adding, Py_ssize_t bloc
     (or at the apex, if ``x_block`` lies in the polar), and hold the ``blocking``
     constraint of a step (:func:`_step`; -1 for none) where the step left it: a box
     entry at its nearer bound, a free block on the boundary, a boundary block at the
-    apex; otherwise release the one held
-    entry or block whose multiplier is the most wrong (:func:`_most_wrong`): a held entry
-    or a boundary block becomes free, an apex block is reclassified from its multiplier
-    as in :func:`_guess`.
-    Returns the number of boundary blocks (planes and curvature at ``x_block``, or at
+    apex. Otherwise release the one held entry or block whose multiplier is the most
+    wrong (:func:`_most_wrong`): a held entry or a boundary block becomes free, an apex
+    block is reclassified from its multiplier as in :func:`_guess`. Returns the number of boundary blocks (planes and curvature at ``x_block``, or at
     the projection for a new one) and counts the changed entries in ``changed``."""
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t j, k, o, d, start, nb = 0, old = 0
