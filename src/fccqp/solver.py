@@ -6,9 +6,8 @@ this module converts the arguments, decides whether the previous solve's workspa
 the new problem's structure, and acts on the codes the call returns instead (a new
 workspace when the bounds changed the structure, the error that names the argument).
 Problems whose KKT matrix exceeds :data:`fccqp.settings.MAX_DENSE_KKT_ROWS` rows, and
-every problem with
-``kkt_backend="sparse"``, go to the sparse path (:mod:`fccqp.sparse_admm`) instead,
-before anything is densified.
+every problem with ``kkt_backend="sparse"``, go to the sparse path
+(:mod:`fccqp.sparse_admm`) instead, before anything is densified.
 """
 
 from __future__ import annotations
