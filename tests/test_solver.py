@@ -148,6 +148,39 @@ def test_a_solver_follows_bounds_that_change_structure():
         assert isinstance(capped.solve(P, q, A, b, lb4, ub4, cones).status, Status)
 
 
+def test_a_return_to_a_structure_reuses_its_workspace_and_starts_cold():
+    # a controller whose contact set changes and comes back: the solver keeps the
+    # workspaces it left (solver.KEPT_WORKSPACES), and a return is a cold start, the
+    # same answer bit for bit as after Solver.reset() (which keeps the scaling of
+    # unchanged matrices), and the answer of a new solver
+    first = random_problem(21, n=30, m=8, n_cones=3, n_box=6)
+    others = [random_problem(22 + k, n=24 + 2 * k, m=6, n_cones=2, n_box=4) for k in range(6)]
+    P, q, A, b, lb, ub, cones = first
+    lb_fixed, ub_fixed = lb.copy(), ub.copy()
+    boxed = np.flatnonzero(np.isfinite(lb))[0]
+    lb_fixed[boxed] = ub_fixed[boxed] = 0.5 * (lb[boxed] + ub[boxed])
+    fixed = P, q, A, b, lb_fixed, ub_fixed, cones
+    solver = fccqp.Solver()
+    solver.solve(*first)
+    kept = solver._workspace
+    for problem in (others[0], fixed, first):   # a new size, new bounds, back
+        again = solver.solve(*problem)
+    assert solver._workspace is kept
+    reset = fccqp.Solver()
+    reset.solve(*first)
+    reset.reset()
+    after_reset = reset.solve(*first)
+    assert again.iterations == after_reset.iterations and again.status is Status.SOLVED
+    np.testing.assert_array_equal(again.x, after_reset.x)
+    fresh = fccqp.Solver().solve(*first)
+    np.testing.assert_allclose(again.x, fresh.x, atol=1e-12)
+    verify_solution(first, again)
+    for problem in others:   # more structures than it keeps: the oldest go
+        solver.solve(*problem)
+    assert len(solver._kept) == fccqp.solver.KEPT_WORKSPACES
+    assert solver.solve(*first).status is Status.SOLVED
+
+
 def test_reuses_factorization_when_matrices_unchanged():
     P, q, A, b, lb, ub, cones = random_problem(9)
     solver = fccqp.Solver(adaptive_rho=False)
