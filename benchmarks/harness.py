@@ -4,8 +4,9 @@ A pass is one variant solving the whole set; passes never interleave per QP, so 
 and warm-start state belong to one solver at a time:
 
 1. every QP is prepared (:meth:`~benchmarks.adapters.Adapter.prepare`) before timing;
-2. warm-up: each variant solves the first few QPs and is reset, so that JIT
-   first-call costs (loading extension modules, caches) are not timed;
+2. warm-up: each variant solves the first few QPs and the first QP of each other
+   problem size in the set, and is reset, so that first-call costs (loading extension
+   modules, caches, a workspace per problem structure) are not timed;
 3. ``repeats`` rounds; in each, every variant makes one pass over the set in
    controller-loop order, resetting the warm start at each sequence boundary, with
    the garbage collector off. Rotating the variants round by round (instead of
@@ -36,7 +37,8 @@ from benchmarks.testsets import TestSet
 __all__ = ["WARMUP_QPS", "run_variants"]
 
 WARMUP_QPS = 5
-"""QPs solved (and discarded) by each variant before timing."""
+"""QPs solved (and discarded) by each variant before timing, besides the first QP of each
+other problem size (:func:`_warmup_indices`)."""
 
 
 def _one_pass(adapter: Adapter, data: Sequence[object], sequence: np.ndarray) -> list[SolveOutcome]:
@@ -49,6 +51,23 @@ def _one_pass(adapter: Adapter, data: Sequence[object], sequence: np.ndarray) ->
             previous = seq
         out.append(adapter.solve(item))
     return out
+
+
+def _warmup_indices(test_set: TestSet) -> list[int]:
+    """The QPs of the warm-up: the first :data:`WARMUP_QPS`, then the first QP of each
+    problem size ``(n, m)`` they do not have. A solver's first call on a new size is a
+    one-time cost of the structure (fccqp allocates a workspace per structure and keeps
+    the last few, 1-4 ms on talos_reduced), and talos' set changes size once, at the
+    start of its last controller sequence; the startup benchmark
+    (:mod:`benchmarks.startup`) times first calls."""
+    first = list(range(min(WARMUP_QPS, len(test_set.qps))))
+    seen = {qp.P.shape + qp.A.shape for qp in (test_set.qps[i] for i in first)}
+    for i, qp in enumerate(test_set.qps):
+        size = qp.P.shape + qp.A.shape
+        if size not in seen:
+            seen.add(size)
+            first.append(i)
+    return first
 
 
 def run_variants(
@@ -86,13 +105,12 @@ def run_variants(
         for adapter in tqdm(adapters, desc=f"{robot}: preparing inputs", leave=False,
                             disable=not progress)
     ]
-    n_qps = len(test_set.qps)
-    warm = min(WARMUP_QPS, n_qps)
+    warm = _warmup_indices(test_set)
     bar = tqdm(adapters, desc=f"{robot}: warm-up (first calls, untimed)",
                leave=False, disable=not progress)
     for adapter, prepared in zip(bar, data, strict=True):
         bar.set_postfix_str(adapter.name)
-        _one_pass(adapter, prepared[:warm], test_set.sequence[:warm])
+        _one_pass(adapter, [prepared[i] for i in warm], test_set.sequence[warm])
     # Freeze what exists now (prepared data, models): the collection before each pass then
     # walks only new objects (without this, 40 % of a run went into gc.collect).
     gc.collect()

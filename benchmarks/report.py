@@ -346,10 +346,11 @@ def _header(info: RunInfo, variants: Sequence[str]) -> list[str]:
         " multipliers); the others solve every QP cold.",
         "- A pass is one variant solving the whole set in controller-loop order, restarting"
         " warm starts at each sequence boundary; passes never interleave per QP. Each"
-        " variant first solves a few QPs untimed (warm-up: loading extension modules and first-call"
-        " costs are excluded). Passes rotate through the variants round by round, so drifts"
-        " of the shared machine's speed reach every variant alike. The garbage collector is"
-        " off during timed passes. Read medians.",
+        " variant first solves a few QPs and the first QP of each other problem size untimed"
+        " (warm-up: loading extension modules and first-call costs, such as fccqp's workspace"
+        " per problem structure, are excluded). Passes rotate through the variants round by"
+        " round, so drifts of the shared machine's speed reach every variant alike. The"
+        " garbage collector is off during timed passes. Read medians.",
         f"- Every solution is judged on the exact-cone problem against the reference"
         f" ({REFERENCE_NOTE}), also for pyramid solvers. **success %** (qpbenchmark's"
         f" convention): share of QPs where the solver reports success and the equality"

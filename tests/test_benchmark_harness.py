@@ -107,3 +107,18 @@ def test_no_sweep_keeps_only_default_settings(tmp_path: Path) -> None:
     main(argv)
     with open(tmp_path / "out" / "results.csv") as fh:
         assert {r["solver"] for r in csv.DictReader(fh)} == {"fccqp-default"}
+
+
+def test_warm_up_reaches_every_problem_size() -> None:
+    """The warm-up solves the first QPs and the first QP of each later size, so that a
+    solver's first call on a size (fccqp's workspace per structure) is not timed."""
+    from types import SimpleNamespace
+
+    from benchmarks.harness import WARMUP_QPS, _warmup_indices
+    from benchmarks.testsets import TestSet
+
+    sizes = [8] * 10 + [6] * 4 + [8] * 3 + [4] * 2
+    qps = [SimpleNamespace(P=np.zeros((n, n)), A=np.zeros((2, n))) for n in sizes]
+    ts = TestSet("solo12", "mix", 0, 0.002, qps, [np.zeros(n) for n in sizes],
+                 np.zeros(len(sizes), dtype=int))
+    assert _warmup_indices(ts) == [*range(WARMUP_QPS), 10, 17]
