@@ -55,26 +55,8 @@ from fccqp.termination cimport (Residuals, converged, gap_scale, nearly_converge
 from fccqp.validation cimport (BOUNDED, FIXED_BOUND, SCAN_OK, UNBOUNDED, Finding, bound_kind,
                                scan_and_copy)
 
-cdef extern from *:
-    """
-    #ifdef _WIN32
-    #include <windows.h>
-    static double fccqp_now(void) {
-        LARGE_INTEGER count, frequency;
-        QueryPerformanceCounter(&count);
-        QueryPerformanceFrequency(&frequency);
-        return (double)count.QuadPart / (double)frequency.QuadPart;
-    }
-    #else
-    #include <time.h>
-    static double fccqp_now(void) {
-        struct timespec t;
-        clock_gettime(CLOCK_MONOTONIC, &t);
-        return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-    }
-    #endif
-    """
-    double fccqp_now() nogil
+cdef extern from "fccqp_clock.h" nogil:
+    double fccqp_now()
 
 # Run codes, mapped to fccqp.Status in fccqp.solver (one table).
 SOLVED, SOLVED_INACCURATE, MAX_ITER, TIME_LIMIT = 1, 2, 3, 4
@@ -208,8 +190,10 @@ cdef int _EARLY_POLISH_TRIES = EARLY_POLISH_TRIES
 RESERVE_DECAY = 0.5
 """Under a time limit the iterations stop when the time left is what the final step
 (polish or restoration, and unscaling) took lately: the largest of its last durations,
-each older one weighted by this factor more (so one slow solve is forgotten within a
-few). At most half the budget is reserved."""
+each weighted by this factor once per solve since (those that end without an iteration
+too: on talos a slow final step was otherwise remembered through a run of warm-polished
+ticks and cut the next run's iterations to half the budget). At most half the budget is
+reserved; the polish itself stops between guesses once the budget is spent."""
 cdef double _RESERVE_DECAY = RESERVE_DECAY
 cdef double _INACCURATE_FACTOR = INACCURATE_FACTOR
 cdef double _REDUCED_COST = REDUCED_COST
@@ -305,6 +289,7 @@ cdef class Workspace:
     cdef double tighten   # factor on the tolerances of the run (see POLISH_RETRIES)
     cdef double clock[6]
     cdef bint has_previous, has_matrices, certified, scaled_once
+    cdef bint has_rho   # prev_rho is a rho some solve adapted (a cold start keeps it too)
     cdef bint table_ready   # the reduced table and base hold for this solve's data and rho
     cdef bint iterated      # the last solve ran the iterations (and then its final step)
     cdef bint prev_polished, from_polished   # the previous solution was polished; this solve starts from it
@@ -455,6 +440,7 @@ cdef class Workspace:
         o.polish, o.polish_refine_iter = settings.polish, settings.polish_refine_iter
         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
         self.has_previous = self.has_matrices = self.certified = self.scaled_once = False
+        self.has_rho = False
         self.prev_polished = self.from_polished = self.equalities_missed = False
         self.user_current = False
         self.factored_rho = -1.0
@@ -605,9 +591,9 @@ cdef class Workspace:
                 if run.status != _NOT_CONVEX:
                     self._finish(&run, x_out, y_out if m else NULL, z_out, cert_out)
                 self.clock[5] = fccqp_now()
+                self.final_reserve *= _RESERVE_DECAY
                 if self.iterated:   # learn what the final step after the iterations costs
-                    self.final_reserve = max(_RESERVE_DECAY * self.final_reserve,
-                                             self.clock[5] - self.clock[4])
+                    self.final_reserve = max(self.final_reserve, self.clock[5] - self.clock[4])
         finally:
             leave()
         if run.status == _NOT_CONVEX:
@@ -648,7 +634,14 @@ cdef class Workspace:
         self._scale(reuse, warm)
         self.clock[2] = fccqp_now()
         self.log_count = 0
-        run.rho = self.prev_rho if warm else self.opt.rho
+        # under a time limit a cold start too keeps the rho the last solve adapted (as
+        # OSQP keeps its rho between solves): on talos_reduced's cold starts (a new
+        # controller sequence) 42 to 173 iterations and 2-3 factorizations instead of 58
+        # to 242 and 3-5 from Settings.rho, the quadrupeds' about the same. Without one
+        # the default preset's iterations went 48.5 -> 9.3 on solo12 but 15.9 -> 22.7 on
+        # talos and 1.8 -> 6.3 on anymal_c, and solo12's worst gap 7.3e-7 -> 1.0e-6
+        run.rho = (self.prev_rho if warm or (self.has_rho and isfinite(self.opt.time_limit))
+                   else self.opt.rho)
         if x0 != NULL:
             self._start_from_guess(x0)
         elif warm:
@@ -1289,7 +1282,8 @@ cdef class Workspace:
         cdef double tol_p, tol_d, tol_g
         cdef int new_status, factorizations = 0   # of polishing's own matrix: not counted
         if not polish(&self.pol, p, it, o.polish_refine_iter, &factorizations,
-                      &self.red if self.table_ready else NULL, &self.kkt, it.rho_vec):
+                      &self.red if self.table_ready else NULL, &self.kkt, it.rho_vec,
+                      start_time + o.time_limit):
             return False
         unscale(self.pol.x, self.pol.nu, self.pol.y, p.D, p.E, p.c, n, m, s, p.constrained,
                 self.user_x, self.user_y, self.user_z)
@@ -1400,6 +1394,7 @@ cdef class Workspace:
             copy(y, self.prev_y, m)
             copy(z, self.prev_z, n)
             self.prev_rho = run.rho
+            self.has_rho = True
         self.prev_polished = self.has_previous and run.polished
 
     cdef void _user_residuals(self, const double* x, const double* y,

@@ -65,6 +65,9 @@ from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.projections cimport proj_block
 from fccqp.reduced cimport Reduced
 
+cdef extern from "fccqp_clock.h" nogil:
+    double fccqp_now()
+
 DELTA = 1e-12
 """Regularization of both diagonal blocks of the polishing KKT matrix (scaled problem):
 it exists for dependent rows and a cost that is flat on the free entries; refinement
@@ -744,7 +747,7 @@ cdef bint polish_prepare(Polish* w, const Problem* p) noexcept nogil:
 
 cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_steps,
                  int* factorizations, const Reduced* table, KKT* kkt,
-                 const double* rho_vec) noexcept nogil:
+                 const double* rho_vec, double deadline) noexcept nogil:
     """Polish the iterate ``it`` into ``w.x``, ``w.nu``, ``w.y`` (scaled problem) and
     leave the final guess in ``w.active``; ``factorizations`` counts the ``dsytrf``
     calls. With ``table`` (the reduced form's, current for ``rho_vec`` and ``kkt``'s
@@ -776,7 +779,8 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     converge fast, see ``CHORD_RATE``), stopping early at the floor rounding leaves. A boundary block that a solve puts past the apex (:func:`_drop_far_side`)
     is held at the apex instead and the corrected guess solved, within the same
     ``GUESS_PASSES``. False when a factorization breaks down or the result is not
-    finite; otherwise the caller judges the point.
+    finite, or when the clock (:func:`fccqp_now`) has passed ``deadline`` before a
+    guess after the first (``INFINITY``: never); otherwise the caller judges the point.
     """
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, nb, nf = 0, j, changed
     cdef long passes = 0, step
@@ -798,6 +802,8 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         w.active[j] = FREE
     nb = _guess(w, p, it.z, it.y, &changed)
     while True:
+        if passes > 0 and fccqp_now() > deadline:
+            return False   # a time limit: the caller keeps its point
         nf = _unknowns(w, p)
         if feasible:
             copy(w.x, w.x_prev, n)
