@@ -36,8 +36,8 @@ talos_reduced): 100 / 100 / 100 / 58.5 %, 100 / 100 / 100 / 89.8 %, 100 / 100 / 
 0.5 ms and 100 % from 1 ms; at c6c2454, on a faster Intel machine, talos 69.0, 94.2,
 99.5, 100 % and the quadrupeds 100 % at every budget). The quadrupeds need 0.5 to 1
 ms (their median solve is 55-106 us, and the budget rarely binds); the humanoid's
-ticks whose active set changed need more than 1 ms. 2 ms is the end of a control tick's usual range; 3 ms
-(pass ``budget=3e-3``) serves the humanoid best."""
+ticks whose active set changed need more than 1 ms. 2 ms is the end of a control
+tick's usual range; 3 ms (pass ``budget=3e-3``) serves the humanoid best."""
 REALTIME_MIN_ITER = 15
 """Iterations :meth:`Settings.realtime` runs whatever the budget: the paper's real-time
 count, so that each tick of a loop whose budget its setup spends still progresses."""
