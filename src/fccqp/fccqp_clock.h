@@ -1,6 +1,7 @@
-/* fccqp_now: seconds on the clock Python's time.perf_counter reads (QueryPerformanceCounter
- * on Windows, CLOCK_MONOTONIC elsewhere), so that a solve's start time taken in Python
- * and its deadlines checked in the compiled core compare. */
+/* fccqp_now: seconds on a monotonic clock, QueryPerformanceCounter on Windows and
+ * CLOCK_MONOTONIC elsewhere: on Linux and Windows the clock Python's time.perf_counter
+ * reads, so that a solve's start time taken in Python and the deadlines the compiled core
+ * checks (admm, polish) compare. */
 #ifndef FCCQP_CLOCK_H
 #define FCCQP_CLOCK_H
 
