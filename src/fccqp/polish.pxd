@@ -49,8 +49,6 @@ cdef struct Polish:
     double* full            # n + m: residual of the KKT conditions
     double* dfull           # n + m: the last correction (dx, dnu)
     double kkt_norm         # infinity norm of full
-    double kkt_floor        # kkt_norm after the last correction that solved with the KKT matrix
-    bint kkt_solved         # the last correction did
 
 cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_steps,
                  int* factorizations, const Reduced* table, KKT* kkt,

@@ -787,7 +787,6 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     cdef double total = 0.0
     cdef double scale = max(1.0, max(inf_norm(p.q, n), inf_norm(p.b, m)))
     cdef bint tabled = table != NULL
-    w.kkt_floor = 0.0
     cdef double miss, rate, last_miss = INFINITY
     cdef bint refactored = False
     cdef bint feasible = False   # a pass's point violated nothing: from then on, steps
