@@ -14,8 +14,9 @@ and warm-start state belong to one solver at a time:
    machine's speed, which last minutes, over all variants alike. Objects that exist
    before the first round are frozen out of the garbage collector (``gc.freeze``), so
    the collection before each pass costs little.
-   A pass is deterministic, so the per-QP time reported is the median over the passes
-   and the solution is the one of the first pass. Each round ends with a pass of the
+   The per-QP time reported is the median over the passes and the solution is the one
+   of the first pass: a pass is deterministic, except for variants with a time budget
+   (fccqp's realtime presets), whose answers depend on where the clock stops them. Each round ends with a pass of the
    floor (:class:`benchmarks.baseline.KktFloor`: one ``dsytrf`` per QP), timed the same
    way.
 """
