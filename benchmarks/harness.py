@@ -16,9 +16,9 @@ and warm-start state belong to one solver at a time:
    the collection before each pass costs little.
    The per-QP time reported is the median over the passes and the solution is the one
    of the first pass: a pass is deterministic, except for variants with a time budget
-   (fccqp's realtime presets), whose answers depend on where the clock stops them. Each round ends with a pass of the
-   floor (:class:`benchmarks.baseline.KktFloor`: one ``dsytrf`` per QP), timed the same
-   way.
+   (fccqp's realtime presets), whose answers depend on where the clock stops them.
+   Each round ends with a pass of the floor (:class:`benchmarks.baseline.KktFloor`: one
+   ``dsytrf`` per QP), timed the same way.
 """
 
 from __future__ import annotations
