@@ -179,7 +179,7 @@ cdef void _correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
     if sign > 0.0:
         if w.kkt_norm > max(tiny, _MINOR_PART * inf_norm(w.tr, s + nb)):
             kkt_solve_once(kkt, p, rho, w.full, w.dfull)   # d0 = K_R^-1 (r1, r2)
-        else:   # the KKT part holds already, is minor, or is at its rounding floor
+        else:   # the KKT part holds already or is minor
             fill(w.dfull, 0.0, N)
         for j in range(s):
             code = w.active[j]
