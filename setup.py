@@ -14,7 +14,8 @@ MODULES = sorted(path.stem for path in Path("src/fccqp").glob("*.pyx"))
 
 extensions = [
     Extension(f"fccqp.{name}", [f"src/fccqp/{name}.pyx"], include_dirs=["src/fccqp"],
-              depends=["src/fccqp/fccqp_kernels.h", "src/fccqp/fccqp_clock.h"], extra_compile_args=["-O3"])
+              depends=["src/fccqp/fccqp_kernels.h", "src/fccqp/fccqp_clock.h"],
+              extra_compile_args=["-O3"])
     for name in MODULES
 ]
 

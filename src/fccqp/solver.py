@@ -31,7 +31,7 @@ iterations, the first and the last)."""
 KEPT_WORKSPACES = 4
 """Workspaces a :class:`Solver` keeps for structures it left, so that a return to one
 (a controller whose contact set comes back) starts cold without allocating: on
-talos_reduced (124 variables, 68 rows) a new workspace took 0.35-1.7 ms, most of a
+talos_reduced (124 variables, 68 rows) a new workspace took 0.35-4 ms, most of a
 2 ms budget, against the microseconds of the return to a kept one."""
 
 
@@ -103,6 +103,7 @@ class Solver:
         self.settings = (settings or Settings()).replace(**overrides)
         self._structure: _Structure | None = None
         self._workspace: admm.Workspace | None = None
+        self._key: tuple[object, ...] = ()   # what the current workspace was made for
         self._kept: dict[tuple[object, ...], admm.Workspace] = {}   # oldest first
         self._sparse = None   # the sparse path's workspace, made on its first problem
         self._cones: object = None   # the cones argument of the last dense solve
@@ -229,18 +230,18 @@ class Solver:
         (:data:`KEPT_WORKSPACES`): a kept workspace of the same structure starts cold,
         as after :meth:`reset` (the scaling of unchanged matrices is reused), otherwise
         a new one is allocated."""
-        settings = self.settings
         if self._workspace is not None:
-            self._kept[self._structure.key(settings)] = self._workspace
+            self._kept[self._key] = self._workspace
             while len(self._kept) > KEPT_WORKSPACES:
                 del self._kept[next(iter(self._kept))]
-        w = self._kept.pop(structure.key(settings), None)
+        key = structure.key(self.settings)
+        w = self._kept.pop(key, None)
         if w is None:
-            w = structure.workspace(settings)
+            w = structure.workspace(self.settings)
         else:
             w.forget()
             w.update_cones(structure.cones.mu, structure.cones.normal)
-        self._structure, self._workspace = structure, w
+        self._structure, self._workspace, self._key = structure, w, key
         return w
 
     def _solve_sparse(self, P: object, q: object, A: object, b: object, lb: object,
