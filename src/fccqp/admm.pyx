@@ -195,6 +195,32 @@ too: on talos a slow final step was otherwise remembered through a run of warm-p
 ticks and cut the next run's iterations to half the budget). At most half the budget is
 reserved; the polish itself stops between guesses once the budget is spent."""
 cdef double _RESERVE_DECAY = RESERVE_DECAY
+RESERVE_PASSES = 2
+"""The final step's reserve is at least this many guesses of the polish, at what a guess
+of the last polish cost: a run that a time limit stops polishes an iterate short of
+convergence, whose guess needs correcting. On talos_reduced's tick 73 (a contact
+switch) the polish of ADMM's iterate after 250 to 400 iterations took 2 guesses and
+was exact; with a reserve learned from the cheap one-guess polishes of the ticks
+before, the clock cut it after the first and the tick returned a gap of 0.05-0.1 at
+1.5 ms (and up to 0.04 at 2 ms)."""
+cdef double _RESERVE_PASSES = RESERVE_PASSES
+RHO_PERSISTENCE = 5
+"""Updates in a row (each ``adaptive_rho_interval`` iterations) after which a rho move
+that OSQP's rule keeps asking for, by more than the square root of
+``adaptive_rho_tolerance`` but less than the tolerance, is tried (see _new_rho): the
+tolerance keeps rho from chasing noise, but an imbalance that persists while the
+residuals do not even halve is no noise. On talos_reduced's tick 73 (a contact switch)
+the rule asked for 3.5x for 550 iterations and the warm run took 660; with the move,
+355. A move whose residuals then fall more slowly than before is undone (talos' tick
+288 went 181 -> 1214 iterations, rho 100x down in moves that were not undone).
+Measured over each robot's 400 ticks, total iterations without / with: default preset
+solo12 19391 / 5026, talos 8811 / 8806, go2 and anymal_c unchanged;
+``Settings.realtime(1.0)`` talos 5513 / 5017, the quadrupeds unchanged. At the
+realtime preset's 2 ms, talos missed the objective-gap target (1e-3) in 2 of 12 and 1
+of 12 alternating passes, at 1.5 ms in 7 of 8 and 4 of 8; with 3 updates instead of 5
+it lost more ticks (talos 7113 iterations). On the general-QP suite 7 of 543 problems
+changed, 6 to fewer iterations (1510 -> 580 at most), one 267 -> 369."""
+cdef int _RHO_PERSISTENCE = RHO_PERSISTENCE
 cdef double _INACCURATE_FACTOR = INACCURATE_FACTOR
 cdef double _REDUCED_COST = REDUCED_COST
 cdef double _RHO_MIN = RHO_MIN, _RHO_MAX = RHO_MAX
@@ -216,6 +242,16 @@ cdef struct Options:
     long max_iter, min_iter, check_termination, adaptive_rho_interval, scaling, polish_refine_iter
     bint adaptive_rho, restore_feasibility, polish
     int backend, anderson_memory
+
+
+cdef struct RhoTrial:
+    # A rho move smaller than adaptive_rho_tolerance, asked for again and again (_new_rho).
+    int side          # +1 (up) or -1 (down): the way the current streak asks; 0: none
+    int count         # updates in the streak, or since the move on trial
+    double start      # larger relative residual at the streak's (or the trial's) first
+    double progress   # its fall over the streak that made the move (a factor below 1)
+    double old_rho    # the rho before the move on trial; 0 when none is
+    bint locked       # a move was undone: none is tried again in this run
 
 
 cdef struct Run:
@@ -286,6 +322,7 @@ cdef class Workspace:
     cdef Py_ssize_t log_rows, log_count
     cdef double prev_rho, factored_rho, setup_time
     cdef double final_reserve   # seconds the final polish or restoration took lately
+    cdef double pass_time   # seconds per guess of the last polish, its check included
     cdef double tighten   # factor on the tolerances of the run (see POLISH_RETRIES)
     cdef double clock[6]
     cdef bint has_previous, has_matrices, certified, scaled_once
@@ -444,7 +481,7 @@ cdef class Workspace:
         self.prev_polished = self.from_polished = self.equalities_missed = False
         self.user_current = False
         self.factored_rho = -1.0
-        self.final_reserve = 0.0
+        self.final_reserve = self.pass_time = 0.0
 
     cdef double* _new(self, Py_ssize_t size):
         """A zeroed array of ``size`` doubles (at least one) that lives with ``self``."""
@@ -710,13 +747,18 @@ cdef class Workspace:
         cdef bint guess_polished = False, first_check = True
         cdef bint unbounded_start = False, timed = isfinite(o.time_limit)
         # the iterations stop early enough for the final polish or restoration to fit
-        cdef double deadline = o.time_limit - min(self.final_reserve, 0.5 * o.time_limit)
+        cdef double deadline = o.time_limit - min(
+            max(self.final_reserve, _RESERVE_PASSES * self.pass_time), 0.5 * o.time_limit)
         cdef bint reduced, fresh, last, periodic, adapt, check, gated, accelerate, warm_polish
         cdef bint polished
         cdef double eps_p, eps_d, new_rho, periodic_prim
+        cdef RhoTrial trial
         cdef int stalls
         run.factorizations = 0
         run.backend = self.form
+        trial.side = trial.count = 0
+        trial.old_rho = trial.start = trial.progress = 0.0
+        trial.locked = False
         run.polished = False
         self.tighten = 1.0
         self.table_ready = False   # base is for the previous q, b
@@ -849,7 +891,7 @@ cdef class Workspace:
                     accelerate = stalls < _STALLS
                     periodic_prim = r.prim
                 if status == _RUNNING and adapt:
-                    new_rho = self._new_rho(run.rho)
+                    new_rho = self._new_rho(run.rho, &trial)
                     if new_rho != run.rho:
                         code = self._change_rho(run, new_rho, iteration, reduced)
                         if code != FACTORED:
@@ -1052,17 +1094,48 @@ cdef class Workspace:
         for j in range(s):
             it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])
 
-    cdef double _new_rho(self, double rho) noexcept nogil:
-        """OSQP's rule: rho *= sqrt(relative primal / relative dual residual), clipped;
-        unchanged unless it moves by more than ``adaptive_rho_tolerance``."""
+    cdef double _new_rho(self, double rho, RhoTrial* trial) noexcept nogil:
+        """OSQP's rule: rho *= sqrt(relative primal / relative dual residual), clipped,
+        when that moves it by more than ``adaptive_rho_tolerance``. A smaller move, by
+        more than the tolerance's square root, is tried when the rule asked for it, the
+        same way, at ``RHO_PERSISTENCE`` updates in a row while the larger relative
+        residual did not halve; it is undone (and none tried again in this run) when
+        over the next ``RHO_PERSISTENCE`` updates the residual falls more slowly than
+        it did before (see ``RHO_PERSISTENCE``)."""
         cdef Residuals* r = &self.res
-        cdef double ratio = (r.prim_s / max(r.prim_scale_s, 1e-30)) / max(
-            r.dual_s / max(r.dual_scale_s, 1e-30), 1e-30)
-        cdef double new_rho = min(max(rho * sqrt(ratio), _RHO_MIN), _RHO_MAX)
-        cdef double tolerance = self.opt.adaptive_rho_tolerance
+        cdef double prim = r.prim_s / max(r.prim_scale_s, 1e-30)
+        cdef double dual = r.dual_s / max(r.dual_scale_s, 1e-30)
+        cdef double worst = max(prim, dual), old
+        cdef double new_rho = min(max(rho * sqrt(prim / max(dual, 1e-30)), _RHO_MIN), _RHO_MAX)
+        cdef double tolerance = self.opt.adaptive_rho_tolerance, half = sqrt(tolerance)
+        cdef int side = 1 if new_rho > rho * half else (-1 if new_rho < rho / half else 0)
         if new_rho > rho * tolerance or new_rho < rho / tolerance:
+            trial.side = trial.count = 0
+            trial.old_rho = 0.0
             return new_rho
-        return rho
+        if trial.old_rho > 0.0:   # a move on trial
+            trial.count += 1
+            if trial.count == 1:
+                trial.start = worst
+            elif trial.count == _RHO_PERSISTENCE:
+                old, trial.old_rho = trial.old_rho, 0.0
+                trial.side = trial.count = 0
+                if worst / trial.start > trial.progress:
+                    trial.locked = True
+                    return old
+            return rho
+        if trial.locked or side == 0 or side != trial.side:
+            trial.side, trial.count, trial.start = side, 1, worst
+            return rho
+        trial.count += 1
+        if trial.count < _RHO_PERSISTENCE:
+            return rho
+        trial.side = trial.count = 0
+        if worst <= 0.5 * trial.start:
+            return rho
+        trial.progress = worst / trial.start
+        trial.old_rho = rho
+        return new_rho
 
     # -------------------------------------------------------- factorizations
 
@@ -1258,6 +1331,15 @@ cdef class Workspace:
 
     cdef bint _keep_polished(self, int* status, long iteration, double start_time,
                             bint solved_only=False) noexcept nogil:
+        """:func:`_try_polished`, timed: learn what a guess of the polish costs (see
+        ``RESERVE_PASSES``)."""
+        cdef double began = fccqp_now()
+        cdef bint kept = self._try_polished(status, iteration, start_time, solved_only)
+        self.pass_time = (fccqp_now() - began) / max(self.pol.passes, 1)
+        return kept
+
+    cdef bint _try_polished(self, int* status, long iteration, double start_time,
+                            bint solved_only) noexcept nogil:
         """Replace the final iterate by its polished version (see :mod:`fccqp.polish`)
         when that passes a KKT check on the user's problem; True if it did.
 

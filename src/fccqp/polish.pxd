@@ -27,6 +27,7 @@ cdef struct Polish:
     bint structured         # the current guess is factored in schur, not in K
     bint schur_only         # fail rather than assemble for dsytrf where schur does not apply
     bint schur_failed       # the last polish failed so
+    long passes             # the guesses the last polish solved
     double* work            # lwork entries, for dsytrf
     int lwork
     double* rhs             # N: residual of the current solution

@@ -801,6 +801,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         w.active[j] = FREE
     nb = _guess(w, p, it.z, it.y, &changed)
     while True:
+        w.passes = passes
         if passes > 0 and fccqp_now() > deadline:
             return False   # a time limit: the caller keeps its point
         nf = _unknowns(w, p)
@@ -866,6 +867,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
                 _solve(w, p, nf, nb, _REFINE_TOLERANCE * scale)
         _multipliers(w, p, nf, nb)
         break
+    w.passes = passes
     for j in range(n):
         total += w.x[j]
     for j in range(m):
