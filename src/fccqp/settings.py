@@ -140,7 +140,9 @@ class Settings:
     adaptive_rho_interval: int = 10
     """Iterations between two rho updates, and between two unconditional residual checks."""
     adaptive_rho_tolerance: float = 5.0
-    """Refactor only when rho would change by more than this factor."""
+    """Refactor only when rho would change by more than this factor, or by more than its
+    square root at ``fccqp.admm.RHO_PERSISTENCE`` updates in a row while the residuals
+    stall (a move then undone if they fall more slowly after it)."""
     anderson_memory: int = 10
     """Anderson acceleration memory (0 disables, at most :data:`MAX_ANDERSON_MEMORY`);
     safeguarded, see fccqp.admm._anderson."""
