@@ -415,3 +415,13 @@ def test_feasible_problem_with_dependent_rows_is_not_certified_infeasible():
     result = fccqp.solve(*problem, eps_abs=1e-7, eps_rel=1e-7)
     assert result.status is Status.SOLVED
     verify_solution(Problem.of(*problem), result, Tolerances.of(eps_abs=1e-7, eps_rel=1e-7))
+
+
+def test_settings_of_a_solver_cannot_be_replaced():
+    """The dense workspaces are built for the solver's settings, so an assignment that
+    the next solves would silently ignore is refused by name."""
+    solver = fccqp.Solver(max_iter=50)
+    assert solver.settings.max_iter == 50
+    with pytest.raises(AttributeError, match="Solver.settings"):
+        solver.settings = fccqp.Settings(max_iter=5)
+    assert solver.settings.max_iter == 50

@@ -100,13 +100,25 @@ class Solver:
     def __init__(self, settings: Settings | None = None, **overrides: object) -> None:
         if settings is not None and not isinstance(settings, Settings):
             raise TypeError(f"settings must be a fccqp.Settings, got {type(settings).__name__}")
-        self.settings = (settings or Settings()).replace(**overrides)
+        self._settings = (settings or Settings()).replace(**overrides)
         self._structure: _Structure | None = None
         self._workspace: admm.Workspace | None = None
         self._key: tuple[object, ...] = ()   # what the current workspace was made for
         self._kept: dict[tuple[object, ...], admm.Workspace] = {}   # oldest first
         self._sparse = None   # the sparse path's workspace, made on its first problem
         self._cones: object = None   # the cones argument of the last dense solve
+
+    @property
+    def settings(self) -> Settings:
+        """The settings of every solve, fixed for the solver's life: its workspaces are
+        built for them (Anderson memory, log, backend), so a new ``Solver`` takes others."""
+        return self._settings
+
+    @settings.setter
+    def settings(self, value: object) -> None:
+        raise AttributeError(
+            "Solver.settings cannot be changed: the solver's workspaces are built for its "
+            "settings; make a new fccqp.Solver(settings) instead")
 
     def reset(self) -> None:
         """Forget the previous solve: the next one starts cold."""
@@ -164,7 +176,7 @@ class Solver:
             When the problem takes the sparse path and ``qdldl`` is not installed.
         """
         start = time.perf_counter()
-        settings = self.settings
+        settings = self._settings
         w, structure = self._workspace, self._structure
         sparse = settings.kkt_backend == "sparse"
         if w is not None and x0 is None and not sparse and same_cones(cones, self._cones):
@@ -204,7 +216,7 @@ class Solver:
         """The :class:`Result` of the dense solve that returned ``out``: ``out`` itself,
         after a new workspace and a second solve when the bounds changed its structure,
         or the error the code says it found."""
-        settings = self.settings
+        settings = self._settings
         w, structure = self._workspace, self._structure
         if type(out) is int and out == admm.STRUCTURE_CHANGED:   # the workspace's own scan
             structure = _Structure(structure.n, structure.m, structure.cones)
@@ -234,10 +246,10 @@ class Solver:
             self._kept[self._key] = self._workspace
             while len(self._kept) > KEPT_WORKSPACES:
                 del self._kept[next(iter(self._kept))]
-        key = structure.key(self.settings)
+        key = structure.key(self._settings)
         w = self._kept.pop(key, None)
         if w is None:
-            w = structure.workspace(self.settings)
+            w = structure.workspace(self._settings)
         else:
             w.forget()
             w.update_cones(structure.cones.mu, structure.cones.normal)
@@ -250,7 +262,7 @@ class Solver:
         """The sparse path (:mod:`fccqp.sparse_admm`): the same arguments and Result."""
         from fccqp import sparse_admm, sparse_problem
 
-        settings = self.settings
+        settings = self._settings
         data = sparse_problem.convert(P, q, A, b, lb, ub, cones)
         guess = None if x0 is None else _initial_guess(x0, data.n)
         if self._sparse is None:
