@@ -60,15 +60,17 @@ def test_narrow_boxes_far_from_the_origin_are_solved(member):
     assert result.status is Status.SOLVED
 
 
-def test_a_persistent_rho_imbalance_within_the_tolerance_moves_rho():
+@pytest.mark.parametrize("backend", ["auto", "sparse"])
+def test_a_persistent_rho_imbalance_within_the_tolerance_moves_rho(backend):
     """fixed_entries[15]: OSQP's rule asks, update after update, for rho about 3.6x
     larger, less than ``adaptive_rho_tolerance`` (5), and rho stayed 0.1 for the 210
     iterations of the run. A move that persists while the residuals do not halve is
-    tried (``admm.RHO_PERSISTENCE``): the run ends at a rho that only such a move
-    reaches, in 110 iterations, with the answer of the rule alone."""
+    tried (``admm.RHO_PERSISTENCE``, on the sparse path ``sparse_admm.RhoTrial``): the
+    run ends at a rho that only such a move reaches, in 110 iterations (sparse: 145),
+    with the answer of the rule alone."""
     problem = build("fixed_entries", 15).problem
-    settings = fccqp.Settings(**EPS)
-    result = fccqp.solve(*problem.args(), **EPS)
+    settings = fccqp.Settings(**EPS, kkt_backend=backend)
+    result = fccqp.solve(*problem.args(), settings)
     verify_solution(problem, result, Tolerances.of(**EPS))
     assert result.status is Status.SOLVED
     moved = result.rho / settings.rho

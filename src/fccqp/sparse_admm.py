@@ -52,6 +52,7 @@ from fccqp.admm import (
     RESERVE_DECAY,
     RHO_MAX,
     RHO_MIN,
+    RHO_PERSISTENCE,
     STALL_FACTOR,
     STALLS,
 )
@@ -70,6 +71,54 @@ from fccqp.sparse_kkt import FactorizationError, SparseKKT
 from fccqp.sparse_polish import multiplier_violation, polish
 from fccqp.sparse_problem import Scaled, SparseData, equilibrate
 from fccqp.status import Status
+
+
+@dataclass
+class RhoTrial:
+    """A rho move smaller than ``adaptive_rho_tolerance`` that OSQP's rule keeps asking
+    for, tried and perhaps undone: the dense core's rule (``fccqp.admm._new_rho``,
+    :data:`fccqp.admm.RHO_PERSISTENCE`), one per run."""
+
+    side: int = 0            # +1 (up) or -1 (down): the way the current streak asks
+    count: int = 0           # updates in the streak, or since the move on trial
+    start: float = 0.0       # larger relative residual at the streak's (trial's) first
+    progress: float = 0.0    # its fall over the streak that made the move
+    old_rho: float = 0.0     # the rho before the move on trial; 0 when none is
+    locked: bool = False     # a move was undone: none is tried again in this run
+
+    def propose(self, rho: float, new_rho: float, worst: float, tolerance: float) -> float:
+        """The rho to take, given the rule's ``new_rho`` and the larger relative
+        residual ``worst`` at this update."""
+        half = math.sqrt(tolerance)
+        side = 1 if new_rho > rho * half else (-1 if new_rho < rho / half else 0)
+        if new_rho > rho * tolerance or new_rho < rho / tolerance:
+            self.side = self.count = 0
+            self.old_rho = 0.0
+            return new_rho
+        if self.old_rho > 0.0:   # a move on trial
+            self.count += 1
+            if self.count == 1:
+                self.start = worst
+            elif self.count == RHO_PERSISTENCE:
+                old, self.old_rho = self.old_rho, 0.0
+                self.side = self.count = 0
+                if worst / self.start > self.progress:
+                    self.locked = True
+                    return old
+            return rho
+        if self.locked or side == 0 or side != self.side:
+            self.side, self.count, self.start = side, 1, worst
+            return rho
+        self.count += 1
+        if self.count < RHO_PERSISTENCE:
+            return rho
+        self.side = self.count = 0
+        if worst <= 0.5 * self.start:
+            return rho
+        self.progress = worst / self.start
+        self.old_rho = rho
+        return new_rho
+
 
 BACKEND = "sparse"
 """``Result.backend`` of a solve on this path (and the ``Settings.kkt_backend`` that
@@ -409,16 +458,15 @@ class _Run:
             return self._classify(iteration, True)
         return None
 
-    def _new_rho(self) -> float:
+    def _new_rho(self, trial: RhoTrial) -> float:
         """OSQP's rule on the scaled residuals: ``rho sqrt(relative primal / relative
-        dual)``, clipped; unchanged unless it moves by more than the tolerance."""
+        dual)``, clipped, when it moves rho by more than the tolerance; a smaller move
+        on trial as in the dense core (:class:`RhoTrial`)."""
         r = self.res
-        ratio = (r.prim_s / max(r.prim_scale_s, 1e-30)) / max(
-            r.dual_s / max(r.dual_scale_s, 1e-30), 1e-30)
-        new_rho = min(max(self.rho * math.sqrt(ratio), RHO_MIN), RHO_MAX)
-        tolerance = self.o.adaptive_rho_tolerance
-        return new_rho if (new_rho > self.rho * tolerance or
-                           new_rho < self.rho / tolerance) else self.rho
+        prim = r.prim_s / max(r.prim_scale_s, 1e-30)
+        dual = r.dual_s / max(r.dual_scale_s, 1e-30)
+        new_rho = min(max(self.rho * math.sqrt(prim / max(dual, 1e-30)), RHO_MIN), RHO_MAX)
+        return trial.propose(self.rho, new_rho, max(prim, dual), self.o.adaptive_rho_tolerance)
 
     def _log(self, iteration: int) -> None:
         if self.o.verbose:
@@ -531,6 +579,7 @@ class _Run:
         accelerate = o.anderson_memory > 0
         periodic_prim, stalls, retries = math.inf, 0, 0
         iteration, polished_at, polished = 0, -1, False
+        trial = RhoTrial()
         fresh = True   # the next step starts a run of KKT solutions: do not relax x
         status = None
         if timed and o.min_iter == 0 and time.perf_counter() - start >= deadline:
@@ -569,7 +618,7 @@ class _Run:
                     accelerate = stalls < STALLS
                     periodic_prim = r.prim
                 if status is None and adapt:
-                    new_rho = self._new_rho()
+                    new_rho = self._new_rho(trial)
                     if new_rho != self.rho:
                         self.rho, self.rho_vec = new_rho, new_rho * self.rho_scale
                         self._factor_rho()
