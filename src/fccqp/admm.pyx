@@ -244,8 +244,8 @@ cdef struct Options:
     int backend, anderson_memory
 
 
-cdef struct RhoTrial:
-    # A rho move smaller than adaptive_rho_tolerance, asked for again and again (_new_rho).
+cdef struct TrialState:
+    # A rho move smaller than adaptive_rho_tolerance, asked for again and again (_rho_trial).
     int side          # +1 (up) or -1 (down): the way the current streak asks; 0: none
     int count         # updates in the streak, or since the move on trial
     double start      # larger relative residual at the streak's (or the trial's) first
@@ -263,6 +263,65 @@ cdef struct Run:
     double setup_time
     int backend
     bint polished
+
+
+cdef double _rho_trial(TrialState* trial, double rho, double new_rho, double worst,
+                       double tolerance) noexcept nogil:
+    """The rho to take, given OSQP's proposal ``new_rho`` and the larger relative
+    residual ``worst`` at this update: ``new_rho`` when it moves rho by more than
+    ``tolerance``. A smaller move, by more than the tolerance's square root, is made when
+    the rule asked for it, the same way, at ``RHO_PERSISTENCE`` updates in a row while
+    ``worst`` did not halve; it is undone (and none made again in the run) when over the
+    next ``RHO_PERSISTENCE`` updates ``worst`` falls by less than it did over the streak."""
+    cdef double half = sqrt(tolerance), old
+    cdef int side = 1 if new_rho > rho * half else (-1 if new_rho < rho / half else 0)
+    if new_rho > rho * tolerance or new_rho < rho / tolerance:
+        trial.side = trial.count = 0
+        trial.old_rho = 0.0
+        return new_rho
+    if trial.old_rho > 0.0:   # a move on trial
+        trial.count += 1
+        if trial.count == 1:
+            trial.start = worst
+        elif trial.count == _RHO_PERSISTENCE:
+            old, trial.old_rho = trial.old_rho, 0.0
+            trial.side = trial.count = 0
+            if worst / trial.start > trial.progress:
+                trial.locked = True
+                return old
+        return rho
+    if trial.locked or side == 0 or side != trial.side:
+        trial.side, trial.count, trial.start = side, 1, worst
+        return rho
+    trial.count += 1
+    if trial.count < _RHO_PERSISTENCE:
+        return rho
+    trial.side = trial.count = 0
+    if worst <= 0.5 * trial.start:
+        return rho
+    trial.progress = worst / trial.start
+    trial.old_rho = rho
+    return new_rho
+
+
+cdef inline void _trial_reset(TrialState* trial) noexcept nogil:
+    trial.side = trial.count = 0
+    trial.old_rho = trial.start = trial.progress = 0.0
+    trial.locked = False
+
+
+cdef class RhoTrial:
+    """:func:`_rho_trial` for the sparse path (:mod:`fccqp.sparse_admm`), which runs
+    the dense core's rho rule: one per run."""
+
+    cdef TrialState state
+
+    def __cinit__(self):
+        _trial_reset(&self.state)
+
+    def propose(self, double rho, double new_rho, double worst, double tolerance):
+        """The rho to take at this update (see :func:`_rho_trial`)."""
+        return _rho_trial(&self.state, rho, new_rho, worst, tolerance)
 
 
 cdef class Workspace:
@@ -752,13 +811,11 @@ cdef class Workspace:
         cdef bint reduced, fresh, last, periodic, adapt, check, gated, accelerate, warm_polish
         cdef bint polished
         cdef double eps_p, eps_d, new_rho, periodic_prim
-        cdef RhoTrial trial
+        cdef TrialState trial
         cdef int stalls
         run.factorizations = 0
         run.backend = self.form
-        trial.side = trial.count = 0
-        trial.old_rho = trial.start = trial.progress = 0.0
-        trial.locked = False
+        _trial_reset(&trial)
         run.polished = False
         self.tighten = 1.0
         self.table_ready = False   # base is for the previous q, b
@@ -1094,25 +1151,15 @@ cdef class Workspace:
         for j in range(s):
             it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])
 
-    cdef double _new_rho(self, double rho, RhoTrial* trial) noexcept nogil:
+    cdef double _new_rho(self, double rho, TrialState* trial) noexcept nogil:
         """OSQP's rule: rho *= sqrt(relative primal / relative dual residual), clipped,
-        when that moves it by more than ``adaptive_rho_tolerance``. A smaller move, by
-        more than the tolerance's square root, is tried when the rule asked for it, the
-        same way, at ``RHO_PERSISTENCE`` updates in a row while the larger relative
-        residual did not halve; it is undone (and none tried again in this run) when
-        over the next ``RHO_PERSISTENCE`` updates the residual falls more slowly than
-        it did before (see ``RHO_PERSISTENCE``)."""
+        when that moves it by more than ``adaptive_rho_tolerance``; a smaller move that
+        the rule keeps asking for is tried (:func:`_rho_trial`)."""
         cdef Residuals* r = &self.res
         cdef double prim = r.prim_s / max(r.prim_scale_s, 1e-30)
         cdef double dual = r.dual_s / max(r.dual_scale_s, 1e-30)
-        cdef double worst = max(prim, dual), old
         cdef double new_rho = min(max(rho * sqrt(prim / max(dual, 1e-30)), _RHO_MIN), _RHO_MAX)
-        cdef double tolerance = self.opt.adaptive_rho_tolerance, half = sqrt(tolerance)
-        cdef int side = 1 if new_rho > rho * half else (-1 if new_rho < rho / half else 0)
-        if new_rho > rho * tolerance or new_rho < rho / tolerance:
-            trial.side = trial.count = 0
-            trial.old_rho = 0.0
-            return new_rho
+        return _rho_trial(trial, rho, new_rho, max(prim, dual), self.opt.adaptive_rho_tolerance)
         if trial.old_rho > 0.0:   # a move on trial
             trial.count += 1
             if trial.count == 1:

@@ -52,9 +52,9 @@ from fccqp.admm import (
     RESERVE_DECAY,
     RHO_MAX,
     RHO_MIN,
-    RHO_PERSISTENCE,
     STALL_FACTOR,
     STALLS,
+    RhoTrial,
 )
 from fccqp.anderson import MAX_REJECTIONS, REGULARIZATION
 from fccqp.settings import Settings
@@ -71,54 +71,6 @@ from fccqp.sparse_kkt import FactorizationError, SparseKKT
 from fccqp.sparse_polish import multiplier_violation, polish
 from fccqp.sparse_problem import Scaled, SparseData, equilibrate
 from fccqp.status import Status
-
-
-@dataclass
-class RhoTrial:
-    """A rho move smaller than ``adaptive_rho_tolerance`` that OSQP's rule keeps asking
-    for, tried and perhaps undone: the dense core's rule (``fccqp.admm._new_rho``,
-    :data:`fccqp.admm.RHO_PERSISTENCE`), one per run."""
-
-    side: int = 0            # +1 (up) or -1 (down): the way the current streak asks
-    count: int = 0           # updates in the streak, or since the move on trial
-    start: float = 0.0       # larger relative residual at the streak's (trial's) first
-    progress: float = 0.0    # its fall over the streak that made the move
-    old_rho: float = 0.0     # the rho before the move on trial; 0 when none is
-    locked: bool = False     # a move was undone: none is tried again in this run
-
-    def propose(self, rho: float, new_rho: float, worst: float, tolerance: float) -> float:
-        """The rho to take, given the rule's ``new_rho`` and the larger relative
-        residual ``worst`` at this update."""
-        half = math.sqrt(tolerance)
-        side = 1 if new_rho > rho * half else (-1 if new_rho < rho / half else 0)
-        if new_rho > rho * tolerance or new_rho < rho / tolerance:
-            self.side = self.count = 0
-            self.old_rho = 0.0
-            return new_rho
-        if self.old_rho > 0.0:   # a move on trial
-            self.count += 1
-            if self.count == 1:
-                self.start = worst
-            elif self.count == RHO_PERSISTENCE:
-                old, self.old_rho = self.old_rho, 0.0
-                self.side = self.count = 0
-                if worst / self.start > self.progress:
-                    self.locked = True
-                    return old
-            return rho
-        if self.locked or side == 0 or side != self.side:
-            self.side, self.count, self.start = side, 1, worst
-            return rho
-        self.count += 1
-        if self.count < RHO_PERSISTENCE:
-            return rho
-        self.side = self.count = 0
-        if worst <= 0.5 * self.start:
-            return rho
-        self.progress = worst / self.start
-        self.old_rho = rho
-        return new_rho
-
 
 BACKEND = "sparse"
 """``Result.backend`` of a solve on this path (and the ``Settings.kkt_backend`` that
@@ -461,7 +413,7 @@ class _Run:
     def _new_rho(self, trial: RhoTrial) -> float:
         """OSQP's rule on the scaled residuals: ``rho sqrt(relative primal / relative
         dual)``, clipped, when it moves rho by more than the tolerance; a smaller move
-        on trial as in the dense core (:class:`RhoTrial`)."""
+        on trial as in the dense core (:class:`fccqp.admm.RhoTrial`)."""
         r = self.res
         prim = r.prim_s / max(r.prim_scale_s, 1e-30)
         dual = r.dual_s / max(r.dual_scale_s, 1e-30)
