@@ -1160,29 +1160,6 @@ cdef class Workspace:
         cdef double dual = r.dual_s / max(r.dual_scale_s, 1e-30)
         cdef double new_rho = min(max(rho * sqrt(prim / max(dual, 1e-30)), _RHO_MIN), _RHO_MAX)
         return _rho_trial(trial, rho, new_rho, max(prim, dual), self.opt.adaptive_rho_tolerance)
-        if trial.old_rho > 0.0:   # a move on trial
-            trial.count += 1
-            if trial.count == 1:
-                trial.start = worst
-            elif trial.count == _RHO_PERSISTENCE:
-                old, trial.old_rho = trial.old_rho, 0.0
-                trial.side = trial.count = 0
-                if worst / trial.start > trial.progress:
-                    trial.locked = True
-                    return old
-            return rho
-        if trial.locked or side == 0 or side != trial.side:
-            trial.side, trial.count, trial.start = side, 1, worst
-            return rho
-        trial.count += 1
-        if trial.count < _RHO_PERSISTENCE:
-            return rho
-        trial.side = trial.count = 0
-        if worst <= 0.5 * trial.start:
-            return rho
-        trial.progress = worst / trial.start
-        trial.old_rho = rho
-        return new_rho
 
     # -------------------------------------------------------- factorizations
 
