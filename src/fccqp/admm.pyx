@@ -207,7 +207,7 @@ cdef double _RESERVE_PASSES = RESERVE_PASSES
 RHO_PERSISTENCE = 5
 """Updates in a row (each ``adaptive_rho_interval`` iterations) after which a rho move
 that OSQP's rule keeps asking for, by more than the square root of
-``adaptive_rho_tolerance`` but less than the tolerance, is tried (see _new_rho): the
+``adaptive_rho_tolerance`` but less than the tolerance, is tried (see _rho_trial): the
 tolerance keeps rho from chasing noise, but an imbalance that persists while the
 residuals do not even halve is no noise. On talos_reduced's tick 73 (a contact switch)
 the rule asked for 3.5x for 550 iterations and the warm run took 660; with the move,
