@@ -497,6 +497,7 @@ cdef class Workspace:
         rs.start, rs.point = self._new(N), self._new(N)
         pol = &self.pol
         pol.active = <char*>self._new(s)
+        pol.dropped = <char*>self._new(s)
         pol.index, pol.free = <Py_ssize_t*>self._new_int(n), <Py_ssize_t*>self._new_int(n)
         pol.boundary = <Py_ssize_t*>self._new_int(s)
         pol.g, pol.lam, pol.hess = self._new(s), self._new(s), self._new(s * s)

@@ -28,6 +28,8 @@ cdef struct Polish:
     bint schur_only         # fail rather than assemble for dsytrf where schur does not apply
     bint schur_failed       # the last polish failed so
     long passes             # the guesses the last polish solved
+    char* dropped           # cone count: the block went past its apex in this polish
+    bint cycling            # a block went past its apex twice: the guess cycles
     double* work            # lwork entries, for dsytrf
     int lwork
     double* rhs             # N: residual of the current solution
