@@ -34,8 +34,8 @@ talos_reduced): 100 / 100 / 100 / 58.5 %, 100 / 100 / 100 / 89.8 %, 100 / 100 / 
 99.0 %, 100 / 100 / 100 / 99.8 % (at f956755, on a slower machine state: talos 42.5,
 68.2, 97.3, 98.8 %; at 2a7b277 58.5, 84.0, 96.2, 99.8 %, the quadrupeds 99.5-100 % at
 0.5 ms and 100 % from 1 ms; at c6b0d4d, on a faster Intel machine, talos 83.2, 96.5,
-99.8, 100 % and the quadrupeds 100 % at every budget; at fa1eaa0, on the AMD machine
-again, talos 90.0, 97.8, 100, 100 %, the quadrupeds 100 % at every budget). The
+99.8, 100 % and the quadrupeds 100 % at every budget; at c02d1c8, on the AMD machine
+again, talos 92.0, 98.0, 100, 100 %, the quadrupeds 100 % at every budget). The
 quadrupeds need 0.5 to 1 ms (their median solve is 42-106 us, and the budget rarely
 binds); the humanoid's ticks whose active set changed need more than 1 ms. 2 ms is the
 end of a control tick's usual range; 3 ms (pass ``budget=3e-3``) serves the humanoid
