@@ -59,13 +59,13 @@ class _Structure:
         self.count = count
         return changed
 
-    def key(self, settings: Settings) -> tuple[object, ...]:
-        """What a workspace for this structure and ``settings`` is made of: equal keys,
-        interchangeable workspaces."""
+    def key(self) -> tuple[object, ...]:
+        """What a workspace for this structure is made of (a solver's settings are
+        fixed): equal keys, interchangeable workspaces."""
         cones, count = self.cones, self.count
         return (self.n, self.m, self.constrained[:count].tobytes(),
                 self.fixed[:count].tobytes(), cones.kind.tobytes(), cones.offset.tobytes(),
-                cones.dim.tobytes(), settings)
+                cones.dim.tobytes())
 
     def workspace(self, settings: Settings) -> admm.Workspace:
         """A workspace for this structure."""
@@ -103,7 +103,6 @@ class Solver:
         self._settings = (settings or Settings()).replace(**overrides)
         self._structure: _Structure | None = None
         self._workspace: admm.Workspace | None = None
-        self._key: tuple[object, ...] = ()   # what the current workspace was made for
         self._kept: dict[tuple[object, ...], admm.Workspace] = {}   # oldest first
         self._sparse = None   # the sparse path's workspace, made on its first problem
         self._cones: object = None   # the cones argument of the last dense solve
@@ -243,17 +242,16 @@ class Solver:
         as after :meth:`reset` (the scaling of unchanged matrices is reused), otherwise
         a new one is allocated."""
         if self._workspace is not None:
-            self._kept[self._key] = self._workspace
+            self._kept[self._structure.key()] = self._workspace
             while len(self._kept) > KEPT_WORKSPACES:
                 del self._kept[next(iter(self._kept))]
-        key = structure.key(self._settings)
-        w = self._kept.pop(key, None)
+        w = self._kept.pop(structure.key(), None)
         if w is None:
             w = structure.workspace(self._settings)
         else:
             w.forget()
             w.update_cones(structure.cones.mu, structure.cones.normal)
-        self._structure, self._workspace, self._key = structure, w, key
+        self._structure, self._workspace = structure, w
         return w
 
     def _solve_sparse(self, P: object, q: object, A: object, b: object, lb: object,
