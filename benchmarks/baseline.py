@@ -9,11 +9,12 @@ residual an exact-equality solver can reach on the QP ("factorization accuracy")
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 
 import numpy as np
 from scipy.linalg import lapack
 
-from benchmarks.testsets import TestSet
+from benchmarks.wbc_qp import WbcQP
 
 __all__ = ["KKT_REGULARIZATION", "KktFloor"]
 
@@ -28,7 +29,7 @@ REPEATS_PER_QP = 3
 
 
 class KktFloor:
-    """The floor of a test set: each QP's KKT matrix ``[[P + 1e-6 I, A'], [A, 0]]``.
+    """The floor of some QPs: each QP's KKT matrix ``[[P + 1e-6 I, A'], [A, 0]]``.
 
     :meth:`time_pass` factors every matrix once per QP (the median of
     ``REPEATS_PER_QP`` back-to-back ``dsytrf``); the harness runs it in its rotation of
@@ -39,10 +40,10 @@ class KktFloor:
     factorization (``dsytrs``), NaN where the factorization fails.
     """
 
-    def __init__(self, test_set: TestSet) -> None:
+    def __init__(self, qps: Sequence[WbcQP]) -> None:
         self._systems: list[tuple[np.ndarray, int]] = []
         self.residuals: list[float] = []
-        for qp in test_set.qps:
+        for qp in qps:
             n, m = qp.n, qp.A.shape[0]
             K = np.zeros((n + m, n + m), order="F")
             K[:n, :n] = qp.P + KKT_REGULARIZATION * np.eye(n)

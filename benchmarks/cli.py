@@ -1,10 +1,12 @@
 """Command line: ``python -m benchmarks [--quick | --full] [options]`` and ``... export``.
 
 The benchmark loads (or generates and caches, :mod:`benchmarks.cache`) one test set per
-robot (scenario ``mix`` by default), runs every installed solver variant on it
-(:mod:`benchmarks.harness`) with the BLAS thread pools limited, and writes the report
-(:mod:`benchmarks.report`) into the output folder, by default one that git ignores.
-``python -m benchmarks export ...`` writes a test set for qpbenchmark instead
+robot (scenario ``mix`` by default) and, for the coarse views of the quick preset, the
+full preset's set of the robot; runs every installed solver variant along the views'
+paths (:mod:`benchmarks.views`, :mod:`benchmarks.harness`) with the BLAS thread pools
+limited; and writes the report (:mod:`benchmarks.report`) into the output folder, by
+default one that git ignores. Progress lines go to stdout, warnings and progress bars to
+stderr. ``python -m benchmarks export ...`` writes a test set for qpbenchmark instead
 (:mod:`benchmarks.export`).
 """
 
@@ -20,16 +22,16 @@ from pathlib import Path
 from threadpoolctl import threadpool_limits
 
 from benchmarks import export
-from benchmarks.baseline import KktFloor
 from benchmarks.cache import DEFAULT_CACHE, cached_test_set
 from benchmarks.harness import run_variants
 from benchmarks.machine import blas_info, load_average
-from benchmarks.presets import PRESETS
-from benchmarks.report import RunInfo, write_outputs
+from benchmarks.presets import PRESETS, Preset
+from benchmarks.report import RunInfo, SetResult, write_outputs
 from benchmarks.robots import ROBOTS
 from benchmarks.scenarios import SCENARIOS
 from benchmarks.solvers import VARIANTS, available_variants, make_adapter
 from benchmarks.testsets import MIX
+from benchmarks.views import timed_paths
 
 __all__ = ["DEFAULT_OUT", "build_parser", "main"]
 
@@ -61,6 +63,12 @@ def _positive_int(value: str) -> int:
     return number
 
 
+def _sizes(preset: Preset) -> str:
+    sequences = -(-preset.n_qps // preset.seq_len)
+    return (f"{preset.n_qps} QPs per robot in {sequences} sequences of {preset.seq_len} ticks, "
+            f"{preset.repeats} timing passes")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser (its errors name the valid choices)."""
     parser = argparse.ArgumentParser(
@@ -70,8 +78,11 @@ def build_parser() -> argparse.ArgumentParser:
         "CSV. `python -m benchmarks export --help`: write a test set for qpbenchmark.",
     )
     size = parser.add_mutually_exclusive_group()
-    size.add_argument("--quick", action="store_true", help="a few minutes on 2 cores (default)")
-    size.add_argument("--full", action="store_true", help="more QPs and timing passes")
+    quick, full = PRESETS["quick"], PRESETS["full"]
+    size.add_argument("--quick", action="store_true",
+                      help=f"{_sizes(quick)}; the coarse views walk the full preset's "
+                      "sequences (default; under 5 minutes on 2 cores, test sets included)")
+    size.add_argument("--full", action="store_true", help=_sizes(full))
     parser.add_argument("--out", type=Path, help="output folder (default benchmarks/out/"
                         "<preset>, ignored by git)")
     parser.add_argument("--cache", type=Path, default=DEFAULT_CACHE,
@@ -90,15 +101,22 @@ def build_parser() -> argparse.ArgumentParser:
                         help="BLAS/OpenMP threads while timing (default 1)")
     parser.add_argument("--seed", type=int, default=0, help="test-set seed (default 0)")
     parser.add_argument("--repeats", type=_positive_int,
-                        help="timing passes per QP (preset: quick 5, full 10)")
-    parser.add_argument("--n-qps", type=_positive_int, help="QPs per robot (overrides preset)")
+                        help=f"timing passes per QP (preset: quick {quick.repeats}, "
+                        f"full {full.repeats})")
+    parser.add_argument("--n-qps", type=_positive_int,
+                        help="QPs per robot (overrides the preset; the coarse views then walk "
+                        "this set)")
     parser.add_argument("--seq-len", type=_positive_int,
-                        help="ticks per sequence (overrides preset)")
+                        help="ticks per sequence (overrides the preset, as --n-qps)")
     parser.add_argument("--no-progress", action="store_true", help="hide progress bars")
     return parser
 
 
 def _say(message: str) -> None:
+    print(message, flush=True)
+
+
+def _warn(message: str) -> None:
     print(message, file=sys.stderr, flush=True)
 
 
@@ -121,19 +139,25 @@ def main(argv: Sequence[str] | None = None) -> Path:
                  if not (args.no_sweep and VARIANTS[v].sweep)]
     variants, skipped = available_variants(requested)
     for missing in skipped:
-        _say(f"skipping {missing}: {VARIANTS[missing].module} is not installed")
+        _warn(f"skipping {missing}: {VARIANTS[missing].module} is not installed")
     if not variants:
         raise SystemExit("none of the requested solvers is installed")
     start = time.perf_counter()
-    sets = []
+    full = PRESETS["full"]
+    results = []
     with threadpool_limits(limits=args.blas_threads):
         blas = tuple(blas_info())
         for robot in args.robots:
             ts, _ = cached_test_set(args.cache, robot, args.scenario, n_qps, args.seed,
                                     seq_len=seq_len, verbose=progress, report=_say)
-            floor = KktFloor(ts)   # timed in the rounds, beside the variants
+            coarse = ts
+            if not custom and (n_qps, seq_len) != (full.n_qps, full.seq_len):
+                coarse, _ = cached_test_set(args.cache, robot, args.scenario, full.n_qps,
+                                            args.seed, seq_len=full.seq_len, verbose=progress,
+                                            report=_say)
             adapters = [make_adapter(variant) for variant in variants]
-            sets.append((ts, run_variants(adapters, ts, repeats, floor, progress=progress)))
+            rows = run_variants(adapters, timed_paths(ts, coarse), repeats, progress=progress)
+            results.append(SetResult(ts, coarse, rows))
             _say(f"{robot}: {len(variants)} variants timed "
                  f"({time.perf_counter() - start:.0f} s so far)")
     info = RunInfo(
@@ -141,8 +165,9 @@ def main(argv: Sequence[str] | None = None) -> Path:
         preset="custom" if custom else name, repeats=repeats, seed=args.seed,
         skipped=tuple(skipped), blas=blas, blas_threads=args.blas_threads,
         load_start=load_start, load_end=load_average(),
+        seconds=time.perf_counter() - start,
     )
     _say(f"writing the report and figures into {out}")
-    report = write_outputs(out, sets, variants, info)
+    report = write_outputs(out, results, variants, info)
     _say(f"wrote {report} in {time.perf_counter() - start:.0f} s")
     return report

@@ -1,4 +1,4 @@
-"""Per-QP accuracy metrics and per-solver aggregates.
+"""Per-QP accuracy metrics and per-solver aggregates, with one percentile method.
 
 Every solution is judged on the ORIGINAL problem, with exact friction cones, even when
 the solver only saw a pyramid: a pyramid answer is feasible but restricted, which shows
@@ -7,9 +7,16 @@ as an objective gap and a torque error against the exact-cone reference.
 Success follows qpbenchmark's convention (a solver succeeds on a QP when it reports
 success AND its solution passes checks within a tolerance); the checks here are the
 ones that exist for every variant, pyramid or not (see :func:`qp_metrics`), at the
-relative tolerance :data:`TOLERANCE`. Times are aggregated as qpbenchmark does too:
-shifted geometric mean with shift 10 (seconds), a solve the solver itself does not
-report as solved counting as the time limit.
+relative tolerance :data:`TOLERANCE`.
+
+Every percentile, median included, is the nearest rank over per-QP values
+(:func:`percentile`, numpy's ``method="inverted_cdf"``): the value of an actual QP,
+never an interpolation, so that a table's p95 and a target's p95 of the same QPs are
+the same number. A QP the solver does not report solved counts as an infinite error
+(:func:`solved_torque_errors`, :func:`solved_objective_gaps`) and, in time, as the
+controller period, or its own time when that is longer (:func:`penalized_times`). The
+shifted geometric mean follows qpbenchmark (shift 10 s, an unreported solve counting as
+the time limit).
 """
 
 from __future__ import annotations
@@ -29,8 +36,12 @@ __all__ = [
     "QPMetrics",
     "Summary",
     "deadline_share",
+    "exact_share",
+    "penalized_times",
+    "percentile",
     "qp_metrics",
     "shifted_geometric_mean",
+    "solved_objective_gaps",
     "solved_torque_errors",
     "summarize",
 ]
@@ -128,17 +139,81 @@ def shifted_geometric_mean(values: np.ndarray, shift: float = SHIFT) -> float:
     return float(np.exp(np.mean(np.log(v + shift))) - shift)
 
 
+def percentile(values: Sequence[float] | np.ndarray, q: float) -> float:
+    """The ``q``-th percentile of ``values`` by nearest rank (the value of rank
+    ``ceil(q / 100 * n)``; ``q = 50`` is the median, ``100`` the maximum).
+
+    Infinite values (failures) are ranked like any other, so a p95 is infinite exactly
+    when more than 5 % of the values are.
+    """
+    v = np.asarray(values, dtype=float)
+    if v.size == 0:
+        return float("nan")
+    return float(np.percentile(v, q, method="inverted_cdf"))
+
+
+def _reported(row: dict[str, object]) -> bool:
+    return bool(row["reported"])
+
+
+def penalized_times(rows: Sequence[dict[str, object]], period: float) -> np.ndarray:
+    """Per-QP times, a solve not reported solved counting as ``max(time, period)``: an
+    answer the controller cannot use is as late as a missed tick."""
+    return np.array(
+        [float(r["time"]) if _reported(r) else max(float(r["time"]), period) for r in rows],
+        dtype=float,
+    )
+
+
+def solved_torque_errors(rows: Sequence[dict[str, object]]) -> np.ndarray:
+    """``torque_error_rel`` of each row, infinite where the solver did not report success."""
+    return _solved(rows, "torque_error_rel")
+
+
+def solved_objective_gaps(rows: Sequence[dict[str, object]]) -> np.ndarray:
+    """``objective_gap`` of each row, infinite where the solver did not report success."""
+    return _solved(rows, "objective_gap")
+
+
+def _solved(rows: Sequence[dict[str, object]], key: str) -> np.ndarray:
+    return np.array([float(r[key]) if _reported(r) else np.inf for r in rows], dtype=float)
+
+
+def exact_share(rows: Sequence[dict[str, object]]) -> float:
+    """Share of ``rows`` answered exactly: reported solved, with every joint's torque
+    within :data:`TORQUE_LIMIT_SHARE` of its limit of the exact-cone reference's."""
+    ok = [_reported(r) and float(r["torque_error_rel"]) <= TORQUE_LIMIT_SHARE for r in rows]
+    return float(np.mean(ok)) if ok else float("nan")
+
+
+def deadline_share(rows: Sequence[dict[str, object]], budget: float) -> float:
+    """Share of ``rows`` (one solver) answered within ``budget`` seconds, and usefully.
+
+    A QP counts when the solve took at most ``budget``, the solver reports success, the
+    point is feasible for the exact cones (:attr:`QPMetrics.feasible`) and its largest
+    torque error is below :data:`TORQUE_LIMIT_SHARE` of the joint's limit.
+    """
+    ok = [
+        float(r["time"]) <= budget
+        and _reported(r)
+        and bool(r["feasible"])
+        and float(r["torque_error_rel"]) < TORQUE_LIMIT_SHARE
+        for r in rows
+    ]
+    return float(np.mean(ok)) if ok else float("nan")
+
+
 @dataclass(frozen=True)
 class Summary:
-    """Aggregates of one solver on one test set (times in seconds).
+    """Aggregates of one solver over some QPs (times in seconds).
 
     ``success_rate`` is qpbenchmark's: solver reports success and the solution is
     accurate; ``feasible_rate`` drops the objective check (a pyramid answer is feasible
-    but suboptimal); ``reported_rate`` is how often the solver itself reports success.
-    ``shm_time`` counts unreported solves as ``time_limit``; the ratios compare medians
-    with the fastest variant of the set and with one ``dsytrf`` of the KKT matrix.
-    ``p95_torque_error_rel`` judges every returned point; ``p95_solved_torque_error_rel``
-    counts a QP the solver did not report solved as an infinite error.
+    but restricted); ``reported_rate`` is how often the solver itself reports success;
+    ``exact_rate`` is :func:`exact_share`. Times are :func:`penalized_times`; the
+    torque errors and objective gaps count a QP not reported solved as infinite.
+    ``shm_time`` counts unreported solves as the time limit; the ratios compare medians
+    with the fastest variant of the same rows and with one ``dsytrf`` of the KKT matrix.
     """
 
     solver: str
@@ -146,8 +221,11 @@ class Summary:
     success_rate: float
     feasible_rate: float
     reported_rate: float
+    exact_rate: float
     median_time: float
     p95_time: float
+    p99_time: float
+    max_time: float
     shm_time: float
     shm_ratio: float
     ratio_to_fastest: float
@@ -161,40 +239,11 @@ class Summary:
     p95_torque_error: float
     max_torque_error: float
     p95_torque_error_rel: float
-    p95_solved_torque_error_rel: float
 
 
-def solved_torque_errors(rows: Sequence[dict[str, object]]) -> np.ndarray:
-    """``torque_error_rel`` of each row, infinite where the solver did not report success.
-
-    The work-precision view counts an unsolved QP as a failure whatever point came back.
-    """
-    return np.array(
-        [float(r["torque_error_rel"]) if r["reported"] else np.inf for r in rows], dtype=float
-    )
-
-
-def deadline_share(rows: Sequence[dict[str, object]], budget: float) -> float:
-    """Share of ``rows`` (one solver) answered within ``budget`` seconds, and usefully.
-
-    A QP counts when the solve took at most ``budget``, the solver reports success, the
-    point is feasible for the exact cones (:attr:`QPMetrics.feasible`) and its largest
-    torque error is below :data:`TORQUE_LIMIT_SHARE` of the joint's limit.
-    """
-    ok = [
-        float(r["time"]) <= budget
-        and bool(r["reported"])
-        and bool(r["feasible"])
-        and float(r["torque_error_rel"]) < TORQUE_LIMIT_SHARE
-        for r in rows
-    ]
-    return float(np.mean(ok)) if ok else float("nan")
-
-
-def summarize(
-    rows: Sequence[dict[str, object]], time_limit: float
-) -> list[Summary]:
-    """Aggregate result rows of ONE test set per solver, in order of first appearance.
+def summarize(rows: Sequence[dict[str, object]], period: float) -> list[Summary]:
+    """Aggregate result rows (one view of one test set) per solver, in order of first
+    appearance.
 
     Parameters
     ----------
@@ -202,27 +251,30 @@ def summarize(
         Rows as written to ``results.csv`` (keys ``solver``, ``time``, ``reported``,
         ``success``, ``feasible``, ``iterations``, the metric names and
         ``dsytrf_time``).
-    time_limit
-        Time (s) counted for a solve the solver does not report as solved, in the
-        shifted geometric mean.
+    period
+        The controller period (s): the time a solve not reported solved counts as at
+        least, and the time limit of the shifted geometric mean.
     """
     solvers = list(dict.fromkeys(str(r["solver"]) for r in rows))
+    mine = {s: [r for r in rows if r["solver"] == s] for s in solvers}
 
     def column(solver: str, key: str) -> np.ndarray:
-        return np.array([r[key] for r in rows if r["solver"] == solver], dtype=float)
+        return np.array([r[key] for r in mine[solver]], dtype=float)
 
-    medians = {s: float(np.median(column(s, "time"))) for s in solvers}
+    times = {s: penalized_times(mine[s], period) for s in solvers}
+    medians = {s: percentile(times[s], 50) for s in solvers}
     fastest = min(medians.values())
     shms = {}
     for s in solvers:
-        penalized = np.where(column(s, "reported") > 0, column(s, "time"), time_limit)
-        shms[s] = shifted_geometric_mean(penalized)
+        limited = np.where(column(s, "reported") > 0, column(s, "time"), period)
+        shms[s] = shifted_geometric_mean(limited)
     best_shm = min(shms.values())
     out = []
     for s in solvers:
-        t = column(s, "time")
+        t = times[s]
         it = column(s, "iterations")
-        du = column(s, "torque_error")
+        du = np.where(column(s, "reported") > 0, column(s, "torque_error"), np.inf)
+        gaps = solved_objective_gaps(mine[s])
         out.append(
             Summary(
                 solver=s,
@@ -230,27 +282,24 @@ def summarize(
                 success_rate=float(np.mean(column(s, "success"))),
                 feasible_rate=float(np.mean(column(s, "feasible"))),
                 reported_rate=float(np.mean(column(s, "reported"))),
+                exact_rate=exact_share(mine[s]),
                 median_time=medians[s],
-                p95_time=float(np.percentile(t, 95)),
+                p95_time=percentile(t, 95),
+                p99_time=percentile(t, 99),
+                max_time=float(np.max(t)),
                 shm_time=shms[s],
                 shm_ratio=shms[s] / best_shm,
                 ratio_to_fastest=medians[s] / fastest,
-                ratio_to_dsytrf=medians[s] / float(np.median(column(s, "dsytrf_time"))),
-                median_iterations=float(np.median(it)) if np.all(it >= 0) else float("nan"),
+                ratio_to_dsytrf=medians[s] / percentile(column(s, "dsytrf_time"), 50),
+                median_iterations=percentile(it, 50) if np.all(it >= 0) else float("nan"),
                 max_equality_residual=float(np.max(column(s, "equality_residual"))),
                 max_cone_violation=float(np.max(column(s, "cone_violation"))),
-                median_objective_gap=float(np.median(column(s, "objective_gap"))),
-                max_objective_gap=float(np.max(column(s, "objective_gap"))),
-                median_torque_error=float(np.median(du)),
-                p95_torque_error=float(np.percentile(du, 95)),
+                median_objective_gap=percentile(gaps, 50),
+                max_objective_gap=float(np.max(gaps)),
+                median_torque_error=percentile(du, 50),
+                p95_torque_error=percentile(du, 95),
                 max_torque_error=float(np.max(du)),
-                p95_torque_error_rel=float(np.percentile(column(s, "torque_error_rel"), 95)),
-                p95_solved_torque_error_rel=float(
-                    np.percentile(
-                        solved_torque_errors([r for r in rows if r["solver"] == s]), 95,
-                        method="higher",  # no interpolation with an infinite neighbour
-                    )
-                ),
+                p95_torque_error_rel=percentile(solved_torque_errors(mine[s]), 95),
             )
         )
     return out

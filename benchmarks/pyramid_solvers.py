@@ -22,6 +22,7 @@ The pyramid rows ``G x <= h`` come from :meth:`benchmarks.wbc_qp.WbcQP.pyramid` 
 from __future__ import annotations
 
 import time
+import warnings
 from typing import Any
 
 import numpy as np
@@ -249,13 +250,20 @@ class PiqpAdapter(Adapter):
 
 
 class QpsolversAdapter(Adapter):
-    """Any qpsolvers backend on the 4-facet inner pyramid, cold, one call per QP."""
+    """Any qpsolvers backend on the 4-facet inner pyramid, cold, one call per QP.
+
+    qpsolvers calls OSQP's ``solve()`` without ``raise_error``, on which OSQP 1.x warns
+    that the default will change; the failure is read from the status either way, so
+    that warning is silenced (once, not in the timed call).
+    """
 
     _SPARSE = frozenset({"osqp", "clarabel", "scs", "highs"})
 
     def __init__(self, name: str, solver: str) -> None:
         import qpsolvers
 
+        warnings.filterwarnings("ignore", message="The default value of raise_error",
+                                category=PendingDeprecationWarning)
         self.name = name
         self._qpsolvers = qpsolvers
         self._solver = solver

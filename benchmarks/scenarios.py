@@ -323,8 +323,9 @@ def rollout(
     gains: Gains | None = None,
     tol: float = 1e-9,
     progress: Callable[[], None] | None = None,
-) -> tuple[list[WbcQP], list[np.ndarray]]:
-    """Run the controller loop of ``spec`` and return the recorded QPs and solutions.
+) -> tuple[list[WbcQP], list[np.ndarray], list[tuple[str, ...]]]:
+    """Run the controller loop of ``spec``; return the recorded QPs, their solutions and
+    the feet in contact at each (the phase's ``stance``, sorted).
 
     Parameters
     ----------
@@ -359,7 +360,7 @@ def rollout(
     handle = data.oMf[robot.hand_frame].copy() if robot.hand_frame is not None else None
     com0 = pin.centerOfMass(model, data, q).copy()
     R0 = data.oMi[1].rotation.copy()
-    qs, xs = [], []
+    qs, xs, stances = [], [], []
     total = sum(ph.ticks for ph in spec.phases)
     rec = -1
     for tick in range(total):
@@ -446,6 +447,7 @@ def rollout(
         if phase.record:
             qs.append(qp)
             xs.append(x)
+            stances.append(tuple(sorted(phase.stance)))
             if progress is not None:
                 progress()
         v = v + dt * x[qp.layout["vdot"]]
@@ -454,4 +456,4 @@ def rollout(
             raise RuntimeError(
                 f"{robot.config.name} fell in {spec.scenario} at tick {tick} (phase {i})"
             )
-    return qs, xs
+    return qs, xs, stances

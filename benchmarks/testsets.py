@@ -29,10 +29,11 @@ __all__ = [
     "save",
 ]
 
-GENERATOR_VERSION = 1
+GENERATOR_VERSION = 2
 """Version of the generator's output: bump it with any change to ``robots``, ``wbc_qp``,
-``scenarios`` or this module that changes the generated QPs or references, so that cached
-test sets (:mod:`benchmarks.cache`) are generated anew."""
+``scenarios`` or this module that changes the generated QPs, references or records, so
+that cached test sets (:mod:`benchmarks.cache`) are generated anew. Version 2 records
+each QP's stance (the QPs and references are those of version 1)."""
 
 MIX = "mix"
 """Scenario name of the default mix: sequence ``j`` runs ``SCENARIOS[j % 4]``."""
@@ -61,6 +62,9 @@ class TestSet:
     generator_version
         :data:`GENERATOR_VERSION` of the code that generated the set (0 for files
         written before the version existed).
+    stance
+        Per QP, the sorted names of the feet in contact (empty for files written before
+        version 2): where it changes within a sequence a contact was made or broken.
     """
 
     __test__ = False  # not a pytest test class
@@ -73,6 +77,7 @@ class TestSet:
     x_ref: list[np.ndarray]
     sequence: np.ndarray
     generator_version: int = 0
+    stance: tuple[tuple[str, ...], ...] = ()
 
     def __len__(self) -> int:
         return len(self.qps)
@@ -116,6 +121,7 @@ def generate_test_set(
     loaded = load_robot(robot)
     qps: list[WbcQP] = []
     xs: list[np.ndarray] = []
+    stance: list[tuple[str, ...]] = []
     seq: list[int] = []
     bar = None
     if verbose:
@@ -127,14 +133,17 @@ def generate_test_set(
         name = SCENARIOS[j % len(SCENARIOS)] if scenario == MIX else scenario
         ticks = min(seq_len, n_qps - len(qps))
         spec = make_sequence(loaded, name, np.random.default_rng([seed, j]), ticks, dt)
-        new_qps, new_xs = rollout(loaded, spec, dt, progress=bar.update if bar else None)
+        new_qps, new_xs, new_stance = rollout(loaded, spec, dt,
+                                              progress=bar.update if bar else None)
         qps += new_qps
         xs += new_xs
+        stance += new_stance
         seq += [j] * len(new_qps)
         j += 1
     if bar is not None:
         bar.close()
-    return TestSet(robot, scenario, seed, dt, qps, xs, np.array(seq), GENERATOR_VERSION)
+    return TestSet(robot, scenario, seed, dt, qps, xs, np.array(seq), GENERATOR_VERSION,
+                   tuple(stance))
 
 
 def active_flags(qp: WbcQP, x: np.ndarray, rtol: float = 1e-6) -> tuple[bool, bool]:
@@ -170,7 +179,7 @@ def save(test_set: TestSet, path: str | Path) -> None:
     """Write ``test_set`` to one compressed ``.npz`` (format in docs/benchmarks-generator.md).
 
     Keys: ``robot``, ``scenario`` (str), ``seed``, ``dt``, ``n_qps``, ``sequence``,
-    ``generator_version``, and
+    ``generator_version``, ``stance`` (one str per QP, the feet joined by ``+``), and
     per QP ``i``: ``qp{i}_P``, ``_q``, ``_A``, ``_b``, ``_lb``, ``_ub``, ``_cone_starts``,
     ``_mus``, ``_normals``, ``_nv``, ``_layout`` (5 x 2 ``[start, stop]`` in the order of
     :data:`LAYOUT_NAMES`) and ``_x_ref``.
@@ -183,6 +192,7 @@ def save(test_set: TestSet, path: str | Path) -> None:
         "n_qps": np.array(len(test_set)),
         "sequence": np.asarray(test_set.sequence),
         "generator_version": np.array(test_set.generator_version),
+        "stance": np.array(["+".join(feet) for feet in test_set.stance], dtype=str),
     }
     for i, (qp, x) in enumerate(zip(test_set.qps, test_set.x_ref, strict=True)):
         for name in _QP_ARRAYS:
@@ -216,4 +226,10 @@ def load(path: str | Path) -> TestSet:
             xs,
             z["sequence"],
             int(z["generator_version"]) if "generator_version" in z else 0,
+            tuple(_feet(str(s)) for s in z["stance"]) if "stance" in z else (),
         )
+
+
+def _feet(joined: str) -> tuple[str, ...]:
+    """The stance ``save`` wrote as ``"A+B"`` (``""``: no foot down)."""
+    return tuple(joined.split("+")) if joined else ()

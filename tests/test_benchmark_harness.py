@@ -37,11 +37,29 @@ def test_csv_has_one_row_per_solver_and_qp(run: Path) -> None:
     with open(run / "results.csv") as fh:
         rows = list(csv.DictReader(fh))
     installed, _ = available_variants(list(VARIANTS))
-    assert len(rows) == len(installed) * N_QPS
-    assert {(r["solver"], int(r["qp"])) for r in rows} == {
+    warm = [r for r in rows if r["view"] == "warm"]
+    assert len(warm) == len(installed) * N_QPS
+    assert {(r["solver"], int(r["qp"])) for r in warm} == {
         (s, i) for s in installed for i in range(N_QPS)
     }
     assert all(float(r["time"]) > 0 for r in rows)
+
+
+def test_csv_holds_every_view(run: Path) -> None:
+    """Every variant walks the warm view; the solvers at their defaults through their own
+    APIs walk the cold and coarse views too (every 5th and 10th of two 3-tick sequences:
+    their first QPs)."""
+    from benchmarks.views import runs_every_view
+
+    with open(run / "results.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    installed, _ = available_variants(list(VARIANTS))
+    every = [s for s in installed if runs_every_view(s)]
+    for view, count in (("warm", N_QPS), ("cold", N_QPS), ("every 5th", 2), ("every 10th", 2)):
+        mine = [r for r in rows if r["view"] == view]
+        solvers = installed if view == "warm" else every
+        assert len(mine) == len(solvers) * count, view
+    assert {int(r["qp"]) for r in rows if r["view"] == "every 5th"} == {0, 3}
 
 
 def test_report_names_every_solver_and_the_targets(run: Path) -> None:
@@ -51,7 +69,11 @@ def test_report_names_every_solver_and_the_targets(run: Path) -> None:
         assert f"| {name} |" in text
     assert "## Targets" in text and ("MET" in text or "MISSED" in text)
     assert "fastest exact-cone peer" in text and "fastest pyramid peer" in text
+    for view in ("| warm |", "| cold |", "| every 5th |", "| every 10th |"):
+        assert view in text
+    assert "fccqp-realtime cold median <= 1x daqp-pyr4's" in text
     assert "BLAS" in text and "load average" in text
+    assert "cython" not in text  # a build dependency, absent from a run's environment
     assert "issue" not in text.lower()  # readers have not seen the issue tracker
 
 
@@ -109,16 +131,23 @@ def test_no_sweep_keeps_only_default_settings(tmp_path: Path) -> None:
         assert {r["solver"] for r in csv.DictReader(fh)} == {"fccqp-default"}
 
 
-def test_warm_up_reaches_every_problem_size() -> None:
-    """The warm-up solves the first QPs and the first QP of each later size, so that a
-    solver's first call on a size (fccqp's workspace per structure) is not timed."""
+def _sized_set(sizes: list[int]):
     from types import SimpleNamespace
 
-    from benchmarks.harness import WARMUP_QPS, _warmup_indices
     from benchmarks.testsets import TestSet
 
-    sizes = [8] * 10 + [6] * 4 + [8] * 3 + [4] * 2
     qps = [SimpleNamespace(P=np.zeros((n, n)), A=np.zeros((2, n))) for n in sizes]
-    ts = TestSet("solo12", "mix", 0, 0.002, qps, [np.zeros(n) for n in sizes],
-                 np.zeros(len(sizes), dtype=int))
-    assert _warmup_indices(ts) == [*range(WARMUP_QPS), 10, 17]
+    return TestSet("solo12", "mix", 0, 0.002, qps, [np.zeros(n) for n in sizes],
+                   np.zeros(len(sizes), dtype=int))
+
+
+def test_warm_up_reaches_every_problem_size() -> None:
+    """The warm-up solves the first QPs and the first QP of each later size, in every set
+    a variant walks, so that a solver's first call on a size (fccqp's workspace per
+    structure) is not timed."""
+    from benchmarks.harness import WARMUP_QPS, _warmup_indices
+
+    main = _sized_set([8] * 10 + [6] * 4 + [8] * 3 + [4] * 2)
+    assert _warmup_indices([main]) == [(0, i) for i in (*range(WARMUP_QPS), 10, 17)]
+    coarse = _sized_set([8] * 3 + [5] * 2 + [4])
+    assert _warmup_indices([main, coarse])[-1] == (1, 3)

@@ -11,10 +11,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from benchmarks.cache import DEFAULT_CACHE
+from benchmarks.cache import DEFAULT_CACHE, cache_path
 from benchmarks.cli import DEFAULT_OUT
 from benchmarks.export import SCRIPT_NAME, write_qpbenchmark
-from benchmarks.metrics import deadline_share, solved_torque_errors
+from benchmarks.metrics import deadline_share, penalized_times, percentile, solved_torque_errors
 from benchmarks.testsets import generate_test_set
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -29,7 +29,7 @@ def _ignored(path: Path) -> bool:
 
 def test_default_output_and_cache_are_ignored_by_git():
     assert _ignored(DEFAULT_OUT / "quick" / "report.md")
-    assert _ignored(DEFAULT_CACHE / "solo12-mix-seed0-n80-len20-dt0.002-gen1.npz")
+    assert _ignored(cache_path(DEFAULT_CACHE, "solo12", "mix", 60, 0, 15, 0.002))
 
 
 def test_committed_reports_are_not_ignored():
@@ -66,3 +66,19 @@ def test_deadline_share_counts_only_timely_solved_feasible_accurate_answers():
 def test_unsolved_qps_count_as_infinite_torque_error():
     errors = solved_torque_errors([_row(1e-4, err=0.01), _row(1e-4, reported=False, err=0.0)])
     assert errors[0] == 0.01 and np.isinf(errors[1])
+
+
+def test_unsolved_qps_count_as_the_controller_period_in_time():
+    times = penalized_times([_row(1e-4), _row(1e-4, reported=False),
+                             _row(3e-3, reported=False)], 2e-3)
+    np.testing.assert_array_equal(times, [1e-4, 2e-3, 3e-3])
+
+
+def test_percentiles_are_nearest_ranks():
+    """The value of an actual QP: of 60, p95 is the 57th smallest, p99 the largest; an
+    infinite value (a failure) counts only when it is that rank."""
+    values = np.arange(1.0, 61.0)
+    assert percentile(values, 95) == 57 and percentile(values, 99) == 60
+    assert percentile(values, 50) == 30 and percentile(values, 100) == 60
+    failed = np.r_[np.ones(57), np.inf, np.inf, np.inf]
+    assert percentile(failed, 95) == 1 and np.isinf(percentile(failed, 96))
