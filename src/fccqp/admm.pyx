@@ -40,7 +40,8 @@ from fccqp._types cimport Cones, Iterates, Problem
 from fccqp.blas_threads cimport enter, leave
 from fccqp.anderson cimport Anderson, anderson_reset, anderson_step
 from fccqp.certificates cimport (CERTIFIED, SEPARATED, dual_infeasible, equality_direction,
-                                 equality_inconsistent, primal_infeasible)
+                                 equality_inconsistent, magnitudes, primal_infeasible,
+                                 row_size)
 from fccqp.fast_checks cimport hold_dense, hold_float64
 from fccqp.kkt cimport (AUTO, FACTORED, KKT, LDL_FULL, LDL_REDUCED, NOT_CONVEX, SCHUR_REDUCED,
                         UNAVAILABLE, kkt_convexity, kkt_factor, kkt_solve)
@@ -836,7 +837,7 @@ cdef class Workspace:
             return
         if cold or s == 0:   # not at factorization accuracy: inconsistent or dependent rows
             self.equalities_missed = r.prim_eq > _EQUALITY_MISSED * max(r.prim_eq_scale, 1.0)
-            if self._missed() and self._inconsistent(True):
+            if self._missed_by_data() and self._inconsistent(True):
                 # tested on the penalty-free start: with rho in the KKT matrix (up to 1e9
                 # on fixed entries) the regularization's trace in A'r can hide it
                 self._finish_run(run, _PRIMAL_INFEASIBLE, 0)
@@ -857,8 +858,12 @@ cdef class Workspace:
             it.rho_vec[j] = run.rho * self.rho_scale[j]
         warm_polish = self.from_polished and o.polish
         if self.factored_rho != run.rho or cold:
-            if warm_polish and polish_prepare(&self.pol, p):
-                # polish before ADMM's factorization, which it does not need
+            if (warm_polish and polish_prepare(&self.pol, p)
+                    and (self.certified or self.pol.schur.convex)):
+                # polish before ADMM's factorization, which it does not need; new
+                # matrices must be proven convex first, which the set-up does for free
+                # where P is positive semidefinite, else the factorization below does
+                self.certified = True
                 self.pol.schur_only = True
                 polished = self._warm_polish(run, start_time)
                 self.pol.schur_only = False
@@ -1034,7 +1039,8 @@ cdef class Workspace:
         cdef Py_ssize_t i
         if not r.finite:
             return _NUMERICAL_ERROR
-        if self._missed() and self._inconsistent(iteration % o.adaptive_rho_interval == 0):
+        if (self._missed_by_data()
+                and self._inconsistent(iteration % o.adaptive_rho_interval == 0)):
             # A x = b has no solution: no point can be SOLVED (cleaned on the schedule
             # of rho adaptation, a KKT solve each time)
             return _PRIMAL_INFEASIBLE
@@ -1058,11 +1064,29 @@ cdef class Workspace:
 
     cdef bint _missed(self) noexcept nogil:
         """The last residuals miss ``A x = b`` beyond factorization accuracy
-        (``EQUALITY_MISSED`` of their scale): only then can the equality certificate
-        hold. Not the tolerance: rows inconsistent by less than ``eps_rel`` of the
-        largest row (a duplicated row of size 2 off by 0.65 among rows of 3e6) are no
-        more solvable, and were left uncertified for 4000 iterations."""
+        (``EQUALITY_MISSED`` of their scale). Not the tolerance: rows inconsistent by
+        less than ``eps_rel`` of the largest row (a duplicated row of size 2 off by 0.65
+        among rows of 3e6) are no more solvable, and were left uncertified for 4000
+        iterations."""
         return self.res.prim_eq > _EQUALITY_MISSED * self.res.prim_eq_scale
+
+    cdef bint _missed_by_data(self) noexcept nogil:
+        """:meth:`_missed`, and also beyond ``EQUALITY_MISSED`` of each row's terms at the
+        magnitude of the iterate and the box (:func:`fccqp.certificates.row_size`): only
+        then can the equality certificate hold. Where ``b`` and ``A x`` both cancel to
+        rounding noise (consistent dependent rows asking 0 with right-hand sides of
+        4e-16, at a start of 1e-13), ``max(|A x|, |b|)`` alone made that a miss, and a
+        public QP (QSCORPIO) was claimed infeasible. Computed only when :meth:`_missed`
+        holds."""
+        cdef Problem* p = &self.prob
+        cdef Py_ssize_t i
+        cdef double largest = 0.0
+        if not self._missed():
+            return False
+        magnitudes(p, self.it.x, self.vec_n)
+        for i in range(p.m):
+            largest = max(largest, row_size(p, i, self.vec_n) / p.E[i])
+        return self.res.prim_eq > _EQUALITY_MISSED * largest
 
     cdef bint _inconsistent(self, bint clean) noexcept nogil:
         """The equality certificate; on success ``cert`` holds ``(-E r, 0)``: ``A'y ~ 0`` and
@@ -1090,7 +1114,8 @@ cdef class Workspace:
             kkt_solve(&self.kkt, p, self.it.rho_vec, self.rhs, self.sol)
             for i in range(m):
                 r[i] = -self.sol[n + i]
-            code = equality_direction(p, r, self.opt.eps_prim_inf, self.vec_n, self.vec_n2)
+            code = equality_direction(p, r, self.it.x, self.opt.eps_prim_inf, self.vec_n,
+                                      self.vec_n2)
         if code != CERTIFIED:
             return False
         fill(self.cert, 0.0, n + m)

@@ -11,7 +11,9 @@ cdef enum:
 
 cdef int equality_inconsistent(const Problem* p, const Iterates* it, double eps, double* r,
                                double* ATr, double* terms) noexcept nogil
-cdef int equality_direction(const Problem* p, const double* r, double eps, double* ATr,
-                            double* terms) noexcept nogil
+cdef int equality_direction(const Problem* p, const double* r, const double* x, double eps,
+                            double* ATr, double* terms) noexcept nogil
 cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double* Pdx,
                           double* terms, double* block) noexcept nogil
+cdef void magnitudes(const Problem* p, const double* x, double* t) noexcept nogil
+cdef double row_size(const Problem* p, Py_ssize_t i, const double* t) noexcept nogil

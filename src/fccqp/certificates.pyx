@@ -2,8 +2,9 @@
 """Infeasibility certificates from ADMM's last step, judged relative to their own terms.
 
 On an infeasible problem ADMM's iterates diverge along a certificate, so the last step
-is tested (as in OSQP), but with every "approximately zero" judged against the size of
-the terms that must cancel, not in absolute terms: a certificate is then invariant to
+is tested (as in OSQP), but with every "approximately zero" of the primal certificates
+judged against the size of the terms that must cancel, not in absolute terms (the dual
+certificate's against the size of the direction, see :func:`_near_zero`): a certificate is then invariant to
 the scale of the data, and the rounding noise of a sum (``1e-16`` of its terms) never
 passes for one. Concretely, for terms ``t_k`` of a sum ``S``, "``S ~ 0``" is ``|S| <= eps
 max |t_k|``, relative residual ``rho = |S| / max |t_k|``. All tests run on the scaled
@@ -26,8 +27,9 @@ has no solution. The dual certificate keeps ``q'dx < -eps |q|'|dx|``.
   finite);
 - equality: the residual ``r = b - A x`` of a KKT solution, when ``A x = b`` has no
   solution, is the least-squares residual: ``A'r ~ 0`` and ``b'r > 0``;
-- dual: a direction ``dx`` with ``P dx ~ 0``, ``A dx ~ 0``, ``q'dx < 0`` and ``dx_S`` in the
-  recession cone of C.
+- dual: a direction ``dx`` with ``P dx ~ 0``, ``A dx ~ 0`` (each row against its norm
+  times ``||dx||``, see :func:`_near_zero`), ``q'dx < 0`` and ``dx_S`` in the recession
+  cone of C.
 """
 
 from libc.math cimport fabs, isfinite
@@ -49,6 +51,32 @@ a fuzz case); the certificates of 397 infeasible problems of a random property r
 separate by 120 times their residual or more (98 % of them by 1e4 or more)."""
 cdef double _SEPARATION_FLOOR = SEPARATION_FLOOR
 cdef double _DOMINANCE = DOMINANCE
+
+
+cdef void magnitudes(const Problem* p, const double* x, double* t) noexcept nogil:
+    """``t_j = max(|x_j|, |lb_j|, |ub_j|)`` over the finite bounds (scaled, n entries):
+    the magnitude of a point like ``x`` in the box."""
+    cdef Py_ssize_t i, j
+    for i in range(p.n):
+        t[i] = fabs(x[i])
+    for j in range(p.s):
+        i = p.constrained[j]
+        if isfinite(p.lo[j]):
+            t[i] = max(t[i], fabs(p.lo[j]))
+        if isfinite(p.hi[j]):
+            t[i] = max(t[i], fabs(p.hi[j]))
+
+
+cdef double row_size(const Problem* p, Py_ssize_t i, const double* t) noexcept nogil:
+    """``sum_j |A_ij| t_j`` for the :func:`magnitudes` ``t``: the size of row ``i``'s terms
+    at a point of that magnitude, whose rounding (and ``A x = b`` at factorization
+    accuracy) no certificate can tell from an inconsistency. At the iterate alone it
+    was no floor where the iterate is 0 (an equality-only start of 1e-13)."""
+    cdef Py_ssize_t j, n = p.n
+    cdef double row = 0.0
+    for j in range(n):
+        row += fabs(p.A[i * n + j]) * t[j]
+    return row
 
 
 cdef inline void _transpose_product(const Problem* p, const double* v, double* out,
@@ -128,52 +156,69 @@ cdef int equality_inconsistent(const Problem* p, const Iterates* it, double eps,
         for j in range(n):
             value -= p.A[i * n + j] * it.x[j]
         r[i] = value
-    return equality_direction(p, r, eps, ATr, terms)
+    return equality_direction(p, r, it.x, eps, ATr, terms)
 
 
-cdef int equality_direction(const Problem* p, const double* r, double eps, double* ATr,
-                            double* terms) noexcept nogil:
+cdef int equality_direction(const Problem* p, const double* r, const double* x, double eps,
+                            double* ATr, double* terms) noexcept nogil:
     """Test ``r`` (m) for ``A'r ~ 0`` and ``b'r > 0``: ``CERTIFIED``, ``SEPARATED`` when
     ``b'r`` separates but ``A'r`` is not small enough against it (a cleaner ``r`` may
     pass, see :meth:`fccqp.admm.Workspace._inconsistent`), else ``REJECTED`` (``ATr``,
-    ``terms``: n scratch)."""
+    ``terms``: n scratch).
+
+    Its separation is measured against the data's size, not only its own terms: ``b'r``
+    must exceed ``SEPARATION_FLOOR`` of ``sum_i |r_i| max(|b_i|, row_size_i)`` (see
+    :func:`row_size`: the rounding a right-hand side ``A x`` carries for a point of the
+    iterate's and the box's magnitude), and what the residual explains at the iterate
+    (every ``x`` with ``A x = b`` has ``b'r = (A'r)'x``, as for the primal certificate).
+    Relative to its own terms alone, ``b'r`` of dependent rows whose right-hand sides
+    are rounding noise (entries of 4e-16 where the rows ask 0, at a start ``x`` of
+    1e-13) looked like a proof: a public QP (QSCORPIO) was claimed infeasible."""
     cdef Py_ssize_t n = p.n, i, j
-    cdef double br = 0.0, size = 0.0, lhs_max = 0.0, terms_max = 0.0
+    cdef double br = 0.0, size = 0.0, lhs_max = 0.0, terms_max = 0.0, explained = 0.0
+    cdef double data = 0.0
     if p.m == 0:
         return REJECTED
+    magnitudes(p, x, terms)
     for i in range(p.m):
         br += p.b[i] * r[i]
         size += fabs(p.b[i] * r[i])
-    if not (br > _SEPARATION_FLOOR * size) or not isfinite(br):
+        data += fabs(r[i]) * max(fabs(p.b[i]), row_size(p, i, terms))
+    if not (br > _SEPARATION_FLOOR * data) or not isfinite(br):
         return REJECTED
     _transpose_product(p, r, ATr, terms)
     for j in range(n):
         lhs_max = max(lhs_max, fabs(ATr[j]) / p.D[j])
         terms_max = max(terms_max, terms[j] / p.D[j])
-    if lhs_max <= eps * terms_max and _DOMINANCE * lhs_max * size <= br * terms_max:
+        explained += fabs(ATr[j] * x[j])
+    if (lhs_max <= eps * terms_max and _DOMINANCE * lhs_max * size <= br * terms_max
+            and br > explained):
         return CERTIFIED
     return SEPARATED
 
 
 cdef inline bint _near_zero(const double* M, const double* dx, Py_ssize_t rows,
-                            Py_ssize_t cols, const double* row_unit, double unit_scale,
-                            double eps, double* out, double* terms) noexcept nogil:
-    """``M dx ~ 0`` (row-major ``M``) relative to the largest row of terms, row ``i``
-    divided by ``unit_scale * row_unit[i]`` (the user's units); ``out`` and ``terms``
-    are scratch of ``rows`` entries."""
+                            Py_ssize_t cols, const double* D, double dx_norm, double eps,
+                            double* out) noexcept nogil:
+    """``M dx ~ 0`` (row-major ``M``, scaled columns ``x = D x_scaled``) row by row:
+    ``|M_i dx| <= eps ||M_i|| ||dx||`` with the row's 1-norm and ``dx``'s max-norm in the
+    user's units (``dx_norm``), as OSQP and COSMO normalize by ``||dx||``. A row scale
+    cancels from both sides, so the test is invariant to scaling rows, the cost and
+    ``dx``. Not relative to the terms ``|M_i||dx|``: along a ray in a coordinate-aligned
+    null space (zero columns of ``P``) the ray contributes to neither side, and the
+    unconverged remainder is compared with itself; ``out`` is scratch of ``rows``."""
     cdef Py_ssize_t i, j
-    cdef double value, lhs_max = 0.0, terms_max = 0.0, unit
+    cdef double value, norm
     for i in range(rows):
-        out[i] = 0.0
-        terms[i] = 0.0
+        value = 0.0
+        norm = 0.0
         for j in range(cols):
-            value = M[i * cols + j] * dx[j]
-            out[i] += value
-            terms[i] += fabs(value)
-        unit = unit_scale * row_unit[i]
-        lhs_max = max(lhs_max, fabs(out[i]) / unit)
-        terms_max = max(terms_max, terms[i] / unit)
-    return lhs_max <= eps * terms_max
+            value += M[i * cols + j] * dx[j]
+            norm += fabs(M[i * cols + j]) / D[j]
+        out[i] = value
+        if not fabs(value) <= eps * norm * dx_norm:
+            return False
+    return True
 
 
 cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double* Pdx,
@@ -203,6 +248,6 @@ cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double
         for j in range(dim):
             if fabs(block[a + j] - terms[j]) * p.D[p.constrained[a]] > tol:
                 return False
-    if not _near_zero(p.P, dx, n, n, p.D, p.c, eps, Pdx, terms):
+    if not _near_zero(p.P, dx, n, n, p.D, norm, eps, Pdx):
         return False
-    return p.m == 0 or _near_zero(p.A, dx, p.m, n, p.E, 1.0, eps, Pdx, terms)
+    return p.m == 0 or _near_zero(p.A, dx, p.m, n, p.D, norm, eps, Pdx)

@@ -5,6 +5,7 @@ cdef struct PolishSchur:
     # The polished QP's KKT system by Schur complement where P's structure allows it
     # (see polish_schur.pyx); set up once per solve, factored once per guess.
     bint ready              # set up for the current scaled P and A
+    bint convex             # the set-up proved P positive semidefinite
     int dense               # leading rows of the unconstrained entries that P couples
     Py_ssize_t unconstrained    # entries without a bound or a cone (n - s)
     Py_ssize_t* order       # n: the unconstrained entries, coupled ones first

@@ -69,11 +69,15 @@ cdef extern from "fccqp_kernels.h" nogil:
 cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noexcept nogil:
     """Check ``P``'s structure, factor its dense unconstrained block, and compute the
     unconstrained rows of ``Y`` and their part ``SU`` of ``S``; sets and returns
-    ``ready``."""
+    ``ready``. When ready, ``convex`` says whether that proves ``P`` positive
+    semidefinite: its dense block factored and no diagonal entry is negative (``P`` is
+    block diagonal here), so that a polish without ADMM's factorization, which holds
+    the convexity test, still answers only convex problems."""
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j, r, c, lead = 0, rest
     cdef double largest = 0.0, pivot
     cdef int k
     f.ready = False
+    f.convex = True
     mark_coupled(p.P, n, f.coupled)
     for i in range(n):
         largest = max(largest, p.P[i * n + i])
@@ -84,6 +88,8 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
         if f.coupled[i]:
             return False
         f.coupled[i] = 2   # constrained: not part of the unconstrained order
+        if p.P[i * n + i] < 0.0:
+            f.convex = False
         f.root[i] = sqrt(p.P[i * n + i] + delta) if p.P[i * n + i] > _PIVOT_TOLERANCE * largest else 0.0
     for i in range(n):
         if f.coupled[i] == 1:
@@ -214,7 +220,7 @@ cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t
             S[r + c * size] = f.SU[r + c * m] if r < m else 0.0
         if c >= m:
             S[c + c * size] = delta
-    if row > f.unconstrained:
+    if size > 0 and row > f.unconstrained:   # BLAS rejects a leading dimension of 0
         syrk_t(<int>size, <int>(row - f.unconstrained), Y + f.unconstrained, <int>n, 1.0, S,
                <int>size)
     for c in range(size):
