@@ -61,6 +61,59 @@ BAD_INPUT = [
         ValueError, r"x\[0\] is in a cone block and has a finite bound",
     ),
     (dict(P=-np.eye(6)), ValueError, "P is not positive semidefinite"),
+    # types: object arrays (even of numbers), None, complex, ragged lists
+    (dict(P=np.eye(6).astype(object)), TypeError, "P must be a numeric matrix, got dtype object"),
+    (dict(P=None), TypeError, "P must be a numeric matrix"),
+    (dict(P=[[1.0, 2.0], [3.0]]), TypeError, "P must be a numeric matrix"),
+    (dict(P=np.eye(6) + 0j), TypeError, "P must be real"),
+    (dict(q=np.ones(6).astype(object)), TypeError, "q must be a numeric vector, got dtype object"),
+    (dict(q=None), TypeError, "q must be a numeric vector"),
+    (dict(q=np.ones(6) + 0j), TypeError, "q must be real"),
+    (dict(A=np.ones((2, 6)).astype(object)), TypeError, "A must be a numeric matrix"),
+    (dict(A=np.ones((2, 6)) + 0j), TypeError, "A must be real"),
+    (dict(b=np.ones(2).astype(object)), TypeError, "b must be a numeric vector"),
+    (dict(b=np.ones(2) + 0j), TypeError, "b must be real"),
+    (dict(lb=np.zeros(6).astype(object)), TypeError, "lb must be a numeric vector"),
+    (dict(ub=np.ones(6) + 0j), TypeError, "ub must be real"),
+    # shapes
+    (dict(P=np.zeros((0, 0)), q=np.zeros(0), A=None, b=None), ValueError,
+     "P must have at least one row"),
+    (dict(A=np.ones(6)), ValueError, "A must be 2-dimensional"),
+    (dict(b=np.ones((2, 2))), ValueError, "b must be a vector"),
+    (dict(lb=np.zeros((1, 1, 6))), ValueError, "lb must be a vector"),
+    # magnitudes beyond 1e20
+    (dict(P=np.diag([1e21, 1, 1, 1, 1, 1])), ValueError, "P has an entry of magnitude"),
+    (dict(q=np.full(6, -1e21)), ValueError, r"q has an entry of magnitude 1e\+21"),
+    (dict(A=np.full((2, 6), 1e21)), ValueError, r"A has an entry of magnitude 1e\+21"),
+    (dict(b=np.full(2, 1e21)), ValueError, r"b has an entry of magnitude 1e\+21"),
+    # bounds
+    (dict(ub=np.full(6, -np.inf)), ValueError, r"ub\[0\] = -inf: lb may not be \+inf and ub"),
+    (dict(ub=np.full(6, np.nan)), ValueError, "ub contains NaN"),
+    (
+        dict(cones=[FrictionCone(3, 0.5)], lb=np.full(6, -1.0)),
+        ValueError, r"x\[3\] is in a cone block and has a finite bound \(lb\[3\] = -1.0",
+    ),
+    # cones
+    (dict(cones=None), TypeError, "cones must be a sequence of FrictionCone or SecondOrderCone"),
+    (dict(cones=5), TypeError, "cones must be a sequence"),
+    (dict(cones="cone"), TypeError, "cones must be a sequence"),
+    (dict(cones=[FrictionCone(True, 0.5)]), TypeError, r"cones\[0\].start must be an integer"),
+    (dict(cones=[SecondOrderCone(0, 2.0)]), TypeError, r"cones\[0\].dim must be an integer"),
+    (dict(cones=[FrictionCone(0, True)]), TypeError, r"cones\[0\].mu must be a real number"),
+    (dict(cones=[FrictionCone(0, 0.5j)]), TypeError, r"cones\[0\].mu must be a real number"),
+    (
+        dict(cones=[FrictionCone(0, 0.5, ("a", "b", "c"))]),
+        TypeError, r"cones\[0\].normal must be 3 real numbers",
+    ),
+    (
+        dict(cones=[FrictionCone(0, 0.5, (0, 0, 1j))]),
+        TypeError, r"cones\[0\].normal must be 3 real numbers",
+    ),
+    (dict(cones=[FrictionCone(0, 0.5, (0, 0, np.inf))]), ValueError, "normal contains NaN or inf"),
+    (
+        dict(cones=[SecondOrderCone(0, 2), FrictionCone(3, 0.5), SecondOrderCone(4, 2)]),
+        ValueError, r"cones\[1\] \(x\[3:6\]\) overlaps cones\[2\]",
+    ),
 ]
 
 
@@ -80,6 +133,13 @@ def test_bad_input_after_a_solve(changes, error, message):
     args.update(changes)
     with pytest.raises(error, match=message):
         solver.solve(**args)
+
+
+@pytest.mark.parametrize("changes, error, message", BAD_INPUT)
+def test_bad_input_on_the_sparse_path(changes, error, message):
+    """The sparse path (fccqp.sparse_problem) raises the dense path's errors."""
+    with pytest.raises(error, match=message):
+        solve(kkt_backend="sparse", **changes)
 
 
 @pytest.mark.parametrize("convert", [
@@ -146,6 +206,28 @@ def test_dense_arguments_recognizes_only_contiguous_float64_of_the_shapes():
         (dict(time_limit=-1.0), r"time_limit must lie in \(0, inf\]"),
         (dict(adaptive_rho="yes"), "adaptive_rho must be a bool"),
         (dict(verbose=None), "verbose must be a bool"),
+        (dict(polish=1), "polish must be a bool"),
+        (dict(sigma=0.0), r"sigma must lie in \(0, inf\)"),
+        (dict(rho=np.inf), r"rho must lie in \(0, inf\), got inf"),
+        (dict(alpha=True), "alpha must be a real number"),
+        (dict(eps_rel=np.inf), r"eps_rel must lie in \[0, inf\)"),
+        (dict(eps_prim_inf=0.0), r"eps_prim_inf must lie in \(0, inf\)"),
+        (dict(eps_dual_inf=-1.0), r"eps_dual_inf must lie in \(0, inf\)"),
+        (dict(adaptive_rho_tolerance=1.0), r"adaptive_rho_tolerance must lie in \(1, inf\)"),
+        (dict(time_limit=np.nan), r"time_limit must lie in \(0, inf\], got nan"),
+        (dict(min_iter=-1), r"min_iter must lie in \[0, 2147483647\]"),
+        (dict(min_iter=2**31), r"min_iter must lie in \[0, 2147483647\]"),
+        (dict(check_termination=2**31), r"check_termination must lie in \[1, 2147483647\]"),
+        (dict(check_termination=0), r"check_termination must lie in \[1, 2147483647\]"),
+        (dict(adaptive_rho_interval=2**31),
+         r"adaptive_rho_interval must lie in \[1, 2147483647\]"),
+        (dict(scaling=101), r"scaling must lie in \[0, 100\]"),
+        (dict(scaling=-1), r"scaling must lie in \[0, 100\]"),
+        (dict(scaling=4.0), "scaling must be an integer"),
+        (dict(anderson_memory=-1), r"anderson_memory must lie in \[0, 100\]"),
+        (dict(polish_refine_iter=101), r"polish_refine_iter must lie in \[0, 100\]"),
+        (dict(kkt_backend="dense"), "kkt_backend must be one of auto"),
+        (dict(kkt_backend=None), "kkt_backend must be one of auto"),
     ],
 )
 def test_bad_settings(overrides, message):
@@ -161,6 +243,84 @@ def test_settings_argument_must_be_settings():
 def test_bad_initial_guess():
     with pytest.raises(ValueError, match="x0 must be a finite vector of 6 entries"):
         fccqp.Solver().solve(P, q, A, b, x0=np.ones(3))
+
+
+@pytest.mark.parametrize("backend", ["auto", "sparse"])
+@pytest.mark.parametrize(
+    "x0, error, message",
+    [
+        (np.full(6, np.nan), ValueError, "x0 must be a finite vector of 6 entries"),
+        (np.full(6, 1e21), ValueError, r"x0 has an entry beyond 1e\+20"),
+        (np.ones(6).astype(object), TypeError, "x0 must be a real numeric vector"),
+        (np.ones(6) + 0j, TypeError, "x0 must be a real numeric vector"),
+        ("abcdef", TypeError, "x0 must be a real numeric vector"),
+    ],
+)
+def test_bad_initial_guesses(backend, x0, error, message):
+    with pytest.raises(error, match=message):
+        fccqp.Solver(kkt_backend=backend).solve(P, q, A, b, x0=x0)
+
+
+@pytest.mark.parametrize(
+    "call, error, message",
+    [
+        (lambda: fccqp.Settings.realtime(0.0), ValueError, r"budget must lie in \(0, inf\]"),
+        (lambda: fccqp.Settings.realtime(np.nan), ValueError, "budget must lie in"),
+        (lambda: fccqp.Settings.realtime("2e-3"), TypeError, "budget must be a real number"),
+        (lambda: fccqp.Settings.realtime(foo=1), ValueError, "unknown setting.*foo"),
+        (lambda: fccqp.Settings().replace(bar=1), ValueError, "unknown setting.*bar"),
+        (lambda: fccqp.Solver(baz=1), ValueError, "unknown setting.*baz"),
+    ],
+)
+def test_bad_presets_and_overrides(call, error, message):
+    with pytest.raises(error, match=message):
+        call()
+
+
+def test_integer_settings_take_their_largest_value():
+    settings = fccqp.Settings(max_iter=2**31 - 1, min_iter=2**31 - 1,
+                              check_termination=2**31 - 1, adaptive_rho_interval=2**31 - 1,
+                              scaling=100, anderson_memory=100, polish_refine_iter=100)
+    assert settings.max_iter == fccqp.settings.INT_MAX == 2**31 - 1
+    assert settings.scaling == fccqp.settings.MAX_SCALING == 100
+
+
+def _cone_problem():
+    """Two torques, a contact force in a friction cone and a second-order block, with
+    the cones binding: the targets of ``q`` lie outside them."""
+    n = 8
+    P_c = np.diag([1.0, 1.0, 1e-2, 1e-2, 1e-2, 1.0, 1.0, 1.0])
+    q_c = np.array([-8.0, 0.0, 0.0, 0.0, 0.0, 0.0, -3.0, -4.0])
+    A_c = np.zeros((3, n))
+    A_c[0, [0, 2]] = 1.0, -1.0
+    A_c[1, [1, 3]] = 1.0, -1.0
+    A_c[2, 4] = 1.0
+    b_c = np.array([0.0, 0.0, 10.0])
+    lb_c = np.array([-6.0, -6.0] + [-np.inf] * 6)
+    ub_c = np.array([6.0, 6.0] + [np.inf] * 6)
+    return P_c, q_c, A_c, b_c, lb_c, ub_c
+
+
+@pytest.mark.parametrize("backend", ["auto", "sparse"])
+@pytest.mark.parametrize("cone", [
+    FrictionCone(2, 0.5),
+    FrictionCone(2, 0.5, (0.0, 0.6, 0.8)),
+    SecondOrderCone(5, 3),
+])
+def test_a_single_cone_is_a_one_element_list(backend, cone):
+    """``cones=cone`` is accepted and means ``cones=[cone]`` (docs/api.md), cold and on
+    a warm Solver that alternates between the two spellings."""
+    data = _cone_problem()
+    listed = fccqp.solve(*data, cones=[cone], kkt_backend=backend)
+    single = fccqp.solve(*data, cones=cone, kkt_backend=backend)
+    assert listed.status is single.status is fccqp.Status.SOLVED
+    np.testing.assert_array_equal(single.x, listed.x)
+    np.testing.assert_array_equal(single.z, listed.z)
+    solver, reference = fccqp.Solver(kkt_backend=backend), fccqp.Solver(kkt_backend=backend)
+    for spelling in ([cone], cone, (cone,), cone):
+        got, expected = solver.solve(*data, cones=spelling), reference.solve(*data, cones=[cone])
+        assert got.status is expected.status is fccqp.Status.SOLVED
+        np.testing.assert_array_equal(got.x, expected.x)
 
 
 def test_rounding_asymmetry_is_accepted():
