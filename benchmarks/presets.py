@@ -1,4 +1,6 @@
-"""Sizes of the two benchmark runs, shared by the benchmark and the qpbenchmark export."""
+"""Sizes of the two benchmark runs, shared by the benchmark, the qpbenchmark export and the
+documentation (``tests/test_benchmark_report.py`` checks that ``--help`` and
+docs/benchmarks.md give these sizes)."""
 
 from __future__ import annotations
 
@@ -17,8 +19,9 @@ class Preset:
 
 
 PRESETS: dict[str, Preset] = {
-    # 4 sequences of 15 ticks: one of each scenario of the mix; every variant, the settings
-    # sweeps included, in under 2 minutes on 2 cores once fccqp is compiled.
+    # 4 sequences of 15 ticks: one of each scenario of the mix; every variant and view (the
+    # coarse views walk the full preset's sets), test sets generated, in about 3 minutes of
+    # CPU time: within 5 minutes on 2 cores.
     "quick": Preset(n_qps=60, seq_len=15, repeats=3),
     # 4 sequences of 100 ticks (the generator's default length).
     "full": Preset(n_qps=400, seq_len=100, repeats=10),

@@ -138,8 +138,9 @@ def _coarse_description(result: SetResult) -> str:
     n = sum(r["view"] == "warm" and r["contact_change"] for r in result.rows
             if r["solver"] == result.rows[0]["solver"])
     return (f"Cold: every QP of this set from a reset solver. Every 5th / 10th: those QPs of "
-            f"{where}, warm from the previous kept QP. Contact change: the {n} QPs of this "
-            "set whose stance differs from the previous QP's.")
+            f"{where}, warm from the previous kept QP. Contact change: the "
+            f"{n} QP{'s' if n != 1 else ''} of this set whose stance (feet in contact) differs "
+            "from the previous QP's.")
 
 
 def _machine(info: RunInfo) -> list[str]:

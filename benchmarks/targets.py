@@ -83,8 +83,8 @@ def _ratio_row(robot: str, goal: str, pair: tuple[Summary, Summary], stat: str, 
                beside: str = "") -> str:
     a, b = pair
     ok = getattr(a, stat) <= limit * getattr(b, stat)
-    return (f"| {robot} | {goal} <= {limit:g}x {PEER}'s | {_versus(a, b, stat)} ({a.n} QPs)"
-            f"{beside} | {_verdict(ok)} |")
+    return (f"| {robot} | {goal} <= {limit:g}x {PEER}'s | {_versus(a, b, stat)} "
+            f"({a.n} QP{'s' if a.n != 1 else ''}){beside} | {_verdict(ok)} |")
 
 
 def every_tick_rows(robot: str, views: dict[str, list[Summary]]) -> list[str]:
