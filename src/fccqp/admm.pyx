@@ -39,9 +39,9 @@ from fccqp._dense cimport copy, fill, inf_norm, matvec, matvec_t
 from fccqp._types cimport Cones, Iterates, Problem
 from fccqp.blas_threads cimport enter, leave
 from fccqp.anderson cimport Anderson, anderson_reset, anderson_step
-from fccqp.certificates cimport (CERTIFIED, SEPARATED, dual_infeasible, equality_direction,
-                                 equality_inconsistent, magnitudes, primal_infeasible,
-                                 row_size)
+from fccqp.certificates cimport (CERTIFIED, SEPARATED, clean_primal_certificate,
+                                 dual_infeasible, equality_direction, equality_inconsistent,
+                                 gram_factor, magnitudes, primal_infeasible, row_size)
 from fccqp.fast_checks cimport hold_dense, hold_float64
 from fccqp.kkt cimport (AUTO, FACTORED, KKT, LDL_FULL, LDL_REDUCED, NOT_CONVEX, SCHUR_REDUCED,
                         UNAVAILABLE, kkt_convexity, kkt_factor, kkt_solve)
@@ -127,6 +127,10 @@ STALL_FACTOR, STALLS = 1e3, 2
 """Anderson acceleration stops for the rest of a run when, at ``STALLS`` scheduled checks
 in a row, the primal residual is above ``STALL_FACTOR`` times its tolerance and not half
 of what it was at the previous scheduled check (see _iterate)."""
+CLEANING_GATE = 1.0
+"""A primal certificate's candidate is cleaned only while the primal residual is above
+this many times its tolerance (see ``Workspace._cleaned_certificate``): weakly
+infeasible problems stall near it (rows off two friction cones by 1e-4 at 10 times)."""
 GATED_CHECK_WAIT = 8
 """In the reduced form a full residual check runs between the scheduled ones only when
 ``near_convergence`` says that it may pass; after a gated check that did not end the run
@@ -233,6 +237,7 @@ cdef long _GATED_CHECK_WAIT = GATED_CHECK_WAIT
 cdef long _EQUALITY_START_STEPS = EQUALITY_START_STEPS
 cdef long _LOG_INTERVAL = LOG_INTERVAL
 cdef double _STALL_FACTOR = STALL_FACTOR
+cdef double _CLEANING_GATE = CLEANING_GATE
 cdef int _STALLS = STALLS
 
 
@@ -369,6 +374,7 @@ cdef class Workspace:
     cdef double* vec_m
     cdef double* direction
     cdef double* cert
+    cdef double* gram   # m x m: Cholesky factor of A A' for cleaning certificates
     cdef double* saved
     cdef double* log
     cdef double* prev_x
@@ -384,6 +390,8 @@ cdef class Workspace:
     cdef double final_reserve   # seconds the final polish or restoration took lately
     cdef double pass_time   # seconds per guess of the last polish, its check included
     cdef double tighten   # factor on the tolerances of the run (see POLISH_RETRIES)
+    cdef double stalled_prim   # primal residual at the last check that could clean
+    cdef int gram_state   # gram: 0 not factored in this solve, 1 factored, -1 failed
     cdef double clock[6]
     cdef bint has_previous, has_matrices, certified, scaled_once
     cdef bint has_rho   # prev_rho is a rho some solve adapted (a cold start keeps it too)
@@ -459,6 +467,7 @@ cdef class Workspace:
         cdef Py_ssize_t wide = max(n, m)
         self.vec_n, self.vec_n2, self.vec_n3 = self._new(wide), self._new(wide), self._new(wide)
         self.vec_s, self.vec_s2, self.vec_m = self._new(s), self._new(s), self._new(m)
+        self.gram = self._new(m * m)
         self.guess_point, self.guess_codes = self._new(s), <char*>self._new(s)
         self.direction, self.saved, self.cert = self._new(n), self._new(N + s), self._new(N)
         self.prev_x, self.prev_y, self.prev_z = self._new(n), self._new(m), self._new(n)
@@ -820,6 +829,8 @@ cdef class Workspace:
         _trial_reset(&trial)
         run.polished = False
         self.tighten = 1.0
+        self.stalled_prim = INFINITY
+        self.gram_state = 0
         self.table_ready = False   # base is for the previous q, b
         self.pol.schur.ready = False   # set up for the previous P, A
         self.iterated = False
@@ -1037,6 +1048,7 @@ cdef class Workspace:
         cdef Options* o = &self.opt
         cdef Residuals* r = &self.res
         cdef Py_ssize_t i
+        cdef int code
         if not r.finite:
             return _NUMERICAL_ERROR
         if (self._missed_by_data()
@@ -1046,8 +1058,10 @@ cdef class Workspace:
             return _PRIMAL_INFEASIBLE
         if converged(r, self.tighten * o.eps_abs, self.tighten * o.eps_rel):
             return _SOLVED
-        if primal_infeasible(p, it, o.eps_prim_inf, self.vec_m, self.vec_s, self.vec_n,
-                             self.vec_n2):
+        code = primal_infeasible(p, it, o.eps_prim_inf, self.vec_m, self.vec_s, self.vec_n,
+                                 self.vec_n2)
+        if code == CERTIFIED or (code == SEPARATED and iteration % o.adaptive_rho_interval == 0
+                                 and self._cleaned_certificate()):
             fill(self.cert, 0.0, p.n + p.m)
             for i in range(p.m):   # in the user's units (the common factor 1/c dropped)
                 self.cert[i] = self.vec_m[i] * p.E[i]
@@ -1061,6 +1075,26 @@ cdef class Workspace:
         if last:
             return self._classify(iteration, True, start_time)
         return _RUNNING
+
+    cdef bint _cleaned_certificate(self) noexcept nogil:
+        """Clean the primal certificate's candidate that the last test left in ``vec_m``,
+        ``vec_s`` (:func:`fccqp.certificates.clean_primal_certificate`), on the schedule
+        of rho adaptation, when the primal residual is far from its tolerance
+        (``CLEANING_GATE``) and did not halve since the last such check, and the
+        candidate separates: how infeasibility looks, and the only case worth an ``A
+        A'`` factorization (m x m, once per solve)."""
+        cdef Problem* p = &self.prob
+        cdef Residuals* r = &self.res
+        cdef double previous = self.stalled_prim
+        self.stalled_prim = r.prim
+        if not (p.m > 0 and r.prim > 0.5 * previous
+                and r.prim > _CLEANING_GATE * (self.opt.eps_abs + self.opt.eps_rel * r.prim_scale)):
+            return False
+        if self.gram_state == 0:   # once per solve: A A' of this solve's scaled rows
+            self.gram_state = 1 if gram_factor(p, self.gram) else -1
+        return self.gram_state == 1 and clean_primal_certificate(
+            p, self.it.x, self.gram, self.opt.eps_prim_inf, self.vec_m, self.vec_s,
+            self.vec_n3, self.vec_n, self.vec_n2)
 
     cdef bint _missed(self) noexcept nogil:
         """The last residuals miss ``A x = b`` beyond factorization accuracy

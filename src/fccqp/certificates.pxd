@@ -1,13 +1,14 @@
 # cython: language_level=3
 from fccqp._types cimport Iterates, Problem
 
-cdef bint primal_infeasible(const Problem* p, const Iterates* it, double eps, double* d_nu,
-                            double* d_y, double* lhs, double* terms) noexcept nogil
 cdef enum:
-    # Outcomes of the equality certificate's tests.
+    # Outcomes of a primal or equality certificate's tests.
     REJECTED = 0
     CERTIFIED = 1
-    SEPARATED = 2   # b'r > 0, but A'r is not small enough against it
+    SEPARATED = 2   # it separates, but its residual is not small enough against that
+
+cdef int primal_infeasible(const Problem* p, const Iterates* it, double eps, double* d_nu,
+                           double* d_y, double* lhs, double* terms) noexcept nogil
 
 cdef int equality_inconsistent(const Problem* p, const Iterates* it, double eps, double* r,
                                double* ATr, double* terms) noexcept nogil
@@ -17,3 +18,7 @@ cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double
                           double* terms, double* block) noexcept nogil
 cdef void magnitudes(const Problem* p, const double* x, double* t) noexcept nogil
 cdef double row_size(const Problem* p, Py_ssize_t i, const double* t) noexcept nogil
+cdef bint gram_factor(const Problem* p, double* gram) noexcept nogil
+cdef bint clean_primal_certificate(const Problem* p, const double* x, const double* gram,
+                                   double eps, double* d_nu, double* d_y, double* w,
+                                   double* lhs, double* terms) noexcept nogil
