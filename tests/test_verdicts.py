@@ -16,7 +16,15 @@ from fccqp import FrictionCone, SecondOrderCone, Status
 from reference import clarabel_solve
 from verify import Problem, check_solution, verify_solution
 
-BACKENDS = ["auto", "schur_reduced", "ldl_reduced", "ldl_full"]
+SPARSE_DRIFT = pytest.mark.xfail(
+    strict=True, reason="the sparse path re-implements the algorithm in Python and has "
+    "drifted from it; it must pass once it is a backend of the one compiled algorithm")
+
+
+def backends(sparse_fails: bool) -> list:
+    """Every ``kkt_backend``, the sparse path marked as expected to fail where it does."""
+    sparse = pytest.param("sparse", marks=SPARSE_DRIFT) if sparse_fails else "sparse"
+    return ["auto", "schur_reduced", "ldl_reduced", "ldl_full", sparse]
 
 
 def solve_verified(problem: Problem, **settings) -> fccqp.Result:
@@ -48,7 +56,7 @@ def rotated(problem: Problem, seed: int = 1) -> Problem:
     return Problem.of(Q @ problem.P @ Q.T, Q @ problem.q, problem.A @ Q.T, problem.b)
 
 
-@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("backend", backends(sparse_fails=True))
 def test_a_free_direction_without_curvature_is_certified_unbounded(backend):
     """The ray is large in a coordinate-aligned null space of ``P`` and the rest of the
     step small: a ``P dx ~ 0`` test relative to the terms of ``P dx`` compared that
@@ -59,9 +67,10 @@ def test_a_free_direction_without_curvature_is_certified_unbounded(backend):
     assert clarabel_solve(*problem.args()).status == "dual_infeasible"
 
 
-def test_a_ray_along_a_rotated_null_direction_is_certified_unbounded():
+@pytest.mark.parametrize("backend", backends(sparse_fails=False))
+def test_a_ray_along_a_rotated_null_direction_is_certified_unbounded(backend):
     problem = rotated(free_direction_without_curvature())
-    result = solve_verified(problem)
+    result = solve_verified(problem, kkt_backend=backend)
     assert result.status is Status.DUAL_INFEASIBLE
     assert clarabel_solve(*problem.args()).status == "dual_infeasible"
 
@@ -104,6 +113,14 @@ def test_rows_just_outside_a_friction_cone_are_certified_infeasible(mu, gap, cur
     assert clarabel_solve(*problem.args()).status == "primal_infeasible"
 
 
+@pytest.mark.parametrize("backend", backends(sparse_fails=True))
+def test_rows_just_outside_a_friction_cone_are_certified_on_every_backend(backend):
+    A = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
+    problem = Problem.of(np.eye(3), np.array([0.1, -0.2, 0.3]), A, np.array([1.0, 0.7007]),
+                         cones=[FrictionCone(0, 0.7)])
+    assert solve_verified(problem, kkt_backend=backend).status is Status.PRIMAL_INFEASIBLE
+
+
 def dependent_rows_with_rounding_noise(seed: int) -> Problem:
     """Rows ``B`` and two combinations of them, all asking 0, with right-hand sides of
     rounding noise (4e-16, -2e-16) on the combinations; ``x >= 0``, a flat cost on most
@@ -121,14 +138,15 @@ def dependent_rows_with_rounding_noise(seed: int) -> Problem:
     return Problem.of(P, q, A, b, np.zeros(n), ub)
 
 
+@pytest.mark.parametrize("backend", backends(sparse_fails=False))
 @pytest.mark.parametrize("seed", range(4))
-def test_rounding_noise_on_dependent_rows_is_not_called_infeasible(seed):
+def test_rounding_noise_on_dependent_rows_is_not_called_infeasible(seed, backend):
     """A public QP (QSCORPIO, Maros-Meszaros) has such rows: the equality certificate,
     relative to its own terms alone, accepted ``r`` of 7e-17 at iteration 0. Its
     separation must now exceed the rows' size at the magnitude of the box."""
     problem = dependent_rows_with_rounding_noise(seed)
     assert clarabel_solve(*problem.args()).status == "solved"
-    assert solve_verified(problem).status is Status.SOLVED
+    assert solve_verified(problem, kkt_backend=backend).status is Status.SOLVED
 
 
 def test_a_kept_workspace_rejects_a_non_convex_P(capfd):
@@ -149,3 +167,33 @@ def test_a_kept_workspace_rejects_a_non_convex_P(capfd):
     with pytest.raises(ValueError, match="not convex"):
         fccqp.solve(P, q, None, None, lb, ub)
     assert "DSYRK" not in capfd.readouterr().err
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e-200, 1e-20])
+@pytest.mark.parametrize("scaling", [0, 4])
+def test_equalities_of_tiny_rows_hold(scale, scaling):
+    """Rows of norm 1e-300 sat below the KKT matrix's regularization: ``x`` ignored them
+    and MAX_ITER_REACHED came back with ``|A x - b| = |b|``. They now start at norm 1
+    (an exact power of two) whatever the Ruiz passes."""
+    misses = []
+    for seed in range(6):
+        rng = np.random.default_rng(seed)
+        M = rng.standard_normal((6, 6))
+        A = scale * rng.standard_normal((3, 6))
+        b = A @ rng.uniform(-0.5, 0.5, 6)
+        problem = Problem.of(M @ M.T / 6, rng.standard_normal(6), A, b)
+        result = solve_verified(problem, scaling=scaling)
+        assert result.status is Status.SOLVED
+        misses.append(np.abs(A @ result.x - b).max() / np.abs(b).max())
+    assert max(misses) < 1e-9
+
+
+@pytest.mark.parametrize("backend", backends(sparse_fails=True))
+def test_equalities_of_tiny_rows_hold_on_every_backend(backend):
+    rng = np.random.default_rng(0)
+    M = rng.standard_normal((6, 6))
+    A = 1e-300 * rng.standard_normal((3, 6))
+    b = A @ rng.uniform(-0.5, 0.5, 6)
+    result = solve_verified(Problem.of(M @ M.T / 6, rng.standard_normal(6), A, b),
+                            kkt_backend=backend)
+    assert np.abs(A @ result.x - b).max() < 1e-9 * np.abs(b).max()

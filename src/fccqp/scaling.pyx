@@ -17,7 +17,7 @@ cone: friction cones keep their ``mu`` and normal.
 
 import numpy as np
 
-from libc.math cimport exp, fabs, log, sqrt
+from libc.math cimport exp, fabs, ilogb, ldexp, log, sqrt
 
 from fccqp._types cimport Cones
 from fccqp.projections cimport proj_set
@@ -88,7 +88,11 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
     for j in range(n):
         D[j] = 1.0
     for i in range(m):
-        E[i] = 1.0
+        # a row below MIN_NORM, which the passes leave alone, starts at norm 1 exactly
+        # (a power of two): rows of 1e-300 were lost to the KKT matrix's regularization
+        # and A x = b to |b|, whatever the passes
+        value = _row_max(A + i * n, D, n)
+        E[i] = ldexp(1.0, -ilogb(value)) if 0.0 < value < _MIN_NORM else 1.0
     for it in range(iterations):
         # column maxima accumulate row by row (independent per column: the loops vectorize)
         for j in range(n):
