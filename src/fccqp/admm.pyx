@@ -127,6 +127,9 @@ STALL_FACTOR, STALLS = 1e3, 2
 """Anderson acceleration stops for the rest of a run when, at ``STALLS`` scheduled checks
 in a row, the primal residual is above ``STALL_FACTOR`` times its tolerance and not half
 of what it was at the previous scheduled check (see _iterate)."""
+RESTART_MIN_ITER = 200
+"""A start from a previous solution or ``x0`` that fails within half of ``max_iter``
+restarts cold for the rest only when ``max_iter`` is at least this (``Workspace._run``)."""
 CLEANING_GATE = 1.0
 """A primal certificate's candidate is cleaned only while the primal residual is above
 this many times its tolerance (see ``Workspace._cleaned_certificate``): weakly
@@ -238,6 +241,7 @@ cdef long _EQUALITY_START_STEPS = EQUALITY_START_STEPS
 cdef long _LOG_INTERVAL = LOG_INTERVAL
 cdef double _STALL_FACTOR = STALL_FACTOR
 cdef double _CLEANING_GATE = CLEANING_GATE
+cdef long _RESTART_MIN_ITER = RESTART_MIN_ITER
 cdef int _STALLS = STALLS
 
 
@@ -680,6 +684,7 @@ cdef class Workspace:
         cdef Py_ssize_t n = p.n, m = p.m
         cdef bint same = self.has_matrices
         cdef Run run
+        cdef long spent
         self.clock[0] = fccqp_now()
         with nogil:
             self.found = scan_and_copy(
@@ -691,12 +696,32 @@ cdef class Workspace:
         if not self._same_structure(lb, ub):
             self.has_matrices = False
             return _STRUCTURE_CHANGED
+        cdef long max_iter = self.opt.max_iter
+        # a start from the previous solution (or x0), with the previous scaling, that
+        # has not succeeded in half the iterations gets a cold start with a new scaling
+        # for the other half, as a fresh solve would have (a changed A once ran 4000
+        # iterations warm, where a fresh solve needed none); not under a time limit,
+        # which leaves no time for it, nor for budgets too small to split
+        cdef bint restartable = ((x0 != NULL or (warm and self.has_previous))
+                                 and not isfinite(self.opt.time_limit)
+                                 and max_iter >= _RESTART_MIN_ITER)
         enter()   # single-threaded BLAS for this solve (see fccqp.blas_threads)
         try:
             with nogil:
+                if restartable:
+                    self.opt.max_iter = max_iter // 2
                 run = self._solve(same, x0, warm and self.has_previous, start_time)
                 if run.status != _NOT_CONVEX:
                     self._finish(&run, x_out, y_out if m else NULL, z_out, cert_out)
+                self.opt.max_iter = max_iter
+                if restartable and (run.status == _MAX_ITER or run.status == _NUMERICAL_ERROR):
+                    self.opt.max_iter = max_iter - run.iterations
+                    spent = run.iterations
+                    run = self._solve(False, NULL, False, start_time)
+                    self.opt.max_iter = max_iter
+                    run.iterations += spent
+                    if run.status != _NOT_CONVEX:
+                        self._finish(&run, x_out, y_out if m else NULL, z_out, cert_out)
                 self.clock[5] = fccqp_now()
                 self.final_reserve *= _RESERVE_DECAY
                 if self.iterated:   # learn what the final step after the iterations costs
@@ -1550,7 +1575,12 @@ cdef class Workspace:
             elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
                 run.status = _INACCURATE
             elif run.status in (_SOLVED, _INACCURATE):
-                run.status = _NUMERICAL_ERROR   # the scaled test passed, the point does not
+                # the iterate passed, the returned point does not: a budget that ran out
+                # says so (finite residuals are no numerical error), else the point
+                # carries no guarantee
+                run.status = (_MAX_ITER if run.iterations >= self.opt.max_iter
+                              else _TIME_LIMIT if fccqp_now() - self.clock[0] >= self.opt.time_limit
+                              else _NUMERICAL_ERROR)
         if not self.res.finite:
             run.status = _NUMERICAL_ERROR
         self.has_previous = self.res.finite and run.status not in (
