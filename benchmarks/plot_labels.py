@@ -19,7 +19,7 @@ __all__ = ["Point", "place_labels"]
 
 _MERGE_PX = 8.0
 """Points of one solver closer than this (pixels) share a label."""
-_OFFSETS = [(dx, dy) for r in (6, 14, 24) for dx, dy in
+_OFFSETS = [(dx, dy) for r in (6, 14, 24, 36) for dx, dy in
             ((r, 2), (r, -r), (-r, 2), (-r, -r), (0, r), (0, -r - 6), (r, r), (-r, r))]
 """Candidate offsets (points) of a label's anchor from its point, nearest first."""
 _MARKER_PX = 5.0
@@ -72,22 +72,21 @@ def place_labels(ax: plt.Axes, points: Sequence[Point], transform=None,
     for group in _groups(points, transform):
         text = ", ".join(dict.fromkeys(p.text for p in group))
         anchor = group[0]
+        label = ax.annotate(text, (anchor.x, anchor.y), xycoords=transform, xytext=(0, 0),
+                            textcoords="offset points", fontsize=fontsize,
+                            color=anchor.colour, va="bottom")
         best, best_cost = None, None
         for dx, dy in _OFFSETS:
-            label = ax.annotate(text, (anchor.x, anchor.y), xycoords=transform,
-                                xytext=(dx, dy), textcoords="offset points",
-                                fontsize=fontsize, color=anchor.colour,
-                                ha="left" if dx >= 0 else "right", va="bottom")
+            label.xyann = (dx, dy)
+            label.set_horizontalalignment("left" if dx >= 0 else "right")
             box = label.get_window_extent(renderer).padded(1.0 * to_px)
             outside = not (frame.x0 <= box.x0 and box.x1 <= frame.x1 and box.y1 <= frame.y1)
             cost = (sum(box.overlaps(b) for b in taken) + sum(box.overlaps(b) for b in markers)
                     + 2 * outside)
             if best_cost is None or cost < best_cost:
-                if best is not None:
-                    best[0].remove()
-                best, best_cost = (label, box), cost
-            else:
-                label.remove()
+                best, best_cost = ((dx, dy), box), cost
             if cost == 0:
                 break
+        label.xyann = best[0]
+        label.set_horizontalalignment("left" if best[0][0] >= 0 else "right")
         taken.append(best[1])
