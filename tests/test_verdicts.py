@@ -113,6 +113,22 @@ def test_rows_just_outside_a_friction_cone_are_certified_infeasible(mu, gap, cur
     assert clarabel_solve(*problem.args()).status == "primal_infeasible"
 
 
+@pytest.mark.parametrize("mu", [0.4, 0.8])
+@pytest.mark.parametrize("gap", [1e-2, 1e-3, 1e-4])
+def test_two_cones_pinned_outside_their_sum_beside_a_boxed_row_are_certified(mu, gap):
+    """``fz1 + fz2 = 1``, ``fx1 + fx2 = mu (1 + gap)`` need both cones for a certificate,
+    and a third row ``fy1 + x6 = 0.5`` through a boxed entry leaves the candidate a
+    multiplier that only adds support: plain projections kept it (4000 iterations at
+    ``gap`` 1e-4), the proximal step on the support removes it."""
+    A = np.zeros((3, 7))
+    A[0, [2, 5]] = A[1, [0, 3]] = A[2, [1, 6]] = 1.0
+    problem = Problem.of(np.eye(7), np.linspace(-0.3, 0.3, 7), A, [1.0, mu * (1 + gap), 0.5],
+                         np.r_[np.full(6, -np.inf), -1.0], np.r_[np.full(6, np.inf), 1.0],
+                         [FrictionCone(0, mu), FrictionCone(3, mu)])
+    assert solve_verified(problem).status is Status.PRIMAL_INFEASIBLE
+    assert clarabel_solve(*problem.args()).status == "primal_infeasible"
+
+
 @pytest.mark.parametrize("backend", backends(sparse_fails=True))
 def test_rows_just_outside_a_friction_cone_are_certified_on_every_backend(backend):
     A = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])

@@ -1119,7 +1119,7 @@ cdef class Workspace:
             self.gram_state = 1 if gram_factor(p, self.gram) else -1
         return self.gram_state == 1 and clean_primal_certificate(
             p, self.it.x, self.gram, self.opt.eps_prim_inf, self.vec_m, self.vec_s,
-            self.vec_n3, self.vec_n, self.vec_n2)
+            self.saved, self.vec_n3, self.vec_n, self.vec_n2)
 
     cdef bint _missed(self) noexcept nogil:
         """The last residuals miss ``A x = b`` beyond factorization accuracy

@@ -20,5 +20,5 @@ cdef void magnitudes(const Problem* p, const double* x, double* t) noexcept nogi
 cdef double row_size(const Problem* p, Py_ssize_t i, const double* t) noexcept nogil
 cdef bint gram_factor(const Problem* p, double* gram) noexcept nogil
 cdef bint clean_primal_certificate(const Problem* p, const double* x, const double* gram,
-                                   double eps, double* d_nu, double* d_y, double* w,
-                                   double* lhs, double* terms) noexcept nogil
+                                   double eps, double* d_nu, double* d_y, double* saved,
+                                   double* w, double* lhs, double* terms) noexcept nogil
