@@ -3,7 +3,7 @@
 A variant is one solver at one setting (:class:`Variant`). Each peer runs at its own
 default settings and, for the work-precision plot, at one looser and one tighter
 tolerance (the ``-loose`` / ``-tight`` variants, ``sweep=True``); fccqp runs its two
-presets plus a sweep of its tolerance and of the real-time preset's iteration budget.
+presets plus a sweep of its tolerance and of the real-time preset's time budget.
 The table :data:`VARIANTS` is the single source of names, descriptions and classes;
 the adapters are in :mod:`benchmarks.exact_solvers` and :mod:`benchmarks.pyramid_solvers`.
 
