@@ -23,7 +23,7 @@ SEEDS = {
     "primal_infeasible": (0, 1, 2, 3, 80),
     "dual_infeasible": (0, 1, 2, 33, 257),
     "solver_reuse": (0, 1, 2, 211),
-    "extreme_data": (0, 1, 38, 138, 202, 335),
+    "extreme_data": (0, 1, 38, 138, 202, 254, 326, 335),
     "qpsolvers": (0, 1, 2),
     "cvxpy": (1, 2, 3),
 }
@@ -38,17 +38,49 @@ SPARSE_SEEDS = {
 }
 """Seeds per class run on the sparse path (each ends within a few dozen iterations)."""
 
-CASES = [(name, seed, backend) for backend in DENSE_BACKENDS
+OPEN = {
+    "primal_infeasible:3": "a tilted friction cone beside a boxed entry: the multipliers' "
+    "steps reach the certificates too slowly even after cleaning",
+    "primal_infeasible:80": "a tilted friction cone beside a boxed entry: the multipliers' "
+    "steps reach the certificates too slowly even after cleaning",
+    "dual_infeasible:33": "a reduced backend factors a numerically singular P + R "
+    "(null direction off the axes): |x| of 1e17 and no direction passes",
+    "dual_infeasible:257": "a second-order-cone ray stalls in the full form",
+    "solver_reuse:211": "sigma in scaled units decides convexity: a fresh solve accepts "
+    "-3.9e-3 curvature that a kept workspace rejects",
+    "extreme_data:138": "SOLVED through the absolute tolerance on a cone block rescaled by 1e-8",
+    "extreme_data:335": "four Ruiz passes leave A x 1e11 badly scaled: rho pinned at its cap",
+    "cvxpy:1": "a feasible problem whose dual residual stalls near 0.8 in the LDL' forms "
+    "with adaptive rho",
+    "solver_reuse:38": "the sparse path's first factorization breaks down on dependent rows",
+    "extreme_data:26": "the sparse path's dual certificate hides A dx under large rows",
+}
+"""Reproducers of mechanisms still open (issue 26), each the reason it fails: expected
+to fail (strictly) on the backends where it does, so that a fix turns them red."""
+OPEN_BACKENDS = {"dual_infeasible:33": ("auto", "schur_reduced", "ldl_reduced"),
+                 "dual_infeasible:257": ("auto", "ldl_full"),
+                 "cvxpy:1": ("auto", "ldl_reduced", "ldl_full")}
+"""Where an open case fails on some backends only."""
+
+
+def _case(name: str, seed: int, backend: str):
+    key = f"{name}:{seed}"
+    if key in OPEN and backend in OPEN_BACKENDS.get(key, (*DENSE_BACKENDS, "sparse")):
+        return pytest.param(name, seed, backend, id=f"{key}-{backend}",
+                            marks=pytest.mark.xfail(strict=True, reason=OPEN[key]))
+    return pytest.param(name, seed, backend, id=f"{key}-{backend}")
+
+
+CASES = [_case(name, seed, backend) for backend in DENSE_BACKENDS
          for name, seeds in SEEDS.items() for seed in seeds]
-CASES += [(name, seed, "sparse") for name, seeds in SPARSE_SEEDS.items() for seed in seeds]
+CASES += [_case(name, seed, "sparse") for name, seeds in SPARSE_SEEDS.items() for seed in seeds]
 
 
 def test_every_class_is_covered() -> None:
     assert set(SEEDS) == set(CLASSES)
 
 
-@pytest.mark.parametrize(("name", "seed", "backend"), CASES,
-                         ids=[f"{name}:{seed}-{backend}" for name, seed, backend in CASES])
+@pytest.mark.parametrize(("name", "seed", "backend"), CASES)
 def test_fuzz_case(name: str, seed: int, backend: str) -> None:
     failure = judge(Case.of(name, seed), backend)
     assert failure is None, failure

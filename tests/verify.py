@@ -26,10 +26,10 @@ primal point (``||b||``, ``|A||x|``, ``||q||``, ``||Px||``, ``|q'x|``, ``|x'Px|`
 never from the multipliers: an iterate with multipliers of 1e8 must not make its own
 residuals look small. Certificate conditions are relative to the size of their own
 terms (the dual certificate's ``P dx ~ 0`` and ``A dx ~ 0`` to each row's norm times
-``||dx||``: along a ray in a coordinate-aligned null space of ``P`` the ray adds
-nothing to the terms of ``P dx``, which then measured the unconverged rest against
-itself), so they are invariant to scaling the certificate, the rows of ``A`` or the
-objective.
+``||dx||``, columns balanced: along a ray in a coordinate-aligned null space of ``P``
+the ray adds nothing to the terms of ``P dx``, which then measured the unconverged
+rest against itself), so they are invariant to scaling the certificate, the rows of
+``A`` or the objective.
 
 The primal certificate's separation. By Farkas, ``(dy, dz)`` proves that no ``x`` has
 ``A x = b`` and ``x`` in C when ``A'dy + dz = 0`` and ``b'dy + sigma_C(dz) < 0``; with a
@@ -344,7 +344,10 @@ def _check_primal_certificate(problem: Problem, result: fccqp.Result, tol: Toler
 
 
 def _row_relative(M: np.ndarray, dx: np.ndarray) -> float:
-    """``max_i |M_i dx| / ||M_i||_1`` (a zero row counts 0) for ``||dx||_inf = 1``."""
+    """``max_i |M_i dx| / ||M_i||_1`` (a zero row counts 0) for ``||dx||_inf = 1``; the
+    callers balance the columns first (``x = D u`` with ``D_j = 1 / sqrt(max_i
+    |M_ij|)``), since in the user's units a row whose norm comes from large-scale
+    variables hides curvature on small-scale ones."""
     norms = np.abs(M).sum(axis=1)
     products = np.abs(M @ dx)
     return float(np.max(np.where(norms > 0, products / np.where(norms > 0, norms, 1.0), 0.0),
@@ -359,10 +362,16 @@ def _check_dual_certificate(problem: Problem, result: fccqp.Result, tol: Toleran
     if not size > 0:
         return
     dx = dx / size
-    # "~ 0" row by row against the row's norm times ||dx|| (1 now), as formulation.md
-    # says; "< 0" relative to the terms of the sum
-    report.add("P dx ~ 0 (relative)", _row_relative(problem.P, dx), tol.certificate)
-    report.add("A dx ~ 0 (relative)", _row_relative(problem.A, dx), tol.certificate)
+    # "~ 0" row by row against the row's norm times ||dx||, with the columns balanced
+    # (as formulation.md says); "< 0" relative to the terms of the sum
+    columns = np.maximum(np.abs(problem.P).max(axis=0, initial=0.0),
+                         np.abs(problem.A).max(axis=0, initial=0.0))
+    D = np.where(columns > 0, 1.0 / np.sqrt(np.where(columns > 0, columns, 1.0)), 1.0)
+    balanced = dx / D
+    balanced /= _inf(balanced)
+    report.add("P dx ~ 0 (relative)", _row_relative(D[:, None] * problem.P * D, balanced),
+               tol.certificate)
+    report.add("A dx ~ 0 (relative)", _row_relative(problem.A * D, balanced), tol.certificate)
     report.add("q'dx < 0 (relative)",
                float(problem.q @ dx) / max(float(np.abs(problem.q) @ np.abs(dx)), 1e-300),
                -tol.certificate)

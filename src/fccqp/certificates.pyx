@@ -27,9 +27,9 @@ has no solution. The dual certificate keeps ``q'dx < -eps |q|'|dx|``.
   finite);
 - equality: the residual ``r = b - A x`` of a KKT solution, when ``A x = b`` has no
   solution, is the least-squares residual: ``A'r ~ 0`` and ``b'r > 0``;
-- dual: a direction ``dx`` with ``P dx ~ 0``, ``A dx ~ 0`` (each row against its norm
-  times ``||dx||``, see :func:`_near_zero`), ``q'dx < 0`` and ``dx_S`` in the recession
-  cone of C.
+- dual: a direction ``dx`` with ``P dx ~ 0``, ``A dx ~ 0`` (each row of the scaled
+  problem against its norm times ``||dx||``, see :func:`_near_zero`), ``q'dx < 0``
+  dominating those residuals, and ``dx_S`` in the recession cone of C.
 """
 
 from libc.math cimport INFINITY, fabs, isfinite
@@ -331,15 +331,18 @@ cdef int equality_direction(const Problem* p, const double* r, const double* x, 
 
 
 cdef inline bint _near_zero(const double* M, const double* dx, Py_ssize_t rows,
-                            Py_ssize_t cols, const double* D, double dx_norm, double eps,
+                            Py_ssize_t cols, double dx_norm, double eps,
                             double* out) noexcept nogil:
-    """``M dx ~ 0`` (row-major ``M``, scaled columns ``x = D x_scaled``) row by row:
-    ``|M_i dx| <= eps ||M_i|| ||dx||`` with the row's 1-norm and ``dx``'s max-norm in the
-    user's units (``dx_norm``), as OSQP and COSMO normalize by ``||dx||``. A row scale
-    cancels from both sides, so the test is invariant to scaling rows, the cost and
-    ``dx``. Not relative to the terms ``|M_i||dx|``: along a ray in a coordinate-aligned
-    null space (zero columns of ``P``) the ray contributes to neither side, and the
-    unconverged remainder is compared with itself; ``out`` is scratch of ``rows``."""
+    """``M dx ~ 0`` (row-major, scaled) row by row: ``|M_i dx| <= eps ||M_i|| ||dx||``
+    with the row's 1-norm and ``dx``'s max-norm (``dx_norm``), as OSQP and COSMO
+    normalize by ``||dx||``; ``out`` is scratch of ``rows``.
+
+    In the equilibrated problem, where columns are balanced: in the user's units a row
+    whose norm comes from large-scale variables hid curvature on small-scale ones
+    (variables rescaled by 1e-8..1e11: a bounded problem certified unbounded). Not
+    relative to the terms ``|M_i||dx|``: along a ray in a coordinate-aligned null
+    space (zero columns of ``P``) the ray contributes to neither side, and the
+    unconverged remainder is compared with itself."""
     cdef Py_ssize_t i, j
     cdef double value, norm
     for i in range(rows):
@@ -347,7 +350,7 @@ cdef inline bint _near_zero(const double* M, const double* dx, Py_ssize_t rows,
         norm = 0.0
         for j in range(cols):
             value += M[i * cols + j] * dx[j]
-            norm += fabs(M[i * cols + j]) / D[j]
+            norm += fabs(M[i * cols + j])
         out[i] = value
         if not fabs(value) <= eps * norm * dx_norm:
             return False
@@ -357,15 +360,22 @@ cdef inline bint _near_zero(const double* M, const double* dx, Py_ssize_t rows,
 cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double* Pdx,
                           double* terms, double* block) noexcept nogil:
     """Test the direction ``dx`` (scaled); ``Pdx`` and ``terms`` (``max(n, m)``) and
-    ``block`` (s) are scratch."""
+    ``block`` (s) are scratch.
+
+    Its descent ``-q'dx``, relative to its terms, must also dominate every residual
+    (``DOMINANCE`` times, as for the primal certificate): with ``P = 0`` and ``|q| =
+    1e14`` a bounded problem once passed with a descent of 2e-6 against residuals of
+    5e-7 in the cone and 1e-7 in ``A dx``."""
     cdef Py_ssize_t n = p.n, s = p.s, i, j, k, a, dim
-    cdef double qdx = 0.0, size = 0.0, norm = 0.0, step, tol
+    cdef double qdx = 0.0, size = 0.0, norm = 0.0, scaled = 0.0, step, tol
     for i in range(n):
         qdx += p.q[i] * dx[i]
         size += fabs(p.q[i] * dx[i])
         norm = max(norm, fabs(dx[i] * p.D[i]))
+        scaled = max(scaled, fabs(dx[i]))
     if not (qdx < -eps * size) or not isfinite(qdx) or norm <= 1e-300:
         return False
+    eps = min(eps, -qdx / (size * _DOMINANCE))
     tol = eps * norm
     for j in range(s):
         i = p.constrained[j]
@@ -381,6 +391,6 @@ cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double
         for j in range(dim):
             if fabs(block[a + j] - terms[j]) * p.D[p.constrained[a]] > tol:
                 return False
-    if not _near_zero(p.P, dx, n, n, p.D, norm, eps, Pdx):
+    if not _near_zero(p.P, dx, n, n, scaled, eps, Pdx):
         return False
-    return p.m == 0 or _near_zero(p.A, dx, p.m, n, p.D, norm, eps, Pdx)
+    return p.m == 0 or _near_zero(p.A, dx, p.m, n, scaled, eps, Pdx)
