@@ -213,3 +213,25 @@ def test_equalities_of_tiny_rows_hold_on_every_backend(backend):
     result = solve_verified(Problem.of(M @ M.T / 6, rng.standard_normal(6), A, b),
                             kkt_backend=backend)
     assert np.abs(A @ result.x - b).max() < 1e-9 * np.abs(b).max()
+
+
+@pytest.mark.parametrize("max_iter, restarted", [(199, False), (200, True), (400, True)])
+def test_a_start_that_fails_in_half_the_budget_restarts_cold(max_iter, restarted):
+    """A primal guess 1e15 away with a small fixed rho needs more than 100 iterations;
+    a cold start solves the problem at once (its equality-constrained QP is inside the
+    box). With ``max_iter >= 200`` the guess gets half the budget, then the solve
+    restarts cold, as a fresh solve would have (a reused ``Solver`` once ran 4000
+    iterations where a fresh solve needed none); below it the guess keeps it all."""
+    rng = np.random.default_rng(0)
+    M = rng.standard_normal((8, 8))
+    A = rng.standard_normal((3, 8))
+    problem = Problem.of(M @ M.T / 8 + np.eye(8), 0.1 * rng.standard_normal(8), A,
+                         A @ rng.uniform(-0.1, 0.1, 8), -10 * np.ones(8), 10 * np.ones(8))
+    solver = fccqp.Solver(max_iter=max_iter, adaptive_rho=False, rho=1e-3)
+    result = solver.solve(*problem.args(), x0=1e15 * rng.standard_normal(8))
+    verify_solution(problem, result)
+    assert result.iterations <= max_iter
+    if restarted:
+        assert result.status is Status.SOLVED and result.iterations == max_iter // 2
+    else:
+        assert result.status is Status.MAX_ITER_REACHED

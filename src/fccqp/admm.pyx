@@ -685,6 +685,7 @@ cdef class Workspace:
         cdef bint same = self.has_matrices
         cdef Run run
         cdef long spent
+        cdef int factored
         self.clock[0] = fccqp_now()
         with nogil:
             self.found = scan_and_copy(
@@ -716,10 +717,11 @@ cdef class Workspace:
                 self.opt.max_iter = max_iter
                 if restartable and (run.status == _MAX_ITER or run.status == _NUMERICAL_ERROR):
                     self.opt.max_iter = max_iter - run.iterations
-                    spent = run.iterations
+                    spent, factored = run.iterations, run.factorizations
                     run = self._solve(False, NULL, False, start_time)
                     self.opt.max_iter = max_iter
                     run.iterations += spent
+                    run.factorizations += factored
                     if run.status != _NOT_CONVEX:
                         self._finish(&run, x_out, y_out if m else NULL, z_out, cert_out)
                 self.clock[5] = fccqp_now()
