@@ -366,7 +366,9 @@ def _check_dual_certificate(problem: Problem, result: fccqp.Result, tol: Toleran
     # (as formulation.md says); "< 0" relative to the terms of the sum
     columns = np.maximum(np.abs(problem.P).max(axis=0, initial=0.0),
                          np.abs(problem.A).max(axis=0, initial=0.0))
-    D = np.where(columns > 0, 1.0 / np.sqrt(np.where(columns > 0, columns, 1.0)), 1.0)
+    # a column of norm 1e-118 is not scaled up 1e59 (it would crush the rest of dx),
+    # as equilibrations bound their factors
+    D = 1.0 / np.sqrt(np.clip(np.where(columns > 0, columns, 1.0), 1e-8, 1e8))
     balanced = dx / D
     balanced /= _inf(balanced)
     report.add("P dx ~ 0 (relative)", _row_relative(D[:, None] * problem.P * D, balanced),
