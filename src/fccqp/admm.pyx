@@ -396,6 +396,7 @@ cdef class Workspace:
     cdef double tighten   # factor on the tolerances of the run (see POLISH_RETRIES)
     cdef double stalled_prim   # primal residual at the last check that could clean
     cdef int gram_state   # gram: 0 not factored in this solve, 1 factored, -1 failed
+    cdef int stalled_checks   # checks in a row that could clean whose residual did not halve
     cdef double clock[6]
     cdef bint has_previous, has_matrices, certified, scaled_once
     cdef bint has_rho   # prev_rho is a rho some solve adapted (a cold start keeps it too)
@@ -857,6 +858,7 @@ cdef class Workspace:
         run.polished = False
         self.tighten = 1.0
         self.stalled_prim = INFINITY
+        self.stalled_checks = 0
         self.gram_state = 0
         self.table_ready = False   # base is for the previous q, b
         self.pol.schur.ready = False   # set up for the previous P, A
@@ -1107,14 +1109,15 @@ cdef class Workspace:
         """Clean the primal certificate's candidate that the last test left in ``vec_m``,
         ``vec_s`` (:func:`fccqp.certificates.clean_primal_certificate`), on the schedule
         of rho adaptation, when the primal residual is far from its tolerance
-        (``CLEANING_GATE``) and did not halve since the last such check, and the
+        (``CLEANING_GATE``) and did not halve over the last two such checks, and the
         candidate separates: how infeasibility looks, and the only case worth an ``A
         A'`` factorization (m x m, once per solve)."""
         cdef Problem* p = &self.prob
         cdef Residuals* r = &self.res
         cdef double previous = self.stalled_prim
         self.stalled_prim = r.prim
-        if not (p.m > 0 and r.prim > 0.5 * previous
+        self.stalled_checks = self.stalled_checks + 1 if r.prim > 0.5 * previous else 0
+        if not (p.m > 0 and self.stalled_checks >= 2
                 and r.prim > _CLEANING_GATE * (self.opt.eps_abs + self.opt.eps_rel * r.prim_scale)):
             return False
         if self.gram_state == 0:   # once per solve: A A' of this solve's scaled rows
