@@ -127,6 +127,9 @@ STALL_FACTOR, STALLS = 1e3, 2
 """Anderson acceleration stops for the rest of a run when, at ``STALLS`` scheduled checks
 in a row, the primal residual is above ``STALL_FACTOR`` times its tolerance and not half
 of what it was at the previous scheduled check (see _iterate)."""
+CLEANING_START = 500
+"""No primal certificate is cleaned before this many iterations of a run (see
+``Workspace._cleaned_certificate``)."""
 RESTART_MIN_ITER = 200
 """A start from a previous solution or ``x0`` that fails within half of ``max_iter``
 restarts cold for the rest only when ``max_iter`` is at least this (``Workspace._run``)."""
@@ -242,6 +245,7 @@ cdef long _LOG_INTERVAL = LOG_INTERVAL
 cdef double _STALL_FACTOR = STALL_FACTOR
 cdef double _CLEANING_GATE = CLEANING_GATE
 cdef long _RESTART_MIN_ITER = RESTART_MIN_ITER
+cdef long _CLEANING_START = CLEANING_START
 cdef int _STALLS = STALLS
 
 
@@ -397,6 +401,7 @@ cdef class Workspace:
     cdef double stalled_prim   # primal residual at the last check that could clean
     cdef int gram_state   # gram: 0 not factored in this solve, 1 factored, -1 failed
     cdef int stalled_checks   # checks in a row that could clean whose residual did not halve
+    cdef long next_cleaning, cleaning_wait   # when the next cleaning may run, and the wait after
     cdef double clock[6]
     cdef bint has_previous, has_matrices, certified, scaled_once
     cdef bint has_rho   # prev_rho is a rho some solve adapted (a cold start keeps it too)
@@ -859,6 +864,8 @@ cdef class Workspace:
         self.tighten = 1.0
         self.stalled_prim = INFINITY
         self.stalled_checks = 0
+        self.next_cleaning = _CLEANING_START
+        self.cleaning_wait = self.opt.adaptive_rho_interval
         self.gram_state = 0
         self.table_ready = False   # base is for the previous q, b
         self.pol.schur.ready = False   # set up for the previous P, A
@@ -1089,8 +1096,9 @@ cdef class Workspace:
             return _SOLVED
         code = primal_infeasible(p, it, o.eps_prim_inf, self.vec_m, self.vec_s, self.vec_n,
                                  self.vec_n2)
-        if code == CERTIFIED or (code == SEPARATED and iteration % o.adaptive_rho_interval == 0
-                                 and self._cleaned_certificate()):
+        if code == CERTIFIED or (code == SEPARATED and iteration >= self.next_cleaning
+                                 and iteration % o.adaptive_rho_interval == 0
+                                 and self._cleaned_certificate(iteration)):
             fill(self.cert, 0.0, p.n + p.m)
             for i in range(p.m):   # in the user's units (the common factor 1/c dropped)
                 self.cert[i] = self.vec_m[i] * p.E[i]
@@ -1105,13 +1113,17 @@ cdef class Workspace:
             return self._classify(iteration, True, start_time)
         return _RUNNING
 
-    cdef bint _cleaned_certificate(self) noexcept nogil:
+    cdef bint _cleaned_certificate(self, long iteration) noexcept nogil:
         """Clean the primal certificate's candidate that the last test left in ``vec_m``,
         ``vec_s`` (:func:`fccqp.certificates.clean_primal_certificate`), on the schedule
         of rho adaptation, when the primal residual is far from its tolerance
         (``CLEANING_GATE``) and did not halve over the last two such checks, and the
         candidate separates: how infeasibility looks, and the only case worth an ``A
-        A'`` factorization (m x m, once per solve)."""
+        A'`` factorization (m x m, once per solve). Not before ``CLEANING_START``
+        iterations, and each failed try doubles the wait before the next: a try costs
+        about a hundred of talos_reduced's iterations, and its slow feasible ticks
+        stall and separate too (tried at every such check, cleaning took 20 % of the
+        realtime preset's warm instructions)."""
         cdef Problem* p = &self.prob
         cdef Residuals* r = &self.res
         cdef double previous = self.stalled_prim
@@ -1122,9 +1134,13 @@ cdef class Workspace:
             return False
         if self.gram_state == 0:   # once per solve: A A' of this solve's scaled rows
             self.gram_state = 1 if gram_factor(p, self.gram) else -1
-        return self.gram_state == 1 and clean_primal_certificate(
-            p, self.it.x, self.gram, self.opt.eps_prim_inf, self.vec_m, self.vec_s,
-            self.saved, self.vec_n3, self.vec_n, self.vec_n2)
+        if self.gram_state == 1 and clean_primal_certificate(
+                p, self.it.x, self.gram, self.opt.eps_prim_inf, self.vec_m, self.vec_s,
+                self.saved, self.vec_n3, self.vec_n, self.vec_n2):
+            return True
+        self.cleaning_wait *= 2   # the next try waits twice as long
+        self.next_cleaning = iteration + self.cleaning_wait
+        return False
 
     cdef bint _missed(self) noexcept nogil:
         """The last residuals miss ``A x = b`` beyond factorization accuracy
