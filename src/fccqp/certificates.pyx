@@ -4,7 +4,8 @@
 On an infeasible problem ADMM's iterates diverge along a certificate, so the last step
 is tested (as in OSQP), but with every "approximately zero" of the primal certificates
 judged against the size of the terms that must cancel, not in absolute terms (the dual
-certificate's against the size of the direction, see :func:`_near_zero`): a certificate is then invariant to
+certificate's against the size of the direction, see :func:`_near_zero`): a
+certificate is then invariant to
 the scale of the data, and the rounding noise of a sum (``1e-16`` of its terms) never
 passes for one. Concretely, for terms ``t_k`` of a sum ``S``, "``S ~ 0``" is ``|S| <= eps
 max |t_k|``, relative residual ``rho = |S| / max |t_k|``. All tests run on the scaled
@@ -34,8 +35,8 @@ has no solution. The dual certificate keeps ``q'dx < -eps |q|'|dx|``.
 
 from libc.math cimport INFINITY, fabs, isfinite
 
-from fccqp._blas cimport cholesky, cholesky_solve_vector
-from fccqp._dense cimport copy
+from fccqp._blas cimport cholesky, cholesky_solve_vector, syrk_t
+from fccqp._dense cimport copy, matvec
 from fccqp._types cimport Iterates, Problem
 from fccqp.projections cimport proj_block
 
@@ -194,14 +195,11 @@ cdef bint gram_factor(const Problem* p, double* gram) noexcept nogil:
     """``gram`` (m x m, column-major) := the Cholesky factor of ``A A'`` plus
     ``GRAM_REGULARIZATION`` of its largest diagonal entry (dependent rows); False when
     that fails."""
-    cdef Py_ssize_t n = p.n, m = p.m, i, k, j
-    cdef double value, largest = 0.0
+    cdef Py_ssize_t m = p.m, i
+    cdef double largest = 0.0
+    # the row-major m x n A is, column-major, A' (n x m): one dsyrk gives A A'
+    syrk_t(<int>m, <int>p.n, p.A, <int>p.n, 0.0, gram, <int>m)
     for i in range(m):
-        for k in range(i, m):
-            value = 0.0
-            for j in range(n):
-                value += p.A[i * n + j] * p.A[k * n + j]
-            gram[k + i * m] = value
         largest = max(largest, gram[i + i * m])
     if not largest > 0.0:
         return False
@@ -256,18 +254,15 @@ cdef bint _alternate(const Problem* p, const double* x, const double* gram, doub
     subspace step followed by :func:`_shrink` with ``tau = shrink ||d_y||`` (``tau = 0``:
     the plain projection onto the polar) and the tests; stops after two passes in a
     row that do not separate."""
-    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j, k, pass_
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j, pass_
     cdef double size
     cdef int code, rejected = 0
     for pass_ in range(_CLEANING_PASSES):
-        for i in range(n):   # w = E_S'd_y, then d_nu := -(A A')^-1 A w
+        for i in range(n):   # w = -E_S'd_y, then d_nu := (A A')^-1 A w
             w[i] = 0.0
         for j in range(s):
-            w[p.constrained[j]] = d_y[j]
-        for i in range(m):
-            d_nu[i] = 0.0
-            for k in range(n):
-                d_nu[i] -= p.A[i * n + k] * w[k]
+            w[p.constrained[j]] = -d_y[j]
+        matvec(p.A, w, d_nu, m, n)
         cholesky_solve_vector(gram, <int>m, <int>m, d_nu)
         _transpose_product(p, d_nu, w, terms)   # w = A'd_nu, then d_y := -(A'd_nu)_S
         size = 0.0
