@@ -1116,8 +1116,8 @@ cdef class Workspace:
     cdef bint _cleaned_certificate(self, long iteration) noexcept nogil:
         """Clean the primal certificate's candidate that the last test left in ``vec_m``,
         ``vec_s`` (:func:`fccqp.certificates.clean_primal_certificate`), on the schedule
-        of rho adaptation, when the primal residual is far from its tolerance
-        (``CLEANING_GATE``) and did not halve over the last two such checks, and the
+        of rho adaptation, when the primal residual is above ``CLEANING_GATE`` times
+        its tolerance and did not halve over the last two such checks, and the
         candidate separates: how infeasibility looks, and the only case worth an ``A
         A'`` factorization (m x m, once per solve). Not before ``CLEANING_START``
         iterations, and each failed try doubles the wait before the next: a try costs
