@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 from fccqp.projections import project_constraint_set
-from fccqp.scaling import MAX_NORM, MIN_NORM, RESCALE_DRIFT
 from fccqp.scaling import equilibrate_py as equilibrate
 from fccqp.scaling import rescale_py as rescale
 from fccqp.scaling import scale_start_py as scale_start
 from fccqp.scaling import scaled_norms_py as scaled_norms
 from fccqp.scaling import unscale_py as unscale
+from fccqp.tuning import MAX_NORM, MIN_NORM, RESCALE_DRIFT
 
 
 def _inverse_sqrt(norm):

@@ -61,7 +61,7 @@ def test_default_settings_solve_every_qp(test_set):
 def test_a_settled_active_set_is_polished_before_admm_converges(test_set):
     """ADMM crawls along the weak torque and force directions after its active set has
     settled; the run polishes that active set at a scheduled check and ends there
-    (admm.EARLY_POLISH_GATE) instead of at ADMM's own convergence, which is where a run
+    (tuning.EARLY_POLISH_GATE) instead of at ADMM's own convergence, which is where a run
     without polishing stops. The answers are those of the reference."""
     early = plain = 0
     for qp, x_ref in zip(test_set.qps, test_set.x_ref, strict=True):

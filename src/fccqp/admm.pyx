@@ -53,6 +53,13 @@ from fccqp.restoration cimport Restoration, restore
 from fccqp.scaling cimport equilibrate, rescale, scale_start, scaled_norms, unscale
 from fccqp.termination cimport (Residuals, converged, gap_scale, nearly_converged, residuals,
                                row_spans)
+from fccqp.tuning cimport (CLEANING_GATE, CLEANING_START, EARLY_POLISH_GATE, EARLY_POLISH_TRIES,
+                           EQUALITY_EXACT, EQUALITY_MISSED, EQUALITY_SLACK, EQUALITY_START_LIMIT,
+                           EQUALITY_START_STEPS, FIXED_RHO_SCALE, GATED_CHECK_WAIT,
+                           INACCURATE_FACTOR, LOG_INTERVAL, POLISH_EXACT, POLISH_GATE,
+                           POLISH_RETRIES, REDUCED_COST, RESERVE_DECAY, RESERVE_PASSES,
+                           RESTART_MIN_ITER, RESTORED_EQUALITY, RHO_MAX, RHO_MIN, RHO_PERSISTENCE,
+                           STALLS, STALL_FACTOR)
 from fccqp.validation cimport (BOUNDED, FIXED_BOUND, SCAN_OK, UNBOUNDED, Finding, bound_kind,
                                scan_and_copy)
 
@@ -103,151 +110,6 @@ BACKENDS = {"schur_reduced": SCHUR_REDUCED, "ldl_reduced": LDL_REDUCED, "ldl_ful
 """``Settings.kkt_backend`` names and their codes (see :mod:`fccqp.kkt`)."""
 BACKEND_NAMES = {code: name for name, code in BACKENDS.items()}
 
-INACCURATE_FACTOR = 10.0
-"""A budget-stopped iterate within this multiple of the tolerances is 'inaccurate'."""
-RHO_MIN, RHO_MAX = 1e-6, 1e6
-"""Range of the adaptive rho."""
-REDUCED_COST = 0.5
-"""The reduced iteration is used when ``REDUCED_COST * s`` fits in the iteration budget:
-tabulating ``s`` columns costs about ``s / 4`` single KKT solves (measured at KKT sizes
-84 and 192), each iteration then saves about one; 0.5 leaves a factor 2 of margin."""
-FIXED_RHO_SCALE = 1e3
-"""rho multiplier on entries with lb == ub, which act as equalities (as in OSQP)."""
-EQUALITY_START_STEPS = 3
-"""Proximal steps of the cold start's equality-constrained QP (see _equality_start)."""
-EQUALITY_START_LIMIT = 1e-3
-"""The cold start's equality-constrained QP counts as unbounded when sigma * ||x_eq||
-exceeds this * max(1, ||q||): its last proximal step is then an (unbounded) direction,
-tested as a dual infeasibility certificate, and the start falls back onto A x = b."""
-RESTORED_EQUALITY = 1e-7
-"""A restored point is kept only if its primal residual is below this times its scale:
-otherwise the other entries could not absorb the pinning. Refinement aims at 1e-13, but
-an ill-conditioned ``W_TT`` (condition 1e8 on solo12) costs digits."""
-STALL_FACTOR, STALLS = 1e3, 2
-"""Anderson acceleration stops for the rest of a run when, at ``STALLS`` scheduled checks
-in a row, the primal residual is above ``STALL_FACTOR`` times its tolerance and not half
-of what it was at the previous scheduled check (see _iterate)."""
-CLEANING_START = 500
-"""No primal certificate is cleaned before this many iterations of a run (see
-``Workspace._cleaned_certificate``)."""
-RESTART_MIN_ITER = 200
-"""A start from a previous solution or ``x0`` that fails within half of ``max_iter``
-restarts cold for the rest only when ``max_iter`` is at least this (``Workspace._run``)."""
-CLEANING_GATE = 1.0
-"""A primal certificate's candidate is cleaned only while the primal residual is above
-this many times its tolerance (see ``Workspace._cleaned_certificate``): weakly
-infeasible problems stall near it (rows off two friction cones by 1e-4 at 10 times)."""
-GATED_CHECK_WAIT = 8
-"""In the reduced form a full residual check runs between the scheduled ones only when
-``near_convergence`` says that it may pass; after a gated check that did not end the run
-(a gap still open where the residuals already pass, say) the next one waits 1, 3, 7
-iterations, then this many, until a scheduled check or a new rho. A full check (residuals,
-gap, infeasibility tests) costs about 60k instructions on talos_reduced, an iteration
-about 25k, and its cold solves ran one every other iteration: 80 in 218 iterations,
-a fifth of the solve."""
-POLISH_RETRIES = 2
-"""When ADMM converges but its polished point is rejected, ADMM goes on with 10x tighter
-tolerances and polishes again, at most this many times (the budgets still apply): on
-talos' hardest controller sequence, 13 of 22 cold solves polished at eps 1e-5, 17 at
-1e-6, 21 at 1e-7."""
-POLISH_EXACT = 1e-3
-"""A polished residual counts as no worse than ADMM's when it is below this times its
-tolerance (rounding of an exact solve), and its multipliers may miss their cones by
-this times the dual tolerance."""
-LOG_INTERVAL = 25
-"""With ``verbose``, the log keeps one line every this many iterations (as OSQP)."""
-EQUALITY_SLACK = 10.0
-EQUALITY_EXACT = 1e-13
-"""A polished point keeps ``A x = b`` as ADMM's iterates do, at factorization accuracy:
-within ``EQUALITY_SLACK`` times the ADMM point's residual, or below ``EQUALITY_EXACT``
-times ``max(||A x||, ||b||)``, and never beyond ``EQUALITY_MISSED`` times the largest
-row of ``|A| |x|``. (The tolerance alone let a polished point with ``A x - b`` at 2e-9
-of its terms pass as SOLVED in a random test; the slack alone one at 8e-9 where the
-ADMM point, a reduced form's combination ``base + W u`` with a wild ``u`` before its
-final correction, missed by 1e-9.)"""
-cdef double _EQUALITY_SLACK = EQUALITY_SLACK
-cdef double _EQUALITY_EXACT = EQUALITY_EXACT
-EQUALITY_MISSED = 1e-9
-"""The equality-constrained cold start meets ``A x = b`` to factorization accuracy
-(1e-14 of ``max(||A x||, ||b||)`` or better) unless the rows are inconsistent or
-numerically dependent; beyond this the "auto" backend takes the full form."""
-cdef double _EQUALITY_MISSED = EQUALITY_MISSED
-POLISH_GATE = 1e3
-"""A run under a time limit is polished at its end only when its residuals are within
-this factor of the tolerances: farther out the iterate's active set is mostly wrong
-(talos' realtime sequences, stopped after 0-30 iterations: 6 guesses changing 14-33
-entries each, 1 ms, never accepted), and the time is better spent iterating. Without a
-time limit the polish is tried whatever the residuals: after 4000 iterations on a
-degenerate LP it is what finds the answer (2 of the general suite's 60)."""
-cdef double _POLISH_GATE = POLISH_GATE
-EARLY_POLISH_GATE = 1e2
-EARLY_POLISH_TRIES = 3
-"""ADMM converges slowly along the weakly determined directions of whole-body control's
-costs (torque and force weights of 1e-4 to 1e-6) long after its active set has settled.
-So at a scheduled check (every ``adaptive_rho_interval`` iterations) whose residuals are
-within ``EARLY_POLISH_GATE`` of the tolerances, the run polishes early when the active
-set ADMM's iterate points to (:func:`fccqp.polish.guess_changes`) is the one of the
-previous scheduled check and was not polished yet; it ends there when the polished
-point passes the KKT check and is solved. At most ``EARLY_POLISH_TRIES`` such attempts
-per solve, and none under a time limit: on talos at the realtime preset's 2 ms a failed
-polish of its 64-row systems takes the time the next iterations need (success 87-89 %
-against 96 % when every settled guess was tried; with a rule that tried only while
-twice the final step's reserve fit, 94.5 % against 95.2 % over nine alternating runs).
-Measured on talos' first 100 ticks at default settings (callgrind): 9.07M instructions
-per tick without, 6.99M with a gate of 1e2, 7.41M with 1e3, 7.96M with 1e4; mean
-iterations 63 -> 25 over all 200 ticks, the worst gap unchanged."""
-cdef double _EARLY_POLISH_GATE = EARLY_POLISH_GATE
-cdef int _EARLY_POLISH_TRIES = EARLY_POLISH_TRIES
-RESERVE_DECAY = 0.5
-"""Under a time limit the iterations stop when the time left is what the final step
-(polish or restoration, and unscaling) took lately: the largest of its last durations,
-each weighted by this factor once per solve since (those that end without an iteration
-too: on talos a slow final step was otherwise remembered through a run of warm-polished
-ticks and cut the next run's iterations to half the budget). At most half the budget is
-reserved; the polish itself stops between guesses once the budget is spent."""
-cdef double _RESERVE_DECAY = RESERVE_DECAY
-RESERVE_PASSES = 2
-"""The final step's reserve is at least this many guesses of the polish, at what a guess
-of the last polish cost: a run that a time limit stops polishes an iterate short of
-convergence, whose guess needs correcting. On talos_reduced's tick 73 (a contact
-switch) the polish of ADMM's iterate after 250 to 400 iterations took 2 guesses and
-was exact; with a reserve learned from the cheap one-guess polishes of the ticks
-before, the clock cut it after the first and the tick returned a gap of 0.05-0.1 at
-1.5 ms (and up to 0.04 at 2 ms)."""
-cdef double _RESERVE_PASSES = RESERVE_PASSES
-RHO_PERSISTENCE = 5
-"""Updates in a row (each ``adaptive_rho_interval`` iterations) after which a rho move
-that OSQP's rule keeps asking for, by more than the square root of
-``adaptive_rho_tolerance`` but less than the tolerance, is tried (see _rho_trial): the
-tolerance keeps rho from chasing noise, but an imbalance that persists while the
-residuals do not even halve is no noise. On talos_reduced's tick 73 (a contact switch)
-the rule asked for 3.5x for 550 iterations and the warm run took 660; with the move,
-355. A move whose residuals then fall more slowly than before is undone (talos' tick
-288 went 181 -> 1214 iterations, rho 100x down in moves that were not undone).
-Measured over each robot's 400 ticks, total iterations without / with: default preset
-solo12 19391 / 5026, talos 8811 / 8806, go2 and anymal_c unchanged;
-``Settings.realtime(1.0)`` talos 5513 / 5017, the quadrupeds unchanged. At the
-realtime preset's 2 ms, talos missed the objective-gap target (1e-3) in 2 of 12 and 1
-of 12 alternating passes, at 1.5 ms in 7 of 8 and 4 of 8; with 3 updates instead of 5
-it lost more ticks (talos 7113 iterations). On the general-QP suite 7 of 543 problems
-changed, 6 to fewer iterations (1510 -> 580 at most), one 267 -> 369."""
-cdef int _RHO_PERSISTENCE = RHO_PERSISTENCE
-cdef double _INACCURATE_FACTOR = INACCURATE_FACTOR
-cdef double _REDUCED_COST = REDUCED_COST
-cdef double _RHO_MIN = RHO_MIN, _RHO_MAX = RHO_MAX
-cdef double _EQUALITY_START_LIMIT = EQUALITY_START_LIMIT
-cdef double _RESTORED_EQUALITY = RESTORED_EQUALITY
-cdef double _POLISH_EXACT = POLISH_EXACT
-cdef int _POLISH_RETRIES = POLISH_RETRIES
-cdef long _GATED_CHECK_WAIT = GATED_CHECK_WAIT
-cdef long _EQUALITY_START_STEPS = EQUALITY_START_STEPS
-cdef long _LOG_INTERVAL = LOG_INTERVAL
-cdef double _STALL_FACTOR = STALL_FACTOR
-cdef double _CLEANING_GATE = CLEANING_GATE
-cdef long _RESTART_MIN_ITER = RESTART_MIN_ITER
-cdef long _CLEANING_START = CLEANING_START
-cdef int _STALLS = STALLS
-
 
 cdef struct Options:
     # Settings of fccqp.Settings the kernels read.
@@ -297,7 +159,7 @@ cdef double _rho_trial(TrialState* trial, double rho, double new_rho, double wor
         trial.count += 1
         if trial.count == 1:
             trial.start = worst
-        elif trial.count == _RHO_PERSISTENCE:
+        elif trial.count == RHO_PERSISTENCE:
             old, trial.old_rho = trial.old_rho, 0.0
             trial.side = trial.count = 0
             if worst / trial.start > trial.progress:
@@ -308,7 +170,7 @@ cdef double _rho_trial(TrialState* trial, double rho, double new_rho, double wor
         trial.side, trial.count, trial.start = side, 1, worst
         return rho
     trial.count += 1
-    if trial.count < _RHO_PERSISTENCE:
+    if trial.count < RHO_PERSISTENCE:
         return rho
     trial.side = trial.count = 0
     if worst <= 0.5 * trial.start:
@@ -711,7 +573,7 @@ cdef class Workspace:
         # which leaves no time for it, nor for budgets too small to split
         cdef bint restartable = ((x0 != NULL or (warm and self.has_previous))
                                  and not isfinite(self.opt.time_limit)
-                                 and max_iter >= _RESTART_MIN_ITER)
+                                 and max_iter >= RESTART_MIN_ITER)
         enter()   # single-threaded BLAS for this solve (see fccqp.blas_threads)
         try:
             with nogil:
@@ -731,7 +593,7 @@ cdef class Workspace:
                     if run.status != _NOT_CONVEX:
                         self._finish(&run, x_out, y_out if m else NULL, z_out, cert_out)
                 self.clock[5] = fccqp_now()
-                self.final_reserve *= _RESERVE_DECAY
+                self.final_reserve *= RESERVE_DECAY
                 if self.iterated:   # learn what the final step after the iterations costs
                     self.final_reserve = max(self.final_reserve, self.clock[5] - self.clock[4])
         finally:
@@ -851,7 +713,7 @@ cdef class Workspace:
         cdef bint unbounded_start = False, timed = isfinite(o.time_limit)
         # the iterations stop early enough for the final polish or restoration to fit
         cdef double deadline = o.time_limit - min(
-            max(self.final_reserve, _RESERVE_PASSES * self.pass_time), 0.5 * o.time_limit)
+            max(self.final_reserve, RESERVE_PASSES * self.pass_time), 0.5 * o.time_limit)
         cdef bint reduced, fresh, last, periodic, adapt, check, gated, accelerate, warm_polish
         cdef bint polished
         cdef double eps_p, eps_d, new_rho, periodic_prim
@@ -864,7 +726,7 @@ cdef class Workspace:
         self.tighten = 1.0
         self.stalled_prim = INFINITY
         self.stalled_checks = 0
-        self.next_cleaning = _CLEANING_START
+        self.next_cleaning = CLEANING_START
         self.cleaning_wait = self.opt.adaptive_rho_interval
         self.gram_state = 0
         self.table_ready = False   # base is for the previous q, b
@@ -883,7 +745,7 @@ cdef class Workspace:
             self._finish_run(run, _DUAL_INFEASIBLE, 0)
             return
         if cold or s == 0:   # not at factorization accuracy: inconsistent or dependent rows
-            self.equalities_missed = r.prim_eq > _EQUALITY_MISSED * max(r.prim_eq_scale, 1.0)
+            self.equalities_missed = r.prim_eq > EQUALITY_MISSED * max(r.prim_eq_scale, 1.0)
             if self._missed_by_data() and self._inconsistent(True):
                 # tested on the penalty-free start: with rho in the KKT matrix (up to 1e9
                 # on fixed entries) the regularization's trace in A'r can hide it
@@ -964,13 +826,13 @@ cdef class Workspace:
                 self._residuals()
                 eps_p = self.tighten * (o.eps_abs + o.eps_rel * r.prim_set_scale)
                 eps_d = self.tighten * (o.eps_abs + o.eps_rel * r.dual_scale)
-                if iteration % _LOG_INTERVAL == 0:
+                if iteration % LOG_INTERVAL == 0:
                     self._log(iteration, run.rho)
                 status = self._check(iteration, last, start_time)
                 if gated and status == _RUNNING:   # the gate passed, the check did not
-                    wait = min(2 * wait + 1, _GATED_CHECK_WAIT)
+                    wait = min(2 * wait + 1, GATED_CHECK_WAIT)
                     next_gated = iteration + wait
-                if status == _SOLVED and o.polish and not last and retries < _POLISH_RETRIES:
+                if status == _SOLVED and o.polish and not last and retries < POLISH_RETRIES:
                     polished_at = iteration
                     run.polished = self._keep_polished(&status, iteration, start_time)
                     if not run.polished:   # go on, closer to the active set
@@ -978,12 +840,12 @@ cdef class Workspace:
                         self.tighten *= 0.1
                         status = _RUNNING
                 if (status == _RUNNING and periodic and o.polish and not timed and not last
-                        and early_tries < _EARLY_POLISH_TRIES):
+                        and early_tries < EARLY_POLISH_TRIES):
                     if (guess_changes(p, it.z, it.y, self.guess_point, self.guess_codes) != 0
                             or first_check):
                         guess_polished = first_check = False   # polish it once it settles
                     elif not guess_polished and nearly_converged(r, o.eps_abs, o.eps_rel,
-                                                                 _EARLY_POLISH_GATE):
+                                                                 EARLY_POLISH_GATE):
                         guess_polished = True
                         early_tries += 1
                         polished_at = iteration
@@ -993,12 +855,12 @@ cdef class Workspace:
                     # far from tolerance is how infeasibility looks; Anderson's
                     # extrapolated points there hide the steady step that certifies it
                     # (CVXPY's lp_4 ran 4000 iterations uncertified), so plain ADMM runs on
-                    if (r.prim > _STALL_FACTOR * (o.eps_abs + o.eps_rel * r.prim_scale)
+                    if (r.prim > STALL_FACTOR * (o.eps_abs + o.eps_rel * r.prim_scale)
                             and r.prim > 0.5 * periodic_prim):
                         stalls += 1
                     else:
                         stalls = 0
-                    accelerate = stalls < _STALLS
+                    accelerate = stalls < STALLS
                     periodic_prim = r.prim
                 if status == _RUNNING and adapt:
                     new_rho = self._new_rho(run.rho, &trial)
@@ -1016,7 +878,7 @@ cdef class Workspace:
         self.iterated = True
         if (not run.polished and o.polish and _SOLVED <= status <= _TIME_LIMIT
                 and polished_at != iteration
-                and (not timed or nearly_converged(r, o.eps_abs, o.eps_rel, _POLISH_GATE))):
+                and (not timed or nearly_converged(r, o.eps_abs, o.eps_rel, POLISH_GATE))):
             run.polished = self._keep_polished(&status, iteration, start_time)
         if not run.polished:   # a polished point is feasible already: nothing to restore
             if o.restore_feasibility and _SOLVED <= status <= _TIME_LIMIT:
@@ -1130,7 +992,7 @@ cdef class Workspace:
         self.stalled_prim = r.prim
         self.stalled_checks = self.stalled_checks + 1 if r.prim > 0.5 * previous else 0
         if not (p.m > 0 and self.stalled_checks >= 2
-                and r.prim > _CLEANING_GATE * (self.opt.eps_abs + self.opt.eps_rel * r.prim_scale)):
+                and r.prim > CLEANING_GATE * (self.opt.eps_abs + self.opt.eps_rel * r.prim_scale)):
             return False
         if self.gram_state == 0:   # once per solve: A A' of this solve's scaled rows
             self.gram_state = 1 if gram_factor(p, self.gram) else -1
@@ -1148,7 +1010,7 @@ cdef class Workspace:
         less than ``eps_rel`` of the largest row (a duplicated row of size 2 off by 0.65
         among rows of 3e6) are no more solvable, and were left uncertified for 4000
         iterations."""
-        return self.res.prim_eq > _EQUALITY_MISSED * self.res.prim_eq_scale
+        return self.res.prim_eq > EQUALITY_MISSED * self.res.prim_eq_scale
 
     cdef bint _missed_by_data(self) noexcept nogil:
         """:meth:`_missed`, and also beyond ``EQUALITY_MISSED`` of each row's terms at the
@@ -1166,7 +1028,7 @@ cdef class Workspace:
         magnitudes(p, self.it.x, self.vec_n)
         for i in range(p.m):
             largest = max(largest, row_size(p, i, self.vec_n) / p.E[i])
-        return self.res.prim_eq > _EQUALITY_MISSED * largest
+        return self.res.prim_eq > EQUALITY_MISSED * largest
 
     cdef bint _inconsistent(self, bint clean) noexcept nogil:
         """The equality certificate; on success ``cert`` holds ``(-E r, 0)``: ``A'y ~ 0`` and
@@ -1222,7 +1084,7 @@ cdef class Workspace:
             return _NUMERICAL_ERROR
         if converged(r, self.opt.eps_abs, self.opt.eps_rel):
             return _SOLVED
-        if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
+        if nearly_converged(r, self.opt.eps_abs, self.opt.eps_rel, INACCURATE_FACTOR):
             return _INACCURATE
         if iteration >= self.opt.max_iter or not stopped:
             return _MAX_ITER
@@ -1264,7 +1126,7 @@ cdef class Workspace:
         cdef Residuals* r = &self.res
         cdef double prim = r.prim_s / max(r.prim_scale_s, 1e-30)
         cdef double dual = r.dual_s / max(r.dual_scale_s, 1e-30)
-        cdef double new_rho = min(max(rho * sqrt(prim / max(dual, 1e-30)), _RHO_MIN), _RHO_MAX)
+        cdef double new_rho = min(max(rho * sqrt(prim / max(dual, 1e-30)), RHO_MIN), RHO_MAX)
         return _rho_trial(trial, rho, new_rho, max(prim, dual), self.opt.adaptive_rho_tolerance)
 
     # -------------------------------------------------------- factorizations
@@ -1300,7 +1162,7 @@ cdef class Workspace:
             # numerically dependent) go to the full form: its regularized solves give
             # least-squares iterates, on which the equality certificate is tested
             # (a random test: the reduced form ran 4000 iterations uncertified)
-            reduced_pays = (2 * p.s <= p.n + p.m and _REDUCED_COST * p.s <= budget
+            reduced_pays = (2 * p.s <= p.n + p.m and REDUCED_COST * p.s <= budget
                             and not self.equalities_missed)
             first = SCHUR_REDUCED if reduced_pays else LDL_FULL
         for backend in range(first, LDL_FULL + 1):
@@ -1375,7 +1237,7 @@ cdef class Workspace:
         fill(it.x, 0.0, n)
         for i in range(m):
             self.rhs[n + i] = p.b[i]
-        for step in range(_EQUALITY_START_STEPS):
+        for step in range(EQUALITY_START_STEPS):
             for i in range(n):
                 self.rhs[i] = sigma * it.x[i] - p.q[i]
             kkt_solve(&self.kkt, p, it.rho_vec, self.rhs, self.sol)
@@ -1383,7 +1245,7 @@ cdef class Workspace:
                 self.direction[i] = self.sol[i] - it.x[i]
             copy(self.sol, it.x, n)
         copy(self.sol + n, it.nu, m)
-        unbounded[0] = sigma * inf_norm(it.x, n) > _EQUALITY_START_LIMIT * max(
+        unbounded[0] = sigma * inf_norm(it.x, n) > EQUALITY_START_LIMIT * max(
             1.0, inf_norm(p.q, n))
         if unbounded[0]:
             # min 1/2 x'(P + sigma I) x subject to A x = b: bounded, and A x = b holds
@@ -1449,7 +1311,7 @@ cdef class Workspace:
             proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
             self._residuals()
             new_status = self._classify(iteration, True, start_time)
-            if (self.res.prim <= _RESTORED_EQUALITY * max(1.0, self.res.prim_scale)
+            if (self.res.prim <= RESTORED_EQUALITY * max(1.0, self.res.prim_scale)
                     and (status != _SOLVED or new_status == _SOLVED)):
                 return new_status
         copy(self.saved, it.x, n)
@@ -1503,9 +1365,9 @@ cdef class Workspace:
         tol_p = o.eps_abs + o.eps_rel * r.prim_scale
         tol_d = o.eps_abs + o.eps_rel * r.dual_scale
         tol_g = o.eps_abs + o.eps_rel * r.gap_scale
-        if (r.prim <= _POLISH_EXACT * tol_p and r.dual <= _POLISH_EXACT * tol_d
-                and r.gap <= _POLISH_EXACT * tol_g
-                and r.prim_eq <= _EQUALITY_EXACT * r.prim_eq_scale):
+        if (r.prim <= POLISH_EXACT * tol_p and r.dual <= POLISH_EXACT * tol_d
+                and r.gap <= POLISH_EXACT * tol_g
+                and r.prim_eq <= EQUALITY_EXACT * r.prim_eq_scale):
             plain = self.res   # the comparisons below do not need the ADMM point's
         else:   # measure the ADMM point, then the polished one again (into user_x, ...)
             polished = self.res
@@ -1519,14 +1381,14 @@ cdef class Workspace:
         if not (r.finite
                 and r.prim_eq <= o.eps_abs + o.eps_rel * r.prim_eq_scale
                 and r.prim_set <= o.eps_abs + o.eps_rel * r.prim_set_scale
-                and multiplier_violation(&self.pol, p, self.user_z) <= _POLISH_EXACT * tol_d
+                and multiplier_violation(&self.pol, p, self.user_z) <= POLISH_EXACT * tol_d
                 # at EQUALITY_EXACT of max(|A x|, |b|) it is below EQUALITY_MISSED of |A||x|
-                and (r.prim_eq <= _EQUALITY_EXACT * r.prim_eq_scale
-                     or (r.prim_eq <= _EQUALITY_SLACK * plain.prim_eq
-                         and r.prim_eq <= _EQUALITY_MISSED * self._row_terms(self.user_x)))
-                and (r.prim <= plain.prim or r.prim <= _POLISH_EXACT * tol_p)
-                and (r.dual <= plain.dual or r.dual <= _POLISH_EXACT * tol_d)
-                and (r.gap <= plain.gap or r.gap <= _POLISH_EXACT * tol_g)
+                and (r.prim_eq <= EQUALITY_EXACT * r.prim_eq_scale
+                     or (r.prim_eq <= EQUALITY_SLACK * plain.prim_eq
+                         and r.prim_eq <= EQUALITY_MISSED * self._row_terms(self.user_x)))
+                and (r.prim <= plain.prim or r.prim <= POLISH_EXACT * tol_p)
+                and (r.dual <= plain.dual or r.dual <= POLISH_EXACT * tol_d)
+                and (r.gap <= plain.gap or r.gap <= POLISH_EXACT * tol_g)
                 and not (solved_only and self._classify(iteration, True, start_time) != _SOLVED)):
             self.res = before
             return False
@@ -1593,7 +1455,7 @@ cdef class Workspace:
         if run.status in (_SOLVED, _INACCURATE, _MAX_ITER, _TIME_LIMIT):
             if converged(&self.res, self.opt.eps_abs, self.opt.eps_rel):
                 run.status = _SOLVED
-            elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, _INACCURATE_FACTOR):
+            elif nearly_converged(&self.res, self.opt.eps_abs, self.opt.eps_rel, INACCURATE_FACTOR):
                 run.status = _INACCURATE
             elif run.status in (_SOLVED, _INACCURATE):
                 # the iterate passed, the returned point does not: a budget that ran out

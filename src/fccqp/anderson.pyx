@@ -22,20 +22,7 @@ import numpy as np
 from libc.math cimport sqrt
 
 from fccqp._types cimport Iterates
-
-MAX_REJECTIONS = 3
-"""Anderson steps rejected by the safeguard before a run gives up accelerating."""
-REGULARIZATION = 1e-8
-"""Tikhonov weight of the least-squares problem, relative to its largest diagonal."""
-MAX_WEIGHT_NORM = 1e4
-"""Weights of this Euclidean norm or more are not used (see the module docstring). The
-WBC sets' largest is 3.7e3 (go2 and talos_reduced, default and realtime settings); on
-the general suite every step with more was rejected by the safeguard but one on an
-infeasible problem, and with the cap the suite's ``large_multipliers[32]`` is solved
-(1455 iterations, was 4000 uncertified: an extrapolation raised ``|y|`` 1e4 times)."""
-cdef long _MAX_REJECTIONS = MAX_REJECTIONS
-cdef double _REGULARIZATION = REGULARIZATION
-cdef double _MAX_WEIGHT_NORM = MAX_WEIGHT_NORM
+from fccqp.tuning cimport MAX_REJECTIONS, MAX_WEIGHT_NORM, REGULARIZATION
 
 
 cdef void anderson_reset(Anderson* a, bint keep_rejections) noexcept nogil:
@@ -104,7 +91,7 @@ cdef void anderson_step(Anderson* a, Iterates* it, Py_ssize_t s) noexcept nogil:
         a.rejections += 1
         anderson_reset(a, True)
         # let plain ADMM run before trying again; after a few failures, for good
-        a.wait = cap if a.rejections < _MAX_REJECTIONS else (<long>1) << 62
+        a.wait = cap if a.rejections < MAX_REJECTIONS else (<long>1) << 62
         return
     if a.wait > 0:
         a.wait -= 1
@@ -141,13 +128,13 @@ cdef void anderson_step(Anderson* a, Iterates* it, Py_ssize_t s) noexcept nogil:
             acc += a.df[i * two_s + j] * f[j]
         a.gamma[i] = acc
     for i in range(stored):
-        a.gram[i * stored + i] += _REGULARIZATION * ridge + 1e-300
+        a.gram[i * stored + i] += REGULARIZATION * ridge + 1e-300
     if not solve_small_spd(a.gram, a.gamma, stored):
         return
     acc = 0.0
     for i in range(stored):
         acc += a.gamma[i] * a.gamma[i]
-    if not acc < _MAX_WEIGHT_NORM * _MAX_WEIGHT_NORM:
+    if not acc < MAX_WEIGHT_NORM * MAX_WEIGHT_NORM:
         anderson_reset(a, True)   # nothing to extrapolate from: plain steps rebuild it
         return
     for j in range(s):

@@ -39,33 +39,8 @@ from fccqp._blas cimport cholesky, cholesky_solve_vector, syrk_t
 from fccqp._dense cimport copy, matvec
 from fccqp._types cimport Iterates, Problem
 from fccqp.projections cimport proj_block
-
-SEPARATION_FLOOR = 1e-9
-"""A Farkas certificate separates by more than this fraction of the magnitude of its
-terms: rounding of data built as ``b = A x`` (feasible by intent) leaves ``1e-16`` times
-its cancellation, and ``A x = b`` itself is promised to this accuracy
-(``fccqp.admm.EQUALITY_MISSED``)."""
-DOMINANCE = 100.0
-"""A Farkas certificate's relative separation is at least this multiple of its relative
-residual: a feasible ``x`` would need products with the certificate this many times
-larger than ``b``'s to explain the separation away. Nearly dependent but consistent
-rows give certificates whose two are alike (``rho = 9e-7`` against ``delta = 1.1e-6`` in
-a fuzz case); the certificates of 397 infeasible problems of a random property run
-separate by 120 times their residual or more (98 % of them by 1e4 or more)."""
-CLEANING_PASSES = 30
-"""Alternating steps :func:`clean_primal_certificate` tries on a candidate, in each of its
-two ways: with shrinking, each halved the residual of two friction cones pinned
-outside their sum beside a row through a boxed entry (gap 1e-4): 4e-12 after 30."""
-CLEANING_SHRINK = 0.1
-"""Largest shift of a cleaning step's proximal step on the box's support, relative to
-the size of ``d_y``."""
-GRAM_REGULARIZATION = 1e-12
-"""Added to ``A A'``'s diagonal, relative to its largest entry, for dependent rows."""
-cdef double _SEPARATION_FLOOR = SEPARATION_FLOOR
-cdef int _CLEANING_PASSES = CLEANING_PASSES
-cdef double _CLEANING_SHRINK = CLEANING_SHRINK
-cdef double _GRAM_REGULARIZATION = GRAM_REGULARIZATION
-cdef double _DOMINANCE = DOMINANCE
+from fccqp.tuning cimport (CLEANING_PASSES, CLEANING_SHRINK, DOMINANCE, GRAM_REGULARIZATION,
+                           SEPARATION_FLOOR)
 
 
 cdef void magnitudes(const Problem* p, const double* x, double* t) noexcept nogil:
@@ -171,7 +146,7 @@ cdef int _farkas(const Problem* p, const double* x, const double* d_nu, const do
     for i in range(m):
         support += p.b[i] * d_nu[i]
         size += fabs(p.b[i] * d_nu[i])
-    if not (support < -_SEPARATION_FLOOR * size) or not isfinite(support):
+    if not (support < -SEPARATION_FLOOR * size) or not isfinite(support):
         return REJECTED
     _transpose_product(p, d_nu, lhs, terms)
     for j in range(s):
@@ -186,7 +161,7 @@ cdef int _farkas(const Problem* p, const double* x, const double* d_nu, const do
     # separation no larger than what the residual explains at the iterate's own x proves
     # nothing (dependent rows let d_nu drift along null(A') with b'd_nu ~ 0)
     if (lhs_max <= eps * terms_max and support < -explained
-            and _DOMINANCE * lhs_max * size <= -support * terms_max):
+            and DOMINANCE * lhs_max * size <= -support * terms_max):
         return CERTIFIED
     return SEPARATED
 
@@ -204,7 +179,7 @@ cdef bint gram_factor(const Problem* p, double* gram) noexcept nogil:
     if not largest > 0.0:
         return False
     for i in range(m):
-        gram[i + i * m] += _GRAM_REGULARIZATION * largest
+        gram[i + i * m] += GRAM_REGULARIZATION * largest
     return cholesky(gram, <int>m, <int>m)
 
 
@@ -244,7 +219,7 @@ cdef bint clean_primal_certificate(const Problem* p, const double* x, const doub
         return False
     copy(saved, d_nu, m)
     copy(saved + m, d_y, s)
-    return _alternate(p, x, gram, eps, _CLEANING_SHRINK / bounds, d_nu, d_y, w, lhs, terms)
+    return _alternate(p, x, gram, eps, CLEANING_SHRINK / bounds, d_nu, d_y, w, lhs, terms)
 
 
 cdef bint _alternate(const Problem* p, const double* x, const double* gram, double eps,
@@ -257,7 +232,7 @@ cdef bint _alternate(const Problem* p, const double* x, const double* gram, doub
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j, pass_
     cdef double size
     cdef int code, rejected = 0
-    for pass_ in range(_CLEANING_PASSES):
+    for pass_ in range(CLEANING_PASSES):
         for i in range(n):   # w = -E_S'd_y, then d_nu := (A A')^-1 A w
             w[i] = 0.0
         for j in range(s):
@@ -321,14 +296,14 @@ cdef int equality_direction(const Problem* p, const double* r, const double* x, 
         br += p.b[i] * r[i]
         size += fabs(p.b[i] * r[i])
         data += fabs(r[i]) * max(fabs(p.b[i]), row_size(p, i, terms))
-    if not (br > _SEPARATION_FLOOR * data) or not isfinite(br):
+    if not (br > SEPARATION_FLOOR * data) or not isfinite(br):
         return REJECTED
     _transpose_product(p, r, ATr, terms)
     for j in range(n):
         lhs_max = max(lhs_max, fabs(ATr[j]) / p.D[j])
         terms_max = max(terms_max, terms[j] / p.D[j])
         explained += fabs(ATr[j] * x[j])
-    if (lhs_max <= eps * terms_max and _DOMINANCE * lhs_max * size <= br * terms_max
+    if (lhs_max <= eps * terms_max and DOMINANCE * lhs_max * size <= br * terms_max
             and br > explained):
         return CERTIFIED
     return SEPARATED
@@ -379,7 +354,7 @@ cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double
         scaled = max(scaled, fabs(dx[i]))
     if not (qdx < -eps * size) or not isfinite(qdx) or norm <= 1e-300:
         return False
-    eps = min(eps, -qdx / (size * _DOMINANCE))
+    eps = min(eps, -qdx / (size * DOMINANCE))
     tol = eps * norm
     for j in range(s):
         i = p.constrained[j]

@@ -9,7 +9,7 @@
  * Right-looking in panels of FCCQP_LU_PANEL columns, as dgetrf blocks: a panel is
  * factored one column at a time (rows swapped in full), then each trailing column gets
  * the panel's four updates in one pass, which loads and stores it once instead of four
- * times (callgrind, talos' 64-row systems: see polish_table.LU_LOOP_ROWS).
+ * times (callgrind, talos' 64-row systems: see tuning.LU_LOOP_ROWS and notes/tuning.md).
  *
  * fccqp_cholesky: Cholesky factor L L' of the lower triangle of a column-major n x n
  * matrix (leading dimension ld) in place; returns 0 at a pivot that is not positive.

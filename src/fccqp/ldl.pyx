@@ -27,16 +27,7 @@ from scipy.linalg.cython_lapack cimport dsytrf, dsytrs, dsytrs2
 from fccqp._types cimport Problem
 from fccqp._blas cimport gemm
 from fccqp._dense cimport matvec, matvec_t
-
-DELTA = 1e-13
-"""Quasi-definite regularization of the (2, 2) block (scaled problem)."""
-MAX_REFINE = 5
-"""Most refinement steps per solve."""
-REFINE_TOLERANCE = 1e-13
-"""Refine while ``||A x - b||`` (unscaled) exceeds this times ``max(1, ||b||, ||A x||)``."""
-cdef double _DELTA = DELTA
-cdef int _MAX_REFINE = MAX_REFINE
-cdef double _REFINE_TOLERANCE = REFINE_TOLERANCE
+from fccqp.tuning cimport KKT_DELTA, KKT_REFINE_TOLERANCE, MAX_REFINE
 
 
 cdef int ldl_factor(LDL* f, const Problem* p, double sigma, const double* rho_vec) noexcept nogil:
@@ -58,7 +49,7 @@ cdef int ldl_factor(LDL* f, const Problem* p, double sigma, const double* rho_ve
     for i in range(m):
         for j in range(i, m):
             K[n + j + (n + i) * N] = 0.0
-        K[n + i + (n + i) * N] = -_DELTA
+        K[n + i + (n + i) * N] = -KKT_DELTA
     cdef char uplo = b"L"
     cdef int size = f.N, info = 0
     dsytrf(&uplo, &size, K, &size, f.ipiv, f.work, &f.lwork, &info)
@@ -106,13 +97,13 @@ cdef bint meets_equalities(const double* Ax, const double* b, const double* row_
     for i in range(m):
         error = max(error, fabs(b[i] - Ax[i]) / row_scale[i])
         size = max(size, max(fabs(b[i]), fabs(Ax[i])) / row_scale[i])
-    return error <= _REFINE_TOLERANCE * max(1.0, size)
+    return error <= KKT_REFINE_TOLERANCE * max(1.0, size)
 
 
 cdef void _refine_step(LDL* f, const Problem* p, double sigma, const double* rho_vec,
                        const double* rhs, double* sol, double delta) noexcept nogil:
     """One refinement step against the KKT matrix with ``-delta I`` as its (2, 2) block:
-    0 for the true system, ``DELTA`` for the factored one. Needs ``f.Ax = A x`` on entry;
+    0 for the true system, ``KKT_DELTA`` for the factored one. Needs ``f.Ax = A x`` on entry;
     leaves the correction in ``f.residual``."""
     cdef Py_ssize_t n = p.n, m = p.m, i, k
     cdef double* res = f.residual
@@ -138,7 +129,7 @@ cdef void _refine_regularized(LDL* f, const Problem* p, double sigma, const doub
     cdef int step
     for step in range(2):
         matvec(p.A, sol, f.Ax, p.m, p.n)
-        _refine_step(f, p, sigma, rho_vec, rhs, sol, _DELTA)
+        _refine_step(f, p, sigma, rho_vec, rhs, sol, KKT_DELTA)
 
 
 cdef void ldl_solve(LDL* f, const Problem* p, double sigma, const double* rho_vec,
@@ -157,7 +148,7 @@ cdef void ldl_solve(LDL* f, const Problem* p, double sigma, const double* rho_ve
         return
     cdef double* res = f.residual
     cdef double error, last_error = INFINITY
-    for r in range(_MAX_REFINE + 1):
+    for r in range(MAX_REFINE + 1):
         matvec(p.A, sol, f.Ax, m, n)
         if meets_equalities(f.Ax, rhs + n, p.E, m):
             return
@@ -175,7 +166,7 @@ cdef void ldl_solve(LDL* f, const Problem* p, double sigma, const double* rho_ve
             _refine_regularized(f, p, sigma, rho_vec, rhs, sol)
             return
         last_error = error
-        if r == _MAX_REFINE:
+        if r == MAX_REFINE:
             return
         _refine_step(f, p, sigma, rho_vec, rhs, sol, 0.0)
 
@@ -195,7 +186,7 @@ cdef bint _in_null_space(const double* AW, const Problem* p, const double* W, in
         a_max = max(a_max, fabs(p.A[i]))
     for i in range(m):
         e_min = min(e_min, p.E[i])
-    return error <= _REFINE_TOLERANCE * max(1.0, a_max * w_max / e_min)
+    return error <= KKT_REFINE_TOLERANCE * max(1.0, a_max * w_max / e_min)
 
 
 cdef bint ldl_unit_columns(LDL* f, const Problem* p, double sigma, const double* rho_vec,
@@ -203,7 +194,7 @@ cdef bint ldl_unit_columns(LDL* f, const Problem* p, double sigma, const double*
                            double* work) noexcept nogil:
     """Fill ``W`` (Fortran, ``N x count``) with the KKT solutions for ``[e_i; 0]``, ``i``
     in ``entries``, refined like :func:`ldl_solve`; ``R`` is scratch of ``W``'s size and
-    ``work`` of ``N``. False when the equality part misses ``REFINE_TOLERANCE``."""
+    ``work`` of ``N``. False when the equality part misses ``KKT_REFINE_TOLERANCE``."""
     cdef int n = <int>p.n, m = <int>p.m, N = f.N, i, j, k, r
     for j in range(count):
         for i in range(N):
@@ -212,7 +203,7 @@ cdef bint ldl_unit_columns(LDL* f, const Problem* p, double sigma, const double*
     ldl_solve_many(f, W, count, work)
     if m == 0:
         return True
-    for r in range(_MAX_REFINE + 1):
+    for r in range(MAX_REFINE + 1):
         # R_nu = A W_x (m x count, stored in the first m rows of R's columns of length m)
         gemm(b"T", b"N", m, count, n, 1.0, p.A, n, W, N, 0.0, R, m)
         if _in_null_space(R, p, W, N, count):

@@ -64,62 +64,12 @@ from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup, polish_
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.projections cimport proj_block
 from fccqp.reduced cimport Reduced
+from fccqp.tuning cimport (ACTIVE_TOLERANCE, CHORD_RATE, CHORD_STEPS, GUESS_PASSES, GUESS_TOLERANCE,
+                           MAX_REFINE, MISS_FLOOR, NEWTON_TOLERANCE, POLISH_DELTA,
+                           POLISH_REFINE_TOLERANCE)
 
 cdef extern from "fccqp_clock.h" nogil:
     double fccqp_now()
-
-DELTA = 1e-12
-"""Regularization of both diagonal blocks of the polishing KKT matrix (scaled problem):
-it exists for dependent rows and a cost that is flat on the free entries; refinement
-against the unregularized matrix removes it."""
-MAX_REFINE = 5
-"""Most refinement steps per solve."""
-REFINE_TOLERANCE = 1e-14
-"""Refine while the KKT residual exceeds this times ``max(1, ||q||, ||b||)`` (scaled)."""
-GUESS_TOLERANCE = 1e-10
-"""A guess's first solve, which the guess corrections and Newton steps move on from, is
-refined only to this (same scale); the point returned is refined to ``REFINE_TOLERANCE``.
-With the Schur complement (:mod:`fccqp.polish_schur`) the first solve leaves about
-2e-12 on whole-body control, and refining it to 1e-14 took a second KKT solve and
-residual that the next chord step repeats."""
-GUESS_PASSES = 8
-"""Most active sets solved per polish: the first from ADMM's iterate, each next one
-corrected from the previous polished point or step (:func:`_renew`). With the steps of
-:func:`polish`, 6, 8 and 10 passes ended 88, 89 and 90.5 % of talos' ticks and 92.5, 93
-and 93.5 % of go2's without an iteration (``Settings.realtime(math.inf)``, 200 ticks
-each), at 4.72M, 4.92M and 5.20M instructions per talos tick and 701k, 700k and 725k
-per go2 tick (callgrind); with 6 a polish that had not settled was accepted within the
-realtime preset's tolerance at a gap of 2.5e-4 (1.1e-4 with 8, 6e-10 with 10)."""
-ACTIVE_TOLERANCE = 1e-12
-"""A free entry or block joins the active set when it violates by more than this
-(relative to the bound, or to ``||x_block||``)."""
-NEWTON_TOLERANCE = 1e-13
-"""Stop re-linearizing when every boundary block has ``|phi| <= this * ||x_block||``."""
-MISS_FLOOR = 1e-11
-"""Newton also stops when a fresh factorization did not reduce a miss already below
-this: the floor rounding leaves (talos: 1.8e-13, for all 10 steps). Farther out a
-Newton step may grow the miss before it converges, so it goes on there."""
-cdef double _MISS_FLOOR = MISS_FLOOR
-CHORD_RATE = 0.25
-CHORD_STEPS = 3
-"""A Newton step reuses the last factorization (a chord step: the Jacobian of earlier
-planes) while the cones' miss ``|phi| / ||x_block||`` keeps shrinking by ``CHORD_RATE``
-per step and, at the rate of the last step, would reach ``NEWTON_TOLERANCE`` within
-``CHORD_STEPS`` more; otherwise it refactors at the current planes (quadratic
-convergence). A chord step costs a residual and a solve, a refactorization about four
-of those; at a rate of 0.1 per step solo12's ticks took up to 10 chord steps. Measured
-(callgrind, realtime preset without a clock, instructions per tick) for 1, 2, 3, 5, 8
-steps and the rate alone: solo12 0.805, 0.799, 0.799, 0.807, 0.816M and 0.832M; go2
-0.860, 0.853, 0.852, 0.854, 0.863M and 0.869M."""
-cdef double _CHORD_RATE = CHORD_RATE
-cdef int _CHORD_STEPS = CHORD_STEPS
-cdef double _DELTA = DELTA
-cdef int _MAX_REFINE = MAX_REFINE
-cdef double _REFINE_TOLERANCE = REFINE_TOLERANCE
-cdef double _GUESS_TOLERANCE = GUESS_TOLERANCE
-cdef double _NEWTON_TOLERANCE = NEWTON_TOLERANCE
-cdef int _GUESS_PASSES = GUESS_PASSES
-cdef double _ACTIVE_TOLERANCE = ACTIVE_TOLERANCE
 
 
 cdef inline double _axis(const double* v, Py_ssize_t kind, Py_ssize_t dim, double mu,
@@ -335,7 +285,7 @@ cdef bint _inside(const double* v, Py_ssize_t kind, Py_ssize_t dim, double mu,
     cdef double along = _axis(v, kind, dim, mu, normal, &across)
     for j in range(dim):
         size += v[j] * v[j]
-    return across - _slope(kind, mu) * along <= _ACTIVE_TOLERANCE * sqrt(size)
+    return across - _slope(kind, mu) * along <= ACTIVE_TOLERANCE * sqrt(size)
 
 
 cdef double _cone_step(const double* x0, const double* x1, Py_ssize_t kind, Py_ssize_t dim,
@@ -428,9 +378,9 @@ cdef Py_ssize_t _renew(Polish* w, const Problem* p, bint adding, Py_ssize_t bloc
         elif adding and code == FREE and j == blocking:
             code = LOWER if fabs(value - p.lo[j]) <= fabs(value - p.hi[j]) else UPPER
         elif adding and code == FREE:
-            if value < p.lo[j] - _ACTIVE_TOLERANCE * max(1.0, fabs(p.lo[j])):
+            if value < p.lo[j] - ACTIVE_TOLERANCE * max(1.0, fabs(p.lo[j])):
                 code = LOWER
-            elif value > p.hi[j] + _ACTIVE_TOLERANCE * max(1.0, fabs(p.hi[j])):
+            elif value > p.hi[j] + ACTIVE_TOLERANCE * max(1.0, fabs(p.hi[j])):
                 code = UPPER
         changed[0] += code != before
         w.active[j] = code
@@ -454,7 +404,7 @@ cdef Py_ssize_t _renew(Polish* w, const Problem* p, bint adding, Py_ssize_t bloc
             for j in range(d):
                 size += w.x[start + j] * w.x[start + j]
             along = _axis(w.x + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
-            if across - slope * along > _ACTIVE_TOLERANCE * sqrt(size) or blocking == p.s + k:
+            if across - slope * along > ACTIVE_TOLERANCE * sqrt(size) or blocking == p.s + k:
                 code = APEX if slope * across <= -along or size == 0.0 else BOUNDARY
                 proj_block(w.x + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
         elif released == p.s + k:   # an apex block whose y left the polar
@@ -511,7 +461,7 @@ cdef void _assemble(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) n
         jc = w.free[col]
         for r in range(col, nf):
             K[r + col * N] = p.P[w.free[r] * n + jc]
-        K[col + col * N] += _DELTA
+        K[col + col * N] += POLISH_DELTA
         for i in range(m):
             K[nf + i + col * N] = p.A[i * n + jc]
     for k in range(nb):
@@ -522,7 +472,7 @@ cdef void _assemble(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) n
             for i in range(j, d):   # entries of a block are consecutive unknowns
                 K[w.index[start + i] + w.index[start + j] * N] += w.hess[o * p.s + i * d + j]
     for r in range(nf, N):
-        K[r + r * N] = -_DELTA
+        K[r + r * N] = -POLISH_DELTA
 
 
 cdef double _residual(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) noexcept nogil:
@@ -579,12 +529,12 @@ cdef void _solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
     after the first; a correction that makes it grow is undone."""
     cdef double norm, last = INFINITY
     cdef int r
-    for r in range(_MAX_REFINE + 2):
+    for r in range(MAX_REFINE + 2):
         norm = _residual(w, p, nf, nb)
         if norm > last:
             _apply(w, nf, p.m, nb, -1.0)
             return
-        if norm <= tolerance or norm > 0.5 * last or r == _MAX_REFINE + 1:
+        if norm <= tolerance or norm > 0.5 * last or r == MAX_REFINE + 1:
             return
         last = norm
         _factored_solve(w, p, nf, nb)
@@ -631,7 +581,7 @@ cdef bint _relinearize(Polish* w, const Problem* p, Py_ssize_t nb,
             size += w.x[start + j] * w.x[start + j]
         along = _axis(w.x + start, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, &across)
         miss = fabs(across - _slope(c.kind[cone], c.mu[cone]) * along)
-        if miss > _NEWTON_TOLERANCE * sqrt(size):
+        if miss > NEWTON_TOLERANCE * sqrt(size):
             converged = False
             worst[0] = max(worst[0], miss / sqrt(size))
     if converged:
@@ -694,7 +644,7 @@ cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t n
     if size == 0:   # every entry held, no rows: nothing to solve
         return True
     w.structured = w.schur.ready and polish_schur_factor(&w.schur, p, w.index, w.boundary, nb,
-                                                         w.g, w.hess, _DELTA)
+                                                         w.g, w.hess, POLISH_DELTA)
     factorizations[0] += 1
     if w.structured:
         _solve(w, p, nf, nb, tolerance)
@@ -723,7 +673,8 @@ cdef bint _solve_guess(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
             table_solve(w, p, table, kkt, rho_vec, nb, scale)
             return True
         tabled[0] = False
-    return _factor_solve(w, p, nf, nb, (_GUESS_TOLERANCE if first else _REFINE_TOLERANCE) * scale,
+    return _factor_solve(w, p, nf, nb,
+                         (GUESS_TOLERANCE if first else POLISH_REFINE_TOLERANCE) * scale,
                          factorizations)
 
 
@@ -751,7 +702,7 @@ cdef void _multipliers(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
 cdef bint polish_prepare(Polish* w, const Problem* p) noexcept nogil:
     """Set up the Schur-complement solve of :mod:`fccqp.polish_schur` for this solve's
     ``P`` and ``A``; True when it applies, and then polishing needs no table."""
-    return polish_schur_setup(&w.schur, p, _DELTA)
+    return polish_schur_setup(&w.schur, p, POLISH_DELTA)
 
 
 cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_steps,
@@ -825,9 +776,9 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
             return False
         _multipliers(w, p, nf, nb)
         passes += 1
-        if passes == _GUESS_PASSES or w.cycling:   # not settled: the caller judges this point
+        if passes == GUESS_PASSES or w.cycling:   # not settled: the caller judges this point
             if not tabled:
-                _solve(w, p, nf, nb, _REFINE_TOLERANCE * scale)
+                _solve(w, p, nf, nb, POLISH_REFINE_TOLERANCE * scale)
                 _multipliers(w, p, nf, nb)
             break
         if feasible:
@@ -852,10 +803,10 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         refactored = False
         for step in range(newton_steps):
             if not _relinearize(w, p, nb, &miss) or (
-                    refactored and miss >= last_miss and miss <= _MISS_FLOOR):
+                    refactored and miss >= last_miss and miss <= MISS_FLOOR):
                 break   # converged, or at the floor that rounding leaves
             rate = miss / last_miss   # 0 at the first step: a chord step
-            refactored = rate > _CHORD_RATE or pow(rate, _CHORD_STEPS) * miss > _NEWTON_TOLERANCE
+            refactored = rate > CHORD_RATE or pow(rate, CHORD_STEPS) * miss > NEWTON_TOLERANCE
             if not refactored:   # a chord step: one correction, the last factor, the current planes
                 if tabled:
                     table_correct(w, p, table, kkt, rho_vec, nb, scale)
@@ -876,7 +827,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
                 table_solve(w, p, table, kkt, rho_vec, nb, scale)
                 w.grad_current = False
             else:
-                _solve(w, p, nf, nb, _REFINE_TOLERANCE * scale)
+                _solve(w, p, nf, nb, POLISH_REFINE_TOLERANCE * scale)
         _multipliers(w, p, nf, nb)
         break
     w.passes = passes

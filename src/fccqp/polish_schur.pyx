@@ -48,16 +48,7 @@ from fccqp._blas cimport (backward_substitution, cholesky_solve_vector, forward_
                           syrk_t, trsm)
 from fccqp._types cimport Problem
 from fccqp.schur cimport mark_coupled
-
-PIVOT_TOLERANCE = 1e-12
-"""A diagonal entry of ``P`` (or pivot of its dense block) below this times ``P``'s
-largest diagonal entry makes ``H`` too close to singular for the Schur complement:
-``dsytrf`` of the assembled matrix takes such problems (flat costs, LPs)."""
-RANK_TOLERANCE = 1e-10
-"""``S`` counts as singular when a Cholesky pivot falls below this times its largest
-diagonal entry, as in :mod:`fccqp.schur`."""
-cdef double _PIVOT_TOLERANCE = PIVOT_TOLERANCE
-cdef double _RANK_TOLERANCE = RANK_TOLERANCE
+from fccqp.tuning cimport PIVOT_TOLERANCE, RANK_TOLERANCE
 
 
 cdef extern from "fccqp_kernels.h" nogil:
@@ -90,7 +81,7 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
         f.coupled[i] = 2   # constrained: not part of the unconstrained order
         if p.P[i * n + i] < 0.0:
             f.convex = False
-        f.root[i] = sqrt(p.P[i * n + i] + delta) if p.P[i * n + i] > _PIVOT_TOLERANCE * largest else 0.0
+        f.root[i] = sqrt(p.P[i * n + i] + delta) if p.P[i * n + i] > PIVOT_TOLERANCE * largest else 0.0
     for i in range(n):
         if f.coupled[i] == 1:
             f.order[lead] = i
@@ -98,7 +89,7 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
     rest = lead
     for i in range(n):
         if f.coupled[i] == 0:
-            if not p.P[i * n + i] > _PIVOT_TOLERANCE * largest:
+            if not p.P[i * n + i] > PIVOT_TOLERANCE * largest:
                 return False
             f.root[i] = sqrt(p.P[i * n + i] + delta)
             f.order[rest] = i
@@ -116,7 +107,7 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
         return False
     for c in range(k):
         pivot = f.L[c + c * n]
-        if not pivot * pivot > _PIVOT_TOLERANCE * largest:
+        if not pivot * pivot > PIVOT_TOLERANCE * largest:
             return False
     for c in range(m):
         for r in range(rest):
@@ -228,7 +219,7 @@ cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t
     if size > 0 and not fccqp_cholesky(S, <int>size, <int>size):
         return False
     for c in range(size):
-        if S[c + c * size] * S[c + c * size] <= _RANK_TOLERANCE * largest:
+        if S[c + c * size] * S[c + c * size] <= RANK_TOLERANCE * largest:
             return False
     f.size = <int>size
     return True

@@ -43,31 +43,7 @@ from fccqp._types cimport Problem
 from fccqp.kkt cimport KKT, kkt_solve_once
 from fccqp.polish cimport APEX, FIXED, LOWER, UPPER, Polish
 from fccqp.reduced cimport Reduced
-
-LU_LOOP_ROWS = 64
-"""Systems up to this size are LU-factored by the loop ``fccqp_lu`` (fccqp_kernels.h,
-built for AVX2 + FMA beside the baseline), larger ones by LAPACK's ``dgetrf``. Measured
-per tick (callgrind, the WBC sets, AVX2 copy): go2's 28 rows took 40k instructions in
-the baseline loop against ``dgetrf``'s 59k, 30k with AVX2; on talos, whose systems
-reach 64 rows, the AVX2 loop cut a tick from 8.15M to 7.81M instructions against
-``dgetrf`` (the baseline loop had lost there, 350k against 248k per factorization).
-Larger systems were not measured: ``dgetrf``'s blocked kernels gain with the size."""
-cdef int _LU_LOOP_ROWS = LU_LOOP_ROWS
-PIVOT_RATIO = 1e-13
-"""The LU factor counts as singular when its smallest pivot is below this times its
-largest (the polished QP's solution is then not unique: the caller regularizes)."""
-MAX_REFINE = 5
-"""Most corrections after the first solve."""
-REFINE_TOLERANCE = 1e-14
-"""Refine while the residual exceeds this times ``max(1, ||q||, ||b||)`` (scaled)."""
-MINOR_PART = 1e-2
-"""A correction skips the KKT solve when the KKT conditions' residual is below this
-times the constraints' (after a Newton step only the planes moved): the next correction
-takes it up if it matters."""
-cdef double _MINOR_PART = MINOR_PART
-cdef double _PIVOT_RATIO = PIVOT_RATIO
-cdef int _MAX_REFINE = MAX_REFINE
-cdef double _REFINE_TOLERANCE = REFINE_TOLERANCE
+from fccqp.tuning cimport LU_LOOP_ROWS, MAX_REFINE, MINOR_PART, PIVOT_RATIO, POLISH_REFINE_TOLERANCE
 
 
 cdef inline double _held_value(const Problem* p, Py_ssize_t j, char code) noexcept nogil:
@@ -177,7 +153,7 @@ cdef void _correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
     cdef double value
     cdef char code
     if sign > 0.0:
-        if w.kkt_norm > max(tiny, _MINOR_PART * inf_norm(w.tr, s + nb)):
+        if w.kkt_norm > max(tiny, MINOR_PART * inf_norm(w.tr, s + nb)):
             kkt_solve_once(kkt, p, rho, w.full, w.dfull)   # d0 = K_R^-1 (r1, r2)
         else:   # the KKT part holds already or is minor
             fill(w.dfull, 0.0, N)
@@ -222,7 +198,7 @@ cdef bint table_factor(Polish* w, const Problem* p, const Reduced* t, const doub
     cdef Py_ssize_t i
     cdef double big = 0.0, small = INFINITY, pivot
     _assemble(w, p, t, rho, nb)
-    if size <= _LU_LOOP_ROWS:
+    if size <= LU_LOOP_ROWS:
         if not fccqp_lu(w.T, size, w.tpiv):
             return False
     else:
@@ -233,7 +209,7 @@ cdef bint table_factor(Polish* w, const Problem* p, const Reduced* t, const doub
         pivot = fabs(w.T[i + i * size])
         big = max(big, pivot)
         small = min(small, pivot)
-    return small > _PIVOT_RATIO * big
+    return small > PIVOT_RATIO * big
 
 
 cdef void table_solve(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
@@ -245,19 +221,19 @@ cdef void table_solve(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
     method, the Jacobian of the earlier planes standing in for the current one."""
     cdef double norm, last = INFINITY
     cdef int r
-    for r in range(_MAX_REFINE + 2):
+    for r in range(MAX_REFINE + 2):
         norm = _residual(w, p, nb)
         if norm > last:
             _correct(w, p, t, kkt, rho, nb, -1.0, 0.0)
             return
-        if norm <= _REFINE_TOLERANCE * scale or norm > 0.5 * last or r == _MAX_REFINE + 1:
+        if norm <= POLISH_REFINE_TOLERANCE * scale or norm > 0.5 * last or r == MAX_REFINE + 1:
             return
         last = norm
-        _correct(w, p, t, kkt, rho, nb, 1.0, _REFINE_TOLERANCE * scale)
+        _correct(w, p, t, kkt, rho, nb, 1.0, POLISH_REFINE_TOLERANCE * scale)
 
 
 cdef void table_correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
                         const double* rho, Py_ssize_t nb, double scale) noexcept nogil:
     """One correction of the current point with the last factor (a chord step)."""
     _residual(w, p, nb)
-    _correct(w, p, t, kkt, rho, nb, 1.0, _REFINE_TOLERANCE * scale)
+    _correct(w, p, t, kkt, rho, nb, 1.0, POLISH_REFINE_TOLERANCE * scale)

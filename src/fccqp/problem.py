@@ -17,12 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fccqp.cones import Cone, ConeArrays, flatten_cones
-
-INFINITE_BOUND = 1e20
-"""Bounds at or beyond this magnitude are no bounds (as in Clarabel's presolve);
-the same threshold as :data:`fccqp.validation.INFINITE_BOUND`."""
-MAX_ENTRY = 1e20
-"""Largest magnitude accepted in ``P, q, A, b, x0`` (see :mod:`fccqp.validation`)."""
+from fccqp.tuning import INFINITE_BOUND, MAX_ENTRY  # noqa: F401  (public here: docs/api.md)
 
 
 class Sizes:

@@ -32,10 +32,7 @@ from fccqp._types cimport Iterates, Problem
 from fccqp.kkt cimport KKT, kkt_unit_columns
 from fccqp.projections cimport proj_set
 from fccqp.reduced cimport Reduced
-
-VIOLATION_TOLERANCE = 1e-12
-"""An entry violates when its projection moves it by more than this (relative)."""
-cdef double _VIOLATION_TOLERANCE = VIOLATION_TOLERANCE
+from fccqp.tuning cimport VIOLATION_TOLERANCE
 
 
 cdef bint _pin_violators(Restoration* r, const Problem* p, const double* x) noexcept nogil:
@@ -48,7 +45,7 @@ cdef bint _pin_violators(Restoration* r, const Problem* p, const double* x) noex
         r.projected[j] = x[p.constrained[j]]
     proj_set(r.projected, p.lo, p.hi, p.cones, s, r.projected)
     for j in range(s):
-        if fabs(r.projected[j] - x[p.constrained[j]]) > _VIOLATION_TOLERANCE * max(
+        if fabs(r.projected[j] - x[p.constrained[j]]) > VIOLATION_TOLERANCE * max(
                 1.0, fabs(x[p.constrained[j]])):
             if not r.pinned[j]:
                 new = True

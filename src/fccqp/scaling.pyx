@@ -21,36 +21,18 @@ from libc.math cimport exp, fabs, ilogb, ldexp, log, sqrt
 
 from fccqp._types cimport Cones
 from fccqp.projections cimport proj_set
+from fccqp.tuning cimport MAX_NORM, MIN_COST_NORM, MIN_NORM, RESCALE_DRIFT
 
 cdef extern from "fccqp_kernels.h" nogil:
     void fccqp_scale_rows(const double* M, int rows, int cols, const double* left,
                           const double* right, double* out, double* row_max,
                           double* column_max)
 
-MIN_NORM = 1e-8
-"""Column norms below this are treated as 1 (a column of zeros is left alone). OSQP
-uses 1e-4; that left an equality row of size 1e-7 unscaled, and ADMM then did not
-converge in 4000 iterations (issue 11, item 1); with 1e-8 it is scaled up, 100x per
-pass, and solved in 51."""
-MAX_NORM = 1e4
-"""Column norms are capped here, bounding one pass's scale change to 100x."""
-MIN_COST_NORM = 1e-4
-"""The cost is normalized by its size (mean column norm of ``P``, ``||q||``) only above
-this: a nearly zero cost is left as it is rather than multiplied by up to 1e4."""
-RESCALE_DRIFT = 4.0
-""":func:`rescale` keeps an earlier scaling while every norm of the scaled matrices
-stays within this factor of what it gave its own data (one Ruiz pass corrects a
-column by the square root of its norm: a factor of 4 is about one pass's work)."""
-cdef double _RESCALE_DRIFT = RESCALE_DRIFT
-cdef double _MIN_NORM = MIN_NORM
-cdef double _MAX_NORM = MAX_NORM
-cdef double _MIN_COST_NORM = MIN_COST_NORM
-
 
 cdef inline double _inverse_sqrt_norm(double norm) noexcept nogil:
-    if norm < _MIN_NORM:
+    if norm < MIN_NORM:
         return 1.0
-    return 1.0 / sqrt(norm if norm < _MAX_NORM else _MAX_NORM)
+    return 1.0 / sqrt(norm if norm < MAX_NORM else MAX_NORM)
 
 
 cdef inline double _row_max(const double* row, const double* weight, Py_ssize_t n) noexcept nogil:
@@ -92,7 +74,7 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
         # (a power of two): rows of 1e-300 were lost to the KKT matrix's regularization
         # and A x = b to |b|, whatever the passes
         value = _row_max(A + i * n, D, n)
-        E[i] = ldexp(1.0, -ilogb(value)) if 0.0 < value < _MIN_NORM else 1.0
+        E[i] = ldexp(1.0, -ilogb(value)) if 0.0 < value < MIN_NORM else 1.0
     for it in range(iterations):
         # column maxima accumulate row by row (independent per column: the loops vectorize)
         for j in range(n):
@@ -138,9 +120,9 @@ cdef inline double _cost_scale(double mean_col, double q_norm) noexcept nogil:
     """``c = 1 / size`` of a cost whose ``P`` has mean column norm ``mean_col`` and whose
     ``q`` has norm ``q_norm``: the larger of the two, each counted only above
     ``MIN_COST_NORM``, at most ``MAX_NORM``."""
-    cdef double size = max(mean_col if mean_col >= _MIN_COST_NORM else 1.0,
-                           q_norm if q_norm >= _MIN_COST_NORM else 1.0)
-    return 1.0 / min(size, _MAX_NORM)
+    cdef double size = max(mean_col if mean_col >= MIN_COST_NORM else 1.0,
+                           q_norm if q_norm >= MIN_COST_NORM else 1.0)
+    return 1.0 / min(size, MAX_NORM)
 
 
 cdef double _normalize_cost(double* P, double* q, Py_ssize_t n, double* ones) noexcept nogil:
@@ -221,8 +203,8 @@ cdef bint rescale(const double* P, const double* q, const double* A, const doubl
     for i in range(m):
         b_s[i] = b[i] * E[i]
     for i in range(n + m):
-        if not (norms[i] <= _RESCALE_DRIFT * reference[i]
-                and reference[i] <= _RESCALE_DRIFT * norms[i]):
+        if not (norms[i] <= RESCALE_DRIFT * reference[i]
+                and reference[i] <= RESCALE_DRIFT * norms[i]):
             return False
     return True
 

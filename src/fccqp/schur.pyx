@@ -37,12 +37,7 @@ from fccqp._blas cimport cholesky, cholesky_solve, cholesky_solve_vector, gemm, 
 from fccqp._dense cimport matvec, matvec_t
 from fccqp._types cimport Problem
 from fccqp.ldl cimport meets_equalities
-
-RANK_TOLERANCE = 1e-10
-"""``S`` counts as singular when a Cholesky pivot falls below this times its largest
-diagonal entry: (nearly) dependent rows of ``A`` go to the LDL' backend."""
-cdef double _RANK_TOLERANCE = RANK_TOLERANCE
-cdef int _MAX_REFINE = 5
+from fccqp.tuning cimport MAX_REFINE, RANK_TOLERANCE
 
 
 def ordering(n, constrained):
@@ -127,7 +122,7 @@ cdef bint schur_factor(Schur* f, const Problem* p, const double* rho_vec) noexce
     if not cholesky(f.LS, m, m):
         return False
     for i in range(m):  # a pivot lost to cancellation: dependent rows, leave them to LDL'
-        if f.LS[i + i * m] * f.LS[i + i * m] <= _RANK_TOLERANCE * largest:
+        if f.LS[i + i * m] * f.LS[i + i * m] <= RANK_TOLERANCE * largest:
             return False
     return True
 
@@ -223,7 +218,7 @@ cdef void schur_solve(Schur* f, const Problem* p, const double* rho_vec, const d
     _solve(f, p, rhs, rhs + n, x, nu)
     if m == 0:
         return
-    for r in range(_MAX_REFINE):
+    for r in range(MAX_REFINE):
         matvec(p.A, x, f.Ax, m, n)
         if meets_equalities(f.Ax, rhs + n, p.E, m):
             return

@@ -143,7 +143,7 @@ class Settings:
     """Iterations between two rho updates, and between two unconditional residual checks."""
     adaptive_rho_tolerance: float = 5.0
     """Refactor only when rho would change by more than this factor, or by more than its
-    square root at ``fccqp.admm.RHO_PERSISTENCE`` updates in a row while the residuals
+    square root at ``fccqp.tuning.RHO_PERSISTENCE`` updates in a row while the residuals
     stall (a move then undone if they fall more slowly after it)."""
     anderson_memory: int = 10
     """Anderson acceleration memory (0 disables, at most :data:`MAX_ANDERSON_MEMORY`);
@@ -172,7 +172,7 @@ class Settings:
     1.1e-3 to 9e-9 and 4e-7 (docs/performance.md has its current cost). A warm start
     from a polished solution polishes its active set first, before any iteration, and
     without a time limit a run polishes early once the active set its iterate points
-    to has settled (``fccqp.admm.EARLY_POLISH_GATE``)."""
+    to has settled (``fccqp.tuning.EARLY_POLISH_GATE``)."""
     polish_refine_iter: int = 10
     """Most re-linearizations of the boundary cones' tangent planes in polishing (Newton
     steps, taken only until the cone function is met to 1e-13 or stops improving; a

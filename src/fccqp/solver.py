@@ -20,13 +20,14 @@ import numpy as np
 from fccqp import admm, schur
 from fccqp.cones import Cone, ConeArrays, flatten_cones
 from fccqp.fast_checks import dense_arguments, same_cones
-from fccqp.problem import MAX_ENTRY, check_cone_bounds, convert, raise_finding
+from fccqp.problem import check_cone_bounds, convert, raise_finding
 from fccqp.result import Result
 from fccqp.settings import MAX_DENSE_KKT_ROWS, Settings
+from fccqp.tuning import MAX_ENTRY
 from fccqp.validation import structure_scan
 
 LOG_ROWS = 1024
-"""Most lines of the verbose log kept per solve (one every ``admm.LOG_INTERVAL``
+"""Most lines of the verbose log kept per solve (one every ``tuning.LOG_INTERVAL``
 iterations, the first and the last)."""
 KEPT_WORKSPACES = 4
 """Workspaces a :class:`Solver` keeps for structures it left, so that a return to one
@@ -310,7 +311,7 @@ def _initial_guess(x0: object, n: int) -> np.ndarray:
 
 
 def _print_log(lines: list[tuple[float, ...]], result: Result) -> None:
-    """OSQP-style log: a header, one line every ``admm.LOG_INTERVAL`` iterations, and
+    """OSQP-style log: a header, one line every ``tuning.LOG_INTERVAL`` iterations, and
     the returned point's residuals (those of ``result``) as the last line."""
     print(f"{'iter':>6} {'prim_res':>10} {'dual_res':>10} {'gap':>10} {'rho':>9}")
     for it, prim, dual, gap, rho in lines:

@@ -38,25 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fccqp.admm import (
-    EQUALITY_EXACT,
-    EQUALITY_SLACK,
-    EQUALITY_START_LIMIT,
-    EQUALITY_START_STEPS,
-    FIXED_RHO_SCALE,
-    INACCURATE_FACTOR,
-    LOG_INTERVAL,
-    POLISH_EXACT,
-    POLISH_GATE,
-    POLISH_RETRIES,
-    RESERVE_DECAY,
-    RHO_MAX,
-    RHO_MIN,
-    STALL_FACTOR,
-    STALLS,
-    RhoTrial,
-)
-from fccqp.anderson import MAX_REJECTIONS, REGULARIZATION
+from fccqp.admm import RhoTrial
 from fccqp.settings import Settings
 from fccqp.sparse_checks import (
     Residuals,
@@ -71,6 +53,25 @@ from fccqp.sparse_kkt import FactorizationError, SparseKKT
 from fccqp.sparse_polish import multiplier_violation, polish
 from fccqp.sparse_problem import Scaled, SparseData, equilibrate
 from fccqp.status import Status
+from fccqp.tuning import (
+    EQUALITY_EXACT,
+    EQUALITY_SLACK,
+    EQUALITY_START_LIMIT,
+    EQUALITY_START_STEPS,
+    FIXED_RHO_SCALE,
+    INACCURATE_FACTOR,
+    LOG_INTERVAL,
+    MAX_REJECTIONS,
+    POLISH_EXACT,
+    POLISH_GATE,
+    POLISH_RETRIES,
+    REGULARIZATION,
+    RESERVE_DECAY,
+    RHO_MAX,
+    RHO_MIN,
+    STALL_FACTOR,
+    STALLS,
+)
 
 BACKEND = "sparse"
 """``Result.backend`` of a solve on this path (and the ``Settings.kkt_backend`` that

@@ -45,7 +45,7 @@ REFINE_TOLERANCE = 1e-13
 || |A| |x| ||)``, the size of the terms of ``A x``: the rounding of ``A x`` itself is
 ``eps |A| |x|``, and on long rows (a row of 15000 ones in qpsolvers' sparse
 least-squares test) that floor lies above ``1e-13 max(||b||, ||A x||)``, which the
-dense backend's test uses (:data:`fccqp.ldl.REFINE_TOLERANCE`)."""
+dense backend's test uses (:data:`fccqp.tuning.KKT_REFINE_TOLERANCE`)."""
 REGULARIZED_STEPS = 2
 """Refinement steps against the factored matrix when ``A x = b`` has no solution."""
 

@@ -35,17 +35,17 @@ import numpy as np
 import scipy.sparse as sp
 
 from fccqp.cones import FRICTION
-from fccqp.polish import (
+from fccqp.projections import project_cone_block
+from fccqp.sparse_problem import Scaled
+from fccqp.tuning import (
     ACTIVE_TOLERANCE,
     CHORD_RATE,
     GUESS_PASSES,
     MAX_REFINE,
     MISS_FLOOR,
     NEWTON_TOLERANCE,
-    REFINE_TOLERANCE,
+    POLISH_REFINE_TOLERANCE,
 )
-from fccqp.projections import project_cone_block
-from fccqp.sparse_problem import Scaled
 
 DELTA = 1e-9
 """Regularization of both diagonal blocks of the polishing KKT matrix (scaled problem)."""
@@ -317,7 +317,7 @@ class _Polish:
     def solve(self, scale: float) -> None:
         """Correct ``(x, nu, lam)`` to the solution of the unregularized system, as
         :mod:`fccqp.polish`'s ``_solve``: until the residual is below
-        ``REFINE_TOLERANCE * scale``, stops halving, or ``MAX_REFINE`` corrections after
+        ``POLISH_REFINE_TOLERANCE * scale``, stops halving, or ``MAX_REFINE`` corrections after
         the first; a correction that makes it grow is undone."""
         if self.solver is None:
             return
@@ -328,7 +328,7 @@ class _Polish:
             if norm > last:
                 self._apply(step, -1.0)
                 return
-            if norm <= REFINE_TOLERANCE * scale or norm > 0.5 * last or r == MAX_REFINE + 1:
+            if norm <= POLISH_REFINE_TOLERANCE * scale or norm > 0.5 * last or r == MAX_REFINE + 1:
                 return
             last = norm
             step = self.solver.solve(rhs)

@@ -19,10 +19,16 @@ import scipy.sparse as sp
 
 from fccqp import problem as dense_problem
 from fccqp.cones import Cone, ConeArrays
-from fccqp.problem import INFINITE_BOUND, MAX_ENTRY, Sizes, raise_finding, structure
+from fccqp.problem import Sizes, raise_finding, structure
 from fccqp.projections import project_constraint_set
-from fccqp.scaling import MAX_NORM, MIN_COST_NORM, MIN_NORM
-from fccqp.validation import SYMMETRY_TOLERANCE
+from fccqp.tuning import (
+    INFINITE_BOUND,
+    MAX_ENTRY,
+    MAX_NORM,
+    MIN_COST_NORM,
+    MIN_NORM,
+    SYMMETRY_TOLERANCE,
+)
 
 
 @dataclass(frozen=True)

@@ -56,15 +56,11 @@ from libc.math cimport INFINITY, fabs, isfinite
 
 from fccqp._dense cimport matvec, matvec_t
 from fccqp._types cimport Iterates, Problem
+from fccqp.tuning cimport GAP_TERMS_CAP
 
 cdef extern from "fccqp_kernels.h" nogil:
     void fccqp_row_spans(const double* A, int rows, int cols, const double* width,
                          double* span)
-
-GAP_TERMS_CAP = 10.0
-"""The multiplier terms widen the gap's scale to at most this multiple of
-``max(|x'Px|, |q'x|)`` (see the module docstring)."""
-cdef double _GAP_TERMS_CAP = GAP_TERMS_CAP
 
 
 cdef void row_spans(Problem* p, double* width) noexcept nogil:
@@ -107,7 +103,7 @@ cdef double gap_scale(double xPx, double qx, double terms) noexcept nogil:
     multiplier ``terms`` (sum of the magnitudes of the products in ``b'y + sigma_C(z)``)
     up to ``GAP_TERMS_CAP`` times, so that diverging multipliers cannot hide a gap."""
     cdef double primal = max(fabs(xPx), fabs(qx))
-    return max(primal, min(terms, _GAP_TERMS_CAP * primal))
+    return max(primal, min(terms, GAP_TERMS_CAP * primal))
 
 
 cdef void residuals(const Problem* p, const Iterates* it, double* Ax, double* ATnu,

@@ -13,21 +13,12 @@ The shape and type half lives in :mod:`fccqp.problem`.
 
 from libc.math cimport INFINITY, fabs, isfinite, isnan
 
+from fccqp.tuning cimport INFINITE_BOUND, MAX_ENTRY, SYMMETRY_TOLERANCE
+
 cdef extern from "fccqp_kernels.h" nogil:
     int FCCQP_NOT_FINITE, FCCQP_CHANGED
     int fccqp_symmetric_copy(const double* P, int n, double* out, double* sizes)
     int fccqp_checked_copy(const double* v, long k, double limit, double* out)
-
-SYMMETRY_TOLERANCE = 1e-10
-"""Relative asymmetry of ``P`` above which it is rejected rather than symmetrized."""
-MAX_ENTRY = 1e20
-"""Largest magnitude accepted in ``P, q, A, b``: equilibration brings at most ``1e20``
-of spread to unit scale, beyond it products overflow or lose every digit."""
-INFINITE_BOUND = 1e20
-"""Bounds at or beyond this magnitude are no bounds."""
-cdef double _SYMMETRY_TOLERANCE = SYMMETRY_TOLERANCE
-cdef double _MAX_ENTRY = MAX_ENTRY
-cdef double _INFINITE_BOUND = INFINITE_BOUND
 
 
 cdef inline Finding _found(int code, int argument, Py_ssize_t index, double value) noexcept nogil:
@@ -42,7 +33,7 @@ cdef inline Finding _check_vector(const double* v, double* out, Py_ssize_t k,
     for i in range(k):
         if not isfinite(v[i]):
             return _found(NOT_FINITE, argument, i, v[i])
-        if fabs(v[i]) > _MAX_ENTRY:
+        if fabs(v[i]) > MAX_ENTRY:
             return _found(TOO_LARGE, argument, i, v[i])
         out[i] = v[i]
     return _found(SCAN_OK, -1, -1, 0.0)
@@ -78,18 +69,18 @@ cdef Finding scan_and_copy(const double* P, const double* q, const double* A, co
     cdef bint same = same_matrices[0], differs
     cdef int found = fccqp_symmetric_copy(P, <int>n, P_out, sizes)
     cdef Finding f
-    if found & FCCQP_NOT_FINITE or sizes[0] > _MAX_ENTRY:
+    if found & FCCQP_NOT_FINITE or sizes[0] > MAX_ENTRY:
         return _first_bad_entry(P, n)
-    if sizes[1] > _SYMMETRY_TOLERANCE * sizes[0]:
+    if sizes[1] > SYMMETRY_TOLERANCE * sizes[0]:
         return _found(P_ASYMMETRIC, -1, -1, sizes[1])
     differs = found & FCCQP_CHANGED
-    found = fccqp_checked_copy(A, m * n, _MAX_ENTRY, A_out)
+    found = fccqp_checked_copy(A, m * n, MAX_ENTRY, A_out)
     differs |= found & FCCQP_CHANGED
     if found & FCCQP_NOT_FINITE:   # NaN, infinite or too large
         for i in range(m * n):
             if not isfinite(A[i]):
                 return _found(NOT_FINITE, 1, i // n, A[i])
-            if fabs(A[i]) > _MAX_ENTRY:
+            if fabs(A[i]) > MAX_ENTRY:
                 return _found(TOO_LARGE, 1, i // n, A[i])
     same_matrices[0] = same and not differs
     f = _check_vector(q, q_out, n, 0)
@@ -109,8 +100,8 @@ cdef Finding scan_and_copy(const double* P, const double* q, const double* A, co
             return _found(INFINITE_SIDE, 3, i, lb[i])
         if ub[i] == -INFINITY:
             return _found(INFINITE_SIDE, 4, i, ub[i])
-        lb_out[i] = lb[i] if lb[i] > -_INFINITE_BOUND else -INFINITY
-        ub_out[i] = ub[i] if ub[i] < _INFINITE_BOUND else INFINITY
+        lb_out[i] = lb[i] if lb[i] > -INFINITE_BOUND else -INFINITY
+        ub_out[i] = ub[i] if ub[i] < INFINITE_BOUND else INFINITY
     return _found(SCAN_OK, -1, -1, 0.0)
 
 
@@ -118,7 +109,7 @@ cdef int bound_kind(double lb, double ub) noexcept nogil:
     """How the bounds ``lb, ub`` of one entry constrain it: ``UNBOUNDED`` (both beyond
     ``INFINITE_BOUND``), ``FIXED_BOUND`` (``lb == ub``) or ``BOUNDED``. The one rule for
     :func:`structure_scan` and the workspace's check of each solve's bounds."""
-    if lb > -_INFINITE_BOUND or ub < _INFINITE_BOUND:
+    if lb > -INFINITE_BOUND or ub < INFINITE_BOUND:
         return FIXED_BOUND if lb == ub else BOUNDED
     return UNBOUNDED
 

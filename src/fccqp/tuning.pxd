@@ -1,0 +1,225 @@
+# Tuning constants of the compiled core: the one definition of each, grouped by topic.
+#
+# Each is a C literal (a macro of the verbatim block below, which Cython copies into every
+# module that cimports a name from here), so the compiler folds it into the code as
+# it would a number written in place: no module variable to load, nothing set at import.
+# Macros rather than ``static const`` variables, which -Wall would report as unused in
+# every module that does not read all of them. One comment line each says what the
+# constant does and why its value; notes/tuning.md has the measurements behind them.
+# Python sees them as attributes of :mod:`fccqp.tuning` (tuning.pyx), built from these.
+# A new constant: its #define here, its declaration below, its name in tuning.pyx.
+
+cdef extern from *:
+    """
+    /* ---- Input validation (fccqp.validation) ---- */
+    /* P asymmetric by more than this (relative) is rejected, not symmetrized: above rounding */
+    #define FCCQP_SYMMETRY_TOLERANCE 1e-10
+    /* largest |entry| of P, q, A, b, x0: Ruiz brings at most 1e20 of spread to unit scale */
+    #define FCCQP_MAX_ENTRY 1e20
+    /* bounds at or beyond this magnitude are no bounds (as in Clarabel's presolve) */
+    #define FCCQP_INFINITE_BOUND 1e20
+
+    /* ---- Scaling (fccqp.scaling) ---- */
+    /* column norms below this count as 1: OSQP's 1e-4 left a 1e-7 equality row unscaled */
+    #define FCCQP_MIN_NORM 1e-8
+    /* column norms are capped here, so one Ruiz pass changes a scale by at most 100x */
+    #define FCCQP_MAX_NORM 1e4
+    /* the cost is normalized only above this size: a near-zero cost is not blown up 1e4x */
+    #define FCCQP_MIN_COST_NORM 1e-4
+    /* rescale keeps an old scaling while every norm stays within this factor (~1 pass) */
+    #define FCCQP_RESCALE_DRIFT 4.0
+
+    /* ---- Factorization of the ADMM KKT system (fccqp.ldl, fccqp.schur, fccqp.kkt) ---- */
+    /* quasi-definite regularization of LDL's (2, 2) block (scaled): refinement removes it */
+    #define FCCQP_KKT_DELTA 1e-13
+    /* most iterative-refinement steps per solve, in every backend and in the polish */
+    #define FCCQP_MAX_REFINE 5
+    /* refine while ||A x - b|| (user units) > this max(1, ||b||, ||A x||): near rounding */
+    #define FCCQP_KKT_REFINE_TOLERANCE 1e-13
+    /* a Schur complement's Cholesky pivot below this times its largest diagonal: singular */
+    #define FCCQP_RANK_TOLERANCE 1e-10
+    /* reduced iteration when this * s fits the budget: s columns cost ~s/4 solves, x2 margin */
+    #define FCCQP_REDUCED_COST 0.5
+
+    /* ---- Cold start and equalities (fccqp.admm) ---- */
+    /* proximal steps of the cold start's equality-constrained QP */
+    #define FCCQP_EQUALITY_START_STEPS 3
+    /* that QP is unbounded when sigma ||x_eq|| > this max(1, ||q||): test it as a direction */
+    #define FCCQP_EQUALITY_START_LIMIT 1e-3
+    /* the cold start missing A x = b by more than this (relative): "auto" takes full form */
+    #define FCCQP_EQUALITY_MISSED 1e-9
+    /* a failed warm start restarts cold for the rest only when max_iter is at least this */
+    #define FCCQP_RESTART_MIN_ITER 200
+
+    /* ---- Rho adaptation (fccqp.admm) ---- */
+    /* range of the adaptive rho */
+    #define FCCQP_RHO_MIN 1e-6
+    #define FCCQP_RHO_MAX 1e6
+    /* rho multiplier on entries with lb == ub, which act as equalities (as in OSQP) */
+    #define FCCQP_FIXED_RHO_SCALE 1e3
+    /* a small rho move asked for this many updates in a row is tried (3 lost talos ticks) */
+    #define FCCQP_RHO_PERSISTENCE 5
+
+    /* ---- Anderson acceleration (fccqp.anderson, fccqp.admm) ---- */
+    /* steps rejected by the safeguard before a run gives up accelerating */
+    #define FCCQP_MAX_REJECTIONS 3
+    /* Tikhonov weight of the least-squares problem, relative to its largest diagonal */
+    #define FCCQP_REGULARIZATION 1e-8
+    /* weights of this norm or more are not used: the WBC sets' largest is 3.7e3 */
+    #define FCCQP_MAX_WEIGHT_NORM 1e4
+    /* acceleration stops after STALLS checks in a row above this x tolerance, not halving */
+    #define FCCQP_STALL_FACTOR 1e3
+    #define FCCQP_STALLS 2
+
+    /* ---- Termination (fccqp.termination, fccqp.admm) ---- */
+    /* a budget-stopped iterate within this multiple of the tolerances is SOLVED_INACCURATE */
+    #define FCCQP_INACCURATE_FACTOR 10.0
+    /* multiplier terms widen the gap's scale to at most this x max(|x'Px|, |q'x|) */
+    #define FCCQP_GAP_TERMS_CAP 10.0
+    /* gated full checks back off 1, 3, 7, then this many iterations (one costs ~2.4) */
+    #define FCCQP_GATED_CHECK_WAIT 8
+    /* the verbose log keeps one line every this many iterations (as OSQP) */
+    #define FCCQP_LOG_INTERVAL 25
+
+    /* ---- Infeasibility certificates (fccqp.certificates, fccqp.admm) ---- */
+    /* a Farkas certificate separates by more than this of its terms (see EQUALITY_MISSED) */
+    #define FCCQP_SEPARATION_FLOOR 1e-9
+    /* and by this multiple of its residual: infeasible ones measured separate by >= 120x */
+    #define FCCQP_DOMINANCE 100.0
+    /* alternating cleaning steps per way: a 1e-4 gap's residual fell to 4e-12 after 30 */
+    #define FCCQP_CLEANING_PASSES 30
+    /* largest shift of a cleaning step on the box's support, relative to ||d_y|| */
+    #define FCCQP_CLEANING_SHRINK 0.1
+    /* added to A A''s diagonal, relative to its largest entry, for dependent rows */
+    #define FCCQP_GRAM_REGULARIZATION 1e-12
+    /* no certificate is cleaned before this many iterations (doubling after each failure) */
+    #define FCCQP_CLEANING_START 500
+    /* cleaned only while the primal residual is above this x its tolerance */
+    #define FCCQP_CLEANING_GATE 1.0
+
+    /* ---- Polish (fccqp.polish, fccqp.polish_schur, fccqp.polish_table, fccqp.admm) ---- */
+    /* regularization of both diagonal blocks of the polishing KKT matrix (scaled) */
+    #define FCCQP_POLISH_DELTA 1e-12
+    /* refine the returned point while the KKT residual > this max(1, ||q||, ||b||) */
+    #define FCCQP_POLISH_REFINE_TOLERANCE 1e-14
+    /* a guess's first solve is refined only to this: the next chord step repeats the work */
+    #define FCCQP_GUESS_TOLERANCE 1e-10
+    /* most active sets per polish: 6 accepted an unsettled one, 10 cost 6 % more per tick */
+    #define FCCQP_GUESS_PASSES 8
+    /* a free entry or block joins the active set when it violates by more than this */
+    #define FCCQP_ACTIVE_TOLERANCE 1e-12
+    /* Newton stops when every boundary block has |phi| <= this ||x_block|| */
+    #define FCCQP_NEWTON_TOLERANCE 1e-13
+    /* or when a refactorization did not reduce a miss below this (rounding's floor) */
+    #define FCCQP_MISS_FLOOR 1e-11
+    /* chord steps while the miss shrinks by CHORD_RATE and would meet the tolerance
+       within CHORD_STEPS more: fewest instructions per tick measured */
+    #define FCCQP_CHORD_RATE 0.25
+    #define FCCQP_CHORD_STEPS 3
+    /* P's diagonal below this x its largest: too singular for the Schur complement */
+    #define FCCQP_PIVOT_TOLERANCE 1e-12
+    /* the table's LU is singular when smallest / largest pivot is below this */
+    #define FCCQP_PIVOT_RATIO 1e-13
+    /* LU by the AVX2 loop up to this size, dgetrf above: measured faster up to talos' 64 */
+    #define FCCQP_LU_LOOP_ROWS 64
+    /* a correction skips the KKT solve when that residual is below this x the constraints' */
+    #define FCCQP_MINOR_PART 1e-2
+    /* a rejected polish: ADMM goes on at 10x tighter tolerances at most this many times */
+    #define FCCQP_POLISH_RETRIES 2
+    /* a polished residual below this x its tolerance counts as exact (rounding) */
+    #define FCCQP_POLISH_EXACT 1e-3
+    /* a polished point keeps A x = b within EQUALITY_SLACK x ADMM's residual, or below
+       EQUALITY_EXACT x max(||A x||, ||b||): factorization accuracy */
+    #define FCCQP_EQUALITY_SLACK 10.0
+    #define FCCQP_EQUALITY_EXACT 1e-13
+    /* polish early, at most EARLY_POLISH_TRIES times, at checks within EARLY_POLISH_GATE
+       of the tolerances whose active set settled: 1e2 fewest instructions per tick */
+    #define FCCQP_EARLY_POLISH_GATE 1e2
+    #define FCCQP_EARLY_POLISH_TRIES 3
+
+    /* ---- Restoration (fccqp.restoration, fccqp.admm) ---- */
+    /* an entry violates when its projection moves it by more than this (relative) */
+    #define FCCQP_VIOLATION_TOLERANCE 1e-12
+    /* a restored point is kept if its primal residual < this x its scale (W_TT costs digits) */
+    #define FCCQP_RESTORED_EQUALITY 1e-7
+
+    /* ---- Time budget (fccqp.admm) ---- */
+    /* a timed run is polished only within this factor of the tolerances (else guess wrong) */
+    #define FCCQP_POLISH_GATE 1e3
+    /* the final step's reserve: its largest recent duration, decayed by this per solve */
+    #define FCCQP_RESERVE_DECAY 0.5
+    /* and at least this many polish guesses: a clock-stopped iterate's guess needs a fix */
+    #define FCCQP_RESERVE_PASSES 2.0
+    """
+    # The declarations, in the order above; each type is the one the code computes with.
+    # Input validation
+    const double SYMMETRY_TOLERANCE "FCCQP_SYMMETRY_TOLERANCE"
+    const double MAX_ENTRY "FCCQP_MAX_ENTRY"
+    const double INFINITE_BOUND "FCCQP_INFINITE_BOUND"
+    # Scaling
+    const double MIN_NORM "FCCQP_MIN_NORM"
+    const double MAX_NORM "FCCQP_MAX_NORM"
+    const double MIN_COST_NORM "FCCQP_MIN_COST_NORM"
+    const double RESCALE_DRIFT "FCCQP_RESCALE_DRIFT"
+    # Factorization
+    const double KKT_DELTA "FCCQP_KKT_DELTA"
+    const int MAX_REFINE "FCCQP_MAX_REFINE"
+    const double KKT_REFINE_TOLERANCE "FCCQP_KKT_REFINE_TOLERANCE"
+    const double RANK_TOLERANCE "FCCQP_RANK_TOLERANCE"
+    const double REDUCED_COST "FCCQP_REDUCED_COST"
+    # Cold start and equalities
+    const long EQUALITY_START_STEPS "FCCQP_EQUALITY_START_STEPS"
+    const double EQUALITY_START_LIMIT "FCCQP_EQUALITY_START_LIMIT"
+    const double EQUALITY_MISSED "FCCQP_EQUALITY_MISSED"
+    const long RESTART_MIN_ITER "FCCQP_RESTART_MIN_ITER"
+    # Rho adaptation
+    const double RHO_MIN "FCCQP_RHO_MIN"
+    const double RHO_MAX "FCCQP_RHO_MAX"
+    const double FIXED_RHO_SCALE "FCCQP_FIXED_RHO_SCALE"
+    const int RHO_PERSISTENCE "FCCQP_RHO_PERSISTENCE"
+    # Anderson acceleration
+    const long MAX_REJECTIONS "FCCQP_MAX_REJECTIONS"
+    const double REGULARIZATION "FCCQP_REGULARIZATION"
+    const double MAX_WEIGHT_NORM "FCCQP_MAX_WEIGHT_NORM"
+    const double STALL_FACTOR "FCCQP_STALL_FACTOR"
+    const int STALLS "FCCQP_STALLS"
+    # Termination
+    const double INACCURATE_FACTOR "FCCQP_INACCURATE_FACTOR"
+    const double GAP_TERMS_CAP "FCCQP_GAP_TERMS_CAP"
+    const long GATED_CHECK_WAIT "FCCQP_GATED_CHECK_WAIT"
+    const long LOG_INTERVAL "FCCQP_LOG_INTERVAL"
+    # Infeasibility certificates
+    const double SEPARATION_FLOOR "FCCQP_SEPARATION_FLOOR"
+    const double DOMINANCE "FCCQP_DOMINANCE"
+    const int CLEANING_PASSES "FCCQP_CLEANING_PASSES"
+    const double CLEANING_SHRINK "FCCQP_CLEANING_SHRINK"
+    const double GRAM_REGULARIZATION "FCCQP_GRAM_REGULARIZATION"
+    const long CLEANING_START "FCCQP_CLEANING_START"
+    const double CLEANING_GATE "FCCQP_CLEANING_GATE"
+    # Polish
+    const double POLISH_DELTA "FCCQP_POLISH_DELTA"
+    const double POLISH_REFINE_TOLERANCE "FCCQP_POLISH_REFINE_TOLERANCE"
+    const double GUESS_TOLERANCE "FCCQP_GUESS_TOLERANCE"
+    const int GUESS_PASSES "FCCQP_GUESS_PASSES"
+    const double ACTIVE_TOLERANCE "FCCQP_ACTIVE_TOLERANCE"
+    const double NEWTON_TOLERANCE "FCCQP_NEWTON_TOLERANCE"
+    const double MISS_FLOOR "FCCQP_MISS_FLOOR"
+    const double CHORD_RATE "FCCQP_CHORD_RATE"
+    const int CHORD_STEPS "FCCQP_CHORD_STEPS"
+    const double PIVOT_TOLERANCE "FCCQP_PIVOT_TOLERANCE"
+    const double PIVOT_RATIO "FCCQP_PIVOT_RATIO"
+    const int LU_LOOP_ROWS "FCCQP_LU_LOOP_ROWS"
+    const double MINOR_PART "FCCQP_MINOR_PART"
+    const int POLISH_RETRIES "FCCQP_POLISH_RETRIES"
+    const double POLISH_EXACT "FCCQP_POLISH_EXACT"
+    const double EQUALITY_SLACK "FCCQP_EQUALITY_SLACK"
+    const double EQUALITY_EXACT "FCCQP_EQUALITY_EXACT"
+    const double EARLY_POLISH_GATE "FCCQP_EARLY_POLISH_GATE"
+    const int EARLY_POLISH_TRIES "FCCQP_EARLY_POLISH_TRIES"
+    # Restoration
+    const double VIOLATION_TOLERANCE "FCCQP_VIOLATION_TOLERANCE"
+    const double RESTORED_EQUALITY "FCCQP_RESTORED_EQUALITY"
+    # Time budget
+    const double POLISH_GATE "FCCQP_POLISH_GATE"
+    const double RESERVE_DECAY "FCCQP_RESERVE_DECAY"
+    const double RESERVE_PASSES "FCCQP_RESERVE_PASSES"
