@@ -1,0 +1,275 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""Whether a replacement of ADMM's iterate is kept: the polished point
+(:mod:`fccqp.polish`), checked on the user's problem in the user's units, and the
+feasibility restoration (:mod:`fccqp.restoration`); and the residuals of a point in
+the user's units that both checks (and the returned point) are measured by.
+"""
+
+from libc.math cimport fabs, isfinite
+
+from fccqp._dense cimport copy, fill, matvec, matvec_t
+from fccqp._types cimport Iterates, Problem
+from fccqp.engine cimport (INACCURATE, RUNNING, SOLVED, Engine, Options, Run, end_run,
+                           fccqp_now, measure)
+from fccqp.kkt cimport kkt_solve
+from fccqp.polish cimport multiplier_violation, polish
+from fccqp.projections cimport proj_block, proj_set
+from fccqp.restoration cimport restore
+from fccqp.scaling cimport unscale
+from fccqp.termination cimport Residuals, gap_scale
+from fccqp.tuning cimport (EQUALITY_EXACT, EQUALITY_MISSED, EQUALITY_SLACK, POLISH_EXACT,
+                           RESTORED_EQUALITY)
+from fccqp.verdict cimport classify, missed
+
+
+cdef bint keep_polished(Engine* e, int* status, long iteration, double start_time,
+                        bint solved_only) noexcept nogil:
+    """:func:`_try_polished`, timed: learn what a guess of the polish costs (see
+    ``RESERVE_PASSES``)."""
+    cdef double began = fccqp_now()
+    cdef bint kept = _try_polished(e, status, iteration, start_time, solved_only)
+    e.clock.pass_time = (fccqp_now() - began) / max(e.pol.passes, 1)
+    return kept
+
+
+cdef bint _try_polished(Engine* e, int* status, long iteration, double start_time,
+                        bint solved_only) noexcept nogil:
+    """Replace the final iterate by its polished version (see :mod:`fccqp.polish`)
+    when that passes a KKT check on the user's problem; True if it did.
+
+    The polished point is accepted only when, in the user's units, it is primal
+    feasible within the tolerance (box and exact cones), its multipliers lie in the
+    normal cones its active set needs (:func:`fccqp.polish.multiplier_violation`,
+    within ``POLISH_EXACT`` of the dual tolerance), it keeps ``A x = b`` at
+    factorization accuracy (``EQUALITY_SLACK``, ``EQUALITY_EXACT``) and its primal
+    and dual residuals and gap are each no worse than the ADMM point's (or below
+    ``POLISH_EXACT`` times their tolerance: then the ADMM point is not measured at
+    all, 12k of a go2 tick's 0.79M instructions); with ``solved_only`` (the warm
+    polish) it must also be solved. Otherwise the iterate and its residuals are left as
+    they were. On acceptance the status is the polished point's when that is
+    solved or inaccurate.
+    """
+    cdef Problem* p = &e.prob
+    cdef Iterates* it = &e.it
+    cdef Options* o = &e.opt
+    cdef Residuals* r = &e.res
+    cdef Residuals before = e.res, plain, polished
+    cdef double* ux = e.unscaled.x
+    cdef double* uy = e.unscaled.y
+    cdef double* uz = e.unscaled.z
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j
+    cdef double tol_p, tol_d, tol_g
+    cdef int new_status, factorizations = 0   # of polishing's own matrix: not counted
+    if not polish(&e.pol, p, it, o.polish_refine_iter, &factorizations,
+                  &e.red if e.fact.table_ready else NULL, &e.fact.kkt, it.rho_vec,
+                  start_time + o.time_limit):
+        return False
+    unscale(e.pol.x, e.pol.nu, e.pol.y, p.D, p.E, p.c, n, m, s, p.constrained, ux, uy, uz)
+    user_residuals(e, ux, uy, uz)
+    tol_p = o.eps_abs + o.eps_rel * r.prim_scale
+    tol_d = o.eps_abs + o.eps_rel * r.dual_scale
+    tol_g = o.eps_abs + o.eps_rel * r.gap_scale
+    if (r.prim <= POLISH_EXACT * tol_p and r.dual <= POLISH_EXACT * tol_d
+            and r.gap <= POLISH_EXACT * tol_g
+            and r.prim_eq <= EQUALITY_EXACT * r.prim_eq_scale):
+        plain = e.res   # the comparisons below do not need the ADMM point's
+    else:   # measure the ADMM point, then the polished one again (into the user point)
+        polished = e.res
+        unscale(it.x, it.nu, it.y, p.D, p.E, p.c, n, m, s, p.constrained, ux, uy, uz)
+        user_residuals(e, ux, uy, uz)
+        plain = e.res
+        unscale(e.pol.x, e.pol.nu, e.pol.y, p.D, p.E, p.c, n, m, s, p.constrained,
+                ux, uy, uz)
+        e.res = polished
+    if not (r.finite
+            and r.prim_eq <= o.eps_abs + o.eps_rel * r.prim_eq_scale
+            and r.prim_set <= o.eps_abs + o.eps_rel * r.prim_set_scale
+            and multiplier_violation(&e.pol, p, uz) <= POLISH_EXACT * tol_d
+            # at EQUALITY_EXACT of max(|A x|, |b|) it is below EQUALITY_MISSED of |A||x|
+            and (r.prim_eq <= EQUALITY_EXACT * r.prim_eq_scale
+                 or (r.prim_eq <= EQUALITY_SLACK * plain.prim_eq
+                     and r.prim_eq <= EQUALITY_MISSED * _row_terms(e, ux)))
+            and (r.prim <= plain.prim or r.prim <= POLISH_EXACT * tol_p)
+            and (r.dual <= plain.dual or r.dual <= POLISH_EXACT * tol_d)
+            and (r.gap <= plain.gap or r.gap <= POLISH_EXACT * tol_g)
+            and not (solved_only and classify(e, iteration, True) != SOLVED)):
+        e.res = before
+        return False
+    copy(e.pol.x, it.x, n)
+    copy(e.pol.nu, it.nu, m)
+    copy(e.pol.y, it.y, s)
+    for j in range(s):
+        it.z[j] = it.x[p.constrained[j]]
+    proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
+    new_status = classify(e, iteration, True)
+    if new_status == SOLVED or new_status == INACCURATE:
+        status[0] = new_status
+    return True
+
+
+cdef bint warm_polish(Engine* e, Run* run, double start_time) noexcept nogil:
+    """Polish the warm start (a polished solution of the previous data) before any
+    iteration; True, and the run finished SOLVED, when the point passes
+    :func:`keep_polished`'s check and is solved.
+
+    In a control loop the active set mostly survives a tick, and then this is the
+    whole solve: no iteration (go2: 91 % of the ticks). Where ``P`` is diagonal on the
+    constrained entries (whole-body control) it runs before ADMM's factorization, its
+    systems solved by Schur complement on ``P``'s blocks (:mod:`fccqp.polish_schur`),
+    and a success skips that factorization and the reduced table; otherwise it runs
+    after them in the table's coordinates (one small LU a guess). The polished QP's
+    own KKT matrix by ``dsytrf`` instead was no cheaper than the table, and dearer when
+    the guess fails; polishing from every previous solution, or from an unpolished one,
+    did not pay either (notes/tuning.md, "The warm polish").
+    """
+    cdef int status = RUNNING
+    if not keep_polished(e, &status, 0, start_time, True):
+        return False
+    run.polished = True
+    e.unscaled.current = True   # keep_polished left them so
+    e.clock.marks[3] = e.clock.marks[4] = fccqp_now()
+    end_run(e, run, SOLVED, 0)
+    return True
+
+
+cdef void restore_equalities(Engine* e) noexcept nogil:
+    """Remove the rounding that a combination of KKT solutions (``x = base + W u`` in
+    the reduced form, a restoration) accumulates in ``A x = b``: one refined KKT
+    solve for ``(0, b - A x)`` with the current factorization. The full form needs
+    it only when its iterate misses ``A x = b`` beyond factorization accuracy
+    (:func:`fccqp.verdict.missed`): diverging iterates of an infeasible problem
+    (``|x| = 4e6``, rho 2.4e5) left a 3.5e-7 relative error in their KKT solves'
+    ``A x = b``."""
+    cdef Problem* p = &e.prob
+    cdef double* rhs = e.work.rhs
+    cdef Py_ssize_t n = p.n, m = p.m, i
+    if m == 0:
+        return
+    fill(rhs, 0.0, n)
+    matvec(p.A, e.it.x, rhs + n, m, n)
+    for i in range(m):
+        rhs[n + i] = p.b[i] - rhs[n + i]
+    kkt_solve(&e.fact.kkt, p, e.it.rho_vec, rhs, e.work.sol)
+    for i in range(n):
+        e.it.x[i] += e.work.sol[i]
+    for i in range(m):
+        e.it.nu[i] += e.work.sol[n + i]
+
+
+cdef int keep_restored(Engine* e, int status, long iteration, bint reduced) noexcept nogil:
+    """Replace the final iterate by its feasibility restoration (see
+    :mod:`fccqp.restoration`) when that is better.
+
+    The restored point has its violating constrained entries pinned at their
+    projection; its status comes from its own residuals, with the slack set to its
+    (feasible) ``x_S``. It is kept when its primal residual shows that the other
+    entries absorbed the pinning (``RESTORED_EQUALITY``) and, if the iterate was
+    solved, when it is solved too. Equalities hold to factorization accuracy in
+    either case.
+    """
+    cdef Problem* p = &e.prob
+    cdef Iterates* it = &e.it
+    cdef double* saved = e.work.saved
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j
+    cdef int new_status
+    cdef bint was_missed = missed(e)
+    copy(it.x, saved, n)
+    copy(it.nu, saved + n, m)
+    copy(it.z, saved + n + m, s)
+    if restore(&e.rest, &e.fact.kkt, &e.red, reduced, p, it):
+        restore_equalities(e)
+        for j in range(s):
+            it.z[j] = it.x[p.constrained[j]]
+        proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
+        measure(e)
+        new_status = classify(e, iteration, True)
+        if (e.res.prim <= RESTORED_EQUALITY * max(1.0, e.res.prim_scale)
+                and (status != SOLVED or new_status == SOLVED)):
+            return new_status
+    copy(saved, it.x, n)
+    copy(saved + n, it.nu, m)
+    copy(saved + n + m, it.z, s)
+    if reduced or was_missed:
+        restore_equalities(e)
+    return status
+
+
+cdef double _row_terms(const Engine* e, const double* x) noexcept nogil:
+    """``max_i sum_j |A_ij x_j|`` on the user's data: the size of the terms whose
+    rounding ``A x = b`` carries at factorization accuracy."""
+    cdef Py_ssize_t n = e.prob.n, i, j
+    cdef double largest = 0.0, row
+    for i in range(e.prob.m):
+        row = 0.0
+        for j in range(n):
+            row += fabs(e.user.A[i * n + j] * x[j])
+        largest = max(largest, row)
+    return largest
+
+
+cdef void user_residuals(Engine* e, const double* x, const double* y,
+                         const double* z) noexcept nogil:
+    """:mod:`fccqp.termination`'s residuals of the returned ``(x, y, z)`` on the user's
+    data, with ``dist(x_S, C)`` as the primal part off the equalities."""
+    cdef Problem* p = &e.prob
+    cdef Residuals* r = &e.res
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
+    cdef const double* A = e.user.A
+    cdef const double* b = e.user.b
+    cdef const double* lb = e.user.lb
+    cdef const double* ub = e.user.ub
+    cdef const double* q = e.user.q
+    cdef double* Ax = e.work.vec_m
+    cdef double* grad = e.work.vec_n
+    cdef double* ATy = e.work.vec_n2
+    cdef double* proj = e.work.vec_s
+    cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, terms = 0.0, total = 0.0
+    cdef double value
+    matvec(A, x, Ax, m, n)
+    matvec_t(A, y, ATy, m, n)
+    matvec(e.user.P, x, grad, n, n)
+    r.prim_eq = r.prim_eq_scale = r.prim_set = r.prim_set_scale = 0.0
+    for i in range(m):
+        r.prim_eq = max(r.prim_eq, fabs(Ax[i] - b[i]))
+        r.prim_eq_scale = max(r.prim_eq_scale, max(fabs(Ax[i]), fabs(b[i])))
+        by += b[i] * y[i]
+        terms += fabs(b[i] * y[i])
+    for j in range(s):
+        i = p.constrained[j]
+        value = x[i]
+        if value < lb[i]:
+            value = lb[i]
+        if value > ub[i]:
+            value = ub[i]
+        proj[j] = value
+    for j in range(p.cones.count):   # cone blocks are contiguous in x too
+        i = p.cones.offset[j]
+        proj_block(x + p.constrained[i], p.cones.kind[j], p.cones.dim[j], p.cones.mu[j],
+                   p.cones.normal + 3 * j, proj + i)
+    r.dual_scale = 0.0
+    for j in range(s):
+        i = p.constrained[j]
+        r.prim_set = max(r.prim_set, fabs(x[i] - proj[j]))
+        r.prim_set_scale = max(r.prim_set_scale, fabs(x[i]))
+        if z[i] > 0.0 and isfinite(ub[i]):
+            support += ub[i] * z[i]
+            terms += fabs(ub[i] * z[i])
+        elif z[i] < 0.0 and isfinite(lb[i]):
+            support += lb[i] * z[i]
+            terms += fabs(lb[i] * z[i])
+    r.dual = 0.0
+    for i in range(n):
+        xPx += x[i] * grad[i]
+        qx += q[i] * x[i]
+        r.dual_scale = max(r.dual_scale, max(fabs(grad[i]), fabs(q[i])))
+        value = grad[i] + q[i] + ATy[i] + z[i]
+        r.dual = max(r.dual, fabs(value))
+        total += fabs(value) + fabs(x[i]) + fabs(z[i])
+    for i in range(m):
+        total += fabs(y[i])
+    r.objective = 0.5 * xPx + qx
+    r.gap = fabs(xPx + qx + by + support)
+    r.gap_scale = gap_scale(xPx, qx, terms)
+    r.prim = max(r.prim_eq, r.prim_set)
+    r.prim_scale = max(r.prim_eq_scale, r.prim_set_scale)
+    r.finite = isfinite(total) and isfinite(r.gap) and isfinite(r.prim)

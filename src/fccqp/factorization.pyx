@@ -1,0 +1,182 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""The factorizations of a run: the backend choice and its fallback, the convexity
+certificate, rho changes, and the cold start on the equality-constrained QP.
+
+:mod:`fccqp.kkt` factors and solves one backend; this module decides which backend
+serves the run (and falls back when one breaks down), keeps the reduced form's table
+and ``base`` in step with the factorization, and records what it holds
+(:c:type:`fccqp.engine.Factorization`).
+"""
+
+from fccqp._dense cimport copy, fill, inf_norm
+from fccqp._types cimport Iterates, Problem
+from fccqp.anderson cimport anderson_reset
+from fccqp.engine cimport Engine, Run
+from fccqp.kkt cimport (AUTO, FACTORED, LDL_FULL, NOT_CONVEX, SCHUR_REDUCED, UNAVAILABLE,
+                        kkt_convexity, kkt_factor, kkt_solve)
+from fccqp.projections cimport proj_set
+from fccqp.reduced cimport reduced_rebase, reduced_table
+from fccqp.tuning cimport EQUALITY_START_LIMIT, EQUALITY_START_STEPS, REDUCED_COST
+
+
+cdef long budget(const Engine* e, long iteration) noexcept nogil:
+    """Solves the reduced form's table can save: the iterations left, plus, when the
+    result will be restored, the columns the restoration would otherwise compute."""
+    cdef long restoring = e.prob.s if e.opt.restore_feasibility else 0
+    return e.opt.max_iter - iteration + restoring
+
+
+cdef int _certify(Engine* e, bint schur_factored) noexcept nogil:
+    """Establish convexity for the current matrices (see :func:`fccqp.kkt.kkt_convexity`);
+    ``schur_factored`` says that the Schur backend has just factored them."""
+    cdef int code = kkt_convexity(&e.fact.kkt, &e.prob, e.opt.sigma, e.it.rho_vec,
+                                  schur_factored)
+    if code == FACTORED:
+        e.fact.certified = True
+    return code
+
+
+cdef int factor(Engine* e, Run* run, long solves) noexcept nogil:
+    """Factor for the current rho with the backend the settings ask for, falling back
+    in the order Schur, LDL' reduced, LDL' full ("auto" starts with Schur when the
+    reduced table pays for itself within ``solves`` and the constrained entries are
+    at most half the KKT size, else with LDL' full). Certifies convexity when the
+    matrices are new. Returns FACTORED, NOT_CONVEX, or UNAVAILABLE (numerical
+    breakdown); records the form and the rho it factored."""
+    cdef Problem* p = &e.prob
+    cdef int backend, code, first = e.opt.backend
+    cdef bint reduced_pays
+    e.fact.table_ready = False
+    if first == AUTO:
+        # rows the equality-constrained start could not meet (inconsistent, or
+        # numerically dependent) go to the full form: its regularized solves give
+        # least-squares iterates, on which the equality certificate is tested
+        # (a random test: the reduced form ran 4000 iterations uncertified)
+        reduced_pays = (2 * p.s <= p.n + p.m and REDUCED_COST * p.s <= solves
+                        and not e.equalities_missed)
+        first = SCHUR_REDUCED if reduced_pays else LDL_FULL
+    for backend in range(first, LDL_FULL + 1):
+        if not e.fact.certified and backend != SCHUR_REDUCED:
+            # certify first: the certificate overwrites an LDL' factorization
+            code = _certify(e, False)
+            run.factorizations += 1
+            if code == NOT_CONVEX:
+                return NOT_CONVEX
+        code = kkt_factor(&e.fact.kkt, p, backend,
+                          e.opt.sigma if backend == LDL_FULL else 0.0, e.it.rho_vec)
+        run.factorizations += 1
+        if code != FACTORED:
+            if backend == LDL_FULL:
+                return UNAVAILABLE
+            continue
+        if not e.fact.certified and _certify(e, True) == NOT_CONVEX:
+            return NOT_CONVEX
+        if backend != LDL_FULL and not reduced_table(&e.red, &e.fact.kkt, p, e.it.rho_vec):
+            continue
+        e.fact.form = backend
+        run.backend = backend
+        e.fact.factored_rho = run.rho
+        return FACTORED
+    return UNAVAILABLE
+
+
+cdef void reduced_base(Engine* e) noexcept nogil:
+    """``base``: the x-update's response to ``(-q, b)`` alone (q and b change every
+    solve; the table only with the factorization)."""
+    cdef Problem* p = &e.prob
+    cdef double* rhs = e.work.rhs
+    cdef Py_ssize_t i
+    for i in range(p.n):
+        rhs[i] = -p.q[i]
+    for i in range(p.m):
+        rhs[p.n + i] = p.b[i]
+    kkt_solve(&e.fact.kkt, p, e.it.rho_vec, rhs, e.red.base)
+    e.fact.table_ready = True
+
+
+cdef int change_rho(Engine* e, Run* run, double new_rho, long iteration,
+                    bint reduced) noexcept nogil:
+    """Refactor for ``new_rho``: carry the reduced form's coordinates into the new
+    table (before the old one is gone), factor, recompute ``base``, forget
+    Anderson's memory. Returns :func:`factor`'s code."""
+    cdef Problem* p = &e.prob
+    cdef Iterates* it = &e.it
+    cdef Py_ssize_t j
+    cdef int code
+    if reduced:
+        for j in range(p.s):
+            e.work.vec_s[j] = new_rho * e.fact.rho_scale[j]
+        reduced_rebase(&e.red, p, it.rho_vec, e.work.vec_s)
+    run.rho = new_rho
+    for j in range(p.s):
+        it.rho_vec[j] = new_rho * e.fact.rho_scale[j]
+    code = factor(e, run, budget(e, iteration))
+    if code == FACTORED:
+        if e.fact.form != LDL_FULL:
+            reduced_base(e)
+        anderson_reset(&e.aa, True)
+    return code
+
+
+cdef int equality_start(Engine* e, bint* unbounded) noexcept nogil:
+    """Paper's cold start: ``x`` solves the QP with equalities only, ``z = P_C(x_S)``,
+    ``y = 0``.
+
+    The factorization carries the regularization ``sigma I`` and no rho, so its
+    inertia certifies convexity; a few proximal steps (``x_{j+1} = argmin f +
+    sigma/2 ||x - x_j||^2`` on the same factorization) remove sigma's bias, so that
+    an optimum with no active constraint is recognised at once. When the solution
+    is huge the equality-constrained QP is unbounded: ``direction`` keeps the last
+    proximal step (a candidate certificate) and the start falls back to the point
+    of ``A x = b`` with the least ``x'(P + sigma I) x``.
+
+    The step, not the solution, is the direction: along a ray ``d`` (``P d = 0``,
+    ``A d = 0``) each step adds the same multiple of ``d``, while the solution also
+    carries its bounded part and ``A x = b``, so that ``P x`` and ``A x`` are up to
+    ``1e-6`` of their terms (the suite's unbounded problems: 2e-7 to 9e-7 after
+    three steps), the certificate test's own tolerance; in the step they are
+    rounding (1e-16), the bounded part shrinking by ``sigma / (lambda + sigma)``
+    per step.
+    """
+    cdef Problem* p = &e.prob
+    cdef Iterates* it = &e.it
+    cdef double* rhs = e.work.rhs
+    cdef double* sol = e.work.sol
+    cdef Py_ssize_t n = p.n, m = p.m, i, step
+    cdef double sigma = e.opt.sigma
+    fill(it.rho_vec, 0.0, p.s)
+    e.fact.factored_rho = -1.0  # the KKT matrix now holds no rho factorization
+    e.fact.form = LDL_FULL
+    e.fact.table_ready = False
+    cdef int code = kkt_factor(&e.fact.kkt, p, LDL_FULL, sigma, it.rho_vec)
+    if code != FACTORED:
+        return NOT_CONVEX
+    e.fact.certified = True
+    fill(it.x, 0.0, n)
+    for i in range(m):
+        rhs[n + i] = p.b[i]
+    for step in range(EQUALITY_START_STEPS):
+        for i in range(n):
+            rhs[i] = sigma * it.x[i] - p.q[i]
+        kkt_solve(&e.fact.kkt, p, it.rho_vec, rhs, sol)
+        for i in range(n):
+            e.certs.direction[i] = sol[i] - it.x[i]
+        copy(sol, it.x, n)
+    copy(sol + n, it.nu, m)
+    unbounded[0] = sigma * inf_norm(it.x, n) > EQUALITY_START_LIMIT * max(
+        1.0, inf_norm(p.q, n))
+    if unbounded[0]:
+        # min 1/2 x'(P + sigma I) x subject to A x = b: bounded, and A x = b holds
+        # for whatever status the run ends with
+        fill(rhs, 0.0, n)
+        kkt_solve(&e.fact.kkt, p, it.rho_vec, rhs, sol)
+        copy(sol, it.x, n)
+        fill(it.nu, 0.0, m)
+    for i in range(p.s):
+        it.z[i] = it.x[p.constrained[i]]
+    proj_set(it.z, p.lo, p.hi, p.cones, p.s, it.z)
+    fill(it.y, 0.0, p.s)
+    copy(it.x, it.x_prev, n)
+    copy(it.nu, it.nu_prev, m)
+    copy(it.y, it.y_prev, p.s)
+    return FACTORED

@@ -1,0 +1,394 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""The ADMM iteration of one run: :func:`iterate`, each of its steps a function below.
+
+Splitting: the constrained entries ``x_S`` (finite bound or cone) are copied into a
+slack ``z`` that must lie in ``C`` = box x cones; the equalities stay in the x-update.
+With multipliers ``y`` of ``x_S = z`` and over-relaxation ``alpha``, one iteration is
+
+    (x~, nu) = argmin_{A x = b} 1/2 x'Px + q'x + sigma/2 ||x - x_k||^2
+                                 + rho/2 ||x_S - z_k + y_k / rho||^2     (update_x)
+    x_S^r    = alpha x~_S + (1 - alpha) z_k
+    z_{k+1}  = P_C(x_S^r + y_k / rho)                                    (update_z)
+    y_{k+1}  = y_k + rho (x_S^r - z_{k+1})                               (update_y)
+    x_{k+1}  = alpha x~ + (1 - alpha) x_k     (x_1 = x~)
+
+Unlike the paper, rho touches the constrained entries only: a free variable gets no
+penalty (sigma is a 1e-6 proximal regularization of the full form; the reduced form,
+:mod:`fccqp.reduced`, needs none). The first x of a run is not relaxed, because the
+start (a warm start after ``b`` changed, say) may violate the equalities; from then on
+every ``x_k`` is a combination of KKT solutions for the same ``b``, so ``A x = b`` holds
+at every iterate. After each step, safeguarded Anderson acceleration may extrapolate
+``(z, y)`` (:mod:`fccqp.anderson`). Everything here works on the scaled problem
+(:mod:`fccqp.scaling`); residuals and tolerances are in the user's units
+(:mod:`fccqp.termination`).
+"""
+
+from libc.math cimport INFINITY, isfinite
+
+from fccqp._dense cimport copy
+from fccqp._types cimport Iterates, Problem
+from fccqp.acceptance cimport keep_polished, keep_restored, restore_equalities, warm_polish
+from fccqp.anderson cimport anderson_reset, anderson_step
+from fccqp.engine cimport (DUAL_INFEASIBLE, NOT_CONVEX_QP, NUMERICAL_ERROR, PRIMAL_INFEASIBLE,
+                           RUNNING, SOLVED, TIME_LIMIT, Engine, Options, Run, end_run,
+                           fccqp_now, measure)
+from fccqp.factorization cimport budget, change_rho, equality_start, factor, reduced_base
+from fccqp.kkt cimport FACTORED, LDL_FULL, NOT_CONVEX, kkt_solve
+from fccqp.polish cimport guess_changes, polish_prepare
+from fccqp.projections cimport proj_set
+from fccqp.reduced cimport materialize, near_convergence, reduced_start, reduced_step
+from fccqp.rho_rule cimport TrialState, new_rho, trial_reset
+from fccqp.termination cimport Residuals, converged, nearly_converged
+from fccqp.tuning cimport (CLEANING_START, EARLY_POLISH_GATE, EARLY_POLISH_TRIES,
+                           EQUALITY_MISSED, GATED_CHECK_WAIT, LOG_INTERVAL, POLISH_GATE,
+                           POLISH_RETRIES, RESERVE_PASSES, STALL_FACTOR, STALLS)
+from fccqp.verdict cimport check, classify, inconsistent, missed, missed_by_data, unbounded
+
+
+cdef struct Loop:
+    # The state of one run's iterations.
+    double start_time       # the solve's start (fccqp_now's clock)
+    double deadline         # under a time limit the iterations stop this long after start_time
+    long iteration
+    int status
+    bint cold               # the run starts from the equality-constrained QP
+    bint timed              # a time limit holds
+    bint unbounded_start    # that QP is unbounded: its last step is a candidate ray
+    bint warm_polish        # polish the warm start (a polished solution) before iterating
+    bint reduced            # the reduced form iterates (else the full KKT form)
+    bint fresh              # the next step starts a run of KKT solutions: do not relax x
+    bint last, periodic, adapt, check, gated   # what this iteration does (_schedule)
+    double eps_p, eps_d     # the gate's tolerances on x_S - z and the dual residual
+    long wait, next_gated   # the gated check backs off: its wait, and when it may run again
+    long polished_at        # the iteration of the last polish tried; -1: none
+    int retries             # polishes of SOLVED iterates that failed (POLISH_RETRIES)
+    int early_tries         # early polishes tried (EARLY_POLISH_TRIES)
+    bint guess_polished     # the settled active set was polished early already
+    bint first_check        # no early-polish check has run yet
+    bint accelerate         # Anderson acceleration is on
+    int stalls              # scheduled checks in a row whose primal residual stalled
+    double periodic_prim    # the primal residual at the last scheduled check
+    TrialState trial        # small rho moves on trial (fccqp.rho_rule)
+
+
+cdef void iterate(Engine* e, Run* run, bint cold, double start_time) noexcept nogil:
+    """Run ADMM from the iterate in the engine (or a cold start) to a verdict."""
+    cdef Loop loop
+    _begin(e, &loop, run, cold, start_time)
+    if not _start(e, &loop, run):                 # the start was the answer
+        return
+    if not _factor_or_polish(e, &loop, run):      # the warm polish was, or no factorization
+        return
+    _prepare(e, &loop)
+    while loop.status == RUNNING:
+        loop.iteration += 1
+        _step(e, &loop)                           # update_x, update_z, update_y
+        _schedule(e, &loop)                       # check, adapt rho, or neither
+        if loop.check:
+            _check(e, &loop, run)                 # residuals, termination, certificates
+            _polish_attempts(e, &loop, run)
+            _stall_rule(e, &loop)
+            if not _adapt_rho(e, &loop, run):     # no factorization for the new rho
+                return
+        if loop.status == RUNNING and loop.accelerate:
+            anderson_step(&e.aa, &e.it, e.prob.s)
+    _final_step(e, &loop, run)
+
+
+cdef inline void _begin(Engine* e, Loop* L, Run* run, bint cold, double start_time) noexcept nogil:
+    """Reset the run's state; the iterations stop early enough for the final polish or
+    restoration to fit in the time limit."""
+    cdef Options* o = &e.opt
+    L.start_time = start_time
+    L.cold = cold
+    L.iteration = 0
+    L.polished_at = -1
+    L.wait = L.next_gated = 0
+    L.status = RUNNING
+    L.retries = L.early_tries = 0
+    L.guess_polished = False
+    L.first_check = True
+    L.unbounded_start = False
+    L.timed = isfinite(o.time_limit)
+    L.deadline = o.time_limit - min(
+        max(e.clock.final_reserve, RESERVE_PASSES * e.clock.pass_time), 0.5 * o.time_limit)
+    run.factorizations = 0
+    run.backend = e.fact.form
+    trial_reset(&L.trial)
+    run.polished = False
+    e.tighten = 1.0
+    e.certs.stalled_prim = INFINITY
+    e.certs.stalled_checks = 0
+    e.certs.next_cleaning = CLEANING_START
+    e.certs.cleaning_wait = o.adaptive_rho_interval
+    e.certs.gram_state = 0
+    e.fact.table_ready = False   # base is for the previous q, b
+    e.pol.schur.ready = False   # set up for the previous P, A
+    e.iterated = False
+    e.clock.marks[3] = e.clock.marks[4] = fccqp_now()   # phases skipped show 0
+
+
+cdef inline bint _start(Engine* e, Loop* L, Run* run) noexcept nogil:
+    """The cold start (:func:`fccqp.factorization.equality_start`) and what it decides
+    alone: an unbounded or inconsistent QP, a start that is solved already, a QP with
+    no constrained entry. False when the run ended here."""
+    cdef Options* o = &e.opt
+    cdef Residuals* r = &e.res
+    cdef bint at_start = L.cold or e.prob.s == 0
+    cdef int status
+    if at_start:
+        status = equality_start(e, &L.unbounded_start)
+        run.factorizations += 1
+        if status == NOT_CONVEX:
+            run.status = NOT_CONVEX_QP
+            return False
+    measure(e)
+    _log(e, 0, run.rho)
+    if L.unbounded_start and unbounded(e):
+        end_run(e, run, DUAL_INFEASIBLE, 0)
+        return False
+    if at_start:   # not at factorization accuracy: inconsistent or dependent rows
+        e.equalities_missed = r.prim_eq > EQUALITY_MISSED * max(r.prim_eq_scale, 1.0)
+        if missed_by_data(e) and inconsistent(e, True):
+            # tested on the penalty-free start: with rho in the KKT matrix (up to 1e9
+            # on fixed entries) the regularization's trace in A'r can hide it
+            end_run(e, run, PRIMAL_INFEASIBLE, 0)
+            return False
+    if at_start and converged(r, o.eps_abs, o.eps_rel) and not L.unbounded_start:
+        status = SOLVED
+        if o.polish:   # the start carries sigma's bias where the cost is flat
+            run.polished = keep_polished(e, &status, 0, L.start_time, False)
+        end_run(e, run, status, 0)
+        return False
+    if e.prob.s == 0:  # nothing to iterate: the equality-constrained QP was the answer
+        status = classify(e, 0, False)
+        if o.polish and SOLVED <= status <= TIME_LIMIT:
+            run.polished = keep_polished(e, &status, 0, L.start_time, False)
+        end_run(e, run, status, 0)
+        return False
+    return True
+
+
+cdef inline bint _factor_or_polish(Engine* e, Loop* L, Run* run) noexcept nogil:
+    """Factor for the run's rho unless the factorization holds it, and the reduced
+    form's ``base``; first, where it can, polish a polished warm start
+    (:func:`fccqp.acceptance.warm_polish`). False when the run ended here."""
+    cdef Problem* p = &e.prob
+    cdef Py_ssize_t j
+    cdef int code
+    cdef bint polished
+    for j in range(p.s):
+        e.it.rho_vec[j] = run.rho * e.fact.rho_scale[j]
+    L.warm_polish = e.prev.from_polished and e.opt.polish
+    if e.fact.factored_rho != run.rho or L.cold:
+        if (L.warm_polish and polish_prepare(&e.pol, p)
+                and (e.fact.certified or e.pol.schur.convex)):
+            # polish before ADMM's factorization, which it does not need; new
+            # matrices must be proven convex first, which the set-up does for free
+            # where P is positive semidefinite, else the factorization below does
+            e.fact.certified = True
+            e.pol.schur_only = True
+            polished = warm_polish(e, run, L.start_time)
+            e.pol.schur_only = False
+            if polished:
+                return False
+            # a guess that failed the check would fail again; one that the Schur
+            # complement could not solve goes to the table
+            L.warm_polish = e.pol.schur_failed
+        code = factor(e, run, budget(e, 0))
+        if code != FACTORED:
+            run.status = NOT_CONVEX_QP if code == NOT_CONVEX else NUMERICAL_ERROR
+            return False
+    L.reduced = e.fact.form != LDL_FULL
+    if L.reduced:
+        reduced_base(e)
+    if L.warm_polish and warm_polish(e, run, L.start_time):
+        return False
+    return True
+
+
+cdef inline void _prepare(Engine* e, Loop* L) noexcept nogil:
+    """The iterations' own start: the reduced coordinates, the gate's tolerances,
+    Anderson's memory; a setup that spent the time limit leaves no iteration."""
+    cdef Options* o = &e.opt
+    cdef Residuals* r = &e.res
+    e.clock.marks[3] = fccqp_now()
+    if L.reduced:
+        reduced_start(&e.red, &e.prob, &e.it)
+    L.eps_p = o.eps_abs + o.eps_rel * r.prim_set_scale   # the gate tests x_S - z
+    L.eps_d = o.eps_abs + o.eps_rel * r.dual_scale
+    anderson_reset(&e.aa, False)
+    L.accelerate = o.anderson_memory > 0
+    L.periodic_prim = INFINITY
+    L.stalls = 0
+    L.fresh = True
+    if L.timed and o.min_iter == 0 and fccqp_now() - L.start_time >= L.deadline:
+        L.status = classify(e, 0, True)   # the setup spent the budget
+
+
+cdef inline void _step(Engine* e, Loop* L) noexcept nogil:
+    """One ADMM iteration, in the reduced form's coordinates or with a KKT solve."""
+    if L.reduced:
+        reduced_step(&e.red, &e.prob, &e.it, e.opt.alpha, not L.fresh)
+    else:
+        _full_step(e, not L.fresh)
+    L.fresh = False
+
+
+cdef inline void _schedule(Engine* e, Loop* L) noexcept nogil:
+    """Whether this iteration is the last, adapts rho, and is checked: every
+    ``check_termination`` iterations, or in the reduced form when the gate
+    (:func:`fccqp.reduced.near_convergence`) says that the check may pass."""
+    cdef Options* o = &e.opt
+    L.last = L.iteration >= o.max_iter or (L.timed and L.iteration >= o.min_iter
+                                           and fccqp_now() - L.start_time >= L.deadline)
+    L.periodic = L.iteration % o.adaptive_rho_interval == 0
+    L.adapt = o.adaptive_rho and L.periodic
+    L.check = L.iteration % o.check_termination == 0 or L.last or L.adapt
+    L.gated = L.check and L.reduced and not (L.last or L.periodic)
+    if L.gated:
+        # a scheduled full check (and with it infeasibility detection) still runs
+        # every adaptive_rho_interval iterations
+        L.check = L.iteration >= L.next_gated and near_convergence(&e.red, &e.prob, &e.it,
+                                                                   L.eps_p, L.eps_d)
+
+
+cdef inline void _check(Engine* e, Loop* L, Run* run) noexcept nogil:
+    """The residuals and :func:`fccqp.verdict.check`; a gate that passed where the
+    check did not backs off."""
+    cdef Options* o = &e.opt
+    cdef Residuals* r = &e.res
+    if L.reduced:
+        materialize(&e.red, &e.prob, &e.it)
+    measure(e)
+    L.eps_p = e.tighten * (o.eps_abs + o.eps_rel * r.prim_set_scale)
+    L.eps_d = e.tighten * (o.eps_abs + o.eps_rel * r.dual_scale)
+    if L.iteration % LOG_INTERVAL == 0:
+        _log(e, L.iteration, run.rho)
+    L.status = check(e, L.iteration, L.last)
+    if L.gated and L.status == RUNNING:   # the gate passed, the check did not
+        L.wait = min(2 * L.wait + 1, GATED_CHECK_WAIT)
+        L.next_gated = L.iteration + L.wait
+
+
+cdef inline void _polish_attempts(Engine* e, Loop* L, Run* run) noexcept nogil:
+    """Polish a SOLVED iterate (a failure goes on at tighter tolerances, closer to the
+    active set, ``POLISH_RETRIES`` times); without a time limit, also polish an active
+    set that settled near convergence (``EARLY_POLISH_GATE``)."""
+    cdef Options* o = &e.opt
+    if L.status == SOLVED and o.polish and not L.last and L.retries < POLISH_RETRIES:
+        L.polished_at = L.iteration
+        run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, False)
+        if not run.polished:   # go on, closer to the active set
+            L.retries += 1
+            e.tighten *= 0.1
+            L.status = RUNNING
+    if (L.status == RUNNING and L.periodic and o.polish and not L.timed and not L.last
+            and L.early_tries < EARLY_POLISH_TRIES):
+        if (guess_changes(&e.prob, e.it.z, e.it.y, e.work.guess_point,
+                          e.work.guess_codes) != 0 or L.first_check):
+            L.guess_polished = L.first_check = False   # polish it once it settles
+        elif not L.guess_polished and nearly_converged(&e.res, o.eps_abs, o.eps_rel,
+                                                       EARLY_POLISH_GATE):
+            L.guess_polished = True
+            L.early_tries += 1
+            L.polished_at = L.iteration
+            run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, True)
+
+
+cdef inline void _stall_rule(Engine* e, Loop* L) noexcept nogil:
+    """Stop Anderson acceleration where the primal residual stalls far from tolerance.
+
+    A primal residual that does not halve between two scheduled checks far from
+    tolerance is how infeasibility looks; Anderson's extrapolated points there hide
+    the steady step that certifies it (CVXPY's lp_4 ran 4000 iterations uncertified),
+    so plain ADMM runs on."""
+    cdef Options* o = &e.opt
+    cdef Residuals* r = &e.res
+    if L.status == RUNNING and L.periodic and L.accelerate:
+        if (r.prim > STALL_FACTOR * (o.eps_abs + o.eps_rel * r.prim_scale)
+                and r.prim > 0.5 * L.periodic_prim):
+            L.stalls += 1
+        else:
+            L.stalls = 0
+        L.accelerate = L.stalls < STALLS
+        L.periodic_prim = r.prim
+
+
+cdef inline bint _adapt_rho(Engine* e, Loop* L, Run* run) noexcept nogil:
+    """Adapt rho on its schedule (:func:`fccqp.rho_rule.new_rho`) and refactor for a
+    new one; False, the run ended, when that factorization fails."""
+    cdef double rho
+    cdef int code
+    if L.status == RUNNING and L.adapt:
+        rho = new_rho(&e.res, run.rho, &L.trial, e.opt.adaptive_rho_tolerance)
+        if rho != run.rho:
+            code = change_rho(e, run, rho, L.iteration, L.reduced)
+            if code != FACTORED:
+                run.status = NOT_CONVEX_QP if code == NOT_CONVEX else NUMERICAL_ERROR
+                return False
+            L.reduced = e.fact.form != LDL_FULL
+            L.fresh = True
+            L.wait = L.next_gated = 0
+    return True
+
+
+cdef inline void _final_step(Engine* e, Loop* L, Run* run) noexcept nogil:
+    """After the iterations: polish the final iterate (under a time limit only near
+    convergence, ``POLISH_GATE``), else restore its feasibility when the settings ask,
+    else remove the rounding in ``A x = b`` that the reduced form accumulates."""
+    cdef Options* o = &e.opt
+    e.clock.marks[4] = fccqp_now()
+    e.iterated = True
+    if (not run.polished and o.polish and SOLVED <= L.status <= TIME_LIMIT
+            and L.polished_at != L.iteration
+            and (not L.timed or nearly_converged(&e.res, o.eps_abs, o.eps_rel, POLISH_GATE))):
+        run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, False)
+    if not run.polished:   # a polished point is feasible already: nothing to restore
+        if o.restore_feasibility and SOLVED <= L.status <= TIME_LIMIT:
+            L.status = keep_restored(e, L.status, L.iteration, L.reduced)
+        elif (L.reduced or missed(e)) and L.status != NUMERICAL_ERROR:
+            restore_equalities(e)   # certificates are already in cert
+    end_run(e, run, L.status, L.iteration)
+
+
+cdef void _full_step(Engine* e, bint relax_x) noexcept nogil:
+    """One ADMM iteration with a KKT solve (update_x, update_z, update_y)."""
+    cdef Problem* p = &e.prob
+    cdef Iterates* it = &e.it
+    cdef double* rhs = e.work.rhs
+    cdef double* sol = e.work.sol
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
+    cdef double alpha = e.opt.alpha, alpha_x = alpha if relax_x else 1.0
+    cdef double sigma = e.opt.sigma
+    copy(it.x, it.x_prev, n)
+    copy(it.nu, it.nu_prev, m)
+    copy(it.z, it.z_prev, s)
+    copy(it.y, it.y_prev, s)
+    for i in range(n):
+        rhs[i] = sigma * it.x[i] - p.q[i]
+    for i in range(m):
+        rhs[n + i] = p.b[i]
+    for j in range(s):
+        rhs[p.constrained[j]] += it.rho_vec[j] * it.z[j] - it.y[j]
+    kkt_solve(&e.fact.kkt, p, it.rho_vec, rhs, sol)
+    for j in range(s):
+        it.relaxed[j] = alpha * sol[p.constrained[j]] + (1.0 - alpha) * it.z_prev[j]
+    for i in range(n):
+        it.x[i] = alpha_x * sol[i] + (1.0 - alpha_x) * it.x_prev[i]
+    copy(sol + n, it.nu, m)
+    for j in range(s):
+        it.z[j] = it.relaxed[j] + it.y[j] / it.rho_vec[j]
+    proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
+    for j in range(s):
+        it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])
+
+
+cdef void _log(Engine* e, long iteration, double rho) noexcept nogil:
+    """A row of the solve's log (:attr:`fccqp.admm.Workspace.log_lines`)."""
+    cdef double* row
+    if e.log.count < e.log.capacity:
+        row = e.log.rows + 5 * e.log.count
+        row[0], row[1], row[2], row[3], row[4] = (
+            iteration, e.res.prim, e.res.dual, e.res.gap, rho)
+        e.log.count += 1

@@ -1,0 +1,81 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""Rho adaptation: OSQP's rule, and the trial of the small moves it keeps asking for.
+
+Shared by the dense core (:mod:`fccqp.iteration`) and the sparse path
+(:mod:`fccqp.sparse_admm`, through :class:`RhoTrial`), so that both adapt rho alike.
+"""
+
+from libc.math cimport sqrt
+
+from fccqp.termination cimport Residuals
+from fccqp.tuning cimport RHO_MAX, RHO_MIN, RHO_PERSISTENCE
+
+
+cdef double rho_trial(TrialState* trial, double rho, double new_rho, double worst,
+                      double tolerance) noexcept nogil:
+    """The rho to take, given OSQP's proposal ``new_rho`` and the larger relative
+    residual ``worst`` at this update: ``new_rho`` when it moves rho by more than
+    ``tolerance``. A smaller move, by more than the tolerance's square root, is made when
+    the rule asked for it, the same way, at ``RHO_PERSISTENCE`` updates in a row while
+    ``worst`` did not halve; it is undone (and none made again in the run) when over the
+    next ``RHO_PERSISTENCE`` updates ``worst`` falls by less than it did over the streak."""
+    cdef double half = sqrt(tolerance), old
+    cdef int side = 1 if new_rho > rho * half else (-1 if new_rho < rho / half else 0)
+    if new_rho > rho * tolerance or new_rho < rho / tolerance:
+        trial.side = trial.count = 0
+        trial.old_rho = 0.0
+        return new_rho
+    if trial.old_rho > 0.0:   # a move on trial
+        trial.count += 1
+        if trial.count == 1:
+            trial.start = worst
+        elif trial.count == RHO_PERSISTENCE:
+            old, trial.old_rho = trial.old_rho, 0.0
+            trial.side = trial.count = 0
+            if worst / trial.start > trial.progress:
+                trial.locked = True
+                return old
+        return rho
+    if trial.locked or side == 0 or side != trial.side:
+        trial.side, trial.count, trial.start = side, 1, worst
+        return rho
+    trial.count += 1
+    if trial.count < RHO_PERSISTENCE:
+        return rho
+    trial.side = trial.count = 0
+    if worst <= 0.5 * trial.start:
+        return rho
+    trial.progress = worst / trial.start
+    trial.old_rho = rho
+    return new_rho
+
+
+cdef void trial_reset(TrialState* trial) noexcept nogil:
+    trial.side = trial.count = 0
+    trial.old_rho = trial.start = trial.progress = 0.0
+    trial.locked = False
+
+
+cdef double new_rho(const Residuals* r, double rho, TrialState* trial,
+                    double tolerance) noexcept nogil:
+    """OSQP's rule: rho *= sqrt(relative primal / relative dual residual), clipped,
+    when that moves it by more than ``tolerance`` (``adaptive_rho_tolerance``); a
+    smaller move that the rule keeps asking for is tried (:func:`rho_trial`)."""
+    cdef double prim = r.prim_s / max(r.prim_scale_s, 1e-30)
+    cdef double dual = r.dual_s / max(r.dual_scale_s, 1e-30)
+    cdef double proposal = min(max(rho * sqrt(prim / max(dual, 1e-30)), RHO_MIN), RHO_MAX)
+    return rho_trial(trial, rho, proposal, max(prim, dual), tolerance)
+
+
+cdef class RhoTrial:
+    """:func:`rho_trial` for the sparse path (:mod:`fccqp.sparse_admm`), which runs
+    the dense core's rho rule: one per run."""
+
+    cdef TrialState state
+
+    def __cinit__(self):
+        trial_reset(&self.state)
+
+    def propose(self, double rho, double new_rho, double worst, double tolerance):
+        """The rho to take at this update (see :func:`rho_trial`)."""
+        return rho_trial(&self.state, rho, new_rho, worst, tolerance)

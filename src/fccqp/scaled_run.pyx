@@ -1,0 +1,124 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""One run on the scaled problem: scale the user's data (or reuse the scaling), place the
+start, iterate (:mod:`fccqp.iteration`); then unscale the answer into the user's arrays,
+settle its status on its own residuals and keep it for the next warm start.
+"""
+
+from libc.math cimport isfinite
+
+from fccqp._dense cimport copy, fill
+from fccqp._types cimport Problem
+from fccqp.acceptance cimport user_residuals
+from fccqp.engine cimport DUAL_INFEASIBLE, PRIMAL_INFEASIBLE, Engine, Run, fccqp_now
+from fccqp.iteration cimport iterate
+from fccqp.projections cimport proj_set
+from fccqp.scaling cimport equilibrate, rescale, scale_start, scaled_norms, unscale
+from fccqp.termination cimport row_spans
+from fccqp.verdict cimport settle
+
+
+cdef Run scaled_run(Engine* e, bint same_matrices, const double* x0, bint warm,
+                    double start_time) noexcept nogil:
+    """Scale (or reuse the scaling), start, run."""
+    cdef Problem* p = &e.prob
+    cdef Run run
+    cdef bint reuse = same_matrices and e.scaling.done
+    if not same_matrices:
+        e.fact.certified = False
+    e.user.has_matrices = True
+    e.prev.from_polished = x0 == NULL and warm and e.prev.polished
+    e.unscaled.current = False
+    e.clock.marks[1] = fccqp_now()
+    _scale(e, reuse, warm)
+    e.clock.marks[2] = fccqp_now()
+    e.log.count = 0
+    # under a time limit a cold start too keeps the rho the last solve adapted (as
+    # OSQP keeps its rho between solves): fewer iterations and factorizations on
+    # talos_reduced's cold starts; without one it helped solo12 but cost talos_reduced
+    # and anymal_c iterations (notes/tuning.md, "The rho of a cold start")
+    run.rho = (e.prev.rho if warm or (e.prev.has_rho and isfinite(e.opt.time_limit))
+               else e.opt.rho)
+    if x0 != NULL:
+        _start_from_guess(e, x0)
+    elif warm:
+        scale_start(e.prev.x, e.prev.y, e.prev.z, e.prev.rho, p.D, p.E, p.c,
+                    p.n, p.m, p.s, p.constrained, p.lo, p.hi, p.cones, e.it.x,
+                    e.it.nu, e.it.y, e.it.z)
+    if not reuse:
+        e.fact.factored_rho = -1.0
+    run.setup_time = fccqp_now() - start_time
+    iterate(e, &run, x0 == NULL and not warm, start_time)
+    return run
+
+
+cdef void _scale(Engine* e, bint reuse, bint warm) noexcept nogil:
+    """Equilibrate the user's data into the scaled problem; with ``reuse`` (unchanged
+    matrices) apply the scaling to the new vectors only, and with ``warm`` (a start
+    from the previous solution) scale the new data with the previous equilibration
+    (:func:`fccqp.scaling.rescale`); then the rows' spans over the (new) box."""
+    cdef Problem* p = &e.prob
+    cdef Py_ssize_t n = p.n, m = p.m, i, j
+    if reuse:
+        for i in range(n):
+            p.q[i] = p.c * p.D[i] * e.user.q[i]
+        for i in range(m):
+            p.b[i] = p.E[i] * e.user.b[i]
+    elif not (warm and e.scaling.done and rescale(
+            e.user.P, e.user.q, e.user.A, e.user.b, n, m, p.D, p.E,
+            e.scaling.reference, e.scaling.norms, p.P, p.q, p.A, p.b, &p.c)):
+        copy(e.user.P, p.P, n * n)
+        copy(e.user.A, p.A, m * n)
+        copy(e.user.q, p.q, n)
+        copy(e.user.b, p.b, m)
+        p.c = equilibrate(p.P, p.q, p.A, p.b, n, m, e.user.block_start, p.cones.dim,
+                          p.cones.count, e.opt.scaling, p.D, p.E, e.scaling.d,
+                          e.scaling.e)
+        scaled_norms(p.P, p.A, n, m, p.c, e.scaling.reference)
+        e.scaling.done = True
+    for j in range(p.s):
+        i = p.constrained[j]
+        p.lo[j] = e.user.lb[i] / p.D[i]
+        p.hi[j] = e.user.ub[i] / p.D[i]
+    row_spans(p, e.scaling.d)
+
+
+cdef void _start_from_guess(Engine* e, const double* x0) noexcept nogil:
+    """Primal guess ``x0`` (user's units), duals zero, slack its projection."""
+    cdef Problem* p = &e.prob
+    cdef Py_ssize_t i, j
+    for i in range(p.n):
+        e.it.x[i] = x0[i] / p.D[i]
+    fill(e.it.nu, 0.0, p.m)
+    fill(e.it.y, 0.0, p.s)
+    for j in range(p.s):
+        e.it.z[j] = e.it.x[p.constrained[j]]
+    proj_set(e.it.z, p.lo, p.hi, p.cones, p.s, e.it.z)
+
+
+cdef void unscaled_answer(Engine* e, Run* run, double* x, double* y, double* z,
+                          double* cert) noexcept nogil:
+    """Unscale the iterate into the result arrays, recompute its residuals in the
+    user's units from the returned point alone (the primal one as the distance of
+    ``x_S`` to C), settle the status on them (:func:`fccqp.verdict.settle`) and keep
+    the point for a warm start."""
+    cdef Problem* p = &e.prob
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s
+    if e.unscaled.current:   # a warm polish's point: unscaled and measured already
+        copy(e.unscaled.x, x, n)
+        if m:
+            copy(e.unscaled.y, y, m)
+        copy(e.unscaled.z, z, n)
+    else:
+        unscale(e.it.x, e.it.nu, e.it.y, p.D, p.E, p.c, n, m, s, p.constrained, x, y, z)
+        if run.status == PRIMAL_INFEASIBLE or run.status == DUAL_INFEASIBLE:
+            copy(e.certs.cert, cert, n + m)
+        user_residuals(e, x, y, z)
+    settle(e, run)
+    e.prev.exists = e.res.finite and run.status not in (PRIMAL_INFEASIBLE, DUAL_INFEASIBLE)
+    if e.prev.exists:
+        copy(x, e.prev.x, n)
+        copy(y, e.prev.y, m)
+        copy(z, e.prev.z, n)
+        e.prev.rho = run.rho
+        e.prev.has_rho = True
+    e.prev.polished = e.prev.exists and run.polished

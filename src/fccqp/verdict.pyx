@@ -1,0 +1,198 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""The verdict on an iterate: solved, infeasible (with a certificate), unbounded, or the
+budget's status, from the residuals of :mod:`fccqp.termination` and the certificates
+of :mod:`fccqp.certificates`.
+
+:func:`check` is the test after each checked iteration; :func:`classify` the status of
+a point from its residuals alone; :func:`settle` the status of the returned point.
+The certificates found are left in ``Engine.certs.cert``, in the user's units.
+"""
+
+from fccqp._dense cimport copy, fill
+from fccqp._types cimport Iterates, Problem
+from fccqp.certificates cimport (CERTIFIED, SEPARATED, clean_primal_certificate,
+                                 dual_infeasible, equality_direction, equality_inconsistent,
+                                 gram_factor, magnitudes, primal_infeasible, row_size)
+from fccqp.engine cimport (DUAL_INFEASIBLE, INACCURATE, MAX_ITER, NUMERICAL_ERROR,
+                           PRIMAL_INFEASIBLE, RUNNING, SOLVED, TIME_LIMIT, Engine, Run,
+                           fccqp_now)
+from fccqp.kkt cimport kkt_solve
+from fccqp.termination cimport Residuals, converged, nearly_converged
+from fccqp.tuning cimport CLEANING_GATE, EQUALITY_MISSED, INACCURATE_FACTOR
+
+
+cdef int check(Engine* e, long iteration, bint last) noexcept nogil:
+    """Termination and infeasibility tests after the residuals of ``iteration``."""
+    cdef Problem* p = &e.prob
+    cdef Iterates* it = &e.it
+    cdef Residuals* r = &e.res
+    cdef Py_ssize_t i
+    cdef int code
+    if not r.finite:
+        return NUMERICAL_ERROR
+    if (missed_by_data(e)
+            and inconsistent(e, iteration % e.opt.adaptive_rho_interval == 0)):
+        # A x = b has no solution: no point can be SOLVED (cleaned on the schedule
+        # of rho adaptation, a KKT solve each time)
+        return PRIMAL_INFEASIBLE
+    if converged(r, e.tighten * e.opt.eps_abs, e.tighten * e.opt.eps_rel):
+        return SOLVED
+    code = primal_infeasible(p, it, e.opt.eps_prim_inf, e.work.vec_m, e.work.vec_s,
+                             e.work.vec_n, e.work.vec_n2)
+    if code == CERTIFIED or (code == SEPARATED and iteration >= e.certs.next_cleaning
+                             and iteration % e.opt.adaptive_rho_interval == 0
+                             and _cleaned_certificate(e, iteration)):
+        fill(e.certs.cert, 0.0, p.n + p.m)
+        for i in range(p.m):   # in the user's units (the common factor 1/c dropped)
+            e.certs.cert[i] = e.work.vec_m[i] * p.E[i]
+        for i in range(p.s):
+            e.certs.cert[p.m + p.constrained[i]] = e.work.vec_s[i] / p.D[p.constrained[i]]
+        return PRIMAL_INFEASIBLE
+    for i in range(p.n):
+        e.certs.direction[i] = it.x[i] - it.x_prev[i]
+    if unbounded(e):
+        return DUAL_INFEASIBLE
+    if last:
+        return classify(e, iteration, True)
+    return RUNNING
+
+
+cdef bint _cleaned_certificate(Engine* e, long iteration) noexcept nogil:
+    """Clean the primal certificate's candidate that the last test left in ``vec_m``,
+    ``vec_s`` (:func:`fccqp.certificates.clean_primal_certificate`), on the schedule
+    of rho adaptation, when the primal residual is above ``CLEANING_GATE`` times
+    its tolerance and did not halve over the last two such checks, and the
+    candidate separates: how infeasibility looks, and the only case worth an ``A
+    A'`` factorization (m x m, once per solve). Not before ``CLEANING_START``
+    iterations, and each failed try doubles the wait before the next: a try costs
+    about a hundred of talos_reduced's iterations, and its slow feasible ticks
+    stall and separate too (tried at every such check, cleaning took 20 % of the
+    realtime preset's warm instructions)."""
+    cdef Problem* p = &e.prob
+    cdef Residuals* r = &e.res
+    cdef double previous = e.certs.stalled_prim
+    e.certs.stalled_prim = r.prim
+    e.certs.stalled_checks = e.certs.stalled_checks + 1 if r.prim > 0.5 * previous else 0
+    if not (p.m > 0 and e.certs.stalled_checks >= 2
+            and r.prim > CLEANING_GATE * (e.opt.eps_abs + e.opt.eps_rel * r.prim_scale)):
+        return False
+    if e.certs.gram_state == 0:   # once per solve: A A' of this solve's scaled rows
+        e.certs.gram_state = 1 if gram_factor(p, e.certs.gram) else -1
+    if e.certs.gram_state == 1 and clean_primal_certificate(
+            p, e.it.x, e.certs.gram, e.opt.eps_prim_inf, e.work.vec_m, e.work.vec_s,
+            e.work.saved, e.work.vec_n3, e.work.vec_n, e.work.vec_n2):
+        return True
+    e.certs.cleaning_wait *= 2   # the next try waits twice as long
+    e.certs.next_cleaning = iteration + e.certs.cleaning_wait
+    return False
+
+
+cdef bint missed(const Engine* e) noexcept nogil:
+    """The last residuals miss ``A x = b`` beyond factorization accuracy
+    (``EQUALITY_MISSED`` of their scale). Not the tolerance: rows inconsistent by
+    less than ``eps_rel`` of the largest row (a duplicated row of size 2 off by 0.65
+    among rows of 3e6) are no more solvable, and were left uncertified for 4000
+    iterations."""
+    return e.res.prim_eq > EQUALITY_MISSED * e.res.prim_eq_scale
+
+
+cdef bint missed_by_data(Engine* e) noexcept nogil:
+    """:func:`missed`, and also beyond ``EQUALITY_MISSED`` of each row's terms at the
+    magnitude of the iterate and the box (:func:`fccqp.certificates.row_size`): only
+    then can the equality certificate hold. Where ``b`` and ``A x`` both cancel to
+    rounding noise (consistent dependent rows asking 0 with right-hand sides of
+    4e-16, at a start of 1e-13), ``max(|A x|, |b|)`` alone made that a miss, and a
+    public QP (QSCORPIO) was claimed infeasible. Computed only when :func:`missed`
+    holds."""
+    cdef Problem* p = &e.prob
+    cdef Py_ssize_t i
+    cdef double largest = 0.0
+    if not missed(e):
+        return False
+    magnitudes(p, e.it.x, e.work.vec_n)
+    for i in range(p.m):
+        largest = max(largest, row_size(p, i, e.work.vec_n) / p.E[i])
+    return e.res.prim_eq > EQUALITY_MISSED * largest
+
+
+cdef bint inconsistent(Engine* e, bint clean) noexcept nogil:
+    """The equality certificate; on success ``cert`` holds ``(-E r, 0)``: ``A'y ~ 0`` and
+    ``b'y < 0`` in the user's units.
+
+    ``r = b_s - A_s x_s`` of a regularized KKT solution is the least-squares residual
+    when ``A x = b`` has no solution, but it carries the regularization's trace:
+    ``A'r = -delta A'nu``, which is large against ``r`` itself when the rows are
+    inconsistent by little (``rho = 2.6e-9`` against ``delta = 5.9e-8`` on a random
+    problem), or when a row is so small that ``delta`` outweighs it (rows of norm
+    1e-9, ``r`` all on such a row, ``rho = 1``). With ``clean``, an ``r`` that
+    separates but is not certified is cleaned by one step of inverse iteration: the
+    regularized solve for ``(0, r)`` returns ``nu`` with ``-delta nu`` equal to the
+    part of ``r`` in the null space of ``A'`` and the rest shrunk by ``delta /
+    lambda`` (``lambda`` the eigenvalues of ``A H^-1 A'`` off that null space): the
+    first problem's ``rho`` fell to 1e-17, the second's to 7e-17."""
+    cdef Problem* p = &e.prob
+    cdef Py_ssize_t n = p.n, m = p.m, i
+    cdef double* r = e.work.vec_m
+    cdef int code = equality_inconsistent(p, &e.it, e.opt.eps_prim_inf, r,
+                                          e.work.vec_n, e.work.vec_n2)
+    if code == SEPARATED and clean:
+        fill(e.work.rhs, 0.0, n)
+        copy(r, e.work.rhs + n, m)
+        kkt_solve(&e.fact.kkt, p, e.it.rho_vec, e.work.rhs, e.work.sol)
+        for i in range(m):
+            r[i] = -e.work.sol[n + i]
+        code = equality_direction(p, r, e.it.x, e.opt.eps_prim_inf, e.work.vec_n,
+                                  e.work.vec_n2)
+    if code != CERTIFIED:
+        return False
+    fill(e.certs.cert, 0.0, n + m)
+    for i in range(m):
+        e.certs.cert[i] = -r[i] * p.E[i]
+    return True
+
+
+cdef bint unbounded(Engine* e) noexcept nogil:
+    """The dual certificate for ``direction``; on success ``cert`` holds it, unscaled."""
+    cdef Problem* p = &e.prob
+    cdef Py_ssize_t i
+    if not dual_infeasible(p, e.certs.direction, e.opt.eps_dual_inf, e.work.vec_n,
+                           e.work.vec_n2, e.work.vec_s2):
+        return False
+    for i in range(p.n):
+        e.certs.cert[i] = e.certs.direction[i] * p.D[i]
+    return True
+
+
+cdef int classify(const Engine* e, long iteration, bint stopped) noexcept nogil:
+    """Status of an iterate from its residuals alone: solved, inaccurate (within
+    ``INACCURATE_FACTOR`` of the tolerances), or the budget that ran out."""
+    cdef const Residuals* r = &e.res
+    if not r.finite:
+        return NUMERICAL_ERROR
+    if converged(r, e.opt.eps_abs, e.opt.eps_rel):
+        return SOLVED
+    if nearly_converged(r, e.opt.eps_abs, e.opt.eps_rel, INACCURATE_FACTOR):
+        return INACCURATE
+    if iteration >= e.opt.max_iter or not stopped:
+        return MAX_ITER
+    return TIME_LIMIT
+
+
+cdef void settle(const Engine* e, Run* run) noexcept nogil:
+    """Settle the status of a run on the residuals of the point it returns (in
+    ``Engine.res``): a budget's status or a solved one becomes solved or inaccurate
+    when the point is, and one that no longer passes says why."""
+    if run.status in (SOLVED, INACCURATE, MAX_ITER, TIME_LIMIT):
+        if converged(&e.res, e.opt.eps_abs, e.opt.eps_rel):
+            run.status = SOLVED
+        elif nearly_converged(&e.res, e.opt.eps_abs, e.opt.eps_rel, INACCURATE_FACTOR):
+            run.status = INACCURATE
+        elif run.status in (SOLVED, INACCURATE):
+            # the iterate passed, the returned point does not: a budget that ran out
+            # says so (finite residuals are no numerical error), else the point
+            # carries no guarantee
+            run.status = (MAX_ITER if run.iterations >= e.opt.max_iter
+                          else TIME_LIMIT if fccqp_now() - e.clock.marks[0] >= e.opt.time_limit
+                          else NUMERICAL_ERROR)
+    if not e.res.finite:
+        run.status = NUMERICAL_ERROR
