@@ -20,7 +20,6 @@ from cpython.buffer cimport PyBuffer_Release
 from libc.math cimport isfinite
 
 from fccqp cimport engine
-from fccqp._types cimport Problem
 from fccqp.anderson cimport anderson_reset
 from fccqp.blas_threads cimport enter, leave
 from fccqp.engine cimport CONE_ENTRY, Engine, Run, fccqp_now

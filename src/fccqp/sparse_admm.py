@@ -22,7 +22,7 @@ Anderson acceleration, infeasibility certificates (:mod:`fccqp.sparse_checks`),
 polishing with its acceptance test and retries (:mod:`fccqp.sparse_polish`), and the
 status settled on the returned point in the user's units. Each iteration is a few
 vectorized numpy operations and one sparse triangular solve pair; constants are the
-dense core's (imported from :mod:`fccqp.admm` and :mod:`fccqp.anderson`).
+dense core's (imported from :mod:`fccqp.admm`, :mod:`fccqp.tuning` and :mod:`fccqp.anderson`).
 
 Not on this path: the reduced iteration, the Schur backend and the warm polish in the
 table's coordinates (dense-only accelerations), and the feasibility restoration after
@@ -310,7 +310,7 @@ class _Run:
         return negative
 
     def _equality_start(self) -> bool:
-        """The paper's cold start (see ``fccqp.admm.Workspace._equality_start``): ``x``
+        """The paper's cold start (see ``fccqp.factorization.equality_start``): ``x``
         solves the QP with the equalities only, from a penalty-free factorization whose
         inertia certifies convexity, with ``EQUALITY_START_STEPS`` proximal steps to
         remove sigma's bias; when that QP is unbounded, ``direction`` keeps the last step
@@ -341,7 +341,7 @@ class _Run:
 
     def _factor_rho(self) -> None:
         """Factor for the current rho, certifying convexity first when the matrices are
-        new (the penalty-free factorization, as the dense ``_factor``)."""
+        new (the penalty-free factorization, as the dense ``fccqp.factorization.factor``)."""
         if not self.w.certified:
             self._factor(self.o.sigma, np.zeros(self.p.s))
             self.w.certified = True
@@ -370,7 +370,7 @@ class _Run:
         self.res = iterate_residuals(self.p, self.x, self.nu, self.z, self.y)
 
     def _classify(self, iteration: int, stopped: bool) -> Status:
-        """Status of the point from its residuals alone (see ``fccqp.admm``)."""
+        """Status of the point from its residuals alone (see ``fccqp.verdict.classify``)."""
         r, o = self.res, self.o
         if not r.finite:
             return Status.NUMERICAL_ERROR
@@ -414,7 +414,7 @@ class _Run:
     def _new_rho(self, trial: RhoTrial) -> float:
         """OSQP's rule on the scaled residuals: ``rho sqrt(relative primal / relative
         dual)``, clipped, when it moves rho by more than the tolerance; a smaller move
-        on trial as in the dense core (:class:`fccqp.admm.RhoTrial`)."""
+        on trial as in the dense core (:class:`fccqp.rho_rule.RhoTrial`)."""
         r = self.res
         prim = r.prim_s / max(r.prim_scale_s, 1e-30)
         dual = r.dual_s / max(r.dual_scale_s, 1e-30)
@@ -439,7 +439,7 @@ class _Run:
     def _keep_polished(self, status: Status, iteration: int,
                        solved_only: bool = False) -> tuple[bool, Status]:
         """Replace the iterate by its polished version when that passes the dense core's
-        acceptance test (``fccqp.admm.Workspace._keep_polished``): on the user's problem,
+        acceptance test (``fccqp.acceptance.keep_polished``): on the user's problem,
         primal feasible within the tolerance, multipliers in the normal cones of the
         guess, ``A x = b`` at factorization accuracy, and each residual and the gap no
         worse than the ADMM point's (or at the rounding of an exact solve); with
@@ -483,7 +483,7 @@ class _Run:
         return self._finish(status, iterations, polished)
 
     def _iterate(self, cold: bool, start: float) -> tuple[Status, int, bool]:
-        """The loop of ``fccqp.admm.Workspace._iterate`` for the full form; returns the
+        """The loop of ``fccqp.iteration.iterate`` for the full form; returns the
         run's status (before it is settled on the returned point), its iterations and
         whether the point is polished."""
         p, o = self.p, self.o
@@ -589,7 +589,7 @@ class _Run:
 
     def _finish(self, status: Status, iterations: int, polished: bool) -> Outcome:
         """Unscale, recompute the residuals of the returned point on the user's data and
-        settle the status on them (as ``fccqp.admm.Workspace._finish``)."""
+        settle the status on them (as ``fccqp.scaled_run.unscaled_answer``)."""
         o = self.o
         x, y, z = self._unscaled(self.x, self.nu, self.y)
         r = user_residuals(self.data, self.p, x, y, z)

@@ -121,7 +121,7 @@ def iterate_residuals(p: Scaled, x: np.ndarray, nu: np.ndarray, z: np.ndarray,
 def user_residuals(data: SparseData, p: Scaled, x: np.ndarray, y: np.ndarray,
                    z: np.ndarray) -> Residuals:
     """Residuals of a returned ``(x, y, z)`` on the user's data (as
-    ``fccqp.admm.Workspace._user_residuals``): ``||A x - b||``, the distance of ``x_S``
+    ``fccqp.acceptance.user_residuals``): ``||A x - b||``, the distance of ``x_S``
     to the box and the exact cones, ``||P x + q + A'y + z||`` and the gap with
     ``sigma_C(z)``; ``p`` provides only the cone blocks."""
     S = data.constrained

@@ -31,7 +31,7 @@ has no multiplier terms at all, so a ``SOLVED`` here passes it there. ``sigma_C`
 and the cones; ADMM's multiplier lies in the normal cone of ``C`` at its slack, so it is
 finite (``sum hi_i z_i`` over upper, ``lo_i z_i`` over lower entries, 0 on cones).
 
-Rho adaptation (:mod:`fccqp.admm`) balances the scaled primal and dual residuals, each
+Rho adaptation (:mod:`fccqp.rho_rule`) balances the scaled primal and dual residuals, each
 relative to its own scale. There the primal scale of a box entry is capped by the
 width of its box, and that of a row by the range its ``A x`` can take over the box
 (:func:`row_spans`): a residual as large as that range says the iterate does not know
