@@ -147,7 +147,7 @@ class Settings:
     stall (a move then undone if they fall more slowly after it)."""
     anderson_memory: int = 10
     """Anderson acceleration memory (0 disables, at most :data:`MAX_ANDERSON_MEMORY`);
-    safeguarded, see fccqp.admm._anderson."""
+    safeguarded, see :mod:`fccqp.anderson`."""
     scaling: int = 4
     """Ruiz equilibration passes (0 disables scaling, at most :data:`MAX_SCALING`). Four
     rather than OSQP's 10: on the general-QP suite at eps 1e-6 (``python -m
