@@ -57,8 +57,8 @@ def _set_inertia(body: mujoco.MjsBody, inertia: pin.Inertia) -> None:
     body.explicitinertial = True
     body.mass = float(inertia.mass)
     body.ipos = np.array(inertia.lever, dtype=float)
-    I = np.array(inertia.inertia, dtype=float)
-    body.fullinertia = [I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]
+    rot = np.array(inertia.inertia, dtype=float)
+    body.fullinertia = [rot[0, 0], rot[1, 1], rot[2, 2], rot[0, 1], rot[0, 2], rot[1, 2]]
 
 
 def _quat_wxyz(rotation: np.ndarray) -> np.ndarray:
