@@ -32,7 +32,7 @@ from benchmarks.report import RunInfo, SetResult, write_outputs
 from benchmarks.robots import ROBOTS
 from benchmarks.scenarios import SCENARIOS
 from benchmarks.solvers import VARIANTS, available_variants, make_adapter
-from benchmarks.testsets import MIX
+from benchmarks.testsets import CLOSEDLOOP, MIX
 from benchmarks.views import timed_paths
 
 __all__ = ["DEFAULT_OUT", "build_parser", "main"]
@@ -92,8 +92,10 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--robots", nargs="+", type=_choice_list("robot", list(ROBOTS)),
                         default=list(ROBOTS), metavar="ROBOT",
                         help=f"robots (default all: {', '.join(ROBOTS)})")
-    parser.add_argument("--scenario", type=_choice_list("scenario", [*SCENARIOS, MIX]),
-                        default=MIX, help="scenario of the test sets (default mix)")
+    parser.add_argument("--scenario",
+                        type=_choice_list("scenario", [*SCENARIOS, MIX, CLOSEDLOOP]),
+                        default=MIX, help="scenario of the test sets (default mix; "
+                        "closedloop: QPs logged from the MuJoCo closed loop)")
     parser.add_argument("--solvers", nargs="+", type=_choice_list("solver", list(VARIANTS)),
                         default=list(VARIANTS), metavar="SOLVER",
                         help=f"variants (default all installed: {', '.join(VARIANTS)})")

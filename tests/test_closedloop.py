@@ -13,6 +13,7 @@ from benchmarks.closedloop.model import build_sim_model  # noqa: E402
 from benchmarks.closedloop.scenarios import Phase, Scenario, make_scenario  # noqa: E402
 from benchmarks.closedloop.simulate import run  # noqa: E402
 from benchmarks.robots import load_robot  # noqa: E402
+from benchmarks.testsets import CLOSEDLOOP, generate_test_set  # noqa: E402
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -85,3 +86,17 @@ def test_lift_scenario_switches_contacts() -> None:
     assert stances[0] == stances[-1] == 4
     with pytest.raises(ValueError, match="known"):
         make_scenario(robot, "shift", 0.7)
+
+
+def test_closedloop_test_set_logs_windows_around_events() -> None:
+    """The ``closedloop`` test set: QPs from the MuJoCo loop, references that solve them.
+
+    Seed 2 draws early events (the first push at 0.5 s, the lift's weight shift at 1 s),
+    so the loop runs only about 750 ticks before and between the windows.
+    """
+    ts = generate_test_set("go2", CLOSEDLOOP, 6, 2, seq_len=3)
+    assert len(ts) == 6 and ts.scenario == CLOSEDLOOP
+    assert list(ts.sequence) == [0, 0, 0, 1, 1, 1]
+    assert len(ts.stance) == 6 and all(len(s) in (3, 4) for s in ts.stance)
+    for qp, x in zip(ts.qps, ts.x_ref, strict=True):
+        assert qp.equality_residual(x) < 1e-6 and qp.cone_violation(x) < 1e-6

@@ -69,6 +69,11 @@ class Controller:
                           for name, fid in robot.foot_frames.items()}
         self._stance = tuple(f.name for f in robot.config.feet)
 
+    @property
+    def stance(self) -> tuple[str, ...]:
+        """Feet in contact at the last :meth:`qp` call."""
+        return self._stance
+
     def _switch(self, stance: tuple[str, ...]) -> None:
         """Re-anchor feet that touched down and remember where lifted feet left."""
         data = self._data

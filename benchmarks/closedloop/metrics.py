@@ -50,7 +50,10 @@ class RunSummary:
     foot_max
         Largest swing-foot tracking error (0 without a swing).
     slip_max, slip_mean
-        Largest tangential contact-point speed, and its mean over ticks with a contact.
+        Largest tangential contact-point speed, and its mean over ticks with a contact
+        (a foot landing with a sideways speed counts: it slides as it lands).
+    slide
+        Distance the contact points slid, summed over them and over the run.
     sliding
         Share of ticks with a contact at the simulated friction cone's boundary.
     qp_cone_max
@@ -79,6 +82,7 @@ class RunSummary:
     foot_max: float
     slip_max: float
     slip_mean: float
+    slide: float
     sliding: float
     qp_cone_max: float
     torque_rate: float
@@ -121,6 +125,7 @@ def summarize(trace: Trace) -> RunSummary:
         foot_max=float(np.max(trace.foot_error, initial=0.0)),
         slip_max=float(slip.max(initial=0.0)),
         slip_mean=float(slip[touching].mean()) if touching.any() else 0.0,
+        slide=float(np.sum(np.asarray(trace.slide)[late])),
         sliding=float(np.mean(ratio[touching] >= SLIDING)) if touching.any() else 0.0,
         qp_cone_max=float(np.nanmax(qp_ratio)) if np.isfinite(qp_ratio).any() else float("nan"),
         torque_rate=float(np.sqrt(np.mean(rate**2))),

@@ -11,7 +11,10 @@ a free joint. No joint damping, friction, armature or limit (Pinocchio's ``crba`
 both). The only collision geometry is one sphere per contact point, centred on it, of the
 radius in :data:`FOOT_RADIUS`; the floor is a plane at the height of the lowest sphere's
 bottom in the starting posture, so the robot starts touching it. Contacts use MuJoCo's
-elliptic (exact) friction cone with the floor's coefficient.
+elliptic (exact) friction cone with the floor's coefficient, and its no-slip pass
+(:data:`NOSLIP_ITERATIONS`): MuJoCo's friction is otherwise soft, and a loaded foot crept
+at 10-30 mm/s with its force at 60 % of the cone, which would blur the slip the friction
+margin is about.
 
 Velocities differ by convention: Pinocchio's free-flyer velocity is the base twist in the
 base frame, MuJoCo's free joint has the linear velocity in the world frame and the
@@ -29,7 +32,10 @@ import pinocchio as pin
 
 from benchmarks.robots import LoadedRobot
 
-__all__ = ["FOOT_RADIUS", "SimModel", "build_sim_model"]
+__all__ = ["FOOT_RADIUS", "NOSLIP_ITERATIONS", "SimModel", "build_sim_model"]
+
+NOSLIP_ITERATIONS = 10
+"""Iterations of MuJoCo's no-slip solver (no tangential creep inside the friction cone)."""
 
 FOOT_RADIUS: dict[str, float] = {
     "go2": 0.022,  # the foot sphere of Unitree's own MuJoCo model
@@ -140,7 +146,8 @@ def build_sim_model(robot: LoadedRobot, floor_mu: float, timestep: float) -> Sim
     """Compile the MuJoCo model of ``robot`` on a floor of friction ``floor_mu``.
 
     ``timestep`` is the physics step (s); the semi-implicit Euler integrator is MuJoCo's
-    default. Contact softness is MuJoCo's default (``solref`` time constant 0.02 s).
+    default. Contact softness is MuJoCo's default (``solref`` time constant 0.02 s),
+    friction made hard by the no-slip pass.
     """
     pmodel = robot.model
     spec = mujoco.MjSpec()
@@ -148,6 +155,7 @@ def build_sim_model(robot: LoadedRobot, floor_mu: float, timestep: float) -> Sim
     spec.option.timestep = timestep
     spec.option.gravity = np.array(pmodel.gravity.linear, dtype=float)
     spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
+    spec.option.noslip_iterations = NOSLIP_ITERATIONS
     spec.compiler.autolimits = True
     radius = FOOT_RADIUS[robot.config.name]
 

@@ -63,14 +63,18 @@ class Trace:
     slip
         Largest tangential contact-point speed over the tick's physics steps (m/s; 0
         without contact).
+    slide
+        Distance the contact points slid during the tick, summed over them (m).
     cone_ratio
         Largest simulated ``|f_t| / (mu f_n)`` over the tick's contacts (0 without).
     qp_cone_ratio
-        Largest ``|f_t| / (floor mu f_n)`` of the applied answer's contact forces.
+        Largest ``|f_t| / (floor mu f_n)`` of the applied answer's contact forces (over
+        contacts carrying at least 1 % of the mean normal force).
     fell_at
         Time of the fall (s), or ``None`` if the run completed.
-    qps, answers
-        The QPs and the applied answers, when the run was asked to keep them.
+    qps, answers, stances
+        The QPs, the solver's answers and the feet in contact (sorted names), when the
+        run was asked to keep them.
     """
 
     variant: str
@@ -88,17 +92,20 @@ class Trace:
     n_contacts: list[int] = field(default_factory=list)
     touching: list[bool] = field(default_factory=list)
     slip: list[float] = field(default_factory=list)
+    slide: list[float] = field(default_factory=list)
     cone_ratio: list[float] = field(default_factory=list)
     qp_cone_ratio: list[float] = field(default_factory=list)
     fell_at: float | None = None
     qps: list[WbcQP] = field(default_factory=list)
     answers: list[np.ndarray] = field(default_factory=list)
+    stances: list[tuple[str, ...]] = field(default_factory=list)
 
 
-def _contacts(sim: SimModel, data: mujoco.MjData, feet: set[int]) -> tuple[bool, float, float]:
-    """Whether a foot touches the floor now, and the largest slip speed and
-    ``|f_t| / (mu f_n)`` over the foot-floor contacts."""
-    touching, slip, ratio = False, 0.0, 0.0
+def _contacts(sim: SimModel, data: mujoco.MjData,
+              feet: set[int]) -> tuple[bool, float, float, float]:
+    """Whether a foot touches the floor now; the largest and the summed slip speed and
+    the largest ``|f_t| / (mu f_n)`` over the foot-floor contacts."""
+    touching, slip, total, ratio = False, 0.0, 0.0, 0.0
     velocity = np.zeros(6)
     force = np.zeros(6)
     for i in range(data.ncon):
@@ -111,12 +118,13 @@ def _contacts(sim: SimModel, data: mujoco.MjData, feet: set[int]) -> tuple[bool,
         w, arm = velocity[:3], contact.pos - data.geom_xpos[geom]
         vx = velocity[3] + w[1] * arm[2] - w[2] * arm[1]  # (v + w x arm), horizontal part
         vy = velocity[4] + w[2] * arm[0] - w[0] * arm[2]
-        slip = max(slip, float(np.hypot(vx, vy)))
+        speed = float(np.hypot(vx, vy))
+        slip, total = max(slip, speed), total + speed
         mujoco.mj_contactForce(sim.model, data, i, force)
         if force[0] > 0.0:
             tangential = np.hypot(force[1], force[2])
             ratio = max(ratio, float(tangential / (contact.friction[0] * force[0])))
-    return touching, slip, ratio
+    return touching, slip, total, ratio
 
 
 def _fallen(sim: SimModel, data: mujoco.MjData, height0: float) -> bool:
@@ -130,17 +138,19 @@ def _qp_cone_ratio(qp: WbcQP, x: np.ndarray, floor_mu: float) -> float:
     if qp.n_contacts == 0:
         return 0.0
     f = qp.forces(x)
-    fn = np.maximum(f[:, 2], 1e-9)
-    return float(np.max(np.hypot(f[:, 0], f[:, 1]) / (floor_mu * fn)))
+    loaded = f[:, 2] >= 0.01 * max(float(np.mean(f[:, 2])), 1e-9)  # unloaded: no ratio
+    return float(np.max(np.hypot(f[loaded, 0], f[loaded, 1]) / (floor_mu * f[loaded, 2]),
+                        initial=0.0))
 
 
 def run(sim: SimModel, scenario: Scenario, variant: str, period: float,
-        mu_fraction: float = 1.0, keep_qps: bool = False) -> Trace:
+        mu_fraction: float = 1.0, keep_qps: bool = False, ticks: int | None = None) -> Trace:
     """Run ``scenario`` with solver ``variant`` at control period ``period`` (s).
 
     ``sim`` must have been built with the scenario's floor friction; its timestep must
     divide ``period``. ``mu_fraction`` scales the controller's friction coefficient
-    (the margin of the friction sweep). ``keep_qps`` keeps every QP and applied answer.
+    (the margin of the friction sweep). ``keep_qps`` keeps every QP, answer and stance.
+    ``ticks`` stops the run after that many ticks (default: the scenario's end).
     """
     robot = sim.robot
     steps = round(period / sim.model.opt.timestep)
@@ -154,8 +164,8 @@ def run(sim: SimModel, scenario: Scenario, variant: str, period: float,
     feet = {g for ids in sim.foot_geoms.values() for g in ids}
     trace = Trace(variant, scenario, period, mu_fraction)
     u = np.zeros(robot.model.nv - 6)
-    ticks = round(scenario.duration / period)
-    for tick in range(ticks):
+    total = round(scenario.duration / period)
+    for tick in range(total if ticks is None else min(ticks, total)):
         t = tick * period
         q, v = sim.to_pinocchio(data)
         qp, tracking = controller.qp(t, q, v)
@@ -164,12 +174,13 @@ def run(sim: SimModel, scenario: Scenario, variant: str, period: float,
         if ok:
             u = np.array(outcome.x[qp.layout["u"]])
         sim.set_torques(data, u)
-        touching, slip, ratio, fell = False, 0.0, 0.0, False
+        touching, slip, slide, ratio, fell = False, 0.0, 0.0, 0.0, False
         for _ in range(steps):
             data.xfrc_applied[sim.root_body, :3] = scenario.push_force(data.time)
             mujoco.mj_step(sim.model, data)
-            c, s, r = _contacts(sim, data, feet)
+            c, s, total, r = _contacts(sim, data, feet)
             touching, slip, ratio = touching or c, max(slip, s), max(ratio, r)
+            slide += total * sim.model.opt.timestep
             if _fallen(sim, data, height0):
                 fell = True
                 break
@@ -184,12 +195,14 @@ def run(sim: SimModel, scenario: Scenario, variant: str, period: float,
         trace.n_contacts.append(qp.n_contacts)
         trace.touching.append(touching)
         trace.slip.append(slip)
+        trace.slide.append(slide)
         trace.cone_ratio.append(ratio)
         trace.qp_cone_ratio.append(_qp_cone_ratio(qp, outcome.x, scenario.floor_mu) if ok
                                    else float("nan"))
         if keep_qps:
             trace.qps.append(qp)
             trace.answers.append(np.array(outcome.x))
+            trace.stances.append(tuple(sorted(controller.stance)))
         if fell:
             trace.fell_at = float(data.time)
             break
