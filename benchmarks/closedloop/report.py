@@ -110,6 +110,7 @@ def _header(info: RunInfo, variants: Sequence[str]) -> list[str]:
         "max in us; *over*: ticks longer than the control period; *failed*: answers not "
         "applied; CoM error RMS / max and largest swing-foot error in mm; *slip*: largest "
         "tangential contact-point speed (mm/s) and its mean over ticks with a contact; "
+        "*slid*: distance the contact points slid, summed over them (mm); "
         f"*sliding*: % of ticks with a contact at the simulated cone's boundary "
         f"(|f_t| >= {SLIDING:g} mu f_n; MuJoCo never exceeds the cone); *QP cone*: largest "
         "|f_t| / (floor mu f_n) the applied answers asked for; *torque rate*: RMS torque "
@@ -131,13 +132,14 @@ def _row(s: RunSummary) -> str:
     return (f"| {s.scenario} | {s.variant} | {_kept(s)} | {us(s.median)} | {us(s.p99)} | "
             f"{us(s.max)} | {s.overruns} | {s.failed} / {s.ticks} | "
             f"{s.com_rms * 1e3:.1f} / {s.com_max * 1e3:.1f} | {s.foot_max * 1e3:.1f} | "
-            f"{s.slip_max * 1e3:.0f} / {s.slip_mean * 1e3:.1f} | {100 * s.sliding:.0f} | "
+            f"{s.slip_max * 1e3:.0f} / {s.slip_mean * 1e3:.1f} | {s.slide * 1e3:.1f} | "
+            f"{100 * s.sliding:.0f} | "
             f"{s.qp_cone_max:.2f} | {s.torque_rate:.0f} |")
 
 
 _TABLE = ("| scenario | solver | kept up | median | p99 | max | over | failed | CoM mm | "
-          "foot mm | slip mm/s | sliding % | QP cone | torque rate |",
-          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+          "foot mm | slip mm/s | slid mm | sliding % | QP cone | torque rate |",
+          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
 
 
 def _summary(runs: Sequence[RunSummary]) -> list[str]:
@@ -171,7 +173,8 @@ def _sweep(sweep: Sequence[RunSummary]) -> list[str]:
                      == (robot, scenario, variant, f)]
             s = match[0] if match else None
             cells.append("-" if s is None else
-                         f"{s.slip_max * 1e3:.0f} mm/s{'' if s.completed else ', **fell**'}")
+                         f"{s.slip_max * 1e3:.0f} mm/s, {s.slide * 1e3:.1f} mm"
+                         f"{'' if s.completed else ', **fell**'}")
         lines.append(f"| {robot} | {scenario} | {variant} | " + " | ".join(cells) + " |")
     return lines
 
@@ -224,7 +227,7 @@ def write_report(out: Path, info: RunInfo, variants: Sequence[str], traces: Sequ
             "",
             f"Floor mu {info.sweep_mu:g}; the controller's mu is the floor's times the "
             f"fraction of each column ({first.rate:.0f} Hz). Each cell: largest slip speed, "
-            "and whether the robot fell. The exact cones let the controller ask for all the "
+            "distance slid (summed over contact points), and whether the robot fell. The exact cones let the controller ask for all the "
             "friction it is given; the inner pyramid keeps an implicit margin (1/sqrt 2 "
             "along the tangent axes, none on its diagonals).",
             "",
