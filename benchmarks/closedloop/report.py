@@ -227,9 +227,10 @@ def write_report(out: Path, info: RunInfo, variants: Sequence[str], traces: Sequ
             "",
             f"Floor mu {info.sweep_mu:g}; the controller's mu is the floor's times the "
             f"fraction of each column ({first.rate:.0f} Hz). Each cell: largest slip speed, "
-            "distance slid (summed over contact points), and whether the robot fell. The exact cones let the controller ask for all the "
-            "friction it is given; the inner pyramid keeps an implicit margin (1/sqrt 2 "
-            "along the tangent axes, none on its diagonals).",
+            "distance slid (summed over contact points), and whether the robot fell. The "
+            "exact cones let the controller ask for all the friction it is given; the inner "
+            "pyramid keeps an implicit margin (1/sqrt 2 along the tangent axes, none on its "
+            "diagonals).",
             "",
             *_sweep(sweep),
             "",
