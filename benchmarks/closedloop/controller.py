@@ -4,7 +4,8 @@ At every control tick :meth:`Controller.qp` turns the measured state ``(q, v)`` 
 scenario's :class:`~benchmarks.closedloop.scenarios.Reference` into task commands --
 CoM (PD to the scripted offset from the starting CoM), base orientation (PD to the
 starting orientation), posture (PD to the starting joint angles), a point task per
-swinging foot (PD to a half-sine bump over its lift-off point) -- and contact
+swinging foot (PD to a half-sine bump over the line from its lift-off point to its
+lift-off point plus the scenario's stride, by a minimum-jerk curve) -- and contact
 stabilization accelerations that hold each stance contact point at its anchor (where it
 touched down), then builds the QP of :func:`benchmarks.wbc_qp.build_wbc_qp` with the
 controller's friction coefficient. Gains are the open-loop generator's
@@ -21,7 +22,7 @@ import pinocchio as pin
 
 from benchmarks.closedloop.scenarios import Scenario
 from benchmarks.robots import LoadedRobot
-from benchmarks.scenarios import Gains
+from benchmarks.scenarios import Gains, _min_jerk
 from benchmarks.wbc_qp import TaskCommands, WbcQP, build_wbc_qp
 
 __all__ = ["Controller", "Tracking"]
@@ -104,15 +105,20 @@ class Controller:
         posture_cmd = g.posture[0] * pin.difference(model, q, robot.q0)[6:] - g.posture[1] * v[6:]
 
         points, foot_err = {}, 0.0
-        height = self.scenario.swing_height
+        height, stride = self.scenario.swing_height, np.r_[self.scenario.stride, 0.0]
         for foot, (s, T) in ref.swing.items():
             fid = robot.foot_frames[foot]
             w = np.pi / T
             bump = height * np.array([np.sin(np.pi * s), w * np.cos(np.pi * s),
                                       -(w**2) * np.sin(np.pi * s)])
-            err = self._lift_off[foot] + np.r_[0.0, 0.0, bump[0]] - data.oMf[fid].translation
-            vel = np.r_[0.0, 0.0, bump[1]] - pin.getFrameVelocity(model, data, fid, _LWA).linear
-            points[fid] = np.r_[0.0, 0.0, bump[2]] + g.swing[0] * err + g.swing[1] * vel
+            blend = _min_jerk(s)
+            up = np.array([0.0, 0.0, 1.0])
+            p_ref = self._lift_off[foot] + blend[0] * stride + bump[0] * up
+            v_ref = blend[1] / T * stride + bump[1] * up
+            a_ref = blend[2] / T**2 * stride + bump[2] * up
+            err = p_ref - data.oMf[fid].translation
+            vel = v_ref - pin.getFrameVelocity(model, data, fid, _LWA).linear
+            points[fid] = a_ref + g.swing[0] * err + g.swing[1] * vel
             foot_err = max(foot_err, float(np.linalg.norm(err)))
 
         contacts = [fid for f in ref.stance for fid in robot.contact_frames[f]]

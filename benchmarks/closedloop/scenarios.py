@@ -18,6 +18,8 @@ parameter of each.
   right) lifted 6 cm (humanoid 5 cm) and put down, CoM back.
 - ``trot`` (quadrupeds): a trot in place, diagonal pairs alternating every 0.2 s.
 - ``shift`` (humanoid): the CoM moves over one foot, then the other, and back.
+- ``step`` (humanoid): CoM over the left foot, the right foot steps 10 cm forward, CoM
+  to the middle of the new support.
 """
 
 from __future__ import annotations
@@ -101,6 +103,8 @@ class Scenario:
         Pushes on the base.
     swing_height
         Peak height of a swing foot above its lift-off point (m).
+    stride
+        Horizontal displacement of a swing foot from lift-off to touch-down (m).
     """
 
     name: str
@@ -111,6 +115,7 @@ class Scenario:
     sway_freq: float = 0.0
     pushes: tuple[Push, ...] = ()
     swing_height: float = 0.06
+    stride: tuple[float, float] = (0.0, 0.0)
 
     @property
     def duration(self) -> float:
@@ -153,7 +158,7 @@ class Scenario:
 
 SCENARIOS: dict[str, tuple[str, ...]] = {
     "quadruped": ("stand", "sway", "push", "lift", "trot"),
-    "humanoid": ("stand", "sway", "push", "lift", "shift"),
+    "humanoid": ("stand", "sway", "push", "lift", "shift", "step"),
 }
 """Scenario names by robot kind, in report order."""
 
@@ -220,6 +225,15 @@ def make_scenario(robot: LoadedRobot, name: str, floor_mu: float) -> Scenario:
         return Scenario(phases=(Phase(0.3, feet), *steps, Phase(0.5, feet)),
                         swing_height=0.05, **common)
     left = _support_shift(robot, (feet[0],), 0.8)
+    if name == "step":
+        stride = (0.1, 0.0)
+        left_full = _support_shift(robot, (feet[0],), 0.95)
+        middle = (0.5 * stride[0], 0.0)
+        return Scenario(
+            phases=(Phase(0.2, feet), Phase(1.2, feet, left_full), Phase(0.8, (feet[0],),
+                    left_full), Phase(1.2, feet, middle), Phase(0.6, feet, middle)),
+            swing_height=0.04, stride=stride, **common,
+        )
     right = _support_shift(robot, (feet[1],), 0.8)
     return Scenario(
         phases=(Phase(0.2, feet), Phase(1.0, feet, left), Phase(1.5, feet, right),
