@@ -8,6 +8,7 @@ import pytest
 
 mujoco = pytest.importorskip("mujoco")
 
+from benchmarks.cli import main  # noqa: E402
 from benchmarks.closedloop.metrics import summarize  # noqa: E402
 from benchmarks.closedloop.model import build_sim_model  # noqa: E402
 from benchmarks.closedloop.scenarios import Phase, Scenario, make_scenario  # noqa: E402
@@ -100,3 +101,14 @@ def test_closedloop_test_set_logs_windows_around_events() -> None:
     assert len(ts.stance) == 6 and all(len(s) in (3, 4) for s in ts.stance)
     for qp, x in zip(ts.qps, ts.x_ref, strict=True):
         assert qp.equality_residual(x) < 1e-6 and qp.cone_violation(x) < 1e-6
+
+
+def test_cli_writes_report_csv_and_cdf(tmp_path) -> None:
+    """``python -m benchmarks closedloop`` with one short run writes every output file."""
+    report = main(["closedloop", "--scenarios", "stand", "--solvers", "fccqp-realtime",
+                   "--fractions", "--out", str(tmp_path)])
+    text = report.read_text()
+    assert "| stand | fccqp-realtime | yes |" in text
+    assert "python -m benchmarks closedloop --scenarios stand" in text
+    assert (tmp_path / "cdf_go2_500hz.png").exists()
+    assert (tmp_path / "results.csv").read_text().count("\n") == 2

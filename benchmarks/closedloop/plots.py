@@ -50,7 +50,13 @@ def _style(variant: str) -> dict[str, object]:
     return {"color": colour, "linestyle": "--" if dashed or variant == "fccqp-default" else "-"}
 
 
-def _save(fig: plt.Figure, out: Path, name: str) -> str:
+def _save(fig: plt.Figure, ax: plt.Axes, labels: tuple[str, str, str], out: Path,
+          name: str) -> str:
+    """Label the axes (x, y, title), add the legend, write ``out / name``; return ``name``."""
+    ax.set_xlabel(labels[0])
+    ax.set_ylabel(labels[1])
+    ax.set_title(labels[2], fontsize=9)
+    ax.legend(**_LEGEND)
     fig.tight_layout()
     fig.savefig(out / name, dpi=_DPI)
     plt.close(fig)
@@ -69,11 +75,9 @@ def plot_cdf(traces: Sequence[Trace], robot: str, rate: int, out: Path) -> str:
     ax.axvline(period * 1e3, color="k", linewidth=0.8, linestyle=":")
     ax.text(period * 1e3, 0.02, " control period", fontsize=7)
     ax.set_xscale("log")
-    ax.set_xlabel("solver call per tick (ms, log)")
-    ax.set_ylabel("share of ticks")
-    ax.set_title(f"{robot}, {rate} Hz: tick-time CDF, every scenario", fontsize=9)
-    ax.legend(**_LEGEND)
-    return _save(fig, out, f"cdf_{robot}_{rate}hz.png")
+    labels = ("solver call per tick (ms, log)", "share of ticks",
+              f"{robot}, {rate} Hz: tick-time CDF, every scenario")
+    return _save(fig, ax, labels, out, f"cdf_{robot}_{rate}hz.png")
 
 
 def _switches(ax: plt.Axes, trace: Trace) -> None:
@@ -95,11 +99,9 @@ def plot_trace(traces: Sequence[Trace], out: Path) -> str:
     _switches(ax, first)
     ax.axhline(first.period * 1e3, color="k", linewidth=0.8, linestyle=":")
     ax.set_yscale("log")
-    ax.set_xlabel("time (s); grey lines: contact switches")
-    ax.set_ylabel("solver call (ms, log)")
-    ax.set_title(f"{robot}, {scenario}, {rate} Hz: solve time along the run", fontsize=9)
-    ax.legend(**_LEGEND)
-    return _save(fig, out, f"trace_{robot}_{rate}hz_{scenario}.png")
+    labels = ("time (s); grey lines: contact switches", "solver call (ms, log)",
+              f"{robot}, {scenario}, {rate} Hz: solve time along the run")
+    return _save(fig, ax, labels, out, f"trace_{robot}_{rate}hz_{scenario}.png")
 
 
 def plot_torques(traces: Sequence[Trace], out: Path) -> str:
@@ -119,8 +121,6 @@ def plot_torques(traces: Sequence[Trace], out: Path) -> str:
         ax.axhline(limit, color="k", linewidth=0.8, linestyle=":")
     if low < -0.8 * limit:
         ax.axhline(-limit, color="k", linewidth=0.8, linestyle=":")
-    ax.set_xlabel("time (s); grey lines: contact switches")
-    ax.set_ylabel(f"{KNEES[robot]} torque (Nm)")
-    ax.set_title(f"{robot}, {scenario}, {rate} Hz: applied knee torque", fontsize=9)
-    ax.legend(**_LEGEND)
-    return _save(fig, out, f"torque_{robot}_{rate}hz_{scenario}.png")
+    labels = ("time (s); grey lines: contact switches", f"{KNEES[robot]} torque (Nm)",
+              f"{robot}, {scenario}, {rate} Hz: applied knee torque")
+    return _save(fig, ax, labels, out, f"torque_{robot}_{rate}hz_{scenario}.png")
