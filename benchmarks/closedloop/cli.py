@@ -26,9 +26,10 @@ from benchmarks.closedloop.model import FOOT_RADIUS, build_sim_model
 from benchmarks.closedloop.report import RunInfo, write_report
 from benchmarks.closedloop.scenarios import SCENARIOS, make_scenario
 from benchmarks.closedloop.simulate import Trace, run
+from benchmarks.closedloop.variants import CLOSEDLOOP_VARIANTS, available, lookup
 from benchmarks.machine import blas_info, load_average
 from benchmarks.robots import load_robot
-from benchmarks.solvers import VARIANTS, available_variants
+from benchmarks.solvers import VARIANTS
 
 __all__ = ["PRESETS", "ClosedLoopPreset", "build_parser", "main"]
 
@@ -50,7 +51,8 @@ class ClosedLoopPreset:
 
 
 _CORE = ("fccqp-realtime", "fccqp-default", "daqp-pyr4", "osqp-pyr4", "clarabel")
-_FULL = (*_CORE[:3], "proxqp-pyr4", "osqp-pyr4", "clarabel", "qoco")
+_FULL = (*_CORE[:3], "proxqp-pyr4", "osqp-pyr4", "osqp-paper", "clarabel", "qoco")
+_NAMES = [*VARIANTS, *CLOSEDLOOP_VARIANTS]
 
 PRESETS: dict[str, ClosedLoopPreset] = {
     # go2 only, 500 Hz, three scenarios, five solvers and a two-point sweep of three: 21
@@ -73,7 +75,7 @@ def build_parser() -> argparse.ArgumentParser:
                       help="go2, 500 Hz, stand/push/lift, 5 solvers, sweep 1.0 and 0.7 "
                       "(default; about 3 minutes)")
     size.add_argument("--full", action="store_true",
-                      help="go2 and talos_reduced, 500 and 100 Hz, every scenario, 7 "
+                      help="go2 and talos_reduced, 500 and 100 Hz, every scenario, 8 "
                       "solvers, sweep 1.0 0.9 0.8 0.7")
     parser.add_argument("--out", type=Path,
                         help="output folder (default benchmarks/out/closedloop/<preset>)")
@@ -84,12 +86,12 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--scenarios", nargs="+", metavar="NAME",
                         help="scenarios (quadruped: " + ", ".join(SCENARIOS["quadruped"])
                         + "; humanoid: " + ", ".join(SCENARIOS["humanoid"]) + ")")
-    parser.add_argument("--solvers", nargs="+", choices=list(VARIANTS), metavar="SOLVER",
-                        help="solver variants of benchmarks/solvers.py")
+    parser.add_argument("--solvers", nargs="+", choices=_NAMES, metavar="SOLVER",
+                        help="solver variants of benchmarks/solvers.py, or osqp-paper")
     parser.add_argument("--fractions", nargs="*", type=float, metavar="F",
                         help="controller mu as fractions of the floor's for the sweep "
                         "(none: no sweep)")
-    parser.add_argument("--sweep-solvers", nargs="+", choices=list(VARIANTS), metavar="SOLVER",
+    parser.add_argument("--sweep-solvers", nargs="+", choices=_NAMES, metavar="SOLVER",
                         help="solver variants of the sweep (default: the preset's, or "
                         "--solvers when given)")
     parser.add_argument("--floor-mu", type=float, default=0.7,
@@ -134,11 +136,11 @@ def main(argv: Sequence[str] | None = None) -> Path:
     rates = args.rates or preset.rates
     fractions = preset.fractions if args.fractions is None else tuple(args.fractions)
     requested = list(args.solvers or preset.solvers)
-    variants, skipped = available_variants(requested)
-    swept, missing_swept = available_variants(
+    variants, skipped = available(requested)
+    swept, missing_swept = available(
         list(args.sweep_solvers or args.solvers or preset.sweep_solvers))
     for missing in dict.fromkeys([*skipped, *missing_swept]):
-        _say(f"skipping {missing}: {VARIANTS[missing].module} is not installed")
+        _say(f"skipping {missing}: {lookup(missing).module} is not installed")
     for rate in rates:
         if rate < 1 or args.physics_hz % rate:
             raise SystemExit(f"control rate {rate} Hz does not divide {args.physics_hz} Hz")

@@ -24,9 +24,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from benchmarks.closedloop.simulate import Trace  # noqa: E402
+from benchmarks.closedloop.variants import lookup  # noqa: E402
 from benchmarks.plots import STYLE  # noqa: E402
 from benchmarks.robots import actuated_joint_names, load_robot  # noqa: E402
-from benchmarks.solvers import VARIANTS  # noqa: E402
 
 __all__ = ["KNEES", "TORQUED", "TRACED", "plot_cdf", "plot_torques", "plot_trace"]
 
@@ -45,8 +45,8 @@ _LEGEND = {"loc": "upper left", "bbox_to_anchor": (1.01, 1.0), "fontsize": 7, "f
 
 
 def _style(variant: str) -> dict[str, object]:
-    colour, marker = STYLE[VARIANTS[variant].family]
-    dashed = VARIANTS[variant].setting not in ("default", "realtime")
+    colour, _ = STYLE[lookup(variant).family]
+    dashed = lookup(variant).setting not in ("default", "realtime")
     return {"color": colour, "linestyle": "--" if dashed or variant == "fccqp-default" else "-"}
 
 

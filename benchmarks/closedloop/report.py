@@ -20,8 +20,8 @@ from pathlib import Path
 from benchmarks.closedloop.metrics import SETTLE, SLIDING, RunSummary
 from benchmarks.closedloop.plots import TORQUED, TRACED, plot_cdf, plot_torques, plot_trace
 from benchmarks.closedloop.simulate import Trace
+from benchmarks.closedloop.variants import lookup
 from benchmarks.machine import cpu_model, git_revision, version
-from benchmarks.solvers import VARIANTS
 from benchmarks.tables import us
 
 __all__ = ["RunInfo", "write_report"]
@@ -116,9 +116,10 @@ def _header(info: RunInfo, variants: Sequence[str]) -> list[str]:
         "|f_t| / (floor mu f_n) the applied answers asked for; *torque rate*: RMS torque "
         "change (Nm/s), smoothness.",
         "",
-        "Solvers (variants of the open-loop benchmark, `benchmarks/solvers.py`):",
+        "Solvers (variants of the open-loop benchmark, `benchmarks/solvers.py`, and "
+        "`osqp-paper`, `benchmarks/closedloop/variants.py`):",
         "",
-        *[f"- `{v}`: {VARIANTS[v].description}" for v in variants],
+        *[f"- `{v}`: {lookup(v).description}" for v in variants],
         "",
     ]
     return lines

@@ -4,8 +4,9 @@
 period, reads MuJoCo's state, builds the QP (:class:`~benchmarks.closedloop.controller.
 Controller`), prepares it for the solver (not timed) and calls the solver; only that call
 is timed (the adapter's own :func:`time.perf_counter` pair, see
-:mod:`benchmarks.adapters`). The answer's torques then drive the motors for the whole
-period (zero-order hold over the physics steps). Every answer the solver reports solved
+:mod:`benchmarks.adapters`; variants of :mod:`benchmarks.closedloop.variants`). The
+answer's torques then drive the motors for the whole period (zero-order hold over the
+physics steps). Every answer the solver reports solved
 is applied, however long it took: the run is offline, and a tick longer than the period
 is counted as an overrun (a real controller would have missed that deadline). An answer
 not reported solved (or not finite) is not applied: the controller holds the previous
@@ -27,7 +28,7 @@ import numpy as np
 from benchmarks.closedloop.controller import Controller
 from benchmarks.closedloop.model import SimModel
 from benchmarks.closedloop.scenarios import Scenario
-from benchmarks.solvers import make_adapter
+from benchmarks.closedloop.variants import make
 from benchmarks.wbc_qp import WbcQP
 
 __all__ = ["Trace", "run"]
@@ -160,7 +161,7 @@ def run(sim: SimModel, scenario: Scenario, variant: str, period: float,
     sim.set_state(data, robot.q0, np.zeros(robot.model.nv))
     height0 = data.xpos[sim.root_body][2] - sim.floor_height
     controller = Controller(robot, scenario, mu_fraction * scenario.floor_mu)
-    adapter = make_adapter(variant)
+    adapter = make(variant)
     feet = {g for ids in sim.foot_geoms.values() for g in ids}
     trace = Trace(variant, scenario, period, mu_fraction)
     u = np.zeros(robot.model.nv - 6)
