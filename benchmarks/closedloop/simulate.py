@@ -10,7 +10,11 @@ physics steps). Every answer the solver reports solved
 is applied, however long it took: the run is offline, and a tick longer than the period
 is counted as an overrun (a real controller would have missed that deadline). An answer
 not reported solved (or not finite) is not applied: the controller holds the previous
-torques (zeros before the first answer) and counts the failure.
+torques (zeros before the first answer) and counts the failure. As in the open-loop
+harness, the solver's first-call costs (imports, workspaces) are paid before the run: it
+solves the first QP once, untimed, and is reset; and the objects that exist when the run
+starts are frozen out of the garbage collector (``gc.freeze``), so that collections stay
+short.
 
 While the physics steps, every foot contact with the floor is measured: the tangential
 speed of the contact point (slip) and the simulated force's ``|f_t| / (mu f_n)``. The run
@@ -20,11 +24,13 @@ or tilted by more than 60 degrees.
 
 from __future__ import annotations
 
+import gc
 from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
 
+from benchmarks.adapters import Adapter
 from benchmarks.closedloop.controller import Controller
 from benchmarks.closedloop.model import SimModel
 from benchmarks.closedloop.scenarios import Scenario
@@ -162,11 +168,27 @@ def run(sim: SimModel, scenario: Scenario, variant: str, period: float,
     height0 = data.xpos[sim.root_body][2] - sim.floor_height
     controller = Controller(robot, scenario, mu_fraction * scenario.floor_mu)
     adapter = make(variant)
-    feet = {g for ids in sim.foot_geoms.values() for g in ids}
     trace = Trace(variant, scenario, period, mu_fraction)
-    u = np.zeros(robot.model.nv - 6)
-    total = round(scenario.duration / period)
-    for tick in range(total if ticks is None else min(ticks, total)):
+    first, _ = controller.qp(0.0, *sim.to_pinocchio(data))
+    adapter.solve(adapter.prepare(first))  # warm-up, untimed
+    adapter.reset()
+    gc.collect()
+    gc.freeze()
+    try:
+        _loop(sim, data, controller, adapter, trace, steps, keep_qps,
+              round(scenario.duration / period) if ticks is None else ticks, height0)
+    finally:
+        gc.unfreeze()
+    return trace
+
+
+def _loop(sim: SimModel, data: mujoco.MjData, controller: Controller, adapter: Adapter,
+          trace: Trace, steps: int, keep_qps: bool, ticks: int, height0: float) -> None:
+    """The control ticks of :func:`run` (at most ``ticks``), recorded into ``trace``."""
+    period, scenario = trace.period, trace.scenario
+    u = np.zeros(sim.robot.model.nv - 6)
+    feet = {g for ids in sim.foot_geoms.values() for g in ids}
+    for tick in range(min(ticks, round(scenario.duration / period))):
         t = tick * period
         q, v = sim.to_pinocchio(data)
         qp, tracking = controller.qp(t, q, v)
@@ -207,5 +229,4 @@ def run(sim: SimModel, scenario: Scenario, variant: str, period: float,
         if fell:
             trace.fell_at = float(data.time)
             break
-    return trace
 
