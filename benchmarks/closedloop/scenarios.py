@@ -11,9 +11,9 @@ parameter of each.
 - ``stand``: all feet down, nothing else.
 - ``sway``: all feet down, CoM sinusoid (5 cm sideways, 3 cm forward for a quadruped,
   4 cm / 2 cm for the humanoid; 0.8 Hz).
-- ``push``: all feet down, four sideways pushes of 0.1 s, each larger than the last
-  (base speed changes of 0.15, 0.3, 0.45 and 0.6 m/s if the robot were free; the last
-  one's force, 0.61 of the robot's weight, is more than a floor of mu 0.4 can resist).
+- ``push``: all feet down, five sideways pushes of 0.1 s, 0.8 s apart, each larger than
+  the last (base speed changes of 0.2, 0.4, 0.6, 0.8 and 1 m/s if the robot were free;
+  the last one's force is the robot's weight): the later ones may throw it over.
 - ``lift``: CoM over the other feet, one foot (a quadruped's left front, the humanoid's
   right) lifted 6 cm (humanoid 5 cm) and put down, CoM back.
 - ``trot`` (quadrupeds): a trot in place, diagonal pairs alternating every 0.2 s.
@@ -201,7 +201,8 @@ def make_scenario(robot: LoadedRobot, name: str, floor_mu: float) -> Scenario:
         mass = _mass(robot)
         pushes = tuple(
             Push(start, 0.1, (0.0, mass * dv / 0.1, 0.0))
-            for start, dv in ((0.5, 0.15), (1.5, 0.3), (2.5, 0.45), (3.5, 0.6))
+            for start, dv in zip((0.5, 1.3, 2.1, 2.9, 3.7), (0.2, 0.4, 0.6, 0.8, 1.0),
+                                 strict=True)
         )
         return Scenario(phases=(Phase(4.5, feet),), pushes=pushes, **common)
     if name == "lift":
