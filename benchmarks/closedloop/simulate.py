@@ -73,7 +73,8 @@ class Trace:
     slide
         Distance the contact points slid during the tick, summed over them (m).
     cone_ratio
-        Largest simulated ``|f_t| / (mu f_n)`` over the tick's contacts (0 without).
+        Largest simulated ``|f_t| / (mu f_n)`` over the tick's contacts pressed by at
+        least 1 % of the robot's weight (0 without).
     qp_cone_ratio
         Largest ``|f_t| / (floor mu f_n)`` of the applied answer's contact forces (over
         contacts carrying at least 1 % of the mean normal force).
@@ -108,10 +109,11 @@ class Trace:
     stances: list[tuple[str, ...]] = field(default_factory=list)
 
 
-def _contacts(sim: SimModel, data: mujoco.MjData,
-              feet: set[int]) -> tuple[bool, float, float, float]:
-    """Whether a foot touches the floor now; the largest and the summed slip speed and
-    the largest ``|f_t| / (mu f_n)`` over the foot-floor contacts."""
+def _contacts(sim: SimModel, data: mujoco.MjData, feet: set[int],
+              min_force: float) -> tuple[bool, float, float, float]:
+    """Whether a foot touches the floor now; the largest and the summed slip speed over
+    the foot-floor contacts, and the largest ``|f_t| / (mu f_n)`` over those pressed by
+    at least ``min_force`` (N; a corner barely touching slides at any force ratio)."""
     touching, slip, total, ratio = False, 0.0, 0.0, 0.0
     velocity = np.zeros(6)
     force = np.zeros(6)
@@ -128,7 +130,7 @@ def _contacts(sim: SimModel, data: mujoco.MjData,
         speed = float(np.hypot(vx, vy))
         slip, total = max(slip, speed), total + speed
         mujoco.mj_contactForce(sim.model, data, i, force)
-        if force[0] > 0.0:
+        if force[0] >= min_force:
             tangential = np.hypot(force[1], force[2])
             ratio = max(ratio, float(tangential / (contact.friction[0] * force[0])))
     return touching, slip, total, ratio
@@ -187,6 +189,8 @@ def _loop(sim: SimModel, data: mujoco.MjData, controller: Controller, adapter: A
     """The control ticks of :func:`run` (at most ``ticks``), recorded into ``trace``."""
     period, scenario = trace.period, trace.scenario
     u = np.zeros(sim.robot.model.nv - 6)
+    model = sim.robot.model
+    min_force = 0.01 * np.linalg.norm(model.gravity.linear) * sum(i.mass for i in model.inertias)
     feet = {g for ids in sim.foot_geoms.values() for g in ids}
     for tick in range(min(ticks, round(scenario.duration / period))):
         t = tick * period
@@ -201,7 +205,7 @@ def _loop(sim: SimModel, data: mujoco.MjData, controller: Controller, adapter: A
         for _ in range(steps):
             data.xfrc_applied[sim.root_body, :3] = scenario.push_force(data.time)
             mujoco.mj_step(sim.model, data)
-            c, s, total, r = _contacts(sim, data, feet)
+            c, s, total, r = _contacts(sim, data, feet, min_force)
             touching, slip, ratio = touching or c, max(slip, s), max(ratio, r)
             slide += total * sim.model.opt.timestep
             if _fallen(sim, data, height0):
