@@ -114,7 +114,8 @@ def _header(info: RunInfo, variants: Sequence[str]) -> list[str]:
         f"*sliding*: % of ticks with a contact at the simulated cone's boundary "
         f"(|f_t| >= {SLIDING:g} mu f_n; MuJoCo never exceeds the cone); *QP cone*: largest "
         "|f_t| / (floor mu f_n) the applied answers asked for; *torque rate*: RMS torque "
-        "change (Nm/s), smoothness.",
+        "change (Nm/s), smoothness. In a run that fell, tracking and slip include the "
+        "fall itself.",
         "",
         "Solvers (variants of the open-loop benchmark, `benchmarks/solvers.py`, and "
         "`osqp-paper`, `benchmarks/closedloop/variants.py`):",
