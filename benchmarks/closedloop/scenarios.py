@@ -133,8 +133,7 @@ class Scenario:
     def reference(self, t: float) -> Reference:
         """The stance, CoM offset and swing progress at time ``t``."""
         start, prev = 0.0, (0.0, 0.0)
-        phase = self.phases[-1]
-        for phase in self.phases:
+        for phase in self.phases:  # noqa: B007  (the phase holding t is used below)
             if t < start + phase.duration or phase is self.phases[-1]:
                 break
             start += phase.duration
