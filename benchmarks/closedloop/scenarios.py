@@ -133,7 +133,7 @@ class Scenario:
     def reference(self, t: float) -> Reference:
         """The stance, CoM offset and swing progress at time ``t``."""
         start, prev = 0.0, (0.0, 0.0)
-        for phase in self.phases:  # noqa: B007  (the phase holding t is used below)
+        for phase in self.phases:  # stops at the phase holding t (or the last)
             if t < start + phase.duration or phase is self.phases[-1]:
                 break
             start += phase.duration
