@@ -40,7 +40,7 @@ DEFAULT_OUT = Path(__file__).resolve().parent.parent / "out" / "closedloop"
 @dataclass(frozen=True)
 class ClosedLoopPreset:
     """What a preset runs: robots, control rates (Hz), scenarios (``None``: all of the
-    robot's kind), solver variants, the margin sweep's fractions and its solvers."""
+    robot's kind), solver variants, the margin sweep's fractions, solvers and robots."""
 
     robots: tuple[str, ...]
     rates: tuple[int, ...]
@@ -48,6 +48,7 @@ class ClosedLoopPreset:
     solvers: tuple[str, ...]
     fractions: tuple[float, ...]
     sweep_solvers: tuple[str, ...]
+    sweep_robots: tuple[str, ...]
 
 
 _CORE = ("fccqp-realtime", "fccqp-default", "daqp-pyr4", "osqp-pyr4", "clarabel")
@@ -57,11 +58,11 @@ _NAMES = [*VARIANTS, *CLOSEDLOOP_VARIANTS]
 PRESETS: dict[str, ClosedLoopPreset] = {
     # go2 only, 500 Hz, three scenarios, five solvers and a two-point sweep of two: 19 runs.
     "quick": ClosedLoopPreset(("go2",), (500,), ("stand", "push", "lift"), _CORE, (1.0, 0.7),
-                              ("fccqp-realtime", "daqp-pyr4")),
-    # The sweep with the five of the quick preset: with all eight the run took about an
-    # hour on a loaded 2-core machine.
+                              ("fccqp-realtime", "daqp-pyr4"), ("go2",)),
+    # The sweep with the five of the quick preset, on go2: with all eight solvers on both
+    # robots the run would take over an hour on a loaded 2-core machine.
     "full": ClosedLoopPreset(("go2", "talos_reduced"), (500, 100), None, _FULL,
-                             (1.0, 0.9, 0.8, 0.7), _CORE),
+                             (1.0, 0.9, 0.8, 0.7), _CORE, ("go2",)),
 }
 
 
@@ -77,7 +78,7 @@ def build_parser() -> argparse.ArgumentParser:
                       "with 2 (default; within 5 minutes on 2 cores)")
     size.add_argument("--full", action="store_true",
                       help="go2 and talos_reduced, 500 and 100 Hz, every scenario, 8 "
-                      "solvers, sweep 1.0 0.9 0.8 0.7 with 5")
+                      "solvers, sweep 1.0 0.9 0.8 0.7 with 5 on go2")
     parser.add_argument("--out", type=Path,
                         help="output folder (default benchmarks/out/closedloop/<preset>)")
     parser.add_argument("--robots", nargs="+", choices=sorted(FOOT_RADIUS), metavar="ROBOT",
@@ -95,6 +96,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--sweep-solvers", nargs="+", choices=_NAMES, metavar="SOLVER",
                         help="solver variants of the sweep (default: the preset's, or "
                         "--solvers when given)")
+    parser.add_argument("--sweep-robots", nargs="+", choices=sorted(FOOT_RADIUS),
+                        metavar="ROBOT", help="robots of the sweep (default: the preset's, or "
+                        "--robots when given)")
     parser.add_argument("--floor-mu", type=float, default=0.7,
                         help="floor friction of the main runs (default 0.7)")
     parser.add_argument("--sweep-mu", type=float, default=0.4,
@@ -136,6 +140,7 @@ def main(argv: Sequence[str] | None = None) -> Path:
     robots = args.robots or preset.robots
     rates = args.rates or preset.rates
     fractions = preset.fractions if args.fractions is None else tuple(args.fractions)
+    sweep_robots = args.sweep_robots or (preset.sweep_robots if not args.robots else robots)
     requested = list(args.solvers or preset.solvers)
     variants, skipped = available(requested)
     swept, missing_swept = available(
@@ -160,7 +165,7 @@ def main(argv: Sequence[str] | None = None) -> Path:
             for rate in rates:
                 traces += _runs(robot, scenarios, rate, variants, args.floor_mu, 1.0,
                                 args.physics_hz)
-            for fraction in fractions:
+            for fraction in fractions if robot in sweep_robots else ():
                 sweep += [summarize(t) for t in _runs(robot, ("push",), rates[0], swept,
                                                       args.sweep_mu, fraction, args.physics_hz)]
     info = RunInfo(

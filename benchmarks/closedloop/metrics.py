@@ -45,6 +45,9 @@ class RunSummary:
         Solver-call time along the run.
     overruns
         Ticks whose solver call took longer than the control period.
+    cpu_p99, cpu_max
+        The solver call's CPU time (this thread's), p99 and largest: its tail without
+        preemptions by other processes.
     com_rms, com_max
         CoM tracking error, RMS and largest.
     foot_max
@@ -77,6 +80,8 @@ class RunSummary:
     p99: float
     max: float
     overruns: int
+    cpu_p99: float
+    cpu_max: float
     com_rms: float
     com_max: float
     foot_max: float
@@ -120,6 +125,8 @@ def summarize(trace: Trace) -> RunSummary:
         p99=percentile(times, 99),
         max=float(times.max()),
         overruns=int(np.sum(times > trace.period)),
+        cpu_p99=percentile(trace.cpu_time, 99),
+        cpu_max=float(np.max(trace.cpu_time)),
         com_rms=float(np.sqrt(np.mean(com**2))) if com.size else float("nan"),
         com_max=float(com.max(initial=0.0)),
         foot_max=float(np.max(trace.foot_error, initial=0.0)),

@@ -107,7 +107,9 @@ def _header(info: RunInfo, variants: Sequence[str]) -> list[str]:
         f"soft floor). Main runs: floor mu {info.floor_mu:g}, controller mu = floor mu.",
         "",
         "Columns: *kept up* (or the time of the fall); solver-call time median, p99 and "
-        "max in us; *over*: ticks longer than the control period; *failed*: answers not "
+        "max in us (wall time); *CPU p99 / max*: the same call's CPU time (this thread's, "
+        "`time.thread_time`), the tail without preemptions by other processes; *over*: "
+        "ticks longer than the control period; *failed*: answers not "
         "applied; CoM error RMS / max and largest swing-foot error in mm; *slip*: largest "
         "tangential contact-point speed (mm/s) and its mean over ticks with a contact; "
         "*slid*: distance the contact points slid, summed over them (mm); "
@@ -132,29 +134,35 @@ def _kept(s: RunSummary) -> str:
 
 def _row(s: RunSummary) -> str:
     return (f"| {s.scenario} | {s.variant} | {_kept(s)} | {us(s.median)} | {us(s.p99)} | "
-            f"{us(s.max)} | {s.overruns} | {s.failed} / {s.ticks} | "
+            f"{us(s.max)} | {us(s.cpu_p99)} / {us(s.cpu_max)} | {s.overruns} | "
+            f"{s.failed} / {s.ticks} | "
             f"{s.com_rms * 1e3:.1f} / {s.com_max * 1e3:.1f} | {s.foot_max * 1e3:.1f} | "
             f"{s.slip_max * 1e3:.0f} / {s.slip_mean * 1e3:.1f} | {s.slide * 1e3:.1f} | "
             f"{100 * s.sliding:.0f} | "
             f"{s.qp_cone_max:.2f} | {s.torque_rate:.0f} |")
 
 
-_TABLE = ("| scenario | solver | kept up | median | p99 | max | over | failed | CoM mm | "
-          "foot mm | slip mm/s | slid mm | sliding % | QP cone | torque rate |",
-          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+_TABLE = ("| scenario | solver | kept up | median | p99 | max | CPU p99 / max | over | failed "
+          "| CoM mm | foot mm | slip mm/s | slid mm | sliding % | QP cone | torque rate |",
+          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+
+
+def _tails(s: RunSummary) -> str:
+    return f"{us(s.p99)} / {us(s.max)} ({us(s.cpu_p99)} / {us(s.cpu_max)})"
 
 
 def _summary(runs: Sequence[RunSummary]) -> list[str]:
-    lines = ["| robot | rate | scenario | kept up | fell | fccqp-realtime p99 / max | "
-             "peers' p99 / max |", "|---|---|---|---|---|---|---|"]
+    lines = ["| robot | rate | scenario | kept up | fell | fccqp-realtime p99 / max "
+             "(CPU p99 / max) | peers' p99 / max (CPU p99 / max) |",
+             "|---|---|---|---|---|---|---|"]
     keys = dict.fromkeys((s.robot, s.rate, s.scenario) for s in runs)
     for robot, rate, scenario in keys:
         group = [s for s in runs if (s.robot, s.rate, s.scenario) == (robot, rate, scenario)]
         up = ", ".join(s.variant for s in group if s.completed) or "none"
         down = ", ".join(s.variant for s in group if not s.completed) or "none"
         fccqp = [s for s in group if s.variant == "fccqp-realtime"]
-        mine = f"{us(fccqp[0].p99)} / {us(fccqp[0].max)}" if fccqp else "-"
-        peers = "; ".join(f"{s.variant} {us(s.p99)} / {us(s.max)}" for s in group
+        mine = _tails(fccqp[0]) if fccqp else "-"
+        peers = "; ".join(f"{s.variant} {_tails(s)}" for s in group
                           if s.variant != "fccqp-realtime")
         lines.append(f"| {robot} | {rate:.0f} Hz | {scenario} | {up} | {down} | {mine} | "
                      f"{peers} |")

@@ -25,6 +25,7 @@ or tilted by more than 60 degrees.
 from __future__ import annotations
 
 import gc
+import time
 from dataclasses import dataclass, field
 
 import mujoco
@@ -55,6 +56,9 @@ class Trace:
         Tick times (s).
     solve_time
         Wall time of the solver call (s).
+    cpu_time
+        CPU time of this thread over the same call (s, :func:`time.thread_time`): the
+        solver's work without the time other processes took the core away.
     solved
         Whether the answer was reported solved and finite (else the torques were held).
     status, iterations
@@ -91,6 +95,7 @@ class Trace:
     mu_fraction: float
     time: list[float] = field(default_factory=list)
     solve_time: list[float] = field(default_factory=list)
+    cpu_time: list[float] = field(default_factory=list)
     solved: list[bool] = field(default_factory=list)
     status: list[str] = field(default_factory=list)
     iterations: list[int] = field(default_factory=list)
@@ -196,7 +201,10 @@ def _loop(sim: SimModel, data: mujoco.MjData, controller: Controller, adapter: A
         t = tick * period
         q, v = sim.to_pinocchio(data)
         qp, tracking = controller.qp(t, q, v)
-        outcome = adapter.solve(adapter.prepare(qp))
+        prepared = adapter.prepare(qp)
+        cpu = time.thread_time()
+        outcome = adapter.solve(prepared)
+        cpu = time.thread_time() - cpu
         ok = bool(outcome.success and np.all(np.isfinite(outcome.x)))
         if ok:
             u = np.array(outcome.x[qp.layout["u"]])
@@ -213,6 +221,7 @@ def _loop(sim: SimModel, data: mujoco.MjData, controller: Controller, adapter: A
                 break
         trace.time.append(t)
         trace.solve_time.append(outcome.time)
+        trace.cpu_time.append(cpu)
         trace.solved.append(ok)
         trace.status.append(outcome.status)
         trace.iterations.append(outcome.iterations)
