@@ -1,4 +1,5 @@
-"""Command line: ``python -m benchmarks [--quick | --full] [options]`` and ``... export``.
+"""Command line: ``python -m benchmarks [--quick | --full] [options]``, ``... export`` and
+``... closedloop``.
 
 The benchmark loads (or generates and caches, :mod:`benchmarks.cache`) one test set per
 robot (scenario ``mix`` by default) and, for the coarse views of the quick preset, the
@@ -7,7 +8,8 @@ paths (:mod:`benchmarks.views`, :mod:`benchmarks.harness`) with the BLAS thread 
 limited; and writes the report (:mod:`benchmarks.report`) into the output folder, by
 default one that git ignores. Progress lines go to stdout, warnings and progress bars to
 stderr. ``python -m benchmarks export ...`` writes a test set for qpbenchmark instead
-(:mod:`benchmarks.export`).
+(:mod:`benchmarks.export`); ``python -m benchmarks closedloop ...`` runs the closed-loop
+MuJoCo benchmark (:mod:`benchmarks.closedloop.cli`).
 """
 
 from __future__ import annotations
@@ -30,7 +32,7 @@ from benchmarks.report import RunInfo, SetResult, write_outputs
 from benchmarks.robots import ROBOTS
 from benchmarks.scenarios import SCENARIOS
 from benchmarks.solvers import VARIANTS, available_variants, make_adapter
-from benchmarks.testsets import MIX
+from benchmarks.testsets import CLOSEDLOOP, MIX
 from benchmarks.views import timed_paths
 
 __all__ = ["DEFAULT_OUT", "build_parser", "main"]
@@ -90,8 +92,10 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--robots", nargs="+", type=_choice_list("robot", list(ROBOTS)),
                         default=list(ROBOTS), metavar="ROBOT",
                         help=f"robots (default all: {', '.join(ROBOTS)})")
-    parser.add_argument("--scenario", type=_choice_list("scenario", [*SCENARIOS, MIX]),
-                        default=MIX, help="scenario of the test sets (default mix)")
+    parser.add_argument("--scenario",
+                        type=_choice_list("scenario", [*SCENARIOS, MIX, CLOSEDLOOP]),
+                        default=MIX, help="scenario of the test sets (default mix; "
+                        "closedloop: QPs logged from the MuJoCo closed loop)")
     parser.add_argument("--solvers", nargs="+", type=_choice_list("solver", list(VARIANTS)),
                         default=list(VARIANTS), metavar="SOLVER",
                         help=f"variants (default all installed: {', '.join(VARIANTS)})")
@@ -121,10 +125,15 @@ def _warn(message: str) -> None:
 
 
 def main(argv: Sequence[str] | None = None) -> Path:
-    """Run the benchmark (or ``export``); return the path of the written report."""
+    """Run the benchmark (or ``export``, ``closedloop``); return the path of the written
+    report."""
     argv_list = sys.argv[1:] if argv is None else list(argv)
     if argv_list[:1] == ["export"]:
         return export.main(argv_list[1:])
+    if argv_list[:1] == ["closedloop"]:  # imported here: only it needs mujoco
+        from benchmarks.closedloop.cli import main as closedloop
+
+        return closedloop(argv_list[1:])
     args = build_parser().parse_args(argv_list)
     load_start = load_average()
     name = "full" if args.full else "quick"

@@ -19,6 +19,7 @@ from benchmarks.wbc_qp import WbcQP
 
 __all__ = [
     "GENERATOR_VERSION",
+    "CLOSEDLOOP",
     "LAYOUT_NAMES",
     "MIX",
     "TestSet",
@@ -31,12 +32,17 @@ __all__ = [
 
 GENERATOR_VERSION = 2
 """Version of the generator's output: bump it with any change to ``robots``, ``wbc_qp``,
-``scenarios`` or this module that changes the generated QPs, references or records, so
+``scenarios``, this module or, for the ``closedloop`` set, ``benchmarks/closedloop``
+that changes the generated QPs, references or records, so
 that cached test sets (:mod:`benchmarks.cache`) are generated anew. Version 2 records
 each QP's stance (the QPs and references are those of version 1)."""
 
 MIX = "mix"
 """Scenario name of the default mix: sequence ``j`` runs ``SCENARIOS[j % 4]``."""
+
+CLOSEDLOOP = "closedloop"
+"""Scenario name of the QPs logged from the MuJoCo closed loop
+(:mod:`benchmarks.closedloop.logged`; needs ``mujoco``)."""
 
 LAYOUT_NAMES: tuple[str, ...] = ("vdot", "u", "lambda_h", "eps", "lambda_c")
 """Blocks of ``x``, in order."""
@@ -100,8 +106,9 @@ def generate_test_set(
     robot
         A key of :data:`benchmarks.robots.ROBOTS`.
     scenario
-        One of :data:`benchmarks.scenarios.SCENARIOS`, or ``"mix"`` to cycle through
-        them one sequence each.
+        One of :data:`benchmarks.scenarios.SCENARIOS`, ``"mix"`` to cycle through
+        them one sequence each, or ``"closedloop"`` for QPs logged from the MuJoCo
+        closed loop (:func:`benchmarks.closedloop.logged.logged_sequences`).
     n_qps
         Number of QPs; the last sequence is cut short if needed.
     seed
@@ -114,8 +121,10 @@ def generate_test_set(
     verbose
         Show a progress bar.
     """
-    if scenario != MIX and scenario not in SCENARIOS:
-        raise ValueError(f"unknown scenario {scenario!r}; known: {[*SCENARIOS, MIX]}")
+    if scenario not in (MIX, CLOSEDLOOP) and scenario not in SCENARIOS:
+        raise ValueError(
+            f"unknown scenario {scenario!r}; known: {[*SCENARIOS, MIX, CLOSEDLOOP]}"
+        )
     if n_qps < 1 or seq_len < 1:
         raise ValueError(f"n_qps and seq_len must be positive, got {n_qps} and {seq_len}")
     loaded = load_robot(robot)
@@ -129,7 +138,12 @@ def generate_test_set(
 
         bar = tqdm(total=n_qps, desc=f"{robot}/{scenario}")
     j = 0
-    while len(qps) < n_qps:
+    if scenario == CLOSEDLOOP:  # imported here: only this set needs mujoco
+        from benchmarks.closedloop.logged import logged_sequences
+
+        qps, xs, stance, seq = logged_sequences(robot, n_qps, seed, dt, seq_len,
+                                                bar.update if bar else None)
+    while len(qps) < n_qps:  # the open-loop scenarios (a closedloop set is complete)
         name = SCENARIOS[j % len(SCENARIOS)] if scenario == MIX else scenario
         ticks = min(seq_len, n_qps - len(qps))
         spec = make_sequence(loaded, name, np.random.default_rng([seed, j]), ticks, dt)
