@@ -352,28 +352,24 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     ``GUESS_PASSES`` guesses were solved. A correction first only adds the violated
     constraints; a wrong-signed multiplier is released only from a point that violates
     nothing, and only one per pass, the most wrong (:func:`~fccqp.polish_guess.most_wrong`),
-    as a primal active-set method drops one constraint at a time. Changing both at once (a
-    plain primal-dual active-set step) was measured to diverge on whole-body control, where
-    the cost is flat on the torques and forces: releasing a bound and a cone together sent
-    free torques to 1e3. Releasing every wrong-signed multiplier of a pass together cycled
-    on talos' contact switches (32 entries released, 17 held again the next pass); one at a
-    time, 83.5 % of talos' ticks ended in the warm polish, without an iteration, instead of
-    80.5 %, and 93 % of go2's instead of 91.5 % (``Settings.realtime(math.inf)``, 200 ticks
-    each). Once a pass's point violates nothing, each next pass is a step of a primal
-    active-set method: from that point toward the new guess's solution only as far as the
-    first free constraint allows (:func:`~fccqp.polish_guess.step_length`), which is then
-    held, and a release only from a full step. The polished QP of a wrong guess lies far out
-    where the cost is flat on the forces, and jumping there swung talos' contact forces by
-    hundreds of newtons from pass to pass (a block flipping between apex and boundary); with
-    the steps, 88 instead of 83.5 % of talos' ticks ended in the warm polish and a tick took
-    4.72M instead of 5.96M instructions (six passes each). On a settled guess the boundary
-    planes are then re-linearized up to ``newton_steps`` times (chord steps while they
-    converge fast, see ``CHORD_RATE``), stopping early at the floor rounding leaves. A
-    boundary block that a solve puts past the apex
+    as a primal active-set method drops one constraint at a time: changing both at once (a
+    plain primal-dual active-set step) diverged on whole-body control, where the cost is
+    flat on the torques and forces, and releasing every wrong-signed multiplier of a pass
+    together cycled on contact switches. Once a pass's point violates nothing, each next
+    pass is a step of a primal active-set method: from that point toward the new guess's
+    solution only as far as the first free constraint allows
+    (:func:`~fccqp.polish_guess.step_length`), which is then held, and a release only from
+    a full step: the polished QP of a wrong guess lies far out where the cost is flat on
+    the forces, and jumping there swung contact forces by hundreds of newtons from pass to
+    pass. (The measurements behind these rules are in notes/polish.md.) On a settled guess
+    the boundary planes are then re-linearized up to ``newton_steps`` times (chord steps
+    while they converge fast, see ``CHORD_RATE``), stopping early at the floor rounding
+    leaves. A boundary block that a solve puts past the apex
     (:func:`~fccqp.polish_guess.drop_far_side`) is held at the apex instead and the
     corrected guess solved, within the same ``GUESS_PASSES``. False when a factorization
-    breaks down or the result is not finite, or when the clock (:func:`fccqp_now`) has passed ``deadline`` before a
-    guess after the first (``INFINITY``: never); otherwise the caller judges the point.
+    breaks down or the result is not finite, or when the clock (:func:`fccqp_now`) has
+    passed ``deadline`` before a guess after the first (``INFINITY``: never); otherwise
+    the caller judges the point.
     """
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, nb, nf = 0, j, changed
     cdef long passes = 0, step

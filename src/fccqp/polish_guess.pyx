@@ -227,17 +227,13 @@ cdef Py_ssize_t drop_far_side(Polish* w, const Problem* p, Py_ssize_t nb,
     changed entries in ``changed``.
 
     Newton's re-linearization cannot leave that side: each new plane is tangent along
-    the projection of a point outside the cone, and on talos' whole-body control the
-    miss stayed at 1.1-1.2 for all ten steps (a fresh factorization each) in one of five
-    polishes. The apex is the active set such a block asks for (no force); the next
-    guess pass releases it again if its multiplier leaves the polar cone. A block that
-    goes past its apex a second time in one polish sets ``cycling``: the guess flips it
-    between apex and boundary, and the polish ends after the next solve, as after
-    ``GUESS_PASSES`` guesses. Many of talos' failing polishes had run all 8 guesses
-    releasing and dropping the same block; ending them so changed no result on the four
-    robots' 400 ticks (the same iterations at both presets); instructions per 400 ticks
-    (``Settings.realtime(1.0)``, callgrind) talos 1.350G -> 1.317G, go2 255.4M ->
-    253.7M, solo12 289.1M -> 285.8M."""
+    the projection of a point outside the cone, and the miss stays where it is (on
+    talos' whole-body control, in one polish of five). The apex is the active set such a
+    block asks for (no force); the next guess pass releases it again if its multiplier
+    leaves the polar cone. A block that goes past its apex a second time in one polish
+    sets ``cycling``: the guess flips it between apex and boundary, and the polish ends
+    after the next solve, as after ``GUESS_PASSES`` guesses: failing polishes had run all
+    their guesses releasing and dropping the same block (notes/polish.md)."""
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t k, j, cone, o, d, kept = 0
     cdef double across, along
