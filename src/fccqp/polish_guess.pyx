@@ -7,7 +7,8 @@ and corrects it from each polished point (the rules and why they are so are in
 (:c:type:`Polish`'s ``active``): a box entry is free or held at a bound, a cone block is
 free, at its apex or on its boundary, where it contributes its tangent plane and the
 curvature term of Newton's step (:func:`linearize`). The cone geometry comes from
-:mod:`fccqp.cone_dispatch`: nothing here depends on the cone's kind.
+:mod:`fccqp.cone_dispatch` (projection, axis and slope, tangent plane, curvature, step
+to the boundary): nothing here names a cone kind.
 """
 
 from libc.math cimport fabs, sqrt
