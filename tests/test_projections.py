@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from fccqp.cones import FRICTION, SECOND_ORDER
+from fccqp.cones import FRICTION, KINDS, SECOND_ORDER
 
 finite = st.floats(-1e3, 1e3, allow_nan=False, allow_infinity=False)
 mus = st.floats(1e-3, 1e3)
@@ -136,3 +136,20 @@ def test_constraint_set_clips_box_and_projects_cones_in_place():
     expected[5:] = [3.5, 3.5]
     project_constraint_set(v, lo, hi, cones, v)
     np.testing.assert_allclose(v, expected)
+
+
+def test_every_registered_kind_has_its_code_in_the_compiled_core():
+    """fccqp.cones.KINDS and the compiled registry (cone_dispatch.pxd) agree on the codes:
+    each kind's code projects a block of its size as that kind, and sizes the kind
+    cannot have, or codes no kind has, are rejected."""
+    v = np.array([0.9, -0.4, 0.3])
+    own = {FRICTION: friction(v, 0.5), SECOND_ORDER: soc(v)}
+    assert sorted(kind.code for kind in KINDS) == sorted(own)
+    for kind in KINDS:
+        out = np.empty(3)
+        project_cone_block(v, kind.code, 0.5, UP, out)
+        np.testing.assert_array_equal(out, own[kind.code])
+    with pytest.raises(ValueError, match="cannot have 4 entries"):
+        project_cone_block(np.ones(4), FRICTION, 0.5, UP, np.empty(4))
+    with pytest.raises(ValueError, match="kind 7"):
+        project_cone_block(v, 7, 0.5, UP, np.empty(3))

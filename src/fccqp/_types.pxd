@@ -7,19 +7,15 @@ Matrices are dense; ``P`` is symmetric (so its storage order does not matter) an
 ``A`` is row-major, ``A[i * n + j]``.
 """
 
-cdef enum:
-    FRICTION = 0        # kind code of a friction cone (see fccqp.cones)
-    SECOND_ORDER = 1    # kind code of a second-order cone
-
-
 cdef struct Cones:
-    # Disjoint cone blocks of the constrained-entry vector.
+    # Disjoint cone blocks of the constrained-entry vector; fccqp.cone_dispatch lists the
+    # kinds and their operations.
     Py_ssize_t count
-    const Py_ssize_t* kind
+    const Py_ssize_t* kind      # kind code (fccqp.cone_dispatch, fccqp.cones.KINDS)
     const Py_ssize_t* offset    # into the constrained-entry vector, not into x
     const Py_ssize_t* dim
-    const double* mu
-    const double* normal        # count x 3, unit normals of friction cones
+    const double* mu            # a scalar parameter per cone: the friction coefficient
+    const double* normal        # count x 3, a vector parameter: the unit normal of a friction cone
 
 
 cdef struct Problem:

@@ -9,13 +9,18 @@ A cone constrains a contiguous block ``x[start:start + dim]``:
 
 The compiled kernels never see these objects: :func:`flatten_cones` turns them into
 :class:`ConeArrays`, plain arrays of kinds, offsets, sizes, friction coefficients and
-normals.
+normals. :data:`KINDS` is the registry of the kinds on the Python side: each spec class
+with its kind code (the compiled core's, ``fccqp/cone_dispatch.pxd``) and the function
+that validates a spec into its block size and parameters. Adding a kind: its spec class
+and flattening function here, its entry in :data:`KINDS` and in :data:`Cone`; the
+compiled side is its module ``fccqp/cone_<kind>.pxd`` and its branches in
+``fccqp/cone_dispatch.pxd``.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -24,9 +29,9 @@ import numpy as np
 from fccqp.fast_checks import cone_key
 
 FRICTION = 0
-"""Kind code of a friction cone in :class:`ConeArrays`."""
+"""Kind code of a friction cone in :class:`ConeArrays` (``fccqp/cone_friction.pxd``)."""
 SECOND_ORDER = 1
-"""Kind code of a standard second-order cone in :class:`ConeArrays`."""
+"""Kind code of a standard second-order cone in :class:`ConeArrays` (``fccqp/cone_soc.pxd``)."""
 
 _UNIT_TOLERANCE = 1e-8
 
@@ -150,6 +155,41 @@ def _check_friction(cone: FrictionCone, index: int) -> np.ndarray:
     return normal / norm
 
 
+def _flat_friction(cone: FrictionCone, index: int) -> tuple[int, float, np.ndarray | None]:
+    normal = _check_friction(cone, index)
+    return 3, float(cone.mu), normal
+
+
+def _flat_second_order(cone: SecondOrderCone, index: int) -> tuple[int, float, np.ndarray | None]:
+    size = _integer(cone.dim, f"cones[{index}].dim")
+    if size < 2:
+        raise ValueError(f"cones[{index}].dim must be >= 2, got {size}")
+    return size, 0.0, None
+
+
+@dataclass(frozen=True)
+class ConeKind:
+    """One cone kind of the registry :data:`KINDS`."""
+
+    code: int
+    """Its code in :attr:`ConeArrays.kind`, the same as the compiled core's."""
+    spec: type
+    """The user-facing spec class."""
+    flatten: Callable[[object, int], tuple[int, float, np.ndarray | None]]
+    """``(size, mu, normal)`` of a spec, which is ``cones[index]``, validated (raising
+    the error that names it); ``normal`` ``None`` for none (a zero row)."""
+
+
+KINDS: tuple[ConeKind, ...] = (
+    ConeKind(FRICTION, FrictionCone, _flat_friction),
+    ConeKind(SECOND_ORDER, SecondOrderCone, _flat_second_order),
+)
+"""The cone kinds, in the order of their codes."""
+
+_SPECS = tuple(kind.spec for kind in KINDS)
+_NAMES = " or ".join(spec.__name__ for spec in _SPECS)
+
+
 def flatten_cones(cones: Sequence[Cone], n: int) -> ConeArrays:
     """Validate cone specs for an ``n``-vector and return them as flat arrays.
 
@@ -161,19 +201,18 @@ def flatten_cones(cones: Sequence[Cone], n: int) -> ConeArrays:
     Raises
     ------
     TypeError
-        If ``cones`` is not a sequence of cones, an entry is not a
-        :class:`FrictionCone` or :class:`SecondOrderCone`, or a field has the wrong type.
+        If ``cones`` is not a sequence of cones, an entry is not a spec of one of the
+        :data:`KINDS` (:class:`FrictionCone`, :class:`SecondOrderCone`), or a field has
+        the wrong type.
     ValueError
         If a block leaves ``[0, n)``, overlaps another block, a second-order cone has
         ``dim < 2``, or a friction cone has a bad ``mu`` or normal.
     """
     if type(cones) is not tuple:   # a tuple, the control loop's case, needs no checks
-        if isinstance(cones, (FrictionCone, SecondOrderCone)):
+        if isinstance(cones, _SPECS):
             cones = (cones,)
         elif isinstance(cones, (str, bytes)) or not isinstance(cones, Iterable):
-            raise TypeError(
-                f"cones must be a sequence of FrictionCone or SecondOrderCone, got {cones!r}"
-            )
+            raise TypeError(f"cones must be a sequence of {_NAMES}, got {cones!r}")
         cones = tuple(cones)
     try:
         flat = _MEMO.get(key := cone_key(cones, n))
@@ -200,18 +239,15 @@ def _flatten(cones: Sequence[Cone], n: int) -> ConeArrays:
     mu = np.zeros(k)
     normal = np.zeros((k, 3))
     for i, cone in enumerate(cones):
-        if isinstance(cone, FrictionCone):
-            normal[i] = _check_friction(cone, i)
-            kind[i], size, mu[i] = FRICTION, 3, float(cone.mu)
-        elif isinstance(cone, SecondOrderCone):
-            kind[i] = SECOND_ORDER
-            size = _integer(cone.dim, f"cones[{i}].dim")
-            if size < 2:
-                raise ValueError(f"cones[{i}].dim must be >= 2, got {size}")
+        for entry in KINDS:
+            if isinstance(cone, entry.spec):
+                break
         else:
-            raise TypeError(
-                f"cones[{i}] must be a FrictionCone or SecondOrderCone, got {type(cone).__name__}"
-            )
+            raise TypeError(f"cones[{i}] must be a {_NAMES}, got {type(cone).__name__}")
+        size, mu[i], row = entry.flatten(cone, i)
+        kind[i] = entry.code
+        if row is not None:
+            normal[i] = row
         start = _integer(cone.start, f"cones[{i}].start")
         if start < 0 or start + size > n:  # Python ints: no overflow before the check
             raise ValueError(

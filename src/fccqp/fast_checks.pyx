@@ -78,7 +78,11 @@ def dense_arguments(P, q, A, b, lb, ub, Py_ssize_t n, Py_ssize_t m):
 
 
 cdef tuple _one_key(object cone):
-    """One spec's values and the types behind them (see :func:`cone_key`)."""
+    """One spec's values and the types behind them (see :func:`cone_key`). The two
+    kinds of the control loops are spelled out; any other spec (a kind of
+    :data:`fccqp.cones.KINDS` without a line here) gives its fields' values and types
+    in order, or itself where it has no ``__dict__`` (then :func:`fccqp.cones.flatten_cones`
+    rejects it)."""
     cdef object kind = type(cone), start, mu, normal, dim
     if isinstance(cone, _FRICTION):
         start, mu, normal = cone.start, cone.mu, cone.normal
@@ -88,7 +92,13 @@ cdef tuple _one_key(object cone):
     if isinstance(cone, _SECOND_ORDER):
         start, dim = cone.start, cone.dim
         return kind, start, type(start), dim, type(dim)
-    return kind, cone
+    try:
+        fields = vars(cone)
+    except TypeError:
+        return kind, cone
+    return kind, tuple(fields.items()), tuple(
+        tuple(map(type, value)) if type(value) is tuple else type(value)
+        for value in fields.values())
 
 
 def cone_key(tuple cones, Py_ssize_t n):

@@ -1,0 +1,257 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""The polish's active set: its first guess from ADMM's iterate and its corrections.
+
+:mod:`fccqp.polish` solves the QP on a guessed active set; this module makes the guess
+and corrects it from each polished point (the rules and why they are so are in
+:func:`fccqp.polish.polish`'s docstring). One code per constrained entry
+(:c:type:`Polish`'s ``active``): a box entry is free or held at a bound, a cone block is
+free, at its apex or on its boundary, where it contributes its tangent plane and the
+curvature term of Newton's step (:func:`linearize`). The cone geometry comes from
+:mod:`fccqp.cone_dispatch` (projection, axis and slope, tangent plane, curvature, step
+to the boundary): nothing here names a cone kind.
+"""
+
+from libc.math cimport fabs, sqrt
+
+from fccqp._dense cimport copy
+from fccqp._types cimport Cones, Problem
+from fccqp.cone_dispatch cimport (cone_curvature, cone_plane, cone_polar_distance, cone_project,
+                                  cone_slope, cone_split, cone_step)
+from fccqp.polish cimport APEX, BOUNDARY, FREE, LOWER, UPPER, Polish
+from fccqp.tuning cimport ACTIVE_TOLERANCE
+
+
+cdef void linearize(Polish* w, const Problem* p, Py_ssize_t k, const double* v) noexcept nogil:
+    """Plane ``g`` and curvature ``hess`` of boundary block ``k`` (of ``boundary``) at
+    ``v``, with its current multiplier; a block whose ``v`` is on the axis keeps its plane
+    and gets no curvature."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t cone = w.boundary[k], o = c.offset[cone], d = c.dim[cone]
+    cdef double phi
+    cone_plane(v, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, w.g + o, &phi)
+    cone_curvature(v, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, w.lam[k],
+                   w.hess + o * p.s)
+
+
+cdef Py_ssize_t guess(Polish* w, const Problem* p, const double* z, const double* y,
+                      Py_ssize_t* changed) noexcept nogil:
+    """Fill ``active`` from the slack ``z`` and multiplier ``y``, the list ``boundary``
+    and each boundary block's multiplier ``lam`` (the component of ``y`` along the
+    plane's normal), plane and curvature at the projection of ``z + y`` onto the cone;
+    return the number of boundary blocks and count in ``changed`` the constrained
+    entries whose code changed."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t j, k, o, d, nb = 0
+    cdef double phi, lam
+    cdef char code
+    changed[0] = 0
+    for j in range(p.s):
+        if not p.in_cone[j]:
+            code = box_code(p, j, z[j] + y[j])
+            changed[0] += code != w.active[j]
+            w.active[j] = code
+    for k in range(c.count):
+        o, d = c.offset[k], c.dim[k]
+        for j in range(o, o + d):
+            w.g[j] = z[j] + y[j]
+        code = cone_code(c, k, w.g + o)
+        if code == BOUNDARY:
+            cone_project(w.g + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
+            cone_plane(w.step, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.g + o, &phi)
+            lam = 0.0
+            for j in range(o, o + d):
+                lam += y[j] * w.g[j]
+            w.lam[nb] = lam
+            w.boundary[nb] = k
+            linearize(w, p, nb, w.step)
+            nb += 1
+        for j in range(o, o + d):
+            changed[0] += code != w.active[j]
+            w.active[j] = code
+    return nb
+
+
+cdef Py_ssize_t most_wrong(Polish* w, const Problem* p) noexcept nogil:
+    """The held entry (its index ``j < s``) or held block (``s`` plus its cone's index)
+    whose multiplier is farthest, in the user's units, from the normal cone its code
+    needs; -1 when none is. The distance is a box entry's wrong-signed ``|y_j|``, a
+    boundary block's ``-lam``, an apex block's distance of ``y_block`` to the polar cone
+    (``||P_K(y_block)||``), each divided by ``c D_i`` as :func:`fccqp.scaling.unscale`
+    does: what :func:`fccqp.polish.multiplier_violation` measures on the polished point."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t j, k, o, d, old = 0, most = -1
+    cdef double worst = 0.0, wrong
+    cdef char code
+    for j in range(p.s):
+        if p.in_cone[j]:
+            continue
+        code = w.active[j]
+        wrong = w.y[j] if code == LOWER else (-w.y[j] if code == UPPER else 0.0)
+        wrong /= p.c * p.D[p.constrained[j]]
+        if wrong > worst:
+            worst, most = wrong, j
+    for k in range(c.count):
+        o, d = c.offset[k], c.dim[k]
+        wrong = 0.0
+        if w.active[o] == BOUNDARY:
+            wrong = -w.lam[old]
+            old += 1
+        elif w.active[o] == APEX:
+            wrong = cone_polar_distance(w.y + o, c.kind[k], d, c.mu[k], c.normal + 3 * k,
+                                        w.step)
+        wrong /= p.c * p.D[p.constrained[o]]
+        if wrong > worst:
+            worst, most = wrong, p.s + k
+    return most
+
+
+cdef double step_length(Polish* w, const Problem* p, Py_ssize_t* blocking) noexcept nogil:
+    """The largest ``t`` in ``[0, 1]`` such that ``x_prev + t (x - x_prev)`` keeps every
+    free box entry within its bounds, every free cone block in its cone and every
+    boundary block on the near side of its apex; ``blocking`` receives the constraint
+    that stops it first (an entry ``j < s``, or ``s`` plus a cone's index), -1 when none
+    does and ``t`` is 1."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t j, k, o, d, i, start
+    cdef double t = 1.0, stop, x0, x1, along0, along1, across
+    blocking[0] = -1
+    for j in range(p.s):
+        if p.in_cone[j] or w.active[j] != FREE:
+            continue
+        i = p.constrained[j]
+        x0, x1 = w.x_prev[i], w.x[i]
+        stop = 1.0
+        if x1 < p.lo[j] and x1 < x0:
+            stop = max(0.0, (p.lo[j] - x0) / (x1 - x0))
+        elif x1 > p.hi[j] and x1 > x0:
+            stop = max(0.0, (p.hi[j] - x0) / (x1 - x0))
+        if stop < t:
+            t, blocking[0] = stop, j
+    for k in range(c.count):
+        o, d = c.offset[k], c.dim[k]
+        start = p.constrained[o]
+        if w.active[o] == FREE:
+            stop = cone_step(w.x_prev + start, w.x + start, c.kind[k], d, c.mu[k],
+                             c.normal + 3 * k, ACTIVE_TOLERANCE, w.step)
+        elif w.active[o] == BOUNDARY:   # its tangent plane also holds the far ray
+            along0 = cone_split(w.x_prev + start, c.kind[k], d, c.mu[k], c.normal + 3 * k,
+                                &across)
+            along1 = cone_split(w.x + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
+            stop = 1.0
+            if along1 <= 0.0:
+                stop = max(0.0, along0 / (along0 - along1)) if along0 > along1 else 0.0
+        else:
+            continue
+        if stop < t:
+            t, blocking[0] = stop, p.s + k
+    return t
+
+
+cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, Py_ssize_t blocking,
+                      Py_ssize_t* changed) noexcept nogil:
+    """Correct the guess from the polished point. With ``adding``, hold free entries
+    that violate their bound and put free blocks that left their cone on the boundary
+    (or at the apex, if ``x_block`` lies in the polar), and hold the ``blocking``
+    constraint of a step (:func:`step_length`; -1 for none) where the step left it: a
+    box entry at its nearer bound, a free block on the boundary, a boundary block at the
+    apex. Otherwise release the one held entry or block whose multiplier is the most
+    wrong (:func:`most_wrong`): a held entry or a boundary block becomes free, an apex
+    block is reclassified from its multiplier as in :func:`guess`. Returns the number of
+    boundary blocks (planes and curvature at ``x_block``, or at the projection for a new
+    one) and counts the changed entries in ``changed``."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t j, k, o, d, start, nb = 0, old = 0
+    cdef double value, size, along, across, slope, lam
+    cdef char code, before
+    cdef Py_ssize_t released = -1 if adding else most_wrong(w, p)
+    changed[0] = 0
+    for j in range(p.s):
+        if p.in_cone[j]:
+            continue
+        code = before = w.active[j]
+        value = w.x[p.constrained[j]]
+        if j == released:
+            code = FREE
+        elif adding and code == FREE and j == blocking:
+            code = LOWER if fabs(value - p.lo[j]) <= fabs(value - p.hi[j]) else UPPER
+        elif adding and code == FREE:
+            if value < p.lo[j] - ACTIVE_TOLERANCE * max(1.0, fabs(p.lo[j])):
+                code = LOWER
+            elif value > p.hi[j] + ACTIVE_TOLERANCE * max(1.0, fabs(p.hi[j])):
+                code = UPPER
+        changed[0] += code != before
+        w.active[j] = code
+    copy(w.lam, w.rhs, c.count)   # the old boundary multipliers, by old position
+    for k in range(c.count):
+        o, d = c.offset[k], c.dim[k]
+        start = p.constrained[o]
+        code = before = w.active[o]
+        lam = 0.0
+        slope = cone_slope(c.kind[k], c.mu[k])
+        if before == BOUNDARY:
+            lam = w.rhs[old]
+            old += 1
+            if released == p.s + k:
+                code = FREE
+            elif blocking == p.s + k:
+                code = APEX
+            copy(w.x + start, w.step, d)
+        elif before == FREE and adding:
+            size = 0.0
+            for j in range(d):
+                size += w.x[start + j] * w.x[start + j]
+            along = cone_split(w.x + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
+            if across - slope * along > ACTIVE_TOLERANCE * sqrt(size) or blocking == p.s + k:
+                code = APEX if slope * across <= -along or size == 0.0 else BOUNDARY
+                cone_project(w.x + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
+        elif released == p.s + k:   # an apex block whose y left the polar
+            along = cone_split(w.y + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
+            code = FREE if across <= slope * along else BOUNDARY
+            cone_project(w.y + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
+        for j in range(o, o + d):
+            changed[0] += code != before
+            w.active[j] = code
+        if code == BOUNDARY:
+            w.lam[nb] = lam
+            w.boundary[nb] = k
+            linearize(w, p, nb, w.step)
+            nb += 1
+    return nb
+
+
+cdef Py_ssize_t drop_far_side(Polish* w, const Problem* p, Py_ssize_t nb,
+                              Py_ssize_t* changed) noexcept nogil:
+    """Hold at the apex every boundary block whose ``x_block`` lies on the far side of it
+    (``n'x_block <= 0``: the tangent plane through the origin also holds the opposite
+    ray, and a polished QP that pulls a contact ends there); return the number of
+    boundary blocks left, compacted in order with their multipliers, and count the
+    changed entries in ``changed``.
+
+    Newton's re-linearization cannot leave that side: each new plane is tangent along
+    the projection of a point outside the cone, and the miss stays where it is (on
+    talos' whole-body control, in one polish of five). The apex is the active set such a
+    block asks for (no force); the next guess pass releases it again if its multiplier
+    leaves the polar cone. A block that goes past its apex a second time in one polish
+    sets ``cycling``: the guess flips it between apex and boundary, and the polish ends
+    after the next solve, as after ``GUESS_PASSES`` guesses: failing polishes had run all
+    their guesses releasing and dropping the same block (notes/polish.md)."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t k, j, cone, o, d, kept = 0
+    cdef double across, along
+    changed[0] = 0
+    for k in range(nb):
+        cone = w.boundary[k]
+        o, d = c.offset[cone], c.dim[cone]
+        along = cone_split(w.x + p.constrained[o], c.kind[cone], d, c.mu[cone],
+                           c.normal + 3 * cone, &across)
+        if along <= 0.0:
+            for j in range(o, o + d):
+                w.active[j] = APEX
+            changed[0] += d
+            w.cycling = w.cycling or w.dropped[cone]
+            w.dropped[cone] = True
+            continue
+        w.boundary[kept] = cone
+        w.lam[kept] = w.lam[k]
+        kept += 1
+    return kept
