@@ -41,7 +41,8 @@ from fccqp.blas_threads cimport enter, leave
 from fccqp.anderson cimport Anderson, anderson_reset, anderson_step
 from fccqp.certificates cimport (CERTIFIED, SEPARATED, clean_primal_certificate,
                                  dual_infeasible, equality_direction, equality_inconsistent,
-                                 gram_factor, magnitudes, primal_infeasible, row_size)
+                                 gram_factor, magnitudes, primal_candidate,
+                                 primal_infeasible, row_size)
 from fccqp.fast_checks cimport hold_dense, hold_float64
 from fccqp.kkt cimport (AUTO, FACTORED, KKT, LDL_FULL, LDL_REDUCED, NOT_CONVEX, SCHUR_REDUCED,
                         UNAVAILABLE, kkt_convexity, kkt_factor, kkt_solve)
@@ -585,6 +586,40 @@ cdef class Workspace:
     def forget(self):
         """Drop the previous solution, so that the next solve starts cold."""
         self.has_previous = False
+
+    def judge_certificate(self, const double[::1] candidate, bint primal):
+        """The certificate ``candidate`` (user's units, ``Result.certificate``'s layout:
+        ``(dy, dz)`` for ``primal``, else ``dx``), found outside the run (see
+        :mod:`fccqp.auxiliary`), judged by the tests of the run's own candidates on the
+        last solve's scaled problem; the certificate as it passed (the primal one's
+        ``dz`` projected onto the polar), or None."""
+        cdef Problem* p = &self.prob
+        cdef Py_ssize_t n = p.n, m = p.m, i, j
+        if candidate.shape[0] != (n + m if primal else n):
+            raise ValueError("a certificate of the wrong size")
+        if primal:
+            if m == 0:
+                return None
+            for i in range(m):
+                self.vec_m[i] = candidate[i] / p.E[i]
+            for j in range(p.s):
+                i = p.constrained[j]
+                self.vec_s[j] = candidate[m + i] * p.D[i]
+            if primal_candidate(p, self.it.x, self.vec_m, self.vec_s, self.opt.eps_prim_inf,
+                                self.vec_n, self.vec_n2) != CERTIFIED:
+                return None
+            fill(self.cert, 0.0, n + m)
+            for i in range(m):
+                self.cert[i] = self.vec_m[i] * p.E[i]
+            for j in range(p.s):
+                i = p.constrained[j]
+                self.cert[m + i] = self.vec_s[j] / p.D[i]
+            return np.asarray(<double[:n + m]>self.cert).copy()
+        for i in range(n):
+            self.direction[i] = candidate[i] / p.D[i]
+        if not self._unbounded():
+            return None
+        return np.asarray(<double[:n]>self.cert).copy()
 
     @property
     def finding(self):
