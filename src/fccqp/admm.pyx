@@ -587,25 +587,36 @@ cdef class Workspace:
         """Drop the previous solution, so that the next solve starts cold."""
         self.has_previous = False
 
-    def judge_certificate(self, const double[::1] candidate, bint primal):
+    def judge_certificate(self, const double[::1] candidate, bint primal,
+                          const double[::1] point=None):
         """The certificate ``candidate`` (user's units, ``Result.certificate``'s layout:
         ``(dy, dz)`` for ``primal``, else ``dx``), found outside the run (see
         :mod:`fccqp.auxiliary`), judged by the tests of the run's own candidates on the
         last solve's scaled problem; the certificate as it passed (the primal one's
-        ``dz`` projected onto the polar), or None."""
+        ``dz`` projected onto the polar), or None. A primal certificate's separation
+        must exceed what its residual explains at ``point`` (user's units, with ``A x =
+        b``; default the run's iterate, which on a run that diverges along a ray, ``q``
+        of 4.5e14 beside a cone pinned outside itself, explained away an exact one)."""
         cdef Problem* p = &self.prob
         cdef Py_ssize_t n = p.n, m = p.m, i, j
+        cdef const double* x = self.it.x
         if candidate.shape[0] != (n + m if primal else n):
             raise ValueError("a certificate of the wrong size")
         if primal:
             if m == 0:
                 return None
+            if point is not None:
+                if point.shape[0] != n:
+                    raise ValueError("a point of the wrong size")
+                for i in range(n):
+                    self.vec_n3[i] = point[i] / p.D[i]
+                x = self.vec_n3
             for i in range(m):
                 self.vec_m[i] = candidate[i] / p.E[i]
             for j in range(p.s):
                 i = p.constrained[j]
                 self.vec_s[j] = candidate[m + i] * p.D[i]
-            if primal_candidate(p, self.it.x, self.vec_m, self.vec_s, self.opt.eps_prim_inf,
+            if primal_candidate(p, x, self.vec_m, self.vec_s, self.opt.eps_prim_inf,
                                 self.vec_n, self.vec_n2) != CERTIFIED:
                 return None
             fill(self.cert, 0.0, n + m)

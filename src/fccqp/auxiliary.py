@@ -12,7 +12,9 @@ in a few dozen iterations on the fuzzing campaign's stalls):
   ``min 1/2 ||x_S - u||^2`` s.t. ``A x = b``, ``u`` in C (the box and the cones). Its
   multipliers ``(y, z_u)`` satisfy ``A'y + E_S'z_u = 0`` and ``b'y + sigma_C(z_u) =
   -||x_S - u||^2``: a Farkas certificate whenever the distance is positive (the dual of
-  the least-distance problem is the certificate problem);
+  the least-distance problem is the certificate problem), its separation weighed
+  against what the residual explains at the nearest ``x`` (not the run's iterate, which
+  may be diverging along a ray);
 - dual: the projection of ``-q`` onto the cone of rays, ``min 1/2 ||d||^2 + q'd`` s.t.
   ``P d = 0``, ``A d = 0``, ``d`` in the recession cone of C, which by Moreau has
   ``q'd = -||d||^2``: a ray of descent whenever it is not zero.
@@ -124,7 +126,8 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
                     candidate = np.zeros(m + n)
                     candidate[:m] = result.y
                     candidate[m + S] = result.z[n:]
-                    found = workspace.judge_certificate(candidate, True)
+                    point = np.ascontiguousarray(result.x[:n])
+                    found = workspace.judge_certificate(candidate, True, point)
                     if found is not None:
                         return Status.PRIMAL_INFEASIBLE, found, spent, factored
         if not np.any(q):
