@@ -23,7 +23,7 @@ SEEDS = {
     "primal_infeasible": (0, 1, 2, 3, 80, 146, 177, 182, 350),
     "dual_infeasible": (0, 1, 2, 33, 166, 257, 368),
     "solver_reuse": (0, 1, 2, 50, 164, 211),
-    "extreme_data": (0, 1, 7, 9, 38, 56, 138, 202, 254, 302, 308, 326, 335, 355),
+    "extreme_data": (0, 1, 7, 9, 38, 56, 138, 149, 202, 254, 302, 308, 326, 335, 355, 363),
     "qpsolvers": (0, 1, 2),
     "cvxpy": (1, 2, 3),
 }
@@ -43,7 +43,6 @@ OPEN = {
     "solver_reuse:211": "sigma in scaled units decides convexity: a fresh solve accepts "
     "-3.9e-3 curvature that a kept workspace rejects",
     "extreme_data:138": "SOLVED through the absolute tolerance on a cone block rescaled by 1e-8",
-    "extreme_data:335": "four Ruiz passes leave A x 1e11 badly scaled: rho pinned at its cap",
     "cvxpy:1": "a feasible problem whose dual residual stalls near 0.8 in the LDL' forms "
     "with adaptive rho",
     "solver_reuse:38": "the sparse path's first factorization breaks down on dependent rows",

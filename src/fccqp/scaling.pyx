@@ -41,7 +41,12 @@ RESCALE_DRIFT = 4.0
 """:func:`rescale` keeps an earlier scaling while every norm of the scaled matrices
 stays within this factor of what it gave its own data (one Ruiz pass corrects a
 column by the square root of its norm: a factor of 4 is about one pass's work)."""
+CAPPED_PASSES = 20
+"""Passes in which a column or row norm exceeded ``MAX_NORM`` (their correction was
+capped) do not count toward ``Settings.scaling``, up to this many: data off by 1e11
+(``A`` scaled by 1e10-1e15 in the fuzzer) needed more than four passes of at most 100x."""
 cdef double _RESCALE_DRIFT = RESCALE_DRIFT
+cdef Py_ssize_t _CAPPED_PASSES = CAPPED_PASSES
 cdef double _MIN_NORM = MIN_NORM
 cdef double _MAX_NORM = MAX_NORM
 cdef double _MIN_COST_NORM = MIN_COST_NORM
@@ -82,9 +87,10 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
     once per pass and rescaled once at the end. ``block_start``/``block_dim`` give the
     cone blocks in ``x``; ``d`` and ``e`` are scratch of sizes ``n`` and ``m``.
     """
-    cdef Py_ssize_t it, i, j, k, a, t
-    cdef double value, log_mean
+    cdef Py_ssize_t it = 0, i, j, k, a, t, passes = iterations
+    cdef double value, log_mean, norm
     cdef const double* row
+    cdef bint capped
     for j in range(n):
         D[j] = 1.0
     for i in range(m):
@@ -93,7 +99,9 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
         # and A x = b to |b|, whatever the passes
         value = _row_max(A + i * n, D, n)
         E[i] = ldexp(1.0, -ilogb(value)) if 0.0 < value < _MIN_NORM else 1.0
-    for it in range(iterations):
+    while it < passes:
+        it += 1
+        capped = False
         # column maxima accumulate row by row (independent per column: the loops vectorize)
         for j in range(n):
             d[j] = 0.0
@@ -107,9 +115,14 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
             row = A + i * n
             for j in range(n):
                 d[j] = max(d[j], fabs(row[j]) * D[j] * E[i])
-            e[i] = _inverse_sqrt_norm(_row_max(row, D, n) * E[i])
+            norm = _row_max(row, D, n) * E[i]
+            capped = capped or norm > _MAX_NORM
+            e[i] = _inverse_sqrt_norm(norm)
         for j in range(n):
+            capped = capped or d[j] > _MAX_NORM
             d[j] = _inverse_sqrt_norm(d[j])
+        if capped and passes < iterations + _CAPPED_PASSES:
+            passes += 1
         for k in range(blocks):
             a, t = block_start[k], block_start[k] + block_dim[k]
             log_mean = 0.0
