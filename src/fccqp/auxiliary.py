@@ -34,6 +34,7 @@ import numpy as np
 
 from fccqp.cones import FrictionCone, SecondOrderCone
 from fccqp.problem import INFINITE_BOUND
+from fccqp.settings import MAX_DENSE_KKT_ROWS
 from fccqp.status import Status
 
 
@@ -96,6 +97,12 @@ def ray_problem(P: np.ndarray, q: np.ndarray, A: np.ndarray, lb: np.ndarray,
     return (np.eye(n), q, rows, np.zeros(rows.shape[0]), low, high, list(cones))
 
 
+def _dense_path(problem: tuple) -> bool:
+    """Whether an auxiliary problem stays on the dense path (its KKT matrix has up to
+    twice the rows of the run's: on the sparse path it would cost far more)."""
+    return problem[0].shape[0] + problem[2].shape[0] <= MAX_DENSE_KKT_ROWS
+
+
 def stalled_certificate(solver_type: type, settings: object, workspace: object,
                         P: object, q: object, A: object, b: object, lb: object,
                         ub: object, cones: object) -> tuple | None:
@@ -119,7 +126,7 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
     try:
         if m > 0:
             problem, S = distance_problem(A, b, lb, ub, cones)
-            if S.size:
+            if S.size and _dense_path(problem):
                 result = auxiliary.solve(*problem)
                 spent, factored = spent + result.iterations, factored + result.factorizations
                 if np.all(np.isfinite(result.y)) and np.all(np.isfinite(result.z)):
@@ -130,9 +137,10 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
                     found = workspace.judge_certificate(candidate, True, point)
                     if found is not None:
                         return Status.PRIMAL_INFEASIBLE, found, spent, factored
-        if not np.any(q):
+        rays = ray_problem(P, q, A, lb, ub, cones)
+        if not np.any(q) or not _dense_path(rays):
             return None
-        result = auxiliary.solve(*ray_problem(P, q, A, lb, ub, cones))
+        result = auxiliary.solve(*rays)
         spent, factored = spent + result.iterations, factored + result.factorizations
         if not np.all(np.isfinite(result.x)):
             return None
