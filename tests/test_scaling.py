@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 from fccqp.projections import project_constraint_set
-from fccqp.scaling import CAPPED_PASSES, MAX_NORM, MIN_NORM, RESCALE_DRIFT
+from fccqp.scaling import CAPPED_PASSES, GAUGE_LIMIT, MAX_NORM, MIN_NORM, RESCALE_DRIFT
 from fccqp.scaling import equilibrate_py as equilibrate
 from fccqp.scaling import rescale_py as rescale
 from fccqp.scaling import scale_start_py as scale_start
@@ -89,6 +89,24 @@ def test_variables_scaled_by_1e_8_to_1e8_are_equilibrated(seed):
     c = equilibrate(P_s, q, A_s, b, start, dim, 4, D, E)
     norms = scaled_norms(P_s, A_s, c)
     assert 0.25 <= norms.min() and norms.max() <= 4.0
+
+
+@pytest.mark.parametrize("factor", [1e10, 1e12, 1e15])
+def test_rows_scaled_by_1e10_and_more_leave_the_variables_their_scale(factor):
+    """Ruiz split rows of ``A`` scaled by ``factor`` between ``E`` and ``D``: the scaled
+    variables grew by ``sqrt(factor)`` and the cost shrank by as much, and rho hit its
+    floor on such feasible fuzz problems (``A huge``). ``D`` keeps its scale now
+    (``GAUGE_LIMIT``), with ``A_s`` as balanced and ``D P D`` at most 1."""
+    rng = np.random.default_rng(0)
+    n, m = 8, 3
+    M = rng.standard_normal((n, n))
+    P_s, A_s = M @ M.T / n, factor * rng.standard_normal((m, n))
+    q, b = rng.standard_normal(n), factor * rng.standard_normal(m)
+    D, E = np.empty(n), np.empty(m)
+    start = dim = np.zeros(0, dtype=np.intp)
+    c = equilibrate(P_s, q, A_s, b, start, dim, 4, D, E)
+    assert 1 / GAUGE_LIMIT <= np.exp(np.log(D).mean()) <= GAUGE_LIMIT
+    assert np.abs(A_s).max(axis=1).max() <= 4.0 and np.abs(P_s).max() / c <= 1.0
 
 
 def test_warm_start_and_unscaling_are_inverse():

@@ -45,8 +45,15 @@ CAPPED_PASSES = 20
 """Passes in which a column or row norm exceeded ``MAX_NORM`` (their correction was
 capped) do not count toward ``Settings.scaling``, up to this many: data off by 1e11
 (``A`` scaled by 1e10-1e15 in the fuzzer) needed more than four passes of at most 100x."""
+GAUGE_LIMIT = 1e3
+"""When the column scales' geometric mean ends below ``1 / GAUGE_LIMIT`` (rows of ``A``
+scaled by 1e10-1e15 split their size between ``E`` and ``D``), all of ``D`` is
+multiplied and ``E`` divided by a power of two toward a mean of 1, as far as ``D P D``
+stays at most 1: ``A_s`` is unchanged, and the scaled variables are no longer 1e7
+with a cost of 1e-7 that drove rho to its floor (see :func:`equilibrate`)."""
 cdef double _RESCALE_DRIFT = RESCALE_DRIFT
 cdef Py_ssize_t _CAPPED_PASSES = CAPPED_PASSES
+cdef double _GAUGE_LIMIT = GAUGE_LIMIT
 cdef double _MIN_NORM = MIN_NORM
 cdef double _MAX_NORM = MAX_NORM
 cdef double _MIN_COST_NORM = MIN_COST_NORM
@@ -135,6 +142,8 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
             D[j] *= d[j]
         for i in range(m):
             E[i] *= e[i]
+    if m > 0 and passes > 0:
+        _gauge(P, D, E, n, m)
     for i in range(n):
         row = P + i * n
         for j in range(n):
@@ -145,6 +154,37 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
             A[i * n + j] *= E[i] * D[j]
         b[i] *= E[i]
     return _normalize_cost(P, q, n, d)
+
+
+cdef void _gauge(const double* P, double* D, double* E, Py_ssize_t n,
+                 Py_ssize_t m) noexcept nogil:
+    """Ruiz leaves ``(D t, E / t)`` free: ``E A D`` is the same for every ``t``. Rows of
+    ``A`` 1e15 times the rest split that size between ``E`` and ``D`` (about 1e-7.5
+    each): the scaled variables were then 1e7 and the cost 1e-7 (``D q``, ``D P D`` of
+    1e-15), and OSQP's rule drove rho to ``RHO_MIN`` and the run stalled (six feasible
+    fuzz problems). When ``D``'s geometric mean is below ``1 / GAUGE_LIMIT``, ``t`` (a
+    power of two, exact) moves it toward 1 as far as ``D P D`` stays at most 1."""
+    cdef Py_ssize_t i, j
+    cdef double log_mean = 0.0, largest = 0.0, shift
+    cdef int exponent
+    for j in range(n):
+        log_mean += log(D[j])
+    log_mean /= n
+    if not log_mean < -log(_GAUGE_LIMIT):
+        return
+    shift = -log_mean
+    for i in range(n):
+        for j in range(n):
+            largest = max(largest, fabs(P[i * n + j]) * D[i] * D[j])
+    if largest > 0.0:
+        shift = min(shift, -0.5 * log(largest))
+    exponent = <int>(shift / log(2.0))
+    if exponent <= 0:
+        return
+    for j in range(n):
+        D[j] = ldexp(D[j], exponent)
+    for i in range(m):
+        E[i] = ldexp(E[i], -exponent)
 
 
 cdef inline double _cost_scale(double mean_col, double q_norm) noexcept nogil:
