@@ -8,6 +8,10 @@ Clarabel at tight tolerance.
 
 from __future__ import annotations
 
+import os
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -302,3 +306,24 @@ def test_no_auxiliary_solve_under_a_time_limit():
     problem = capped_friction_cone(0.3, 1e-3, 0.3)
     result = fccqp.solve(*problem.args(), max_iter=300, time_limit=10.0)
     assert result.status is Status.MAX_ITER_REACHED and result.iterations == 300
+
+
+MAROS_MESZAROS = Path(os.environ.get("FCCQP_MAROS_MESZAROS", "/work/data/maros_meszaros/data"))
+"""The .mat files of qpsolvers/maros_meszaros_qpbenchmark (not in this repository)."""
+
+
+@pytest.mark.skipif(not MAROS_MESZAROS.is_dir(), reason="no Maros-Meszaros data")
+@pytest.mark.parametrize("name", ["QSCORPIO", "QE226"])
+def test_no_auxiliary_certificate_on_public_qps_with_an_optimum(name):
+    """Both have an optimum and stall at 4000 iterations without a time limit. The
+    least-distance solve of QSCORPIO ended PRIMAL_INFEASIBLE on rounding noise, and the
+    ray solve of QE226 returned a ``d`` of 1e-5 within its tolerance of 0: both passed
+    the run's tests as certificates. The auxiliary solution must now be SOLVED and meet
+    its identity (``fccqp.auxiliary.IDENTITY``)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
+    import maros_meszaros
+    import qpsolvers
+
+    problem = maros_meszaros.load_problem(MAROS_MESZAROS / f"{name}.mat")[0]
+    solution = qpsolvers.solve_problem(problem, solver="fccqp", eps_abs=1e-3, eps_rel=0.0)
+    assert not solution.extras["status"].is_infeasible()

@@ -103,6 +103,43 @@ def _dense_path(problem: tuple) -> bool:
     return problem[0].shape[0] + problem[2].shape[0] <= MAX_DENSE_KKT_ROWS
 
 
+IDENTITY = 1e-3
+"""The auxiliary solution must meet its identity (``b'y + sigma_C(z_u) = -||x_S - u||^2``,
+``q'd = -||d||^2``) to this fraction of ``||.||^2``: a point within the auxiliary solve's
+tolerance of a zero solution (a feasible or bounded problem) does not, whatever its
+residuals. Without it, on Maros-Meszaros QE226 (which has an optimum) a ray solve's
+``d`` of 1e-5 with ``q'd`` of -0.87 ``|q||d|`` passed the dual tests."""
+
+
+def _least_distance(result: object, b: np.ndarray, low: np.ndarray, high: np.ndarray,
+                    n: int) -> bool:
+    """Whether the least-distance solve ended SOLVED, finite, at a positive distance
+    that its multipliers' separation equals (duality): on QSCORPIO (Maros-Meszaros, an
+    optimum) the solve itself ended PRIMAL_INFEASIBLE on rounding noise, and its ``y``
+    passed the Farkas tests."""
+    if result.status is not Status.SOLVED:
+        return False
+    if not (np.all(np.isfinite(result.x)) and np.all(np.isfinite(result.y))
+            and np.all(np.isfinite(result.z))):
+        return False
+    w = result.z[n:]
+    distance = float(w @ w)
+    up, down = np.maximum(w, 0.0), np.minimum(w, 0.0)
+    support = float(np.where(np.isfinite(high), high, 0.0) @ up
+                    + np.where(np.isfinite(low), low, 0.0) @ down)
+    separation = float(b @ result.y) + support
+    return distance > 0.0 and abs(separation + distance) <= IDENTITY * distance
+
+
+def _moreau(d: np.ndarray, q: np.ndarray) -> bool:
+    """Whether ``d`` is finite, nonzero and meets ``q'd = -||d||^2``, as the projection of
+    ``-q`` onto the rays does."""
+    if not np.all(np.isfinite(d)):
+        return False
+    norm = float(d @ d)
+    return norm > 0.0 and abs(float(q @ d) + norm) <= IDENTITY * norm
+
+
 def stalled_certificate(solver_type: type, settings: object, workspace: object,
                         P: object, q: object, A: object, b: object, lb: object,
                         ub: object, cones: object) -> tuple | None:
@@ -129,7 +166,7 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
             if S.size and _dense_path(problem):
                 result = auxiliary.solve(*problem)
                 spent, factored = spent + result.iterations, factored + result.factorizations
-                if np.all(np.isfinite(result.y)) and np.all(np.isfinite(result.z)):
+                if _least_distance(result, b, lb[S], ub[S], n):
                     candidate = np.zeros(m + n)
                     candidate[:m] = result.y
                     candidate[m + S] = result.z[n:]
@@ -142,7 +179,7 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
             return None
         result = auxiliary.solve(*rays)
         spent, factored = spent + result.iterations, factored + result.factorizations
-        if not np.all(np.isfinite(result.x)):
+        if not _moreau(result.x, rays[1]):
             return None
         found = workspace.judge_certificate(np.ascontiguousarray(result.x), False)
         if found is None:
