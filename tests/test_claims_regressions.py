@@ -175,13 +175,16 @@ def test_diverging_full_form_iterate_keeps_the_equalities():
     when its iterate misses it beyond factorization accuracy. Found with OSQP's 10 Ruiz
     passes, kept there (with the default 4 the problem is certified, verified); with
     cleaned certificates it is certified there too after 680 iterations, so the budget
-    stops it at 500, |x| = 1.3e6."""
+    stops it at 500, |x| = 1.3e6: under a time limit, which leaves the stalled run as it
+    is; without one, the least-distance QP of ``fccqp.auxiliary`` certifies it."""
     assert solve(DIVERGING_FULL_FORM)[1].status is Status.PRIMAL_INFEASIBLE
     assert solve(DIVERGING_FULL_FORM, scaling=10)[1].status is Status.PRIMAL_INFEASIBLE
-    problem, result = solve(DIVERGING_FULL_FORM, scaling=10, max_iter=500)
+    problem, result = solve(DIVERGING_FULL_FORM, scaling=10, max_iter=500, time_limit=100.0)
     assert result.status is Status.MAX_ITER_REACHED
     assert np.abs(result.x).max() > 1e6
     assert clarabel_solve(*problem.args()).status == "primal_infeasible"
+    assert solve(DIVERGING_FULL_FORM, scaling=10, max_iter=500)[1].status is (
+        Status.PRIMAL_INFEASIBLE)
 
 
 def test_claimed_residual_of_a_large_cone_block():

@@ -20,15 +20,17 @@ DENSE_BACKENDS = ("auto", "schur_reduced", "ldl_reduced", "ldl_full")
 SEEDS = {
     "bad_input": (0, 1, 2, 3, 4, 5),
     "feasible": (0, 1, 2, 3, 4, 5),
-    "primal_infeasible": (0, 1, 2, 3, 80),
-    "dual_infeasible": (0, 1, 2, 33, 257),
-    "solver_reuse": (0, 1, 2, 211),
-    "extreme_data": (0, 1, 38, 138, 202, 254, 326, 335),
+    "primal_infeasible": (0, 1, 2, 3, 80, 146, 177, 182, 350),
+    "dual_infeasible": (0, 1, 2, 33, 166, 257, 368),
+    "solver_reuse": (0, 1, 2, 50, 164, 211),
+    "extreme_data": (0, 1, 7, 9, 38, 47, 56, 108, 138, 149, 202, 214, 254, 302, 308, 316,
+                     326, 335, 337, 355, 363, 365),
     "qpsolvers": (0, 1, 2),
     "cvxpy": (1, 2, 3),
 }
 """Seeds per class run on every dense backend: a passing case or two per class and the
-reproducers of the failure mechanisms the campaign found at ed3b90e (issue 26)."""
+reproducers of the failure mechanisms the campaign found at ed3b90e and 836ab4b (issue
+26)."""
 
 SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),
@@ -39,17 +41,9 @@ SPARSE_SEEDS = {
 """Seeds per class run on the sparse path (each ends within a few dozen iterations)."""
 
 OPEN = {
-    "primal_infeasible:3": "a tilted friction cone beside a boxed entry: the multipliers' "
-    "steps reach the certificates too slowly even after cleaning",
-    "primal_infeasible:80": "a tilted friction cone beside a boxed entry: the multipliers' "
-    "steps reach the certificates too slowly even after cleaning",
-    "dual_infeasible:33": "a reduced backend factors a numerically singular P + R "
-    "(null direction off the axes): |x| of 1e17 and no direction passes",
-    "dual_infeasible:257": "a second-order-cone ray stalls in the full form",
     "solver_reuse:211": "sigma in scaled units decides convexity: a fresh solve accepts "
     "-3.9e-3 curvature that a kept workspace rejects",
     "extreme_data:138": "SOLVED through the absolute tolerance on a cone block rescaled by 1e-8",
-    "extreme_data:335": "four Ruiz passes leave A x 1e11 badly scaled: rho pinned at its cap",
     "cvxpy:1": "a feasible problem whose dual residual stalls near 0.8 in the LDL' forms "
     "with adaptive rho",
     "solver_reuse:38": "the sparse path's first factorization breaks down on dependent rows",
@@ -57,9 +51,7 @@ OPEN = {
 }
 """Reproducers of mechanisms still open (issue 26), each the reason it fails: expected
 to fail (strictly) on the backends where it does, so that a fix turns them red."""
-OPEN_BACKENDS = {"dual_infeasible:33": ("auto", "schur_reduced", "ldl_reduced"),
-                 "dual_infeasible:257": ("auto", "ldl_full"),
-                 "cvxpy:1": ("auto", "ldl_reduced", "ldl_full")}
+OPEN_BACKENDS = {"cvxpy:1": ("auto", "ldl_reduced", "ldl_full")}
 """Where an open case fails on some backends only."""
 
 

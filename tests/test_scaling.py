@@ -8,7 +8,7 @@ from fccqp.scaling import rescale_py as rescale
 from fccqp.scaling import scale_start_py as scale_start
 from fccqp.scaling import scaled_norms_py as scaled_norms
 from fccqp.scaling import unscale_py as unscale
-from fccqp.tuning import MAX_NORM, MIN_NORM, RESCALE_DRIFT
+from fccqp.tuning import CAPPED_PASSES, GAUGE_LIMIT, MAX_NORM, MIN_NORM, RESCALE_DRIFT
 
 
 def _inverse_sqrt(norm):
@@ -18,11 +18,18 @@ def _inverse_sqrt(norm):
 def _ruiz(P, q, A, blocks, iterations):
     n, m = P.shape[0], A.shape[0]
     D, E = np.ones(n), np.ones(m)
-    for _ in range(iterations):
+    done, passes = 0, iterations
+    while done < passes:
+        done += 1
         P_s = D[:, None] * P * D[None, :]
         A_s = E[:, None] * A * D[None, :]
-        d = _inverse_sqrt(np.maximum(np.abs(P_s).max(axis=0), np.abs(A_s).max(axis=0, initial=0.0)))
-        e = _inverse_sqrt(np.abs(A_s).max(axis=1, initial=0.0))
+        columns = np.maximum(np.abs(P_s).max(axis=0), np.abs(A_s).max(axis=0, initial=0.0))
+        rows = np.abs(A_s).max(axis=1, initial=0.0)
+        if max(columns.max(), rows.max(initial=0.0)) > MAX_NORM and (
+                passes < iterations + CAPPED_PASSES):
+            passes += 1   # a pass whose correction was capped does not count
+        d = _inverse_sqrt(columns)
+        e = _inverse_sqrt(rows)
         for start, dim in blocks:
             d[start : start + dim] = np.exp(np.log(d[start : start + dim]).mean())
         D, E = D * d, E * e
@@ -63,6 +70,43 @@ def test_equilibrate_matches_its_definition(seed, n, m, iterations):
     np.testing.assert_allclose(A_s, E[:, None] * A * D[None, :], rtol=1e-12, atol=1e-300)
     np.testing.assert_allclose(b_s, E * b, rtol=1e-12)
     assert np.ptp(D[2:5]) <= 1e-12 * D[2]  # a cone block keeps one scale
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_variables_scaled_by_1e_8_to_1e8_are_equilibrated(seed):
+    """Each pass corrects a norm by at most ``sqrt(MAX_NORM)`` = 100x, so four passes
+    left variables rescaled by 1e-8 to 1e8 with column norms of 1e-4 (and ADMM ran 4000
+    iterations on such feasible problems of the fuzzer's ``extreme_data``). Passes whose
+    correction was capped no longer count toward ``scaling``."""
+    rng = np.random.default_rng(seed)
+    n, m = 8, 3
+    M = rng.standard_normal((n, n))
+    s = 10.0 ** np.linspace(-8, 8, n)
+    P_s, A_s = (M @ M.T / n) * np.outer(s, s), rng.standard_normal((m, n)) * s
+    q, b = rng.standard_normal(n) * s, rng.standard_normal(m)
+    D, E = np.empty(n), np.empty(m)
+    start = dim = np.zeros(0, dtype=np.intp)
+    c = equilibrate(P_s, q, A_s, b, start, dim, 4, D, E)
+    norms = scaled_norms(P_s, A_s, c)
+    assert 0.25 <= norms.min() and norms.max() <= 4.0
+
+
+@pytest.mark.parametrize("factor", [1e10, 1e12, 1e15])
+def test_rows_scaled_by_1e10_and_more_leave_the_variables_their_scale(factor):
+    """Ruiz split rows of ``A`` scaled by ``factor`` between ``E`` and ``D``: the scaled
+    variables grew by ``sqrt(factor)`` and the cost shrank by as much, and rho hit its
+    floor on such feasible fuzz problems (``A huge``). ``D`` keeps its scale now
+    (``GAUGE_LIMIT``), with ``A_s`` as balanced and ``D P D`` at most 1."""
+    rng = np.random.default_rng(0)
+    n, m = 8, 3
+    M = rng.standard_normal((n, n))
+    P_s, A_s = M @ M.T / n, factor * rng.standard_normal((m, n))
+    q, b = rng.standard_normal(n), factor * rng.standard_normal(m)
+    D, E = np.empty(n), np.empty(m)
+    start = dim = np.zeros(0, dtype=np.intp)
+    c = equilibrate(P_s, q, A_s, b, start, dim, 4, D, E)
+    assert 1 / GAUGE_LIMIT <= np.exp(np.log(D).mean()) <= GAUGE_LIMIT
+    assert np.abs(A_s).max(axis=1).max() <= 4.0 and np.abs(P_s).max() / c <= 1.0
 
 
 def test_warm_start_and_unscaling_are_inverse():

@@ -8,6 +8,10 @@ Clarabel at tight tolerance.
 
 from __future__ import annotations
 
+import os
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -235,3 +239,91 @@ def test_a_start_that_fails_in_half_the_budget_restarts_cold(max_iter, restarted
         assert result.status is Status.SOLVED and result.iterations == max_iter // 2
     else:
         assert result.status is Status.MAX_ITER_REACHED
+
+
+def capped_friction_cone(mu: float, gap: float, tilt: float) -> Problem:
+    """A friction cone whose normal is tilted by ``tilt``, its normal force tied by a row
+    to a boxed entry ``s`` in ``[0, 1.5]``, a second row asking a tangential force ``mu
+    1.5 (1 + gap)``: infeasible through the box and the cone together."""
+    normal = np.array([np.sin(tilt), 0.0, np.cos(tilt)])
+    tangent = np.array([np.cos(tilt), 0.0, -np.sin(tilt)])
+    A = np.zeros((2, 5))
+    A[0, :3], A[0, 4], A[1, :3] = normal, -1.0, tangent
+    q = np.random.default_rng(0).standard_normal(5)
+    return Problem.of(np.eye(5), q, A, [0.0, 1.5 * mu * (1 + gap)],
+                      [-np.inf, -np.inf, -np.inf, -1.0, 0.0], [np.inf, np.inf, np.inf, 2.0, 1.5],
+                      [FrictionCone(0, mu, tuple(normal))])
+
+
+@pytest.mark.parametrize("backend", backends(sparse_fails=True))
+@pytest.mark.parametrize(("mu", "gap", "tilt"), [(0.3, 1e-3, 0.3), (0.8, 1e-4, 0.9)])
+def test_an_infeasible_run_that_stalls_is_certified(backend, mu, gap, tilt):
+    """Cut at 300 iterations, before the cleaning of ADMM's candidate starts, the run
+    stalled at MAX_ITER_REACHED (the fuzzing campaign's 21 infeasible stalls at 836ab4b
+    too, after the cleaning); the least-distance QP (``fccqp.auxiliary``) now gives the
+    certificate, which the run's own tests judge."""
+    problem = capped_friction_cone(mu, gap, tilt)
+    result = solve_verified(problem, kkt_backend=backend, max_iter=300)
+    assert result.status is Status.PRIMAL_INFEASIBLE
+    assert clarabel_solve(*problem.args()).status == "primal_infeasible"
+
+
+@pytest.mark.parametrize("backend", ["auto", "schur_reduced", "ldl_reduced", "ldl_full"])
+@pytest.mark.parametrize("seed", [166, 257, 368])
+def test_an_unbounded_run_that_stalls_is_certified(backend, seed):
+    """Rays of the fuzzer (``dual_infeasible``: a combination of free, one-sided and cone
+    entries; a ray along a second-order cone) that ran 4000 iterations uncertified at
+    836ab4b on some backend (257 on the full form): the projection of ``-q`` onto the
+    rays (``fccqp.auxiliary``) is a certificate, judged by the run's own tests."""
+    from fuzzing import Case
+
+    problem = Case.of("dual_infeasible", seed).scenario().problem
+    result = solve_verified(problem, kkt_backend=backend)
+    assert result.status is Status.DUAL_INFEASIBLE
+    assert clarabel_solve(*problem.args()).status == "dual_infeasible"
+
+
+@pytest.mark.parametrize("max_iter", [1, 3, 10, 30])
+def test_a_feasible_run_cut_short_is_not_certified(max_iter):
+    """A run that stalls asks the auxiliary QPs for certificates; on feasible, bounded
+    problems (the fuzzer's, with active and weakly active cones and bounds, singular
+    ``P``, dependent rows) their candidates must not pass, however short the run."""
+    from fuzzing import Case
+
+    claims = []
+    for seed in range(40):
+        problem = Case.of("feasible", seed).scenario().problem
+        result = fccqp.solve(*problem.args(), max_iter=max_iter)
+        verify_solution(problem, result)
+        if result.status.is_infeasible():
+            claims.append((seed, result.status.name))
+    assert claims == []
+
+
+def test_no_auxiliary_solve_under_a_time_limit():
+    """Under a time limit (the control loop) a run that stalls returns as it is: the
+    auxiliary solves would take the next tick's time."""
+    problem = capped_friction_cone(0.3, 1e-3, 0.3)
+    result = fccqp.solve(*problem.args(), max_iter=300, time_limit=10.0)
+    assert result.status is Status.MAX_ITER_REACHED and result.iterations == 300
+
+
+MAROS_MESZAROS = Path(os.environ.get("FCCQP_MAROS_MESZAROS", "/work/data/maros_meszaros/data"))
+"""The .mat files of qpsolvers/maros_meszaros_qpbenchmark (not in this repository)."""
+
+
+@pytest.mark.skipif(not MAROS_MESZAROS.is_dir(), reason="no Maros-Meszaros data")
+@pytest.mark.parametrize("name", ["QSCORPIO", "QE226"])
+def test_no_auxiliary_certificate_on_public_qps_with_an_optimum(name):
+    """Both have an optimum and stall at 4000 iterations without a time limit. The
+    least-distance solve of QSCORPIO ended PRIMAL_INFEASIBLE on rounding noise, and the
+    ray solve of QE226 returned a ``d`` of 1e-5 within its tolerance of 0: both passed
+    the run's tests as certificates. The auxiliary solution must now be SOLVED and meet
+    its identity (``fccqp.auxiliary.IDENTITY``)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
+    import maros_meszaros
+    import qpsolvers
+
+    problem = maros_meszaros.load_problem(MAROS_MESZAROS / f"{name}.mat")[0]
+    solution = qpsolvers.solve_problem(problem, solver="fccqp", eps_abs=1e-3, eps_rel=0.0)
+    assert not solution.extras["status"].is_infeasible()

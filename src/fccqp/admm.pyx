@@ -20,14 +20,18 @@ from cpython.buffer cimport PyBuffer_Release
 from libc.math cimport isfinite
 
 from fccqp cimport engine
+from fccqp._dense cimport fill
+from fccqp._types cimport Problem
 from fccqp.anderson cimport anderson_reset
 from fccqp.blas_threads cimport enter, leave
+from fccqp.certificates cimport CERTIFIED, primal_candidate
 from fccqp.engine cimport CONE_ENTRY, Engine, Run, fccqp_now
 from fccqp.fast_checks cimport hold_dense, hold_float64
 from fccqp.kkt cimport AUTO, LDL_FULL, LDL_REDUCED, SCHUR_REDUCED
 from fccqp.scaled_run cimport scaled_run, unscaled_answer
 from fccqp.termination cimport Residuals
 from fccqp.tuning cimport FIXED_RHO_SCALE, RESERVE_DECAY, RESTART_MIN_ITER
+from fccqp.verdict cimport unbounded
 from fccqp.validation cimport (BOUNDED, FIXED_BOUND, SCAN_OK, UNBOUNDED, Finding, bound_kind,
                                scan_and_copy)
 
@@ -254,6 +258,52 @@ cdef class Workspace:
     def forget(self):
         """Drop the previous solution, so that the next solve starts cold."""
         self.e.prev.exists = False
+
+    def judge_certificate(self, const double[::1] candidate, bint primal,
+                          const double[::1] point=None):
+        """The certificate ``candidate`` (user's units, ``Result.certificate``'s layout:
+        ``(dy, dz)`` for ``primal``, else ``dx``), found outside the run (see
+        :mod:`fccqp.auxiliary`), judged by the tests of the run's own candidates on the
+        last solve's scaled problem; the certificate as it passed (the primal one's
+        ``dz`` projected onto the polar), or None. A primal certificate's separation
+        must exceed what its residual explains at ``point`` (user's units, with ``A x =
+        b``; default the run's iterate, which on a run that diverges along a ray, ``q``
+        of 4.5e14 beside a cone pinned outside itself, explained away an exact one)."""
+        cdef Engine* e = &self.e
+        cdef Problem* p = &e.prob
+        cdef Py_ssize_t n = p.n, m = p.m, i, j
+        cdef const double* x = e.it.x
+        if candidate.shape[0] != (n + m if primal else n):
+            raise ValueError("a certificate of the wrong size")
+        if primal:
+            if m == 0:
+                return None
+            if point is not None:
+                if point.shape[0] != n:
+                    raise ValueError("a point of the wrong size")
+                for i in range(n):
+                    e.work.vec_n3[i] = point[i] / p.D[i]
+                x = e.work.vec_n3
+            for i in range(m):
+                e.work.vec_m[i] = candidate[i] / p.E[i]
+            for j in range(p.s):
+                i = p.constrained[j]
+                e.work.vec_s[j] = candidate[m + i] * p.D[i]
+            if primal_candidate(p, x, e.work.vec_m, e.work.vec_s, e.opt.eps_prim_inf,
+                                e.work.vec_n, e.work.vec_n2) != CERTIFIED:
+                return None
+            fill(e.certs.cert, 0.0, n + m)
+            for i in range(m):
+                e.certs.cert[i] = e.work.vec_m[i] * p.E[i]
+            for j in range(p.s):
+                i = p.constrained[j]
+                e.certs.cert[m + i] = e.work.vec_s[j] / p.D[i]
+            return np.asarray(<double[:n + m]>e.certs.cert).copy()
+        for i in range(n):
+            e.certs.direction[i] = candidate[i] / p.D[i]
+        if not unbounded(e):
+            return None
+        return np.asarray(<double[:n]>e.certs.cert).copy()
 
     @property
     def finding(self):

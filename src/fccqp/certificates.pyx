@@ -99,6 +99,14 @@ cdef int primal_infeasible(const Problem* p, const Iterates* it, double eps, dou
     return _farkas(p, it.x, d_nu, d_y, eps, lhs, terms)
 
 
+cdef int primal_candidate(const Problem* p, const double* x, const double* d_nu,
+                          double* d_y, double eps, double* lhs, double* terms) noexcept nogil:
+    """:func:`primal_infeasible`'s tests on a candidate ``(d_nu, d_y)`` found otherwise
+    (scaled; ``d_y`` is projected onto the polar first), at the iterate ``x``."""
+    _onto_polar(p, d_y, terms)
+    return _farkas(p, x, d_nu, d_y, eps, lhs, terms)
+
+
 cdef void _onto_polar(const Problem* p, double* d_y, double* scratch) noexcept nogil:
     """Project ``d_y`` (s) onto the set where ``sigma_C`` is finite: each cone block onto
     its polar (``d_y - P_K(d_y)``), and a box entry's sign onto its finite bounds

@@ -34,7 +34,8 @@ class Result:
     obj: float
     """Objective ``1/2 x'Px + q'x`` at ``x``."""
     iterations: int
-    """ADMM iterations performed."""
+    """ADMM iterations performed (with those of the auxiliary solves that certified a
+    stalled run, see :mod:`fccqp.auxiliary`)."""
     prim_res: float
     """Primal residual of the returned ``x``: ``max(||Ax - b||, ||x_S - P_C(x_S)||)``
     (infinity norm), the second term its largest distance to the box and the cones."""

@@ -21,7 +21,8 @@ from libc.math cimport exp, fabs, ilogb, ldexp, log, sqrt
 
 from fccqp._types cimport Cones
 from fccqp.projections cimport proj_set
-from fccqp.tuning cimport MAX_NORM, MIN_COST_NORM, MIN_NORM, RESCALE_DRIFT
+from fccqp.tuning cimport (CAPPED_PASSES, GAUGE_LIMIT, MAX_NORM, MIN_COST_NORM, MIN_NORM,
+                           RESCALE_DRIFT)
 
 cdef extern from "fccqp_kernels.h" nogil:
     void fccqp_scale_rows(const double* M, int rows, int cols, const double* left,
@@ -64,9 +65,10 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
     once per pass and rescaled once at the end. ``block_start``/``block_dim`` give the
     cone blocks in ``x``; ``d`` and ``e`` are scratch of sizes ``n`` and ``m``.
     """
-    cdef Py_ssize_t it, i, j, k, a, t
-    cdef double value, log_mean
+    cdef Py_ssize_t it = 0, i, j, k, a, t, passes = iterations
+    cdef double value, log_mean, norm
     cdef const double* row
+    cdef bint capped
     for j in range(n):
         D[j] = 1.0
     for i in range(m):
@@ -75,7 +77,9 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
         # and A x = b to |b|, whatever the passes
         value = _row_max(A + i * n, D, n)
         E[i] = ldexp(1.0, -ilogb(value)) if 0.0 < value < MIN_NORM else 1.0
-    for it in range(iterations):
+    while it < passes:
+        it += 1
+        capped = False
         # column maxima accumulate row by row (independent per column: the loops vectorize)
         for j in range(n):
             d[j] = 0.0
@@ -89,9 +93,14 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
             row = A + i * n
             for j in range(n):
                 d[j] = max(d[j], fabs(row[j]) * D[j] * E[i])
-            e[i] = _inverse_sqrt_norm(_row_max(row, D, n) * E[i])
+            norm = _row_max(row, D, n) * E[i]
+            capped = capped or norm > MAX_NORM
+            e[i] = _inverse_sqrt_norm(norm)
         for j in range(n):
+            capped = capped or d[j] > MAX_NORM
             d[j] = _inverse_sqrt_norm(d[j])
+        if capped and passes < iterations + CAPPED_PASSES:
+            passes += 1
         for k in range(blocks):
             a, t = block_start[k], block_start[k] + block_dim[k]
             log_mean = 0.0
@@ -104,6 +113,8 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
             D[j] *= d[j]
         for i in range(m):
             E[i] *= e[i]
+    if m > 0 and passes > 0:
+        _gauge(P, D, E, n, m)
     for i in range(n):
         row = P + i * n
         for j in range(n):
@@ -114,6 +125,37 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
             A[i * n + j] *= E[i] * D[j]
         b[i] *= E[i]
     return _normalize_cost(P, q, n, d)
+
+
+cdef void _gauge(const double* P, double* D, double* E, Py_ssize_t n,
+                 Py_ssize_t m) noexcept nogil:
+    """Ruiz leaves ``(D t, E / t)`` free: ``E A D`` is the same for every ``t``. Rows of
+    ``A`` 1e15 times the rest split that size between ``E`` and ``D`` (about 1e-7.5
+    each): the scaled variables were then 1e7 and the cost 1e-7 (``D q``, ``D P D`` of
+    1e-15), and OSQP's rule drove rho to ``RHO_MIN`` and the run stalled (six feasible
+    fuzz problems). When ``D``'s geometric mean is below ``1 / GAUGE_LIMIT``, ``t`` (a
+    power of two, exact) moves it toward 1 as far as ``D P D`` stays at most 1."""
+    cdef Py_ssize_t i, j
+    cdef double log_mean = 0.0, largest = 0.0, shift
+    cdef int exponent
+    for j in range(n):
+        log_mean += log(D[j])
+    log_mean /= n
+    if not log_mean < -log(GAUGE_LIMIT):
+        return
+    shift = -log_mean
+    for i in range(n):
+        for j in range(n):
+            largest = max(largest, fabs(P[i * n + j]) * D[i] * D[j])
+    if largest > 0.0:
+        shift = min(shift, -0.5 * log(largest))
+    exponent = <int>(shift / log(2.0))
+    if exponent <= 0:
+        return
+    for j in range(n):
+        D[j] = ldexp(D[j], exponent)
+    for i in range(m):
+        E[i] = ldexp(E[i], -exponent)
 
 
 cdef inline double _cost_scale(double mean_col, double q_norm) noexcept nogil:

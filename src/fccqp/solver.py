@@ -12,17 +12,19 @@ every problem with ``kkt_backend="sparse"``, go to the sparse path
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Sequence
 
 import numpy as np
 
-from fccqp import admm, schur
+from fccqp import admm, auxiliary, schur
 from fccqp.cones import Cone, ConeArrays, flatten_cones
 from fccqp.fast_checks import dense_arguments, same_cones
 from fccqp.problem import check_cone_bounds, convert, raise_finding
 from fccqp.result import Result
 from fccqp.settings import MAX_DENSE_KKT_ROWS, Settings
+from fccqp.status import Status
 from fccqp.tuning import MAX_ENTRY
 from fccqp.validation import structure_scan
 
@@ -107,6 +109,7 @@ class Solver:
         self._kept: dict[tuple[object, ...], admm.Workspace] = {}   # oldest first
         self._sparse = None   # the sparse path's workspace, made on its first problem
         self._cones: object = None   # the cones argument of the last dense solve
+        self._stalled_certificates = True   # False in fccqp.auxiliary's own solves
 
     @property
     def settings(self) -> Settings:
@@ -183,7 +186,8 @@ class Solver:
             # the control loop: the caller's arrays as they came, checked by the solve
             out = w.solve(P, q, A, b, lb, ub, None, settings.warm_start, start,
                           structure.certificate, False)
-            if type(out) is Result and not settings.verbose:
+            if (type(out) is Result and not settings.verbose
+                    and out.status is not Status.MAX_ITER_REACHED):
                 return out
             if type(out) is Result or out != admm.NOT_DENSE:
                 return self._result(out, P, q, A, b, lb, ub, None, start)
@@ -233,9 +237,32 @@ class Solver:
                 f"(P is not positive semidefinite: its smallest eigenvalue is "
                 f"{np.linalg.eigvalsh((P + P.T) / 2)[0]:.3g})"
             )
+        if (out.status is Status.MAX_ITER_REACHED and self._stalled_certificates
+                and not math.isfinite(settings.time_limit)):
+            out = self._stalled(out, P, q, A, b, lb, ub, start)
         if settings.verbose:
             _print_log(w.log_lines, out)
         return out
+
+    def _stalled(self, out: Result, P: object, q: object, A: object, b: object,
+                 lb: object, ub: object, start: float) -> Result:
+        """``out`` of a run that stalled (``MAX_ITER_REACHED``), or the certificate that
+        :func:`fccqp.auxiliary.stalled_certificate` found for it instead (its solves'
+        iterations and factorizations added); a certified problem leaves no previous
+        solution to start from, as an infeasible run does."""
+        found = auxiliary.stalled_certificate(Solver, self._settings, self._workspace, P, q,
+                                              A, b, lb, ub, self._cones)
+        if found is None:
+            return out
+        status, certificate, iterations, factorizations = found
+        self._workspace.forget()
+        return Result._of({
+            **out.__dict__, "status": status, "certificate": certificate,
+            "iterations": out.iterations + iterations,
+            "factorizations": out.factorizations + factorizations,
+            "gap": float("nan"), "polished": False,
+            "solve_time": time.perf_counter() - start,
+        })
 
     def _adopt(self, structure: _Structure) -> admm.Workspace:
         """Make ``structure`` and a workspace for it current, keeping the current one

@@ -28,6 +28,10 @@ cdef extern from *:
     #define FCCQP_MIN_COST_NORM 1e-4
     /* rescale keeps an old scaling while every norm stays within this factor (~1 pass) */
     #define FCCQP_RESCALE_DRIFT 4.0
+    /* Ruiz passes whose correction hit MAX_NORM's cap do not count, up to this many more */
+    #define FCCQP_CAPPED_PASSES 20
+    /* D's geometric mean below 1 / this: D up, E down by a power of two (as far as D P D <= 1) */
+    #define FCCQP_GAUGE_LIMIT 1e3
 
     /* ---- Factorization of the ADMM KKT system (fccqp.ldl, fccqp.schur, fccqp.kkt) ---- */
     /* quasi-definite regularization of LDL's (2, 2) block (scaled): refinement removes it */
@@ -161,6 +165,8 @@ cdef extern from *:
     const double MAX_NORM "FCCQP_MAX_NORM"
     const double MIN_COST_NORM "FCCQP_MIN_COST_NORM"
     const double RESCALE_DRIFT "FCCQP_RESCALE_DRIFT"
+    const long CAPPED_PASSES "FCCQP_CAPPED_PASSES"
+    const double GAUGE_LIMIT "FCCQP_GAUGE_LIMIT"
     # Factorization
     const double KKT_DELTA "FCCQP_KKT_DELTA"
     const int MAX_REFINE "FCCQP_MAX_REFINE"

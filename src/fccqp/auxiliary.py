@@ -1,0 +1,189 @@
+"""Certificates for runs that stalled, from two auxiliary QPs of fccqp's own class.
+
+ADMM's successive differences reach an infeasibility certificate only like ``1/k``
+where the certificate set is thin (a tilted friction cone beside a boxed entry, cones
+pinned outside their sum by a gap of 1e-4: 4000 iterations and the cleaning of
+:func:`fccqp.certificates.clean_primal_certificate` left them uncertified). When a run
+ends at ``MAX_ITER_REACHED`` without a time limit, :class:`fccqp.Solver` asks for a
+certificate directly, each by a strongly posed QP that fccqp solves (with its polish,
+in a few dozen iterations on the fuzzing campaign's stalls):
+
+- primal: the least distance between ``{x: A x = b}`` and the constraint set,
+  ``min 1/2 ||x_S - u||^2`` s.t. ``A x = b``, ``u`` in C (the box and the cones). Its
+  multipliers ``(y, z_u)`` satisfy ``A'y + E_S'z_u = 0`` and ``b'y + sigma_C(z_u) =
+  -||x_S - u||^2``: a Farkas certificate whenever the distance is positive (the dual of
+  the least-distance problem is the certificate problem), its separation weighed
+  against what the residual explains at the nearest ``x`` (not the run's iterate, which
+  may be diverging along a ray);
+- dual: the projection of ``-q`` onto the cone of rays, ``min 1/2 ||d||^2 + q'd`` s.t.
+  ``P d = 0``, ``A d = 0``, ``d`` in the recession cone of C, which by Moreau has
+  ``q'd = -||d||^2``: a ray of descent whenever it is not zero.
+
+Neither is trusted as it comes: each candidate passes the tests the run's own
+candidates take, on the run's scaled problem (:meth:`fccqp.admm.Workspace.judge_certificate`),
+or the run keeps its status. On a feasible, bounded problem the distance and the
+projection are zero, and what the auxiliary solves return does not separate.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from fccqp.cones import FrictionCone, SecondOrderCone
+from fccqp.problem import INFINITE_BOUND
+from fccqp.settings import MAX_DENSE_KKT_ROWS
+from fccqp.status import Status
+
+
+def _dense(matrix: object, rows: int, n: int) -> np.ndarray:
+    if matrix is None:
+        return np.zeros((rows, n))
+    return np.asarray(matrix, dtype=np.float64).reshape(rows, n)
+
+
+def _bounds(lb: object, ub: object, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The bounds with ``None`` and entries beyond ``INFINITE_BOUND`` as infinite."""
+    low = np.full(n, -np.inf) if lb is None else np.array(lb, dtype=np.float64).reshape(n)
+    high = np.full(n, np.inf) if ub is None else np.array(ub, dtype=np.float64).reshape(n)
+    low[low <= -INFINITE_BOUND] = -np.inf
+    high[high >= INFINITE_BOUND] = np.inf
+    return low, high
+
+
+def _cone_tuple(cones: object) -> tuple:
+    if isinstance(cones, (FrictionCone, SecondOrderCone)):
+        return (cones,)
+    return tuple(cones or ())
+
+
+def distance_problem(A: np.ndarray, b: np.ndarray, lb: np.ndarray, ub: np.ndarray,
+                     cones: tuple) -> tuple[tuple, np.ndarray]:
+    """The least-distance QP in the variables ``(x, u)``, ``u`` a copy of the
+    constrained entries ``S`` (in their order, so cone blocks stay contiguous), and
+    ``S``."""
+    n = A.shape[1]
+    member = np.zeros(n, dtype=bool)
+    for cone in cones:
+        member[cone.start:cone.start + cone.dim] = True
+    S = np.flatnonzero(member | np.isfinite(lb) | np.isfinite(ub))
+    s = S.size
+    position = np.full(n, -1)
+    position[S] = np.arange(s)
+    E = np.zeros((s, n))
+    E[np.arange(s), S] = 1.0
+    P = np.block([[E.T @ E, -E.T], [-E, np.eye(s)]])
+    A_ext = np.hstack([A, np.zeros((A.shape[0], s))])
+    lb_ext = np.concatenate([np.full(n, -np.inf), lb[S]])
+    ub_ext = np.concatenate([np.full(n, np.inf), ub[S]])
+    moved = [dataclasses.replace(c, start=n + int(position[c.start])) for c in cones]
+    return (P, np.zeros(n + s), A_ext, b, lb_ext, ub_ext, moved), S
+
+
+def ray_problem(P: np.ndarray, q: np.ndarray, A: np.ndarray, lb: np.ndarray,
+                ub: np.ndarray, cones: tuple) -> tuple:
+    """The projection of ``-q`` onto the rays: ``P``'s nonzero rows and ``A``'s as
+    equalities asking 0, each entry's bounds at 0 on their finite sides (the box's
+    recession cone), the same cones; ``q`` scaled by a power of two to largest entry
+    about 1 (the projection is homogeneous)."""
+    n = q.shape[0]
+    rows = np.vstack([P[np.abs(P).max(axis=1, initial=0.0) > 0], A])
+    largest = float(np.abs(q).max(initial=0.0))
+    q = q * 2.0 ** -math.frexp(largest)[1] if largest > 0 else q
+    low = np.where(np.isfinite(lb), 0.0, -np.inf)
+    high = np.where(np.isfinite(ub), 0.0, np.inf)
+    return (np.eye(n), q, rows, np.zeros(rows.shape[0]), low, high, list(cones))
+
+
+def _dense_path(problem: tuple) -> bool:
+    """Whether an auxiliary problem stays on the dense path (its KKT matrix has up to
+    twice the rows of the run's: on the sparse path it would cost far more)."""
+    return problem[0].shape[0] + problem[2].shape[0] <= MAX_DENSE_KKT_ROWS
+
+
+IDENTITY = 1e-3
+"""The auxiliary solution must meet its identity (``b'y + sigma_C(z_u) = -||x_S - u||^2``,
+``q'd = -||d||^2``) to this fraction of ``||.||^2``: a point within the auxiliary solve's
+tolerance of a zero solution (a feasible or bounded problem) does not, whatever its
+residuals. Without it, on Maros-Meszaros QE226 (which has an optimum) a ray solve's
+``d`` of 1e-5 with ``q'd`` of -0.87 ``|q||d|`` passed the dual tests."""
+
+
+def _least_distance(result: object, b: np.ndarray, low: np.ndarray, high: np.ndarray,
+                    n: int) -> bool:
+    """Whether the least-distance solve ended SOLVED, finite, at a positive distance
+    that its multipliers' separation equals (duality): on QSCORPIO (Maros-Meszaros, an
+    optimum) the solve itself ended PRIMAL_INFEASIBLE on rounding noise, and its ``y``
+    passed the Farkas tests."""
+    if result.status is not Status.SOLVED:
+        return False
+    if not (np.all(np.isfinite(result.x)) and np.all(np.isfinite(result.y))
+            and np.all(np.isfinite(result.z))):
+        return False
+    w = result.z[n:]
+    distance = float(w @ w)
+    up, down = np.maximum(w, 0.0), np.minimum(w, 0.0)
+    support = float(np.where(np.isfinite(high), high, 0.0) @ up
+                    + np.where(np.isfinite(low), low, 0.0) @ down)
+    separation = float(b @ result.y) + support
+    return distance > 0.0 and abs(separation + distance) <= IDENTITY * distance
+
+
+def _moreau(d: np.ndarray, q: np.ndarray) -> bool:
+    """Whether ``d`` is finite, nonzero and meets ``q'd = -||d||^2``, as the projection of
+    ``-q`` onto the rays does."""
+    if not np.all(np.isfinite(d)):
+        return False
+    norm = float(d @ d)
+    return norm > 0.0 and abs(float(q @ d) + norm) <= IDENTITY * norm
+
+
+def stalled_certificate(solver_type: type, settings: object, workspace: object,
+                        P: object, q: object, A: object, b: object, lb: object,
+                        ub: object, cones: object) -> tuple | None:
+    """``(status, certificate, iterations, factorizations)`` for a run that stalled on
+    this problem in ``workspace``, or None: the primal certificate of the least
+    distance (when there are rows and constrained entries), else the dual one of the
+    projection onto the rays, each judged by ``workspace``. The auxiliary solves use
+    ``settings`` (with no log nor warm start) in a ``solver_type`` that asks for no
+    certificate of its own."""
+    q = np.asarray(q, dtype=np.float64).reshape(-1)
+    n = q.shape[0]
+    P = _dense(P, n, n)
+    b = np.zeros(0) if b is None else np.asarray(b, dtype=np.float64).reshape(-1)
+    A = _dense(A, b.shape[0], n)
+    m = b.shape[0]
+    lb, ub = _bounds(lb, ub, n)
+    cones = _cone_tuple(cones)
+    auxiliary = solver_type(settings.replace(verbose=False, warm_start=False))
+    auxiliary._stalled_certificates = False
+    spent = factored = 0
+    try:
+        if m > 0:
+            problem, S = distance_problem(A, b, lb, ub, cones)
+            if S.size and _dense_path(problem):
+                result = auxiliary.solve(*problem)
+                spent, factored = spent + result.iterations, factored + result.factorizations
+                if _least_distance(result, b, lb[S], ub[S], n):
+                    candidate = np.zeros(m + n)
+                    candidate[:m] = result.y
+                    candidate[m + S] = result.z[n:]
+                    point = np.ascontiguousarray(result.x[:n])
+                    found = workspace.judge_certificate(candidate, True, point)
+                    if found is not None:
+                        return Status.PRIMAL_INFEASIBLE, found, spent, factored
+        rays = ray_problem(P, q, A, lb, ub, cones)
+        if not np.any(q) or not _dense_path(rays):
+            return None
+        result = auxiliary.solve(*rays)
+        spent, factored = spent + result.iterations, factored + result.factorizations
+        if not _moreau(result.x, rays[1]):
+            return None
+        found = workspace.judge_certificate(np.ascontiguousarray(result.x), False)
+        if found is None:
+            return None
+        return Status.DUAL_INFEASIBLE, found, spent, factored
+    except (ValueError, TypeError):   # an auxiliary problem fccqp refuses: no claim
+        return None
