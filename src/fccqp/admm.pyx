@@ -31,9 +31,9 @@ from fccqp.kkt cimport AUTO, LDL_FULL, LDL_REDUCED, SCHUR_REDUCED
 from fccqp.scaled_run cimport scaled_run, unscaled_answer
 from fccqp.termination cimport Residuals
 from fccqp.tuning cimport FIXED_RHO_SCALE, RESERVE_DECAY, RESTART_MIN_ITER
-from fccqp.verdict cimport unbounded
 from fccqp.validation cimport (BOUNDED, FIXED_BOUND, SCAN_OK, UNBOUNDED, Finding, bound_kind,
                                scan_and_copy)
+from fccqp.verdict cimport unbounded
 
 # Run codes, mapped to fccqp.Status in fccqp.solver (one table).
 SOLVED, SOLVED_INACCURATE = engine.SOLVED, engine.INACCURATE
