@@ -32,7 +32,7 @@ import math
 
 import numpy as np
 
-from fccqp.cones import FrictionCone, SecondOrderCone
+from fccqp.cones import KINDS
 from fccqp.problem import INFINITE_BOUND
 from fccqp.settings import MAX_DENSE_KKT_ROWS
 from fccqp.status import Status
@@ -54,7 +54,7 @@ def _bounds(lb: object, ub: object, n: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _cone_tuple(cones: object) -> tuple:
-    if isinstance(cones, (FrictionCone, SecondOrderCone)):
+    if isinstance(cones, tuple(kind.spec for kind in KINDS)):   # a single cone
         return (cones,)
     return tuple(cones or ())
 
