@@ -45,7 +45,7 @@ cdef extern from *:
     /* reduced iteration when this * s fits the budget: s columns cost ~s/4 solves, x2 margin */
     #define FCCQP_REDUCED_COST 0.5
 
-    /* ---- Cold start and equalities (fccqp.admm) ---- */
+    /* ---- Cold start and equalities (fccqp.factorization, fccqp.verdict, fccqp.admm) ---- */
     /* proximal steps of the cold start's equality-constrained QP */
     #define FCCQP_EQUALITY_START_STEPS 3
     /* that QP is unbounded when sigma ||x_eq|| > this max(1, ||q||): test it as a direction */
@@ -55,7 +55,7 @@ cdef extern from *:
     /* a failed warm start restarts cold for the rest only when max_iter is at least this */
     #define FCCQP_RESTART_MIN_ITER 200
 
-    /* ---- Rho adaptation (fccqp.admm) ---- */
+    /* ---- Rho adaptation (fccqp.rho_rule, fccqp.admm) ---- */
     /* range of the adaptive rho */
     #define FCCQP_RHO_MIN 1e-6
     #define FCCQP_RHO_MAX 1e6
@@ -64,7 +64,7 @@ cdef extern from *:
     /* a small rho move asked for this many updates in a row is tried (3 lost talos ticks) */
     #define FCCQP_RHO_PERSISTENCE 5
 
-    /* ---- Anderson acceleration (fccqp.anderson, fccqp.admm) ---- */
+    /* ---- Anderson acceleration (fccqp.anderson, fccqp.iteration) ---- */
     /* steps rejected by the safeguard before a run gives up accelerating */
     #define FCCQP_MAX_REJECTIONS 3
     /* Tikhonov weight of the least-squares problem, relative to its largest diagonal */
@@ -75,7 +75,7 @@ cdef extern from *:
     #define FCCQP_STALL_FACTOR 1e3
     #define FCCQP_STALLS 2
 
-    /* ---- Termination (fccqp.termination, fccqp.admm) ---- */
+    /* ---- Termination (fccqp.termination, fccqp.verdict, fccqp.iteration) ---- */
     /* a budget-stopped iterate within this multiple of the tolerances is SOLVED_INACCURATE */
     #define FCCQP_INACCURATE_FACTOR 10.0
     /* multiplier terms widen the gap's scale to at most this x max(|x'Px|, |q'x|) */
@@ -85,7 +85,7 @@ cdef extern from *:
     /* the verbose log keeps one line every this many iterations (as OSQP) */
     #define FCCQP_LOG_INTERVAL 25
 
-    /* ---- Infeasibility certificates (fccqp.certificates, fccqp.admm) ---- */
+    /* ---- Infeasibility certificates (fccqp.certificates, fccqp.verdict) ---- */
     /* a Farkas certificate separates by more than this of its terms (see EQUALITY_MISSED) */
     #define FCCQP_SEPARATION_FLOOR 1e-9
     /* and by this multiple of its residual: infeasible ones measured separate by >= 120x */
@@ -101,7 +101,7 @@ cdef extern from *:
     /* cleaned only while the primal residual is above this x its tolerance */
     #define FCCQP_CLEANING_GATE 1.0
 
-    /* ---- Polish (fccqp.polish, fccqp.polish_schur, fccqp.polish_table, fccqp.admm) ---- */
+    /* ---- Polish (fccqp.polish*, fccqp.iteration, fccqp.acceptance) ---- */
     /* regularization of both diagonal blocks of the polishing KKT matrix (scaled) */
     #define FCCQP_POLISH_DELTA 1e-12
     /* refine the returned point while the KKT residual > this max(1, ||q||, ||b||) */
@@ -141,13 +141,13 @@ cdef extern from *:
     #define FCCQP_EARLY_POLISH_GATE 1e2
     #define FCCQP_EARLY_POLISH_TRIES 3
 
-    /* ---- Restoration (fccqp.restoration, fccqp.admm) ---- */
+    /* ---- Restoration (fccqp.restoration, fccqp.acceptance) ---- */
     /* an entry violates when its projection moves it by more than this (relative) */
     #define FCCQP_VIOLATION_TOLERANCE 1e-12
     /* a restored point is kept if its primal residual < this x its scale (W_TT costs digits) */
     #define FCCQP_RESTORED_EQUALITY 1e-7
 
-    /* ---- Time budget (fccqp.admm) ---- */
+    /* ---- Time budget (fccqp.iteration, fccqp.admm) ---- */
     /* a timed run is polished only within this factor of the tolerances (else guess wrong) */
     #define FCCQP_POLISH_GATE 1e3
     /* the final step's reserve: its largest recent duration, decayed by this per solve */
