@@ -32,7 +32,7 @@ import math
 
 import numpy as np
 
-from fccqp.cones import KINDS
+from fccqp.cones import cone_tuple
 from fccqp.problem import INFINITE_BOUND
 from fccqp.settings import MAX_DENSE_KKT_ROWS
 from fccqp.status import Status
@@ -51,12 +51,6 @@ def _bounds(lb: object, ub: object, n: int) -> tuple[np.ndarray, np.ndarray]:
     low[low <= -INFINITE_BOUND] = -np.inf
     high[high >= INFINITE_BOUND] = np.inf
     return low, high
-
-
-def _cone_tuple(cones: object) -> tuple:
-    if isinstance(cones, tuple(kind.spec for kind in KINDS)):   # a single cone
-        return (cones,)
-    return tuple(cones or ())
 
 
 def distance_problem(A: np.ndarray, b: np.ndarray, lb: np.ndarray, ub: np.ndarray,
@@ -156,7 +150,7 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
     A = _dense(A, b.shape[0], n)
     m = b.shape[0]
     lb, ub = _bounds(lb, ub, n)
-    cones = _cone_tuple(cones)
+    cones = cone_tuple(cones or ())
     auxiliary = solver_type(settings.replace(verbose=False, warm_start=False))
     auxiliary._stalled_certificates = False
     spent = factored = 0

@@ -190,6 +190,24 @@ _SPECS = tuple(kind.spec for kind in KINDS)
 _NAMES = " or ".join(spec.__name__ for spec in _SPECS)
 
 
+def cone_tuple(cones: Cone | Sequence[Cone]) -> tuple[Cone, ...]:
+    """``cones`` as a tuple: a single spec becomes a one-element tuple.
+
+    Raises
+    ------
+    TypeError
+        If ``cones`` is neither a spec of one of the :data:`KINDS` nor an iterable
+        (a string is not).
+    """
+    if type(cones) is tuple:
+        return cones
+    if isinstance(cones, _SPECS):
+        return (cones,)
+    if isinstance(cones, (str, bytes)) or not isinstance(cones, Iterable):
+        raise TypeError(f"cones must be a sequence of {_NAMES}, got {cones!r}")
+    return tuple(cones)
+
+
 def flatten_cones(cones: Sequence[Cone], n: int) -> ConeArrays:
     """Validate cone specs for an ``n``-vector and return them as flat arrays.
 
@@ -209,11 +227,7 @@ def flatten_cones(cones: Sequence[Cone], n: int) -> ConeArrays:
         ``dim < 2``, or a friction cone has a bad ``mu`` or normal.
     """
     if type(cones) is not tuple:   # a tuple, the control loop's case, needs no checks
-        if isinstance(cones, _SPECS):
-            cones = (cones,)
-        elif isinstance(cones, (str, bytes)) or not isinstance(cones, Iterable):
-            raise TypeError(f"cones must be a sequence of {_NAMES}, got {cones!r}")
-        cones = tuple(cones)
+        cones = cone_tuple(cones)
     try:
         flat = _MEMO.get(key := cone_key(cones, n))
     except TypeError:  # unhashable field, e.g. a numpy normal: validate uncached
