@@ -36,6 +36,13 @@ cdef int _certify(Engine* e, bint schur_factored) noexcept nogil:
     return code
 
 
+cdef inline bint _reduced_pays(const Engine* e, long solves) noexcept nogil:
+    """Whether "auto" iterates in the reduced form: its table pays for itself within
+    ``solves`` and the constrained entries are at most half the KKT size."""
+    cdef const Problem* p = &e.prob
+    return 2 * p.s <= p.n + p.m and REDUCED_COST * p.s <= solves
+
+
 cdef int factor(Engine* e, Run* run, long solves) noexcept nogil:
     """Factor for the current rho with the backend the settings ask for, falling back
     in the order Schur, LDL' reduced, LDL' full ("auto" starts with Schur when the
@@ -45,16 +52,14 @@ cdef int factor(Engine* e, Run* run, long solves) noexcept nogil:
     breakdown); records the form and the rho it factored."""
     cdef Problem* p = &e.prob
     cdef int backend, code, first = e.opt.backend
-    cdef bint reduced_pays
     e.fact.table_ready = False
     if first == AUTO:
         # rows the equality-constrained start could not meet (inconsistent, or
         # numerically dependent) go to the full form: its regularized solves give
         # least-squares iterates, on which the equality certificate is tested
         # (a random test: the reduced form ran 4000 iterations uncertified)
-        reduced_pays = (2 * p.s <= p.n + p.m and REDUCED_COST * p.s <= solves
-                        and not e.equalities_missed)
-        first = SCHUR_REDUCED if reduced_pays else LDL_FULL
+        first = (SCHUR_REDUCED if _reduced_pays(e, solves) and not e.equalities_missed
+                 else LDL_FULL)
     for backend in range(first, LDL_FULL + 1):
         if not e.fact.certified and backend != SCHUR_REDUCED:
             # certify first: the certificate overwrites an LDL' factorization
@@ -118,12 +123,34 @@ cdef int change_rho(Engine* e, Run* run, double new_rho, long iteration,
     return code
 
 
+cdef int _start_factor(Engine* e) noexcept nogil:
+    """Factor the cold start's penalty-free KKT matrix (``sigma I``, no rho): with the
+    Schur backend where the iteration will use it, else with LDL'. Returns FACTORED
+    or NOT_CONVEX.
+
+    The iteration's Schur factors are of ``P + R`` without ``sigma`` and the start's of
+    ``P + sigma I`` without rho, so one factorization cannot serve both; but where
+    ``A`` has full row rank the start's two Choleskys cost a fraction of the LDL' of
+    the whole KKT matrix (go2: 0.14M against 0.33M instructions, and its solves a
+    third). Their success proves ``P + sigma I`` positive definite (the QP convex).
+    Dependent or inconsistent rows, or a ``P + sigma I`` that Cholesky cannot factor,
+    fall back to LDL', whose inertia decides convexity and whose regularized solves
+    the inconsistency test reads."""
+    cdef int backend = e.opt.backend
+    if backend == SCHUR_REDUCED or (backend == AUTO and _reduced_pays(e, budget(e, 0))):
+        if kkt_factor(&e.fact.kkt, &e.prob, SCHUR_REDUCED, e.opt.sigma,
+                      e.it.rho_vec) == FACTORED:
+            return FACTORED
+    return FACTORED if kkt_factor(&e.fact.kkt, &e.prob, LDL_FULL, e.opt.sigma,
+                                  e.it.rho_vec) == FACTORED else NOT_CONVEX
+
+
 cdef int equality_start(Engine* e, bint* unbounded) noexcept nogil:
     """Paper's cold start: ``x`` solves the QP with equalities only, ``z = P_C(x_S)``,
     ``y = 0``.
 
-    The factorization carries the regularization ``sigma I`` and no rho, so its
-    inertia certifies convexity; a few proximal steps (``x_{j+1} = argmin f +
+    The factorization (:func:`_start_factor`) carries the regularization ``sigma I``
+    and no rho, so it certifies convexity; a few proximal steps (``x_{j+1} = argmin f +
     sigma/2 ||x - x_j||^2`` on the same factorization) remove sigma's bias, so that
     an optimum with no active constraint is recognised at once. When the solution
     is huge the equality-constrained QP is unbounded: ``direction`` keeps the last
@@ -148,8 +175,7 @@ cdef int equality_start(Engine* e, bint* unbounded) noexcept nogil:
     e.fact.factored_rho = -1.0  # the KKT matrix now holds no rho factorization
     e.fact.form = LDL_FULL
     e.fact.table_ready = False
-    cdef int code = kkt_factor(&e.fact.kkt, p, LDL_FULL, sigma, it.rho_vec)
-    if code != FACTORED:
+    if _start_factor(e) != FACTORED:
         return NOT_CONVEX
     e.fact.certified = True
     fill(it.x, 0.0, n)

@@ -85,13 +85,18 @@ cdef void _order(Schur* f, const Problem* p) noexcept nogil:
         f.order[k] = f.base_order[k]
 
 
-cdef bint schur_factor(Schur* f, const Problem* p, const double* rho_vec) noexcept nogil:
-    """Factor ``H = P + R`` (rows in ``order``) into ``L`` and ``S`` into ``LS``;
-    ``Y := L^-1 A'``. False when ``H`` or ``S`` is not (numerically) positive definite."""
+cdef bint schur_factor(Schur* f, const Problem* p, double sigma,
+                       const double* rho_vec) noexcept nogil:
+    """Factor ``H = P + sigma I + R`` (rows in ``order``) into ``L`` and ``S`` into
+    ``LS``; ``Y := L^-1 A'``. False when ``H`` or ``S`` is not (numerically) positive
+    definite. ``sigma`` is 0 in the reduced form and the cold start's proximal term
+    there (:func:`fccqp.factorization.equality_start`); the solves refine against
+    the matrix with it."""
     cdef int n = <int>p.n, m = <int>p.m, s = <int>p.s, first = n - s, i, j
     cdef int k
     cdef Py_ssize_t column
     cdef double largest = 0.0
+    f.sigma = sigma
     _order(f, p)
     k = f.dense
     for j in range(k):   # the dense block's lower triangle; below it L is never read
@@ -101,6 +106,9 @@ cdef bint schur_factor(Schur* f, const Problem* p, const double* rho_vec) noexce
     for j in range(k, n):
         column = f.order[j]
         f.L[j + j * n] = p.P[column * n + column]
+    if sigma != 0.0:
+        for j in range(n):
+            f.L[j + j * n] += sigma
     for j in range(s):
         f.L[first + j + (first + j) * n] += rho_vec[j]
     if k > 0 and not cholesky(f.L, k, n):
@@ -226,6 +234,9 @@ cdef void schur_solve(Schur* f, const Problem* p, const double* rho_vec, const d
         matvec_t(p.A, nu, f.ATnu, m, n)
         for i in range(n):
             f.r[i] = rhs[i] - f.r[i] - f.ATnu[i]
+        if f.sigma != 0.0:
+            for i in range(n):
+                f.r[i] -= f.sigma * x[i]
         for k in range(p.s):
             i = p.constrained[k]
             f.r[i] -= rho_vec[k] * x[i]
