@@ -173,7 +173,7 @@ cdef class Workspace:
         red = &e.red
         red.W, red.W_S, red.base = self._new(N * s), self._new(s * s), self._new(N)
         red.u, red.u_prev, red.v, red.v_prev = self._new(s), self._new(s), self._new(s), self._new(s)
-        red.xs, red.rhs = self._new(s), self._new(N)
+        red.xs = self._new(s)
         aa = &e.aa
         aa.capacity = <int>memory
         aa.dg, aa.df = self._new(memory * 2 * s), self._new(memory * 2 * s)

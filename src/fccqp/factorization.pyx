@@ -131,8 +131,8 @@ cdef int _start_factor(Engine* e) noexcept nogil:
     The iteration's Schur factors are of ``P + R`` without ``sigma`` and the start's of
     ``P + sigma I`` without rho, so one factorization cannot serve both; but where
     ``A`` has full row rank the start's two Choleskys cost a fraction of the LDL' of
-    the whole KKT matrix (go2: 0.14M against 0.33M instructions, and its solves a
-    third). Their success proves ``P + sigma I`` positive definite (the QP convex).
+    the whole KKT matrix (go2, callgrind: 135k against 335k instructions, a refined
+    solve 20k against 80k). Their success proves ``P + sigma I`` positive definite (the QP convex).
     Dependent or inconsistent rows, or a ``P + sigma I`` that Cholesky cannot factor,
     fall back to LDL', whose inertia decides convexity and whose regularized solves
     the inconsistency test reads."""
