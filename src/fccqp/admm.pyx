@@ -162,6 +162,7 @@ cdef class Workspace:
         kk.ldl.Ax, kk.ldl.ATnu = self._new(m), self._new(n)
         kk.schur.n, kk.schur.m = <int>n, <int>m
         kk.schur.L, kk.schur.LS, kk.schur.Y = self._new(n * n), self._new(m * m), self._new(n * m)
+        kk.schur.G, kk.schur.free_ready = self._new(m * m), False
         kk.schur.base_order = &order_v[0]
         kk.schur.order = <Py_ssize_t*>self._new_int(n)
         kk.schur.coupled = <char*>self._new(n)

@@ -11,8 +11,8 @@ through four calls: :func:`kkt_factor` (for given P, A, sigma, rho), :func:`kkt_
 :func:`kkt_unit_columns` (responses to unit right-hand sides on chosen entries, the
 reduced form's table and the restoration's columns) and :func:`kkt_convexity` (is the
 QP convex?). The backends are :mod:`fccqp.schur`
-(Cholesky, needs ``P + sigma I + R`` positive definite and ``A`` of full row rank; the
-reduced form, and the cold start of a run that will iterate in it) and :mod:`fccqp.ldl`
+(Cholesky, needs ``P + R`` positive definite and ``A`` of full row rank; the reduced
+form, and the cold start of a run that will iterate in it) and :mod:`fccqp.ldl`
 (quasi-definite LDL', any ``A``). ``sigma`` is 0 in the reduced forms.
 """
 
@@ -30,7 +30,7 @@ cdef int kkt_factor(KKT* k, const Problem* p, int backend, double sigma,
     k.backend = backend
     k.sigma = sigma
     if backend == SCHUR_REDUCED:
-        return FACTORED if schur_factor(&k.schur, p, sigma, rho_vec) else UNAVAILABLE
+        return FACTORED if schur_factor(&k.schur, p, rho_vec) else UNAVAILABLE
     negative = ldl_factor(&k.ldl, p, sigma, rho_vec)
     if negative < 0 or (negative < p.m and backend == LDL_REDUCED):
         return UNAVAILABLE   # the reduced form needs P + R definite on the null space of A

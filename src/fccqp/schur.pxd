@@ -10,7 +10,8 @@ cdef struct Schur:
     const Py_ssize_t* base_order   # free entries first, the s constrained entries last
     Py_ssize_t* order    # base_order with the diagonal free entries moved behind the others
     int dense            # rows of the dense leading block of L; a diagonal tail follows
-    double sigma         # the proximal term on every entry of H (0 in the reduced form)
+    bint free_ready      # the free rows of L and Y and G hold for this run's P and A
+    double* G            # m x m, Fortran: Y_F' Y_F over the free rows (diagonal-tail split)
     char* coupled        # n scratch: which rows of P have entries off the diagonal
     double* perm         # n scratch
     double* dx           # n scratch
@@ -23,8 +24,7 @@ cdef struct Schur:
     double* M            # s x s scratch (convexity test)
 
 cdef void mark_coupled(const double* P, Py_ssize_t n, char* coupled) noexcept nogil
-cdef bint schur_factor(Schur* f, const Problem* p, double sigma,
-                       const double* rho_vec) noexcept nogil
+cdef bint schur_factor(Schur* f, const Problem* p, const double* rho_vec) noexcept nogil
 cdef bint schur_certifies_convexity(Schur* f, const Problem* p, const double* rho_vec,
                                     double sigma) noexcept nogil
 cdef void schur_solve_once(Schur* f, const Problem* p, const double* rhs,
