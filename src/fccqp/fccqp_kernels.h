@@ -477,6 +477,7 @@ static void fccqp_scale_rows(const double *restrict M, int rows, int cols,
  * column[j] = max(D_j max_i |P_ij| D_i, max_i (|A_ij| D_j) E_i) and
  * row[i] = (max_j |A_ij| D_j) E_i, each product in the order written (the loops this
  * replaces rounded them so). D, E are positive, P and A finite. */
+FCCQP_CLONES
 static void fccqp_ruiz_maxima(const double *restrict P, const double *restrict A, int n,
                               int m, const double *restrict D, const double *restrict E,
                               double *restrict column, double *restrict row)
