@@ -9,10 +9,10 @@ from libc.math cimport fabs, isfinite
 
 from fccqp._dense cimport copy, fill
 from fccqp._types cimport Iterates, Problem
-from fccqp.matrices cimport abs_product, product, product_t
 from fccqp.engine cimport (INACCURATE, RUNNING, SOLVED, Engine, Options, Run, end_run,
                            fccqp_now, measure)
 from fccqp.kkt cimport kkt_solve
+from fccqp.matrices cimport abs_product, product, product_t
 from fccqp.polish cimport multiplier_violation, polish
 from fccqp.projections cimport proj_block, proj_set
 from fccqp.restoration cimport restore
