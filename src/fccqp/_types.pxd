@@ -3,9 +3,11 @@
 
 The kernels take raw pointers into arrays that the Python layer allocated once per
 problem structure (:class:`fccqp.admm.Workspace`): nothing is allocated in a solve.
-Matrices are dense; ``P`` is symmetric (so its storage order does not matter) and
-``A`` is row-major, ``A[i * n + j]``.
+``P`` and ``A`` are :c:type:`fccqp.matrices.Matrix`: the algorithm reads them through
+that contract's operations.
 """
+
+from fccqp.matrices cimport Matrix
 
 cdef struct Cones:
     # Disjoint cone blocks of the constrained-entry vector; fccqp.cone_dispatch lists the
@@ -21,9 +23,9 @@ cdef struct Cones:
 cdef struct Problem:
     # The equilibrated problem min 1/2 x'Px + q'x  s.t.  Ax = b, x_S in C (see scaling).
     Py_ssize_t n, m, s          # variables, equality rows, constrained entries
-    double* P                   # n x n
+    Matrix P                    # n x n, symmetric
     double* q
-    double* A                   # m x n, row-major
+    Matrix A                    # m x n
     double* b
     const Py_ssize_t* constrained   # the s entries S of x with a bound or in a cone
     const char* in_cone         # s flags: the constrained entry belongs to a cone block

@@ -7,11 +7,12 @@ the user's units that both checks (and the returned point) are measured by.
 
 from libc.math cimport fabs, isfinite
 
-from fccqp._dense cimport copy, fill, matvec, matvec_t
+from fccqp._dense cimport copy, fill
 from fccqp._types cimport Iterates, Problem
 from fccqp.engine cimport (INACCURATE, RUNNING, SOLVED, Engine, Options, Run, end_run,
                            fccqp_now, measure)
 from fccqp.kkt cimport kkt_solve
+from fccqp.matrices cimport abs_product, product, product_t
 from fccqp.polish cimport multiplier_violation, polish
 from fccqp.projections cimport proj_block, proj_set
 from fccqp.restoration cimport restore
@@ -146,7 +147,7 @@ cdef void restore_equalities(Engine* e) noexcept nogil:
     if m == 0:
         return
     fill(rhs, 0.0, n)
-    matvec(p.A, e.it.x, rhs + n, m, n)
+    product(&p.A, e.it.x, rhs + n)
     for i in range(m):
         rhs[n + i] = p.b[i] - rhs[n + i]
     kkt_solve(&e.fact.kkt, p, e.it.rho_vec, rhs, e.work.sol)
@@ -194,16 +195,17 @@ cdef int keep_restored(Engine* e, int status, long iteration, bint reduced) noex
     return status
 
 
-cdef double _row_terms(const Engine* e, const double* x) noexcept nogil:
+cdef double _row_terms(Engine* e, const double* x) noexcept nogil:
     """``max_i sum_j |A_ij x_j|`` on the user's data: the size of the terms whose
-    rounding ``A x = b`` carries at factorization accuracy."""
-    cdef Py_ssize_t n = e.prob.n, i, j
-    cdef double largest = 0.0, row
+    rounding ``A x = b`` carries at factorization accuracy (``|A_ij x_j|`` is
+    ``|A_ij| |x_j|`` exactly; ``vec_n3`` and ``vec_m2`` are its scratch)."""
+    cdef Py_ssize_t i
+    cdef double largest = 0.0
+    for i in range(e.prob.n):
+        e.work.vec_n3[i] = fabs(x[i])
+    abs_product(&e.user.A, e.work.vec_n3, e.work.vec_m2)
     for i in range(e.prob.m):
-        row = 0.0
-        for j in range(n):
-            row += fabs(e.user.A[i * n + j] * x[j])
-        largest = max(largest, row)
+        largest = max(largest, e.work.vec_m2[i])
     return largest
 
 
@@ -214,7 +216,6 @@ cdef void user_residuals(Engine* e, const double* x, const double* y,
     cdef Problem* p = &e.prob
     cdef Residuals* r = &e.res
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j
-    cdef const double* A = e.user.A
     cdef const double* b = e.user.b
     cdef const double* lb = e.user.lb
     cdef const double* ub = e.user.ub
@@ -225,9 +226,9 @@ cdef void user_residuals(Engine* e, const double* x, const double* y,
     cdef double* proj = e.work.vec_s
     cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, terms = 0.0, total = 0.0
     cdef double value
-    matvec(A, x, Ax, m, n)
-    matvec_t(A, y, ATy, m, n)
-    matvec(e.user.P, x, grad, n, n)
+    product(&e.user.A, x, Ax)
+    product_t(&e.user.A, y, ATy)
+    product(&e.user.P, x, grad)
     r.prim_eq = r.prim_eq_scale = r.prim_set = r.prim_set_scale = 0.0
     for i in range(m):
         r.prim_eq = max(r.prim_eq, fabs(Ax[i] - b[i]))

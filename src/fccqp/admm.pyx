@@ -28,6 +28,7 @@ from fccqp.certificates cimport CERTIFIED, primal_candidate
 from fccqp.engine cimport CONE_ENTRY, Engine, Run, fccqp_now
 from fccqp.fast_checks cimport hold_dense, hold_float64
 from fccqp.kkt cimport AUTO, LDL_FULL, LDL_REDUCED, SCHUR_REDUCED
+from fccqp.matrices cimport dense
 from fccqp.scaled_run cimport scaled_run, unscaled_answer
 from fccqp.termination cimport Residuals
 from fccqp.tuning cimport FIXED_RHO_SCALE, RESERVE_DECAY, RESTART_MIN_ITER
@@ -122,13 +123,14 @@ cdef class Workspace:
             for j in range(offset_v[k], offset_v[k] + dim_v[k]):
                 in_cone[j] = 1
         p.in_cone = in_cone
-        p.P, p.q, p.A, p.b = self._new(n * n), self._new(n), self._new(m * n), self._new(m)
+        p.P, p.A = dense(self._new(n * n), n, n), dense(self._new(m * n), m, n)
+        p.q, p.b = self._new(n), self._new(m)
         p.lo, p.hi, p.D, p.E = self._new(s), self._new(s), self._new(n), self._new(m)
         p.span = self._new(m)
         p.c = 1.0
         u = &e.user
-        u.P, u.q = self._new(n * n), self._new(n)
-        u.A, u.b = self._new(m * n), self._new(m)
+        u.P, u.A = dense(self._new(n * n), n, n), dense(self._new(m * n), m, n)
+        u.q, u.b = self._new(n), self._new(m)
         u.lb, u.ub = self._new(n), self._new(n)
         e.fact.rho_scale = self._new(s)
         for k in range(s):
@@ -149,6 +151,7 @@ cdef class Workspace:
         cdef Py_ssize_t wide = max(n, m)
         w.vec_n, w.vec_n2, w.vec_n3 = self._new(wide), self._new(wide), self._new(wide)
         w.vec_s, w.vec_s2, w.vec_m = self._new(s), self._new(s), self._new(m)
+        w.vec_m2 = self._new(m)
         e.certs.gram = self._new(m * m)
         w.guess_point, w.guess_codes = self._new(s), <char*>self._new(s)
         e.certs.direction, w.saved, e.certs.cert = self._new(n), self._new(N + s), self._new(N)
@@ -417,8 +420,8 @@ cdef class Workspace:
         e.clock.marks[0] = fccqp_now()
         with nogil:
             self.found = scan_and_copy(
-                P, q, A if m else NULL, b if m else NULL, lb, ub, n, m, e.user.P,
-                e.user.q, e.user.A, e.user.b, e.user.lb, e.user.ub, &same)
+                P, q, A if m else NULL, b if m else NULL, lb, ub, n, m, e.user.P.values,
+                e.user.q, e.user.A.values, e.user.b, e.user.lb, e.user.ub, &same)
         if self.found.code != SCAN_OK:
             e.user.has_matrices = False
             return engine.BAD_NUMBERS

@@ -13,13 +13,12 @@ cdef int primal_infeasible(const Problem* p, const Iterates* it, double eps, dou
 cdef int primal_candidate(const Problem* p, const double* x, const double* d_nu,
                           double* d_y, double eps, double* lhs, double* terms) noexcept nogil
 cdef int equality_inconsistent(const Problem* p, const Iterates* it, double eps, double* r,
-                               double* ATr, double* terms) noexcept nogil
+                               double* ATr, double* terms, double* sizes) noexcept nogil
 cdef int equality_direction(const Problem* p, const double* r, const double* x, double eps,
-                            double* ATr, double* terms) noexcept nogil
+                            double* ATr, double* terms, double* sizes) noexcept nogil
 cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double* Pdx,
                           double* terms, double* block) noexcept nogil
-cdef void magnitudes(const Problem* p, const double* x, double* t) noexcept nogil
-cdef double row_size(const Problem* p, Py_ssize_t i, const double* t) noexcept nogil
+cdef void row_sizes(const Problem* p, const double* x, double* t, double* sizes) noexcept nogil
 cdef bint gram_factor(const Problem* p, double* gram) noexcept nogil
 cdef bint clean_primal_certificate(const Problem* p, const double* x, const double* gram,
                                    double eps, double* d_nu, double* d_y, double* saved,

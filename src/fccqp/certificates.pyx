@@ -36,8 +36,10 @@ has no solution. The dual certificate keeps ``q'dx < -eps |q|'|dx|``.
 from libc.math cimport INFINITY, fabs, isfinite
 
 from fccqp._blas cimport cholesky, cholesky_solve_vector, syrk_t
-from fccqp._dense cimport copy, matvec
+from fccqp._dense cimport copy
 from fccqp._types cimport Iterates, Problem
+from fccqp.matrices cimport (Matrix, abs_product, product, product_row_norms, product_t_terms,
+                             subtract_product)
 from fccqp.projections cimport proj_block
 from fccqp.tuning cimport (CLEANING_PASSES, CLEANING_SHRINK, DOMINANCE, GRAM_REGULARIZATION,
                            SEPARATION_FLOOR)
@@ -57,31 +59,14 @@ cdef void magnitudes(const Problem* p, const double* x, double* t) noexcept nogi
             t[i] = max(t[i], fabs(p.hi[j]))
 
 
-cdef double row_size(const Problem* p, Py_ssize_t i, const double* t) noexcept nogil:
-    """``sum_j |A_ij| t_j`` for the :func:`magnitudes` ``t``: the size of row ``i``'s terms
-    at a point of that magnitude, whose rounding (and ``A x = b`` at factorization
-    accuracy) no certificate can tell from an inconsistency. At the iterate alone it
-    was no floor where the iterate is 0 (an equality-only start of 1e-13)."""
-    cdef Py_ssize_t j, n = p.n
-    cdef double row = 0.0
-    for j in range(n):
-        row += fabs(p.A[i * n + j]) * t[j]
-    return row
-
-
-cdef inline void _transpose_product(const Problem* p, const double* v, double* out,
-                                    double* terms) noexcept nogil:
-    """``out = A'v`` and ``terms = |A|'|v|``, the size of the products each entry sums."""
-    cdef Py_ssize_t n = p.n, i, j
-    cdef double value
-    for j in range(n):
-        out[j] = 0.0
-        terms[j] = 0.0
-    for i in range(p.m):
-        for j in range(n):
-            value = p.A[i * n + j] * v[i]
-            out[j] += value
-            terms[j] += fabs(value)
+cdef void row_sizes(const Problem* p, const double* x, double* t, double* sizes) noexcept nogil:
+    """``sizes_i = sum_j |A_ij| t_j`` for the :func:`magnitudes` ``t`` of ``x`` (``t``: n,
+    filled; ``sizes``: m): the size of each row's terms at a point of that magnitude,
+    whose rounding (and ``A x = b`` at factorization accuracy) no certificate can tell
+    from an inconsistency. At the iterate alone it was no floor where the iterate is 0
+    (an equality-only start of 1e-13)."""
+    magnitudes(p, x, t)
+    abs_product(&p.A, t, sizes)
 
 
 cdef int primal_infeasible(const Problem* p, const Iterates* it, double eps, double* d_nu,
@@ -156,7 +141,7 @@ cdef int _farkas(const Problem* p, const double* x, const double* d_nu, const do
         size += fabs(p.b[i] * d_nu[i])
     if not (support < -SEPARATION_FLOOR * size) or not isfinite(support):
         return REJECTED
-    _transpose_product(p, d_nu, lhs, terms)
+    product_t_terms(&p.A, d_nu, lhs, terms)
     for j in range(s):
         i = p.constrained[j]
         lhs[i] += d_y[j]
@@ -180,8 +165,9 @@ cdef bint gram_factor(const Problem* p, double* gram) noexcept nogil:
     that fails."""
     cdef Py_ssize_t m = p.m, i
     cdef double largest = 0.0
-    # the row-major m x n A is, column-major, A' (n x m): one dsyrk gives A A'
-    syrk_t(<int>m, <int>p.n, p.A, <int>p.n, 0.0, gram, <int>m)
+    # the row-major m x n A is, column-major, A' (n x m): one dsyrk gives A A' (dense
+    # storage)
+    syrk_t(<int>m, <int>p.n, p.A.values, <int>p.n, 0.0, gram, <int>m)
     for i in range(m):
         largest = max(largest, gram[i + i * m])
     if not largest > 0.0:
@@ -245,9 +231,9 @@ cdef bint _alternate(const Problem* p, const double* x, const double* gram, doub
             w[i] = 0.0
         for j in range(s):
             w[p.constrained[j]] = -d_y[j]
-        matvec(p.A, w, d_nu, m, n)
+        product(&p.A, w, d_nu)
         cholesky_solve_vector(gram, <int>m, <int>m, d_nu)
-        _transpose_product(p, d_nu, w, terms)   # w = A'd_nu, then d_y := -(A'd_nu)_S
+        product_t_terms(&p.A, d_nu, w, terms)   # w = A'd_nu, then d_y := -(A'd_nu)_S
         size = 0.0
         for j in range(s):
             d_y[j] = -w[p.constrained[j]]
@@ -266,29 +252,24 @@ cdef bint _alternate(const Problem* p, const double* x, const double* gram, doub
 
 
 cdef int equality_inconsistent(const Problem* p, const Iterates* it, double eps, double* r,
-                               double* ATr, double* terms) noexcept nogil:
+                               double* ATr, double* terms, double* sizes) noexcept nogil:
     """:func:`equality_direction` for ``r = b - A x`` (``r``: m, filled; ``ATr``,
-    ``terms``: n scratch)."""
-    cdef Py_ssize_t n = p.n, i, j
-    cdef double value
-    for i in range(p.m):
-        value = p.b[i]
-        for j in range(n):
-            value -= p.A[i * n + j] * it.x[j]
-        r[i] = value
-    return equality_direction(p, r, it.x, eps, ATr, terms)
+    ``terms``: n, ``sizes``: m scratch)."""
+    copy(p.b, r, p.m)
+    subtract_product(&p.A, it.x, r)
+    return equality_direction(p, r, it.x, eps, ATr, terms, sizes)
 
 
 cdef int equality_direction(const Problem* p, const double* r, const double* x, double eps,
-                            double* ATr, double* terms) noexcept nogil:
+                            double* ATr, double* terms, double* sizes) noexcept nogil:
     """Test ``r`` (m) for ``A'r ~ 0`` and ``b'r > 0``: ``CERTIFIED``, ``SEPARATED`` when
     ``b'r`` separates but ``A'r`` is not small enough against it (a cleaner ``r`` may
     pass, see :meth:`fccqp.admm.Workspace._inconsistent`), else ``REJECTED`` (``ATr``,
-    ``terms``: n scratch).
+    ``terms``: n, ``sizes``: m scratch).
 
     Its separation is measured against the data's size, not only its own terms: ``b'r``
     must exceed ``SEPARATION_FLOOR`` of ``sum_i |r_i| max(|b_i|, row_size_i)`` (see
-    :func:`row_size`: the rounding a right-hand side ``A x`` carries for a point of the
+    :func:`row_sizes`: the rounding a right-hand side ``A x`` carries for a point of the
     iterate's and the box's magnitude), and what the residual explains at the iterate
     (every ``x`` with ``A x = b`` has ``b'r = (A'r)'x``, as for the primal certificate).
     Relative to its own terms alone, ``b'r`` of dependent rows whose right-hand sides
@@ -299,14 +280,14 @@ cdef int equality_direction(const Problem* p, const double* r, const double* x, 
     cdef double data = 0.0
     if p.m == 0:
         return REJECTED
-    magnitudes(p, x, terms)
+    row_sizes(p, x, terms, sizes)
     for i in range(p.m):
         br += p.b[i] * r[i]
         size += fabs(p.b[i] * r[i])
-        data += fabs(r[i]) * max(fabs(p.b[i]), row_size(p, i, terms))
+        data += fabs(r[i]) * max(fabs(p.b[i]), sizes[i])
     if not (br > SEPARATION_FLOOR * data) or not isfinite(br):
         return REJECTED
-    _transpose_product(p, r, ATr, terms)
+    product_t_terms(&p.A, r, ATr, terms)
     for j in range(n):
         lhs_max = max(lhs_max, fabs(ATr[j]) / p.D[j])
         terms_max = max(terms_max, terms[j] / p.D[j])
@@ -317,12 +298,11 @@ cdef int equality_direction(const Problem* p, const double* r, const double* x, 
     return SEPARATED
 
 
-cdef inline bint _near_zero(const double* M, const double* dx, Py_ssize_t rows,
-                            Py_ssize_t cols, double dx_norm, double eps,
-                            double* out) noexcept nogil:
-    """``M dx ~ 0`` (row-major, scaled) row by row: ``|M_i dx| <= eps ||M_i|| ||dx||``
-    with the row's 1-norm and ``dx``'s max-norm (``dx_norm``), as OSQP and COSMO
-    normalize by ``||dx||``; ``out`` is scratch of ``rows``.
+cdef inline bint _near_zero(const Matrix* M, const double* dx, double dx_norm, double eps,
+                            double* out, double* norms) noexcept nogil:
+    """``M dx ~ 0`` (scaled) row by row: ``|M_i dx| <= eps ||M_i|| ||dx||`` with the row's
+    1-norm and ``dx``'s max-norm (``dx_norm``), as OSQP and COSMO normalize by
+    ``||dx||``; ``out`` and ``norms`` are scratch of ``M``'s rows.
 
     In the equilibrated problem, where columns are balanced: in the user's units a row
     whose norm comes from large-scale variables hid curvature on small-scale ones
@@ -330,16 +310,10 @@ cdef inline bint _near_zero(const double* M, const double* dx, Py_ssize_t rows,
     relative to the terms ``|M_i||dx|``: along a ray in a coordinate-aligned null
     space (zero columns of ``P``) the ray contributes to neither side, and the
     unconverged remainder is compared with itself."""
-    cdef Py_ssize_t i, j
-    cdef double value, norm
-    for i in range(rows):
-        value = 0.0
-        norm = 0.0
-        for j in range(cols):
-            value += M[i * cols + j] * dx[j]
-            norm += fabs(M[i * cols + j])
-        out[i] = value
-        if not fabs(value) <= eps * norm * dx_norm:
+    cdef Py_ssize_t i
+    product_row_norms(M, dx, out, norms)
+    for i in range(M.rows):
+        if not fabs(out[i]) <= eps * norms[i] * dx_norm:
             return False
     return True
 
@@ -347,7 +321,7 @@ cdef inline bint _near_zero(const double* M, const double* dx, Py_ssize_t rows,
 cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double* Pdx,
                           double* terms, double* block) noexcept nogil:
     """Test the direction ``dx`` (scaled); ``Pdx`` and ``terms`` (``max(n, m)``) and
-    ``block`` (s) are scratch.
+    ``block`` (s) are scratch (``terms`` holds the rows' norms of :func:`_near_zero`).
 
     Its descent ``-q'dx``, relative to its terms, must also dominate every residual
     (``DOMINANCE`` times, as for the primal certificate): with ``P = 0`` and ``|q| =
@@ -378,6 +352,6 @@ cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double
         for j in range(dim):
             if fabs(block[a + j] - terms[j]) * p.D[p.constrained[a]] > tol:
                 return False
-    if not _near_zero(p.P, dx, n, n, scaled, eps, Pdx):
+    if not _near_zero(&p.P, dx, scaled, eps, Pdx, terms):
         return False
-    return p.m == 0 or _near_zero(p.A, dx, p.m, n, scaled, eps, Pdx)
+    return p.m == 0 or _near_zero(&p.A, dx, scaled, eps, Pdx, terms)

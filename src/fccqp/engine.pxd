@@ -10,6 +10,7 @@ hold pointers into the workspace's numpy arrays.
 from fccqp._types cimport Iterates, Problem
 from fccqp.anderson cimport Anderson
 from fccqp.kkt cimport KKT
+from fccqp.matrices cimport Matrix
 from fccqp.polish cimport Polish
 from fccqp.reduced cimport Reduced
 from fccqp.restoration cimport Restoration
@@ -59,9 +60,9 @@ cdef struct Run:
 
 cdef struct UserData:
     # Private copies of the user's last data (validation.scan_and_copy writes them).
-    double* P
+    Matrix P
     double* q
-    double* A
+    Matrix A
     double* b
     double* lb
     double* ub
@@ -141,6 +142,7 @@ cdef struct Scratch:
     double* vec_s
     double* vec_s2
     double* vec_m
+    double* vec_m2
     double* saved               # n + m + s: an iterate kept while a replacement is tried
     double* guess_point         # s scratch of guess_changes
     char* guess_codes           # s: the active set ADMM's iterate pointed to at the last check

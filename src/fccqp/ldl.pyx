@@ -24,9 +24,9 @@ from libc.math cimport INFINITY, fabs
 
 from scipy.linalg.cython_lapack cimport dsytrf, dsytrs, dsytrs2
 
-from fccqp._types cimport Problem
 from fccqp._blas cimport gemm
-from fccqp._dense cimport matvec, matvec_t
+from fccqp._types cimport Problem
+from fccqp.matrices cimport product, product_t
 from fccqp.tuning cimport KKT_DELTA, KKT_REFINE_TOLERANCE, MAX_REFINE
 
 
@@ -39,10 +39,10 @@ cdef int ldl_factor(LDL* f, const Problem* p, double sigma, const double* rho_ve
     cdef double* K = f.K
     for j in range(n):
         for i in range(j, n):
-            K[i + j * N] = p.P[i * n + j]
+            K[i + j * N] = p.P.values[i * n + j]
         K[j + j * N] += sigma
         for i in range(m):
-            K[n + i + j * N] = p.A[i * n + j]
+            K[n + i + j * N] = p.A.values[i * n + j]
     for k in range(p.s):
         j = p.constrained[k]
         K[j + j * N] += rho_vec[k]
@@ -107,8 +107,8 @@ cdef void _refine_step(LDL* f, const Problem* p, double sigma, const double* rho
     leaves the correction in ``f.residual``."""
     cdef Py_ssize_t n = p.n, m = p.m, i, k
     cdef double* res = f.residual
-    matvec(p.P, sol, res, n, n)
-    matvec_t(p.A, sol + n, f.ATnu, m, n)
+    product(&p.P, sol, res)
+    product_t(&p.A, sol + n, f.ATnu)
     for i in range(n):
         res[i] = rhs[i] - res[i] - sigma * sol[i] - f.ATnu[i]
     for k in range(p.s):
@@ -128,7 +128,7 @@ cdef void _refine_regularized(LDL* f, const Problem* p, double sigma, const doub
     recovers."""
     cdef int step
     for step in range(2):
-        matvec(p.A, sol, f.Ax, p.m, p.n)
+        product(&p.A, sol, f.Ax)
         _refine_step(f, p, sigma, rho_vec, rhs, sol, KKT_DELTA)
 
 
@@ -149,7 +149,7 @@ cdef void ldl_solve(LDL* f, const Problem* p, double sigma, const double* rho_ve
     cdef double* res = f.residual
     cdef double error, last_error = INFINITY
     for r in range(MAX_REFINE + 1):
-        matvec(p.A, sol, f.Ax, m, n)
+        product(&p.A, sol, f.Ax)
         if meets_equalities(f.Ax, rhs + n, p.E, m):
             return
         error = 0.0
@@ -183,7 +183,7 @@ cdef bint _in_null_space(const double* AW, const Problem* p, const double* W, in
         for i in range(n):
             w_max = max(w_max, fabs(W[i + j * N]))
     for i in range(m * n):
-        a_max = max(a_max, fabs(p.A[i]))
+        a_max = max(a_max, fabs(p.A.values[i]))
     for i in range(m):
         e_min = min(e_min, p.E[i])
     return error <= KKT_REFINE_TOLERANCE * max(1.0, a_max * w_max / e_min)
@@ -205,15 +205,15 @@ cdef bint ldl_unit_columns(LDL* f, const Problem* p, double sigma, const double*
         return True
     for r in range(MAX_REFINE + 1):
         # R_nu = A W_x (m x count, stored in the first m rows of R's columns of length m)
-        gemm(b"T", b"N", m, count, n, 1.0, p.A, n, W, N, 0.0, R, m)
+        gemm(b"T", b"N", m, count, n, 1.0, p.A.values, n, W, N, 0.0, R, m)
         if _in_null_space(R, p, W, N, count):
             return True
         for j in range(count - 1, -1, -1):  # -A W_x to rows n.. (back to front: no overlap)
             for i in range(m - 1, -1, -1):
                 R[n + i + j * N] = -R[i + j * m]
         # R_x = e - (P + sigma I) W_x - A' W_nu - R W_x
-        gemm(b"N", b"N", n, count, n, -1.0, p.P, n, W, N, 0.0, R, N)
-        gemm(b"N", b"N", n, count, m, -1.0, p.A, n, W + n, N, 1.0, R, N)
+        gemm(b"N", b"N", n, count, n, -1.0, p.P.values, n, W, N, 0.0, R, N)
+        gemm(b"N", b"N", n, count, m, -1.0, p.A.values, n, W + n, N, 1.0, R, N)
         for j in range(count):
             for i in range(n):
                 R[i + j * N] -= sigma * W[i + j * N]

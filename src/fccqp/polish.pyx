@@ -57,10 +57,11 @@ from libc.math cimport INFINITY, fabs, isfinite, pow, sqrt
 
 from scipy.linalg.cython_lapack cimport dsytrf, dsytrs
 
-from fccqp._dense cimport copy, inf_norm, matvec, matvec_t
+from fccqp._dense cimport copy, inf_norm
 from fccqp._types cimport Cones, Iterates, Problem
 from fccqp.cone_dispatch cimport cone_phi, cone_plane, cone_polar_distance
 from fccqp.kkt cimport KKT
+from fccqp.matrices cimport product, product_t
 from fccqp.polish_guess cimport (box_code, cone_code, drop_far_side, guess, linearize, renew,
                                  step_length)
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup, polish_schur_solve
@@ -135,10 +136,10 @@ cdef void _assemble(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) n
     for col in range(nf):
         jc = w.free[col]
         for r in range(col, nf):
-            K[r + col * N] = p.P[w.free[r] * n + jc]
+            K[r + col * N] = p.P.values[w.free[r] * n + jc]
         K[col + col * N] += POLISH_DELTA
         for i in range(m):
-            K[nf + i + col * N] = p.A[i * n + jc]
+            K[nf + i + col * N] = p.A.values[i * n + jc]
     for k in range(nb):
         o, d = p.cones.offset[w.boundary[k]], p.cones.dim[w.boundary[k]]
         start = p.constrained[o]
@@ -157,8 +158,8 @@ cdef double _residual(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb)
     multipliers of the held entries)."""
     cdef Py_ssize_t n = p.n, m = p.m, i, j, k, o, d, start, cone
     cdef double value, curved
-    matvec(p.P, w.x, w.grad, n, n)
-    matvec_t(p.A, w.nu, w.ATnu, m, n)
+    product(&p.P, w.x, w.grad)
+    product_t(&p.A, w.nu, w.ATnu)
     for i in range(n):
         w.grad[i] += p.q[i] + w.ATnu[i]
     for i in range(nf):
@@ -176,7 +177,7 @@ cdef double _residual(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb)
             w.rhs[w.index[start + j]] -= w.lam[k] * w.g[o + j] + curved
             value += w.g[o + j] * w.x[start + j]
         w.rhs[nf + m + k] = -value
-    matvec(p.A, w.x, w.Ax, m, n)
+    product(&p.A, w.x, w.Ax)
     for i in range(m):
         w.rhs[nf + i] = p.b[i] - w.Ax[i]
     w.grad_current = True

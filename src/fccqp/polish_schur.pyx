@@ -69,9 +69,9 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
     cdef int k
     f.ready = False
     f.convex = True
-    mark_coupled(p.P, n, f.coupled)
+    mark_coupled(p.P.values, n, f.coupled)
     for i in range(n):
-        largest = max(largest, p.P[i * n + i])
+        largest = max(largest, p.P.values[i * n + i])
     if not largest > 0.0:
         return False
     for j in range(s):
@@ -79,9 +79,9 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
         if f.coupled[i]:
             return False
         f.coupled[i] = 2   # constrained: not part of the unconstrained order
-        if p.P[i * n + i] < 0.0:
+        if p.P.values[i * n + i] < 0.0:
             f.convex = False
-        f.root[i] = sqrt(p.P[i * n + i] + delta) if p.P[i * n + i] > PIVOT_TOLERANCE * largest else 0.0
+        f.root[i] = sqrt(p.P.values[i * n + i] + delta) if p.P.values[i * n + i] > PIVOT_TOLERANCE * largest else 0.0
     for i in range(n):
         if f.coupled[i] == 1:
             f.order[lead] = i
@@ -89,9 +89,9 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
     rest = lead
     for i in range(n):
         if f.coupled[i] == 0:
-            if not p.P[i * n + i] > PIVOT_TOLERANCE * largest:
+            if not p.P.values[i * n + i] > PIVOT_TOLERANCE * largest:
                 return False
-            f.root[i] = sqrt(p.P[i * n + i] + delta)
+            f.root[i] = sqrt(p.P.values[i * n + i] + delta)
             f.order[rest] = i
             rest += 1
     k = <int>lead
@@ -101,7 +101,7 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
         f.inv_root[r] = 1.0 / f.root[f.order[r]] if r >= k else 0.0
     for c in range(k):
         for r in range(c, k):
-            f.L[r + c * n] = p.P[f.order[r] * n + f.order[c]]
+            f.L[r + c * n] = p.P.values[f.order[r] * n + f.order[c]]
         f.L[c + c * n] += delta
     if k > 0 and not fccqp_cholesky(f.L, k, <int>n):
         return False
@@ -111,7 +111,7 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
             return False
     for c in range(m):
         for r in range(rest):
-            f.Y[r + c * n] = p.A[c * n + f.order[r]]
+            f.Y[r + c * n] = p.A.values[c * n + f.order[r]]
         for r in range(k, rest):
             f.Y[r + c * n] *= f.inv_root[r]
     if m > 0:
@@ -135,7 +135,7 @@ cdef inline bint _diagonal_row(PolishSchur* f, const Problem* p, Py_ssize_t i, P
         return False
     inverse = 1.0 / f.root[i]
     for c in range(m):
-        f.Y[row + c * n] = p.A[c * n + i] * inverse
+        f.Y[row + c * n] = p.A.values[c * n + i] * inverse
     for c in range(m, size):
         f.Y[row + c * n] = 0.0
     f.rowvar[row] = i
@@ -198,7 +198,7 @@ cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t
         for a in range(d):
             f.rowvar[row + a] = start + a
             for c in range(m):
-                Y[row + a + c * n] = p.A[c * n + start + a]
+                Y[row + a + c * n] = p.A.values[c * n + start + a]
             for c in range(m, size):
                 Y[row + a + c * n] = 0.0
             Y[row + a + (m + kb) * n] = g[o + a]

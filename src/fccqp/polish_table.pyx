@@ -38,9 +38,10 @@ from libc.math cimport INFINITY, fabs
 
 from scipy.linalg.cython_lapack cimport dgetrf, dgetrs
 
-from fccqp._dense cimport colmatvec, fill, inf_norm, matvec, matvec_t
+from fccqp._dense cimport colmatvec, fill, inf_norm
 from fccqp._types cimport Problem
 from fccqp.kkt cimport KKT, kkt_solve_once
+from fccqp.matrices cimport product, product_t
 from fccqp.polish cimport APEX, FIXED, LOWER, UPPER, Polish
 from fccqp.reduced cimport Reduced
 from fccqp.tuning cimport LU_LOOP_ROWS, MAX_REFINE, MINOR_PART, PIVOT_RATIO, POLISH_REFINE_TOLERANCE
@@ -102,13 +103,13 @@ cdef double _residual(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil
     cdef double value, curved
     cdef const double* H
     cdef char code
-    matvec(p.P, w.x, w.grad, n, n)
-    matvec_t(p.A, w.nu, w.ATnu, m, n)
+    product(&p.P, w.x, w.grad)
+    product_t(&p.A, w.nu, w.ATnu)
     for i in range(n):
         w.full[i] = -(w.grad[i] + p.q[i] + w.ATnu[i])
     for j in range(s):
         w.full[p.constrained[j]] -= w.y[j]
-    matvec(p.A, w.x, w.Ax, m, n)
+    product(&p.A, w.x, w.Ax)
     for i in range(m):
         w.full[n + i] = p.b[i] - w.Ax[i]
     for j in range(s):

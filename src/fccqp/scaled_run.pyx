@@ -64,16 +64,16 @@ cdef void _scale(Engine* e, bint reuse, bint warm) noexcept nogil:
         for i in range(m):
             p.b[i] = p.E[i] * e.user.b[i]
     elif not (warm and e.scaling.done and rescale(
-            e.user.P, e.user.q, e.user.A, e.user.b, n, m, p.D, p.E,
-            e.scaling.reference, e.scaling.norms, p.P, p.q, p.A, p.b, &p.c)):
-        copy(e.user.P, p.P, n * n)
-        copy(e.user.A, p.A, m * n)
+            e.user.P.values, e.user.q, e.user.A.values, e.user.b, n, m, p.D, p.E,
+            e.scaling.reference, e.scaling.norms, p.P.values, p.q, p.A.values, p.b, &p.c)):
+        copy(e.user.P.values, p.P.values, n * n)
+        copy(e.user.A.values, p.A.values, m * n)
         copy(e.user.q, p.q, n)
         copy(e.user.b, p.b, m)
-        p.c = equilibrate(p.P, p.q, p.A, p.b, n, m, e.user.block_start, p.cones.dim,
+        p.c = equilibrate(p.P.values, p.q, p.A.values, p.b, n, m, e.user.block_start, p.cones.dim,
                           p.cones.count, e.opt.scaling, p.D, p.E, e.scaling.d,
                           e.scaling.e)
-        scaled_norms(p.P, p.A, n, m, p.c, e.scaling.reference)
+        scaled_norms(p.P.values, p.A.values, n, m, p.c, e.scaling.reference)
         e.scaling.done = True
     for j in range(p.s):
         i = p.constrained[j]

@@ -34,9 +34,9 @@ import numpy as np
 from libc.math cimport sqrt
 
 from fccqp._blas cimport cholesky, cholesky_solve, cholesky_solve_vector, gemm, syrk_t, trsm
-from fccqp._dense cimport matvec, matvec_t
 from fccqp._types cimport Problem
 from fccqp.ldl cimport meets_equalities
+from fccqp.matrices cimport product, product_t
 from fccqp.tuning cimport MAX_REFINE, RANK_TOLERANCE
 
 
@@ -65,7 +65,7 @@ cdef void _order(Schur* f, const Problem* p) noexcept nogil:
     ``order`` is rebuilt from ``base_order``, so it depends only on this ``P``."""
     cdef Py_ssize_t n = p.n, s = p.s, first = n - s, i, k, lead = 0
     cdef char* coupled = f.coupled
-    mark_coupled(p.P, n, coupled)
+    mark_coupled(p.P.values, n, coupled)
     for k in range(s):
         if coupled[p.constrained[k]]:
             for i in range(n):
@@ -115,12 +115,12 @@ cdef bint _factor_free(Schur* f, const Problem* p) noexcept nogil:
     for j in range(k):   # the dense block's lower triangle; below it L is never read
         column = f.order[j]
         for i in range(j, k):
-            f.L[i + j * n] = p.P[f.order[i] * n + column]
+            f.L[i + j * n] = p.P.values[f.order[i] * n + column]
     if k > 0 and not cholesky(f.L, k, n):
         return False
     for j in range(k, first):   # the diagonal tail's free rows
         column = f.order[j]
-        f.L[j + j * n] = p.P[column * n + column]
+        f.L[j + j * n] = p.P.values[column * n + column]
         if not f.L[j + j * n] > 0.0:
             return False
         f.L[j + j * n] = sqrt(f.L[j + j * n])
@@ -129,7 +129,7 @@ cdef bint _factor_free(Schur* f, const Problem* p) noexcept nogil:
     for j in range(first):
         column = f.order[j]
         for i in range(m):
-            f.Y[j + i * n] = p.A[i * n + column]
+            f.Y[j + i * n] = p.A.values[i * n + column]
     if k > 0:
         trsm(b"L", b"N", k, m, f.L, n, f.Y, n)
     for i in range(m):
@@ -147,7 +147,7 @@ cdef bint _factor_constrained(Schur* f, const Problem* p, const double* rho_vec)
     cdef double d
     for j in range(first, n):
         column = f.order[j]
-        d = p.P[column * n + column] + rho_vec[j - first]
+        d = p.P.values[column * n + column] + rho_vec[j - first]
         if not d > 0.0:
             return False
         f.L[j + j * n] = sqrt(d)
@@ -155,7 +155,7 @@ cdef bint _factor_constrained(Schur* f, const Problem* p, const double* rho_vec)
         return True
     for i in range(m):
         for j in range(first, n):
-            f.Y[j + i * n] = p.A[i * n + f.order[j]] / f.L[j + j * n]
+            f.Y[j + i * n] = p.A.values[i * n + f.order[j]] / f.L[j + j * n]
     for i in range(m * m):
         f.LS[i] = f.G[i]
     if s > 0:
@@ -171,7 +171,7 @@ cdef bint _factor_whole(Schur* f, const Problem* p, const double* rho_vec) noexc
     for j in range(n):
         column = f.order[j]
         for i in range(j, n):
-            f.L[i + j * n] = p.P[f.order[i] * n + column]
+            f.L[i + j * n] = p.P.values[f.order[i] * n + column]
     for j in range(s):
         f.L[first + j + (first + j) * n] += rho_vec[j]
     if not cholesky(f.L, n, n):
@@ -181,7 +181,7 @@ cdef bint _factor_whole(Schur* f, const Problem* p, const double* rho_vec) noexc
     for j in range(n):
         column = f.order[j]
         for i in range(m):
-            f.Y[j + i * n] = p.A[i * n + column]
+            f.Y[j + i * n] = p.A.values[i * n + column]
     trsm(b"L", b"N", n, m, f.L, n, f.Y, n)
     syrk_t(m, n, f.Y, n, 0.0, f.LS, m)
     return _factor_complement(f, m)
@@ -267,11 +267,11 @@ cdef void _solve(Schur* f, const Problem* p, const double* rhs_x, const double* 
     _h_solve(f, x, n)
     if m == 0:
         return
-    matvec(p.A, x, nu, m, n)
+    product(&p.A, x, nu)
     for i in range(m):
         nu[i] -= rhs_nu[i]
     cholesky_solve_vector(f.LS, <int>m, <int>m, nu)
-    matvec_t(p.A, nu, f.ATnu, m, n)
+    product_t(&p.A, nu, f.ATnu)
     _h_solve(f, f.ATnu, n)
     for i in range(n):
         x[i] -= f.ATnu[i]
@@ -294,11 +294,11 @@ cdef void schur_solve(Schur* f, const Problem* p, const double* rho_vec, const d
     if m == 0:
         return
     for r in range(MAX_REFINE):
-        matvec(p.A, x, f.Ax, m, n)
+        product(&p.A, x, f.Ax)
         if meets_equalities(f.Ax, rhs + n, p.E, m):
             return
-        matvec(p.P, x, f.r, n, n)
-        matvec_t(p.A, nu, f.ATnu, m, n)
+        product(&p.P, x, f.r)
+        product_t(&p.A, nu, f.ATnu)
         for i in range(n):
             f.r[i] = rhs[i] - f.r[i] - f.ATnu[i]
         for k in range(p.s):

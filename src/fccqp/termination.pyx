@@ -54,26 +54,22 @@ row ``i`` is the scaled one divided by ``E_i``, of entry ``i`` of ``x`` by ``c D
 
 from libc.math cimport INFINITY, fabs, isfinite
 
-from fccqp._dense cimport matvec, matvec_t
 from fccqp._types cimport Iterates, Problem
+from fccqp.matrices cimport product, product_t
+from fccqp.matrices cimport row_spans as matrix_row_spans
 from fccqp.tuning cimport GAP_TERMS_CAP
-
-cdef extern from "fccqp_kernels.h" nogil:
-    void fccqp_row_spans(const double* A, int rows, int cols, const double* width,
-                         double* span)
 
 
 cdef void row_spans(Problem* p, double* width) noexcept nogil:
     """``span``: for each row ``i``, ``sum_j |A_ij| (hi_j - lo_j)``, the range of ``(A x)_i``
-    over the box (infinite where the row meets an entry without two finite bounds), by
-    ``fccqp_row_spans`` (fccqp_kernels.h); ``width`` (n) is scratch."""
+    over the box (infinite where the row meets an entry without two finite bounds);
+    ``width`` (n) is scratch."""
     cdef Py_ssize_t n = p.n, j
     for j in range(n):
         width[j] = INFINITY
     for j in range(p.s):
         width[p.constrained[j]] = p.hi[j] - p.lo[j]
-    if p.m:
-        fccqp_row_spans(p.A, <int>p.m, <int>n, width, p.span)
+    matrix_row_spans(&p.A, width, p.span)
 
 
 cdef inline double _capped(double size, double span) noexcept nogil:
@@ -113,9 +109,9 @@ cdef void residuals(const Problem* p, const Iterates* it, double* Ax, double* AT
     cdef double c = p.c, value, scale, xPx, qx, bnu, support, terms, total = 0.0
     r.prim_eq = r.prim_eq_scale = r.prim_set = r.prim_set_scale = 0.0
     r.prim_s = r.prim_scale_s = 0.0
-    matvec(p.A, it.x, Ax, m, n)
-    matvec_t(p.A, it.nu, ATnu, m, n)
-    matvec(p.P, it.x, Px, n, n)
+    product(&p.A, it.x, Ax)
+    product_t(&p.A, it.nu, ATnu)
+    product(&p.P, it.x, Px)
     for i in range(m):
         value = fabs(Ax[i] - p.b[i])
         scale = max(fabs(Ax[i]), fabs(p.b[i]))

@@ -12,7 +12,7 @@ from fccqp._dense cimport copy, fill
 from fccqp._types cimport Iterates, Problem
 from fccqp.certificates cimport (CERTIFIED, SEPARATED, clean_primal_certificate,
                                  dual_infeasible, equality_direction, equality_inconsistent,
-                                 gram_factor, magnitudes, primal_infeasible, row_size)
+                                 gram_factor, primal_infeasible, row_sizes)
 from fccqp.engine cimport (DUAL_INFEASIBLE, INACCURATE, MAX_ITER, NUMERICAL_ERROR,
                            PRIMAL_INFEASIBLE, RUNNING, SOLVED, TIME_LIMIT, Engine, Run,
                            fccqp_now)
@@ -98,7 +98,7 @@ cdef bint missed(const Engine* e) noexcept nogil:
 
 cdef bint missed_by_data(Engine* e) noexcept nogil:
     """:func:`missed`, and also beyond ``EQUALITY_MISSED`` of each row's terms at the
-    magnitude of the iterate and the box (:func:`fccqp.certificates.row_size`): only
+    magnitude of the iterate and the box (:func:`fccqp.certificates.row_sizes`): only
     then can the equality certificate hold. Where ``b`` and ``A x`` both cancel to
     rounding noise (consistent dependent rows asking 0 with right-hand sides of
     4e-16, at a start of 1e-13), ``max(|A x|, |b|)`` alone made that a miss, and a
@@ -109,9 +109,9 @@ cdef bint missed_by_data(Engine* e) noexcept nogil:
     cdef double largest = 0.0
     if not missed(e):
         return False
-    magnitudes(p, e.it.x, e.work.vec_n)
+    row_sizes(p, e.it.x, e.work.vec_n, e.work.vec_m2)
     for i in range(p.m):
-        largest = max(largest, row_size(p, i, e.work.vec_n) / p.E[i])
+        largest = max(largest, e.work.vec_m2[i] / p.E[i])
     return e.res.prim_eq > EQUALITY_MISSED * largest
 
 
@@ -134,7 +134,7 @@ cdef bint inconsistent(Engine* e, bint clean) noexcept nogil:
     cdef Py_ssize_t n = p.n, m = p.m, i
     cdef double* r = e.work.vec_m
     cdef int code = equality_inconsistent(p, &e.it, e.opt.eps_prim_inf, r,
-                                          e.work.vec_n, e.work.vec_n2)
+                                          e.work.vec_n, e.work.vec_n2, e.work.vec_m2)
     if code == SEPARATED and clean:
         fill(e.work.rhs, 0.0, n)
         copy(r, e.work.rhs + n, m)
@@ -142,7 +142,7 @@ cdef bint inconsistent(Engine* e, bint clean) noexcept nogil:
         for i in range(m):
             r[i] = -e.work.sol[n + i]
         code = equality_direction(p, r, e.it.x, e.opt.eps_prim_inf, e.work.vec_n,
-                                  e.work.vec_n2)
+                                  e.work.vec_n2, e.work.vec_m2)
     if code != CERTIFIED:
         return False
     fill(e.certs.cert, 0.0, n + m)
