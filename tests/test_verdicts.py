@@ -283,6 +283,48 @@ def test_an_unbounded_run_that_stalls_is_certified(backend, seed):
     assert clarabel_solve(*problem.args()).status == "dual_infeasible"
 
 
+@pytest.mark.parametrize("backend", ["auto", "schur_reduced", "ldl_reduced", "ldl_full"])
+def test_a_least_distance_solve_that_stalls_in_one_form_is_solved_in_the_other(backend):
+    """Three friction cones pinned outside their sum by 1.8e-3 (the fuzzer's
+    ``primal_infeasible:100094``): the run stalls in the full form, and at 5f3a658 its
+    least-distance QP stalled too in the reduced form that "auto" chose for it (4000
+    iterations), where the full form solves it in 30. An auxiliary solve that is not
+    SOLVED now runs again in the other form, whatever form the run used."""
+    from fuzzing import Case
+
+    problem = Case.of("primal_infeasible", 100094).scenario().problem
+    result = solve_verified(problem, kkt_backend=backend)
+    assert result.status is Status.PRIMAL_INFEASIBLE
+    assert clarabel_solve(*problem.args()).status == "primal_infeasible"
+
+
+@pytest.mark.parametrize(("name", "seed"), [("extreme_data", 100213), ("cvxpy", 1)])
+def test_a_run_that_stalls_in_the_form_auto_chose_is_solved_in_the_other(name, seed):
+    """Feasible problems that stall for 4000 iterations in the full form that "auto"
+    chose (``P`` of 1e-12 in the fuzzer's ``extreme_data:100213``; ADMM cycling on
+    ``cvxpy:1``) and solve in a reduced one: with ``kkt_backend="auto"`` a stalled run
+    with no certificate is solved again, cold, in the other form, and its answer
+    (verified) replaces MAX_ITER_REACHED."""
+    from fuzzing import Case, judge
+
+    assert judge(Case.of(name, seed), "auto") is None
+    if name == "extreme_data":
+        problem = Case.of(name, seed).scenario().problem
+        result = solve_verified(problem)
+        assert result.status is Status.SOLVED and result.backend != "ldl_full"
+        assert clarabel_solve(*problem.args()).status == "solved"
+
+
+def test_a_forced_backend_is_not_replaced_after_a_stall():
+    """The second form is fccqp's choice only under "auto": a forced ``ldl_full`` that
+    stalls on ``extreme_data:100213`` reports MAX_ITER_REACHED, honestly."""
+    from fuzzing import Case
+
+    problem = Case.of("extreme_data", 100213).scenario().problem
+    result = solve_verified(problem, kkt_backend="ldl_full")
+    assert result.status is Status.MAX_ITER_REACHED and result.backend == "ldl_full"
+
+
 @pytest.mark.parametrize("max_iter", [1, 3, 10, 30])
 def test_a_feasible_run_cut_short_is_not_certified(max_iter):
     """A run that stalls asks the auxiliary QPs for certificates; on feasible, bounded
