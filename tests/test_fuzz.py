@@ -24,7 +24,7 @@ SEEDS = {
     "dual_infeasible": (0, 1, 2, 33, 166, 257, 368),
     "solver_reuse": (0, 1, 2, 50, 164, 211, 100008, 100206),
     "extreme_data": (0, 1, 7, 9, 38, 47, 56, 108, 138, 149, 202, 214, 254, 302, 308, 316,
-                     326, 335, 337, 355, 363, 365, 100213),
+                     326, 335, 337, 355, 363, 365, 100180, 100213, 100233),
     "qpsolvers": (0, 1, 2),
     "cvxpy": (1, 2, 3),
 }
@@ -43,7 +43,6 @@ SPARSE_SEEDS = {
 OPEN = {
     "solver_reuse:211": "sigma in scaled units decides convexity: a fresh solve accepts "
     "-3.9e-3 curvature that a kept workspace rejects",
-    "extreme_data:138": "SOLVED through the absolute tolerance on a cone block rescaled by 1e-8",
     "cvxpy:1": "a feasible problem whose dual residual stalls near 0.8 in the LDL' forms "
     "with adaptive rho; only auto solves it again in the other form",
     "extreme_data:100213": "P of 1e-12: the full form stalls where the reduced one solves; "
