@@ -20,7 +20,7 @@ DENSE_BACKENDS = ("auto", "schur_reduced", "ldl_reduced", "ldl_full")
 SEEDS = {
     "bad_input": (0, 1, 2, 3, 4, 5),
     "feasible": (0, 1, 2, 3, 4, 5),
-    "primal_infeasible": (0, 1, 2, 3, 80, 146, 177, 182, 350, 100094),
+    "primal_infeasible": (0, 1, 2, 3, 80, 146, 177, 182, 350, 100094, 300345),
     "dual_infeasible": (0, 1, 2, 33, 166, 257, 368),
     "solver_reuse": (0, 1, 2, 50, 164, 211, 100008, 100206),
     "extreme_data": (0, 1, 7, 9, 38, 47, 56, 108, 138, 149, 202, 214, 254, 302, 308, 316,

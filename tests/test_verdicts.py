@@ -301,6 +301,23 @@ def test_a_least_distance_solve_that_stalls_in_one_form_is_solved_in_the_other(b
     assert clarabel_solve(*problem.args()).status == "primal_infeasible"
 
 
+@pytest.mark.parametrize("backend", ["auto", "ldl_full"])
+@pytest.mark.parametrize("seed", [300345, 300371])
+def test_a_least_distance_solution_is_solved_again_to_the_farkas_tolerance(backend, seed):
+    """A friction cone capped through a boxed copy of its normal force, infeasible by a
+    gap of 3e-4 to 6e-4 (the fuzzer's ``primal_infeasible``): the least distance is
+    1.4e-4, and solved to the run's absolute tolerance its multipliers kept a residual
+    of 1.2e-6 to 2.1e-6 of their size, above the Farkas test's ``eps_prim_inf``; the
+    run stayed at MAX_ITER_REACHED. The least-distance QP is now solved again to that
+    test (``AUXILIARY_MARGIN``)."""
+    from fuzzing import Case
+
+    problem = Case.of("primal_infeasible", seed).scenario().problem
+    result = solve_verified(problem, kkt_backend=backend)
+    assert result.status is Status.PRIMAL_INFEASIBLE
+    assert clarabel_solve(*problem.args()).status == "primal_infeasible"
+
+
 @pytest.mark.parametrize(("name", "seed"), [("extreme_data", 100213), ("cvxpy", 1)])
 def test_a_run_that_stalls_in_the_form_auto_chose_is_solved_in_the_other(name, seed):
     """Feasible problems that stall for 4000 iterations in the full form that "auto"

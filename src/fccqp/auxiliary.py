@@ -46,6 +46,7 @@ from fccqp.cones import cone_tuple
 from fccqp.problem import INFINITE_BOUND
 from fccqp.settings import MAX_DENSE_KKT_ROWS
 from fccqp.status import Status
+from fccqp.tuning import AUXILIARY_MARGIN
 
 
 def _dense(matrix: object, rows: int, n: int) -> np.ndarray:
@@ -189,6 +190,28 @@ def in_other_form(solver_type: type, settings: object, stalled: object,
     return result if result.status in ANSWERS else None
 
 
+def _farkas(workspace: object, result: object, b: np.ndarray, lb: np.ndarray,
+            ub: np.ndarray, S: np.ndarray) -> np.ndarray | None:
+    """The Farkas certificate of a least-distance ``result`` as ``workspace`` judges it
+    (:meth:`fccqp.admm.Workspace.judge_certificate`), or None when the solution does not
+    meet its identity (:func:`_least_distance`) or the certificate fails."""
+    n, m = lb.shape[0], b.shape[0]
+    if not _least_distance(result, b, lb[S], ub[S], n):
+        return None
+    candidate = np.zeros(m + n)
+    candidate[:m] = result.y
+    candidate[m + S] = result.z[n:]
+    return workspace.judge_certificate(candidate, True, np.ascontiguousarray(result.x[:n]))
+
+
+def _farkas_tolerances(settings: object, w: np.ndarray) -> object:
+    """``settings`` whose termination meets the Farkas test of a least-distance solution
+    with multipliers ``w``: its dual residual, ``A'y + z``, within ``eps_prim_inf``
+    (relative) of their size, ``AUXILIARY_MARGIN`` times over."""
+    eps = settings.eps_prim_inf / AUXILIARY_MARGIN
+    return settings.replace(eps_rel=eps, eps_abs=eps * float(np.abs(w).max()))
+
+
 def stalled_certificate(solver_type: type, settings: object, workspace: object,
                         P: object, q: object, A: object, b: object, lb: object,
                         ub: object, cones: object) -> tuple | None:
@@ -212,14 +235,17 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
             problem, S = distance_problem(A, b, lb, ub, cones)
             if S.size and _dense_path(problem):
                 result, spent, factored = _solved(solver_type, settings, problem)
-                if _least_distance(result, b, lb[S], ub[S], n):
-                    candidate = np.zeros(m + n)
-                    candidate[:m] = result.y
-                    candidate[m + S] = result.z[n:]
-                    point = np.ascontiguousarray(result.x[:n])
-                    found = workspace.judge_certificate(candidate, True, point)
-                    if found is not None:
-                        return Status.PRIMAL_INFEASIBLE, found, spent, factored
+                found = _farkas(workspace, result, b, lb, ub, S)
+                if found is None and _least_distance(result, b, lb[S], ub[S], n):
+                    # its multipliers have the size of the distance, and the run's
+                    # tolerance (absolute) left them a residual of 2e-6 of it where the
+                    # Farkas test allows eps_prim_inf = 1e-6: solved again to that test
+                    result, iterations, factorizations = _solved(
+                        solver_type, _farkas_tolerances(settings, result.z[n:]), problem)
+                    spent, factored = spent + iterations, factored + factorizations
+                    found = _farkas(workspace, result, b, lb, ub, S)
+                if found is not None:
+                    return Status.PRIMAL_INFEASIBLE, found, spent, factored
         rays = ray_problem(P, q, A, lb, ub, cones)
         if not np.any(q) or not _dense_path(rays):
             return None

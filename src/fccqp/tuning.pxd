@@ -102,6 +102,8 @@ cdef extern from *:
     #define FCCQP_CLEANING_START 500
     /* cleaned only while the primal residual is above this x its tolerance */
     #define FCCQP_CLEANING_GATE 1.0
+    /* a least-distance QP solved again meets the Farkas test's eps_prim_inf this many times */
+    #define FCCQP_AUXILIARY_MARGIN 10.0
 
     /* ---- Polish (fccqp.polish*, fccqp.iteration, fccqp.acceptance) ---- */
     /* regularization of both diagonal blocks of the polishing KKT matrix (scaled) */
@@ -205,6 +207,7 @@ cdef extern from *:
     const double GRAM_REGULARIZATION "FCCQP_GRAM_REGULARIZATION"
     const long CLEANING_START "FCCQP_CLEANING_START"
     const double CLEANING_GATE "FCCQP_CLEANING_GATE"
+    const double AUXILIARY_MARGIN "FCCQP_AUXILIARY_MARGIN"
     # Polish
     const double POLISH_DELTA "FCCQP_POLISH_DELTA"
     const double POLISH_REFINE_TOLERANCE "FCCQP_POLISH_REFINE_TOLERANCE"
