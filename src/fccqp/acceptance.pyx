@@ -230,6 +230,7 @@ cdef void user_residuals(Engine* e, const double* x, const double* y,
     product_t(&e.user.A, y, ATy)
     product(&e.user.P, x, grad)
     r.prim_eq = r.prim_eq_scale = r.prim_set = r.prim_set_scale = 0.0
+    r.set_s = r.set_scale_s = 0.0
     for i in range(m):
         r.prim_eq = max(r.prim_eq, fabs(Ax[i] - b[i]))
         r.prim_eq_scale = max(r.prim_eq_scale, max(fabs(Ax[i]), fabs(b[i])))
@@ -252,6 +253,8 @@ cdef void user_residuals(Engine* e, const double* x, const double* y,
         i = p.constrained[j]
         r.prim_set = max(r.prim_set, fabs(x[i] - proj[j]))
         r.prim_set_scale = max(r.prim_set_scale, fabs(x[i]))
+        r.set_s = max(r.set_s, fabs(x[i] - proj[j]) / p.D[i])
+        r.set_scale_s = max(r.set_scale_s, max(fabs(x[i]), fabs(proj[j])) / p.D[i])
         if z[i] > 0.0 and isfinite(ub[i]):
             support += ub[i] * z[i]
             terms += fabs(ub[i] * z[i])

@@ -10,6 +10,7 @@ cdef struct Residuals:
     double prim_eq_scale, prim_set_scale
     double prim_scale, dual_scale, gap_scale   # prim_scale: the larger of the two
     double prim_s, dual_s, prim_scale_s, dual_scale_s
+    double set_s, set_scale_s   # x_S - w and the size of x_S, w in scaled units, uncapped
     bint finite
 
 cdef void residuals(const Problem* p, const Iterates* it, double* Ax, double* ATnu,
