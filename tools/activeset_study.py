@@ -65,6 +65,17 @@ MAX_PASSES = 30
 """Passes (pdas) or working-set changes / 4 (dual) before a run counts as failed."""
 
 
+NEWTON_COSINE = 0.9
+"""A cone's cut is relinearized (Newton) rather than joined by a new cut when the two
+normals' cosine exceeds this: far from the solution (or at an apex, which needs several
+cuts) a rotating single plane cycles."""
+
+
+NEWTON_STEPS = 40
+"""Steps after which the dual method stops relinearizing and only cuts (a guard against
+the cycles that Newton steps, which are not dual ascent steps, can make)."""
+
+
 @dataclass
 class Qp:
     """The dense data: box entries ``box`` with finite ``lo``/``hi``, cone blocks."""
@@ -323,52 +334,97 @@ def most_violated(qp: Qp, x, cuts):
     return best
 
 
-def dual_as(qp: Qp, working, x=None, y=None) -> Run:
+def dual_as(qp: Qp, working, newton: bool = False) -> Run:
     """Goldfarb-Idnani from the working set ``working`` (list of (row, rhs, key)).
 
+    With ``newton``, a violated cone that already has exactly one cut in the working
+    set is not cut again when the new cut is near the old one
+    (:data:`NEWTON_COSINE`, and before :data:`NEWTON_STEPS`): its cut is replaced by the tangent plane at the projection
+    of its block and its curvature ``lam H`` joins the Hessian (a Newton step on that
+    block, quadratic instead of the linear rate of cuts), then the working set's
+    equality QP is solved again and negative multipliers are dropped.
+
     The KKT matrix of the working set is refactored here with numpy (prototype); the
-    cost model counts one ``N^2`` update per change and one ``N^2`` solve per step.
+    cost model counts one ``N^2`` update per change and one ``N^2`` solve per step
+    (four rank-one updates for a relinearized plane and curvature).
     """
     n, m = qp.n, qp.m
     run = Run()
     W = list(working)
+    Hc: dict = {}
     run.flops_update += (n + m) ** 3 / 3
 
-    def solve_w(rhs_top):
+    def kkt():
         C = np.array([r for r, _, _ in W]).reshape(-1, n)
         nc = C.shape[0]
-        K = np.block([[qp.P, qp.A.T, C.T], [qp.A, np.zeros((m, m + nc))],
+        H = qp.P.copy()
+        for k, Hk in Hc.items():
+            s = qp.starts[k]
+            H[s:s + 3, s:s + 3] += Hk
+        K = np.block([[H, qp.A.T, C.T], [qp.A, np.zeros((m, m + nc))],
                       [C, np.zeros((nc, m + nc))]])
         run.sizes.append(n + m + nc)
-        return K, C, nc
+        return K, nc
 
     def eqp():
-        K, C, nc = solve_w(None)
+        K, nc = kkt()
         s = kkt_solve(K, np.r_[-qp.q, qp.b, [h for _, h, _ in W]])
         run.flops_update += K.shape[0] ** 2
         return s[:n], s[n:n + m], s[n + m:]
 
-    # a dual-feasible start: drop the most negative multiplier until none is
-    if W:
-        run.flops_update += len(W) * (n + m + len(W)) ** 2
-    while True:
-        x, y, lamw = eqp()
-        if not W or lamw.min() >= 0:
-            break
-        W.pop(int(np.argmin(lamw)))
+    def drop(i):
+        key = W.pop(i)[2]
+        if key[0] == "cut":
+            Hc.pop(key[1], None)
         run.changes += 1
         run.flops_update += (n + m + len(W)) ** 2
+
+    def dual_feasible():
+        # drop the most negative multiplier until none is (the start, and after a
+        # Newton step on a cone)
+        while True:
+            x, y, lamw = eqp()
+            if not W or lamw.min() >= 0:
+                return x, y, lamw
+            drop(int(np.argmin(lamw)))
+
+    if W:
+        run.flops_update += len(W) * (n + m + len(W)) ** 2
+    x, y, lamw = dual_feasible()
     cuts: list = []
     steps = 0
-    while steps < 4 * MAX_PASSES:
+    while steps < 200:
         new = most_violated(qp, x, cuts)
         if new is None:
             break
         r_p, h_p, key_p, _ = new
+        if newton and steps >= NEWTON_STEPS:
+            newton = False  # cycling: the cuts alone terminate
+        if newton and key_p[0] == "cut":
+            k = key_p[1]
+            mine = [i for i, w in enumerate(W) if w[2][0] == "cut" and w[2][1] == k]
+            s = qp.starts[k]
+            v = project(x[s:s + 3], qp.mus[k], qp.normals[k])
+            near = bool(mine) and all(W[i][0] @ r_p > NEWTON_COSINE for i in mine)
+            if near and split(v, qp.normals[k])[2] > 0:
+                # one plane at the projection replaces the block's cuts; the
+                # curvature's weight is their multipliers' sum
+                lam_k = float(sum(lamw[i] for i in mine))
+                for i in sorted(mine[1:], reverse=True):
+                    W.pop(i)
+                    lamw = np.delete(lamw, i)
+                i = mine[0]
+                W[i] = (r_p, h_p, W[i][2])
+                Hc[k] = lam_k * curvature(v, qp.mus[k], qp.normals[k])
+                steps += 1
+                run.changes += len(mine)
+                run.flops_update += (3 + len(mine)) * (n + m + len(W)) ** 2
+                x, y, lamw = dual_feasible()
+                continue
         lam_p = 0.0
         while True:
             steps += 1
-            K, C, nc = solve_w(None)
+            K, nc = kkt()
             d = kkt_solve(K, np.r_[-r_p, np.zeros(m + nc)])
             run.flops_update += K.shape[0] ** 2
             dx, dlw = d[:n], d[n + m:]
@@ -394,13 +450,15 @@ def dual_as(qp: Qp, working, x=None, y=None) -> Run:
                 run.changes += 1
                 run.flops_update += K.shape[0] ** 2 + 2 * (n + m + nc)
                 break
-            W.pop(block)
+            had_curvature = W[block][2][0] == "cut" and W[block][2][1] in Hc
+            drop(block)
             lamw = np.delete(lamw, block)
-            run.changes += 1
-            run.flops_update += K.shape[0] ** 2
+            if had_curvature:  # the Hessian changed: back to the working set's QP
+                x, y, lamw = dual_feasible()
         if key_p[0] == "cut":
             cuts.append(key_p)
-    # the exact duals, to verify the KKT conditions of the exact problem
+    # the duals of the final point, to verify the KKT conditions of the exact problem
+    # (the curvature terms stay: they vanish at a converged boundary point, H v = 0)
     x, y, lamw = eqp()
     u = qp.P @ x + qp.q + qp.A.T @ y
     run.passes = steps
@@ -455,7 +513,7 @@ def study(ts, paths, c_scale: float):
     for path in paths:
         daqp = daqp_iterations(ts, path, DaqpAdapter("daqp"))
         changed = views.contact_changes(path)
-        prev_a = prev_b = None
+        prev_a = prev_b = prev_c = None
         prev_n = None
         for pos, (idx, fresh) in enumerate(zip(path.indices, path.fresh, strict=True)):
             wbc = ts.qps[idx]
@@ -467,21 +525,24 @@ def study(ts, paths, c_scale: float):
             if cold:
                 a = pdas(qp, x0, np.zeros(qp.n), {}, c_box, c_cone, count_base=True)
                 a.flops_refactor += (qp.n + qp.m) ** 3 / 3
-                b = dual_as(qp, [])
+                b = dual_as(qp, [], newton=True)
+                bc = dual_as(qp, [])
             else:
                 xp, up, lamp = prev_a
                 a = pdas(qp, xp, up, lamp, c_box, c_cone, count_base=True)
-                b = dual_as(qp, prev_b)
+                b = dual_as(qp, prev_b, newton=True)
+                bc = dual_as(qp, prev_c)
             base = {"robot": ts.robot, "view": path.view, "qp": int(idx), "cold": bool(cold),
                     "contact_change": bool(changed[pos]), "daqp_iterations": daqp[pos],
                     "n": qp.n, "m": qp.m}
             rows.append(base | record(a, wbc, ts.x_ref[idx], "pdas"))
-            rows.append(base | record(b, wbc, ts.x_ref[idx], "dual"))
+            rows.append(base | record(b, wbc, ts.x_ref[idx], "dual+newton"))
+            rows.append(base | record(bc, wbc, ts.x_ref[idx], "dual cuts"))
             # the warm start of the next tick: each method's own state when it succeeded,
             # else the exact previous answer (what a fallback to ADMM would leave)
             exact = b.point if b.ok else None
             prev_a = a.state if a.ok else exact
-            prev_b, prev_n = b.state, qp.n
+            prev_b, prev_c, prev_n = b.state, bc.state, qp.n
             if prev_a is None:
                 prev_n = None
     return rows
