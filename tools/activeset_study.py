@@ -388,6 +388,29 @@ def dual_as(qp: Qp, working, newton: bool = False) -> Run:
                 return x, y, lamw
             drop(int(np.argmin(lamw)))
 
+    def relinearize(k, r_p):
+        """Replace cone ``k``'s cuts by the plane ``r_p`` at the projection of its
+        block, with the curvature weighted by their multipliers' sum; False (nothing
+        done) unless every cut of ``k`` is near ``r_p`` and the projection is off the
+        axis."""
+        nonlocal lamw
+        mine = [i for i, w in enumerate(W) if w[2][0] == "cut" and w[2][1] == k]
+        s = qp.starts[k]
+        v = project(x[s:s + 3], qp.mus[k], qp.normals[k])
+        near = bool(mine) and all(W[i][0] @ r_p > NEWTON_COSINE for i in mine)
+        if not (near and split(v, qp.normals[k])[2] > 0):
+            return False
+        lam_k = float(sum(lamw[i] for i in mine))
+        for i in sorted(mine[1:], reverse=True):
+            W.pop(i)
+            lamw = np.delete(lamw, i)
+        i = mine[0]
+        W[i] = (r_p, 0.0, W[i][2])
+        Hc[k] = lam_k * curvature(v, qp.mus[k], qp.normals[k])
+        run.changes += len(mine)
+        run.flops_update += (3 + len(mine)) * (n + m + len(W)) ** 2
+        return True
+
     if W:
         run.flops_update += len(W) * (n + m + len(W)) ** 2
     x, y, lamw = dual_feasible()
@@ -400,27 +423,19 @@ def dual_as(qp: Qp, working, newton: bool = False) -> Run:
         r_p, h_p, key_p, _ = new
         if newton and steps >= NEWTON_STEPS:
             newton = False  # cycling: the cuts alone terminate
-        if newton and key_p[0] == "cut":
-            k = key_p[1]
-            mine = [i for i, w in enumerate(W) if w[2][0] == "cut" and w[2][1] == k]
-            s = qp.starts[k]
-            v = project(x[s:s + 3], qp.mus[k], qp.normals[k])
-            near = bool(mine) and all(W[i][0] @ r_p > NEWTON_COSINE for i in mine)
-            if near and split(v, qp.normals[k])[2] > 0:
-                # one plane at the projection replaces the block's cuts; the
-                # curvature's weight is their multipliers' sum
-                lam_k = float(sum(lamw[i] for i in mine))
-                for i in sorted(mine[1:], reverse=True):
-                    W.pop(i)
-                    lamw = np.delete(lamw, i)
-                i = mine[0]
-                W[i] = (r_p, h_p, W[i][2])
-                Hc[k] = lam_k * curvature(v, qp.mus[k], qp.normals[k])
-                steps += 1
-                run.changes += len(mine)
-                run.flops_update += (3 + len(mine)) * (n + m + len(W)) ** 2
-                x, y, lamw = dual_feasible()
-                continue
+        if newton and key_p[0] == "cut" and relinearize(key_p[1], r_p):
+            # a Newton pass: every other violated cone with near cuts moves too
+            for k in range(qp.starts.size):
+                s = qp.starts[k]
+                v = x[s:s + 3]
+                if k != key_p[1] and violation(v, qp.mus[k], qp.normals[k]) > 0:
+                    d = v - project(v, qp.mus[k], qp.normals[k])
+                    r = np.zeros(n)
+                    r[s:s + 3] = d / np.linalg.norm(d)
+                    relinearize(k, r)
+            steps += 1
+            x, y, lamw = dual_feasible()
+            continue
         lam_p = 0.0
         while True:
             steps += 1
@@ -508,7 +523,7 @@ def record(run: Run, wbc, x_ref, method):
     }
 
 
-def study(ts, paths, c_scale: float):
+def study(ts, paths, c_scale: float, everything: bool = True):
     rows = []
     for path in paths:
         daqp = daqp_iterations(ts, path, DaqpAdapter("daqp"))
@@ -523,28 +538,33 @@ def study(ts, paths, c_scale: float):
             c_box = c_scale / np.maximum(np.diag(qp.P)[qp.box], 1e-12)
             c_cone = c_scale / max(np.max(np.diag(qp.P)[np.r_[[s + d for s in qp.starts for d in range(3)]]]), 1e-12)
             if cold:
+                b = dual_as(qp, [], newton=True)
+            else:
+                b = dual_as(qp, prev_b, newton=True)
+            if everything and cold:
                 a = pdas(qp, x0, np.zeros(qp.n), {}, c_box, c_cone, count_base=True)
                 a.flops_refactor += (qp.n + qp.m) ** 3 / 3
-                b = dual_as(qp, [], newton=True)
                 bc = dual_as(qp, [])
-            else:
+            elif everything:
                 xp, up, lamp = prev_a
                 a = pdas(qp, xp, up, lamp, c_box, c_cone, count_base=True)
-                b = dual_as(qp, prev_b, newton=True)
                 bc = dual_as(qp, prev_c)
             base = {"robot": ts.robot, "view": path.view, "qp": int(idx), "cold": bool(cold),
                     "contact_change": bool(changed[pos]), "daqp_iterations": daqp[pos],
                     "n": qp.n, "m": qp.m}
-            rows.append(base | record(a, wbc, ts.x_ref[idx], "pdas"))
             rows.append(base | record(b, wbc, ts.x_ref[idx], "dual+newton"))
-            rows.append(base | record(bc, wbc, ts.x_ref[idx], "dual cuts"))
+            if everything:
+                rows.append(base | record(a, wbc, ts.x_ref[idx], "pdas"))
+                rows.append(base | record(bc, wbc, ts.x_ref[idx], "dual cuts"))
             # the warm start of the next tick: each method's own state when it succeeded,
             # else the exact previous answer (what a fallback to ADMM would leave)
-            exact = b.point if b.ok else None
-            prev_a = a.state if a.ok else exact
-            prev_b, prev_c, prev_n = b.state, bc.state, qp.n
-            if prev_a is None:
-                prev_n = None
+            prev_b, prev_n = b.state, qp.n
+            if everything:
+                exact = b.point if b.ok else None
+                prev_a = a.state if a.ok else exact
+                prev_c = bc.state
+                if prev_a is None:
+                    prev_n = None
     return rows
 
 
@@ -587,6 +607,8 @@ def main() -> None:
                         help="semismooth Newton's c as a multiple of 1/diag(P)")
     parser.add_argument("--views", nargs="+", default=["cold", "every 10th", "warm"])
     parser.add_argument("--save", default=None)
+    parser.add_argument("--newton-only", action="store_true",
+                        help="run dual+newton alone (not pdas and the cuts-only dual)")
     args = parser.parse_args()
     rows = []
     for robot in args.robots:
@@ -600,7 +622,7 @@ def main() -> None:
             p = all_paths[v]
             sel = np.isin(p.indices, keep)
             paths.append(views.Path(p.view, ts, p.indices[sel], p.fresh[sel]))
-        rows += study(ts, paths, args.c_scale)
+        rows += study(ts, paths, args.c_scale, not args.newton_only)
         print(summary([r for r in rows if r["robot"] == robot]), flush=True)
     if args.save:
         with open(args.save, "w") as fh:
