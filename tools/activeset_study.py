@@ -47,7 +47,6 @@ import json
 from dataclasses import dataclass, field
 
 import numpy as np
-
 from benchmarks import testsets, views
 from benchmarks.metrics import qp_metrics
 from benchmarks.pyramid_solvers import DaqpAdapter
@@ -337,12 +336,13 @@ def most_violated(qp: Qp, x, cuts):
 def dual_as(qp: Qp, working, newton: bool = False) -> Run:
     """Goldfarb-Idnani from the working set ``working`` (list of (row, rhs, key)).
 
-    With ``newton``, a violated cone that already has exactly one cut in the working
-    set is not cut again when the new cut is near the old one
-    (:data:`NEWTON_COSINE`, and before :data:`NEWTON_STEPS`): its cut is replaced by the tangent plane at the projection
-    of its block and its curvature ``lam H`` joins the Hessian (a Newton step on that
-    block, quadratic instead of the linear rate of cuts), then the working set's
-    equality QP is solved again and negative multipliers are dropped.
+    With ``newton`` (before :data:`NEWTON_STEPS` steps), a violated cone whose cuts in
+    the working set are all near its new cut (:data:`NEWTON_COSINE`) is not cut again:
+    its cuts are replaced by the tangent plane at the projection of its block, and its
+    curvature ``lam H`` (``lam`` the cuts' multipliers' sum) joins the Hessian, and so
+    for every other violated cone with near cuts (a Newton pass on those blocks,
+    quadratic instead of the linear rate of cuts); then the working set's equality QP is
+    solved again and negative multipliers are dropped.
 
     The KKT matrix of the working set is refactored here with numpy (prototype); the
     cost model counts one ``N^2`` update per change and one ``N^2`` solve per step
@@ -536,7 +536,8 @@ def study(ts, paths, c_scale: float, everything: bool = True):
             cold = fresh or prev_n != qp.n
             x0, y0, _ = eq_solution(qp)
             c_box = c_scale / np.maximum(np.diag(qp.P)[qp.box], 1e-12)
-            c_cone = c_scale / max(np.max(np.diag(qp.P)[np.r_[[s + d for s in qp.starts for d in range(3)]]]), 1e-12)
+            forces = (qp.starts[:, None] + np.arange(3)).ravel()
+            c_cone = c_scale / max(np.max(np.diag(qp.P)[forces]), 1e-12)
             if cold:
                 b = dual_as(qp, [], newton=True)
             else:
@@ -572,7 +573,8 @@ def summary(rows):
     out = []
     keys = sorted({(r["robot"], r["view"], r["method"]) for r in rows})
     for robot, view, method in keys:
-        for sel, label in ((lambda r: True, view), (lambda r: r["contact_change"], "contact change")):
+        for sel, label in ((lambda r: True, view),
+                           (lambda r: r["contact_change"], "contact change")):
             rs = [r for r in rows if r["robot"] == robot and r["view"] == view
                   and r["method"] == method and sel(r)]
             if not rs or (label == "contact change" and view != "warm"):
