@@ -616,6 +616,8 @@ def main() -> None:
     parser.add_argument("--robots", nargs="+", default=["go2", "talos_reduced"])
     parser.add_argument("--cache", default="/tmp/fullrun/benchmarks/.cache")
     parser.add_argument("--qps", type=int, default=400, help="first QPs of each set")
+    parser.add_argument("--every", type=int, default=1,
+                        help="keep every k-th of those QPs (the cold view of a sample)")
     parser.add_argument("--c-scale", type=float, default=1.0,
                         help="semismooth Newton's c as a multiple of 1/diag(P)")
     parser.add_argument("--views", nargs="+", default=["cold", "every 10th", "warm"])
@@ -627,7 +629,7 @@ def main() -> None:
     for robot in args.robots:
         (path,) = glob.glob(f"{args.cache}/{robot}-mix-seed0-n400-*gen2.npz")
         ts = testsets.load(path)
-        keep = np.arange(min(args.qps, len(ts)))
+        keep = np.arange(min(args.qps, len(ts)))[::args.every]
         all_paths = {"cold": views.cold_path(ts), "every 10th": views.coarse_path(ts, 10),
                      "warm": views.warm_path(ts)}
         paths = []
