@@ -523,6 +523,15 @@ def record(run: Run, wbc, x_ref, method):
     }
 
 
+def guarded_dual(qp: Qp, working, x0) -> Run:
+    """``dual_as`` with Newton steps; a singular working-set KKT matrix (dependent rows,
+    which the prototype does not resolve as DAQP does) counts as a failure at ``x0``."""
+    try:
+        return dual_as(qp, working, newton=True)
+    except np.linalg.LinAlgError:
+        return Run(x=x0, state=[])
+
+
 def study(ts, paths, c_scale: float, everything: bool = True):
     rows = []
     for path in paths:
@@ -538,10 +547,7 @@ def study(ts, paths, c_scale: float, everything: bool = True):
             c_box = c_scale / np.maximum(np.diag(qp.P)[qp.box], 1e-12)
             forces = (qp.starts[:, None] + np.arange(3)).ravel()
             c_cone = c_scale / max(np.max(np.diag(qp.P)[forces]), 1e-12)
-            if cold:
-                b = dual_as(qp, [], newton=True)
-            else:
-                b = dual_as(qp, prev_b, newton=True)
+            b = guarded_dual(qp, [] if cold else prev_b, x0)
             if everything and cold:
                 a = pdas(qp, x0, np.zeros(qp.n), {}, c_box, c_cone, count_base=True)
                 a.flops_refactor += (qp.n + qp.m) ** 3 / 3
@@ -556,7 +562,8 @@ def study(ts, paths, c_scale: float, everything: bool = True):
             rows.append(base | record(b, wbc, ts.x_ref[idx], "dual+newton"))
             # the same run handed to a Newton polish (the existing polish's job): its
             # final point and duals guess the active set, pdas makes it exact
-            p = pdas(qp, *b.point, c_box, c_cone, count_base=False)
+            p = (pdas(qp, *b.point, c_box, c_cone, count_base=False) if b.point is not None
+                 else Run(x=b.x))
             joint = Run(ok=p.ok, passes=b.passes, changes=b.changes + p.changes,
                         sizes=b.sizes + p.sizes, flops_refactor=p.flops_refactor,
                         flops_update=b.flops_update + p.flops_refactor, x=p.x)
