@@ -16,7 +16,7 @@ import scipy.sparse as sp
 import fccqp
 from fccqp import FrictionCone, SecondOrderCone, Status, scaling, sparse_problem
 from fccqp.settings import MAX_DENSE_KKT_ROWS
-from problems import random_problem
+from problems import large_problem, random_problem
 from reference import clarabel_solve
 from verify import Tolerances, from_qpsolvers, verify_solution
 
@@ -263,21 +263,6 @@ def test_missing_qdldl_is_a_clear_import_error(monkeypatch):
     monkeypatch.setitem(sys.modules, "qdldl", None)
     with pytest.raises(ImportError, match="pip install qdldl"):
         fccqp.solve(np.eye(2), np.zeros(2), lb=[0, 0], ub=[1, 1], **SPARSE)
-
-
-def large_problem(n: int, seed: int = 0):
-    """A separable QP with a coupling row and a friction cone: ``n`` variables, a
-    tridiagonal ``P``, two equalities, a box on most entries."""
-    rng = np.random.default_rng(seed)
-    main = rng.uniform(1.0, 2.0, n)
-    P = sp.diags([main, -0.25 * np.ones(n - 1), -0.25 * np.ones(n - 1)], [0, 1, -1],
-                 format="csc")
-    q = rng.standard_normal(n)
-    A = sp.csc_matrix(np.vstack([np.ones(n), np.r_[np.zeros(n - 1), 1.0]]))
-    b = np.array([1.0, 2.0])
-    lb, ub = np.full(n, -0.5), np.full(n, 0.5)
-    lb[-3:], ub[-3:] = -np.inf, np.inf   # the cone's entries
-    return P, q, A, b, lb, ub, [FrictionCone(n - 3, 0.4)]
 
 
 def clarabel_sparse(P, q, A, b, lb, ub, cones):

@@ -26,12 +26,19 @@ from __future__ import annotations
 
 import argparse
 import statistics
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import scipy.sparse as sp
 
 import fccqp
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path[:0] = [str(ROOT / "tests")]
+
+import problems  # noqa: E402 - tests/problems.py, found through the path set just above
 
 
 def mpc(states: int = 12, inputs: int = 4, horizon: int = 100, seed: int = 0):
@@ -55,17 +62,9 @@ def mpc(states: int = 12, inputs: int = 4, horizon: int = 100, seed: int = 0):
 
 
 def large_friction(n: int = 5000, seed: int = 0):
-    """``tests/test_sparse_path.large_problem``."""
-    rng = np.random.default_rng(seed)
-    main = rng.uniform(1.0, 2.0, n)
-    P = sp.diags([main, -0.25 * np.ones(n - 1), -0.25 * np.ones(n - 1)], [0, 1, -1],
-                 format="csc")
-    q = rng.standard_normal(n)
-    A = sp.csc_matrix(np.vstack([np.ones(n), np.r_[np.zeros(n - 1), 1.0]]))
-    b = np.array([1.0, 2.0])
-    lb, ub = np.full(n, -0.5), np.full(n, 0.5)
-    lb[-3:], ub[-3:] = -np.inf, np.inf
-    return P, q, A, b, lb, ub, [fccqp.FrictionCone(n - 3, 0.4)]
+    """``tests/problems.large_problem``: a tridiagonal ``P``, two equalities, a box on
+    most entries and one friction cone."""
+    return problems.large_problem(n, seed)
 
 
 def sparse_ls(size: int = 1700):
