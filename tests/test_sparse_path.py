@@ -17,7 +17,7 @@ import fccqp
 from fccqp import FrictionCone, SecondOrderCone, Status, scaling, sparse_problem
 from fccqp.settings import MAX_DENSE_KKT_ROWS
 from problems import large_problem, random_problem
-from reference import clarabel_solve
+from reference import clarabel_solve, clarabel_sparse_form
 from verify import Tolerances, from_qpsolvers, verify_solution
 
 SPARSE = dict(kkt_backend="sparse")
@@ -266,25 +266,12 @@ def test_missing_qdldl_is_a_clear_import_error(monkeypatch):
 
 
 def clarabel_sparse(P, q, A, b, lb, ub, cones):
-    """Clarabel at tight tolerance on a sparse problem with friction cones about the z
-    axis (``reference.clarabel_form`` builds dense matrices, too large here)."""
+    """Clarabel at tight tolerance on a sparse problem with friction cones about z."""
     clarabel = pytest.importorskip("clarabel")
-    n = q.shape[0]
-    eye = sp.eye(n, format="csr")
-    low, high = np.flatnonzero(np.isfinite(lb)), np.flatnonzero(np.isfinite(ub))
-    rows = [A, -eye[low], eye[high]]
-    kinds = [clarabel.ZeroConeT(A.shape[0]), clarabel.NonnegativeConeT(len(low) + len(high))]
-    for cone in cones:
-        f = cone.start
-        rows.append(-sp.csr_matrix(([cone.mu, 1.0, 1.0], ([0, 1, 2], [f + 2, f, f + 1])),
-                                   shape=(3, n)))
-        kinds.append(clarabel.SecondOrderConeT(3))
-    rhs = np.concatenate([b, -lb[low], ub[high], np.zeros(3 * len(cones))])
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = 1e-10
-    solution = clarabel.DefaultSolver(sp.triu(P, format="csc"), q,
-                                      sp.vstack(rows, format="csc"), rhs, kinds,
+    solution = clarabel.DefaultSolver(*clarabel_sparse_form(P, q, A, b, lb, ub, cones),
                                       settings).solve()
     assert str(solution.status) == "Solved"
     x = np.array(solution.x)
