@@ -5,7 +5,7 @@ feasibility restoration (:mod:`fccqp.restoration`); and the residuals of a point
 the user's units that both checks (and the returned point) are measured by.
 """
 
-from libc.math cimport fabs, isfinite
+from libc.math cimport INFINITY, fabs, isfinite
 
 from fccqp._dense cimport copy, fill
 from fccqp._types cimport Iterates, Problem
@@ -19,7 +19,7 @@ from fccqp.restoration cimport restore
 from fccqp.scaling cimport unscale
 from fccqp.termination cimport Residuals, gap_scale
 from fccqp.tuning cimport (EQUALITY_EXACT, EQUALITY_MISSED, EQUALITY_SLACK, POLISH_EXACT,
-                           RESTORED_EQUALITY)
+                           RESTORED_EQUALITY, SCALED_VIOLATION)
 from fccqp.verdict cimport classify, missed
 
 
@@ -231,6 +231,7 @@ cdef void user_residuals(Engine* e, const double* x, const double* y,
     product(&e.user.P, x, grad)
     r.prim_eq = r.prim_eq_scale = r.prim_set = r.prim_set_scale = 0.0
     r.set_s = r.set_scale_s = 0.0
+    r.box_excess = -INFINITY
     for i in range(m):
         r.prim_eq = max(r.prim_eq, fabs(Ax[i] - b[i]))
         r.prim_eq_scale = max(r.prim_eq_scale, max(fabs(Ax[i]), fabs(b[i])))
@@ -255,6 +256,9 @@ cdef void user_residuals(Engine* e, const double* x, const double* y,
         r.prim_set_scale = max(r.prim_set_scale, fabs(x[i]))
         r.set_s = max(r.set_s, fabs(x[i] - proj[j]) / p.D[i])
         r.set_scale_s = max(r.set_scale_s, max(fabs(x[i]), fabs(proj[j])) / p.D[i])
+        if not p.in_cone[j]:
+            r.box_excess = max(r.box_excess, (fabs(x[i] - proj[j]) - SCALED_VIOLATION
+                                              * max(fabs(x[i]), fabs(proj[j]))) / p.D[i])
         if z[i] > 0.0 and isfinite(ub[i]):
             support += ub[i] * z[i]
             terms += fabs(ub[i] * z[i])
