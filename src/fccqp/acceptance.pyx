@@ -17,7 +17,7 @@ from fccqp.polish cimport multiplier_violation, polish
 from fccqp.projections cimport proj_block, proj_set
 from fccqp.restoration cimport restore
 from fccqp.scaling cimport unscale
-from fccqp.termination cimport Residuals, gap_scale
+from fccqp.termination cimport Residuals, box_entry_size, gap_scale
 from fccqp.tuning cimport (EQUALITY_EXACT, EQUALITY_MISSED, EQUALITY_SLACK, POLISH_EXACT,
                            RESTORED_EQUALITY, SCALED_VIOLATION)
 from fccqp.verdict cimport classify, missed
@@ -225,7 +225,7 @@ cdef void user_residuals(Engine* e, const double* x, const double* y,
     cdef double* ATy = e.work.vec_n2
     cdef double* proj = e.work.vec_s
     cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, terms = 0.0, total = 0.0
-    cdef double value
+    cdef double value, size
     product(&e.user.A, x, Ax)
     product_t(&e.user.A, y, ATy)
     product(&e.user.P, x, grad)
@@ -257,8 +257,9 @@ cdef void user_residuals(Engine* e, const double* x, const double* y,
         r.set_s = max(r.set_s, fabs(x[i] - proj[j]) / p.D[i])
         r.set_scale_s = max(r.set_scale_s, max(fabs(x[i]), fabs(proj[j])) / p.D[i])
         if not p.in_cone[j]:
-            r.box_excess = max(r.box_excess, (fabs(x[i] - proj[j]) - SCALED_VIOLATION
-                                              * max(fabs(x[i]), fabs(proj[j]))) / p.D[i])
+            size = box_entry_size(max(fabs(x[i]), fabs(proj[j])), ub[i] - lb[i])
+            r.box_excess = max(r.box_excess,
+                               (fabs(x[i] - proj[j]) - SCALED_VIOLATION * size) / p.D[i])
         if z[i] > 0.0 and isfinite(ub[i]):
             support += ub[i] * z[i]
             terms += fabs(ub[i] * z[i])

@@ -1,4 +1,6 @@
 # cython: language_level=3
+from libc.math cimport isfinite
+
 from fccqp._types cimport Iterates, Problem
 
 cdef struct Residuals:
@@ -22,3 +24,9 @@ cdef bint nearly_converged(const Residuals* r, double eps_abs, double eps_rel,
 cdef double gap_scale(double xPx, double qx, double terms) noexcept nogil
 cdef void row_spans(Problem* p, double* width) noexcept nogil
 cdef double box_support(const Problem* p, const double* y, double* terms) noexcept nogil
+
+
+cdef inline double box_entry_size(double scale, double width) noexcept nogil:
+    """The size a box entry's violation is judged against (``Residuals.box_excess``): its
+    ``scale`` (value), or the box's ``width`` where that is finite and larger."""
+    return max(scale, width) if isfinite(width) else scale

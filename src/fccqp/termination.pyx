@@ -43,9 +43,10 @@ entries of 4e-17 off their bounds of 0).
 The guard is gross on purpose for the cones: judging each cone block against its own
 size instead (in either units) is the exact fix, but it tightens the test on friction
 cones with near-zero forces and doubled the iterations of the whole-body-control QPs.
-A box entry is judged against its own size (``box_excess``): a bound of 2.77 missed by
-0.05 beside a cone block of entries near 5e8 was claimed SOLVED on an infeasible
-problem otherwise.
+A box entry is judged against its own size (``box_excess``), its value or the width of
+a two-sided box (whichever is larger, so that a torque near its limit is held to 1 % of
+its range, not of its value): a one-sided bound of 2.77 missed by 0.05 beside a cone
+block of entries near 5e8 was claimed SOLVED on an infeasible problem otherwise.
 
 Rho adaptation (:mod:`fccqp.rho_rule`) balances the scaled primal and dual residuals, each
 relative to its own scale. There the primal scale of a box entry is capped by the
@@ -148,7 +149,8 @@ cdef void residuals(const Problem* p, const Iterates* it, double* Ax, double* AT
         r.set_s = max(r.set_s, value)
         r.set_scale_s = max(r.set_scale_s, scale)
         if not p.in_cone[j]:
-            r.box_excess = max(r.box_excess, value - SCALED_VIOLATION * scale)
+            r.box_excess = max(r.box_excess, value - SCALED_VIOLATION * box_entry_size(
+                scale, p.hi[j] - p.lo[j]))
         total += value + fabs(it.y[j])
     r.prim = max(r.prim_eq, r.prim_set)
     r.prim_scale = max(r.prim_eq_scale, r.prim_set_scale)
