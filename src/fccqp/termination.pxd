@@ -13,7 +13,8 @@ cdef struct Residuals:
     double prim_scale, dual_scale, gap_scale   # prim_scale: the larger of the two
     double prim_s, dual_s, prim_scale_s, dual_scale_s
     double set_s, set_scale_s   # x_S - w and the size of x_S, w in scaled units, uncapped
-    double box_excess           # largest |x_i - w_i| - SCALED_VIOLATION max(|x_i|, |w_i|), box entries
+    double box_excess           # box entries: largest |x_i - w_i| - SCALED_VIOLATION x size
+                                # (box_entry_size), in scaled units
     bint finite
 
 cdef void residuals(const Problem* p, const Iterates* it, double* Ax, double* ATnu,
