@@ -62,12 +62,13 @@ from fccqp._types cimport Cones, Iterates, Problem
 from fccqp.cone_dispatch cimport cone_phi, cone_plane, cone_polar_distance
 from fccqp.kkt cimport KKT
 from fccqp.matrices cimport product, product_t
-from fccqp.polish_guess cimport (box_code, cone_code, drop_far_side, guess, linearize, renew,
-                                 step_length)
+from fccqp.polish_guess cimport (box_code, cone_code, drop_far_side, guess, linearize,
+                                 most_wrong, renew, step_length)
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup, polish_schur_solve
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.reduced cimport Reduced
-from fccqp.tuning cimport (ACTIVE_TOLERANCE, CHORD_RATE, CHORD_STEPS, GUESS_PASSES, GUESS_TOLERANCE,
+from fccqp.tuning cimport (ACTIVE_TOLERANCE, CHORD_RATE, CHORD_STEPS, COLD_GUESS_PASSES,
+                           GUESS_PASSES, GUESS_TOLERANCE,
                            MAX_REFINE, MISS_FLOOR, NEWTON_TOLERANCE, POLISH_DELTA,
                            POLISH_REFINE_TOLERANCE)
 
@@ -367,13 +368,22 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     while they converge fast, see ``CHORD_RATE``), stopping early at the floor rounding
     leaves. A boundary block that a solve puts past the apex
     (:func:`~fccqp.polish_guess.drop_far_side`) is held at the apex instead and the
-    corrected guess solved, within the same ``GUESS_PASSES``. False when a factorization
+    corrected guess solved, within the same ``GUESS_PASSES``; so is a settled guess whose
+    Newton steps left a multiplier wrong-signed (a plane's ``lam`` past 0: the release
+    was judged on the first solve's), with that constraint released: from the cold
+    start, whose planes begin with ``lam = 0`` and no curvature, 25 of go2's 100 cold
+    polishes had ended so and failed the caller's check. A polish of the cold start
+    (``cold``, :func:`fccqp.acceptance.cold_polish`) may solve ``COLD_GUESS_PASSES``
+    guesses, and gives up (False) when a pass after the first still adds constraints
+    before any pass was feasible: talos' equality-constrained solutions were so far
+    from the active set that its guesses grew for three passes, then released one
+    constraint a pass through 30 passes without settling. False when a factorization
     breaks down or the result is not finite, or when the clock (:func:`fccqp_now`) has
     passed ``deadline`` before a guess after the first (``INFINITY``: never); otherwise
     the caller judges the point.
     """
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, nb, nf = 0, j, changed
-    cdef long passes = 0, step
+    cdef long passes = 0, step, most = COLD_GUESS_PASSES if w.cold else GUESS_PASSES
     cdef double total = 0.0
     cdef double scale = max(1.0, max(inf_norm(p.q, n), inf_norm(p.b, m)))
     cdef bint tabled = table != NULL
@@ -406,7 +416,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
             return False
         _multipliers(w, p, nf, nb)
         passes += 1
-        if passes == GUESS_PASSES or w.cycling:   # not settled: the caller judges this point
+        if passes == most or w.cycling:   # not settled: the caller judges this point
             if not tabled:
                 _solve(w, p, nf, nb, POLISH_REFINE_TOLERANCE * scale)
                 _multipliers(w, p, nf, nb)
@@ -422,6 +432,8 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
                 nb = renew(w, p, True, blocking, &changed)
                 continue
         nb = renew(w, p, True, -1, &changed)
+        if w.cold and passes > 1 and changed != 0 and not feasible:
+            return False   # the cold start's guess still grows: far from the active set
         if changed == 0:
             feasible = True
             nb = renew(w, p, False, -1, &changed)
@@ -459,6 +471,9 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
             else:
                 _solve(w, p, nf, nb, POLISH_REFINE_TOLERANCE * scale)
         _multipliers(w, p, nf, nb)
+        if most_wrong(w, p) >= 0:   # Newton moved a plane's multiplier past 0: release it
+            nb = renew(w, p, False, -1, &changed)
+            continue
         break
     w.passes = passes
     for j in range(n):
