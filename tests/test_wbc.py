@@ -74,35 +74,3 @@ def test_a_settled_active_set_is_polished_before_admm_converges(test_set):
         gap = qp.objective(result.x) - qp.objective(x_ref)
         assert gap <= 1e-7 * (1 + abs(qp.objective(x_ref)))
     assert early <= 0.85 * plain   # 320 against 418 iterations
-
-
-def equality_constrained_solution(qp):
-    """``argmin 1/2 x'Px + q'x`` subject to ``A x = b`` alone: the cold start's point."""
-    n, m = qp.q.size, qp.b.size
-    kkt = np.block([[qp.P, qp.A.T], [qp.A, np.zeros((m, m))]])
-    return np.linalg.lstsq(kkt, np.r_[-qp.q, qp.b], rcond=None)[0][:n]
-
-
-def test_cold_solve_polishes_the_equality_constrained_start():
-    """A cold solve first polishes the equality-constrained solution, its guess read from
-    the bounds and cones that point violates (fccqp.acceptance.cold_polish): on go2's
-    whole-body control QPs whose start violates a torque bound or a friction cone, some
-    end there without an ADMM iteration or factorization; every answer is exact and the
-    reference's."""
-    test_set = generate_test_set("go2", "mix", 12, seed=3)
-    settings = fccqp.Settings.realtime(float("inf"))
-    polished_violating = 0
-    for qp, x_ref in zip(test_set.qps, test_set.x_ref, strict=True):
-        start = equality_constrained_solution(qp)
-        violated = max(qp.bound_violation(start), qp.cone_violation(start)) > 1e-6
-        result = fccqp.Solver(settings).solve(qp.P, qp.q, qp.A, qp.b, qp.lb, qp.ub,
-                                              cones_of(qp))
-        assert result.status is fccqp.Status.SOLVED
-        verify_solution(problem_of(qp), result, Tolerances.of(settings))
-        assert qp.equality_residual(result.x) <= 1e-9
-        gap = qp.objective(result.x) - qp.objective(x_ref)
-        assert gap <= 1e-6 * (1 + abs(qp.objective(x_ref)))
-        if violated and result.iterations == 0:
-            assert result.polished and result.factorizations == 1   # the start's alone
-            polished_violating += 1
-    assert polished_violating >= 3   # 4 of the 7 whose start violates (none on main)

@@ -133,34 +133,6 @@ cdef bint warm_polish(Engine* e, Run* run, double start_time) noexcept nogil:
     return True
 
 
-cdef bint cold_polish(Engine* e, Run* run, double start_time) noexcept nogil:
-    """Polish the cold start (:func:`fccqp.factorization.equality_start`) as
-    :func:`warm_polish` does a warm one; True, and the run finished SOLVED, when the
-    polished point passes :func:`keep_polished`'s check and is solved.
-
-    The guess is read from the equality-constrained solution's ``x_S`` before its
-    projection, with ``y = 0`` (:func:`fccqp.polish_guess.guess` of ``z = x_S``): a box
-    entry beyond a bound is held at it, a cone block outside its cone goes on the
-    boundary, or to the apex where it lies in the polar cone; the polish's passes then
-    correct that guess as they correct ADMM's. From the equality-constrained solution
-    the optimal active set of a whole-body-control QP is a few changes away
-    (notes/activeset.md). On failure the slack is the start's ``P_C(x_S)`` again and
-    ADMM runs from the start as it would have.
-    """
-    cdef Problem* p = &e.prob
-    cdef Iterates* it = &e.it
-    cdef Py_ssize_t j
-    cdef bint kept
-    for j in range(p.s):
-        it.z[j] = it.x[p.constrained[j]]
-    e.pol.cold = True
-    kept = warm_polish(e, run, start_time)
-    e.pol.cold = False
-    if not kept:
-        proj_set(it.z, p.lo, p.hi, p.cones, p.s, it.z)
-    return kept
-
-
 cdef void restore_equalities(Engine* e) noexcept nogil:
     """Remove the rounding that a combination of KKT solutions (``x = base + W u`` in
     the reduced form, a restoration) accumulates in ``A x = b``: one refined KKT

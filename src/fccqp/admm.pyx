@@ -207,7 +207,7 @@ cdef class Workspace:
         pol.T, pol.tpiv = self._new(4 * s * s), <int*>self._new_int(2 * s)
         pol.tr, pol.du = self._new(2 * s), self._new(2 * s)
         pol.full, pol.dfull = self._new(N), self._new(N)
-        pol.schur_only = pol.schur_failed = pol.cold = False
+        pol.schur_only = pol.schur_failed = False
         ps = &pol.schur
         ps.ready = False
         ps.order, ps.coupled = <Py_ssize_t*>self._new_int(n), <char*>self._new(n)

@@ -27,8 +27,7 @@ from libc.math cimport INFINITY, isfinite
 
 from fccqp._dense cimport copy
 from fccqp._types cimport Iterates, Problem
-from fccqp.acceptance cimport (cold_polish, keep_polished, keep_restored, restore_equalities,
-                               warm_polish)
+from fccqp.acceptance cimport keep_polished, keep_restored, restore_equalities, warm_polish
 from fccqp.anderson cimport anderson_reset, anderson_step
 from fccqp.engine cimport (DUAL_INFEASIBLE, NOT_CONVEX_QP, NUMERICAL_ERROR, PRIMAL_INFEASIBLE,
                            RUNNING, SOLVED, TIME_LIMIT, Engine, Options, Run, end_run,
@@ -56,7 +55,6 @@ cdef struct Loop:
     bint timed              # a time limit holds
     bint unbounded_start    # that QP is unbounded: its last step is a candidate ray
     bint warm_polish        # polish the warm start (a polished solution) before iterating
-    bint cold_polish        # polish the cold start (its guess from x_S) before iterating
     bint reduced            # the reduced form iterates (else the full KKT form)
     bint fresh              # the next step starts a run of KKT solutions: do not relax x
     bint last, periodic, adapt, check, gated   # what this iteration does (_schedule)
@@ -175,8 +173,7 @@ cdef inline bint _start(Engine* e, Loop* L, Run* run) noexcept nogil:
 cdef inline bint _factor_or_polish(Engine* e, Loop* L, Run* run) noexcept nogil:
     """Factor for the run's rho unless the factorization holds it, and the reduced
     form's ``base``; first, where it can, polish a polished warm start
-    (:func:`fccqp.acceptance.warm_polish`) or the cold start
-    (:func:`fccqp.acceptance.cold_polish`). False when the run ended here."""
+    (:func:`fccqp.acceptance.warm_polish`). False when the run ended here."""
     cdef Problem* p = &e.prob
     cdef Py_ssize_t j
     cdef int code
@@ -184,25 +181,21 @@ cdef inline bint _factor_or_polish(Engine* e, Loop* L, Run* run) noexcept nogil:
     for j in range(p.s):
         e.it.rho_vec[j] = run.rho * e.fact.rho_scale[j]
     L.warm_polish = e.prev.from_polished and e.opt.polish
-    L.cold_polish = (L.cold and e.opt.polish and not L.unbounded_start
-                     and not e.equalities_missed)
     if e.fact.factored_rho != run.rho or L.cold:
-        if ((L.warm_polish or L.cold_polish) and polish_prepare(&e.pol, p)
+        if (L.warm_polish and polish_prepare(&e.pol, p)
                 and (e.fact.certified or e.pol.schur.convex)):
             # polish before ADMM's factorization, which it does not need; new
             # matrices must be proven convex first, which the set-up does for free
             # where P is positive semidefinite, else the factorization below does
             e.fact.certified = True
-            e.pol.schur_only = not L.cold_polish
-            polished = (cold_polish(e, run, L.start_time) if L.cold_polish
-                        else warm_polish(e, run, L.start_time))
+            e.pol.schur_only = True
+            polished = warm_polish(e, run, L.start_time)
             e.pol.schur_only = False
             if polished:
                 return False
             # a guess that failed the check would fail again; one that the Schur
-            # complement could not solve goes to the table (a warm one: the cold
-            # start's slack is projected again, its guess gone)
-            L.warm_polish = L.warm_polish and e.pol.schur_failed
+            # complement could not solve goes to the table
+            L.warm_polish = e.pol.schur_failed
         code = factor(e, run, budget(e, 0))
         if code != FACTORED:
             run.status = NOT_CONVEX_QP if code == NOT_CONVEX else NUMERICAL_ERROR

@@ -27,7 +27,6 @@ cdef struct Polish:
     bint structured         # the current guess is factored in schur, not in K
     bint schur_only         # fail rather than assemble for dsytrf where schur does not apply
     bint schur_failed       # the last polish failed so
-    bint cold               # the guess is the cold start's (fccqp.acceptance.cold_polish)
     long passes             # the guesses the last polish solved
     char* dropped           # cone count: the block went past its apex in this polish
     bint cycling            # a block went past its apex twice: the guess cycles

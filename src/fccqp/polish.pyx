@@ -67,8 +67,7 @@ from fccqp.polish_guess cimport (box_code, cone_code, drop_far_side, guess, line
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup, polish_schur_solve
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.reduced cimport Reduced
-from fccqp.tuning cimport (ACTIVE_TOLERANCE, CHORD_RATE, CHORD_STEPS, COLD_GUESS_PASSES,
-                           GUESS_PASSES, GUESS_TOLERANCE,
+from fccqp.tuning cimport (ACTIVE_TOLERANCE, CHORD_RATE, CHORD_STEPS, GUESS_PASSES, GUESS_TOLERANCE,
                            MAX_REFINE, MISS_FLOOR, NEWTON_TOLERANCE, POLISH_DELTA,
                            POLISH_REFINE_TOLERANCE)
 
@@ -370,20 +369,16 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     (:func:`~fccqp.polish_guess.drop_far_side`) is held at the apex instead and the
     corrected guess solved, within the same ``GUESS_PASSES``; so is a settled guess whose
     Newton steps left a multiplier wrong-signed (a plane's ``lam`` past 0: the release
-    was judged on the first solve's), with that constraint released: from the cold
-    start, whose planes begin with ``lam = 0`` and no curvature, 25 of go2's 100 cold
-    polishes had ended so and failed the caller's check. A polish of the cold start
-    (``cold``, :func:`fccqp.acceptance.cold_polish`) may solve ``COLD_GUESS_PASSES``
-    guesses, and gives up (False) when a pass after the first still adds constraints
-    before any pass was feasible: talos' equality-constrained solutions were so far
-    from the active set that its guesses grew for three passes, then released one
-    constraint a pass through 30 passes without settling. False when a factorization
+    was judged on the guess's first solve), with that constraint released: polishes of
+    go2's equality-constrained starts, whose planes begin with ``lam = 0``, had ended so
+    in 25 of 100 and failed the caller's check (notes/performance-history.md, "The cold
+    polish"). False when a factorization
     breaks down or the result is not finite, or when the clock (:func:`fccqp_now`) has
     passed ``deadline`` before a guess after the first (``INFINITY``: never); otherwise
     the caller judges the point.
     """
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, nb, nf = 0, j, changed
-    cdef long passes = 0, step, most = COLD_GUESS_PASSES if w.cold else GUESS_PASSES
+    cdef long passes = 0, step
     cdef double total = 0.0
     cdef double scale = max(1.0, max(inf_norm(p.q, n), inf_norm(p.b, m)))
     cdef bint tabled = table != NULL
@@ -416,7 +411,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
             return False
         _multipliers(w, p, nf, nb)
         passes += 1
-        if passes == most or w.cycling:   # not settled: the caller judges this point
+        if passes == GUESS_PASSES or w.cycling:   # not settled: the caller judges this point
             if not tabled:
                 _solve(w, p, nf, nb, POLISH_REFINE_TOLERANCE * scale)
                 _multipliers(w, p, nf, nb)
@@ -432,8 +427,6 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
                 nb = renew(w, p, True, blocking, &changed)
                 continue
         nb = renew(w, p, True, -1, &changed)
-        if w.cold and passes > 1 and changed != 0 and not feasible:
-            return False   # the cold start's guess still grows: far from the active set
         if changed == 0:
             feasible = True
             nb = renew(w, p, False, -1, &changed)
