@@ -31,7 +31,10 @@ How it counts:
   QPs and the first QP of each other problem size, as the harness's ``WARMUP_QPS``; it
   allocates the workspace of each structure), then one counted pass over the QPs in
   order with one ``Solver``: ``warm`` resets it at each sequence boundary only (the
-  benchmark's timed pass), ``cold`` calls ``Solver.reset()`` before every QP.
+  benchmark's timed pass), ``cold`` calls ``Solver.reset()`` before every QP, ``coarse``
+  solves every ``--stride``-th QP of each sequence from its first (default 10), warm
+  from the previous kept QP and reset at each sequence boundary (the benchmark's
+  "every 10th" view, ``benchmarks.views.coarse_path``).
 - Only the solve calls count: each counted solve is called through
   ``contextvars.Context.run``, whose C function (``context_run`` in libpython) is
   callgrind's ``--toggle-collect`` with ``--collect-atstart=no``. The count is thus the
@@ -40,6 +43,10 @@ How it counts:
   ``Context.run`` itself; the share of the compiled ``admm.Workspace.solve`` (inclusive,
   from ``callgrind_annotate``) is printed beside it. Loading, warm-up, resets and the
   garbage collector (frozen and disabled over the pass, as in the harness) are outside.
+- ``--per-tick``: callgrind dumps its counts after each counted solve
+  (``--dump-after``), and the saved JSON holds per tick its instructions, iterations,
+  status and polished flag (``per_tick``), to split a cell into the ticks a change
+  serves and those it does not.
 - One BLAS thread (``threadpoolctl`` plus ``OPENBLAS_NUM_THREADS=1`` etc.),
   ``PYTHONHASHSEED=0``. Note that valgrind reports its own CPU (OpenBLAS picks its
   kernels for it), so the counts are those of valgrind's CPU, not of the machine's.
@@ -81,7 +88,7 @@ ROOT = Path(__file__).resolve().parents[1]
 """The checkout this driver lives in: its ``benchmarks`` generates and caches the QPs."""
 ROBOTS = ("go2", "talos_reduced")
 PRESETS = ("realtime", "default")
-MODES = ("warm", "cold")
+MODES = ("warm", "cold", "coarse")
 SCENARIO, SEED, N_QPS, SEQ_LEN, DT = "mix", 0, 400, 100, 0.002
 """The test set: that of ``python -m benchmarks --full`` (benchmarks.presets.PRESETS)."""
 WARMUP_QPS = 5
@@ -126,6 +133,15 @@ def qp_digest(qps: list[tuple[np.ndarray, ...]]) -> str:
     return h.hexdigest()[:12]
 
 
+def tick_positions(sequence: np.ndarray) -> np.ndarray:
+    """Each QP's position in its sequence (0 at a sequence's first QP), as
+    ``benchmarks.views.ticks``."""
+    seq = np.asarray(sequence)
+    starts = np.r_[True, seq[1:] != seq[:-1]]
+    first = np.maximum.accumulate(np.where(starts, np.arange(seq.size), 0))
+    return np.arange(seq.size) - first
+
+
 def warmup_indices(qps: list[tuple[np.ndarray, ...]]) -> list[int]:
     """As ``benchmarks.harness._warmup_indices``: the first few QPs, then the first QP
     of each problem size they do not have."""
@@ -151,6 +167,9 @@ def child(args: argparse.Namespace) -> None:
     import fccqp
 
     raw, sequence = load_qps(args.set, args.n_qps)
+    if args.mode == "coarse":
+        kept = np.flatnonzero(tick_positions(sequence) % args.stride == 0)
+        raw, sequence = [raw[i] for i in kept], sequence[kept]
     flat = np.array([0.0, 0.0, 1.0])
     data = []
     for P, q, A, b, lb, ub, starts, mus, normals in raw:   # as benchmarks' fccqp_arguments
@@ -181,7 +200,7 @@ def child(args: argparse.Namespace) -> None:
         try:
             previous = None
             for item, seq in zip(data, sequence, strict=True):
-                if args.mode == "cold" or seq != previous:
+                if args.mode == "cold" or seq != previous:   # coarse: warm as warm
                     solver.reset()
                     previous = seq
                 result = run(solver.solve, *item)       # counted
@@ -201,6 +220,7 @@ def child(args: argparse.Namespace) -> None:
         "polished": sum(r[2] for r in rows),
         "answers_digest": answers, "x_digest": xs,
         "longest_solve": max(r[4] for r in rows),
+        "per_tick": [[it, st, int(po)] for it, st, po, _, _ in rows],
     }
     Path(args.json).write_text(json.dumps(out))
 
@@ -235,14 +255,16 @@ def stale_modules(fccqp_file: str) -> list[str]:
 def measure(robot: str, preset: str, mode: str, path: Path, qps: str,
             args: argparse.Namespace, out_dir: Path) -> dict:
     """One callgrind run; its counts and the child's digest."""
-    label = f"{robot}-{preset}-{mode}"
+    label = _key({"robot": robot, "preset": preset, "mode": mode, "stride": args.stride})
     out = out_dir / f"{label}.callgrind"
     js = out_dir / f"{label}.json"
     cmd = [args.valgrind, "--tool=callgrind", f"--callgrind-out-file={out}",
            "--collect-atstart=no", f"--toggle-collect={TOGGLE}",
+           *([f"--dump-after={TOGGLE}"] if args.per_tick else []),
            sys.executable, str(Path(__file__).resolve()), "--child", "--set", str(path),
            "--robot", robot, "--preset", preset, "--mode", mode,
-           "--n-qps", str(args.n_qps), "--budget", repr(args.budget), "--json", str(js)]
+           "--n-qps", str(args.n_qps), "--stride", str(args.stride),
+           "--budget", repr(args.budget), "--json", str(js)]
     env = dict(os.environ, PYTHONHASHSEED="0", **dict.fromkeys(THREAD_ENV, "1"))
     start = time.perf_counter()
     with open(out_dir / f"{label}.log", "w") as log:
@@ -252,10 +274,14 @@ def measure(robot: str, preset: str, mode: str, path: Path, qps: str,
     seconds = time.perf_counter() - start
     if proc.returncode:
         raise SystemExit(f"{label}: valgrind failed, see {out_dir / (label + '.log')}")
-    total = None
-    for line in out.read_text().splitlines():
-        if line.startswith(("summary:", "totals:")):
-            total = int(line.split()[1])
+    result = json.loads(js.read_text())
+    total = _total(out)
+    if args.per_tick:   # out holds the rest after the last dump: nothing counted
+        counts = [_total(out.with_name(f"{out.name}.{k}"))
+                  for k in range(1, len(result["per_tick"]) + 1)]
+        total = sum(counts)
+        for row, count in zip(result["per_tick"], counts, strict=True):
+            row.append(count)
     if not total:
         raise SystemExit(f"{label}: no instructions collected in {out} (is {TOGGLE} "
                          "in this Python's symbols?)")
@@ -267,11 +293,25 @@ def measure(robot: str, preset: str, mode: str, path: Path, qps: str,
             if COMPILED.search(line):
                 compiled = int(line.split()[0].replace(",", ""))
                 break
-    result = json.loads(js.read_text())
-    result.update(robot=robot, preset=preset, mode=mode, instructions=total,
+    result.update(robot=robot, preset=preset, mode=mode, stride=args.stride, instructions=total,
                   compiled=compiled, seconds=seconds, cpu=usage.ru_utime + usage.ru_stime,
                   qps=qps, callgrind=str(out))
     return result
+
+
+def _key(r: dict) -> str:
+    """A run's name: robot-preset-mode, the coarse mode with its stride."""
+    stride = r.get("stride", 10) if r["mode"] == "coarse" else ""
+    return f"{r['robot']}-{r['preset']}-{r['mode']}{stride}"
+
+
+def _total(path: Path) -> int | None:
+    """The instructions a callgrind file counted."""
+    total = None
+    for line in path.read_text().splitlines():
+        if line.startswith(("summary:", "totals:")):
+            total = int(line.split()[1])
+    return total
 
 
 def line_of(r: dict, before: dict | None) -> str:
@@ -283,7 +323,7 @@ def line_of(r: dict, before: dict | None) -> str:
              f"{r['iterations']} ({r['iterations'] / ticks:.2f})", statuses,
              str(r["polished"]), f"`{r['answers_digest']}`", f"`{r['x_digest']}`"]
     if before is not None:
-        old = before.get(f"{r['robot']}-{r['preset']}-{r['mode']}")
+        old = before.get(_key(r))
         if old and old["ticks"] == ticks and old.get("qps") == r["qps"]:
             change = 100 * (r["instructions"] / old["instructions"] - 1)
             same = "same answers" if old["answers_digest"] == r["answers_digest"] else \
@@ -302,6 +342,10 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--mode", choices=MODES, default="warm")
     parser.add_argument("--all", action="store_true",
                         help="every robot x preset x mode, as a Markdown table")
+    parser.add_argument("--stride", type=int, default=10,
+                        help="the coarse mode's step between kept QPs (default 10)")
+    parser.add_argument("--per-tick", action="store_true",
+                        help="count each solve apart (callgrind --dump-after)")
     parser.add_argument("--n-qps", type=int, default=N_QPS,
                         help=f"the first N QPs of each set (default all {N_QPS})")
     parser.add_argument("--budget", type=float, default=100.0,
@@ -378,7 +422,7 @@ def main(argv: list[str] | None = None) -> None:
           f"{sum(r['cpu'] for r in results):.0f} s CPU")
     if args.save:
         args.save.write_text(json.dumps(
-            {f"{r['robot']}-{r['preset']}-{r['mode']}": r for r in results}, indent=1))
+            {_key(r): r for r in results}, indent=1))
 
 
 if __name__ == "__main__":

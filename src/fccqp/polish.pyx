@@ -62,8 +62,8 @@ from fccqp._types cimport Cones, Iterates, Problem
 from fccqp.cone_dispatch cimport cone_phi, cone_plane, cone_polar_distance
 from fccqp.kkt cimport KKT
 from fccqp.matrices cimport product, product_t
-from fccqp.polish_guess cimport (box_code, cone_code, drop_far_side, guess, linearize, renew,
-                                 step_length)
+from fccqp.polish_guess cimport (box_code, cone_code, drop_far_side, guess, linearize,
+                                 most_wrong, renew, step_length)
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup, polish_schur_solve
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.reduced cimport Reduced
@@ -367,7 +367,12 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     while they converge fast, see ``CHORD_RATE``), stopping early at the floor rounding
     leaves. A boundary block that a solve puts past the apex
     (:func:`~fccqp.polish_guess.drop_far_side`) is held at the apex instead and the
-    corrected guess solved, within the same ``GUESS_PASSES``. False when a factorization
+    corrected guess solved, within the same ``GUESS_PASSES``; so is a settled guess whose
+    Newton steps left a multiplier wrong-signed (a plane's ``lam`` past 0: the release
+    was judged on the guess's first solve), with that constraint released: polishes of
+    go2's equality-constrained starts, whose planes begin with ``lam = 0``, had ended so
+    in 25 of 100 and failed the caller's check (notes/performance-history.md, "The cold
+    polish"). False when a factorization
     breaks down or the result is not finite, or when the clock (:func:`fccqp_now`) has
     passed ``deadline`` before a guess after the first (``INFINITY``: never); otherwise
     the caller judges the point.
@@ -459,6 +464,9 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
             else:
                 _solve(w, p, nf, nb, POLISH_REFINE_TOLERANCE * scale)
         _multipliers(w, p, nf, nb)
+        if most_wrong(w, p) >= 0:   # Newton moved a plane's multiplier past 0: release it
+            nb = renew(w, p, False, -1, &changed)
+            continue
         break
     w.passes = passes
     for j in range(n):

@@ -23,13 +23,19 @@ from fccqp.tuning cimport ACTIVE_TOLERANCE
 
 cdef void linearize(Polish* w, const Problem* p, Py_ssize_t k, const double* v) noexcept nogil:
     """Plane ``g`` and curvature ``hess`` of boundary block ``k`` (of ``boundary``) at
-    ``v``, with its current multiplier; a block whose ``v`` is on the axis keeps its plane
-    and gets no curvature."""
+    ``v``, with its current multiplier where that is positive; a block whose ``v`` is on
+    the axis keeps its plane and gets no curvature.
+
+    A negative multiplier marks a wrong guess, which the next correction releases; its
+    curvature would only make the block's Hessian indefinite, and the Schur complement
+    (:mod:`fccqp.polish_schur`) then no longer applies (every pass after the first of
+    go2's cold polishes, whose planes start with ``lam = 0``, had fallen to ``dsytrf``).
+    """
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t cone = w.boundary[k], o = c.offset[cone], d = c.dim[cone]
     cdef double phi
     cone_plane(v, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, w.g + o, &phi)
-    cone_curvature(v, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, w.lam[k],
+    cone_curvature(v, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, max(w.lam[k], 0.0),
                    w.hess + o * p.s)
 
 
