@@ -29,8 +29,8 @@ is built on. So a warm polish that succeeds skips both (see ``Workspace._iterate
 A solve keeps ``Y``: ``w = L^-1 r_x``, ``mu = S^-1 (Y'w - r_c)``, ``x_F = L'^-1 (w -
 Y mu)``, two products with ``Y`` and the triangular solves of ``H``'s blocks. The
 caller refines against the unregularized system, as with ``dsytrf``. Where ``P``
-couples a constrained entry, a block is not positive definite (a negative plane
-multiplier's curvature) or ``S`` loses a pivot (dependent rows), the functions return
+couples a constrained entry, a block is not positive definite or ``S`` loses a pivot
+(dependent rows), the functions return
 False; the warm polish before ADMM's factorization then hands the guess to the table,
 and any other polish assembles the matrix for ``dsytrf``.
 
