@@ -326,21 +326,24 @@ cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double
     Its descent ``-q'dx``, relative to its terms, must also dominate every residual
     (``DOMINANCE`` times, as for the primal certificate): with ``P = 0`` and ``|q| =
     1e14`` a bounded problem once passed with a descent of 2e-6 against residuals of
-    5e-7 in the cone and 1e-7 in ``A dx``."""
+    5e-7 in the cone and 1e-7 in ``A dx``.
+
+    The recession cone too is tested in the scaled units, where the columns are
+    balanced: in the user's units a cone block of entries 1e-7 of the ray's largest
+    (variables rescaled by 1e-8..1e8) was let out of its cone by a whole unit of its own
+    size, and a bounded problem was certified unbounded at its start."""
     cdef Py_ssize_t n = p.n, s = p.s, i, j, k, a, dim
-    cdef double qdx = 0.0, size = 0.0, norm = 0.0, scaled = 0.0, step, tol
+    cdef double qdx = 0.0, size = 0.0, norm = 0.0, step, tol
     for i in range(n):
         qdx += p.q[i] * dx[i]
         size += fabs(p.q[i] * dx[i])
-        norm = max(norm, fabs(dx[i] * p.D[i]))
-        scaled = max(scaled, fabs(dx[i]))
+        norm = max(norm, fabs(dx[i]))
     if not (qdx < -eps * size) or not isfinite(qdx) or norm <= 1e-300:
         return False
     eps = min(eps, -qdx / (size * DOMINANCE))
     tol = eps * norm
     for j in range(s):
-        i = p.constrained[j]
-        step = dx[i] * p.D[i]
+        step = dx[p.constrained[j]]
         if (isfinite(p.hi[j]) and step > tol) or (isfinite(p.lo[j]) and step < -tol):
             return False
     for k in range(p.cones.count):
@@ -350,8 +353,8 @@ cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double
         proj_block(block + a, p.cones.kind[k], dim, p.cones.mu[k], p.cones.normal + 3 * k,
                    terms)
         for j in range(dim):
-            if fabs(block[a + j] - terms[j]) * p.D[p.constrained[a]] > tol:
+            if fabs(block[a + j] - terms[j]) > tol:
                 return False
-    if not _near_zero(&p.P, dx, scaled, eps, Pdx, terms):
+    if not _near_zero(&p.P, dx, norm, eps, Pdx, terms):
         return False
-    return p.m == 0 or _near_zero(&p.A, dx, scaled, eps, Pdx, terms)
+    return p.m == 0 or _near_zero(&p.A, dx, norm, eps, Pdx, terms)
