@@ -208,19 +208,22 @@ cdef bint settle(Engine* e, Run* run) noexcept nogil:
 
 
 cdef bint coordinate_ray(Engine* e) noexcept nogil:
-    """Whether a single entry ``x_i`` outside the cones is a ray: ``P_ii = 0`` and the
-    dual certificate test (:func:`unbounded`) passes for ``-sign(q_i) e_i`` where its
-    box is open that way. Its descent is ``|q_i|`` per unit of ``x_i``, which the
-    tolerances of a solved point can hide when ``x_i``'s units are small (``q_i`` of
-    4.5e-8 on a free entry with empty columns: SOLVED where the problem is unbounded,
-    fuzz extreme_data:500064), and ADMM, moving that entry by ``q_i / sigma`` a step,
-    certifies it only when the other entries have settled. Costs a pass over ``P``'s
-    diagonal when no entry has ``P_ii = 0`` and ``q_i != 0``."""
+    """Whether a single entry ``x_i`` outside the cones is a ray: its columns of ``P``
+    and ``A`` are zero, and the dual certificate test (:func:`unbounded`) passes for
+    ``-sign(q_i) e_i`` where its box is open that way. Its descent is ``|q_i|`` per
+    unit of ``x_i``, which the tolerances of a solved point can hide when ``x_i``'s
+    units are small (``q_i`` of 4.5e-8 on a free entry with empty columns: SOLVED where
+    the problem is unbounded, fuzz extreme_data:500064), and ADMM, moving that entry by
+    ``q_i / sigma`` a step, certifies it only when the other entries have settled.
+    Exactly zero columns, not small ones: the equilibration leaves a column below
+    ``MIN_NORM`` unscaled, and a variable in units of 1e-8 (``A``'s column 4e-9, ``q_i``
+    2.5e-9) then looked like a ray of a bounded problem (extreme_data:100082). Costs a
+    pass over ``P``'s diagonal when no entry has ``P_ii = 0`` and ``q_i != 0``."""
     cdef Problem* p = &e.prob
-    cdef Py_ssize_t n = p.n, i, j, k
+    cdef Py_ssize_t n = p.n, i, j
     cdef double sign
     for i in range(n):
-        if entry(&p.P, i, i) != 0.0 or p.q[i] == 0.0:
+        if entry(&p.P, i, i) != 0.0 or p.q[i] == 0.0 or not _empty_column(p, i):
             continue
         sign = -1.0 if p.q[i] > 0.0 else 1.0
         for j in range(p.s):
@@ -235,3 +238,15 @@ cdef bint coordinate_ray(Engine* e) noexcept nogil:
         if unbounded(e):
             return True
     return False
+
+
+cdef bint _empty_column(const Problem* p, Py_ssize_t i) noexcept nogil:
+    """Whether column ``i`` of ``P`` and of ``A`` is zero."""
+    cdef Py_ssize_t k
+    for k in range(p.n):
+        if entry(&p.P, k, i) != 0.0:
+            return False
+    for k in range(p.m):
+        if entry(&p.A, k, i) != 0.0:
+            return False
+    return True
