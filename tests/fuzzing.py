@@ -1033,19 +1033,43 @@ def _judge_bad_input(s: BadInput, backend: str) -> Verdict:
 
 
 def _clarabel(problem: Problem, truth: str | None) -> tuple[str | None, bool]:
-    """Clarabel's conclusive status if it agrees with ``truth`` (or there is none), and
-    whether the two conflict. Clarabel needs a PSD ``P``: otherwise no reference."""
+    """Clarabel's conclusive status if it agrees with ``truth``, and whether the two
+    conflict. Clarabel needs a PSD ``P``: otherwise no reference. Without a ``truth``
+    (a problem the construction does not decide) Clarabel's status is the reference
+    only when its answer, a point or a certificate, passes :func:`verify.check_solution`
+    on ``problem``: at friction coefficients of 1e-83 Clarabel's form (a row ``mu n'``)
+    loses ``n'f >= 0``, and it called a bounded problem unbounded along a ray with
+    ``n'f = -1`` (extreme_data:500099); on a ray it called "solved" a point of size
+    2.6e14 along it (solver_reuse:700137). An unproven answer counts as a conflict."""
     if np.linalg.eigvalsh(problem.P)[0] < -1e-9 * max(1e-300, np.abs(problem.P).max()):
         return None, False
     try:
-        status = clarabel_solve(*problem.args()).status
+        reference = clarabel_solve(*problem.args())
     except Exception:  # noqa: BLE001 - Clarabel refusing extreme data is no verdict
         return None, False
+    status = reference.status
     if status not in ANSWERS:
         return None, False
     if truth is not None and status != truth:
         return None, True
+    if truth is None and not _proven(problem, reference):
+        return None, True
     return status, False
+
+
+def _proven(problem: Problem, reference) -> bool:
+    """Whether Clarabel's answer (its point and multipliers, or its certificate) passes
+    :mod:`verify`'s checks for its status (no claimed residuals to compare)."""
+    status = {"solved": Status.SOLVED, "primal_infeasible": Status.PRIMAL_INFEASIBLE,
+              "dual_infeasible": Status.DUAL_INFEASIBLE}[reference.status]
+    empty = np.zeros(0)
+    claim = fccqp.Result(x=empty if reference.x is None else reference.x,
+                         y=empty if reference.y is None else reference.y,
+                         z=empty if reference.z is None else reference.z,
+                         status=status, obj=np.nan, iterations=0, prim_res=np.inf,
+                         dual_res=np.inf, setup_time=0.0, solve_time=0.0, rho=np.nan,
+                         factorizations=0, certificate=reference.certificate, gap=np.nan)
+    return check_solution(problem, claim, Tolerances.of()).passed
 
 
 def _arguments(problem: Problem, form: str) -> tuple:

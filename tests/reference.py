@@ -22,6 +22,13 @@ class Reference:
     status: str
     x: np.ndarray | None
     obj: float | None
+    certificate: np.ndarray | None = None
+    """On an infeasibility status, Clarabel's certificate in fccqp's convention
+    (``Result.certificate``): the ray ``dx``, or ``(dy, dz)`` of the Farkas test."""
+    y: np.ndarray | None = None
+    """On ``solved``, the multipliers of ``A x = b`` in fccqp's convention."""
+    z: np.ndarray | None = None
+    """On ``solved``, the multipliers of the box and cones in fccqp's convention."""
 
 
 def tangent_basis(normal: np.ndarray) -> np.ndarray:
@@ -139,9 +146,11 @@ def clarabel_solve(P, q, A=None, b=None, lb=None, ub=None, cones=(), tol=1e-10) 
     status = str(sol.status)
     if status in ("Solved", "AlmostSolved"):
         x = np.array(sol.x)
-        return Reference("solved", x, float(0.5 * x @ P @ x + np.dot(q, x)))
+        y, z = form.duals(sol.z)
+        return Reference("solved", x, float(0.5 * x @ P @ x + np.dot(q, x)), y=y, z=z)
     if "PrimalInfeasible" in status:
-        return Reference("primal_infeasible", None, None)
+        y, z = form.duals(sol.z)
+        return Reference("primal_infeasible", None, None, np.concatenate([y, z]))
     if "DualInfeasible" in status:
-        return Reference("dual_infeasible", None, None)
+        return Reference("dual_infeasible", None, None, np.array(sol.x))
     return Reference(status, None, None)

@@ -22,15 +22,16 @@ SEEDS = {
     "feasible": (0, 1, 2, 3, 4, 5),
     "primal_infeasible": (0, 1, 2, 3, 80, 146, 177, 182, 350, 100094, 300345),
     "dual_infeasible": (0, 1, 2, 33, 166, 257, 368),
-    "solver_reuse": (0, 1, 2, 50, 164, 211, 100008, 100206),
+    "solver_reuse": (0, 1, 2, 50, 164, 211, 100008, 100206, 500061, 700137),
     "extreme_data": (0, 1, 7, 9, 38, 47, 56, 108, 138, 149, 202, 214, 254, 302, 308, 316,
-                     311, 326, 335, 337, 355, 363, 365, 100180, 100213, 100233),
+                     311, 326, 335, 337, 355, 363, 365, 100082, 100180, 100213, 100228, 100233,
+                     500030, 500064, 500099, 500322, 700281),
     "qpsolvers": (0, 1, 2),
     "cvxpy": (1, 2, 3),
 }
 """Seeds per class run on every dense backend: a passing case or two per class and the
-reproducers of the failure mechanisms the campaign found at ed3b90e, 836ab4b and 5f3a658
-(seeds from 100000; issue 26)."""
+reproducers of the failure mechanisms the campaign found at ed3b90e, 836ab4b, 5f3a658 and
+16f1696 (seeds from 100000; issue 26)."""
 
 SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),
@@ -41,8 +42,6 @@ SPARSE_SEEDS = {
 """Seeds per class run on the sparse path (each ends within a few dozen iterations)."""
 
 OPEN = {
-    "solver_reuse:211": "sigma in scaled units decides convexity: a fresh solve accepts "
-    "-3.9e-3 curvature that a kept workspace rejects",
     "cvxpy:1": "a feasible problem whose dual residual stalls near 0.8 in the LDL' forms "
     "with adaptive rho; only auto solves it again in the other form",
     "extreme_data:100213": "P of 1e-12: the full form stalls where the reduced one solves; "

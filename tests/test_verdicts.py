@@ -71,6 +71,21 @@ def test_a_free_direction_without_curvature_is_certified_unbounded(backend):
     assert clarabel_solve(*problem.args()).status == "dual_infeasible"
 
 
+@pytest.mark.parametrize("backend", backends(sparse_fails=True))
+def test_a_free_direction_whose_descent_is_below_the_tolerances_is_unbounded(backend):
+    """The same free entry with a cost of -4e-8: its dual residual passes the absolute
+    tolerance at any point, and SOLVED was claimed (fuzz extreme_data:500064, a free
+    ray in units of 1e-7); the coordinate is an exact ray (``P e = 0``, ``A e = 0``,
+    ``q'e < 0``), and the solve says so. (Clarabel at 1e-10 calls it solved: the
+    descent is below its own tolerances.)"""
+    problem = free_direction_without_curvature()
+    problem.q[-1] = -4e-8
+    result = solve_verified(problem, kkt_backend=backend)
+    assert result.status is Status.DUAL_INFEASIBLE
+    ray = result.certificate / np.abs(result.certificate).max()
+    assert np.abs(ray[:-1]).max() < 1e-12 and ray[-1] == 1.0
+
+
 @pytest.mark.parametrize("backend", backends(sparse_fails=False))
 def test_a_ray_along_a_rotated_null_direction_is_certified_unbounded(backend):
     problem = rotated(free_direction_without_curvature())
@@ -333,6 +348,20 @@ def test_a_run_that_stalls_in_the_form_auto_chose_is_solved_in_the_other(name, s
         result = solve_verified(problem)
         assert result.status is Status.SOLVED and result.backend != "ldl_full"
         assert clarabel_solve(*problem.args()).status == "solved"
+
+
+@pytest.mark.parametrize(("name", "seed"), [("qpsolvers", 500077), ("qpsolvers", 500090),
+                                           ("qpsolvers", 700127), ("extreme_data", 500215),
+                                           ("extreme_data", 500351)])
+def test_a_run_that_stalls_in_both_forms_is_solved_at_a_larger_rho(name, seed):
+    """Feasible problems with a singular ``P`` (or ``P`` of 1e-128, or huge) on which
+    ADMM holds its residuals constant while a multiplier grows by a fixed step, in
+    both KKT forms, for 4000 iterations: with ``kkt_backend="auto"`` the stalled
+    problem is solved again, cold, at ``STALL_RHO_FACTOR`` times ``rho``, and the
+    fuzzer's judge (verify_solution, Clarabel) accepts the answer."""
+    from fuzzing import Case, judge
+
+    assert judge(Case.of(name, seed), "auto") is None
 
 
 def test_a_forced_backend_is_not_replaced_after_a_stall():

@@ -377,9 +377,15 @@ def _check_dual_certificate(problem: Problem, result: fccqp.Result, tol: Toleran
         return
     dx = dx / size
     # "~ 0" row by row against the row's norm times ||dx||, with the columns balanced
-    # (as formulation.md says); "< 0" relative to the terms of the sum
+    # (as formulation.md says); "< 0" relative to the terms of the sum. The balance
+    # reads A with each row at unit size (A dx = 0 is the same claim for any row
+    # scaling): rows of 1e-51..1e-119 had let the columns they alone touch be clipped
+    # to the floor below, shrinking a ray along them 1e4 times against the bounded
+    # remnants elsewhere (extreme_data:100228)
+    rows = np.abs(problem.A).max(axis=1, initial=0.0)
+    A_rows = problem.A / np.where(rows > 0, rows, 1.0)[:, None]
     columns = np.maximum(np.abs(problem.P).max(axis=0, initial=0.0),
-                         np.abs(problem.A).max(axis=0, initial=0.0))
+                         np.abs(A_rows).max(axis=0, initial=0.0))
     # a column of norm 1e-118 is not scaled up 1e59 (it would crush the rest of dx),
     # as equilibrations bound their factors
     D = 1.0 / np.sqrt(np.clip(np.where(columns > 0, columns, 1.0), 1e-8, 1e8))

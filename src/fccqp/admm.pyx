@@ -437,12 +437,21 @@ cdef class Workspace:
         cdef bint restartable = ((x0 != NULL or (warm and e.prev.exists))
                                  and not isfinite(e.opt.time_limit)
                                  and max_iter >= RESTART_MIN_ITER)
+        # convexity is decided on P + sigma I in the scaled units: with a scaling kept
+        # from other matrices a kept workspace rejected -3.9e-3 of curvature on the
+        # null space of A (|P| up to 172) that a fresh solve's scaling accepts
+        # (fuzz solver_reuse:211); a rejection there is decided again as a fresh solve
+        cdef bint kept_scaling = e.scaling.done and (same or (warm and e.prev.exists))
         enter()   # single-threaded BLAS for this solve (see fccqp.blas_threads)
         try:
             with nogil:
                 if restartable:
                     e.opt.max_iter = max_iter // 2
                 run = scaled_run(e, same, x0, warm and e.prev.exists, start_time)
+                if run.status == engine.NOT_CONVEX_QP and kept_scaling:
+                    e.opt.max_iter = max_iter
+                    restartable = False
+                    run = scaled_run(e, False, NULL, False, start_time)
                 if run.status != engine.NOT_CONVEX_QP:
                     unscaled_answer(e, &run, x_out, y_out if m else NULL, z_out, cert_out)
                 e.opt.max_iter = max_iter

@@ -32,7 +32,8 @@ constrained entries alone. A problem that stalls in one form often solves in the
 with ``P`` of 1e-12 stalled in the full form and solved in the reduced one). So an
 auxiliary solve that is not SOLVED runs again in the other form
 (:func:`other_form`), and :func:`in_other_form` solves the stalled problem itself
-again there when no certificate was found.
+again there when no certificate was found, and then, if it stalls there too, at a
+larger rho.
 """
 
 from __future__ import annotations
@@ -46,7 +47,7 @@ from fccqp.cones import cone_tuple
 from fccqp.problem import INFINITE_BOUND
 from fccqp.settings import MAX_DENSE_KKT_ROWS
 from fccqp.status import Status
-from fccqp.tuning import AUXILIARY_MARGIN
+from fccqp.tuning import AUXILIARY_MARGIN, STALL_RHO_FACTOR
 
 
 def _dense(matrix: object, rows: int, n: int) -> np.ndarray:
@@ -184,10 +185,24 @@ def in_other_form(solver_type: type, settings: object, stalled: object,
                   arguments: tuple) -> object | None:
     """The problem of ``arguments`` (``P, q, A, b, lb, ub, cones``), on which a run in
     ``stalled.backend``'s form stalled, solved cold in the other form
-    (:func:`other_form`), when that gives an answer (:data:`ANSWERS`); else None."""
-    result = _auxiliary_solver(solver_type, other_form(settings, stalled.backend)).solve(
-        *arguments)
-    return result if result.status in ANSWERS else None
+    (:func:`other_form`), or else cold at ``STALL_RHO_FACTOR`` times ``settings.rho``,
+    when that gives an answer (:data:`ANSWERS`), with the iterations and
+    factorizations of the solves it took; else None.
+
+    The larger rho: on problems with a singular ``P`` (qpsolvers' form, ``P`` of
+    1e-128) ADMM ran thousands of iterations with constant residuals while a
+    multiplier grew by a fixed step, and the rho rule, which balances the two
+    residuals, saw nothing to change; such a phase lasts about ``1 / rho`` iterations
+    (the fuzz cases qpsolvers 500077, 500090, 700127 and extreme_data 500215, 500351:
+    4000 iterations stalled in both forms, 40 to 1220 from ``rho`` = 100)."""
+    spent = factored = 0
+    for again in (other_form(settings, stalled.backend),
+                  settings.replace(rho=settings.rho * STALL_RHO_FACTOR)):
+        result = _auxiliary_solver(solver_type, again).solve(*arguments)
+        spent, factored = spent + result.iterations, factored + result.factorizations
+        if result.status in ANSWERS:
+            return dataclasses.replace(result, iterations=spent, factorizations=factored)
+    return None
 
 
 def _farkas(workspace: object, result: object, b: np.ndarray, lb: np.ndarray,

@@ -326,22 +326,30 @@ cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double
     Its descent ``-q'dx``, relative to its terms, must also dominate every residual
     (``DOMINANCE`` times, as for the primal certificate): with ``P = 0`` and ``|q| =
     1e14`` a bounded problem once passed with a descent of 2e-6 against residuals of
-    5e-7 in the cone and 1e-7 in ``A dx``."""
+    5e-7 in the cone and 1e-7 in ``A dx``.
+
+    The recession cone is tested in the user's units and in the scaled ones, where the
+    columns are balanced: in the user's units alone a cone block of entries 1e-7 of the
+    ray's largest (variables rescaled by 1e-8..1e8) was let out of its cone by a whole
+    unit of its own size, and a bounded problem was certified unbounded at its start;
+    in the scaled units alone a box entry of large ``D`` left its recession cone by
+    1e-3 of the ray in the user's units."""
     cdef Py_ssize_t n = p.n, s = p.s, i, j, k, a, dim
-    cdef double qdx = 0.0, size = 0.0, norm = 0.0, scaled = 0.0, step, tol
+    cdef double qdx = 0.0, size = 0.0, norm = 0.0, user = 0.0, step, tol, tol_user, miss
     for i in range(n):
         qdx += p.q[i] * dx[i]
         size += fabs(p.q[i] * dx[i])
-        norm = max(norm, fabs(dx[i] * p.D[i]))
-        scaled = max(scaled, fabs(dx[i]))
-    if not (qdx < -eps * size) or not isfinite(qdx) or norm <= 1e-300:
+        norm = max(norm, fabs(dx[i]))
+        user = max(user, fabs(dx[i] * p.D[i]))
+    if not (qdx < -eps * size) or not isfinite(qdx) or user <= 1e-300:
         return False
     eps = min(eps, -qdx / (size * DOMINANCE))
-    tol = eps * norm
+    tol, tol_user = eps * norm, eps * user
     for j in range(s):
         i = p.constrained[j]
-        step = dx[i] * p.D[i]
-        if (isfinite(p.hi[j]) and step > tol) or (isfinite(p.lo[j]) and step < -tol):
+        step = dx[i]
+        if (isfinite(p.hi[j]) and (step > tol or step * p.D[i] > tol_user)) or (
+                isfinite(p.lo[j]) and (step < -tol or step * p.D[i] < -tol_user)):
             return False
     for k in range(p.cones.count):
         a, dim = p.cones.offset[k], p.cones.dim[k]
@@ -350,8 +358,9 @@ cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double
         proj_block(block + a, p.cones.kind[k], dim, p.cones.mu[k], p.cones.normal + 3 * k,
                    terms)
         for j in range(dim):
-            if fabs(block[a + j] - terms[j]) * p.D[p.constrained[a]] > tol:
+            miss = fabs(block[a + j] - terms[j])
+            if miss > tol or miss * p.D[p.constrained[a]] > tol_user:
                 return False
-    if not _near_zero(&p.P, dx, scaled, eps, Pdx, terms):
+    if not _near_zero(&p.P, dx, norm, eps, Pdx, terms):
         return False
-    return p.m == 0 or _near_zero(&p.A, dx, scaled, eps, Pdx, terms)
+    return p.m == 0 or _near_zero(&p.A, dx, norm, eps, Pdx, terms)

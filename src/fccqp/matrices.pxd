@@ -39,6 +39,11 @@ cdef inline Matrix dense(double* values, Py_ssize_t rows, Py_ssize_t cols) noexc
     return M
 
 
+cdef inline double entry(const Matrix* M, Py_ssize_t i, Py_ssize_t j) noexcept nogil:
+    """``M_ij``."""
+    return M.values[i * M.cols + j]
+
+
 cdef inline void product(const Matrix* M, const double* x, double* out) noexcept nogil:
     """``out = M x`` (``dgemv``)."""
     matvec(M.values, x, out, M.rows, M.cols)

@@ -113,7 +113,8 @@ cdef void unscaled_answer(Engine* e, Run* run, double* x, double* y, double* z,
         if run.status == PRIMAL_INFEASIBLE or run.status == DUAL_INFEASIBLE:
             copy(e.certs.cert, cert, n + m)
         user_residuals(e, x, y, z)
-    settle(e, run)
+    if settle(e, run):   # a coordinate ray: its certificate replaces the point's status
+        copy(e.certs.cert, cert, n)
     e.prev.exists = e.res.finite and run.status not in (PRIMAL_INFEASIBLE, DUAL_INFEASIBLE)
     if e.prev.exists:
         copy(x, e.prev.x, n)

@@ -248,8 +248,8 @@ class Solver:
                  lb: object, ub: object, start: float) -> Result:
         """``out`` of a run that stalled (``MAX_ITER_REACHED``), or the certificate that
         :func:`fccqp.auxiliary.stalled_certificate` found for it instead, or (with
-        ``kkt_backend="auto"``) the answer of a solve in the other KKT form
-        (:func:`fccqp.auxiliary.in_other_form`); their iterations and factorizations
+        ``kkt_backend="auto"``) the answer of a solve in the other KKT form or at a
+        larger rho (:func:`fccqp.auxiliary.in_other_form`); their iterations and factorizations
         added. Either leaves no previous solution to start from: a certified problem as
         an infeasible run does, an answer from another solver because this workspace
         holds the stalled point."""

@@ -104,6 +104,8 @@ cdef extern from *:
     #define FCCQP_CLEANING_GATE 1.0
     /* a least-distance QP solved again meets the Farkas test's eps_prim_inf this many times */
     #define FCCQP_AUXILIARY_MARGIN 10.0
+    /* a problem that stalled in both KKT forms is solved again, cold, at this times Settings.rho */
+    #define FCCQP_STALL_RHO_FACTOR 1e3
 
     /* ---- Polish (fccqp.polish*, fccqp.iteration, fccqp.acceptance) ---- */
     /* regularization of both diagonal blocks of the polishing KKT matrix (scaled) */
@@ -208,6 +210,7 @@ cdef extern from *:
     const long CLEANING_START "FCCQP_CLEANING_START"
     const double CLEANING_GATE "FCCQP_CLEANING_GATE"
     const double AUXILIARY_MARGIN "FCCQP_AUXILIARY_MARGIN"
+    const double STALL_RHO_FACTOR "FCCQP_STALL_RHO_FACTOR"
     # Polish
     const double POLISH_DELTA "FCCQP_POLISH_DELTA"
     const double POLISH_REFINE_TOLERANCE "FCCQP_POLISH_REFINE_TOLERANCE"

@@ -7,4 +7,4 @@ cdef bint missed_by_data(Engine* e) noexcept nogil
 cdef bint inconsistent(Engine* e, bint clean) noexcept nogil
 cdef bint unbounded(Engine* e) noexcept nogil
 cdef int classify(const Engine* e, long iteration, bint stopped) noexcept nogil
-cdef void settle(const Engine* e, Run* run) noexcept nogil
+cdef bint settle(Engine* e, Run* run) noexcept nogil

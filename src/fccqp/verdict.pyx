@@ -8,6 +8,8 @@ a point from its residuals alone; :func:`settle` the status of the returned poin
 The certificates found are left in ``Engine.certs.cert``, in the user's units.
 """
 
+from libc.math cimport isinf
+
 from fccqp._dense cimport copy, fill
 from fccqp._types cimport Iterates, Problem
 from fccqp.certificates cimport (CERTIFIED, SEPARATED, clean_primal_certificate,
@@ -17,6 +19,7 @@ from fccqp.engine cimport (DUAL_INFEASIBLE, INACCURATE, MAX_ITER, NUMERICAL_ERRO
                            PRIMAL_INFEASIBLE, RUNNING, SOLVED, TIME_LIMIT, Engine, Run,
                            fccqp_now)
 from fccqp.kkt cimport kkt_solve
+from fccqp.matrices cimport entry
 from fccqp.termination cimport Residuals, converged, nearly_converged
 from fccqp.tuning cimport CLEANING_GATE, EQUALITY_MISSED, INACCURATE_FACTOR
 
@@ -178,10 +181,12 @@ cdef int classify(const Engine* e, long iteration, bint stopped) noexcept nogil:
     return TIME_LIMIT
 
 
-cdef void settle(const Engine* e, Run* run) noexcept nogil:
+cdef bint settle(Engine* e, Run* run) noexcept nogil:
     """Settle the status of a run on the residuals of the point it returns (in
     ``Engine.res``): a budget's status or a solved one becomes solved or inaccurate
-    when the point is, and one that no longer passes says why."""
+    when the point is, and one that no longer passes says why; a solved or inaccurate
+    one becomes unbounded when a coordinate is a ray (:func:`coordinate_ray`). True
+    when that put a certificate in ``Engine.certs.cert``."""
     if run.status in (SOLVED, INACCURATE, MAX_ITER, TIME_LIMIT):
         if converged(&e.res, e.opt.eps_abs, e.opt.eps_rel):
             run.status = SOLVED
@@ -196,3 +201,52 @@ cdef void settle(const Engine* e, Run* run) noexcept nogil:
                           else NUMERICAL_ERROR)
     if not e.res.finite:
         run.status = NUMERICAL_ERROR
+    if run.status in (SOLVED, INACCURATE) and coordinate_ray(e):
+        run.status = DUAL_INFEASIBLE
+        return True
+    return False
+
+
+cdef bint coordinate_ray(Engine* e) noexcept nogil:
+    """Whether a single entry ``x_i`` outside the cones is a ray: its columns of ``P``
+    and ``A`` are zero, and the dual certificate test (:func:`unbounded`) passes for
+    ``-sign(q_i) e_i`` where its box is open that way. Its descent is ``|q_i|`` per
+    unit of ``x_i``, which the tolerances of a solved point can hide when ``x_i``'s
+    units are small (``q_i`` of 4.5e-8 on a free entry with empty columns: SOLVED where
+    the problem is unbounded, fuzz extreme_data:500064), and ADMM, moving that entry by
+    ``q_i / sigma`` a step, certifies it only when the other entries have settled.
+    Exactly zero columns, not small ones: the equilibration leaves a column below
+    ``MIN_NORM`` unscaled, and a variable in units of 1e-8 (``A``'s column 4e-9, ``q_i``
+    2.5e-9) then looked like a ray of a bounded problem (extreme_data:100082). Costs a
+    pass over ``P``'s diagonal when no entry has ``P_ii = 0`` and ``q_i != 0``."""
+    cdef Problem* p = &e.prob
+    cdef Py_ssize_t n = p.n, i, j
+    cdef double sign
+    for i in range(n):
+        if entry(&p.P, i, i) != 0.0 or p.q[i] == 0.0 or not _empty_column(p, i):
+            continue
+        sign = -1.0 if p.q[i] > 0.0 else 1.0
+        for j in range(p.s):
+            if p.constrained[j] == i:
+                break
+        else:
+            j = -1
+        if j >= 0 and (p.in_cone[j] or not isinf(p.hi[j] if sign > 0.0 else p.lo[j])):
+            continue
+        fill(e.certs.direction, 0.0, n)
+        e.certs.direction[i] = sign
+        if unbounded(e):
+            return True
+    return False
+
+
+cdef bint _empty_column(const Problem* p, Py_ssize_t i) noexcept nogil:
+    """Whether column ``i`` of ``P`` and of ``A`` is zero."""
+    cdef Py_ssize_t k
+    for k in range(p.n):
+        if entry(&p.P, k, i) != 0.0:
+            return False
+    for k in range(p.m):
+        if entry(&p.A, k, i) != 0.0:
+            return False
+    return True
