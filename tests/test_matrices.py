@@ -9,7 +9,6 @@ four-lane products to rounding, and both to numpy.
 import numpy as np
 import pytest
 import scipy.sparse as sp
-
 from fccqp.matrix_ops import OPERATIONS, apply
 
 BITWISE = ("product_t_terms", "subtract_product", "abs_product", "product_row_norms")
@@ -18,8 +17,8 @@ BITWISE = ("product_t_terms", "subtract_product", "abs_product", "product_row_no
 def _matrix(rows, cols, seed):
     """A random sparse matrix with an empty row and an empty column when it has some."""
     rng = np.random.default_rng(seed)
-    M = sp.random(rows, cols, density=0.3, random_state=rng, format="lil")
-    M = M.toarray() * rng.choice([-1.0, 1.0], size=(rows, cols)) * 10.0 ** rng.integers(-3, 3, size=(rows, cols))
+    M = sp.random(rows, cols, density=0.3, random_state=rng).toarray()
+    M *= rng.choice([-1.0, 1.0], size=(rows, cols)) * 10.0 ** rng.integers(-3, 3, size=(rows, cols))
     if rows > 2 and cols > 2:
         M[1, :] = 0.0
         M[:, 2] = 0.0
@@ -55,7 +54,7 @@ def test_csc_arm_matches_dense_arm(operation, shape, seed):
     on_dense = apply(operation, M, v, out=start)
     on_csc = apply(operation, sp.csc_matrix(M), v, out=start)
     expected = _reference(operation, M, v, start)
-    pairs = zip(on_dense, on_csc, expected) if isinstance(expected, tuple) else [
+    pairs = zip(on_dense, on_csc, expected, strict=True) if isinstance(expected, tuple) else [
         (on_dense, on_csc, expected)]
     for dense_result, csc_result, reference in pairs:
         np.testing.assert_allclose(dense_result, reference, rtol=1e-12, atol=1e-12)
