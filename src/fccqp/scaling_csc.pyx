@@ -6,7 +6,7 @@ pattern) and ``A`` in compressed columns (:mod:`fccqp.matrices`): :func:`equilib
 :func:`scaled_norms_csc` and :func:`rescale_csc`. Rows' maxima gather entry by entry
 into a vector; every product is formed in the dense kernels' order (``(P_ij D_i) D_j``)
 and a maximum does not depend on the order it is taken in, so ``D``, ``E``, ``c`` and the scaled entries are the dense
-functions' to the bit (``tests/test_scaling.py`` holds them to it). ``scale_start`` and
+functions' to the bit (``tests/test_scaling_csc.py`` holds them to it). ``scale_start`` and
 ``unscale`` do not read the matrices and serve both storages.
 """
 
