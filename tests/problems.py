@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 
 import fccqp
 
@@ -61,3 +62,18 @@ def random_problem(
     if duplicate_rows:
         A = np.vstack([A, 2.0 * A[:duplicate_rows]])
     return P, q, A, A @ x_f, lb, ub, cones
+
+
+def large_problem(n: int, seed: int = 0):
+    """A separable QP with a coupling row and a friction cone: ``n`` variables, a
+    tridiagonal ``P``, two equalities, a box on most entries."""
+    rng = np.random.default_rng(seed)
+    main = rng.uniform(1.0, 2.0, n)
+    P = sp.diags([main, -0.25 * np.ones(n - 1), -0.25 * np.ones(n - 1)], [0, 1, -1],
+                 format="csc")
+    q = rng.standard_normal(n)
+    A = sp.csc_matrix(np.vstack([np.ones(n), np.r_[np.zeros(n - 1), 1.0]]))
+    b = np.array([1.0, 2.0])
+    lb, ub = np.full(n, -0.5), np.full(n, 0.5)
+    lb[-3:], ub[-3:] = -np.inf, np.inf   # the cone's entries
+    return P, q, A, b, lb, ub, [fccqp.FrictionCone(n - 3, 0.4)]

@@ -108,6 +108,24 @@ def clarabel_form(P, q, A=None, b=None, lb=None, ub=None, cones=()) -> ClarabelF
                         sp.csc_matrix(np.vstack(rows)), np.concatenate(rhs), kinds, equalities)
 
 
+def clarabel_sparse_form(P, q, A, b, lb, ub, cones):
+    """``(P, q, G, h, cones)`` for Clarabel from sparse data whose cones are friction
+    cones about the z axis (:func:`clarabel_form` builds dense matrices, too large for
+    the sparse path's problems)."""
+    n = q.shape[0]
+    eye = sp.eye(n, format="csr")
+    low, high = np.flatnonzero(np.isfinite(lb)), np.flatnonzero(np.isfinite(ub))
+    rows = [A, -eye[low], eye[high]]
+    kinds = [clarabel.ZeroConeT(A.shape[0]), clarabel.NonnegativeConeT(len(low) + len(high))]
+    for cone in cones:   # ||(x, y)|| <= mu z
+        f = cone.start
+        rows.append(-sp.csr_matrix(([cone.mu, 1.0, 1.0], ([0, 1, 2], [f + 2, f, f + 1])),
+                                   shape=(3, n)))
+        kinds.append(clarabel.SecondOrderConeT(3))
+    rhs = np.concatenate([b, -lb[low], ub[high], np.zeros(3 * len(cones))])
+    return sp.triu(P, format="csc"), q, sp.vstack(rows, format="csc"), rhs, kinds
+
+
 def clarabel_solve(P, q, A=None, b=None, lb=None, ub=None, cones=(), tol=1e-10) -> Reference:
     """Solve the fccqp problem with Clarabel; return its status and solution."""
     P = np.asarray(P, float)

@@ -20,17 +20,17 @@ DENSE_BACKENDS = ("auto", "schur_reduced", "ldl_reduced", "ldl_full")
 SEEDS = {
     "bad_input": (0, 1, 2, 3, 4, 5),
     "feasible": (0, 1, 2, 3, 4, 5),
-    "primal_infeasible": (0, 1, 2, 3, 80, 146, 177, 182, 350),
+    "primal_infeasible": (0, 1, 2, 3, 80, 146, 177, 182, 350, 100094, 300345),
     "dual_infeasible": (0, 1, 2, 33, 166, 257, 368),
-    "solver_reuse": (0, 1, 2, 50, 164, 211),
+    "solver_reuse": (0, 1, 2, 50, 164, 211, 100008, 100206),
     "extreme_data": (0, 1, 7, 9, 38, 47, 56, 108, 138, 149, 202, 214, 254, 302, 308, 316,
-                     326, 335, 337, 355, 363, 365),
+                     311, 326, 335, 337, 355, 363, 365, 100180, 100213, 100233),
     "qpsolvers": (0, 1, 2),
     "cvxpy": (1, 2, 3),
 }
 """Seeds per class run on every dense backend: a passing case or two per class and the
-reproducers of the failure mechanisms the campaign found at ed3b90e and 836ab4b (issue
-26)."""
+reproducers of the failure mechanisms the campaign found at ed3b90e, 836ab4b and 5f3a658
+(seeds from 100000; issue 26)."""
 
 SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),
@@ -43,15 +43,19 @@ SPARSE_SEEDS = {
 OPEN = {
     "solver_reuse:211": "sigma in scaled units decides convexity: a fresh solve accepts "
     "-3.9e-3 curvature that a kept workspace rejects",
-    "extreme_data:138": "SOLVED through the absolute tolerance on a cone block rescaled by 1e-8",
     "cvxpy:1": "a feasible problem whose dual residual stalls near 0.8 in the LDL' forms "
-    "with adaptive rho",
+    "with adaptive rho; only auto solves it again in the other form",
+    "extreme_data:100213": "P of 1e-12: the full form stalls where the reduced one solves; "
+    "only auto solves it again in the other form",
+    "solver_reuse:100206": "new rows through a kept workspace stall in every form warm; "
+    "only auto solves it again, cold, in the other form",
     "solver_reuse:38": "the sparse path's first factorization breaks down on dependent rows",
     "extreme_data:26": "the sparse path's dual certificate hides A dx under large rows",
 }
 """Reproducers of mechanisms still open (issue 26), each the reason it fails: expected
 to fail (strictly) on the backends where it does, so that a fix turns them red."""
-OPEN_BACKENDS = {"cvxpy:1": ("auto", "ldl_reduced", "ldl_full")}
+OPEN_BACKENDS = {"cvxpy:1": ("ldl_reduced", "ldl_full"), "extreme_data:100213": ("ldl_full",),
+                 "solver_reuse:100206": ("schur_reduced", "ldl_reduced", "ldl_full")}
 """Where an open case fails on some backends only."""
 
 

@@ -16,8 +16,8 @@ import scipy.sparse as sp
 import fccqp
 from fccqp import FrictionCone, SecondOrderCone, Status, scaling, sparse_problem
 from fccqp.settings import MAX_DENSE_KKT_ROWS
-from problems import random_problem
-from reference import clarabel_solve
+from problems import large_problem, random_problem
+from reference import clarabel_solve, clarabel_sparse_form
 from verify import Tolerances, from_qpsolvers, verify_solution
 
 SPARSE = dict(kkt_backend="sparse")
@@ -265,41 +265,13 @@ def test_missing_qdldl_is_a_clear_import_error(monkeypatch):
         fccqp.solve(np.eye(2), np.zeros(2), lb=[0, 0], ub=[1, 1], **SPARSE)
 
 
-def large_problem(n: int, seed: int = 0):
-    """A separable QP with a coupling row and a friction cone: ``n`` variables, a
-    tridiagonal ``P``, two equalities, a box on most entries."""
-    rng = np.random.default_rng(seed)
-    main = rng.uniform(1.0, 2.0, n)
-    P = sp.diags([main, -0.25 * np.ones(n - 1), -0.25 * np.ones(n - 1)], [0, 1, -1],
-                 format="csc")
-    q = rng.standard_normal(n)
-    A = sp.csc_matrix(np.vstack([np.ones(n), np.r_[np.zeros(n - 1), 1.0]]))
-    b = np.array([1.0, 2.0])
-    lb, ub = np.full(n, -0.5), np.full(n, 0.5)
-    lb[-3:], ub[-3:] = -np.inf, np.inf   # the cone's entries
-    return P, q, A, b, lb, ub, [FrictionCone(n - 3, 0.4)]
-
-
 def clarabel_sparse(P, q, A, b, lb, ub, cones):
-    """Clarabel at tight tolerance on a sparse problem with friction cones about the z
-    axis (``reference.clarabel_form`` builds dense matrices, too large here)."""
+    """Clarabel at tight tolerance on a sparse problem with friction cones about z."""
     clarabel = pytest.importorskip("clarabel")
-    n = q.shape[0]
-    eye = sp.eye(n, format="csr")
-    low, high = np.flatnonzero(np.isfinite(lb)), np.flatnonzero(np.isfinite(ub))
-    rows = [A, -eye[low], eye[high]]
-    kinds = [clarabel.ZeroConeT(A.shape[0]), clarabel.NonnegativeConeT(len(low) + len(high))]
-    for cone in cones:
-        f = cone.start
-        rows.append(-sp.csr_matrix(([cone.mu, 1.0, 1.0], ([0, 1, 2], [f + 2, f, f + 1])),
-                                   shape=(3, n)))
-        kinds.append(clarabel.SecondOrderConeT(3))
-    rhs = np.concatenate([b, -lb[low], ub[high], np.zeros(3 * len(cones))])
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = 1e-10
-    solution = clarabel.DefaultSolver(sp.triu(P, format="csc"), q,
-                                      sp.vstack(rows, format="csc"), rhs, kinds,
+    solution = clarabel.DefaultSolver(*clarabel_sparse_form(P, q, A, b, lb, ub, cones),
                                       settings).solve()
     assert str(solution.status) == "Solved"
     x = np.array(solution.x)

@@ -9,7 +9,7 @@ today's sparse path"):
   equality rows: the initial state and the dynamics; 2824 KKT rows), inputs boxed to
   ``[-0.3, 0.3]`` (16 of them active at the optimum), states to ``[-5, 5]``;
   random stable dynamics (seed 0);
-- ``large_friction``: ``tests/test_sparse_path.py``'s problem above the dense limit
+- ``large_friction``: ``tests/problems.large_problem`` above the dense limit
   (5000 variables, a tridiagonal ``P``, two rows, a box and a friction cone);
 - ``sparse_ls``: qpsolvers' sparse least-squares problem as
   ``test_qpsolvers_sparse_problem_above_the_limit`` poses it (5101 KKT rows in
@@ -26,12 +26,19 @@ from __future__ import annotations
 
 import argparse
 import statistics
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import scipy.sparse as sp
 
 import fccqp
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path[:0] = [str(ROOT / "tests")]
+
+import problems  # noqa: E402 - tests/problems.py, found through the path set just above
 
 
 def mpc(states: int = 12, inputs: int = 4, horizon: int = 100, seed: int = 0):
@@ -55,17 +62,9 @@ def mpc(states: int = 12, inputs: int = 4, horizon: int = 100, seed: int = 0):
 
 
 def large_friction(n: int = 5000, seed: int = 0):
-    """``tests/test_sparse_path.large_problem``."""
-    rng = np.random.default_rng(seed)
-    main = rng.uniform(1.0, 2.0, n)
-    P = sp.diags([main, -0.25 * np.ones(n - 1), -0.25 * np.ones(n - 1)], [0, 1, -1],
-                 format="csc")
-    q = rng.standard_normal(n)
-    A = sp.csc_matrix(np.vstack([np.ones(n), np.r_[np.zeros(n - 1), 1.0]]))
-    b = np.array([1.0, 2.0])
-    lb, ub = np.full(n, -0.5), np.full(n, 0.5)
-    lb[-3:], ub[-3:] = -np.inf, np.inf
-    return P, q, A, b, lb, ub, [fccqp.FrictionCone(n - 3, 0.4)]
+    """``tests/problems.large_problem``: a tridiagonal ``P``, two equalities, a box on
+    most entries and one friction cone."""
+    return problems.large_problem(n, seed)
 
 
 def sparse_ls(size: int = 1700):
@@ -109,23 +108,11 @@ def run_osqp(problem):
 def run_clarabel(problem):
     import clarabel
 
-    P, q, A, b, lb, ub, cones = problem
-    n = q.shape[0]
-    eye = sp.eye(n, format="csr")
-    low, high = np.flatnonzero(np.isfinite(lb)), np.flatnonzero(np.isfinite(ub))
-    rows = [A, -eye[low], eye[high]]
-    kinds = [clarabel.ZeroConeT(A.shape[0]), clarabel.NonnegativeConeT(len(low) + len(high))]
-    for cone in cones:   # friction cones about z: ||(x, y)|| <= mu z
-        f = cone.start
-        rows.append(-sp.csr_matrix(([cone.mu, 1.0, 1.0], ([0, 1, 2], [f + 2, f, f + 1])),
-                                   shape=(3, n)))
-        kinds.append(clarabel.SecondOrderConeT(3))
-    rhs = np.concatenate([b, -lb[low], ub[high], np.zeros(3 * len(cones))])
+    from reference import clarabel_sparse_form  # tests/reference.py
+
     settings = clarabel.DefaultSettings()
     settings.verbose = False
-    solution = clarabel.DefaultSolver(sp.triu(P, format="csc"), q,
-                                      sp.vstack(rows, format="csc"), rhs, kinds,
-                                      settings).solve()
+    solution = clarabel.DefaultSolver(*clarabel_sparse_form(*problem), settings).solve()
     return str(solution.status), solution.obj_val
 
 

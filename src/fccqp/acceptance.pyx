@@ -5,7 +5,7 @@ feasibility restoration (:mod:`fccqp.restoration`); and the residuals of a point
 the user's units that both checks (and the returned point) are measured by.
 """
 
-from libc.math cimport fabs, isfinite
+from libc.math cimport INFINITY, fabs, isfinite
 
 from fccqp._dense cimport copy, fill
 from fccqp._types cimport Iterates, Problem
@@ -17,9 +17,9 @@ from fccqp.polish cimport multiplier_violation, polish
 from fccqp.projections cimport proj_block, proj_set
 from fccqp.restoration cimport restore
 from fccqp.scaling cimport unscale
-from fccqp.termination cimport Residuals, gap_scale
+from fccqp.termination cimport Residuals, box_entry_size, gap_scale
 from fccqp.tuning cimport (EQUALITY_EXACT, EQUALITY_MISSED, EQUALITY_SLACK, POLISH_EXACT,
-                           RESTORED_EQUALITY)
+                           RESTORED_EQUALITY, SCALED_VIOLATION)
 from fccqp.verdict cimport classify, missed
 
 
@@ -225,11 +225,13 @@ cdef void user_residuals(Engine* e, const double* x, const double* y,
     cdef double* ATy = e.work.vec_n2
     cdef double* proj = e.work.vec_s
     cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, terms = 0.0, total = 0.0
-    cdef double value
+    cdef double value, size
     product(&e.user.A, x, Ax)
     product_t(&e.user.A, y, ATy)
     product(&e.user.P, x, grad)
     r.prim_eq = r.prim_eq_scale = r.prim_set = r.prim_set_scale = 0.0
+    r.set_s = r.set_scale_s = 0.0
+    r.box_excess = -INFINITY
     for i in range(m):
         r.prim_eq = max(r.prim_eq, fabs(Ax[i] - b[i]))
         r.prim_eq_scale = max(r.prim_eq_scale, max(fabs(Ax[i]), fabs(b[i])))
@@ -252,6 +254,12 @@ cdef void user_residuals(Engine* e, const double* x, const double* y,
         i = p.constrained[j]
         r.prim_set = max(r.prim_set, fabs(x[i] - proj[j]))
         r.prim_set_scale = max(r.prim_set_scale, fabs(x[i]))
+        r.set_s = max(r.set_s, fabs(x[i] - proj[j]) / p.D[i])
+        r.set_scale_s = max(r.set_scale_s, max(fabs(x[i]), fabs(proj[j])) / p.D[i])
+        if not p.in_cone[j]:
+            size = box_entry_size(max(fabs(x[i]), fabs(proj[j])), ub[i] - lb[i])
+            r.box_excess = max(r.box_excess,
+                               (fabs(x[i] - proj[j]) - SCALED_VIOLATION * size) / p.D[i])
         if z[i] > 0.0 and isfinite(ub[i]):
             support += ub[i] * z[i]
             terms += fabs(ub[i] * z[i])

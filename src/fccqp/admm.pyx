@@ -165,6 +165,7 @@ cdef class Workspace:
         kk.ldl.Ax, kk.ldl.ATnu = self._new(m), self._new(n)
         kk.schur.n, kk.schur.m = <int>n, <int>m
         kk.schur.L, kk.schur.LS, kk.schur.Y = self._new(n * n), self._new(m * m), self._new(n * m)
+        kk.schur.G, kk.schur.free_ready = self._new(m * m), False
         kk.schur.base_order = &order_v[0]
         kk.schur.order = <Py_ssize_t*>self._new_int(n)
         kk.schur.coupled = <char*>self._new(n)
@@ -176,7 +177,7 @@ cdef class Workspace:
         red = &e.red
         red.W, red.W_S, red.base = self._new(N * s), self._new(s * s), self._new(N)
         red.u, red.u_prev, red.v, red.v_prev = self._new(s), self._new(s), self._new(s), self._new(s)
-        red.xs, red.rhs = self._new(s), self._new(N)
+        red.xs = self._new(s)
         aa = &e.aa
         aa.capacity = <int>memory
         aa.dg, aa.df = self._new(memory * 2 * s), self._new(memory * 2 * s)

@@ -23,6 +23,16 @@ Neither is trusted as it comes: each candidate passes the tests the run's own
 candidates take, on the run's scaled problem (:meth:`fccqp.admm.Workspace.judge_certificate`),
 or the run keeps its status. On a feasible, bounded problem the distance and the
 projection are zero, and what the auxiliary solves return does not separate.
+
+ADMM's progress on a hard problem depends on the KKT form it iterates in: the full
+form adds ``sigma``'s proximal term on every entry, the reduced forms iterate on the
+constrained entries alone. A problem that stalls in one form often solves in the other
+(the fuzzing campaign: a least-distance QP of three pinned friction cones stalled for
+4000 iterations in the reduced form and solved in 30 in the full one; a feasible QP
+with ``P`` of 1e-12 stalled in the full form and solved in the reduced one). So an
+auxiliary solve that is not SOLVED runs again in the other form
+(:func:`other_form`), and :func:`in_other_form` solves the stalled problem itself
+again there when no certificate was found.
 """
 
 from __future__ import annotations
@@ -36,6 +46,7 @@ from fccqp.cones import cone_tuple
 from fccqp.problem import INFINITE_BOUND
 from fccqp.settings import MAX_DENSE_KKT_ROWS
 from fccqp.status import Status
+from fccqp.tuning import AUXILIARY_MARGIN
 
 
 def _dense(matrix: object, rows: int, n: int) -> np.ndarray:
@@ -134,6 +145,73 @@ def _moreau(d: np.ndarray, q: np.ndarray) -> bool:
     return norm > 0.0 and abs(float(q @ d) + norm) <= IDENTITY * norm
 
 
+def other_form(settings: object, backend: str) -> object:
+    """``settings`` for a solve in the KKT form other than ``backend`` (the form a run
+    ended in, :attr:`fccqp.Result.backend`): the reduced forms (Schur first, with its
+    own fallback to LDL') after the full one, the full one after a reduced one."""
+    return settings.replace(kkt_backend="schur_reduced" if backend == "ldl_full"
+                            else "ldl_full")
+
+
+def _auxiliary_solver(solver_type: type, settings: object) -> object:
+    """A ``solver_type`` with ``settings``, no log nor warm start, that asks for no
+    certificate of its own."""
+    solver = solver_type(settings.replace(verbose=False, warm_start=False))
+    solver._stalled_certificates = False
+    return solver
+
+
+def _solved(solver_type: type, settings: object, problem: tuple) -> tuple:
+    """``(result, iterations, factorizations)`` of an auxiliary ``problem``: solved with
+    ``settings``, and again in the other form (:func:`other_form`) unless that ended
+    SOLVED; the counts are those of both solves."""
+    result = _auxiliary_solver(solver_type, settings).solve(*problem)
+    if result.status is Status.SOLVED:
+        return result, result.iterations, result.factorizations
+    again = _auxiliary_solver(solver_type, other_form(settings, result.backend)).solve(
+        *problem)
+    return (again, result.iterations + again.iterations,
+            result.factorizations + again.factorizations)
+
+
+ANSWERS = (Status.SOLVED, Status.SOLVED_INACCURATE, Status.PRIMAL_INFEASIBLE,
+           Status.DUAL_INFEASIBLE)
+"""The statuses of :func:`in_other_form` that replace a stalled run's: an answer,
+each with the guarantees of its status."""
+
+
+def in_other_form(solver_type: type, settings: object, stalled: object,
+                  arguments: tuple) -> object | None:
+    """The problem of ``arguments`` (``P, q, A, b, lb, ub, cones``), on which a run in
+    ``stalled.backend``'s form stalled, solved cold in the other form
+    (:func:`other_form`), when that gives an answer (:data:`ANSWERS`); else None."""
+    result = _auxiliary_solver(solver_type, other_form(settings, stalled.backend)).solve(
+        *arguments)
+    return result if result.status in ANSWERS else None
+
+
+def _farkas(workspace: object, result: object, b: np.ndarray, lb: np.ndarray,
+            ub: np.ndarray, S: np.ndarray) -> np.ndarray | None:
+    """The Farkas certificate of a least-distance ``result`` as ``workspace`` judges it
+    (:meth:`fccqp.admm.Workspace.judge_certificate`), or None when the solution does not
+    meet its identity (:func:`_least_distance`) or the certificate fails."""
+    n, m = lb.shape[0], b.shape[0]
+    if not _least_distance(result, b, lb[S], ub[S], n):
+        return None
+    candidate = np.zeros(m + n)
+    candidate[:m] = result.y
+    candidate[m + S] = result.z[n:]
+    return workspace.judge_certificate(candidate, True, np.ascontiguousarray(result.x[:n]))
+
+
+def _farkas_tolerances(settings: object, w: np.ndarray) -> object:
+    """``settings`` whose termination meets the Farkas test of a least-distance solution
+    with multipliers ``w``: its dual residual, ``A'y + z``, within ``eps_prim_inf``
+    (relative) of their size, ``AUXILIARY_MARGIN`` times over."""
+    eps = settings.eps_prim_inf / AUXILIARY_MARGIN
+    return settings.replace(eps_rel=eps, eps_abs=eps * float(np.abs(w).max()))
+
+
 def stalled_certificate(solver_type: type, settings: object, workspace: object,
                         P: object, q: object, A: object, b: object, lb: object,
                         ub: object, cones: object) -> tuple | None:
@@ -141,8 +219,8 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
     this problem in ``workspace``, or None: the primal certificate of the least
     distance (when there are rows and constrained entries), else the dual one of the
     projection onto the rays, each judged by ``workspace``. The auxiliary solves use
-    ``settings`` (with no log nor warm start) in a ``solver_type`` that asks for no
-    certificate of its own."""
+    ``settings`` in a ``solver_type`` (:func:`_auxiliary_solver`), in a second form
+    when the first did not solve them (:func:`_solved`)."""
     q = np.asarray(q, dtype=np.float64).reshape(-1)
     n = q.shape[0]
     P = _dense(P, n, n)
@@ -151,28 +229,28 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
     m = b.shape[0]
     lb, ub = _bounds(lb, ub, n)
     cones = cone_tuple(cones or ())
-    auxiliary = solver_type(settings.replace(verbose=False, warm_start=False))
-    auxiliary._stalled_certificates = False
     spent = factored = 0
     try:
         if m > 0:
             problem, S = distance_problem(A, b, lb, ub, cones)
             if S.size and _dense_path(problem):
-                result = auxiliary.solve(*problem)
-                spent, factored = spent + result.iterations, factored + result.factorizations
-                if _least_distance(result, b, lb[S], ub[S], n):
-                    candidate = np.zeros(m + n)
-                    candidate[:m] = result.y
-                    candidate[m + S] = result.z[n:]
-                    point = np.ascontiguousarray(result.x[:n])
-                    found = workspace.judge_certificate(candidate, True, point)
-                    if found is not None:
-                        return Status.PRIMAL_INFEASIBLE, found, spent, factored
+                result, spent, factored = _solved(solver_type, settings, problem)
+                found = _farkas(workspace, result, b, lb, ub, S)
+                if found is None and _least_distance(result, b, lb[S], ub[S], n):
+                    # its multipliers have the size of the distance, and the run's
+                    # tolerance (absolute) left them a residual of 2e-6 of it where the
+                    # Farkas test allows eps_prim_inf = 1e-6: solved again to that test
+                    result, iterations, factorizations = _solved(
+                        solver_type, _farkas_tolerances(settings, result.z[n:]), problem)
+                    spent, factored = spent + iterations, factored + factorizations
+                    found = _farkas(workspace, result, b, lb, ub, S)
+                if found is not None:
+                    return Status.PRIMAL_INFEASIBLE, found, spent, factored
         rays = ray_problem(P, q, A, lb, ub, cones)
         if not np.any(q) or not _dense_path(rays):
             return None
-        result = auxiliary.solve(*rays)
-        spent, factored = spent + result.iterations, factored + result.factorizations
+        result, iterations, factorizations = _solved(solver_type, settings, rays)
+        spent, factored = spent + iterations, factored + factorizations
         if not _moreau(result.x, rays[1]):
             return None
         found = workspace.judge_certificate(np.ascontiguousarray(result.x), False)

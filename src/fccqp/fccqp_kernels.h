@@ -24,15 +24,17 @@
  * stays with dgemv, whose dot-product kernel took 3.2k against 3.7k for a loop in four
  * explicit lanes. fccqp_cholesky also factors polish_schur's d x d cone blocks.
  *
- * fccqp_symmetric_copy, fccqp_checked_copy, fccqp_scale_rows and fccqp_row_spans: the
- * per-solve passes over P and A of the validation scan, the rescaling and the rows'
- * spans. They keep running maxima or skip zeros, which GCC does not vectorize (a float
- * max is not associative once NaN is allowed, not without -ffast-math), so they are
- * written in four lanes (fccqp_v4). Per go2 solve (callgrind, 200 ticks of
- * Settings.realtime(inf)): the scan went from 82k to 42k instructions and the rescaling
- * from 62k to 48k; in wall time (one process each, passes alternated, Zen) the
- * rescaling and spans from 11.5 to 5.7 us; the scan, which is the first read of the
- * caller's arrays, stayed at 10-11 us.
+ * fccqp_symmetric_copy, fccqp_checked_copy, fccqp_scale_rows, fccqp_ruiz_maxima and
+ * fccqp_row_spans: the per-solve passes over P and A of the validation scan, the
+ * rescaling, the equilibration's passes and the rows' spans. They keep running maxima
+ * or skip zeros, which GCC does not vectorize (a float max is not associative once NaN
+ * is allowed, not without -ffast-math), so they are written in four lanes (fccqp_v4).
+ * Per go2 solve (callgrind, 200 ticks of Settings.realtime(inf)): the scan went from
+ * 82k to 42k instructions and the rescaling from 62k to 48k; in wall time (one process
+ * each, passes alternated, Zen) the rescaling and spans from 11.5 to 5.7 us; the scan,
+ * which is the first read of the caller's arrays, stayed at 10-11 us. fccqp_ruiz_maxima,
+ * run 4 times per equilibration, is also cloned: a go2 pass took about 35k instructions
+ * in Cython's loops, 34k in the baseline copy and 24k in the AVX2 one (callgrind).
  */
 #ifndef FCCQP_KERNELS_H
 #define FCCQP_KERNELS_H
@@ -469,6 +471,52 @@ static void fccqp_scale_rows(const double *restrict M, int rows, int cols,
                 column_max[j] = size > column_max[j] ? size : column_max[j];
         }
         row_max[i] = fccqp_largest4(largest, largest_1);
+    }
+}
+
+/* The norms one Ruiz pass reads (fccqp.scaling.equilibrate) off the unscaled row-major P
+ * (n x n) and A (m x n) under the scaling D, E so far:
+ * column[j] = max(D_j max_i |P_ij| D_i, max_i (|A_ij| D_j) E_i) and
+ * row[i] = (max_j |A_ij| D_j) E_i, each product in the order written (the loops this
+ * replaces rounded them so). D, E are positive, P and A finite. */
+FCCQP_CLONES
+static void fccqp_ruiz_maxima(const double *restrict P, const double *restrict A, int n,
+                              int m, const double *restrict D, const double *restrict E,
+                              double *restrict column, double *restrict row)
+{
+    for (int j = 0; j < n; j++)
+        column[j] = 0.0;
+    for (int i = 0; i < n; i++) {   /* column maxima of |P| diag(D), row by row */
+        const double *p_row = P + (long)i * n;
+        fccqp_v4 weight = fccqp_splat4(D[i]);
+        int j = 0;
+        for (; j + 4 <= n; j += 4)
+            fccqp_store4(column + j, fccqp_max4(fccqp_load4(column + j), fccqp_mul4(
+                fccqp_abs4(fccqp_load4(p_row + j)), weight)));
+        for (; j < n; j++) {
+            double size = fabs(p_row[j]) * D[i];
+            column[j] = size > column[j] ? size : column[j];
+        }
+    }
+    for (int j = 0; j < n; j++)
+        column[j] *= D[j];
+    for (int i = 0; i < m; i++) {
+        const double *a_row = A + (long)i * n;
+        fccqp_v4 weight = fccqp_splat4(E[i]), largest = fccqp_splat4(0.0);
+        double largest_1 = 0.0;
+        int j = 0;
+        for (; j + 4 <= n; j += 4) {
+            fccqp_v4 size = fccqp_mul4(fccqp_abs4(fccqp_load4(a_row + j)), fccqp_load4(D + j));
+            largest = fccqp_max4(largest, size);
+            fccqp_store4(column + j, fccqp_max4(fccqp_load4(column + j),
+                                                fccqp_mul4(size, weight)));
+        }
+        for (; j < n; j++) {
+            double size = fabs(a_row[j]) * D[j], scaled = size * E[i];
+            largest_1 = size > largest_1 ? size : largest_1;
+            column[j] = scaled > column[j] ? scaled : column[j];
+        }
+        row[i] = fccqp_largest4(largest, largest_1) * E[i];
     }
 }
 

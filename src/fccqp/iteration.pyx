@@ -124,6 +124,7 @@ cdef inline void _begin(Engine* e, Loop* L, Run* run, bint cold, double start_ti
     e.certs.gram_state = 0
     e.fact.table_ready = False   # base is for the previous q, b
     e.pol.schur.ready = False   # set up for the previous P, A
+    e.fact.kkt.schur.free_ready = False   # likewise
     e.iterated = False
     e.clock.marks[3] = e.clock.marks[4] = fccqp_now()   # phases skipped show 0
 

@@ -12,8 +12,8 @@ through four calls: :func:`kkt_factor` (for given P, A, sigma, rho), :func:`kkt_
 reduced form's table and the restoration's columns) and :func:`kkt_convexity` (is the
 QP convex?). The backends are :mod:`fccqp.schur`
 (Cholesky, needs ``P + R`` positive definite and ``A`` of full row rank; the reduced
-form only) and :mod:`fccqp.ldl` (quasi-definite LDL', any ``A``). ``sigma`` is 0 in
-the reduced forms.
+form, and the cold start of a run that will iterate in it) and :mod:`fccqp.ldl`
+(quasi-definite LDL', any ``A``). ``sigma`` is 0 in the reduced forms.
 """
 
 from fccqp._types cimport Problem

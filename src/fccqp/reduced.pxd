@@ -12,7 +12,6 @@ cdef struct Reduced:
     double* v       # nu = (base + W v)_nu, v = rho z - y of the last step
     double* v_prev
     double* xs      # s scratch
-    double* rhs     # n + m scratch
 
 cdef bint reduced_table(Reduced* r, KKT* k, const Problem* p, const double* rho_vec) noexcept nogil
 cdef void reduced_start(Reduced* r, const Problem* p, Iterates* it) noexcept nogil

@@ -14,24 +14,20 @@ coordinate ``u + (R' - R) x_S`` in the new table (:func:`reduced_rebase`).
 
 from fccqp._dense cimport colmatvec, copy, matvec
 from fccqp._types cimport Iterates, Problem
-from fccqp.kkt cimport KKT, kkt_solve, kkt_unit_columns
+from fccqp.kkt cimport KKT, kkt_unit_columns
 from fccqp.projections cimport proj_set
 
 
 cdef bint reduced_table(Reduced* r, KKT* k, const Problem* p, const double* rho_vec) noexcept nogil:
-    """Tabulate ``W``, ``W_S`` and ``base`` with the factorization in ``k``; False when
-    the columns missed the refinement tolerance."""
-    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, N = n + m, i, j
+    """Tabulate ``W`` and ``W_S`` with the factorization in ``k``; False when the columns
+    missed the refinement tolerance. ``base``, which follows ``q`` and ``b``, is the
+    caller's (:func:`fccqp.factorization.reduced_base`, after every factorization)."""
+    cdef Py_ssize_t s = p.s, N = p.n + p.m, i, j
     if not kkt_unit_columns(k, p, rho_vec, p.constrained, <int>s, r.W):
         return False
     for j in range(s):
         for i in range(s):
             r.W_S[j * s + i] = r.W[p.constrained[j] + i * N]
-    for i in range(n):
-        r.rhs[i] = -p.q[i]
-    for i in range(m):
-        r.rhs[n + i] = p.b[i]
-    kkt_solve(k, p, rho_vec, r.rhs, r.base)
     return True
 
 

@@ -10,6 +10,8 @@ cdef struct Schur:
     const Py_ssize_t* base_order   # free entries first, the s constrained entries last
     Py_ssize_t* order    # base_order with the diagonal free entries moved behind the others
     int dense            # rows of the dense leading block of L; a diagonal tail follows
+    bint free_ready      # the free rows of L and Y and G hold for this run's P and A
+    double* G            # m x m, Fortran: Y_F' Y_F over the free rows (diagonal-tail split)
     char* coupled        # n scratch: which rows of P have entries off the diagonal
     double* perm         # n scratch
     double* dx           # n scratch

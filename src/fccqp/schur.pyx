@@ -87,41 +87,116 @@ cdef void _order(Schur* f, const Problem* p) noexcept nogil:
 
 cdef bint schur_factor(Schur* f, const Problem* p, const double* rho_vec) noexcept nogil:
     """Factor ``H = P + R`` (rows in ``order``) into ``L`` and ``S`` into ``LS``;
-    ``Y := L^-1 A'``. False when ``H`` or ``S`` is not (numerically) positive definite."""
-    cdef int n = <int>p.n, m = <int>p.m, s = <int>p.s, first = n - s, i, j
-    cdef int k
-    cdef Py_ssize_t column
-    cdef double largest = 0.0
+    ``Y := L^-1 A'``. False when ``H`` or ``S`` is not (numerically) positive definite.
+
+    Where the constrained entries are in the diagonal tail, ``R`` reaches only their
+    rows: the free rows of ``L`` and ``Y`` and their share ``G`` of ``S`` are kept
+    (``free_ready``, until the caller's next ``P`` and ``A``) and another ``R`` (a rho
+    change, or the iteration after the cold start) refactors the constrained rows and
+    ``S`` alone (:func:`_factor_constrained`; talos: the dense block's Cholesky and
+    ``dtrsm`` and 68 of ``dsyrk``'s 124 rows skipped)."""
+    cdef int first = <int>(p.n - p.s)
+    if f.free_ready:
+        return _factor_constrained(f, p, rho_vec)
     _order(f, p)
-    k = f.dense
+    if f.dense > first:
+        return _factor_whole(f, p, rho_vec)
+    if not _factor_free(f, p):
+        return False
+    f.free_ready = True
+    return _factor_constrained(f, p, rho_vec)
+
+
+cdef bint _factor_free(Schur* f, const Problem* p) noexcept nogil:
+    """The free rows (the ``first = n - s`` leading ones in ``order``) of ``L`` and
+    ``Y``, and ``G = Y_F' Y_F``; False when ``P`` is not positive definite on them."""
+    cdef int n = <int>p.n, m = <int>p.m, first = n - <int>p.s, k = f.dense, i, j
+    cdef Py_ssize_t column
     for j in range(k):   # the dense block's lower triangle; below it L is never read
         column = f.order[j]
         for i in range(j, k):
             f.L[i + j * n] = p.P.values[f.order[i] * n + column]
-    for j in range(k, n):
-        column = f.order[j]
-        f.L[j + j * n] = p.P.values[column * n + column]
-    for j in range(s):
-        f.L[first + j + (first + j) * n] += rho_vec[j]
     if k > 0 and not cholesky(f.L, k, n):
         return False
-    for j in range(k, n):   # the diagonal tail (off its diagonal L is never read)
+    for j in range(k, first):   # the diagonal tail's free rows
+        column = f.order[j]
+        f.L[j + j * n] = p.P.values[column * n + column]
         if not f.L[j + j * n] > 0.0:
             return False
         f.L[j + j * n] = sqrt(f.L[j + j * n])
+    if m == 0:
+        return True
+    for j in range(first):
+        column = f.order[j]
+        for i in range(m):
+            f.Y[j + i * n] = p.A.values[i * n + column]
+    if k > 0:
+        trsm(b"L", b"N", k, m, f.L, n, f.Y, n)
+    for i in range(m):
+        for j in range(k, first):
+            f.Y[j + i * n] /= f.L[j + j * n]
+    syrk_t(m, first, f.Y, n, 0.0, f.G, m)
+    return True
+
+
+cdef bint _factor_constrained(Schur* f, const Problem* p, const double* rho_vec) noexcept nogil:
+    """The constrained rows of the diagonal tail of ``L`` and ``Y`` for ``rho_vec``, and
+    ``S = G + Y_S' Y_S``, over the free rows that :func:`_factor_free` left."""
+    cdef int n = <int>p.n, m = <int>p.m, s = <int>p.s, first = n - s, i, j
+    cdef Py_ssize_t column
+    cdef double d
+    for j in range(first, n):
+        column = f.order[j]
+        d = p.P.values[column * n + column] + rho_vec[j - first]
+        if not d > 0.0:
+            return False
+        f.L[j + j * n] = sqrt(d)
+    if m == 0:
+        return True
+    for i in range(m):
+        for j in range(first, n):
+            f.Y[j + i * n] = p.A.values[i * n + f.order[j]] / f.L[j + j * n]
+    for i in range(m * m):
+        f.LS[i] = f.G[i]
+    if s > 0:
+        syrk_t(m, s, f.Y + first, n, 1.0, f.LS, m)
+    return _factor_complement(f, m)
+
+
+cdef bint _factor_whole(Schur* f, const Problem* p, const double* rho_vec) noexcept nogil:
+    """:func:`schur_factor` where a constrained entry is coupled in ``P`` (``order``
+    keeps the base order and ``L`` is dense): every row depends on rho."""
+    cdef int n = <int>p.n, m = <int>p.m, s = <int>p.s, first = n - s, i, j
+    cdef Py_ssize_t column
+    for j in range(n):
+        column = f.order[j]
+        for i in range(j, n):
+            f.L[i + j * n] = p.P.values[f.order[i] * n + column]
+    for j in range(s):
+        f.L[first + j + (first + j) * n] += rho_vec[j]
+    if not cholesky(f.L, n, n):
+        return False
     if m == 0:
         return True
     for j in range(n):
         column = f.order[j]
         for i in range(m):
             f.Y[j + i * n] = p.A.values[i * n + column]
-    _triangular_solve(f, b"N", n, m, f.Y, n)
+    trsm(b"L", b"N", n, m, f.L, n, f.Y, n)
     syrk_t(m, n, f.Y, n, 0.0, f.LS, m)
+    return _factor_complement(f, m)
+
+
+cdef bint _factor_complement(Schur* f, int m) noexcept nogil:
+    """Cholesky of ``S`` in ``LS`` (its lower triangle holds ``S``); False when a pivot is
+    not positive or was lost to cancellation (dependent rows: left to LDL')."""
+    cdef int i
+    cdef double largest = 0.0
     for i in range(m):
         largest = max(largest, f.LS[i + i * m])
     if not cholesky(f.LS, m, m):
         return False
-    for i in range(m):  # a pivot lost to cancellation: dependent rows, leave them to LDL'
+    for i in range(m):
         if f.LS[i + i * m] * f.LS[i + i * m] <= RANK_TOLERANCE * largest:
             return False
     return True

@@ -247,11 +247,26 @@ class Solver:
     def _stalled(self, out: Result, P: object, q: object, A: object, b: object,
                  lb: object, ub: object, start: float) -> Result:
         """``out`` of a run that stalled (``MAX_ITER_REACHED``), or the certificate that
-        :func:`fccqp.auxiliary.stalled_certificate` found for it instead (its solves'
-        iterations and factorizations added); a certified problem leaves no previous
-        solution to start from, as an infeasible run does."""
+        :func:`fccqp.auxiliary.stalled_certificate` found for it instead, or (with
+        ``kkt_backend="auto"``) the answer of a solve in the other KKT form
+        (:func:`fccqp.auxiliary.in_other_form`); their iterations and factorizations
+        added. Either leaves no previous solution to start from: a certified problem as
+        an infeasible run does, an answer from another solver because this workspace
+        holds the stalled point."""
         found = auxiliary.stalled_certificate(Solver, self._settings, self._workspace, P, q,
                                               A, b, lb, ub, self._cones)
+        if found is None and self._settings.kkt_backend == "auto":
+            # the form was fccqp's choice: the other one may not stall
+            again = auxiliary.in_other_form(Solver, self._settings, out,
+                                            (P, q, A, b, lb, ub, self._cones))
+            if again is not None:
+                self._workspace.forget()
+                return Result._of({
+                    **again.__dict__,
+                    "iterations": out.iterations + again.iterations,
+                    "factorizations": out.factorizations + again.factorizations,
+                    "solve_time": time.perf_counter() - start,
+                })
         if found is None:
             return out
         status, certificate, iterations, factorizations = found

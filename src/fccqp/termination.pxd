@@ -1,4 +1,6 @@
 # cython: language_level=3
+from libc.math cimport isfinite
+
 from fccqp._types cimport Iterates, Problem
 
 cdef struct Residuals:
@@ -10,6 +12,9 @@ cdef struct Residuals:
     double prim_eq_scale, prim_set_scale
     double prim_scale, dual_scale, gap_scale   # prim_scale: the larger of the two
     double prim_s, dual_s, prim_scale_s, dual_scale_s
+    double set_s, set_scale_s   # x_S - w and the size of x_S, w in scaled units, uncapped
+    double box_excess           # box entries: largest |x_i - w_i| - SCALED_VIOLATION x size
+                                # (box_entry_size), in scaled units
     bint finite
 
 cdef void residuals(const Problem* p, const Iterates* it, double* Ax, double* ATnu,
@@ -20,3 +25,9 @@ cdef bint nearly_converged(const Residuals* r, double eps_abs, double eps_rel,
 cdef double gap_scale(double xPx, double qx, double terms) noexcept nogil
 cdef void row_spans(Problem* p, double* width) noexcept nogil
 cdef double box_support(const Problem* p, const double* y, double* terms) noexcept nogil
+
+
+cdef inline double box_entry_size(double scale, double width) noexcept nogil:
+    """The size a box entry's violation is judged against (``Residuals.box_excess``): its
+    ``scale`` (value), or the box's ``width`` where that is finite and larger."""
+    return max(scale, width) if isfinite(width) else scale

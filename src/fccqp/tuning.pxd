@@ -80,6 +80,8 @@ cdef extern from *:
     #define FCCQP_INACCURATE_FACTOR 10.0
     /* multiplier terms widen the gap's scale to at most this x max(|x'Px|, |q'x|) */
     #define FCCQP_GAP_TERMS_CAP 10.0
+    /* no solved claim while x_S misses C by eps_abs + this of x_S's size in scaled units */
+    #define FCCQP_SCALED_VIOLATION 1e-2
     /* gated full checks back off 1, 3, 7, then this many iterations (one costs ~2.4) */
     #define FCCQP_GATED_CHECK_WAIT 8
     /* the verbose log keeps one line every this many iterations (as OSQP) */
@@ -100,6 +102,8 @@ cdef extern from *:
     #define FCCQP_CLEANING_START 500
     /* cleaned only while the primal residual is above this x its tolerance */
     #define FCCQP_CLEANING_GATE 1.0
+    /* a least-distance QP solved again meets the Farkas test's eps_prim_inf this many times */
+    #define FCCQP_AUXILIARY_MARGIN 10.0
 
     /* ---- Polish (fccqp.polish*, fccqp.iteration, fccqp.acceptance) ---- */
     /* regularization of both diagonal blocks of the polishing KKT matrix (scaled) */
@@ -192,6 +196,7 @@ cdef extern from *:
     # Termination
     const double INACCURATE_FACTOR "FCCQP_INACCURATE_FACTOR"
     const double GAP_TERMS_CAP "FCCQP_GAP_TERMS_CAP"
+    const double SCALED_VIOLATION "FCCQP_SCALED_VIOLATION"
     const long GATED_CHECK_WAIT "FCCQP_GATED_CHECK_WAIT"
     const long LOG_INTERVAL "FCCQP_LOG_INTERVAL"
     # Infeasibility certificates
@@ -202,6 +207,7 @@ cdef extern from *:
     const double GRAM_REGULARIZATION "FCCQP_GRAM_REGULARIZATION"
     const long CLEANING_START "FCCQP_CLEANING_START"
     const double CLEANING_GATE "FCCQP_CLEANING_GATE"
+    const double AUXILIARY_MARGIN "FCCQP_AUXILIARY_MARGIN"
     # Polish
     const double POLISH_DELTA "FCCQP_POLISH_DELTA"
     const double POLISH_REFINE_TOLERANCE "FCCQP_POLISH_REFINE_TOLERANCE"
