@@ -27,8 +27,10 @@ eliminated, so the KKT system of the polished QP
 
 has the free entries ``F`` of ``x``, the equality multipliers and one multiplier per
 boundary block as unknowns (``G`` holds the unit normals ``g``). It is factored with
-Bunch-Kaufman ``dsytrf`` and refined against the unregularized matrix, as
-:mod:`fccqp.ldl` does. Each boundary block's plane is then re-linearized at the new
+Bunch-Kaufman ``dsytrf`` (or by :mod:`fccqp.polish_schur`'s Schur complement where
+``P``'s structure allows it; by qdldl in compressed columns, :mod:`fccqp.polish_csc`, where
+``P`` and ``A`` are CSC) and refined against the unregularized matrix, as :mod:`fccqp.ldl`
+does. Each boundary block's plane is then re-linearized at the new
 ``x_block`` and the system re-solved, ``newton_steps`` times at most or until ``|phi|
 <= NEWTON_TOLERANCE ||x_block||``: Newton's method (SQP) on the KKT conditions of the
 QP on the active manifold, quadratically convergent when the guess is right.
@@ -61,7 +63,8 @@ from fccqp._dense cimport copy, inf_norm
 from fccqp._types cimport Cones, Iterates, Problem
 from fccqp.cone_dispatch cimport cone_phi, cone_plane, cone_polar_distance
 from fccqp.kkt cimport KKT
-from fccqp.matrices cimport product, product_t
+from fccqp.matrices cimport CSC, DENSE, product, product_t
+from fccqp.polish_csc cimport polish_csc_factor, polish_csc_solve
 from fccqp.polish_guess cimport (box_code, cone_code, drop_far_side, guess, linearize, renew,
                                  step_length)
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup, polish_schur_solve
@@ -73,29 +76,6 @@ from fccqp.tuning cimport (ACTIVE_TOLERANCE, CHORD_RATE, CHORD_STEPS, GUESS_PASS
 
 cdef extern from "fccqp_clock.h" nogil:
     double fccqp_now()
-
-
-cdef Py_ssize_t guess_changes(const Problem* p, const double* z, const double* y,
-                              double* point, char* codes) noexcept nogil:
-    """Classify every constrained entry as :func:`fccqp.polish_guess.guess` would from
-    ``z, y`` into ``codes`` (``point``: ``s`` scratch) and return how many codes changed:
-    the iteration asks it whether ADMM's active set has settled before it polishes early."""
-    cdef const Cones* c = &p.cones
-    cdef Py_ssize_t j, k, o, changed = 0
-    cdef char code
-    for j in range(p.s):
-        point[j] = z[j] + y[j]
-        if not p.in_cone[j]:
-            code = box_code(p, j, point[j])
-            changed += code != codes[j]
-            codes[j] = code
-    for k in range(c.count):
-        o = c.offset[k]
-        code = cone_code(c, k, point + o)
-        for j in range(o, o + c.dim[k]):
-            changed += code != codes[j]
-            codes[j] = code
-    return changed
 
 
 cdef Py_ssize_t _unknowns(Polish* w, const Problem* p) noexcept nogil:
@@ -224,6 +204,8 @@ cdef void _factored_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t
     copy(w.rhs, w.step, size)
     if w.structured:
         polish_schur_solve(&w.schur, p, w.index, w.boundary, nb, w.step)
+    elif p.P.kind == CSC:
+        polish_csc_solve(&w.csc, size, w.step)
     else:
         dsytrs(&uplo, &size, &one, w.K, &size, w.ipiv, w.step, &size, &info)
 
@@ -266,13 +248,12 @@ cdef bint _relinearize(Polish* w, const Problem* p, Py_ssize_t nb,
     return True
 
 
-
 cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
                        double tolerance, int* factorizations) noexcept nogil:
     """Factor the KKT matrix of the current active set and planes (by Schur complement
     where :mod:`fccqp.polish_schur` was set up for this problem and applies, else
-    assembled for ``dsytrf``) and solve it from the current point to ``tolerance``;
-    False when the factorization breaks down."""
+    assembled for ``dsytrf``, or for qdldl where ``P`` and ``A`` are CSC) and solve it
+    from the current point to ``tolerance``; False when the factorization breaks down."""
     cdef char uplo = b"L"
     cdef int size = <int>(nf + p.m + nb), info = 0
     if size == 0:   # every entry held, no rows: nothing to solve
@@ -286,10 +267,15 @@ cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t n
     if w.schur_only:
         w.schur_failed = True
         return False
-    _assemble(w, p, nf, nb)
-    dsytrf(&uplo, &size, w.K, &size, w.ipiv, w.work, &w.lwork, &info)
-    if info != 0:
-        return False
+    if p.P.kind == CSC:
+        if not polish_csc_factor(&w.csc, p, nf, w.free, w.index, w.boundary, nb, w.g, w.hess,
+                                 POLISH_DELTA):
+            return False
+    else:
+        _assemble(w, p, nf, nb)
+        dsytrf(&uplo, &size, w.K, &size, w.ipiv, w.work, &w.lwork, &info)
+        if info != 0:
+            return False
     _solve(w, p, nf, nb, tolerance)
     return True
 
@@ -335,7 +321,11 @@ cdef void _multipliers(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
 
 cdef bint polish_prepare(Polish* w, const Problem* p) noexcept nogil:
     """Set up the Schur-complement solve of :mod:`fccqp.polish_schur` for this solve's
-    ``P`` and ``A``; True when it applies, and then polishing needs no table."""
+    ``P`` and ``A``; True when it applies, and then polishing needs no table. Never on
+    CSC ``P`` and ``A`` (the Schur solve reads dense storage): each guess is assembled."""
+    if p.P.kind == CSC:
+        w.schur.ready = False
+        return False
     return polish_schur_setup(&w.schur, p, POLISH_DELTA)
 
 
@@ -376,7 +366,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     cdef long passes = 0, step
     cdef double total = 0.0
     cdef double scale = max(1.0, max(inf_norm(p.q, n), inf_norm(p.b, m)))
-    cdef bint tabled = table != NULL
+    cdef bint tabled = table != NULL and p.P.kind == DENSE   # the table reads dense storage
     cdef double miss, rate, last_miss = INFINITY
     cdef bint refactored = False
     cdef bint feasible = False   # a pass's point violated nothing: from then on, steps

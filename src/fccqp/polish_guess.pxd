@@ -26,6 +26,8 @@ cdef inline char cone_code(const Cones* c, Py_ssize_t k, const double* v) noexce
     return BOUNDARY
 
 
+cdef Py_ssize_t guess_changes(const Problem* p, const double* z, const double* y,
+                              double* point, char* codes) noexcept nogil
 cdef void linearize(Polish* w, const Problem* p, Py_ssize_t k, const double* v) noexcept nogil
 cdef Py_ssize_t guess(Polish* w, const Problem* p, const double* z, const double* y,
                       Py_ssize_t* changed) noexcept nogil

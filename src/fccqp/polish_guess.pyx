@@ -33,6 +33,29 @@ cdef void linearize(Polish* w, const Problem* p, Py_ssize_t k, const double* v) 
                    w.hess + o * p.s)
 
 
+cdef Py_ssize_t guess_changes(const Problem* p, const double* z, const double* y,
+                              double* point, char* codes) noexcept nogil:
+    """Classify every constrained entry as :func:`guess` would from
+    ``z, y`` into ``codes`` (``point``: ``s`` scratch) and return how many codes changed:
+    the iteration asks it whether ADMM's active set has settled before it polishes early."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t j, k, o, changed = 0
+    cdef char code
+    for j in range(p.s):
+        point[j] = z[j] + y[j]
+        if not p.in_cone[j]:
+            code = box_code(p, j, point[j])
+            changed += code != codes[j]
+            codes[j] = code
+    for k in range(c.count):
+        o = c.offset[k]
+        code = cone_code(c, k, point + o)
+        for j in range(o, o + c.dim[k]):
+            changed += code != codes[j]
+            codes[j] = code
+    return changed
+
+
 cdef Py_ssize_t guess(Polish* w, const Problem* p, const double* z, const double* y,
                       Py_ssize_t* changed) noexcept nogil:
     """Fill ``active`` from the slack ``z`` and multiplier ``y``, the list ``boundary``
