@@ -34,8 +34,7 @@ from fccqp.engine cimport (DUAL_INFEASIBLE, NOT_CONVEX_QP, NUMERICAL_ERROR, PRIM
                            fccqp_now, measure)
 from fccqp.factorization cimport budget, change_rho, equality_start, factor, reduced_base
 from fccqp.kkt cimport FACTORED, LDL_FULL, NOT_CONVEX, kkt_solve
-from fccqp.polish cimport polish_prepare
-from fccqp.polish_guess cimport guess_changes
+from fccqp.polish cimport guess_changes, polish_prepare
 from fccqp.projections cimport proj_set
 from fccqp.reduced cimport materialize, near_convergence, reduced_start, reduced_step
 from fccqp.rho_rule cimport TrialState, new_rho, trial_reset

@@ -59,4 +59,5 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
                  int* factorizations, const Reduced* table, KKT* kkt,
                  const double* rho_vec, double deadline) noexcept nogil
 cdef bint polish_prepare(Polish* w, const Problem* p) noexcept nogil
-cdef double multiplier_violation(Polish* w, const Problem* p, const double* z) noexcept nogil
+cdef Py_ssize_t guess_changes(const Problem* p, const double* z, const double* y,
+                              double* point, char* codes) noexcept nogil

@@ -51,7 +51,7 @@ Lagrangian there, a boundary block's is ``lam g`` with ``g`` the normal at the f
 ``x_block`` (in the polar cone when ``lam >= 0``; to first order ``lam g(x) = lam g_k +
 lam H x``, so the curvature term of the last step is accounted for and stationarity
 holds to second order), a free entry's is 0. Whether the guess was right is decided by
-the caller, on the user's problem (:func:`multiplier_violation` and the residuals of
+the caller, on the user's problem (:func:`fccqp.polish_guess.multiplier_violation` and the residuals of
 :mod:`fccqp.admm`); nothing here tells a wrong guess from a right one.
 """
 
@@ -61,7 +61,7 @@ from scipy.linalg.cython_lapack cimport dsytrf, dsytrs
 
 from fccqp._dense cimport copy, inf_norm
 from fccqp._types cimport Cones, Iterates, Problem
-from fccqp.cone_dispatch cimport cone_phi, cone_plane, cone_polar_distance
+from fccqp.cone_dispatch cimport cone_phi, cone_plane
 from fccqp.kkt cimport KKT
 from fccqp.matrices cimport CSC, DENSE, product, product_t
 from fccqp.polish_csc cimport polish_csc_factor, polish_csc_solve
@@ -76,6 +76,29 @@ from fccqp.tuning cimport (ACTIVE_TOLERANCE, CHORD_RATE, CHORD_STEPS, GUESS_PASS
 
 cdef extern from "fccqp_clock.h" nogil:
     double fccqp_now()
+
+
+cdef Py_ssize_t guess_changes(const Problem* p, const double* z, const double* y,
+                              double* point, char* codes) noexcept nogil:
+    """Classify every constrained entry as :func:`fccqp.polish_guess.guess` would from
+    ``z, y`` into ``codes`` (``point``: ``s`` scratch) and return how many codes changed:
+    the iteration asks it whether ADMM's active set has settled before it polishes early."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t j, k, o, changed = 0
+    cdef char code
+    for j in range(p.s):
+        point[j] = z[j] + y[j]
+        if not p.in_cone[j]:
+            code = box_code(p, j, point[j])
+            changed += code != codes[j]
+            codes[j] = code
+    for k in range(c.count):
+        o = c.offset[k]
+        code = cone_code(c, k, point + o)
+        for j in range(o, o + c.dim[k]):
+            changed += code != codes[j]
+            codes[j] = code
+    return changed
 
 
 cdef Py_ssize_t _unknowns(Polish* w, const Problem* p) noexcept nogil:
@@ -458,30 +481,3 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     for j in range(s):
         total += w.y[j]
     return isfinite(total)
-
-
-cdef double multiplier_violation(Polish* w, const Problem* p, const double* z) noexcept nogil:
-    """How far the multipliers ``z`` (user's units, one per entry of ``x``) of the
-    polished point are from the normal cone its guess needs: the wrong-signed part of a
-    held box entry's (``z <= 0`` at a lower bound, ``>= 0`` at an upper one, either on
-    ``lo == hi``) and, on held or boundary cone blocks, the distance of ``z_block`` to
-    the polar cone (``-z_block`` must lie in the dual cone). The scaling is constant on a
-    cone block, so the cones are those of the scaled problem."""
-    cdef const Cones* c = &p.cones
-    cdef Py_ssize_t j, k, o, d, start
-    cdef double worst = 0.0
-    cdef char code
-    for j in range(p.s):
-        code = w.active[j]
-        if code == LOWER:
-            worst = max(worst, z[p.constrained[j]])
-        elif code == UPPER:
-            worst = max(worst, -z[p.constrained[j]])
-    for k in range(c.count):
-        o, d = c.offset[k], c.dim[k]
-        if w.active[o] == FREE:
-            continue
-        start = p.constrained[o]
-        worst = max(worst, cone_polar_distance(z + start, c.kind[k], d, c.mu[k],
-                                               c.normal + 3 * k, w.step))
-    return worst

@@ -26,8 +26,6 @@ cdef inline char cone_code(const Cones* c, Py_ssize_t k, const double* v) noexce
     return BOUNDARY
 
 
-cdef Py_ssize_t guess_changes(const Problem* p, const double* z, const double* y,
-                              double* point, char* codes) noexcept nogil
 cdef void linearize(Polish* w, const Problem* p, Py_ssize_t k, const double* v) noexcept nogil
 cdef Py_ssize_t guess(Polish* w, const Problem* p, const double* z, const double* y,
                       Py_ssize_t* changed) noexcept nogil
@@ -37,3 +35,4 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, Py_ssize_t block
                       Py_ssize_t* changed) noexcept nogil
 cdef Py_ssize_t drop_far_side(Polish* w, const Problem* p, Py_ssize_t nb,
                               Py_ssize_t* changed) noexcept nogil
+cdef double multiplier_violation(Polish* w, const Problem* p, const double* z) noexcept nogil
