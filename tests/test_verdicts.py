@@ -251,16 +251,8 @@ def capped_friction_cone(mu: float, gap: float, tilt: float) -> Problem:
                       [FrictionCone(0, mu, tuple(normal))])
 
 
-NO_SPARSE_POLISH = pytest.mark.xfail(
-    strict=True, reason="the polish is off on compressed columns until its compressed-column "
-    "form (branch polishcsc) is merged: the least-distance QP stalls without it")
-
-
-@pytest.mark.parametrize(("backend", "mu", "gap", "tilt"), [
-    pytest.param(backend, *case, marks=NO_SPARSE_POLISH if (backend, case[0]) == ("sparse", 0.3)
-                 else ())
-    for backend in BACKENDS
-    for case in [(0.3, 1e-3, 0.3), (0.8, 1e-4, 0.9)]])
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize(("mu", "gap", "tilt"), [(0.3, 1e-3, 0.3), (0.8, 1e-4, 0.9)])
 def test_an_infeasible_run_that_stalls_is_certified(backend, mu, gap, tilt):
     """Cut at 300 iterations, before the cleaning of ADMM's candidate starts, the run
     stalled at MAX_ITER_REACHED (the fuzzing campaign's 21 infeasible stalls at 836ab4b

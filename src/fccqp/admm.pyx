@@ -152,10 +152,7 @@ cdef class Workspace:
         o.min_iter = settings.min_iter
         o.adaptive_rho_interval, o.scaling = settings.adaptive_rho_interval, settings.scaling
         o.adaptive_rho, o.restore_feasibility = settings.adaptive_rho, settings.restore_feasibility
-        # the polish has no compressed-column form yet (fccqp.polish_csc, branch
-        # polishcsc): off on compressed columns until it lands
-        o.polish = settings.polish and not self.compressed
-        o.polish_refine_iter = settings.polish_refine_iter
+        o.polish, o.polish_refine_iter = settings.polish, settings.polish_refine_iter
         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
         e.prev.exists = e.user.has_matrices = e.fact.certified = e.scaling.done = False
         e.prev.has_rho = False

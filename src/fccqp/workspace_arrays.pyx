@@ -10,12 +10,14 @@ matrices in row-major storage and everything sized by their products: the ``(n +
 m)^2`` LDL' matrix, the Schur factors, the reduced form's table and the restoration's
 columns (``(n + m) x s``), the polish's ``(n + m + s)^2`` matrix and its Schur and
 table forms, the certificate cleaning's ``A A'``; :func:`csc_arrays` the matrices in
-compressed columns and their ``SparseKKT``, and none of the dense-only arrays (their
-pointers stay NULL: the code that reads them does not run on compressed columns; the
-polish, which would, is off there until its compressed-column form lands, see
-:class:`fccqp.admm.Workspace`).
-On large_friction (5002 KKT rows) the dense set was 3.2 GB, the compressed one a
-few MB.
+compressed columns, their ``SparseKKT`` and the polish's compressed-column arrays
+(:func:`fccqp.polish_csc.arrays`), and none of the dense-only arrays (their pointers
+stay NULL: the code that reads them does not run on compressed columns) but for the
+polish's curvature table ``hess`` (``s x s``: a boundary block's at ``hess + offset *
+s``, a layout of :mod:`fccqp.polish` that ``s`` times the largest cone dimension would
+hold).
+On large_friction (5002 KKT rows) the dense set was 3.2 GB, the compressed one 6 MB
+besides ``hess``'s 200 MB.
 """
 
 import numpy as np
@@ -23,6 +25,9 @@ import numpy as np
 from fccqp.engine cimport Engine
 from fccqp.kkt cimport SPARSE_LDL
 from fccqp.matrices cimport csc, dense
+from fccqp.polish_csc cimport bind
+
+from fccqp.polish_csc import arrays as polish_arrays
 
 
 cdef class Arrays:
@@ -181,13 +186,14 @@ cdef object csc_arrays(Arrays a, Engine* e, object patterns, object constrained)
     user's, over private copies of the ``patterns`` ``(P colptr, P rowind, A colptr, A
     rowind)``, and the ``SPARSE_LDL`` backend's :class:`fccqp.sparse_kkt.SparseKKT`
     over the scaled arrays (``constrained``: the intp array of the constrained
-    entries); returns it, for the workspace to own. The dense-only arrays stay NULL
-    (the workspace's Engine starts zeroed)."""
+    entries), and the polish's arrays (:func:`fccqp.polish_csc.arrays`, bound to
+    ``e.pol.csc``); returns the ``SparseKKT``, for the workspace to own. The dense-only
+    arrays stay NULL (the workspace's Engine starts zeroed)."""
     import scipy.sparse as sp
 
     from fccqp.sparse_kkt import SparseKKT
 
-    cdef Py_ssize_t n = e.prob.n, m = e.prob.m
+    cdef Py_ssize_t n = e.prob.n, m = e.prob.m, s = e.prob.s, k
     P_colptr, P_rowind, A_colptr, A_rowind = (np.array(v, dtype=np.intp) for v in patterns)
     cdef Py_ssize_t entries_P = P_colptr[n], entries_A = A_colptr[n]
     cdef Py_ssize_t* pc = _index_copy(a, P_colptr)
@@ -209,4 +215,9 @@ cdef object csc_arrays(Arrays a, Engine* e, object patterns, object constrained)
     kk.sparse = <void*>kkt
     kk.backend = SPARSE_LDL
     e.fact.form = SPARSE_LDL
+    e.pol.hess = a.new(s * s)
+    held = polish_arrays(n, m, P_colptr, P_rowind, A_colptr, A_rowind,
+                         [p.cones.dim[k] for k in range(p.cones.count)])
+    a.kept.append(held)
+    bind(&e.pol.csc, held)
     return kkt
