@@ -13,7 +13,6 @@ role); :meth:`Workspace.solve` validates the numbers, then scales, runs and unsc
 import numpy as np
 
 from fccqp.result import Result
-from fccqp.rho_rule import RhoTrial   # re-exported: the sparse path imports it from here
 from fccqp.status import Status
 
 from cpython.buffer cimport PyBuffer_Release
