@@ -37,6 +37,7 @@ SPARSE_SEEDS = {
     "feasible": (0,),
     "solver_reuse": (38,),
     "extreme_data": (26,),
+    "cvxpy": (7,),
 }
 """Seeds per class run on the sparse path (each ends within a few dozen iterations)."""
 

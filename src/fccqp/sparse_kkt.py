@@ -41,6 +41,13 @@ import scipy.sparse as sp
 
 DELTA = 1e-9
 """Quasi-definite regularization of the (2, 2) block (scaled problem)."""
+BROKEN_DELTA = 1e-6
+"""The regularization of a second factorization when the first met a zero pivot: rows
+that depend on each other, beside a ``P`` flat but for ``sigma`` (1e-6), make ``(A H^-1
+A')`` about 1e6 against ``delta = 1e-9``, and the second row's pivot, ``delta`` times a
+factor of order one, is lost to rounding (the fuzzer's ``cvxpy:7``, a rank-one ``P``:
+a zero pivot, reported as a non-convex QP). Refinement against the unregularized matrix
+removes the larger bias as it removes the smaller one."""
 MAX_REFINE = 5
 """Most refinement steps per solve."""
 REFINE_TOLERANCE = 1e-13
@@ -112,13 +119,15 @@ class SparseKKT:
         self._solver = None
         self.abs_A = abs(A)
         self.penalty = np.zeros(n)   # sigma + rho on each entry of x, set by factor
+        self.delta = DELTA   # the regularization factored, set by factor
 
     def factor(self, sigma: float, rho_vec: np.ndarray) -> int:
         """Factor for the current ``P`` and ``A``, ``sigma`` (on every entry of ``x``)
         and the penalties ``rho_vec`` on the constrained entries; return the number of
         negative pivots.
 
-        Raises :class:`FactorizationError` when ``qdldl`` meets a zero pivot.
+        A zero pivot is retried with ``BROKEN_DELTA``; :class:`FactorizationError` when
+        that meets one too.
         """
         n, upper = self.n, self._upper.shape[0]
         gathered = self._gathered
@@ -129,17 +138,20 @@ class SparseKKT:
         diagonal = K.data[self._diagonal]
         diagonal[:n] += sigma
         diagonal[self.constrained] += rho_vec
-        diagonal[n:] = -DELTA
-        K.data[self._diagonal] = diagonal
         self.abs_A = abs(self.A)
-        try:
-            if self._solver is None:
-                self._solver = self._qdldl.Solver(K, upper=True)
-            else:
-                self._solver.update(K, upper=True)
-        except RuntimeError as exn:   # qdldl's report of a zero pivot
-            self._solver = None
-            raise FactorizationError(str(exn)) from exn
+        for self.delta in (DELTA, BROKEN_DELTA):
+            diagonal[n:] = -self.delta
+            K.data[self._diagonal] = diagonal
+            try:
+                if self._solver is None:
+                    self._solver = self._qdldl.Solver(K, upper=True)
+                else:
+                    self._solver.update(K, upper=True)
+                break
+            except RuntimeError as exn:   # qdldl's report of a zero pivot
+                self._solver = None
+                if self.delta == BROKEN_DELTA:
+                    raise FactorizationError(str(exn)) from exn
         self.penalty = np.full(n, sigma)
         self.penalty[self.constrained] += rho_vec
         _, d, _ = self._solver.factors()
@@ -174,7 +186,7 @@ class SparseKKT:
                 sol = sol - step
                 for _ in range(REGULARIZED_STEPS):
                     sol = sol + self._solver.solve(
-                        self._residual(rhs, sol, self.A @ sol[:n], DELTA))
+                        self._residual(rhs, sol, self.A @ sol[:n], self.delta))
                 return sol
             last_error = error
             if r == MAX_REFINE:
