@@ -111,12 +111,12 @@ def test_arrays_reject_patterns_that_do_not_fit():
     A = sp.csc_matrix(np.ones((2, 3)))
     args = (P.indptr, P.indices, A.indptr, A.indices, [3])
     with pytest.raises(ValueError, match="P_colptr must have n \\+ 1 = 5"):
-        arrays(4, 2, 3, *args)
+        arrays(4, 2, *args)
     with pytest.raises(ValueError, match="A_rowind must hold rows in \\[0, 1\\)"):
-        arrays(3, 1, 3, *args)
+        arrays(3, 1, *args)
     with pytest.raises(ValueError, match="A_rowind must have 6 entries"):
-        arrays(3, 2, 3, P.indptr, P.indices, A.indptr, A.indices[:4], [3])
-    held = arrays(3, 2, 3, *args)
+        arrays(3, 2, P.indptr, P.indices, A.indptr, A.indices[:4], [3])
+    held = arrays(3, 2, *args)
     # capacity: nnz(P) + n + nnz(A) + m + a block's curvature (6), plane (3) and row (1)
     assert held[5].shape == (3 + 3 + 6 + 2 + 10,) and held[4].shape == (3 + 2 + 1 + 1,)
-    assert held[8].shape == (3 * 3,)   # the curvature terms: s x the largest cone
+    assert held[8].shape == (3 * 3,)   # the curvature terms: n x the largest cone

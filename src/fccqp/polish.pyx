@@ -395,7 +395,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     cdef bint feasible = False   # a pass's point violated nothing: from then on, steps
     cdef Py_ssize_t blocking
     cdef double t
-    if p.P.kind == CSC:   # the curvature terms in PolishCSC's storage (s x the largest cone)
+    if p.P.kind == CSC:   # the curvature terms in PolishCSC's storage (n x the largest cone)
         w.hess, w.hess_stride = w.csc.hess, w.csc.hess_stride
     else:
         w.hess_stride = s

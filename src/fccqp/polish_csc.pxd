@@ -15,7 +15,7 @@ cdef struct PolishCSC:
     int* rowind             # capacity
     double* values          # capacity
     double* rhs             # N: the right-hand side handed to qdldl
-    double* hess            # s x hess_stride: the polish's curvature terms (Polish.hess on CSC)
+    double* hess            # n x hess_stride (n >= s): the polish's curvature terms (Polish.hess on CSC)
     Py_ssize_t hess_stride  # the largest cone dimension (at least 1)
     PyObject* factor        # the polish_csc._Factor of these arrays (held by the workspace)
 

@@ -28,8 +28,9 @@ curvature on the block's rows (a block's entries are consecutive unknowns); colu
 twice. :func:`arrays` sizes every array from the patterns of ``P`` and ``A`` and the
 cone blocks, once per structure: a guess allocates nothing beyond what qdldl's
 factorization and solve allocate themselves. It also holds the polish's curvature terms
-(``Polish.hess``) for CSC problems, ``s`` times the largest cone dimension where the
-dense workspace has ``s x s``: ``polish`` points ``Polish.hess`` there.
+(``Polish.hess``) for CSC problems, ``n`` times the largest cone dimension where the
+dense workspace has ``s x s`` (``s <= n`` constrained entries): ``polish`` points
+``Polish.hess`` there.
 """
 
 from cpython.ref cimport PyObject
@@ -77,13 +78,13 @@ cdef class _Factor:
             v[i] = solution[i]
 
 
-def arrays(Py_ssize_t n, Py_ssize_t m, Py_ssize_t s, P_colptr, P_rowind, A_colptr, A_rowind,
-           cone_dim):
+def arrays(Py_ssize_t n, Py_ssize_t m, P_colptr, P_rowind, A_colptr, A_rowind, cone_dim):
     """The arrays of a :c:type:`PolishCSC` for ``P`` (``n x n``, full symmetric pattern)
     and ``A`` (``m x n``) in compressed columns (``*_colptr``, ``*_rowind``: intp, rows
-    ascending in each column), ``s`` constrained entries and cone blocks of dimensions
-    ``cone_dim``; hand the tuple to :func:`bind`. It holds the polish's curvature terms
-    too (``s`` x the largest cone dimension, where the dense workspace has ``s x s``). Raises ``ValueError`` naming the argument that does not
+    ascending in each column) and cone blocks of dimensions ``cone_dim``; hand the tuple
+    to :func:`bind`. It holds the polish's curvature terms too: ``n`` (which bounds the
+    constrained entries ``s``) times the largest cone dimension, where the dense
+    workspace has ``s x s``. Raises ``ValueError`` naming the argument that does not
     fit."""
     P_colptr, P_rowind = np.asarray(P_colptr, np.intp), np.asarray(P_rowind, np.intp)
     A_colptr, A_rowind = np.asarray(A_colptr, np.intp), np.asarray(A_rowind, np.intp)
@@ -115,7 +116,7 @@ def arrays(Py_ssize_t n, Py_ssize_t m, Py_ssize_t s, P_colptr, P_rowind, A_colpt
     stride = max(int(dims.max(initial=1)), 1)
     held = (np.concatenate([row_start, [0]]), np.concatenate([row_col, [0]]),
             np.concatenate([order.astype(np.intp), [0]]), np.full(max(n, 1), -1, np.intp),
-            colptr, rowind, values, rhs, np.zeros(max(s * stride, 1)))
+            colptr, rowind, values, rhs, np.zeros(max(n * stride, 1)))
     return held + (_Factor(colptr, rowind, values, rhs, stride),)
 
 

@@ -98,7 +98,7 @@ def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5):
     w.grad, w.ATnu, w.Ax = a.new(n), a.new(n), a.new(m)
     w.schur.ready = w.schur_only = w.schur_failed = False
     if Ph.M.kind == CSC:
-        held = arrays(n, m, s, np.asarray(Ph.colptr), np.asarray(Ph.rowind),
+        held = arrays(n, m, np.asarray(Ph.colptr), np.asarray(Ph.rowind),
                       np.asarray(Ah.colptr), np.asarray(Ah.rowind), cones.dim)
         bind(&w.csc, held)
     cdef int factorizations = 0
