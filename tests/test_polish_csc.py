@@ -4,7 +4,8 @@ Both polish the same iterate of the same problem (:func:`fccqp.polish_ops.polish
 the dense arm assembles each guess for ``dsytrf``, the CSC arm assembles its upper
 triangle in compressed columns for qdldl. The guesses, and so the final active set, the
 passes and the factorizations, must be the same, and the points the same to rounding
-(both are refined against the unregularized system).
+(both are refined against the unregularized system). Then whole solves on the sparse
+path (``kkt_backend="sparse"``), judged by ``tests/verify.py`` and Clarabel.
 """
 
 import numpy as np
@@ -17,6 +18,10 @@ import fccqp
 from fccqp.cones import flatten_cones
 from problems import random_problem
 from reference import clarabel_solve
+from verify import Problem, Tolerances, check_solution, verify_solution
+
+EXACT = Tolerances(eps_abs=1e-10, eps_rel=1e-10, factor=1.0)
+"""The KKT conditions to 1e-10: what a polished answer meets (as in test_polish.py)."""
 
 
 def _sparse_cost(P, seed):
@@ -119,3 +124,50 @@ def test_arrays_reject_patterns_that_do_not_fit():
     held = arrays(3, 2, *args)
     # capacity: nnz(P) + n + nnz(A) + m + a block's curvature (6), plane (3) and row (1)
     assert held[5].shape == (3 + 3 + 6 + 2 + 10,) and held[4].shape == (3 + 2 + 1 + 1,)
+    assert held[8].shape == (3 * 3,)   # the curvature terms: n x the largest cone
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_sparse_solves_are_polished_as_dense_ones(seed):
+    """The sparse path polishes the cone problems of test_polish.py as ``ldl_full``
+    does: the same iterations, an exact answer, the same point to rounding."""
+    problem = _problem("dense", seed)
+    sparse = fccqp.solve(*problem, kkt_backend="sparse")
+    dense = fccqp.solve(*problem, kkt_backend="ldl_full")
+    assert sparse.backend == "sparse" and sparse.polished and dense.polished
+    assert sparse.status is dense.status is fccqp.Status.SOLVED
+    assert sparse.iterations == dense.iterations
+    verify_solution(problem, sparse)
+    assert check_solution(Problem.of(*problem), sparse, EXACT).passed
+    assert _close(sparse.x, dense.x, 1e-10)
+
+
+def _mpc(horizon, seed=0):
+    """A linear MPC (12 states, 4 inputs in [-0.3, 0.3], states in [-5, 5]) in sparse
+    form, as tools/sparse_speed.py's."""
+    rng = np.random.default_rng(seed)
+    states, inputs = 12, 4
+    Ad = rng.standard_normal((states, states))
+    Ad *= 0.98 / max(abs(np.linalg.eigvals(Ad)))
+    Bd = rng.standard_normal((states, inputs))
+    nx, nu = states * (horizon + 1), inputs * horizon
+    P = sp.block_diag([sp.eye(nx), 0.1 * sp.eye(nu)], format="csc")
+    dynamics = sp.hstack([sp.kron(sp.eye(horizon, horizon + 1), Ad)
+                          - sp.kron(sp.eye(horizon, horizon + 1, k=1), sp.eye(states)),
+                          sp.kron(sp.eye(horizon), Bd)])
+    start = sp.hstack([sp.eye(states, nx), sp.csr_matrix((states, nu))])
+    A = sp.vstack([start, dynamics], format="csc")
+    b = np.concatenate([rng.uniform(-3.0, 3.0, states), np.zeros(states * horizon)])
+    lb = np.concatenate([np.full(nx, -5.0), np.full(nu, -0.3)])
+    return P, np.zeros(nx + nu), A, b, lb, -lb, []
+
+
+def test_sparse_solve_of_an_mpc_is_polished_to_the_optimum():
+    problem = P, q, A, b, lb, ub, cones = _mpc(horizon=40)
+    result = fccqp.solve(*problem, kkt_backend="sparse")
+    assert result.status is fccqp.Status.SOLVED and result.polished
+    dense = (P.toarray(), q, A.toarray(), b, lb, ub, cones)
+    verify_solution(dense, result)
+    assert check_solution(Problem.of(*dense), result, EXACT).passed
+    reference = clarabel_solve(*dense, tol=1e-12)
+    assert abs(result.obj - reference.obj) <= 1e-10 * abs(reference.obj)

@@ -21,7 +21,8 @@ cdef struct Polish:
     Py_ssize_t* free        # n: the entries that are unknowns, ascending
     Py_ssize_t* boundary    # s: the cone blocks on their boundary
     double* g               # s: unit normal of each boundary block's tangent plane
-    double* hess            # s x s: a boundary block's curvature term at hess + offset * s
+    double* hess            # a boundary block's curvature term (d x d) at hess + offset * hess_stride
+    Py_ssize_t hess_stride  # s (hess is s x s) on dense storage; on CSC, polish points hess at PolishCSC's
     double* K               # N x N, Fortran order; the factor after dsytrf (dense P and A)
     int* ipiv               # N
     PolishSchur schur       # the Schur-complement solve where P's structure allows it

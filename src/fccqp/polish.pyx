@@ -149,7 +149,7 @@ cdef void _assemble(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) n
         for j in range(d):
             K[nf + m + k + w.index[start + j] * N] = w.g[o + j]
             for i in range(j, d):   # entries of a block are consecutive unknowns
-                K[w.index[start + i] + w.index[start + j] * N] += w.hess[o * p.s + i * d + j]
+                K[w.index[start + i] + w.index[start + j] * N] += w.hess[o * w.hess_stride + i * d + j]
     for r in range(nf, N):
         K[r + r * N] = -POLISH_DELTA
 
@@ -176,7 +176,7 @@ cdef double _residual(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb)
         for j in range(d):
             curved = 0.0
             for i in range(d):
-                curved += w.hess[o * p.s + j * d + i] * w.x[start + i]
+                curved += w.hess[o * w.hess_stride + j * d + i] * w.x[start + i]
             w.rhs[w.index[start + j]] -= w.lam[k] * w.g[o + j] + curved
             value += w.g[o + j] * w.x[start + j]
         w.rhs[nf + m + k] = -value
@@ -291,7 +291,7 @@ cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t n
         w.schur_failed = True
         return False
     if p.P.kind == CSC:
-        if not polish_csc_factor(&w.csc, p, nf, w.free, w.index, w.boundary, nb, w.g, w.hess,
+        if not polish_csc_factor(&w.csc, p, nf, w.free, w.index, w.boundary, nb, w.g,
                                  POLISH_DELTA):
             return False
     else:
@@ -395,6 +395,10 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     cdef bint feasible = False   # a pass's point violated nothing: from then on, steps
     cdef Py_ssize_t blocking
     cdef double t
+    if p.P.kind == CSC:   # the curvature terms in PolishCSC's storage (n x the largest cone)
+        w.hess, w.hess_stride = w.csc.hess, w.csc.hess_stride
+    else:
+        w.hess_stride = s
     copy(it.x, w.x, n)
     copy(it.nu, w.nu, m)
     copy(it.y, w.y, s)

@@ -15,11 +15,13 @@ cdef struct PolishCSC:
     int* rowind             # capacity
     double* values          # capacity
     double* rhs             # N: the right-hand side handed to qdldl
+    double* hess            # n x hess_stride (n >= s): the polish's curvature terms (Polish.hess on CSC)
+    Py_ssize_t hess_stride  # the largest cone dimension (at least 1)
     PyObject* factor        # the polish_csc._Factor of these arrays (held by the workspace)
 
 cdef bint polish_csc_factor(PolishCSC* f, const Problem* p, Py_ssize_t nf,
                             const Py_ssize_t* free, const Py_ssize_t* index,
                             const Py_ssize_t* boundary, Py_ssize_t nb, const double* g,
-                            const double* hess, double delta) noexcept nogil
+                            double delta) noexcept nogil
 cdef void polish_csc_solve(PolishCSC* f, Py_ssize_t size, double* v) noexcept nogil
 cdef void bind(PolishCSC* f, tuple arrays) except *

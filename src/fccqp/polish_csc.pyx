@@ -27,7 +27,10 @@ curvature on the block's rows (a block's entries are consecutive unknowns); colu
 ``k``'s plane on its entries, then ``-delta``. Rows ascend in every column, no entry
 twice. :func:`arrays` sizes every array from the patterns of ``P`` and ``A`` and the
 cone blocks, once per structure: a guess allocates nothing beyond what qdldl's
-factorization and solve allocate themselves.
+factorization and solve allocate themselves. It also holds the polish's curvature terms
+(``Polish.hess``) for CSC problems, ``n`` times the largest cone dimension where the
+dense workspace has ``s x s`` (``s <= n`` constrained entries): ``polish`` points
+``Polish.hess`` there.
 """
 
 from cpython.ref cimport PyObject
@@ -40,16 +43,18 @@ from fccqp.matrices cimport Matrix
 
 cdef class _Factor:
     """The assembled matrix as qdldl reads a ``scipy.sparse`` matrix (``data``,
-    ``indices``, ``indptr``, ``shape``, ``nnz`` over :func:`arrays`' arrays, no copy) and
-    the qdldl factorization of it (``None`` after a zero pivot)."""
+    ``indices``, ``indptr``, ``shape``, ``nnz`` over :func:`arrays`' arrays, no copy),
+    the qdldl factorization of it (``None`` after a zero pivot) and the stride of the
+    curvature terms' storage."""
 
     cdef readonly object data, indices, indptr, shape
-    cdef readonly Py_ssize_t nnz
+    cdef readonly Py_ssize_t nnz, hess_stride
     cdef object _colptr, _rhs, _solver, _solver_class
 
-    def __init__(self, colptr, rowind, values, rhs):
+    def __init__(self, colptr, rowind, values, rhs, Py_ssize_t hess_stride):
         import qdldl
         self._solver_class = qdldl.Solver
+        self.hess_stride = hess_stride
         self._colptr, self.indices, self.data, self._rhs = colptr, rowind, values, rhs
         self.indptr, self.shape, self.nnz, self._solver = colptr[:1], (0, 0), 0, None
 
@@ -76,8 +81,10 @@ cdef class _Factor:
 def arrays(Py_ssize_t n, Py_ssize_t m, P_colptr, P_rowind, A_colptr, A_rowind, cone_dim):
     """The arrays of a :c:type:`PolishCSC` for ``P`` (``n x n``, full symmetric pattern)
     and ``A`` (``m x n``) in compressed columns (``*_colptr``, ``*_rowind``: intp, rows
-    ascending in each column) and cone blocks of dimensions ``cone_dim``; hand the
-    tuple to :func:`bind`. Raises ``ValueError`` naming the argument that does not
+    ascending in each column) and cone blocks of dimensions ``cone_dim``; hand the tuple
+    to :func:`bind`. It holds the polish's curvature terms too: ``n`` (which bounds the
+    constrained entries ``s``) times the largest cone dimension, where the dense
+    workspace has ``s x s``. Raises ``ValueError`` naming the argument that does not
     fit."""
     P_colptr, P_rowind = np.asarray(P_colptr, np.intp), np.asarray(P_rowind, np.intp)
     A_colptr, A_rowind = np.asarray(A_colptr, np.intp), np.asarray(A_rowind, np.intp)
@@ -106,10 +113,11 @@ def arrays(Py_ssize_t n, Py_ssize_t m, P_colptr, P_rowind, A_colptr, A_rowind, c
     rowind = np.zeros(max(capacity, 1), np.int32)
     values = np.zeros(max(capacity, 1))
     rhs = np.zeros(max(size, 1))
+    stride = max(int(dims.max(initial=1)), 1)
     held = (np.concatenate([row_start, [0]]), np.concatenate([row_col, [0]]),
             np.concatenate([order.astype(np.intp), [0]]), np.full(max(n, 1), -1, np.intp),
-            colptr, rowind, values, rhs)
-    return held + (_Factor(colptr, rowind, values, rhs),)
+            colptr, rowind, values, rhs, np.zeros(max(n * stride, 1)))
+    return held + (_Factor(colptr, rowind, values, rhs, stride),)
 
 
 cdef void bind(PolishCSC* f, tuple arrays) except *:
@@ -117,11 +125,12 @@ cdef void bind(PolishCSC* f, tuple arrays) except *:
     cdef Py_ssize_t[::1] row_start = arrays[0], row_col = arrays[1], row_entry = arrays[2]
     cdef Py_ssize_t[::1] block_of = arrays[3]
     cdef int[::1] colptr = arrays[4], rowind = arrays[5]
-    cdef double[::1] values = arrays[6], rhs = arrays[7]
+    cdef double[::1] values = arrays[6], rhs = arrays[7], hess = arrays[8]
     f.row_start, f.row_col, f.row_entry = &row_start[0], &row_col[0], &row_entry[0]
     f.block_of, f.colptr, f.rowind = &block_of[0], &colptr[0], &rowind[0]
-    f.values, f.rhs = &values[0], &rhs[0]
-    f.factor = <PyObject*>arrays[8]
+    f.values, f.rhs, f.hess = &values[0], &rhs[0], &hess[0]
+    f.hess_stride = (<_Factor>arrays[9]).hess_stride
+    f.factor = <PyObject*>arrays[9]
 
 
 cdef inline Py_ssize_t _push(PolishCSC* f, Py_ssize_t t, Py_ssize_t row,
@@ -133,7 +142,7 @@ cdef inline Py_ssize_t _push(PolishCSC* f, Py_ssize_t t, Py_ssize_t row,
 
 cdef Py_ssize_t _free_column(PolishCSC* f, const Problem* p, Py_ssize_t col, Py_ssize_t jc,
                              const Py_ssize_t* index, const Py_ssize_t* boundary,
-                             const double* hess, double delta, Py_ssize_t t) noexcept nogil:
+                             double delta, Py_ssize_t t) noexcept nogil:
     """Column ``col`` (free entry ``jc`` of ``x``) of the upper triangle from entry ``t``
     on: ``P``'s free rows above the diagonal, then the diagonal with ``delta`` or, in a
     boundary block, the block's rows with its curvature (added as ``_assemble`` adds
@@ -162,14 +171,14 @@ cdef Py_ssize_t _free_column(PolishCSC* f, const Problem* p, Py_ssize_t col, Py_
             k += 1
         if ii == jj:
             value += delta
-        t = _push(f, t, index[i], value + hess[o * p.s + jj * d + ii])
+        t = _push(f, t, index[i], value + f.hess[o * f.hess_stride + jj * d + ii])
     return t
 
 
 cdef void _assemble_csc(PolishCSC* f, const Problem* p, Py_ssize_t nf,
                         const Py_ssize_t* free, const Py_ssize_t* index,
                         const Py_ssize_t* boundary, Py_ssize_t nb, const double* g,
-                        const double* hess, double delta) noexcept nogil:
+                        double delta) noexcept nogil:
     """The upper triangle of the guess's regularized KKT matrix into ``colptr``,
     ``rowind``, ``values`` (see the module's docstring)."""
     cdef Py_ssize_t m = p.m, col, i, j, k, o, d, start, t = 0
@@ -180,7 +189,7 @@ cdef void _assemble_csc(PolishCSC* f, const Problem* p, Py_ssize_t nf,
             f.block_of[start + j] = k
     for col in range(nf):
         f.colptr[col] = <int>t
-        t = _free_column(f, p, col, free[col], index, boundary, hess, delta, t)
+        t = _free_column(f, p, col, free[col], index, boundary, delta, t)
     for i in range(m):
         f.colptr[nf + i] = <int>t
         for k in range(f.row_start[i], f.row_start[i + 1]):
@@ -201,12 +210,12 @@ cdef void _assemble_csc(PolishCSC* f, const Problem* p, Py_ssize_t nf,
 cdef bint polish_csc_factor(PolishCSC* f, const Problem* p, Py_ssize_t nf,
                             const Py_ssize_t* free, const Py_ssize_t* index,
                             const Py_ssize_t* boundary, Py_ssize_t nb, const double* g,
-                            const double* hess, double delta) noexcept nogil:
+                            double delta) noexcept nogil:
     """Assemble and factor the regularized KKT matrix of the guess (free entries
     ``free[:nf]`` numbered by ``index``, boundary blocks ``boundary[:nb]`` with planes
-    ``g`` and curvature ``hess`` as in :c:type:`fccqp.polish.Polish`); False when qdldl
+    ``g`` as in :c:type:`fccqp.polish.Polish`, curvature in ``f.hess``); False when qdldl
     meets a zero pivot."""
-    _assemble_csc(f, p, nf, free, index, boundary, nb, g, hess, delta)
+    _assemble_csc(f, p, nf, free, index, boundary, nb, g, delta)
     with gil:
         return (<_Factor>f.factor).factor(nf + p.m + nb)
 

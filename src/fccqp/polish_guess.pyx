@@ -32,7 +32,7 @@ cdef void linearize(Polish* w, const Problem* p, Py_ssize_t k, const double* v) 
     cdef double phi
     cone_plane(v, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, w.g + o, &phi)
     cone_curvature(v, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, w.lam[k],
-                   w.hess + o * p.s)
+                   w.hess + o * w.hess_stride)
 
 
 cdef Py_ssize_t guess(Polish* w, const Problem* p, const double* z, const double* y,

@@ -11,13 +11,10 @@ m)^2`` LDL' matrix, the Schur factors, the reduced form's table and the restorat
 columns (``(n + m) x s``), the polish's ``(n + m + s)^2`` matrix and its Schur and
 table forms, the certificate cleaning's ``A A'``; :func:`csc_arrays` the matrices in
 compressed columns, their ``SparseKKT`` and the polish's compressed-column arrays
-(:func:`fccqp.polish_csc.arrays`), and none of the dense-only arrays (their pointers
-stay NULL: the code that reads them does not run on compressed columns) but for the
-polish's curvature table ``hess`` (``s x s``: a boundary block's at ``hess + offset *
-s``, a layout of :mod:`fccqp.polish` that ``s`` times the largest cone dimension would
-hold).
-On large_friction (5002 KKT rows) the dense set was 3.2 GB, the compressed one 8 MB
-besides ``hess``'s 200 MB.
+(:func:`fccqp.polish_csc.arrays`, its curvature terms included), and none of the
+dense-only arrays (their pointers stay NULL: the code that reads them does not run on
+compressed columns).
+On large_friction (5002 KKT rows) the dense set was 3.2 GB, the compressed one 8 MB.
 """
 
 import numpy as np
@@ -193,7 +190,7 @@ cdef object csc_arrays(Arrays a, Engine* e, object patterns, object constrained)
 
     from fccqp.sparse_kkt import SparseKKT
 
-    cdef Py_ssize_t n = e.prob.n, m = e.prob.m, s = e.prob.s, k
+    cdef Py_ssize_t n = e.prob.n, m = e.prob.m, k
     P_colptr, P_rowind, A_colptr, A_rowind = (np.array(v, dtype=np.intp) for v in patterns)
     cdef Py_ssize_t entries_P = P_colptr[n], entries_A = A_colptr[n]
     cdef Py_ssize_t* pc = _index_copy(a, P_colptr)
@@ -215,7 +212,6 @@ cdef object csc_arrays(Arrays a, Engine* e, object patterns, object constrained)
     kk.sparse = <void*>kkt
     kk.backend = SPARSE_LDL
     e.fact.form = SPARSE_LDL
-    e.pol.hess = a.new(s * s)
     held = polish_arrays(n, m, P_colptr, P_rowind, A_colptr, A_rowind,
                          [p.cones.dim[k] for k in range(p.cones.count)])
     a.kept.append(held)
