@@ -13,7 +13,7 @@ from fccqp import Status, schur
 from problems import random_problem
 from reference import clarabel_solve
 
-BACKENDS = ("schur_reduced", "ldl_reduced", "ldl_full")
+BACKENDS = ("schur_reduced", "ldl_reduced", "ldl_full", "sparse")
 
 
 def test_ordering_puts_constrained_entries_last():

@@ -38,6 +38,7 @@ SPARSE_SEEDS = {
     "feasible": (0,),
     "solver_reuse": (38,),
     "extreme_data": (26,),
+    "cvxpy": (7,),
 }
 """Seeds per class run on the sparse path (each ends within a few dozen iterations)."""
 
@@ -48,8 +49,6 @@ OPEN = {
     "only auto solves it again in the other form",
     "solver_reuse:100206": "new rows through a kept workspace stall in every form warm; "
     "only auto solves it again, cold, in the other form",
-    "solver_reuse:38": "the sparse path's first factorization breaks down on dependent rows",
-    "extreme_data:26": "the sparse path's dual certificate hides A dx under large rows",
 }
 """Reproducers of mechanisms still open (issue 26), each the reason it fails: expected
 to fail (strictly) on the backends where it does, so that a fix turns them red."""

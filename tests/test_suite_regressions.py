@@ -65,9 +65,8 @@ def test_a_persistent_rho_imbalance_within_the_tolerance_moves_rho(backend):
     """fixed_entries[15]: OSQP's rule asks, update after update, for rho about 3.6x
     larger, less than ``adaptive_rho_tolerance`` (5), and rho stayed 0.1 for the 210
     iterations of the run. A move that persists while the residuals do not halve is
-    tried (``tuning.RHO_PERSISTENCE``, the sparse path too, through ``admm.RhoTrial``): the
-    run ends at a rho that only such a move reaches, in 110 iterations (sparse: 145),
-    with the answer of the rule alone."""
+    tried (``tuning.RHO_PERSISTENCE``, on either storage): the run ends at a rho that
+    only such a move reaches, with the answer of the rule alone."""
     problem = build("fixed_entries", 15).problem
     settings = fccqp.Settings(**EPS, kkt_backend=backend)
     result = fccqp.solve(*problem.args(), settings)

@@ -20,15 +20,8 @@ from fccqp import FrictionCone, SecondOrderCone, Status
 from reference import clarabel_solve
 from verify import Problem, check_solution, verify_solution
 
-SPARSE_DRIFT = pytest.mark.xfail(
-    strict=True, reason="the sparse path re-implements the algorithm in Python and has "
-    "drifted from it; it must pass once it is a backend of the one compiled algorithm")
-
-
-def backends(sparse_fails: bool) -> list:
-    """Every ``kkt_backend``, the sparse path marked as expected to fail where it does."""
-    sparse = pytest.param("sparse", marks=SPARSE_DRIFT) if sparse_fails else "sparse"
-    return ["auto", "schur_reduced", "ldl_reduced", "ldl_full", sparse]
+BACKENDS = ["auto", "schur_reduced", "ldl_reduced", "ldl_full", "sparse"]
+"""Every ``kkt_backend``."""
 
 
 def solve_verified(problem: Problem, **settings) -> fccqp.Result:
@@ -60,7 +53,7 @@ def rotated(problem: Problem, seed: int = 1) -> Problem:
     return Problem.of(Q @ problem.P @ Q.T, Q @ problem.q, problem.A @ Q.T, problem.b)
 
 
-@pytest.mark.parametrize("backend", backends(sparse_fails=True))
+@pytest.mark.parametrize("backend", BACKENDS)
 def test_a_free_direction_without_curvature_is_certified_unbounded(backend):
     """The ray is large in a coordinate-aligned null space of ``P`` and the rest of the
     step small: a ``P dx ~ 0`` test relative to the terms of ``P dx`` compared that
@@ -71,7 +64,7 @@ def test_a_free_direction_without_curvature_is_certified_unbounded(backend):
     assert clarabel_solve(*problem.args()).status == "dual_infeasible"
 
 
-@pytest.mark.parametrize("backend", backends(sparse_fails=True))
+@pytest.mark.parametrize("backend", BACKENDS)
 def test_a_free_direction_whose_descent_is_below_the_tolerances_is_unbounded(backend):
     """The same free entry with a cost of -4e-8: its dual residual passes the absolute
     tolerance at any point, and SOLVED was claimed (fuzz extreme_data:500064, a free
@@ -86,7 +79,7 @@ def test_a_free_direction_whose_descent_is_below_the_tolerances_is_unbounded(bac
     assert np.abs(ray[:-1]).max() < 1e-12 and ray[-1] == 1.0
 
 
-@pytest.mark.parametrize("backend", backends(sparse_fails=False))
+@pytest.mark.parametrize("backend", BACKENDS)
 def test_a_ray_along_a_rotated_null_direction_is_certified_unbounded(backend):
     problem = rotated(free_direction_without_curvature())
     result = solve_verified(problem, kkt_backend=backend)
@@ -148,7 +141,7 @@ def test_two_cones_pinned_outside_their_sum_beside_a_boxed_row_are_certified(mu,
     assert clarabel_solve(*problem.args()).status == "primal_infeasible"
 
 
-@pytest.mark.parametrize("backend", backends(sparse_fails=True))
+@pytest.mark.parametrize("backend", BACKENDS)
 def test_rows_just_outside_a_friction_cone_are_certified_on_every_backend(backend):
     A = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
     problem = Problem.of(np.eye(3), np.array([0.1, -0.2, 0.3]), A, np.array([1.0, 0.7007]),
@@ -173,7 +166,7 @@ def dependent_rows_with_rounding_noise(seed: int) -> Problem:
     return Problem.of(P, q, A, b, np.zeros(n), ub)
 
 
-@pytest.mark.parametrize("backend", backends(sparse_fails=False))
+@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("seed", range(4))
 def test_rounding_noise_on_dependent_rows_is_not_called_infeasible(seed, backend):
     """A public QP (QSCORPIO, Maros-Meszaros) has such rows: the equality certificate,
@@ -223,7 +216,7 @@ def test_equalities_of_tiny_rows_hold(scale, scaling):
     assert max(misses) < 1e-9
 
 
-@pytest.mark.parametrize("backend", backends(sparse_fails=True))
+@pytest.mark.parametrize("backend", BACKENDS)
 def test_equalities_of_tiny_rows_hold_on_every_backend(backend):
     rng = np.random.default_rng(0)
     M = rng.standard_normal((6, 6))
@@ -273,7 +266,7 @@ def capped_friction_cone(mu: float, gap: float, tilt: float) -> Problem:
                       [FrictionCone(0, mu, tuple(normal))])
 
 
-@pytest.mark.parametrize("backend", backends(sparse_fails=True))
+@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize(("mu", "gap", "tilt"), [(0.3, 1e-3, 0.3), (0.8, 1e-4, 0.9)])
 def test_an_infeasible_run_that_stalls_is_certified(backend, mu, gap, tilt):
     """Cut at 300 iterations, before the cleaning of ADMM's candidate starts, the run

@@ -13,7 +13,8 @@ from fccqp.engine cimport (INACCURATE, RUNNING, SOLVED, Engine, Options, Run, en
                            fccqp_now, measure)
 from fccqp.kkt cimport kkt_solve
 from fccqp.matrices cimport abs_product, product, product_t
-from fccqp.polish cimport multiplier_violation, polish
+from fccqp.polish cimport polish
+from fccqp.polish_guess cimport multiplier_violation
 from fccqp.projections cimport proj_block, proj_set
 from fccqp.restoration cimport restore
 from fccqp.scaling cimport unscale
@@ -40,7 +41,7 @@ cdef bint _try_polished(Engine* e, int* status, long iteration, double start_tim
 
     The polished point is accepted only when, in the user's units, it is primal
     feasible within the tolerance (box and exact cones), its multipliers lie in the
-    normal cones its active set needs (:func:`fccqp.polish.multiplier_violation`,
+    normal cones its active set needs (:func:`fccqp.polish_guess.multiplier_violation`,
     within ``POLISH_EXACT`` of the dual tolerance), it keeps ``A x = b`` at
     factorization accuracy (``EQUALITY_SLACK``, ``EQUALITY_EXACT``) and its primal
     and dual residuals and gap are each no worse than the ADMM point's (or below

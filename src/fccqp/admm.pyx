@@ -13,7 +13,6 @@ role); :meth:`Workspace.solve` validates the numbers, then scales, runs and unsc
 import numpy as np
 
 from fccqp.result import Result
-from fccqp.rho_rule import RhoTrial   # re-exported: the sparse path imports it from here
 from fccqp.status import Status
 
 from cpython.buffer cimport PyBuffer_Release
@@ -27,14 +26,15 @@ from fccqp.blas_threads cimport enter, leave
 from fccqp.certificates cimport CERTIFIED, primal_candidate
 from fccqp.engine cimport CONE_ENTRY, Engine, Run, fccqp_now
 from fccqp.fast_checks cimport hold_dense, hold_float64
-from fccqp.kkt cimport AUTO, LDL_FULL, LDL_REDUCED, SCHUR_REDUCED
-from fccqp.matrices cimport dense
+from fccqp.kkt cimport AUTO, LDL_FULL, LDL_REDUCED, SCHUR_REDUCED, SPARSE_LDL
+from fccqp.matrices cimport Matrix, csc
 from fccqp.scaled_run cimport scaled_run, unscaled_answer
 from fccqp.termination cimport Residuals
 from fccqp.tuning cimport FIXED_RHO_SCALE, RESERVE_DECAY, RESTART_MIN_ITER
-from fccqp.validation cimport (BOUNDED, FIXED_BOUND, SCAN_OK, UNBOUNDED, Finding, bound_kind,
-                               scan_and_copy)
+from fccqp.validation cimport (BOUNDED, FIXED_BOUND, NEW_PATTERN, SCAN_OK, UNBOUNDED, Finding,
+                               bound_kind, scan_and_copy, scan_and_copy_csc)
 from fccqp.verdict cimport unbounded
+from fccqp.workspace_arrays cimport Arrays, common_arrays, csc_arrays, dense_arrays
 
 # Run codes, mapped to fccqp.Status in fccqp.solver (one table).
 SOLVED, SOLVED_INACCURATE = engine.SOLVED, engine.INACCURATE
@@ -47,7 +47,8 @@ BAD_DATA = engine.BAD_NUMBERS
 """The validation scan found bad numbers (see ``Workspace.finding``)."""
 STRUCTURE_CHANGED = engine.NEW_STRUCTURE
 """The bounds no longer have the structure the workspace was made for (another set of
-constrained or fixed entries, or a bound on a cone entry): the caller rescans them
+constrained or fixed entries, or a bound on a cone entry), or compressed-column ``P``
+and ``A`` another pattern: the caller rescans them
 (:func:`fccqp.validation.structure_scan`) and makes a new workspace."""
 NOT_DENSE = -4
 """An input array is not a C-contiguous float64 numpy array of the workspace's shape
@@ -64,7 +65,7 @@ STATUS_BY_CODE = {
 """The run codes as statuses: the only place they meet."""
 
 BACKENDS = {"schur_reduced": SCHUR_REDUCED, "ldl_reduced": LDL_REDUCED, "ldl_full": LDL_FULL,
-            "auto": AUTO}
+            "auto": AUTO, "sparse": SPARSE_LDL}
 """``Settings.kkt_backend`` names and their codes (see :mod:`fccqp.kkt`)."""
 BACKEND_NAMES = {code: name for name, code in BACKENDS.items()}
 
@@ -78,21 +79,28 @@ cdef class Workspace:
     reuse), their scaling and factorization, and the last solution (for a warm start).
     """
 
-    cdef list _arrays
+    cdef Arrays _arrays
     cdef Engine e
     cdef Finding found
     cdef object _keep
+    cdef object _sparse_kkt   # SPARSE_LDL's SparseKKT, which e.fact.kkt.sparse points to
+    cdef readonly bint compressed
+    """``P`` and ``A`` are held in compressed columns (the sparse backend)."""
 
     def __init__(self, Py_ssize_t n, Py_ssize_t m, constrained, cones, fixed, order,
-                 settings, Py_ssize_t log_rows):
+                 settings, Py_ssize_t log_rows, patterns=None):
         """Allocate for ``n`` variables, ``m`` rows, the ``constrained`` entries (intp,
         ascending), ``cones`` (the tuple of :class:`fccqp.cones.ConeArrays` with offsets
         into ``constrained``), the boolean mask ``fixed`` of constrained entries with
-        ``lb == ub``, the Schur ``order`` and a :class:`fccqp.Settings`."""
-        cdef Py_ssize_t s = len(constrained), N = n + m, memory = settings.anderson_memory
+        ``lb == ub``, the Schur ``order`` and a :class:`fccqp.Settings`. With
+        ``patterns``, ``(P colptr, P rowind, A colptr, A rowind)``, ``P`` (its full
+        symmetric pattern) and ``A`` are held in compressed columns and factored by
+        ``SPARSE_LDL`` (``order`` is then unused); :meth:`solve` takes their values."""
+        cdef Py_ssize_t s = len(constrained)
         cdef Py_ssize_t k, j
         cdef Engine* e = &self.e
-        self._arrays = []
+        self._arrays = Arrays()
+        self.compressed = patterns is not None
         kind, offset, dim, mu, normal = cones
         # private copies: update_cones writes into them, and the caller's arrays may be
         # shared (fccqp.cones memoizes one ConeArrays per distinct set of cones)
@@ -102,7 +110,7 @@ cdef class Workspace:
                       np.array(dim, dtype=np.intp),
                       np.array(mu, dtype=np.float64),
                       np.array(normal, dtype=np.float64).reshape(-1),
-                      np.array(order, dtype=np.intp),
+                      np.array(order if order is not None else (0,), dtype=np.intp),
                       np.zeros(max(len(kind), 1), dtype=np.intp))
         cdef Py_ssize_t[::1] c_view = self._keep[0], kind_v = self._keep[1]
         cdef Py_ssize_t[::1] offset_v = self._keep[2], dim_v = self._keep[3]
@@ -118,109 +126,21 @@ cdef class Workspace:
             for k in range(p.cones.count):
                 start_v[k] = c_view[offset_v[k]]
         e.user.block_start = &start_v[0]
-        cdef char* in_cone = <char*>self._new(s)
+        cdef char* in_cone = <char*>self._arrays.new(s)
         for k in range(p.cones.count):
             for j in range(offset_v[k], offset_v[k] + dim_v[k]):
                 in_cone[j] = 1
         p.in_cone = in_cone
-        p.P, p.A = dense(self._new(n * n), n, n), dense(self._new(m * n), m, n)
-        p.q, p.b = self._new(n), self._new(m)
-        p.lo, p.hi, p.D, p.E = self._new(s), self._new(s), self._new(n), self._new(m)
-        p.span = self._new(m)
-        p.c = 1.0
-        u = &e.user
-        u.P, u.A = dense(self._new(n * n), n, n), dense(self._new(m * n), m, n)
-        u.q, u.b = self._new(n), self._new(m)
-        u.lb, u.ub = self._new(n), self._new(n)
-        e.fact.rho_scale = self._new(s)
+        common_arrays(self._arrays, e, settings.anderson_memory, log_rows)
+        if self.compressed:
+            self._sparse_kkt = csc_arrays(self._arrays, e, patterns, self._keep[0])
+        else:
+            dense_arrays(self._arrays, e, &order_v[0])
         for k in range(s):
             e.fact.rho_scale[k] = FIXED_RHO_SCALE if fixed[k] else 1.0
-        u.entry_kind = <char*>self._new(n)
-        for k in range(s):
-            u.entry_kind[c_view[k]] = (CONE_ENTRY if in_cone[k] else
-                                       FIXED_BOUND if fixed[k] else BOUNDED)
-        e.scaling.d, e.scaling.e = self._new(n), self._new(m)
-        e.scaling.reference, e.scaling.norms = self._new(N), self._new(N)
-        it = &e.it
-        it.x, it.nu, it.z, it.y = self._new(n), self._new(m), self._new(s), self._new(s)
-        it.x_prev, it.nu_prev = self._new(n), self._new(m)
-        it.z_prev, it.y_prev = self._new(s), self._new(s)
-        it.relaxed, it.rho_vec = self._new(s), self._new(s)
-        w = &e.work
-        w.rhs, w.sol = self._new(N), self._new(N)
-        cdef Py_ssize_t wide = max(n, m)
-        w.vec_n, w.vec_n2, w.vec_n3 = self._new(wide), self._new(wide), self._new(wide)
-        w.vec_s, w.vec_s2, w.vec_m = self._new(s), self._new(s), self._new(m)
-        w.vec_m2 = self._new(m)
-        e.certs.gram = self._new(m * m)
-        w.guess_point, w.guess_codes = self._new(s), <char*>self._new(s)
-        e.certs.direction, w.saved, e.certs.cert = self._new(n), self._new(N + s), self._new(N)
-        e.prev.x, e.prev.y, e.prev.z = self._new(n), self._new(m), self._new(n)
-        kk = &e.fact.kkt
-        kk.ldl.N = <int>N
-        kk.ldl.K = self._new(N * N)
-        kk.ldl.ipiv = <int*>self._new_int(N)
-        kk.ldl.lwork = <int>(64 * N)
-        kk.ldl.work, kk.ldl.residual = self._new(64 * N), self._new(N)
-        kk.ldl.Ax, kk.ldl.ATnu = self._new(m), self._new(n)
-        kk.schur.n, kk.schur.m = <int>n, <int>m
-        kk.schur.L, kk.schur.LS, kk.schur.Y = self._new(n * n), self._new(m * m), self._new(n * m)
-        kk.schur.G, kk.schur.free_ready = self._new(m * m), False
-        kk.schur.base_order = &order_v[0]
-        kk.schur.order = <Py_ssize_t*>self._new_int(n)
-        kk.schur.coupled = <char*>self._new(n)
-        kk.schur.dense = <int>n
-        kk.schur.perm, kk.schur.dx, kk.schur.r = self._new(n), self._new(n), self._new(n)
-        kk.schur.ATnu, kk.schur.dnu, kk.schur.Ax = self._new(n), self._new(m), self._new(m)
-        kk.schur.X, kk.schur.Wnu, kk.schur.M = self._new(n * s), self._new(m * s), self._new(s * s)
-        kk.R, kk.work = self._new(N * s), self._new(N)
-        red = &e.red
-        red.W, red.W_S, red.base = self._new(N * s), self._new(s * s), self._new(N)
-        red.u, red.u_prev, red.v, red.v_prev = self._new(s), self._new(s), self._new(s), self._new(s)
-        red.xs = self._new(s)
-        aa = &e.aa
-        aa.capacity = <int>memory
-        aa.dg, aa.df = self._new(memory * 2 * s), self._new(memory * 2 * s)
-        aa.g, aa.f, aa.g_new, aa.f_new = self._new(2 * s), self._new(2 * s), self._new(2 * s), self._new(2 * s)
-        aa.plain, aa.gram, aa.gamma = self._new(2 * s + 1), self._new(memory * memory), self._new(memory)
-        aa.products = self._new(memory * memory)
-        anderson_reset(aa, False)
-        rs = &e.rest
-        rs.pinned = <char*>self._new(s)
-        rs.target, rs.projected = self._new(s), self._new(s)
-        rs.positions, rs.entries = <Py_ssize_t*>self._new_int(s), <Py_ssize_t*>self._new_int(s)
-        rs.W_T, rs.gram, rs.step = self._new(N * s), self._new(s * s), self._new(s)
-        rs.start, rs.point = self._new(N), self._new(N)
-        pol = &e.pol
-        pol.active = <char*>self._new(s)
-        pol.dropped = <char*>self._new(s)
-        pol.index, pol.free = <Py_ssize_t*>self._new_int(n), <Py_ssize_t*>self._new_int(n)
-        pol.boundary = <Py_ssize_t*>self._new_int(s)
-        pol.g, pol.lam, pol.hess = self._new(s), self._new(s), self._new(s * s)
-        pol.K, pol.ipiv = self._new((N + s) * (N + s)), <int*>self._new_int(N + s)
-        pol.lwork = <int>(64 * (N + s))
-        pol.work = self._new(64 * (N + s))
-        pol.rhs, pol.step = self._new(N + s), self._new(N + s)
-        pol.x, pol.nu, pol.y = self._new(n), self._new(m), self._new(s)
-        pol.x_prev, pol.nu_prev = self._new(n), self._new(m)
-        pol.grad, pol.ATnu, pol.Ax = self._new(n), self._new(n), self._new(m)
-        pol.T, pol.tpiv = self._new(4 * s * s), <int*>self._new_int(2 * s)
-        pol.tr, pol.du = self._new(2 * s), self._new(2 * s)
-        pol.full, pol.dfull = self._new(N), self._new(N)
-        pol.schur_only = pol.schur_failed = False
-        ps = &pol.schur
-        ps.ready = False
-        ps.order, ps.coupled = <Py_ssize_t*>self._new_int(n), <char*>self._new(n)
-        ps.L, ps.root, ps.Y = self._new(n * n), self._new(n), self._new(n * (m + s))
-        ps.SU, ps.S = self._new(m * m), self._new((m + s) * (m + s))
-        ps.block = self._new(s * s)
-        ps.rowvar, ps.block_row = <Py_ssize_t*>self._new_int(n), <Py_ssize_t*>self._new_int(s)
-        ps.inv_root = self._new(n)
-        ps.t, ps.t2, ps.u = self._new(n), self._new(n), self._new(m + s)
-        e.unscaled.x, e.unscaled.y, e.unscaled.z = self._new(n), self._new(m), self._new(n)
-        e.log.capacity = log_rows
-        e.log.rows = self._new(5 * log_rows)
-        e.log.count = 0
+            e.user.entry_kind[c_view[k]] = (CONE_ENTRY if in_cone[k] else
+                                            FIXED_BOUND if fixed[k] else BOUNDED)
+        anderson_reset(&e.aa, False)
         o = &e.opt
         o.rho, o.sigma, o.alpha = settings.rho, settings.sigma, settings.alpha
         o.eps_abs, o.eps_rel = settings.eps_abs, settings.eps_rel
@@ -233,26 +153,12 @@ cdef class Workspace:
         o.adaptive_rho, o.restore_feasibility = settings.adaptive_rho, settings.restore_feasibility
         o.polish, o.polish_refine_iter = settings.polish, settings.polish_refine_iter
         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
-        e.prev.exists = u.has_matrices = e.fact.certified = e.scaling.done = False
+        e.prev.exists = e.user.has_matrices = e.fact.certified = e.scaling.done = False
         e.prev.has_rho = False
         e.prev.polished = e.prev.from_polished = e.equalities_missed = False
         e.unscaled.current = False
         e.fact.factored_rho = -1.0
         e.clock.final_reserve = e.clock.pass_time = 0.0
-
-    cdef double* _new(self, Py_ssize_t size):
-        """A zeroed array of ``size`` doubles (at least one) that lives with ``self``."""
-        array = np.zeros(max(size, 1))
-        self._arrays.append(array)
-        cdef double[::1] view = array
-        return &view[0]
-
-    cdef void* _new_int(self, Py_ssize_t size):
-        """An array of ``size`` pointer-sized integers that lives with ``self``."""
-        array = np.zeros(max(size, 1), dtype=np.intp)
-        self._arrays.append(array)
-        cdef Py_ssize_t[::1] view = array
-        return &view[0]
 
     def update_cones(self, mu, normal):
         """New friction coefficients and normals for the same cone blocks."""
@@ -338,7 +244,9 @@ cdef class Workspace:
 
         ``P, q, A, b, lb, ub`` are C-contiguous float64 arrays of the workspace's shapes
         (as :func:`fccqp.problem.convert` or :func:`fccqp.fast_checks.dense_arguments`
-        leave them); with ``checked=False`` they are the caller's arguments as they came,
+        leave them; on a :attr:`compressed` workspace ``P`` and ``A`` are the values of
+        its patterns, scipy's ``data`` of :func:`fccqp.sparse_problem.convert`'s
+        matrices); with ``checked=False`` they are the caller's arguments as they came,
         and the code is ``NOT_DENSE`` when one is not such an array. ``x0`` (None or a
         float64 vector) overrides the warm start; ``warm`` asks for a start from the
         previous solution (when there is one); ``start_time`` is the call's start on the
@@ -365,6 +273,9 @@ cdef class Workspace:
         cdef tuple arrays = (P, q, A, b, lb, ub, x_out, y_out, z_out, cert_out, x0)
         rows[:] = [n, n, m, m, n, n, n, m, n, n + m, n]
         columns[:] = [n, -1, n, -1, -1, -1, -1, -1, -1, -1, -1]   # -1: a vector
+        if self.compressed:   # P and A: the values of the patterns
+            rows[0], rows[2] = self.e.user.P.colptr[n], self.e.user.A.colptr[n]
+            columns[0] = columns[2] = -1
         try:
             for i in range(count):   # the outputs, 6 to 9, are written
                 if i < 6 and not checked:
@@ -417,14 +328,23 @@ cdef class Workspace:
         cdef Run run
         cdef long spent
         cdef int factored
+        cdef Matrix P_in, A_in
         e.clock.marks[0] = fccqp_now()
-        with nogil:
-            self.found = scan_and_copy(
-                P, q, A if m else NULL, b if m else NULL, lb, ub, n, m, e.user.P.values,
-                e.user.q, e.user.A.values, e.user.b, e.user.lb, e.user.ub, &same)
+        if self.compressed:   # the values over the workspace's patterns
+            P_in = csc(<double*>P, e.user.P.colptr, e.user.P.rowind, n, n)
+            A_in = csc(<double*>A, e.user.A.colptr, e.user.A.rowind, m, n)
+            with nogil:
+                self.found = scan_and_copy_csc(&P_in, q, &A_in, b if m else NULL, lb, ub,
+                                               &e.user.P, e.user.q, &e.user.A, e.user.b,
+                                               e.user.lb, e.user.ub, &same)
+        else:
+            with nogil:
+                self.found = scan_and_copy(
+                    P, q, A if m else NULL, b if m else NULL, lb, ub, n, m, e.user.P.values,
+                    e.user.q, e.user.A.values, e.user.b, e.user.lb, e.user.ub, &same)
         if self.found.code != SCAN_OK:
             e.user.has_matrices = False
-            return engine.BAD_NUMBERS
+            return engine.NEW_STRUCTURE if self.found.code == NEW_PATTERN else engine.BAD_NUMBERS
         if not self._same_structure(lb, ub):
             e.user.has_matrices = False
             return engine.NEW_STRUCTURE

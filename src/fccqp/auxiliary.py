@@ -34,6 +34,10 @@ auxiliary solve that is not SOLVED runs again in the other form
 (:func:`other_form`), and :func:`in_other_form` solves the stalled problem itself
 again there when no certificate was found, and then, if it stalls there too, at a
 larger rho.
+
+On the sparse path (a :attr:`fccqp.admm.Workspace.compressed` run) the auxiliary QPs
+are built with ``scipy.sparse`` and take the sparse path too, whatever their size;
+there is neither another form nor the larger rho to try.
 """
 
 from __future__ import annotations
@@ -42,6 +46,7 @@ import dataclasses
 import math
 
 import numpy as np
+import scipy.sparse as sp
 
 from fccqp.cones import cone_tuple
 from fccqp.problem import INFINITE_BOUND
@@ -50,7 +55,12 @@ from fccqp.status import Status
 from fccqp.tuning import AUXILIARY_MARGIN, STALL_RHO_FACTOR
 
 
-def _dense(matrix: object, rows: int, n: int) -> np.ndarray:
+def _matrix(matrix: object, rows: int, n: int, sparse: bool) -> object:
+    """``matrix`` (None: zeros) as a ``rows x n`` float64 array, or CSC matrix when
+    ``sparse``."""
+    if sparse:
+        return sp.csc_matrix((rows, n)) if matrix is None else sp.csc_matrix(
+            matrix, dtype=np.float64)
     if matrix is None:
         return np.zeros((rows, n))
     return np.asarray(matrix, dtype=np.float64).reshape(rows, n)
@@ -65,12 +75,12 @@ def _bounds(lb: object, ub: object, n: int) -> tuple[np.ndarray, np.ndarray]:
     return low, high
 
 
-def distance_problem(A: np.ndarray, b: np.ndarray, lb: np.ndarray, ub: np.ndarray,
+def distance_problem(A: object, b: np.ndarray, lb: np.ndarray, ub: np.ndarray,
                      cones: tuple) -> tuple[tuple, np.ndarray]:
     """The least-distance QP in the variables ``(x, u)``, ``u`` a copy of the
     constrained entries ``S`` (in their order, so cone blocks stay contiguous), and
-    ``S``."""
-    n = A.shape[1]
+    ``S``; its matrices are CSC when ``A`` is."""
+    n, m = A.shape[1], A.shape[0]
     member = np.zeros(n, dtype=bool)
     for cone in cones:
         member[cone.start:cone.start + cone.dim] = True
@@ -78,35 +88,49 @@ def distance_problem(A: np.ndarray, b: np.ndarray, lb: np.ndarray, ub: np.ndarra
     s = S.size
     position = np.full(n, -1)
     position[S] = np.arange(s)
-    E = np.zeros((s, n))
-    E[np.arange(s), S] = 1.0
-    P = np.block([[E.T @ E, -E.T], [-E, np.eye(s)]])
-    A_ext = np.hstack([A, np.zeros((A.shape[0], s))])
+    if sp.issparse(A):
+        E = sp.csc_matrix((np.ones(s), (np.arange(s), S)), shape=(s, n))
+        P = sp.bmat([[E.T @ E, -E.T], [-E, sp.eye(s)]], format="csc")
+        A_ext = sp.hstack([A, sp.csc_matrix((m, s))], format="csc")
+    else:
+        E = np.zeros((s, n))
+        E[np.arange(s), S] = 1.0
+        P = np.block([[E.T @ E, -E.T], [-E, np.eye(s)]])
+        A_ext = np.hstack([A, np.zeros((m, s))])
     lb_ext = np.concatenate([np.full(n, -np.inf), lb[S]])
     ub_ext = np.concatenate([np.full(n, np.inf), ub[S]])
     moved = [dataclasses.replace(c, start=n + int(position[c.start])) for c in cones]
     return (P, np.zeros(n + s), A_ext, b, lb_ext, ub_ext, moved), S
 
 
-def ray_problem(P: np.ndarray, q: np.ndarray, A: np.ndarray, lb: np.ndarray,
+def ray_problem(P: object, q: np.ndarray, A: object, lb: np.ndarray,
                 ub: np.ndarray, cones: tuple) -> tuple:
     """The projection of ``-q`` onto the rays: ``P``'s nonzero rows and ``A``'s as
     equalities asking 0, each entry's bounds at 0 on their finite sides (the box's
     recession cone), the same cones; ``q`` scaled by a power of two to largest entry
-    about 1 (the projection is homogeneous)."""
+    about 1 (the projection is homogeneous). Its matrices are CSC when ``P`` is."""
     n = q.shape[0]
-    rows = np.vstack([P[np.abs(P).max(axis=1, initial=0.0) > 0], A])
+    if sp.issparse(P):
+        P = P.tocsr()
+        nonzero = np.flatnonzero(abs(P).max(axis=1).toarray().reshape(-1) > 0)
+        rows = sp.vstack([P[nonzero], A], format="csc")
+        identity = sp.eye(n, format="csc")
+    else:
+        rows = np.vstack([P[np.abs(P).max(axis=1, initial=0.0) > 0], A])
+        identity = np.eye(n)
     largest = float(np.abs(q).max(initial=0.0))
     q = q * 2.0 ** -math.frexp(largest)[1] if largest > 0 else q
     low = np.where(np.isfinite(lb), 0.0, -np.inf)
     high = np.where(np.isfinite(ub), 0.0, np.inf)
-    return (np.eye(n), q, rows, np.zeros(rows.shape[0]), low, high, list(cones))
+    return (identity, q, rows, np.zeros(rows.shape[0]), low, high, list(cones))
 
 
-def _dense_path(problem: tuple) -> bool:
-    """Whether an auxiliary problem stays on the dense path (its KKT matrix has up to
+def _affordable(problem: tuple) -> bool:
+    """Whether an auxiliary problem may be solved: any sparse one (it takes the sparse
+    path), a dense one while it stays on the dense path (its KKT matrix has up to
     twice the rows of the run's: on the sparse path it would cost far more)."""
-    return problem[0].shape[0] + problem[2].shape[0] <= MAX_DENSE_KKT_ROWS
+    return (sp.issparse(problem[0])
+            or problem[0].shape[0] + problem[2].shape[0] <= MAX_DENSE_KKT_ROWS)
 
 
 IDENTITY = 1e-3
@@ -167,7 +191,7 @@ def _solved(solver_type: type, settings: object, problem: tuple) -> tuple:
     ``settings``, and again in the other form (:func:`other_form`) unless that ended
     SOLVED; the counts are those of both solves."""
     result = _auxiliary_solver(solver_type, settings).solve(*problem)
-    if result.status is Status.SOLVED:
+    if result.status is Status.SOLVED or result.backend == "sparse":   # no other form
         return result, result.iterations, result.factorizations
     again = _auxiliary_solver(solver_type, other_form(settings, result.backend)).solve(
         *problem)
@@ -233,14 +257,16 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
     """``(status, certificate, iterations, factorizations)`` for a run that stalled on
     this problem in ``workspace``, or None: the primal certificate of the least
     distance (when there are rows and constrained entries), else the dual one of the
-    projection onto the rays, each judged by ``workspace``. The auxiliary solves use
+    projection onto the rays, each judged by ``workspace`` (sparse QPs when it holds
+    compressed columns). The auxiliary solves use
     ``settings`` in a ``solver_type`` (:func:`_auxiliary_solver`), in a second form
     when the first did not solve them (:func:`_solved`)."""
     q = np.asarray(q, dtype=np.float64).reshape(-1)
     n = q.shape[0]
-    P = _dense(P, n, n)
+    sparse = workspace.compressed
+    P = _matrix(P, n, n, sparse)
     b = np.zeros(0) if b is None else np.asarray(b, dtype=np.float64).reshape(-1)
-    A = _dense(A, b.shape[0], n)
+    A = _matrix(A, b.shape[0], n, sparse)
     m = b.shape[0]
     lb, ub = _bounds(lb, ub, n)
     cones = cone_tuple(cones or ())
@@ -248,7 +274,7 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
     try:
         if m > 0:
             problem, S = distance_problem(A, b, lb, ub, cones)
-            if S.size and _dense_path(problem):
+            if S.size and _affordable(problem):
                 result, spent, factored = _solved(solver_type, settings, problem)
                 found = _farkas(workspace, result, b, lb, ub, S)
                 if found is None and _least_distance(result, b, lb[S], ub[S], n):
@@ -262,7 +288,7 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
                 if found is not None:
                     return Status.PRIMAL_INFEASIBLE, found, spent, factored
         rays = ray_problem(P, q, A, lb, ub, cones)
-        if not np.any(q) or not _dense_path(rays):
+        if not np.any(q) or not _affordable(rays):
             return None
         result, iterations, factorizations = _solved(solver_type, settings, rays)
         spent, factored = spent + iterations, factored + factorizations

@@ -38,8 +38,8 @@ from libc.math cimport INFINITY, fabs, isfinite
 from fccqp._blas cimport cholesky, cholesky_solve_vector, syrk_t
 from fccqp._dense cimport copy
 from fccqp._types cimport Iterates, Problem
-from fccqp.matrices cimport (Matrix, abs_product, product, product_row_norms, product_t_terms,
-                             subtract_product)
+from fccqp.matrices cimport (CSC, Matrix, abs_product, product, product_row_norms,
+                             product_t_terms, subtract_product)
 from fccqp.projections cimport proj_block
 from fccqp.tuning cimport (CLEANING_PASSES, CLEANING_SHRINK, DOMINANCE, GRAM_REGULARIZATION,
                            SEPARATION_FLOOR)
@@ -162,9 +162,12 @@ cdef int _farkas(const Problem* p, const double* x, const double* d_nu, const do
 cdef bint gram_factor(const Problem* p, double* gram) noexcept nogil:
     """``gram`` (m x m, column-major) := the Cholesky factor of ``A A'`` plus
     ``GRAM_REGULARIZATION`` of its largest diagonal entry (dependent rows); False when
-    that fails."""
+    that fails, and on compressed columns, whose workspace has no ``m x m`` array (the
+    certificates are then tested as ADMM leaves them, uncleaned)."""
     cdef Py_ssize_t m = p.m, i
     cdef double largest = 0.0
+    if p.A.kind == CSC:
+        return False
     # the row-major m x n A is, column-major, A' (n x m): one dsyrk gives A A' (dense
     # storage)
     syrk_t(<int>m, <int>p.n, p.A.values, <int>p.n, 0.0, gram, <int>m)

@@ -83,7 +83,7 @@ cdef struct Scaling:
 cdef struct Factorization:
     # The KKT factorization and what it holds.
     KKT kkt
-    int form                    # the backend factored last (LDL_FULL after the cold start)
+    int form                    # the backend factored last (full_form after the cold start)
     double factored_rho         # the rho it factored; -1 when it holds none
     double* rho_scale           # s: rho multiplier per constrained entry (FIXED_RHO_SCALE on lb == ub)
     bint certified              # the current matrices are proven convex

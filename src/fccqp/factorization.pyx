@@ -12,8 +12,10 @@ from fccqp._dense cimport copy, fill, inf_norm
 from fccqp._types cimport Iterates, Problem
 from fccqp.anderson cimport anderson_reset
 from fccqp.engine cimport Engine, Run
-from fccqp.kkt cimport (AUTO, FACTORED, LDL_FULL, NOT_CONVEX, SCHUR_REDUCED, UNAVAILABLE,
-                        kkt_convexity, kkt_factor, kkt_solve)
+from fccqp.kkt cimport (AUTO, FACTORED, LDL_FULL, NOT_CONVEX, SCHUR_REDUCED, SPARSE_LDL,
+                        UNAVAILABLE, full_form, is_reduced, kkt_convexity, kkt_factor,
+                        kkt_solve)
+from fccqp.matrices cimport CSC, DENSE
 from fccqp.projections cimport proj_set
 from fccqp.reduced cimport reduced_rebase, reduced_table
 from fccqp.tuning cimport EQUALITY_START_LIMIT, EQUALITY_START_STEPS, REDUCED_COST
@@ -49,10 +51,13 @@ cdef int factor(Engine* e, Run* run, long solves) noexcept nogil:
     reduced table pays for itself within ``solves`` and the constrained entries are
     at most half the KKT size, else with LDL' full). Certifies convexity when the
     matrices are new. Returns FACTORED, NOT_CONVEX, or UNAVAILABLE (numerical
-    breakdown); records the form and the rho it factored."""
+    breakdown); records the form and the rho it factored. Compressed columns have one
+    backend, ``SPARSE_LDL`` (:func:`_factor_sparse`)."""
     cdef Problem* p = &e.prob
     cdef int backend, code, first = e.opt.backend
     e.fact.table_ready = False
+    if p.P.kind == CSC:
+        return _factor_sparse(e, run)
     if first == AUTO:
         # rows the equality-constrained start could not meet (inconsistent, or
         # numerically dependent) go to the full form: its regularized solves give
@@ -83,6 +88,26 @@ cdef int factor(Engine* e, Run* run, long solves) noexcept nogil:
         e.fact.factored_rho = run.rho
         return FACTORED
     return UNAVAILABLE
+
+
+cdef int _factor_sparse(Engine* e, Run* run) noexcept nogil:
+    """:func:`factor` on compressed columns: certify convexity when the matrices are new,
+    then factor the full form with ``SPARSE_LDL`` (the reduced form's table, ``(n + m)
+    x s``, is too large at these sizes, so there is nothing to fall back to)."""
+    cdef int code
+    if not e.fact.certified:
+        code = _certify(e, False)
+        run.factorizations += 1
+        if code == NOT_CONVEX:
+            return NOT_CONVEX
+    code = kkt_factor(&e.fact.kkt, &e.prob, SPARSE_LDL, e.opt.sigma, e.it.rho_vec)
+    run.factorizations += 1
+    if code != FACTORED:
+        return UNAVAILABLE
+    e.fact.form = SPARSE_LDL
+    run.backend = SPARSE_LDL
+    e.fact.factored_rho = run.rho
+    return FACTORED
 
 
 cdef void reduced_base(Engine* e) noexcept nogil:
@@ -117,7 +142,7 @@ cdef int change_rho(Engine* e, Run* run, double new_rho, long iteration,
         it.rho_vec[j] = new_rho * e.fact.rho_scale[j]
     code = factor(e, run, budget(e, iteration))
     if code == FACTORED:
-        if e.fact.form != LDL_FULL:
+        if is_reduced(e.fact.form):
             reduced_base(e)
         anderson_reset(&e.aa, True)
     return code
@@ -136,14 +161,16 @@ cdef int _start_factor(Engine* e) noexcept nogil:
     (:func:`fccqp.schur.schur_factor`). Its success proves ``P + sigma I`` positive
     definite: the QP is convex. Dependent or inconsistent rows, or a ``P`` that
     Cholesky cannot factor on the free entries, fall back to LDL', whose inertia
-    decides convexity and whose regularized solves the inconsistency test reads."""
+    decides convexity and whose regularized solves the inconsistency test reads.
+    Compressed columns start with ``SPARSE_LDL``, their only backend."""
     cdef int backend = e.opt.backend
-    if backend == SCHUR_REDUCED or (backend == AUTO and _reduced_pays(e, budget(e, 0))):
+    if e.prob.P.kind == DENSE and (backend == SCHUR_REDUCED or (
+            backend == AUTO and _reduced_pays(e, budget(e, 0)))):
         fill(e.it.rho_vec, e.opt.sigma, e.prob.s)
         if kkt_factor(&e.fact.kkt, &e.prob, SCHUR_REDUCED, 0.0, e.it.rho_vec) == FACTORED:
             return FACTORED
     fill(e.it.rho_vec, 0.0, e.prob.s)
-    return FACTORED if kkt_factor(&e.fact.kkt, &e.prob, LDL_FULL, e.opt.sigma,
+    return FACTORED if kkt_factor(&e.fact.kkt, &e.prob, full_form(&e.prob), e.opt.sigma,
                                   e.it.rho_vec) == FACTORED else NOT_CONVEX
 
 
@@ -177,7 +204,7 @@ cdef int equality_start(Engine* e, bint* unbounded) noexcept nogil:
     cdef double sigma = e.opt.sigma, free_sigma
     cdef bint schur_start
     e.fact.factored_rho = -1.0  # the KKT matrix now holds no rho factorization
-    e.fact.form = LDL_FULL
+    e.fact.form = full_form(p)
     e.fact.table_ready = False
     if _start_factor(e) != FACTORED:
         return NOT_CONVEX

@@ -33,7 +33,7 @@ from fccqp.engine cimport (DUAL_INFEASIBLE, NOT_CONVEX_QP, NUMERICAL_ERROR, PRIM
                            RUNNING, SOLVED, TIME_LIMIT, Engine, Options, Run, end_run,
                            fccqp_now, measure)
 from fccqp.factorization cimport budget, change_rho, equality_start, factor, reduced_base
-from fccqp.kkt cimport FACTORED, LDL_FULL, NOT_CONVEX, kkt_solve
+from fccqp.kkt cimport FACTORED, NOT_CONVEX, is_reduced, kkt_solve
 from fccqp.polish cimport guess_changes, polish_prepare
 from fccqp.projections cimport proj_set
 from fccqp.reduced cimport materialize, near_convergence, reduced_start, reduced_step
@@ -200,7 +200,7 @@ cdef inline bint _factor_or_polish(Engine* e, Loop* L, Run* run) noexcept nogil:
         if code != FACTORED:
             run.status = NOT_CONVEX_QP if code == NOT_CONVEX else NUMERICAL_ERROR
             return False
-    L.reduced = e.fact.form != LDL_FULL
+    L.reduced = is_reduced(e.fact.form)
     if L.reduced:
         reduced_base(e)
     if L.warm_polish and warm_polish(e, run, L.start_time):
@@ -328,7 +328,7 @@ cdef inline bint _adapt_rho(Engine* e, Loop* L, Run* run) noexcept nogil:
             if code != FACTORED:
                 run.status = NOT_CONVEX_QP if code == NOT_CONVEX else NUMERICAL_ERROR
                 return False
-            L.reduced = e.fact.form != LDL_FULL
+            L.reduced = is_reduced(e.fact.form)
             L.fresh = True
             L.wait = L.next_gated = 0
     return True

@@ -1,6 +1,7 @@
 # cython: language_level=3
 from fccqp._types cimport Problem
 from fccqp.ldl cimport LDL
+from fccqp.matrices cimport CSC
 from fccqp.schur cimport Schur
 
 cdef enum:
@@ -9,6 +10,7 @@ cdef enum:
     LDL_REDUCED = 1     # quasi-definite LDL', reduced iteration
     LDL_FULL = 2        # quasi-definite LDL', one refined KKT solve per iteration
     AUTO = 3
+    SPARSE_LDL = 4      # qdldl's LDL' of the full form, the only backend of compressed columns
 
 cdef enum:
     # Outcomes of kkt_factor.
@@ -23,6 +25,7 @@ cdef struct KKT:
     Schur schur
     double* R           # (n + m) x s scratch, for refining columns
     double* work        # n + m scratch
+    void* sparse        # SPARSE_LDL: the fccqp.sparse_kkt.SparseKKT (a PyObject* the workspace owns)
 
 cdef int kkt_factor(KKT* k, const Problem* p, int backend, double sigma,
                     const double* rho_vec) noexcept nogil
@@ -34,3 +37,14 @@ cdef bint kkt_unit_columns(KKT* k, const Problem* p, const double* rho_vec,
                            const Py_ssize_t* entries, int count, double* W) noexcept nogil
 cdef int kkt_convexity(KKT* k, const Problem* p, double sigma, const double* rho_vec,
                        bint schur_factored) noexcept nogil
+
+
+cdef inline int full_form(const Problem* p) noexcept nogil:
+    """The backend of one refined KKT solve per iteration for ``p``'s storage:
+    ``LDL_FULL`` (dense) or ``SPARSE_LDL`` (compressed columns)."""
+    return SPARSE_LDL if p.P.kind == CSC else LDL_FULL
+
+
+cdef inline bint is_reduced(int form) noexcept nogil:
+    """Whether the backend ``form`` iterates in the reduced form (with its table)."""
+    return form == SCHUR_REDUCED or form == LDL_REDUCED

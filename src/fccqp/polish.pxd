@@ -1,6 +1,7 @@
 # cython: language_level=3
 from fccqp._types cimport Iterates, Problem
 from fccqp.kkt cimport KKT
+from fccqp.polish_csc cimport PolishCSC
 from fccqp.polish_schur cimport PolishSchur
 from fccqp.reduced cimport Reduced
 
@@ -20,10 +21,12 @@ cdef struct Polish:
     Py_ssize_t* free        # n: the entries that are unknowns, ascending
     Py_ssize_t* boundary    # s: the cone blocks on their boundary
     double* g               # s: unit normal of each boundary block's tangent plane
-    double* hess            # s x s: a boundary block's curvature term at hess + offset * s
-    double* K               # N x N, Fortran order; the factor after dsytrf
+    double* hess            # a boundary block's curvature term (d x d) at hess + offset * hess_stride
+    Py_ssize_t hess_stride  # s (hess is s x s) on dense storage; on CSC, polish points hess at PolishCSC's
+    double* K               # N x N, Fortran order; the factor after dsytrf (dense P and A)
     int* ipiv               # N
     PolishSchur schur       # the Schur-complement solve where P's structure allows it
+    PolishCSC csc           # the assembled matrix and its qdldl factor where P and A are CSC
     bint structured         # the current guess is factored in schur, not in K
     bint schur_only         # fail rather than assemble for dsytrf where schur does not apply
     bint schur_failed       # the last polish failed so
@@ -59,4 +62,3 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
 cdef bint polish_prepare(Polish* w, const Problem* p) noexcept nogil
 cdef Py_ssize_t guess_changes(const Problem* p, const double* z, const double* y,
                               double* point, char* codes) noexcept nogil
-cdef double multiplier_violation(Polish* w, const Problem* p, const double* z) noexcept nogil

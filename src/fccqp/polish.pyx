@@ -27,8 +27,10 @@ eliminated, so the KKT system of the polished QP
 
 has the free entries ``F`` of ``x``, the equality multipliers and one multiplier per
 boundary block as unknowns (``G`` holds the unit normals ``g``). It is factored with
-Bunch-Kaufman ``dsytrf`` and refined against the unregularized matrix, as
-:mod:`fccqp.ldl` does. Each boundary block's plane is then re-linearized at the new
+Bunch-Kaufman ``dsytrf`` (or by :mod:`fccqp.polish_schur`'s Schur complement where
+``P``'s structure allows it; by qdldl in compressed columns, :mod:`fccqp.polish_csc`, where
+``P`` and ``A`` are CSC) and refined against the unregularized matrix, as :mod:`fccqp.ldl`
+does. Each boundary block's plane is then re-linearized at the new
 ``x_block`` and the system re-solved, ``newton_steps`` times at most or until ``|phi|
 <= NEWTON_TOLERANCE ||x_block||``: Newton's method (SQP) on the KKT conditions of the
 QP on the active manifold, quadratically convergent when the guess is right.
@@ -49,7 +51,7 @@ Lagrangian there, a boundary block's is ``lam g`` with ``g`` the normal at the f
 ``x_block`` (in the polar cone when ``lam >= 0``; to first order ``lam g(x) = lam g_k +
 lam H x``, so the curvature term of the last step is accounted for and stationarity
 holds to second order), a free entry's is 0. Whether the guess was right is decided by
-the caller, on the user's problem (:func:`multiplier_violation` and the residuals of
+the caller, on the user's problem (:func:`fccqp.polish_guess.multiplier_violation` and the residuals of
 :mod:`fccqp.admm`); nothing here tells a wrong guess from a right one.
 """
 
@@ -59,9 +61,10 @@ from scipy.linalg.cython_lapack cimport dsytrf, dsytrs
 
 from fccqp._dense cimport copy, inf_norm
 from fccqp._types cimport Cones, Iterates, Problem
-from fccqp.cone_dispatch cimport cone_phi, cone_plane, cone_polar_distance
+from fccqp.cone_dispatch cimport cone_phi, cone_plane
 from fccqp.kkt cimport KKT
-from fccqp.matrices cimport product, product_t
+from fccqp.matrices cimport CSC, DENSE, product, product_t
+from fccqp.polish_csc cimport polish_csc_factor, polish_csc_solve
 from fccqp.polish_guess cimport (box_code, cone_code, drop_far_side, guess, linearize,
                                  most_wrong, renew, step_length)
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup, polish_schur_solve
@@ -146,7 +149,7 @@ cdef void _assemble(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) n
         for j in range(d):
             K[nf + m + k + w.index[start + j] * N] = w.g[o + j]
             for i in range(j, d):   # entries of a block are consecutive unknowns
-                K[w.index[start + i] + w.index[start + j] * N] += w.hess[o * p.s + i * d + j]
+                K[w.index[start + i] + w.index[start + j] * N] += w.hess[o * w.hess_stride + i * d + j]
     for r in range(nf, N):
         K[r + r * N] = -POLISH_DELTA
 
@@ -173,7 +176,7 @@ cdef double _residual(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb)
         for j in range(d):
             curved = 0.0
             for i in range(d):
-                curved += w.hess[o * p.s + j * d + i] * w.x[start + i]
+                curved += w.hess[o * w.hess_stride + j * d + i] * w.x[start + i]
             w.rhs[w.index[start + j]] -= w.lam[k] * w.g[o + j] + curved
             value += w.g[o + j] * w.x[start + j]
         w.rhs[nf + m + k] = -value
@@ -224,6 +227,8 @@ cdef void _factored_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t
     copy(w.rhs, w.step, size)
     if w.structured:
         polish_schur_solve(&w.schur, p, w.index, w.boundary, nb, w.step)
+    elif p.P.kind == CSC:
+        polish_csc_solve(&w.csc, size, w.step)
     else:
         dsytrs(&uplo, &size, &one, w.K, &size, w.ipiv, w.step, &size, &info)
 
@@ -266,13 +271,12 @@ cdef bint _relinearize(Polish* w, const Problem* p, Py_ssize_t nb,
     return True
 
 
-
 cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
                        double tolerance, int* factorizations) noexcept nogil:
     """Factor the KKT matrix of the current active set and planes (by Schur complement
     where :mod:`fccqp.polish_schur` was set up for this problem and applies, else
-    assembled for ``dsytrf``) and solve it from the current point to ``tolerance``;
-    False when the factorization breaks down."""
+    assembled for ``dsytrf``, or for qdldl where ``P`` and ``A`` are CSC) and solve it
+    from the current point to ``tolerance``; False when the factorization breaks down."""
     cdef char uplo = b"L"
     cdef int size = <int>(nf + p.m + nb), info = 0
     if size == 0:   # every entry held, no rows: nothing to solve
@@ -286,10 +290,15 @@ cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t n
     if w.schur_only:
         w.schur_failed = True
         return False
-    _assemble(w, p, nf, nb)
-    dsytrf(&uplo, &size, w.K, &size, w.ipiv, w.work, &w.lwork, &info)
-    if info != 0:
-        return False
+    if p.P.kind == CSC:
+        if not polish_csc_factor(&w.csc, p, nf, w.free, w.index, w.boundary, nb, w.g,
+                                 POLISH_DELTA):
+            return False
+    else:
+        _assemble(w, p, nf, nb)
+        dsytrf(&uplo, &size, w.K, &size, w.ipiv, w.work, &w.lwork, &info)
+        if info != 0:
+            return False
     _solve(w, p, nf, nb, tolerance)
     return True
 
@@ -335,7 +344,11 @@ cdef void _multipliers(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
 
 cdef bint polish_prepare(Polish* w, const Problem* p) noexcept nogil:
     """Set up the Schur-complement solve of :mod:`fccqp.polish_schur` for this solve's
-    ``P`` and ``A``; True when it applies, and then polishing needs no table."""
+    ``P`` and ``A``; True when it applies, and then polishing needs no table. Never on
+    CSC ``P`` and ``A`` (the Schur solve reads dense storage): each guess is assembled."""
+    if p.P.kind == CSC:
+        w.schur.ready = False
+        return False
     return polish_schur_setup(&w.schur, p, POLISH_DELTA)
 
 
@@ -381,12 +394,16 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     cdef long passes = 0, step
     cdef double total = 0.0
     cdef double scale = max(1.0, max(inf_norm(p.q, n), inf_norm(p.b, m)))
-    cdef bint tabled = table != NULL
+    cdef bint tabled = table != NULL and p.P.kind == DENSE   # the table reads dense storage
     cdef double miss, rate, last_miss = INFINITY
     cdef bint refactored = False
     cdef bint feasible = False   # a pass's point violated nothing: from then on, steps
     cdef Py_ssize_t blocking
     cdef double t
+    if p.P.kind == CSC:   # the curvature terms in PolishCSC's storage (n x the largest cone)
+        w.hess, w.hess_stride = w.csc.hess, w.csc.hess_stride
+    else:
+        w.hess_stride = s
     copy(it.x, w.x, n)
     copy(it.nu, w.nu, m)
     copy(it.y, w.y, s)
@@ -476,30 +493,3 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     for j in range(s):
         total += w.y[j]
     return isfinite(total)
-
-
-cdef double multiplier_violation(Polish* w, const Problem* p, const double* z) noexcept nogil:
-    """How far the multipliers ``z`` (user's units, one per entry of ``x``) of the
-    polished point are from the normal cone its guess needs: the wrong-signed part of a
-    held box entry's (``z <= 0`` at a lower bound, ``>= 0`` at an upper one, either on
-    ``lo == hi``) and, on held or boundary cone blocks, the distance of ``z_block`` to
-    the polar cone (``-z_block`` must lie in the dual cone). The scaling is constant on a
-    cone block, so the cones are those of the scaled problem."""
-    cdef const Cones* c = &p.cones
-    cdef Py_ssize_t j, k, o, d, start
-    cdef double worst = 0.0
-    cdef char code
-    for j in range(p.s):
-        code = w.active[j]
-        if code == LOWER:
-            worst = max(worst, z[p.constrained[j]])
-        elif code == UPPER:
-            worst = max(worst, -z[p.constrained[j]])
-    for k in range(c.count):
-        o, d = c.offset[k], c.dim[k]
-        if w.active[o] == FREE:
-            continue
-        start = p.constrained[o]
-        worst = max(worst, cone_polar_distance(z + start, c.kind[k], d, c.mu[k],
-                                               c.normal + 3 * k, w.step))
-    return worst

@@ -35,3 +35,4 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, Py_ssize_t block
                       Py_ssize_t* changed) noexcept nogil
 cdef Py_ssize_t drop_far_side(Polish* w, const Problem* p, Py_ssize_t nb,
                               Py_ssize_t* changed) noexcept nogil
+cdef double multiplier_violation(Polish* w, const Problem* p, const double* z) noexcept nogil

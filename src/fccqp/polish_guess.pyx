@@ -6,7 +6,9 @@ and corrects it from each polished point (the rules and why they are so are in
 :func:`fccqp.polish.polish`'s docstring). One code per constrained entry
 (:c:type:`Polish`'s ``active``): a box entry is free or held at a bound, a cone block is
 free, at its apex or on its boundary, where it contributes its tangent plane and the
-curvature term of Newton's step (:func:`linearize`). The cone geometry comes from
+curvature term of Newton's step (:func:`linearize`); the acceptance asks
+:func:`multiplier_violation` whether the polished point's multipliers fit its final
+guess. The cone geometry comes from
 :mod:`fccqp.cone_dispatch` (projection, axis and slope, tangent plane, curvature, step
 to the boundary): nothing here names a cone kind.
 """
@@ -36,7 +38,7 @@ cdef void linearize(Polish* w, const Problem* p, Py_ssize_t k, const double* v) 
     cdef double phi
     cone_plane(v, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, w.g + o, &phi)
     cone_curvature(v, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, max(w.lam[k], 0.0),
-                   w.hess + o * p.s)
+                   w.hess + o * w.hess_stride)
 
 
 cdef Py_ssize_t guess(Polish* w, const Problem* p, const double* z, const double* y,
@@ -83,7 +85,7 @@ cdef Py_ssize_t most_wrong(Polish* w, const Problem* p) noexcept nogil:
     needs; -1 when none is. The distance is a box entry's wrong-signed ``|y_j|``, a
     boundary block's ``-lam``, an apex block's distance of ``y_block`` to the polar cone
     (``||P_K(y_block)||``), each divided by ``c D_i`` as :func:`fccqp.scaling.unscale`
-    does: what :func:`fccqp.polish.multiplier_violation` measures on the polished point."""
+    does: what :func:`multiplier_violation` measures on the polished point."""
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t j, k, o, d, old = 0, most = -1
     cdef double worst = 0.0, wrong
@@ -261,3 +263,30 @@ cdef Py_ssize_t drop_far_side(Polish* w, const Problem* p, Py_ssize_t nb,
         w.lam[kept] = w.lam[k]
         kept += 1
     return kept
+
+
+cdef double multiplier_violation(Polish* w, const Problem* p, const double* z) noexcept nogil:
+    """How far the multipliers ``z`` (user's units, one per entry of ``x``) of the
+    polished point are from the normal cone its guess needs: the wrong-signed part of a
+    held box entry's (``z <= 0`` at a lower bound, ``>= 0`` at an upper one, either on
+    ``lo == hi``) and, on held or boundary cone blocks, the distance of ``z_block`` to
+    the polar cone (``-z_block`` must lie in the dual cone). The scaling is constant on a
+    cone block, so the cones are those of the scaled problem."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t j, k, o, d, start
+    cdef double worst = 0.0
+    cdef char code
+    for j in range(p.s):
+        code = w.active[j]
+        if code == LOWER:
+            worst = max(worst, z[p.constrained[j]])
+        elif code == UPPER:
+            worst = max(worst, -z[p.constrained[j]])
+    for k in range(c.count):
+        o, d = c.offset[k], c.dim[k]
+        if w.active[o] == FREE:
+            continue
+        start = p.constrained[o]
+        worst = max(worst, cone_polar_distance(z + start, c.kind[k], d, c.mu[k],
+                                               c.normal + 3 * k, w.step))
+    return worst

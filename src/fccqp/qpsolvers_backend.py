@@ -28,7 +28,7 @@ fccqp's core is dense, meant for 30-300 variables: sparse ``P``, ``G``, ``A``
 densified. Before densifying, the size of the slack form's KKT matrix, ``n + m_A + 2
 m_G`` rows, is checked against :data:`fccqp.settings.MAX_DENSE_KKT_ROWS`: a larger
 problem (or any, with ``kkt_backend="sparse"``) keeps its matrices sparse, builds the
-slack form sparse and takes fccqp's sparse path (:mod:`fccqp.sparse_admm`). So fccqp
+slack form sparse and takes fccqp's sparse path (``Result.backend == "sparse"``). So fccqp
 is listed in both ``qpsolvers.dense_solvers`` and ``qpsolvers.sparse_solvers``.
 
 Registration. qpsolvers has no plugin mechanism: :func:`register` adds "fccqp" to

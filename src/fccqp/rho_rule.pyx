@@ -1,8 +1,6 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
-"""Rho adaptation: OSQP's rule, and the trial of the small moves it keeps asking for.
-
-Shared by the dense core (:mod:`fccqp.iteration`) and the sparse path
-(:mod:`fccqp.sparse_admm`, through :class:`RhoTrial`), so that both adapt rho alike.
+"""Rho adaptation: OSQP's rule, and the trial of the small moves it keeps asking for
+(:mod:`fccqp.iteration` calls it, on either storage of the matrices).
 """
 
 from libc.math cimport sqrt
@@ -65,17 +63,3 @@ cdef double new_rho(const Residuals* r, double rho, TrialState* trial,
     cdef double dual = r.dual_s / max(r.dual_scale_s, 1e-30)
     cdef double proposal = min(max(rho * sqrt(prim / max(dual, 1e-30)), RHO_MIN), RHO_MAX)
     return rho_trial(trial, rho, proposal, max(prim, dual), tolerance)
-
-
-cdef class RhoTrial:
-    """:func:`rho_trial` for the sparse path (:mod:`fccqp.sparse_admm`), which runs
-    the dense core's rho rule: one per run."""
-
-    cdef TrialState state
-
-    def __cinit__(self):
-        trial_reset(&self.state)
-
-    def propose(self, double rho, double new_rho, double worst, double tolerance):
-        """The rho to take at this update (see :func:`rho_trial`)."""
-        return rho_trial(&self.state, rho, new_rho, worst, tolerance)

@@ -11,8 +11,10 @@ from fccqp._types cimport Problem
 from fccqp.acceptance cimport user_residuals
 from fccqp.engine cimport DUAL_INFEASIBLE, PRIMAL_INFEASIBLE, Engine, Run, fccqp_now
 from fccqp.iteration cimport iterate
+from fccqp.matrices cimport DENSE
 from fccqp.projections cimport proj_set
 from fccqp.scaling cimport equilibrate, rescale, scale_start, scaled_norms, unscale
+from fccqp.scaling_csc cimport equilibrate_csc, rescale_csc, scaled_norms_csc
 from fccqp.termination cimport row_spans
 from fccqp.verdict cimport settle
 
@@ -55,7 +57,9 @@ cdef void _scale(Engine* e, bint reuse, bint warm) noexcept nogil:
     """Equilibrate the user's data into the scaled problem; with ``reuse`` (unchanged
     matrices) apply the scaling to the new vectors only, and with ``warm`` (a start
     from the previous solution) scale the new data with the previous equilibration
-    (:func:`fccqp.scaling.rescale`); then the rows' spans over the (new) box."""
+    (:func:`fccqp.scaling.rescale`); then the rows' spans over the (new) box. The
+    matrices' storage picks the passes (:mod:`fccqp.scaling` or
+    :mod:`fccqp.scaling_csc`), one test per solve."""
     cdef Problem* p = &e.prob
     cdef Py_ssize_t n = p.n, m = p.m, i, j
     if reuse:
@@ -63,23 +67,48 @@ cdef void _scale(Engine* e, bint reuse, bint warm) noexcept nogil:
             p.q[i] = p.c * p.D[i] * e.user.q[i]
         for i in range(m):
             p.b[i] = p.E[i] * e.user.b[i]
-    elif not (warm and e.scaling.done and rescale(
-            e.user.P.values, e.user.q, e.user.A.values, e.user.b, n, m, p.D, p.E,
-            e.scaling.reference, e.scaling.norms, p.P.values, p.q, p.A.values, p.b, &p.c)):
-        copy(e.user.P.values, p.P.values, n * n)
-        copy(e.user.A.values, p.A.values, m * n)
-        copy(e.user.q, p.q, n)
-        copy(e.user.b, p.b, m)
-        p.c = equilibrate(p.P.values, p.q, p.A.values, p.b, n, m, e.user.block_start, p.cones.dim,
-                          p.cones.count, e.opt.scaling, p.D, p.E, e.scaling.d,
-                          e.scaling.e)
-        scaled_norms(p.P.values, p.A.values, n, m, p.c, e.scaling.reference)
+    elif not (warm and e.scaling.done and _rescale(e)):
+        _equilibrate(e)
         e.scaling.done = True
     for j in range(p.s):
         i = p.constrained[j]
         p.lo[j] = e.user.lb[i] / p.D[i]
         p.hi[j] = e.user.ub[i] / p.D[i]
     row_spans(p, e.scaling.d)
+
+
+cdef inline bint _rescale(Engine* e) noexcept nogil:
+    """The new data scaled with the previous equilibration, unless it drifted (see
+    :func:`fccqp.scaling.rescale`)."""
+    cdef Problem* p = &e.prob
+    if p.P.kind == DENSE:
+        return rescale(e.user.P.values, e.user.q, e.user.A.values, e.user.b, p.n, p.m, p.D,
+                       p.E, e.scaling.reference, e.scaling.norms, p.P.values, p.q,
+                       p.A.values, p.b, &p.c)
+    return rescale_csc(&e.user.P, e.user.q, &e.user.A, e.user.b, p.D, p.E,
+                       e.scaling.reference, e.scaling.norms, &p.P, p.q, &p.A, p.b, &p.c)
+
+
+cdef inline void _equilibrate(Engine* e) noexcept nogil:
+    """Copy the user's data into the scaled problem and equilibrate it; the scaled
+    matrices' norms become the reference of later rescalings."""
+    cdef Problem* p = &e.prob
+    cdef Py_ssize_t n = p.n, m = p.m
+    copy(e.user.q, p.q, n)
+    copy(e.user.b, p.b, m)
+    if p.P.kind == DENSE:
+        copy(e.user.P.values, p.P.values, n * n)
+        copy(e.user.A.values, p.A.values, m * n)
+        p.c = equilibrate(p.P.values, p.q, p.A.values, p.b, n, m, e.user.block_start,
+                          p.cones.dim, p.cones.count, e.opt.scaling, p.D, p.E, e.scaling.d,
+                          e.scaling.e)
+        scaled_norms(p.P.values, p.A.values, n, m, p.c, e.scaling.reference)
+        return
+    copy(e.user.P.values, p.P.values, p.P.colptr[n])
+    copy(e.user.A.values, p.A.values, p.A.colptr[n])
+    p.c = equilibrate_csc(&p.P, p.q, &p.A, p.b, e.user.block_start, p.cones.dim,
+                          p.cones.count, e.opt.scaling, p.D, p.E, e.scaling.d, e.scaling.e)
+    scaled_norms_csc(&p.P, &p.A, p.c, e.scaling.reference)
 
 
 cdef void _start_from_guess(Engine* e, const double* x0) noexcept nogil:

@@ -1,5 +1,29 @@
 # cython: language_level=3
+"""Ruiz equilibration (:mod:`fccqp.scaling`, dense storage; :mod:`fccqp.scaling_csc`,
+compressed columns) and the two rules both storages share, inline here."""
+
+from libc.math cimport sqrt
+
 from fccqp._types cimport Cones
+from fccqp.tuning cimport MAX_NORM, MIN_COST_NORM, MIN_NORM
+
+
+cdef inline double inverse_sqrt_norm(double norm) noexcept nogil:
+    """A Ruiz pass's factor for a column or row of infinity norm ``norm``: ``1 /
+    sqrt(norm)``, with the norm capped at ``MAX_NORM`` and 1 below ``MIN_NORM``."""
+    if norm < MIN_NORM:
+        return 1.0
+    return 1.0 / sqrt(norm if norm < MAX_NORM else MAX_NORM)
+
+
+cdef inline double cost_scale(double mean_col, double q_norm) noexcept nogil:
+    """``c = 1 / size`` of a cost whose ``P`` has mean column norm ``mean_col`` and whose
+    ``q`` has norm ``q_norm``: the larger of the two, each counted only above
+    ``MIN_COST_NORM``, at most ``MAX_NORM``."""
+    cdef double size = max(mean_col if mean_col >= MIN_COST_NORM else 1.0,
+                           q_norm if q_norm >= MIN_COST_NORM else 1.0)
+    return 1.0 / min(size, MAX_NORM)
+
 
 cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n,
                         Py_ssize_t m, const Py_ssize_t* block_start,

@@ -17,12 +17,11 @@ cone: friction cones keep their ``mu`` and normal.
 
 import numpy as np
 
-from libc.math cimport exp, fabs, ilogb, ldexp, log, sqrt
+from libc.math cimport exp, fabs, ilogb, ldexp, log
 
 from fccqp._types cimport Cones
 from fccqp.projections cimport proj_set
-from fccqp.tuning cimport (CAPPED_PASSES, GAUGE_LIMIT, MAX_NORM, MIN_COST_NORM, MIN_NORM,
-                           RESCALE_DRIFT)
+from fccqp.tuning cimport CAPPED_PASSES, GAUGE_LIMIT, RESCALE_DRIFT
 
 cdef extern from "fccqp_kernels.h" nogil:
     void fccqp_scale_rows(const double* M, int rows, int cols, const double* left,
@@ -30,12 +29,6 @@ cdef extern from "fccqp_kernels.h" nogil:
                           double* column_max)
     void fccqp_ruiz_maxima(const double* P, const double* A, int n, int m, const double* D,
                            const double* E, double* column, double* row)
-
-
-cdef inline double _inverse_sqrt_norm(double norm) noexcept nogil:
-    if norm < MIN_NORM:
-        return 1.0
-    return 1.0 / sqrt(norm if norm < MAX_NORM else MAX_NORM)
 
 
 cdef inline double _row_max(const double* row, const double* weight, Py_ssize_t n) noexcept nogil:
@@ -87,10 +80,10 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
         fccqp_ruiz_maxima(P, A, <int>n, <int>m, D, E, d, e)
         for i in range(m):
             capped = capped or e[i] > MAX_NORM
-            e[i] = _inverse_sqrt_norm(e[i])
+            e[i] = inverse_sqrt_norm(e[i])
         for j in range(n):
             capped = capped or d[j] > MAX_NORM
-            d[j] = _inverse_sqrt_norm(d[j])
+            d[j] = inverse_sqrt_norm(d[j])
         if capped and passes < iterations + CAPPED_PASSES:
             passes += 1
         for k in range(blocks):
@@ -150,17 +143,8 @@ cdef void _gauge(const double* P, double* D, double* E, Py_ssize_t n,
         E[i] = ldexp(E[i], -exponent)
 
 
-cdef inline double _cost_scale(double mean_col, double q_norm) noexcept nogil:
-    """``c = 1 / size`` of a cost whose ``P`` has mean column norm ``mean_col`` and whose
-    ``q`` has norm ``q_norm``: the larger of the two, each counted only above
-    ``MIN_COST_NORM``, at most ``MAX_NORM``."""
-    cdef double size = max(mean_col if mean_col >= MIN_COST_NORM else 1.0,
-                           q_norm if q_norm >= MIN_COST_NORM else 1.0)
-    return 1.0 / min(size, MAX_NORM)
-
-
 cdef double _normalize_cost(double* P, double* q, Py_ssize_t n, double* ones) noexcept nogil:
-    """Multiply the (scaled) cost by :func:`_cost_scale`'s ``c`` and return it; ``ones``
+    """Multiply the (scaled) cost by :func:`cost_scale`'s ``c`` and return it; ``ones``
     is scratch of size ``n``."""
     cdef Py_ssize_t i
     cdef double mean_col = 0.0, q_norm = 0.0, c
@@ -171,7 +155,7 @@ cdef double _normalize_cost(double* P, double* q, Py_ssize_t n, double* ones) no
     mean_col /= n
     for i in range(n):
         q_norm = max(q_norm, fabs(q[i]))
-    c = _cost_scale(mean_col, q_norm)
+    c = cost_scale(mean_col, q_norm)
     for i in range(n * n):
         P[i] *= c
     for i in range(n):
@@ -227,7 +211,7 @@ cdef bint rescale(const double* P, const double* q, const double* A, const doubl
         mean_col += norms[i]
         q_s[i] = q[i] * D[i]
         q_norm = max(q_norm, fabs(q_s[i]))
-    c[0] = _cost_scale(mean_col / n, q_norm)
+    c[0] = cost_scale(mean_col / n, q_norm)
     for i in range(n * n):
         P_s[i] *= c[0]
     for i in range(n):

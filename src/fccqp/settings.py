@@ -23,7 +23,8 @@ MAX_DENSE_KKT_ROWS = 5000
 """Largest KKT matrix (``n + m`` rows) that the dense core factors. At this size the
 dense matrix takes 200 MB and one factorization about 4e10 flops (seconds), ten times
 the 500 rows the dense core is meant for; a larger problem takes the sparse path
-(``kkt_backend="sparse"``, :mod:`fccqp.sparse_admm`), whatever ``kkt_backend`` says."""
+(``kkt_backend="sparse"``: ``P`` and ``A`` in compressed columns, factored by qdldl),
+whatever ``kkt_backend`` says."""
 KKT_BACKENDS = ("auto", "schur_reduced", "ldl_reduced", "ldl_full", "sparse")
 """The values of ``Settings.kkt_backend``."""
 
@@ -160,7 +161,7 @@ class Settings:
     """Return a point in the box and the cones: the violating entries are pinned at
     their projection and the others respond through the KKT system, keeping
     ``A x = b``; see :mod:`fccqp.restoration`. The dense path only: it has no effect on
-    the sparse path (:mod:`fccqp.sparse_admm`)."""
+    the sparse path (``kkt_backend="sparse"``), which has no table of KKT columns."""
     polish: bool = True
     """After ADMM (solved or stopped by a budget), solve the equality-constrained QP on
     the active set its iterate suggests (box entries at a bound, cone blocks at the apex
@@ -185,7 +186,7 @@ class Settings:
     and of ``A (P + R)^-1 A'``, reduced iteration), ``"ldl_reduced"`` (LDL', reduced
     iteration), ``"ldl_full"`` (LDL', one KKT solve per iteration), ``"sparse"`` (the
     sparse path: ``scipy.sparse`` data and a sparse LDL' from ``qdldl``, one KKT solve
-    per iteration, :mod:`fccqp.sparse_admm`) or ``"auto"`` (the first of the dense ones
+    per iteration, :mod:`fccqp.kkt_sparse`) or ``"auto"`` (the first of the dense ones
     that applies and pays; see docs/algorithm.md). A forced dense backend that cannot
     factor the matrix falls back to the next one in that order; a problem whose KKT
     matrix has more than :data:`MAX_DENSE_KKT_ROWS` rows takes the sparse path whatever

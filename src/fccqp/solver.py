@@ -6,8 +6,9 @@ this module converts the arguments, decides whether the previous solve's workspa
 the new problem's structure, and acts on the codes the call returns instead (a new
 workspace when the bounds changed the structure, the error that names the argument).
 Problems whose KKT matrix exceeds :data:`fccqp.settings.MAX_DENSE_KKT_ROWS` rows, and
-every problem with ``kkt_backend="sparse"``, go to the sparse path
-(:mod:`fccqp.sparse_admm`) instead, before anything is densified.
+every problem with ``kkt_backend="sparse"``, take the sparse path instead, before
+anything is densified: the same compiled call on a workspace that holds ``P`` and ``A``
+in compressed columns (:meth:`Solver._solve_sparse`).
 """
 
 from __future__ import annotations
@@ -107,7 +108,7 @@ class Solver:
         self._structure: _Structure | None = None
         self._workspace: admm.Workspace | None = None
         self._kept: dict[tuple[object, ...], admm.Workspace] = {}   # oldest first
-        self._sparse = None   # the sparse path's workspace, made on its first problem
+        self._sparse: tuple | None = None   # (its key, the sparse path's workspace)
         self._cones: object = None   # the cones argument of the last dense solve
         self._stalled_certificates = True   # False in fccqp.auxiliary's own solves
 
@@ -128,7 +129,7 @@ class Solver:
         if self._workspace is not None:
             self._workspace.forget()
         if self._sparse is not None:
-            self._sparse.forget()
+            self._sparse[1].forget()
 
     def solve(
         self,
@@ -239,28 +240,30 @@ class Solver:
             )
         if (out.status is Status.MAX_ITER_REACHED and self._stalled_certificates
                 and not math.isfinite(settings.time_limit)):
-            out = self._stalled(out, P, q, A, b, lb, ub, start)
+            out = self._stalled(out, w, (P, q, A, b, lb, ub), self._cones, start)
         if settings.verbose:
             _print_log(w.log_lines, out)
         return out
 
-    def _stalled(self, out: Result, P: object, q: object, A: object, b: object,
-                 lb: object, ub: object, start: float) -> Result:
-        """``out`` of a run that stalled (``MAX_ITER_REACHED``), or the certificate that
+    def _stalled(self, out: Result, workspace: admm.Workspace, arguments: tuple,
+                 cones: object, start: float) -> Result:
+        """``out`` of a run that stalled (``MAX_ITER_REACHED``) in ``workspace`` on the
+        problem of ``arguments`` (``P, q, A, b, lb, ub``), or the certificate that
         :func:`fccqp.auxiliary.stalled_certificate` found for it instead, or (with
-        ``kkt_backend="auto"``) the answer of a solve in the other KKT form or at a
-        larger rho (:func:`fccqp.auxiliary.in_other_form`); their iterations and factorizations
-        added. Either leaves no previous solution to start from: a certified problem as
-        an infeasible run does, an answer from another solver because this workspace
-        holds the stalled point."""
-        found = auxiliary.stalled_certificate(Solver, self._settings, self._workspace, P, q,
-                                              A, b, lb, ub, self._cones)
-        if found is None and self._settings.kkt_backend == "auto":
+        ``kkt_backend="auto"`` on the dense path) the answer of a solve in the other KKT
+        form or at a larger rho (:func:`fccqp.auxiliary.in_other_form`); their iterations
+        and factorizations added. Either leaves no previous solution to start from: a
+        certified problem as an infeasible run does, an answer from another solver
+        because this workspace holds the stalled point."""
+        found = auxiliary.stalled_certificate(Solver, self._settings, workspace, *arguments,
+                                              cones)
+        if (found is None and self._settings.kkt_backend == "auto"
+                and not workspace.compressed):
             # the form was fccqp's choice: the other one may not stall
             again = auxiliary.in_other_form(Solver, self._settings, out,
-                                            (P, q, A, b, lb, ub, self._cones))
+                                            (*arguments, cones))
             if again is not None:
-                self._workspace.forget()
+                workspace.forget()
                 return Result._of({
                     **again.__dict__,
                     "iterations": out.iterations + again.iterations,
@@ -270,7 +273,7 @@ class Solver:
         if found is None:
             return out
         status, certificate, iterations, factorizations = found
-        self._workspace.forget()
+        workspace.forget()
         return Result._of({
             **out.__dict__, "status": status, "certificate": certificate,
             "iterations": out.iterations + iterations,
@@ -300,29 +303,59 @@ class Solver:
     def _solve_sparse(self, P: object, q: object, A: object, b: object, lb: object,
                       ub: object, cones: Sequence[Cone], x0: object,
                       start: float) -> Result:
-        """The sparse path (:mod:`fccqp.sparse_admm`): the same arguments and Result."""
-        from fccqp import sparse_admm, sparse_problem
+        """The sparse path: the arguments in compressed columns
+        (:func:`fccqp.sparse_problem.convert`), solved by the same compiled call in a
+        workspace that holds them so and factors with ``SPARSE_LDL``
+        (:meth:`_sparse_workspace`); the same Result and errors as the dense path."""
+        from fccqp import sparse_problem
 
         settings = self._settings
         data = sparse_problem.convert(P, q, A, b, lb, ub, cones)
         guess = None if x0 is None else _initial_guess(x0, data.n)
-        if self._sparse is None:
-            self._sparse = sparse_admm.SparseWorkspace(settings)
-        out = self._sparse.solve(data, guess, start)
-        status = out.status
-        result = Result._of({
-            "x": out.x, "y": out.y, "z": out.z, "status": status,
-            "obj": out.residuals.objective, "iterations": out.iterations,
-            "prim_res": out.residuals.prim, "dual_res": out.residuals.dual,
-            "setup_time": out.setup_time, "solve_time": time.perf_counter() - start,
-            "rho": out.rho, "factorizations": out.factorizations,
-            "certificate": out.certificate, "backend": sparse_admm.BACKEND,
-            "gap": float("nan") if status.is_infeasible() else out.residuals.gap,
-            "polished": out.polished,
-        })
+        w = self._sparse_workspace(data, False)
+        certificate = np.empty(data.n + data.m)
+        arguments = (data.P.data, data.q, data.A.data, data.b, data.lb, data.ub, guess,
+                     settings.warm_start, start, certificate)
+        out = w.solve(*arguments)
+        if type(out) is int and out == admm.STRUCTURE_CHANGED:
+            w = self._sparse_workspace(data, True)
+            out = w.solve(*arguments)
+        if type(out) is int and out == admm.BAD_DATA:
+            raise_finding(w.finding, data.lb, data.ub)
+        if type(out) is int:   # NOT_CONVEX_CODE, the only code left
+            self._sparse = None
+            raise ValueError(
+                "the QP is not convex: P has negative curvature on the null space of A "
+                "(P is not positive semidefinite: the KKT matrix has more negative pivots "
+                "than A has rows)")
+        if (out.status is Status.MAX_ITER_REACHED and self._stalled_certificates
+                and not math.isfinite(settings.time_limit)):
+            out = self._stalled(out, w, (data.P, data.q, data.A, data.b, data.lb, data.ub),
+                                cones, start)
         if settings.verbose:
-            _print_log(out.log, result)
-        return result
+            _print_log(w.log_lines, out)
+        return out
+
+    def _sparse_workspace(self, data: object, renew: bool) -> admm.Workspace:
+        """The compressed-column workspace for ``data`` (a
+        :class:`fccqp.sparse_problem.SparseData`): the last one when its structure and
+        its matrices' patterns are ``data``'s (and not ``renew``), else a new one."""
+        cones = data.cones
+        key = (data.n, data.m, data.constrained.tobytes(), data.fixed.tobytes(),
+               cones.kind.tobytes(), cones.offset.tobytes(), cones.dim.tobytes(),
+               data.P.indptr.tobytes(), data.P.indices.tobytes(), data.A.indptr.tobytes(),
+               data.A.indices.tobytes())
+        if self._sparse is None or self._sparse[0] != key or renew:
+            log_rows = LOG_ROWS if self._settings.verbose else 0
+            patterns = (data.P.indptr, data.P.indices, data.A.indptr, data.A.indices)
+            workspace = admm.Workspace(
+                data.n, data.m, data.constrained, (cones.kind, cones.offset, cones.dim,
+                                                   cones.mu, cones.normal),
+                data.fixed, None, self._settings, log_rows, patterns)
+            self._sparse = (key, workspace)
+        workspace = self._sparse[1]
+        workspace.update_cones(cones.mu, cones.normal)
+        return workspace
 
 
 def _rows(matrix: object) -> int:

@@ -25,10 +25,13 @@ Inertia. By Sylvester's law the signs of the pivots ``d`` are the inertia of the
 factored matrix: without ``R``, more than ``m`` negative pivots means that ``P +
 sigma I`` has negative curvature on the null space of ``A`` (the QP is not convex).
 
-Contract (as in :mod:`fccqp.kkt`): :class:`SparseKKT` is built once per structure
-from the scaled ``(P, A)``; :meth:`SparseKKT.factor` for given ``sigma`` and penalties
-(a new numeric factorization on the same pattern); :meth:`SparseKKT.solve` for one
-right-hand side, refined.
+Contract (as in :mod:`fccqp.kkt`, whose ``SPARSE_LDL`` backend calls it through
+:mod:`fccqp.kkt_sparse`): :class:`SparseKKT` is built once per pattern over the
+workspace's scaled compressed-column arrays, which it reads without copying;
+:meth:`SparseKKT.factor` assembles the KKT values from their current entries, ``sigma``
+and the penalties (a new numeric factorization on the same pattern: a new scaling or a
+rho change refactors values only); :meth:`SparseKKT.solve` for one right-hand side,
+refined.
 """
 
 from __future__ import annotations
@@ -38,6 +41,13 @@ import scipy.sparse as sp
 
 DELTA = 1e-9
 """Quasi-definite regularization of the (2, 2) block (scaled problem)."""
+BROKEN_DELTA = 1e-6
+"""The regularization of a second factorization when the first met a zero pivot: rows
+that depend on each other, beside a ``P`` flat but for ``sigma`` (1e-6), make ``(A H^-1
+A')`` about 1e6 against ``delta = 1e-9``, and the second row's pivot, ``delta`` times a
+factor of order one, is lost to rounding (the fuzzer's ``cvxpy:7``, a rank-one ``P``:
+a zero pivot, reported as a non-convex QP). Refinement against the unregularized matrix
+removes the larger bias as it removes the smaller one."""
 MAX_REFINE = 5
 """Most refinement steps per solve."""
 REFINE_TOLERANCE = 1e-13
@@ -61,12 +71,14 @@ class SparseKKT:
     Parameters
     ----------
     P, A : scipy.sparse.csc_matrix
-        The scaled problem's ``P`` (both triangles) and ``A``.
+        The scaled problem's ``P`` (both triangles) and ``A``, over the arrays the
+        compiled workspace scales in place (not copied: :meth:`factor` reads their
+        current entries).
     constrained : (s,) int array
         The entries of ``x`` that carry a penalty.
     E : (m,) array
-        Row scaling of ``A``: the refinement's stopping test divides row ``i`` of
-        ``A x - b`` by ``E_i`` (the user's units).
+        Row scaling of ``A``, the workspace's (updated in place): the refinement's
+        stopping test divides row ``i`` of ``A x - b`` by ``E_i`` (the user's units).
     """
 
     def __init__(self, P: sp.csc_matrix, A: sp.csc_matrix, constrained: np.ndarray,
@@ -80,50 +92,66 @@ class SparseKKT:
             ) from exn
         self._qdldl = qdldl
         self.P, self.A, self.E = P, A, E
-        self.abs_A = abs(A).tocsc()
-        self.AT = A.T.tocsc()
+        self.AT = A.T   # a CSR view over A's arrays
         n, m = P.shape[0], A.shape[0]
         self.n, self.m = n, m
         self.constrained = constrained
         # the upper triangle with every diagonal entry stored, zero or not, so that the
-        # pattern stays the same whatever sigma and rho are
-        upper = sp.triu(P, format="coo")
+        # pattern stays the same whatever sigma and rho are; each entry of K is tagged
+        # with its source (an entry of P, of A, or an added diagonal zero), so that
+        # factor() assembles K's values with one gather
+        coo = P.tocoo()
+        self._upper = np.flatnonzero(coo.row <= coo.col)
         At = A.tocoo()
-        diagonal = np.arange(n + m)
-        rows = np.concatenate([upper.row, At.col, diagonal])
-        cols = np.concatenate([upper.col, n + At.row, diagonal])
-        values = np.concatenate([upper.data, At.data, np.zeros(n + m)])
-        K = sp.csc_matrix((values, (rows, cols)), shape=(n + m, n + m))
+        stored = np.zeros(n, dtype=bool)
+        stored[coo.row[coo.row == coo.col]] = True
+        added = np.concatenate([np.flatnonzero(~stored), np.arange(n, n + m)])
+        rows = np.concatenate([coo.row[self._upper], At.col, added])
+        cols = np.concatenate([coo.col[self._upper], n + At.row, added])
+        sources = len(rows)
+        K = sp.csc_matrix((np.arange(1.0, sources + 1.0), (rows, cols)), shape=(n + m, n + m))
         K.sort_indices()
-        coo = K.tocoo()
+        self._source = K.data.astype(np.intp) - 1
+        self._gathered = np.zeros(sources)
         self._K = K
-        self._values = K.data.copy()
+        coo = K.tocoo()
         self._diagonal = np.flatnonzero(coo.row == coo.col)   # column order
         self._solver = None
+        self.abs_A = abs(A)
         self.penalty = np.zeros(n)   # sigma + rho on each entry of x, set by factor
+        self.delta = DELTA   # the regularization factored, set by factor
 
     def factor(self, sigma: float, rho_vec: np.ndarray) -> int:
-        """Factor for ``sigma`` (on every entry of ``x``) and the penalties ``rho_vec`` on
-        the constrained entries; return the number of negative pivots.
+        """Factor for the current ``P`` and ``A``, ``sigma`` (on every entry of ``x``)
+        and the penalties ``rho_vec`` on the constrained entries; return the number of
+        negative pivots.
 
-        Raises :class:`FactorizationError` when ``qdldl`` meets a zero pivot.
+        A zero pivot is retried with ``BROKEN_DELTA``; :class:`FactorizationError` when
+        that meets one too.
         """
-        n = self.n
-        diagonal = self._values[self._diagonal]
+        n, upper = self.n, self._upper.shape[0]
+        gathered = self._gathered
+        gathered[:upper] = self.P.data[self._upper]
+        gathered[upper:upper + self.A.nnz] = self.A.data
+        K = self._K
+        np.take(gathered, self._source, out=K.data)
+        diagonal = K.data[self._diagonal]
         diagonal[:n] += sigma
         diagonal[self.constrained] += rho_vec
-        diagonal[n:] = -DELTA
-        K = self._K
-        K.data[:] = self._values
-        K.data[self._diagonal] = diagonal
-        try:
-            if self._solver is None:
-                self._solver = self._qdldl.Solver(K, upper=True)
-            else:
-                self._solver.update(K, upper=True)
-        except RuntimeError as exn:   # qdldl's report of a zero pivot
-            self._solver = None
-            raise FactorizationError(str(exn)) from exn
+        self.abs_A = abs(self.A)
+        for self.delta in (DELTA, BROKEN_DELTA):
+            diagonal[n:] = -self.delta
+            K.data[self._diagonal] = diagonal
+            try:
+                if self._solver is None:
+                    self._solver = self._qdldl.Solver(K, upper=True)
+                else:
+                    self._solver.update(K, upper=True)
+                break
+            except RuntimeError as exn:   # qdldl's report of a zero pivot
+                self._solver = None
+                if self.delta == BROKEN_DELTA:
+                    raise FactorizationError(str(exn)) from exn
         self.penalty = np.full(n, sigma)
         self.penalty[self.constrained] += rho_vec
         _, d, _ = self._solver.factors()
@@ -158,7 +186,7 @@ class SparseKKT:
                 sol = sol - step
                 for _ in range(REGULARIZED_STEPS):
                     sol = sol + self._solver.solve(
-                        self._residual(rhs, sol, self.A @ sol[:n], DELTA))
+                        self._residual(rhs, sol, self.A @ sol[:n], self.delta))
                 return sol
             last_error = error
             if r == MAX_REFINE:

@@ -1,4 +1,5 @@
 # cython: language_level=3
+from fccqp.matrices cimport Matrix
 
 cdef enum:
     # Codes of scan_and_copy's findings, turned into messages by fccqp.problem.
@@ -10,6 +11,7 @@ cdef enum:
     CROSSED = 5
     INFINITE_SIDE = 6
     TOO_LARGE = 7       # an entry beyond MAX_ENTRY
+    NEW_PATTERN = 8     # scan_and_copy_csc: P or A has another pattern than the workspace's
 
 cdef enum:
     # Codes of bound_kind.
@@ -27,4 +29,9 @@ cdef Finding scan_and_copy(const double* P, const double* q, const double* A, co
                            const double* lb, const double* ub, Py_ssize_t n, Py_ssize_t m,
                            double* P_out, double* q_out, double* A_out, double* b_out,
                            double* lb_out, double* ub_out, bint* same_matrices) noexcept nogil
+cdef Finding scan_and_copy_csc(const Matrix* P, const double* q, const Matrix* A,
+                               const double* b, const double* lb, const double* ub,
+                               Matrix* P_out, double* q_out, Matrix* A_out, double* b_out,
+                               double* lb_out, double* ub_out,
+                               bint* same_matrices) noexcept nogil
 cdef int bound_kind(double lb, double ub) noexcept nogil

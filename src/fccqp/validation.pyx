@@ -8,11 +8,15 @@ into the workspace's private copies (a caller may refill its arrays in place bef
 the next solve) and reports whether ``P`` and ``A`` equal the previous copies, which
 decides whether the scaling and the factorization can be reused. Bounds of magnitude
 ``INFINITE_BOUND`` or more are stored as infinite, as Clarabel's presolve does.
-The shape and type half lives in :mod:`fccqp.problem`.
+The shape and type half lives in :mod:`fccqp.problem`. :func:`scan_and_copy_csc` is
+the scan of compressed-column ``P`` and ``A`` (the sparse backend, issue 28; not yet on
+a solve's path).
 """
 
 from libc.math cimport INFINITY, fabs, isfinite, isnan
 
+from fccqp.matrices cimport Matrix
+from fccqp.matrix_ops cimport Held
 from fccqp.tuning cimport INFINITE_BOUND, MAX_ENTRY, SYMMETRY_TOLERANCE
 
 cdef extern from "fccqp_kernels.h" nogil:
@@ -89,6 +93,14 @@ cdef Finding scan_and_copy(const double* P, const double* q, const double* A, co
     f = _check_vector(b, b_out, m, 2)
     if f.code != SCAN_OK:
         return f
+    return _check_bounds(lb, ub, n, lb_out, ub_out)
+
+
+cdef inline Finding _check_bounds(const double* lb, const double* ub, Py_ssize_t n,
+                                  double* lb_out, double* ub_out) noexcept nogil:
+    """Check and copy the bounds (both storages' last step), magnitudes of
+    ``INFINITE_BOUND`` or more stored as infinite."""
+    cdef Py_ssize_t i
     for i in range(n):
         if isnan(lb[i]):
             return _found(NAN_BOUND, 3, i, lb[i])
@@ -103,6 +115,81 @@ cdef Finding scan_and_copy(const double* P, const double* q, const double* A, co
         lb_out[i] = lb[i] if lb[i] > -INFINITE_BOUND else -INFINITY
         ub_out[i] = ub[i] if ub[i] < INFINITE_BOUND else INFINITY
     return _found(SCAN_OK, -1, -1, 0.0)
+
+
+cdef Finding scan_and_copy_csc(const Matrix* P, const double* q, const Matrix* A,
+                               const double* b, const double* lb, const double* ub,
+                               Matrix* P_out, double* q_out, Matrix* A_out, double* b_out,
+                               double* lb_out, double* ub_out,
+                               bint* same_matrices) noexcept nogil:
+    """:func:`scan_and_copy` for ``P`` and ``A`` in compressed columns (issue 28): the
+    finding ``NEW_PATTERN`` when their patterns are not ``P_out``'s and ``A_out``'s (the
+    workspace's, fixed at allocation), else the same checks, copies, findings and
+    ``same_matrices`` as the dense scan, but for the symmetry of ``P``, which the
+    conversion to compressed columns checks and makes exact (``(P + P') / 2``)."""
+    cdef bint differs = False
+    cdef Finding f
+    if not (_same_pattern(P, P_out) and _same_pattern(A, A_out)):
+        return _found(NEW_PATTERN, -1, -1, 0.0)
+    if not _copy_entries(P, P_out, &differs):
+        return _first_bad_csc(P, -1)
+    if not _copy_entries(A, A_out, &differs):
+        return _first_bad_csc(A, 1)
+    same_matrices[0] = same_matrices[0] and not differs
+    f = _check_vector(q, q_out, P.cols, 0)
+    if f.code != SCAN_OK:
+        return f
+    f = _check_vector(b, b_out, A.rows, 2)
+    if f.code != SCAN_OK:
+        return f
+    return _check_bounds(lb, ub, P.cols, lb_out, ub_out)
+
+
+cdef bint _same_pattern(const Matrix* M, const Matrix* pattern) noexcept nogil:
+    cdef Py_ssize_t j, k
+    if M.rows != pattern.rows or M.cols != pattern.cols:
+        return False
+    for j in range(M.cols + 1):
+        if M.colptr[j] != pattern.colptr[j]:
+            return False
+    for k in range(M.colptr[M.cols]):
+        if M.rowind[k] != pattern.rowind[k]:
+            return False
+    return True
+
+
+cdef bint _copy_entries(const Matrix* M, Matrix* out, bint* differs) noexcept nogil:
+    """Copy ``M``'s entries into ``out`` (the same pattern); False when one is not
+    finite or exceeds ``MAX_ENTRY``. ``differs`` becomes True where an entry changed."""
+    cdef Py_ssize_t k
+    cdef double value
+    cdef bint good = True
+    for k in range(M.colptr[M.cols]):
+        value = M.values[k]
+        good = good and fabs(value) <= MAX_ENTRY   # False on NaN too
+        differs[0] = differs[0] or out.values[k] != value
+        out.values[k] = value
+    return good
+
+
+cdef Finding _first_bad_csc(const Matrix* M, int argument) noexcept nogil:
+    """The dense scan's finding for the bad entries of ``M`` (``argument`` -1 for ``P``,
+    1 for ``A``): the first in row order that is not finite (``P``) or bad at all
+    (``A``), else (``P``) its largest entry."""
+    cdef Py_ssize_t j, k, row = M.rows, col = M.cols
+    cdef double value, largest = 0.0, bad = 0.0
+    for j in range(M.cols):
+        for k in range(M.colptr[j], M.colptr[j + 1]):
+            value = M.values[k]
+            largest = max(largest, fabs(value))
+            if (not isfinite(value) or (argument >= 0 and fabs(value) > MAX_ENTRY)) and (
+                    M.rowind[k] < row or (M.rowind[k] == row and j < col)):
+                row, col, bad = M.rowind[k], j, value
+    if row < M.rows:
+        if argument < 0:
+            return _found(P_NOT_FINITE, -1, row, bad)
+        return _found(NOT_FINITE if not isfinite(bad) else TOO_LARGE, argument, row, bad)
+    return _found(TOO_LARGE, argument, 0, largest)
 
 
 cdef int bound_kind(double lb, double ub) noexcept nogil:
@@ -152,3 +239,23 @@ def structure_scan(const double[::1] lb, const double[::1] ub, const Py_ssize_t[
                 fixed[j] = is_fixed
             j += 1
     return j, changed or j != count, member
+
+
+def scan_and_copy_csc_py(P, q, A, b, lb, ub, P_previous, A_previous):
+    """:func:`scan_and_copy_csc` on ``scipy.sparse`` ``P, A`` against the workspace's
+    copies ``P_previous, A_previous`` (whose patterns are the workspace's); returns
+    ``(finding, same_matrices, P_copy, q, A_copy, b, lb, ub)``, the copies as written."""
+    import numpy as np
+    cdef Held Pi = Held(P), Ai = Held(A), Po = Held(P_previous), Ao = Held(A_previous)
+    cdef Py_ssize_t n = Pi.M.cols, m = Ai.M.rows
+    cdef double[::1] qi = np.append(np.asarray(q, dtype=np.float64), 0.0)
+    cdef double[::1] bi = np.append(np.asarray(b, dtype=np.float64), 0.0)
+    cdef double[::1] lbi = np.append(np.asarray(lb, dtype=np.float64), 0.0)
+    cdef double[::1] ubi = np.append(np.asarray(ub, dtype=np.float64), 0.0)
+    cdef double[::1] qo = np.zeros(n + 1), bo = np.zeros(m + 1)
+    cdef double[::1] lbo = np.zeros(n + 1), ubo = np.zeros(n + 1)
+    cdef bint same = True
+    cdef Finding f = scan_and_copy_csc(&Pi.M, &qi[0], &Ai.M, &bi[0], &lbi[0], &ubi[0], &Po.M,
+                                       &qo[0], &Ao.M, &bo[0], &lbo[0], &ubo[0], &same)
+    return ((f.code, f.argument, f.index, f.value), same, Po.matrix(), np.asarray(qo)[:n],
+            Ao.matrix(), np.asarray(bo)[:m], np.asarray(lbo)[:n], np.asarray(ubo)[:n])

@@ -19,7 +19,7 @@ from fccqp.engine cimport (DUAL_INFEASIBLE, INACCURATE, MAX_ITER, NUMERICAL_ERRO
                            PRIMAL_INFEASIBLE, RUNNING, SOLVED, TIME_LIMIT, Engine, Run,
                            fccqp_now)
 from fccqp.kkt cimport kkt_solve
-from fccqp.matrices cimport entry
+from fccqp.matrices cimport entry, zero_column
 from fccqp.termination cimport Residuals, converged, nearly_converged
 from fccqp.tuning cimport CLEANING_GATE, EQUALITY_MISSED, INACCURATE_FACTOR
 
@@ -242,11 +242,4 @@ cdef bint coordinate_ray(Engine* e) noexcept nogil:
 
 cdef bint _empty_column(const Problem* p, Py_ssize_t i) noexcept nogil:
     """Whether column ``i`` of ``P`` and of ``A`` is zero."""
-    cdef Py_ssize_t k
-    for k in range(p.n):
-        if entry(&p.P, k, i) != 0.0:
-            return False
-    for k in range(p.m):
-        if entry(&p.A, k, i) != 0.0:
-            return False
-    return True
+    return zero_column(&p.P, i) and zero_column(&p.A, i)

@@ -1,0 +1,5 @@
+# cython: language_level=3
+
+cdef int sparse_factor(void* handle, Py_ssize_t s, double sigma,
+                       const double* rho_vec) noexcept nogil
+cdef void sparse_solve(void* handle, Py_ssize_t N, const double* rhs, double* sol) noexcept nogil

@@ -1,0 +1,14 @@
+# cython: language_level=3
+from fccqp.engine cimport Engine
+
+
+cdef class Arrays:
+    cdef list kept
+    cdef double* new(self, Py_ssize_t size) except NULL
+    cdef void* new_int(self, Py_ssize_t size) except NULL
+    cdef double* adopt(self, object array) except NULL
+
+
+cdef void common_arrays(Arrays a, Engine* e, Py_ssize_t memory, Py_ssize_t log_rows) except *
+cdef void dense_arrays(Arrays a, Engine* e, Py_ssize_t* order) except *
+cdef object csc_arrays(Arrays a, Engine* e, object patterns, object constrained)

@@ -1,0 +1,219 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""The arrays of a :class:`fccqp.admm.Workspace`, one function per storage of ``P`` and
+``A`` (:mod:`fccqp.matrices`).
+
+Every array is allocated once per problem structure and lives with the workspace
+(:class:`Arrays`); the C state (:c:type:`fccqp.engine.Engine`) points into them.
+:func:`common_arrays` allocates what every storage needs (vectors of sizes ``n``,
+``m``, ``s``, ``n + m``, Anderson's memory, the log); :func:`dense_arrays` the
+matrices in row-major storage and everything sized by their products: the ``(n +
+m)^2`` LDL' matrix, the Schur factors, the reduced form's table and the restoration's
+columns (``(n + m) x s``), the polish's ``(n + m + s)^2`` matrix and its Schur and
+table forms, the certificate cleaning's ``A A'``; :func:`csc_arrays` the matrices in
+compressed columns, their ``SparseKKT`` and the polish's compressed-column arrays
+(:func:`fccqp.polish_csc.arrays`, its curvature terms included), and none of the
+dense-only arrays (their pointers stay NULL: the code that reads them does not run on
+compressed columns).
+On large_friction (5002 KKT rows) the dense set was 3.2 GB, the compressed one 8 MB.
+"""
+
+import numpy as np
+
+from fccqp.engine cimport Engine
+from fccqp.kkt cimport SPARSE_LDL
+from fccqp.matrices cimport csc, dense
+from fccqp.polish_csc cimport bind
+
+from fccqp.polish_csc import arrays as polish_arrays
+
+
+cdef class Arrays:
+    """The numpy arrays a workspace's C state points into, kept alive with it."""
+
+    def __init__(self):
+        self.kept = []
+
+    cdef double* new(self, Py_ssize_t size) except NULL:
+        """A zeroed array of ``size`` doubles (at least one)."""
+        return self.adopt(np.zeros(max(size, 1)))
+
+    cdef void* new_int(self, Py_ssize_t size) except NULL:
+        """A zeroed array of ``size`` pointer-sized integers (at least one)."""
+        array = np.zeros(max(size, 1), dtype=np.intp)
+        self.kept.append(array)
+        cdef Py_ssize_t[::1] view = array
+        return &view[0]
+
+    cdef double* adopt(self, object array) except NULL:
+        """Keep the float64 numpy ``array`` (at least one entry) and point into it."""
+        self.kept.append(array)
+        cdef double[::1] view = array
+        return &view[0]
+
+
+cdef void common_arrays(Arrays a, Engine* e, Py_ssize_t memory, Py_ssize_t log_rows) except *:
+    """The vectors of every storage, for ``e.prob``'s sizes (``n``, ``m``, ``s`` set)."""
+    cdef Py_ssize_t n = e.prob.n, m = e.prob.m, s = e.prob.s, N = n + m
+    cdef Py_ssize_t wide = max(n, m)
+    p = &e.prob
+    p.q, p.b = a.new(n), a.new(m)
+    p.lo, p.hi, p.D, p.E = a.new(s), a.new(s), a.new(n), a.new(m)
+    p.span = a.new(m)
+    p.c = 1.0
+    u = &e.user
+    u.q, u.b = a.new(n), a.new(m)
+    u.lb, u.ub = a.new(n), a.new(n)
+    e.fact.rho_scale = a.new(s)
+    u.entry_kind = <char*>a.new(n)
+    e.scaling.d, e.scaling.e = a.new(n), a.new(m)
+    e.scaling.reference, e.scaling.norms = a.new(N), a.new(N)
+    it = &e.it
+    it.x, it.nu, it.z, it.y = a.new(n), a.new(m), a.new(s), a.new(s)
+    it.x_prev, it.nu_prev = a.new(n), a.new(m)
+    it.z_prev, it.y_prev = a.new(s), a.new(s)
+    it.relaxed, it.rho_vec = a.new(s), a.new(s)
+    w = &e.work
+    w.rhs, w.sol = a.new(N), a.new(N)
+    w.vec_n, w.vec_n2, w.vec_n3 = a.new(wide), a.new(wide), a.new(wide)
+    w.vec_s, w.vec_s2, w.vec_m = a.new(s), a.new(s), a.new(m)
+    w.vec_m2 = a.new(m)
+    w.guess_point, w.guess_codes = a.new(s), <char*>a.new(s)
+    e.certs.direction, w.saved, e.certs.cert = a.new(n), a.new(N + s), a.new(N)
+    e.prev.x, e.prev.y, e.prev.z = a.new(n), a.new(m), a.new(n)
+    kk = &e.fact.kkt
+    kk.work = a.new(N)
+    red = &e.red
+    red.base = a.new(N)
+    red.u, red.u_prev, red.v, red.v_prev = a.new(s), a.new(s), a.new(s), a.new(s)
+    red.xs = a.new(s)
+    aa = &e.aa
+    aa.capacity = <int>memory
+    aa.dg, aa.df = a.new(memory * 2 * s), a.new(memory * 2 * s)
+    aa.g, aa.f, aa.g_new, aa.f_new = a.new(2 * s), a.new(2 * s), a.new(2 * s), a.new(2 * s)
+    aa.plain, aa.gram, aa.gamma = a.new(2 * s + 1), a.new(memory * memory), a.new(memory)
+    aa.products = a.new(memory * memory)
+    rs = &e.rest
+    rs.pinned = <char*>a.new(s)
+    rs.target, rs.projected = a.new(s), a.new(s)
+    rs.positions, rs.entries = <Py_ssize_t*>a.new_int(s), <Py_ssize_t*>a.new_int(s)
+    rs.step = a.new(s)
+    rs.start, rs.point = a.new(N), a.new(N)
+    pol = &e.pol
+    pol.active = <char*>a.new(s)
+    pol.dropped = <char*>a.new(s)
+    pol.index, pol.free = <Py_ssize_t*>a.new_int(n), <Py_ssize_t*>a.new_int(n)
+    pol.boundary = <Py_ssize_t*>a.new_int(s)
+    pol.g, pol.lam = a.new(s), a.new(s)
+    pol.ipiv = <int*>a.new_int(N + s)
+    pol.rhs, pol.step = a.new(N + s), a.new(N + s)
+    pol.x, pol.nu, pol.y = a.new(n), a.new(m), a.new(s)
+    pol.x_prev, pol.nu_prev = a.new(n), a.new(m)
+    pol.grad, pol.ATnu, pol.Ax = a.new(n), a.new(n), a.new(m)
+    pol.tpiv = <int*>a.new_int(2 * s)
+    pol.tr, pol.du = a.new(2 * s), a.new(2 * s)
+    pol.full, pol.dfull = a.new(N), a.new(N)
+    pol.schur_only = pol.schur_failed = False
+    ps = &pol.schur
+    ps.ready = False
+    ps.order, ps.coupled = <Py_ssize_t*>a.new_int(n), <char*>a.new(n)
+    ps.root = a.new(n)
+    ps.rowvar, ps.block_row = <Py_ssize_t*>a.new_int(n), <Py_ssize_t*>a.new_int(s)
+    ps.inv_root = a.new(n)
+    ps.t, ps.t2, ps.u = a.new(n), a.new(n), a.new(m + s)
+    e.unscaled.x, e.unscaled.y, e.unscaled.z = a.new(n), a.new(m), a.new(n)
+    e.log.capacity = log_rows
+    e.log.rows = a.new(5 * log_rows)
+    e.log.count = 0
+
+
+cdef void dense_arrays(Arrays a, Engine* e, Py_ssize_t* order) except *:
+    """Row-major ``P`` and ``A`` (scaled and the user's) and the arrays sized by their
+    products, for the dense backends (``order``: the Schur backend's base order)."""
+    cdef Py_ssize_t n = e.prob.n, m = e.prob.m, s = e.prob.s, N = n + m
+    p = &e.prob
+    p.P, p.A = dense(a.new(n * n), n, n), dense(a.new(m * n), m, n)
+    u = &e.user
+    u.P, u.A = dense(a.new(n * n), n, n), dense(a.new(m * n), m, n)
+    e.certs.gram = a.new(m * m)
+    kk = &e.fact.kkt
+    kk.sparse = NULL
+    kk.ldl.N = <int>N
+    kk.ldl.K = a.new(N * N)
+    kk.ldl.ipiv = <int*>a.new_int(N)
+    kk.ldl.lwork = <int>(64 * N)
+    kk.ldl.work, kk.ldl.residual = a.new(64 * N), a.new(N)
+    kk.ldl.Ax, kk.ldl.ATnu = a.new(m), a.new(n)
+    kk.schur.n, kk.schur.m = <int>n, <int>m
+    kk.schur.L, kk.schur.LS, kk.schur.Y = a.new(n * n), a.new(m * m), a.new(n * m)
+    kk.schur.G, kk.schur.free_ready = a.new(m * m), False
+    kk.schur.base_order = order
+    kk.schur.order = <Py_ssize_t*>a.new_int(n)
+    kk.schur.coupled = <char*>a.new(n)
+    kk.schur.dense = <int>n
+    kk.schur.perm, kk.schur.dx, kk.schur.r = a.new(n), a.new(n), a.new(n)
+    kk.schur.ATnu, kk.schur.dnu, kk.schur.Ax = a.new(n), a.new(m), a.new(m)
+    kk.schur.X, kk.schur.Wnu, kk.schur.M = a.new(n * s), a.new(m * s), a.new(s * s)
+    kk.R = a.new(N * s)
+    e.red.W, e.red.W_S = a.new(N * s), a.new(s * s)
+    e.rest.W_T, e.rest.gram = a.new(N * s), a.new(s * s)
+    pol = &e.pol
+    pol.hess = a.new(s * s)
+    pol.K = a.new((N + s) * (N + s))
+    pol.lwork = <int>(64 * (N + s))
+    pol.work = a.new(64 * (N + s))
+    pol.T = a.new(4 * s * s)
+    ps = &pol.schur
+    ps.L, ps.Y = a.new(n * n), a.new(n * (m + s))
+    ps.SU, ps.S = a.new(m * m), a.new((m + s) * (m + s))
+    ps.block = a.new(s * s)
+
+
+cdef Py_ssize_t* _index_copy(Arrays a, object values) except NULL:
+    """A private intp copy of ``values`` (at least one entry), kept with the workspace."""
+    cdef Py_ssize_t* out = <Py_ssize_t*>a.new_int(len(values))
+    cdef Py_ssize_t[::1] source = values
+    cdef Py_ssize_t k
+    for k in range(source.shape[0]):
+        out[k] = source[k]
+    return out
+
+
+cdef object csc_arrays(Arrays a, Engine* e, object patterns, object constrained):
+    """``P`` (its full symmetric pattern) and ``A`` in compressed columns, scaled and the
+    user's, over private copies of the ``patterns`` ``(P colptr, P rowind, A colptr, A
+    rowind)``, and the ``SPARSE_LDL`` backend's :class:`fccqp.sparse_kkt.SparseKKT`
+    over the scaled arrays (``constrained``: the intp array of the constrained
+    entries), and the polish's arrays (:func:`fccqp.polish_csc.arrays`, bound to
+    ``e.pol.csc``); returns the ``SparseKKT``, for the workspace to own. The dense-only
+    arrays stay NULL (the workspace's Engine starts zeroed)."""
+    import scipy.sparse as sp
+
+    from fccqp.sparse_kkt import SparseKKT
+
+    cdef Py_ssize_t n = e.prob.n, m = e.prob.m, k
+    P_colptr, P_rowind, A_colptr, A_rowind = (np.array(v, dtype=np.intp) for v in patterns)
+    cdef Py_ssize_t entries_P = P_colptr[n], entries_A = A_colptr[n]
+    cdef Py_ssize_t* pc = _index_copy(a, P_colptr)
+    cdef Py_ssize_t* pr = _index_copy(a, P_rowind)
+    cdef Py_ssize_t* ac = _index_copy(a, A_colptr)
+    cdef Py_ssize_t* ar = _index_copy(a, A_rowind)
+    P_scaled, A_scaled = np.zeros(max(entries_P, 1)), np.zeros(max(entries_A, 1))
+    p = &e.prob
+    p.P = csc(a.adopt(P_scaled), pc, pr, n, n)
+    p.A = csc(a.adopt(A_scaled), ac, ar, m, n)
+    u = &e.user
+    u.P = csc(a.new(entries_P), pc, pr, n, n)
+    u.A = csc(a.new(entries_A), ac, ar, m, n)
+    E = np.asarray(<double[:m]>p.E) if m else np.ones(0)
+    kkt = SparseKKT(sp.csc_matrix((P_scaled[:entries_P], P_rowind, P_colptr), shape=(n, n)),
+                    sp.csc_matrix((A_scaled[:entries_A], A_rowind, A_colptr), shape=(m, n)),
+                    constrained, E)
+    kk = &e.fact.kkt
+    kk.sparse = <void*>kkt
+    kk.backend = SPARSE_LDL
+    e.fact.form = SPARSE_LDL
+    held = polish_arrays(n, m, P_colptr, P_rowind, A_colptr, A_rowind,
+                         [p.cones.dim[k] for k in range(p.cones.count)])
+    a.kept.append(held)
+    bind(&e.pol.csc, held)
+    return kkt
