@@ -38,9 +38,12 @@ SPARSE_SEEDS = {
     "feasible": (0,),
     "solver_reuse": (38,),
     "extreme_data": (26,),
+    "qpsolvers": (100035,),
     "cvxpy": (7,),
 }
-"""Seeds per class run on the sparse path (each ends within a few dozen iterations)."""
+"""Seeds per class run on the sparse path (each ends within a few dozen iterations);
+``qpsolvers:100035`` is an LP that the compressed-column polish lost at
+``POLISH_CSC_DELTA = 1e-12`` (qdldl without pivoting)."""
 
 OPEN = {
     "cvxpy:1": "a feasible problem whose dual residual stalls near 0.8 in the LDL' forms "

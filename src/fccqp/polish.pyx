@@ -291,8 +291,7 @@ cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t n
         w.schur_failed = True
         return False
     if p.P.kind == CSC:
-        if not polish_csc_factor(&w.csc, p, nf, w.free, w.index, w.boundary, nb, w.g,
-                                 POLISH_DELTA):
+        if not polish_csc_factor(&w.csc, p, nf, w.free, w.index, w.boundary, nb, w.g):
             return False
     else:
         _assemble(w, p, nf, nb)

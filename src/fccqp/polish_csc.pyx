@@ -9,14 +9,17 @@
 
 (``F`` the free entries of ``x``, ``G`` one tangent-plane row per boundary cone block,
 ``H`` those blocks' curvature terms). On dense ``P`` and ``A`` it is assembled for
-``dsytrf`` (``polish._assemble``); here, where they are CSC
-(:mod:`fccqp.matrices`), the same matrix is assembled as the compressed columns of its
+``dsytrf`` (``polish._assemble``, ``delta = POLISH_DELTA``); here, where they are CSC
+(:mod:`fccqp.matrices`), the same blocks are assembled as the compressed columns of the
 upper triangle and factored by ``qdldl`` (its Python API, with the GIL: a call costs
 about 10 us, small beside a factorization of the sizes that take the sparse path).
 The matrix is quasi-definite (positive definite top-left block on a convex problem,
 ``-delta I`` below), so an LDL' factorization without pivoting exists in qdldl's
-fill-reducing order; its rounding grows like ``1 / delta``, which the polish's
-refinement against the unregularized system (``polish._solve``) removes.
+fill-reducing order; but without pivoting its rounding grows like ``1 / delta``, so
+``delta`` is ``POLISH_CSC_DELTA`` (1e-9, as the sparse backend's ``sparse_kkt.DELTA``)
+rather than the dense ``1e-12``: on an LP (``P = 0``: the top-left block is ``delta I``)
+1e-12 lost the solves of the fuzzer's ``qpsolvers:100035``, and the polish's refinement
+against the unregularized system (``polish._solve``) removes the larger bias.
 
 Column ``c < |F|`` of the upper triangle is column ``F_c`` of ``P`` restricted to the
 free rows up to the diagonal (``P``'s full symmetric pattern makes its columns its
@@ -39,6 +42,7 @@ import numpy as np
 
 from fccqp._types cimport Problem
 from fccqp.matrices cimport Matrix
+from fccqp.tuning cimport POLISH_CSC_DELTA
 
 
 cdef class _Factor:
@@ -209,13 +213,13 @@ cdef void _assemble_csc(PolishCSC* f, const Problem* p, Py_ssize_t nf,
 
 cdef bint polish_csc_factor(PolishCSC* f, const Problem* p, Py_ssize_t nf,
                             const Py_ssize_t* free, const Py_ssize_t* index,
-                            const Py_ssize_t* boundary, Py_ssize_t nb, const double* g,
-                            double delta) noexcept nogil:
+                            const Py_ssize_t* boundary, Py_ssize_t nb,
+                            const double* g) noexcept nogil:
     """Assemble and factor the regularized KKT matrix of the guess (free entries
     ``free[:nf]`` numbered by ``index``, boundary blocks ``boundary[:nb]`` with planes
     ``g`` as in :c:type:`fccqp.polish.Polish`, curvature in ``f.hess``); False when qdldl
     meets a zero pivot."""
-    _assemble_csc(f, p, nf, free, index, boundary, nb, g, delta)
+    _assemble_csc(f, p, nf, free, index, boundary, nb, g, POLISH_CSC_DELTA)
     with gil:
         return (<_Factor>f.factor).factor(nf + p.m + nb)
 

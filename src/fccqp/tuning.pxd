@@ -110,6 +110,8 @@ cdef extern from *:
     /* ---- Polish (fccqp.polish*, fccqp.iteration, fccqp.acceptance) ---- */
     /* regularization of both diagonal blocks of the polishing KKT matrix (scaled) */
     #define FCCQP_POLISH_DELTA 1e-12
+    /* the same for qdldl's factorization without pivoting (fccqp.polish_csc): 1e-12 lost LPs */
+    #define FCCQP_POLISH_CSC_DELTA 1e-9
     /* refine the returned point while the KKT residual > this max(1, ||q||, ||b||) */
     #define FCCQP_POLISH_REFINE_TOLERANCE 1e-14
     /* a guess's first solve is refined only to this: the next chord step repeats the work */
@@ -213,6 +215,7 @@ cdef extern from *:
     const double STALL_RHO_FACTOR "FCCQP_STALL_RHO_FACTOR"
     # Polish
     const double POLISH_DELTA "FCCQP_POLISH_DELTA"
+    const double POLISH_CSC_DELTA "FCCQP_POLISH_CSC_DELTA"
     const double POLISH_REFINE_TOLERANCE "FCCQP_POLISH_REFINE_TOLERANCE"
     const double GUESS_TOLERANCE "FCCQP_GUESS_TOLERANCE"
     const int GUESS_PASSES "FCCQP_GUESS_PASSES"
