@@ -2,7 +2,7 @@
 """Ruiz equilibration (:mod:`fccqp.scaling`, dense storage; :mod:`fccqp.scaling_csc`,
 compressed columns) and the two rules both storages share, inline here."""
 
-from libc.math cimport sqrt
+from libc.math cimport exp, log, sqrt
 
 from fccqp._types cimport Cones
 from fccqp.tuning cimport MAX_NORM, MIN_COST_NORM, MIN_NORM
@@ -14,6 +14,37 @@ cdef inline double inverse_sqrt_norm(double norm) noexcept nogil:
     if norm < MIN_NORM:
         return 1.0
     return 1.0 / sqrt(norm if norm < MAX_NORM else MAX_NORM)
+
+
+cdef inline bint ruiz_factors(double* D, double* E, double* d, double* e, Py_ssize_t n,
+                              Py_ssize_t m, const Py_ssize_t* block_start,
+                              const Py_ssize_t* block_dim, Py_ssize_t blocks) noexcept nogil:
+    """The end of a Ruiz pass, from the scaled columns' norms ``d`` and rows' norms
+    ``e``: each becomes its factor (:func:`inverse_sqrt_norm`), a cone block's columns
+    share the geometric mean of theirs (a cone stays a cone), and ``D``, ``E`` take
+    them. Returns whether a norm was capped at ``MAX_NORM``."""
+    cdef Py_ssize_t i, j, k, a, t
+    cdef double log_mean, value
+    cdef bint capped = False
+    for i in range(m):
+        capped = capped or e[i] > MAX_NORM
+        e[i] = inverse_sqrt_norm(e[i])
+    for j in range(n):
+        capped = capped or d[j] > MAX_NORM
+        d[j] = inverse_sqrt_norm(d[j])
+    for k in range(blocks):
+        a, t = block_start[k], block_start[k] + block_dim[k]
+        log_mean = 0.0
+        for j in range(a, t):
+            log_mean += log(d[j])
+        value = exp(log_mean / (t - a))
+        for j in range(a, t):
+            d[j] = value
+    for j in range(n):
+        D[j] *= d[j]
+    for i in range(m):
+        E[i] *= e[i]
+    return capped
 
 
 cdef inline double cost_scale(double mean_col, double q_norm) noexcept nogil:

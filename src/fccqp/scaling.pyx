@@ -17,7 +17,7 @@ cone: friction cones keep their ``mu`` and normal.
 
 import numpy as np
 
-from libc.math cimport exp, fabs, ilogb, ldexp, log
+from libc.math cimport fabs, ilogb, ldexp, log
 
 from fccqp._types cimport Cones
 from fccqp.projections cimport proj_set
@@ -60,8 +60,8 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
     once per pass and rescaled once at the end. ``block_start``/``block_dim`` give the
     cone blocks in ``x``; ``d`` and ``e`` are scratch of sizes ``n`` and ``m``.
     """
-    cdef Py_ssize_t it = 0, i, j, k, a, t, passes = iterations
-    cdef double value, log_mean
+    cdef Py_ssize_t it = 0, i, j, passes = iterations
+    cdef double value
     cdef const double* row
     cdef bint capped
     for j in range(n):
@@ -74,30 +74,12 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
         E[i] = ldexp(1.0, -ilogb(value)) if 0.0 < value < MIN_NORM else 1.0
     while it < passes:
         it += 1
-        capped = False
         # the columns' norms into d, the rows' into e (in four lanes: a running maximum
         # does not vectorize by itself)
         fccqp_ruiz_maxima(P, A, <int>n, <int>m, D, E, d, e)
-        for i in range(m):
-            capped = capped or e[i] > MAX_NORM
-            e[i] = inverse_sqrt_norm(e[i])
-        for j in range(n):
-            capped = capped or d[j] > MAX_NORM
-            d[j] = inverse_sqrt_norm(d[j])
+        capped = ruiz_factors(D, E, d, e, n, m, block_start, block_dim, blocks)
         if capped and passes < iterations + CAPPED_PASSES:
             passes += 1
-        for k in range(blocks):
-            a, t = block_start[k], block_start[k] + block_dim[k]
-            log_mean = 0.0
-            for j in range(a, t):
-                log_mean += log(d[j])
-            value = exp(log_mean / (t - a))
-            for j in range(a, t):
-                d[j] = value
-        for j in range(n):
-            D[j] *= d[j]
-        for i in range(m):
-            E[i] *= e[i]
     if m > 0 and passes > 0:
         _gauge(P, D, E, n, m)
     for i in range(n):

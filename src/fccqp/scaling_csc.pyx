@@ -12,11 +12,11 @@ functions' to the bit (``tests/test_scaling_csc.py`` holds them to it). ``scale_
 
 import numpy as np
 
-from libc.math cimport exp, fabs, ilogb, ldexp, log
+from libc.math cimport fabs, ilogb, ldexp, log
 
 from fccqp.matrices cimport Matrix
 from fccqp.matrix_ops cimport Held
-from fccqp.scaling cimport cost_scale, inverse_sqrt_norm
+from fccqp.scaling cimport cost_scale, inverse_sqrt_norm, ruiz_factors
 from fccqp.tuning cimport CAPPED_PASSES, GAUGE_LIMIT, MAX_NORM, MIN_NORM, RESCALE_DRIFT
 
 
@@ -27,8 +27,8 @@ cdef double equilibrate_csc(Matrix* P, double* q, Matrix* A, double* b,
     """:func:`fccqp.scaling.equilibrate` on compressed columns: scale ``P, q, A, b`` in
     place, fill ``D`` and ``E``, return the cost scale ``c``; ``d`` and ``e`` are
     scratch of sizes ``n`` and ``m``."""
-    cdef Py_ssize_t n = P.cols, m = A.rows, it = 0, i, j, k, a, t, passes = iterations
-    cdef double value, log_mean, norm
+    cdef Py_ssize_t n = P.cols, m = A.rows, it = 0, i, j, k, passes = iterations
+    cdef double value, norm
     cdef bint capped
     for j in range(n):
         D[j] = 1.0
@@ -39,7 +39,6 @@ cdef double equilibrate_csc(Matrix* P, double* q, Matrix* A, double* b,
         E[i] = ldexp(1.0, -ilogb(value)) if 0.0 < value < MIN_NORM else 1.0
     while it < passes:
         it += 1
-        capped = False
         for j in range(n):
             norm = 0.0
             for k in range(P.colptr[j], P.colptr[j + 1]):
@@ -54,26 +53,10 @@ cdef double equilibrate_csc(Matrix* P, double* q, Matrix* A, double* b,
                 d[j] = max(d[j], value * E[i])
                 e[i] = max(e[i], value)
         for i in range(m):
-            norm = e[i] * E[i]
-            capped = capped or norm > MAX_NORM
-            e[i] = inverse_sqrt_norm(norm)
-        for j in range(n):
-            capped = capped or d[j] > MAX_NORM
-            d[j] = inverse_sqrt_norm(d[j])
+            e[i] *= E[i]
+        capped = ruiz_factors(D, E, d, e, n, m, block_start, block_dim, blocks)
         if capped and passes < iterations + CAPPED_PASSES:
             passes += 1
-        for k in range(blocks):
-            a, t = block_start[k], block_start[k] + block_dim[k]
-            log_mean = 0.0
-            for j in range(a, t):
-                log_mean += log(d[j])
-            value = exp(log_mean / (t - a))
-            for j in range(a, t):
-                d[j] = value
-        for j in range(n):
-            D[j] *= d[j]
-        for i in range(m):
-            E[i] *= e[i]
     if m > 0 and passes > 0:
         _gauge(P, D, E, n, m)
     for j in range(n):
