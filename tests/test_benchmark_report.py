@@ -101,9 +101,11 @@ def test_the_report_shows_each_figure_once_whatever_the_table(report):
     assert _cells(text, "fccqp-realtime", default)[-1] == torque
     target = _cells(text, "solo12 | fccqp-realtime torque error p95 <= 5 % of the joint limit")[2]
     assert target.startswith(f"p95 {torque}")
-    # And the figure is the documented method applied to results.csv.
+    # And the figure is the documented method applied to results.csv, whose four
+    # significant digits are 5e-4 of the figure at worst (a p95 of 22076 us read back
+    # as 22080 on a loaded machine)
     assert float(p95_time) == pytest.approx(
-        1e6 * _from_csv(rows, "fccqp-realtime", "warm", "time", 95), abs=1.0)
+        1e6 * _from_csv(rows, "fccqp-realtime", "warm", "time", 95), rel=5e-4, abs=1.0)
     assert float(torque.split()[0]) == pytest.approx(
         100 * _from_csv(rows, "fccqp-realtime", "warm", "torque_error_rel", 95), rel=0.05)
 
