@@ -2,10 +2,10 @@
 """Ruiz equilibration (:mod:`fccqp.scaling`, dense storage; :mod:`fccqp.scaling_csc`,
 compressed columns) and the two rules both storages share, inline here."""
 
-from libc.math cimport exp, log, sqrt
+from libc.math cimport exp, ldexp, log, sqrt
 
 from fccqp._types cimport Cones
-from fccqp.tuning cimport MAX_NORM, MIN_COST_NORM, MIN_NORM
+from fccqp.tuning cimport GAUGE_LIMIT, MAX_NORM, MIN_COST_NORM, MIN_NORM
 
 
 cdef inline double inverse_sqrt_norm(double norm) noexcept nogil:
@@ -45,6 +45,40 @@ cdef inline bint ruiz_factors(double* D, double* E, double* d, double* e, Py_ssi
     for i in range(m):
         E[i] *= e[i]
     return capped
+
+
+cdef inline bint gauge_shift(const double* D, Py_ssize_t n, double* shift) noexcept nogil:
+    """Whether the gauge applies (see :func:`gauge_apply`): ``D``'s geometric mean is
+    below ``1 / GAUGE_LIMIT``; ``shift`` receives minus its logarithm."""
+    cdef Py_ssize_t j
+    cdef double log_mean = 0.0
+    for j in range(n):
+        log_mean += log(D[j])
+    log_mean /= n
+    shift[0] = -log_mean
+    return log_mean < -log(GAUGE_LIMIT)
+
+
+cdef inline void gauge_apply(double* D, double* E, Py_ssize_t n, Py_ssize_t m, double shift,
+                             double largest) noexcept nogil:
+    """Ruiz leaves ``(D t, E / t)`` free: ``E A D`` is the same for every ``t``. Rows of
+    ``A`` 1e15 times the rest split that size between ``E`` and ``D`` (about 1e-7.5
+    each): the scaled variables were then 1e7 and the cost 1e-7 (``D q``, ``D P D`` of
+    1e-15), and OSQP's rule drove rho to ``RHO_MIN`` and the run stalled (six feasible
+    fuzz problems). Where :func:`gauge_shift` says so, ``t`` (a power of two, exact)
+    moves ``D`` toward 1 by ``shift`` as far as ``D P D``, whose largest entry is
+    ``largest``, stays at most 1."""
+    cdef Py_ssize_t i, j
+    cdef int exponent
+    if largest > 0.0:
+        shift = min(shift, -0.5 * log(largest))
+    exponent = <int>(shift / log(2.0))
+    if exponent <= 0:
+        return
+    for j in range(n):
+        D[j] = ldexp(D[j], exponent)
+    for i in range(m):
+        E[i] = ldexp(E[i], -exponent)
 
 
 cdef inline double cost_scale(double mean_col, double q_norm) noexcept nogil:

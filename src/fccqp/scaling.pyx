@@ -21,7 +21,7 @@ from libc.math cimport fabs, ilogb, ldexp, log
 
 from fccqp._types cimport Cones
 from fccqp.projections cimport proj_set
-from fccqp.tuning cimport CAPPED_PASSES, GAUGE_LIMIT, RESCALE_DRIFT
+from fccqp.tuning cimport CAPPED_PASSES, RESCALE_DRIFT
 
 cdef extern from "fccqp_kernels.h" nogil:
     void fccqp_scale_rows(const double* M, int rows, int cols, const double* left,
@@ -96,33 +96,15 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
 
 cdef void _gauge(const double* P, double* D, double* E, Py_ssize_t n,
                  Py_ssize_t m) noexcept nogil:
-    """Ruiz leaves ``(D t, E / t)`` free: ``E A D`` is the same for every ``t``. Rows of
-    ``A`` 1e15 times the rest split that size between ``E`` and ``D`` (about 1e-7.5
-    each): the scaled variables were then 1e7 and the cost 1e-7 (``D q``, ``D P D`` of
-    1e-15), and OSQP's rule drove rho to ``RHO_MIN`` and the run stalled (six feasible
-    fuzz problems). When ``D``'s geometric mean is below ``1 / GAUGE_LIMIT``, ``t`` (a
-    power of two, exact) moves it toward 1 as far as ``D P D`` stays at most 1."""
+    """The gauge of ``D`` (:func:`fccqp.scaling.gauge_apply` says why) on dense ``P``."""
     cdef Py_ssize_t i, j
-    cdef double log_mean = 0.0, largest = 0.0, shift
-    cdef int exponent
-    for j in range(n):
-        log_mean += log(D[j])
-    log_mean /= n
-    if not log_mean < -log(GAUGE_LIMIT):
+    cdef double largest = 0.0, shift
+    if not gauge_shift(D, n, &shift):
         return
-    shift = -log_mean
     for i in range(n):
         for j in range(n):
             largest = max(largest, fabs(P[i * n + j]) * D[i] * D[j])
-    if largest > 0.0:
-        shift = min(shift, -0.5 * log(largest))
-    exponent = <int>(shift / log(2.0))
-    if exponent <= 0:
-        return
-    for j in range(n):
-        D[j] = ldexp(D[j], exponent)
-    for i in range(m):
-        E[i] = ldexp(E[i], -exponent)
+    gauge_apply(D, E, n, m, shift, largest)
 
 
 cdef double _normalize_cost(double* P, double* q, Py_ssize_t n, double* ones) noexcept nogil:

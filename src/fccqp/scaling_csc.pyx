@@ -16,8 +16,9 @@ from libc.math cimport fabs, ilogb, ldexp, log
 
 from fccqp.matrices cimport Matrix
 from fccqp.matrix_ops cimport Held
-from fccqp.scaling cimport cost_scale, inverse_sqrt_norm, ruiz_factors
-from fccqp.tuning cimport CAPPED_PASSES, GAUGE_LIMIT, MAX_NORM, MIN_NORM, RESCALE_DRIFT
+from fccqp.scaling cimport (cost_scale, gauge_apply, gauge_shift, inverse_sqrt_norm,
+                            ruiz_factors)
+from fccqp.tuning cimport CAPPED_PASSES, MAX_NORM, MIN_NORM, RESCALE_DRIFT
 
 
 cdef double equilibrate_csc(Matrix* P, double* q, Matrix* A, double* b,
@@ -84,28 +85,16 @@ cdef void _row_maxima(const Matrix* A, const double* weight, double* out) noexce
 
 cdef void _gauge(const Matrix* P, double* D, double* E, Py_ssize_t n,
                  Py_ssize_t m) noexcept nogil:
-    """:func:`fccqp.scaling._gauge` (why: see there) on compressed columns."""
-    cdef Py_ssize_t i, j, k
-    cdef double log_mean = 0.0, largest = 0.0, shift
-    cdef int exponent
-    for j in range(n):
-        log_mean += log(D[j])
-    log_mean /= n
-    if not log_mean < -log(GAUGE_LIMIT):
+    """The gauge of ``D`` (:func:`fccqp.scaling.gauge_apply` says why) on compressed
+    columns."""
+    cdef Py_ssize_t j, k
+    cdef double largest = 0.0, shift
+    if not gauge_shift(D, n, &shift):
         return
-    shift = -log_mean
     for j in range(n):
         for k in range(P.colptr[j], P.colptr[j + 1]):
             largest = max(largest, fabs(P.values[k]) * D[P.rowind[k]] * D[j])
-    if largest > 0.0:
-        shift = min(shift, -0.5 * log(largest))
-    exponent = <int>(shift / log(2.0))
-    if exponent <= 0:
-        return
-    for j in range(n):
-        D[j] = ldexp(D[j], exponent)
-    for i in range(m):
-        E[i] = ldexp(E[i], -exponent)
+    gauge_apply(D, E, n, m, shift, largest)
 
 
 cdef void _row_norms(const Matrix* P, double* out) noexcept nogil:
