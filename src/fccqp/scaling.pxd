@@ -5,7 +5,7 @@ compressed columns) and the two rules both storages share, inline here."""
 from libc.math cimport exp, ldexp, log, sqrt
 
 from fccqp._types cimport Cones
-from fccqp.tuning cimport GAUGE_LIMIT, MAX_NORM, MIN_COST_NORM, MIN_NORM
+from fccqp.tuning cimport GAUGE_LIMIT, MAX_NORM, MIN_COST_NORM, MIN_NORM, RESCALE_DRIFT
 
 
 cdef inline double inverse_sqrt_norm(double norm) noexcept nogil:
@@ -79,6 +79,18 @@ cdef inline void gauge_apply(double* D, double* E, Py_ssize_t n, Py_ssize_t m, d
         D[j] = ldexp(D[j], exponent)
     for i in range(m):
         E[i] = ldexp(E[i], -exponent)
+
+
+cdef inline bint within_drift(const double* norms, const double* reference,
+                              Py_ssize_t count) noexcept nogil:
+    """Whether every norm of a rescaled problem is within ``RESCALE_DRIFT`` of the
+    equilibrated one's (``reference``), either way: :func:`rescale`'s verdict."""
+    cdef Py_ssize_t i
+    for i in range(count):
+        if not (norms[i] <= RESCALE_DRIFT * reference[i]
+                and reference[i] <= RESCALE_DRIFT * norms[i]):
+            return False
+    return True
 
 
 cdef inline double cost_scale(double mean_col, double q_norm) noexcept nogil:

@@ -21,7 +21,7 @@ from libc.math cimport fabs, ilogb, ldexp, log
 
 from fccqp._types cimport Cones
 from fccqp.projections cimport proj_set
-from fccqp.tuning cimport CAPPED_PASSES, RESCALE_DRIFT
+from fccqp.tuning cimport CAPPED_PASSES
 
 cdef extern from "fccqp_kernels.h" nogil:
     void fccqp_scale_rows(const double* M, int rows, int cols, const double* left,
@@ -184,11 +184,7 @@ cdef bint rescale(const double* P, const double* q, const double* A, const doubl
         fccqp_scale_rows(A, <int>m, <int>n, E, D, A_s, norms + n, norms)
     for i in range(m):
         b_s[i] = b[i] * E[i]
-    for i in range(n + m):
-        if not (norms[i] <= RESCALE_DRIFT * reference[i]
-                and reference[i] <= RESCALE_DRIFT * norms[i]):
-            return False
-    return True
+    return within_drift(norms, reference, n + m)
 
 
 cdef void scale_start(const double* x, const double* y, const double* z, double rho,

@@ -17,8 +17,8 @@ from libc.math cimport fabs, ilogb, ldexp, log
 from fccqp.matrices cimport Matrix
 from fccqp.matrix_ops cimport Held
 from fccqp.scaling cimport (cost_scale, gauge_apply, gauge_shift, inverse_sqrt_norm,
-                            ruiz_factors)
-from fccqp.tuning cimport CAPPED_PASSES, MAX_NORM, MIN_NORM, RESCALE_DRIFT
+                            ruiz_factors, within_drift)
+from fccqp.tuning cimport CAPPED_PASSES, MAX_NORM, MIN_NORM
 
 
 cdef double equilibrate_csc(Matrix* P, double* q, Matrix* A, double* b,
@@ -181,11 +181,7 @@ cdef bint rescale_csc(const Matrix* P, const double* q, const Matrix* A, const d
             norms[j] = max(norms[j], size)
     for i in range(m):
         b_s[i] = b[i] * E[i]
-    for i in range(n + m):
-        if not (norms[i] <= RESCALE_DRIFT * reference[i]
-                and reference[i] <= RESCALE_DRIFT * norms[i]):
-            return False
-    return True
+    return within_drift(norms, reference, n + m)
 
 
 cdef inline double* _ptr(double[::1] v) noexcept:
