@@ -53,6 +53,13 @@ and ``A`` another pattern: the caller rescans them
 NOT_DENSE = -4
 """An input array is not a C-contiguous float64 numpy array of the workspace's shape
 (:meth:`Workspace.solve` with ``checked=False``): the caller converts the arguments."""
+
+cdef enum:
+    # Workspace.doubt's bits
+    PRIMAL_LENT = 1
+    DUAL_LENT = 2
+DOUBT_PRIMAL, DOUBT_DUAL = PRIMAL_LENT, DUAL_LENT
+"""``Workspace.doubt``'s bits: the set test, the dual test passed on lent tolerances."""
 STATUS_BY_CODE = {
     SOLVED: Status.SOLVED,
     SOLVED_INACCURATE: Status.SOLVED_INACCURATE,
@@ -86,6 +93,12 @@ cdef class Workspace:
     cdef object _sparse_kkt   # SPARSE_LDL's SparseKKT, which e.fact.kkt.sparse points to
     cdef readonly bint compressed
     """``P`` and ``A`` are held in compressed columns (the sparse backend)."""
+    cdef readonly int doubt
+    """The last result is solved or inaccurate only on tolerances its entries' own units
+    do not give it: ``DOUBT_PRIMAL`` (a cone block or box entry off C by more than
+    ``eps_abs + eps_rel`` times its own size), plus ``DOUBT_DUAL`` (the cost's terms below
+    ``eps_abs``, where any point passes the dual test); 0 otherwise (see ``acceptance.user_residuals``). Then
+    :class:`fccqp.Solver` asks the auxiliary QPs for a certificate."""
 
     def __init__(self, Py_ssize_t n, Py_ssize_t m, constrained, cones, fixed, order,
                  settings, Py_ssize_t log_rows, patterns=None):
@@ -302,6 +315,9 @@ cdef class Workspace:
         ``Result.certificate`` for the infeasible statuses)."""
         cdef Residuals* r = &self.e.res
         certificate = None
+        self.doubt = 0
+        if run.status == engine.SOLVED or run.status == engine.INACCURATE:
+            self.doubt = (PRIMAL_LENT if r.set_lent else 0) + (DUAL_LENT if r.dual_lent else 0)
         if run.status == engine.PRIMAL_INFEASIBLE:
             certificate = cert_out.copy()
         elif run.status == engine.DUAL_INFEASIBLE:

@@ -253,12 +253,14 @@ def _farkas_tolerances(settings: object, w: np.ndarray) -> object:
 
 def stalled_certificate(solver_type: type, settings: object, workspace: object,
                         P: object, q: object, A: object, b: object, lb: object,
-                        ub: object, cones: object) -> tuple | None:
+                        ub: object, cones: object, primal: bool = True,
+                        dual: bool = True) -> tuple | None:
     """``(status, certificate, iterations, factorizations)`` for a run that stalled on
-    this problem in ``workspace``, or None: the primal certificate of the least
-    distance (when there are rows and constrained entries), else the dual one of the
-    projection onto the rays, each judged by ``workspace`` (sparse QPs when it holds
-    compressed columns). The auxiliary solves use
+    this problem in ``workspace`` (or whose point passed on lent tolerances,
+    :attr:`fccqp.admm.Workspace.doubt`), or None: with ``primal``, the primal
+    certificate of the least distance (when there are rows and constrained entries),
+    else with ``dual`` the dual one of the projection onto the rays, each judged by
+    ``workspace`` (sparse QPs when it holds compressed columns). The auxiliary solves use
     ``settings`` in a ``solver_type`` (:func:`_auxiliary_solver`), in a second form
     when the first did not solve them (:func:`_solved`)."""
     q = np.asarray(q, dtype=np.float64).reshape(-1)
@@ -272,7 +274,7 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
     cones = cone_tuple(cones or ())
     spent = factored = 0
     try:
-        if m > 0:
+        if primal and m > 0:
             problem, S = distance_problem(A, b, lb, ub, cones)
             if S.size and _affordable(problem):
                 result, spent, factored = _solved(solver_type, settings, problem)
@@ -287,6 +289,8 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
                     found = _farkas(workspace, result, b, lb, ub, S)
                 if found is not None:
                     return Status.PRIMAL_INFEASIBLE, found, spent, factored
+        if not dual:
+            return None
         rays = ray_problem(P, q, A, lb, ub, cones)
         if not np.any(q) or not _affordable(rays):
             return None

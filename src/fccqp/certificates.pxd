@@ -17,7 +17,8 @@ cdef int equality_inconsistent(const Problem* p, const Iterates* it, double eps,
 cdef int equality_direction(const Problem* p, const double* r, const double* x, double eps,
                             double* ATr, double* terms, double* sizes) noexcept nogil
 cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double* Pdx,
-                          double* terms, double* block) noexcept nogil
+                          double* terms, double* block, double* weights,
+                          double* rows) noexcept nogil
 cdef void row_sizes(const Problem* p, const double* x, double* t, double* sizes) noexcept nogil
 cdef bint gram_factor(const Problem* p, double* gram) noexcept nogil
 cdef bint clean_primal_certificate(const Problem* p, const double* x, const double* gram,

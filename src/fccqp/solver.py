@@ -188,7 +188,7 @@ class Solver:
             out = w.solve(P, q, A, b, lb, ub, None, settings.warm_start, start,
                           structure.certificate, False)
             if (type(out) is Result and not settings.verbose
-                    and out.status is not Status.MAX_ITER_REACHED):
+                    and out.status is not Status.MAX_ITER_REACHED and not w.doubt):
                 return out
             if type(out) is Result or out != admm.NOT_DENSE:
                 return self._result(out, P, q, A, b, lb, ub, None, start)
@@ -241,6 +241,9 @@ class Solver:
         if (out.status is Status.MAX_ITER_REACHED and self._stalled_certificates
                 and not math.isfinite(settings.time_limit)):
             out = self._stalled(out, w, (P, q, A, b, lb, ub), self._cones, start)
+        elif (w.doubt and self._stalled_certificates
+              and not math.isfinite(settings.time_limit)):
+            out = self._doubted(out, w, (P, q, A, b, lb, ub), self._cones, start)
         if settings.verbose:
             _print_log(w.log_lines, out)
         return out
@@ -270,17 +273,26 @@ class Solver:
                     "factorizations": out.factorizations + again.factorizations,
                     "solve_time": time.perf_counter() - start,
                 })
-        if found is None:
-            return out
-        status, certificate, iterations, factorizations = found
-        workspace.forget()
-        return Result._of({
-            **out.__dict__, "status": status, "certificate": certificate,
-            "iterations": out.iterations + iterations,
-            "factorizations": out.factorizations + factorizations,
-            "gap": float("nan"), "polished": False,
-            "solve_time": time.perf_counter() - start,
-        })
+        return out if found is None else _certified(out, found, workspace, start)
+
+    def _doubted(self, out: Result, workspace: admm.Workspace, arguments: tuple,
+                 cones: object, start: float) -> Result:
+        """``out``, solved or inaccurate on tolerances that its entries' own units do
+        not give it (:attr:`fccqp.admm.Workspace.doubt`), or the certificate that
+        :func:`fccqp.auxiliary.stalled_certificate` finds for the problem instead: the
+        primal one when the set test was lent, the dual one when the dual test was.
+
+        Such a point meets the tolerances as documented, and the problem may still have
+        no solution: cones pinned outside their sum by 1e-3 of their size beside an
+        entry of 6.3e6, a ray whose descent ``q`` of 1e-9 lies below ``eps_abs`` (fuzz
+        extreme_data 1182, 489). A certificate is judged relative to the data, not in
+        its units, and proves that no point is a solution: it wins. Without a time
+        limit only, as for a stalled run; a feasible, bounded problem keeps ``out``."""
+        found = auxiliary.stalled_certificate(
+            Solver, self._settings, workspace, *arguments, cones,
+            primal=bool(workspace.doubt & admm.DOUBT_PRIMAL),
+            dual=bool(workspace.doubt & admm.DOUBT_DUAL))
+        return out if found is None else _certified(out, found, workspace, start)
 
     def _adopt(self, structure: _Structure) -> admm.Workspace:
         """Make ``structure`` and a workspace for it current, keeping the current one
@@ -332,6 +344,10 @@ class Solver:
                 and not math.isfinite(settings.time_limit)):
             out = self._stalled(out, w, (data.P, data.q, data.A, data.b, data.lb, data.ub),
                                 cones, start)
+        elif (w.doubt and self._stalled_certificates
+              and not math.isfinite(settings.time_limit)):
+            out = self._doubted(out, w, (data.P, data.q, data.A, data.b, data.lb, data.ub),
+                                cones, start)
         if settings.verbose:
             _print_log(w.log_lines, out)
         return out
@@ -356,6 +372,22 @@ class Solver:
         workspace = self._sparse[1]
         workspace.update_cones(cones.mu, cones.normal)
         return workspace
+
+
+def _certified(out: Result, found: tuple, workspace: admm.Workspace, start: float) -> Result:
+    """``out`` with the certificate ``found`` (``(status, certificate, iterations,
+    factorizations)`` of :func:`fccqp.auxiliary.stalled_certificate`) as its status, the
+    auxiliary solves' counts added; ``workspace`` forgets its point, as after an
+    infeasible run."""
+    status, certificate, iterations, factorizations = found
+    workspace.forget()
+    return Result._of({
+        **out.__dict__, "status": status, "certificate": certificate,
+        "iterations": out.iterations + iterations,
+        "factorizations": out.factorizations + factorizations,
+        "gap": float("nan"), "polished": False,
+        "solve_time": time.perf_counter() - start,
+    })
 
 
 def _rows(matrix: object) -> int:

@@ -15,6 +15,10 @@ cdef struct Residuals:
     double set_s, set_scale_s   # x_S - w and the size of x_S, w in scaled units, uncapped
     double box_excess           # box entries: largest |x_i - w_i| - SCALED_VIOLATION x size
                                 # (box_entry_size), in scaled units
+    bint set_lent, dual_lent    # the returned point's (acceptance.user_residuals): a cone
+                                # block or box entry misses C by more than eps_abs + eps_rel
+                                # x its own size (user's or scaled units); the dual residual
+                                # passes only through eps_abs
     bint finite
 
 cdef void residuals(const Problem* p, const Iterates* it, double* Ax, double* ATnu,

@@ -96,6 +96,8 @@ cdef extern from *:
     #define FCCQP_CLEANING_PASSES 30
     /* largest shift of a cleaning step on the box's support, relative to ||d_y|| */
     #define FCCQP_CLEANING_SHRINK 0.1
+    /* the dual certificate's second balance bounds its column norms to 1/this..this */
+    #define FCCQP_BALANCE_RANGE 1e8
     /* added to A A''s diagonal, relative to its largest entry, for dependent rows */
     #define FCCQP_GRAM_REGULARIZATION 1e-12
     /* no certificate is cleaned before this many iterations (doubling after each failure) */
@@ -206,6 +208,7 @@ cdef extern from *:
     # Infeasibility certificates
     const double SEPARATION_FLOOR "FCCQP_SEPARATION_FLOOR"
     const double DOMINANCE "FCCQP_DOMINANCE"
+    const double BALANCE_RANGE "FCCQP_BALANCE_RANGE"
     const int CLEANING_PASSES "FCCQP_CLEANING_PASSES"
     const double CLEANING_SHRINK "FCCQP_CLEANING_SHRINK"
     const double GRAM_REGULARIZATION "FCCQP_GRAM_REGULARIZATION"

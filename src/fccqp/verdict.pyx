@@ -159,7 +159,7 @@ cdef bint unbounded(Engine* e) noexcept nogil:
     cdef Problem* p = &e.prob
     cdef Py_ssize_t i
     if not dual_infeasible(p, e.certs.direction, e.opt.eps_dual_inf, e.work.vec_n,
-                           e.work.vec_n2, e.work.vec_s2):
+                           e.work.vec_n2, e.work.vec_s2, e.work.vec_n3, e.work.vec_m2):
         return False
     for i in range(p.n):
         e.certs.cert[i] = e.certs.direction[i] * p.D[i]
