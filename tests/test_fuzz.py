@@ -25,14 +25,16 @@ SEEDS = {
     "solver_reuse": (0, 1, 2, 50, 164, 211, 100008, 100206, 500061, 700137),
     "extreme_data": (0, 1, 7, 9, 38, 47, 56, 108, 138, 149, 202, 214, 254, 302, 308, 316,
                      311, 326, 335, 337, 355, 363, 365, 489, 1182, 2244, 100082, 100180, 100213,
-                     100228, 100233, 500030, 500064, 500099, 500322, 700281, 900343, 900360),
+                     100228, 100233, 500030, 500064, 500099, 500322, 700281, 900343, 900360,
+                     1100037, 1100057, 1100253),
     "qpsolvers": (0, 1, 2),
     "cvxpy": (1, 2, 3),
 }
 """Seeds per class run on every dense backend: a passing case or two per class and the
 reproducers of the failure mechanisms the campaign found at ed3b90e, 836ab4b, 5f3a658,
 16f1696 and 206a4f0 (seeds from 100000, and extreme_data 489, 1182, 2244 of the deep
-``--classes extreme_data`` run; issue 26)."""
+``--classes extreme_data`` run; 1100037, 1100057, 1100253 are the same mechanisms on a
+seed unseen by their fix; issue 26)."""
 
 SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),
