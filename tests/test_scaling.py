@@ -8,7 +8,14 @@ from fccqp.scaling import rescale_py as rescale
 from fccqp.scaling import scale_start_py as scale_start
 from fccqp.scaling import scaled_norms_py as scaled_norms
 from fccqp.scaling import unscale_py as unscale
-from fccqp.tuning import CAPPED_PASSES, GAUGE_LIMIT, MAX_NORM, MIN_NORM, RESCALE_DRIFT
+from fccqp.tuning import (
+    CAPPED_PASSES,
+    GAUGE_LIMIT,
+    MAX_NORM,
+    MIN_NORM,
+    RESCALE_DRIFT,
+    SPARSE_PASSES,
+)
 
 
 def _inverse_sqrt(norm):
@@ -47,13 +54,21 @@ def _cost_normalization(D, P, q):
 
 @pytest.mark.parametrize(("seed", "n", "m"), [(0, 9, 4), (1, 13, 6), (2, 31, 12), (3, 5, 0)])
 @pytest.mark.parametrize("iterations", [0, 1, 4, 10])
-def test_equilibrate_matches_its_definition(seed, n, m, iterations):
+@pytest.mark.parametrize("density", [1.0, 0.2])
+def test_equilibrate_matches_its_definition(seed, n, m, iterations, density):
+    """Dense data (the four-lane passes) and sparse data (the passes over the nonzeros,
+    ``SPARSE_PASSES``) alike."""
     rng = np.random.default_rng(seed)
     # badly scaled rows and columns, a zero column, one cone block of 3 entries
     G = rng.standard_normal((n, n)) * np.logspace(-3, 3, n)
     P = G @ G.T
     P[:, 1] = P[1, :] = 0.0
     A = rng.standard_normal((m, n)) * np.logspace(2, -2, m)[:, None]
+    if density < 1.0:   # a symmetric pattern with the diagonal, at most density of the rest
+        keep = np.triu(rng.random((n, n)) < density)
+        P *= keep | keep.T | np.eye(n, dtype=bool)
+        A *= rng.random((m, n)) < density
+        assert np.count_nonzero(P) + np.count_nonzero(A) <= SPARSE_PASSES * (n + m) * n
     q, b = rng.standard_normal(n) * 100, rng.standard_normal(m)
     blocks = [(2, 3)]
     D_ref, E_ref, c_ref = _ruiz(P, q, A, blocks, iterations)

@@ -73,9 +73,10 @@ cdef void anderson_step(Anderson* a, Iterates* it, Py_ssize_t s) noexcept nogil:
     """Record the step just taken and extrapolate ``(z, y)`` in ``it`` when possible."""
     cdef Py_ssize_t j, i, l, two_s = 2 * s, slot
     cdef int stored, cap = a.capacity
-    cdef double f_norm = 0.0, ridge, acc, step_z, step_y, coefficient
+    cdef double f_norm = 0.0, ridge, acc, coefficient
     cdef double* g = a.g_new
     cdef double* f = a.f_new
+    cdef double* step
     for j in range(s):
         g[j] = it.z_prev[j]
         g[s + j] = it.y_prev[j] / it.rho_vec[j]
@@ -137,17 +138,21 @@ cdef void anderson_step(Anderson* a, Iterates* it, Py_ssize_t s) noexcept nogil:
     if not acc < MAX_WEIGHT_NORM * MAX_WEIGHT_NORM:
         anderson_reset(a, True)   # nothing to extrapolate from: plain steps rebuild it
         return
+    # the step (dG + dF) gamma, slot by slot into g_new (free again: g is in a.g): each
+    # entry sums its terms in the order a loop over the slots per entry would, and the
+    # loop over entries vectorizes
+    step = a.g_new
+    for j in range(two_s):
+        step[j] = 0.0
+    for i in range(stored):
+        coefficient = a.gamma[i]
+        for j in range(two_s):
+            step[j] += (a.dg[i * two_s + j] + a.df[i * two_s + j]) * coefficient
     for j in range(s):
         a.plain[j] = it.z[j]
         a.plain[s + j] = it.y[j] / it.rho_vec[j]
-        step_z = 0.0
-        step_y = 0.0
-        for i in range(stored):
-            coefficient = a.gamma[i]
-            step_z += (a.dg[i * two_s + j] + a.df[i * two_s + j]) * coefficient
-            step_y += (a.dg[i * two_s + s + j] + a.df[i * two_s + s + j]) * coefficient
-        it.z[j] -= step_z
-        it.y[j] -= step_y * it.rho_vec[j]
+        it.z[j] -= step[j]
+        it.y[j] -= step[s + j] * it.rho_vec[j]
     a.accelerated = True
 
 

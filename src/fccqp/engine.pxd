@@ -14,6 +14,7 @@ from fccqp.matrices cimport Matrix
 from fccqp.polish cimport Polish
 from fccqp.reduced cimport Reduced
 from fccqp.restoration cimport Restoration
+from fccqp.scaling cimport Pattern
 from fccqp.termination cimport Residuals, residuals
 
 cdef extern from "fccqp_clock.h" nogil:
@@ -77,6 +78,7 @@ cdef struct Scaling:
     double* norms               # n + m scratch
     double* d                   # n scratch
     double* e                   # m scratch
+    Pattern pattern             # the nonzeros of the dense P and A at the last equilibration
     bint done                   # an equilibration ran for this workspace
 
 

@@ -101,8 +101,9 @@ cdef inline void _equilibrate(Engine* e) noexcept nogil:
         copy(e.user.A.values, p.A.values, m * n)
         p.c = equilibrate(p.P.values, p.q, p.A.values, p.b, n, m, e.user.block_start,
                           p.cones.dim, p.cones.count, e.opt.scaling, p.D, p.E, e.scaling.d,
-                          e.scaling.e)
-        scaled_norms(p.P.values, p.A.values, n, m, p.c, e.scaling.reference)
+                          e.scaling.e, &e.scaling.pattern)
+        scaled_norms(p.P.values, p.A.values, n, m, p.c, &e.scaling.pattern,
+                     e.scaling.reference)
         return
     copy(e.user.P.values, p.P.values, p.P.colptr[n])
     copy(e.user.A.values, p.A.values, p.A.colptr[n])

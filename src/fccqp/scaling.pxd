@@ -8,6 +8,15 @@ from fccqp._types cimport Cones
 from fccqp.tuning cimport GAUGE_LIMIT, MAX_NORM, MIN_COST_NORM, MIN_NORM, RESCALE_DRIFT
 
 
+cdef struct Pattern:
+    # The nonzeros of the dense P and A, row by row (compressed rows), found once per
+    # equilibration: the Ruiz passes and the scaling walk them instead of every entry.
+    int* P_start    # n + 1: row i of P has its columns at P_index[P_start[i]:P_start[i + 1]]
+    int* P_index    # n * n
+    int* A_start    # m + 1
+    int* A_index    # m * n
+
+
 cdef inline double inverse_sqrt_norm(double norm) noexcept nogil:
     """A Ruiz pass's factor for a column or row of infinity norm ``norm``: ``1 /
     sqrt(norm)``, with the norm capped at ``MAX_NORM`` and 1 below ``MIN_NORM``."""
@@ -105,9 +114,10 @@ cdef inline double cost_scale(double mean_col, double q_norm) noexcept nogil:
 cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n,
                         Py_ssize_t m, const Py_ssize_t* block_start,
                         const Py_ssize_t* block_dim, Py_ssize_t blocks, Py_ssize_t iterations,
-                        double* D, double* E, double* d, double* e) noexcept nogil
+                        double* D, double* E, double* d, double* e,
+                        Pattern* pattern) noexcept nogil
 cdef void scaled_norms(const double* P_s, const double* A_s, Py_ssize_t n, Py_ssize_t m,
-                       double c, double* norms) noexcept nogil
+                       double c, const Pattern* pattern, double* norms) noexcept nogil
 cdef bint rescale(const double* P, const double* q, const double* A, const double* b,
                   Py_ssize_t n, Py_ssize_t m, const double* D, const double* E,
                   const double* reference, double* norms, double* P_s, double* q_s,

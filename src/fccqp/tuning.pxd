@@ -32,6 +32,8 @@ cdef extern from *:
     #define FCCQP_CAPPED_PASSES 20
     /* D's geometric mean below 1 / this: D up, E down by a power of two (as far as D P D <= 1) */
     #define FCCQP_GAUGE_LIMIT 1e3
+    /* Ruiz passes walk P's and A's nonzeros, not every entry, when at most this share is nonzero */
+    #define FCCQP_SPARSE_PASSES 0.5
 
     /* ---- Factorization of the ADMM KKT system (fccqp.ldl, fccqp.schur, fccqp.kkt) ---- */
     /* quasi-definite regularization of LDL's (2, 2) block (scaled): refinement removes it */
@@ -177,6 +179,7 @@ cdef extern from *:
     const double RESCALE_DRIFT "FCCQP_RESCALE_DRIFT"
     const long CAPPED_PASSES "FCCQP_CAPPED_PASSES"
     const double GAUGE_LIMIT "FCCQP_GAUGE_LIMIT"
+    const double SPARSE_PASSES "FCCQP_SPARSE_PASSES"
     # Factorization
     const double KKT_DELTA "FCCQP_KKT_DELTA"
     const int MAX_REFINE "FCCQP_MAX_REFINE"

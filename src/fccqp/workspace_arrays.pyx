@@ -135,6 +135,9 @@ cdef void dense_arrays(Arrays a, Engine* e, Py_ssize_t* order) except *:
     u = &e.user
     u.P, u.A = dense(a.new(n * n), n, n), dense(a.new(m * n), m, n)
     e.certs.gram = a.new(m * m)
+    sp = &e.scaling.pattern   # ints in arrays of pointer-sized ones: room to spare
+    sp.P_start, sp.P_index = <int*>a.new_int(n + 1), <int*>a.new_int(n * n)
+    sp.A_start, sp.A_index = <int*>a.new_int(m + 1), <int*>a.new_int(m * n)
     kk = &e.fact.kkt
     kk.sparse = NULL
     kk.ldl.N = <int>N
