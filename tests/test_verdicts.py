@@ -357,6 +357,20 @@ def test_a_run_that_stalls_in_both_forms_is_solved_at_a_larger_rho(name, seed):
     assert judge(Case.of(name, seed), "auto") is None
 
 
+@pytest.mark.parametrize(("name", "seed"), [("extreme_data", 212), ("extreme_data", 473),
+                                           ("extreme_data", 1251)])
+def test_a_run_whose_rho_sits_at_its_floor_is_solved_at_a_smaller_one(name, seed):
+    """Extreme data whose multipliers are 1e-8 of the scaled primal (``P`` of 1e-11 with
+    the optimum at 5e9; ``P`` of 1e10 or 8e10 with the optimum, or a ray, in its
+    near-null space): the rho rule sits at ``RHO_MIN`` and ADMM stalls in both forms and
+    at the larger rho; with ``kkt_backend="auto"`` the problem is solved again, cold, at
+    a fixed rho and ``sigma`` of ``RHO_MIN / STALL_RHO_FACTOR``, and the fuzzer's judge
+    (verify_solution, Clarabel) accepts the answer (an optimum, or the ray of 1251)."""
+    from fuzzing import Case, judge
+
+    assert judge(Case.of(name, seed), "auto") is None
+
+
 def test_a_forced_backend_is_not_replaced_after_a_stall():
     """The second form is fccqp's choice only under "auto": a forced ``ldl_full`` that
     stalls on ``extreme_data:100213`` reports MAX_ITER_REACHED, honestly."""

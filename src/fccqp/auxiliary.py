@@ -33,7 +33,7 @@ with ``P`` of 1e-12 stalled in the full form and solved in the reduced one). So 
 auxiliary solve that is not SOLVED runs again in the other form
 (:func:`other_form`), and :func:`in_other_form` solves the stalled problem itself
 again there when no certificate was found, and then, if it stalls there too, at a
-larger rho.
+larger rho, and, when the stalled run's rho sat at its floor, at a smaller one.
 
 On the sparse path (a :attr:`fccqp.admm.Workspace.compressed` run) the auxiliary QPs
 are built with ``scipy.sparse`` and take the sparse path too, whatever their size;
@@ -52,7 +52,7 @@ from fccqp.cones import cone_tuple
 from fccqp.problem import INFINITE_BOUND
 from fccqp.settings import MAX_DENSE_KKT_ROWS
 from fccqp.status import Status
-from fccqp.tuning import AUXILIARY_MARGIN, STALL_RHO_FACTOR
+from fccqp.tuning import AUXILIARY_MARGIN, RHO_MIN, STALL_RHO_FACTOR
 
 
 def _matrix(matrix: object, rows: int, n: int, sparse: bool) -> object:
@@ -231,11 +231,29 @@ def in_other_form(solver_type: type, settings: object, stalled: object,
     multiplier grew by a fixed step, and the rho rule, which balances the two
     residuals, saw nothing to change; such a phase lasts about ``1 / rho`` iterations
     (the fuzz cases qpsolvers 500077, 500090, 700127 and extreme_data 500215, 500351:
-    4000 iterations stalled in both forms, 40 to 1220 from ``rho`` = 100)."""
+    4000 iterations stalled in both forms, 40 to 1220 from ``rho`` = 100).
+
+    The smaller rho: where the stalled run ended with rho at its floor (``RHO_MIN``,
+    within the rule's ``adaptive_rho_tolerance``), the balance of the residuals asked
+    for less: multipliers 1e-8 of the scaled primal (``P`` of 1e10 with the optimum in
+    its near-null space and the cost normalized by ``P``; ``P`` of 1e-11 with the
+    optimum at 5e9). At the floor ADMM crawls, in the full form ``sigma`` alike; the
+    last try fixes rho and ``sigma`` at ``RHO_MIN / STALL_RHO_FACTOR`` (extreme_data 212
+    and 473: 4000 iterations stalled in every form, 30 to 600 at 1e-9). A smaller
+    ``sigma`` can make the convexity test fail on a ``P`` that is semidefinite to
+    rounding: that try then gives no answer."""
     spent = factored = 0
-    for again in (other_form(settings, stalled.backend),
-                  settings.replace(rho=settings.rho * STALL_RHO_FACTOR)):
-        result = _auxiliary_solver(solver_type, again).solve(*arguments)
+    tries = [other_form(settings, stalled.backend),
+             settings.replace(rho=settings.rho * STALL_RHO_FACTOR)]
+    if stalled.rho < RHO_MIN * settings.adaptive_rho_tolerance:
+        floor = RHO_MIN / STALL_RHO_FACTOR
+        tries.append(settings.replace(rho=floor, sigma=min(settings.sigma, floor),
+                                      adaptive_rho=False))
+    for again in tries:
+        try:
+            result = _auxiliary_solver(solver_type, again).solve(*arguments)
+        except ValueError:   # "not convex" under the smaller sigma: no answer there
+            continue
         spent, factored = spent + result.iterations, factored + result.factorizations
         if result.status in ANSWERS:
             return dataclasses.replace(result, iterations=spent, factorizations=factored)

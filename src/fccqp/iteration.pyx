@@ -29,9 +29,10 @@ from fccqp._dense cimport copy
 from fccqp._types cimport Iterates, Problem
 from fccqp.acceptance cimport keep_polished, keep_restored, restore_equalities, warm_polish
 from fccqp.anderson cimport anderson_reset, anderson_step
-from fccqp.engine cimport (DUAL_INFEASIBLE, NOT_CONVEX_QP, NUMERICAL_ERROR, PRIMAL_INFEASIBLE,
-                           RUNNING, SOLVED, TIME_LIMIT, Engine, Options, Run, end_run,
-                           fccqp_now, measure)
+from fccqp.engine cimport (DUAL_INFEASIBLE, MAX_ITER, NOT_CONVEX_QP, NUMERICAL_ERROR,
+                           PRIMAL_INFEASIBLE, RUNNING, SOLVED, TIME_LIMIT, Engine, Options,
+                           Run, end_run, fccqp_now, measure)
+from fccqp.equalities cimport hold_equalities
 from fccqp.factorization cimport budget, change_rho, equality_start, factor, reduced_base
 from fccqp.kkt cimport FACTORED, NOT_CONVEX, is_reduced, kkt_solve
 from fccqp.polish cimport guess_changes, polish_prepare
@@ -337,7 +338,8 @@ cdef inline bint _adapt_rho(Engine* e, Loop* L, Run* run) noexcept nogil:
 cdef inline void _final_step(Engine* e, Loop* L, Run* run) noexcept nogil:
     """After the iterations: polish the final iterate (under a time limit only near
     convergence, ``POLISH_GATE``), else restore its feasibility when the settings ask,
-    else remove the rounding in ``A x = b`` that the reduced form accumulates."""
+    else remove the rounding in ``A x = b`` that the reduced form accumulates; a
+    stalled point that still misses ``A x = b`` is projected onto it."""
     cdef Options* o = &e.opt
     e.clock.marks[4] = fccqp_now()
     e.iterated = True
@@ -350,6 +352,8 @@ cdef inline void _final_step(Engine* e, Loop* L, Run* run) noexcept nogil:
             L.status = keep_restored(e, L.status, L.iteration, L.reduced)
         elif (L.reduced or missed(e)) and L.status != NUMERICAL_ERROR:
             restore_equalities(e)   # certificates are already in cert
+    if L.status == MAX_ITER or L.status == TIME_LIMIT:
+        hold_equalities(e)   # where the KKT solves could not (fccqp.equalities)
     end_run(e, run, L.status, L.iteration)
 
 
