@@ -376,15 +376,17 @@ cdef inline bint _adapt_rho(Engine* e, Loop* L, Run* run) noexcept nogil:
 
 
 cdef inline void _final_step(Engine* e, Loop* L, Run* run) noexcept nogil:
-    """After the iterations: polish the final iterate (under a time limit only near
-    convergence, ``POLISH_GATE``), else restore its feasibility when the settings ask,
+    """After the iterations: polish the final iterate (when the clock stopped them only
+    near convergence, ``POLISH_GATE``; a run that stalled at its cap has no better use
+    for the time left), else restore its feasibility when the settings ask,
     else remove the rounding in ``A x = b`` that the reduced form accumulates."""
     cdef Options* o = &e.opt
     e.clock.marks[4] = fccqp_now()
     e.iterated = True
     if (not run.polished and o.polish and SOLVED <= L.status <= TIME_LIMIT
             and L.polished_at != L.iteration
-            and (not L.timed or nearly_converged(&e.res, o.eps_abs, o.eps_rel, POLISH_GATE))):
+            and (not L.timed or L.iteration >= L.cap
+                 or nearly_converged(&e.res, o.eps_abs, o.eps_rel, POLISH_GATE))):
         run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, False)
     if not run.polished:   # a polished point is feasible already: nothing to restore
         if o.restore_feasibility and SOLVED <= L.status <= TIME_LIMIT:
