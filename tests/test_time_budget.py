@@ -1,8 +1,9 @@
 """A finite ``time_limit`` is the budget of a long run (issue 30, Maros-Meszaros).
 
-Two mechanisms of :mod:`fccqp.iteration`, each judged by :func:`verify.verify_solution`:
-the iteration cap extends while the run converges (``_extend``), and the early polish
-runs from ``TIMED_EARLY_POLISH`` iterations on. Both problems are small LP-like QPs
+Three mechanisms of :mod:`fccqp.iteration`, each judged by :func:`verify.verify_solution`:
+the iteration cap extends while the run converges (``_extend``); the early polish runs
+from ``TIMED_EARLY_POLISH`` iterations on; a run stopped at its cap (not by the clock)
+is polished whatever its distance to tolerance. The problems are small LP-like QPs
 (``P`` of rank 2 and norm ~1e-2, boxes on every entry, four equalities) on which ADMM
 crawls at tolerance 1e-7; before these mechanisms a timed run stopped at ``max_iter``
 where the same run without a time limit was solved.
@@ -59,4 +60,19 @@ def test_a_long_timed_run_polishes_early_as_an_untimed_one():
     assert TIMED_EARLY_POLISH <= untimed.iterations < fccqp.Settings().max_iter
     assert timed.status is Status.SOLVED and timed.polished
     assert timed.iterations == untimed.iterations
+    verify_solution(problem, timed, Tolerances.of(**EPS))
+
+
+def test_a_timed_run_stopped_at_its_cap_is_polished_as_an_untimed_one():
+    """At ``max_iter`` 1000 this run is not halving its distance any more, so the cap
+    holds; its residuals are beyond ``POLISH_GATE`` times the tolerances, which under a
+    time limit used to skip the final polish (MAX_ITER_REACHED, unpolished). That gate is
+    for runs the clock stops: one stopped by its cap is polished, and here the polish
+    is exact, as without a time limit."""
+    problem = flat_qp(50)
+    untimed = fccqp.solve(*problem, max_iter=1000, **EPS)
+    timed = fccqp.solve(*problem, max_iter=1000, time_limit=100.0, **EPS)
+    assert untimed.status is Status.SOLVED and untimed.polished
+    assert timed.status is Status.SOLVED and timed.polished, timed.status
+    assert timed.iterations == 1000
     verify_solution(problem, timed, Tolerances.of(**EPS))
