@@ -23,6 +23,7 @@ at every iterate. After each step, safeguarded Anderson acceleration may extrapo
 (:mod:`fccqp.termination`).
 """
 
+from libc.limits cimport LONG_MAX
 from libc.math cimport INFINITY, isfinite
 
 from fccqp._dense cimport copy
@@ -40,9 +41,10 @@ from fccqp.projections cimport proj_set
 from fccqp.reduced cimport materialize, near_convergence, reduced_start, reduced_step
 from fccqp.rho_rule cimport TrialState, new_rho, trial_reset
 from fccqp.termination cimport Residuals, converged, nearly_converged
-from fccqp.tuning cimport (CLEANING_START, EARLY_POLISH_GATE, EARLY_POLISH_TRIES,
+from fccqp.tuning cimport (CLEANING_START, CONVERGING, EARLY_POLISH_GATE, EARLY_POLISH_TRIES,
                            EQUALITY_MISSED, GATED_CHECK_WAIT, LOG_INTERVAL, POLISH_GATE,
-                           POLISH_RETRIES, RESERVE_PASSES, STALL_FACTOR, STALLS)
+                           POLISH_RETRIES, RESERVE_PASSES, STALL_FACTOR, STALLS,
+                           TIMED_EARLY_POLISH)
 from fccqp.verdict cimport check, classify, inconsistent, missed, missed_by_data, unbounded
 
 
@@ -70,6 +72,9 @@ cdef struct Loop:
     int stalls              # scheduled checks in a row whose primal residual stalled
     double periodic_prim    # the primal residual at the last scheduled check
     TrialState trial        # small rho moves on trial (fccqp.rho_rule)
+    long cap                # the iteration cap: max_iter, extended under a time limit (_extend)
+    long mark_at            # the first check from this iteration records mark
+    double mark             # _distance at that check
 
 
 cdef void iterate(Engine* e, Run* run, bint cold, double start_time) noexcept nogil:
@@ -111,6 +116,9 @@ cdef inline void _begin(Engine* e, Loop* L, Run* run, bint cold, double start_ti
     L.first_check = True
     L.unbounded_start = False
     L.timed = isfinite(o.time_limit)
+    L.cap = o.max_iter
+    L.mark_at = o.max_iter - o.max_iter // 2 if L.timed else LONG_MAX
+    L.mark = INFINITY
     L.deadline = o.time_limit - min(
         max(e.clock.final_reserve, RESERVE_PASSES * e.clock.pass_time), 0.5 * o.time_limit)
     run.factorizations = 0
@@ -242,8 +250,10 @@ cdef inline void _schedule(Engine* e, Loop* L) noexcept nogil:
     ``check_termination`` iterations, or in the reduced form when the gate
     (:func:`fccqp.reduced.near_convergence`) says that the check may pass."""
     cdef Options* o = &e.opt
-    L.last = L.iteration >= o.max_iter or (L.timed and L.iteration >= o.min_iter
-                                           and fccqp_now() - L.start_time >= L.deadline)
+    if L.iteration == L.cap and L.timed:
+        _extend(e, L)
+    L.last = L.iteration >= L.cap or (L.timed and L.iteration >= o.min_iter
+                                      and fccqp_now() - L.start_time >= L.deadline)
     L.periodic = L.iteration % o.adaptive_rho_interval == 0
     L.adapt = o.adaptive_rho and L.periodic
     L.check = L.iteration % o.check_termination == 0 or L.last or L.adapt
@@ -268,6 +278,9 @@ cdef inline void _check(Engine* e, Loop* L, Run* run) noexcept nogil:
     if L.iteration % LOG_INTERVAL == 0:
         _log(e, L.iteration, run.rho)
     L.status = check(e, L.iteration, L.last)
+    if L.iteration >= L.mark_at:
+        L.mark = _distance(e)
+        L.mark_at = LONG_MAX
     if L.gated and L.status == RUNNING:   # the gate passed, the check did not
         L.wait = min(2 * L.wait + 1, GATED_CHECK_WAIT)
         L.next_gated = L.iteration + L.wait
@@ -275,8 +288,10 @@ cdef inline void _check(Engine* e, Loop* L, Run* run) noexcept nogil:
 
 cdef inline void _polish_attempts(Engine* e, Loop* L, Run* run) noexcept nogil:
     """Polish a SOLVED iterate (a failure goes on at tighter tolerances, closer to the
-    active set, ``POLISH_RETRIES`` times); without a time limit, also polish an active
-    set that settled near convergence (``EARLY_POLISH_GATE``)."""
+    active set, ``POLISH_RETRIES`` times); also polish an active set that settled near
+    convergence (``EARLY_POLISH_GATE``), under a time limit only from
+    ``TIMED_EARLY_POLISH`` iterations on: a control tick's budget has no room for it, a
+    long run needs it (PRIMALC1 of Maros-Meszaros: its gap stays at 1.6 without it)."""
     cdef Options* o = &e.opt
     if L.status == SOLVED and o.polish and not L.last and L.retries < POLISH_RETRIES:
         L.polished_at = L.iteration
@@ -285,7 +300,8 @@ cdef inline void _polish_attempts(Engine* e, Loop* L, Run* run) noexcept nogil:
             L.retries += 1
             e.tighten *= 0.1
             L.status = RUNNING
-    if (L.status == RUNNING and L.periodic and o.polish and not L.timed and not L.last
+    if (L.status == RUNNING and L.periodic and o.polish and not L.last
+            and (not L.timed or L.iteration >= TIMED_EARLY_POLISH)
             and L.early_tries < EARLY_POLISH_TRIES):
         if (guess_changes(&e.prob, e.it.z, e.it.y, e.work.guess_point,
                           e.work.guess_codes) != 0 or L.first_check):
@@ -296,6 +312,32 @@ cdef inline void _polish_attempts(Engine* e, Loop* L, Run* run) noexcept nogil:
             L.early_tries += 1
             L.polished_at = L.iteration
             run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, True)
+
+
+cdef inline void _extend(Engine* e, Loop* L) noexcept nogil:
+    """Under a time limit the clock is the budget: a run at its iteration cap whose
+    :func:`_distance` to tolerance shrank by ``CONVERGING`` since the last mark (half a
+    ``max_iter`` ago) gets half a ``max_iter`` more, until the clock or a stall stops it
+    (PRIMALC2 of Maros-Meszaros at 1e-6: SOLVED at 11,250 iterations, stopped at
+    4,000 before).
+    """
+    cdef double now = _distance(e)
+    if isfinite(now) and now <= CONVERGING * L.mark:
+        L.cap += max(e.opt.max_iter // 2, 1)
+        L.mark = now
+
+
+cdef inline double _distance(const Engine* e) noexcept nogil:
+    """How far the last check's residuals are from the termination test: the largest
+    of the primal, dual and gap residuals over their tolerances."""
+    cdef const Residuals* r = &e.res
+    cdef const Options* o = &e.opt
+    if not r.finite:
+        return INFINITY
+    return max(max(r.prim_eq / (o.eps_abs + o.eps_rel * r.prim_eq_scale),
+                   r.prim_set / (o.eps_abs + o.eps_rel * r.prim_set_scale)),
+               max(r.dual / (o.eps_abs + o.eps_rel * r.dual_scale),
+                   r.gap / (o.eps_abs + o.eps_rel * r.gap_scale)))
 
 
 cdef inline void _stall_rule(Engine* e, Loop* L) noexcept nogil:
@@ -336,16 +378,20 @@ cdef inline bint _adapt_rho(Engine* e, Loop* L, Run* run) noexcept nogil:
 
 
 cdef inline void _final_step(Engine* e, Loop* L, Run* run) noexcept nogil:
-    """After the iterations: polish the final iterate (under a time limit only near
-    convergence, ``POLISH_GATE``), else restore its feasibility when the settings ask,
+    """After the iterations: polish the final iterate (when the clock stopped them only
+    near convergence, ``POLISH_GATE``; a run that stalled at its cap has no better use
+    for the time left), else restore its feasibility when the settings ask,
     else remove the rounding in ``A x = b`` that the reduced form accumulates; a
     stalled point that still misses ``A x = b`` is projected onto it."""
     cdef Options* o = &e.opt
     e.clock.marks[4] = fccqp_now()
     e.iterated = True
+    if L.status == MAX_ITER and L.iteration < L.cap:
+        L.status = TIME_LIMIT   # past max_iter on an extended cap (_extend): the clock stopped it
     if (not run.polished and o.polish and SOLVED <= L.status <= TIME_LIMIT
             and L.polished_at != L.iteration
-            and (not L.timed or nearly_converged(&e.res, o.eps_abs, o.eps_rel, POLISH_GATE))):
+            and (not L.timed or L.iteration >= L.cap
+                 or nearly_converged(&e.res, o.eps_abs, o.eps_rel, POLISH_GATE))):
         run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, False)
     if not run.polished:   # a polished point is feasible already: nothing to restore
         if o.restore_feasibility and SOLVED <= L.status <= TIME_LIMIT:

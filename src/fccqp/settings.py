@@ -127,7 +127,11 @@ class Settings:
     """Tolerance of the dual infeasibility certificate."""
     max_iter: int = 4000
     """Iteration budget, at most :data:`INT_MAX`; when it runs out the current iterate
-    is returned."""
+    is returned. Under a finite ``time_limit`` the clock is the budget: a run at its cap
+    whose distance to tolerance (the largest residual over its tolerance) halved over
+    the last ``max_iter / 2`` iterations gets ``max_iter / 2`` more, again and again
+    while it keeps halving (``fccqp.tuning.CONVERGING``); a stalled run still stops at
+    the cap."""
     time_limit: float = math.inf
     """Wall-clock budget of one solve in seconds (setup included); ``inf`` for none."""
     min_iter: int = 0
@@ -173,7 +177,8 @@ class Settings:
     1.1e-3 to 9e-9 and 4e-7 (docs/performance.md has its current cost). A warm start
     from a polished solution polishes its active set first, before any iteration, and
     without a time limit a run polishes early once the active set its iterate points
-    to has settled (``fccqp.tuning.EARLY_POLISH_GATE``)."""
+    to has settled (``fccqp.tuning.EARLY_POLISH_GATE``); under a time limit only
+    from ``fccqp.tuning.TIMED_EARLY_POLISH`` iterations on."""
     polish_refine_iter: int = 10
     """Most re-linearizations of the boundary cones' tangent planes in polishing (Newton
     steps, taken only until the cone function is met to 1e-13 or stops improving; a

@@ -166,6 +166,10 @@ cdef extern from *:
     #define FCCQP_RESERVE_DECAY 0.5
     /* and at least this many polish guesses: a clock-stopped iterate's guess needs a fix */
     #define FCCQP_RESERVE_PASSES 2.0
+    /* with a time limit the early polish runs from this iteration (no control tick runs so long) */
+    #define FCCQP_TIMED_EARLY_POLISH 1000
+    /* with a time limit max_iter grows by half while the distance to tolerance shrinks this much */
+    #define FCCQP_CONVERGING 0.5
     """
     # The declarations, in the order above; each type is the one the code computes with.
     # Input validation
@@ -247,3 +251,5 @@ cdef extern from *:
     const double POLISH_GATE "FCCQP_POLISH_GATE"
     const double RESERVE_DECAY "FCCQP_RESERVE_DECAY"
     const double RESERVE_PASSES "FCCQP_RESERVE_PASSES"
+    const long TIMED_EARLY_POLISH "FCCQP_TIMED_EARLY_POLISH"
+    const double CONVERGING "FCCQP_CONVERGING"

@@ -1,0 +1,78 @@
+"""A finite ``time_limit`` is the budget of a long run (issue 30, Maros-Meszaros).
+
+Three mechanisms of :mod:`fccqp.iteration`, each judged by :func:`verify.verify_solution`:
+the iteration cap extends while the run converges (``_extend``); the early polish runs
+from ``TIMED_EARLY_POLISH`` iterations on; a run stopped at its cap (not by the clock)
+is polished whatever its distance to tolerance. The problems are small LP-like QPs
+(``P`` of rank 2 and norm ~1e-2, boxes on every entry, four equalities) on which ADMM
+crawls at tolerance 1e-7; before these mechanisms a timed run stopped at ``max_iter``
+where the same run without a time limit was solved.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from fccqp.tuning import TIMED_EARLY_POLISH
+
+import fccqp
+from fccqp import Status
+from verify import Tolerances, verify_solution
+
+EPS = dict(eps_abs=1e-7, eps_rel=1e-7)
+
+
+def flat_qp(seed: int) -> tuple[np.ndarray, ...]:
+    """``(P, q, A, b, lb, ub)``: 20 boxed entries, 4 consistent equalities, a rank-2
+    ``P`` of small norm (nearly an LP)."""
+    rng = np.random.default_rng(seed)
+    n, m = 20, 4
+    F = rng.standard_normal((n, 2))
+    P = F @ F.T * 1e-3
+    q = rng.standard_normal(n)
+    A = rng.standard_normal((m, n))
+    b = A @ rng.uniform(-1, 1, n)
+    lb = -rng.uniform(1, 2, n)
+    ub = rng.uniform(1, 2, n)
+    return P, q, A, b, lb, ub
+
+
+def test_a_converging_run_under_a_time_limit_goes_past_max_iter():
+    """Unpolished, this QP needs 371 iterations; with ``max_iter`` 185 a run without a
+    time limit stops at the cap, one with a time limit is still halving its distance to
+    tolerance there and goes on to SOLVED."""
+    problem = flat_qp(4)
+    capped = fccqp.solve(*problem, polish=False, max_iter=185, **EPS)
+    assert capped.status is Status.MAX_ITER_REACHED and capped.iterations == 185
+    timed = fccqp.solve(*problem, polish=False, max_iter=185, time_limit=100.0, **EPS)
+    assert timed.status is Status.SOLVED, timed.status
+    assert timed.iterations > 185
+    verify_solution(problem, timed, Tolerances.of(**EPS))
+
+
+def test_a_long_timed_run_polishes_early_as_an_untimed_one():
+    """ADMM crawls here for thousands of iterations after its active set settled; the
+    early polish ends the run at 3060 iterations without a time limit, and now with one
+    (it ran into ``max_iter`` before)."""
+    problem = flat_qp(83)
+    untimed = fccqp.solve(*problem, **EPS)
+    timed = fccqp.solve(*problem, time_limit=100.0, **EPS)
+    assert untimed.status is Status.SOLVED and untimed.polished
+    assert TIMED_EARLY_POLISH <= untimed.iterations < fccqp.Settings().max_iter
+    assert timed.status is Status.SOLVED and timed.polished
+    assert timed.iterations == untimed.iterations
+    verify_solution(problem, timed, Tolerances.of(**EPS))
+
+
+def test_a_timed_run_stopped_at_its_cap_is_polished_as_an_untimed_one():
+    """At ``max_iter`` 1000 this run is not halving its distance any more, so the cap
+    holds; its residuals are beyond ``POLISH_GATE`` times the tolerances, which under a
+    time limit used to skip the final polish (MAX_ITER_REACHED, unpolished). That gate is
+    for runs the clock stops: one stopped by its cap is polished, and here the polish
+    is exact, as without a time limit."""
+    problem = flat_qp(50)
+    untimed = fccqp.solve(*problem, max_iter=1000, **EPS)
+    timed = fccqp.solve(*problem, max_iter=1000, time_limit=100.0, **EPS)
+    assert untimed.status is Status.SOLVED and untimed.polished
+    assert timed.status is Status.SOLVED and timed.polished, timed.status
+    assert timed.iterations == 1000
+    verify_solution(problem, timed, Tolerances.of(**EPS))
