@@ -26,7 +26,7 @@ SEEDS = {
     "extreme_data": (0, 1, 7, 9, 38, 47, 56, 108, 138, 149, 202, 214, 254, 302, 308, 316,
                      311, 326, 335, 337, 355, 363, 365, 489, 1182, 2244, 100082, 100180, 100213,
                      100228, 100233, 500030, 500064, 500099, 500322, 700281, 900343, 900360,
-                     1100037, 1100057, 1100253),
+                     1100037, 1100057, 1100253, 1300300),
     "qpsolvers": (0, 1, 2),
     "cvxpy": (1, 2, 3),
 }
@@ -34,7 +34,8 @@ SEEDS = {
 reproducers of the failure mechanisms the campaign found at ed3b90e, 836ab4b, 5f3a658,
 16f1696 and 206a4f0 (seeds from 100000, and extreme_data 489, 1182, 2244 of the deep
 ``--classes extreme_data`` run; 1100037, 1100057, 1100253 are the same mechanisms on a
-seed unseen by their fix; issue 26)."""
+seed unseen by their fix; 1300300 an infeasibility claim at the data's rounding; issue
+26)."""
 
 SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),
@@ -53,12 +54,15 @@ OPEN = {
     "with adaptive rho; only auto solves it again in the other form",
     "extreme_data:100213": "P of 1e-12: the full form stalls where the reduced one solves; "
     "only auto solves it again in the other form",
+    "extreme_data:1300300": "a primal certificate at 2.7e-8 of its terms (rows of 1e-8 to "
+    "3e7) beside a constructed optimum; only auto checks it in the other form",
     "solver_reuse:100206": "new rows through a kept workspace stall in every form warm; "
     "only auto solves it again, cold, in the other form",
 }
 """Reproducers of mechanisms still open (issue 26), each the reason it fails: expected
 to fail (strictly) on the backends where it does, so that a fix turns them red."""
 OPEN_BACKENDS = {"cvxpy:1": ("ldl_reduced", "ldl_full"), "extreme_data:100213": ("ldl_full",),
+                 "extreme_data:1300300": ("ldl_full",),
                  "solver_reuse:100206": ("schur_reduced", "ldl_reduced", "ldl_full")}
 """Where an open case fails on some backends only."""
 

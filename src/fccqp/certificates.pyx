@@ -164,13 +164,21 @@ cdef bint gram_factor(const Problem* p, double* gram) noexcept nogil:
     ``GRAM_REGULARIZATION`` of its largest diagonal entry (dependent rows); False when
     that fails, and on compressed columns, whose workspace has no ``m x m`` array (the
     certificates are then tested as ADMM leaves them, uncleaned)."""
-    cdef Py_ssize_t m = p.m, i
-    cdef double largest = 0.0
+    cdef Py_ssize_t m = p.m
     if p.A.kind == CSC:
         return False
     # the row-major m x n A is, column-major, A' (n x m): one dsyrk gives A A' (dense
     # storage)
     syrk_t(<int>m, <int>p.n, p.A.values, <int>p.n, 0.0, gram, <int>m)
+    return regularized_cholesky(gram, m)
+
+
+cdef bint regularized_cholesky(double* gram, Py_ssize_t m) noexcept nogil:
+    """Factor ``gram`` (m x m, column-major, lower triangle) in place after adding
+    ``GRAM_REGULARIZATION`` of its largest diagonal entry (dependent rows); False when
+    it is zero or Cholesky fails."""
+    cdef Py_ssize_t i
+    cdef double largest = 0.0
     for i in range(m):
         largest = max(largest, gram[i + i * m])
     if not largest > 0.0:

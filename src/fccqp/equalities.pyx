@@ -21,12 +21,13 @@ after the refined KKT solve for it, so it costs a tick nothing.
 
 from libc.math cimport fabs
 
-from fccqp._blas cimport cholesky, cholesky_solve
+from fccqp._blas cimport cholesky_solve
+from fccqp.certificates cimport regularized_cholesky
 from fccqp._dense cimport copy
 from fccqp._types cimport Problem
 from fccqp.engine cimport Engine
 from fccqp.matrices cimport DENSE, product
-from fccqp.tuning cimport EQUALITY_MISSED, GRAM_REGULARIZATION, KKT_REFINE_TOLERANCE, MAX_REFINE
+from fccqp.tuning cimport EQUALITY_MISSED, KKT_REFINE_TOLERANCE, MAX_REFINE
 
 
 cdef double _equality_error(const Problem* p, const double* x, double* r,
@@ -57,7 +58,7 @@ cdef bint _gram(const Problem* p, double* w, double* rows, double* gram) noexcep
     ``GRAM_REGULARIZATION`` of its largest diagonal entry (dependent rows). False when
     Cholesky fails."""
     cdef Py_ssize_t n = p.n, m = p.m, i, k, j
-    cdef double value, largest = 0.0
+    cdef double value
     cdef const double* A = p.A.values
     for j in range(n):
         w[j] = 0.0
@@ -72,18 +73,15 @@ cdef bint _gram(const Problem* p, double* w, double* rows, double* gram) noexcep
             rows[i] = max(rows[i], fabs(A[i * n + j]) * w[j])
         if not rows[i] > 0.0:
             rows[i] = 1.0
+    # a plain loop, not dsyrk on a weighted copy: the workspace holds no m x n scratch,
+    # and this runs only on a stalled run's returned point
     for k in range(m):
         for i in range(k, m):
             value = 0.0
             for j in range(n):
                 value += A[i * n + j] * A[k * n + j] * w[j] * w[j]
             gram[i + k * m] = value / (rows[i] * rows[k])
-        largest = max(largest, gram[k + k * m])
-    if not largest > 0.0:
-        return False
-    for i in range(m):
-        gram[i + i * m] += GRAM_REGULARIZATION * largest
-    return cholesky(gram, <int>m, <int>m)
+    return regularized_cholesky(gram, m)
 
 
 cdef void hold_equalities(Engine* e) noexcept nogil:

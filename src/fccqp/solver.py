@@ -244,6 +244,14 @@ class Solver:
         elif (w.doubt and self._stalled_certificates
               and not math.isfinite(settings.time_limit)):
             out = self._doubted(out, w, (P, q, A, b, lb, ub), self._cones, start)
+        elif (out.status is Status.PRIMAL_INFEASIBLE and self._stalled_certificates
+              and settings.kkt_backend == "auto" and not math.isfinite(settings.time_limit)
+              and auxiliary.weakly_separated(out, b, lb, ub)):
+            again = auxiliary.solved_in_other_form(Solver, settings, out,
+                                                   (P, q, A, b, lb, ub, self._cones))
+            if again is not None:   # this workspace holds no solution to start from
+                w.forget()
+                out = Result._of({**again.__dict__, "solve_time": time.perf_counter() - start})
         if settings.verbose:
             _print_log(w.log_lines, out)
         return out

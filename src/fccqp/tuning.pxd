@@ -110,6 +110,8 @@ cdef extern from *:
     #define FCCQP_AUXILIARY_MARGIN 10.0
     /* a problem that stalled in both KKT forms is solved again, cold, at this times Settings.rho */
     #define FCCQP_STALL_RHO_FACTOR 1e3
+    /* a primal certificate separating by less than this of its terms is checked in the other KKT form */
+    #define FCCQP_WEAK_SEPARATION 1e-6
 
     /* ---- Polish (fccqp.polish*, fccqp.iteration, fccqp.acceptance) ---- */
     /* regularization of both diagonal blocks of the polishing KKT matrix (scaled) */
@@ -223,6 +225,7 @@ cdef extern from *:
     const double CLEANING_GATE "FCCQP_CLEANING_GATE"
     const double AUXILIARY_MARGIN "FCCQP_AUXILIARY_MARGIN"
     const double STALL_RHO_FACTOR "FCCQP_STALL_RHO_FACTOR"
+    const double WEAK_SEPARATION "FCCQP_WEAK_SEPARATION"
     # Polish
     const double POLISH_DELTA "FCCQP_POLISH_DELTA"
     const double POLISH_CSC_DELTA "FCCQP_POLISH_CSC_DELTA"
