@@ -77,3 +77,24 @@ def large_problem(n: int, seed: int = 0):
     lb, ub = np.full(n, -0.5), np.full(n, 0.5)
     lb[-3:], ub[-3:] = -np.inf, np.inf   # the cone's entries
     return P, q, A, b, lb, ub, [fccqp.FrictionCone(n - 3, 0.4)]
+
+
+def mpc_problem(states: int = 12, inputs: int = 4, horizon: int = 100, seed: int = 0):
+    """A linear MPC in sparse form: ``states`` states in [-5, 5], ``inputs`` inputs in
+    [-0.3, 0.3]; variables ``(x_0..x_H, u_0..u_{H-1})``, ``x_{k+1} = Ad x_k + Bd u_k``,
+    ``x_0`` given, cost ``sum x'Qx + u'Ru`` plus a terminal ``x'Qx``."""
+    rng = np.random.default_rng(seed)
+    Ad = rng.standard_normal((states, states))
+    Ad *= 0.98 / max(abs(np.linalg.eigvals(Ad)))
+    Bd = rng.standard_normal((states, inputs))
+    nx, nu = states * (horizon + 1), inputs * horizon
+    P = sp.block_diag([sp.eye(nx), 0.1 * sp.eye(nu)], format="csc")
+    q = np.zeros(nx + nu)
+    dynamics = sp.hstack([sp.kron(sp.eye(horizon, horizon + 1), Ad)
+                          - sp.kron(sp.eye(horizon, horizon + 1, k=1), sp.eye(states)),
+                          sp.kron(sp.eye(horizon), Bd)])
+    start = sp.hstack([sp.eye(states, nx), sp.csr_matrix((states, nu))])
+    A = sp.vstack([start, dynamics], format="csc")
+    b = np.concatenate([rng.uniform(-3.0, 3.0, states), np.zeros(states * horizon)])
+    lb = np.concatenate([np.full(nx, -5.0), np.full(nu, -0.3)])
+    return P, q, A, b, lb, -lb, []

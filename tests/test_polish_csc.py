@@ -16,7 +16,7 @@ from fccqp.polish_ops import polish_point
 
 import fccqp
 from fccqp.cones import flatten_cones
-from problems import random_problem
+from problems import mpc_problem, random_problem
 from reference import clarabel_solve
 from verify import Problem, Tolerances, check_solution, verify_solution
 
@@ -142,28 +142,8 @@ def test_sparse_solves_are_polished_as_dense_ones(seed):
     assert _close(sparse.x, dense.x, 1e-10)
 
 
-def _mpc(horizon, seed=0):
-    """A linear MPC (12 states, 4 inputs in [-0.3, 0.3], states in [-5, 5]) in sparse
-    form, as tools/sparse_speed.py's."""
-    rng = np.random.default_rng(seed)
-    states, inputs = 12, 4
-    Ad = rng.standard_normal((states, states))
-    Ad *= 0.98 / max(abs(np.linalg.eigvals(Ad)))
-    Bd = rng.standard_normal((states, inputs))
-    nx, nu = states * (horizon + 1), inputs * horizon
-    P = sp.block_diag([sp.eye(nx), 0.1 * sp.eye(nu)], format="csc")
-    dynamics = sp.hstack([sp.kron(sp.eye(horizon, horizon + 1), Ad)
-                          - sp.kron(sp.eye(horizon, horizon + 1, k=1), sp.eye(states)),
-                          sp.kron(sp.eye(horizon), Bd)])
-    start = sp.hstack([sp.eye(states, nx), sp.csr_matrix((states, nu))])
-    A = sp.vstack([start, dynamics], format="csc")
-    b = np.concatenate([rng.uniform(-3.0, 3.0, states), np.zeros(states * horizon)])
-    lb = np.concatenate([np.full(nx, -5.0), np.full(nu, -0.3)])
-    return P, np.zeros(nx + nu), A, b, lb, -lb, []
-
-
 def test_sparse_solve_of_an_mpc_is_polished_to_the_optimum():
-    problem = P, q, A, b, lb, ub, cones = _mpc(horizon=40)
+    problem = P, q, A, b, lb, ub, cones = mpc_problem(horizon=40)
     result = fccqp.solve(*problem, kkt_backend="sparse")
     assert result.status is fccqp.Status.SOLVED and result.polished
     dense = (P.toarray(), q, A.toarray(), b, lb, ub, cones)

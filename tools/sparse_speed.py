@@ -41,26 +41,6 @@ sys.path[:0] = [str(ROOT / "tests")]
 import problems  # noqa: E402 - tests/problems.py, found through the path set just above
 
 
-def mpc(states: int = 12, inputs: int = 4, horizon: int = 100, seed: int = 0):
-    """The MPC's QP: variables ``(x_0..x_H, u_0..u_{H-1})``, ``x_{k+1} = Ad x_k + Bd u_k``,
-    ``x_0`` given, cost ``sum x'Qx + u'Ru`` plus a terminal ``x'Qx``."""
-    rng = np.random.default_rng(seed)
-    Ad = rng.standard_normal((states, states))
-    Ad *= 0.98 / max(abs(np.linalg.eigvals(Ad)))
-    Bd = rng.standard_normal((states, inputs))
-    nx, nu = states * (horizon + 1), inputs * horizon
-    P = sp.block_diag([sp.eye(nx), 0.1 * sp.eye(nu)], format="csc")
-    q = np.zeros(nx + nu)
-    dynamics = sp.hstack([sp.kron(sp.eye(horizon, horizon + 1), Ad)
-                          - sp.kron(sp.eye(horizon, horizon + 1, k=1), sp.eye(states)),
-                          sp.kron(sp.eye(horizon), Bd)])
-    start = sp.hstack([sp.eye(states, nx), sp.csr_matrix((states, nu))])
-    A = sp.vstack([start, dynamics], format="csc")
-    b = np.concatenate([rng.uniform(-3.0, 3.0, states), np.zeros(states * horizon)])
-    lb = np.concatenate([np.full(nx, -5.0), np.full(nu, -0.3)])
-    return P, q, A, b, lb, -lb, []
-
-
 def large_friction(n: int = 5000, seed: int = 0):
     """``tests/problems.large_problem``: a tridiagonal ``P``, two equalities, a box on
     most entries and one friction cone."""
@@ -81,7 +61,7 @@ def sparse_ls(size: int = 1700):
     return P, q, rows, np.concatenate([b, h]), lb, np.full(n + k, np.inf), []
 
 
-PROBLEMS = {"mpc": mpc, "large_friction": large_friction, "sparse_ls": sparse_ls}
+PROBLEMS = {"mpc": problems.mpc_problem, "large_friction": large_friction, "sparse_ls": sparse_ls}
 
 
 def run_fccqp(problem):
