@@ -97,8 +97,9 @@ cdef class Workspace:
     """The last result is solved or inaccurate only on tolerances its entries' own units
     do not give it: ``DOUBT_PRIMAL`` (a cone block or box entry off C by more than
     ``eps_abs + eps_rel`` times its own size), plus ``DOUBT_DUAL`` (the cost's terms below
-    ``eps_abs``, where any point passes the dual test); 0 otherwise (see ``acceptance.user_residuals``). Then
-    :class:`fccqp.Solver` asks the auxiliary QPs for a certificate."""
+    ``eps_abs``, where any point passes the dual test); 0 otherwise (see
+    ``acceptance.user_residuals``). Then :class:`fccqp.Solver` asks the auxiliary QPs
+    for a certificate."""
 
     def __init__(self, Py_ssize_t n, Py_ssize_t m, constrained, cones, fixed, order,
                  settings, Py_ssize_t log_rows, patterns=None):

@@ -40,7 +40,7 @@ from fccqp.polish cimport guess_changes, polish_prepare
 from fccqp.projections cimport proj_set
 from fccqp.reduced cimport materialize, near_convergence, reduced_start, reduced_step
 from fccqp.rho_rule cimport TrialState, new_rho, trial_reset
-from fccqp.termination cimport Residuals, converged, nearly_converged
+from fccqp.termination cimport Residuals, converged, distance, nearly_converged
 from fccqp.tuning cimport (CLEANING_START, CONVERGING, EARLY_POLISH_GATE, EARLY_POLISH_TRIES,
                            EQUALITY_MISSED, GATED_CHECK_WAIT, LOG_INTERVAL, POLISH_GATE,
                            POLISH_RETRIES, RESERVE_PASSES, STALL_FACTOR, STALLS,
@@ -74,7 +74,7 @@ cdef struct Loop:
     TrialState trial        # small rho moves on trial (fccqp.rho_rule)
     long cap                # the iteration cap: max_iter, extended under a time limit (_extend)
     long mark_at            # the first check from this iteration records mark
-    double mark             # _distance at that check
+    double mark             # termination.distance at that check
 
 
 cdef void iterate(Engine* e, Run* run, bint cold, double start_time) noexcept nogil:
@@ -279,7 +279,7 @@ cdef inline void _check(Engine* e, Loop* L, Run* run) noexcept nogil:
         _log(e, L.iteration, run.rho)
     L.status = check(e, L.iteration, L.last)
     if L.iteration >= L.mark_at:
-        L.mark = _distance(e)
+        L.mark = distance(&e.res, e.opt.eps_abs, e.opt.eps_rel)
         L.mark_at = LONG_MAX
     if L.gated and L.status == RUNNING:   # the gate passed, the check did not
         L.wait = min(2 * L.wait + 1, GATED_CHECK_WAIT)
@@ -316,28 +316,15 @@ cdef inline void _polish_attempts(Engine* e, Loop* L, Run* run) noexcept nogil:
 
 cdef inline void _extend(Engine* e, Loop* L) noexcept nogil:
     """Under a time limit the clock is the budget: a run at its iteration cap whose
-    :func:`_distance` to tolerance shrank by ``CONVERGING`` since the last mark (half a
-    ``max_iter`` ago) gets half a ``max_iter`` more, until the clock or a stall stops it
-    (PRIMALC2 of Maros-Meszaros at 1e-6: SOLVED at 11,250 iterations, stopped at
-    4,000 before).
+    distance to tolerance (:func:`fccqp.termination.distance`) shrank by ``CONVERGING``
+    since the last mark (half a ``max_iter`` ago) gets half a ``max_iter`` more, until
+    the clock or a stall stops it (PRIMALC2 of Maros-Meszaros at 1e-6: SOLVED at 11,250
+    iterations, stopped at 4,000 before).
     """
-    cdef double now = _distance(e)
+    cdef double now = distance(&e.res, e.opt.eps_abs, e.opt.eps_rel)
     if isfinite(now) and now <= CONVERGING * L.mark:
         L.cap += max(e.opt.max_iter // 2, 1)
         L.mark = now
-
-
-cdef inline double _distance(const Engine* e) noexcept nogil:
-    """How far the last check's residuals are from the termination test: the largest
-    of the primal, dual and gap residuals over their tolerances."""
-    cdef const Residuals* r = &e.res
-    cdef const Options* o = &e.opt
-    if not r.finite:
-        return INFINITY
-    return max(max(r.prim_eq / (o.eps_abs + o.eps_rel * r.prim_eq_scale),
-                   r.prim_set / (o.eps_abs + o.eps_rel * r.prim_set_scale)),
-               max(r.dual / (o.eps_abs + o.eps_rel * r.dual_scale),
-                   r.gap / (o.eps_abs + o.eps_rel * r.gap_scale)))
 
 
 cdef inline void _stall_rule(Engine* e, Loop* L) noexcept nogil:

@@ -24,6 +24,7 @@ cdef struct Residuals:
 cdef void residuals(const Problem* p, const Iterates* it, double* Ax, double* ATnu,
                     double* Px, Residuals* r) noexcept nogil
 cdef bint converged(const Residuals* r, double eps_abs, double eps_rel) noexcept nogil
+cdef double distance(const Residuals* r, double eps_abs, double eps_rel) noexcept nogil
 cdef bint nearly_converged(const Residuals* r, double eps_abs, double eps_rel,
                            double factor) noexcept nogil
 cdef double gap_scale(double xPx, double qx, double terms) noexcept nogil

@@ -200,3 +200,16 @@ cdef bint nearly_converged(const Residuals* r, double eps_abs, double eps_rel,
             and r.box_excess <= eps_abs
             and r.dual <= factor * (eps_abs + eps_rel * r.dual_scale)
             and r.gap <= factor * (eps_abs + eps_rel * r.gap_scale))
+
+
+cdef double distance(const Residuals* r, double eps_abs, double eps_rel) noexcept nogil:
+    """How far the residuals are from the termination test: the smallest ``factor`` of
+    :func:`nearly_converged`'s four tolerance tests (the equalities, the set, the dual
+    residual, the gap), ``INFINITY`` when a residual is not finite. A run's progress
+    measure under a time limit (:func:`fccqp.iteration._extend`)."""
+    if not r.finite:
+        return INFINITY
+    return max(max(r.prim_eq / (eps_abs + eps_rel * r.prim_eq_scale),
+                   r.prim_set / (eps_abs + eps_rel * r.prim_set_scale)),
+               max(r.dual / (eps_abs + eps_rel * r.dual_scale),
+                   r.gap / (eps_abs + eps_rel * r.gap_scale)))
