@@ -223,8 +223,9 @@ def in_other_form(solver_type: type, settings: object, stalled: object,
     """The problem of ``arguments`` (``P, q, A, b, lb, ub, cones``), on which a run in
     ``stalled.backend``'s form stalled, solved cold in the other form
     (:func:`other_form`), or else cold at ``STALL_RHO_FACTOR`` times ``settings.rho``,
-    when that gives an answer (:data:`ANSWERS`), with the iterations and
-    factorizations of the solves it took; else None.
+    at a fixed rho below its floor (when the run ended there), or without
+    equilibration, the first of these that gives an answer (:data:`ANSWERS`), with the
+    iterations and factorizations of the solves it took; else None.
 
     The larger rho: on problems with a singular ``P`` (qpsolvers' form, ``P`` of
     1e-128) ADMM ran thousands of iterations with constant residuals while a
@@ -241,7 +242,17 @@ def in_other_form(solver_type: type, settings: object, stalled: object,
     last try fixes rho and ``sigma`` at ``RHO_MIN / STALL_RHO_FACTOR`` (extreme_data 212
     and 473: 4000 iterations stalled in every form, 30 to 600 at 1e-9). A smaller
     ``sigma`` can make the convexity test fail on a ``P`` that is semidefinite to
-    rounding: that try then gives no answer."""
+    rounding: that try then gives no answer.
+
+    Without equilibration, last: with ``P`` huge the cost normalization sits at its cap
+    (``c`` = 1e-4) and a cone block shares one column scale between entries that ``P``
+    weighs at 1e14 and entries it does not touch, so the scaled problem puts the
+    optimum 1e6 from the origin while its cost pulls at 1e-7; ADMM crawls there in
+    every form and at every rho (extreme_data:1300030: `|x_s|` 3e-2 of the 2e6 it must
+    reach after 4000 iterations, rho at 3.7e-3). On the user's own units rho climbs to
+    7e5 and the run ends in 327 iterations (SOLVED); a friction cone capped through a
+    boxed copy of its normal force, variables rescaled by 1e-8..1e8
+    (extreme_data:1500043), is certified infeasible in 520."""
     spent = factored = 0
     tries = [other_form(settings, stalled.backend),
              settings.replace(rho=settings.rho * STALL_RHO_FACTOR)]
@@ -249,6 +260,7 @@ def in_other_form(solver_type: type, settings: object, stalled: object,
         floor = RHO_MIN / STALL_RHO_FACTOR
         tries.append(settings.replace(rho=floor, sigma=min(settings.sigma, floor),
                                       adaptive_rho=False))
+    tries.append(settings.replace(scaling=0))
     for again in tries:
         try:
             result = _auxiliary_solver(solver_type, again).solve(*arguments)
