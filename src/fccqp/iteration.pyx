@@ -26,7 +26,7 @@ at every iterate. After each step, safeguarded Anderson acceleration may extrapo
 from libc.limits cimport LONG_MAX
 from libc.math cimport INFINITY, isfinite
 
-from fccqp._dense cimport copy
+from fccqp._dense cimport copy, fill
 from fccqp._types cimport Iterates, Problem
 from fccqp.acceptance cimport keep_polished, keep_restored, restore_equalities, warm_polish
 from fccqp.anderson cimport anderson_reset, anderson_step
@@ -159,7 +159,7 @@ cdef inline bint _start(Engine* e, Loop* L, Run* run) noexcept nogil:
         return False
     if at_start:   # not at factorization accuracy: inconsistent or dependent rows
         e.equalities_missed = r.prim_eq > EQUALITY_MISSED * max(r.prim_eq_scale, 1.0)
-        if missed_by_data(e) and inconsistent(e, True):
+        if missed_by_data(e) and (inconsistent(e, True) or _least_squares_inconsistent(e)):
             # tested on the penalty-free start: with rho in the KKT matrix (up to 1e9
             # on fixed entries) the regularization's trace in A'r can hide it
             end_run(e, run, PRIMAL_INFEASIBLE, 0)
@@ -177,6 +177,29 @@ cdef inline bint _start(Engine* e, Loop* L, Run* run) noexcept nogil:
         end_run(e, run, status, 0)
         return False
     return True
+
+
+cdef bint _least_squares_inconsistent(Engine* e) noexcept nogil:
+    """The equality certificate (:func:`fccqp.verdict.inconsistent`) at the point of
+    least ``A x = b`` residual, the start's regularized solve for ``(0, b)``, in place of
+    the start's ``x``: that one solves for ``-q`` too, and with ``q`` huge it carries the
+    regularization's pull (``delta`` times ``q``, through ``A``), so that its residual is
+    not the least-squares one and ``A'r ~ 0`` fails (the fuzzer's extreme_data:1100150,
+    ``q`` of 1e16 on six inconsistent rows of rank 2: ``|b - A x|`` 0.052 where least
+    squares leaves 1.7e-3, MAX_ITER_REACHED at 0 iterations). ``x`` is kept only with
+    the certificate."""
+    cdef Problem* p = &e.prob
+    cdef Py_ssize_t n = p.n
+    cdef double* saved = e.work.vec_n3   # not among inconsistent's scratch
+    copy(e.it.x, saved, n)
+    fill(e.work.rhs, 0.0, n)
+    copy(p.b, e.work.rhs + n, p.m)
+    kkt_solve(&e.fact.kkt, p, e.it.rho_vec, e.work.rhs, e.work.sol)
+    copy(e.work.sol, e.it.x, n)
+    if inconsistent(e, True):
+        return True
+    copy(saved, e.it.x, n)
+    return False
 
 
 cdef inline bint _factor_or_polish(Engine* e, Loop* L, Run* run) noexcept nogil:
