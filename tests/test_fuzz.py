@@ -26,16 +26,19 @@ SEEDS = {
     "extreme_data": (0, 1, 7, 9, 38, 47, 56, 108, 138, 149, 202, 214, 254, 302, 308, 316,
                      311, 326, 335, 337, 355, 363, 365, 489, 1182, 2244, 100082, 100180, 100213,
                      100228, 100233, 500030, 500064, 500099, 500322, 700281, 900343, 900360,
-                     1100037, 1100057, 1100253, 1300300),
-    "qpsolvers": (0, 1, 2),
+                     1100037, 1100057, 1100150, 1100253, 1300030, 1300300, 1500043, 1700106,
+                     1700359),
+    "qpsolvers": (0, 1, 2, 1700123),
     "cvxpy": (1, 2, 3),
 }
 """Seeds per class run on every dense backend: a passing case or two per class and the
 reproducers of the failure mechanisms the campaign found at ed3b90e, 836ab4b, 5f3a658,
 16f1696 and 206a4f0 (seeds from 100000, and extreme_data 489, 1182, 2244 of the deep
 ``--classes extreme_data`` run; 1100037, 1100057, 1100253 are the same mechanisms on a
-seed unseen by their fix; 1300300 an infeasibility claim at the data's rounding; issue
-26)."""
+seed unseen by their fix; 1300300 an infeasibility claim at the data's rounding;
+1100150 inconsistent rows under a huge ``q``; 1300030, 1500043, 1700106, 1700359 and
+qpsolvers 1700123 stalls that a forced backend now solves again at another rho or
+unequilibrated; issues 26 and 28)."""
 
 SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),
@@ -50,20 +53,12 @@ SPARSE_SEEDS = {
 ``POLISH_CSC_DELTA = 1e-12`` (qdldl without pivoting)."""
 
 OPEN = {
-    "cvxpy:1": "a feasible problem whose dual residual stalls near 0.8 in the LDL' forms "
-    "with adaptive rho; only auto solves it again in the other form",
-    "extreme_data:100213": "P of 1e-12: the full form stalls where the reduced one solves; "
-    "only auto solves it again in the other form",
     "extreme_data:1300300": "a primal certificate at 2.7e-8 of its terms (rows of 1e-8 to "
     "3e7) beside a constructed optimum; only auto checks it in the other form",
-    "solver_reuse:100206": "new rows through a kept workspace stall in every form warm; "
-    "only auto solves it again, cold, in the other form",
 }
 """Reproducers of mechanisms still open (issue 26), each the reason it fails: expected
 to fail (strictly) on the backends where it does, so that a fix turns them red."""
-OPEN_BACKENDS = {"cvxpy:1": ("ldl_reduced", "ldl_full"), "extreme_data:100213": ("ldl_full",),
-                 "extreme_data:1300300": ("ldl_full",),
-                 "solver_reuse:100206": ("schur_reduced", "ldl_reduced", "ldl_full")}
+OPEN_BACKENDS = {"extreme_data:1300300": ("ldl_full",)}
 """Where an open case fails on some backends only."""
 
 

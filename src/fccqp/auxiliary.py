@@ -31,13 +31,14 @@ constrained entries alone. A problem that stalls in one form often solves in the
 4000 iterations in the reduced form and solved in 30 in the full one; a feasible QP
 with ``P`` of 1e-12 stalled in the full form and solved in the reduced one). So an
 auxiliary solve that is not SOLVED runs again in the other form
-(:func:`other_form`), and :func:`in_other_form` solves the stalled problem itself
+(:func:`other_form`), and :func:`solved_again` solves the stalled problem itself
 again there when no certificate was found, and then, if it stalls there too, at a
-larger rho, and, when the stalled run's rho sat at its floor, at a smaller one.
+larger rho, when the stalled run's rho sat at its floor at a smaller one, and without
+equilibration. A forced ``kkt_backend`` keeps its form and gets the other tries.
 
 On the sparse path (a :attr:`fccqp.admm.Workspace.compressed` run) the auxiliary QPs
 are built with ``scipy.sparse`` and take the sparse path too, whatever their size;
-there is neither another form nor the larger rho to try.
+there is no other form to try there, and the other tries stay on the sparse path.
 """
 
 from __future__ import annotations
@@ -214,18 +215,21 @@ def _solved(solver_type: type, settings: object, problem: tuple) -> tuple:
 
 ANSWERS = (Status.SOLVED, Status.SOLVED_INACCURATE, Status.PRIMAL_INFEASIBLE,
            Status.DUAL_INFEASIBLE)
-"""The statuses of :func:`in_other_form` that replace a stalled run's: an answer,
+"""The statuses of :func:`solved_again` that replace a stalled run's: an answer,
 each with the guarantees of its status."""
 
 
-def in_other_form(solver_type: type, settings: object, stalled: object,
-                  arguments: tuple) -> object | None:
+def solved_again(solver_type: type, settings: object, stalled: object,
+                 arguments: tuple, switch_form: bool) -> object | None:
     """The problem of ``arguments`` (``P, q, A, b, lb, ub, cones``), on which a run in
     ``stalled.backend``'s form stalled, solved cold in the other form
-    (:func:`other_form`), or else cold at ``STALL_RHO_FACTOR`` times ``settings.rho``,
-    at a fixed rho below its floor (when the run ended there), or without
-    equilibration, the first of these that gives an answer (:data:`ANSWERS`), with the
-    iterations and factorizations of the solves it took; else None.
+    (:func:`other_form`, with ``switch_form``: when the form was fccqp's choice), or
+    else cold at ``STALL_RHO_FACTOR`` times ``settings.rho``, at a fixed rho below its
+    floor (when the run ended there), or without equilibration, the first of these
+    that gives an answer (:data:`ANSWERS`), with the iterations and factorizations of
+    the solves it took; else None. Without ``switch_form`` every try keeps
+    ``settings.kkt_backend`` (a forced backend, the sparse path): rho and the scaling
+    are fccqp's to choose, the form then is not.
 
     The larger rho: on problems with a singular ``P`` (qpsolvers' form, ``P`` of
     1e-128) ADMM ran thousands of iterations with constant residuals while a
@@ -254,8 +258,8 @@ def in_other_form(solver_type: type, settings: object, stalled: object,
     boxed copy of its normal force, variables rescaled by 1e-8..1e8
     (extreme_data:1500043), is certified infeasible in 520."""
     spent = factored = 0
-    tries = [other_form(settings, stalled.backend),
-             settings.replace(rho=settings.rho * STALL_RHO_FACTOR)]
+    tries = [other_form(settings, stalled.backend)] if switch_form else []
+    tries.append(settings.replace(rho=settings.rho * STALL_RHO_FACTOR))
     if stalled.rho < RHO_MIN * settings.adaptive_rho_tolerance:
         floor = RHO_MIN / STALL_RHO_FACTOR
         tries.append(settings.replace(rho=floor, sigma=min(settings.sigma, floor),
