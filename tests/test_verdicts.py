@@ -388,6 +388,19 @@ def test_a_run_the_equilibration_leaves_crawling_is_solved_unscaled(seed, status
     assert result.status is status
 
 
+def test_a_retry_solved_on_lent_tolerances_is_no_answer():
+    """A retry's SOLVED point that its entries' own units do not give it (the doubt
+    whose second opinion an auxiliary solver does not ask) does not replace a stalled
+    run's status: extreme_data:1700359 on the sparse path (a friction cone capped
+    through a boxed copy of its normal force, variables rescaled 1e-8..1e8; infeasible
+    by construction) was SOLVED unequilibrated after two stalls."""
+    from fuzzing import Case
+
+    problem = Case.of("extreme_data", 1700359).scenario().problem
+    result = solve_verified(problem, kkt_backend="sparse")
+    assert result.status in (Status.MAX_ITER_REACHED, Status.PRIMAL_INFEASIBLE)
+
+
 def test_a_forced_backend_keeps_its_form_after_a_stall():
     """The second form is fccqp's choice only under "auto"; rho and the scaling are
     fccqp's under any backend: a forced ``ldl_full`` that stalls on

@@ -266,14 +266,27 @@ def solved_again(solver_type: type, settings: object, stalled: object,
                                       adaptive_rho=False))
     tries.append(settings.replace(scaling=0))
     for again in tries:
+        solver = _auxiliary_solver(solver_type, again)
         try:
-            result = _auxiliary_solver(solver_type, again).solve(*arguments)
+            result = solver.solve(*arguments)
         except ValueError:   # "not convex" under the smaller sigma: no answer there
             continue
         spent, factored = spent + result.iterations, factored + result.factorizations
-        if result.status in ANSWERS:
+        if result.status in ANSWERS and not _doubted(solver, result):
             return dataclasses.replace(result, iterations=spent, factorizations=factored)
     return None
+
+
+def _doubted(solver: object, result: object) -> bool:
+    """Whether ``result``, ``solver``'s last answer, is a solved point on tolerances
+    that its entries' own units do not give it (:attr:`fccqp.admm.Workspace.doubt`),
+    whose second opinion an auxiliary solver does not ask: such a point is no answer
+    for a stalled run (the fuzzer's extreme_data:1700359 on the sparse path, variables
+    rescaled 1e-8..1e8: SOLVED unequilibrated where the construction is infeasible)."""
+    if result.status not in (Status.SOLVED, Status.SOLVED_INACCURATE):
+        return False
+    workspace = solver._sparse[1] if result.backend == "sparse" else solver._workspace
+    return bool(workspace.doubt)
 
 
 def weakly_separated(result: object, b: np.ndarray, lb: np.ndarray,
