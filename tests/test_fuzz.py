@@ -54,15 +54,12 @@ OPEN = {
     "with adaptive rho; only auto solves it again in the other form",
     "extreme_data:100213": "P of 1e-12: the full form stalls where the reduced one solves; "
     "only auto solves it again in the other form",
-    "extreme_data:1300300": "a primal certificate at 2.7e-8 of its terms (rows of 1e-8 to "
-    "3e7) beside a constructed optimum; only auto checks it in the other form",
     "solver_reuse:100206": "new rows through a kept workspace stall in every form warm; "
     "only auto solves it again, cold, in the other form",
 }
 """Reproducers of mechanisms still open (issue 26), each the reason it fails: expected
 to fail (strictly) on the backends where it does, so that a fix turns them red."""
 OPEN_BACKENDS = {"cvxpy:1": ("ldl_reduced", "ldl_full"), "extreme_data:100213": ("ldl_full",),
-                 "extreme_data:1300300": ("ldl_full",),
                  "solver_reuse:100206": ("schur_reduced", "ldl_reduced", "ldl_full")}
 """Where an open case fails on some backends only."""
 

@@ -100,6 +100,8 @@ cdef struct Certificates:
     int gram_state              # gram: 0 not factored in this solve, 1 factored, -1 failed
     double stalled_prim         # primal residual at the last check that could clean
     long stalled_at             # and that check's iteration
+    double checked_prim         # primal residual at the last check
+    long checked_at             # and that check's iteration
     int stalled_checks          # checks in a row that could clean whose residual stalled
     long next_cleaning          # when the next cleaning may run
     long cleaning_wait          # and the wait after a failed one

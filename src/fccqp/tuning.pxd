@@ -106,7 +106,7 @@ cdef extern from *:
     #define FCCQP_CLEANING_START 500
     /* cleaned only while the primal residual is above this x its tolerance */
     #define FCCQP_CLEANING_GATE 1.0
-    /* cleaned only if, at its last rate, the primal residual needs more than this x the run's iterations */
+    /* the primal residual stalls (certificate tested, cleaned) if its last rate needs more than this x the run's iterations to its tolerance */
     #define FCCQP_CLEANING_HORIZON 1.0
     /* a least-distance QP solved again meets the Farkas test's eps_prim_inf this many times */
     #define FCCQP_AUXILIARY_MARGIN 10.0
