@@ -52,13 +52,11 @@ SPARSE_SEEDS = {
 ``qpsolvers:100035`` is an LP that the compressed-column polish lost at
 ``POLISH_CSC_DELTA = 1e-12`` (qdldl without pivoting)."""
 
-OPEN = {
-    "extreme_data:1300300": "a primal certificate at 2.7e-8 of its terms (rows of 1e-8 to "
-    "3e7) beside a constructed optimum; only auto checks it in the other form",
-}
+OPEN: dict[str, str] = {}
 """Reproducers of mechanisms still open (issue 26), each the reason it fails: expected
-to fail (strictly) on the backends where it does, so that a fix turns them red."""
-OPEN_BACKENDS = {"extreme_data:1300300": ("ldl_full",)}
+to fail (strictly) on the backends where it does, so that a fix turns them red (none
+open now)."""
+OPEN_BACKENDS: dict[str, tuple[str, ...]] = {}
 """Where an open case fails on some backends only."""
 
 

@@ -99,7 +99,10 @@ cdef struct Certificates:
     double* gram                # m x m: Cholesky factor of A A' for cleaning certificates
     int gram_state              # gram: 0 not factored in this solve, 1 factored, -1 failed
     double stalled_prim         # primal residual at the last check that could clean
-    int stalled_checks          # checks in a row that could clean whose residual did not halve
+    long stalled_at             # and that check's iteration
+    double checked_prim         # primal residual at the last check
+    long checked_at             # and that check's iteration
+    int stalled_checks          # checks in a row that could clean whose residual stalled
     long next_cleaning          # when the next cleaning may run
     long cleaning_wait          # and the wait after a failed one
 

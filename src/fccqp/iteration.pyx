@@ -127,6 +127,8 @@ cdef inline void _begin(Engine* e, Loop* L, Run* run, bint cold, double start_ti
     run.polished = False
     e.tighten = 1.0
     e.certs.stalled_prim = INFINITY
+    e.certs.stalled_at = e.certs.checked_at = 0
+    e.certs.checked_prim = INFINITY
     e.certs.stalled_checks = 0
     e.certs.next_cleaning = CLEANING_START
     e.certs.cleaning_wait = o.adaptive_rho_interval

@@ -106,6 +106,8 @@ cdef extern from *:
     #define FCCQP_CLEANING_START 500
     /* cleaned only while the primal residual is above this x its tolerance */
     #define FCCQP_CLEANING_GATE 1.0
+    /* the primal residual stalls (certificate tested, cleaned) if its last rate needs more than this x the run's iterations to its tolerance */
+    #define FCCQP_CLEANING_HORIZON 1.0
     /* a least-distance QP solved again meets the Farkas test's eps_prim_inf this many times */
     #define FCCQP_AUXILIARY_MARGIN 10.0
     /* a problem that stalled in both KKT forms is solved again, cold, at this times Settings.rho */
@@ -223,6 +225,7 @@ cdef extern from *:
     const double GRAM_REGULARIZATION "FCCQP_GRAM_REGULARIZATION"
     const long CLEANING_START "FCCQP_CLEANING_START"
     const double CLEANING_GATE "FCCQP_CLEANING_GATE"
+    const double CLEANING_HORIZON "FCCQP_CLEANING_HORIZON"
     const double AUXILIARY_MARGIN "FCCQP_AUXILIARY_MARGIN"
     const double STALL_RHO_FACTOR "FCCQP_STALL_RHO_FACTOR"
     const double WEAK_SEPARATION "FCCQP_WEAK_SEPARATION"
