@@ -276,11 +276,23 @@ cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t n
     """Factor the KKT matrix of the current active set and planes (by Schur complement
     where :mod:`fccqp.polish_schur` was set up for this problem and applies, else
     assembled for ``dsytrf``, or for qdldl where ``P`` and ``A`` are CSC) and solve it
-    from the current point to ``tolerance``; False when the factorization breaks down."""
+    from the current point to ``tolerance``; False when the factorization breaks down.
+
+    A polish after ADMM's factorization (the table's fallback where its system is
+    singular, or a run without a table) sets the Schur solve up here when no warm polish
+    of this solve did: on talos' cold ticks the table's fallback had been ``dsytrf`` of
+    the whole polished KKT matrix, 1.5M instructions a guess, where the set-up costs
+    0.4M once and a guess 0.15M (notes/polish.md, "polishcost"). Where ``P`` does not
+    allow it the set-up is tried again at the next fallback, at most its own cost
+    against the ``dsytrf`` that follows anyway. Not without the workspace's storage
+    (``schur.L`` NULL: :mod:`fccqp.polish_ops`' dense arm, which the tests hold to the
+    CSC arm)."""
     cdef char uplo = b"L"
     cdef int size = <int>(nf + p.m + nb), info = 0
     if size == 0:   # every entry held, no rows: nothing to solve
         return True
+    if not w.schur.ready and not w.schur_only and w.schur.L != NULL:
+        polish_prepare(w, p)   # first fallback of this solve from the table (see polish)
     w.structured = w.schur.ready and polish_schur_factor(&w.schur, p, w.index, w.boundary, nb,
                                                          w.g, w.hess, POLISH_DELTA)
     factorizations[0] += 1

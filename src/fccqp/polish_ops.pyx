@@ -97,6 +97,7 @@ def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5):
     w.x, w.nu, w.y, w.x_prev, w.nu_prev = a.new(n), a.new(m), a.new(s), a.new(n), a.new(m)
     w.grad, w.ATnu, w.Ax = a.new(n), a.new(n), a.new(m)
     w.schur.ready = w.schur_only = w.schur_failed = False
+    w.schur.L = NULL   # no Schur storage: every guess is assembled
     if Ph.M.kind == CSC:
         held = arrays(n, m, np.asarray(Ph.colptr), np.asarray(Ph.rowind),
                       np.asarray(Ah.colptr), np.asarray(Ah.rowind), cones.dim)
