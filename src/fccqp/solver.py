@@ -47,7 +47,7 @@ class _Structure:
     (``admm.STRUCTURE_CHANGED``) when they moved."""
 
     __slots__ = ("n", "m", "count", "constrained", "fixed", "relocated", "cones", "certificate",
-                 "last_cones")
+                 "last_cones", "_key")
 
     def __init__(self, n: int, m: int, cones: ConeArrays) -> None:
         self.n, self.m, self.count, self.cones = n, m, 0, cones
@@ -55,6 +55,7 @@ class _Structure:
         self.relocated = np.empty(cones.count, np.intp)
         self.certificate = np.empty(n + m)  # copied into the Result only when infeasible
         self.last_cones: object = None   # the cones argument last solved in its workspace
+        self._key: tuple[object, ...] | None = None
 
     def update(self, lb: np.ndarray, ub: np.ndarray) -> bool:
         """Scan the bounds; True when the constrained or fixed entries changed."""
@@ -62,16 +63,19 @@ class _Structure:
             lb, ub, self.cones.offset, self.cones.dim, self.constrained, self.fixed,
             self.relocated, self.count)
         check_cone_bounds(member, lb, ub)
-        self.count = count
+        self.count, self._key = count, None
         return changed
 
     def key(self) -> tuple[object, ...]:
         """What a workspace for this structure is made of (a solver's settings are
-        fixed): equal keys, interchangeable workspaces."""
-        cones, count = self.cones, self.count
-        return (self.n, self.m, self.constrained[:count].tobytes(),
-                self.fixed[:count].tobytes(), cones.kind.tobytes(), cones.offset.tobytes(),
-                cones.dim.tobytes())
+        fixed): equal keys, interchangeable workspaces. Kept until the next
+        :meth:`update` (the cone blocks, the rest of it, do not change)."""
+        if self._key is None:
+            cones, count = self.cones, self.count
+            self._key = (self.n, self.m, self.constrained[:count].tobytes(),
+                         self.fixed[:count].tobytes(), cones.kind.tobytes(),
+                         cones.offset.tobytes(), cones.dim.tobytes())
+        return self._key
 
     def workspace(self, settings: Settings) -> admm.Workspace:
         """A workspace for this structure."""
