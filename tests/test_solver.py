@@ -181,6 +181,41 @@ def test_a_return_to_a_structure_reuses_its_workspace_and_starts_cold():
     assert solver.solve(*first).status is Status.SOLVED
 
 
+def test_a_contact_set_that_comes_back_takes_its_kept_workspace_directly(monkeypatch):
+    # two contact sets in turn: the return finds the kept workspace by its last cones and
+    # the arguments' shapes, without the general path's conversion and structure scan,
+    # and answers as a reset solver does, bit for bit
+    # (cones as a control loop passes them: a tuple of specs with Python numbers)
+    def plain(cone):
+        return FrictionCone(cone.start, float(cone.mu),
+                            None if cone.normal is None else tuple(map(float, cone.normal)))
+
+    first, second = ((*problem[:6], tuple(map(plain, problem[6]))) for problem in (
+        random_problem(31, n=30, m=8, n_cones=3, n_box=6),
+        random_problem(32, n=24, m=6, n_cones=2, n_box=4)))
+    solver = fccqp.Solver()
+    solver.solve(*first)
+    kept = solver._workspace
+    solver.solve(*second)
+
+    def no_conversion(*arguments):
+        raise AssertionError("the return converted its arguments")
+
+    monkeypatch.setattr(fccqp.solver, "convert", no_conversion)
+    again = solver.solve(*first)
+    assert solver._workspace is kept
+    back = solver.solve(*second)
+    monkeypatch.undo()
+    reset = fccqp.Solver()
+    reset.solve(*first)
+    reset.reset()
+    after_reset = reset.solve(*first)
+    assert again.iterations == after_reset.iterations and again.status is Status.SOLVED
+    np.testing.assert_array_equal(again.x, after_reset.x)
+    verify_solution(first, again)
+    verify_solution(second, back)
+
+
 def test_reuses_factorization_when_matrices_unchanged():
     P, q, A, b, lb, ub, cones = random_problem(9)
     solver = fccqp.Solver(adaptive_rho=False)

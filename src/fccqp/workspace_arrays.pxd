@@ -4,6 +4,8 @@ from fccqp.engine cimport Engine
 
 cdef class Arrays:
     cdef list kept
+    cdef double* free        # the unused rest of the current chunk
+    cdef Py_ssize_t left     # its doubles
     cdef double* new(self, Py_ssize_t size) except NULL
     cdef void* new_int(self, Py_ssize_t size) except NULL
     cdef double* adopt(self, object array) except NULL
