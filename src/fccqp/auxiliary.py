@@ -31,13 +31,15 @@ constrained entries alone. A problem that stalls in one form often solves in the
 4000 iterations in the reduced form and solved in 30 in the full one; a feasible QP
 with ``P`` of 1e-12 stalled in the full form and solved in the reduced one). So an
 auxiliary solve that is not SOLVED runs again in the other form
-(:func:`other_form`), and :func:`in_other_form` solves the stalled problem itself
+(:func:`other_form`), and :func:`solved_again` solves the stalled problem itself
 again there when no certificate was found, and then, if it stalls there too, at a
-larger rho, and, when the stalled run's rho sat at its floor, at a smaller one.
+larger rho, and, when the stalled run's rho sat at its floor, at a smaller one. Where
+the form was the user's (a forced ``kkt_backend``) or the sparse path's (a
+:attr:`fccqp.admm.Workspace.compressed` run, which has one form), only the rho tries
+run, in that form.
 
-On the sparse path (a :attr:`fccqp.admm.Workspace.compressed` run) the auxiliary QPs
-are built with ``scipy.sparse`` and take the sparse path too, whatever their size;
-there is neither another form nor the larger rho to try.
+On the sparse path the auxiliary QPs are built with ``scipy.sparse`` and take the
+sparse path too, whatever their size.
 """
 
 from __future__ import annotations
@@ -214,17 +216,18 @@ def _solved(solver_type: type, settings: object, problem: tuple) -> tuple:
 
 ANSWERS = (Status.SOLVED, Status.SOLVED_INACCURATE, Status.PRIMAL_INFEASIBLE,
            Status.DUAL_INFEASIBLE)
-"""The statuses of :func:`in_other_form` that replace a stalled run's: an answer,
+"""The statuses of :func:`solved_again` that replace a stalled run's: an answer,
 each with the guarantees of its status."""
 
 
-def in_other_form(solver_type: type, settings: object, stalled: object,
-                  arguments: tuple) -> object | None:
+def solved_again(solver_type: type, settings: object, stalled: object,
+                 arguments: tuple, change_form: bool) -> object | None:
     """The problem of ``arguments`` (``P, q, A, b, lb, ub, cones``), on which a run in
     ``stalled.backend``'s form stalled, solved cold in the other form
-    (:func:`other_form`), or else cold at ``STALL_RHO_FACTOR`` times ``settings.rho``,
-    when that gives an answer (:data:`ANSWERS`), with the iterations and
-    factorizations of the solves it took; else None.
+    (:func:`other_form`, when ``change_form``: the form was fccqp's choice), or else
+    cold at ``STALL_RHO_FACTOR`` times ``settings.rho``, when that gives an answer
+    (:data:`ANSWERS`), with the iterations and factorizations of the solves it took;
+    else None.
 
     The larger rho: on problems with a singular ``P`` (qpsolvers' form, ``P`` of
     1e-128) ADMM ran thousands of iterations with constant residuals while a
@@ -243,8 +246,8 @@ def in_other_form(solver_type: type, settings: object, stalled: object,
     ``sigma`` can make the convexity test fail on a ``P`` that is semidefinite to
     rounding: that try then gives no answer."""
     spent = factored = 0
-    tries = [other_form(settings, stalled.backend),
-             settings.replace(rho=settings.rho * STALL_RHO_FACTOR)]
+    tries = [other_form(settings, stalled.backend)] if change_form else []
+    tries.append(settings.replace(rho=settings.rho * STALL_RHO_FACTOR))
     if stalled.rho < RHO_MIN * settings.adaptive_rho_tolerance:
         floor = RHO_MIN / STALL_RHO_FACTOR
         tries.append(settings.replace(rho=floor, sigma=min(settings.sigma, floor),

@@ -260,19 +260,19 @@ class Solver:
                  cones: object, start: float) -> Result:
         """``out`` of a run that stalled (``MAX_ITER_REACHED``) in ``workspace`` on the
         problem of ``arguments`` (``P, q, A, b, lb, ub``), or the certificate that
-        :func:`fccqp.auxiliary.stalled_certificate` found for it instead, or (with
-        ``kkt_backend="auto"`` on the dense path) the answer of a solve in the other KKT
-        form or at a larger rho (:func:`fccqp.auxiliary.in_other_form`); their iterations
+        :func:`fccqp.auxiliary.stalled_certificate` found for it instead, or the answer
+        of a solve in the other KKT form (with ``kkt_backend="auto"`` on the dense path)
+        or at another rho (:func:`fccqp.auxiliary.solved_again`); their iterations
         and factorizations added. Either leaves no previous solution to start from: a
         certified problem as an infeasible run does, an answer from another solver
         because this workspace holds the stalled point."""
         found = auxiliary.stalled_certificate(Solver, self._settings, workspace, *arguments,
                                               cones)
-        if (found is None and self._settings.kkt_backend == "auto"
-                and not workspace.compressed):
-            # the form was fccqp's choice: the other one may not stall
-            again = auxiliary.in_other_form(Solver, self._settings, out,
-                                            (*arguments, cones))
+        if found is None:
+            # the other form, where it was fccqp's choice, may not stall; another rho
+            again = auxiliary.solved_again(
+                Solver, self._settings, out, (*arguments, cones),
+                self._settings.kkt_backend == "auto" and not workspace.compressed)
             if again is not None:
                 workspace.forget()
                 return Result._of({
