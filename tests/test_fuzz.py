@@ -43,27 +43,24 @@ SPARSE_SEEDS = {
     "solver_reuse": (38,),
     "extreme_data": (26,),
     "qpsolvers": (100035,),
-    "cvxpy": (7,),
+    "cvxpy": (7, 1700154),
+    "dual_infeasible": (1700072,),
 }
 """Seeds per class run on the sparse path (each ends within a few dozen iterations);
 ``qpsolvers:100035`` is an LP that the compressed-column polish lost at
-``POLISH_CSC_DELTA = 1e-12`` (qdldl without pivoting)."""
+``POLISH_CSC_DELTA = 1e-12`` (qdldl without pivoting); ``cvxpy:1700154`` a zero pivot
+that ``qdldl``'s update did not report, ``dual_infeasible:1700072`` solves whose first
+block was left unrefined (both diverged to NUMERICAL_ERROR on unbounded problems)."""
 
 OPEN = {
-    "cvxpy:1": "a feasible problem whose dual residual stalls near 0.8 in the LDL' forms "
-    "with adaptive rho; only auto solves it again in the other form",
     "extreme_data:100213": "P of 1e-12: the full form stalls where the reduced one solves; "
     "only auto solves it again in the other form",
     "extreme_data:1300300": "a primal certificate at 2.7e-8 of its terms (rows of 1e-8 to "
     "3e7) beside a constructed optimum; only auto checks it in the other form",
-    "solver_reuse:100206": "new rows through a kept workspace stall in every form warm; "
-    "only auto solves it again, cold, in the other form",
 }
 """Reproducers of mechanisms still open (issue 26), each the reason it fails: expected
 to fail (strictly) on the backends where it does, so that a fix turns them red."""
-OPEN_BACKENDS = {"cvxpy:1": ("ldl_reduced", "ldl_full"), "extreme_data:100213": ("ldl_full",),
-                 "extreme_data:1300300": ("ldl_full",),
-                 "solver_reuse:100206": ("schur_reduced", "ldl_reduced", "ldl_full")}
+OPEN_BACKENDS = {"extreme_data:100213": ("ldl_full",), "extreme_data:1300300": ("ldl_full",)}
 """Where an open case fails on some backends only."""
 
 
