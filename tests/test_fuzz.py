@@ -46,11 +46,14 @@ SPARSE_SEEDS = {
     "solver_reuse": (38,),
     "extreme_data": (26,),
     "qpsolvers": (100035,),
-    "cvxpy": (7,),
+    "cvxpy": (7, 1700154),
+    "dual_infeasible": (1700072,),
 }
 """Seeds per class run on the sparse path (each ends within a few dozen iterations);
 ``qpsolvers:100035`` is an LP that the compressed-column polish lost at
-``POLISH_CSC_DELTA = 1e-12`` (qdldl without pivoting)."""
+``POLISH_CSC_DELTA = 1e-12`` (qdldl without pivoting); ``cvxpy:1700154`` a zero pivot
+that ``qdldl``'s update did not report, ``dual_infeasible:1700072`` solves whose first
+block was left unrefined (both diverged to NUMERICAL_ERROR on unbounded problems)."""
 
 OPEN: dict[str, str] = {}
 """Reproducers of mechanisms still open (issue 26), each the reason it fails: expected

@@ -343,32 +343,40 @@ def test_a_run_that_stalls_in_the_form_auto_chose_is_solved_in_the_other(name, s
         assert clarabel_solve(*problem.args()).status == "solved"
 
 
+@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize(("name", "seed"), [("qpsolvers", 500077), ("qpsolvers", 500090),
                                            ("qpsolvers", 700127), ("extreme_data", 500215),
                                            ("extreme_data", 500351)])
-def test_a_run_that_stalls_in_both_forms_is_solved_at_a_larger_rho(name, seed):
+def test_a_run_that_stalls_in_both_forms_is_solved_at_a_larger_rho(name, seed, backend):
     """Feasible problems with a singular ``P`` (or ``P`` of 1e-128, or huge) on which
     ADMM holds its residuals constant while a multiplier grows by a fixed step, in
-    both KKT forms, for 4000 iterations: with ``kkt_backend="auto"`` the stalled
-    problem is solved again, cold, at ``STALL_RHO_FACTOR`` times ``rho``, and the
-    fuzzer's judge (verify_solution, Clarabel) accepts the answer."""
+    both KKT forms, for 4000 iterations: the stalled problem is solved again, cold, at
+    ``STALL_RHO_FACTOR`` times ``rho`` (in the forced form when the user chose one: a
+    forced backend had no second try and reported MAX_ITER_REACHED), and the fuzzer's
+    judge (verify_solution, Clarabel) accepts the answer."""
     from fuzzing import Case, judge
 
-    assert judge(Case.of(name, seed), "auto") is None
+    assert judge(Case.of(name, seed), backend) is None
 
 
+@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize(("name", "seed"), [("extreme_data", 212), ("extreme_data", 473),
                                            ("extreme_data", 1251)])
-def test_a_run_whose_rho_sits_at_its_floor_is_solved_at_a_smaller_one(name, seed):
+def test_a_run_whose_rho_sits_at_its_floor_is_solved_at_a_smaller_one(name, seed, backend,
+                                                                     request):
     """Extreme data whose multipliers are 1e-8 of the scaled primal (``P`` of 1e-11 with
     the optimum at 5e9; ``P`` of 1e10 or 8e10 with the optimum, or a ray, in its
     near-null space): the rho rule sits at ``RHO_MIN`` and ADMM stalls in both forms and
-    at the larger rho; with ``kkt_backend="auto"`` the problem is solved again, cold, at
-    a fixed rho and ``sigma`` of ``RHO_MIN / STALL_RHO_FACTOR``, and the fuzzer's judge
-    (verify_solution, Clarabel) accepts the answer (an optimum, or the ray of 1251)."""
+    at the larger rho; the problem is solved again, cold, at a fixed rho and ``sigma``
+    of ``RHO_MIN / STALL_RHO_FACTOR`` (in the forced form when the user chose one), and
+    the fuzzer's judge (verify_solution, Clarabel) accepts the answer (an optimum, or
+    the ray of 1251)."""
     from fuzzing import Case, judge
 
-    assert judge(Case.of(name, seed), "auto") is None
+    if (seed, backend) == (473, "sparse"):
+        request.node.add_marker(pytest.mark.xfail(strict=True, reason=(
+            "P huge on the sparse backend: MAX_ITER_REACHED at every rho tried")))
+    assert judge(Case.of(name, seed), backend) is None
 
 
 @pytest.mark.parametrize(("seed", "status"), [(1300030, Status.SOLVED),

@@ -26,6 +26,7 @@ from fccqp.certificates cimport regularized_cholesky
 from fccqp._dense cimport copy
 from fccqp._types cimport Problem
 from fccqp.engine cimport Engine
+from fccqp.kkt_sparse cimport sparse_hold_equalities
 from fccqp.matrices cimport DENSE, product
 from fccqp.tuning cimport EQUALITY_MISSED, KKT_REFINE_TOLERANCE, MAX_REFINE
 
@@ -88,8 +89,9 @@ cdef void hold_equalities(Engine* e) noexcept nogil:
     """Project the iterate's ``x`` onto ``A x = b`` (see the module docstring) when it
     misses it beyond ``EQUALITY_MISSED`` of its terms; up to ``MAX_REFINE`` projections,
     until ``KKT_REFINE_TOLERANCE`` of them, each kept only while it reduces the error (inconsistent rows keep the least-squares
-    point the KKT solves left). Dense storage only; uses ``e.certs.gram`` as scratch and
-    leaves it to be factored again for the certificates."""
+    point the KKT solves left). Uses ``e.certs.gram`` as scratch and leaves it to be
+    factored again for the certificates; over compressed columns, the sparse backend's
+    projection (:mod:`fccqp.sparse_equalities`)."""
     cdef Problem* p = &e.prob
     cdef Py_ssize_t n = p.n, m = p.m, i, j, step
     cdef double* x = e.it.x
@@ -99,7 +101,11 @@ cdef void hold_equalities(Engine* e) noexcept nogil:
     cdef double* saved = e.work.vec_n2
     cdef double* v = e.work.sol
     cdef double error, scale, new_error
-    if m == 0 or p.A.kind != DENSE:
+    if m == 0:
+        return
+    if p.A.kind != DENSE:
+        if e.fact.kkt.sparse != NULL:
+            sparse_hold_equalities(e.fact.kkt.sparse, n, m, x, p.b)
         return
     error = _equality_error(p, x, r, &scale)
     if error <= EQUALITY_MISSED * scale:

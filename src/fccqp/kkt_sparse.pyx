@@ -12,6 +12,7 @@ linked as a C library (``notes/one-algorithm.md``).
 
 import numpy as np
 
+from fccqp.sparse_equalities import hold_equalities
 from fccqp.sparse_kkt import FactorizationError
 
 
@@ -32,3 +33,13 @@ cdef void sparse_solve(void* handle, Py_ssize_t N, const double* rhs, double* so
     with gil:
         np.asarray(<double[:N]>sol)[:] = (<object>handle).solve(
             np.asarray(<double[:N]><double*>rhs))
+
+
+cdef void sparse_hold_equalities(void* handle, Py_ssize_t n, Py_ssize_t m, double* x,
+                                 const double* b) noexcept nogil:
+    """Project ``x`` (``n`` scaled entries) onto ``A x = b`` over the handle's scaled
+    ``A`` (:func:`fccqp.sparse_equalities.hold_equalities`)."""
+    with gil:
+        kkt = <object>handle
+        hold_equalities(kkt.A, kkt.E, np.asarray(<double[:n]>x),
+                        np.asarray(<double[:m]><double*>b))

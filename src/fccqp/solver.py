@@ -32,6 +32,9 @@ from fccqp.validation import structure_scan
 LOG_ROWS = 1024
 """Most lines of the verbose log kept per solve (one every ``tuning.LOG_INTERVAL``
 iterations, the first and the last)."""
+EIGENVALUE_DENSE_LIMIT = 2000
+"""Largest ``n`` whose smallest eigenvalue of ``P`` a non-convexity error computes with a
+dense ``eigvalsh``; ARPACK above."""
 KEPT_WORKSPACES = 4
 """Workspaces a :class:`Solver` keeps for structures it left, so that a return to one
 (a controller whose contact set comes back) starts cold without allocating: on
@@ -273,11 +276,7 @@ class Solver:
             raise_finding(w.finding, lb, ub)
         if type(out) is int:   # NOT_CONVEX_CODE, the only code left
             self._workspace = self._structure = None
-            raise ValueError(
-                "the QP is not convex: P has negative curvature on the null space of A "
-                f"(P is not positive semidefinite: its smallest eigenvalue is "
-                f"{np.linalg.eigvalsh((P + P.T) / 2)[0]:.3g})"
-            )
+            raise _not_convex(P)
         if (out.status is Status.MAX_ITER_REACHED and self._stalled_certificates
                 and not math.isfinite(settings.time_limit)):
             out = self._stalled(out, w, (P, q, A, b, lb, ub), self._cones, start)
@@ -383,10 +382,7 @@ class Solver:
             raise_finding(w.finding, data.lb, data.ub)
         if type(out) is int:   # NOT_CONVEX_CODE, the only code left
             self._sparse = None
-            raise ValueError(
-                "the QP is not convex: P has negative curvature on the null space of A "
-                "(P is not positive semidefinite: the KKT matrix has more negative pivots "
-                "than A has rows)")
+            raise _not_convex(data.P)
         if (out.status is Status.MAX_ITER_REACHED and self._stalled_certificates
                 and not math.isfinite(settings.time_limit)):
             out = self._stalled(out, w, (data.P, data.q, data.A, data.b, data.lb, data.ub),
@@ -435,6 +431,31 @@ def _certified(out: Result, found: tuple, workspace: admm.Workspace, start: floa
         "gap": float("nan"), "polished": False,
         "solve_time": time.perf_counter() - start,
     })
+
+
+def _not_convex(P: object) -> ValueError:
+    """The error for a QP whose KKT matrix has more negative pivots than ``A`` has rows:
+    ``P`` has negative curvature on the null space of ``A``. It gives ``P``'s smallest
+    eigenvalue, computed densely up to ``EIGENVALUE_DENSE_LIMIT`` entries and by ARPACK
+    above (left out when ARPACK does not converge)."""
+    message = "the QP is not convex: P has negative curvature on the null space of A"
+    n = P.shape[0]
+    try:
+        if n <= EIGENVALUE_DENSE_LIMIT:
+            dense = P.toarray() if hasattr(P, "toarray") else np.asarray(P)
+            smallest = np.linalg.eigvalsh((dense + dense.T) / 2)[0]
+        else:
+            from scipy.sparse.linalg import ArpackNoConvergence, eigsh
+            try:
+                smallest = eigsh((P + P.T) / 2, k=1, which="SA",
+                                 return_eigenvectors=False)[0]
+            except ArpackNoConvergence:
+                return ValueError(f"{message} (the KKT matrix has more negative pivots "
+                                  "than A has rows)")
+    except MemoryError:
+        return ValueError(message)
+    return ValueError(f"{message} (P is not positive semidefinite: its smallest "
+                      f"eigenvalue is {smallest:.3g})")
 
 
 def _rows(matrix: object) -> int:

@@ -10,7 +10,8 @@ by ``-delta I``, which makes the matrix quasi-definite (``P + sigma I + R`` is p
 definite on a convex problem), so an LDL' factorization exists in any symmetric
 order, rank-deficient ``A`` included; ``qdldl`` factors it in its fill-reducing (AMD)
 order, without pivoting. Each solve is refined against the unregularized matrix until
-``A x = b`` holds to ``REFINE_TOLERANCE`` of its terms in the user's units; when a
+``A x = b`` holds to ``REFINE_TOLERANCE`` of its terms in the user's units and the
+first block to ``STATIONARITY_TOLERANCE`` of its own; when a
 step stops halving that error, ``A x = b`` has no solution and the regularized
 (least-squares) solution is returned, refined against the factored matrix itself,
 which the equality certificate reads.
@@ -56,6 +57,9 @@ REFINE_TOLERANCE = 1e-13
 ``eps |A| |x|``, and on long rows (a row of 15000 ones in qpsolvers' sparse
 least-squares test) that floor lies above ``1e-13 max(||b||, ||A x||)``, which the
 dense backend's test uses (:data:`fccqp.tuning.KKT_REFINE_TOLERANCE`)."""
+STATIONARITY_TOLERANCE = 1e-10
+"""Refine also while the first block of the residual exceeds this times its terms (see
+:meth:`SparseKKT._stationary`)."""
 REGULARIZED_STEPS = 2
 """Refinement steps against the factored matrix when ``A x = b`` has no solution."""
 
@@ -118,6 +122,7 @@ class SparseKKT:
         self._diagonal = np.flatnonzero(coo.row == coo.col)   # column order
         self._solver = None
         self.abs_A = abs(A)
+        self.abs_P = abs(P)
         self.penalty = np.zeros(n)   # sigma + rho on each entry of x, set by factor
         self.delta = DELTA   # the regularization factored, set by factor
 
@@ -127,7 +132,13 @@ class SparseKKT:
         negative pivots.
 
         A zero pivot is retried with ``BROKEN_DELTA``; :class:`FactorizationError` when
-        that meets one too.
+        that meets one too. So is a factorization whose pivots are not all finite and
+        nonzero or that has fewer than ``m`` negative ones, which no quasi-definite
+        matrix has (Sylvester's law: its inertia is ``(n, m)`` for a positive definite
+        ``P + sigma I + R``): ``qdldl``'s ``update`` reports no zero pivot, and after a
+        rho change a pivot of ``-delta`` lost to cancellation left 3 negative pivots of
+        9 and one of 0 (fuzz ``cvxpy:1700154``: every later solve wrong, the iterates
+        grew by 1e19 every 25 iterations to NUMERICAL_ERROR).
         """
         n, upper = self.n, self._upper.shape[0]
         gathered = self._gathered
@@ -139,6 +150,7 @@ class SparseKKT:
         diagonal[:n] += sigma
         diagonal[self.constrained] += rho_vec
         self.abs_A = abs(self.A)
+        self.abs_P = abs(self.P)
         for self.delta in (DELTA, BROKEN_DELTA):
             diagonal[n:] = -self.delta
             K.data[self._diagonal] = diagonal
@@ -147,15 +159,19 @@ class SparseKKT:
                     self._solver = self._qdldl.Solver(K, upper=True)
                 else:
                     self._solver.update(K, upper=True)
-                break
+                _, d, _ = self._solver.factors()
+                negative = int(np.count_nonzero(d < 0))
+                if negative >= self.m and np.all(np.isfinite(d)) and np.all(d != 0.0):
+                    break
+                failure = f"{negative} negative pivots of {self.m}, or a zero one"
             except RuntimeError as exn:   # qdldl's report of a zero pivot
-                self._solver = None
-                if self.delta == BROKEN_DELTA:
-                    raise FactorizationError(str(exn)) from exn
+                failure = str(exn)
+            self._solver = None
+            if self.delta == BROKEN_DELTA:
+                raise FactorizationError(failure)
         self.penalty = np.full(n, sigma)
         self.penalty[self.constrained] += rho_vec
-        _, d, _ = self._solver.factors()
-        return int(np.count_nonzero(d < 0))
+        return negative
 
     def _residual(self, rhs: np.ndarray, sol: np.ndarray, Ax: np.ndarray,
                   delta: float) -> np.ndarray:
@@ -165,21 +181,34 @@ class SparseKKT:
         top = rhs[:n] - self.P @ x - self.penalty * x - self.AT @ nu
         return np.concatenate([top, rhs[n:] - Ax + delta * nu])
 
+    def _stationary(self, rhs: np.ndarray, sol: np.ndarray, residual: np.ndarray) -> bool:
+        """Whether the first block of ``residual`` (``rhs - K sol``) lies within
+        ``STATIONARITY_TOLERANCE`` of its terms: without pivoting, a nearly singular ``P +
+        sigma I + R`` (rho and sigma at 1e-6 beside a flat ``P``) left it at 5e-5 of them,
+        and ADMM on those solves grew geometrically instead of along its ray (fuzz
+        ``dual_infeasible:1700072``: NUMERICAL_ERROR where the dense LDL' certifies)."""
+        n = self.n
+        x, nu = np.abs(sol[:n]), np.abs(sol[n:])
+        terms = np.abs(rhs[:n]) + self.abs_P @ x + self.penalty * x + self.abs_A.T @ nu
+        return float(np.max(np.abs(residual[:n]))) <= STATIONARITY_TOLERANCE * max(
+            1.0, float(np.max(terms)))
+
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """Solve the unregularized system for ``rhs`` (refined, see the module docstring)."""
         sol = self._solver.solve(rhs)
-        if self.m == 0:
-            return sol
         n, E = self.n, self.E
         b = rhs[n:]
         last_error, step = np.inf, None
         for r in range(MAX_REFINE + 1):
             Ax = self.A @ sol[:n]
-            error = float(np.max(np.abs(b - Ax) / E))
-            size = float(np.max(np.maximum(np.abs(b), self.abs_A @ np.abs(sol[:n])) / E))
-            if error <= REFINE_TOLERANCE * max(1.0, size):
+            residual = self._residual(rhs, sol, Ax, 0.0)
+            error = float(np.max(np.abs(residual[n:]) / E, initial=0.0))
+            size = float(np.max(np.maximum(np.abs(b), self.abs_A @ np.abs(sol[:n])) / E,
+                                initial=0.0))
+            met = error <= REFINE_TOLERANCE * max(1.0, size)
+            if met and self._stationary(rhs, sol, residual):
                 return sol
-            if error >= 0.5 * last_error:
+            if not met and error >= 0.5 * last_error:
                 # no progress: A x = b has no solution; undo the last step and refine
                 # against the regularized matrix, whose least-squares x the equality
                 # certificate reads
@@ -191,6 +220,6 @@ class SparseKKT:
             last_error = error
             if r == MAX_REFINE:
                 return sol
-            step = self._solver.solve(self._residual(rhs, sol, Ax, 0.0))
+            step = self._solver.solve(residual)
             sol = sol + step
         return sol
