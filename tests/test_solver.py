@@ -148,6 +148,17 @@ def test_a_solver_follows_bounds_that_change_structure():
         assert isinstance(capped.solve(P, q, A, b, lb4, ub4, cones).status, Status)
 
 
+def assert_as_after_a_reset(problem, result):
+    """``result`` is SOLVED and, bit for bit, what a solver that solved ``problem`` and
+    was reset answers on it: a cold start in a kept workspace."""
+    reset = fccqp.Solver()
+    reset.solve(*problem)
+    reset.reset()
+    after_reset = reset.solve(*problem)
+    assert result.iterations == after_reset.iterations and result.status is Status.SOLVED
+    np.testing.assert_array_equal(result.x, after_reset.x)
+
+
 def test_a_return_to_a_structure_reuses_its_workspace_and_starts_cold():
     # a controller whose contact set changes and comes back: the solver keeps the
     # workspaces it left (solver.KEPT_WORKSPACES), and a return is a cold start, the
@@ -166,12 +177,7 @@ def test_a_return_to_a_structure_reuses_its_workspace_and_starts_cold():
     for problem in (others[0], fixed, first):   # a new size, new bounds, back
         again = solver.solve(*problem)
     assert solver._workspace is kept
-    reset = fccqp.Solver()
-    reset.solve(*first)
-    reset.reset()
-    after_reset = reset.solve(*first)
-    assert again.iterations == after_reset.iterations and again.status is Status.SOLVED
-    np.testing.assert_array_equal(again.x, after_reset.x)
+    assert_as_after_a_reset(first, again)
     fresh = fccqp.Solver().solve(*first)
     np.testing.assert_allclose(again.x, fresh.x, atol=1e-12)
     verify_solution(first, again)
@@ -206,12 +212,7 @@ def test_a_contact_set_that_comes_back_takes_its_kept_workspace_directly(monkeyp
     assert solver._workspace is kept
     back = solver.solve(*second)
     monkeypatch.undo()
-    reset = fccqp.Solver()
-    reset.solve(*first)
-    reset.reset()
-    after_reset = reset.solve(*first)
-    assert again.iterations == after_reset.iterations and again.status is Status.SOLVED
-    np.testing.assert_array_equal(again.x, after_reset.x)
+    assert_as_after_a_reset(first, again)
     verify_solution(first, again)
     verify_solution(second, back)
 
