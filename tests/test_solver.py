@@ -366,12 +366,14 @@ def test_realtime_preset_keeps_its_status_promise():
     verify_solution(problem, fccqp.solve(*problem, settings=settings), Tolerances.of(settings))
 
 
-def test_nonconvex_objective_is_rejected():
+@pytest.mark.parametrize("backend", ["auto", "sparse"])
+def test_nonconvex_objective_is_rejected(backend):
     """No equalities: a negative eigenvalue of P is a non-convex QP (see item 18 in
-    test_regressions for the null-space criterion)."""
+    test_regressions for the null-space criterion); the error gives it on the sparse
+    path too."""
     P = np.diag([1.0, -2.0, 1.0])
     with pytest.raises(ValueError, match="positive semidefinite.*-2"):
-        fccqp.solve(P, np.zeros(3), lb=-np.ones(3), ub=np.ones(3))
+        fccqp.solve(P, np.zeros(3), lb=-np.ones(3), ub=np.ones(3), kkt_backend=backend)
 
 
 def test_sparse_input_matches_dense():
