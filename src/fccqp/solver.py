@@ -439,21 +439,16 @@ def _not_convex(P: object) -> ValueError:
     eigenvalue, computed densely up to ``EIGENVALUE_DENSE_LIMIT`` entries and by ARPACK
     above (left out when ARPACK does not converge)."""
     message = "the QP is not convex: P has negative curvature on the null space of A"
-    n = P.shape[0]
-    try:
-        if n <= EIGENVALUE_DENSE_LIMIT:
-            dense = P.toarray() if hasattr(P, "toarray") else np.asarray(P)
-            smallest = np.linalg.eigvalsh((dense + dense.T) / 2)[0]
-        else:
-            from scipy.sparse.linalg import ArpackNoConvergence, eigsh
-            try:
-                smallest = eigsh((P + P.T) / 2, k=1, which="SA",
-                                 return_eigenvectors=False)[0]
-            except ArpackNoConvergence:
-                return ValueError(f"{message} (the KKT matrix has more negative pivots "
-                                  "than A has rows)")
-    except MemoryError:
-        return ValueError(message)
+    if P.shape[0] <= EIGENVALUE_DENSE_LIMIT:
+        dense = P.toarray() if hasattr(P, "toarray") else np.asarray(P)
+        smallest = np.linalg.eigvalsh((dense + dense.T) / 2)[0]
+    else:
+        from scipy.sparse.linalg import ArpackNoConvergence, eigsh
+        try:
+            smallest = eigsh((P + P.T) / 2, k=1, which="SA", return_eigenvectors=False)[0]
+        except ArpackNoConvergence:
+            return ValueError(f"{message} (the KKT matrix has more negative pivots than A "
+                              "has rows)")
     return ValueError(f"{message} (P is not positive semidefinite: its smallest "
                       f"eigenvalue is {smallest:.3g})")
 
