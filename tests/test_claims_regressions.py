@@ -175,15 +175,21 @@ def test_diverging_full_form_iterate_keeps_the_equalities():
     when its iterate misses it beyond factorization accuracy. Found with OSQP's 10 Ruiz
     passes, kept there (with the default 4 the problem is certified, verified); with
     cleaned certificates it is certified there too after 680 iterations, so the budget
-    stops it at 500, |x| = 1.3e6: under a time limit, which leaves the stalled run as it
-    is; without one, the least-distance QP of ``fccqp.auxiliary`` certifies it."""
+    stops it at 500, |x| = 1.3e6: under a time limit shorter than ``AUXILIARY_TIME``,
+    which leaves the stalled run as it is; without one, or with that much time left,
+    the least-distance QP of ``fccqp.auxiliary`` certifies it."""
+    from fccqp.tuning import AUXILIARY_TIME
+
     assert solve(DIVERGING_FULL_FORM)[1].status is Status.PRIMAL_INFEASIBLE
     assert solve(DIVERGING_FULL_FORM, scaling=10)[1].status is Status.PRIMAL_INFEASIBLE
-    problem, result = solve(DIVERGING_FULL_FORM, scaling=10, max_iter=500, time_limit=100.0)
+    problem, result = solve(DIVERGING_FULL_FORM, scaling=10, max_iter=500,
+                            time_limit=0.9 * AUXILIARY_TIME)
     assert result.status is Status.MAX_ITER_REACHED
     assert np.abs(result.x).max() > 1e6
     assert clarabel_solve(*problem.args()).status == "primal_infeasible"
     assert solve(DIVERGING_FULL_FORM, scaling=10, max_iter=500)[1].status is (
+        Status.PRIMAL_INFEASIBLE)
+    assert solve(DIVERGING_FULL_FORM, scaling=10, max_iter=500, time_limit=100.0)[1].status is (
         Status.PRIMAL_INFEASIBLE)
 
 

@@ -76,3 +76,18 @@ def test_a_timed_run_stopped_at_its_cap_is_polished_as_an_untimed_one():
     assert timed.status is Status.SOLVED and timed.polished, timed.status
     assert timed.iterations == 1000
     verify_solution(problem, timed, Tolerances.of(**EPS))
+
+
+def test_an_extended_cap_polishes_as_an_untimed_run_at_its_cap():
+    """Without a time limit this run ends at ``max_iter`` 200, polished and SOLVED; under
+    one it was still halving its distance there, so the cap grew and it ran to 800
+    iterations (PRIMALC8 of Maros-Meszaros: solved at 4000 untimed, past 90 s timed).
+    Each extension now first tries that polish, kept when it solves."""
+    problem = flat_qp(2)
+    untimed = fccqp.solve(*problem, max_iter=200, **EPS)
+    timed = fccqp.solve(*problem, max_iter=200, time_limit=100.0, **EPS)
+    assert untimed.status is Status.SOLVED and untimed.polished
+    assert untimed.iterations == 200
+    assert timed.status is Status.SOLVED and timed.polished, timed.status
+    assert timed.iterations == 200
+    verify_solution(problem, timed, Tolerances.of(**EPS))

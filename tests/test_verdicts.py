@@ -480,10 +480,12 @@ def test_a_feasible_run_cut_short_is_not_certified(max_iter):
 
 
 def test_no_auxiliary_solve_under_a_time_limit():
-    """Under a time limit (the control loop) a run that stalls returns as it is: the
-    auxiliary solves would take the next tick's time."""
+    """Under a time limit shorter than ``AUXILIARY_TIME`` (the control loop) a run that
+    stalls returns as it is: the auxiliary solves would take the next tick's time."""
+    from fccqp.tuning import AUXILIARY_TIME
+
     problem = capped_friction_cone(0.3, 1e-3, 0.3)
-    result = fccqp.solve(*problem.args(), max_iter=300, time_limit=10.0)
+    result = fccqp.solve(*problem.args(), max_iter=300, time_limit=AUXILIARY_TIME / 2)
     assert result.status is Status.MAX_ITER_REACHED and result.iterations == 300
 
 

@@ -4,8 +4,9 @@ ADMM's successive differences reach an infeasibility certificate only like ``1/k
 where the certificate set is thin (a tilted friction cone beside a boxed entry, cones
 pinned outside their sum by a gap of 1e-4: 4000 iterations and the cleaning of
 :func:`fccqp.certificates.clean_primal_certificate` left them uncertified). When a run
-ends at ``MAX_ITER_REACHED`` without a time limit, :class:`fccqp.Solver` asks for a
-certificate directly, each by a strongly posed QP that fccqp solves (with its polish,
+ends at ``MAX_ITER_REACHED`` untimed, or with ``AUXILIARY_TIME`` seconds of its time
+limit left (never in a control tick), :class:`fccqp.Solver` asks for a certificate
+directly, within the time left, each by a strongly posed QP that fccqp solves (with its polish,
 in a few dozen iterations on the fuzzing campaign's stalls):
 
 - primal: the least distance between ``{x: A x = b}`` and the constraint set,
@@ -45,6 +46,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import time
 
 import numpy as np
 import scipy.sparse as sp
@@ -54,6 +56,9 @@ from fccqp.problem import INFINITE_BOUND
 from fccqp.settings import MAX_DENSE_KKT_ROWS
 from fccqp.status import Status
 from fccqp.tuning import AUXILIARY_MARGIN, RHO_MIN, STALL_RHO_FACTOR, WEAK_SEPARATION
+
+UNTIMED = math.inf
+"""The deadline of an untimed run's auxiliary solves (none)."""
 
 
 def _matrix(matrix: object, rows: int, n: int, sparse: bool) -> object:
@@ -192,23 +197,27 @@ def other_form(settings: object, backend: str) -> object:
                             else "ldl_full")
 
 
-def _auxiliary_solver(solver_type: type, settings: object) -> object:
+def _auxiliary_solver(solver_type: type, settings: object, deadline: float) -> object:
     """A ``solver_type`` with ``settings``, no log nor warm start, that asks for no
-    certificate of its own."""
-    solver = solver_type(settings.replace(verbose=False, warm_start=False))
+    certificate of its own, and whose time limit is what is left until ``deadline``
+    (a ``time.perf_counter`` instant; :data:`UNTIMED` for none): the auxiliary solves of
+    a timed run share the run's own budget."""
+    left = max(deadline - time.perf_counter(), 0.0)
+    solver = solver_type(settings.replace(verbose=False, warm_start=False,
+                                          time_limit=min(settings.time_limit, left)))
     solver._stalled_certificates = False
     return solver
 
 
-def _solved(solver_type: type, settings: object, problem: tuple) -> tuple:
+def _solved(solver_type: type, settings: object, problem: tuple, deadline: float) -> tuple:
     """``(result, iterations, factorizations)`` of an auxiliary ``problem``: solved with
-    ``settings``, and again in the other form (:func:`other_form`) unless that ended
-    SOLVED; the counts are those of both solves."""
-    result = _auxiliary_solver(solver_type, settings).solve(*problem)
+    ``settings`` by ``deadline``, and again in the other form (:func:`other_form`) unless
+    that ended SOLVED; the counts are those of both solves."""
+    result = _auxiliary_solver(solver_type, settings, deadline).solve(*problem)
     if result.status is Status.SOLVED or result.backend == "sparse":   # no other form
         return result, result.iterations, result.factorizations
-    again = _auxiliary_solver(solver_type, other_form(settings, result.backend)).solve(
-        *problem)
+    again = _auxiliary_solver(solver_type, other_form(settings, result.backend),
+                              deadline).solve(*problem)
     return (again, result.iterations + again.iterations,
             result.factorizations + again.factorizations)
 
@@ -220,14 +229,16 @@ each with the guarantees of its status."""
 
 
 def solved_again(solver_type: type, settings: object, stalled: object,
-                 arguments: tuple, switch_form: bool) -> object | None:
+                 arguments: tuple, switch_form: bool,
+                 deadline: float = UNTIMED) -> object | None:
     """The problem of ``arguments`` (``P, q, A, b, lb, ub, cones``), on which a run in
     ``stalled.backend``'s form stalled, solved cold in the other form
     (:func:`other_form`, with ``switch_form``: when the form was fccqp's choice), or
     else cold at ``STALL_RHO_FACTOR`` times ``settings.rho``, at a fixed rho below its
     floor (when the run ended there), or without equilibration, the first of these
     that gives an answer (:data:`ANSWERS`), with the iterations and factorizations of
-    the solves it took; else None. Without ``switch_form`` every try keeps
+    the solves it took; else None. The tries share the time left until ``deadline``
+    (:func:`_auxiliary_solver`) and stop when it has passed. Without ``switch_form`` every try keeps
     ``settings.kkt_backend`` (a forced backend, the sparse path): rho and the scaling
     are fccqp's to choose, the form then is not.
 
@@ -266,7 +277,9 @@ def solved_again(solver_type: type, settings: object, stalled: object,
                                       adaptive_rho=False))
     tries.append(settings.replace(scaling=0))
     for again in tries:
-        solver = _auxiliary_solver(solver_type, again)
+        if time.perf_counter() >= deadline:
+            break
+        solver = _auxiliary_solver(solver_type, again, deadline)
         try:
             result = solver.solve(*arguments)
         except ValueError:   # "not convex" under the smaller sigma: no answer there
@@ -306,14 +319,14 @@ def weakly_separated(result: object, b: np.ndarray, lb: np.ndarray,
 
 
 def solved_in_other_form(solver_type: type, settings: object, claimed: object,
-                         arguments: tuple) -> object | None:
+                         arguments: tuple, deadline: float = UNTIMED) -> object | None:
     """The problem of ``arguments`` (``P, q, A, b, lb, ub, cones``) solved cold in the
-    KKT form other than ``claimed.backend``'s (:func:`other_form`) when that solve
-    reaches ``SOLVED``, with the iterations and factorizations of both; else None.
+    KKT form other than ``claimed.backend``'s (:func:`other_form`, by ``deadline``) when
+    that solve reaches ``SOLVED``, with the iterations and factorizations of both; else None.
     A second opinion on a weak infeasibility claim (:func:`weakly_separated`): a point
     that meets the tolerances where the certificate lies at the data's rounding."""
-    result = _auxiliary_solver(solver_type, other_form(settings, claimed.backend)).solve(
-        *arguments)
+    result = _auxiliary_solver(solver_type, other_form(settings, claimed.backend),
+                               deadline).solve(*arguments)
     if result.status is not Status.SOLVED:
         return None
     return dataclasses.replace(result, iterations=claimed.iterations + result.iterations,
@@ -346,15 +359,15 @@ def _farkas_tolerances(settings: object, w: np.ndarray) -> object:
 def stalled_certificate(solver_type: type, settings: object, workspace: object,
                         P: object, q: object, A: object, b: object, lb: object,
                         ub: object, cones: object, primal: bool = True,
-                        dual: bool = True) -> tuple | None:
+                        dual: bool = True, deadline: float = UNTIMED) -> tuple | None:
     """``(status, certificate, iterations, factorizations)`` for a run that stalled on
     this problem in ``workspace`` (or whose point passed on lent tolerances,
     :attr:`fccqp.admm.Workspace.doubt`), or None: with ``primal``, the primal
     certificate of the least distance (when there are rows and constrained entries),
     else with ``dual`` the dual one of the projection onto the rays, each judged by
     ``workspace`` (sparse QPs when it holds compressed columns). The auxiliary solves use
-    ``settings`` in a ``solver_type`` (:func:`_auxiliary_solver`), in a second form
-    when the first did not solve them (:func:`_solved`)."""
+    ``settings`` in a ``solver_type`` (:func:`_auxiliary_solver`) by ``deadline``, in a
+    second form when the first did not solve them (:func:`_solved`)."""
     q = np.asarray(q, dtype=np.float64).reshape(-1)
     n = q.shape[0]
     sparse = workspace.compressed
@@ -369,7 +382,7 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
         if primal and m > 0:
             problem, S = distance_problem(A, b, lb, ub, cones)
             if S.size and _affordable(problem):
-                result, spent, factored = _solved(solver_type, settings, problem)
+                result, spent, factored = _solved(solver_type, settings, problem, deadline)
                 found = _farkas(workspace, result, b, lb, ub, S)
                 if found is None and (_least_distance(result, b, lb[S], ub[S], n)
                                       or _unresolved(result, settings, n)):
@@ -377,7 +390,8 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
                     # tolerance (absolute) left them a residual of 2e-6 of it where the
                     # Farkas test allows eps_prim_inf = 1e-6: solved again to that test
                     result, iterations, factorizations = _solved(
-                        solver_type, _farkas_tolerances(settings, result.z[n:]), problem)
+                        solver_type, _farkas_tolerances(settings, result.z[n:]), problem,
+                        deadline)
                     spent, factored = spent + iterations, factored + factorizations
                     found = _farkas(workspace, result, b, lb, ub, S)
                 if found is not None:
@@ -387,7 +401,7 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
         rays = ray_problem(P, q, A, lb, ub, cones)
         if not np.any(q) or not _affordable(rays):
             return None
-        result, iterations, factorizations = _solved(solver_type, settings, rays)
+        result, iterations, factorizations = _solved(solver_type, settings, rays, deadline)
         spent, factored = spent + iterations, factored + factorizations
         if not _moreau(result.x, rays[1]):
             return None

@@ -13,7 +13,6 @@ in compressed columns (:meth:`Solver._solve_sparse`).
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Sequence
 
@@ -26,7 +25,7 @@ from fccqp.problem import check_cone_bounds, convert, raise_finding
 from fccqp.result import Result
 from fccqp.settings import MAX_DENSE_KKT_ROWS, Settings
 from fccqp.status import Status
-from fccqp.tuning import MAX_ENTRY
+from fccqp.tuning import AUXILIARY_TIME, MAX_ENTRY
 from fccqp.validation import structure_scan
 
 LOG_ROWS = 1024
@@ -278,16 +277,16 @@ class Solver:
             self._workspace = self._structure = None
             raise _not_convex(P)
         if (out.status is Status.MAX_ITER_REACHED and self._stalled_certificates
-                and not math.isfinite(settings.time_limit)):
+                and _room(settings, start)):
             out = self._stalled(out, w, (P, q, A, b, lb, ub), self._cones, start)
-        elif (w.doubt and self._stalled_certificates
-              and not math.isfinite(settings.time_limit)):
+        elif w.doubt and self._stalled_certificates and _room(settings, start):
             out = self._doubted(out, w, (P, q, A, b, lb, ub), self._cones, start)
         elif (out.status is Status.PRIMAL_INFEASIBLE and self._stalled_certificates
-              and settings.kkt_backend == "auto" and not math.isfinite(settings.time_limit)
+              and settings.kkt_backend == "auto" and _room(settings, start)
               and auxiliary.weakly_separated(out, b, lb, ub)):
             again = auxiliary.solved_in_other_form(Solver, settings, out,
-                                                   (P, q, A, b, lb, ub, self._cones))
+                                                   (P, q, A, b, lb, ub, self._cones),
+                                                   start + settings.time_limit)
             if again is not None:   # this workspace holds no solution to start from
                 w.forget()
                 out = Result._of({**again.__dict__, "solve_time": time.perf_counter() - start})
@@ -306,13 +305,14 @@ class Solver:
         added. Either leaves no previous solution to start from: a certified problem as
         an infeasible run does, an answer from another solver because this workspace
         holds the stalled point."""
+        deadline = start + self._settings.time_limit   # the run's budget (_room)
         found = auxiliary.stalled_certificate(Solver, self._settings, workspace, *arguments,
-                                              cones)
+                                              cones, deadline=deadline)
         if found is None:
             # the other form only where the form was fccqp's choice
             switch_form = self._settings.kkt_backend == "auto" and not workspace.compressed
             again = auxiliary.solved_again(Solver, self._settings, out,
-                                           (*arguments, cones), switch_form)
+                                           (*arguments, cones), switch_form, deadline)
             if again is not None:
                 workspace.forget()
                 return Result._of({
@@ -335,11 +335,13 @@ class Solver:
         entry of 6.3e6, a ray whose descent ``q`` of 1e-9 lies below ``eps_abs`` (fuzz
         extreme_data 1182, 489). A certificate is judged relative to the data, not in
         its units, and proves that no point is a solution: it wins. Without a time
-        limit only, as for a stalled run; a feasible, bounded problem keeps ``out``."""
+        limit or with its room (:func:`_room`), as for a stalled run; a feasible, bounded
+        problem keeps ``out``."""
         found = auxiliary.stalled_certificate(
             Solver, self._settings, workspace, *arguments, cones,
             primal=bool(workspace.doubt & admm.DOUBT_PRIMAL),
-            dual=bool(workspace.doubt & admm.DOUBT_DUAL))
+            dual=bool(workspace.doubt & admm.DOUBT_DUAL),
+            deadline=start + self._settings.time_limit)
         return out if found is None else _certified(out, found, workspace, start)
 
     def _adopt(self, structure: _Structure) -> admm.Workspace:
@@ -384,11 +386,10 @@ class Solver:
             self._sparse = None
             raise _not_convex(data.P)
         if (out.status is Status.MAX_ITER_REACHED and self._stalled_certificates
-                and not math.isfinite(settings.time_limit)):
+                and _room(settings, start)):
             out = self._stalled(out, w, (data.P, data.q, data.A, data.b, data.lb, data.ub),
                                 cones, start)
-        elif (w.doubt and self._stalled_certificates
-              and not math.isfinite(settings.time_limit)):
+        elif w.doubt and self._stalled_certificates and _room(settings, start):
             out = self._doubted(out, w, (data.P, data.q, data.A, data.b, data.lb, data.ub),
                                 cones, start)
         if settings.verbose:
@@ -415,6 +416,16 @@ class Solver:
         workspace = self._sparse[1]
         workspace.update_cones(cones.mu, cones.normal)
         return workspace
+
+
+def _room(settings: Settings, start: float) -> bool:
+    """Whether a solve started at ``start`` (``time.perf_counter``) has room for the
+    auxiliary solves of a stalled or doubted run (:mod:`fccqp.auxiliary`): untimed, or
+    with ``AUXILIARY_TIME`` seconds of its ``time_limit`` left, which those solves then
+    share. A control tick's budget of milliseconds never has it, so a tick never pays
+    for them; qpbenchmark's 1000 s on Maros-Meszaros does."""
+    left = settings.time_limit - (time.perf_counter() - start)
+    return left >= AUXILIARY_TIME
 
 
 def _certified(out: Result, found: tuple, workspace: admm.Workspace, start: float) -> Result:

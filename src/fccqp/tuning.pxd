@@ -174,6 +174,8 @@ cdef extern from *:
     #define FCCQP_TIMED_EARLY_POLISH 1000
     /* with a time limit max_iter grows by half while the distance to tolerance shrinks this much */
     #define FCCQP_CONVERGING 0.5
+    /* a stalled timed run gets its certificates and retries only with this many seconds left */
+    #define FCCQP_AUXILIARY_TIME 1.0
     """
     # The declarations, in the order above; each type is the one the code computes with.
     # Input validation
@@ -259,3 +261,4 @@ cdef extern from *:
     const double RESERVE_PASSES "FCCQP_RESERVE_PASSES"
     const long TIMED_EARLY_POLISH "FCCQP_TIMED_EARLY_POLISH"
     const double CONVERGING "FCCQP_CONVERGING"
+    const double AUXILIARY_TIME "FCCQP_AUXILIARY_TIME"
