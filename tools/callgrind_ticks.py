@@ -54,8 +54,9 @@ How it counts:
   does: the final polish only within ``POLISH_GATE``, restoration otherwise, the
   successor warm from that point. The setup, the factorizations and the polishes are
   not counted against the cut: ``K`` stands for what is left of 2 ms after a tick's
-  fixed costs (2 ms ~ 8M instructions on these machines; an iterating talos
-  iteration ~60-80k).
+  fixed costs (2 ms ~ 8M instructions on these machines). ``--cut 100 --cut-polish
+  60`` put the talos realtime warm ticks that the cut ends at 5-17M instructions,
+  median 8.2M (notes/performance-history.md, "clock").
 - Exactness: the parent judges each answer as the benchmark does
   (``benchmarks.metrics.exact_share``): SOLVED with every joint's torque within 5 % of
   its limit of the set's reference ``x_ref`` (a tight exact-cone solve); the table's
@@ -240,8 +241,7 @@ def child(args: argparse.Namespace) -> None:
         "per_tick": [[it, st, int(po)] for it, st, po, _, _ in rows],
     }
     Path(args.json).write_text(json.dumps(out))
-    np.save(Path(args.json).with_suffix(".npy"), np.array([np.frombuffer(r[3]) for r in rows],
-                                                          dtype=object), allow_pickle=True)
+    np.savez(Path(args.json).with_suffix(".npz"), *(np.frombuffer(r[3]) for r in rows))
 
 
 # --- the parent: launches valgrind, reads its counts ---------------------------------------
@@ -298,8 +298,9 @@ def measure(robot: str, preset: str, mode: str, path: Path, qps: str,
     if proc.returncode:
         raise SystemExit(f"{label}: valgrind failed, see {out_dir / (label + '.log')}")
     result = json.loads(js.read_text())
-    result["exact_ticks"] = exact_ticks(path, args, mode, result["per_tick"],
-                                        np.load(js.with_suffix(".npy"), allow_pickle=True))
+    with np.load(js.with_suffix(".npz"), allow_pickle=False) as answers:
+        xs = [answers[f"arr_{k}"] for k in range(len(result["per_tick"]))]
+    result["exact_ticks"] = exact_ticks(path, args, mode, result["per_tick"], xs)
     result["exact"] = sum(result["exact_ticks"])
     total = _total(out)
     if args.per_tick:   # out holds the rest after the last dump: nothing counted
@@ -328,7 +329,7 @@ def measure(robot: str, preset: str, mode: str, path: Path, qps: str,
 
 
 def exact_ticks(path: Path, args: argparse.Namespace, mode: str, rows: list,
-                xs: np.ndarray) -> list[int]:
+                xs: list[np.ndarray]) -> list[int]:
     """Per counted tick, 1 when its answer is exact as the benchmark counts it
     (``benchmarks.metrics.exact_share``): SOLVED, and every joint's torque within
     ``TORQUE_LIMIT_SHARE`` of its limit of the set's reference."""
