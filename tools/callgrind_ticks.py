@@ -47,6 +47,20 @@ How it counts:
   (``--dump-after``), and the saved JSON holds per tick its instructions, iterations,
   status and polished flag (``per_tick``), to split a cell into the ticks a change
   serves and those it does not.
+- ``--cut K`` (realtime only): the 2 ms clock's cut without wall time. Through the
+  test hook ``fccqp.iteration.cut_after``, a run stops after ``K`` ADMM iterations as
+  if its clock had passed the deadline (``--cut-polish C``: ``C`` fewer when its warm
+  polish was tried and failed, the time that polish took), and ends as a clock-cut run
+  does: the final polish only within ``POLISH_GATE``, restoration otherwise, the
+  successor warm from that point. The setup, the factorizations and the polishes are
+  not counted against the cut: ``K`` stands for what is left of 2 ms after a tick's
+  fixed costs (2 ms ~ 8M instructions on these machines). ``--cut 100 --cut-polish
+  60`` put the talos realtime warm ticks that the cut ends at 5-17M instructions,
+  median 8.2M (notes/performance-history.md, "clock").
+- Exactness: the parent judges each answer as the benchmark does
+  (``benchmarks.metrics.exact_share``): SOLVED with every joint's torque within 5 % of
+  its limit of the set's reference ``x_ref`` (a tight exact-cone solve); the table's
+  ``exact`` column counts those ticks.
 - One BLAS thread (``threadpoolctl`` plus ``OPENBLAS_NUM_THREADS=1`` etc.),
   ``PYTHONHASHSEED=0``. Note that valgrind reports its own CPU (OpenBLAS picks its
   kernels for it), so the counts are those of valgrind's CPU, not of the machine's.
@@ -180,6 +194,10 @@ def child(args: argparse.Namespace) -> None:
         data.append((P, q, A, b, lb, ub, cones))
     settings = (fccqp.Settings.realtime(args.budget) if args.preset == "realtime"
                 else fccqp.Settings())
+    if args.cut is not None:
+        from fccqp.iteration import cut_after
+
+        cut_after(args.cut, args.cut_polish)
     rows = []
     with threadpool_limits(limits=1):
         blas = [f"{i.get('internal_api')} {i.get('version')} {i.get('architecture', '')} "
@@ -223,6 +241,7 @@ def child(args: argparse.Namespace) -> None:
         "per_tick": [[it, st, int(po)] for it, st, po, _, _ in rows],
     }
     Path(args.json).write_text(json.dumps(out))
+    np.savez(Path(args.json).with_suffix(".npz"), *(np.frombuffer(r[3]) for r in rows))
 
 
 # --- the parent: launches valgrind, reads its counts ---------------------------------------
@@ -255,7 +274,9 @@ def stale_modules(fccqp_file: str) -> list[str]:
 def measure(robot: str, preset: str, mode: str, path: Path, qps: str,
             args: argparse.Namespace, out_dir: Path) -> dict:
     """One callgrind run; its counts and the child's digest."""
-    label = _key({"robot": robot, "preset": preset, "mode": mode, "stride": args.stride})
+    label = _key({"robot": robot, "preset": preset, "mode": mode, "stride": args.stride,
+                  "cut": args.cut if preset == "realtime" else None,
+                  "cut_polish": args.cut_polish})
     out = out_dir / f"{label}.callgrind"
     js = out_dir / f"{label}.json"
     cmd = [args.valgrind, "--tool=callgrind", f"--callgrind-out-file={out}",
@@ -264,7 +285,9 @@ def measure(robot: str, preset: str, mode: str, path: Path, qps: str,
            sys.executable, str(Path(__file__).resolve()), "--child", "--set", str(path),
            "--robot", robot, "--preset", preset, "--mode", mode,
            "--n-qps", str(args.n_qps), "--stride", str(args.stride),
-           "--budget", repr(args.budget), "--json", str(js)]
+           "--budget", repr(args.budget), "--json", str(js),
+           *(["--cut", str(args.cut), "--cut-polish", str(args.cut_polish)]
+             if args.cut is not None else [])]
     env = dict(os.environ, PYTHONHASHSEED="0", **dict.fromkeys(THREAD_ENV, "1"))
     start = time.perf_counter()
     with open(out_dir / f"{label}.log", "w") as log:
@@ -275,6 +298,10 @@ def measure(robot: str, preset: str, mode: str, path: Path, qps: str,
     if proc.returncode:
         raise SystemExit(f"{label}: valgrind failed, see {out_dir / (label + '.log')}")
     result = json.loads(js.read_text())
+    with np.load(js.with_suffix(".npz"), allow_pickle=False) as answers:
+        xs = [answers[f"arr_{k}"] for k in range(len(result["per_tick"]))]
+    result["exact_ticks"] = exact_ticks(path, args, mode, result["per_tick"], xs)
+    result["exact"] = sum(result["exact_ticks"])
     total = _total(out)
     if args.per_tick:   # out holds the rest after the last dump: nothing counted
         counts = [_total(out.with_name(f"{out.name}.{k}"))
@@ -293,16 +320,43 @@ def measure(robot: str, preset: str, mode: str, path: Path, qps: str,
             if COMPILED.search(line):
                 compiled = int(line.split()[0].replace(",", ""))
                 break
-    result.update(robot=robot, preset=preset, mode=mode, stride=args.stride, instructions=total,
+    result.update(robot=robot, preset=preset, mode=mode, stride=args.stride,
+                  cut=args.cut if preset == "realtime" else None, cut_polish=args.cut_polish,
+                  instructions=total,
                   compiled=compiled, seconds=seconds, cpu=usage.ru_utime + usage.ru_stime,
                   qps=qps, callgrind=str(out))
     return result
 
 
+def exact_ticks(path: Path, args: argparse.Namespace, mode: str, rows: list,
+                xs: list[np.ndarray]) -> list[int]:
+    """Per counted tick, 1 when its answer is exact as the benchmark counts it
+    (``benchmarks.metrics.exact_share``): SOLVED, and every joint's torque within
+    ``TORQUE_LIMIT_SHARE`` of its limit of the set's reference."""
+    if str(ROOT) not in sys.path:
+        sys.path.insert(0, str(ROOT))
+    from benchmarks.metrics import TORQUE_LIMIT_SHARE
+    from benchmarks.testsets import LAYOUT_NAMES
+
+    with np.load(path, allow_pickle=False) as z:
+        sequence = np.asarray(z["sequence"][:args.n_qps])
+        kept = (np.flatnonzero(tick_positions(sequence) % args.stride == 0)
+                if mode == "coarse" else np.arange(args.n_qps))
+        flags = []
+        for row, x, i in zip(rows, xs, kept, strict=True):
+            u = slice(*(int(v) for v in z[f"qp{i}_layout"][LAYOUT_NAMES.index("u")]))
+            error = np.max(np.abs(x[u] - z[f"qp{i}_x_ref"][u]) / z[f"qp{i}_ub"][u],
+                           initial=0.0)
+            flags.append(int(row[1] == "solved" and bool(error <= TORQUE_LIMIT_SHARE)))
+    return flags
+
+
 def _key(r: dict) -> str:
-    """A run's name: robot-preset-mode, the coarse mode with its stride."""
+    """A run's name: robot-preset-mode, the coarse mode with its stride, the cut's K."""
     stride = r.get("stride", 10) if r["mode"] == "coarse" else ""
-    return f"{r['robot']}-{r['preset']}-{r['mode']}{stride}"
+    cut = f"-cut{r['cut']}" if r.get("cut") is not None else ""
+    polish = f"p{r['cut_polish']}" if cut and r.get("cut_polish") else ""
+    return f"{r['robot']}-{r['preset']}-{r['mode']}{stride}{cut}{polish}"
 
 
 def _total(path: Path) -> int | None:
@@ -321,7 +375,8 @@ def line_of(r: dict, before: dict | None) -> str:
     cells = [r["robot"], r["preset"], r["mode"], str(ticks),
              f"{r['instructions'] / ticks / 1e6:.4f}M", f"{r['instructions']:,}", share,
              f"{r['iterations']} ({r['iterations'] / ticks:.2f})", statuses,
-             str(r["polished"]), f"`{r['answers_digest']}`", f"`{r['x_digest']}`"]
+             str(r["polished"]), f"{r['exact']} ({100 * r['exact'] / ticks:.0f} %)",
+             f"`{r['answers_digest']}`", f"`{r['x_digest']}`"]
     if before is not None:
         old = before.get(_key(r))
         if old and old["ticks"] == ticks and old.get("qps") == r["qps"]:
@@ -351,6 +406,11 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--budget", type=float, default=100.0,
                         help="time budget of the realtime preset under valgrind (s, default "
                         "100: never binds)")
+    parser.add_argument("--cut", type=int,
+                        help="realtime: stop each run after this many iterations as the 2 ms "
+                        "clock would (fccqp.iteration.cut_after; default no cut)")
+    parser.add_argument("--cut-polish", type=int, default=0,
+                        help="with --cut: this many fewer after a failed warm polish")
     parser.add_argument("--jobs", type=int, default=1, help="callgrind runs at a time")
     parser.add_argument("--cache", type=Path, default=ROOT / "benchmarks" / ".cache",
                         help="cached test sets (default this checkout's benchmarks/.cache)")
@@ -367,6 +427,8 @@ def main(argv: list[str] | None = None) -> None:
     if args.child:
         child(args)
         return
+    if args.cut is not None and (args.cut < 0 or args.cut_polish < 0):
+        parser.error("--cut and --cut-polish must be >= 0")
     if not 1 <= args.n_qps <= N_QPS:
         parser.error(f"--n-qps must be in 1..{N_QPS}")
     if shutil.which(args.valgrind) is None:
@@ -410,7 +472,8 @@ def main(argv: list[str] | None = None) -> None:
         print("WARNING: a solve took more than a quarter of the budget: raise --budget")
     before = json.loads(args.compare.read_text()) if args.compare else None
     head = ["robot", "preset", "mode", "ticks", "instr./tick", "instructions",
-            "Workspace.solve", "iterations (mean)", "statuses", "polished", "answers", "x"]
+            "Workspace.solve", "iterations (mean)", "statuses", "polished", "exact", "answers",
+            "x"]
     if before is not None:
         head.append(f"vs {args.compare.name}")
     print()

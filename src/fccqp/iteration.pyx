@@ -76,6 +76,29 @@ cdef struct Loop:
     bint cap_polish         # the cap was just extended: polish as an untimed run's end would
     long mark_at            # the first check from this iteration records mark
     double mark             # termination.distance at that check
+    long cut                # under a time limit the clock counts as run out at this iteration
+
+
+cdef long _cut_iterations = LONG_MAX
+cdef long _cut_polish_charge = 0
+
+
+def cut_after(long iterations, long failed_polish_charge=0):
+    """Test hook: a clock that counts iterations, not seconds (tools/callgrind_ticks.py).
+
+    From now on, in this process, a run under a time limit stops as if its clock had
+    passed the deadline after ``iterations`` iterations, ``failed_polish_charge`` fewer
+    when its warm polish was tried and failed (that polish took the budget's time):
+    the clock's own stop (``_schedule``) and everything after it (the final step's
+    ``POLISH_GATE``) unchanged, so that a cut is deterministic under valgrind. The wall
+    clock still stops a run first when it runs out. ``cut_after(-1)`` (or any negative
+    count) removes the cut.
+    """
+    global _cut_iterations, _cut_polish_charge
+    if iterations < 0:
+        _cut_iterations, _cut_polish_charge = LONG_MAX, 0
+    else:
+        _cut_iterations, _cut_polish_charge = iterations, max(failed_polish_charge, 0)
 
 
 cdef void iterate(Engine* e, Run* run, bint cold, double start_time) noexcept nogil:
@@ -121,6 +144,7 @@ cdef inline void _begin(Engine* e, Loop* L, Run* run, bint cold, double start_ti
     L.cap_polish = False
     L.mark_at = o.max_iter - o.max_iter // 2 if L.timed else LONG_MAX
     L.mark = INFINITY
+    L.cut = _cut_iterations
     L.deadline = o.time_limit - min(
         max(e.clock.final_reserve, RESERVE_PASSES * e.clock.pass_time), 0.5 * o.time_limit)
     run.factorizations = 0
@@ -241,6 +265,8 @@ cdef inline bint _factor_or_polish(Engine* e, Loop* L, Run* run) noexcept nogil:
         reduced_base(e)
     if L.warm_polish and warm_polish(e, run, L.start_time):
         return False
+    if e.prev.from_polished and e.opt.polish and L.cut != LONG_MAX:   # it failed
+        L.cut = max(L.cut - _cut_polish_charge, 0)
     return True
 
 
@@ -280,7 +306,8 @@ cdef inline void _schedule(Engine* e, Loop* L) noexcept nogil:
     if L.iteration == L.cap and L.timed:
         _extend(e, L)
     L.last = L.iteration >= L.cap or (L.timed and L.iteration >= o.min_iter
-                                      and fccqp_now() - L.start_time >= L.deadline)
+                                      and (L.iteration >= L.cut
+                                           or fccqp_now() - L.start_time >= L.deadline))
     L.periodic = L.iteration % o.adaptive_rho_interval == 0
     L.adapt = o.adaptive_rho and L.periodic
     L.check = L.iteration % o.check_termination == 0 or L.last or L.adapt
