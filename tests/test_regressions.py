@@ -21,6 +21,9 @@ from problems import random_problem
 from reference import clarabel_solve
 from verify import Problem, Tolerances, check_solution, verify_solution
 
+pytestmark = pytest.mark.usefixtures("every_kkt_backend")
+"""Every test on every KKT backend (tests/conftest.py)."""
+
 ROOT = Path(__file__).resolve().parents[1]
 INF = np.inf
 
@@ -280,6 +283,7 @@ def test_item9_errors_name_the_argument(arguments, name):
     """Item 9 (and 14's scaling=10**7, now out of range): wrong types and sizes raise
     ValueError or TypeError naming the argument, not OverflowError or numba's errors."""
     args = dict(P=np.eye(6), q=np.ones(6), cones=())
+    arguments = dict(arguments)   # the parameter itself is shared by every backend's run
     guess = {"x0": arguments.pop("x0")} if "x0" in arguments else {}
     cones = arguments.pop("cones", ())
     with pytest.raises((ValueError, TypeError), match=name):

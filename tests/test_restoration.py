@@ -8,6 +8,9 @@ from fccqp import Status
 from problems import random_problem
 from verify import Problem, primal_violations, verify_solution
 
+pytestmark = pytest.mark.usefixtures("every_kkt_backend")
+"""Every test on every KKT backend (tests/conftest.py)."""
+
 
 def _infeasibility(problem, x):
     violations = primal_violations(Problem.of(*problem), x)
