@@ -107,6 +107,9 @@ def test_verify_rejects_a_direction_with_curvature():
     assert "P dx ~ 0 (relative)" in report.failures
 
 
+@pytest.mark.kkt_backends("auto", "schur_reduced", "ldl_reduced", "ldl_full", reason=(
+    "12 cases of 1.5-3 s of CPU each on the sparse path: it runs one, "
+    "test_rows_just_outside_a_friction_cone_are_certified_on_the_sparse_path"))
 @pytest.mark.parametrize("mu", [0.3, 0.7, 1.0])
 @pytest.mark.parametrize("gap", [1e-3, 1e-4])
 @pytest.mark.parametrize("curvature", [np.eye(3), np.zeros((3, 3))])
@@ -120,6 +123,14 @@ def test_rows_just_outside_a_friction_cone_are_certified_infeasible(mu, gap, cur
     problem = Problem.of(curvature, np.array([0.1, -0.2, 0.3]), A, b, cones=[FrictionCone(0, mu)])
     assert solve_verified(problem).status is Status.PRIMAL_INFEASIBLE
     assert clarabel_solve(*problem.args()).status == "primal_infeasible"
+
+
+@pytest.mark.kkt_backends("sparse", reason="one case of the dense backends' twelve")
+def test_rows_just_outside_a_friction_cone_are_certified_on_the_sparse_path():
+    A = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
+    problem = Problem.of(np.eye(3), np.array([0.1, -0.2, 0.3]), A, np.array([1.0, 0.7007]),
+                         cones=[FrictionCone(0, 0.7)])
+    assert solve_verified(problem).status is Status.PRIMAL_INFEASIBLE
 
 
 @pytest.mark.parametrize("mu", [0.4, 0.8])
