@@ -52,7 +52,7 @@ SPARSE_SEEDS = {
 that ``qdldl``'s update did not report, ``dual_infeasible:1700072`` solves whose first
 block was left unrefined (both diverged to NUMERICAL_ERROR on unbounded problems).
 Every case of :data:`SEEDS` on the sparse path took 100 s of CPU at b11793f (the whole
-module, four dense backends and these: 25 s), with 5 failures: 4 stalls at
+module, four dense backends and these: 25 s of wall time at load 8), with 5 failures: 4 stalls at
 MAX_ITER_REACHED that the dense backends' retries answer (extreme_data 100213, 1500043,
 1700359, cvxpy 1), and ``extreme_data:900343``, kept here (see :data:`OPEN`)."""
 
