@@ -13,7 +13,9 @@ from fccqp import Status, schur
 from problems import random_problem
 from reference import clarabel_solve
 
-BACKENDS = ("schur_reduced", "ldl_reduced", "ldl_full", "sparse")
+pytestmark = pytest.mark.kkt_backends(
+    "schur_reduced", "ldl_reduced", "ldl_full", "sparse",
+    reason="each test forces its backend and checks Result.backend (tests/conftest.py)")
 
 
 def test_ordering_puts_constrained_entries_last():
@@ -21,13 +23,12 @@ def test_ordering_puts_constrained_entries_last():
     np.testing.assert_array_equal(order, [1, 2, 3, 5, 4, 0])
 
 
-@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("seed", range(3))
-def test_backend_matches_clarabel(backend, seed):
+def test_backend_matches_clarabel(kkt_backend, seed):
     problem = random_problem(seed, n_box=6, soc_dim=4 if seed == 2 else 0)
-    result = fccqp.solve(*problem, kkt_backend=backend, eps_abs=1e-8, eps_rel=1e-8)
+    result = fccqp.solve(*problem, kkt_backend=kkt_backend, eps_abs=1e-8, eps_rel=1e-8)
     assert result.status is Status.SOLVED
-    assert result.backend == backend
+    assert result.backend == kkt_backend
     reference = clarabel_solve(*problem)
     np.testing.assert_allclose(result.x, reference.x, atol=1e-5 * (1 + np.abs(reference.x).max()))
     P, q, A, b = problem[:4]
@@ -56,15 +57,14 @@ def _block_diagonal(problem, coupled_constrained=False, flat_free=False):
     return P2, q, A, b, lb, ub, cones
 
 
-@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("shape", ["diagonal tail", "coupled constrained", "flat free"])
-def test_backend_matches_clarabel_on_block_diagonal_costs(backend, shape):
+def test_backend_matches_clarabel_on_block_diagonal_costs(kkt_backend, shape):
     problem = _block_diagonal(random_problem(4, n_box=6), shape == "coupled constrained",
                               shape == "flat free")
-    result = fccqp.solve(*problem, kkt_backend=backend, eps_abs=1e-8, eps_rel=1e-8)
+    result = fccqp.solve(*problem, kkt_backend=kkt_backend, eps_abs=1e-8, eps_rel=1e-8)
     assert result.status is Status.SOLVED
-    if backend != "schur_reduced" or shape != "flat free":
-        assert result.backend == backend
+    if kkt_backend != "schur_reduced" or shape != "flat free":
+        assert result.backend == kkt_backend
     else:   # H = P + R is singular on the flat entry: LDL' takes over
         assert result.backend in ("ldl_reduced", "ldl_full")
     reference = clarabel_solve(*problem)
@@ -90,44 +90,41 @@ def test_negative_curvature_on_the_diagonal_tail_is_rejected(entry):
         fccqp.Solver(kkt_backend="schur_reduced").solve(P, q, A, b, lb, ub, cones)
 
 
-@pytest.mark.parametrize("backend", BACKENDS)
-def test_warm_solver_reuses_every_backend(backend):
+def test_warm_solver_reuses_every_backend(kkt_backend):
     problem = random_problem(1, n_box=6)
-    solver = fccqp.Solver(kkt_backend=backend)
+    solver = fccqp.Solver(kkt_backend=kkt_backend)
     first = solver.solve(*problem)
     again = solver.solve(*problem)
     assert first.status is again.status is Status.SOLVED
-    assert again.factorizations == 0 and again.backend == backend
+    assert again.factorizations == 0 and again.backend == kkt_backend
 
 
-@pytest.mark.parametrize("backend", ["schur_reduced", "ldl_reduced"])
-def test_reduced_forms_fall_back_on_dependent_rows(backend):
+@pytest.mark.kkt_backends("schur_reduced", "ldl_reduced", reason="the reduced forms' fallback")
+def test_reduced_forms_fall_back_on_dependent_rows(kkt_backend):
     P, q, A, b, lb, ub, cones = random_problem(0, n_box=6)
     A, b = np.vstack([A, 2.0 * A[0]]), np.append(b, 2.0 * b[0])
-    result = fccqp.solve(P, q, A, b, lb, ub, cones, kkt_backend=backend)
+    result = fccqp.solve(P, q, A, b, lb, ub, cones, kkt_backend=kkt_backend)
     assert result.status is Status.SOLVED
     assert result.backend in ("ldl_reduced", "ldl_full")  # Schur: S is singular
     assert np.abs(A @ result.x - b).max() <= 1e-9 * (1 + np.abs(b).max())
 
 
-@pytest.mark.parametrize("backend", BACKENDS)
-def test_nonconvex_cost_is_rejected_by_every_backend(backend):
+def test_nonconvex_cost_is_rejected_by_every_backend(kkt_backend):
     P, q, A, b, lb, ub, cones = random_problem(0, n_box=6)
     P = P - 10.0 * np.eye(P.shape[0])
     with pytest.raises(ValueError, match="not convex"):
-        fccqp.Solver(kkt_backend=backend).solve(P, q, A, b, lb, ub, cones, x0=np.zeros(30))
+        fccqp.Solver(kkt_backend=kkt_backend).solve(P, q, A, b, lb, ub, cones, x0=np.zeros(30))
 
 
-@pytest.mark.parametrize("backend", BACKENDS)
-def test_infeasibility_after_rho_changes_is_certified(backend):
+def test_infeasibility_after_rho_changes_is_certified(kkt_backend):
     """The reduced forms carry their coordinates across a refactorization (a change of
     rho), so the step that the certificate tests right after it is a real one."""
     P, q, A, b, lb, ub, cones = random_problem(0, n_cones=0)
     lb[5:8], ub[5:8] = 1.0, 2.0
     A = np.vstack([A, np.eye(30)[5]])
     b = np.append(b, -1.0)  # x5 = -1 against lb 1
-    result = fccqp.solve(P, q, A, b, lb, ub, cones, kkt_backend=backend, adaptive_rho_interval=2,
-                         adaptive_rho_tolerance=1.01)
+    result = fccqp.solve(P, q, A, b, lb, ub, cones, kkt_backend=kkt_backend,
+                         adaptive_rho_interval=2, adaptive_rho_tolerance=1.01)
     assert result.status is Status.PRIMAL_INFEASIBLE
     y, z = result.certificate[: A.shape[0]], result.certificate[A.shape[0]:]
     support = np.sum(np.where(z > 0, np.where(np.isfinite(ub), ub, 0) * z,

@@ -24,6 +24,9 @@ from reference import clarabel_solve
 from test_properties import Draw, build
 from verify import Tolerances, check_solution, verify_solution
 
+pytestmark = pytest.mark.usefixtures("every_kkt_backend")
+"""Every test on every KKT backend (tests/conftest.py)."""
+
 WEAKLY_INCONSISTENT = Draw(172, 0, 4, 0, 0, 3, 1, 3, -2, -2, 6, True)
 """Three rows of a 4-entry second-order cone, the last a multiple of the first whose
 right-hand side is off by 4e-7 of its terms."""

@@ -26,8 +26,9 @@ CLAIMS_A_POINT = (Status.SOLVED, Status.SOLVED_INACCURATE)
 
 
 @pytest.mark.parametrize("item", ITEMS, ids=IDS)
-def test_fccqp_never_claims_a_point_verify_rejects(item):
-    outcome = run_fccqp(item.problem)  # raises anything but ValueError / TypeError
+def test_fccqp_never_claims_a_point_verify_rejects(item, kkt_backend):
+    """On every KKT backend (tests/conftest.py)."""
+    outcome = run_fccqp(item.problem, kkt_backend)  # raises anything but ValueError / TypeError
     if outcome.result is None:
         assert outcome.status.startswith("error: ")
         return

@@ -9,7 +9,6 @@ from problems import random_problem
 from reference import clarabel_solve
 from verify import Problem, Tolerances, check_solution, verify_solution
 
-BACKENDS = ("schur_reduced", "ldl_reduced", "ldl_full")
 EXACT = Tolerances(eps_abs=1e-10, eps_rel=1e-10, factor=1.0)
 """The KKT conditions to 1e-10: what a polished answer meets and ADMM at 1e-5 does not."""
 
@@ -34,12 +33,11 @@ def _block_kinds(problem, x):
     return apex, boundary
 
 
-@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("seed", range(4))
-def test_polished_answer_is_exact(seed, backend):
+def test_polished_answer_is_exact(seed, kkt_backend):
     problem = P, q, A, b, lb, ub, cones = _cone_problem(seed)
-    plain = fccqp.solve(*problem, kkt_backend=backend, polish=False)
-    result = fccqp.solve(*problem, kkt_backend=backend, polish=True)
+    plain = fccqp.solve(*problem, kkt_backend=kkt_backend, polish=False)
+    result = fccqp.solve(*problem, kkt_backend=kkt_backend, polish=True)
     assert result.polished and not plain.polished
     assert result.status is plain.status is Status.SOLVED
     verify_solution(problem, result)
@@ -62,13 +60,12 @@ def test_polished_answer_is_exact(seed, backend):
     assert np.abs(plain.x - reference.x).max() > 2e-5
 
 
-@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("seed", [3, 5])
-def test_wrong_guess_keeps_the_admm_point(seed, backend):
+def test_wrong_guess_keeps_the_admm_point(seed, kkt_backend):
     # two iterations of ADMM do not know the active set: the polished point fails the
     # check and the (restored) ADMM point is returned unchanged
     problem = _cone_problem(seed)
-    settings = dict(max_iter=2, kkt_backend=backend)
+    settings = dict(max_iter=2, kkt_backend=kkt_backend)
     kept = fccqp.solve(*problem, polish=True, **settings)
     plain = fccqp.solve(*problem, polish=False, **settings)
     assert not kept.polished
@@ -79,11 +76,10 @@ def test_wrong_guess_keeps_the_admm_point(seed, backend):
     verify_solution(problem, kept)
 
 
-@pytest.mark.parametrize("backend", BACKENDS)
-def test_budget_stopped_solve_is_polished_to_solved(backend):
+def test_budget_stopped_solve_is_polished_to_solved(kkt_backend):
     problem = _cone_problem(1)
-    plain = fccqp.solve(*problem, max_iter=15, kkt_backend=backend, polish=False)
-    result = fccqp.solve(*problem, max_iter=15, kkt_backend=backend, polish=True)
+    plain = fccqp.solve(*problem, max_iter=15, kkt_backend=kkt_backend, polish=False)
+    result = fccqp.solve(*problem, max_iter=15, kkt_backend=kkt_backend, polish=True)
     assert plain.status is Status.MAX_ITER_REACHED
     assert result.polished and result.status is Status.SOLVED
     verify_solution(problem, result)
@@ -161,18 +157,17 @@ def test_table_and_full_polish_agree(seed):
     assert np.abs(table.x - full.x).max() <= 1e-8 * max(1.0, np.abs(full.x).max())
 
 
-@pytest.mark.parametrize("backend", BACKENDS)
-def test_warm_solve_polishes_the_previous_active_set_without_iterating(backend):
+def test_warm_solve_polishes_the_previous_active_set_without_iterating(kkt_backend):
     """A control loop's next tick: the data moves a little, the active set stays, so
     the warm solve's first polish is the answer (0 iterations), as exact as a cold
     solve's."""
     P, q, A, b, lb, ub, cones = _cone_problem(1)
-    solver = fccqp.Solver(fccqp.Settings(kkt_backend=backend))
+    solver = fccqp.Solver(fccqp.Settings(kkt_backend=kkt_backend))
     assert solver.solve(P, q, A, b, lb, ub, cones).polished
     rng = np.random.default_rng(0)
     moved = (P, q + 1e-4 * rng.standard_normal(q.size), A, b, lb, ub, cones)
     warm = solver.solve(*moved)
-    cold = fccqp.solve(*moved, kkt_backend=backend)
+    cold = fccqp.solve(*moved, kkt_backend=kkt_backend)
     assert warm.status is Status.SOLVED and warm.polished and warm.iterations == 0
     assert check_solution(Problem.of(*moved), warm, EXACT).passed
     assert abs(warm.obj - cold.obj) <= 1e-10 * abs(cold.obj)

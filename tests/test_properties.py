@@ -16,12 +16,16 @@ import re
 from typing import NamedTuple
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
 import fccqp
 from fccqp import FrictionCone, SecondOrderCone
 from verify import Problem, verify_solution
+
+pytestmark = pytest.mark.usefixtures("every_kkt_backend")
+"""Every test on every KKT backend (tests/conftest.py)."""
 
 ARGUMENT = re.compile(r"\b(P|q|A|b|lb|ub|cones(\[\d+\](\.\w+)?)?|x0)\b")
 """An error message must name one of the arguments."""

@@ -8,23 +8,31 @@ from fccqp import Status
 from problems import random_problem
 from verify import Problem, primal_violations, verify_solution
 
+pytestmark = pytest.mark.usefixtures("every_kkt_backend")
+"""Every test on every KKT backend (tests/conftest.py)."""
+
 
 def _infeasibility(problem, x):
     violations = primal_violations(Problem.of(*problem), x)
     return max(violations["box"], violations["cone"])
 
 
-# The reduced form needs at most half the KKT size constrained (n + m = 38 here): 15
-# constrained entries use it, 21 take the full form.
+# Auto's reduced form needs at most half the KKT size constrained (n + m = 38 here): 15
+# constrained entries use it, 21 take the full form. A forced backend keeps its form.
+@pytest.mark.kkt_backends("auto", "schur_reduced", "ldl_reduced", "ldl_full", reason=(
+    "restore_feasibility has no effect on the sparse path"))
 @pytest.mark.parametrize(("n_box", "reduced"), [(6, 1), (12, 0)])
-def test_budget_stopped_solve_is_exactly_feasible(n_box, reduced):
+def test_budget_stopped_solve_is_exactly_feasible(n_box, reduced, kkt_backend):
     settings = dict(max_iter=3, eps_abs=1e-10, eps_rel=0.0, polish=False)
     unrestored = []
     for seed in range(4):
         problem = P, q, A, b, lb, ub, cones = random_problem(seed, n_box=n_box)
         solver = fccqp.Solver(**settings)
         result = solver.solve(*problem)
-        assert (result.backend != "ldl_full") == reduced
+        if kkt_backend == "auto":
+            assert (result.backend != "ldl_full") == reduced
+        else:
+            assert result.backend == kkt_backend
         assert result.status is Status.MAX_ITER_REACHED
         assert _infeasibility(problem, result.x) <= 1e-12
         verify_solution(problem, result)  # A x = b at factorization accuracy

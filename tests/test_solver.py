@@ -11,6 +11,9 @@ from problems import random_problem
 from reference import clarabel_solve
 from verify import Problem, Tolerances, verify_solution
 
+pytestmark = pytest.mark.usefixtures("every_kkt_backend")
+"""Every test on every KKT backend (tests/conftest.py)."""
+
 TIGHT = dict(eps_abs=1e-8, eps_rel=1e-8, max_iter=20000)
 TIGHT_TOLERANCES = Tolerances.of(**TIGHT)
 
@@ -50,7 +53,11 @@ def test_rank_deficient_equalities():
     verify_solution(problem, result, TIGHT_TOLERANCES)
 
 
-def test_nearly_dependent_equalities_stay_exact():
+def test_nearly_dependent_equalities_stay_exact(kkt_backend, request):
+    if kkt_backend in ("schur_reduced", "ldl_reduced"):
+        request.applymarker(pytest.mark.xfail(strict=True, reason=(
+            "the reduced forms end SOLVED_INACCURATE on a row repeated to 1e-9 (auto and "
+            "ldl_full are SOLVED, sparse in 20 iterations)")))
     P, q, A, b, lb, ub, cones = random_problem(4)
     A = np.vstack([A, A[0] + 1e-9 * np.random.default_rng(0).standard_normal(A.shape[1])])
     result = fccqp.solve(P, q, A, np.append(b, b[0]), lb, ub, cones)
@@ -148,6 +155,12 @@ def test_a_solver_follows_bounds_that_change_structure():
         assert isinstance(capped.solve(P, q, A, b, lb4, ub4, cones).status, Status)
 
 
+BITWISE_RETURN = pytest.mark.xfail(strict=True, reason=(
+    "sparse path: a return to a kept workspace answers within 1e-14 of a reset solver, "
+    "same iterations, not bit for bit (not diagnosed)"))
+"""Where :func:`assert_as_after_a_reset` fails: the sparse path."""
+
+
 def assert_as_after_a_reset(problem, result):
     """``result`` is SOLVED and, bit for bit, what a solver that solved ``problem`` and
     was reset answers on it: a cold start in a kept workspace."""
@@ -159,11 +172,13 @@ def assert_as_after_a_reset(problem, result):
     np.testing.assert_array_equal(result.x, after_reset.x)
 
 
-def test_a_return_to_a_structure_reuses_its_workspace_and_starts_cold():
+def test_a_return_to_a_structure_reuses_its_workspace_and_starts_cold(kkt_backend, request):
     # a controller whose contact set changes and comes back: the solver keeps the
     # workspaces it left (solver.KEPT_WORKSPACES), and a return is a cold start, the
     # same answer bit for bit as after Solver.reset() (which keeps the scaling of
     # unchanged matrices), and the answer of a new solver
+    if kkt_backend == "sparse":
+        request.applymarker(BITWISE_RETURN)
     first = random_problem(21, n=30, m=8, n_cones=3, n_box=6)
     others = [random_problem(22 + k, n=24 + 2 * k, m=6, n_cones=2, n_box=4) for k in range(6)]
     P, q, A, b, lb, ub, cones = first
@@ -187,11 +202,14 @@ def test_a_return_to_a_structure_reuses_its_workspace_and_starts_cold():
     assert solver.solve(*first).status is Status.SOLVED
 
 
-def test_a_contact_set_that_comes_back_takes_its_kept_workspace_directly(monkeypatch):
+def test_a_contact_set_that_comes_back_takes_its_kept_workspace_directly(monkeypatch,
+                                                                         kkt_backend, request):
     # two contact sets in turn: the return finds the kept workspace by its last cones and
     # the arguments' shapes, without the general path's conversion and structure scan,
     # and answers as a reset solver does, bit for bit
     # (cones as a control loop passes them: a tuple of specs with Python numbers)
+    if kkt_backend == "sparse":
+        request.applymarker(BITWISE_RETURN)
     def plain(cone):
         return FrictionCone(cone.start, float(cone.mu),
                             None if cone.normal is None else tuple(map(float, cone.normal)))
@@ -217,7 +235,14 @@ def test_a_contact_set_that_comes_back_takes_its_kept_workspace_directly(monkeyp
     verify_solution(second, back)
 
 
-def test_reuses_factorization_when_matrices_unchanged():
+FACTORIZATIONS_AFTER_A_NEW_P = {"auto": 1, "schur_reduced": 1, "ldl_reduced": 2,
+                                "ldl_full": 2, "sparse": 2}
+"""Factorizations of a warm solve whose ``P`` changed (problems.random_problem(9), measured
+at b11793f, with and without polish): the Schur backend's Cholesky of ``P + R`` is its
+convexity test too; the LDL' backends and the sparse path take two."""
+
+
+def test_reuses_factorization_when_matrices_unchanged(kkt_backend):
     P, q, A, b, lb, ub, cones = random_problem(9)
     solver = fccqp.Solver(adaptive_rho=False)
     solver.solve(P, q, A, b, lb, ub, cones)
@@ -226,7 +251,7 @@ def test_reuses_factorization_when_matrices_unchanged():
     assert again.status is Status.SOLVED
     verify_solution((P, q + 0.01, A, b, lb, ub, cones), again)
     changed = solver.solve(P * 1.01, q, A, b, lb, ub, cones)
-    assert changed.factorizations == 1
+    assert changed.factorizations == FACTORIZATIONS_AFTER_A_NEW_P[kkt_backend]
 
 
 def test_reuse_after_a_solve_that_needed_no_iteration():
@@ -366,14 +391,13 @@ def test_realtime_preset_keeps_its_status_promise():
     verify_solution(problem, fccqp.solve(*problem, settings=settings), Tolerances.of(settings))
 
 
-@pytest.mark.parametrize("backend", ["auto", "sparse"])
-def test_nonconvex_objective_is_rejected(backend):
+def test_nonconvex_objective_is_rejected():
     """No equalities: a negative eigenvalue of P is a non-convex QP (see item 18 in
     test_regressions for the null-space criterion); the error gives it on the sparse
     path too."""
     P = np.diag([1.0, -2.0, 1.0])
     with pytest.raises(ValueError, match="positive semidefinite.*-2"):
-        fccqp.solve(P, np.zeros(3), lb=-np.ones(3), ub=np.ones(3), kkt_backend=backend)
+        fccqp.solve(P, np.zeros(3), lb=-np.ones(3), ub=np.ones(3))
 
 
 def test_sparse_input_matches_dense():

@@ -13,6 +13,9 @@ import fccqp
 from fccqp import Status
 from verify import Tolerances, equality_bound, primal_violations, verify_solution
 
+pytestmark = pytest.mark.usefixtures("every_kkt_backend")
+"""Every test on every KKT backend (tests/conftest.py)."""
+
 EPS = {"eps_abs": 1e-6, "eps_rel": 1e-6}
 
 
@@ -60,15 +63,14 @@ def test_narrow_boxes_far_from_the_origin_are_solved(member):
     assert result.status is Status.SOLVED
 
 
-@pytest.mark.parametrize("backend", ["auto", "sparse"])
-def test_a_persistent_rho_imbalance_within_the_tolerance_moves_rho(backend):
+def test_a_persistent_rho_imbalance_within_the_tolerance_moves_rho():
     """fixed_entries[15]: OSQP's rule asks, update after update, for rho about 3.6x
     larger, less than ``adaptive_rho_tolerance`` (5), and rho stayed 0.1 for the 210
     iterations of the run. A move that persists while the residuals do not halve is
     tried (``tuning.RHO_PERSISTENCE``, on either storage): the run ends at a rho that
     only such a move reaches, with the answer of the rule alone."""
     problem = build("fixed_entries", 15).problem
-    settings = fccqp.Settings(**EPS, kkt_backend=backend)
+    settings = fccqp.Settings(**EPS)
     result = fccqp.solve(*problem.args(), settings)
     verify_solution(problem, result, Tolerances.of(**EPS))
     assert result.status is Status.SOLVED

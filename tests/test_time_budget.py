@@ -12,11 +12,15 @@ where the same run without a time limit was solved.
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from fccqp.tuning import TIMED_EARLY_POLISH
 
 import fccqp
 from fccqp import Status
 from verify import Tolerances, verify_solution
+
+pytestmark = pytest.mark.usefixtures("every_kkt_backend")
+"""Every test on every KKT backend (tests/conftest.py)."""
 
 EPS = dict(eps_abs=1e-7, eps_rel=1e-7)
 

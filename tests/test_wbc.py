@@ -9,6 +9,9 @@ from verify import Problem, Tolerances, verify_solution
 pytest.importorskip("pinocchio")
 from benchmarks.testsets import generate_test_set  # noqa: E402
 
+pytestmark = pytest.mark.usefixtures("every_kkt_backend")
+"""Every test on every KKT backend (tests/conftest.py)."""
+
 
 @pytest.fixture(scope="module")
 def test_set():

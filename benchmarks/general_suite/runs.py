@@ -93,12 +93,14 @@ def _claim(solver: str, status: str) -> str:
     return CLAIMS[solver].get(status, OTHER)
 
 
-def run_fccqp(problem: Problem) -> Run:
-    """fccqp at :data:`FCCQP_SETTINGS`. Only ``ValueError`` and ``TypeError`` (fccqp's
-    documented input errors) become a failed run; anything else propagates."""
+def run_fccqp(problem: Problem, kkt_backend: str = "auto") -> Run:
+    """fccqp at :data:`FCCQP_SETTINGS` on ``kkt_backend``. Only ``ValueError`` and
+    ``TypeError`` (fccqp's documented input errors) become a failed run; anything else
+    propagates."""
     start = time.perf_counter()
     try:
-        result = fccqp.solve(*problem.args(), settings=FCCQP_SETTINGS)
+        result = fccqp.solve(*problem.args(), settings=FCCQP_SETTINGS,
+                             kkt_backend=kkt_backend)
     except (ValueError, TypeError) as exn:
         return Run("fccqp", f"error: {type(exn).__name__}: {exn}", OTHER,
                    time.perf_counter() - start)
