@@ -68,6 +68,53 @@ cdef void reduced_step(Reduced* r, const Problem* p, Iterates* it, double alpha,
         it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])
 
 
+cdef double ROUNDING = 4.5e-16
+"""Four times the unit roundoff: twice the bound ``s u |W||u|`` by which two summation
+orders of one row product can differ, so that a decision made on one order's value
+stands for the other's (a rounding bound, not a tuning constant)."""
+cdef double SLACK = 1e-12
+"""Relative room for the few roundings of the gate's comparisons themselves."""
+
+
+cdef inline int _surely(double value, double error, double tolerance) noexcept nogil:
+    """Whether ``|t| > tolerance`` for every ``t`` within ``error`` of ``value``: 1 for
+    all of them, 0 for none, -1 undecided (NaN included)."""
+    value = abs(value)
+    if (value - error) * (1.0 - SLACK) > tolerance:
+        return 1
+    if (value + error) * (1.0 + SLACK) <= tolerance:
+        return 0
+    return -1
+
+
+cdef inline int _row_gate(Reduced* r, const Problem* p, Iterates* it, Py_ssize_t j,
+                          double eps_p, double eps_d) noexcept nogil:
+    """The gate's two tests on constrained entry ``j`` alone, from one row of ``W_S``
+    summed in this loop's order: 1 when one of them surely fails whatever the order
+    of :func:`_table_product`'s sums, 0 when both surely pass, -1 undecided."""
+    cdef Py_ssize_t s = p.s, i = p.constrained[j], l
+    cdef const double* row = r.W_S + j * s
+    cdef double d0 = 0.0, d1 = 0.0, a0 = 0.0, a1 = 0.0, x, error, w
+    cdef int primal, dual
+    for l in range(0, s - 1, 2):   # two sums each: the compiler pairs them in vectors
+        d0 += row[l] * r.u[l]
+        d1 += row[l + 1] * r.u[l + 1]
+        a0 += abs(row[l] * r.u[l])
+        a1 += abs(row[l + 1] * r.u[l + 1])
+    if s % 2:
+        d0 += row[s - 1] * r.u[s - 1]
+        a0 += abs(row[s - 1] * r.u[s - 1])
+    x = r.base[i] + (d0 + d1)
+    error = (s + 4) * ROUNDING * ((a0 + a1) + abs(r.base[i]) + abs(x))
+    primal = _surely((x - it.z[j]) * p.D[i], error * p.D[i], eps_p)
+    if primal != 0:
+        return primal
+    w = r.u[j] - it.rho_vec[j] * x + it.y[j]
+    error = it.rho_vec[j] * error + ROUNDING * (abs(r.u[j]) + abs(it.rho_vec[j] * x)
+                                                + abs(it.y[j]))
+    return _surely(w, error, eps_d * p.c * p.D[i])
+
+
 cdef bint near_convergence(Reduced* r, const Problem* p, Iterates* it, double eps_p,
                            double eps_d) noexcept nogil:
     """Cheap gate before a residual check, in ``O(s^2)``.
@@ -78,9 +125,25 @@ cdef bint near_convergence(Reduced* r, const Problem* p, Iterates* it, double ep
     z`` (``A x = b`` holds by construction). The iterate's ``nu`` comes from ``v``, not
     ``u``, and ``eps_p``, ``eps_d`` are from the last full check, so this only decides
     whether the full check is worth running.
+
+    The gate mostly fails, and at an early entry: the entries are first tested one row
+    of ``W_S`` at a time (:func:`_row_gate`), stopping at the first that surely fails;
+    only where a test is too close to call for rounding is ``x_S`` formed as before, by
+    one product, so the decision is always that product's (on talos' cold ticks the
+    gate runs at 87 % of the iterations and its product was 2.6k of its 2.9k
+    instructions a call).
     """
     cdef Py_ssize_t j, i
     cdef double x
+    cdef int verdict
+    for j in range(p.s):
+        verdict = _row_gate(r, p, it, j, eps_p, eps_d)
+        if verdict == 1:
+            return False
+        if verdict == -1:
+            break
+    else:
+        return True
     _table_product(r, r.u, r.xs, p.s)
     for j in range(p.s):
         i = p.constrained[j]
