@@ -202,3 +202,26 @@ def test_rescale_refuses_data_that_moved_beyond_the_drift(where):
         A2[2] *= factor
     assert not rescale(P2, q, A2, b, D, E, reference)[0]
     assert rescale(P, q, A, b, D, E, reference)[0]
+
+
+@pytest.mark.parametrize("column", range(11))
+def test_the_nonzero_pattern_finds_an_entry_at_every_place_of_a_group_of_four(column):
+    """The pattern tests four entries at once and skips groups of zeros: a lone
+    nonzero in each column of ``A`` (two groups of four and a tail of three) and
+    negative zeros elsewhere give the scaling of the definition."""
+    n, m = 11, 2
+    rng = np.random.default_rng(column)
+    P = np.diag(rng.uniform(1e-2, 1e2, n))
+    P[P == 0.0] = -0.0
+    A = np.full((m, n), -0.0)
+    A[0, column] = 50.0
+    A[1, (column + 5) % n] = -0.02
+    assert np.count_nonzero(P) + np.count_nonzero(A) <= SPARSE_PASSES * (n + m) * n
+    q, b = rng.standard_normal(n), rng.standard_normal(m)
+    D_ref, E_ref, c_ref = _ruiz(P, q, A, [], 4)
+    D, E = np.empty(n), np.empty(m)
+    none = np.zeros(0, dtype=np.intp)
+    c = equilibrate(P.copy(), q.copy(), A.copy(), b.copy(), none, none, 4, D, E)
+    np.testing.assert_allclose(D, D_ref, rtol=1e-12)
+    np.testing.assert_allclose(E, E_ref, rtol=1e-12)
+    assert c == pytest.approx(c_ref, rel=1e-12)

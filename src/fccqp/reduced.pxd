@@ -12,6 +12,7 @@ cdef struct Reduced:
     double* v       # nu = (base + W v)_nu, v = rho z - y of the last step
     double* v_prev
     double* xs      # s scratch
+    Py_ssize_t hint # the entry that failed near_convergence's gate last (tested first)
 
 cdef bint reduced_table(Reduced* r, KKT* k, const Problem* p, const double* rho_vec) noexcept nogil
 cdef void reduced_start(Reduced* r, const Problem* p, Iterates* it) noexcept nogil

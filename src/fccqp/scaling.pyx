@@ -18,6 +18,7 @@ cone: friction cones keep their ``mu`` and normal.
 import numpy as np
 
 from libc.math cimport fabs, ilogb, ldexp, log
+from libc.stdint cimport uint64_t
 
 from fccqp._types cimport Cones
 from fccqp.projections cimport proj_set
@@ -41,17 +42,25 @@ cdef int find_pattern(const double* P, const double* A, Py_ssize_t n, Py_ssize_t
 cdef inline int _nonzero_rows(const double* M, Py_ssize_t rows, Py_ssize_t cols, int* start,
                               int* index) noexcept nogil:
     """Compressed rows of the nonzeros of the row-major ``rows x cols`` ``M``; returns
-    their count. Without a branch: every column is written, and kept (the count moves
-    on) where its entry is nonzero."""
-    cdef Py_ssize_t i, j
+    their count. An entry is nonzero where its bits without the sign are (``-0.0`` is
+    zero, NaN is not: ``!= 0.0`` exactly), so four entries are tested at once by one
+    OR and a group of zeros (most of them: ``P`` and ``A`` are 10-27 % nonzero on the
+    benchmark's robots) is skipped; a group with a nonzero is compacted without a
+    branch: every column is written, and kept (the count moves on) where nonzero."""
+    cdef Py_ssize_t i, j, l, whole = cols - cols % 4
     cdef int k = 0
-    cdef const double* row
+    cdef const uint64_t* row
     start[0] = 0
     for i in range(rows):
-        row = M + i * cols
-        for j in range(cols):
+        row = <const uint64_t*>(M + i * cols)
+        for j in range(0, whole, 4):
+            if (row[j] | row[j + 1] | row[j + 2] | row[j + 3]) << 1:
+                for l in range(j, j + 4):
+                    index[k] = <int>l
+                    k += (row[l] << 1) != 0
+        for j in range(whole, cols):
             index[k] = <int>j
-            k += row[j] != 0.0
+            k += (row[j] << 1) != 0
         start[i + 1] = k
     return k
 
