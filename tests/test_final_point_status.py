@@ -45,9 +45,12 @@ def test_a_polished_point_that_loses_the_iterates_status_is_not_kept():
 @pytest.mark.parametrize("case", ["extreme_data:1100361", "extreme_data:2500055"])
 def test_a_qp_without_constrained_entries_is_iterated_to_its_optimum(case, backend):
     """No box entry nor cone, ``q`` of 4e11 / 2.4e12 orthogonal to the rays of ``[P; A]``
-    to rounding, the optimum at 1e11: the start's proximal steps read as a ray, the
-    ray test failed, and the run ended MAX_ITER_REACHED at 0 iterations. It now goes on
-    with proximal steps to the optimum, on every dense backend."""
+    to rounding, the optimum at 1e11 / 2e13: the start's proximal steps read as a ray,
+    the ray test failed, and the run ended MAX_ITER_REACHED at 0 iterations. It now goes
+    on with proximal steps to the optimum, on every dense backend. At 2e13 (2500055)
+    ``A x`` of 1.2 is a sum of terms of 3e13 whose rounding (7e-3) exceeds ``eps_rel
+    max(|A x|, |b|)``: the returned point passes at the rounding of its terms (which
+    ``verify`` allows to 1e-9 of them), else it stays MAX_ITER_REACHED at 4000."""
     result = _solved(case, kkt_backend=backend)
     assert result.status is Status.SOLVED
     assert result.iterations > 0
