@@ -223,12 +223,23 @@ cdef double _row_terms(Engine* e, const double* x) noexcept nogil:
     return largest
 
 
+cdef void judge_rounding(Engine* e, const double* x) noexcept nogil:
+    """``Residuals.eq_rounding`` of the returned point ``x``, just after
+    :func:`user_residuals` measured it (its ``A x`` still in ``vec_m``): whether each
+    row of ``A x = b`` that misses its tolerance lies within ``EQUALITY_EXACT`` of its
+    terms ``|A_i| |x| + |b_i|``, the rounding no double-precision point avoids. Only
+    when a row misses: the ``|A| |x|`` product would cost a warm tick, whose previous
+    point (measured beside the polished one) misses the new rows, 0.25 % (go2)."""
+    cdef double tolerance = e.opt.eps_abs + e.opt.eps_rel * e.res.prim_eq_scale
+    e.res.eq_rounding = (e.res.prim_eq > tolerance
+                         and _at_rounding(e, x, e.work.vec_m, tolerance))
+
+
 cdef bint _at_rounding(Engine* e, const double* x, const double* Ax,
                        double tolerance) noexcept nogil:
     """Whether each row of ``A x = b`` (user's data, ``Ax`` given) is within
-    ``tolerance`` or within ``EQUALITY_EXACT`` of its terms ``|A_i| |x| + |b_i|``: the
-    rounding no double-precision point avoids (``vec_n3``, ``vec_m2``: scratch).
-    Computed only for a point whose rows miss ``tolerance``."""
+    ``tolerance`` or within ``EQUALITY_EXACT`` of its terms (``vec_n3``, ``vec_m2``:
+    scratch)."""
     cdef Py_ssize_t i
     cdef double miss
     for i in range(e.prob.n):
@@ -255,8 +266,7 @@ cdef void user_residuals(Engine* e, const double* x, const double* y,
     residual of 1.4e-5 of a scale near 1. Also the largest complementarity of a box
     entry (``|z_i|`` times the distance of ``x_i`` to the bound on ``z_i``'s side) or
     cone block (``|x_block' z_block|``) and its scale (``Residuals.compl``), which the
-    summed gap can hide (:func:`fccqp.termination.nearly_converged`), and whether rows
-    that miss their tolerance lie at the rounding of their terms (:func:`_at_rounding`)."""
+    summed gap can hide (:func:`fccqp.termination.nearly_converged`)."""
     cdef Problem* p = &e.prob
     cdef Residuals* r = &e.res
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j, k
@@ -283,8 +293,7 @@ cdef void user_residuals(Engine* e, const double* x, const double* y,
         r.prim_eq_scale = max(r.prim_eq_scale, max(fabs(Ax[i]), fabs(b[i])))
         by += b[i] * y[i]
         terms += fabs(b[i] * y[i])
-    r.eq_rounding = (r.prim_eq > eps_abs + eps_rel * r.prim_eq_scale
-                     and _at_rounding(e, x, Ax, eps_abs + eps_rel * r.prim_eq_scale))
+    r.eq_rounding = False   # judge_rounding's, for the returned point
     for j in range(s):
         i = p.constrained[j]
         value = x[i]
