@@ -208,8 +208,7 @@ class Solver:
                 out = w.solve(P, q, A, b, lb, ub, None, settings.warm_start, start,
                               structure.certificate, False)
                 if (type(out) is Result and not settings.verbose
-                        and out.status is not Status.MAX_ITER_REACHED
-                        and out.status is not Status.NUMERICAL_ERROR and not w.doubt):
+                        and out.status not in UNANSWERED and not w.doubt):
                     return out
                 if type(out) is Result or out != admm.NOT_DENSE:
                     return self._result(out, P, q, A, b, lb, ub, None, start)
