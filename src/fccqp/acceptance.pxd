@@ -8,3 +8,4 @@ cdef int keep_restored(Engine* e, int status, long iteration, bint reduced) noex
 cdef void restore_equalities(Engine* e) noexcept nogil
 cdef void user_residuals(Engine* e, const double* x, const double* y,
                          const double* z) noexcept nogil
+cdef void judge_rounding(Engine* e, const double* x) noexcept nogil

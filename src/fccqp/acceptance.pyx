@@ -47,7 +47,14 @@ cdef bint _try_polished(Engine* e, int* status, long iteration, double start_tim
     and dual residuals and gap are each no worse than the ADMM point's (or below
     ``POLISH_EXACT`` times their tolerance: then the ADMM point is not measured at
     all, 12k of a go2 tick's 0.79M instructions); with ``solved_only`` (the warm
-    polish) it must also be solved. Otherwise the iterate and its residuals are left as
+    polish) it must also be solved, and where the iterate earned a solved or
+    inaccurate status, so must the polished point: the tests above are the residuals',
+    and the status also asks each box entry and cone block to lie within its own size
+    of C in the scaled units (:func:`fccqp.termination.nearly_converged`), which a
+    polished point can miss where the iterate did not (fuzz extreme_data:1100169,
+    ``P`` of 9e16: an entry bounded above by -2.5e-8 polished to 1.0e-4, within the
+    set tolerance of entries of 71; the iterate, solved at 11 iterations, was then
+    returned NUMERICAL_ERROR). Otherwise the iterate and its residuals are left as
     they were. On acceptance the status is the polished point's when that is
     solved or inaccurate.
     """
@@ -83,6 +90,7 @@ cdef bint _try_polished(Engine* e, int* status, long iteration, double start_tim
         unscale(e.pol.x, e.pol.nu, e.pol.y, p.D, p.E, p.c, n, m, s, p.constrained,
                 ux, uy, uz)
         e.res = polished
+    new_status = classify(e, iteration, True)
     if not (r.finite
             and r.prim_eq <= o.eps_abs + o.eps_rel * r.prim_eq_scale
             and r.prim_set <= o.eps_abs + o.eps_rel * r.prim_set_scale
@@ -94,7 +102,8 @@ cdef bint _try_polished(Engine* e, int* status, long iteration, double start_tim
             and (r.prim <= plain.prim or r.prim <= POLISH_EXACT * tol_p)
             and (r.dual <= plain.dual or r.dual <= POLISH_EXACT * tol_d)
             and (r.gap <= plain.gap or r.gap <= POLISH_EXACT * tol_g)
-            and not (solved_only and classify(e, iteration, True) != SOLVED)):
+            and not (solved_only and new_status != SOLVED)
+            and not (_claimed(status[0]) and not _claimed(new_status))):
         e.res = before
         return False
     copy(e.pol.x, it.x, n)
@@ -103,10 +112,14 @@ cdef bint _try_polished(Engine* e, int* status, long iteration, double start_tim
     for j in range(s):
         it.z[j] = it.x[p.constrained[j]]
     proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
-    new_status = classify(e, iteration, True)
-    if new_status == SOLVED or new_status == INACCURATE:
+    if _claimed(new_status):
         status[0] = new_status
     return True
+
+
+cdef inline bint _claimed(int status) noexcept nogil:
+    """Whether ``status`` claims the tolerances (``SOLVED``, ``SOLVED_INACCURATE``)."""
+    return status == SOLVED or status == INACCURATE
 
 
 cdef bint warm_polish(Engine* e, Run* run, double start_time) noexcept nogil:
@@ -210,6 +223,36 @@ cdef double _row_terms(Engine* e, const double* x) noexcept nogil:
     return largest
 
 
+cdef void judge_rounding(Engine* e, const double* x) noexcept nogil:
+    """``Residuals.eq_rounding`` of the returned point ``x``, just after
+    :func:`user_residuals` measured it (its ``A x`` still in ``vec_m``): whether each
+    row of ``A x = b`` that misses its tolerance lies within ``EQUALITY_EXACT`` of its
+    terms ``|A_i| |x| + |b_i|``, the rounding no double-precision point avoids. Only
+    when a row misses: the ``|A| |x|`` product would cost a warm tick, whose previous
+    point (measured beside the polished one) misses the new rows, 0.25 % (go2)."""
+    cdef double tolerance = e.opt.eps_abs + e.opt.eps_rel * e.res.prim_eq_scale
+    e.res.eq_rounding = (e.res.prim_eq > tolerance
+                         and _at_rounding(e, x, e.work.vec_m, tolerance))
+
+
+cdef bint _at_rounding(Engine* e, const double* x, const double* Ax,
+                       double tolerance) noexcept nogil:
+    """Whether each row of ``A x = b`` (user's data, ``Ax`` given) is within
+    ``tolerance`` or within ``EQUALITY_EXACT`` of its terms (``vec_n3``, ``vec_m2``:
+    scratch)."""
+    cdef Py_ssize_t i
+    cdef double miss
+    for i in range(e.prob.n):
+        e.work.vec_n3[i] = fabs(x[i])
+    abs_product(&e.user.A, e.work.vec_n3, e.work.vec_m2)
+    for i in range(e.prob.m):
+        miss = fabs(Ax[i] - e.user.b[i])
+        if miss > tolerance and miss > EQUALITY_EXACT * (e.work.vec_m2[i]
+                                                         + fabs(e.user.b[i])):
+            return False
+    return True
+
+
 cdef void user_residuals(Engine* e, const double* x, const double* y,
                          const double* z) noexcept nogil:
     """:mod:`fccqp.termination`'s residuals of the returned ``(x, y, z)`` on the user's
@@ -220,7 +263,10 @@ cdef void user_residuals(Engine* e, const double* x, const double* y,
     ``eps_abs`` alone, as any point would (``P = 0`` and ``q`` of 1e-9: an unbounded
     problem, a second-order-cone ray, was SOLVED, fuzz extreme_data 489). Not on every
     residual that needs ``eps_abs``: an unpolished solo12 tick passed with a dual
-    residual of 1.4e-5 of a scale near 1."""
+    residual of 1.4e-5 of a scale near 1. Also the largest complementarity of a box
+    entry (``|z_i|`` times the distance of ``x_i`` to the bound on ``z_i``'s side) or
+    cone block (``|x_block' z_block|``) and its scale (``Residuals.compl``), which the
+    summed gap can hide (:func:`fccqp.termination.nearly_converged`)."""
     cdef Problem* p = &e.prob
     cdef Residuals* r = &e.res
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j, k
@@ -239,7 +285,7 @@ cdef void user_residuals(Engine* e, const double* x, const double* y,
     product_t(&e.user.A, y, ATy)
     product(&e.user.P, x, grad)
     r.prim_eq = r.prim_eq_scale = r.prim_set = r.prim_set_scale = 0.0
-    r.set_s = r.set_scale_s = 0.0
+    r.set_s = r.set_scale_s = r.compl = 0.0
     r.box_excess = -INFINITY
     r.set_lent = False
     for i in range(m):
@@ -247,6 +293,7 @@ cdef void user_residuals(Engine* e, const double* x, const double* y,
         r.prim_eq_scale = max(r.prim_eq_scale, max(fabs(Ax[i]), fabs(b[i])))
         by += b[i] * y[i]
         terms += fabs(b[i] * y[i])
+    r.eq_rounding = False   # judge_rounding's, for the returned point
     for j in range(s):
         i = p.constrained[j]
         value = x[i]
@@ -259,11 +306,13 @@ cdef void user_residuals(Engine* e, const double* x, const double* y,
         i = p.cones.offset[j]
         proj_block(x + p.constrained[i], p.cones.kind[j], p.cones.dim[j], p.cones.mu[j],
                    p.cones.normal + 3 * j, proj + i)
-        miss = block = 0.0
+        miss = block = value = 0.0
         for k in range(i, i + p.cones.dim[j]):
             miss = max(miss, fabs(x[p.constrained[k]] - proj[k]))
             block = max(block, max(fabs(x[p.constrained[k]]), fabs(proj[k])))
+            value += x[p.constrained[k]] * z[p.constrained[k]]
         r.set_lent |= _lent(miss, block, p.D[p.constrained[i]], eps_abs, eps_rel)
+        r.compl = max(r.compl, fabs(value))
     r.dual_scale = 0.0
     for j in range(s):
         i = p.constrained[j]
@@ -279,9 +328,11 @@ cdef void user_residuals(Engine* e, const double* x, const double* y,
         if z[i] > 0.0 and isfinite(ub[i]):
             support += ub[i] * z[i]
             terms += fabs(ub[i] * z[i])
+            r.compl = max(r.compl, z[i] * fabs(ub[i] - x[i]))
         elif z[i] < 0.0 and isfinite(lb[i]):
             support += lb[i] * z[i]
             terms += fabs(lb[i] * z[i])
+            r.compl = max(r.compl, -z[i] * fabs(x[i] - lb[i]))
     r.dual = 0.0
     for i in range(n):
         xPx += x[i] * grad[i]
@@ -295,6 +346,7 @@ cdef void user_residuals(Engine* e, const double* x, const double* y,
     r.objective = 0.5 * xPx + qx
     r.gap = fabs(xPx + qx + by + support)
     r.gap_scale = gap_scale(xPx, qx, terms)
+    r.compl_scale = max(fabs(xPx), fabs(qx))
     r.prim = max(r.prim_eq, r.prim_set)
     r.prim_scale = max(r.prim_eq_scale, r.prim_set_scale)
     r.finite = isfinite(total) and isfinite(r.gap) and isfinite(r.prim)

@@ -30,9 +30,9 @@ from fccqp._dense cimport copy, fill
 from fccqp._types cimport Iterates, Problem
 from fccqp.acceptance cimport keep_polished, keep_restored, restore_equalities, warm_polish
 from fccqp.anderson cimport anderson_reset, anderson_step
-from fccqp.engine cimport (DUAL_INFEASIBLE, MAX_ITER, NOT_CONVEX_QP, NUMERICAL_ERROR,
-                           PRIMAL_INFEASIBLE, RUNNING, SOLVED, TIME_LIMIT, Engine, Options,
-                           Run, end_run, fccqp_now, measure)
+from fccqp.engine cimport (DUAL_INFEASIBLE, INACCURATE, MAX_ITER, NOT_CONVEX_QP,
+                           NUMERICAL_ERROR, PRIMAL_INFEASIBLE, RUNNING, SOLVED, TIME_LIMIT,
+                           Engine, Options, Run, end_run, fccqp_now, measure)
 from fccqp.equalities cimport hold_equalities
 from fccqp.factorization cimport budget, change_rho, equality_start, factor, reduced_base
 from fccqp.kkt cimport FACTORED, NOT_CONVEX, is_reduced, kkt_solve
@@ -169,7 +169,15 @@ cdef inline void _begin(Engine* e, Loop* L, Run* run, bint cold, double start_ti
 cdef inline bint _start(Engine* e, Loop* L, Run* run) noexcept nogil:
     """The cold start (:func:`fccqp.factorization.equality_start`) and what it decides
     alone: an unbounded or inconsistent QP, a start that is solved already, a QP with
-    no constrained entry. False when the run ended here."""
+    no constrained entry whose start is solved. False when the run ended here.
+
+    A QP with no constrained entry whose start is not solved is iterated: ADMM's steps
+    are then proximal steps ``x_{k+1} = argmin f + sigma/2 ||x - x_k||^2`` subject to
+    ``A x = b``, which converge to an optimum of a bounded QP and, along a ray, step by
+    the same direction each time (the dual certificate). Ending at 0 iterations left
+    MAX_ITER_REACHED on a bounded QP whose optimum the start mistook for a ray (fuzz
+    extreme_data:1100361: ``q`` of 3.8e11 orthogonal to the two rays of ``[P; A]`` to
+    rounding, the optimum at 1e11)."""
     cdef Options* o = &e.opt
     cdef Residuals* r = &e.res
     cdef bint at_start = L.cold or e.prob.s == 0
@@ -198,12 +206,15 @@ cdef inline bint _start(Engine* e, Loop* L, Run* run) noexcept nogil:
             run.polished = keep_polished(e, &status, 0, L.start_time, False)
         end_run(e, run, status, 0)
         return False
-    if e.prob.s == 0:  # nothing to iterate: the equality-constrained QP was the answer
+    if e.prob.s == 0:  # the equality-constrained QP: the start's steps are its answer
         status = classify(e, 0, False)
         if o.polish and SOLVED <= status <= TIME_LIMIT:
             run.polished = keep_polished(e, &status, 0, L.start_time, False)
-        end_run(e, run, status, 0)
-        return False
+        if status == SOLVED or status == INACCURATE or o.max_iter == 0:
+            end_run(e, run, status, 0)
+            return False
+        # not there yet: the iterations go on as proximal steps on the same problem
+        # (nothing to project), from the start's point (see _start's docstring)
     return True
 
 

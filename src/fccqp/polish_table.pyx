@@ -171,7 +171,8 @@ cdef void _correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
                 for b in range(d):
                     w.tr[o + a] += H[a * d + b] * w.dfull[start + b]
                 w.tr[s + k] -= w.g[o + a] * w.dfull[start + a]
-        dgetrs(&trans, &size, &one, w.T, &size, w.tpiv, w.tr, &size, &info)
+        if size > 0:   # no constrained entry nor plane: nothing to solve (LAPACK refuses)
+            dgetrs(&trans, &size, &one, w.T, &size, w.tpiv, w.tr, &size, &info)
         for j in range(s + nb):
             w.du[j] = w.tr[j]
         colmatvec(t.W, <int>N, w.du, w.dfull, N, s, 1.0)   # dx = d0 + W du

@@ -8,7 +8,7 @@ from libc.math cimport isfinite
 
 from fccqp._dense cimport copy, fill
 from fccqp._types cimport Problem
-from fccqp.acceptance cimport user_residuals
+from fccqp.acceptance cimport judge_rounding, user_residuals
 from fccqp.engine cimport DUAL_INFEASIBLE, PRIMAL_INFEASIBLE, Engine, Run, fccqp_now
 from fccqp.iteration cimport iterate
 from fccqp.matrices cimport DENSE
@@ -143,6 +143,7 @@ cdef void unscaled_answer(Engine* e, Run* run, double* x, double* y, double* z,
         if run.status == PRIMAL_INFEASIBLE or run.status == DUAL_INFEASIBLE:
             copy(e.certs.cert, cert, n + m)
         user_residuals(e, x, y, z)
+        judge_rounding(e, x)   # A x = b at the rounding of its terms, for settle
     if settle(e, run):   # a coordinate ray: its certificate replaces the point's status
         copy(e.certs.cert, cert, n)
     e.prev.exists = e.res.finite and run.status not in (PRIMAL_INFEASIBLE, DUAL_INFEASIBLE)

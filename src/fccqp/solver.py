@@ -39,6 +39,13 @@ KEPT_WORKSPACES = 4
 (a controller whose contact set comes back) starts cold without allocating: on
 talos_reduced (124 variables, 68 rows) a new workspace took 0.35-4 ms, most of a
 2 ms budget, against the microseconds of the return to a kept one."""
+UNANSWERED = (Status.MAX_ITER_REACHED, Status.NUMERICAL_ERROR)
+"""The statuses of a run that gave no answer, which, without a time limit, gets the
+stalled run's certificates and second tries (:meth:`Solver._stalled`). A
+NUMERICAL_ERROR is also the run whose iterate passed and whose returned point did not:
+with ``P`` of 1e18 the reduced form's final ``A x = b`` correction moved a cone block
+of size 3e-11 outside its cone by 5e-12, beyond the scaled-units guard, where the
+full form ends SOLVED (fuzz extreme_data:2100247)."""
 
 
 class _Structure:
@@ -200,7 +207,7 @@ class Solver:
                 out = w.solve(P, q, A, b, lb, ub, None, settings.warm_start, start,
                               structure.certificate, False)
                 if (type(out) is Result and not settings.verbose
-                        and out.status is not Status.MAX_ITER_REACHED and not w.doubt):
+                        and out.status not in UNANSWERED and not w.doubt):
                     return out
                 if type(out) is Result or out != admm.NOT_DENSE:
                     return self._result(out, P, q, A, b, lb, ub, None, start)
@@ -276,7 +283,7 @@ class Solver:
         if type(out) is int:   # NOT_CONVEX_CODE, the only code left
             self._workspace = self._structure = None
             raise _not_convex(P)
-        if (out.status is Status.MAX_ITER_REACHED and self._stalled_certificates
+        if (out.status in UNANSWERED and self._stalled_certificates
                 and _room(settings, start)):
             out = self._stalled(out, w, (P, q, A, b, lb, ub), self._cones, start)
         elif w.doubt and self._stalled_certificates and _room(settings, start):
@@ -296,7 +303,7 @@ class Solver:
 
     def _stalled(self, out: Result, workspace: admm.Workspace, arguments: tuple,
                  cones: object, start: float) -> Result:
-        """``out`` of a run that stalled (``MAX_ITER_REACHED``) in ``workspace`` on the
+        """``out`` of a run that stalled (:data:`UNANSWERED`) in ``workspace`` on the
         problem of ``arguments`` (``P, q, A, b, lb, ub``), or the certificate that
         :func:`fccqp.auxiliary.stalled_certificate` found for it instead, or the
         answer of a solve in the other KKT form (with ``kkt_backend="auto"`` on the
@@ -385,7 +392,7 @@ class Solver:
         if type(out) is int:   # NOT_CONVEX_CODE, the only code left
             self._sparse = None
             raise _not_convex(data.P)
-        if (out.status is Status.MAX_ITER_REACHED and self._stalled_certificates
+        if (out.status in UNANSWERED and self._stalled_certificates
                 and _room(settings, start)):
             out = self._stalled(out, w, (data.P, data.q, data.A, data.b, data.lb, data.ub),
                                 cones, start)

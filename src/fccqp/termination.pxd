@@ -15,6 +15,11 @@ cdef struct Residuals:
     double set_s, set_scale_s   # x_S - w and the size of x_S, w in scaled units, uncapped
     double box_excess           # box entries: largest |x_i - w_i| - SCALED_VIOLATION x size
                                 # (box_entry_size), in scaled units
+    double compl, compl_scale   # the returned point's (acceptance.user_residuals): the
+                                # largest complementarity of a box entry or cone block,
+                                # and max(|x'Px|, |q'x|); 0 and 0 on iterates
+    bint eq_rounding            # the returned point's: every row that misses its tolerance
+                                # is within EQUALITY_EXACT of its terms (False on iterates)
     bint set_lent, dual_lent    # the returned point's (acceptance.user_residuals): a cone
                                 # block or box entry misses C by more than eps_abs + eps_rel
                                 # x its own size (user's or scaled units); the dual residual

@@ -82,6 +82,9 @@ cdef extern from *:
     #define FCCQP_INACCURATE_FACTOR 10.0
     /* multiplier terms widen the gap's scale to at most this x max(|x'Px|, |q'x|) */
     #define FCCQP_GAP_TERMS_CAP 10.0
+    /* a returned point's complementarity per box entry and cone block: within this x the
+       gap's tolerance on max(|x'Px|, |q'x|) (x INACCURATE_FACTOR for SOLVED_INACCURATE) */
+    #define FCCQP_COMPLEMENTARITY_FACTOR 10.0
     /* no solved claim while x_S misses C by eps_abs + this of x_S's size in scaled units */
     #define FCCQP_SCALED_VIOLATION 1e-2
     /* gated full checks back off 1, 3, 7, then this many iterations (one costs ~2.4) */
@@ -215,6 +218,7 @@ cdef extern from *:
     # Termination
     const double INACCURATE_FACTOR "FCCQP_INACCURATE_FACTOR"
     const double GAP_TERMS_CAP "FCCQP_GAP_TERMS_CAP"
+    const double COMPLEMENTARITY_FACTOR "FCCQP_COMPLEMENTARITY_FACTOR"
     const double SCALED_VIOLATION "FCCQP_SCALED_VIOLATION"
     const long GATED_CHECK_WAIT "FCCQP_GATED_CHECK_WAIT"
     const long LOG_INTERVAL "FCCQP_LOG_INTERVAL"
