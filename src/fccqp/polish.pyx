@@ -446,18 +446,18 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
             break
         if feasible:
             t = step_length(w, p, &blocking)
-            if blocking >= 0:   # stop where the first constraint does, and hold it
+            if blocking >= 0:   # stop where the first constraint does, and hold it (all at t = 0)
                 for j in range(n):
                     w.x[j] = w.x_prev[j] + t * (w.x[j] - w.x_prev[j])
                 for j in range(m):
                     w.nu[j] = w.nu_prev[j] + t * (w.nu[j] - w.nu_prev[j])
                 w.grad_current = False
-                nb = renew(w, p, True, blocking, &changed)
+                nb = renew(w, p, True, True, &changed)
                 continue
-        nb = renew(w, p, True, -1, &changed)
+        nb = renew(w, p, True, False, &changed)
         if changed == 0:
             feasible = True
-            nb = renew(w, p, False, -1, &changed)
+            nb = renew(w, p, False, False, &changed)
         if changed == 0:
             nb = drop_far_side(w, p, nb, &changed)
         if changed != 0:
@@ -493,7 +493,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
                 _solve(w, p, nf, nb, POLISH_REFINE_TOLERANCE * scale)
         _multipliers(w, p, nf, nb)
         if most_wrong(w, p) >= 0:   # Newton moved a plane's multiplier past 0: release it
-            nb = renew(w, p, False, -1, &changed)
+            nb = renew(w, p, False, False, &changed)
             continue
         break
     w.passes = passes
