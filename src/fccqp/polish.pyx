@@ -70,8 +70,8 @@ from fccqp.polish_guess cimport (box_code, cone_code, drop_far_side, guess, line
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup, polish_schur_solve
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.reduced cimport Reduced
-from fccqp.tuning cimport (ACTIVE_TOLERANCE, CHORD_RATE, CHORD_STEPS, GUESS_PASSES, GUESS_TOLERANCE,
-                           MAX_REFINE, MISS_FLOOR, NEWTON_TOLERANCE, POLISH_DELTA,
+from fccqp.tuning cimport (ACTIVE_TOLERANCE, CHORD_RATE, CHORD_STEPS, FEASIBLE_PASSES, GUESS_PASSES,
+                           GUESS_TOLERANCE, MAX_REFINE, MISS_FLOOR, NEWTON_TOLERANCE, POLISH_DELTA,
                            POLISH_REFINE_TOLERANCE)
 
 cdef extern from "fccqp_clock.h" nogil:
@@ -396,8 +396,10 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     was judged on the guess's first solve), with that constraint released: polishes of
     go2's equality-constrained starts, whose planes begin with ``lam = 0``, had ended so
     in 25 of 100 and failed the caller's check (notes/performance-history.md, "The cold
-    polish"). False when a factorization
-    breaks down or the result is not finite, or when the clock (:func:`fccqp_now`) has
+    polish"). A polish none of whose first ``FEASIBLE_PASSES`` guesses reached a point
+    that violates nothing gives up: on talos' cold ticks such polishes had run all their
+    guesses and been rejected (notes/polish.md, "zerostep"). False then, when a
+    factorization breaks down or the result is not finite, or when the clock (:func:`fccqp_now`) has
     passed ``deadline`` before a guess after the first (``INFINITY``: never); otherwise
     the caller judges the point.
     """
@@ -446,18 +448,20 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
             break
         if feasible:
             t = step_length(w, p, &blocking)
-            if blocking >= 0:   # stop where the first constraint does, and hold it
+            if blocking >= 0:   # stop where the first constraint does, and hold it (all at t = 0)
                 for j in range(n):
                     w.x[j] = w.x_prev[j] + t * (w.x[j] - w.x_prev[j])
                 for j in range(m):
                     w.nu[j] = w.nu_prev[j] + t * (w.nu[j] - w.nu_prev[j])
                 w.grad_current = False
-                nb = renew(w, p, True, blocking, &changed)
+                nb = renew(w, p, True, True, &changed)
                 continue
-        nb = renew(w, p, True, -1, &changed)
+        nb = renew(w, p, True, False, &changed)
         if changed == 0:
             feasible = True
-            nb = renew(w, p, False, -1, &changed)
+            nb = renew(w, p, False, False, &changed)
+        elif not feasible and passes >= FEASIBLE_PASSES:
+            return False   # no guess's point was feasible yet: none of those settled in time
         if changed == 0:
             nb = drop_far_side(w, p, nb, &changed)
         if changed != 0:
@@ -493,7 +497,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
                 _solve(w, p, nf, nb, POLISH_REFINE_TOLERANCE * scale)
         _multipliers(w, p, nf, nb)
         if most_wrong(w, p) >= 0:   # Newton moved a plane's multiplier past 0: release it
-            nb = renew(w, p, False, -1, &changed)
+            nb = renew(w, p, False, False, &changed)
             continue
         break
     w.passes = passes

@@ -118,7 +118,12 @@ cdef double step_length(Polish* w, const Problem* p, Py_ssize_t* blocking) noexc
     free box entry within its bounds, every free cone block in its cone and every
     boundary block on the near side of its apex; ``blocking`` receives the constraint
     that stops it first (an entry ``j < s``, or ``s`` plus a cone's index), -1 when none
-    does and ``t`` is 1."""
+    does and ``t`` is 1. ``blocked`` (by entry, a cone block at its first entry) marks
+    the constraints :func:`renew` is to hold after the step: the first one that stops
+    it, and at ``t = 0`` every one that does. A step of length 0 does not move, so
+    holding its blocking constraints one per pass paid a solve each for the same point:
+    on talos' cold ticks, most of the passes of polishes that used all their guesses
+    (notes/polish.md, "zerostep")."""
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t j, k, o, d, i, start
     cdef double t = 1.0, stop, x0, x1, along0, along1, across
@@ -133,6 +138,7 @@ cdef double step_length(Polish* w, const Problem* p, Py_ssize_t* blocking) noexc
             stop = max(0.0, (p.lo[j] - x0) / (x1 - x0))
         elif x1 > p.hi[j] and x1 > x0:
             stop = max(0.0, (p.hi[j] - x0) / (x1 - x0))
+        w.blocked[j] = stop == 0.0
         if stop < t:
             t, blocking[0] = stop, j
     for k in range(c.count):
@@ -150,19 +156,23 @@ cdef double step_length(Polish* w, const Problem* p, Py_ssize_t* blocking) noexc
                 stop = max(0.0, along0 / (along0 - along1)) if along0 > along1 else 0.0
         else:
             continue
+        w.blocked[o] = stop == 0.0
         if stop < t:
             t, blocking[0] = stop, p.s + k
+    if t > 0.0 and blocking[0] >= 0:   # no constraint had stop 0: mark the first
+        j = blocking[0]
+        w.blocked[j if j < p.s else c.offset[j - p.s]] = True
     return t
 
 
-cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, Py_ssize_t blocking,
+cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
                       Py_ssize_t* changed) noexcept nogil:
     """Correct the guess from the polished point. With ``adding``, hold free entries
     that violate their bound and put free blocks that left their cone on the boundary
-    (or at the apex, if ``x_block`` lies in the polar), and hold the ``blocking``
-    constraint of a step (:func:`step_length`; -1 for none) where the step left it: a
-    box entry at its nearer bound, a free block on the boundary, a boundary block at the
-    apex. Otherwise release the one held entry or block whose multiplier is the most
+    (or at the apex, if ``x_block`` lies in the polar), and, after a step (``stepped``),
+    hold the constraints :func:`step_length` marked in ``blocked`` where the step left
+    them: a box entry at its nearer bound, a free block on the boundary, a boundary
+    block at the apex. Otherwise release the one held entry or block whose multiplier is the most
     wrong (:func:`most_wrong`): a held entry or a boundary block becomes free, an apex
     block is reclassified from its multiplier as in :func:`guess`. Returns the number of
     boundary blocks (planes and curvature at ``x_block``, or at the projection for a new
@@ -180,7 +190,7 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, Py_ssize_t block
         value = w.x[p.constrained[j]]
         if j == released:
             code = FREE
-        elif adding and code == FREE and j == blocking:
+        elif adding and code == FREE and stepped and w.blocked[j]:
             code = LOWER if fabs(value - p.lo[j]) <= fabs(value - p.hi[j]) else UPPER
         elif adding and code == FREE:
             if value < p.lo[j] - ACTIVE_TOLERANCE * max(1.0, fabs(p.lo[j])):
@@ -201,7 +211,7 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, Py_ssize_t block
             old += 1
             if released == p.s + k:
                 code = FREE
-            elif blocking == p.s + k:
+            elif stepped and w.blocked[o]:
                 code = APEX
             copy(w.x + start, w.step, d)
         elif before == FREE and adding:
@@ -209,7 +219,7 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, Py_ssize_t block
             for j in range(d):
                 size += w.x[start + j] * w.x[start + j]
             along = cone_split(w.x + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
-            if across - slope * along > ACTIVE_TOLERANCE * sqrt(size) or blocking == p.s + k:
+            if across - slope * along > ACTIVE_TOLERANCE * sqrt(size) or (stepped and w.blocked[o]):
                 code = APEX if slope * across <= -along or size == 0.0 else BOUNDARY
                 cone_project(w.x + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
         elif released == p.s + k:   # an apex block whose y left the polar
