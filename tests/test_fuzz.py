@@ -69,6 +69,15 @@ turns them red."""
 OPEN_BACKENDS: dict[str, tuple[str, ...]] = {"extreme_data:900343": ("sparse",)}
 """Where an open case fails."""
 
+ROUNDING_DEPENDENT: dict[str, tuple[tuple[str, ...], str]] = {
+    "extreme_data:100213": (("schur_reduced", "ldl_reduced"), (
+        "an LP to rounding (P of 1e-195): MAX_ITER_REACHED in the reduced forms at every "
+        "rho tried and unscaled under OpenBLAS' AVX-512 kernels, solved under AVX2's "
+        "(where the full form stalls instead and auto's other form answers)")),
+}
+"""Open cases whose failure depends on the BLAS kernels' rounding: the backends where
+they fail on some machines, and why; expected to fail, not strictly."""
+
 
 def _cases(seeds: dict[str, tuple[int, ...]]) -> list:
     return [pytest.param(name, seed, id=f"{name}:{seed}")
@@ -79,6 +88,9 @@ def _judge(name: str, seed: int, backend: str, request: pytest.FixtureRequest) -
     key = f"{name}:{seed}"
     if key in OPEN and backend in OPEN_BACKENDS[key]:
         request.node.add_marker(pytest.mark.xfail(strict=True, reason=OPEN[key]))
+    if key in ROUNDING_DEPENDENT and backend in ROUNDING_DEPENDENT[key][0]:
+        request.node.add_marker(pytest.mark.xfail(strict=False,
+                                                  reason=ROUNDING_DEPENDENT[key][1]))
     failure = judge(Case.of(name, seed), backend)
     assert failure is None, failure
 

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import fccqp
-from fccqp import FrictionCone, SecondOrderCone, Status
+from fccqp import FrictionCone, SecondOrderCone, Status, auxiliary
 from reference import clarabel_solve
 from verify import Problem, check_solution, verify_solution
 
@@ -315,20 +315,39 @@ def test_a_least_distance_solution_is_solved_again_to_the_farkas_tolerance(seed)
 
 @pytest.mark.kkt_backends("auto", reason="the other form is auto's retry")
 @pytest.mark.parametrize(("name", "seed"), [("extreme_data", 100213), ("cvxpy", 1)])
-def test_a_run_that_stalls_in_the_form_auto_chose_is_solved_in_the_other(name, seed):
-    """Feasible problems that stall for 4000 iterations in the full form that "auto"
-    chose (``P`` of 1e-12 in the fuzzer's ``extreme_data:100213``; ADMM cycling on
-    ``cvxpy:1``) and solve in a reduced one: with ``kkt_backend="auto"`` a stalled run
-    with no certificate is solved again, cold, in the other form, and its answer
-    (verified) replaces MAX_ITER_REACHED."""
+def test_a_run_that_stalls_in_one_form_is_answered(name, seed):
+    """Feasible problems that stall for 4000 iterations in one KKT form and not in the
+    other (``P`` of 1e-195 in the fuzzer's ``extreme_data:100213``, an LP to rounding;
+    ADMM cycling on ``cvxpy:1``): with ``kkt_backend="auto"`` the answer is verified.
+    Which form stalls on ``100213`` depends on the rounding of the BLAS kernels
+    (the full form under OpenBLAS' AVX2 kernels, the reduced ones under AVX-512's), so
+    the form switch itself is tested on a problem where it does not
+    (:func:`test_auto_solves_a_stalled_run_again_in_the_other_form`)."""
     from fuzzing import Case, judge
 
     assert judge(Case.of(name, seed), "auto") is None
-    if name == "extreme_data":
-        problem = Case.of(name, seed).scenario().problem
-        result = solve_verified(problem)
-        assert result.status is Status.SOLVED and result.backend != "ldl_full"
-        assert clarabel_solve(*problem.args()).status == "solved"
+
+
+@pytest.mark.kkt_backends("auto", reason="the other form is auto's retry")
+def test_auto_solves_a_stalled_run_again_in_the_other_form():
+    """A run that stopped short of the tolerances in the form "auto" chose is solved
+    again, cold, in the other form first (``switch_form``); a forced backend keeps its
+    form. The fuzzer's ``feasible:21`` without the polish needs 156 iterations in the
+    full form and 75 in the Schur form: cut at 120, the full form's run stops unsolved
+    and the other form answers within the same cap."""
+    from fuzzing import Case
+
+    problem = Case.of("feasible", 21).scenario().problem
+    settings = fccqp.Settings(polish=False, max_iter=120)
+    stopped = fccqp.Solver(settings.replace(kkt_backend="ldl_full"))
+    stopped._stalled_certificates = False
+    cut = stopped.solve(*problem.args())
+    assert cut.status is not Status.SOLVED and cut.backend == "ldl_full"
+    again = auxiliary.solved_again(fccqp.Solver, settings, cut, problem.args(), True)
+    assert again.status is Status.SOLVED and again.backend != "ldl_full"
+    verify_solution(problem, again)
+    kept = auxiliary.solved_again(fccqp.Solver, settings, cut, problem.args(), False)
+    assert kept is None or kept.backend == "ldl_full"
 
 
 @pytest.mark.parametrize(("name", "seed"), [("qpsolvers", 500077), ("qpsolvers", 500090),
@@ -359,11 +378,15 @@ def test_a_run_whose_rho_sits_at_its_floor_is_solved_at_a_smaller_one(name, seed
     the ray of 1251)."""
     from fuzzing import Case, judge
 
-    if kkt_backend == "sparse" and seed in (212, 473):
+    if kkt_backend == "sparse" and seed == 473:
         request.node.add_marker(pytest.mark.xfail(strict=True, reason=(
-            "P tiny (212) or huge (473) on the sparse backend: MAX_ITER_REACHED at every "
-            "rho tried and unscaled (212's unscaled point meets the tolerances only on "
-            "lent units, no answer)")))
+            "P huge on the sparse backend: MAX_ITER_REACHED at every rho tried and "
+            "unscaled")))
+    if kkt_backend == "sparse" and seed == 212:
+        request.node.add_marker(pytest.mark.xfail(strict=False, reason=(
+            "P tiny on the sparse backend: MAX_ITER_REACHED at every rho tried and "
+            "unscaled under OpenBLAS' AVX2 kernels (the unscaled point meets the "
+            "tolerances only on lent units, no answer), solved under AVX-512's")))
     assert judge(Case.of(name, seed), kkt_backend) is None
 
 
@@ -408,11 +431,11 @@ def test_a_retry_solved_on_lent_tolerances_is_no_answer():
 def test_a_forced_backend_keeps_its_form_after_a_stall():
     """The second form is fccqp's choice only under "auto"; rho and the scaling are
     fccqp's under any backend: a forced ``ldl_full`` that stalls on
-    ``extreme_data:100213`` (``P`` of 1e-12, 4000 iterations) is solved again in the
-    full form, at another rho or unequilibrated, and its answer is verified."""
+    ``extreme_data:500215`` (4000 iterations) is solved again in the full form, at
+    another rho, and its answer is verified."""
     from fuzzing import Case
 
-    problem = Case.of("extreme_data", 100213).scenario().problem
+    problem = Case.of("extreme_data", 500215).scenario().problem
     stalled = fccqp.Solver(fccqp.Settings(kkt_backend="ldl_full"))
     stalled._stalled_certificates = False
     assert stalled.solve(*problem.args()).status is Status.MAX_ITER_REACHED
