@@ -358,12 +358,12 @@ static void fccqp_matvec_t(const double *restrict M, int ld, const double *restr
  * or a pair whose difference is not finite (both beyond 1e308). out is symmetric on
  * entry, as this pass leaves it, so FCCQP_CHANGED compares its upper triangle.
  *
- * Two passes: the largest entry and the entries' finiteness in memory order, then the
- * pairs (i, j), (j, i) over the upper triangle, four pairs to a step. P is the caller's
- * array, often not in cache, and the pairs read it down columns, a cache line per
- * entry, which the prefetchers do not follow; the first pass reads it in the order
- * they do, so that the pairs find it in cache (go2's 54 x 54 P from L3: 4-5 us, against
- * 8-10 us for the pairs' pass alone; notes/performance-history.md, "wallgap"). */
+ * Two passes: the largest entry in memory order, then the pairs (i, j), (j, i) over the
+ * upper triangle, four pairs to a step. P is the caller's array, often not in cache,
+ * and the pairs read it down columns, a cache line per entry, which the prefetchers do
+ * not follow; the first pass reads it in the order they do, so that the pairs find it
+ * in cache (go2's 54 x 54 P from L3: 4-5 us, against 8-10 us for the pairs' pass
+ * alone; notes/performance-history.md, "wallgap"). */
 static int fccqp_symmetric_copy(const double *restrict P, int n, double *restrict out,
                                 double sizes[2])
 {
@@ -372,21 +372,16 @@ static int fccqp_symmetric_copy(const double *restrict P, int n, double *restric
     double largest_1 = 0.0, asymmetry_1 = 0.0;
     int found = 0;
     long k = 0, entries = (long)n * n;
-    for (; k + 4 <= entries; k += 4) {
-        fccqp_v4 size = fccqp_abs4(fccqp_load4(P + k));
-        not_finite = fccqp_flag_beyond4(not_finite, size, 1.7976931348623157e308);
-        largest = fccqp_max4(largest, size);
-    }
-    for (; k < entries; k++) {
-        double size = fabs(P[k]);
-        if (!(size <= 1.7976931348623157e308))
-            found |= FCCQP_NOT_FINITE;
-        largest_1 = size > largest_1 ? size : largest_1;
-    }
+    for (; k + 4 <= entries; k += 4)
+        largest = fccqp_max4(largest, fccqp_abs4(fccqp_load4(P + k)));
+    for (; k < entries; k++)
+        largest_1 = fabs(P[k]) > largest_1 ? fabs(P[k]) : largest_1;
     for (int i = 0; i < n; i++) {
         const double *row = P + (long)i * n;
         double *out_row = out + (long)i * n;
         double v = row[i];
+        if (!(fabs(v) <= 1.7976931348623157e308))
+            found |= FCCQP_NOT_FINITE;
         if (out_row[i] != v)
             found |= FCCQP_CHANGED;
         out_row[i] = v;
