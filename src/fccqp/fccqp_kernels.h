@@ -353,12 +353,17 @@ static void fccqp_matvec_t(const double *restrict M, int ld, const double *restr
 #define FCCQP_NOT_FINITE 1   /* an entry NaN or infinite (symmetric copy), or beyond the limit */
 #define FCCQP_CHANGED 2      /* out did not hold the result already */
 
-/* out = (P + P') / 2 for a row-major n x n P, a pair (i, j), (j, i) at a time over the
- * upper triangle, four pairs to a step; sizes[0] becomes the largest |entry| and
- * sizes[1] the largest |P_ij - P_ji|. A pair is flagged FCCQP_NOT_FINITE when its
- * difference is not finite (an entry NaN or infinite, or both beyond 1e308). out is
- * symmetric on entry, as this pass leaves it, so FCCQP_CHANGED compares its upper
- * triangle. */
+/* out = (P + P') / 2 for a row-major n x n P; sizes[0] becomes the largest |entry| and
+ * sizes[1] the largest |P_ij - P_ji|. FCCQP_NOT_FINITE flags an entry NaN or infinite,
+ * or a pair whose difference is not finite (both beyond 1e308). out is symmetric on
+ * entry, as this pass leaves it, so FCCQP_CHANGED compares its upper triangle.
+ *
+ * Two passes: the largest entry in memory order, then the pairs (i, j), (j, i) over the
+ * upper triangle, four pairs to a step. P is the caller's array, often not in cache,
+ * and the pairs read it down columns, a cache line per entry, which the prefetchers do
+ * not follow; the first pass reads it in the order they do, so that the pairs find it
+ * in cache (go2's 54 x 54 P from L3: 4-5 us, against 8-10 us for the pairs' pass
+ * alone; notes/performance-history.md, "wallgap"). */
 static int fccqp_symmetric_copy(const double *restrict P, int n, double *restrict out,
                                 double sizes[2])
 {
@@ -366,13 +371,17 @@ static int fccqp_symmetric_copy(const double *restrict P, int n, double *restric
     fccqp_flags4 not_finite = fccqp_no_flags4(), changed = not_finite;
     double largest_1 = 0.0, asymmetry_1 = 0.0;
     int found = 0;
+    long k = 0, entries = (long)n * n;
+    for (; k + 4 <= entries; k += 4)
+        largest = fccqp_max4(largest, fccqp_abs4(fccqp_load4(P + k)));
+    for (; k < entries; k++)
+        largest_1 = fabs(P[k]) > largest_1 ? fabs(P[k]) : largest_1;
     for (int i = 0; i < n; i++) {
         const double *row = P + (long)i * n;
         double *out_row = out + (long)i * n;
         double v = row[i];
         if (!(fabs(v) <= 1.7976931348623157e308))
             found |= FCCQP_NOT_FINITE;
-        largest_1 = fabs(v) > largest_1 ? fabs(v) : largest_1;
         if (out_row[i] != v)
             found |= FCCQP_CHANGED;
         out_row[i] = v;
@@ -385,7 +394,6 @@ static int fccqp_symmetric_copy(const double *restrict P, int n, double *restric
             fccqp_v4 difference = fccqp_abs4(fccqp_sub4(upper, lower));
             fccqp_v4 value = fccqp_mul4(half, fccqp_add4(upper, lower));
             not_finite = fccqp_flag_beyond4(not_finite, difference, 1.7976931348623157e308);
-            largest = fccqp_max4(fccqp_max4(largest, fccqp_abs4(upper)), fccqp_abs4(lower));
             asymmetry = fccqp_max4(asymmetry, difference);
             changed = fccqp_flag_unequal4(changed, fccqp_load4(out_row + j), value);
             fccqp_store4(out_row + j, value);
@@ -400,8 +408,6 @@ static int fccqp_symmetric_copy(const double *restrict P, int n, double *restric
             double difference = fabs(u - l);
             if (!(difference <= 1.7976931348623157e308))
                 found |= FCCQP_NOT_FINITE;
-            largest_1 = fabs(u) > largest_1 ? fabs(u) : largest_1;
-            largest_1 = fabs(l) > largest_1 ? fabs(l) : largest_1;
             asymmetry_1 = difference > asymmetry_1 ? difference : asymmetry_1;
             if (out_row[j] != value)
                 found |= FCCQP_CHANGED;
