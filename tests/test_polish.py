@@ -2,9 +2,11 @@
 
 import numpy as np
 import pytest
+from fccqp.polish_ops import polish_point
 
 import fccqp
 from fccqp import Status
+from fccqp.cones import flatten_cones
 from problems import random_problem
 from reference import clarabel_solve
 from verify import Problem, Tolerances, check_solution, verify_solution
@@ -271,3 +273,22 @@ def test_warm_polish_factors_where_p_couples_a_constrained_entry():
     warm = solver.solve(*moved)
     assert warm.status is Status.SOLVED and warm.polished and warm.factorizations >= 1
     assert check_solution(Problem.of(*moved), warm, EXACT).passed
+
+
+@pytest.mark.parametrize("feasible_passes, gives_up", [(1, True), (2, False)])
+def test_polish_gives_up_when_its_first_guesses_violate_a_bound(feasible_passes, gives_up):
+    """An iterate inside its box with no multiplier frees every entry; the unconstrained
+    optimum (2, 2) is past the upper bounds, so the first guess's point is infeasible and
+    the second, with both held, is the answer (1, 1). A polish allowed one infeasible
+    guess (the first SOLVED check's, ``FIRST_CHECK_FEASIBLE_PASSES``) gives up after its
+    one factorization; one allowed two finds the answer."""
+    inside = np.full(2, 0.5)
+    result = polish_point(np.eye(2), np.full(2, -2.0), np.zeros((0, 2)), np.zeros(0),
+                          np.zeros(2), np.ones(2), flatten_cones((), 2),
+                          inside, np.zeros(0), np.zeros(2), inside,
+                          feasible_passes=feasible_passes)
+    assert result["ok"] is not gives_up
+    if gives_up:
+        assert result["factorizations"] == 1
+    else:
+        assert np.allclose(result["x"], 1.0) and result["factorizations"] == 2
