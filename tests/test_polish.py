@@ -275,20 +275,15 @@ def test_warm_polish_factors_where_p_couples_a_constrained_entry():
     assert check_solution(Problem.of(*moved), warm, EXACT).passed
 
 
-@pytest.mark.parametrize("feasible_passes, gives_up", [(1, True), (2, False)])
-def test_polish_gives_up_when_its_first_guesses_violate_a_bound(feasible_passes, gives_up):
-    """An iterate inside its box with no multiplier frees every entry; the unconstrained
-    optimum (2, 2) is past the upper bounds, so the first guess's point is infeasible and
-    the second, with both held, is the answer (1, 1). A polish allowed one infeasible
-    guess (the first SOLVED check's, ``FIRST_CHECK_FEASIBLE_PASSES``) gives up after its
-    one factorization; one allowed two finds the answer."""
-    inside = np.full(2, 0.5)
-    result = polish_point(np.eye(2), np.full(2, -2.0), np.zeros((0, 2)), np.zeros(0),
-                          np.zeros(2), np.ones(2), flatten_cones((), 2),
-                          inside, np.zeros(0), np.zeros(2), inside,
-                          feasible_passes=feasible_passes)
-    assert result["ok"] is not gives_up
-    if gives_up:
-        assert result["factorizations"] == 1
-    else:
-        assert np.allclose(result["x"], 1.0) and result["factorizations"] == 2
+def test_polish_gives_up_when_its_first_two_guesses_violate_a_bound():
+    """``min 1/2 ||x - (3, 1.4, 0)||^2`` s.t. ``sum x = 3``, ``x <= (1, 1.5, 10)``, from an
+    iterate inside the box with no multiplier: the first guess frees every entry and puts
+    ``x_1`` past its bound; holding it puts ``x_2`` past its; only the third guess is
+    feasible (and the answer ``(1, 1.5, 0.5)``). The polish gives up after two
+    factorizations rather than search on from guesses that stay infeasible
+    (``FEASIBLE_PASSES``): such searches ended rejected on the whole-body-control ticks."""
+    inside = np.zeros(3)
+    result = polish_point(np.eye(3), np.array([-3.0, -1.4, 0.0]), np.ones((1, 3)),
+                          np.array([3.0]), np.full(3, -10.0), np.array([1.0, 1.5, 10.0]),
+                          flatten_cones((), 3), inside, np.zeros(1), np.zeros(3), inside)
+    assert not result["ok"] and result["factorizations"] == 2

@@ -2,7 +2,7 @@
 from fccqp.engine cimport Engine, Run
 
 cdef bint keep_polished(Engine* e, int* status, long iteration, double start_time,
-                        bint solved_only, int feasible_passes) noexcept nogil
+                        bint solved_only) noexcept nogil
 cdef bint warm_polish(Engine* e, Run* run, double start_time) noexcept nogil
 cdef int keep_restored(Engine* e, int status, long iteration, bint reduced) noexcept nogil
 cdef void restore_equalities(Engine* e) noexcept nogil

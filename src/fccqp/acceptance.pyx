@@ -19,27 +19,25 @@ from fccqp.projections cimport proj_block, proj_set
 from fccqp.restoration cimport restore
 from fccqp.scaling cimport unscale
 from fccqp.termination cimport Residuals, box_entry_size, gap_scale
-from fccqp.tuning cimport (EQUALITY_EXACT, EQUALITY_MISSED, EQUALITY_SLACK, FEASIBLE_PASSES,
-                           POLISH_EXACT, RESTORED_EQUALITY, SCALED_VIOLATION)
+from fccqp.tuning cimport (EQUALITY_EXACT, EQUALITY_MISSED, EQUALITY_SLACK, POLISH_EXACT,
+                           RESTORED_EQUALITY, SCALED_VIOLATION)
 from fccqp.verdict cimport classify, missed
 
 
 cdef bint keep_polished(Engine* e, int* status, long iteration, double start_time,
-                        bint solved_only, int feasible_passes) noexcept nogil:
+                        bint solved_only) noexcept nogil:
     """:func:`_try_polished`, timed: learn what a guess of the polish costs (see
     ``RESERVE_PASSES``)."""
     cdef double began = fccqp_now()
-    cdef bint kept = _try_polished(e, status, iteration, start_time, solved_only,
-                                   feasible_passes)
+    cdef bint kept = _try_polished(e, status, iteration, start_time, solved_only)
     e.clock.pass_time = (fccqp_now() - began) / max(e.pol.passes, 1)
     return kept
 
 
 cdef bint _try_polished(Engine* e, int* status, long iteration, double start_time,
-                        bint solved_only, int feasible_passes) noexcept nogil:
-    """Replace the final iterate by its polished version (see :mod:`fccqp.polish`, which
-    gives up where none of its first ``feasible_passes`` guesses is feasible) when that
-    passes a KKT check on the user's problem; True if it did.
+                        bint solved_only) noexcept nogil:
+    """Replace the final iterate by its polished version (see :mod:`fccqp.polish`)
+    when that passes a KKT check on the user's problem; True if it did.
 
     The polished point is accepted only when, in the user's units, it is primal
     feasible within the tolerance (box and exact cones), its multipliers lie in the
@@ -71,7 +69,7 @@ cdef bint _try_polished(Engine* e, int* status, long iteration, double start_tim
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j
     cdef double tol_p, tol_d, tol_g
     cdef int new_status, factorizations = 0   # of polishing's own matrix: not counted
-    if not polish(&e.pol, p, it, o.polish_refine_iter, feasible_passes, &factorizations,
+    if not polish(&e.pol, p, it, o.polish_refine_iter, &factorizations,
                   &e.red if e.fact.table_ready else NULL, &e.fact.kkt, it.rho_vec,
                   start_time + o.time_limit):
         return False
@@ -140,7 +138,7 @@ cdef bint warm_polish(Engine* e, Run* run, double start_time) noexcept nogil:
     did not pay either (notes/tuning.md, "The warm polish").
     """
     cdef int status = RUNNING
-    if not keep_polished(e, &status, 0, start_time, True, FEASIBLE_PASSES):
+    if not keep_polished(e, &status, 0, start_time, True):
         return False
     run.polished = True
     e.unscaled.current = True   # keep_polished left them so

@@ -42,9 +42,9 @@ from fccqp.reduced cimport materialize, near_convergence, reduced_start, reduced
 from fccqp.rho_rule cimport TrialState, new_rho, trial_reset
 from fccqp.termination cimport Residuals, converged, distance, nearly_converged
 from fccqp.tuning cimport (CLEANING_START, CONVERGING, EARLY_POLISH_GATE, EARLY_POLISH_TRIES,
-                           EQUALITY_MISSED, FEASIBLE_PASSES, FIRST_CHECK_FEASIBLE_PASSES,
-                           GATED_CHECK_WAIT, LOG_INTERVAL, POLISH_GATE, POLISH_RETRIES,
-                           RESERVE_PASSES, STALL_FACTOR, STALLS, TIMED_EARLY_POLISH)
+                           EQUALITY_MISSED, GATED_CHECK_WAIT, LOG_INTERVAL, POLISH_GATE,
+                           POLISH_RETRIES, RESERVE_PASSES, STALL_FACTOR, STALLS,
+                           TIMED_EARLY_POLISH)
 from fccqp.verdict cimport check, classify, inconsistent, missed, missed_by_data, unbounded
 
 
@@ -203,15 +203,13 @@ cdef inline bint _start(Engine* e, Loop* L, Run* run) noexcept nogil:
     if at_start and converged(r, o.eps_abs, o.eps_rel) and not L.unbounded_start:
         status = SOLVED
         if o.polish:   # the start carries sigma's bias where the cost is flat
-            run.polished = keep_polished(e, &status, 0, L.start_time, False,
-                                         FEASIBLE_PASSES)
+            run.polished = keep_polished(e, &status, 0, L.start_time, False)
         end_run(e, run, status, 0)
         return False
     if e.prob.s == 0:  # the equality-constrained QP: the start's steps are its answer
         status = classify(e, 0, False)
         if o.polish and SOLVED <= status <= TIME_LIMIT:
-            run.polished = keep_polished(e, &status, 0, L.start_time, False,
-                                         FEASIBLE_PASSES)
+            run.polished = keep_polished(e, &status, 0, L.start_time, False)
         if status == SOLVED or status == INACCURATE or o.max_iter == 0:
             end_run(e, run, status, 0)
             return False
@@ -355,20 +353,14 @@ cdef inline void _check(Engine* e, Loop* L, Run* run) noexcept nogil:
 
 cdef inline void _polish_attempts(Engine* e, Loop* L, Run* run) noexcept nogil:
     """Polish a SOLVED iterate (a failure goes on at tighter tolerances, closer to the
-    active set, ``POLISH_RETRIES`` times; the first try, which a retry follows, gives up
-    unless its first ``FIRST_CHECK_FEASIBLE_PASSES`` guesses reach a feasible point: on
-    talos' cold ticks the polishes whose first guess violated a constraint were rejected
-    after up to ``GUESS_PASSES`` guesses, and the retry was kept at its first, see
-    notes/polish.md, "talospolish"); also polish an active set that settled near
+    active set, ``POLISH_RETRIES`` times); also polish an active set that settled near
     convergence (``EARLY_POLISH_GATE``), under a time limit only from
     ``TIMED_EARLY_POLISH`` iterations on: a control tick's budget has no room for it, a
     long run needs it (PRIMALC1 of Maros-Meszaros: its gap stays at 1.6 without it)."""
     cdef Options* o = &e.opt
     if L.status == SOLVED and o.polish and not L.last and L.retries < POLISH_RETRIES:
         L.polished_at = L.iteration
-        run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, False,
-                                     FIRST_CHECK_FEASIBLE_PASSES if L.retries == 0
-                                     else FEASIBLE_PASSES)
+        run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, False)
         if not run.polished:   # go on, closer to the active set
             L.retries += 1
             e.tighten *= 0.1
@@ -384,15 +376,13 @@ cdef inline void _polish_attempts(Engine* e, Loop* L, Run* run) noexcept nogil:
             L.guess_polished = True
             L.early_tries += 1
             L.polished_at = L.iteration
-            run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, True,
-                                         FEASIBLE_PASSES)
+            run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, True)
     if L.cap_polish and L.status == RUNNING and o.polish and not L.last:
         # an extended cap (_extend): where an untimed run ends and polishes whatever its
         # distance, this one polishes too and goes on unless that solved it
         L.cap_polish = False
         L.polished_at = L.iteration
-        run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, True,
-                                     FEASIBLE_PASSES)
+        run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, True)
 
 
 cdef inline void _extend(Engine* e, Loop* L) noexcept nogil:
@@ -464,8 +454,7 @@ cdef inline void _final_step(Engine* e, Loop* L, Run* run) noexcept nogil:
             and L.polished_at != L.iteration
             and (not L.timed or L.iteration >= L.cap
                  or nearly_converged(&e.res, o.eps_abs, o.eps_rel, POLISH_GATE))):
-        run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, False,
-                                     FEASIBLE_PASSES)
+        run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, False)
     if not run.polished:   # a polished point is feasible already: nothing to restore
         if o.restore_feasibility and SOLVED <= L.status <= TIME_LIMIT:
             L.status = keep_restored(e, L.status, L.iteration, L.reduced)

@@ -58,7 +58,7 @@ cdef struct Polish:
     double kkt_norm         # infinity norm of full
 
 cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_steps,
-                 int feasible_passes, int* factorizations, const Reduced* table, KKT* kkt,
+                 int* factorizations, const Reduced* table, KKT* kkt,
                  const double* rho_vec, double deadline) noexcept nogil
 cdef bint polish_prepare(Polish* w, const Problem* p) noexcept nogil
 cdef Py_ssize_t guess_changes(const Problem* p, const double* z, const double* y,

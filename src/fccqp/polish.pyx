@@ -70,7 +70,7 @@ from fccqp.polish_guess cimport (box_code, cone_code, drop_far_side, guess, line
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup, polish_schur_solve
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.reduced cimport Reduced
-from fccqp.tuning cimport (ACTIVE_TOLERANCE, CHORD_RATE, CHORD_STEPS, GUESS_PASSES,
+from fccqp.tuning cimport (ACTIVE_TOLERANCE, CHORD_RATE, CHORD_STEPS, FEASIBLE_PASSES, GUESS_PASSES,
                            GUESS_TOLERANCE, MAX_REFINE, MISS_FLOOR, NEWTON_TOLERANCE, POLISH_DELTA,
                            POLISH_REFINE_TOLERANCE)
 
@@ -364,7 +364,7 @@ cdef bint polish_prepare(Polish* w, const Problem* p) noexcept nogil:
 
 
 cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_steps,
-                 int feasible_passes, int* factorizations, const Reduced* table, KKT* kkt,
+                 int* factorizations, const Reduced* table, KKT* kkt,
                  const double* rho_vec, double deadline) noexcept nogil:
     """Polish the iterate ``it`` into ``w.x``, ``w.nu``, ``w.y`` (scaled problem) and
     leave the final guess in ``w.active``; ``factorizations`` counts the ``dsytrf``
@@ -396,13 +396,12 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     was judged on the guess's first solve), with that constraint released: polishes of
     go2's equality-constrained starts, whose planes begin with ``lam = 0``, had ended so
     in 25 of 100 and failed the caller's check (notes/performance-history.md, "The cold
-    polish"). A polish none of whose first ``feasible_passes`` guesses reached a point
+    polish"). A polish none of whose first ``FEASIBLE_PASSES`` guesses reached a point
     that violates nothing gives up: on talos' cold ticks such polishes had run all their
-    guesses and been rejected (notes/polish.md, "zerostep"; the caller's
-    ``FEASIBLE_PASSES``, or ``FIRST_CHECK_FEASIBLE_PASSES`` where a retry follows). False
-    then, when a factorization breaks down or the result is not finite, or when the clock
-    (:func:`fccqp_now`) has passed ``deadline`` before a guess after the first
-    (``INFINITY``: never); otherwise the caller judges the point.
+    guesses and been rejected (notes/polish.md, "zerostep"). False then, when a
+    factorization breaks down or the result is not finite, or when the clock (:func:`fccqp_now`) has
+    passed ``deadline`` before a guess after the first (``INFINITY``: never); otherwise
+    the caller judges the point.
     """
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, nb, nf = 0, j, changed
     cdef long passes = 0, step
@@ -461,7 +460,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         if changed == 0:
             feasible = True
             nb = renew(w, p, False, False, &changed)
-        elif not feasible and passes >= feasible_passes:
+        elif not feasible and passes >= FEASIBLE_PASSES:
             return False   # no guess's point was feasible yet: none of those settled in time
         if changed == 0:
             nb = drop_far_side(w, p, nb, &changed)

@@ -18,7 +18,6 @@ from fccqp.matrices cimport CSC
 from fccqp.matrix_ops cimport Held
 from fccqp.polish cimport Polish, polish
 from fccqp.polish_csc cimport bind
-from fccqp.tuning cimport FEASIBLE_PASSES
 
 from fccqp.polish_csc import arrays
 
@@ -47,11 +46,9 @@ cdef class _Arrays:
         return &view[0]
 
 
-def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5,
-                 int feasible_passes=FEASIBLE_PASSES):
+def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5):
     """Polish the iterate ``(x, nu, z, y)`` of ``min 1/2 x'Px + q'x`` s.t. ``A x = b``,
-    ``lb <= x <= ub``, ``x`` in ``cones`` (a :class:`fccqp.cones.ConeArrays` over ``x``),
-    giving up where none of the first ``feasible_passes`` guesses is feasible.
+    ``lb <= x <= ub``, ``x`` in ``cones`` (a :class:`fccqp.cones.ConeArrays` over ``x``).
 
     ``y`` and ``z`` (``n`` entries) are the multipliers and slacks of the entries of ``x``
     (read on the constrained entries: a finite bound or a cone). ``P`` and ``A`` are both
@@ -106,8 +103,7 @@ def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5,
                       np.asarray(Ah.colptr), np.asarray(Ah.rowind), cones.dim)
         bind(&w.csc, held)
     cdef int factorizations = 0
-    ok = polish(&w, &p, &it, newton_steps, feasible_passes, &factorizations, NULL, NULL, NULL,
-                INFINITY)
+    ok = polish(&w, &p, &it, newton_steps, &factorizations, NULL, NULL, NULL, INFINITY)
     result_y = np.zeros(n)
     result_y[constrained] = [w.y[j] for j in range(s)]
     return {"ok": bool(ok), "x": np.array([w.x[j] for j in range(n)]),

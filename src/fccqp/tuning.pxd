@@ -131,8 +131,6 @@ cdef extern from *:
     #define FCCQP_GUESS_PASSES 8
     /* a polish whose first this many guesses all violate a constraint gives up (kept ones: by 2) */
     #define FCCQP_FEASIBLE_PASSES 2
-    /* the same at a run's first SOLVED check, which a retry follows (talos: 98 % of kept by 1) */
-    #define FCCQP_FIRST_CHECK_FEASIBLE_PASSES 1
     /* a free entry or block joins the active set when it violates by more than this */
     #define FCCQP_ACTIVE_TOLERANCE 1e-12
     /* Newton stops when every boundary block has |phi| <= this ||x_block|| */
@@ -246,7 +244,6 @@ cdef extern from *:
     const double GUESS_TOLERANCE "FCCQP_GUESS_TOLERANCE"
     const int GUESS_PASSES "FCCQP_GUESS_PASSES"
     const int FEASIBLE_PASSES "FCCQP_FEASIBLE_PASSES"
-    const int FIRST_CHECK_FEASIBLE_PASSES "FCCQP_FIRST_CHECK_FEASIBLE_PASSES"
     const double ACTIVE_TOLERANCE "FCCQP_ACTIVE_TOLERANCE"
     const double NEWTON_TOLERANCE "FCCQP_NEWTON_TOLERANCE"
     const double MISS_FLOOR "FCCQP_MISS_FLOOR"
