@@ -2,9 +2,11 @@
 
 import numpy as np
 import pytest
+from fccqp.polish_ops import polish_point
 
 import fccqp
 from fccqp import Status
+from fccqp.cones import flatten_cones
 from problems import random_problem
 from reference import clarabel_solve
 from verify import Problem, Tolerances, check_solution, verify_solution
@@ -271,3 +273,17 @@ def test_warm_polish_factors_where_p_couples_a_constrained_entry():
     warm = solver.solve(*moved)
     assert warm.status is Status.SOLVED and warm.polished and warm.factorizations >= 1
     assert check_solution(Problem.of(*moved), warm, EXACT).passed
+
+
+def test_polish_gives_up_when_its_first_two_guesses_violate_a_bound():
+    """``min 1/2 ||x - (3, 1.4, 0)||^2`` s.t. ``sum x = 3``, ``x <= (1, 1.5, 10)``, from an
+    iterate inside the box with no multiplier: the first guess frees every entry and puts
+    ``x_1`` past its bound; holding it puts ``x_2`` past its; only the third guess is
+    feasible (and the answer ``(1, 1.5, 0.5)``). The polish gives up after two
+    factorizations rather than search on from guesses that stay infeasible
+    (``FEASIBLE_PASSES``): such searches ended rejected on the whole-body-control ticks."""
+    inside = np.zeros(3)
+    result = polish_point(np.eye(3), np.array([-3.0, -1.4, 0.0]), np.ones((1, 3)),
+                          np.array([3.0]), np.full(3, -10.0), np.array([1.0, 1.5, 10.0]),
+                          flatten_cones((), 3), inside, np.zeros(1), np.zeros(3), inside)
+    assert not result["ok"] and result["factorizations"] == 2
