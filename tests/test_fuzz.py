@@ -16,7 +16,7 @@ from fuzzing import CLASSES, Case, judge
 
 SEEDS = {
     "bad_input": (0, 1, 2, 3, 4, 5),
-    "feasible": (0, 1, 2, 3, 4, 5),
+    "feasible": (0, 1, 2, 3, 4, 5, 2900227),
     "primal_infeasible": (0, 1, 2, 3, 80, 146, 177, 182, 350, 100094, 300345),
     "dual_infeasible": (0, 1, 2, 33, 166, 257, 368),
     "solver_reuse": (0, 1, 2, 50, 164, 211, 100008, 100206, 500061, 700137),
@@ -35,7 +35,8 @@ reproducers of the failure mechanisms the campaign found at ed3b90e, 836ab4b, 5f
 seed unseen by their fix; 1300300 an infeasibility claim at the data's rounding;
 1100150 inconsistent rows under a huge ``q``; 1300030, 1500043, 1700106, 1700359 and
 qpsolvers 1700123 stalls that a forced backend now solves again at another rho or
-unequilibrated; issues 26 and 28)."""
+unequilibrated; feasible 2900227 a run still converging at its cap, which the stalled
+run's continuation answers; issues 26 and 28)."""
 
 SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),

@@ -42,15 +42,30 @@ def flat_qp(seed: int) -> tuple[np.ndarray, ...]:
 
 def test_a_converging_run_under_a_time_limit_goes_past_max_iter():
     """Unpolished, this QP needs 371 iterations; with ``max_iter`` 185 a run without a
-    time limit stops at the cap, one with a time limit is still halving its distance to
-    tolerance there and goes on to SOLVED."""
+    time limit stops at the cap (where the stalled path takes over), one with a time
+    limit is still halving its distance to tolerance there and goes on to SOLVED."""
     problem = flat_qp(4)
-    capped = fccqp.solve(*problem, polish=False, max_iter=185, **EPS)
+    solver = fccqp.Solver(polish=False, max_iter=185, **EPS)
+    solver._stalled_certificates = False
+    capped = solver.solve(*problem)
     assert capped.status is Status.MAX_ITER_REACHED and capped.iterations == 185
     timed = fccqp.solve(*problem, polish=False, max_iter=185, time_limit=100.0, **EPS)
     assert timed.status is Status.SOLVED, timed.status
     assert timed.iterations > 185
     verify_solution(problem, timed, Tolerances.of(**EPS))
+
+
+def test_an_untimed_run_stopped_at_its_cap_goes_on_from_where_it_stopped():
+    """The same QP without a time limit and ``max_iter`` 250 (a cap worth halving,
+    ``RESTART_MIN_ITER``): the run that stopped there, still halving its distance to
+    tolerance, is continued once from its own iterate and rho (a cold retry would stop
+    at 250 again), and it ends SOLVED within the continuation's 250 iterations,
+    counted."""
+    problem = flat_qp(4)
+    result = fccqp.solve(*problem, polish=False, max_iter=250, **EPS)
+    assert result.status is Status.SOLVED
+    assert 250 < result.iterations <= 2 * 250
+    verify_solution(problem, result, Tolerances.of(**EPS))
 
 
 def test_a_long_timed_run_polishes_early_as_an_untimed_one():

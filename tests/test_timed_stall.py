@@ -30,14 +30,14 @@ def test_a_stall_with_time_left_is_certified(backend):
 
 def test_a_stall_with_time_left_is_solved_again():
     """The fuzzer's ``extreme_data:500215`` stalls for 4000 iterations in both KKT
-    forms; with 100 s of time limit it is solved again (the other form, then a larger
-    rho), as without a limit, and the answer is verified."""
+    forms; with 100 s of time limit the stalled path runs as without a limit (the
+    continuation, the other form, a larger rho), and the answer is verified."""
     from fuzzing import Case
 
     problem = Case.of("extreme_data", 500215).scenario().problem
     result = solve_verified(problem, time_limit=100.0)
     assert result.status is Status.SOLVED
-    assert result.iterations > 2 * fccqp.Settings().max_iter   # both stalls, then the answer
+    assert result.iterations > fccqp.Settings().max_iter   # the stall, then the answer
 
 
 def test_the_retries_stop_at_the_deadline():

@@ -100,6 +100,9 @@ cdef class Workspace:
     ``eps_abs``, where any point passes the dual test); 0 otherwise (see
     ``acceptance.user_residuals``). Then :class:`fccqp.Solver` asks the auxiliary QPs
     for a certificate."""
+    cdef readonly bint converging
+    """The last run stopped at ``max_iter`` while still converging: its distance to
+    tolerance shrank by ``fccqp.tuning.CONVERGING`` over the last half of the cap."""
 
     def __init__(self, Py_ssize_t n, Py_ssize_t m, constrained, cones, fixed, order,
                  settings, Py_ssize_t log_rows, patterns=None):
@@ -317,6 +320,7 @@ cdef class Workspace:
         cdef Residuals* r = &self.e.res
         certificate = None
         self.doubt = 0
+        self.converging = run.converging
         if run.status == engine.SOLVED or run.status == engine.INACCURATE:
             self.doubt = (PRIMAL_LENT if r.set_lent else 0) + (DUAL_LENT if r.dual_lent else 0)
         if run.status == engine.PRIMAL_INFEASIBLE:

@@ -57,6 +57,7 @@ cdef struct Run:
     double setup_time
     int backend
     bint polished
+    bint converging     # stopped at its cap, its distance shrunk by CONVERGING over the last half
 
 
 cdef struct UserData:

@@ -43,8 +43,8 @@ from fccqp.rho_rule cimport TrialState, new_rho, trial_reset
 from fccqp.termination cimport Residuals, converged, distance, nearly_converged
 from fccqp.tuning cimport (CLEANING_START, CONVERGING, EARLY_POLISH_GATE, EARLY_POLISH_TRIES,
                            EQUALITY_MISSED, GATED_CHECK_WAIT, LOG_INTERVAL, POLISH_GATE,
-                           POLISH_RETRIES, RESERVE_PASSES, STALL_FACTOR, STALLS,
-                           TIMED_EARLY_POLISH)
+                           POLISH_RETRIES, RESERVE_PASSES, RESTART_MIN_ITER, STALL_FACTOR,
+                           STALLS, TIMED_EARLY_POLISH)
 from fccqp.verdict cimport check, classify, inconsistent, missed, missed_by_data, unbounded
 
 
@@ -76,6 +76,7 @@ cdef struct Loop:
     bint cap_polish         # the cap was just extended: polish as an untimed run's end would
     long mark_at            # the first check from this iteration records mark
     double mark             # termination.distance at that check
+    double last_distance    # termination.distance at the last iteration's check
     long cut                # under a time limit the clock counts as run out at this iteration
 
 
@@ -142,15 +143,15 @@ cdef inline void _begin(Engine* e, Loop* L, Run* run, bint cold, double start_ti
     L.timed = isfinite(o.time_limit)
     L.cap = o.max_iter
     L.cap_polish = False
-    L.mark_at = o.max_iter - o.max_iter // 2 if L.timed else LONG_MAX
-    L.mark = INFINITY
+    L.mark_at = o.max_iter - o.max_iter // 2
+    L.mark = L.last_distance = INFINITY
     L.cut = _cut_iterations
     L.deadline = o.time_limit - min(
         max(e.clock.final_reserve, RESERVE_PASSES * e.clock.pass_time), 0.5 * o.time_limit)
     run.factorizations = 0
     run.backend = e.fact.form
     trial_reset(&L.trial)
-    run.polished = False
+    run.polished = run.converging = False
     e.tighten = 1.0
     e.certs.stalled_prim = INFINITY
     e.certs.stalled_at = e.certs.checked_at = 0
@@ -346,6 +347,8 @@ cdef inline void _check(Engine* e, Loop* L, Run* run) noexcept nogil:
     if L.iteration >= L.mark_at:
         L.mark = distance(&e.res, e.opt.eps_abs, e.opt.eps_rel)
         L.mark_at = LONG_MAX
+    if L.last:
+        L.last_distance = distance(&e.res, e.opt.eps_abs, e.opt.eps_rel)
     if L.gated and L.status == RUNNING:   # the gate passed, the check did not
         L.wait = min(2 * L.wait + 1, GATED_CHECK_WAIT)
         L.next_gated = L.iteration + L.wait
@@ -385,6 +388,13 @@ cdef inline void _polish_attempts(Engine* e, Loop* L, Run* run) noexcept nogil:
         run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, True)
 
 
+cdef inline bint _converging(const Loop* L, double now) noexcept nogil:
+    """Whether the run's distance to tolerance ``now`` (:func:`fccqp.termination.distance`)
+    shrank by ``CONVERGING`` since the last mark (half a ``max_iter`` before the cap,
+    or the cap's last extension)."""
+    return isfinite(now) and now <= CONVERGING * L.mark
+
+
 cdef inline void _extend(Engine* e, Loop* L) noexcept nogil:
     """Under a time limit the clock is the budget: a run at its iteration cap whose
     distance to tolerance (:func:`fccqp.termination.distance`) shrank by ``CONVERGING``
@@ -396,7 +406,7 @@ cdef inline void _extend(Engine* e, Loop* L) noexcept nogil:
     on past 90 s under qpbenchmark's time limit.
     """
     cdef double now = distance(&e.res, e.opt.eps_abs, e.opt.eps_rel)
-    if isfinite(now) and now <= CONVERGING * L.mark:
+    if _converging(L, now):
         L.cap += max(e.opt.max_iter // 2, 1)
         L.mark = now
         L.cap_polish = True
@@ -450,6 +460,8 @@ cdef inline void _final_step(Engine* e, Loop* L, Run* run) noexcept nogil:
     e.iterated = True
     if L.status == MAX_ITER and L.iteration < L.cap:
         L.status = TIME_LIMIT   # past max_iter on an extended cap (_extend): the clock stopped it
+    run.converging = (L.iteration >= L.cap and o.max_iter >= RESTART_MIN_ITER
+                      and _converging(L, L.last_distance))   # halves worth judging
     if (not run.polished and o.polish and SOLVED <= L.status <= TIME_LIMIT
             and L.polished_at != L.iteration
             and (not L.timed or L.iteration >= L.cap

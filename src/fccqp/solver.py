@@ -285,7 +285,8 @@ class Solver:
             raise _not_convex(P)
         if (out.status in UNANSWERED and self._stalled_certificates
                 and _room(settings, start)):
-            out = self._stalled(out, w, (P, q, A, b, lb, ub), self._cones, start)
+            resume = (P, q, A, b, lb, ub, None, True, start, structure.certificate, False)
+            out = self._stalled(out, w, (P, q, A, b, lb, ub), self._cones, start, resume)
         elif w.doubt and self._stalled_certificates and _room(settings, start):
             out = self._doubted(out, w, (P, q, A, b, lb, ub), self._cones, start)
         elif (out.status is Status.PRIMAL_INFEASIBLE and self._stalled_certificates
@@ -302,16 +303,20 @@ class Solver:
         return out
 
     def _stalled(self, out: Result, workspace: admm.Workspace, arguments: tuple,
-                 cones: object, start: float) -> Result:
+                 cones: object, start: float, resume: tuple) -> Result:
         """``out`` of a run that stalled (:data:`UNANSWERED`) in ``workspace`` on the
-        problem of ``arguments`` (``P, q, A, b, lb, ub``), or the certificate that
-        :func:`fccqp.auxiliary.stalled_certificate` found for it instead, or the
-        answer of a solve in the other KKT form (with ``kkt_backend="auto"`` on the
-        dense path), at another rho or without equilibration
-        (:func:`fccqp.auxiliary.solved_again`); their iterations and factorizations
-        added. Either leaves no previous solution to start from: a certified problem as
-        an infeasible run does, an answer from another solver because this workspace
-        holds the stalled point."""
+        problem of ``arguments`` (``P, q, A, b, lb, ub``): first the run goes on from
+        where it stopped (:func:`_resumed`; ``resume``, the arguments of
+        ``workspace.solve`` for it); when that too ends unanswered, the certificate that
+        :func:`fccqp.auxiliary.stalled_certificate` finds for it, or the answer of a
+        solve in the other KKT form (with ``kkt_backend="auto"`` on the dense path), at
+        another rho or without equilibration (:func:`fccqp.auxiliary.solved_again`);
+        their iterations and factorizations added. Either leaves no previous solution to
+        start from: a certified problem as an infeasible run does, an answer from
+        another solver because this workspace holds the stalled point."""
+        out = _resumed(out, workspace, resume)
+        if out.status not in UNANSWERED:
+            return out
         deadline = start + self._settings.time_limit   # the run's budget (_room)
         found = auxiliary.stalled_certificate(Solver, self._settings, workspace, *arguments,
                                               cones, deadline=deadline)
@@ -394,8 +399,9 @@ class Solver:
             raise _not_convex(data.P)
         if (out.status in UNANSWERED and self._stalled_certificates
                 and _room(settings, start)):
+            resume = (*arguments[:6], None, True, start, certificate)
             out = self._stalled(out, w, (data.P, data.q, data.A, data.b, data.lb, data.ub),
-                                cones, start)
+                                cones, start, resume)
         elif w.doubt and self._stalled_certificates and _room(settings, start):
             out = self._doubted(out, w, (data.P, data.q, data.A, data.b, data.lb, data.ub),
                                 cones, start)
@@ -423,6 +429,27 @@ class Solver:
         workspace = self._sparse[1]
         workspace.update_cones(cones.mu, cones.normal)
         return workspace
+
+
+def _resumed(out: Result, workspace: admm.Workspace, resume: tuple) -> Result:
+    """``out`` of a run that stopped at its iteration cap while still converging
+    (``workspace.converging``), continued once from its own last iterate, rho and
+    scaling (``workspace.solve(*resume)``, a warm start with up to ``max_iter`` more
+    iterations, the run's own time limit from the same start): a run that converges
+    linearly but slowly may be a few iterations from its tolerances there, where a
+    cold retry would spend its whole cap again. The continuation's result, with both
+    runs' iterations and factorizations; ``out`` itself for any other stall, or when
+    the continuation ends in a numerical error or rests on tolerances lent to its
+    entries (``workspace.doubt``)."""
+    if out.status is not Status.MAX_ITER_REACHED or not workspace.converging:
+        return out
+    again = workspace.solve(*resume)
+    if (type(again) is not Result or again.status is Status.NUMERICAL_ERROR
+            or workspace.doubt):
+        return out
+    return Result._of({**again.__dict__,
+                       "iterations": out.iterations + again.iterations,
+                       "factorizations": out.factorizations + again.factorizations})
 
 
 def _room(settings: Settings, start: float) -> bool:

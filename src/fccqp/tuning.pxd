@@ -54,7 +54,8 @@ cdef extern from *:
     #define FCCQP_EQUALITY_START_LIMIT 1e-3
     /* the cold start missing A x = b by more than this (relative): "auto" takes full form */
     #define FCCQP_EQUALITY_MISSED 1e-9
-    /* a failed warm start restarts cold for the rest only when max_iter is at least this */
+    /* a failed warm start restarts cold for the rest, and a run still converging at its
+       cap is continued (fccqp.solver._resumed), only when max_iter is at least this */
     #define FCCQP_RESTART_MIN_ITER 200
 
     /* ---- Rho adaptation (fccqp.rho_rule, fccqp.admm) ---- */
