@@ -124,7 +124,7 @@ cdef extern from *:
     /* regularization of both diagonal blocks of the polishing KKT matrix (scaled) */
     #define FCCQP_POLISH_DELTA 1e-12
     /* the same for qdldl's factorization without pivoting (fccqp.polish_csc): 1e-12 lost LPs */
-    #define FCCQP_POLISH_CSC_DELTA 1e-9
+    #define FCCQP_POLISH_CSC_DELTA 1e-8
     /* refine the returned point while the KKT residual > this max(1, ||q||, ||b||) */
     #define FCCQP_POLISH_REFINE_TOLERANCE 1e-14
     /* a guess's first solve is refined only to this: the next chord step repeats the work */
