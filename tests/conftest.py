@@ -11,7 +11,9 @@ Two fixtures:
   pytest.mark.usefixtures("every_kkt_backend")``, every :class:`fccqp.Settings` built
   without a ``kkt_backend`` (``fccqp.solve``, ``Solver``, ``Settings.realtime``, the
   qpsolvers and CVXPY adapters) takes the fixture's backend; one given explicitly keeps
-  it. Under "auto" nothing is changed: those are the module's tests as they were.
+  it (as the CVXPY plugin's ``FCCQP``, built at import: test_cvxpy_plugin gives it the
+  fixture's default settings). Under "auto" nothing is changed: those are the module's
+  tests as they were.
 
 ``@pytest.mark.kkt_backends("auto", "ldl_full", reason="...")`` restricts a test to some
 backends, the reason saying why: a test of one backend's mechanism (a factorization

@@ -109,6 +109,26 @@ def test_reduced_forms_fall_back_on_dependent_rows(kkt_backend):
     assert np.abs(A @ result.x - b).max() <= 1e-9 * (1 + np.abs(b).max())
 
 
+def test_a_cost_flat_to_rounding_on_entries_the_rows_tie_down_is_solved(kkt_backend):
+    """``P`` of 1e-100 (a linear program to rounding) with ``A`` square and invertible on
+    the free entries: the Schur route's ``H^-1`` multiplies the rounding of ``f - A' nu``
+    by 1e100 (``S`` outgrows ``H`` and ``A`` by as much: ADMM stalled there, and only
+    the retries answered), so the reduced form goes to LDL', whose pivoting ties the
+    free entries to the boxed ones through ``A``."""
+    P = 1e-100 * np.eye(4)
+    q = np.array([0.3, -0.2, 1.0, -1.5])
+    A = np.array([[1.0, 0.5, 0.4, -0.3], [0.2, 1.0, -0.6, 0.8]])
+    b = np.array([1.0, -0.5])
+    lb, ub = np.array([-np.inf, -np.inf, -1.0, -2.0]), np.array([np.inf, np.inf, 1.0, 2.0])
+    result = fccqp.solve(P, q, A, b, lb, ub, kkt_backend=kkt_backend)
+    assert result.status is Status.SOLVED
+    assert result.iterations < fccqp.Settings().max_iter
+    if kkt_backend == "schur_reduced":
+        assert result.backend in ("ldl_reduced", "ldl_full")
+    reference = clarabel_solve(P, q, A, b, lb, ub, [])
+    np.testing.assert_allclose(result.x, reference.x, atol=1e-4 * (1 + np.abs(reference.x).max()))
+
+
 def test_nonconvex_cost_is_rejected_by_every_backend(kkt_backend):
     P, q, A, b, lb, ub, cones = random_problem(0, n_box=6)
     P = P - 10.0 * np.eye(P.shape[0])

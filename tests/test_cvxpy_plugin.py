@@ -22,6 +22,19 @@ from fccqp_cvxpy import FCCQP, FCCQPSolver
 from fccqp_cvxpy.translation import Translation
 from verify import Problem, Tolerances, verify_solution
 
+pytestmark = pytest.mark.usefixtures("every_kkt_backend", "default_instance_on_the_backend")
+
+
+@pytest.fixture(scope="module")
+def default_instance_on_the_backend(every_kkt_backend):
+    """``FCCQP``, the instance the plugin builds at import (and registers under its
+    name), takes the default settings of ``every_kkt_backend``'s backend too; the
+    instances the tests build do by themselves."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(FCCQP, "settings", fccqp.Settings())
+        yield
+
+
 TIGHT = {"eps_abs": 1e-8, "eps_rel": 1e-8, "max_iter": 100_000}
 TIGHTER = {**TIGHT, "eps_abs": 1e-10, "eps_rel": 1e-10}
 CLARABEL_TIGHT = {"tol_gap_abs": 1e-11, "tol_gap_rel": 1e-11, "tol_feas": 1e-11}

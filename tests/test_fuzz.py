@@ -44,30 +44,28 @@ SPARSE_SEEDS = {
     "solver_reuse": (38,),
     "extreme_data": (26, 900343),
     "qpsolvers": (100035,),
-    "cvxpy": (7, 1700154),
+    "cvxpy": (7, 1700154, 1900171),
     "dual_infeasible": (1700072,),
 }
 """Seeds per class run on the sparse path (each ends within a few dozen iterations);
 ``qpsolvers:100035`` is an LP that the compressed-column polish lost at
-``POLISH_CSC_DELTA = 1e-12`` (qdldl without pivoting); ``cvxpy:1700154`` a zero pivot
+``POLISH_CSC_DELTA = 1e-12`` (qdldl without pivoting), ``cvxpy:1900171`` one it lost at
+1e-9 (ADMM crawls on every backend; the dense polish ends it at 4000 iterations);
+``cvxpy:1700154`` a zero pivot
 that ``qdldl``'s update did not report, ``dual_infeasible:1700072`` solves whose first
 block was left unrefined (both diverged to NUMERICAL_ERROR on unbounded problems).
 Every case of :data:`SEEDS` on the sparse path took 100 s of CPU at b11793f (the whole
 module, four dense backends and these: 25 s of wall time at load 8), with 5 failures: 4 stalls at
 MAX_ITER_REACHED that the dense backends' retries answer (extreme_data 100213, 1500043,
-1700359, cvxpy 1), and ``extreme_data:900343``, kept here (see :data:`OPEN`)."""
+1700359, cvxpy 1), and ``extreme_data:900343``, kept here: SOLVED at the start on an
+infeasible problem (a friction cone pinned outside itself by 1e-3, variables rescaled
+1e-8..1e8) while ``POLISH_CSC_DELTA`` was 1e-9, certified since."""
 
-OPEN: dict[str, str] = {
-    "extreme_data:900343": (
-        "SOLVED at the start on an infeasible problem (a friction cone pinned outside "
-        "itself by 1e-3, variables rescaled 1e-8..1e8): the start meets the tolerances "
-        "in the user's units, as ldl_full's start does with polish=False; with the "
-        "polish the dense backends go on and certify it"),
-}
+OPEN: dict[str, str] = {}
 """Reproducers of mechanisms still open (issues 26 and 28), each the reason it fails:
 expected to fail (strictly) on the backends of :data:`OPEN_BACKENDS`, so that a fix
 turns them red."""
-OPEN_BACKENDS: dict[str, tuple[str, ...]] = {"extreme_data:900343": ("sparse",)}
+OPEN_BACKENDS: dict[str, tuple[str, ...]] = {}
 """Where an open case fails."""
 
 ROUNDING_DEPENDENT: dict[str, tuple[tuple[str, ...], str]] = {

@@ -17,6 +17,12 @@ import fccqp
 from fccqp.qpsolvers_backend import fccqp_solve_qp, register
 from verify import Tolerances, from_qpsolvers, verify_solution
 
+pytestmark = pytest.mark.usefixtures("every_kkt_backend")
+BEFORE_ANY_BACKEND = pytest.mark.kkt_backends(
+    "auto", reason="settings, arguments and registration checked before a backend is chosen")
+IN_A_SUBPROCESS = pytest.mark.kkt_backends(
+    "auto", reason="runs in a new Python process, outside the fixture")
+
 TIGHT = dict(eps_abs=1e-9, eps_rel=1e-9, max_iter=100_000)
 DEFAULT_EPS = fccqp.Settings().eps_abs
 
@@ -297,6 +303,7 @@ def test_initvals_is_the_primal_start():
     assert_close(warm.x, cold.x, 1e-7, "x")
 
 
+@BEFORE_ANY_BACKEND
 @pytest.mark.parametrize(
     "kwargs, name",
     [
@@ -311,6 +318,7 @@ def test_unknown_setting_raises_param_error(kwargs, name):
     assert isinstance(info.value.__cause__, ValueError)
 
 
+@BEFORE_ANY_BACKEND
 def test_invalid_setting_value_raises_param_error():
     problem, _ = problems.get_qpsut01()
     with pytest.raises(ParamError, match="max_iter"):
@@ -366,6 +374,7 @@ def test_bad_input_names_the_argument(changes, error, message):
         solve_qp(**args, solver="fccqp")
 
 
+@BEFORE_ANY_BACKEND
 def test_incomplete_inequality_is_a_problem_error():
     # qpsolvers' own check, run before the backend (its message says "missing G").
     with pytest.raises(qpsolvers.ProblemError, match="incomplete inequality"):
@@ -381,6 +390,7 @@ def test_verbose_prints_the_iteration_log(capsys):
     assert capsys.readouterr().out == ""
 
 
+@BEFORE_ANY_BACKEND
 def test_registered_once_in_qpsolvers_lists():
     assert register() is True
     assert register() is True
@@ -398,6 +408,7 @@ def run_python(code: str) -> str:
     return result.stdout
 
 
+@IN_A_SUBPROCESS
 def test_import_fccqp_first_then_qpsolvers():
     """``import fccqp`` leaves qpsolvers unimported; importing it later registers fccqp."""
     out = run_python(
@@ -421,6 +432,7 @@ def test_import_fccqp_first_then_qpsolvers():
     assert out.split() == ["1", "0.5"]
 
 
+@IN_A_SUBPROCESS
 def test_import_qpsolvers_first_then_fccqp():
     out = run_python(
         """
@@ -435,6 +447,7 @@ def test_import_qpsolvers_first_then_fccqp():
     assert out.split() == ["1"]
 
 
+@IN_A_SUBPROCESS
 def test_without_qpsolvers_registration_does_nothing():
     out = run_python(
         """
@@ -454,11 +467,13 @@ def test_without_qpsolvers_registration_does_nothing():
 DOC = Path(__file__).resolve().parents[1] / "docs" / "qpsolvers.md"
 
 
+@IN_A_SUBPROCESS
 def test_doc_example_runs():
     """The page's example, which asserts its own answer, runs as written."""
     run_python(DOC.read_text().split("```python\n")[1].split("```")[0])
 
 
+@BEFORE_ANY_BACKEND
 def test_doc_settings_table_matches_settings():
     rows = re.findall(r"^\| `(\w+)` \| .* \| `(.+)` \|$", DOC.read_text(), flags=re.MULTILINE)
     documented = {name: default for name, default in rows}

@@ -6,6 +6,10 @@ import pytest
 import fccqp
 from fccqp import FrictionCone, SecondOrderCone
 
+pytestmark = pytest.mark.usefixtures("every_kkt_backend")
+BEFORE_ANY_BACKEND = pytest.mark.kkt_backends(
+    "auto", reason="settings and arguments checked before a backend is chosen")
+
 P = np.eye(6)
 q = np.ones(6)
 A = np.ones((2, 6))
@@ -135,13 +139,6 @@ def test_bad_input_after_a_solve(changes, error, message):
         solver.solve(**args)
 
 
-@pytest.mark.parametrize("changes, error, message", BAD_INPUT)
-def test_bad_input_on_the_sparse_path(changes, error, message):
-    """The sparse path (fccqp.sparse_problem) raises the dense path's errors."""
-    with pytest.raises(error, match=message):
-        solve(kkt_backend="sparse", **changes)
-
-
 @pytest.mark.parametrize("convert", [
     lambda v: v.tolist(),
     lambda v: v.astype(np.float32),
@@ -167,6 +164,7 @@ def test_arrays_the_fast_path_does_not_take_are_converted(convert):
     np.testing.assert_allclose(got.x, expected.x, atol=1e-6)
 
 
+@BEFORE_ANY_BACKEND
 def test_dense_arguments_recognizes_only_contiguous_float64_of_the_shapes():
     from fccqp.fast_checks import dense_arguments
 
@@ -187,6 +185,7 @@ def test_dense_arguments_recognizes_only_contiguous_float64_of_the_shapes():
     assert not dense_arguments(M, v, Z, z, v, v.astype(np.int64), 3, 1)
 
 
+@BEFORE_ANY_BACKEND
 @pytest.mark.parametrize(
     "overrides, message",
     [
@@ -235,6 +234,7 @@ def test_bad_settings(overrides, message):
         solve(**overrides)
 
 
+@BEFORE_ANY_BACKEND
 def test_settings_argument_must_be_settings():
     with pytest.raises(TypeError, match="settings must be a fccqp.Settings"):
         fccqp.Solver(settings={"rho": 1.0})
@@ -245,7 +245,6 @@ def test_bad_initial_guess():
         fccqp.Solver().solve(P, q, A, b, x0=np.ones(3))
 
 
-@pytest.mark.parametrize("backend", ["auto", "sparse"])
 @pytest.mark.parametrize(
     "x0, error, message",
     [
@@ -256,11 +255,12 @@ def test_bad_initial_guess():
         ("abcdef", TypeError, "x0 must be a real numeric vector"),
     ],
 )
-def test_bad_initial_guesses(backend, x0, error, message):
+def test_bad_initial_guesses(x0, error, message):
     with pytest.raises(error, match=message):
-        fccqp.Solver(kkt_backend=backend).solve(P, q, A, b, x0=x0)
+        fccqp.Solver().solve(P, q, A, b, x0=x0)
 
 
+@BEFORE_ANY_BACKEND
 @pytest.mark.parametrize(
     "call, error, message",
     [
@@ -277,6 +277,7 @@ def test_bad_presets_and_overrides(call, error, message):
         call()
 
 
+@BEFORE_ANY_BACKEND
 def test_integer_settings_take_their_largest_value():
     settings = fccqp.Settings(max_iter=2**31 - 1, min_iter=2**31 - 1,
                               check_termination=2**31 - 1, adaptive_rho_interval=2**31 - 1,
@@ -301,22 +302,21 @@ def _cone_problem():
     return P_c, q_c, A_c, b_c, lb_c, ub_c
 
 
-@pytest.mark.parametrize("backend", ["auto", "sparse"])
 @pytest.mark.parametrize("cone", [
     FrictionCone(2, 0.5),
     FrictionCone(2, 0.5, (0.0, 0.6, 0.8)),
     SecondOrderCone(5, 3),
 ])
-def test_a_single_cone_is_a_one_element_list(backend, cone):
+def test_a_single_cone_is_a_one_element_list(cone):
     """``cones=cone`` is accepted and means ``cones=[cone]`` (docs/api.md), cold and on
     a warm Solver that alternates between the two spellings."""
     data = _cone_problem()
-    listed = fccqp.solve(*data, cones=[cone], kkt_backend=backend)
-    single = fccqp.solve(*data, cones=cone, kkt_backend=backend)
+    listed = fccqp.solve(*data, cones=[cone])
+    single = fccqp.solve(*data, cones=cone)
     assert listed.status is single.status is fccqp.Status.SOLVED
     np.testing.assert_array_equal(single.x, listed.x)
     np.testing.assert_array_equal(single.z, listed.z)
-    solver, reference = fccqp.Solver(kkt_backend=backend), fccqp.Solver(kkt_backend=backend)
+    solver, reference = fccqp.Solver(), fccqp.Solver()
     for spelling in ([cone], cone, (cone,), cone):
         got, expected = solver.solve(*data, cones=spelling), reference.solve(*data, cones=[cone])
         assert got.status is expected.status is fccqp.Status.SOLVED
@@ -328,6 +328,7 @@ def test_rounding_asymmetry_is_accepted():
     assert solve(P=noisy).status is fccqp.Status.SOLVED
 
 
+@BEFORE_ANY_BACKEND
 def test_time_limit_infinity_is_default():
     assert fccqp.Settings().time_limit == np.inf
 

@@ -95,3 +95,20 @@ def test_bad_numbers_give_the_dense_scans_message(argument, entries):
     with pytest.raises(ValueError) as on_csc:
         raise_finding(finding, data["lb"], data["ub"])
     assert str(on_csc.value) == str(on_dense.value)
+
+
+@pytest.mark.parametrize(("argument", "entries"), BAD)
+def test_the_sparse_path_names_the_entry_the_dense_path_names(argument, entries):
+    """The sparse path's first conversion (:func:`fccqp.sparse_problem.convert`) reports
+    the first bad entry by row, its row and value, as the dense scan does."""
+    data = dict(zip(("P", "q", "A", "b", "lb", "ub"), _data(), strict=True))
+    for i, j, value in entries:
+        if j is None:
+            data[argument][i] = value
+        else:
+            data[argument][i, j] = value
+    with pytest.raises(ValueError) as on_dense:
+        fccqp.solve(**data)
+    with pytest.raises(ValueError) as on_sparse:
+        fccqp.solve(**data, kkt_backend="sparse")
+    assert str(on_sparse.value) == str(on_dense.value)

@@ -367,8 +367,7 @@ def test_a_run_that_stalls_in_both_forms_is_solved_at_a_larger_rho(name, seed, k
 
 @pytest.mark.parametrize(("name", "seed"), [("extreme_data", 212), ("extreme_data", 473),
                                            ("extreme_data", 1251)])
-def test_a_run_whose_rho_sits_at_its_floor_is_solved_at_a_smaller_one(name, seed, kkt_backend,
-                                                                     request):
+def test_a_run_whose_rho_sits_at_its_floor_is_solved_at_a_smaller_one(name, seed, kkt_backend):
     """Extreme data whose multipliers are 1e-8 of the scaled primal (``P`` of 1e-11 with
     the optimum at 5e9; ``P`` of 1e10 or 8e10 with the optimum, or a ray, in its
     near-null space): the rho rule sits at ``RHO_MIN`` and ADMM stalls in both forms and
@@ -378,15 +377,6 @@ def test_a_run_whose_rho_sits_at_its_floor_is_solved_at_a_smaller_one(name, seed
     the ray of 1251)."""
     from fuzzing import Case, judge
 
-    if kkt_backend == "sparse" and seed == 473:
-        request.node.add_marker(pytest.mark.xfail(strict=True, reason=(
-            "P huge on the sparse backend: MAX_ITER_REACHED at every rho tried and "
-            "unscaled")))
-    if kkt_backend == "sparse" and seed == 212:
-        request.node.add_marker(pytest.mark.xfail(strict=False, reason=(
-            "P tiny on the sparse backend: MAX_ITER_REACHED at every rho tried and "
-            "unscaled under OpenBLAS' AVX2 kernels (the unscaled point meets the "
-            "tolerances only on lent units, no answer), solved under AVX-512's")))
     assert judge(Case.of(name, seed), kkt_backend) is None
 
 

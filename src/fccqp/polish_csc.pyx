@@ -16,10 +16,10 @@ about 10 us, small beside a factorization of the sizes that take the sparse path
 The matrix is quasi-definite (positive definite top-left block on a convex problem,
 ``-delta I`` below), so an LDL' factorization without pivoting exists in qdldl's
 fill-reducing order; but without pivoting its rounding grows like ``1 / delta``, so
-``delta`` is ``POLISH_CSC_DELTA`` (1e-9, as the sparse backend's ``sparse_kkt.DELTA``)
-rather than the dense ``1e-12``: on an LP (``P = 0``: the top-left block is ``delta I``)
-1e-12 lost the solves of the fuzzer's ``qpsolvers:100035``, and the polish's refinement
-against the unregularized system (``polish._solve``) removes the larger bias.
+``delta`` is ``POLISH_CSC_DELTA`` (1e-8) rather than the dense ``1e-12``: on an LP (``P =
+0``: the top-left block is ``delta I``) the solves of an active set that the dense
+backends' polish accepts were lost below it, and the polish's refinement against the
+unregularized system (``polish._solve``) removes the larger bias.
 
 Column ``c < |F|`` of the upper triangle is column ``F_c`` of ``P`` restricted to the
 free rows up to the diagonal (``P``'s full symmetric pattern makes its columns its

@@ -12,6 +12,7 @@ cdef struct Schur:
     int dense            # rows of the dense leading block of L; a diagonal tail follows
     bint free_ready      # the free rows of L and Y and G hold for this run's P and A
     double* G            # m x m, Fortran: Y_F' Y_F over the free rows (diagonal-tail split)
+    double free_largest  # largest |entry| of H and A over the free rows (with free_ready)
     char* coupled        # n scratch: which rows of P have entries off the diagonal
     double* perm         # n scratch
     double* dx           # n scratch

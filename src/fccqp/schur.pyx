@@ -24,20 +24,23 @@ division. On talos (``n, m, s`` = 124, 68, 56, a dense block of 38) the factoriz
 and the table take half the multiply-adds of the dense way.
 
 ``S`` is positive definite exactly when ``A`` has full row rank; when either
-factorization fails (or loses a pivot to cancellation, see ``RANK_TOLERANCE``) the
+factorization fails (or loses a pivot to cancellation, see ``RANK_TOLERANCE``), or ``S``
+outgrows ``H`` and ``A`` by more than ``SCHUR_GROWTH`` (``P`` nearly singular on free
+entries that ``A`` ties down: ``x = H^-1 (f - A' nu)`` then multiplies the rounding of
+``f - A' nu`` by ``H^-1``, while a pivoting LDL' keeps its growth bounded), the
 caller falls back to the quasi-definite LDL' backend of :mod:`fccqp.ldl`, which handles
 rank-deficient ``A``. Solves are refined like :func:`fccqp.ldl.ldl_solve`.
 """
 
 import numpy as np
 
-from libc.math cimport sqrt
+from libc.math cimport fabs, sqrt
 
 from fccqp._blas cimport cholesky, cholesky_solve, cholesky_solve_vector, gemm, syrk_t, trsm
 from fccqp._types cimport Problem
 from fccqp.ldl cimport meets_equalities
 from fccqp.matrices cimport product, product_t
-from fccqp.tuning cimport MAX_REFINE, RANK_TOLERANCE
+from fccqp.tuning cimport MAX_REFINE, RANK_TOLERANCE, SCHUR_GROWTH
 
 
 def ordering(n, constrained):
@@ -112,10 +115,12 @@ cdef bint _factor_free(Schur* f, const Problem* p) noexcept nogil:
     ``Y``, and ``G = Y_F' Y_F``; False when ``P`` is not positive definite on them."""
     cdef int n = <int>p.n, m = <int>p.m, first = n - <int>p.s, k = f.dense, i, j
     cdef Py_ssize_t column
+    cdef double largest = 0.0
     for j in range(k):   # the dense block's lower triangle; below it L is never read
         column = f.order[j]
         for i in range(j, k):
             f.L[i + j * n] = p.P.values[f.order[i] * n + column]
+            largest = max(largest, fabs(f.L[i + j * n]))
     if k > 0 and not cholesky(f.L, k, n):
         return False
     for j in range(k, first):   # the diagonal tail's free rows
@@ -123,6 +128,7 @@ cdef bint _factor_free(Schur* f, const Problem* p) noexcept nogil:
         f.L[j + j * n] = p.P.values[column * n + column]
         if not f.L[j + j * n] > 0.0:
             return False
+        largest = max(largest, f.L[j + j * n])
         f.L[j + j * n] = sqrt(f.L[j + j * n])
     if m == 0:
         return True
@@ -130,6 +136,8 @@ cdef bint _factor_free(Schur* f, const Problem* p) noexcept nogil:
         column = f.order[j]
         for i in range(m):
             f.Y[j + i * n] = p.A.values[i * n + column]
+            largest = max(largest, fabs(f.Y[j + i * n]))
+    f.free_largest = largest
     if k > 0:
         trsm(b"L", b"N", k, m, f.L, n, f.Y, n)
     for i in range(m):
@@ -144,23 +152,26 @@ cdef bint _factor_constrained(Schur* f, const Problem* p, const double* rho_vec)
     ``S = G + Y_S' Y_S``, over the free rows that :func:`_factor_free` left."""
     cdef int n = <int>p.n, m = <int>p.m, s = <int>p.s, first = n - s, i, j
     cdef Py_ssize_t column
-    cdef double d
+    cdef double d, a, largest = f.free_largest
     for j in range(first, n):
         column = f.order[j]
         d = p.P.values[column * n + column] + rho_vec[j - first]
         if not d > 0.0:
             return False
+        largest = max(largest, d)
         f.L[j + j * n] = sqrt(d)
     if m == 0:
         return True
     for i in range(m):
         for j in range(first, n):
-            f.Y[j + i * n] = p.A.values[i * n + f.order[j]] / f.L[j + j * n]
+            a = p.A.values[i * n + f.order[j]]
+            largest = max(largest, fabs(a))
+            f.Y[j + i * n] = a / f.L[j + j * n]
     for i in range(m * m):
         f.LS[i] = f.G[i]
     if s > 0:
         syrk_t(m, s, f.Y + first, n, 1.0, f.LS, m)
-    return _factor_complement(f, m)
+    return _factor_complement(f, m, largest)
 
 
 cdef bint _factor_whole(Schur* f, const Problem* p, const double* rho_vec) noexcept nogil:
@@ -168,12 +179,15 @@ cdef bint _factor_whole(Schur* f, const Problem* p, const double* rho_vec) noexc
     keeps the base order and ``L`` is dense): every row depends on rho."""
     cdef int n = <int>p.n, m = <int>p.m, s = <int>p.s, first = n - s, i, j
     cdef Py_ssize_t column
+    cdef double largest = 0.0
     for j in range(n):
         column = f.order[j]
         for i in range(j, n):
             f.L[i + j * n] = p.P.values[f.order[i] * n + column]
+            largest = max(largest, fabs(f.L[i + j * n]))
     for j in range(s):
         f.L[first + j + (first + j) * n] += rho_vec[j]
+        largest = max(largest, fabs(f.L[first + j + (first + j) * n]))
     if not cholesky(f.L, n, n):
         return False
     if m == 0:
@@ -182,18 +196,23 @@ cdef bint _factor_whole(Schur* f, const Problem* p, const double* rho_vec) noexc
         column = f.order[j]
         for i in range(m):
             f.Y[j + i * n] = p.A.values[i * n + column]
+            largest = max(largest, fabs(f.Y[j + i * n]))
     trsm(b"L", b"N", n, m, f.L, n, f.Y, n)
     syrk_t(m, n, f.Y, n, 0.0, f.LS, m)
-    return _factor_complement(f, m)
+    return _factor_complement(f, m, largest)
 
 
-cdef bint _factor_complement(Schur* f, int m) noexcept nogil:
-    """Cholesky of ``S`` in ``LS`` (its lower triangle holds ``S``); False when a pivot is
-    not positive or was lost to cancellation (dependent rows: left to LDL')."""
+cdef bint _factor_complement(Schur* f, int m, double kkt_largest) noexcept nogil:
+    """Cholesky of ``S`` in ``LS`` (its lower triangle holds ``S``); False when ``S``
+    outgrew ``kkt_largest``, the largest entry of ``H`` and ``A``, by ``SCHUR_GROWTH``
+    (see the module docstring), or a pivot is not positive or was lost to cancellation
+    (dependent rows: left to LDL')."""
     cdef int i
     cdef double largest = 0.0
     for i in range(m):
         largest = max(largest, f.LS[i + i * m])
+    if not largest <= SCHUR_GROWTH * kkt_largest:
+        return False
     if not cholesky(f.LS, m, m):
         return False
     for i in range(m):

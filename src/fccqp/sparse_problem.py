@@ -69,16 +69,21 @@ def _sparse_matrix(value: object, name: str) -> sp.csc_matrix:
 
 
 def _finite_entries(M: sp.csc_matrix, argument: int, name: str) -> None:
-    """Raise for the first NaN, inf or too large stored entry of ``M`` (by row, as the
-    dense scan reports it; ``argument`` is the code :func:`raise_finding` names)."""
+    """Raise for the first NaN or inf stored entry of ``M``, else its first too large
+    one, or for ``P`` the first of its largest (by row, as the dense scan reports them;
+    ``argument`` is the code :func:`raise_finding` names)."""
     bad = ~np.isfinite(M.data)
     code = dense_problem._P_NOT_FINITE if name == "P" else dense_problem._NOT_FINITE
     if not bad.any():
-        bad = np.abs(M.data) > MAX_ENTRY
+        magnitude = np.abs(M.data)
+        bad = magnitude > MAX_ENTRY
+        if name == "P" and bad.any():
+            bad = magnitude == magnitude.max()
         code = dense_problem._TOO_LARGE
     if bad.any():
         coo = M.tocoo()
-        first = int(np.argmin(np.where(bad, coo.row, np.iinfo(np.int64).max)))
+        found = np.flatnonzero(bad)
+        first = int(found[np.argmin(coo.row[found])])
         raise_finding((code, argument, int(coo.row[first]), float(coo.data[first])),
                       np.empty(0), np.empty(0))
 

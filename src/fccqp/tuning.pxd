@@ -44,6 +44,8 @@ cdef extern from *:
     #define FCCQP_KKT_REFINE_TOLERANCE 1e-13
     /* a Schur complement's Cholesky pivot below this times its largest diagonal: singular */
     #define FCCQP_RANK_TOLERANCE 1e-10
+    /* S's largest diagonal above this times H's and A's largest entry: growth, go to LDL' */
+    #define FCCQP_SCHUR_GROWTH 1e10
     /* reduced iteration when this * s fits the budget: s columns cost ~s/4 solves, x2 margin */
     #define FCCQP_REDUCED_COST 0.5
 
@@ -123,7 +125,7 @@ cdef extern from *:
     /* regularization of both diagonal blocks of the polishing KKT matrix (scaled) */
     #define FCCQP_POLISH_DELTA 1e-12
     /* the same for qdldl's factorization without pivoting (fccqp.polish_csc): 1e-12 lost LPs */
-    #define FCCQP_POLISH_CSC_DELTA 1e-9
+    #define FCCQP_POLISH_CSC_DELTA 1e-8
     /* refine the returned point while the KKT residual > this max(1, ||q||, ||b||) */
     #define FCCQP_POLISH_REFINE_TOLERANCE 1e-14
     /* a guess's first solve is refined only to this: the next chord step repeats the work */
@@ -201,6 +203,7 @@ cdef extern from *:
     const int MAX_REFINE "FCCQP_MAX_REFINE"
     const double KKT_REFINE_TOLERANCE "FCCQP_KKT_REFINE_TOLERANCE"
     const double RANK_TOLERANCE "FCCQP_RANK_TOLERANCE"
+    const double SCHUR_GROWTH "FCCQP_SCHUR_GROWTH"
     const double REDUCED_COST "FCCQP_REDUCED_COST"
     # Cold start and equalities
     const long EQUALITY_START_STEPS "FCCQP_EQUALITY_START_STEPS"

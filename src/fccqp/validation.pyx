@@ -44,16 +44,17 @@ cdef inline Finding _check_vector(const double* v, double* out, Py_ssize_t k,
 
 
 cdef Finding _first_bad_entry(const double* P, Py_ssize_t n) noexcept nogil:
-    """The first non-finite entry of ``P``, or the largest one (the slow path of a
-    scan that found something wrong)."""
-    cdef Py_ssize_t i, j
+    """The first non-finite entry of ``P``, or the first of its largest ones, with its
+    row (the slow path of a scan that found something wrong)."""
+    cdef Py_ssize_t i, j, largest_row = 0
     cdef double largest = 0.0
     for i in range(n):
         for j in range(n):
             if not isfinite(P[i * n + j]):
                 return _found(P_NOT_FINITE, -1, i, P[i * n + j])
-            largest = max(largest, fabs(P[i * n + j]))
-    return _found(TOO_LARGE, -1, 0, largest)
+            if fabs(P[i * n + j]) > largest:
+                largest, largest_row = fabs(P[i * n + j]), i
+    return _found(TOO_LARGE, -1, largest_row, largest)
 
 
 cdef Finding scan_and_copy(const double* P, const double* q, const double* A, const double* b,
@@ -175,13 +176,16 @@ cdef bint _copy_entries(const Matrix* M, Matrix* out, bint* differs) noexcept no
 cdef Finding _first_bad_csc(const Matrix* M, int argument) noexcept nogil:
     """The dense scan's finding for the bad entries of ``M`` (``argument`` -1 for ``P``,
     1 for ``A``): the first in row order that is not finite (``P``) or bad at all
-    (``A``), else (``P``) its largest entry."""
-    cdef Py_ssize_t j, k, row = M.rows, col = M.cols
+    (``A``), else (``P``) the first in row order of its largest entries."""
+    cdef Py_ssize_t j, k, row = M.rows, col = M.cols, largest_row = 0, largest_col = 0
     cdef double value, largest = 0.0, bad = 0.0
     for j in range(M.cols):
         for k in range(M.colptr[j], M.colptr[j + 1]):
             value = M.values[k]
-            largest = max(largest, fabs(value))
+            if fabs(value) > largest or (fabs(value) == largest and (
+                    M.rowind[k] < largest_row
+                    or (M.rowind[k] == largest_row and j < largest_col))):
+                largest, largest_row, largest_col = fabs(value), M.rowind[k], j
             if (not isfinite(value) or (argument >= 0 and fabs(value) > MAX_ENTRY)) and (
                     M.rowind[k] < row or (M.rowind[k] == row and j < col)):
                 row, col, bad = M.rowind[k], j, value
@@ -189,7 +193,7 @@ cdef Finding _first_bad_csc(const Matrix* M, int argument) noexcept nogil:
         if argument < 0:
             return _found(P_NOT_FINITE, -1, row, bad)
         return _found(NOT_FINITE if not isfinite(bad) else TOO_LARGE, argument, row, bad)
-    return _found(TOO_LARGE, argument, 0, largest)
+    return _found(TOO_LARGE, argument, largest_row, largest)
 
 
 cdef int bound_kind(double lb, double ub) noexcept nogil:
