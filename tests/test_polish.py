@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 from fccqp.polish_ops import polish_point
+from fccqp.tuning import FEASIBLE_PASSES
 
 import fccqp
 from fccqp import Status
@@ -275,15 +276,25 @@ def test_warm_polish_factors_where_p_couples_a_constrained_entry():
     assert check_solution(Problem.of(*moved), warm, EXACT).passed
 
 
-def test_polish_gives_up_when_its_first_two_guesses_violate_a_bound():
-    """``min 1/2 ||x - (3, 1.4, 0)||^2`` s.t. ``sum x = 3``, ``x <= (1, 1.5, 10)``, from an
-    iterate inside the box with no multiplier: the first guess frees every entry and puts
-    ``x_1`` past its bound; holding it puts ``x_2`` past its; only the third guess is
-    feasible (and the answer ``(1, 1.5, 0.5)``). The polish gives up after two
-    factorizations rather than search on from guesses that stay infeasible
-    (``FEASIBLE_PASSES``): such searches ended rejected on the whole-body-control ticks."""
-    inside = np.zeros(3)
-    result = polish_point(np.eye(3), np.array([-3.0, -1.4, 0.0]), np.ones((1, 3)),
-                          np.array([3.0]), np.full(3, -10.0), np.array([1.0, 1.5, 10.0]),
-                          flatten_cones((), 3), inside, np.zeros(1), np.zeros(3), inside)
-    assert not result["ok"] and result["factorizations"] == 2
+def _chain(target, upper):
+    """``min 1/2 ||x - target||^2`` s.t. ``sum x = 3``, ``-10 <= x <= upper``, polished
+    from an iterate inside the box with no multiplier."""
+    n = len(target)
+    inside = np.zeros(n)
+    return polish_point(np.eye(n), -np.asarray(target, float), np.ones((1, n)),
+                        np.array([3.0]), np.full(n, -10.0), np.asarray(upper, float),
+                        flatten_cones((), n), inside, np.zeros(1), np.zeros(n), inside)
+
+
+def test_polish_gives_up_when_its_first_guesses_violate_a_bound():
+    """Each guess holds the bound its predecessor's point crossed and puts the next entry
+    past its own: with three entries the third guess is feasible and solves the QP
+    (``(1, 1.5, 0.5)``); with four, the first ``FEASIBLE_PASSES`` (3) guesses are all
+    infeasible and the polish gives up rather than search on (such searches ended
+    rejected on the whole-body-control ticks; giving up after two lost polishes that
+    solo12's and go2's cold ticks had kept)."""
+    three = _chain([3.0, 1.4, 0.0], [1.0, 1.5, 10.0])
+    assert three["ok"] and three["factorizations"] == 3
+    np.testing.assert_allclose(three["x"], [1.0, 1.5, 0.5], atol=1e-12)
+    four = _chain([10.0, 0.0, -0.3, -5.0], [1.0, 0.5, 2.3, 10.0])
+    assert not four["ok"] and four["factorizations"] == FEASIBLE_PASSES

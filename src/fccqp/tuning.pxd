@@ -132,8 +132,8 @@ cdef extern from *:
     #define FCCQP_GUESS_TOLERANCE 1e-10
     /* most active sets per polish: 6 accepted an unsettled one, 10 cost 6 % more per tick */
     #define FCCQP_GUESS_PASSES 8
-    /* a polish whose first this many guesses all violate a constraint gives up (kept ones: by 2) */
-    #define FCCQP_FEASIBLE_PASSES 2
+    /* a polish whose first this many guesses all violate a constraint gives up */
+    #define FCCQP_FEASIBLE_PASSES 3
     /* a free entry or block joins the active set when it violates by more than this */
     #define FCCQP_ACTIVE_TOLERANCE 1e-12
     /* Newton stops when every boundary block has |phi| <= this ||x_block|| */
