@@ -63,6 +63,7 @@ def census(fccqp: object, qps: list[tuple], sequence: np.ndarray, mode: str,
 
 
 def main(argv: list[str] | None = None) -> None:
+    """Print the census of each robot and mode asked for (one BLAS thread)."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--robots", nargs="+", choices=ROBOTS, default=list(ROBOTS))
     parser.add_argument("--modes", nargs="+", choices=("warm", "cold"),
