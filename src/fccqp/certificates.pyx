@@ -206,9 +206,9 @@ cdef bint clean_primal_certificate(const Problem* p, const double* x, const doub
     """Clean the candidate ``(d_nu, d_y)`` that :func:`primal_infeasible` left by
     alternating steps between the subspace ``A'd_nu + E_S'd_y = 0`` (``d_nu`` by least
     squares on :func:`gram_factor`'s factor, in ``gram`` or ``sparse``) and the polar
-    (``d_y := -(A'd_nu)_S`` projected): ``CLEANING_PASSES`` plain projections, then as many again from the
-    candidate with each projection preceded by :func:`_shrink`'s proximal step on the
-    box's support. True, with the certificate in ``(d_nu, d_y)``, as soon as a pass's
+    (``d_y := -(A'd_nu)_S`` projected): ``CLEANING_PASSES`` plain projections, then as
+    many again from the candidate with each projection preceded by :func:`_shrink`'s
+    proximal step on the box's support. True, with the certificate in ``(d_nu, d_y)``, as soon as a pass's
     pair passes the tests (``saved``: m + s, ``w``, ``lhs``, ``terms``: n scratch).
 
     On a curved cone boundary the differences of ADMM's multipliers reach the set of
