@@ -208,8 +208,9 @@ cdef bint clean_primal_certificate(const Problem* p, const double* x, const doub
     squares on :func:`gram_factor`'s factor, in ``gram`` or ``sparse``) and the polar
     (``d_y := -(A'd_nu)_S`` projected): ``CLEANING_PASSES`` plain projections, then as
     many again from the candidate with each projection preceded by :func:`_shrink`'s
-    proximal step on the box's support. True, with the certificate in ``(d_nu, d_y)``, as soon as a pass's
-    pair passes the tests (``saved``: m + s, ``w``, ``lhs``, ``terms``: n scratch).
+    proximal step on the box's support. True, with the certificate in ``(d_nu, d_y)``,
+    as soon as a pass's pair passes the tests (``saved``: m + s, ``w``, ``lhs``,
+    ``terms``: n scratch).
 
     On a curved cone boundary the differences of ADMM's multipliers reach the set of
     certificates only like 1/k: rows ``fz = 1``, ``fx = mu (1 + 1e-3)`` with one friction
