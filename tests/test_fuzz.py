@@ -42,12 +42,15 @@ SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),
     "feasible": (0,),
     "solver_reuse": (38,),
-    "extreme_data": (26, 900343),
+    "extreme_data": (26, 900343, 1700359),
     "qpsolvers": (100035,),
     "cvxpy": (7, 1700154, 1900171),
     "dual_infeasible": (1700072,),
 }
-"""Seeds per class run on the sparse path (each ends within a few dozen iterations);
+"""Seeds per class run on the sparse path (each ends within a second of CPU);
+``extreme_data:1700359`` a friction cone capped through a boxed copy of its normal
+force (variables rescaled 1e-8..1e8), infeasible, whose certificate the run finds only
+by cleaning its candidate on ``A A'`` (uncleaned: MAX_ITER_REACHED after every retry);
 ``qpsolvers:100035`` is an LP that the compressed-column polish lost at
 ``POLISH_CSC_DELTA = 1e-12`` (qdldl without pivoting), ``cvxpy:1900171`` one it lost at
 1e-9 (ADMM crawls on every backend; the dense polish ends it at 4000 iterations);

@@ -133,6 +133,28 @@ def test_cone_infeasible():
     verify_solution(problem, result)
 
 
+
+@pytest.mark.parametrize(("mu", "gap"), [(0.3, 1e-3), (0.7, 1e-4), (1.0, 1e-4)])
+def test_the_run_cleans_its_certificate_on_compressed_columns(mu, gap):
+    """Rows ``fz = 1``, ``fx = mu (1 + gap)`` beside one friction cone: the certificates
+    form a thin wedge that the differences of ADMM's multipliers reach only like 1/k.
+    The run cleans its candidate by least squares on ``A A'`` (a Cholesky factor on the
+    dense path, a ``qdldl`` one on compressed columns) and certifies in the iterations
+    the dense path takes; the stalled run's auxiliary QPs, which answered such a case
+    after 4000 iterations, are switched off here."""
+    A = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
+    problem = (np.eye(3), np.array([0.1, -0.2, 0.3]), A, [1.0, mu * (1 + gap)], None, None,
+               [FrictionCone(0, mu)])
+    results = []
+    for backend in ("sparse", "ldl_full"):
+        solver = fccqp.Solver(fccqp.Settings(kkt_backend=backend))
+        solver._stalled_certificates = False
+        results.append(solver.solve(*problem))
+    sparse, dense = results
+    assert sparse.status is Status.PRIMAL_INFEASIBLE and sparse.backend == "sparse"
+    assert sparse.iterations == dense.iterations < 4000
+    verify_solution(problem, sparse)
+
 def test_inconsistent_equalities():
     problem = (np.eye(2), np.zeros(2), np.array([[1.0, 1.0], [2.0, 2.0]]), [1.0, 3.0],
                [-5, -5], [5, 5], ())

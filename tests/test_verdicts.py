@@ -382,8 +382,7 @@ def test_a_run_whose_rho_sits_at_its_floor_is_solved_at_a_smaller_one(name, seed
 
 @pytest.mark.parametrize(("seed", "status"), [(1300030, Status.SOLVED),
                                               (1500043, Status.PRIMAL_INFEASIBLE)])
-def test_a_run_the_equilibration_leaves_crawling_is_solved_unscaled(seed, status, kkt_backend,
-                                                                   request):
+def test_a_run_the_equilibration_leaves_crawling_is_solved_unscaled(seed, status, kkt_backend):
     """``P`` huge (the cost normalization at its cap, a cone block's one column scale
     shared by entries ``P`` weighs at 1e14 and entries it does not touch), or variables
     rescaled by 1e-8..1e8: the equilibrated problem puts the optimum 1e6 from the origin
@@ -393,10 +392,6 @@ def test_a_run_the_equilibration_leaves_crawling_is_solved_unscaled(seed, status
     optimum; a Farkas certificate)."""
     from fuzzing import Case, judge
 
-    if kkt_backend == "sparse" and seed == 1500043:
-        request.applymarker(pytest.mark.xfail(strict=True, reason=(
-            "variables rescaled 1e-8..1e8 on the sparse path: MAX_ITER_REACHED at every "
-            "rho tried and unscaled")))
     assert judge(Case.of("extreme_data", seed), kkt_backend) is None
     result = solve_verified(Case.of("extreme_data", seed).scenario().problem)
     assert result.status is status

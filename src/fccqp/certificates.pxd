@@ -20,8 +20,9 @@ cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double
                           double* terms, double* block, double* weights,
                           double* rows) noexcept nogil
 cdef void row_sizes(const Problem* p, const double* x, double* t, double* sizes) noexcept nogil
-cdef bint gram_factor(const Problem* p, double* gram) noexcept nogil
+cdef bint gram_factor(const Problem* p, void* sparse, double* gram) noexcept nogil
 cdef bint regularized_cholesky(double* gram, Py_ssize_t m) noexcept nogil
 cdef bint clean_primal_certificate(const Problem* p, const double* x, const double* gram,
-                                   double eps, double* d_nu, double* d_y, double* saved,
-                                   double* w, double* lhs, double* terms) noexcept nogil
+                                   void* sparse, double eps, double* d_nu, double* d_y,
+                                   double* saved, double* w, double* lhs,
+                                   double* terms) noexcept nogil

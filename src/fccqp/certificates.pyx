@@ -38,6 +38,7 @@ from libc.math cimport INFINITY, fabs, isfinite, sqrt
 from fccqp._blas cimport cholesky, cholesky_solve_vector, syrk_t
 from fccqp._dense cimport copy
 from fccqp._types cimport Iterates, Problem
+from fccqp.kkt_sparse cimport sparse_gram_factor, sparse_gram_solve
 from fccqp.matrices cimport (CSC, DENSE, Matrix, abs_product, product, product_row_norms,
                              product_t_terms, subtract_product)
 from fccqp.projections cimport proj_block
@@ -159,18 +160,28 @@ cdef int _farkas(const Problem* p, const double* x, const double* d_nu, const do
     return SEPARATED
 
 
-cdef bint gram_factor(const Problem* p, double* gram) noexcept nogil:
-    """``gram`` (m x m, column-major) := the Cholesky factor of ``A A'`` plus
-    ``GRAM_REGULARIZATION`` of its largest diagonal entry (dependent rows); False when
-    that fails, and on compressed columns, whose workspace has no ``m x m`` array (the
-    certificates are then tested as ADMM leaves them, uncleaned)."""
+cdef bint gram_factor(const Problem* p, void* sparse, double* gram) noexcept nogil:
+    """Factor ``A A'`` plus ``GRAM_REGULARIZATION`` of its largest diagonal entry
+    (dependent rows); False when that fails. On dense rows ``gram`` (m x m,
+    column-major) := its Cholesky factor; on compressed columns, whose workspace has no
+    ``m x m`` array, the ``SparseKKT`` ``sparse`` holds a sparse LDL' factor of it
+    (:func:`fccqp.kkt_sparse.sparse_gram_factor`) and ``gram`` is not used."""
     cdef Py_ssize_t m = p.m
     if p.A.kind == CSC:
-        return False
+        return sparse_gram_factor(sparse)
     # the row-major m x n A is, column-major, A' (n x m): one dsyrk gives A A' (dense
     # storage)
     syrk_t(<int>m, <int>p.n, p.A.values, <int>p.n, 0.0, gram, <int>m)
     return regularized_cholesky(gram, m)
+
+
+cdef inline void _gram_solve(const Problem* p, const double* gram, void* sparse,
+                             double* v) noexcept nogil:
+    """``v`` (m) := ``(A A')^-1 v`` on the factor of :func:`gram_factor`."""
+    if p.A.kind == CSC:
+        sparse_gram_solve(sparse, p.m, v)
+    else:
+        cholesky_solve_vector(gram, <int>p.m, <int>p.m, v)
 
 
 cdef bint regularized_cholesky(double* gram, Py_ssize_t m) noexcept nogil:
@@ -189,15 +200,17 @@ cdef bint regularized_cholesky(double* gram, Py_ssize_t m) noexcept nogil:
 
 
 cdef bint clean_primal_certificate(const Problem* p, const double* x, const double* gram,
-                                   double eps, double* d_nu, double* d_y, double* saved,
-                                   double* w, double* lhs, double* terms) noexcept nogil:
+                                   void* sparse, double eps, double* d_nu, double* d_y,
+                                   double* saved, double* w, double* lhs,
+                                   double* terms) noexcept nogil:
     """Clean the candidate ``(d_nu, d_y)`` that :func:`primal_infeasible` left by
     alternating steps between the subspace ``A'd_nu + E_S'd_y = 0`` (``d_nu`` by least
-    squares on ``gram``, :func:`gram_factor`) and the polar (``d_y := -(A'd_nu)_S``
-    projected): ``CLEANING_PASSES`` plain projections, then as many again from the
-    candidate with each projection preceded by :func:`_shrink`'s proximal step on the
-    box's support. True, with the certificate in ``(d_nu, d_y)``, as soon as a pass's
-    pair passes the tests (``saved``: m + s, ``w``, ``lhs``, ``terms``: n scratch).
+    squares on :func:`gram_factor`'s factor, in ``gram`` or ``sparse``) and the polar
+    (``d_y := -(A'd_nu)_S`` projected): ``CLEANING_PASSES`` plain projections, then as
+    many again from the candidate with each projection preceded by :func:`_shrink`'s
+    proximal step on the box's support. True, with the certificate in ``(d_nu, d_y)``,
+    as soon as a pass's pair passes the tests (``saved``: m + s, ``w``, ``lhs``,
+    ``terms``: n scratch).
 
     On a curved cone boundary the differences of ADMM's multipliers reach the set of
     certificates only like 1/k: rows ``fz = 1``, ``fx = mu (1 + 1e-3)`` with one friction
@@ -218,18 +231,19 @@ cdef bint clean_primal_certificate(const Problem* p, const double* x, const doub
                 bounds = max(bounds, fabs(p.hi[j]))
     copy(d_nu, saved, m)
     copy(d_y, saved + m, s)
-    if _alternate(p, x, gram, eps, 0.0, d_nu, d_y, w, lhs, terms):
+    if _alternate(p, x, gram, sparse, eps, 0.0, d_nu, d_y, w, lhs, terms):
         return True
     if bounds == 0.0:
         return False
     copy(saved, d_nu, m)
     copy(saved + m, d_y, s)
-    return _alternate(p, x, gram, eps, CLEANING_SHRINK / bounds, d_nu, d_y, w, lhs, terms)
+    return _alternate(p, x, gram, sparse, eps, CLEANING_SHRINK / bounds, d_nu, d_y, w, lhs,
+                      terms)
 
 
-cdef bint _alternate(const Problem* p, const double* x, const double* gram, double eps,
-                     double shrink, double* d_nu, double* d_y, double* w, double* lhs,
-                     double* terms) noexcept nogil:
+cdef bint _alternate(const Problem* p, const double* x, const double* gram, void* sparse,
+                     double eps, double shrink, double* d_nu, double* d_y, double* w,
+                     double* lhs, double* terms) noexcept nogil:
     """At most ``CLEANING_PASSES`` passes of :func:`clean_primal_certificate`, each
     subspace step followed by :func:`_shrink` with ``tau = shrink ||d_y||`` (``tau = 0``:
     the plain projection onto the polar) and the tests; stops after two passes in a
@@ -243,7 +257,7 @@ cdef bint _alternate(const Problem* p, const double* x, const double* gram, doub
         for j in range(s):
             w[p.constrained[j]] = -d_y[j]
         product(&p.A, w, d_nu)
-        cholesky_solve_vector(gram, <int>m, <int>m, d_nu)
+        _gram_solve(p, gram, sparse, d_nu)
         product_t_terms(&p.A, d_nu, w, terms)   # w = A'd_nu, then d_y := -(A'd_nu)_S
         size = 0.0
         for j in range(s):

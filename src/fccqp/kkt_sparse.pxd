@@ -5,3 +5,5 @@ cdef int sparse_factor(void* handle, Py_ssize_t s, double sigma,
 cdef void sparse_solve(void* handle, Py_ssize_t N, const double* rhs, double* sol) noexcept nogil
 cdef void sparse_hold_equalities(void* handle, Py_ssize_t n, Py_ssize_t m, double* x,
                                  const double* b) noexcept nogil
+cdef bint sparse_gram_factor(void* handle) noexcept nogil
+cdef void sparse_gram_solve(void* handle, Py_ssize_t m, double* v) noexcept nogil

@@ -43,3 +43,18 @@ cdef void sparse_hold_equalities(void* handle, Py_ssize_t n, Py_ssize_t m, doubl
         kkt = <object>handle
         hold_equalities(kkt.A, kkt.E, np.asarray(<double[:n]>x),
                         np.asarray(<double[:m]><double*>b))
+
+
+cdef bint sparse_gram_factor(void* handle) noexcept nogil:
+    """Factor ``A A'`` of the handle's scaled ``A``, regularized
+    (:meth:`fccqp.sparse_kkt.SparseKKT.factor_gram`); False when that fails."""
+    with gil:
+        return (<object>handle).factor_gram()
+
+
+cdef void sparse_gram_solve(void* handle, Py_ssize_t m, double* v) noexcept nogil:
+    """``v`` (``m`` entries) := the solve of the factor of :func:`sparse_gram_factor`
+    for ``v``."""
+    with gil:
+        view = np.asarray(<double[:m]>v)
+        view[:] = (<object>handle).solve_gram(view)

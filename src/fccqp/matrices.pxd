@@ -9,7 +9,8 @@ in the storage-specific code, which reads ``values`` directly: the validation sc
 (``validation.scan_and_copy``), the equilibration (``scaling``), the dense KKT backends
 (``ldl``, ``schur``: their assembly and many-column products), the polish's dense
 assembly (``polish._assemble``, ``polish_schur``) and the certificate cleaning's ``A A'``
-(``certificates.gram_factor``).
+(``certificates.gram_factor``, which on compressed columns asks the sparse backend's
+``SparseKKT.factor_gram``).
 
 Two storages (``Matrix.kind``):
 

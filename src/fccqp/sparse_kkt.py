@@ -32,13 +32,17 @@ workspace's scaled compressed-column arrays, which it reads without copying;
 :meth:`SparseKKT.factor` assembles the KKT values from their current entries, ``sigma``
 and the penalties (a new numeric factorization on the same pattern: a new scaling or a
 rho change refactors values only); :meth:`SparseKKT.solve` for one right-hand side,
-refined.
+refined. :meth:`SparseKKT.factor_gram` and :meth:`SparseKKT.solve_gram` are the
+compressed-column counterpart of the dense path's Gram factor for cleaning primal
+certificates (:func:`fccqp.certificates.gram_factor`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
+
+from fccqp.tuning import GRAM_REGULARIZATION
 
 DELTA = 1e-9
 """Quasi-definite regularization of the (2, 2) block (scaled problem)."""
@@ -125,6 +129,7 @@ class SparseKKT:
         self.abs_P = abs(P)
         self.penalty = np.zeros(n)   # sigma + rho on each entry of x, set by factor
         self.delta = DELTA   # the regularization factored, set by factor
+        self._gram = None   # the qdldl factor of A A', set by factor_gram
 
     def factor(self, sigma: float, rho_vec: np.ndarray) -> int:
         """Factor for the current ``P`` and ``A``, ``sigma`` (on every entry of ``x``)
@@ -223,3 +228,30 @@ class SparseKKT:
             step = self._solver.solve(residual)
             sol = sol + step
         return sol
+
+    def factor_gram(self) -> bool:
+        """Factor ``A A'`` of the current scaled ``A`` plus ``GRAM_REGULARIZATION`` of its
+        largest diagonal entry (dependent rows), as the dense path's
+        :func:`fccqp.certificates.gram_factor` does with Cholesky: sparse, ``m x m``,
+        positive definite once regularized, factored by ``qdldl`` in its fill-reducing
+        order. False when the diagonal is zero or a pivot is not positive and finite
+        (where Cholesky fails)."""
+        self._gram = None
+        gram = (self.A @ self.AT).tocsc()
+        largest = float(gram.diagonal().max(initial=0.0))
+        if not largest > 0.0:
+            return False
+        gram = gram + sp.identity(self.m, format="csc") * (GRAM_REGULARIZATION * largest)
+        try:
+            solver = self._qdldl.Solver(sp.triu(gram, format="csc"), upper=True)
+        except RuntimeError:   # qdldl's report of a zero pivot
+            return False
+        _, d, _ = solver.factors()
+        if not np.all(np.isfinite(d) & (d > 0.0)):
+            return False
+        self._gram = solver
+        return True
+
+    def solve_gram(self, v: np.ndarray) -> np.ndarray:
+        """``(A A' + regularization)^-1 v`` on the factor of :meth:`factor_gram`."""
+        return self._gram.solve(v)

@@ -102,10 +102,10 @@ cdef bint _cleaned_certificate(Engine* e, long iteration) noexcept nogil:
     if not (p.m > 0 and e.certs.stalled_checks >= 2 and r.prim > CLEANING_GATE * tolerance):
         return False
     if e.certs.gram_state == 0:   # once per solve: A A' of this solve's scaled rows
-        e.certs.gram_state = 1 if gram_factor(p, e.certs.gram) else -1
+        e.certs.gram_state = 1 if gram_factor(p, e.fact.kkt.sparse, e.certs.gram) else -1
     if e.certs.gram_state == 1 and clean_primal_certificate(
-            p, e.it.x, e.certs.gram, e.opt.eps_prim_inf, e.work.vec_m, e.work.vec_s,
-            e.work.saved, e.work.vec_n3, e.work.vec_n, e.work.vec_n2):
+            p, e.it.x, e.certs.gram, e.fact.kkt.sparse, e.opt.eps_prim_inf, e.work.vec_m,
+            e.work.vec_s, e.work.saved, e.work.vec_n3, e.work.vec_n, e.work.vec_n2):
         return True
     e.certs.cleaning_wait *= 2   # the next try waits twice as long
     e.certs.next_cleaning = iteration + e.certs.cleaning_wait
