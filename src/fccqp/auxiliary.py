@@ -16,10 +16,11 @@ in a few dozen iterations on the fuzzing campaign's stalls):
   the least-distance problem is the certificate problem), its separation weighed
   against what the residual explains at the nearest ``x`` (not the run's iterate, which
   may be diverging along a ray). When that certificate fails though the distance is
-  positive, the distance measured against the rows' terms: each row with ``b_i != 0``
-  may be missed by ``|b_i| r_i`` at the cost ``1/2 r_i^2``, whose multipliers maximize
-  the separation against the size of ``(b_i y_i)`` and ``z_u`` together, the
-  terms the Farkas test weighs it against (:func:`relative_distance_problem`);
+  positive, the distance measured against the rows' terms: each row whose ``b_i`` is
+  not zero to its terms' accuracy may be missed by ``|b_i| r_i`` at the cost ``1/2
+  r_i^2``, whose multipliers maximize the separation against the size of ``(b_i y_i)``
+  and ``z_u`` together, the terms the Farkas test weighs it against
+  (:func:`relative_distance_problem`);
 - dual: the projection of ``-q`` onto the cone of rays, ``min 1/2 ||d||^2 + q'd`` s.t.
   ``P d = 0``, ``A d = 0``, ``d`` in the recession cone of C, which by Moreau has
   ``q'd = -||d||^2``: a ray of descent whenever it is not zero.
@@ -423,14 +424,13 @@ def _distance_certificate(solver_type: type, settings: object, workspace: object
     ``first`` is the result of its first solve."""
     n = lb.shape[0]
     first, spent, factored = _solved(solver_type, settings, problem, deadline)
-    result = first
-    found = _farkas(workspace, result, b, lb, ub, S, divisors)
-    if found is None and _at_positive_distance(result, n):
+    found = _farkas(workspace, first, b, lb, ub, S, divisors)
+    if found is None and _at_positive_distance(first, n):
         # its multipliers have the size of the distance, and the run's tolerances left
         # them a residual of 2e-6 of it where the Farkas test allows eps_prim_inf =
         # 1e-6, or left the identity unmet: solved again to that test
         result, iterations, factorizations = _solved(
-            solver_type, _farkas_tolerances(settings, result.z[n:]), problem, deadline)
+            solver_type, _farkas_tolerances(settings, first.z[n:]), problem, deadline)
         spent, factored = spent + iterations, factored + factorizations
         found = _farkas(workspace, result, b, lb, ub, S, divisors)
     return found, first, spent, factored
@@ -468,7 +468,8 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
                 if found is None and _at_positive_distance(nearest, n):
                     relative, S, divisors = relative_distance_problem(
                         A, b, lb, ub, cones, nearest.x[:n])
-                    if _affordable(relative):
+                    softened = relative[0].shape[0] > problem[0].shape[0]
+                    if softened and _affordable(relative):
                         found, _, iterations, factorizations = _distance_certificate(
                             solver_type, settings, workspace, relative, S, divisors, b,
                             lb, ub, deadline)
