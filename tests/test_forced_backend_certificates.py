@@ -37,3 +37,19 @@ def test_a_least_distance_a_few_tolerances_wide_is_certified_in_the_reduced_form
     assert result.status is Status.PRIMAL_INFEASIBLE
     assert result.iterations > 4000   # the stalled run's, then the auxiliary solves'
     assert judge(Case.of("primal_infeasible", seed), backend) is None
+
+
+@pytest.mark.parametrize("backend", ["ldl_full", *REDUCED])
+def test_a_certificate_on_nearly_parallel_rows_is_sought_against_the_rows_terms(backend):
+    """A friction cone capped through a boxed copy of its normal force, rows of 1e10
+    with two nearly parallel: the plain least distance's certificate cancels the two
+    rows' terms to 2.3e-10 of them, below ``SEPARATION_FLOOR``; the least distance with
+    the rows softened to their right-hand sides' size
+    (:func:`fccqp.auxiliary.relative_distance_problem`) finds one that separates by
+    1.8e-4 of its terms, as Clarabel's does."""
+    case = Case.of("extreme_data", 1900317)
+    problem = case.scenario().problem
+    result = fccqp.solve(*problem.args(), kkt_backend=backend)
+    verify_solution(problem, result)
+    assert result.status is Status.PRIMAL_INFEASIBLE
+    assert judge(case, backend) is None

@@ -15,7 +15,12 @@ in a few dozen iterations on the fuzzing campaign's stalls):
   -||x_S - u||^2``: a Farkas certificate whenever the distance is positive (the dual of
   the least-distance problem is the certificate problem), its separation weighed
   against what the residual explains at the nearest ``x`` (not the run's iterate, which
-  may be diverging along a ray);
+  may be diverging along a ray). When that certificate fails though the distance is
+  positive, the distance measured against the rows' terms: each row whose ``b_i`` is
+  not zero to its terms' accuracy may be missed by ``|b_i| r_i`` at the cost ``1/2
+  r_i^2``, whose multipliers maximize the separation against the size of ``(b_i y_i)``
+  and ``z_u`` together, the terms the Farkas test weighs it against
+  (:func:`relative_distance_problem`);
 - dual: the projection of ``-q`` onto the cone of rays, ``min 1/2 ||d||^2 + q'd`` s.t.
   ``P d = 0``, ``A d = 0``, ``d`` in the recession cone of C, which by Moreau has
   ``q'd = -||d||^2``: a ray of descent whenever it is not zero.
@@ -55,7 +60,13 @@ from fccqp.cones import cone_tuple
 from fccqp.problem import INFINITE_BOUND
 from fccqp.settings import MAX_DENSE_KKT_ROWS
 from fccqp.status import Status
-from fccqp.tuning import AUXILIARY_MARGIN, RHO_MIN, STALL_RHO_FACTOR, WEAK_SEPARATION
+from fccqp.tuning import (
+    AUXILIARY_MARGIN,
+    EQUALITY_MISSED,
+    RHO_MIN,
+    STALL_RHO_FACTOR,
+    WEAK_SEPARATION,
+)
 
 UNTIMED = math.inf
 """The deadline of an untimed run's auxiliary solves (none)."""
@@ -109,6 +120,46 @@ def distance_problem(A: object, b: np.ndarray, lb: np.ndarray, ub: np.ndarray,
     return (P, np.zeros(n + s), A_ext, b, lb_ext, ub_ext, moved), S
 
 
+def relative_distance_problem(A: object, b: np.ndarray, lb: np.ndarray, ub: np.ndarray,
+                              cones: tuple, x: np.ndarray) -> tuple[tuple, np.ndarray,
+                                                                    np.ndarray]:
+    """The least-distance QP with the rows softened to their own size: variables
+    ``(x, u, r)``, ``r`` one entry per soft row, ``min 1/2 ||x_S - u||^2 + 1/2 ||r||^2``
+    s.t. ``A_i x / |b_i| - r_i = b_i / |b_i|`` on the soft rows and ``A_i x = b_i`` on
+    the others, ``u`` in C; with ``S`` and the rows' divisors (``|b_i|``, 1 on the hard
+    rows), by which its multipliers ``y`` are divided to be ``A``'s. A row is hard when
+    ``|b_i|`` is within ``EQUALITY_MISSED`` of its terms ``sum_j |A_ij x_j|`` at ``x``
+    (the plain least distance's point): zero to the accuracy the Farkas test grants,
+    its ``b_i y_i`` costs nothing there (a right-hand side of 2.6e-6 beside terms of
+    1e10 made a row of 6e15 soft, and the solve missed its identity).
+
+    Its dual asks ``A'y + E_S'z_u = 0`` and the largest separation ``-(b'y +
+    sigma_C(z_u))`` less ``1/2 (||z_u||^2 + sum_i (b_i y_i)^2)``: the certificate whose
+    separation is largest against its terms, as the Farkas test measures them, and the
+    same whatever the rows' scale. The plain least distance ignores ``y``'s size, so
+    two nearly parallel rows whose terms cancel can carry its certificate, which then
+    separates by less than ``SEPARATION_FLOOR`` of them (rows of 2e10 beside a capped
+    friction cone: 2.3e-10 of its terms, where this one gives 1.8e-4)."""
+    (P, q, A_ext, b, lb_ext, ub_ext, moved), S = distance_problem(A, b, lb, ub, cones)
+    terms = abs(A) @ np.abs(x)
+    hard = np.abs(b) <= EQUALITY_MISSED * np.asarray(terms).reshape(-1)
+    soft = np.flatnonzero(~hard)
+    divisors = np.where(hard, 1.0, np.abs(b))
+    m, k = b.shape[0], soft.size
+    if sp.issparse(A_ext):
+        R = sp.csc_matrix((-np.ones(k), (soft, np.arange(k))), shape=(m, k))
+        A_ext = sp.hstack([sp.diags(1.0 / divisors) @ A_ext, R], format="csc")
+        P = sp.block_diag([P, sp.eye(k)], format="csc")
+    else:
+        R = np.zeros((m, k))
+        R[soft, np.arange(k)] = -1.0
+        A_ext = np.hstack([A_ext / divisors[:, None], R])
+        P = np.block([[P, np.zeros((P.shape[0], k))], [np.zeros((k, P.shape[0])), np.eye(k)]])
+    lb_ext = np.concatenate([lb_ext, np.full(k, -np.inf)])
+    ub_ext = np.concatenate([ub_ext, np.full(k, np.inf)])
+    return (P, np.zeros(q.shape[0] + k), A_ext, b / divisors, lb_ext, ub_ext, moved), S, divisors
+
+
 def ray_problem(P: object, q: np.ndarray, A: object, lb: np.ndarray,
                 ub: np.ndarray, cones: tuple) -> tuple:
     """The projection of ``-q`` onto the rays: ``P``'s nonzero rows and ``A``'s as
@@ -149,17 +200,20 @@ residuals. Without it, on Maros-Meszaros QE226 (which has an optimum) a ray solv
 
 def _least_distance(result: object, b: np.ndarray, low: np.ndarray, high: np.ndarray,
                     n: int) -> bool:
-    """Whether the least-distance solve ended SOLVED, finite, at a positive distance
-    that its multipliers' separation equals (duality): on QSCORPIO (Maros-Meszaros, an
-    optimum) the solve itself ended PRIMAL_INFEASIBLE on rounding noise, and its ``y``
-    passed the Farkas tests."""
+    """Whether the least-distance solve (``b`` its own right-hand side) ended SOLVED,
+    finite, at a positive distance that its multipliers' separation equals (duality):
+    on QSCORPIO (Maros-Meszaros, an optimum) the solve itself ended PRIMAL_INFEASIBLE
+    on rounding noise, and its ``y`` passed the Farkas tests. The distance counts the
+    rows' misses ``r`` of :func:`relative_distance_problem` (the entries after ``u``)."""
     if result.status is not Status.SOLVED:
         return False
     if not (np.all(np.isfinite(result.x)) and np.all(np.isfinite(result.y))
             and np.all(np.isfinite(result.z))):
         return False
-    w = result.z[n:]
-    distance = float(w @ w)
+    s = low.shape[0]
+    w = result.z[n:n + s]
+    misses = result.x[n + s:]
+    distance = float(w @ w) + float(misses @ misses)
     up, down = np.maximum(w, 0.0), np.minimum(w, 0.0)
     support = float(np.where(np.isfinite(high), high, 0.0) @ up
                     + np.where(np.isfinite(low), low, 0.0) @ down)
@@ -338,16 +392,17 @@ def solved_in_other_form(solver_type: type, settings: object, claimed: object,
 
 
 def _farkas(workspace: object, result: object, b: np.ndarray, lb: np.ndarray,
-            ub: np.ndarray, S: np.ndarray) -> np.ndarray | None:
+            ub: np.ndarray, S: np.ndarray, divisors: np.ndarray) -> np.ndarray | None:
     """The Farkas certificate of a least-distance ``result`` as ``workspace`` judges it
     (:meth:`fccqp.admm.Workspace.judge_certificate`), or None when the solution does not
-    meet its identity (:func:`_least_distance`) or the certificate fails."""
+    meet its identity (:func:`_least_distance`) or the certificate fails; the solve's
+    rows are ``A``'s divided by ``divisors``, its ``y`` multiplied by them."""
     n, m = lb.shape[0], b.shape[0]
-    if not _least_distance(result, b, lb[S], ub[S], n):
+    if not _least_distance(result, b / divisors, lb[S], ub[S], n):
         return None
     candidate = np.zeros(m + n)
-    candidate[:m] = result.y
-    candidate[m + S] = result.z[n:]
+    candidate[:m] = result.y / divisors
+    candidate[m + S] = result.z[n:n + S.size]
     return workspace.judge_certificate(candidate, True, np.ascontiguousarray(result.x[:n]))
 
 
@@ -357,6 +412,28 @@ def _farkas_tolerances(settings: object, w: np.ndarray) -> object:
     (relative) of their size, ``AUXILIARY_MARGIN`` times over."""
     eps = settings.eps_prim_inf / AUXILIARY_MARGIN
     return settings.replace(eps_rel=eps, eps_abs=eps * float(np.abs(w).max()))
+
+
+def _distance_certificate(solver_type: type, settings: object, workspace: object,
+                          problem: tuple, S: np.ndarray, divisors: np.ndarray,
+                          b: np.ndarray, lb: np.ndarray, ub: np.ndarray,
+                          deadline: float) -> tuple:
+    """``(certificate or None, first, iterations, factorizations)`` of a least-distance
+    ``problem`` (:func:`distance_problem`, :func:`relative_distance_problem`: its rows
+    ``A``'s divided by ``divisors``), judged by ``workspace`` (:func:`_farkas`);
+    ``first`` is the result of its first solve."""
+    n = lb.shape[0]
+    first, spent, factored = _solved(solver_type, settings, problem, deadline)
+    found = _farkas(workspace, first, b, lb, ub, S, divisors)
+    if found is None and _at_positive_distance(first, n):
+        # its multipliers have the size of the distance, and the run's tolerances left
+        # them a residual of 2e-6 of it where the Farkas test allows eps_prim_inf =
+        # 1e-6, or left the identity unmet: solved again to that test
+        result, iterations, factorizations = _solved(
+            solver_type, _farkas_tolerances(settings, first.z[n:]), problem, deadline)
+        spent, factored = spent + iterations, factored + factorizations
+        found = _farkas(workspace, result, b, lb, ub, S, divisors)
+    return found, first, spent, factored
 
 
 def stalled_certificate(solver_type: type, settings: object, workspace: object,
@@ -385,18 +462,18 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
         if primal and m > 0:
             problem, S = distance_problem(A, b, lb, ub, cones)
             if S.size and _affordable(problem):
-                result, spent, factored = _solved(solver_type, settings, problem, deadline)
-                found = _farkas(workspace, result, b, lb, ub, S)
-                if found is None and _at_positive_distance(result, n):
-                    # its multipliers have the size of the distance, and the run's
-                    # tolerances left them a residual of 2e-6 of it where the Farkas
-                    # test allows eps_prim_inf = 1e-6, or left the identity unmet:
-                    # solved again to that test
-                    result, iterations, factorizations = _solved(
-                        solver_type, _farkas_tolerances(settings, result.z[n:]), problem,
-                        deadline)
-                    spent, factored = spent + iterations, factored + factorizations
-                    found = _farkas(workspace, result, b, lb, ub, S)
+                found, nearest, spent, factored = _distance_certificate(
+                    solver_type, settings, workspace, problem, S, np.ones(m), b, lb, ub,
+                    deadline)
+                if found is None and _at_positive_distance(nearest, n):
+                    relative, S, divisors = relative_distance_problem(
+                        A, b, lb, ub, cones, nearest.x[:n])
+                    softened = relative[0].shape[0] > problem[0].shape[0]
+                    if softened and _affordable(relative):
+                        found, _, iterations, factorizations = _distance_certificate(
+                            solver_type, settings, workspace, relative, S, divisors, b,
+                            lb, ub, deadline)
+                        spent, factored = spent + iterations, factored + factorizations
                 if found is not None:
                     return Status.PRIMAL_INFEASIBLE, found, spent, factored
         if not dual:
