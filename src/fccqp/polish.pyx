@@ -65,8 +65,8 @@ from fccqp.cone_dispatch cimport cone_phi, cone_plane
 from fccqp.kkt cimport KKT
 from fccqp.matrices cimport CSC, DENSE, product, product_t
 from fccqp.polish_csc cimport polish_csc_factor, polish_csc_solve
-from fccqp.polish_guess cimport (box_code, cone_code, drop_far_side, guess, linearize,
-                                 most_wrong, renew, step_length)
+from fccqp.polish_guess cimport (boundary_entries, box_code, cone_code, drop_far_side, guess,
+                                 linearize, most_wrong, renew, step_length)
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup, polish_schur_solve
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.reduced cimport Reduced
@@ -396,9 +396,17 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     was judged on the guess's first solve), with that constraint released: polishes of
     go2's equality-constrained starts, whose planes begin with ``lam = 0``, had ended so
     in 25 of 100 and failed the caller's check (notes/performance-history.md, "The cold
-    polish"). A polish none of whose first ``FEASIBLE_PASSES`` guesses reached a point
-    that violates nothing gives up: on talos' cold ticks such polishes had run all their
-    guesses and been rejected (notes/polish.md, "zerostep"). False then, when a
+    polish"). Likewise a settled guess whose Newton steps moved a free entry or block out of
+    its set (the first solve's planes, at the projections of points outside their cones,
+    kept it inside) holds it and solves the corrected guess: solo12's cold polishes had
+    been rejected so, a free friction cone missed by 0.3 N. A polish none of whose first
+    ``FEASIBLE_PASSES`` guesses reached a point that violates nothing gives up: on talos'
+    cold ticks such polishes had run all their guesses and been rejected (notes/polish.md,
+    "zerostep"); not while each of its corrections only put free blocks on their boundary
+    (at most one pass per block): where the cone multipliers are too small for ADMM to
+    resolve (solo12, 1e-5), its guess has every block free and the polish finds the
+    boundary blocks one or two a pass, kept at its fourth or fifth (notes/polish.md,
+    "polishmiss"). False then, when a
     factorization breaks down or the result is not finite, or when the clock (:func:`fccqp_now`) has
     passed ``deadline`` before a guess after the first (``INFINITY``: never); otherwise
     the caller judges the point.
@@ -411,6 +419,8 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     cdef double miss, rate, last_miss = INFINITY
     cdef bint refactored = False
     cdef bint feasible = False   # a pass's point violated nothing: from then on, steps
+    cdef bint planes_only = True   # every infeasible pass only put free blocks on their boundary
+    cdef Py_ssize_t held
     cdef Py_ssize_t blocking
     cdef double t
     if p.P.kind == CSC:   # the curvature terms in PolishCSC's storage (n x the largest cone)
@@ -456,12 +466,15 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
                 w.grad_current = False
                 nb = renew(w, p, True, True, &changed)
                 continue
+        held = boundary_entries(w, p, nb)
         nb = renew(w, p, True, False, &changed)
         if changed == 0:
             feasible = True
             nb = renew(w, p, False, False, &changed)
-        elif not feasible and passes >= FEASIBLE_PASSES:
-            return False   # no guess's point was feasible yet: none of those settled in time
+        elif not feasible:
+            planes_only = planes_only and changed == boundary_entries(w, p, nb) - held
+            if passes >= FEASIBLE_PASSES and not planes_only:
+                return False   # no guess's point was feasible yet: none of those settled in time
         if changed == 0:
             nb = drop_far_side(w, p, nb, &changed)
         if changed != 0:
@@ -496,6 +509,10 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
             else:
                 _solve(w, p, nf, nb, POLISH_REFINE_TOLERANCE * scale)
         _multipliers(w, p, nf, nb)
+        nb = renew(w, p, True, False, &changed)
+        if changed != 0:   # Newton's planes moved a free constraint out of its set: hold it
+            feasible = False   # and solve the corrected guess from this point, without a step
+            continue
         if most_wrong(w, p) >= 0:   # Newton moved a plane's multiplier past 0: release it
             nb = renew(w, p, False, False, &changed)
             continue

@@ -237,6 +237,16 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
     return nb
 
 
+cdef Py_ssize_t boundary_entries(const Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
+    """How many constrained entries the ``nb`` blocks of ``boundary`` have: a correction
+    that only put free blocks on their boundary changes exactly as many more entries
+    (:func:`fccqp.polish.polish`'s give-up does not count such passes)."""
+    cdef Py_ssize_t k, entries = 0
+    for k in range(nb):
+        entries += p.cones.dim[w.boundary[k]]
+    return entries
+
+
 cdef Py_ssize_t drop_far_side(Polish* w, const Problem* p, Py_ssize_t nb,
                               Py_ssize_t* changed) noexcept nogil:
     """Hold at the apex every boundary block whose ``x_block`` lies on the far side of it
