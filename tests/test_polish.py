@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 from fccqp.polish_ops import polish_point
-from fccqp.tuning import FEASIBLE_PASSES
+from fccqp.tuning import FEASIBLE_PASSES, GUESS_PASSES
 
 import fccqp
 from fccqp import Status
@@ -349,4 +349,25 @@ def test_polish_holds_a_free_block_that_newton_moved_out_of_its_cone():
                             flatten_cones(cones, n), z, np.zeros(1), y, z, newton_steps=20)
     reference = clarabel_solve(*args, cones=cones)
     assert polished["ok"]
+    np.testing.assert_allclose(polished["x"], reference.x, atol=1e-7)
+
+
+def test_polish_puts_its_last_guess_on_the_cones():
+    """This polish uses all ``GUESS_PASSES`` guesses, and its last one is the optimal
+    active set; its first solve, at the planes of the previous point, left the boundary
+    blocks off their cones by 3e-2. The last guess also gets Newton's steps, and the
+    polished point is the reference's."""
+    targets = np.array([[-1.7, -2.9, 0.8], [-0.3, -1.2, -0.9], [-1.0, 0.2, 0.1],
+                        [0.6, -0.1, 1.7]])
+    z = np.array([0.8, -0.1, 3.5, 0.8, -0.2, 1.4, 0.6, 0.3, 2.3, 0.8, -0.5, 1.7])
+    y = np.zeros(12)
+    y[6:8] = [0.9, -0.2]
+    cones = tuple(fccqp.FrictionCone(3 * i, 0.2) for i in range(4))
+    A = np.zeros((1, 12))
+    A[0, 2::3] = 1.0
+    args = (np.eye(12), -np.ravel(targets), A, np.array([9.3]))
+    polished = polish_point(*args, np.full(12, -np.inf), np.full(12, np.inf),
+                            flatten_cones(cones, 12), z, np.zeros(1), y, z, newton_steps=20)
+    reference = clarabel_solve(*args, cones=cones)
+    assert polished["ok"] and polished["passes"] == GUESS_PASSES
     np.testing.assert_allclose(polished["x"], reference.x, atol=1e-7)
