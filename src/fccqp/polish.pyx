@@ -431,9 +431,11 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     the boundary planes are then re-linearized up to ``newton_steps`` times (chord steps
     while they converge fast, see ``CHORD_RATE``), stopping early at the floor rounding
     leaves (:func:`_newton`); so are those of the last guess of a polish that did not
-    settle (``GUESS_PASSES`` guesses, or ``cycling``), which the caller then judges: go2's
-    and solo12's polishes had ended so on the right active set, its blocks off their cones
-    by up to 3e-2 N at the first solve's planes, and been rejected. A boundary block that a solve puts past the apex
+    settle (``GUESS_PASSES`` guesses, or ``cycling``) where its multipliers fit it, and the
+    caller then judges the point: go2's and solo12's polishes had ended so on the right
+    active set, its blocks off their cones by up to 3e-2 N at the first solve's planes, and
+    been rejected. (Where a multiplier is wrong-signed the guess is wrong, and on talos'
+    warm ticks those steps had cost 5 % of the instructions for nothing.) A boundary block that a solve puts past the apex
     (:func:`~fccqp.polish_guess.drop_far_side`) is held at the apex instead and the
     corrected guess solved, within the same ``GUESS_PASSES``; so is a settled guess whose
     Newton steps left a multiplier wrong-signed (a plane's ``lam`` past 0: the release
@@ -494,9 +496,14 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
             return False
         _multipliers(w, p, nf, nb)
         passes += 1
-        if passes == GUESS_PASSES or w.cycling:   # not settled: the caller judges this point,
+        if passes == GUESS_PASSES or w.cycling:   # not settled: the caller judges this point
+            if most_wrong(w, p) >= 0:   # its multipliers do not fit it: as it is
+                if not tabled:
+                    _solve(w, p, nf, nb, POLISH_REFINE_TOLERANCE * scale)
+                    _multipliers(w, p, nf, nb)
+                break
             settled = _newton(w, p, nf, &nb, newton_steps, scale, factorizations, table, kkt,
-                              rho_vec, &tabled)   # on its cones
+                              rho_vec, &tabled)   # else on its cones
             if settled < 0:
                 return False
             if settled > 0:   # the multipliers of the block now held at its apex
