@@ -66,7 +66,7 @@ from fccqp.kkt cimport KKT
 from fccqp.matrices cimport CSC, DENSE, product, product_t
 from fccqp.polish_csc cimport polish_csc_factor, polish_csc_solve
 from fccqp.polish_guess cimport (boundary_entries, box_code, cone_code, drop_far_side, guess,
-                                 linearize, most_wrong, renew, step_length)
+                                 leaves_set, linearize, most_wrong, renew, step_length)
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup, polish_schur_solve
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.reduced cimport Reduced
@@ -431,11 +431,11 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     the boundary planes are then re-linearized up to ``newton_steps`` times (chord steps
     while they converge fast, see ``CHORD_RATE``), stopping early at the floor rounding
     leaves (:func:`_newton`); so are those of the last guess of a polish that did not
-    settle (``GUESS_PASSES`` guesses, or ``cycling``) where its multipliers fit it, and the
-    caller then judges the point: go2's and solo12's polishes had ended so on the right
+    settle (``GUESS_PASSES`` guesses, or ``cycling``) where its multipliers fit it and its
+    first solve's point violates no free constraint, and the caller then judges the point: go2's and solo12's polishes had ended so on the right
     active set, its blocks off their cones by up to 3e-2 N at the first solve's planes, and
-    been rejected. (Where a multiplier is wrong-signed the guess is wrong, and on talos'
-    warm ticks those steps had cost 5 % of the instructions for nothing.) A boundary block that a solve puts past the apex
+    been rejected. (Otherwise the guess is wrong: on talos' warm ticks those steps had cost
+    5 % of the instructions, on go2's cold ones 2 %, for nothing.) A boundary block that a solve puts past the apex
     (:func:`~fccqp.polish_guess.drop_far_side`) is held at the apex instead and the
     corrected guess solved, within the same ``GUESS_PASSES``; so is a settled guess whose
     Newton steps left a multiplier wrong-signed (a plane's ``lam`` past 0: the release
@@ -497,7 +497,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         _multipliers(w, p, nf, nb)
         passes += 1
         if passes == GUESS_PASSES or w.cycling:   # not settled: the caller judges this point
-            if most_wrong(w, p) >= 0:   # its multipliers do not fit it: as it is
+            if most_wrong(w, p) >= 0 or leaves_set(w, p):   # not its point: as it is
                 if not tabled:
                     _solve(w, p, nf, nb, POLISH_REFINE_TOLERANCE * scale)
                     _multipliers(w, p, nf, nb)
