@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 from fccqp.polish_ops import polish_point
-from fccqp.tuning import FEASIBLE_PASSES
+from fccqp.tuning import FEASIBLE_PASSES, GUESS_PASSES
 
 import fccqp
 from fccqp import Status
@@ -298,3 +298,76 @@ def test_polish_gives_up_when_its_first_guesses_violate_a_bound():
     np.testing.assert_allclose(three["x"], [1.0, 1.5, 0.5], atol=1e-12)
     four = _chain([10.0, 0.0, -0.3, -5.0], [1.0, 0.5, 2.3, 10.0])
     assert not four["ok"] and four["factorizations"] == FEASIBLE_PASSES
+
+
+def _contacts(targets, total, mu=0.5):
+    """``min 1/2 ||f - targets||^2`` over friction cones (``mu``, flat normal), one per row
+    of ``targets``, with the normal forces summing to ``total``; polished from an
+    iterate strictly inside every cone with no multiplier (every block guessed free)."""
+    k = len(targets)
+    n = 3 * k
+    cones = tuple(fccqp.FrictionCone(3 * i, mu) for i in range(k))
+    A = np.zeros((1, n))
+    A[0, 2::3] = 1.0
+    q = -np.ravel(targets)
+    inside = np.tile([0.0, 0.0, 1.0], k)
+    polished = polish_point(np.eye(n), q, A, np.array([total]), np.full(n, -np.inf),
+                            np.full(n, np.inf), flatten_cones(cones, n), inside, np.zeros(1),
+                            np.zeros(n), inside, newton_steps=20)
+    return polished, clarabel_solve(np.eye(n), q, A, np.array([total]), cones=cones)
+
+
+def test_polish_goes_on_while_its_guesses_only_put_blocks_on_their_boundary():
+    """Every block guessed free, each of the first three guesses' points leaves one more
+    cone than the last: the fourth guess, with those blocks on their boundary, violates
+    nothing and solves the QP. A guess that had only put free blocks on their boundary
+    is no sign of a hopeless search (the polish gives up on those after
+    ``FEASIBLE_PASSES`` infeasible guesses otherwise)."""
+    polished, reference = _contacts([[0.7, 0.2, -0.2], [-0.4, -1.5, 1.7], [-2.5, -2.5, -2.2],
+                                     [0.1, 0.4, 0.2]], 6.7)
+    assert polished["ok"] and polished["factorizations"] > FEASIBLE_PASSES
+    np.testing.assert_allclose(polished["x"], reference.x, atol=1e-7)
+
+
+def test_polish_holds_a_free_block_that_newton_moved_out_of_its_cone():
+    """The settled guess (three blocks on their boundary) leaves the fourth inside its
+    cone at its first solve, whose planes lie at the projections of points far outside;
+    the Newton steps that put the three on their cones push the fourth out. The polish
+    puts it on its boundary and solves again, instead of returning a point that misses
+    its cone by 2e-2."""
+    k, total = 4, 8.3
+    targets = np.array([[-2.9, -3.0, -2.5], [0.7, -0.8, -1.8], [2.2, -2.9, 1.9],
+                        [0.2, -0.7, -0.8]])
+    z = np.array([-0.5, -0.8, 1.1, 0.1, -0.5, 3.5, 0.0, -0.5, 2.0, 0.2, -0.1, 2.9])
+    y = np.array([0.0, 0.6, -0.6, 0.0, 0.0, -0.6, -0.9, 0.7, -0.9, -0.5, -0.9, 0.2])
+    n = 3 * k
+    cones = tuple(fccqp.FrictionCone(3 * i, 0.5) for i in range(k))
+    A = np.zeros((1, n))
+    A[0, 2::3] = 1.0
+    args = (np.eye(n), -np.ravel(targets), A, np.array([total]))
+    polished = polish_point(*args, np.full(n, -np.inf), np.full(n, np.inf),
+                            flatten_cones(cones, n), z, np.zeros(1), y, z, newton_steps=20)
+    reference = clarabel_solve(*args, cones=cones)
+    assert polished["ok"]
+    np.testing.assert_allclose(polished["x"], reference.x, atol=1e-7)
+
+
+def test_polish_puts_its_last_guess_on_the_cones():
+    """This polish uses all ``GUESS_PASSES`` guesses, and its last one is the optimal
+    active set; its first solve, at the planes of the previous point, left the boundary
+    blocks off their cones by 3e-2. The last guess also gets Newton's steps, and the
+    polished point is the reference's."""
+    targets = np.array([[-1.7, -2.9, 0.8], [-0.3, -1.2, -0.9], [-1.0, 0.2, 0.1],
+                        [0.6, -0.1, 1.7]])
+    z = np.array([0.8, -0.1, 3.5, 0.8, -0.2, 1.4, 0.6, 0.3, 2.3, 0.8, -0.5, 1.7])
+    y = np.zeros(12)
+    y[6:8] = [0.9, -0.2]
+    cones = tuple(fccqp.FrictionCone(3 * i, 0.2) for i in range(4))
+    A = np.zeros((1, 12))
+    A[0, 2::3] = 1.0
+    args = (np.eye(12), -np.ravel(targets), A, np.array([9.3]))
+    polished = polish_point(*args, np.full(12, -np.inf), np.full(12, np.inf),
+                            flatten_cones(cones, 12), z, np.zeros(1), y, z, newton_steps=20)
+    reference = clarabel_solve(*args, cones=cones)
+    assert polished["ok"] and polished["passes"] == GUESS_PASSES
+    np.testing.assert_allclose(polished["x"], reference.x, atol=1e-7)

@@ -65,8 +65,8 @@ from fccqp.cone_dispatch cimport cone_phi, cone_plane
 from fccqp.kkt cimport KKT
 from fccqp.matrices cimport CSC, DENSE, product, product_t
 from fccqp.polish_csc cimport polish_csc_factor, polish_csc_solve
-from fccqp.polish_guess cimport (box_code, cone_code, drop_far_side, guess, linearize,
-                                 most_wrong, renew, step_length)
+from fccqp.polish_guess cimport (boundary_entries, box_code, cone_code, drop_far_side, guess,
+                                 leaves_set, linearize, most_wrong, renew, step_length)
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup, polish_schur_solve
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.reduced cimport Reduced
@@ -353,6 +353,47 @@ cdef void _multipliers(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
             w.y[j] = w.lam[k] * w.g[j]
 
 
+cdef int _newton(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t* nb, long newton_steps,
+                 double scale, int* factorizations, const Reduced* table, KKT* kkt,
+                 const double* rho_vec, bint* tabled) noexcept nogil:
+    """Newton's method on the current guess's ``nb`` boundary planes (see :func:`polish`):
+    re-linearize them at the current point up to ``newton_steps`` times (chord steps while
+    they converge fast), then refine the point and set its multipliers: 0. 1 when a block
+    went past its apex (held there now, ``nb`` the blocks left, the point not re-solved);
+    -1 when a factorization broke down."""
+    cdef double miss, rate, last_miss = INFINITY
+    cdef bint refactored = False
+    cdef Py_ssize_t changed
+    cdef long step
+    for step in range(newton_steps):
+        if not _relinearize(w, p, nb[0], &miss) or (
+                refactored and miss >= last_miss and miss <= MISS_FLOOR):
+            break   # converged, or at the floor that rounding leaves
+        rate = miss / last_miss   # 0 at the first step: a chord step
+        refactored = rate > CHORD_RATE or pow(rate, CHORD_STEPS) * miss > NEWTON_TOLERANCE
+        if not refactored:   # a chord step: one correction, the last factor, the current planes
+            if tabled[0]:
+                table_correct(w, p, table, kkt, rho_vec, nb[0], scale)
+                w.grad_current = False
+            else:
+                _correct_once(w, p, nf, nb[0])
+        elif not _solve_guess(w, p, nf, nb[0], scale, factorizations, table, kkt, rho_vec,
+                              tabled, False):
+            return -1
+        last_miss = miss
+        nb[0] = drop_far_side(w, p, nb[0], &changed)
+        if changed != 0:
+            return 1
+    if not refactored:   # refine the last chord step's (or the first solve's) point
+        if tabled[0]:
+            table_solve(w, p, table, kkt, rho_vec, nb[0], scale)
+            w.grad_current = False
+        else:
+            _solve(w, p, nf, nb[0], POLISH_REFINE_TOLERANCE * scale)
+    _multipliers(w, p, nf, nb[0])
+    return 0
+
+
 cdef bint polish_prepare(Polish* w, const Problem* p) noexcept nogil:
     """Set up the Schur-complement solve of :mod:`fccqp.polish_schur` for this solve's
     ``P`` and ``A``; True when it applies, and then polishing needs no table. Never on
@@ -389,28 +430,42 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     pass. (The measurements behind these rules are in notes/polish.md.) On a settled guess
     the boundary planes are then re-linearized up to ``newton_steps`` times (chord steps
     while they converge fast, see ``CHORD_RATE``), stopping early at the floor rounding
-    leaves. A boundary block that a solve puts past the apex
+    leaves (:func:`_newton`); so are those of the last guess of a polish that did not
+    settle (``GUESS_PASSES`` guesses, or ``cycling``) where its multipliers fit it and its
+    first solve's point violates no free constraint, and the caller then judges the point: go2's and solo12's polishes had ended so on the right
+    active set, its blocks off their cones by up to 3e-2 N at the first solve's planes, and
+    been rejected. (Otherwise the guess is wrong: on talos' warm ticks those steps had cost
+    5 % of the instructions, on go2's cold ones 2 %, for nothing.) A boundary block that a solve puts past the apex
     (:func:`~fccqp.polish_guess.drop_far_side`) is held at the apex instead and the
     corrected guess solved, within the same ``GUESS_PASSES``; so is a settled guess whose
     Newton steps left a multiplier wrong-signed (a plane's ``lam`` past 0: the release
     was judged on the guess's first solve), with that constraint released: polishes of
     go2's equality-constrained starts, whose planes begin with ``lam = 0``, had ended so
     in 25 of 100 and failed the caller's check (notes/performance-history.md, "The cold
-    polish"). A polish none of whose first ``FEASIBLE_PASSES`` guesses reached a point
-    that violates nothing gives up: on talos' cold ticks such polishes had run all their
-    guesses and been rejected (notes/polish.md, "zerostep"). False then, when a
+    polish"). Likewise a settled guess whose Newton steps moved a free entry or block out of
+    its set (the first solve's planes, at the projections of points outside their cones,
+    kept it inside) holds it and solves the corrected guess: solo12's cold polishes had
+    been rejected so, a free friction cone missed by 0.3 N. A polish none of whose first
+    ``FEASIBLE_PASSES`` guesses reached a point that violates nothing gives up: on talos'
+    cold ticks such polishes had run all their guesses and been rejected (notes/polish.md,
+    "zerostep"); not while each of its corrections only put free blocks on their boundary
+    (at most one pass per block): where the cone multipliers are too small for ADMM to
+    resolve (solo12, 1e-5), its guess has every block free and the polish finds the
+    boundary blocks one or two a pass, kept at its fourth or fifth (notes/polish.md,
+    "polishmiss"). False then, when a
     factorization breaks down or the result is not finite, or when the clock (:func:`fccqp_now`) has
     passed ``deadline`` before a guess after the first (``INFINITY``: never); otherwise
     the caller judges the point.
     """
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, nb, nf = 0, j, changed
-    cdef long passes = 0, step
+    cdef long passes = 0
+    cdef int settled
     cdef double total = 0.0
     cdef double scale = max(1.0, max(inf_norm(p.q, n), inf_norm(p.b, m)))
     cdef bint tabled = table != NULL and p.P.kind == DENSE   # the table reads dense storage
-    cdef double miss, rate, last_miss = INFINITY
-    cdef bint refactored = False
     cdef bint feasible = False   # a pass's point violated nothing: from then on, steps
+    cdef bint planes_only = True   # every infeasible pass only put free blocks on their boundary
+    cdef Py_ssize_t held
     cdef Py_ssize_t blocking
     cdef double t
     if p.P.kind == CSC:   # the curvature terms in PolishCSC's storage (n x the largest cone)
@@ -442,8 +497,16 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         _multipliers(w, p, nf, nb)
         passes += 1
         if passes == GUESS_PASSES or w.cycling:   # not settled: the caller judges this point
-            if not tabled:
-                _solve(w, p, nf, nb, POLISH_REFINE_TOLERANCE * scale)
+            if most_wrong(w, p) >= 0 or leaves_set(w, p):   # not its point: as it is
+                if not tabled:
+                    _solve(w, p, nf, nb, POLISH_REFINE_TOLERANCE * scale)
+                    _multipliers(w, p, nf, nb)
+                break
+            settled = _newton(w, p, nf, &nb, newton_steps, scale, factorizations, table, kkt,
+                              rho_vec, &tabled)   # else on its cones
+            if settled < 0:
+                return False
+            if settled > 0:   # the multipliers of the block now held at its apex
                 _multipliers(w, p, nf, nb)
             break
         if feasible:
@@ -456,46 +519,29 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
                 w.grad_current = False
                 nb = renew(w, p, True, True, &changed)
                 continue
+        held = boundary_entries(w, p, nb)
         nb = renew(w, p, True, False, &changed)
         if changed == 0:
             feasible = True
             nb = renew(w, p, False, False, &changed)
-        elif not feasible and passes >= FEASIBLE_PASSES:
-            return False   # no guess's point was feasible yet: none of those settled in time
+        elif not feasible:
+            planes_only = planes_only and changed == boundary_entries(w, p, nb) - held
+            if passes >= FEASIBLE_PASSES and not planes_only:
+                return False   # no guess's point was feasible yet: none of those settled in time
         if changed == 0:
             nb = drop_far_side(w, p, nb, &changed)
         if changed != 0:
             continue
-        last_miss = INFINITY
-        refactored = False
-        for step in range(newton_steps):
-            if not _relinearize(w, p, nb, &miss) or (
-                    refactored and miss >= last_miss and miss <= MISS_FLOOR):
-                break   # converged, or at the floor that rounding leaves
-            rate = miss / last_miss   # 0 at the first step: a chord step
-            refactored = rate > CHORD_RATE or pow(rate, CHORD_STEPS) * miss > NEWTON_TOLERANCE
-            if not refactored:   # a chord step: one correction, the last factor, the current planes
-                if tabled:
-                    table_correct(w, p, table, kkt, rho_vec, nb, scale)
-                    w.grad_current = False
-                else:
-                    _correct_once(w, p, nf, nb)
-            elif not _solve_guess(w, p, nf, nb, scale, factorizations, table, kkt, rho_vec,
-                                  &tabled, False):
-                return False
-            last_miss = miss
-            nb = drop_far_side(w, p, nb, &changed)
-            if changed != 0:
-                break
-        if changed != 0:
+        settled = _newton(w, p, nf, &nb, newton_steps, scale, factorizations, table, kkt,
+                          rho_vec, &tabled)
+        if settled < 0:
+            return False
+        if settled > 0:
             continue   # a block went past its apex: solve the corrected guess
-        if not refactored:   # refine the last chord step's (or the first solve's) point
-            if tabled:
-                table_solve(w, p, table, kkt, rho_vec, nb, scale)
-                w.grad_current = False
-            else:
-                _solve(w, p, nf, nb, POLISH_REFINE_TOLERANCE * scale)
-        _multipliers(w, p, nf, nb)
+        nb = renew(w, p, True, False, &changed)
+        if changed != 0:   # Newton's planes moved a free constraint out of its set: hold it
+            feasible = False   # and solve the corrected guess from this point, without a step
+            continue
         if most_wrong(w, p) >= 0:   # Newton moved a plane's multiplier past 0: release it
             nb = renew(w, p, False, False, &changed)
             continue

@@ -33,6 +33,8 @@ cdef Py_ssize_t most_wrong(Polish* w, const Problem* p) noexcept nogil
 cdef double step_length(Polish* w, const Problem* p, Py_ssize_t* blocking) noexcept nogil
 cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
                       Py_ssize_t* changed) noexcept nogil
+cdef bint leaves_set(const Polish* w, const Problem* p) noexcept nogil
+cdef Py_ssize_t boundary_entries(const Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil
 cdef Py_ssize_t drop_far_side(Polish* w, const Problem* p, Py_ssize_t nb,
                               Py_ssize_t* changed) noexcept nogil
 cdef double multiplier_violation(Polish* w, const Problem* p, const double* z) noexcept nogil

@@ -165,6 +165,47 @@ cdef double step_length(Polish* w, const Problem* p, Py_ssize_t* blocking) noexc
     return t
 
 
+cdef inline char _bound_passed(const Problem* p, Py_ssize_t j, double value) noexcept nogil:
+    """The bound that box entry ``j`` at ``value`` passed by more than ``ACTIVE_TOLERANCE``
+    (``LOWER``, ``UPPER``), else ``FREE``."""
+    if value < p.lo[j] - ACTIVE_TOLERANCE * max(1.0, fabs(p.lo[j])):
+        return LOWER
+    if value > p.hi[j] + ACTIVE_TOLERANCE * max(1.0, fabs(p.hi[j])):
+        return UPPER
+    return FREE
+
+
+cdef inline bint _left_cone(const Cones* c, Py_ssize_t k, const double* x, double* along,
+                            double* across, double* size) noexcept nogil:
+    """Whether block ``x`` of cone ``k`` lies outside it by more than ``ACTIVE_TOLERANCE``
+    of its norm; ``along``, ``across`` its split (:func:`cone_split`), ``size`` its
+    squared norm."""
+    cdef Py_ssize_t j
+    size[0] = 0.0
+    for j in range(c.dim[k]):
+        size[0] += x[j] * x[j]
+    along[0] = cone_split(x, c.kind[k], c.dim[k], c.mu[k], c.normal + 3 * k, across)
+    return (across[0] - cone_slope(c.kind[k], c.mu[k]) * along[0]
+            > ACTIVE_TOLERANCE * sqrt(size[0]))
+
+
+cdef bint leaves_set(const Polish* w, const Problem* p) noexcept nogil:
+    """Whether the point ``x`` puts a free box entry past a bound or a free cone block
+    outside its cone (as :func:`renew` would hold them), the guess left as it is."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t j, k
+    cdef double along, across, size
+    for j in range(p.s):
+        if (not p.in_cone[j] and w.active[j] == FREE
+                and _bound_passed(p, j, w.x[p.constrained[j]]) != FREE):
+            return True
+    for k in range(c.count):
+        if (w.active[c.offset[k]] == FREE
+                and _left_cone(c, k, w.x + p.constrained[c.offset[k]], &along, &across, &size)):
+            return True
+    return False
+
+
 cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
                       Py_ssize_t* changed) noexcept nogil:
     """Correct the guess from the polished point. With ``adding``, hold free entries
@@ -193,10 +234,7 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
         elif adding and code == FREE and stepped and w.blocked[j]:
             code = LOWER if fabs(value - p.lo[j]) <= fabs(value - p.hi[j]) else UPPER
         elif adding and code == FREE:
-            if value < p.lo[j] - ACTIVE_TOLERANCE * max(1.0, fabs(p.lo[j])):
-                code = LOWER
-            elif value > p.hi[j] + ACTIVE_TOLERANCE * max(1.0, fabs(p.hi[j])):
-                code = UPPER
+            code = _bound_passed(p, j, value)
         changed[0] += code != before
         w.active[j] = code
     copy(w.lam, w.rhs, c.count)   # the old boundary multipliers, by old position
@@ -215,11 +253,7 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
                 code = APEX
             copy(w.x + start, w.step, d)
         elif before == FREE and adding:
-            size = 0.0
-            for j in range(d):
-                size += w.x[start + j] * w.x[start + j]
-            along = cone_split(w.x + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
-            if across - slope * along > ACTIVE_TOLERANCE * sqrt(size) or (stepped and w.blocked[o]):
+            if _left_cone(c, k, w.x + start, &along, &across, &size) or (stepped and w.blocked[o]):
                 code = APEX if slope * across <= -along or size == 0.0 else BOUNDARY
                 cone_project(w.x + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
         elif released == p.s + k:   # an apex block whose y left the polar
@@ -235,6 +269,16 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
             linearize(w, p, nb, w.step)
             nb += 1
     return nb
+
+
+cdef Py_ssize_t boundary_entries(const Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
+    """How many constrained entries the ``nb`` blocks of ``boundary`` have: a correction
+    that only put free blocks on their boundary changes exactly as many more entries
+    (:func:`fccqp.polish.polish`'s give-up does not count such passes)."""
+    cdef Py_ssize_t k, entries = 0
+    for k in range(nb):
+        entries += p.cones.dim[w.boundary[k]]
+    return entries
 
 
 cdef Py_ssize_t drop_far_side(Polish* w, const Problem* p, Py_ssize_t nb,

@@ -181,13 +181,16 @@ class Settings:
     without a time limit a run polishes early once the active set its iterate points
     to has settled (``fccqp.tuning.EARLY_POLISH_GATE``); under a time limit only
     from ``fccqp.tuning.TIMED_EARLY_POLISH`` iterations on."""
-    polish_refine_iter: int = 10
+    polish_refine_iter: int = 20
     """Most re-linearizations of the boundary cones' tangent planes in polishing (Newton
     steps, taken only until the cone function is met to 1e-13 or stops improving; a
     step reuses the last factorization while the steps converge fast; at most
     :data:`MAX_POLISH_REFINE_ITER`). From ADMM's point Newton sometimes needs about 8
     on whole-body control (small contact forces); on go2 10 instead of 3 raised the
-    polished share from 91 % to 92 % for 0.2 more factorizations per solve."""
+    polished share from 91 % to 92 % for 0.2 more factorizations per solve. From a
+    guess whose first solve slid far along a new block's plane (the cost flat on the
+    forces) it needed up to 19, and with 10 solo12's realtime warm ticks missed 2 polishes
+    in 400 (notes/polish.md, "polishmiss"); talos' polishes never needed more than 10."""
     kkt_backend: str = "auto"
     """Linear-system backend of the x-update: ``"schur_reduced"`` (Cholesky of ``P + R``
     and of ``A (P + R)^-1 A'``, reduced iteration), ``"ldl_reduced"`` (LDL', reduced
