@@ -1,7 +1,8 @@
 """A finite ``time_limit`` is the budget of a long run (issue 30, Maros-Meszaros).
 
 Three mechanisms of :mod:`fccqp.iteration`, each judged by :func:`verify.verify_solution`:
-the iteration cap extends while the run converges (``_extend``); the early polish runs
+the iteration cap extends while the run converges or is on course to its tolerance
+within the time left (``_extend``); the early polish runs
 from ``TIMED_EARLY_POLISH`` iterations on; a run stopped at its cap (not by the clock)
 is polished whatever its distance to tolerance. The problems are small LP-like QPs
 (``P`` of rank 2 and norm ~1e-2, boxes on every entry, four equalities) on which ADMM
@@ -13,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from fccqp.tuning import TIMED_EARLY_POLISH
+from fccqp.tuning import AUXILIARY_TIME, TIMED_EARLY_POLISH
 
 import fccqp
 from fccqp import Status
@@ -53,6 +54,32 @@ def test_a_converging_run_under_a_time_limit_goes_past_max_iter():
     assert timed.status is Status.SOLVED, timed.status
     assert timed.iterations > 185
     verify_solution(problem, timed, Tolerances.of(**EPS))
+
+
+def test_a_timed_run_on_course_to_its_tolerance_goes_past_a_cap_it_does_not_halve_in():
+    """Unpolished with ``max_iter`` 50, this QP's distance to tolerance stops halving in
+    every 25 iterations after 125, but it still falls at a rate that reaches the
+    tolerance long before a 100 s limit: the cap extends and the run ends SOLVED at the
+    371 iterations of an uncapped run (QSCAGR7 of Maros-Meszaros: SOLVED at 76,000
+    iterations in 13 s of its 1000, stopped at 8,000 before)."""
+    problem = flat_qp(4)
+    solver = fccqp.Solver(polish=False, max_iter=50, time_limit=100.0, **EPS)
+    solver._stalled_certificates = False
+    timed = solver.solve(*problem)
+    assert timed.status is Status.SOLVED, timed.status
+    assert timed.iterations > 125
+    verify_solution(problem, timed, Tolerances.of(**EPS))
+
+
+def test_a_short_time_limit_keeps_a_cap_the_distance_does_not_halve_in():
+    """The same run with less than ``AUXILIARY_TIME`` of limit (a control tick's kind of
+    budget) is not judged by its course: it stops where its distance stopped halving,
+    unsolved."""
+    problem = flat_qp(4)
+    solver = fccqp.Solver(polish=False, max_iter=50, time_limit=0.5 * AUXILIARY_TIME, **EPS)
+    solver._stalled_certificates = False
+    capped = solver.solve(*problem)
+    assert capped.status is Status.MAX_ITER_REACHED, capped.status
 
 
 def test_an_untimed_run_stopped_at_its_cap_goes_on_from_where_it_stopped():

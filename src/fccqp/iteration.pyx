@@ -24,7 +24,7 @@ at every iterate. After each step, safeguarded Anderson acceleration may extrapo
 """
 
 from libc.limits cimport LONG_MAX
-from libc.math cimport INFINITY, isfinite
+from libc.math cimport INFINITY, isfinite, log
 
 from fccqp._dense cimport copy, fill
 from fccqp._types cimport Iterates, Problem
@@ -41,7 +41,7 @@ from fccqp.projections cimport proj_set
 from fccqp.reduced cimport materialize, near_convergence, reduced_start, reduced_step
 from fccqp.rho_rule cimport TrialState, new_rho, trial_reset
 from fccqp.termination cimport Residuals, converged, distance, nearly_converged
-from fccqp.tuning cimport (CLEANING_START, CONVERGING, EARLY_POLISH_GATE, EARLY_POLISH_TRIES,
+from fccqp.tuning cimport (AUXILIARY_TIME, CLEANING_START, CONVERGING, EARLY_POLISH_GATE, EARLY_POLISH_TRIES,
                            EQUALITY_MISSED, GATED_CHECK_WAIT, LOG_INTERVAL, POLISH_GATE,
                            POLISH_RETRIES, RESERVE_PASSES, RESTART_MIN_ITER, STALL_FACTOR,
                            STALLS, TIMED_EARLY_POLISH)
@@ -76,6 +76,9 @@ cdef struct Loop:
     bint cap_polish         # the cap was just extended: polish as an untimed run's end would
     long mark_at            # the first check from this iteration records mark
     double mark             # termination.distance at that check
+    long trend_from         # the iteration of the first mark; LONG_MAX before it
+    double trend_start      # termination.distance there
+    double best             # the lowest termination.distance at a check since then
     double last_distance    # termination.distance at the last iteration's check
     long cut                # under a time limit the clock counts as run out at this iteration
 
@@ -144,7 +147,8 @@ cdef inline void _begin(Engine* e, Loop* L, Run* run, bint cold, double start_ti
     L.cap = o.max_iter
     L.cap_polish = False
     L.mark_at = o.max_iter - o.max_iter // 2
-    L.mark = L.last_distance = INFINITY
+    L.mark = L.last_distance = L.trend_start = L.best = INFINITY
+    L.trend_from = LONG_MAX
     L.cut = _cut_iterations
     L.deadline = o.time_limit - min(
         max(e.clock.final_reserve, RESERVE_PASSES * e.clock.pass_time), 0.5 * o.time_limit)
@@ -345,8 +349,12 @@ cdef inline void _check(Engine* e, Loop* L, Run* run) noexcept nogil:
         _log(e, L.iteration, run.rho)
     L.status = check(e, L.iteration, L.last)
     if L.iteration >= L.mark_at:
-        L.mark = distance(&e.res, e.opt.eps_abs, e.opt.eps_rel)
-        L.mark_at = LONG_MAX
+        L.mark = L.trend_start = distance(&e.res, e.opt.eps_abs, e.opt.eps_rel)
+        L.mark_at = L.trend_from = LONG_MAX
+        if L.timed:
+            L.trend_from = L.iteration
+    elif L.iteration > L.trend_from:
+        L.best = min(L.best, distance(&e.res, e.opt.eps_abs, e.opt.eps_rel))
     if L.last:
         L.last_distance = distance(&e.res, e.opt.eps_abs, e.opt.eps_rel)
     if L.gated and L.status == RUNNING:   # the gate passed, the check did not
@@ -395,18 +403,38 @@ cdef inline bint _converging(const Loop* L, double now) noexcept nogil:
     return isfinite(now) and now <= CONVERGING * L.mark
 
 
+cdef inline bint _on_course(const Loop* L, double now) noexcept nogil:
+    """Whether the run's lowest distance to tolerance so far, falling from the first
+    mark at the geometric rate it has fallen since, reaches the tolerance (distance 1)
+    within the iterations' time left at the run's own time per iteration; never with
+    less than ``AUXILIARY_TIME`` left, so never on a control tick."""
+    cdef double elapsed = fccqp_now() - L.start_time
+    cdef double left = L.deadline - elapsed
+    cdef double best = min(L.best, now)
+    cdef double rate   # log of the distance's factor per iteration (negative)
+    if left < AUXILIARY_TIME or not (best < L.trend_start) or L.iteration <= L.trend_from:
+        return False
+    if best <= 1.0:
+        return True
+    rate = log(best / L.trend_start) / (L.iteration - L.trend_from)
+    return log(best) / -rate * (elapsed / L.iteration) <= left
+
+
 cdef inline void _extend(Engine* e, Loop* L) noexcept nogil:
     """Under a time limit the clock is the budget: a run at its iteration cap whose
     distance to tolerance (:func:`fccqp.termination.distance`) shrank by ``CONVERGING``
-    since the last mark (half a ``max_iter`` ago) gets half a ``max_iter`` more, until
-    the clock or a stall stops it (PRIMALC2 of Maros-Meszaros at 1e-6: SOLVED at 11,250
-    iterations, stopped at 4,000 before). Each extension first asks for the polish
-    that ends an untimed run at its cap (``cap_polish``, :func:`_polish_attempts`), kept
-    only when it solves: PRIMALC8 was solved so at 4,000 iterations untimed and ran
-    on past 90 s under qpbenchmark's time limit.
+    since the last mark (half a ``max_iter`` ago), or which is on course to reach the
+    tolerance before the clock stops it (:func:`_on_course`), gets half a ``max_iter``
+    more, until the clock or a stall stops it (PRIMALC2 of Maros-Meszaros at 1e-6:
+    SOLVED at 11,250 iterations, stopped at 4,000 before; QSCAGR7 at 1e-3, whose
+    residuals fall by 1e1-1e2 over 20,000 iterations without halving in every 2,000:
+    SOLVED at 76,000 iterations in 13 s of its 1,000, stopped at 8,000 before). Each extension first asks for
+    the polish that ends an untimed run at its cap (``cap_polish``,
+    :func:`_polish_attempts`), kept only when it solves: PRIMALC8 was solved so at
+    4,000 iterations untimed and ran on past 90 s under qpbenchmark's time limit.
     """
     cdef double now = distance(&e.res, e.opt.eps_abs, e.opt.eps_rel)
-    if _converging(L, now):
+    if _converging(L, now) or _on_course(L, now):
         L.cap += max(e.opt.max_iter // 2, 1)
         L.mark = now
         L.cap_polish = True

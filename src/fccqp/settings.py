@@ -130,10 +130,12 @@ class Settings:
     is returned. Under a finite ``time_limit`` the clock is the budget: a run at its cap
     whose distance to tolerance (the largest residual over its tolerance) halved over
     the last ``max_iter / 2`` iterations gets ``max_iter / 2`` more, again and again
-    while it keeps halving (``fccqp.tuning.CONVERGING``), each time after trying the
-    polish that ends an untimed run at its cap (kept when it solves); a stalled run
-    still stops at the cap, and with ``fccqp.tuning.AUXILIARY_TIME`` left gets the
-    certificates and retries of an untimed one within that time."""
+    while it keeps halving (``fccqp.tuning.CONVERGING``) or, with
+    ``fccqp.tuning.AUXILIARY_TIME`` left, while its lowest distance falls at a geometric
+    rate that reaches the tolerance within the time left; each time after trying the
+    polish that ends an untimed run at its cap (kept when it solves). A stalled run
+    still stops at the cap, and with ``AUXILIARY_TIME`` left gets the certificates and
+    retries of an untimed one within that time."""
     time_limit: float = math.inf
     """Wall-clock budget of one solve in seconds (setup included); ``inf`` for none."""
     min_iter: int = 0
