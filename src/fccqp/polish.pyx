@@ -61,7 +61,7 @@ from scipy.linalg.cython_lapack cimport dsytrf, dsytrs
 
 from fccqp._dense cimport copy, inf_norm
 from fccqp._types cimport Cones, Iterates, Problem
-from fccqp.cone_dispatch cimport cone_phi, cone_plane
+from fccqp.cone_dispatch cimport cone_phi, cone_plane, cone_split
 from fccqp.kkt cimport KKT
 from fccqp.matrices cimport CSC, DENSE, product, product_t
 from fccqp.polish_csc cimport polish_csc_factor, polish_csc_solve
@@ -242,6 +242,97 @@ cdef void _correct_once(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t n
     _apply(w, nf, p.m, nb, 1.0)
 
 
+cdef void _keep_point(Polish* w, const Problem* p, Py_ssize_t nb, bint undo) noexcept nogil:
+    """Copy ``(x, nu, y, lam)`` into ``chord_start``, or back from it with ``undo``."""
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s
+    cdef double* kept = w.chord_start
+    if undo:
+        copy(kept, w.x, n)
+        copy(kept + n, w.nu, m)
+        copy(kept + n + m, w.y, s)
+        copy(kept + n + m + s, w.lam, nb)
+        w.grad_current = False
+    else:
+        copy(w.x, kept, n)
+        copy(w.nu, kept + n, m)
+        copy(w.y, kept + n + m, s)
+        copy(w.lam, kept + n + m + s, nb)
+
+
+cdef bint _past_apex(const Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
+    """Whether some boundary block's ``x_block`` lies on the far side of its apex."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t k, cone, o
+    cdef double across
+    for k in range(nb):
+        cone = w.boundary[k]
+        o = c.offset[cone]
+        if cone_split(w.x + p.constrained[o], c.kind[cone], c.dim[cone], c.mu[cone],
+                      c.normal + 3 * cone, &across) <= 0.0:
+            return True
+    return False
+
+
+cdef bint _chord_step(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb, double scale,
+                      const Reduced* table, KKT* kkt, const double* rho_vec,
+                      bint tabled) noexcept nogil:
+    """One chord step of Newton's method (the last factorization, the current planes)
+    from the point kept in ``chord_start``; False, with the step undone, when it puts a
+    boundary block past its apex.
+
+    The last factorization lacks the curvature of a plane that entered the guess with
+    ``lam = 0`` (:func:`~fccqp.polish_guess.linearize`), and where ``P`` is flat on the
+    forces its step along that plane is then all but unbounded: a contact that a warm
+    polish loaded (an apex block released to its boundary) was thrown past its apex by
+    the first chord step, held at the apex again and released again until the polish
+    gave up, and the tick ran ADMM (most of talos' and solo12's warm ticks with
+    iterations; notes/polish.md, "warmtail"). A Newton step, whose factorization has
+    the curvature, stays on the near side."""
+    if tabled:
+        table_correct(w, p, table, kkt, rho_vec, nb, scale)
+        w.grad_current = False
+    else:
+        _correct_once(w, p, nf, nb)
+    if _past_apex(w, p, nb):
+        _keep_point(w, p, nb, True)
+        return False
+    return True
+
+
+cdef bint _damp(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
+    """Shorten the step from the point kept in ``chord_start`` so that every boundary
+    block that it put past its apex stops halfway to it instead (``n'x_block`` halved);
+    False, with the step kept, when none crossed or one was past its apex already."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, k, i, cone, start
+    cdef double* kept = w.chord_start
+    cdef double across, along0, along1, t = 1.0
+    for k in range(nb):
+        cone = w.boundary[k]
+        start = p.constrained[c.offset[cone]]
+        along1 = cone_split(w.x + start, c.kind[cone], c.dim[cone], c.mu[cone],
+                            c.normal + 3 * cone, &across)
+        if along1 > 0.0:
+            continue
+        along0 = cone_split(kept + start, c.kind[cone], c.dim[cone], c.mu[cone],
+                            c.normal + 3 * cone, &across)
+        if along0 <= 0.0:
+            return False
+        t = min(t, 0.5 * along0 / (along0 - along1))
+    if t == 1.0:
+        return False
+    for i in range(n):
+        w.x[i] = kept[i] + t * (w.x[i] - kept[i])
+    for i in range(m):
+        w.nu[i] = kept[n + i] + t * (w.nu[i] - kept[n + i])
+    for i in range(s):
+        w.y[i] = kept[n + m + i] + t * (w.y[i] - kept[n + m + i])
+    for k in range(nb):
+        w.lam[k] = kept[n + m + s + k] + t * (w.lam[k] - kept[n + m + s + k])
+    w.grad_current = False
+    return True
+
+
 cdef bint _relinearize(Polish* w, const Problem* p, Py_ssize_t nb,
                        double* worst) noexcept nogil:
     """Move each boundary block's plane and curvature to the current ``x_block``,
@@ -409,7 +500,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     cdef double scale = max(1.0, max(inf_norm(p.q, n), inf_norm(p.b, m)))
     cdef bint tabled = table != NULL and p.P.kind == DENSE   # the table reads dense storage
     cdef double miss, rate, last_miss = INFINITY
-    cdef bint refactored = False
+    cdef bint refactored = False, damped
     cdef bint feasible = False   # a pass's point violated nothing: from then on, steps
     cdef Py_ssize_t blocking
     cdef double t
@@ -467,22 +558,22 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         if changed != 0:
             continue
         last_miss = INFINITY
-        refactored = False
+        refactored = damped = False
         for step in range(newton_steps):
             if not _relinearize(w, p, nb, &miss) or (
                     refactored and miss >= last_miss and miss <= MISS_FLOOR):
                 break   # converged, or at the floor that rounding leaves
             rate = miss / last_miss   # 0 at the first step: a chord step
             refactored = rate > CHORD_RATE or pow(rate, CHORD_STEPS) * miss > NEWTON_TOLERANCE
-            if not refactored:   # a chord step: one correction, the last factor, the current planes
-                if tabled:
-                    table_correct(w, p, table, kkt, rho_vec, nb, scale)
-                    w.grad_current = False
-                else:
-                    _correct_once(w, p, nf, nb)
-            elif not _solve_guess(w, p, nf, nb, scale, factorizations, table, kkt, rho_vec,
-                                  &tabled, False):
+            _keep_point(w, p, nb, False)
+            if not refactored and not _chord_step(w, p, nf, nb, scale, table, kkt, rho_vec,
+                                                  tabled):
+                refactored = True   # the chord step crossed an apex: a Newton step instead
+            if refactored and not _solve_guess(w, p, nf, nb, scale, factorizations, table,
+                                               kkt, rho_vec, &tabled, False):
                 return False
+            if refactored and not damped:
+                damped = _damp(w, p, nb)
             last_miss = miss
             nb = drop_far_side(w, p, nb, &changed)
             if changed != 0:
