@@ -70,7 +70,7 @@ from fccqp.polish_guess cimport (box_code, cone_code, drop_far_side, guess, line
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup, polish_schur_solve
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.reduced cimport Reduced
-from fccqp.tuning cimport (ACTIVE_TOLERANCE, CHORD_RATE, CHORD_STEPS, FEASIBLE_PASSES, GUESS_PASSES,
+from fccqp.tuning cimport (ACTIVE_TOLERANCE, APEX_DAMPS, CHORD_RATE, CHORD_STEPS, FEASIBLE_PASSES, GUESS_PASSES,
                            GUESS_TOLERANCE, MAX_REFINE, MISS_FLOOR, NEWTON_TOLERANCE, POLISH_DELTA,
                            POLISH_REFINE_TOLERANCE)
 
@@ -500,7 +500,8 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     cdef double scale = max(1.0, max(inf_norm(p.q, n), inf_norm(p.b, m)))
     cdef bint tabled = table != NULL and p.P.kind == DENSE   # the table reads dense storage
     cdef double miss, rate, last_miss = INFINITY
-    cdef bint refactored = False, damped
+    cdef bint refactored = False
+    cdef int damps
     cdef bint feasible = False   # a pass's point violated nothing: from then on, steps
     cdef Py_ssize_t blocking
     cdef double t
@@ -558,7 +559,8 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         if changed != 0:
             continue
         last_miss = INFINITY
-        refactored = damped = False
+        refactored = False
+        damps = 0
         for step in range(newton_steps):
             if not _relinearize(w, p, nb, &miss) or (
                     refactored and miss >= last_miss and miss <= MISS_FLOOR):
@@ -572,8 +574,8 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
             if refactored and not _solve_guess(w, p, nf, nb, scale, factorizations, table,
                                                kkt, rho_vec, &tabled, False):
                 return False
-            if refactored and not damped:
-                damped = _damp(w, p, nb)
+            if refactored and damps < APEX_DAMPS and _damp(w, p, nb):
+                damps += 1   # past an apex: halfway to it, and Newton again from there
             last_miss = miss
             nb = drop_far_side(w, p, nb, &changed)
             if changed != 0:
