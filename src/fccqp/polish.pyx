@@ -70,7 +70,7 @@ from fccqp.polish_guess cimport (box_code, cone_code, drop_far_side, guess, line
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup, polish_schur_solve
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.reduced cimport Reduced
-from fccqp.tuning cimport (ACTIVE_TOLERANCE, APEX_DAMPS, CHORD_RATE, CHORD_STEPS, FEASIBLE_PASSES, GUESS_PASSES,
+from fccqp.tuning cimport (ACTIVE_TOLERANCE, CHORD_RATE, CHORD_STEPS, FEASIBLE_PASSES, GUESS_PASSES,
                            GUESS_TOLERANCE, MAX_REFINE, MISS_FLOOR, NEWTON_TOLERANCE, POLISH_DELTA,
                            POLISH_REFINE_TOLERANCE)
 
@@ -276,18 +276,19 @@ cdef bint _past_apex(const Polish* w, const Problem* p, Py_ssize_t nb) noexcept 
 cdef bint _chord_step(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb, double scale,
                       const Reduced* table, KKT* kkt, const double* rho_vec,
                       bint tabled) noexcept nogil:
-    """One chord step of Newton's method (the last factorization, the current planes)
-    from the point kept in ``chord_start``; False, with the step undone, when it puts a
-    boundary block past its apex.
+    """One chord step of Newton's method (the last factorization, the current planes);
+    False, with the step undone, when it puts a boundary block past its apex: the
+    caller then refactors (a Newton step) from the same point.
 
     The last factorization lacks the curvature of a plane that entered the guess with
     ``lam = 0`` (:func:`~fccqp.polish_guess.linearize`), and where ``P`` is flat on the
-    forces its step along that plane is then all but unbounded: a contact that a warm
-    polish loaded (an apex block released to its boundary) was thrown past its apex by
-    the first chord step, held at the apex again and released again until the polish
-    gave up, and the tick ran ADMM (most of talos' and solo12's warm ticks with
-    iterations; notes/polish.md, "warmtail"). A Newton step, whose factorization has
-    the curvature, stays on the near side."""
+    forces its step along that plane is all but unbounded: contacts that a warm polish
+    loaded (an apex block released to its boundary) were thrown past the apex by that
+    first chord step, held at the apex by :func:`~fccqp.polish_guess.drop_far_side`,
+    released again, and the polish ended cycling; the tick then ran ADMM. The Newton
+    step's factorization has the curvature; where it too crosses, ``drop_far_side``
+    holds the block as before (notes/polish.md, "warmtail")."""
+    _keep_point(w, p, nb, False)
     if tabled:
         table_correct(w, p, table, kkt, rho_vec, nb, scale)
         w.grad_current = False
@@ -296,40 +297,6 @@ cdef bint _chord_step(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
     if _past_apex(w, p, nb):
         _keep_point(w, p, nb, True)
         return False
-    return True
-
-
-cdef bint _damp(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
-    """Shorten the step from the point kept in ``chord_start`` so that every boundary
-    block that it put past its apex stops halfway to it instead (``n'x_block`` halved);
-    False, with the step kept, when none crossed or one was past its apex already."""
-    cdef const Cones* c = &p.cones
-    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, k, i, cone, start
-    cdef double* kept = w.chord_start
-    cdef double across, along0, along1, t = 1.0
-    for k in range(nb):
-        cone = w.boundary[k]
-        start = p.constrained[c.offset[cone]]
-        along1 = cone_split(w.x + start, c.kind[cone], c.dim[cone], c.mu[cone],
-                            c.normal + 3 * cone, &across)
-        if along1 > 0.0:
-            continue
-        along0 = cone_split(kept + start, c.kind[cone], c.dim[cone], c.mu[cone],
-                            c.normal + 3 * cone, &across)
-        if along0 <= 0.0:
-            return False
-        t = min(t, 0.5 * along0 / (along0 - along1))
-    if t == 1.0:
-        return False
-    for i in range(n):
-        w.x[i] = kept[i] + t * (w.x[i] - kept[i])
-    for i in range(m):
-        w.nu[i] = kept[n + i] + t * (w.nu[i] - kept[n + i])
-    for i in range(s):
-        w.y[i] = kept[n + m + i] + t * (w.y[i] - kept[n + m + i])
-    for k in range(nb):
-        w.lam[k] = kept[n + m + s + k] + t * (w.lam[k] - kept[n + m + s + k])
-    w.grad_current = False
     return True
 
 
@@ -501,7 +468,6 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     cdef bint tabled = table != NULL and p.P.kind == DENSE   # the table reads dense storage
     cdef double miss, rate, last_miss = INFINITY
     cdef bint refactored = False
-    cdef int damps
     cdef bint feasible = False   # a pass's point violated nothing: from then on, steps
     cdef Py_ssize_t blocking
     cdef double t
@@ -560,22 +526,18 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
             continue
         last_miss = INFINITY
         refactored = False
-        damps = 0
         for step in range(newton_steps):
             if not _relinearize(w, p, nb, &miss) or (
                     refactored and miss >= last_miss and miss <= MISS_FLOOR):
                 break   # converged, or at the floor that rounding leaves
             rate = miss / last_miss   # 0 at the first step: a chord step
             refactored = rate > CHORD_RATE or pow(rate, CHORD_STEPS) * miss > NEWTON_TOLERANCE
-            _keep_point(w, p, nb, False)
             if not refactored and not _chord_step(w, p, nf, nb, scale, table, kkt, rho_vec,
                                                   tabled):
                 refactored = True   # the chord step crossed an apex: a Newton step instead
             if refactored and not _solve_guess(w, p, nf, nb, scale, factorizations, table,
                                                kkt, rho_vec, &tabled, False):
                 return False
-            if refactored and damps < APEX_DAMPS and _damp(w, p, nb):
-                damps += 1   # past an apex: halfway to it, and Newton again from there
             last_miss = miss
             nb = drop_far_side(w, p, nb, &changed)
             if changed != 0:

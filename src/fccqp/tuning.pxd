@@ -144,8 +144,6 @@ cdef extern from *:
        within CHORD_STEPS more: fewest instructions per tick measured */
     #define FCCQP_CHORD_RATE 0.25
     #define FCCQP_CHORD_STEPS 3
-    /* Newton steps of a pass shortened to stay short of an apex; one more past it drops the block */
-    #define FCCQP_APEX_DAMPS 3
     /* P's diagonal below this x its largest: too singular for the Schur complement */
     #define FCCQP_PIVOT_TOLERANCE 1e-12
     /* the table's LU is singular when smallest / largest pivot is below this */
@@ -255,7 +253,6 @@ cdef extern from *:
     const double MISS_FLOOR "FCCQP_MISS_FLOOR"
     const double CHORD_RATE "FCCQP_CHORD_RATE"
     const int CHORD_STEPS "FCCQP_CHORD_STEPS"
-    const int APEX_DAMPS "FCCQP_APEX_DAMPS"
     const double PIVOT_TOLERANCE "FCCQP_PIVOT_TOLERANCE"
     const double PIVOT_RATIO "FCCQP_PIVOT_RATIO"
     const int LU_LOOP_ROWS "FCCQP_LU_LOOP_ROWS"
