@@ -298,3 +298,24 @@ def test_polish_gives_up_when_its_first_guesses_violate_a_bound():
     np.testing.assert_allclose(three["x"], [1.0, 1.5, 0.5], atol=1e-12)
     four = _chain([10.0, 0.0, -0.3, -5.0], [1.0, 0.5, 2.3, 10.0])
     assert not four["ok"] and four["factorizations"] == FEASIBLE_PASSES
+
+
+def test_warm_polish_keeps_a_contact_a_chord_step_threw_past_its_apex():
+    """solo12's third benchmark sequence (``mix``, seed 0), ticks 200-208: from tick 204
+    the previous tick's active set holds, but the first Newton step of the warm polish,
+    a chord step with a factorization that lacks a plane's curvature, threw a boundary
+    block past its apex; held at the apex, the block was released and thrown again until
+    the polish ended, and each tick ran ADMM (12 iterations). The chord step is now
+    undone and refactored: the warm polish answers each of these ticks."""
+    pytest.importorskip("pinocchio")
+    from benchmarks.testsets import generate_test_set
+
+    qps = generate_test_set("solo12", "mix", 400, seed=0).qps[200:209]
+    solver = fccqp.Solver(fccqp.Settings.realtime(100.0))
+    results = [solver.solve(qp.P, qp.q, qp.A, qp.b, qp.lb, qp.ub,
+                            [fccqp.FrictionCone(int(start), float(mu), tuple(map(float, normal)))
+                             for start, mu, normal in zip(qp.cone_starts, qp.mus, qp.normals,
+                                                          strict=True)])
+               for qp in qps]
+    assert all(r.status is Status.SOLVED for r in results)
+    assert all(r.polished and r.iterations == 0 for r in results[4:])
