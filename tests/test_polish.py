@@ -371,3 +371,24 @@ def test_polish_puts_its_last_guess_on_the_cones():
     reference = clarabel_solve(*args, cones=cones)
     assert polished["ok"] and polished["passes"] == GUESS_PASSES
     np.testing.assert_allclose(polished["x"], reference.x, atol=1e-7)
+
+
+def test_warm_polish_keeps_a_contact_a_chord_step_threw_past_its_apex():
+    """solo12's third benchmark sequence (``mix``, seed 0), ticks 200-208: from tick 204
+    the previous tick's active set holds, but the first Newton step of the warm polish,
+    a chord step with a factorization that lacks a plane's curvature, threw a boundary
+    block past its apex; held at the apex, the block was released and thrown again until
+    the polish ended, and each tick ran ADMM (12 iterations). The chord step is now
+    undone and refactored: the warm polish answers each of these ticks."""
+    pytest.importorskip("pinocchio")
+    from benchmarks.testsets import generate_test_set
+
+    qps = generate_test_set("solo12", "mix", 400, seed=0).qps[200:209]
+    solver = fccqp.Solver(fccqp.Settings.realtime(100.0))
+    results = [solver.solve(qp.P, qp.q, qp.A, qp.b, qp.lb, qp.ub,
+                            [fccqp.FrictionCone(int(start), float(mu), tuple(map(float, normal)))
+                             for start, mu, normal in zip(qp.cone_starts, qp.mus, qp.normals,
+                                                          strict=True)])
+               for qp in qps]
+    assert all(r.status is Status.SOLVED for r in results)
+    assert all(r.polished and r.iterations == 0 for r in results[4:])

@@ -44,6 +44,7 @@ cdef struct Polish:
     double* y               # s: its constraint multipliers
     double* x_prev          # n: the point a step starts from (see polish)
     double* nu_prev         # m: its equality multipliers
+    double* chord_start     # n + m + 2 s: (x, nu, y, lam) before a chord step, to undo it
     double* grad            # n: scratch, the gradient of the Lagrangian
     bint grad_current       # grad is that of the current (x, nu): _multipliers reuses it
     double* ATnu            # n: scratch

@@ -61,7 +61,7 @@ from scipy.linalg.cython_lapack cimport dsytrf, dsytrs
 
 from fccqp._dense cimport copy, inf_norm
 from fccqp._types cimport Cones, Iterates, Problem
-from fccqp.cone_dispatch cimport cone_phi, cone_plane
+from fccqp.cone_dispatch cimport cone_phi, cone_plane, cone_split
 from fccqp.kkt cimport KKT
 from fccqp.matrices cimport CSC, DENSE, product, product_t
 from fccqp.polish_csc cimport polish_csc_factor, polish_csc_solve
@@ -242,6 +242,64 @@ cdef void _correct_once(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t n
     _apply(w, nf, p.m, nb, 1.0)
 
 
+cdef void _keep_point(Polish* w, const Problem* p, Py_ssize_t nb, bint undo) noexcept nogil:
+    """Copy ``(x, nu, y, lam)`` into ``chord_start``, or back from it with ``undo``."""
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s
+    cdef double* kept = w.chord_start
+    if undo:
+        copy(kept, w.x, n)
+        copy(kept + n, w.nu, m)
+        copy(kept + n + m, w.y, s)
+        copy(kept + n + m + s, w.lam, nb)
+        w.grad_current = False
+    else:
+        copy(w.x, kept, n)
+        copy(w.nu, kept + n, m)
+        copy(w.y, kept + n + m, s)
+        copy(w.lam, kept + n + m + s, nb)
+
+
+cdef bint _past_apex(const Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
+    """Whether some boundary block's ``x_block`` lies on the far side of its apex."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t k, cone, o
+    cdef double across
+    for k in range(nb):
+        cone = w.boundary[k]
+        o = c.offset[cone]
+        if cone_split(w.x + p.constrained[o], c.kind[cone], c.dim[cone], c.mu[cone],
+                      c.normal + 3 * cone, &across) <= 0.0:
+            return True
+    return False
+
+
+cdef bint _chord_step(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb, double scale,
+                      const Reduced* table, KKT* kkt, const double* rho_vec,
+                      bint tabled) noexcept nogil:
+    """One chord step of Newton's method (the last factorization, the current planes);
+    False, with the step undone, when it puts a boundary block past its apex: the
+    caller then refactors (a Newton step) from the same point.
+
+    The last factorization lacks the curvature of a plane that entered the guess with
+    ``lam = 0`` (:func:`~fccqp.polish_guess.linearize`), and where ``P`` is flat on the
+    forces its step along that plane is all but unbounded: contacts that a warm polish
+    loaded (an apex block released to its boundary) were thrown past the apex by that
+    first chord step, held at the apex by :func:`~fccqp.polish_guess.drop_far_side`,
+    released again, and the polish ended cycling; the tick then ran ADMM. The Newton
+    step's factorization has the curvature; where it too crosses, ``drop_far_side``
+    holds the block as before (notes/polish.md, "warmtail")."""
+    _keep_point(w, p, nb, False)
+    if tabled:
+        table_correct(w, p, table, kkt, rho_vec, nb, scale)
+        w.grad_current = False
+    else:
+        _correct_once(w, p, nf, nb)
+    if _past_apex(w, p, nb):
+        _keep_point(w, p, nb, True)
+        return False
+    return True
+
+
 cdef bint _relinearize(Polish* w, const Problem* p, Py_ssize_t nb,
                        double* worst) noexcept nogil:
     """Move each boundary block's plane and curvature to the current ``x_block``,
@@ -371,14 +429,11 @@ cdef int _newton(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t* nb, lon
             break   # converged, or at the floor that rounding leaves
         rate = miss / last_miss   # 0 at the first step: a chord step
         refactored = rate > CHORD_RATE or pow(rate, CHORD_STEPS) * miss > NEWTON_TOLERANCE
-        if not refactored:   # a chord step: one correction, the last factor, the current planes
-            if tabled[0]:
-                table_correct(w, p, table, kkt, rho_vec, nb[0], scale)
-                w.grad_current = False
-            else:
-                _correct_once(w, p, nf, nb[0])
-        elif not _solve_guess(w, p, nf, nb[0], scale, factorizations, table, kkt, rho_vec,
-                              tabled, False):
+        if not refactored and not _chord_step(w, p, nf, nb[0], scale, table, kkt, rho_vec,
+                                              tabled[0]):
+            refactored = True   # the chord step crossed an apex: a Newton step instead
+        if refactored and not _solve_guess(w, p, nf, nb[0], scale, factorizations, table,
+                                           kkt, rho_vec, tabled, False):
             return -1
         last_miss = miss
         nb[0] = drop_far_side(w, p, nb[0], &changed)

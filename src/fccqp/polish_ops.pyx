@@ -95,6 +95,7 @@ def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5):
     w.lwork, w.work = <int>(64 * N), a.new(64 * N)
     w.rhs, w.step = a.new(N), a.new(N)
     w.x, w.nu, w.y, w.x_prev, w.nu_prev = a.new(n), a.new(m), a.new(s), a.new(n), a.new(m)
+    w.chord_start = a.new(n + m + 2 * s)
     w.grad, w.ATnu, w.Ax = a.new(n), a.new(n), a.new(m)
     w.schur.ready = w.schur_only = w.schur_failed = False
     w.schur.L = NULL   # no Schur storage: every guess is assembled

@@ -131,6 +131,7 @@ cdef void common_arrays(Arrays a, Engine* e, Py_ssize_t memory, Py_ssize_t log_r
     pol.rhs, pol.step = a.new(N + s), a.new(N + s)
     pol.x, pol.nu, pol.y = a.new(n), a.new(m), a.new(s)
     pol.x_prev, pol.nu_prev = a.new(n), a.new(m)
+    pol.chord_start = a.new(n + m + 2 * s)
     pol.grad, pol.ATnu, pol.Ax = a.new(n), a.new(n), a.new(m)
     pol.tpiv = <int*>a.new_int(2 * s)
     pol.tr, pol.du = a.new(2 * s), a.new(2 * s)
