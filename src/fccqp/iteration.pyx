@@ -41,10 +41,10 @@ from fccqp.projections cimport proj_set
 from fccqp.reduced cimport materialize, near_convergence, reduced_start, reduced_step
 from fccqp.rho_rule cimport TrialState, new_rho, trial_reset
 from fccqp.termination cimport Residuals, converged, distance, nearly_converged
-from fccqp.tuning cimport (AUXILIARY_TIME, CLEANING_START, CONVERGING, EARLY_POLISH_GATE, EARLY_POLISH_TRIES,
-                           EQUALITY_MISSED, GATED_CHECK_WAIT, LOG_INTERVAL, POLISH_GATE,
-                           POLISH_RETRIES, RESERVE_PASSES, RESTART_MIN_ITER, STALL_FACTOR,
-                           STALLS, TIMED_EARLY_POLISH)
+from fccqp.tuning cimport (AUXILIARY_TIME, CLEANING_START, CONVERGING, EARLY_POLISH_GATE,
+                           EARLY_POLISH_TRIES, EQUALITY_MISSED, GATED_CHECK_WAIT, LOG_INTERVAL,
+                           POLISH_GATE, POLISH_RETRIES, RESERVE_PASSES, RESTART_MIN_ITER,
+                           STALL_FACTOR, STALLS, TIMED_EARLY_POLISH)
 from fccqp.verdict cimport check, classify, inconsistent, missed, missed_by_data, unbounded
 
 

@@ -61,12 +61,13 @@ from scipy.linalg.cython_lapack cimport dsytrf, dsytrs
 
 from fccqp._dense cimport copy, inf_norm
 from fccqp._types cimport Cones, Iterates, Problem
-from fccqp.cone_dispatch cimport cone_phi, cone_plane, cone_split
+from fccqp.cone_dispatch cimport cone_phi, cone_plane
 from fccqp.kkt cimport KKT
 from fccqp.matrices cimport CSC, DENSE, product, product_t
 from fccqp.polish_csc cimport polish_csc_factor, polish_csc_solve
 from fccqp.polish_guess cimport (boundary_entries, box_code, cone_code, drop_far_side, guess,
-                                 leaves_set, linearize, most_wrong, renew, step_length)
+                                 leaves_set, linearize, most_wrong, past_apex, renew,
+                                 step_length)
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup, polish_schur_solve
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.reduced cimport Reduced
@@ -259,20 +260,6 @@ cdef void _keep_point(Polish* w, const Problem* p, Py_ssize_t nb, bint undo) noe
         copy(w.lam, kept + n + m + s, nb)
 
 
-cdef bint _past_apex(const Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
-    """Whether some boundary block's ``x_block`` lies on the far side of its apex."""
-    cdef const Cones* c = &p.cones
-    cdef Py_ssize_t k, cone, o
-    cdef double across
-    for k in range(nb):
-        cone = w.boundary[k]
-        o = c.offset[cone]
-        if cone_split(w.x + p.constrained[o], c.kind[cone], c.dim[cone], c.mu[cone],
-                      c.normal + 3 * cone, &across) <= 0.0:
-            return True
-    return False
-
-
 cdef bint _chord_step(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb, double scale,
                       const Reduced* table, KKT* kkt, const double* rho_vec,
                       bint tabled) noexcept nogil:
@@ -294,7 +281,7 @@ cdef bint _chord_step(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
         w.grad_current = False
     else:
         _correct_once(w, p, nf, nb)
-    if _past_apex(w, p, nb):
+    if past_apex(w, p, nb):
         _keep_point(w, p, nb, True)
         return False
     return True

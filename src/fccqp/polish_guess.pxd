@@ -35,6 +35,7 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
                       Py_ssize_t* changed) noexcept nogil
 cdef bint leaves_set(const Polish* w, const Problem* p) noexcept nogil
 cdef Py_ssize_t boundary_entries(const Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil
+cdef bint past_apex(const Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil
 cdef Py_ssize_t drop_far_side(Polish* w, const Problem* p, Py_ssize_t nb,
                               Py_ssize_t* changed) noexcept nogil
 cdef double multiplier_violation(Polish* w, const Problem* p, const double* z) noexcept nogil

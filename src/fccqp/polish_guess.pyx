@@ -281,6 +281,25 @@ cdef Py_ssize_t boundary_entries(const Polish* w, const Problem* p, Py_ssize_t n
     return entries
 
 
+cdef inline bint _far_side(const Polish* w, const Problem* p, Py_ssize_t cone) noexcept nogil:
+    """Whether block ``cone``'s ``x_block`` lies on the far side of its apex
+    (``n'x_block <= 0``)."""
+    cdef const Cones* c = &p.cones
+    cdef double across
+    return cone_split(w.x + p.constrained[c.offset[cone]], c.kind[cone], c.dim[cone],
+                      c.mu[cone], c.normal + 3 * cone, &across) <= 0.0
+
+
+cdef bint past_apex(const Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
+    """Whether some block of the ``nb`` of ``boundary`` lies on the far side of its apex
+    (the test of :func:`drop_far_side`, which would hold it there)."""
+    cdef Py_ssize_t k
+    for k in range(nb):
+        if _far_side(w, p, w.boundary[k]):
+            return True
+    return False
+
+
 cdef Py_ssize_t drop_far_side(Polish* w, const Problem* p, Py_ssize_t nb,
                               Py_ssize_t* changed) noexcept nogil:
     """Hold at the apex every boundary block whose ``x_block`` lies on the far side of it
@@ -299,14 +318,11 @@ cdef Py_ssize_t drop_far_side(Polish* w, const Problem* p, Py_ssize_t nb,
     their guesses releasing and dropping the same block (notes/polish.md)."""
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t k, j, cone, o, d, kept = 0
-    cdef double across, along
     changed[0] = 0
     for k in range(nb):
         cone = w.boundary[k]
         o, d = c.offset[cone], c.dim[cone]
-        along = cone_split(w.x + p.constrained[o], c.kind[cone], d, c.mu[cone],
-                           c.normal + 3 * cone, &across)
-        if along <= 0.0:
+        if _far_side(w, p, cone):
             for j in range(o, o + d):
                 w.active[j] = APEX
             changed[0] += d
