@@ -181,7 +181,7 @@ def assert_as_after_a_reset(problem, result):
     np.testing.assert_array_equal(result.x, after_reset.x)
 
 
-def two_structures(seeds=(31, 32)):
+def two_structures():
     """Two problems of different sizes, their cones as a control loop passes them: a
     tuple of specs with Python numbers."""
     def plain(cone):
@@ -189,8 +189,8 @@ def two_structures(seeds=(31, 32)):
                             None if cone.normal is None else tuple(map(float, cone.normal)))
 
     return tuple((*problem[:6], tuple(map(plain, problem[6]))) for problem in (
-        random_problem(seeds[0], n=30, m=8, n_cones=3, n_box=6),
-        random_problem(seeds[1], n=24, m=6, n_cones=2, n_box=4)))
+        random_problem(31, n=30, m=8, n_cones=3, n_box=6),
+        random_problem(32, n=24, m=6, n_cones=2, n_box=4)))
 
 
 @pytest.mark.kkt_backends(*DENSE_PATH_KEEPS, reason="the dense path's kept workspaces")
