@@ -155,10 +155,19 @@ def test_a_solver_follows_bounds_that_change_structure():
         assert isinstance(capped.solve(P, q, A, b, lb4, ub4, cones).status, Status)
 
 
-BITWISE_RETURN = pytest.mark.xfail(strict=True, reason=(
-    "sparse path: a return to a kept workspace answers within 1e-14 of a reset solver, "
-    "same iterations, not bit for bit (not diagnosed)"))
-"""Where :func:`assert_as_after_a_reset` fails: the sparse path."""
+DENSE_PATH_KEEPS = ("auto", "schur_reduced", "ldl_reduced", "ldl_full")
+"""The backends whose solver keeps the workspaces of structures it left (the sparse path
+keeps one workspace, and a return there allocates a new one and starts cold)."""
+
+
+def assert_as_solved_again(problem, result):
+    """``result`` is SOLVED and, bit for bit, what a solver that just solved ``problem``
+    answers on it again: a warm start from the kept workspace's last answer."""
+    solver = fccqp.Solver()
+    solver.solve(*problem)
+    again = solver.solve(*problem)
+    assert result.iterations == again.iterations and result.status is Status.SOLVED
+    np.testing.assert_array_equal(result.x, again.x)
 
 
 def assert_as_after_a_reset(problem, result):
@@ -172,13 +181,24 @@ def assert_as_after_a_reset(problem, result):
     np.testing.assert_array_equal(result.x, after_reset.x)
 
 
-def test_a_return_to_a_structure_reuses_its_workspace_and_starts_cold(kkt_backend, request):
+def two_structures():
+    """Two problems of different sizes, their cones as a control loop passes them: a
+    tuple of specs with Python numbers."""
+    def plain(cone):
+        return FrictionCone(cone.start, float(cone.mu),
+                            None if cone.normal is None else tuple(map(float, cone.normal)))
+
+    return tuple((*problem[:6], tuple(map(plain, problem[6]))) for problem in (
+        random_problem(31, n=30, m=8, n_cones=3, n_box=6),
+        random_problem(32, n=24, m=6, n_cones=2, n_box=4)))
+
+
+@pytest.mark.kkt_backends(*DENSE_PATH_KEEPS, reason="the dense path's kept workspaces")
+def test_a_return_to_a_structure_reuses_its_workspace_and_its_last_answer():
     # a controller whose contact set changes and comes back: the solver keeps the
-    # workspaces it left (solver.KEPT_WORKSPACES), and a return is a cold start, the
-    # same answer bit for bit as after Solver.reset() (which keeps the scaling of
-    # unchanged matrices), and the answer of a new solver
-    if kkt_backend == "sparse":
-        request.applymarker(BITWISE_RETURN)
+    # workspaces it left (solver.KEPT_WORKSPACES), and a return starts from the last
+    # answer of that structure, the same answer bit for bit as a solver that solved it
+    # just before; through the general path (new bounds, then back)
     first = random_problem(21, n=30, m=8, n_cones=3, n_box=6)
     others = [random_problem(22 + k, n=24 + 2 * k, m=6, n_cones=2, n_box=4) for k in range(6)]
     P, q, A, b, lb, ub, cones = first
@@ -192,9 +212,7 @@ def test_a_return_to_a_structure_reuses_its_workspace_and_starts_cold(kkt_backen
     for problem in (others[0], fixed, first):   # a new size, new bounds, back
         again = solver.solve(*problem)
     assert solver._workspace is kept
-    assert_as_after_a_reset(first, again)
-    fresh = fccqp.Solver().solve(*first)
-    np.testing.assert_allclose(again.x, fresh.x, atol=1e-12)
+    assert_as_solved_again(first, again)
     verify_solution(first, again)
     for problem in others:   # more structures than it keeps: the oldest go
         solver.solve(*problem)
@@ -202,21 +220,12 @@ def test_a_return_to_a_structure_reuses_its_workspace_and_starts_cold(kkt_backen
     assert solver.solve(*first).status is Status.SOLVED
 
 
-def test_a_contact_set_that_comes_back_takes_its_kept_workspace_directly(monkeypatch,
-                                                                         kkt_backend, request):
+@pytest.mark.kkt_backends(*DENSE_PATH_KEEPS, reason="the dense path's kept workspaces")
+def test_a_contact_set_that_comes_back_takes_its_kept_workspace_directly(monkeypatch):
     # two contact sets in turn: the return finds the kept workspace by its last cones and
     # the arguments' shapes, without the general path's conversion and structure scan,
-    # and answers as a reset solver does, bit for bit
-    # (cones as a control loop passes them: a tuple of specs with Python numbers)
-    if kkt_backend == "sparse":
-        request.applymarker(BITWISE_RETURN)
-    def plain(cone):
-        return FrictionCone(cone.start, float(cone.mu),
-                            None if cone.normal is None else tuple(map(float, cone.normal)))
-
-    first, second = ((*problem[:6], tuple(map(plain, problem[6]))) for problem in (
-        random_problem(31, n=30, m=8, n_cones=3, n_box=6),
-        random_problem(32, n=24, m=6, n_cones=2, n_box=4)))
+    # and starts from its last answer, bit for bit
+    first, second = two_structures()
     solver = fccqp.Solver()
     solver.solve(*first)
     kept = solver._workspace
@@ -230,9 +239,22 @@ def test_a_contact_set_that_comes_back_takes_its_kept_workspace_directly(monkeyp
     assert solver._workspace is kept
     back = solver.solve(*second)
     monkeypatch.undo()
-    assert_as_after_a_reset(first, again)
+    assert_as_solved_again(first, again)
+    assert_as_solved_again(second, back)
     verify_solution(first, again)
     verify_solution(second, back)
+
+
+@pytest.mark.kkt_backends(*DENSE_PATH_KEEPS, reason="the dense path's kept workspaces")
+def test_after_a_reset_a_return_to_a_kept_structure_starts_cold():
+    # the cold view resets before every QP: reset() forgets the kept workspaces'
+    # answers too, so a structure left before the reset starts cold when it comes back
+    first, second = two_structures()
+    solver = fccqp.Solver()
+    solver.solve(*first)
+    solver.solve(*second)
+    solver.reset()
+    assert_as_after_a_reset(first, solver.solve(*first))
 
 
 FACTORIZATIONS_AFTER_A_NEW_P = {"auto": 1, "schur_reduced": 1, "ldl_reduced": 2,

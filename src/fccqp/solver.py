@@ -36,9 +36,10 @@ EIGENVALUE_DENSE_LIMIT = 2000
 dense ``eigvalsh``; ARPACK above."""
 KEPT_WORKSPACES = 4
 """Workspaces a :class:`Solver` keeps for structures it left, so that a return to one
-(a controller whose contact set comes back) starts cold without allocating: on
-talos_reduced (124 variables, 68 rows) a new workspace took 0.35-4 ms, most of a
-2 ms budget, against the microseconds of the return to a kept one."""
+(a controller whose contact set comes back) allocates nothing and, with
+``settings.warm_start``, starts from that structure's last answer: on talos_reduced
+(124 variables, 68 rows) a new workspace took 0.35-4 ms, most of a 2 ms budget, against
+the microseconds of the return to a kept one."""
 UNANSWERED = (Status.MAX_ITER_REACHED, Status.NUMERICAL_ERROR)
 """The statuses of a run that gave no answer, which, without a time limit, gets the
 stalled run's certificates and second tries (:meth:`Solver._stalled`). A
@@ -106,7 +107,8 @@ class Solver:
     unchanged the scaling and the KKT factorization are reused as well. When the sizes,
     the cone blocks or which entries are bounded or fixed change, the solve starts cold
     in a workspace for the new structure; the last :data:`KEPT_WORKSPACES` ones are kept,
-    so that a structure that comes back (a contact set) allocates nothing.
+    so that a structure that comes back (a contact set) allocates nothing and starts
+    warm from its own last answer. :meth:`reset` makes every next start cold.
 
     Parameters
     ----------
@@ -141,9 +143,12 @@ class Solver:
             "settings; make a new fccqp.Solver(settings) instead")
 
     def reset(self) -> None:
-        """Forget the previous solve: the next one starts cold."""
+        """Forget the previous solves: the next one starts cold, and so does the first
+        solve of each structure left before (the kept workspaces' answers)."""
         if self._workspace is not None:
             self._workspace.forget()
+        for _, w in self._kept.values():
+            w.forget()
         if self._sparse is not None:
             self._sparse[1].forget()
 
@@ -239,10 +244,9 @@ class Solver:
                    lb: object, ub: object) -> tuple[admm.Workspace | None, _Structure | None]:
         """The kept workspace whose last solve had the cones ``cones`` (the same values,
         :func:`fccqp.fast_checks.same_cones`) and the shapes of the arguments as they
-        came, made current and forgotten (it starts cold, as :meth:`_adopt` would start
-        it), with its structure; ``(None, None)`` when none is. A contact set that comes
-        back then costs what a cold solve of an unchanged structure costs: the general
-        path (conversion, a structure scan, two keys, new structure arrays) took 87k
+        came, made current (it starts from its last answer, as :meth:`_adopt` would
+        start it), with its structure; ``(None, None)`` when none is. The general path
+        (conversion, a structure scan, two keys, new structure arrays) took 87k
         instructions per go2 switch beside a 1.43M cold solve (callgrind). The solve
         still checks the bounds against the workspace's structure, and
         ``STRUCTURE_CHANGED`` leads to a new workspace as on the general path."""
@@ -251,7 +255,6 @@ class Solver:
                     and dense_arguments(P, q, A, b, lb, ub, structure.n, structure.m)):
                 del self._kept[key]
                 self._keep_current()
-                w.forget()
                 self._structure, self._workspace, self._cones = structure, w, cones
                 return w, structure
         return None, None
@@ -358,16 +361,15 @@ class Solver:
 
     def _adopt(self, structure: _Structure) -> admm.Workspace:
         """Make ``structure`` and a workspace for it current, keeping the current one
-        (:data:`KEPT_WORKSPACES`): a kept workspace of the same structure starts cold,
-        as after :meth:`reset` (the scaling of unchanged matrices is reused), otherwise
-        a new one is allocated."""
+        (:data:`KEPT_WORKSPACES`): a kept workspace of the same structure is reused
+        (with ``settings.warm_start`` it starts from its last answer, as a return through
+        :meth:`_returning` does), otherwise a new one is allocated."""
         self._keep_current()
         kept = self._kept.pop(structure.key(), None)
         if kept is None:
             w = structure.workspace(self._settings)
         else:
             w = kept[1]
-            w.forget()
             w.update_cones(structure.cones.mu, structure.cones.normal)
         self._structure, self._workspace = structure, w
         return w

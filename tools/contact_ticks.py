@@ -1,0 +1,90 @@
+"""Iterations and exactness of fccqp on the contact-change ticks of a cached test set.
+
+What: each robot's test set walked as the benchmark's warm view walks it (one
+``fccqp.Solver`` with the realtime preset, ``Solver.reset()`` at each sequence start,
+``benchmarks.views.warm_path``), and for each contact-change tick
+(``benchmarks.views.contact_changes``: the stance differs from the previous tick's, no
+reset in between) the tick, the stance before and after, the sizes, the iterations, the
+polished flag, the status and the largest torque error in shares of the joint's limit
+against the set's exact reference (``benchmarks.metrics.qp_metrics``, the report's
+``torque_error_rel``); then the iterations over all ticks of the walk.
+
+Why: the report's contact-change view is a median over one tick per robot in the
+``mix`` sets (tick 360 of ``--full``, 54 of ``--quick``); a ``contact_switch`` set
+(``--scenario contact_switch --n-qps 800 --seq-len 200``, generated and cached in
+``--cache`` on the first run, seconds per robot) has trot switches and feet put down
+again, to judge a change of how the solver crosses a contact change. Run it on the
+revision before and after (``PYTHONPATH=<build>/src:<build>``), same arguments::
+
+    python tools/contact_ticks.py [--robots go2 ...] [--scenario mix --n-qps 400 --seq-len 100]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from threadpoolctl import threadpool_limits
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))   # this checkout's benchmarks
+from benchmarks.cache import cached_test_set  # noqa: E402
+from benchmarks.exact_solvers import fccqp_arguments  # noqa: E402
+from benchmarks.metrics import qp_metrics  # noqa: E402
+from benchmarks.views import contact_changes, warm_path  # noqa: E402
+
+ROBOTS = ("solo12", "anymal_c", "go2", "talos_reduced")
+
+
+def contact_ticks(fccqp: object, test_set: object, budget: float) -> tuple[list[str], int]:
+    """The lines of the contact-change ticks of ``test_set``'s warm walk, and the
+    iterations of the whole walk."""
+    path = warm_path(test_set)
+    changed = contact_changes(path)
+    solver = fccqp.Solver(fccqp.Settings.realtime(budget))
+    lines, iterations, previous = [], 0, None
+    for i, fresh, change in zip(path.indices, path.fresh, changed, strict=True):
+        if fresh:
+            solver.reset()
+        qp = test_set.qps[i]
+        result = solver.solve(*fccqp_arguments(qp))
+        iterations += result.iterations
+        if change:
+            error = qp_metrics(qp, result.x, test_set.x_ref[i]).torque_error_rel
+            lines.append(f"tick {i}: {'+'.join(test_set.stance[previous])} -> "
+                         f"{'+'.join(test_set.stance[i])} (n {test_set.qps[previous].n} -> "
+                         f"{qp.n}), iterations {result.iterations}, polished "
+                         f"{int(result.polished)}, {result.status.name}, torque error "
+                         f"{error:.2%}")
+        previous = i
+    return lines, iterations
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Print each robot's contact-change ticks (one BLAS thread)."""
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--robots", nargs="+", choices=ROBOTS, default=list(ROBOTS))
+    parser.add_argument("--scenario", default="mix")
+    parser.add_argument("--n-qps", type=int, default=400)
+    parser.add_argument("--seq-len", type=int, default=100)
+    parser.add_argument("--cache", type=Path, default=ROOT / "benchmarks" / ".cache")
+    parser.add_argument("--budget", type=float, default=100.0,
+                        help="the realtime preset's time limit (s); large: never stops a solve")
+    args = parser.parse_args(argv)
+    import fccqp
+
+    threadpool_limits(1)
+    print(f"fccqp: {Path(fccqp.__file__).parent}")
+    for robot in args.robots:
+        test_set, _ = cached_test_set(args.cache, robot, args.scenario, args.n_qps, 0,
+                                      seq_len=args.seq_len, report=lambda line: None)
+        lines, iterations = contact_ticks(fccqp, test_set, args.budget)
+        print(f"{robot}: {len(lines)} contact-change ticks, {iterations} iterations in all "
+              f"{len(test_set)} ticks")
+        for line in lines:
+            print(f"  {line}", flush=True)
+
+
+if __name__ == "__main__":
+    main()
