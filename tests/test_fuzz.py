@@ -73,12 +73,7 @@ turns them red."""
 OPEN_BACKENDS: dict[str, tuple[str, ...]] = {}
 """Where an open case fails."""
 
-ROUNDING_DEPENDENT: dict[str, tuple[tuple[str, ...], str]] = {
-    "extreme_data:100213": (("schur_reduced", "ldl_reduced"), (
-        "an LP to rounding (P of 1e-195): MAX_ITER_REACHED in the reduced forms at every "
-        "rho tried and unscaled under OpenBLAS' AVX-512 kernels, solved under AVX2's "
-        "(where the full form stalls instead and auto's other form answers)")),
-}
+ROUNDING_DEPENDENT: dict[str, tuple[tuple[str, ...], str]] = {}
 """Open cases whose failure depends on the BLAS kernels' rounding: the backends where
 they fail on some machines, and why; expected to fail, not strictly."""
 
