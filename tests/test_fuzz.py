@@ -24,7 +24,7 @@ SEEDS = {
                      311, 326, 335, 337, 355, 363, 365, 489, 1182, 2244, 100082, 100180, 100213,
                      100228, 100233, 500030, 500064, 500099, 500322, 700281, 900343, 900360,
                      1100037, 1100057, 1100150, 1100253, 1300030, 1300300, 1500043, 1700106,
-                     1700359, 1900050),
+                     1700359, 1900050, 2900030),
     "qpsolvers": (0, 1, 2, 1700123),
     "cvxpy": (1, 2, 3),
 }
@@ -38,13 +38,15 @@ qpsolvers 1700123 stalls that a forced backend now solves again at another rho o
 unequilibrated; feasible 2900227 a run still converging at its cap, which the stalled
 run's continuation answers; extreme_data 1900050 a stall where the dual test lies
 below the rounding of ``P x`` and Clarabel's optimum fails it, no failure
-(``fuzzing._below_rounding``); issues 26 and 28)."""
+(``fuzzing._below_rounding``); extreme_data 2900030 a stall whose rho rule climbed to
+where the dual residual crawls, which the retry from a smaller rho answers; issues 26
+and 28)."""
 
 SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),
     "feasible": (0,),
     "solver_reuse": (38,),
-    "extreme_data": (26, 900343, 1700359),
+    "extreme_data": (26, 900343, 1700359, 2900030),
     "qpsolvers": (100035,),
     "cvxpy": (7, 1700154, 1900171),
     "dual_infeasible": (1700072,),
@@ -58,13 +60,15 @@ by cleaning its candidate on ``A A'`` (uncleaned: MAX_ITER_REACHED after every r
 1e-9 (ADMM crawls on every backend; the dense polish ends it at 4000 iterations);
 ``cvxpy:1700154`` a zero pivot
 that ``qdldl``'s update did not report, ``dual_infeasible:1700072`` solves whose first
-block was left unrefined (both diverged to NUMERICAL_ERROR on unbounded problems).
-Every case of :data:`SEEDS` on the sparse path took 100 s of CPU at b11793f (the whole
-module, four dense backends and these: 25 s of wall time at load 8), with 5 failures: 4 stalls at
-MAX_ITER_REACHED that the dense backends' retries answer (extreme_data 100213, 1500043,
-1700359, cvxpy 1), and ``extreme_data:900343``, kept here: SOLVED at the start on an
-infeasible problem (a friction cone pinned outside itself by 1e-3, variables rescaled
-1e-8..1e8) while ``POLISH_CSC_DELTA`` was 1e-9, certified since."""
+block was left unrefined (both diverged to NUMERICAL_ERROR on unbounded problems);
+``extreme_data:2900030`` the stall that the retry from a smaller rho answers, as on the
+dense backends. Every case of :data:`SEEDS` on the sparse path took 100 s of CPU at
+b11793f (the whole module, four dense backends and these: 25 s of wall time at load
+8), with 5 failures: 4 stalls at MAX_ITER_REACHED that the dense backends' retries
+answer (extreme_data 100213, 1500043, 1700359, cvxpy 1), and ``extreme_data:900343``,
+kept here: SOLVED at the start on an infeasible problem (a friction cone pinned outside
+itself by 1e-3, variables rescaled 1e-8..1e8) while ``POLISH_CSC_DELTA`` was 1e-9,
+certified since."""
 
 OPEN: dict[str, str] = {}
 """Reproducers of mechanisms still open (issues 26 and 28), each the reason it fails:
@@ -73,12 +77,7 @@ turns them red."""
 OPEN_BACKENDS: dict[str, tuple[str, ...]] = {}
 """Where an open case fails."""
 
-ROUNDING_DEPENDENT: dict[str, tuple[tuple[str, ...], str]] = {
-    "extreme_data:100213": (("schur_reduced", "ldl_reduced"), (
-        "an LP to rounding (P of 1e-195): MAX_ITER_REACHED in the reduced forms at every "
-        "rho tried and unscaled under OpenBLAS' AVX-512 kernels, solved under AVX2's "
-        "(where the full form stalls instead and auto's other form answers)")),
-}
+ROUNDING_DEPENDENT: dict[str, tuple[tuple[str, ...], str]] = {}
 """Open cases whose failure depends on the BLAS kernels' rounding: the backends where
 they fail on some machines, and why; expected to fail, not strictly."""
 

@@ -17,7 +17,7 @@ import pytest
 from fccqp.tuning import AUXILIARY_TIME, TIMED_EARLY_POLISH
 
 import fccqp
-from fccqp import Status
+from fccqp import Status, auxiliary
 from verify import Tolerances, verify_solution
 
 pytestmark = pytest.mark.usefixtures("every_kkt_backend")
@@ -93,6 +93,24 @@ def test_an_untimed_run_stopped_at_its_cap_goes_on_from_where_it_stopped():
     assert result.status is Status.SOLVED
     assert 250 < result.iterations <= 2 * 250
     verify_solution(problem, result, Tolerances.of(**EPS))
+
+
+def test_a_stalled_runs_retry_stopped_at_its_cap_goes_on_from_where_it_stopped():
+    """The retries of a stalled run (:func:`fccqp.auxiliary.solved_again`: cold, at
+    another rho, unequilibrated) are continued as the run itself is (the test above):
+    with ``max_iter`` 250 the first retry of this QP stops at its cap still halving its
+    distance to tolerance and ends SOLVED within its continuation; without the
+    continuation no retry gave an answer."""
+    problem = flat_qp(4)
+    stopped = fccqp.Solver(polish=False, max_iter=100, **EPS)
+    stopped._stalled_certificates = False
+    cut = stopped.solve(*problem)
+    assert cut.status is Status.MAX_ITER_REACHED
+    settings = fccqp.Settings(polish=False, max_iter=250, **EPS)
+    again = auxiliary.solved_again(fccqp.Solver, settings, cut, (*problem, ()), False)
+    assert again is not None and again.status is Status.SOLVED
+    assert 250 < again.iterations <= 2 * 250
+    verify_solution(problem, again, Tolerances.of(**EPS))
 
 
 def test_a_long_timed_run_polishes_early_as_an_untimed_one():

@@ -39,8 +39,8 @@ with ``P`` of 1e-12 stalled in the full form and solved in the reduced one). So 
 auxiliary solve that is not SOLVED runs again in the other form
 (:func:`other_form`), and :func:`solved_again` solves the stalled problem itself
 again there when no certificate was found, and then, if it stalls there too, at a
-larger rho, when the stalled run's rho sat at its floor at a smaller one, and without
-equilibration. A forced ``kkt_backend`` keeps its form and gets the other tries.
+larger rho, at a smaller one (fixed below the floor when the stalled run's rho sat
+there), and without equilibration. A forced ``kkt_backend`` keeps its form and gets the other tries.
 
 On the sparse path (a :attr:`fccqp.admm.Workspace.compressed` run) the auxiliary QPs
 are built with ``scipy.sparse`` and take the sparse path too, whatever their size;
@@ -291,8 +291,9 @@ def solved_again(solver_type: type, settings: object, stalled: object,
     """The problem of ``arguments`` (``P, q, A, b, lb, ub, cones``), on which a run in
     ``stalled.backend``'s form stalled, solved cold in the other form
     (:func:`other_form`, with ``switch_form``: when the form was fccqp's choice), or
-    else cold at ``STALL_RHO_FACTOR`` times ``settings.rho``, at a fixed rho below its
-    floor (when the run ended there), or without equilibration, the first of these
+    else cold at ``STALL_RHO_FACTOR`` times ``settings.rho``, at ``settings.rho /
+    STALL_RHO_FACTOR`` (at a fixed rho below its floor when the run ended there), or
+    without equilibration, the first of these
     that gives an answer (:data:`ANSWERS`), with the iterations and factorizations of
     the solves it took; else None. The tries share the time left until ``deadline``
     (:func:`_auxiliary_solver`) and stop when it has passed. Without ``switch_form`` every try keeps
@@ -306,7 +307,13 @@ def solved_again(solver_type: type, settings: object, stalled: object,
     (the fuzz cases qpsolvers 500077, 500090, 700127 and extreme_data 500215, 500351:
     4000 iterations stalled in both forms, 40 to 1220 from ``rho`` = 100).
 
-    The smaller rho: where the stalled run ended with rho at its floor (``RHO_MIN``,
+    The smaller rho: a run whose rule climbed from ``settings.rho`` to where one
+    residual crawls starts the rule from ``STALL_RHO_FACTOR`` below it instead
+    (variables rescaled by 1e-8..1e8 beside equality rows of entries 1e-8..1e9: rho
+    rose to 16, where the dual residual of 1e14 against a tolerance of 8e3 fell by 1 %
+    per 25 iterations, and 40,000 iterations in the full form did not end it; from
+    1e-4 every form is SOLVED in about 540).
+    Where the stalled run ended with rho at its floor (``RHO_MIN``,
     within the rule's ``adaptive_rho_tolerance``), the balance of the residuals asked
     for less: multipliers 1e-8 of the scaled primal (``P`` of 1e10 with the optimum in
     its near-null space and the cost normalized by ``P``; ``P`` of 1e-11 with the
@@ -332,6 +339,8 @@ def solved_again(solver_type: type, settings: object, stalled: object,
         floor = RHO_MIN / STALL_RHO_FACTOR
         tries.append(settings.replace(rho=floor, sigma=min(settings.sigma, floor),
                                       adaptive_rho=False))
+    else:
+        tries.append(settings.replace(rho=settings.rho / STALL_RHO_FACTOR))
     tries.append(settings.replace(scaling=0))
     for again in tries:
         if time.perf_counter() >= deadline:

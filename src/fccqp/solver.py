@@ -286,8 +286,7 @@ class Solver:
         if type(out) is int:   # NOT_CONVEX_CODE, the only code left
             self._workspace = self._structure = None
             raise _not_convex(P)
-        if (out.status in UNANSWERED and self._stalled_certificates
-                and _room(settings, start)):
+        if out.status in UNANSWERED and _room(settings, start):
             resume = (P, q, A, b, lb, ub, None, True, start, structure.certificate, False)
             out = self._stalled(out, w, (P, q, A, b, lb, ub), self._cones, start, resume)
         elif w.doubt and self._stalled_certificates and _room(settings, start):
@@ -318,7 +317,7 @@ class Solver:
         start from: a certified problem as an infeasible run does, an answer from
         another solver because this workspace holds the stalled point."""
         out = _resumed(out, workspace, resume)
-        if out.status not in UNANSWERED:
+        if out.status not in UNANSWERED or not self._stalled_certificates:
             return out
         deadline = start + self._settings.time_limit   # the run's budget (_room)
         found = auxiliary.stalled_certificate(Solver, self._settings, workspace, *arguments,
@@ -399,8 +398,7 @@ class Solver:
         if type(out) is int:   # NOT_CONVEX_CODE, the only code left
             self._sparse = None
             raise _not_convex(data.P)
-        if (out.status in UNANSWERED and self._stalled_certificates
-                and _room(settings, start)):
+        if out.status in UNANSWERED and _room(settings, start):
             resume = (*arguments[:6], None, True, start, certificate)
             out = self._stalled(out, w, (data.P, data.q, data.A, data.b, data.lb, data.ub),
                                 cones, start, resume)

@@ -116,7 +116,7 @@ cdef extern from *:
     #define FCCQP_CLEANING_HORIZON 1.0
     /* a least-distance QP solved again meets the Farkas test's eps_prim_inf this many times */
     #define FCCQP_AUXILIARY_MARGIN 10.0
-    /* a problem that stalled in both KKT forms is solved again, cold, at this times Settings.rho */
+    /* a problem that stalled in both KKT forms is solved again, cold, at this times Settings.rho and at 1 / this of it */
     #define FCCQP_STALL_RHO_FACTOR 1e3
     /* a primal certificate separating by less than this of its terms is checked in the other KKT form */
     #define FCCQP_WEAK_SEPARATION 1e-6
