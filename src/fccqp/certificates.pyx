@@ -150,10 +150,13 @@ cdef int _farkas(const Problem* p, const double* x, const double* d_nu, const do
     for i in range(n):
         lhs_max = max(lhs_max, fabs(lhs[i]) / p.D[i])
         terms_max = max(terms_max, terms[i] / p.D[i])
-        explained += fabs(lhs[i] * x[i])
-    # For every x with A x = b and x_S in C, b'd_nu + sigma_C(d_y) >= (A'd_nu + d_y)'x: a
-    # separation no larger than what the residual explains at the iterate's own x proves
+    # For every x with A x = b and x_S in C, b'd_nu + sigma_C(d_y) >= (A'd_nu + d_y)'x,
+    # and a boxed x_i reaches its bounds' magnitude: a separation no larger than what the
+    # residual explains there (the iterate's own |x_i| where no bound caps it) proves
     # nothing (dependent rows let d_nu drift along null(A') with b'd_nu ~ 0)
+    magnitudes(p, x, terms)
+    for i in range(n):
+        explained += fabs(lhs[i]) * terms[i]
     if (lhs_max <= eps * terms_max and support < -explained
             and DOMINANCE * lhs_max * size <= -support * terms_max):
         return CERTIFIED
