@@ -43,7 +43,7 @@ rounding of the sum (``1e-16`` of its terms, times its cancellation). On the box
 the bound is explicit: ``res'x >= -sigma_box(-res)``, which the separation must also
 beat; with columns scaled over 1e16 the residual's relative size says nothing of its
 products with the bounds (a feasible problem's certificate had ``rho = 3e-9`` and
-``delta = -0.05``, and its residual reached 29 times its separation in the box). A fixed margin
+``delta = -0.05``, and its residual reached 23 times its separation in the box). A fixed margin
 in ``eps_prim_inf`` (this checker asked ``delta < -10 eps_prim_inf`` before) is not a
 property of a proof: none of the anchors asks it (OSQP: ``u'dy+ + l'dy- < 0``; SCS:
 ``b'y < -1e-9`` and ``||A'y|| <= 1e-7 |b'y|``; Clarabel: ``b'z < -1e-8`` and ``||A'z||

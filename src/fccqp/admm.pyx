@@ -193,10 +193,10 @@ cdef class Workspace:
         :mod:`fccqp.auxiliary`), judged by the tests of the run's own candidates on the
         last solve's scaled problem; the certificate as it passed (the primal one's
         ``dz`` projected onto the polar), or None. A primal certificate's separation
-        must exceed what its residual explains at the magnitudes of ``point`` and the
-        box (user's units, with ``A x = b``; default the run's iterate, which on a run
-        that diverges along a ray, ``q`` of 4.5e14 beside a cone pinned outside itself,
-        explained away an exact one)."""
+        must exceed what its residual explains at ``point`` (user's units, with ``A x =
+        b``; default the run's iterate, which on a run that diverges along a ray, ``q``
+        of 4.5e14 beside a cone pinned outside itself, explained away an exact one) and
+        in the box."""
         cdef Engine* e = &self.e
         cdef Problem* p = &e.prob
         cdef Py_ssize_t n = p.n, m = p.m, i, j
