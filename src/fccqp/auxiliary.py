@@ -20,8 +20,7 @@ in a few dozen iterations on the fuzzing campaign's stalls):
   each row whose ``b_i`` is not zero to its terms' accuracy may be missed by ``|b_i|
   r_i`` at the cost ``1/2 r_i^2``, whose multipliers maximize the separation against
   the size of ``(b_i y_i)`` and ``z_u`` together, the terms the Farkas test weighs it
-  against
-  (:func:`relative_distance_problem`);
+  against (:func:`relative_distance_problem`);
 - dual: the projection of ``-q`` onto the cone of rays, ``min 1/2 ||d||^2 + q'd`` s.t.
   ``P d = 0``, ``A d = 0``, ``d`` in the recession cone of C, which by Moreau has
   ``q'd = -||d||^2``: a ray of descent whenever it is not zero.
