@@ -509,6 +509,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     cdef bint planes_only = True   # every infeasible pass only put free blocks on their boundary
     cdef Py_ssize_t held
     cdef Py_ssize_t blocking
+    cdef const double* ahead
     cdef double t
     if p.P.kind == CSC:   # the curvature terms in PolishCSC's storage (n x the largest cone)
         w.hess, w.hess_stride = w.csc.hess, w.csc.hess_stride
@@ -554,18 +555,22 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         if feasible:
             t = step_length(w, p, &blocking)
             if blocking >= 0:   # stop where the first constraint does, and hold it (all at t = 0)
+                ahead = NULL
+                if t == 0.0:   # renew places the blocks held from where the step pointed
+                    ahead = w.grad   # scratch here: the full step's point
+                    copy(w.x, w.grad, n)
                 for j in range(n):
                     w.x[j] = w.x_prev[j] + t * (w.x[j] - w.x_prev[j])
                 for j in range(m):
                     w.nu[j] = w.nu_prev[j] + t * (w.nu[j] - w.nu_prev[j])
                 w.grad_current = False
-                nb = renew(w, p, True, True, &changed)
+                nb = renew(w, p, True, True, ahead, &changed)
                 continue
         held = boundary_entries(w, p, nb)
-        nb = renew(w, p, True, False, &changed)
+        nb = renew(w, p, True, False, NULL, &changed)
         if changed == 0:
             feasible = True
-            nb = renew(w, p, False, False, &changed)
+            nb = renew(w, p, False, False, NULL, &changed)
         elif not feasible:
             planes_only = planes_only and changed == boundary_entries(w, p, nb) - held
             if passes >= FEASIBLE_PASSES and not planes_only:
@@ -580,12 +585,12 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
             return False
         if settled > 0:
             continue   # a block went past its apex: solve the corrected guess
-        nb = renew(w, p, True, False, &changed)
+        nb = renew(w, p, True, False, NULL, &changed)
         if changed != 0:   # Newton's planes moved a free constraint out of its set: hold it
             feasible = False   # and solve the corrected guess from this point, without a step
             continue
         if most_wrong(w, p) >= 0:   # Newton moved a plane's multiplier past 0: release it
-            nb = renew(w, p, False, False, &changed)
+            nb = renew(w, p, False, False, NULL, &changed)
             continue
         break
     w.passes = passes

@@ -207,20 +207,28 @@ cdef bint leaves_set(const Polish* w, const Problem* p) noexcept nogil:
 
 
 cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
-                      Py_ssize_t* changed) noexcept nogil:
+                      const double* ahead, Py_ssize_t* changed) noexcept nogil:
     """Correct the guess from the polished point. With ``adding``, hold free entries
     that violate their bound and put free blocks that left their cone on the boundary
     (or at the apex, if ``x_block`` lies in the polar), and, after a step (``stepped``),
     hold the constraints :func:`step_length` marked in ``blocked`` where the step left
     them: a box entry at its nearer bound, a free block on the boundary, a boundary
-    block at the apex. Otherwise release the one held entry or block whose multiplier is the most
-    wrong (:func:`most_wrong`): a held entry or a boundary block becomes free, an apex
-    block is reclassified from its multiplier as in :func:`guess`. Returns the number of
-    boundary blocks (planes and curvature at ``x_block``, or at the projection for a new
-    one) and counts the changed entries in ``changed``."""
+    block at the apex. After a step of length 0 (``ahead``: the full step's point, else
+    NULL) a free block it stopped is classified and given its plane from where the full
+    step took it, not from the unmoved point: there it sits at the apex or on the plane
+    it was just released from, and the next pass would release it again, stop at length
+    0 and hold it back, all the polish's guesses long (go2, solo12 and anymal_c warm
+    ticks; notes/performance-history.md, "warmtail2"). Otherwise release the one held
+    entry or block whose multiplier is the most wrong (:func:`most_wrong`): a held entry
+    or a boundary block becomes free, an apex block is reclassified from its multiplier
+    as in :func:`guess`. Returns the number of boundary blocks (planes and curvature at
+    ``x_block``, or at the projection for a new one) and counts the changed entries in
+    ``changed``."""
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t j, k, o, d, start, nb = 0, old = 0
     cdef double value, size, along, across, slope, lam
+    cdef const double* point
+    cdef bint held
     cdef char code, before
     cdef Py_ssize_t released = -1 if adding else most_wrong(w, p)
     changed[0] = 0
@@ -253,9 +261,11 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
                 code = APEX
             copy(w.x + start, w.step, d)
         elif before == FREE and adding:
-            if _left_cone(c, k, w.x + start, &along, &across, &size) or (stepped and w.blocked[o]):
+            held = stepped and w.blocked[o]
+            point = (ahead if held and ahead != NULL else w.x) + start
+            if _left_cone(c, k, point, &along, &across, &size) or held:
                 code = APEX if slope * across <= -along or size == 0.0 else BOUNDARY
-                cone_project(w.x + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
+                cone_project(point, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
         elif released == p.s + k:   # an apex block whose y left the polar
             along = cone_split(w.y + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
             code = FREE if across <= slope * along else BOUNDARY
