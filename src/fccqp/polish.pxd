@@ -32,6 +32,7 @@ cdef struct Polish:
     bint schur_failed       # the last polish failed so
     long passes             # the guesses the last polish solved
     char* dropped           # cone count: the block went past its apex in this polish
+    char* bare              # cone count: the block's plane was placed without its curvature (lam <= 0), unsolved with it since
     char* blocked           # s: the constraints a step holds (polish_guess.step_length)
     bint cycling            # a block went past its apex twice: the guess cycles
     double* work            # lwork entries, for dsytrf

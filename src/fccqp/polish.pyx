@@ -365,8 +365,13 @@ cdef bint _solve_guess(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
     """Solve the polished QP of the current guess in the reduced form's coordinates
     while ``tabled`` (:mod:`fccqp.polish_table`), else with its own KKT matrix (refined
     to ``GUESS_TOLERANCE`` on a guess's ``first`` solve); a singular system in the
-    table's coordinates ends ``tabled`` for this polish."""
+    table's coordinates ends ``tabled`` for this polish. Planes with a positive
+    multiplier stop being ``bare``."""
+    cdef Py_ssize_t k
     w.grad_current = False
+    for k in range(nb):   # these planes are now solved with their curvature
+        if w.lam[k] > 0.0:
+            w.bare[w.boundary[k]] = False
     if tabled[0]:
         if table_factor(w, p, table, rho_vec, nb):
             table_solve(w, p, table, kkt, rho_vec, nb, scale)
@@ -398,6 +403,16 @@ cdef void _multipliers(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
             w.y[j] = w.lam[k] * w.g[j]
 
 
+cdef bint _gained_curvature(const Polish* w, Py_ssize_t nb) noexcept nogil:
+    """Whether a ``bare`` boundary block now has a positive multiplier (and so, from
+    :func:`~fccqp.polish_guess.renew`, its curvature on its own plane)."""
+    cdef Py_ssize_t k
+    for k in range(nb):
+        if w.bare[w.boundary[k]] and w.lam[k] > 0.0:
+            return True
+    return False
+
+
 cdef int _newton(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t* nb, long newton_steps,
                  double scale, int* factorizations, const Reduced* table, KKT* kkt,
                  const double* rho_vec, bint* tabled) noexcept nogil:
@@ -405,11 +420,20 @@ cdef int _newton(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t* nb, lon
     re-linearize them at the current point up to ``newton_steps`` times (chord steps while
     they converge fast), then refine the point and set its multipliers: 0. 1 when a block
     went past its apex (held there now, ``nb`` the blocks left, the point not re-solved);
-    -1 when a factorization broke down."""
+    -1 when a factorization broke down. Planes that :func:`~fccqp.polish_guess.renew`
+    left in place with their new curvature (``bare`` ones) are solved there first."""
     cdef double miss, rate, last_miss = INFINITY
     cdef bint refactored = False
     cdef Py_ssize_t changed
     cdef long step
+    if _gained_curvature(w, nb[0]):   # first solve those planes where they are
+        if not _solve_guess(w, p, nf, nb[0], scale, factorizations, table, kkt, rho_vec,
+                            tabled, False):
+            return -1
+        refactored = True
+        nb[0] = drop_far_side(w, p, nb[0], &changed)
+        if changed != 0:
+            return 1
     for step in range(newton_steps):
         if not _relinearize(w, p, nb[0], &miss) or (
                 refactored and miss >= last_miss and miss <= MISS_FLOOR):
@@ -524,6 +548,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         w.active[j] = FREE
     for j in range(p.cones.count):
         w.dropped[j] = False
+        w.bare[j] = False
     w.cycling = False
     nb = guess(w, p, it.z, it.y, &changed)
     while True:

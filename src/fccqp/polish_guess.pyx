@@ -18,7 +18,7 @@ from libc.math cimport fabs, sqrt
 from fccqp._dense cimport copy
 from fccqp._types cimport Cones, Problem
 from fccqp.cone_dispatch cimport (cone_curvature, cone_plane, cone_polar_distance, cone_project,
-                                  cone_slope, cone_split, cone_step)
+                                  cone_slope, cone_split, cone_step, cone_touch)
 from fccqp.polish cimport APEX, BOUNDARY, FREE, LOWER, UPPER, Polish
 from fccqp.tuning cimport ACTIVE_TOLERANCE
 
@@ -26,7 +26,8 @@ from fccqp.tuning cimport ACTIVE_TOLERANCE
 cdef void linearize(Polish* w, const Problem* p, Py_ssize_t k, const double* v) noexcept nogil:
     """Plane ``g`` and curvature ``hess`` of boundary block ``k`` (of ``boundary``) at
     ``v``, with its current multiplier where that is positive; a block whose ``v`` is on
-    the axis keeps its plane and gets no curvature.
+    the axis keeps its plane and gets no curvature. Without a positive multiplier the
+    block is marked ``bare`` (see :func:`renew`).
 
     A negative multiplier marks a wrong guess, which the next correction releases; its
     curvature would only make the block's Hessian indefinite, and the Schur complement
@@ -39,6 +40,21 @@ cdef void linearize(Polish* w, const Problem* p, Py_ssize_t k, const double* v) 
     cone_plane(v, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, w.g + o, &phi)
     cone_curvature(v, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, max(w.lam[k], 0.0),
                    w.hess + o * w.hess_stride)
+    if not w.lam[k] > 0.0:
+        w.bare[cone] = True
+
+
+cdef inline void _own_point(const Polish* w, const Cones* c, Py_ssize_t k, const double* x,
+                            double* out) noexcept nogil:
+    """Into ``out``: the point of cone ``k``'s current plane's touching ray with the axis
+    part of ``x`` (its block), where a bare plane gains its curvature; ``x`` itself where
+    that part is not positive or the plane lies on the axis."""
+    cdef Py_ssize_t o = c.offset[k], d = c.dim[k]
+    cdef double across
+    cdef double along = cone_split(x, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
+    if not (along > 0.0 and cone_touch(w.g + o, c.kind[k], d, c.mu[k], c.normal + 3 * k,
+                                       along, out)):
+        copy(x, out, d)
 
 
 cdef Py_ssize_t guess(Polish* w, const Problem* p, const double* z, const double* y,
@@ -223,7 +239,17 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
     or a boundary block becomes free, an apex block is reclassified from its multiplier
     as in :func:`guess`. Returns the number of boundary blocks (planes and curvature at
     ``x_block``, or at the projection for a new one) and counts the changed entries in
-    ``changed``."""
+    ``changed``.
+
+    A ``bare`` boundary block (its plane placed with ``lam = 0``, so solved without its
+    curvature) whose multiplier came out positive keeps its plane and gains the
+    curvature there, at the point of the plane's own touching ray with ``x_block``'s
+    axis part, rather than moving the plane to ``x_block``: that point lies on the plane
+    but off the cone, where nothing held it without the curvature, and the plane at it
+    had pointed up to 20-40 degrees away from the answer's; the QP on that plane then
+    put the contact past its apex, and the polish cycled between apex and boundary (the
+    warm polishes of contacts being loaded; notes/performance-history.md,
+    "warmtail2")."""
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t j, k, o, d, start, nb = 0, old = 0
     cdef double value, size, along, across, slope, lam
@@ -259,7 +285,10 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
                 code = FREE
             elif stepped and w.blocked[o]:
                 code = APEX
-            copy(w.x + start, w.step, d)
+            if w.bare[k] and lam > 0.0:
+                _own_point(w, c, k, w.x + start, w.step)
+            else:
+                copy(w.x + start, w.step, d)
         elif before == FREE and adding:
             held = stepped and w.blocked[o]
             point = (ahead if held and ahead != NULL else w.x) + start
