@@ -66,8 +66,8 @@ from fccqp.kkt cimport KKT
 from fccqp.matrices cimport CSC, DENSE, product, product_t
 from fccqp.polish_csc cimport polish_csc_factor, polish_csc_solve
 from fccqp.polish_guess cimport (boundary_entries, box_code, cone_code, drop_far_side, guess,
-                                 leaves_set, linearize, most_wrong, past_apex, renew,
-                                 step_length)
+                                 keep_bare_plane, leaves_set, linearize, most_wrong, past_apex,
+                                 renew, step_length)
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup, polish_schur_solve
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.reduced cimport Reduced
@@ -365,13 +365,13 @@ cdef bint _solve_guess(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
     """Solve the polished QP of the current guess in the reduced form's coordinates
     while ``tabled`` (:mod:`fccqp.polish_table`), else with its own KKT matrix (refined
     to ``GUESS_TOLERANCE`` on a guess's ``first`` solve); a singular system in the
-    table's coordinates ends ``tabled`` for this polish. Planes with a positive
-    multiplier stop being ``bare``."""
+    table's coordinates ends ``tabled`` for this polish. ``KEPT`` planes are dropped:
+    they serve only the first solve of :func:`_newton`."""
     cdef Py_ssize_t k
     w.grad_current = False
-    for k in range(nb):   # these planes are now solved with their curvature
-        if w.lam[k] > 0.0:
-            w.bare[w.boundary[k]] = False
+    for k in range(nb):   # a kept plane serves only the Newton step that follows it
+        if w.bare[w.boundary[k]] == KEPT:
+            w.bare[w.boundary[k]] = CURVED
     if tabled[0]:
         if table_factor(w, p, table, rho_vec, nb):
             table_solve(w, p, table, kkt, rho_vec, nb, scale)
@@ -403,14 +403,16 @@ cdef void _multipliers(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
             w.y[j] = w.lam[k] * w.g[j]
 
 
-cdef bint _gained_curvature(const Polish* w, Py_ssize_t nb) noexcept nogil:
-    """Whether a ``bare`` boundary block now has a positive multiplier (and so, from
-    :func:`~fccqp.polish_guess.renew`, its curvature on its own plane)."""
+cdef bint _restore_kept_planes(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
+    """Put every ``KEPT`` plane of the ``nb`` boundary blocks back, with its curvature
+    (:func:`~fccqp.polish_guess.keep_bare_plane`); whether there was one."""
     cdef Py_ssize_t k
+    cdef bint any = False
     for k in range(nb):
-        if w.bare[w.boundary[k]] and w.lam[k] > 0.0:
-            return True
-    return False
+        if w.bare[w.boundary[k]] == KEPT:
+            keep_bare_plane(w, p, k)
+            any = True
+    return any
 
 
 cdef int _newton(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t* nb, long newton_steps,
@@ -420,13 +422,13 @@ cdef int _newton(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t* nb, lon
     re-linearize them at the current point up to ``newton_steps`` times (chord steps while
     they converge fast), then refine the point and set its multipliers: 0. 1 when a block
     went past its apex (held there now, ``nb`` the blocks left, the point not re-solved);
-    -1 when a factorization broke down. Planes that :func:`~fccqp.polish_guess.renew`
-    left in place with their new curvature (``bare`` ones) are solved there first."""
+    -1 when a factorization broke down. Where planes were ``KEPT``
+    (:func:`~fccqp.polish_guess.keep_bare_plane`), the first step solves them there."""
     cdef double miss, rate, last_miss = INFINITY
     cdef bint refactored = False
     cdef Py_ssize_t changed
     cdef long step
-    if _gained_curvature(w, nb[0]):   # first solve those planes where they are
+    if _restore_kept_planes(w, p, nb[0]):
         if not _solve_guess(w, p, nf, nb[0], scale, factorizations, table, kkt, rho_vec,
                             tabled, False):
             return -1
@@ -548,7 +550,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         w.active[j] = FREE
     for j in range(p.cones.count):
         w.dropped[j] = False
-        w.bare[j] = False
+        w.bare[j] = CURVED
     w.cycling = False
     nb = guess(w, p, it.z, it.y, &changed)
     while True:

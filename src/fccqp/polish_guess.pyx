@@ -19,7 +19,7 @@ from fccqp._dense cimport copy
 from fccqp._types cimport Cones, Problem
 from fccqp.cone_dispatch cimport (cone_curvature, cone_plane, cone_polar_distance, cone_project,
                                   cone_slope, cone_split, cone_step, cone_touch)
-from fccqp.polish cimport APEX, BOUNDARY, FREE, LOWER, UPPER, Polish
+from fccqp.polish cimport APEX, BARE, BOUNDARY, FREE, KEPT, LOWER, UPPER, Polish
 from fccqp.tuning cimport ACTIVE_TOLERANCE
 
 
@@ -27,7 +27,7 @@ cdef void linearize(Polish* w, const Problem* p, Py_ssize_t k, const double* v) 
     """Plane ``g`` and curvature ``hess`` of boundary block ``k`` (of ``boundary``) at
     ``v``, with its current multiplier where that is positive; a block whose ``v`` is on
     the axis keeps its plane and gets no curvature. Without a positive multiplier the
-    block is marked ``bare`` (see :func:`renew`).
+    block is marked ``BARE`` (see :func:`renew`).
 
     A negative multiplier marks a wrong guess, which the next correction releases; its
     curvature would only make the block's Hessian indefinite, and the Schur complement
@@ -41,14 +41,32 @@ cdef void linearize(Polish* w, const Problem* p, Py_ssize_t k, const double* v) 
     cone_curvature(v, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, max(w.lam[k], 0.0),
                    w.hess + o * w.hess_stride)
     if not w.lam[k] > 0.0:
-        w.bare[cone] = True
+        w.bare[cone] = BARE
+
+
+cdef void keep_bare_plane(Polish* w, const Problem* p, Py_ssize_t k) noexcept nogil:
+    """Put boundary block ``k``'s ``KEPT`` plane back and give it its curvature there, at
+    the point of the plane's own touching ray with ``x_block``'s axis part (``x_block``
+    itself where that part is not positive or the plane lies on the axis).
+
+    A plane placed with ``lam = 0`` (an apex block released, a free block that left its
+    cone) is solved without its curvature, and nothing held the block's tangential part
+    on the cone: moving the plane to that ``x_block`` had turned it 20-40 degrees away
+    from the answer's, and the next solve put the contact past its apex; the polish then
+    cycled between apex and boundary and the tick ran ADMM (warm polishes of contacts
+    being loaded; notes/performance-history.md, "warmtail2")."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t cone = w.boundary[k], o = c.offset[cone]
+    copy(w.kept_plane + o, w.g + o, c.dim[cone])
+    _own_point(w, c, cone, w.x + p.constrained[o], w.step)
+    linearize(w, p, k, w.step)
 
 
 cdef inline void _own_point(const Polish* w, const Cones* c, Py_ssize_t k, const double* x,
                             double* out) noexcept nogil:
     """Into ``out``: the point of cone ``k``'s current plane's touching ray with the axis
-    part of ``x`` (its block), where a bare plane gains its curvature; ``x`` itself where
-    that part is not positive or the plane lies on the axis."""
+    part of ``x`` (its block); ``x`` itself where that part is not positive or the plane
+    lies on the axis."""
     cdef Py_ssize_t o = c.offset[k], d = c.dim[k]
     cdef double across
     cdef double along = cone_split(x, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
@@ -241,15 +259,8 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
     ``x_block``, or at the projection for a new one) and counts the changed entries in
     ``changed``.
 
-    A ``bare`` boundary block (its plane placed with ``lam = 0``, so solved without its
-    curvature) whose multiplier came out positive keeps its plane and gains the
-    curvature there, at the point of the plane's own touching ray with ``x_block``'s
-    axis part, rather than moving the plane to ``x_block``: that point lies on the plane
-    but off the cone, where nothing held it without the curvature, and the plane at it
-    had pointed up to 20-40 degrees away from the answer's; the QP on that plane then
-    put the contact past its apex, and the polish cycled between apex and boundary (the
-    warm polishes of contacts being loaded; notes/performance-history.md,
-    "warmtail2")."""
+    A ``BARE`` boundary block (its plane placed with ``lam = 0``) whose multiplier came
+    out positive has that plane kept (``KEPT``) for :func:`keep_bare_plane`."""
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t j, k, o, d, start, nb = 0, old = 0
     cdef double value, size, along, across, slope, lam
@@ -285,10 +296,10 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
                 code = FREE
             elif stepped and w.blocked[o]:
                 code = APEX
-            if w.bare[k] and lam > 0.0:
-                _own_point(w, c, k, w.x + start, w.step)
-            else:
-                copy(w.x + start, w.step, d)
+            if w.bare[k] == BARE and lam > 0.0:   # for Newton's first solve (see keep_bare_plane)
+                copy(w.g + o, w.kept_plane + o, d)
+                w.bare[k] = KEPT
+            copy(w.x + start, w.step, d)
         elif before == FREE and adding:
             held = stepped and w.blocked[o]
             point = (ahead if held and ahead != NULL else w.x) + start
