@@ -63,7 +63,7 @@ def test_polished_answer_is_exact(seed, kkt_backend):
     assert np.abs(plain.x - reference.x).max() > 2e-5
 
 
-@pytest.mark.parametrize("seed", [3, 5])
+@pytest.mark.parametrize("seed", [5, 18])
 def test_wrong_guess_keeps_the_admm_point(seed, kkt_backend):
     # two iterations of ADMM do not know the active set: the polished point fails the
     # check and the (restored) ADMM point is returned unchanged
@@ -354,12 +354,12 @@ def test_polish_holds_a_free_block_that_newton_moved_out_of_its_cone():
 
 def test_polish_puts_its_last_guess_on_the_cones():
     """This polish uses all ``GUESS_PASSES`` guesses, and its last one is the optimal
-    active set; its first solve, at the planes of the previous point, left the boundary
-    blocks off their cones by 3e-2. The last guess also gets Newton's steps, and the
+    active set; its first solve, at the planes of the previous point, is 0.12 off the
+    reference (``newton_steps=0``). The last guess also gets Newton's steps, and the
     polished point is the reference's."""
-    targets = np.array([[-1.7, -2.9, 0.8], [-0.3, -1.2, -0.9], [-1.0, 0.2, 0.1],
-                        [0.6, -0.1, 1.7]])
-    z = np.array([0.8, -0.1, 3.5, 0.8, -0.2, 1.4, 0.6, 0.3, 2.3, 0.8, -0.5, 1.7])
+    targets = np.array([[-1.64, -3.14, 1.1], [-0.33, -0.99, -1.56], [-1.48, 0.5, 0.22],
+                        [0.45, -0.43, 2.33]])
+    z = np.array([0.8, 0.1, 3.7, 0.6, 0.0, 1.7, 0.5, 0.3, 2.1, 0.6, -0.3, 1.7])
     y = np.zeros(12)
     y[6:8] = [0.9, -0.2]
     cones = tuple(fccqp.FrictionCone(3 * i, 0.2) for i in range(4))
