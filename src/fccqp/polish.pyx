@@ -66,8 +66,8 @@ from fccqp.kkt cimport KKT
 from fccqp.matrices cimport CSC, DENSE, product, product_t
 from fccqp.polish_csc cimport polish_csc_factor, polish_csc_solve
 from fccqp.polish_guess cimport (boundary_entries, box_code, cone_code, drop_far_side, guess,
-                                 leaves_set, linearize, most_wrong, past_apex, renew,
-                                 step_length)
+                                 keep_bare_plane, leaves_set, linearize, most_wrong, past_apex,
+                                 renew, step_length)
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup, polish_schur_solve
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.reduced cimport Reduced
@@ -365,8 +365,13 @@ cdef bint _solve_guess(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
     """Solve the polished QP of the current guess in the reduced form's coordinates
     while ``tabled`` (:mod:`fccqp.polish_table`), else with its own KKT matrix (refined
     to ``GUESS_TOLERANCE`` on a guess's ``first`` solve); a singular system in the
-    table's coordinates ends ``tabled`` for this polish."""
+    table's coordinates ends ``tabled`` for this polish. ``KEPT`` planes are dropped:
+    they serve only the first solve of :func:`_newton`."""
+    cdef Py_ssize_t k
     w.grad_current = False
+    for k in range(nb):   # a kept plane serves only the Newton step that follows it
+        if w.bare[w.boundary[k]] == KEPT:
+            w.bare[w.boundary[k]] = CURVED
     if tabled[0]:
         if table_factor(w, p, table, rho_vec, nb):
             table_solve(w, p, table, kkt, rho_vec, nb, scale)
@@ -398,6 +403,18 @@ cdef void _multipliers(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
             w.y[j] = w.lam[k] * w.g[j]
 
 
+cdef bint _restore_kept_planes(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
+    """Put every ``KEPT`` plane of the ``nb`` boundary blocks back, with its curvature
+    (:func:`~fccqp.polish_guess.keep_bare_plane`); whether there was one."""
+    cdef Py_ssize_t k
+    cdef bint any = False
+    for k in range(nb):
+        if w.bare[w.boundary[k]] == KEPT:
+            keep_bare_plane(w, p, k)
+            any = True
+    return any
+
+
 cdef int _newton(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t* nb, long newton_steps,
                  double scale, int* factorizations, const Reduced* table, KKT* kkt,
                  const double* rho_vec, bint* tabled) noexcept nogil:
@@ -405,11 +422,20 @@ cdef int _newton(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t* nb, lon
     re-linearize them at the current point up to ``newton_steps`` times (chord steps while
     they converge fast), then refine the point and set its multipliers: 0. 1 when a block
     went past its apex (held there now, ``nb`` the blocks left, the point not re-solved);
-    -1 when a factorization broke down."""
+    -1 when a factorization broke down. Where planes were ``KEPT``
+    (:func:`~fccqp.polish_guess.keep_bare_plane`), the first step solves them there."""
     cdef double miss, rate, last_miss = INFINITY
     cdef bint refactored = False
     cdef Py_ssize_t changed
     cdef long step
+    if _restore_kept_planes(w, p, nb[0]):
+        if not _solve_guess(w, p, nf, nb[0], scale, factorizations, table, kkt, rho_vec,
+                            tabled, False):
+            return -1
+        refactored = True
+        nb[0] = drop_far_side(w, p, nb[0], &changed)
+        if changed != 0:
+            return 1
     for step in range(newton_steps):
         if not _relinearize(w, p, nb[0], &miss) or (
                 refactored and miss >= last_miss and miss <= MISS_FLOOR):
@@ -509,6 +535,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     cdef bint planes_only = True   # every infeasible pass only put free blocks on their boundary
     cdef Py_ssize_t held
     cdef Py_ssize_t blocking
+    cdef const double* ahead
     cdef double t
     if p.P.kind == CSC:   # the curvature terms in PolishCSC's storage (n x the largest cone)
         w.hess, w.hess_stride = w.csc.hess, w.csc.hess_stride
@@ -523,6 +550,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         w.active[j] = FREE
     for j in range(p.cones.count):
         w.dropped[j] = False
+        w.bare[j] = CURVED
     w.cycling = False
     nb = guess(w, p, it.z, it.y, &changed)
     while True:
@@ -554,18 +582,22 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         if feasible:
             t = step_length(w, p, &blocking)
             if blocking >= 0:   # stop where the first constraint does, and hold it (all at t = 0)
+                ahead = NULL
+                if t == 0.0:   # renew places the blocks held from where the step pointed
+                    ahead = w.grad   # scratch here: the full step's point
+                    copy(w.x, w.grad, n)
                 for j in range(n):
                     w.x[j] = w.x_prev[j] + t * (w.x[j] - w.x_prev[j])
                 for j in range(m):
                     w.nu[j] = w.nu_prev[j] + t * (w.nu[j] - w.nu_prev[j])
                 w.grad_current = False
-                nb = renew(w, p, True, True, &changed)
+                nb = renew(w, p, True, True, ahead, &changed)
                 continue
         held = boundary_entries(w, p, nb)
-        nb = renew(w, p, True, False, &changed)
+        nb = renew(w, p, True, False, NULL, &changed)
         if changed == 0:
             feasible = True
-            nb = renew(w, p, False, False, &changed)
+            nb = renew(w, p, False, False, NULL, &changed)
         elif not feasible:
             planes_only = planes_only and changed == boundary_entries(w, p, nb) - held
             if passes >= FEASIBLE_PASSES and not planes_only:
@@ -580,12 +612,12 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
             return False
         if settled > 0:
             continue   # a block went past its apex: solve the corrected guess
-        nb = renew(w, p, True, False, &changed)
+        nb = renew(w, p, True, False, NULL, &changed)
         if changed != 0:   # Newton's planes moved a free constraint out of its set: hold it
             feasible = False   # and solve the corrected guess from this point, without a step
             continue
         if most_wrong(w, p) >= 0:   # Newton moved a plane's multiplier past 0: release it
-            nb = renew(w, p, False, False, &changed)
+            nb = renew(w, p, False, False, NULL, &changed)
             continue
         break
     w.passes = passes
