@@ -75,7 +75,7 @@ from fccqp.reduced cimport Reduced
 from fccqp.tuning cimport (ACTIVE_TOLERANCE, CHORD_RATE, CHORD_STEPS, FEASIBLE_PASSES, GUESS_PASSES,
                            GUESS_TOLERANCE, MAX_REFINE, MISS_FLOOR, NEWTON_TOLERANCE,
                            POLISH_CSC_DELTA, POLISH_DELTA, POLISH_REFINE_TOLERANCE,
-                           POLISH_RETRY_CUT, POLISH_RETRY_RESIDUAL)
+                           POLISH_DELTA_CUT, POLISH_STALL_RESIDUAL)
 
 cdef extern from "fccqp_clock.h" nogil:
     double fccqp_now()
@@ -217,14 +217,14 @@ cdef void _solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
     correction, so the residual contracts by ``rate = delta / (c + delta)`` and stays
     far above ``tolerance`` with the step mostly unmade (a friction cone of curvature
     1e-14 against the dense 1e-12, the sparse 1e-8). Where it stops more than
-    ``POLISH_RETRY_RESIDUAL`` times above ``tolerance`` and still contracting, the system
-    is factored again with ``delta`` cut to ``POLISH_RETRY_CUT`` times the curvature that
+    ``POLISH_STALL_RESIDUAL`` times above ``tolerance`` and still contracting, the system
+    is factored again with ``delta`` cut to ``POLISH_DELTA_CUT`` times the curvature that
     rate shows, ``delta (1 - rate) / rate``, and the corrections go on from the current
     point. A correction of that factorization that does not halve the residual is undone
     and the previous factorization restored (a singular block, an LP's free entry, has
     no curvature for any ``delta`` to uncover: its steps would only grow), and no other
     retry is made on it (``retry_spent``). A refinement that halves as it should is
-    untouched, and so is one that stops within ``POLISH_RETRY_RESIDUAL`` of
+    untouched, and so is one that stops within ``POLISH_STALL_RESIDUAL`` of
     ``tolerance`` (where rounding usually stops it) or in a polish held to the Schur
     complement (``schur_only``: it assembles nothing)."""
     cdef double norm, last = INFINITY, previous = 0.0
@@ -243,11 +243,11 @@ cdef void _solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
         if norm <= tolerance or r == MAX_REFINE + 1:
             return
         if norm > 0.5 * last:
-            if (norm >= last or norm <= POLISH_RETRY_RESIDUAL * tolerance or w.retry_spent
+            if (norm >= last or norm <= POLISH_STALL_RESIDUAL * tolerance or w.retry_spent
                     or w.schur_only):
                 return
             previous, was_structured = w.delta, w.structured
-            if not _refactor(w, p, nf, nb, POLISH_RETRY_CUT * w.delta * (last - norm) / norm,
+            if not _refactor(w, p, nf, nb, POLISH_DELTA_CUT * w.delta * (last - norm) / norm,
                              factorizations):
                 _restore(w, p, nf, nb, previous, was_structured, factorizations)
                 return
