@@ -89,6 +89,22 @@ def test_budget_stopped_solve_is_polished_to_solved(kkt_backend):
     assert check_solution(Problem.of(*problem), result, EXACT).passed
 
 
+def test_a_free_cone_flatter_than_the_regularization_is_polished_to_its_minimum(kkt_backend):
+    """A separable QP without rows whose friction cone has curvature 1e-12 (about 1e-14
+    once scaled, below the polish's regularization on every backend) and its unconstrained
+    minimum inside the cone: the polish guesses the cone free and must reach that minimum,
+    where ADMM only crawls toward it (rho at its floor against that curvature)."""
+    curvature = np.array([6e-9, 0.0, 1.7, 2e-12, 2.3e-12, 1.4e-12])
+    q = np.array([5e-4, -90.0, -4.0, 6.6e-7, -9.2e-8, -3.92e-6])
+    ub = np.array([-5e4, 5e-3, 4.0, np.inf, np.inf, np.inf])
+    minimum = np.array([-q[0] / curvature[0], ub[1], -q[2] / curvature[2],
+                        *(-q[3:] / curvature[3:])])   # x[1] at its bound, the rest free
+    result = fccqp.solve(np.diag(curvature), q, None, None, None, ub,
+                         [fccqp.FrictionCone(3, 0.7)], kkt_backend=kkt_backend)
+    assert result.status is Status.SOLVED and result.polished
+    np.testing.assert_allclose(result.x, minimum, rtol=1e-6)
+
+
 def test_warm_solver_polishes_a_sequence():
     P, q, A, b, lb, ub, cones = _cone_problem(2)
     solver = fccqp.Solver(polish=True)

@@ -34,6 +34,8 @@ cdef struct Polish:
     PolishSchur schur       # the Schur-complement solve where P's structure allows it
     PolishCSC csc           # the assembled matrix and its qdldl factor where P and A are CSC
     bint structured         # the current guess is factored in schur, not in K
+    double delta            # the regularization of the current factorization
+    bint retry_spent        # a refactorization with a smaller delta failed: no other on this one
     bint schur_only         # fail rather than assemble for dsytrf where schur does not apply
     bint schur_failed       # the last polish failed so
     long passes             # the guesses the last polish solved
