@@ -414,7 +414,9 @@ cdef inline bint _extended_polish_due(Engine* e, Loop* L) noexcept nogil:
     if not (L.timed and L.periodic and L.iteration >= L.next_guess_look):
         return False
     L.next_guess_look = L.iteration + EXTENDED_POLISH_INTERVAL
-    return L.deadline - (fccqp_now() - L.start_time) >= AUXILIARY_TIME
+    if L.deadline - (fccqp_now() - L.start_time) < AUXILIARY_TIME:
+        return False
+    return guess_changes(&e.prob, e.it.z, e.it.y, e.work.guess_point, e.work.guess_codes) != 0
 
 
 cdef inline bint _converging(const Loop* L, double now) noexcept nogil:
