@@ -42,8 +42,7 @@ from fccqp.reduced cimport materialize, near_convergence, reduced_start, reduced
 from fccqp.rho_rule cimport TrialState, new_rho, trial_reset
 from fccqp.termination cimport Residuals, converged, distance, nearly_converged
 from fccqp.tuning cimport (AUXILIARY_TIME, CLEANING_START, CONVERGING, EARLY_POLISH_GATE,
-                           EARLY_POLISH_TRIES, EQUALITY_MISSED, EXTENDED_POLISH_INTERVAL,
-                           GATED_CHECK_WAIT, LOG_INTERVAL,
+                           EARLY_POLISH_TRIES, EQUALITY_MISSED, GATED_CHECK_WAIT, LOG_INTERVAL,
                            POLISH_GATE, POLISH_RETRIES, RESERVE_PASSES, RESTART_MIN_ITER,
                            STALL_FACTOR, STALLS, TIMED_EARLY_POLISH)
 from fccqp.verdict cimport check, classify, inconsistent, missed, missed_by_data, unbounded
@@ -75,7 +74,6 @@ cdef struct Loop:
     TrialState trial        # small rho moves on trial (fccqp.rho_rule)
     long cap                # the iteration cap: max_iter, extended under a time limit (_extend)
     bint cap_polish         # the cap was just extended: polish as an untimed run's end would
-    long next_guess_look    # past max_iter, when _extended_polish_due next compares guesses
     long mark_at            # the first check from this iteration records mark
     double mark             # termination.distance at that check
     long trend_from         # the iteration of the first mark; LONG_MAX before it
@@ -148,7 +146,6 @@ cdef inline void _begin(Engine* e, Loop* L, Run* run, bint cold, double start_ti
     L.timed = isfinite(o.time_limit)
     L.cap = o.max_iter
     L.cap_polish = False
-    L.next_guess_look = o.max_iter + EXTENDED_POLISH_INTERVAL
     L.mark_at = o.max_iter - o.max_iter // 2
     L.mark = L.last_distance = L.trend_start = L.best = INFINITY
     L.trend_from = LONG_MAX
@@ -396,27 +393,7 @@ cdef inline void _polish_attempts(Engine* e, Loop* L, Run* run) noexcept nogil:
         # distance, this one polishes too and goes on unless that solved it
         L.cap_polish = False
         L.polished_at = L.iteration
-        L.next_guess_look = L.iteration + EXTENDED_POLISH_INTERVAL
         run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, True)
-    elif L.status == RUNNING and o.polish and not L.last and _extended_polish_due(e, L):
-        L.polished_at = L.iteration
-        run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, True)
-
-
-cdef inline bint _extended_polish_due(Engine* e, Loop* L) noexcept nogil:
-    """Whether a timed run past ``max_iter`` (on an extended cap, :func:`_extend`) with
-    ``AUXILIARY_TIME`` left polishes between its cap polishes: every
-    ``EXTENDED_POLISH_INTERVAL`` iterations, where ADMM's guessed active set changed
-    since the last look. These long runs are solved by a polish of the right active set
-    (not by the iterate, which falls slowly toward tolerances of 1e-7..1e-11 relative),
-    and the iterate passes through it between two caps. Never on a control tick (no
-    tick runs past ``max_iter`` with a second left) nor untimed."""
-    if not (L.timed and L.periodic and L.iteration >= L.next_guess_look):
-        return False
-    L.next_guess_look = L.iteration + EXTENDED_POLISH_INTERVAL
-    if L.deadline - (fccqp_now() - L.start_time) < AUXILIARY_TIME:
-        return False
-    return guess_changes(&e.prob, e.it.z, e.it.y, e.work.guess_point, e.work.guess_codes) != 0
 
 
 cdef inline bint _converging(const Loop* L, double now) noexcept nogil:

@@ -184,8 +184,6 @@ cdef extern from *:
     #define FCCQP_CONVERGING 0.5
     /* a stalled timed run gets its certificates and retries only with this many seconds left */
     #define FCCQP_AUXILIARY_TIME 1.0
-    /* past max_iter with AUXILIARY_TIME left a timed run polishes a changed guess this often */
-    #define FCCQP_EXTENDED_POLISH_INTERVAL 500
     """
     # The declarations, in the order above; each type is the one the code computes with.
     # Input validation
@@ -275,4 +273,3 @@ cdef extern from *:
     const long TIMED_EARLY_POLISH "FCCQP_TIMED_EARLY_POLISH"
     const double CONVERGING "FCCQP_CONVERGING"
     const double AUXILIARY_TIME "FCCQP_AUXILIARY_TIME"
-    const long EXTENDED_POLISH_INTERVAL "FCCQP_EXTENDED_POLISH_INTERVAL"
