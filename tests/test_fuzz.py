@@ -21,7 +21,8 @@ SEEDS = {
     "dual_infeasible": (0, 1, 2, 33, 166, 257, 368),
     "solver_reuse": (0, 1, 2, 50, 164, 211, 100008, 100206, 500061, 700137),
     "extreme_data": (0, 1, 7, 9, 38, 47, 56, 108, 138, 149, 202, 214, 254, 302, 308, 316,
-                     311, 326, 335, 337, 355, 363, 365, 489, 1182, 2244, 100082, 100180, 100213,
+                     311, 326, 335, 337, 355, 363, 365, 489, 1182, 2244, 100082, 100121, 100180,
+                     100213,
                      100228, 100233, 500030, 500064, 500099, 500322, 700281, 900343, 900360,
                      1100037, 1100057, 1100150, 1100253, 1300030, 1300300, 1500043, 1700106,
                      1700359, 1900050, 2900030),
@@ -39,14 +40,15 @@ unequilibrated; feasible 2900227 a run still converging at its cap, which the st
 run's continuation answers; extreme_data 1900050 a stall where the dual test lies
 below the rounding of ``P x`` and Clarabel's optimum fails it, no failure
 (``fuzzing._below_rounding``); extreme_data 2900030 a stall whose rho rule climbed to
-where the dual residual crawls, which the retry from a smaller rho answers; issues 26
-and 28)."""
+where the dual residual crawls, which the retry from a smaller rho answers; extreme_data
+100121 a free friction cone flatter than the polish's regularization, whose refinement
+stalled with the step mostly unmade; issues 26 and 28)."""
 
 SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),
     "feasible": (0,),
     "solver_reuse": (38,),
-    "extreme_data": (26, 900343, 1700359, 2900030),
+    "extreme_data": (26, 100121, 900343, 1700359, 2900030),
     "qpsolvers": (100035,),
     "cvxpy": (7, 1700154, 1900171),
     "dual_infeasible": (1700072,),
@@ -55,6 +57,8 @@ SPARSE_SEEDS = {
 ``extreme_data:1700359`` a friction cone capped through a boxed copy of its normal
 force (variables rescaled 1e-8..1e8), infeasible, whose certificate the run finds only
 by cleaning its candidate on ``A A'`` (uncleaned: MAX_ITER_REACHED after every retry);
+``extreme_data:100121`` a free friction cone of curvature 1e-14 (scaled) below
+``POLISH_CSC_DELTA``, polished to its minimum only by the refinement's refactorization;
 ``qpsolvers:100035`` is an LP that the compressed-column polish lost at
 ``POLISH_CSC_DELTA = 1e-12`` (qdldl without pivoting), ``cvxpy:1900171`` one it lost at
 1e-9 (ADMM crawls on every backend; the dense polish ends it at 4000 iterations);

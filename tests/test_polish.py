@@ -63,7 +63,7 @@ def test_polished_answer_is_exact(seed, kkt_backend):
     assert np.abs(plain.x - reference.x).max() > 2e-5
 
 
-@pytest.mark.parametrize("seed", [3, 5])
+@pytest.mark.parametrize("seed", [5, 18])
 def test_wrong_guess_keeps_the_admm_point(seed, kkt_backend):
     # two iterations of ADMM do not know the active set: the polished point fails the
     # check and the (restored) ADMM point is returned unchanged
@@ -87,6 +87,22 @@ def test_budget_stopped_solve_is_polished_to_solved(kkt_backend):
     assert result.polished and result.status is Status.SOLVED
     verify_solution(problem, result)
     assert check_solution(Problem.of(*problem), result, EXACT).passed
+
+
+def test_a_free_cone_flatter_than_the_regularization_is_polished_to_its_minimum(kkt_backend):
+    """A separable QP without rows whose friction cone has curvature 1e-12 (about 1e-14
+    once scaled, below the polish's regularization on every backend) and its unconstrained
+    minimum inside the cone: the polish guesses the cone free and must reach that minimum,
+    where ADMM only crawls toward it (rho at its floor against that curvature)."""
+    curvature = np.array([6e-9, 0.0, 1.7, 2e-12, 2.3e-12, 1.4e-12])
+    q = np.array([5e-4, -90.0, -4.0, 6.6e-7, -9.2e-8, -3.92e-6])
+    ub = np.array([-5e4, 5e-3, 4.0, np.inf, np.inf, np.inf])
+    minimum = np.array([-q[0] / curvature[0], ub[1], -q[2] / curvature[2],
+                        *(-q[3:] / curvature[3:])])   # x[1] at its bound, the rest free
+    result = fccqp.solve(np.diag(curvature), q, None, None, None, ub,
+                         [fccqp.FrictionCone(3, 0.7)], kkt_backend=kkt_backend)
+    assert result.status is Status.SOLVED and result.polished
+    np.testing.assert_allclose(result.x, minimum, rtol=1e-6)
 
 
 def test_warm_solver_polishes_a_sequence():
@@ -354,12 +370,12 @@ def test_polish_holds_a_free_block_that_newton_moved_out_of_its_cone():
 
 def test_polish_puts_its_last_guess_on_the_cones():
     """This polish uses all ``GUESS_PASSES`` guesses, and its last one is the optimal
-    active set; its first solve, at the planes of the previous point, left the boundary
-    blocks off their cones by 3e-2. The last guess also gets Newton's steps, and the
+    active set; its first solve, at the planes of the previous point, is 0.12 off the
+    reference (``newton_steps=0``). The last guess also gets Newton's steps, and the
     polished point is the reference's."""
-    targets = np.array([[-1.7, -2.9, 0.8], [-0.3, -1.2, -0.9], [-1.0, 0.2, 0.1],
-                        [0.6, -0.1, 1.7]])
-    z = np.array([0.8, -0.1, 3.5, 0.8, -0.2, 1.4, 0.6, 0.3, 2.3, 0.8, -0.5, 1.7])
+    targets = np.array([[-1.64, -3.14, 1.1], [-0.33, -0.99, -1.56], [-1.48, 0.5, 0.22],
+                        [0.45, -0.43, 2.33]])
+    z = np.array([0.8, 0.1, 3.7, 0.6, 0.0, 1.7, 0.5, 0.3, 2.1, 0.6, -0.3, 1.7])
     y = np.zeros(12)
     y[6:8] = [0.9, -0.2]
     cones = tuple(fccqp.FrictionCone(3 * i, 0.2) for i in range(4))
@@ -373,17 +389,13 @@ def test_polish_puts_its_last_guess_on_the_cones():
     np.testing.assert_allclose(polished["x"], reference.x, atol=1e-7)
 
 
-def test_warm_polish_keeps_a_contact_a_chord_step_threw_past_its_apex():
-    """solo12's third benchmark sequence (``mix``, seed 0), ticks 200-208: on ticks
-    205-208 the previous tick's active set holds, but the first Newton step of the warm
-    polish, a chord step with a factorization that lacks a plane's curvature, threw a
-    boundary block past its apex; held at the apex, the block was released and thrown
-    again until the polish ended, and ticks ran ADMM (16-20 iterations on 207 and 208).
-    The chord step is now undone and refactored: the warm polish answers each of them."""
+def _warm_ticks(robot, first, last):
+    """The realtime preset's answers, warm along ticks ``first..last`` of ``robot``'s
+    benchmark set (``mix``, seed 0; ``first`` starts a sequence or follows one cold)."""
     pytest.importorskip("pinocchio")
     from benchmarks.testsets import generate_test_set
 
-    qps = generate_test_set("solo12", "mix", 400, seed=0).qps[200:209]
+    qps = generate_test_set(robot, "mix", 400, seed=0).qps[first:last + 1]
     solver = fccqp.Solver(fccqp.Settings.realtime(100.0))
     results = [solver.solve(qp.P, qp.q, qp.A, qp.b, qp.lb, qp.ub,
                             [fccqp.FrictionCone(int(start), float(mu), tuple(map(float, normal)))
@@ -391,4 +403,32 @@ def test_warm_polish_keeps_a_contact_a_chord_step_threw_past_its_apex():
                                                           strict=True)])
                for qp in qps]
     assert all(r.status is Status.SOLVED for r in results)
+    return results
+
+
+def test_warm_polish_keeps_a_contact_a_chord_step_threw_past_its_apex():
+    """solo12's third benchmark sequence, ticks 200-208: on ticks 205-208 the previous
+    tick's active set holds, but the first Newton step of the warm polish, a chord step
+    with a factorization that lacks a plane's curvature, threw a boundary block past its
+    apex; held at the apex, the block was released and thrown again until the polish
+    ended, and ticks ran ADMM (16-20 iterations on 207 and 208). The chord step is now
+    undone and refactored: the warm polish answers each of them."""
+    results = _warm_ticks("solo12", 200, 208)
     assert all(r.polished and r.iterations == 0 for r in results[5:])
+
+
+def test_warm_polish_solves_a_released_contact_on_its_own_plane_first():
+    """go2's first benchmark sequence, tick 38: the warm polish releases an apex block
+    (a contact being loaded) onto a plane with ``lam = 0``; moved to the solved point,
+    where nothing had held the block's tangential part, the plane turned away from the
+    answer's and every next solve put the contact past its apex, and the tick ran 46
+    ADMM iterations. Newton's first solve now keeps that plane, with its curvature."""
+    assert _warm_ticks("go2", 0, 38)[-1].iterations == 0
+
+
+def test_warm_polish_places_a_block_a_zero_length_step_held_where_the_step_pointed():
+    """go2's third benchmark sequence, tick 215: each released block was stopped by a
+    step of length 0 and held back where it had been, then released again, for all the
+    polish's guesses, and the tick ran 17 ADMM iterations. Held from where the step
+    pointed, the warm polish answers it."""
+    assert _warm_ticks("go2", 200, 215)[-1].iterations == 0

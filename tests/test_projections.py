@@ -7,6 +7,7 @@ from fccqp.projections import (
     project_constraint_set,
     project_friction_cone,
     project_second_order_cone,
+    touching_point,
 )
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -153,3 +154,49 @@ def test_every_registered_kind_has_its_code_in_the_compiled_core():
         project_cone_block(np.ones(4), FRICTION, 0.5, UP, np.empty(4))
     with pytest.raises(ValueError, match="kind 7"):
         project_cone_block(v, 7, 0.5, UP, np.empty(3))
+
+
+@pytest.mark.parametrize("kind, dim", [(FRICTION, 3), (SECOND_ORDER, 2), (SECOND_ORDER, 5)])
+def test_the_tangent_plane_touches_the_cone_on_the_ray_of_its_point(kind, dim):
+    """``cone_touch`` of the plane at a boundary point, with that point's axis part, is
+    the point itself; from a point off the cone, it lies on the boundary and on the
+    plane (the polish gives a plane its curvature there)."""
+    rng = np.random.default_rng(0)
+    for _ in range(50):
+        normal = rng.standard_normal(3)
+        normal /= np.linalg.norm(normal)
+        mu = rng.uniform(0.1, 2.0)
+        v = rng.standard_normal(dim)
+        on, out = np.empty(dim), np.empty(dim)
+        project_cone_block(v, kind, mu, normal, on)
+        if _phi(v, kind, mu, normal) <= 0.0 or not touching_point(on, kind, mu, normal, out):
+            continue   # v in the cone, or its projection is the apex
+        np.testing.assert_allclose(out, on, atol=1e-12 * np.linalg.norm(on))
+        off = on + rng.standard_normal(dim)
+        if _split(off, kind, normal)[0] > 0.0 and touching_point(off, kind, mu, normal, out):
+            assert abs(_phi(out, kind, mu, normal)) <= 1e-12 * np.linalg.norm(out)
+            assert abs(_plane_gap(off, out, kind, mu, normal)) <= 1e-12 * np.linalg.norm(out)
+
+
+def _split(v, kind, normal):
+    """The axis part of ``v`` and the norm of the rest."""
+    if kind == FRICTION:
+        along = normal @ v
+        return along, np.linalg.norm(v - along * normal)
+    return v[0], np.linalg.norm(v[1:])
+
+
+def _phi(v, kind, mu, normal):
+    """The cone function ``across - slope * along``."""
+    along, across = _split(v, kind, normal)
+    return across - (mu if kind == FRICTION else 1.0) * along
+
+
+def _plane_gap(at, v, kind, mu, normal):
+    """``g'v`` for ``g`` the cone function's gradient at ``at`` (unnormalized)."""
+    along, across = _split(at, kind, normal)
+    if kind == FRICTION:
+        g = (at - along * normal) / across - mu * normal
+    else:
+        g = np.concatenate([[-1.0], at[1:] / across])
+    return g @ v

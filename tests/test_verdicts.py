@@ -554,3 +554,19 @@ def test_no_auxiliary_certificate_on_public_qps_with_an_optimum(name):
     problem = maros_meszaros.load_problem(MAROS_MESZAROS / f"{name}.mat")[0]
     solution = qpsolvers.solve_problem(problem, solver="fccqp", eps_abs=1e-3, eps_rel=0.0)
     assert not solution.extras["status"].is_infeasible()
+
+
+def test_a_least_distance_solution_that_misses_its_identity_is_solved_in_the_other_form():
+    """A friction cone in units of 1e-2 pinned outside itself by two rows, by 1e-3 of its
+    size (the fuzzer's ``extreme_data``): solved to the Farkas tolerances in the full
+    form, its least-distance QP ended SOLVED, polished to a KKT residual of 2e-15, yet
+    3e-9 off the optimum on two boxed entries, where the support of bounds of 0.08 and
+    ``b'y`` cancel to miss the identity by 1.2 %; the run's SOLVED claim on lent
+    tolerances then stood. Such a solution is now solved again in the other form,
+    as one that is not SOLVED is."""
+    from fuzzing import Case
+
+    problem = Case.of("extreme_data", 900343).scenario().problem
+    result = solve_verified(problem)
+    assert result.status is Status.PRIMAL_INFEASIBLE
+    assert clarabel_solve(*problem.args()).status == "primal_infeasible"

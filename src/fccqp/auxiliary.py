@@ -266,12 +266,18 @@ def _auxiliary_solver(solver_type: type, settings: object, deadline: float) -> o
     return solver
 
 
-def _solved(solver_type: type, settings: object, problem: tuple, deadline: float) -> tuple:
+def _is_solved(result: object) -> bool:
+    """Whether an auxiliary solve ended SOLVED."""
+    return result.status is Status.SOLVED
+
+
+def _solved(solver_type: type, settings: object, problem: tuple, deadline: float,
+            usable: object = _is_solved) -> tuple:
     """``(result, iterations, factorizations)`` of an auxiliary ``problem``: solved with
     ``settings`` by ``deadline``, and again in the other form (:func:`other_form`) unless
-    that ended SOLVED; the counts are those of both solves."""
+    that result is ``usable`` (by default: SOLVED); the counts are those of both solves."""
     result = _auxiliary_solver(solver_type, settings, deadline).solve(*problem)
-    if result.status is Status.SOLVED or result.backend == "sparse":   # no other form
+    if usable(result) or result.backend == "sparse":   # no other form
         return result, result.iterations, result.factorizations
     again = _auxiliary_solver(solver_type, other_form(settings, result.backend),
                               deadline).solve(*problem)
@@ -415,6 +421,23 @@ def _farkas(workspace: object, result: object, b: np.ndarray, lb: np.ndarray,
     return workspace.judge_certificate(candidate, True, np.ascontiguousarray(result.x[:n]))
 
 
+def _certifying(workspace: object, b: np.ndarray, lb: np.ndarray, ub: np.ndarray,
+                S: np.ndarray, divisors: np.ndarray) -> object:
+    """Whether a least-distance result gives a certificate (:func:`_farkas`).
+
+    A solve SOLVED at the Farkas tolerances can still miss the identity of
+    :func:`_least_distance`: those tolerances bound its residuals, not its error along a
+    direction the KKT matrix barely sees. A friction cone pinned outside itself by two
+    rows, in units of 1e-2, polished in the full form to a KKT residual of 2e-15 (its
+    refinement uncovering a curvature of 1.5e-13) with ``x_S - u`` of 3e-9 on two boxed
+    entries where the optimum has 1e-14: against bounds of 0.08 their support and ``b'y``
+    (2.3e-10 each) cancelled to miss the distance of 2.25e-11 by 1.2 %; the reduced
+    form's Schur complement solve met it to 5e-8."""
+    def certifies(result: object) -> bool:
+        return _farkas(workspace, result, b, lb, ub, S, divisors) is not None
+    return certifies
+
+
 def _farkas_tolerances(settings: object, w: np.ndarray) -> object:
     """``settings`` whose termination meets the Farkas test of a least-distance solution
     with multipliers ``w``: its dual residual, ``A'y + z``, within ``eps_prim_inf``
@@ -437,9 +460,11 @@ def _distance_certificate(solver_type: type, settings: object, workspace: object
     if found is None and _at_positive_distance(first, n):
         # its multipliers have the size of the distance, and the run's tolerances left
         # them a residual of 2e-6 of it where the Farkas test allows eps_prim_inf =
-        # 1e-6, or left the identity unmet: solved again to that test
+        # 1e-6, or left the identity unmet: solved again to that test, and in the other
+        # form where its solution still misses it (see _certifying)
         result, iterations, factorizations = _solved(
-            solver_type, _farkas_tolerances(settings, first.z[n:]), problem, deadline)
+            solver_type, _farkas_tolerances(settings, first.z[n:]), problem, deadline,
+            _certifying(workspace, b, lb, ub, S, divisors))
         spent, factored = spent + iterations, factored + factorizations
         found = _farkas(workspace, result, b, lb, ub, S, divisors)
     return found, first, spent, factored

@@ -18,6 +18,10 @@ entries with the block's parameters ``mu`` and ``normal`` (the fields of
   and its value; False where the gradient does not exist;
 - ``curvature(v, dim, mu, normal, weight, H)``: ``weight`` times the Hessian of ``phi``
   at ``v`` over the normalization of ``g`` (``dim x dim``), for the polish's Newton steps.
+- ``touch(g, dim, mu, normal, along, out)``: the point with axis part ``along`` of the
+  ray where the plane through the apex with unit normal ``g`` touches the cone (False
+  where ``g`` lies on the axis), for a plane that keeps its place while it gains its
+  curvature.
 
 This file is the only place in the compiled core that lists the kinds: each ``cone_*``
 function below switches on the kind code to the module's operation, and the algorithm
@@ -38,7 +42,7 @@ or where it is used:
 - a cone is its own recession cone: the dual certificate tests ``dx_block`` against
   ``project``.
 
-Adding a kind: its module ``cone_<kind>.pxd`` with the six operations, its code in the
+Adding a kind: its module ``cone_<kind>.pxd`` with the seven operations, its code in the
 enum below and a branch in each ``cone_*`` switch; on the Python side its spec in
 :mod:`fccqp.cones` (the registry ``KINDS`` there, with the same code).
 """
@@ -114,6 +118,15 @@ cdef inline void cone_curvature(const double* v, Py_ssize_t kind, Py_ssize_t dim
         friction.curvature(v, dim, mu, normal, weight, H)
     else:
         soc.curvature(v, dim, mu, normal, weight, H)
+
+
+cdef inline bint cone_touch(const double* g, Py_ssize_t kind, Py_ssize_t dim, double mu,
+                            const double* normal, double along, double* out) noexcept nogil:
+    """The point with axis part ``along`` where the plane through the apex with unit
+    normal ``g`` touches the cone; False (``out`` untouched) where ``g`` is on the axis."""
+    if kind == FRICTION:
+        return friction.touch(g, dim, mu, normal, along, out)
+    return soc.touch(g, dim, mu, normal, along, out)
 
 
 cdef inline double cone_phi(const double* v, Py_ssize_t kind, Py_ssize_t dim, double mu,

@@ -97,6 +97,22 @@ cdef inline bint plane(const double* v, Py_ssize_t dim, double mu, const double*
     return True
 
 
+cdef inline bint touch(const double* g, Py_ssize_t dim, double mu, const double* normal,
+                       double along, double* out) noexcept nogil:
+    """The point with normal part ``along`` of the ray where the plane through the apex
+    with unit normal ``g`` (:func:`plane`'s) touches the cone, ``along (n + mu e)`` with
+    ``e`` the unit tangential part of ``g``; False (``out`` untouched) where ``g`` has
+    none."""
+    cdef double across
+    cdef double g_along = split(g, dim, mu, normal, &across)
+    cdef Py_ssize_t i
+    if not across > 0.0:
+        return False
+    for i in range(3):
+        out[i] = along * (normal[i] + mu * (g[i] - g_along * normal[i]) / across)
+    return True
+
+
 cdef inline void curvature(const double* v, Py_ssize_t dim, double mu, const double* normal,
                            double weight, double* H) noexcept nogil:
     """``H`` (3 x 3, symmetric) = ``weight`` times the Hessian of the cone function at

@@ -78,6 +78,22 @@ cdef inline bint plane(const double* v, Py_ssize_t dim, double mu, const double*
     return True
 
 
+cdef inline bint touch(const double* g, Py_ssize_t dim, double mu, const double* normal,
+                       double along, double* out) noexcept nogil:
+    """The point with ``t = along`` of the ray where the plane through the apex with unit
+    normal ``g`` (:func:`plane`'s) touches the cone, ``along (1, e)`` with ``e`` the unit
+    direction of ``g``'s ``w`` part; False (``out`` untouched) where that part is 0."""
+    cdef double across
+    cdef Py_ssize_t i
+    split(g, dim, mu, normal, &across)
+    if not across > 0.0:
+        return False
+    out[0] = along
+    for i in range(1, dim):
+        out[i] = along * g[i] / across
+    return True
+
+
 cdef inline void curvature(const double* v, Py_ssize_t dim, double mu, const double* normal,
                            double weight, double* H) noexcept nogil:
     """``H`` (``dim x dim``, symmetric) = ``weight`` times the Hessian of the cone

@@ -14,6 +14,12 @@ cdef enum:
     APEX = 4        # entry of a cone block held at the apex (the block is 0)
     BOUNDARY = 5    # entry of a cone block on the cone's tangent plane
 
+cdef enum:
+    # Whether a boundary block's plane lacks its curvature (Polish.bare).
+    CURVED = 0      # its plane was placed with its curvature
+    BARE = 1        # its plane was placed without (its multiplier was not positive)
+    KEPT = 2        # bare, its multiplier now positive: the plane is in kept_plane
+
 cdef struct Polish:
     # Scratch of the polishing step; N = n + m + s bounds the size of its KKT system.
     char* active            # s: the guess, one code per constrained entry
@@ -28,10 +34,14 @@ cdef struct Polish:
     PolishSchur schur       # the Schur-complement solve where P's structure allows it
     PolishCSC csc           # the assembled matrix and its qdldl factor where P and A are CSC
     bint structured         # the current guess is factored in schur, not in K
+    double delta            # the regularization of the current factorization
+    bint retry_spent        # a refactorization with a smaller delta failed: no other on this one
     bint schur_only         # fail rather than assemble for dsytrf where schur does not apply
     bint schur_failed       # the last polish failed so
     long passes             # the guesses the last polish solved
     char* dropped           # cone count: the block went past its apex in this polish
+    char* bare              # cone count: BARE, the block's plane was placed without its curvature (lam <= 0); KEPT, and that plane is in kept_plane
+    double* kept_plane      # s: a KEPT block's curvature-less plane, where Newton's first solve puts it back
     char* blocked           # s: the constraints a step holds (polish_guess.step_length)
     bint cycling            # a block went past its apex twice: the guess cycles
     double* work            # lwork entries, for dsytrf

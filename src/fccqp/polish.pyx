@@ -30,7 +30,8 @@ boundary block as unknowns (``G`` holds the unit normals ``g``). It is factored 
 Bunch-Kaufman ``dsytrf`` (or by :mod:`fccqp.polish_schur`'s Schur complement where
 ``P``'s structure allows it; by qdldl in compressed columns, :mod:`fccqp.polish_csc`, where
 ``P`` and ``A`` are CSC) and refined against the unregularized matrix, as :mod:`fccqp.ldl`
-does. Each boundary block's plane is then re-linearized at the new
+does; where a free block's curvature lies below ``delta`` and the refinement crawls, it is
+factored again with a smaller ``delta`` (:func:`_solve`). Each boundary block's plane is then re-linearized at the new
 ``x_block`` and the system re-solved, ``newton_steps`` times at most or until ``|phi|
 <= NEWTON_TOLERANCE ||x_block||``: Newton's method (SQP) on the KKT conditions of the
 QP on the active manifold, quadratically convergent when the guess is right.
@@ -66,14 +67,15 @@ from fccqp.kkt cimport KKT
 from fccqp.matrices cimport CSC, DENSE, product, product_t
 from fccqp.polish_csc cimport polish_csc_factor, polish_csc_solve
 from fccqp.polish_guess cimport (boundary_entries, box_code, cone_code, drop_far_side, guess,
-                                 leaves_set, linearize, most_wrong, past_apex, renew,
-                                 step_length)
+                                 keep_bare_plane, leaves_set, linearize, most_wrong, past_apex,
+                                 renew, step_length)
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup, polish_schur_solve
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.reduced cimport Reduced
 from fccqp.tuning cimport (ACTIVE_TOLERANCE, CHORD_RATE, CHORD_STEPS, FEASIBLE_PASSES, GUESS_PASSES,
-                           GUESS_TOLERANCE, MAX_REFINE, MISS_FLOOR, NEWTON_TOLERANCE, POLISH_DELTA,
-                           POLISH_REFINE_TOLERANCE)
+                           GUESS_TOLERANCE, MAX_REFINE, MISS_FLOOR, NEWTON_TOLERANCE,
+                           POLISH_CSC_DELTA, POLISH_DELTA, POLISH_REFINE_TOLERANCE,
+                           POLISH_DELTA_CUT, POLISH_STALL_RESIDUAL)
 
 cdef extern from "fccqp_clock.h" nogil:
     double fccqp_now()
@@ -130,8 +132,10 @@ cdef Py_ssize_t _unknowns(Polish* w, const Problem* p) noexcept nogil:
     return nf
 
 
-cdef void _assemble(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) noexcept nogil:
-    """Lower triangle of the regularized KKT matrix of the polished QP into ``K``."""
+cdef void _assemble(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
+                    double delta) noexcept nogil:
+    """Lower triangle of the KKT matrix of the polished QP, regularized by ``delta``,
+    into ``K``."""
     cdef Py_ssize_t n = p.n, m = p.m, N = nf + m + nb, r, col, i, j, k, o, d, start, jc
     cdef double* K = w.K
     for col in range(N):
@@ -141,7 +145,7 @@ cdef void _assemble(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) n
         jc = w.free[col]
         for r in range(col, nf):
             K[r + col * N] = p.P.values[w.free[r] * n + jc]
-        K[col + col * N] += POLISH_DELTA
+        K[col + col * N] += delta
         for i in range(m):
             K[nf + i + col * N] = p.A.values[i * n + jc]
     for k in range(nb):
@@ -152,7 +156,7 @@ cdef void _assemble(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) n
             for i in range(j, d):   # entries of a block are consecutive unknowns
                 K[w.index[start + i] + w.index[start + j] * N] += w.hess[o * w.hess_stride + i * d + j]
     for r in range(nf, N):
-        K[r + r * N] = -POLISH_DELTA
+        K[r + r * N] = -delta
 
 
 cdef double _residual(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) noexcept nogil:
@@ -202,23 +206,83 @@ cdef void _apply(Polish* w, Py_ssize_t nf, Py_ssize_t m, Py_ssize_t nb,
 
 
 cdef void _solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
-                 double tolerance) noexcept nogil:
+                 double tolerance, int* factorizations) noexcept nogil:
     """Correct ``(x, nu, lam)`` to the solution of the factored system: residual
     corrections against the unregularized matrix until the residual is below
-    ``tolerance``, stops halving (a singular system), or ``MAX_REFINE`` corrections
-    after the first; a correction that makes it grow is undone."""
-    cdef double norm, last = INFINITY
+    ``tolerance``, stops halving, or ``MAX_REFINE`` corrections after the first; a
+    correction that makes it grow is undone.
+
+    A refinement can stop halving because of the regularization: a free block whose
+    curvature ``c`` lies below ``delta`` recovers ``c / (c + delta)`` of its step a
+    correction, so the residual contracts by ``rate = delta / (c + delta)`` and stays
+    far above ``tolerance`` with the step mostly unmade (a friction cone of curvature
+    1e-14 against the dense 1e-12, the sparse 1e-8). Where it stops more than
+    ``POLISH_STALL_RESIDUAL`` times above ``tolerance`` and still contracting, the system
+    is factored again with ``delta`` cut to ``POLISH_DELTA_CUT`` times the curvature that
+    rate shows, ``delta (1 - rate) / rate``, and the corrections go on from the current
+    point. A correction of that factorization that does not halve the residual is undone
+    and the previous factorization restored (a singular block, an LP's free entry, has
+    no curvature for any ``delta`` to uncover: its steps would only grow), and no other
+    retry is made on it (``retry_spent``). A refinement that halves as it should is
+    untouched, and so is one that stops within ``POLISH_STALL_RESIDUAL`` of
+    ``tolerance`` (where rounding usually stops it) or in a polish held to the Schur
+    complement (``schur_only``: it assembles nothing)."""
+    cdef double norm, last = INFINITY, previous = 0.0
+    cdef bint retrying = False, was_structured = False
     cdef int r
     for r in range(MAX_REFINE + 2):
         norm = _residual(w, p, nf, nb)
+        if retrying and not norm <= 0.5 * last:   # NaN included
+            _apply(w, nf, p.m, nb, -1.0)
+            _restore(w, p, nf, nb, previous, was_structured, factorizations)
+            return
+        retrying = False
         if norm > last:
             _apply(w, nf, p.m, nb, -1.0)
             return
-        if norm <= tolerance or norm > 0.5 * last or r == MAX_REFINE + 1:
+        if norm <= tolerance or r == MAX_REFINE + 1:
             return
+        if norm > 0.5 * last:
+            if (norm >= last or norm <= POLISH_STALL_RESIDUAL * tolerance or w.retry_spent
+                    or w.schur_only):
+                return
+            previous, was_structured = w.delta, w.structured
+            if not _refactor(w, p, nf, nb, POLISH_DELTA_CUT * w.delta * (last - norm) / norm,
+                             factorizations):
+                _restore(w, p, nf, nb, previous, was_structured, factorizations)
+                return
+            retrying = True
         last = norm
         _factored_solve(w, p, nf, nb)
         _apply(w, nf, p.m, nb, 1.0)
+
+
+cdef bint _refactor(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb, double delta,
+                    int* factorizations) noexcept nogil:
+    """Factor the current guess's KKT matrix regularized by ``delta``, assembled for
+    ``dsytrf`` (or for qdldl where ``P`` and ``A`` are CSC); False when the
+    factorization breaks down."""
+    cdef char uplo = b"L"
+    cdef int size = <int>(nf + p.m + nb), info = 0
+    factorizations[0] += 1
+    w.structured = False
+    w.delta = delta
+    if p.P.kind == CSC:
+        return polish_csc_factor(&w.csc, p, nf, w.free, w.index, w.boundary, nb, w.g, delta)
+    _assemble(w, p, nf, nb, delta)
+    dsytrf(&uplo, &size, w.K, &size, w.ipiv, w.work, &w.lwork, &info)
+    return info == 0
+
+
+cdef void _restore(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb, double delta,
+                   bint structured, int* factorizations) noexcept nogil:
+    """Return to the factorization with regularization ``delta`` after a retry with a
+    smaller one failed (the Schur complement's is intact: the retry assembled ``K``)."""
+    w.retry_spent = True
+    if structured:
+        w.structured, w.delta = True, delta
+    else:
+        _refactor(w, p, nf, nb, delta, factorizations)   # it factored before: it does again
 
 
 cdef void _factored_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) noexcept nogil:
@@ -332,30 +396,26 @@ cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t n
     against the ``dsytrf`` that follows anyway. Not without the workspace's storage
     (``schur.L`` NULL: :mod:`fccqp.polish_ops`' dense arm, which the tests hold to the
     CSC arm)."""
-    cdef char uplo = b"L"
-    cdef int size = <int>(nf + p.m + nb), info = 0
-    if size == 0:   # every entry held, no rows: nothing to solve
+    if nf + p.m + nb == 0:   # every entry held, no rows: nothing to solve
         return True
     if not w.schur.ready and not w.schur_only and w.schur.L != NULL:
         polish_prepare(w, p)   # first fallback of this solve from the table (see polish)
+    w.retry_spent = False
+    w.delta = POLISH_DELTA
     w.structured = w.schur.ready and polish_schur_factor(&w.schur, p, w.index, w.boundary, nb,
                                                          w.g, w.hess, POLISH_DELTA)
-    factorizations[0] += 1
     if w.structured:
-        _solve(w, p, nf, nb, tolerance)
+        factorizations[0] += 1
+        _solve(w, p, nf, nb, tolerance, factorizations)
         return True
     if w.schur_only:
+        factorizations[0] += 1
         w.schur_failed = True
         return False
-    if p.P.kind == CSC:
-        if not polish_csc_factor(&w.csc, p, nf, w.free, w.index, w.boundary, nb, w.g):
-            return False
-    else:
-        _assemble(w, p, nf, nb)
-        dsytrf(&uplo, &size, w.K, &size, w.ipiv, w.work, &w.lwork, &info)
-        if info != 0:
-            return False
-    _solve(w, p, nf, nb, tolerance)
+    if not _refactor(w, p, nf, nb, POLISH_CSC_DELTA if p.P.kind == CSC else POLISH_DELTA,
+                     factorizations):
+        return False
+    _solve(w, p, nf, nb, tolerance, factorizations)
     return True
 
 
@@ -365,8 +425,13 @@ cdef bint _solve_guess(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
     """Solve the polished QP of the current guess in the reduced form's coordinates
     while ``tabled`` (:mod:`fccqp.polish_table`), else with its own KKT matrix (refined
     to ``GUESS_TOLERANCE`` on a guess's ``first`` solve); a singular system in the
-    table's coordinates ends ``tabled`` for this polish."""
+    table's coordinates ends ``tabled`` for this polish. ``KEPT`` planes are dropped:
+    they serve only the first solve of :func:`_newton`."""
+    cdef Py_ssize_t k
     w.grad_current = False
+    for k in range(nb):   # a kept plane serves only the Newton step that follows it
+        if w.bare[w.boundary[k]] == KEPT:
+            w.bare[w.boundary[k]] = CURVED
     if tabled[0]:
         if table_factor(w, p, table, rho_vec, nb):
             table_solve(w, p, table, kkt, rho_vec, nb, scale)
@@ -398,6 +463,18 @@ cdef void _multipliers(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
             w.y[j] = w.lam[k] * w.g[j]
 
 
+cdef bint _restore_kept_planes(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
+    """Put every ``KEPT`` plane of the ``nb`` boundary blocks back, with its curvature
+    (:func:`~fccqp.polish_guess.keep_bare_plane`); whether there was one."""
+    cdef Py_ssize_t k
+    cdef bint any = False
+    for k in range(nb):
+        if w.bare[w.boundary[k]] == KEPT:
+            keep_bare_plane(w, p, k)
+            any = True
+    return any
+
+
 cdef int _newton(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t* nb, long newton_steps,
                  double scale, int* factorizations, const Reduced* table, KKT* kkt,
                  const double* rho_vec, bint* tabled) noexcept nogil:
@@ -405,11 +482,20 @@ cdef int _newton(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t* nb, lon
     re-linearize them at the current point up to ``newton_steps`` times (chord steps while
     they converge fast), then refine the point and set its multipliers: 0. 1 when a block
     went past its apex (held there now, ``nb`` the blocks left, the point not re-solved);
-    -1 when a factorization broke down."""
+    -1 when a factorization broke down. Where planes were ``KEPT``
+    (:func:`~fccqp.polish_guess.keep_bare_plane`), the first step solves them there."""
     cdef double miss, rate, last_miss = INFINITY
     cdef bint refactored = False
     cdef Py_ssize_t changed
     cdef long step
+    if _restore_kept_planes(w, p, nb[0]):
+        if not _solve_guess(w, p, nf, nb[0], scale, factorizations, table, kkt, rho_vec,
+                            tabled, False):
+            return -1
+        refactored = True
+        nb[0] = drop_far_side(w, p, nb[0], &changed)
+        if changed != 0:
+            return 1
     for step in range(newton_steps):
         if not _relinearize(w, p, nb[0], &miss) or (
                 refactored and miss >= last_miss and miss <= MISS_FLOOR):
@@ -431,7 +517,7 @@ cdef int _newton(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t* nb, lon
             table_solve(w, p, table, kkt, rho_vec, nb[0], scale)
             w.grad_current = False
         else:
-            _solve(w, p, nf, nb[0], POLISH_REFINE_TOLERANCE * scale)
+            _solve(w, p, nf, nb[0], POLISH_REFINE_TOLERANCE * scale, factorizations)
     _multipliers(w, p, nf, nb[0])
     return 0
 
@@ -509,6 +595,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     cdef bint planes_only = True   # every infeasible pass only put free blocks on their boundary
     cdef Py_ssize_t held
     cdef Py_ssize_t blocking
+    cdef const double* ahead
     cdef double t
     if p.P.kind == CSC:   # the curvature terms in PolishCSC's storage (n x the largest cone)
         w.hess, w.hess_stride = w.csc.hess, w.csc.hess_stride
@@ -523,6 +610,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         w.active[j] = FREE
     for j in range(p.cones.count):
         w.dropped[j] = False
+        w.bare[j] = CURVED
     w.cycling = False
     nb = guess(w, p, it.z, it.y, &changed)
     while True:
@@ -541,7 +629,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         if passes == GUESS_PASSES or w.cycling:   # not settled: the caller judges this point
             if most_wrong(w, p) >= 0 or leaves_set(w, p):   # not its point: as it is
                 if not tabled:
-                    _solve(w, p, nf, nb, POLISH_REFINE_TOLERANCE * scale)
+                    _solve(w, p, nf, nb, POLISH_REFINE_TOLERANCE * scale, factorizations)
                     _multipliers(w, p, nf, nb)
                 break
             settled = _newton(w, p, nf, &nb, newton_steps, scale, factorizations, table, kkt,
@@ -554,18 +642,22 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         if feasible:
             t = step_length(w, p, &blocking)
             if blocking >= 0:   # stop where the first constraint does, and hold it (all at t = 0)
+                ahead = NULL
+                if t == 0.0:   # renew places the blocks held from where the step pointed
+                    ahead = w.grad   # scratch here: the full step's point
+                    copy(w.x, w.grad, n)
                 for j in range(n):
                     w.x[j] = w.x_prev[j] + t * (w.x[j] - w.x_prev[j])
                 for j in range(m):
                     w.nu[j] = w.nu_prev[j] + t * (w.nu[j] - w.nu_prev[j])
                 w.grad_current = False
-                nb = renew(w, p, True, True, &changed)
+                nb = renew(w, p, True, True, ahead, &changed)
                 continue
         held = boundary_entries(w, p, nb)
-        nb = renew(w, p, True, False, &changed)
+        nb = renew(w, p, True, False, NULL, &changed)
         if changed == 0:
             feasible = True
-            nb = renew(w, p, False, False, &changed)
+            nb = renew(w, p, False, False, NULL, &changed)
         elif not feasible:
             planes_only = planes_only and changed == boundary_entries(w, p, nb) - held
             if passes >= FEASIBLE_PASSES and not planes_only:
@@ -580,12 +672,12 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
             return False
         if settled > 0:
             continue   # a block went past its apex: solve the corrected guess
-        nb = renew(w, p, True, False, &changed)
+        nb = renew(w, p, True, False, NULL, &changed)
         if changed != 0:   # Newton's planes moved a free constraint out of its set: hold it
             feasible = False   # and solve the corrected guess from this point, without a step
             continue
         if most_wrong(w, p) >= 0:   # Newton moved a plane's multiplier past 0: release it
-            nb = renew(w, p, False, False, &changed)
+            nb = renew(w, p, False, False, NULL, &changed)
             continue
         break
     w.passes = passes

@@ -22,6 +22,6 @@ cdef struct PolishCSC:
 cdef bint polish_csc_factor(PolishCSC* f, const Problem* p, Py_ssize_t nf,
                             const Py_ssize_t* free, const Py_ssize_t* index,
                             const Py_ssize_t* boundary, Py_ssize_t nb,
-                            const double* g) noexcept nogil
+                            const double* g, double delta) noexcept nogil
 cdef void polish_csc_solve(PolishCSC* f, Py_ssize_t size, double* v) noexcept nogil
 cdef void bind(PolishCSC* f, tuple arrays) except *

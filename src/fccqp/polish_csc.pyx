@@ -19,7 +19,8 @@ fill-reducing order; but without pivoting its rounding grows like ``1 / delta``,
 ``delta`` is ``POLISH_CSC_DELTA`` (1e-8) rather than the dense ``1e-12``: on an LP (``P =
 0``: the top-left block is ``delta I``) the solves of an active set that the dense
 backends' polish accepts were lost below it, and the polish's refinement against the
-unregularized system (``polish._solve``) removes the larger bias.
+unregularized system (``polish._solve``) removes the larger bias, factoring again with a
+smaller ``delta`` where a free block's curvature lies below it.
 
 Column ``c < |F|`` of the upper triangle is column ``F_c`` of ``P`` restricted to the
 free rows up to the diagonal (``P``'s full symmetric pattern makes its columns its
@@ -42,7 +43,6 @@ import numpy as np
 
 from fccqp._types cimport Problem
 from fccqp.matrices cimport Matrix
-from fccqp.tuning cimport POLISH_CSC_DELTA
 
 
 cdef class _Factor:
@@ -214,12 +214,13 @@ cdef void _assemble_csc(PolishCSC* f, const Problem* p, Py_ssize_t nf,
 cdef bint polish_csc_factor(PolishCSC* f, const Problem* p, Py_ssize_t nf,
                             const Py_ssize_t* free, const Py_ssize_t* index,
                             const Py_ssize_t* boundary, Py_ssize_t nb,
-                            const double* g) noexcept nogil:
-    """Assemble and factor the regularized KKT matrix of the guess (free entries
-    ``free[:nf]`` numbered by ``index``, boundary blocks ``boundary[:nb]`` with planes
-    ``g`` as in :c:type:`fccqp.polish.Polish`, curvature in ``f.hess``); False when qdldl
-    meets a zero pivot."""
-    _assemble_csc(f, p, nf, free, index, boundary, nb, g, POLISH_CSC_DELTA)
+                            const double* g, double delta) noexcept nogil:
+    """Assemble and factor the KKT matrix of the guess (free entries ``free[:nf]``
+    numbered by ``index``, boundary blocks ``boundary[:nb]`` with planes ``g`` as in
+    :c:type:`fccqp.polish.Polish`, curvature in ``f.hess``) regularized by ``delta``
+    (``POLISH_CSC_DELTA`` but where :mod:`fccqp.polish`'s refinement stalls); False when
+    qdldl meets a zero pivot."""
+    _assemble_csc(f, p, nf, free, index, boundary, nb, g, delta)
     with gil:
         return (<_Factor>f.factor).factor(nf + p.m + nb)
 

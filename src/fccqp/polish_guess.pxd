@@ -29,10 +29,11 @@ cdef inline char cone_code(const Cones* c, Py_ssize_t k, const double* v) noexce
 cdef void linearize(Polish* w, const Problem* p, Py_ssize_t k, const double* v) noexcept nogil
 cdef Py_ssize_t guess(Polish* w, const Problem* p, const double* z, const double* y,
                       Py_ssize_t* changed) noexcept nogil
+cdef void keep_bare_plane(Polish* w, const Problem* p, Py_ssize_t k) noexcept nogil
 cdef Py_ssize_t most_wrong(Polish* w, const Problem* p) noexcept nogil
 cdef double step_length(Polish* w, const Problem* p, Py_ssize_t* blocking) noexcept nogil
 cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
-                      Py_ssize_t* changed) noexcept nogil
+                      const double* ahead, Py_ssize_t* changed) noexcept nogil
 cdef bint leaves_set(const Polish* w, const Problem* p) noexcept nogil
 cdef Py_ssize_t boundary_entries(const Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil
 cdef bint past_apex(const Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil

@@ -18,15 +18,16 @@ from libc.math cimport fabs, sqrt
 from fccqp._dense cimport copy
 from fccqp._types cimport Cones, Problem
 from fccqp.cone_dispatch cimport (cone_curvature, cone_plane, cone_polar_distance, cone_project,
-                                  cone_slope, cone_split, cone_step)
-from fccqp.polish cimport APEX, BOUNDARY, FREE, LOWER, UPPER, Polish
+                                  cone_slope, cone_split, cone_step, cone_touch)
+from fccqp.polish cimport APEX, BARE, BOUNDARY, FREE, KEPT, LOWER, UPPER, Polish
 from fccqp.tuning cimport ACTIVE_TOLERANCE
 
 
 cdef void linearize(Polish* w, const Problem* p, Py_ssize_t k, const double* v) noexcept nogil:
     """Plane ``g`` and curvature ``hess`` of boundary block ``k`` (of ``boundary``) at
     ``v``, with its current multiplier where that is positive; a block whose ``v`` is on
-    the axis keeps its plane and gets no curvature.
+    the axis keeps its plane and gets no curvature. Without a positive multiplier the
+    block is marked ``BARE`` (see :func:`renew`).
 
     A negative multiplier marks a wrong guess, which the next correction releases; its
     curvature would only make the block's Hessian indefinite, and the Schur complement
@@ -39,6 +40,39 @@ cdef void linearize(Polish* w, const Problem* p, Py_ssize_t k, const double* v) 
     cone_plane(v, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, w.g + o, &phi)
     cone_curvature(v, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, max(w.lam[k], 0.0),
                    w.hess + o * w.hess_stride)
+    if not w.lam[k] > 0.0:
+        w.bare[cone] = BARE
+
+
+cdef void keep_bare_plane(Polish* w, const Problem* p, Py_ssize_t k) noexcept nogil:
+    """Put boundary block ``k``'s ``KEPT`` plane back and give it its curvature there, at
+    the point of the plane's own touching ray with ``x_block``'s axis part (``x_block``
+    itself where that part is not positive or the plane lies on the axis).
+
+    A plane placed with ``lam = 0`` (an apex block released, a free block that left its
+    cone) is solved without its curvature, and nothing held the block's tangential part
+    on the cone: moving the plane to that ``x_block`` had turned it 20-50 degrees away
+    from the answer's, and the next solve put the contact past its apex; the polish then
+    cycled between apex and boundary and the tick ran ADMM (warm polishes of contacts
+    being loaded; notes/performance-history.md, "warmtail2")."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t cone = w.boundary[k], o = c.offset[cone]
+    copy(w.kept_plane + o, w.g + o, c.dim[cone])
+    _own_point(w, c, cone, w.x + p.constrained[o], w.step)
+    linearize(w, p, k, w.step)
+
+
+cdef inline void _own_point(const Polish* w, const Cones* c, Py_ssize_t k, const double* x,
+                            double* out) noexcept nogil:
+    """Into ``out``: the point of cone ``k``'s current plane's touching ray with the axis
+    part of ``x`` (its block); ``x`` itself where that part is not positive or the plane
+    lies on the axis."""
+    cdef Py_ssize_t o = c.offset[k], d = c.dim[k]
+    cdef double across
+    cdef double along = cone_split(x, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
+    if not (along > 0.0 and cone_touch(w.g + o, c.kind[k], d, c.mu[k], c.normal + 3 * k,
+                                       along, out)):
+        copy(x, out, d)
 
 
 cdef Py_ssize_t guess(Polish* w, const Problem* p, const double* z, const double* y,
@@ -207,20 +241,31 @@ cdef bint leaves_set(const Polish* w, const Problem* p) noexcept nogil:
 
 
 cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
-                      Py_ssize_t* changed) noexcept nogil:
+                      const double* ahead, Py_ssize_t* changed) noexcept nogil:
     """Correct the guess from the polished point. With ``adding``, hold free entries
     that violate their bound and put free blocks that left their cone on the boundary
     (or at the apex, if ``x_block`` lies in the polar), and, after a step (``stepped``),
     hold the constraints :func:`step_length` marked in ``blocked`` where the step left
     them: a box entry at its nearer bound, a free block on the boundary, a boundary
-    block at the apex. Otherwise release the one held entry or block whose multiplier is the most
-    wrong (:func:`most_wrong`): a held entry or a boundary block becomes free, an apex
-    block is reclassified from its multiplier as in :func:`guess`. Returns the number of
-    boundary blocks (planes and curvature at ``x_block``, or at the projection for a new
-    one) and counts the changed entries in ``changed``."""
+    block at the apex. After a step of length 0 (``ahead``: the full step's point, else
+    NULL) a free block it stopped is classified and given its plane from where the full
+    step took it, not from the unmoved point: there it sits at the apex or on the plane
+    it was just released from, and the next pass would release it again, stop at length
+    0 and hold it back, all the polish's guesses long (go2, solo12 and anymal_c warm
+    ticks; notes/performance-history.md, "warmtail2"). Otherwise release the one held
+    entry or block whose multiplier is the most wrong (:func:`most_wrong`): a held entry
+    or a boundary block becomes free, an apex block is reclassified from its multiplier
+    as in :func:`guess`. Returns the number of boundary blocks (planes and curvature at
+    ``x_block``, or at the projection for a new one) and counts the changed entries in
+    ``changed``.
+
+    A ``BARE`` boundary block (its plane placed with ``lam = 0``) whose multiplier came
+    out positive has that plane kept (``KEPT``) for :func:`keep_bare_plane`."""
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t j, k, o, d, start, nb = 0, old = 0
     cdef double value, size, along, across, slope, lam
+    cdef const double* point
+    cdef bint held
     cdef char code, before
     cdef Py_ssize_t released = -1 if adding else most_wrong(w, p)
     changed[0] = 0
@@ -251,11 +296,16 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
                 code = FREE
             elif stepped and w.blocked[o]:
                 code = APEX
+            if w.bare[k] == BARE and lam > 0.0:   # for Newton's first solve (see keep_bare_plane)
+                copy(w.g + o, w.kept_plane + o, d)
+                w.bare[k] = KEPT
             copy(w.x + start, w.step, d)
         elif before == FREE and adding:
-            if _left_cone(c, k, w.x + start, &along, &across, &size) or (stepped and w.blocked[o]):
+            held = stepped and w.blocked[o]
+            point = (ahead if held and ahead != NULL else w.x) + start
+            if _left_cone(c, k, point, &along, &across, &size) or held:
                 code = APEX if slope * across <= -along or size == 0.0 else BOUNDARY
-                cone_project(w.x + start, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
+                cone_project(point, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
         elif released == p.s + k:   # an apex block whose y left the polar
             along = cone_split(w.y + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
             code = FREE if across <= slope * along else BOUNDARY

@@ -89,6 +89,7 @@ def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5):
     it.y, it.z = a.new(s, np.asarray(y)[constrained]), a.new(s, np.asarray(z)[constrained])
     cdef Polish w
     w.active, w.dropped, w.blocked = <char*>a.new(s), <char*>a.new(s), <char*>a.new(s)
+    w.bare, w.kept_plane = <char*>a.new(s), a.new(s)
     w.index, w.free, w.boundary = a.new_int(n), a.new_int(n), a.new_int(s)
     w.g, w.lam, w.hess = a.new(s), a.new(s), a.new(s * s)
     w.K, w.ipiv = a.new(N * N), <int*>a.new_int(N)

@@ -23,7 +23,7 @@ import numpy as np
 cimport fccqp.cone_friction as friction
 cimport fccqp.cone_soc as soc
 from fccqp._types cimport Cones
-from fccqp.cone_dispatch cimport cone_fits
+from fccqp.cone_dispatch cimport cone_fits, cone_plane, cone_split, cone_touch
 
 
 cdef void proj_set(const double* v, const double* lo, const double* hi, Cones cones,
@@ -98,3 +98,22 @@ def project_cone_block(const double[::1] v, Py_ssize_t kind, double mu, const do
     if not cone_fits(kind, v.shape[0]):
         raise ValueError(f"a cone block of kind {kind} cannot have {v.shape[0]} entries")
     proj_block(&v[0], kind, v.shape[0], mu, &normal[0], &out[0])
+
+
+def touching_point(const double[::1] v, Py_ssize_t kind, double mu, const double[::1] normal,
+                   double[::1] out):
+    """Into ``out``: the point with ``v``'s axis part where the tangent plane of the cone
+    at ``v`` (through the apex, :func:`fccqp.cone_dispatch.cone_plane`) touches the cone
+    (:func:`fccqp.cone_dispatch.cone_touch`); False, ``out`` untouched, where ``v`` is on
+    the axis."""
+    cdef double across, phi
+    cdef double along
+    cdef double[::1] g = np.empty(v.shape[0])
+    if out.shape[0] != v.shape[0] or v.shape[0] < 2 or normal.shape[0] != 3:
+        raise ValueError("v and out need the same size (>= 2) and normal 3 entries")
+    if not cone_fits(kind, v.shape[0]):
+        raise ValueError(f"a cone block of kind {kind} cannot have {v.shape[0]} entries")
+    if not cone_plane(&v[0], kind, v.shape[0], mu, &normal[0], &g[0], &phi):
+        return False
+    along = cone_split(&v[0], kind, v.shape[0], mu, &normal[0], &across)
+    return cone_touch(&g[0], kind, v.shape[0], mu, &normal[0], along, &out[0])

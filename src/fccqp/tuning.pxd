@@ -126,6 +126,10 @@ cdef extern from *:
     #define FCCQP_POLISH_DELTA 1e-12
     /* the same for qdldl's factorization without pivoting (fccqp.polish_csc): 1e-12 lost LPs */
     #define FCCQP_POLISH_CSC_DELTA 1e-8
+    /* a refinement stalled above this times its tolerance refactors with a smaller delta */
+    #define FCCQP_POLISH_STALL_RESIDUAL 1e3
+    /* that delta: this times the curvature the stalled refinement's contraction shows */
+    #define FCCQP_POLISH_DELTA_CUT 1e-2
     /* refine the returned point while the KKT residual > this max(1, ||q||, ||b||) */
     #define FCCQP_POLISH_REFINE_TOLERANCE 1e-14
     /* a guess's first solve is refined only to this: the next chord step repeats the work */
@@ -244,6 +248,8 @@ cdef extern from *:
     # Polish
     const double POLISH_DELTA "FCCQP_POLISH_DELTA"
     const double POLISH_CSC_DELTA "FCCQP_POLISH_CSC_DELTA"
+    const double POLISH_STALL_RESIDUAL "FCCQP_POLISH_STALL_RESIDUAL"
+    const double POLISH_DELTA_CUT "FCCQP_POLISH_DELTA_CUT"
     const double POLISH_REFINE_TOLERANCE "FCCQP_POLISH_REFINE_TOLERANCE"
     const double GUESS_TOLERANCE "FCCQP_GUESS_TOLERANCE"
     const int GUESS_PASSES "FCCQP_GUESS_PASSES"

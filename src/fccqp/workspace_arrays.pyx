@@ -123,6 +123,7 @@ cdef void common_arrays(Arrays a, Engine* e, Py_ssize_t memory, Py_ssize_t log_r
     pol = &e.pol
     pol.active = <char*>a.new(s)
     pol.dropped = <char*>a.new(s)
+    pol.bare, pol.kept_plane = <char*>a.new(s), a.new(s)
     pol.blocked = <char*>a.new(s)
     pol.index, pol.free = <Py_ssize_t*>a.new_int(n), <Py_ssize_t*>a.new_int(n)
     pol.boundary = <Py_ssize_t*>a.new_int(s)
