@@ -176,6 +176,46 @@ def test_rounding_noise_on_dependent_rows_is_not_called_infeasible(seed):
     assert solve_verified(problem).status is Status.SOLVED
 
 
+def columns_scaled_over_sixteen_decades(seed: int, n: int = 12, m: int = 4) -> Problem:
+    """A feasible QP with a box on every entry: ``A x = b`` built from a point of
+    ``[-1, 1]^n``, bounds of magnitude 1 to 2 on either side, ``P`` of rank 3, then each
+    column rescaled by ``s_j = 10**U(-8, 8)`` (``P`` by ``s s'``, ``q`` and ``A``'s columns
+    by ``s``, the bounds divided by it)."""
+    rng = np.random.default_rng(seed)
+    F = rng.standard_normal((n, 3)) * 10.0 ** rng.uniform(-4, 4, (n, 1))
+    x = rng.uniform(-1, 1, n)
+    A = rng.standard_normal((m, n))
+    b = A @ x
+    q = rng.standard_normal(n)
+    lb, ub = -rng.uniform(1, 2, n), rng.uniform(1, 2, n)
+    s = 10.0 ** rng.uniform(-8, 8, n)
+    return Problem.of(F @ F.T * np.outer(s, s), q * s, A * s, b, lb / s, ub / s)
+
+
+@pytest.mark.parametrize("seed", [0, 98])
+def test_columns_scaled_over_sixteen_decades_are_not_called_infeasible(seed):
+    """Bounds up to 4e7 against columns down to 1e-8: primal certificates whose
+    residual is 1e-13 to 3e-9 of their terms reached 23 to 45 times their separation
+    in the box, and were accepted on every backend (ADMM's own, the least distance's
+    after a stall). The separation must exceed the box's support of the residual."""
+    problem = columns_scaled_over_sixteen_decades(seed)
+    assert clarabel_solve(*problem.args()).status == "solved"
+    assert not solve_verified(problem).status.is_infeasible()
+
+
+def test_verify_rejects_a_certificate_its_residual_explains_in_the_box():
+    """verify's side: ``1e-8 x_0 + x_1 = 1.5`` with ``|x_0| <= 1e8``, ``|x_1| <= 1`` is
+    feasible; ``dy = -1``, ``dz = (0, 1)`` leaves a residual of 1e-8 of its terms and
+    separates by a third of them, but ``x_0 = 1e8`` makes up for that residual."""
+    problem = Problem.of(np.eye(2), np.zeros(2), [[1e-8, 1.0]], [1.5], [-1e8, -1.0],
+                         [1e8, 1.0])
+    result = fccqp.solve(*problem.args())
+    claimed = fccqp.Result(**{**result.__dict__, "status": Status.PRIMAL_INFEASIBLE,
+                              "certificate": np.array([-1.0, 0.0, 1.0])})
+    report = check_solution(problem, claimed)
+    assert list(report.failures) == ["b'dy + sigma(dz) < -sigma_box(-res) (relative)"]
+
+
 def test_a_kept_workspace_rejects_a_non_convex_P(capfd):
     """After a solved box-only QP whose ``P`` is diagonal, the warm polish used to run
     before the factorization that holds the convexity test: ``P[0, 0] < 0`` came back

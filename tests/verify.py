@@ -39,7 +39,11 @@ the separation must be large against what the residual can explain. It is judged
 ``rho = ||res|| / ||terms of res||``: ``delta < -max(separation, dominance * rho)``. A
 feasible ``x`` would need products with the certificate ``dominance`` times larger
 than ``b``'s to explain such a separation; ``separation`` (1e-10) stays far above the
-rounding of the sum (``1e-16`` of its terms, times its cancellation). A fixed margin
+rounding of the sum (``1e-16`` of its terms, times its cancellation). On the box
+the bound is explicit: ``res'x >= -sigma_box(-res)``, which the separation must also
+beat; with columns scaled over 1e16 the residual's relative size says nothing of its
+products with the bounds (a feasible problem's certificate had ``rho = 3e-9`` and
+``delta = -0.05``, and its residual reached 23 times its separation in the box). A fixed margin
 in ``eps_prim_inf`` (this checker asked ``delta < -10 eps_prim_inf`` before) is not a
 property of a proof: none of the anchors asks it (OSQP: ``u'dy+ + l'dy- < 0``; SCS:
 ``b'y < -1e-9`` and ``||A'y|| <= 1e-7 |b'y|``; Clarabel: ``b'z < -1e-8`` and ``||A'z||
@@ -355,6 +359,11 @@ def _check_primal_certificate(problem: Problem, result: fccqp.Result, tol: Toler
     # what the residual explains (the module docstring)
     report.add("b'dy + sigma(dz) < 0 (relative)", (by + support) / max(size, 1e-300),
                -max(tol.separation, tol.dominance * residual))
+    # and beyond what the residual reaches in the box: every feasible x has b'dy +
+    # sigma_C(dz) >= res'x, at least -sigma_box(-res) over the box's finite sides
+    reach, _ = _box_support(-(problem.A.T @ dy + dz), problem.lb, problem.ub)
+    report.add("b'dy + sigma(dz) < -sigma_box(-res) (relative)",
+               (by + support + reach) / max(size, 1e-300), -tol.separation)
 
 
 def _row_relative(M: np.ndarray, dx: np.ndarray) -> float:

@@ -195,7 +195,8 @@ cdef class Workspace:
         ``dz`` projected onto the polar), or None. A primal certificate's separation
         must exceed what its residual explains at ``point`` (user's units, with ``A x =
         b``; default the run's iterate, which on a run that diverges along a ray, ``q``
-        of 4.5e14 beside a cone pinned outside itself, explained away an exact one)."""
+        of 4.5e14 beside a cone pinned outside itself, explained away an exact one) and
+        in the box."""
         cdef Engine* e = &self.e
         cdef Problem* p = &e.prob
         cdef Py_ssize_t n = p.n, m = p.m, i, j

@@ -15,12 +15,12 @@ in a few dozen iterations on the fuzzing campaign's stalls):
   -||x_S - u||^2``: a Farkas certificate whenever the distance is positive (the dual of
   the least-distance problem is the certificate problem), its separation weighed
   against what the residual explains at the nearest ``x`` (not the run's iterate, which
-  may be diverging along a ray). When that certificate fails though the distance is
-  positive, the distance measured against the rows' terms: each row whose ``b_i`` is
-  not zero to its terms' accuracy may be missed by ``|b_i| r_i`` at the cost ``1/2
-  r_i^2``, whose multipliers maximize the separation against the size of ``(b_i y_i)``
-  and ``z_u`` together, the terms the Farkas test weighs it against
-  (:func:`relative_distance_problem`);
+  may be diverging along a ray) and the box's bounds. When that certificate fails
+  though the distance is positive, the distance measured against the rows' terms:
+  each row whose ``b_i`` is not zero to its terms' accuracy may be missed by ``|b_i|
+  r_i`` at the cost ``1/2 r_i^2``, whose multipliers maximize the separation against
+  the size of ``(b_i y_i)`` and ``z_u`` together, the terms the Farkas test weighs it
+  against (:func:`relative_distance_problem`);
 - dual: the projection of ``-q`` onto the cone of rays, ``min 1/2 ||d||^2 + q'd`` s.t.
   ``P d = 0``, ``A d = 0``, ``d`` in the recession cone of C, which by Moreau has
   ``q'd = -||d||^2``: a ray of descent whenever it is not zero.
