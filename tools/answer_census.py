@@ -62,20 +62,33 @@ def census(fccqp: object, qps: list[tuple], sequence: np.ndarray, mode: str,
             f"x `{digest.hexdigest()[:12]}`")
 
 
-def main(argv: list[str] | None = None) -> None:
-    """Print the census of each robot and mode asked for (one BLAS thread)."""
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+def tick_arguments(parser: argparse.ArgumentParser) -> None:
+    """The arguments every per-tick tool here takes: robots, the test sets' cache, the
+    realtime preset's time limit."""
     parser.add_argument("--robots", nargs="+", choices=ROBOTS, default=list(ROBOTS))
-    parser.add_argument("--modes", nargs="+", choices=("warm", "cold"),
-                        default=["warm", "cold"])
     parser.add_argument("--cache", type=Path, default=ROOT / "benchmarks" / ".cache")
     parser.add_argument("--budget", type=float, default=100.0,
                         help="the realtime preset's time limit (s); large: never stops a solve")
-    args = parser.parse_args(argv)
+
+
+def imported_fccqp() -> object:
+    """fccqp from ``PYTHONPATH`` (the build under test, whose folder is printed), with one
+    BLAS thread."""
     import fccqp
 
     threadpool_limits(1)
     print(f"fccqp: {Path(fccqp.__file__).parent}")
+    return fccqp
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Print the census of each robot and mode asked for (one BLAS thread)."""
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    tick_arguments(parser)
+    parser.add_argument("--modes", nargs="+", choices=("warm", "cold"),
+                        default=["warm", "cold"])
+    args = parser.parse_args(argv)
+    fccqp = imported_fccqp()
     for robot in args.robots:
         raw, sequence = load_qps(set_path(robot, args.cache), 400)
         qps = [arguments(r, fccqp) for r in raw]

@@ -25,16 +25,14 @@ import argparse
 import sys
 from pathlib import Path
 
-from threadpoolctl import threadpool_limits
-
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))   # this checkout's benchmarks
+sys.path.insert(0, str(ROOT / "tools"))
+from answer_census import imported_fccqp, tick_arguments  # noqa: E402
 from benchmarks.cache import cached_test_set  # noqa: E402
 from benchmarks.exact_solvers import fccqp_arguments  # noqa: E402
 from benchmarks.metrics import qp_metrics  # noqa: E402
 from benchmarks.views import contact_changes, warm_path  # noqa: E402
-
-ROBOTS = ("solo12", "anymal_c", "go2", "talos_reduced")
 
 
 def contact_ticks(fccqp: object, test_set: object, budget: float) -> tuple[list[str], int]:
@@ -64,18 +62,12 @@ def contact_ticks(fccqp: object, test_set: object, budget: float) -> tuple[list[
 def main(argv: list[str] | None = None) -> None:
     """Print each robot's contact-change ticks (one BLAS thread)."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--robots", nargs="+", choices=ROBOTS, default=list(ROBOTS))
+    tick_arguments(parser)
     parser.add_argument("--scenario", default="mix")
     parser.add_argument("--n-qps", type=int, default=400)
     parser.add_argument("--seq-len", type=int, default=100)
-    parser.add_argument("--cache", type=Path, default=ROOT / "benchmarks" / ".cache")
-    parser.add_argument("--budget", type=float, default=100.0,
-                        help="the realtime preset's time limit (s); large: never stops a solve")
     args = parser.parse_args(argv)
-    import fccqp
-
-    threadpool_limits(1)
-    print(f"fccqp: {Path(fccqp.__file__).parent}")
+    fccqp = imported_fccqp()
     for robot in args.robots:
         test_set, _ = cached_test_set(args.cache, robot, args.scenario, args.n_qps, 0,
                                       seq_len=args.seq_len, report=lambda line: None)
