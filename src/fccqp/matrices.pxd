@@ -8,7 +8,7 @@ for the sparse backend of issue 28) needs a second implementation of them here a
 in the storage-specific code, which reads ``values`` directly: the validation scan
 (``validation.scan_and_copy``), the equilibration (``scaling``), the dense KKT backends
 (``ldl``, ``schur``: their assembly and many-column products), the polish's dense
-assembly (``polish._assemble``, ``polish_schur``) and the certificate cleaning's ``A A'``
+assembly (``polish_kkt._assemble``, ``polish_schur``) and the certificate cleaning's ``A A'``
 (``certificates.gram_factor``, which on compressed columns asks the sparse backend's
 ``SparseKKT.factor_gram``).
 

@@ -31,10 +31,13 @@ Bunch-Kaufman ``dsytrf`` (or by :mod:`fccqp.polish_schur`'s Schur complement whe
 ``P``'s structure allows it; by qdldl in compressed columns, :mod:`fccqp.polish_csc`, where
 ``P`` and ``A`` are CSC) and refined against the unregularized matrix, as :mod:`fccqp.ldl`
 does; where a free block's curvature lies below ``delta`` and the refinement crawls, it is
-factored again with a smaller ``delta`` (:func:`_solve`). Each boundary block's plane is then re-linearized at the new
-``x_block`` and the system re-solved, ``newton_steps`` times at most or until ``|phi|
-<= NEWTON_TOLERANCE ||x_block||``: Newton's method (SQP) on the KKT conditions of the
-QP on the active manifold, quadratically convergent when the guess is right.
+factored again with a smaller ``delta``. That system of one guess (its unknowns, its
+matrix, its residual and the refined solve) is :mod:`fccqp.polish_kkt`; this module
+chooses the guesses and drives the steps. Each boundary block's plane is then
+re-linearized at the new ``x_block`` and the system re-solved, ``newton_steps`` times at
+most or until ``|phi| <= NEWTON_TOLERANCE ||x_block||``: Newton's method (SQP) on the
+KKT conditions of the QP on the active manifold, quadratically convergent when the
+guess is right.
 
 Newton needs the curvature of the constraint: the Hessian of the Lagrangian adds
 ``lam H`` on each boundary block, ``H`` the Hessian of the cone function times the
@@ -58,24 +61,21 @@ the caller, on the user's problem (:func:`fccqp.polish_guess.multiplier_violatio
 
 from libc.math cimport INFINITY, fabs, isfinite, pow, sqrt
 
-from scipy.linalg.cython_lapack cimport dsytrf, dsytrs
-
 from fccqp._dense cimport copy, inf_norm
 from fccqp._types cimport Cones, Iterates, Problem
 from fccqp.cone_dispatch cimport cone_phi, cone_plane
 from fccqp.kkt cimport KKT
-from fccqp.matrices cimport CSC, DENSE, product, product_t
-from fccqp.polish_csc cimport polish_csc_factor, polish_csc_solve
+from fccqp.matrices cimport CSC, DENSE
 from fccqp.polish_guess cimport (boundary_entries, box_code, cone_code, drop_far_side, guess,
                                  keep_bare_plane, leaves_set, linearize, most_wrong, past_apex,
                                  renew, step_length)
-from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup, polish_schur_solve
+from fccqp.polish_kkt cimport correct_once, kkt_residual, number_unknowns, refactor, refine
+from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.reduced cimport Reduced
-from fccqp.tuning cimport (ACTIVE_TOLERANCE, CHORD_RATE, CHORD_STEPS, FEASIBLE_PASSES, GUESS_PASSES,
-                           GUESS_TOLERANCE, MAX_REFINE, MISS_FLOOR, NEWTON_TOLERANCE,
-                           POLISH_CSC_DELTA, POLISH_DELTA, POLISH_REFINE_TOLERANCE,
-                           POLISH_DELTA_CUT, POLISH_STALL_RESIDUAL)
+from fccqp.tuning cimport (CHORD_RATE, CHORD_STEPS, FEASIBLE_PASSES, GUESS_PASSES,
+                           GUESS_TOLERANCE, MISS_FLOOR, NEWTON_TOLERANCE, POLISH_CSC_DELTA,
+                           POLISH_DELTA, POLISH_REFINE_TOLERANCE)
 
 cdef extern from "fccqp_clock.h" nogil:
     double fccqp_now()
@@ -102,209 +102,6 @@ cdef Py_ssize_t guess_changes(const Problem* p, const double* z, const double* y
             changed += code != codes[j]
             codes[j] = code
     return changed
-
-
-cdef Py_ssize_t _unknowns(Polish* w, const Problem* p) noexcept nogil:
-    """Put the held entries of ``x`` at their values; number the free entries
-    (``index``, ``free``) and return how many there are."""
-    cdef Py_ssize_t n = p.n, i, j, nf = 0
-    cdef char code
-    w.grad_current = False
-    for i in range(n):
-        w.index[i] = 0
-    for j in range(p.s):
-        code = w.active[j]
-        i = p.constrained[j]
-        if code == LOWER or code == FIXED:
-            w.x[i] = p.lo[j]
-        elif code == UPPER:
-            w.x[i] = p.hi[j]
-        elif code == APEX:
-            w.x[i] = 0.0
-        else:
-            continue
-        w.index[i] = -1
-    for i in range(n):
-        if w.index[i] == 0:
-            w.index[i] = nf
-            w.free[nf] = i
-            nf += 1
-    return nf
-
-
-cdef void _assemble(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
-                    double delta) noexcept nogil:
-    """Lower triangle of the KKT matrix of the polished QP, regularized by ``delta``,
-    into ``K``."""
-    cdef Py_ssize_t n = p.n, m = p.m, N = nf + m + nb, r, col, i, j, k, o, d, start, jc
-    cdef double* K = w.K
-    for col in range(N):
-        for r in range(col, N):
-            K[r + col * N] = 0.0
-    for col in range(nf):
-        jc = w.free[col]
-        for r in range(col, nf):
-            K[r + col * N] = p.P.values[w.free[r] * n + jc]
-        K[col + col * N] += delta
-        for i in range(m):
-            K[nf + i + col * N] = p.A.values[i * n + jc]
-    for k in range(nb):
-        o, d = p.cones.offset[w.boundary[k]], p.cones.dim[w.boundary[k]]
-        start = p.constrained[o]
-        for j in range(d):
-            K[nf + m + k + w.index[start + j] * N] = w.g[o + j]
-            for i in range(j, d):   # entries of a block are consecutive unknowns
-                K[w.index[start + i] + w.index[start + j] * N] += w.hess[o * w.hess_stride + i * d + j]
-    for r in range(nf, N):
-        K[r + r * N] = -delta
-
-
-cdef double _residual(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) noexcept nogil:
-    """Residual of the current ``(x, nu, lam)`` in the unregularized system (with the
-    curvature terms) into ``rhs``; returns its infinity norm. Leaves the gradient of the
-    Lagrangian without the boundary blocks' terms in ``grad`` (there it is minus the
-    multipliers of the held entries)."""
-    cdef Py_ssize_t n = p.n, m = p.m, i, j, k, o, d, start, cone
-    cdef double value, curved
-    product(&p.P, w.x, w.grad)
-    product_t(&p.A, w.nu, w.ATnu)
-    for i in range(n):
-        w.grad[i] += p.q[i] + w.ATnu[i]
-    for i in range(nf):
-        w.rhs[i] = -w.grad[w.free[i]]
-    for k in range(nb):
-        cone = w.boundary[k]
-        o = p.cones.offset[cone]
-        start = p.constrained[o]
-        d = p.cones.dim[cone]
-        value = 0.0
-        for j in range(d):
-            curved = 0.0
-            for i in range(d):
-                curved += w.hess[o * w.hess_stride + j * d + i] * w.x[start + i]
-            w.rhs[w.index[start + j]] -= w.lam[k] * w.g[o + j] + curved
-            value += w.g[o + j] * w.x[start + j]
-        w.rhs[nf + m + k] = -value
-    product(&p.A, w.x, w.Ax)
-    for i in range(m):
-        w.rhs[nf + i] = p.b[i] - w.Ax[i]
-    w.grad_current = True
-    return inf_norm(w.rhs, nf + m + nb)
-
-
-cdef void _apply(Polish* w, Py_ssize_t nf, Py_ssize_t m, Py_ssize_t nb,
-                 double sign) noexcept nogil:
-    """Add ``sign`` times ``step`` to the unknowns."""
-    cdef Py_ssize_t i
-    w.grad_current = False
-    for i in range(nf):
-        w.x[w.free[i]] += sign * w.step[i]
-    for i in range(m):
-        w.nu[i] += sign * w.step[nf + i]
-    for i in range(nb):
-        w.lam[i] += sign * w.step[nf + m + i]
-
-
-cdef void _solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
-                 double tolerance, int* factorizations) noexcept nogil:
-    """Correct ``(x, nu, lam)`` to the solution of the factored system: residual
-    corrections against the unregularized matrix until the residual is below
-    ``tolerance``, stops halving, or ``MAX_REFINE`` corrections after the first; a
-    correction that makes it grow is undone.
-
-    A refinement can stop halving because of the regularization: a free block whose
-    curvature ``c`` lies below ``delta`` recovers ``c / (c + delta)`` of its step a
-    correction, so the residual contracts by ``rate = delta / (c + delta)`` and stays
-    far above ``tolerance`` with the step mostly unmade (a friction cone of curvature
-    1e-14 against the dense 1e-12, the sparse 1e-8). Where it stops more than
-    ``POLISH_STALL_RESIDUAL`` times above ``tolerance`` and still contracting, the system
-    is factored again with ``delta`` cut to ``POLISH_DELTA_CUT`` times the curvature that
-    rate shows, ``delta (1 - rate) / rate``, and the corrections go on from the current
-    point. A correction of that factorization that does not halve the residual is undone
-    and the previous factorization restored (a singular block, an LP's free entry, has
-    no curvature for any ``delta`` to uncover: its steps would only grow), and no other
-    retry is made on it (``retry_spent``). A refinement that halves as it should is
-    untouched, and so is one that stops within ``POLISH_STALL_RESIDUAL`` of
-    ``tolerance`` (where rounding usually stops it) or in a polish held to the Schur
-    complement (``schur_only``: it assembles nothing)."""
-    cdef double norm, last = INFINITY, previous = 0.0
-    cdef bint retrying = False, was_structured = False
-    cdef int r
-    for r in range(MAX_REFINE + 2):
-        norm = _residual(w, p, nf, nb)
-        if retrying and not norm <= 0.5 * last:   # NaN included
-            _apply(w, nf, p.m, nb, -1.0)
-            _restore(w, p, nf, nb, previous, was_structured, factorizations)
-            return
-        retrying = False
-        if norm > last:
-            _apply(w, nf, p.m, nb, -1.0)
-            return
-        if norm <= tolerance or r == MAX_REFINE + 1:
-            return
-        if norm > 0.5 * last:
-            if (norm >= last or norm <= POLISH_STALL_RESIDUAL * tolerance or w.retry_spent
-                    or w.schur_only):
-                return
-            previous, was_structured = w.delta, w.structured
-            if not _refactor(w, p, nf, nb, POLISH_DELTA_CUT * w.delta * (last - norm) / norm,
-                             factorizations):
-                _restore(w, p, nf, nb, previous, was_structured, factorizations)
-                return
-            retrying = True
-        last = norm
-        _factored_solve(w, p, nf, nb)
-        _apply(w, nf, p.m, nb, 1.0)
-
-
-cdef bint _refactor(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb, double delta,
-                    int* factorizations) noexcept nogil:
-    """Factor the current guess's KKT matrix regularized by ``delta``, assembled for
-    ``dsytrf`` (or for qdldl where ``P`` and ``A`` are CSC); False when the
-    factorization breaks down."""
-    cdef char uplo = b"L"
-    cdef int size = <int>(nf + p.m + nb), info = 0
-    factorizations[0] += 1
-    w.structured = False
-    w.delta = delta
-    if p.P.kind == CSC:
-        return polish_csc_factor(&w.csc, p, nf, w.free, w.index, w.boundary, nb, w.g, delta)
-    _assemble(w, p, nf, nb, delta)
-    dsytrf(&uplo, &size, w.K, &size, w.ipiv, w.work, &w.lwork, &info)
-    return info == 0
-
-
-cdef void _restore(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb, double delta,
-                   bint structured, int* factorizations) noexcept nogil:
-    """Return to the factorization with regularization ``delta`` after a retry with a
-    smaller one failed (the Schur complement's is intact: the retry assembled ``K``)."""
-    w.retry_spent = True
-    if structured:
-        w.structured, w.delta = True, delta
-    else:
-        _refactor(w, p, nf, nb, delta, factorizations)   # it factored before: it does again
-
-
-cdef void _factored_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) noexcept nogil:
-    """``step`` := the current factorization's solution for ``rhs``."""
-    cdef char uplo = b"L"
-    cdef int size = <int>(nf + p.m + nb), one = 1, info = 0
-    copy(w.rhs, w.step, size)
-    if w.structured:
-        polish_schur_solve(&w.schur, p, w.index, w.boundary, nb, w.step)
-    elif p.P.kind == CSC:
-        polish_csc_solve(&w.csc, size, w.step)
-    else:
-        dsytrs(&uplo, &size, &one, w.K, &size, w.ipiv, w.step, &size, &info)
-
-
-cdef void _correct_once(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) noexcept nogil:
-    """One correction of the current point with the last factorization (a chord step)."""
-    if nf + p.m + nb == 0:
-        return
-    _residual(w, p, nf, nb)
-    _factored_solve(w, p, nf, nb)
-    _apply(w, nf, p.m, nb, 1.0)
 
 
 cdef void _keep_point(Polish* w, const Problem* p, Py_ssize_t nb, bint undo) noexcept nogil:
@@ -344,7 +141,7 @@ cdef bint _chord_step(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
         table_correct(w, p, table, kkt, rho_vec, nb, scale)
         w.grad_current = False
     else:
-        _correct_once(w, p, nf, nb)
+        correct_once(w, p, nf, nb)
     if past_apex(w, p, nb):
         _keep_point(w, p, nb, True)
         return False
@@ -406,16 +203,16 @@ cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t n
                                                          w.g, w.hess, POLISH_DELTA)
     if w.structured:
         factorizations[0] += 1
-        _solve(w, p, nf, nb, tolerance, factorizations)
+        refine(w, p, nf, nb, tolerance, factorizations)
         return True
     if w.schur_only:
         factorizations[0] += 1
         w.schur_failed = True
         return False
-    if not _refactor(w, p, nf, nb, POLISH_CSC_DELTA if p.P.kind == CSC else POLISH_DELTA,
-                     factorizations):
+    if not refactor(w, p, nf, nb, POLISH_CSC_DELTA if p.P.kind == CSC else POLISH_DELTA,
+                    factorizations):
         return False
-    _solve(w, p, nf, nb, tolerance, factorizations)
+    refine(w, p, nf, nb, tolerance, factorizations)
     return True
 
 
@@ -450,7 +247,7 @@ cdef void _multipliers(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
     cdef char code
     cdef double phi
     if not w.grad_current:   # a solve's last residual is often the point's
-        _residual(w, p, nf, nb)   # grad: the held entries' multipliers, negated
+        kkt_residual(w, p, nf, nb)   # grad: the held entries' multipliers, negated
     for j in range(p.s):
         code = w.active[j]
         w.y[j] = 0.0 if code == FREE or code == BOUNDARY else -w.grad[p.constrained[j]]
@@ -517,7 +314,7 @@ cdef int _newton(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t* nb, lon
             table_solve(w, p, table, kkt, rho_vec, nb[0], scale)
             w.grad_current = False
         else:
-            _solve(w, p, nf, nb[0], POLISH_REFINE_TOLERANCE * scale, factorizations)
+            refine(w, p, nf, nb[0], POLISH_REFINE_TOLERANCE * scale, factorizations)
     _multipliers(w, p, nf, nb[0])
     return 0
 
@@ -617,7 +414,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         w.passes = passes
         if passes > 0 and fccqp_now() > deadline:
             return False   # a time limit: the caller keeps its point
-        nf = _unknowns(w, p)
+        nf = number_unknowns(w, p)
         if feasible:
             copy(w.x, w.x_prev, n)
             copy(w.nu, w.nu_prev, m)
@@ -629,7 +426,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         if passes == GUESS_PASSES or w.cycling:   # not settled: the caller judges this point
             if most_wrong(w, p) >= 0 or leaves_set(w, p):   # not its point: as it is
                 if not tabled:
-                    _solve(w, p, nf, nb, POLISH_REFINE_TOLERANCE * scale, factorizations)
+                    refine(w, p, nf, nb, POLISH_REFINE_TOLERANCE * scale, factorizations)
                     _multipliers(w, p, nf, nb)
                 break
             settled = _newton(w, p, nf, &nb, newton_steps, scale, factorizations, table, kkt,

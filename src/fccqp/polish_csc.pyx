@@ -9,7 +9,7 @@
 
 (``F`` the free entries of ``x``, ``G`` one tangent-plane row per boundary cone block,
 ``H`` those blocks' curvature terms). On dense ``P`` and ``A`` it is assembled for
-``dsytrf`` (``polish._assemble``, ``delta = POLISH_DELTA``); here, where they are CSC
+``dsytrf`` (``polish_kkt._assemble``, ``delta = POLISH_DELTA``); here, where they are CSC
 (:mod:`fccqp.matrices`), the same blocks are assembled as the compressed columns of the
 upper triangle and factored by ``qdldl`` (its Python API, with the GIL: a call costs
 about 10 us, small beside a factorization of the sizes that take the sparse path).
@@ -19,7 +19,7 @@ fill-reducing order; but without pivoting its rounding grows like ``1 / delta``,
 ``delta`` is ``POLISH_CSC_DELTA`` (1e-8) rather than the dense ``1e-12``: on an LP (``P =
 0``: the top-left block is ``delta I``) the solves of an active set that the dense
 backends' polish accepts were lost below it, and the polish's refinement against the
-unregularized system (``polish._solve``) removes the larger bias, factoring again with a
+unregularized system (``polish_kkt.refine``) removes the larger bias, factoring again with a
 smaller ``delta`` where a free block's curvature lies below it.
 
 Column ``c < |F|`` of the upper triangle is column ``F_c`` of ``P`` restricted to the
