@@ -4,8 +4,8 @@ from fccqp._types cimport Iterates
 cdef struct Anderson:
     # Type-II Anderson acceleration of the map (z, y / rho) -> T(z, y / rho).
     int capacity            # memory (pairs of differences kept)
-    double* dg              # capacity x 2s, row per slot: differences of g
-    double* df              # capacity x 2s: differences of f = T(g) - g
+    double* dgf             # capacity x 2s, row per slot: dG + dF, the step's columns
+    double* df              # capacity x 2s, row per slot: differences of f = T(g) - g
     double* g               # 2s: the previous g
     double* f               # 2s: the previous f
     double* g_new           # 2s scratch

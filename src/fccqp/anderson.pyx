@@ -69,6 +69,29 @@ cdef bint solve_small_spd(double* M, double* b, int k) noexcept nogil:
     return True
 
 
+cdef inline void _new_products(Anderson* a, const double* f, Py_ssize_t slot, int stored,
+                               Py_ssize_t two_s) noexcept nogil:
+    """The new slot's row of ``products`` (``df_slot' df_l``) and ``gamma = dF' f`` in one
+    pass over the stored slots: each of the two sums adds its terms in index order, as
+    two separate loops would, and ``df_l`` is read once for both."""
+    cdef Py_ssize_t l, j, cap = a.capacity
+    cdef const double* new = a.df + slot * two_s
+    cdef const double* row
+    cdef double to_new, to_f
+    for l in range(stored):
+        row = a.df + l * two_s
+        to_new = 0.0
+        to_f = 0.0
+        for j in range(0, two_s, 2):   # two_s is even
+            to_new += new[j] * row[j]
+            to_f += row[j] * f[j]
+            to_new += new[j + 1] * row[j + 1]
+            to_f += row[j + 1] * f[j + 1]
+        a.products[slot * cap + l] = to_new
+        a.products[l * cap + slot] = to_new
+        a.gamma[l] = to_f
+
+
 cdef void anderson_step(Anderson* a, Iterates* it, Py_ssize_t s) noexcept nogil:
     """Record the step just taken and extrapolate ``(z, y)`` in ``it`` when possible."""
     cdef Py_ssize_t j, i, l, two_s = 2 * s, slot
@@ -77,6 +100,9 @@ cdef void anderson_step(Anderson* a, Iterates* it, Py_ssize_t s) noexcept nogil:
     cdef double* g = a.g_new
     cdef double* f = a.f_new
     cdef double* step
+    if a.wait > 0:   # plain steps only (a rejection cleared ``accelerated``)
+        a.wait -= 1
+        return
     for j in range(s):
         g[j] = it.z_prev[j]
         g[s + j] = it.y_prev[j] / it.rho_vec[j]
@@ -94,22 +120,14 @@ cdef void anderson_step(Anderson* a, Iterates* it, Py_ssize_t s) noexcept nogil:
         # let plain ADMM run before trying again; after a few failures, for good
         a.wait = cap if a.rejections < MAX_REJECTIONS else (<long>1) << 62
         return
-    if a.wait > 0:
-        a.wait -= 1
-        return
     if a.have_previous:
         slot = a.stored % cap
         for j in range(two_s):
-            a.dg[slot * two_s + j] = g[j] - a.g[j]
             a.df[slot * two_s + j] = f[j] - a.f[j]
+            a.dgf[slot * two_s + j] = (g[j] - a.g[j]) + a.df[slot * two_s + j]
         a.stored += 1
         # only the new slot's products change: O(capacity s) instead of O(capacity^2 s)
-        for l in range(min(a.stored, <long>cap)):
-            acc = 0.0
-            for j in range(two_s):
-                acc += a.df[slot * two_s + j] * a.df[l * two_s + j]
-            a.products[slot * cap + l] = acc
-            a.products[l * cap + slot] = acc
+        _new_products(a, f, slot, <int>min(a.stored, <long>cap), two_s)
     for j in range(two_s):
         a.g[j] = g[j]
         a.f[j] = f[j]
@@ -124,10 +142,6 @@ cdef void anderson_step(Anderson* a, Iterates* it, Py_ssize_t s) noexcept nogil:
         for l in range(stored):
             a.gram[i * stored + l] = a.products[i * cap + l]
         ridge = max(ridge, a.gram[i * stored + i])
-        acc = 0.0
-        for j in range(two_s):
-            acc += a.df[i * two_s + j] * f[j]
-        a.gamma[i] = acc
     for i in range(stored):
         a.gram[i * stored + i] += REGULARIZATION * ridge + 1e-300
     if not solve_small_spd(a.gram, a.gamma, stored):
@@ -147,7 +161,7 @@ cdef void anderson_step(Anderson* a, Iterates* it, Py_ssize_t s) noexcept nogil:
     for i in range(stored):
         coefficient = a.gamma[i]
         for j in range(two_s):
-            step[j] += (a.dg[i * two_s + j] + a.df[i * two_s + j]) * coefficient
+            step[j] += a.dgf[i * two_s + j] * coefficient
     for j in range(s):
         a.plain[j] = it.z[j]
         a.plain[s + j] = it.y[j] / it.rho_vec[j]

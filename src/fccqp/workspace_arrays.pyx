@@ -110,7 +110,7 @@ cdef void common_arrays(Arrays a, Engine* e, Py_ssize_t memory, Py_ssize_t log_r
     red.xs = a.new(s)
     aa = &e.aa
     aa.capacity = <int>memory
-    aa.dg, aa.df = a.new(memory * 2 * s), a.new(memory * 2 * s)
+    aa.dgf, aa.df = a.new(memory * 2 * s), a.new(memory * 2 * s)
     aa.g, aa.f, aa.g_new, aa.f_new = a.new(2 * s), a.new(2 * s), a.new(2 * s), a.new(2 * s)
     aa.plain, aa.gram, aa.gamma = a.new(2 * s + 1), a.new(memory * memory), a.new(memory)
     aa.products = a.new(memory * memory)
