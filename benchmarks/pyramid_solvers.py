@@ -150,7 +150,9 @@ class DaqpAdapter(Adapter):
     """DAQP on the 4-facet inner pyramid, warm started with the previous multipliers,
     carried across a contact change (:meth:`_dual_start`).
 
-    ``tol`` sets ``primal_tol`` (DAQP's default, 1e-6, when ``None``).
+    ``tol`` sets ``primal_tol`` (DAQP's default, 1e-6, when ``None``); ``carry=False``
+    keeps the multipliers only where the sizes match, as a caller without the contact
+    map (the comparison's "before").
     """
 
     _EQUALITY = 5
@@ -158,12 +160,13 @@ class DaqpAdapter(Adapter):
     _FACETS = 4
     """Facets of the pyramid (rows per contact point: one more, the normal force's)."""
 
-    def __init__(self, name: str, tol: float | None = None) -> None:
+    def __init__(self, name: str, tol: float | None = None, carry: bool = True) -> None:
         import daqp
 
         self.name = name
         self._daqp = daqp
         self._settings = {} if tol is None else {"primal_tol": tol}
+        self._carry = carry
         self._maps = ContactMaps()
         self._previous: tuple[WbcQP, np.ndarray] | None = None   # the last QP and its lam
 
@@ -196,8 +199,8 @@ class DaqpAdapter(Adapter):
         if self._previous is None:
             return None
         before, lam = self._previous
-        cmap = self._maps.changed(before, qp)
-        if cmap is None:   # the same points, or points without names: as they were
+        cmap = self._maps.changed(before, qp) if self._carry else None
+        if cmap is None:   # the same points, points without names, or no carry: as they were
             rows = qp.n + qp.A.shape[0] + (self._FACETS + 1) * qp.n_contacts
             return lam if lam.shape[0] == rows else None
         n, m = before.n, before.A.shape[0]

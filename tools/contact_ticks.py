@@ -11,8 +11,9 @@ against the set's exact reference (``benchmarks.metrics.qp_metrics``, the report
 adapter, ``benchmarks.pyramid_solvers.DaqpAdapter``); then the iterations over all ticks
 of the walk. With ``--mapped``, fccqp starts each contact-change tick from the previous
 answer carried by the contact points (``benchmarks.exact_solvers.carried_guess``, as the
-benchmark's adapter does; DAQP's adapter always carries its multipliers); without it, as
-fccqp did before the map, from its own warm start.
+benchmark's adapter does) and DAQP from its multipliers carried likewise; without it,
+as both did before the map: fccqp from its own warm start, DAQP from its previous
+multipliers where the sizes match.
 
 Why: the report's contact-change view is a median over one tick per robot in the
 ``mix`` sets (tick 360 of ``--full``, 54 of ``--quick``); a ``contact_switch`` set
@@ -51,7 +52,7 @@ def contact_ticks(fccqp: object, test_set: object, budget: float,
     path = warm_path(test_set)
     changed = contact_changes(path)
     solver = fccqp.Solver(fccqp.Settings.realtime(budget))
-    daqp, maps = DaqpAdapter("daqp"), ContactMaps()
+    daqp, maps = DaqpAdapter("daqp", carry=mapped), ContactMaps()
     lines, iterations, previous, answer = [], 0, None, None
     for i, fresh, change in zip(path.indices, path.fresh, changed, strict=True):
         if fresh:
