@@ -550,9 +550,12 @@ def _vector(value: object, name: str, size: int) -> np.ndarray:
         raise TypeError(f"{name} must be a real numeric vector of {size} entries, got dtype "
                         f"{vector.dtype}")
     vector = np.ascontiguousarray(vector, dtype=np.float64).reshape(-1)
-    if vector.shape != (size,) or not np.all(np.isfinite(vector)):
-        raise ValueError(f"{name} must be a finite vector of {size} entries")
-    if np.abs(vector).max(initial=0.0) > MAX_ENTRY:
+    finite = f"{name} must be a finite vector of {size} entries"
+    if vector.shape != (size,):
+        raise ValueError(finite)
+    if not np.abs(vector).max(initial=0.0) <= MAX_ENTRY:   # one pass: NaN fails it too
+        if not np.all(np.isfinite(vector)):
+            raise ValueError(finite)
         raise ValueError(f"{name} has an entry beyond {MAX_ENTRY:.0e} in magnitude")
     return vector
 
