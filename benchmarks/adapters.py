@@ -14,13 +14,13 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from benchmarks.wbc_qp import WbcQP
 
-__all__ = ["Adapter", "SolveOutcome", "failed_x", "torque_box"]
+__all__ = ["Adapter", "Prepared", "SolveOutcome", "failed_x", "torque_box"]
 
 
 @dataclass(frozen=True)
@@ -46,6 +46,16 @@ class SolveOutcome:
     success: bool
     iterations: int
     time: float
+
+
+class Prepared(NamedTuple):
+    """The prepared input of an adapter that carries its previous answer across a
+    contact change (:mod:`benchmarks.contact_map`)."""
+
+    arguments: tuple[Any, ...]
+    """The solver's own positional arguments."""
+    qp: WbcQP
+    """The QP they came from, whose contact points the map matches."""
 
 
 class Adapter(ABC):

@@ -1,7 +1,11 @@
 """Adapters of the solvers that see the exact friction cones: fccqp, Clarabel, QOCO, SCS.
 
 - fccqp: :class:`fccqp.Solver` with the given settings, warm across a sequence (the
-  solver keeps its state; ``reset()`` at sequence boundaries).
+  solver keeps its state; ``reset()`` at sequence boundaries); where the contact points
+  change within a sequence, the previous answer carried onto the new QP by its contact
+  points (:mod:`benchmarks.contact_map`) is the guess ``x0, y0, z0``, as a controller
+  would give it. The map and the carried vectors are made before the timed call (the
+  controller's bookkeeping, as DAQP's ``dual_start`` below).
 - Clarabel: second-order cones; it has no warm start and no update for new matrices,
   so ``DefaultSolver(...)`` construction and ``solve()`` are both timed.
 - QOCO: second-order cones, interior point for real time; its Python interface has
@@ -22,7 +26,8 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.adapters import Adapter, SolveOutcome, failed_x
+from benchmarks.adapters import Adapter, Prepared, SolveOutcome, failed_x
+from benchmarks.contact_map import ContactMaps, carried
 from benchmarks.wbc_qp import WbcQP, clarabel_problem
 
 __all__ = [
@@ -30,6 +35,7 @@ __all__ = [
     "FccqpAdapter",
     "QocoAdapter",
     "ScsAdapter",
+    "carried_guess",
     "conic_sizes",
     "fccqp_arguments",
 ]
@@ -60,26 +66,50 @@ def conic_sizes(qp: WbcQP, rows: int) -> tuple[int, int, int]:
 
 
 class FccqpAdapter(Adapter):
-    """fccqp with exact friction cones, warm started across a sequence."""
+    """fccqp with exact friction cones, warm started across a sequence and across its
+    contact changes (:func:`carried_guess`)."""
 
     def __init__(self, name: str, settings: Any) -> None:
         import fccqp
 
         self.name = name
         self._solver = fccqp.Solver(settings)
+        self._maps = ContactMaps()
+        self._previous: tuple[WbcQP, Any] | None = None   # the last QP and its Result
 
-    def prepare(self, qp: WbcQP) -> tuple[Any, ...]:
-        return fccqp_arguments(qp)
+    def prepare(self, qp: WbcQP) -> Prepared:
+        return Prepared(fccqp_arguments(qp), qp)
 
-    def solve(self, data: tuple[Any, ...]) -> SolveOutcome:
+    def solve(self, data: Prepared) -> SolveOutcome:
+        guess = carried_guess(self._maps, self._previous, data.qp)
         start = time.perf_counter()
-        result = self._solver.solve(*data)
+        result = self._solver.solve(*data.arguments, **guess)
         elapsed = time.perf_counter() - start
+        self._previous = (data.qp, result)
         status = result.status
         return SolveOutcome(result.x, status.value, status.is_solved(), result.iterations, elapsed)
 
     def reset(self) -> None:
         self._solver.reset()
+        self._previous = None
+
+
+def carried_guess(maps: ContactMaps, previous: tuple[WbcQP, Any] | None,
+                  qp: WbcQP) -> dict[str, np.ndarray]:
+    """The guess ``{x0, y0, z0}`` of ``fccqp.Solver.solve`` for ``qp``: the previous
+    QP's answer (``previous``, the QP and its ``fccqp.Result``) carried onto ``qp`` by
+    its contact points when they changed, new points' entries zero; empty (the solver's
+    own warm start) when they did not, at a sequence start, or when the previous answer
+    is an infeasibility certificate's point or not finite (the solver keeps none)."""
+    if previous is None:
+        return {}
+    before, result = previous
+    cmap = maps.changed(before, qp)
+    if (cmap is None or result.status.is_infeasible()
+            or not all(np.all(np.isfinite(v)) for v in (result.x, result.y, result.z))):
+        return {}
+    return {"x0": carried(result.x, cmap.variables), "y0": carried(result.y, cmap.rows),
+            "z0": carried(result.z, cmap.variables)}
 
 
 class ClarabelAdapter(Adapter):

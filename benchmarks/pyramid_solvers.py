@@ -9,7 +9,10 @@ The pyramid rows ``G x <= h`` come from :meth:`benchmarks.wbc_qp.WbcQP.pyramid` 
   warm started with ``warm_start(x, y)`` from the previous solution of the sequence.
 - DAQP (dense dual active set): one ``daqp.solve`` call, equalities as ``sense = 5``
   rows and bounds as its simple bounds, warm started with the previous multipliers
-  (``dual_start``, which sets the initial working set) when the dimensions match.
+  (``dual_start``, which sets the initial working set); where the contact points change
+  within a sequence, the multipliers carried onto the new rows by the contact points
+  (:mod:`benchmarks.contact_map`; a new point's pyramid rows at zero), as fccqp's
+  adapter carries its answer. The carried start is made before the timed call.
 - quadprog (Goldfarb-Idnani dual active set): one ``solve_qp`` call, cold (it has no
   warm start and no tolerance setting).
 - PIQP (dense backend, proximal interior point): ``setup`` and ``solve`` timed, cold
@@ -28,7 +31,8 @@ from typing import Any
 import numpy as np
 from scipy import sparse
 
-from benchmarks.adapters import Adapter, SolveOutcome, failed_x, torque_box
+from benchmarks.adapters import Adapter, Prepared, SolveOutcome, failed_x, torque_box
+from benchmarks.contact_map import ContactMaps, carried, shifted
 from benchmarks.wbc_qp import WbcQP
 
 __all__ = [
@@ -143,45 +147,69 @@ class OsqpAdapter(Adapter):
 
 
 class DaqpAdapter(Adapter):
-    """DAQP on the 4-facet inner pyramid, warm started with the previous multipliers.
+    """DAQP on the 4-facet inner pyramid, warm started with the previous multipliers,
+    carried across a contact change (:meth:`_dual_start`).
 
-    ``tol`` sets ``primal_tol`` (DAQP's default, 1e-6, when ``None``).
+    ``tol`` sets ``primal_tol`` (DAQP's default, 1e-6, when ``None``); ``carry=False``
+    keeps the multipliers only where the sizes match, as a caller without the contact
+    map (the comparison's "before").
     """
 
     _EQUALITY = 5
     """DAQP's ``sense`` flag of an equality row."""
+    _FACETS = 4
+    """Facets of the pyramid (rows per contact point: one more, the normal force's)."""
 
-    def __init__(self, name: str, tol: float | None = None) -> None:
+    def __init__(self, name: str, tol: float | None = None, carry: bool = True) -> None:
         import daqp
 
         self.name = name
         self._daqp = daqp
         self._settings = {} if tol is None else {"primal_tol": tol}
-        self._lam: np.ndarray | None = None
+        self._carry = carry
+        self._maps = ContactMaps()
+        self._previous: tuple[WbcQP, np.ndarray] | None = None   # the last QP and its lam
 
-    def prepare(self, qp: WbcQP) -> tuple[Any, ...]:
-        G, h = _pyramid(qp, 4)
+    def prepare(self, qp: WbcQP) -> Prepared:
+        G, h = _pyramid(qp, self._FACETS)
         m = qp.A.shape[0]
         rows = np.ascontiguousarray(np.vstack([qp.A, G]))
         upper = np.concatenate([qp.ub, qp.b, h])
         lower = np.concatenate([qp.lb, qp.b, np.full(h.shape, -np.inf)])
         sense = np.zeros(upper.shape, dtype=np.int32)
         sense[qp.n : qp.n + m] = self._EQUALITY
-        return (np.array(qp.P), np.array(qp.q), rows, upper, lower, sense)
+        return Prepared((np.array(qp.P), np.array(qp.q), rows, upper, lower, sense), qp)
 
-    def solve(self, data: tuple[Any, ...]) -> SolveOutcome:
-        lam = self._lam
-        warm = {"dual_start": lam} if lam is not None and lam.shape == data[3].shape else {}
+    def solve(self, data: Prepared) -> SolveOutcome:
+        lam = self._dual_start(data.qp)
+        warm = {} if lam is None else {"dual_start": lam}
         start = time.perf_counter()
-        x, _, exitflag, info = self._daqp.solve(*data, **self._settings, **warm)
+        x, _, exitflag, info = self._daqp.solve(*data.arguments, **self._settings, **warm)
         elapsed = time.perf_counter() - start
         solved = exitflag == 1
         x = np.array(x, dtype=float)
-        self._lam = np.array(info["lam"]) if solved else None
+        self._previous = (data.qp, np.array(info["lam"])) if solved else None
         return SolveOutcome(x, f"exitflag {exitflag}", solved, int(info["iterations"]), elapsed)
 
+    def _dual_start(self, qp: WbcQP) -> np.ndarray | None:
+        """The previous multipliers for ``qp``'s bounds and rows ``[x, A, pyramid]``: as
+        they were when the contact points did not change, else carried by the points
+        (:class:`benchmarks.contact_map.ContactMap`); None at a sequence start or after
+        a failed solve."""
+        if self._previous is None:
+            return None
+        before, lam = self._previous
+        cmap = self._maps.changed(before, qp) if self._carry else None
+        if cmap is None:   # the same points, points without names, or no carry: as they were
+            rows = qp.n + qp.A.shape[0] + (self._FACETS + 1) * qp.n_contacts
+            return lam if lam.shape[0] == rows else None
+        n, m = before.n, before.A.shape[0]
+        positions = np.concatenate([cmap.variables, shifted(cmap.rows, n),
+                                    shifted(cmap.groups(self._FACETS + 1), n + m)])
+        return carried(lam, positions)
+
     def reset(self) -> None:
-        self._lam = None
+        self._previous = None
 
 
 class QuadprogAdapter(Adapter):

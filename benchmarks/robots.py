@@ -24,6 +24,7 @@ __all__ = [
     "LoadedRobot",
     "RobotConfig",
     "actuated_joint_names",
+    "contact_point_names",
     "data_dir",
     "load_robot",
 ]
@@ -151,6 +152,19 @@ ROBOTS: dict[str, RobotConfig] = {
 }
 
 
+def _point_name(foot: Foot, i: int) -> str:
+    """Name of the frame of ``foot``'s ``i``-th contact point."""
+    return f"{foot.name}_{i}"
+
+
+def contact_point_names(robot: str, stance: tuple[str, ...]) -> tuple[str, ...]:
+    """Names of the contact points of ``robot`` (a key of :data:`ROBOTS`) with the feet
+    ``stance`` down, in the order the scenarios stack their cones: the robot's feet
+    order, each foot's points in order (the frames of :func:`load_robot`)."""
+    return tuple(_point_name(foot, i) for foot in ROBOTS[robot].feet if foot.name in stance
+                 for i in range(len(foot.points)))
+
+
 def data_dir() -> Path:
     """Directory holding example-robot-data's ``robots`` folder."""
     dist = importlib.metadata.distribution("example-robot-data")
@@ -219,7 +233,7 @@ def load_robot(name: str) -> LoadedRobot:
         for i, point in enumerate(foot.points):
             placement = parent.placement * pin.SE3(np.eye(3), np.asarray(point))
             frame = pin.Frame(
-                f"{foot.name}_{i}", parent.parentJoint, fid, placement, pin.FrameType.OP_FRAME
+                _point_name(foot, i), parent.parentJoint, fid, placement, pin.FrameType.OP_FRAME
             )
             ids.append(model.addFrame(frame, False))
         contact_frames[foot.name] = tuple(ids)

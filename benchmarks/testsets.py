@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.robots import load_robot
+from benchmarks.robots import ROBOTS, contact_point_names, load_robot
 from benchmarks.scenarios import SCENARIOS, make_sequence, rollout
 from benchmarks.wbc_qp import WbcQP
 
@@ -220,19 +220,26 @@ def save(test_set: TestSet, path: str | Path) -> None:
 
 
 def load(path: str | Path) -> TestSet:
-    """Read a test set written by :func:`save` (no pickles involved)."""
+    """Read a test set written by :func:`save` (no pickles involved). The QPs' contact
+    points (:attr:`WbcQP.contacts`) are named from the stance, for a robot of
+    :data:`benchmarks.robots.ROBOTS` (:func:`benchmarks.robots.contact_point_names`)."""
     with np.load(path, allow_pickle=False) as z:
         qps, xs = [], []
+        robot = str(z["robot"])
+        stance = tuple(_feet(str(s)) for s in z["stance"]) if "stance" in z else ()
+        named = robot in ROBOTS and len(stance) == int(z["n_qps"])
         for i in range(int(z["n_qps"])):
             layout = {
                 k: slice(int(a), int(b))
                 for k, (a, b) in zip(LAYOUT_NAMES, z[f"qp{i}_layout"], strict=True)
             }
             fields = {name: z[f"qp{i}_{name}"] for name in _QP_ARRAYS}
-            qps.append(WbcQP(**fields, layout=layout, nv=int(z[f"qp{i}_nv"])))
+            contacts = contact_point_names(robot, stance[i]) if named else ()
+            qps.append(WbcQP(**fields, layout=layout, nv=int(z[f"qp{i}_nv"]),
+                             contacts=contacts))
             xs.append(z[f"qp{i}_x_ref"])
         return TestSet(
-            str(z["robot"]),
+            robot,
             str(z["scenario"]),
             int(z["seed"]),
             float(z["dt"]),
@@ -240,7 +247,7 @@ def load(path: str | Path) -> TestSet:
             xs,
             z["sequence"],
             int(z["generator_version"]) if "generator_version" in z else 0,
-            tuple(_feet(str(s)) for s in z["stance"]) if "stance" in z else (),
+            stance,
         )
 
 

@@ -105,6 +105,11 @@ class WbcQP:
         Slices of ``x``: ``vdot``, ``u``, ``lambda_h``, ``eps``, ``lambda_c``.
     nv : int
         Number of generalized velocities of the robot.
+    contacts : tuple of str
+        Name of each contact point, one per cone in order (``"<foot>_<i>"``, the frames
+        of :func:`benchmarks.robots.load_robot`); empty where not known. A caller that
+        carries an answer across a contact change matches the points by these
+        (:mod:`benchmarks.contact_map`).
     """
 
     P: np.ndarray
@@ -118,6 +123,7 @@ class WbcQP:
     normals: np.ndarray
     layout: dict[str, slice]
     nv: int
+    contacts: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         for name in ("P", "q", "A", "b", "lb", "ub", "mus", "normals"):
@@ -369,7 +375,8 @@ def build_wbc_qp(
     nrm = np.tile([0.0, 0.0, 1.0], (k, 1)) if normals is None else np.asarray(normals, float)
     nrm = nrm / np.linalg.norm(nrm, axis=1, keepdims=True) if k else nrm.reshape(0, 3)
     starts = layout["lambda_c"].start + 3 * np.arange(k)
-    return WbcQP(P, qv, A, b, lb, ub, starts, mus, nrm, layout, nv)
+    names = tuple(model.frames[fid].name for fid in contacts)
+    return WbcQP(P, qv, A, b, lb, ub, starts, mus, nrm, layout, nv, names)
 
 
 # Settings tried in turn when Clarabel stops short of a tight tolerance (AlmostSolved):

@@ -312,6 +312,36 @@ def test_x0_initial_guess():
     assert result.iterations < fccqp.solve(*problem).iterations
 
 
+@pytest.mark.parametrize("backend", ["auto", "sparse"])
+@pytest.mark.parametrize("seed", range(4))
+def test_a_result_given_back_as_the_guess_takes_no_iteration(seed, backend):
+    """A primal-dual guess starts warm with the polish on its active set, as a warm
+    start from the solver's own answer does: the problem's own polished answer is
+    answered again at once (its x alone, without the duals, is not)."""
+    problem = random_problem(seed)
+    first = fccqp.solve(*problem, kkt_backend=backend)
+    assert first.status is Status.SOLVED and first.polished
+    again = fccqp.solve(*problem, x0=first.x, y0=first.y, z0=first.z, kkt_backend=backend)
+    assert again.status is Status.SOLVED and again.polished
+    assert again.iterations == 0
+    for name in "xyz":
+        np.testing.assert_allclose(getattr(again, name), getattr(first, name), rtol=1e-9,
+                                   atol=1e-12)
+    assert fccqp.solve(*problem, x0=first.x, kkt_backend=backend).iterations > 0
+
+
+def test_dual_guess_overrides_the_previous_answer_without_warm_start_setting():
+    """Given duals, a solve starts from the guess even with ``warm_start=False`` (as
+    OSQP's ``warm_start(x, y)`` does) and in a solver that has solved another problem."""
+    problem, other = random_problem(5), random_problem(6)
+    first = fccqp.solve(*problem)
+    solver = fccqp.Solver(warm_start=False)
+    solver.solve(*other)
+    again = solver.solve(*problem, x0=first.x, y0=first.y, z0=first.z)
+    assert again.status is Status.SOLVED and again.iterations == 0
+    np.testing.assert_allclose(again.x, first.x, rtol=1e-9, atol=1e-12)
+
+
 def test_box_infeasible():
     P = np.eye(3)
     q = np.zeros(3)

@@ -260,6 +260,28 @@ def test_bad_initial_guesses(x0, error, message):
         fccqp.Solver().solve(P, q, A, b, x0=x0)
 
 
+@pytest.mark.parametrize(
+    "guess, error, message",
+    [
+        ({"y0": np.ones(4)}, ValueError, "y0 must be a finite vector of 2 entries"),
+        ({"z0": np.full(6, np.inf)}, ValueError, "z0 must be a finite vector of 6 entries"),
+        ({"y0": np.full(2, -1e21)}, ValueError, r"y0 has an entry beyond 1e\+20"),
+        ({"z0": np.ones(6) + 0j}, TypeError, "z0 must be a real numeric vector"),
+        ({"y0": "ab"}, TypeError, "y0 must be a real numeric vector"),
+    ],
+)
+def test_bad_dual_guesses(guess, error, message):
+    with pytest.raises(error, match=message):
+        fccqp.Solver().solve(P, q, A, b, x0=np.zeros(6), **guess)
+
+
+@pytest.mark.parametrize("dual", ["y0", "z0"])
+def test_dual_guess_without_x0(dual):
+    guess = {"y0": np.zeros(2), "z0": np.zeros(6)}[dual]
+    with pytest.raises(ValueError, match="y0 and z0 are dual guesses beside x0"):
+        fccqp.solve(P, q, A, b, **{dual: guess})
+
+
 @BEFORE_ANY_BACKEND
 @pytest.mark.parametrize(
     "call, error, message",

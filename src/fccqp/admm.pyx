@@ -19,7 +19,7 @@ from cpython.buffer cimport PyBuffer_Release
 from libc.math cimport isfinite
 
 from fccqp cimport engine
-from fccqp._dense cimport fill
+from fccqp._dense cimport copy, fill
 from fccqp._types cimport Problem
 from fccqp.anderson cimport anderson_reset
 from fccqp.blas_threads cimport enter, leave
@@ -256,7 +256,7 @@ cdef class Workspace:
                 for i in range(self.e.log.count)]
 
     def solve(self, P, q, A, b, lb, ub, x0, bint warm, double start_time, cert_out,
-              bint checked=True):
+              bint checked=True, y0=None, z0=None):
         """Validate, scale, run ADMM and unscale; return the :class:`fccqp.Result`, or
         the code of what the caller must do instead.
 
@@ -266,7 +266,11 @@ cdef class Workspace:
         its patterns, scipy's ``data`` of :func:`fccqp.sparse_problem.convert`'s
         matrices); with ``checked=False`` they are the caller's arguments as they came,
         and the code is ``NOT_DENSE`` when one is not such an array. ``x0`` (None or a
-        float64 vector) overrides the warm start; ``warm`` asks for a start from the
+        float64 vector) overrides the warm start; with ``y0`` and ``z0`` (float64 vectors
+        of ``m`` and ``n`` entries, both or neither, only beside ``x0``) the guess is a
+        primal-dual point that replaces the previous solution, polished (the run starts
+        warm from it, with the warm polish from its active set, at the rho of the last
+        solve, else ``settings.rho``); ``warm`` asks for a start from the
         previous solution (when there is one); ``start_time`` is the call's start on the
         clock of ``time.perf_counter``. ``cert_out`` (``m + n`` entries) receives an
         infeasibility certificate, which the result copies. The other codes are
@@ -282,15 +286,15 @@ cdef class Workspace:
         counts 7k fewer instructions of 706k (callgrind).
         """
         cdef Py_ssize_t n = self.e.prob.n, m = self.e.prob.m
-        cdef Py_buffer views[11]
-        cdef Py_ssize_t rows[11]
-        cdef Py_ssize_t columns[11]
-        cdef int held = 0, count = 10 if x0 is None else 11, i, code
+        cdef Py_buffer views[13]
+        cdef Py_ssize_t rows[13]
+        cdef Py_ssize_t columns[13]
+        cdef int held = 0, count = 10 if x0 is None else (11 if z0 is None else 13), i, code
         cdef Run run
         x_out, y_out, z_out = np.empty(n), np.empty(m), np.empty(n)
-        cdef tuple arrays = (P, q, A, b, lb, ub, x_out, y_out, z_out, cert_out, x0)
-        rows[:] = [n, n, m, m, n, n, n, m, n, n + m, n]
-        columns[:] = [n, -1, n, -1, -1, -1, -1, -1, -1, -1, -1]   # -1: a vector
+        cdef tuple arrays = (P, q, A, b, lb, ub, x_out, y_out, z_out, cert_out, x0, y0, z0)
+        rows[:] = [n, n, m, m, n, n, n, m, n, n + m, n, m, n]
+        columns[:] = [n, -1, n, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1]   # -1: a vector
         if self.compressed:   # P and A: the values of the patterns
             rows[0], rows[2] = self.e.user.P.colptr[n], self.e.user.A.colptr[n]
             columns[0] = columns[2] = -1
@@ -305,7 +309,9 @@ cdef class Workspace:
             code = self._run(<const double*>views[0].buf, <const double*>views[1].buf,
                              <const double*>views[2].buf, <const double*>views[3].buf,
                              <const double*>views[4].buf, <const double*>views[5].buf,
-                             <const double*>views[10].buf if x0 is not None else NULL, warm,
+                             <const double*>views[10].buf if x0 is not None else NULL,
+                             <const double*>views[11].buf if count == 13 else NULL,
+                             <const double*>views[12].buf if count == 13 else NULL, warm,
                              start_time, <double*>views[6].buf, <double*>views[7].buf,
                              <double*>views[8].buf, <double*>views[9].buf, &run)
         finally:
@@ -339,11 +345,13 @@ cdef class Workspace:
         })
 
     cdef int _run(self, const double* P, const double* q, const double* A, const double* b,
-                  const double* lb, const double* ub, const double* x0, bint warm,
-                  double start_time, double* x_out, double* y_out, double* z_out,
-                  double* cert_out, Run* out) except -9:
+                  const double* lb, const double* ub, const double* x0, const double* y0,
+                  const double* z0, bint warm, double start_time, double* x_out,
+                  double* y_out, double* z_out, double* cert_out, Run* out) except -9:
         """:meth:`solve` on the held buffers: the run's status, with ``out`` filled, or
-        one of the codes below ``SOLVED``."""
+        one of the codes below ``SOLVED``. A primal-dual guess (``z0`` not NULL) becomes
+        the previous solution only once the data passed its checks, so that a rejected
+        call leaves the previous solution as it was."""
         cdef Engine* e = &self.e
         cdef Py_ssize_t n = e.prob.n, m = e.prob.m
         cdef bint same = e.user.has_matrices
@@ -370,6 +378,9 @@ cdef class Workspace:
         if not self._same_structure(lb, ub):
             e.user.has_matrices = False
             return engine.NEW_STRUCTURE
+        if z0 != NULL:
+            self._take_guess(x0, y0, z0)
+            x0, warm = NULL, True
         cdef long max_iter = e.opt.max_iter
         # a start from the previous solution (or x0), with the previous scaling, that
         # has not succeeded in half the iterations gets a cold start with a new scaling
@@ -419,6 +430,20 @@ cdef class Workspace:
             return engine.NOT_CONVEX_QP
         out[0] = run
         return run.status
+
+    cdef void _take_guess(self, const double* x0, const double* y0,
+                          const double* z0) noexcept nogil:
+        """Make the primal-dual guess ``(x0, y0, z0)`` (user's units) the previous
+        solution, polished: the run then starts from it exactly as a warm start from
+        its own answer does, the warm polish trying the guess's active set first. Its
+        rho is the last one this workspace ran at, else ``settings.rho``."""
+        cdef Engine* e = &self.e
+        copy(x0, e.prev.x, e.prob.n)
+        copy(y0, e.prev.y, e.prob.m)
+        copy(z0, e.prev.z, e.prob.n)
+        if not e.prev.has_rho:
+            e.prev.rho = e.opt.rho
+        e.prev.exists = e.prev.polished = True
 
     cdef bint _same_structure(self, const double* lb, const double* ub) noexcept nogil:
         """Whether the user's new bounds bound, fix and leave free the entries they did at

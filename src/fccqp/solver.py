@@ -47,6 +47,8 @@ NUMERICAL_ERROR is also the run whose iterate passed and whose returned point di
 with ``P`` of 1e18 the reduced form's final ``A x = b`` correction moved a cone block
 of size 3e-11 outside its cone by 5e-12, beyond the scaled-units guard, where the
 full form ends SOLVED (fuzz extreme_data:2100247)."""
+NO_GUESS = (None, None, None)
+"""The ``(x0, y0, z0)`` of a solve without an initial guess (:func:`_guess`)."""
 
 
 class _Structure:
@@ -163,6 +165,8 @@ class Solver:
         cones: Sequence[Cone] = (),
         *,
         x0: object = None,
+        y0: object = None,
+        z0: object = None,
     ) -> Result:
         """Solve ``min 1/2 x'Px + q'x  s.t.  A x = b, lb <= x <= ub, x[block] in cone``.
 
@@ -183,6 +187,16 @@ class Solver:
             Disjoint cone blocks of ``x``.
         x0 : (n,) array_like, optional
             Primal initial guess; overrides the warm start from the previous solve.
+        y0, z0 : (m,) and (n,) array_like, optional
+            Dual guesses beside ``x0``, in the conventions of :attr:`Result.y` and
+            :attr:`Result.z` (a missing one is zero), as OSQP's ``warm_start(x, y)``:
+            the solve then starts from ``(x0, y0, z0)`` exactly as a warm start from
+            the previous answer does, trying first the polish on the guess's active
+            set, at the rho of this structure's last solve (``settings.rho`` on a new
+            one). Solving a problem again from its own :class:`Result`'s ``x, y, z``
+            takes no ADMM iteration when that result was polished. A caller whose
+            problem changed size (a contact made or broken) passes the previous
+            answer mapped onto the new variables and rows.
 
         Returns
         -------
@@ -204,7 +218,7 @@ class Solver:
         settings = self._settings
         w, structure = self._workspace, self._structure
         sparse = settings.kkt_backend == "sparse"
-        if w is not None and x0 is None and not sparse:
+        if w is not None and x0 is None and y0 is None and z0 is None and not sparse:
             if not same_cones(cones, self._cones):   # a contact change, or other cones
                 w, structure = self._returning(cones, P, q, A, b, lb, ub)
             if w is not None:
@@ -215,19 +229,19 @@ class Solver:
                         and out.status not in UNANSWERED and not w.doubt):
                     return out
                 if type(out) is Result or out != admm.NOT_DENSE:
-                    return self._result(out, P, q, A, b, lb, ub, None, start)
+                    return self._result(out, P, q, A, b, lb, ub, NO_GUESS, start)
             w, structure = self._workspace, self._structure
         if w is not None and not sparse and dense_arguments(P, q, A, b, lb, ub, structure.n,
                                                             structure.m):
             n, m = structure.n, structure.m   # the arrays fit as they are
         else:
             if sparse or _rows(P) + _rows(A) > MAX_DENSE_KKT_ROWS:
-                return self._solve_sparse(P, q, A, b, lb, ub, cones, x0, start)
+                return self._solve_sparse(P, q, A, b, lb, ub, cones, (x0, y0, z0), start)
             P, q, A, b, lb, ub = convert(P, q, A, b, lb, ub)
             n, m = P.shape[0], A.shape[0]
         flat = flatten_cones(cones, n)   # memoized: the same object for the same cones
         self._cones = cones
-        guess = None if x0 is None else _initial_guess(x0, n)
+        guess = _guess(x0, y0, z0, n, m)
         if w is None or (structure.n, structure.m) != (n, m) or not flat.same_blocks(
                 structure.cones):
             structure = _Structure(n, m, flat)
@@ -236,8 +250,8 @@ class Solver:
         elif flat is not structure.cones:
             w.update_cones(flat.mu, flat.normal)
         structure.cones, structure.last_cones = flat, cones
-        out = w.solve(P, q, A, b, lb, ub, guess, settings.warm_start, start,
-                      structure.certificate)
+        out = w.solve(P, q, A, b, lb, ub, guess[0], settings.warm_start, start,
+                      structure.certificate, True, *guess[1:])
         return self._result(out, P, q, A, b, lb, ub, guess, start)
 
     def _returning(self, cones: object, P: object, q: object, A: object, b: object,
@@ -267,11 +281,12 @@ class Solver:
                 del self._kept[next(iter(self._kept))]
 
     def _result(self, out: Result | int, P: np.ndarray, q: np.ndarray, A: np.ndarray,
-                b: np.ndarray, lb: np.ndarray, ub: np.ndarray, guess: np.ndarray | None,
+                b: np.ndarray, lb: np.ndarray, ub: np.ndarray, guess: tuple,
                 start: float) -> Result:
         """The :class:`Result` of the dense solve that returned ``out``: ``out`` itself,
-        after a new workspace and a second solve when the bounds changed its structure,
-        or the error the code says it found."""
+        after a new workspace and a second solve (from the same ``guess``, the
+        ``(x0, y0, z0)`` of :func:`_guess`) when the bounds changed its structure, or
+        the error the code says it found."""
         settings = self._settings
         w, structure = self._workspace, self._structure
         if type(out) is int and out == admm.STRUCTURE_CHANGED:   # the workspace's own scan
@@ -279,8 +294,8 @@ class Solver:
             structure.update(lb, ub)
             structure.last_cones = self._cones
             w = self._adopt(structure)
-            out = w.solve(P, q, A, b, lb, ub, guess, settings.warm_start, start,
-                          structure.certificate)
+            out = w.solve(P, q, A, b, lb, ub, guess[0], settings.warm_start, start,
+                          structure.certificate, True, *guess[1:])
         if type(out) is int and out == admm.BAD_DATA:
             raise_finding(w.finding, lb, ub)
         if type(out) is int:   # NOT_CONVEX_CODE, the only code left
@@ -374,7 +389,7 @@ class Solver:
         return w
 
     def _solve_sparse(self, P: object, q: object, A: object, b: object, lb: object,
-                      ub: object, cones: Sequence[Cone], x0: object,
+                      ub: object, cones: Sequence[Cone], given: tuple,
                       start: float) -> Result:
         """The sparse path: the arguments in compressed columns
         (:func:`fccqp.sparse_problem.convert`), solved by the same compiled call in a
@@ -384,11 +399,11 @@ class Solver:
 
         settings = self._settings
         data = sparse_problem.convert(P, q, A, b, lb, ub, cones)
-        guess = None if x0 is None else _initial_guess(x0, data.n)
+        guess = _guess(*given, data.n, data.m)
         w = self._sparse_workspace(data, False)
         certificate = np.empty(data.n + data.m)
-        arguments = (data.P.data, data.q, data.A.data, data.b, data.lb, data.ub, guess,
-                     settings.warm_start, start, certificate)
+        arguments = (data.P.data, data.q, data.A.data, data.b, data.lb, data.ub, guess[0],
+                     settings.warm_start, start, certificate, True, *guess[1:])
         out = w.solve(*arguments)
         if type(out) is int and out == admm.STRUCTURE_CHANGED:
             w = self._sparse_workspace(data, True)
@@ -510,19 +525,39 @@ def _rows(matrix: object) -> int:
     return int(shape[0]) if len(shape) == 2 else 0
 
 
-def _initial_guess(x0: object, n: int) -> np.ndarray:
+def _guess(x0: object, y0: object, z0: object, n: int, m: int) -> tuple:
+    """The initial guess ``(x, y, z)`` of a solve as float64 vectors of ``n``, ``m`` and
+    ``n`` entries: ``(None, None, None)`` without ``x0``; ``(x, None, None)`` for a
+    primal guess; a dual guess left out is zero beside one given."""
+    if x0 is None:
+        if y0 is not None or z0 is not None:
+            raise ValueError("y0 and z0 are dual guesses beside x0: give x0 too")
+        return NO_GUESS
+    x = _vector(x0, "x0", n)
+    if y0 is None and z0 is None:
+        return (x, None, None)
+    y = np.zeros(m) if y0 is None else _vector(y0, "y0", m)
+    return (x, y, np.zeros(n) if z0 is None else _vector(z0, "z0", n))
+
+
+def _vector(value: object, name: str, size: int) -> np.ndarray:
+    """The argument ``name`` as a finite float64 vector of ``size`` entries."""
     try:
-        guess = np.asarray(x0)
+        vector = np.asarray(value)
     except (TypeError, ValueError) as exn:
-        raise TypeError(f"x0 must be a numeric vector of {n} entries: {exn}") from exn
-    if guess.dtype.kind not in "biuf":
-        raise TypeError(f"x0 must be a real numeric vector of {n} entries, got dtype {guess.dtype}")
-    guess = np.ascontiguousarray(guess, dtype=np.float64).reshape(-1)
-    if guess.shape != (n,) or not np.all(np.isfinite(guess)):
-        raise ValueError(f"x0 must be a finite vector of {n} entries")
-    if np.abs(guess).max(initial=0.0) > MAX_ENTRY:
-        raise ValueError(f"x0 has an entry beyond {MAX_ENTRY:.0e} in magnitude")
-    return guess
+        raise TypeError(f"{name} must be a numeric vector of {size} entries: {exn}") from exn
+    if vector.dtype.kind not in "biuf":
+        raise TypeError(f"{name} must be a real numeric vector of {size} entries, got dtype "
+                        f"{vector.dtype}")
+    vector = np.ascontiguousarray(vector, dtype=np.float64).reshape(-1)
+    finite = f"{name} must be a finite vector of {size} entries"
+    if vector.shape != (size,):
+        raise ValueError(finite)
+    if not np.abs(vector).max(initial=0.0) <= MAX_ENTRY:   # one pass: NaN fails it too
+        if not np.all(np.isfinite(vector)):
+            raise ValueError(finite)
+        raise ValueError(f"{name} has an entry beyond {MAX_ENTRY:.0e} in magnitude")
+    return vector
 
 
 def _print_log(lines: list[tuple[float, ...]], result: Result) -> None:
@@ -547,11 +582,16 @@ def solve(
     ub: object = None,
     cones: Sequence[Cone] = (),
     settings: Settings | None = None,
+    *,
+    x0: object = None,
+    y0: object = None,
+    z0: object = None,
     **overrides: object,
 ) -> Result:
-    """Solve one QP from a cold start; see :meth:`Solver.solve` for the arguments.
+    """Solve one QP in a new :class:`Solver`: from a cold start, or from the guess
+    ``x0`` (``y0``, ``z0``); see :meth:`Solver.solve` for the arguments.
 
     ``settings`` and keyword ``overrides`` (fields of :class:`Settings`) configure
     the solve; an unknown keyword raises ``ValueError``.
     """
-    return Solver(settings, **overrides).solve(P, q, A, b, lb, ub, cones)
+    return Solver(settings, **overrides).solve(P, q, A, b, lb, ub, cones, x0=x0, y0=y0, z0=z0)

@@ -36,12 +36,12 @@ def main() -> None:
                 f"{args.cache}/{robot}-mix-seed0-n400-len100-dt0.002-gen2.npz")
             ad = DaqpAdapter("daqp")
             for i in range(10, 100, 10):
-                d = ad.prepare(ts.qps[i])
+                d = ad.prepare(ts.qps[i]).arguments
                 size = d[0].shape[0]
                 _, _, _, info = daqp.solve(*d)
                 out.append((robot, i, "cold", int(info["iterations"]), size))
                 for back, mode in ((1, "warm"), (10, "coarse")):
-                    before = ad.prepare(ts.qps[i - back])
+                    before = ad.prepare(ts.qps[i - back]).arguments
                     _, _, _, info0 = daqp.solve(*before)
                     out.append((robot, i - back, f"prev{back}", int(info0["iterations"]), size))
                     if before[0].shape == d[0].shape:
