@@ -426,6 +426,18 @@ def test_warm_polish_solves_a_released_contact_on_its_own_plane_first():
     assert _warm_ticks("go2", 0, 38)[-1].iterations == 0
 
 
+def test_warm_polish_solves_a_lifting_foot_by_schur_complement_without_admm_factorization():
+    """talos' first benchmark sequence, ticks 75 and 76 (warm from a cold tick 70): a
+    guess of the warm polish leaves rows that its free entries span only barely (a
+    squared pivot of the Schur complement ~1e-10 of its largest diagonal); refused as
+    singular, the polish failed, ADMM's factorization and reduced table were built and
+    the polish ran again in the table's coordinates, repeating its guesses, to the same
+    answer. The Schur complement now solves those guesses: no ADMM factorization."""
+    results = _warm_ticks("talos_reduced", 70, 76)
+    assert all(r.polished and r.iterations == 0 and r.factorizations == 0
+               for r in results[-2:])
+
+
 def test_warm_polish_places_a_block_a_zero_length_step_held_where_the_step_pointed():
     """go2's third benchmark sequence, tick 215: each released block was stopped by a
     step of length 0 and held back where it had been, then released again, for all the

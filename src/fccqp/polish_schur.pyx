@@ -30,9 +30,15 @@ A solve keeps ``Y``: ``w = L^-1 r_x``, ``mu = S^-1 (Y'w - r_c)``, ``x_F = L'^-1 
 Y mu)``, two products with ``Y`` and the triangular solves of ``H``'s blocks. The
 caller refines against the unregularized system, as with ``dsytrf``. Where ``P``
 couples a constrained entry, a block is not positive definite or ``S`` loses a pivot
-(dependent rows), the functions return
-False; the warm polish before ADMM's factorization then hands the guess to the table,
-and any other polish assembles the matrix for ``dsytrf``.
+(dependent rows: a squared pivot below ``POLISH_RANK_TOLERANCE`` times ``S``'s largest
+diagonal entry), the functions return False; the warm polish before ADMM's
+factorization then hands the guess to the table, and any other polish assembles the
+matrix for ``dsytrf``. Rows that a guess's free entries span only barely are not
+dependent: the guesses of warm polishes whose contacts leave the ground (talos, solo12)
+reach squared pivots of 3e-12 to 1e-10 of the largest diagonal, which ``dsytrf`` and the
+table solve the same regularized way; refused, the warm polish had run again after
+ADMM's factorization, its earlier guesses repeated in the table's coordinates
+(notes/tuning.md, ``POLISH_RANK_TOLERANCE``).
 
 Measured with callgrind (realtime preset without a clock, one OpenBLAS thread,
 instructions per tick): go2 1.12M -> 0.87M, solo12 1.06M -> 0.83M, talos 7.63M ->
@@ -48,7 +54,7 @@ from fccqp._blas cimport (backward_substitution, cholesky_solve_vector, forward_
                           syrk_t, trsm)
 from fccqp._types cimport Problem
 from fccqp.schur cimport mark_coupled
-from fccqp.tuning cimport PIVOT_TOLERANCE, RANK_TOLERANCE
+from fccqp.tuning cimport PIVOT_TOLERANCE, POLISH_RANK_TOLERANCE
 
 
 cdef extern from "fccqp_kernels.h" nogil:
@@ -219,7 +225,7 @@ cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t
     if size > 0 and not fccqp_cholesky(S, <int>size, <int>size):
         return False
     for c in range(size):
-        if S[c + c * size] * S[c + c * size] <= RANK_TOLERANCE * largest:
+        if S[c + c * size] * S[c + c * size] <= POLISH_RANK_TOLERANCE * largest:
             return False
     f.size = <int>size
     return True

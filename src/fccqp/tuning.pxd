@@ -42,7 +42,7 @@ cdef extern from *:
     #define FCCQP_MAX_REFINE 5
     /* refine while ||A x - b|| (user units) > this max(1, ||b||, ||A x||): near rounding */
     #define FCCQP_KKT_REFINE_TOLERANCE 1e-13
-    /* a Schur complement's Cholesky pivot below this times its largest diagonal: singular */
+    /* ADMM's Schur complement (fccqp.schur): a Cholesky pivot^2 below this times its largest diagonal, singular */
     #define FCCQP_RANK_TOLERANCE 1e-10
     /* S's largest diagonal above this times H's and A's largest entry: growth, go to LDL' */
     #define FCCQP_SCHUR_GROWTH 1e10
@@ -126,6 +126,8 @@ cdef extern from *:
     #define FCCQP_POLISH_DELTA 1e-12
     /* the same for qdldl's factorization without pivoting (fccqp.polish_csc): 1e-12 lost LPs */
     #define FCCQP_POLISH_CSC_DELTA 1e-8
+    /* the polish's Schur complement is singular below this pivot^2 / largest diagonal */
+    #define FCCQP_POLISH_RANK_TOLERANCE 1e-14
     /* a refinement stalled above this times its tolerance refactors with a smaller delta */
     #define FCCQP_POLISH_STALL_RESIDUAL 1e3
     /* that delta: this times the curvature the stalled refinement's contraction shows */
@@ -248,6 +250,7 @@ cdef extern from *:
     # Polish
     const double POLISH_DELTA "FCCQP_POLISH_DELTA"
     const double POLISH_CSC_DELTA "FCCQP_POLISH_CSC_DELTA"
+    const double POLISH_RANK_TOLERANCE "FCCQP_POLISH_RANK_TOLERANCE"
     const double POLISH_STALL_RESIDUAL "FCCQP_POLISH_STALL_RESIDUAL"
     const double POLISH_DELTA_CUT "FCCQP_POLISH_DELTA_CUT"
     const double POLISH_REFINE_TOLERANCE "FCCQP_POLISH_REFINE_TOLERANCE"
