@@ -44,12 +44,13 @@ cdef inline bint start_tiny_columns(double* D, const double* d, const double* q,
     a scaled cone is the same cone."""
     cdef Py_ssize_t j, k, a, t
     cdef double q_max = 0.0, factor, smallest
-    cdef bint any = False
     for j in range(n):
-        any = any or 0.0 < d[j] < MIN_NORM
-        q_max = max(q_max, fabs(q[j]))
-    if not any:
+        if 0.0 < d[j] < MIN_NORM:
+            break
+    else:
         return False
+    for j in range(n):
+        q_max = max(q_max, fabs(q[j]))
     for j in range(n):
         if not 0.0 < d[j] < MIN_NORM:
             continue
