@@ -131,7 +131,9 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
     (row ``i`` of ``D P D`` has norm ``D_i max_j |P_ij| D_j``), so the data is touched
     once per pass and rescaled once at the end. ``block_start``/``block_dim`` give the
     cone blocks in ``x``; ``d`` and ``e`` are scratch of sizes ``n`` and ``m``;
-    ``pattern`` receives the nonzeros of ``P`` and ``A`` (:func:`find_pattern`).
+    ``pattern`` receives the nonzeros of ``P`` and ``A`` (:func:`find_pattern`). Rows
+    and columns below ``MIN_NORM``, which the passes leave alone, are started first:
+    a row at norm 1, a column at the root of its norm (:func:`start_tiny_columns`).
 
     Everything after finding the nonzeros walks them alone: the scaling, the cost's
     normalization and, where at most ``SPARSE_PASSES`` of the entries are nonzero, the
