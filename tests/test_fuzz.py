@@ -25,7 +25,7 @@ SEEDS = {
                      100213,
                      100228, 100233, 500030, 500064, 500099, 500322, 700281, 900343, 900360,
                      1100037, 1100057, 1100150, 1100253, 1300030, 1300300, 1500043, 1700106,
-                     1700359, 1900050, 2900030),
+                     1700359, 1900050, 2500125, 2900030),
     "qpsolvers": (0, 1, 2, 1700123),
     "cvxpy": (1, 2, 3),
 }
@@ -42,13 +42,16 @@ below the rounding of ``P x`` and Clarabel's optimum fails it, no failure
 (``fuzzing._below_rounding``); extreme_data 2900030 a stall whose rho rule climbed to
 where the dual residual crawls, which the retry from a smaller rho answers; extreme_data
 100121 a free friction cone flatter than the polish's regularization, whose refinement
-stalled with the step mostly unmade; issues 26 and 28)."""
+stalled with the step mostly unmade; extreme_data 2500125 a free entry in units of 1e-8
+whose columns lay below ``MIN_NORM``, which the equilibration left unscaled: its scaled
+curvature, 2.5e-18, stalled ADMM and the polish 3e6 short of the optimum; issues 26 and
+28)."""
 
 SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),
     "feasible": (0,),
     "solver_reuse": (38,),
-    "extreme_data": (26, 100121, 900343, 1700359, 2900030),
+    "extreme_data": (26, 100121, 900343, 1700359, 2500125, 2900030),
     "qpsolvers": (100035,),
     "cvxpy": (7, 1700154, 1900171),
     "dual_infeasible": (1700072,),
@@ -65,8 +68,9 @@ by cleaning its candidate on ``A A'`` (uncleaned: MAX_ITER_REACHED after every r
 ``cvxpy:1700154`` a zero pivot
 that ``qdldl``'s update did not report, ``dual_infeasible:1700072`` solves whose first
 block was left unrefined (both diverged to NUMERICAL_ERROR on unbounded problems);
-``extreme_data:2900030`` the stall that the retry from a smaller rho answers, as on the
-dense backends. Every case of :data:`SEEDS` on the sparse path took 100 s of CPU at
+``extreme_data:2900030`` the stall that the retry from a smaller rho answers, and
+``extreme_data:2500125`` the column below ``MIN_NORM``, as on the dense backends. Every
+case of :data:`SEEDS` on the sparse path took 100 s of CPU at
 b11793f (the whole module, four dense backends and these: 25 s of wall time at load
 8), with 5 failures: 4 stalls at MAX_ITER_REACHED that the dense backends' retries
 answer (extreme_data 100213, 1500043, 1700359, cvxpy 1), and ``extreme_data:900343``,

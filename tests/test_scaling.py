@@ -22,16 +22,43 @@ def _inverse_sqrt(norm):
     return np.where(norm < MIN_NORM, 1.0, 1.0 / np.sqrt(np.clip(norm, MIN_NORM, MAX_NORM)))
 
 
+def _power_of_two(x):
+    """``2 ** ilogb(x)``: ``x`` rounded down to a power of two."""
+    return np.ldexp(1.0, np.frexp(x)[1] - 1)
+
+
+def _tiny_column_start(columns, q, blocks):
+    """``D`` of the first pass's start: ``1 / sqrt(norm)`` (a power of two) on the
+    columns below ``MIN_NORM``, ``D_j |q_j|`` at most ``max |q|``, a cone block at its
+    smallest."""
+    tiny = (columns > 0.0) & (columns < MIN_NORM)
+    D = np.where(tiny, 1.0 / _power_of_two(np.sqrt(columns)), 1.0)
+    costly = tiny & (q != 0.0)
+    D[costly] = np.minimum(D[costly], np.maximum(
+        _power_of_two(np.abs(q).max() / np.abs(q[costly])), 1.0))
+    for start, dim in blocks:
+        D[start : start + dim] = D[start : start + dim].min()
+    return D
+
+
+def _norms(P, A, D, E):
+    """The columns' and rows' norms of the scaled KKT matrix."""
+    P_s = D[:, None] * P * D[None, :]
+    A_s = E[:, None] * A * D[None, :]
+    columns = np.maximum(np.abs(P_s).max(axis=0), np.abs(A_s).max(axis=0, initial=0.0))
+    return columns, np.abs(A_s).max(axis=1, initial=0.0)
+
+
 def _ruiz(P, q, A, blocks, iterations):
     n, m = P.shape[0], A.shape[0]
     D, E = np.ones(n), np.ones(m)
     done, passes = 0, iterations
     while done < passes:
         done += 1
-        P_s = D[:, None] * P * D[None, :]
-        A_s = E[:, None] * A * D[None, :]
-        columns = np.maximum(np.abs(P_s).max(axis=0), np.abs(A_s).max(axis=0, initial=0.0))
-        rows = np.abs(A_s).max(axis=1, initial=0.0)
+        columns, rows = _norms(P, A, D, E)
+        if done == 1 and ((columns > 0.0) & (columns < MIN_NORM)).any():
+            D = _tiny_column_start(columns, q, blocks)
+            columns, rows = _norms(P, A, D, E)
         if max(columns.max(), rows.max(initial=0.0)) > MAX_NORM and (
                 passes < iterations + CAPPED_PASSES):
             passes += 1   # a pass whose correction was capped does not count
@@ -104,6 +131,56 @@ def test_variables_scaled_by_1e_8_to_1e8_are_equilibrated(seed):
     c = equilibrate(P_s, q, A_s, b, start, dim, 4, D, E)
     norms = scaled_norms(P_s, A_s, c)
     assert 0.25 <= norms.min() and norms.max() <= 4.0
+
+
+def _variables_in_units(s, m, seed=0):
+    """``P, q, A, b`` of a convex QP with ``len(s)`` entries, entry ``j`` in units of
+    ``s_j`` (its columns of ``P`` and ``A`` and its ``q_j`` multiplied by ``s_j``)."""
+    rng = np.random.default_rng(seed)
+    n = len(s)
+    M = rng.standard_normal((n, n))
+    P, A = (M @ M.T / n) * np.outer(s, s), rng.standard_normal((m, n)) * s
+    return P, rng.standard_normal(n) * s, A, rng.standard_normal(m)
+
+
+UNITS_BELOW_MIN_NORM = np.array([1.0, 1.0, 1e-14, 1e-14, 1e-14, 1.0, 1e-12, 1e3])
+"""Entry units whose columns lie below ``MIN_NORM``: a cone block (entries 2-4) and a
+single entry."""
+
+
+def test_variables_in_units_below_min_norm_are_equilibrated():
+    """A column below ``MIN_NORM`` was left unscaled by every pass: an entry in units
+    of 1e-8 (columns of 1e-14 in ``P``, 3.5e-9 in ``A``) kept a scaled curvature of
+    2.5e-18, and ADMM and the polish's refinement both stalled 3e6 short of its
+    optimum. Such a column starts at the square root of its norm, and the passes go
+    on from there."""
+    P_s, q, A_s, b = _variables_in_units(UNITS_BELOW_MIN_NORM, 3)
+    D, E = np.empty(len(q)), np.empty(3)
+    blocks = np.array([2], dtype=np.intp), np.array([3], dtype=np.intp)
+    c = equilibrate(P_s, q, A_s, b, *blocks, 4, D, E)
+    norms = scaled_norms(P_s, A_s, c)
+    assert norms.min() >= 0.25 and norms.max() <= 4.0
+    assert np.ptp(D[2:5]) == 0.0
+
+
+@pytest.mark.parametrize("iterations", [1, 4, 10])
+@pytest.mark.parametrize("m", [0, 3])
+def test_columns_below_min_norm_match_the_definition(iterations, m):
+    """Columns below ``MIN_NORM``: a cone block, a single entry, and a column tiny
+    because the cost is (a ``P`` of 1e-200 on an entry with ``q_j`` of 1, no row when
+    ``m`` is 0), which stays at most ``max |q|`` in ``D_j |q_j|``."""
+    P, q, A, b = _variables_in_units(UNITS_BELOW_MIN_NORM, m)
+    P[-1], P[:, -1], A[:, -1], q[-1] = 0.0, 0.0, 0.0, 1.0
+    P[-1, -1] = 1e-200
+    blocks = [(2, 3)]
+    D_ref, E_ref, c_ref = _ruiz(P, q, A, blocks, iterations)
+    D, E = np.empty(len(q)), np.empty(m)
+    start, dim = np.array([2], dtype=np.intp), np.array([3], dtype=np.intp)
+    c = equilibrate(P.copy(), q.copy(), A.copy(), b.copy(), start, dim, iterations, D, E)
+    np.testing.assert_allclose(D, D_ref, rtol=1e-12)
+    np.testing.assert_allclose(E, E_ref, rtol=1e-12)
+    assert c == pytest.approx(c_ref, rel=1e-12)
+    assert D[-1] * abs(q[-1]) <= np.abs(q).max()
 
 
 @pytest.mark.parametrize("factor", [1e10, 1e12, 1e15])

@@ -10,7 +10,8 @@ from fccqp import scaling, scaling_csc
 
 def _problem(seed, n, m, spread):
     """A sparse convex problem with a zero row and column of ``P``, an empty column of
-    ``A`` and a row of tiny entries; rows and columns ``spread`` orders apart."""
+    ``A`` whose column of ``P`` is tiny, and a row of tiny entries; rows and columns
+    ``spread`` orders apart."""
     rng = np.random.default_rng(seed)
     G = sp.random(n, n, density=0.2, random_state=rng).toarray() * np.logspace(-spread, spread, n)
     P = G @ G.T + np.diag(rng.uniform(0.0, 1.0, n))
@@ -18,6 +19,8 @@ def _problem(seed, n, m, spread):
     A = sp.random(m, n, density=0.3, random_state=rng).toarray()
     A *= np.logspace(spread, -spread, m)[:, None] * rng.choice([-1.0, 1.0], size=(m, n))
     A[:, 0] = 0.0
+    P[0] *= 1e-12   # a column below MIN_NORM
+    P[:, 0] *= 1e-12
     if m > 2:
         A[2] *= 1e-300
     return P, rng.standard_normal(n) * 100, A, rng.standard_normal(m)

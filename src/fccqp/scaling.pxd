@@ -2,7 +2,7 @@
 """Ruiz equilibration (:mod:`fccqp.scaling`, dense storage; :mod:`fccqp.scaling_csc`,
 compressed columns) and the two rules both storages share, inline here."""
 
-from libc.math cimport exp, ldexp, log, sqrt
+from libc.math cimport exp, fabs, ilogb, ldexp, log, sqrt
 
 from fccqp._types cimport Cones
 from fccqp.tuning cimport GAUGE_LIMIT, MAX_NORM, MIN_COST_NORM, MIN_NORM, RESCALE_DRIFT
@@ -23,6 +23,49 @@ cdef inline double inverse_sqrt_norm(double norm) noexcept nogil:
     if norm < MIN_NORM:
         return 1.0
     return 1.0 / sqrt(norm if norm < MAX_NORM else MAX_NORM)
+
+
+cdef inline bint start_tiny_columns(double* D, const double* d, const double* q,
+                                    Py_ssize_t n, const Py_ssize_t* block_start,
+                                    const Py_ssize_t* block_dim,
+                                    Py_ssize_t blocks) noexcept nogil:
+    """Start every column whose norm ``d_j`` (the first pass's, ``D = 1``) lies below
+    ``MIN_NORM``, which the passes leave alone, at ``D_j = 1 / sqrt(d_j)`` (a power of
+    two, exact); whether there was one (``D`` otherwise untouched).
+
+    A variable in units of 1e-8 (its columns of ``P`` and ``A`` 1e-14 and 3.5e-9) was
+    otherwise never scaled: its scaled curvature (2.5e-18) was too flat for ADMM to
+    move it, and for the polish's regularization to see. The square root keeps ``P``'s
+    entries, which ``D`` scales twice, below 1 (``|P_ij| <= d_j``, and for ``P``
+    positive semidefinite ``|P_ij| <= sqrt(d_i d_j)``), and the passes go on from there.
+    ``D_j |q_j|`` is held to the largest ``|q_i|``: a column that is tiny because the
+    cost is (``P`` of 1e-300) must not become the largest linear cost. A cone block
+    takes its columns' smallest factor (one that is 1 where a column is not tiny), so
+    a scaled cone is the same cone."""
+    cdef Py_ssize_t j, k, a, t
+    cdef double q_max = 0.0, factor, smallest
+    for j in range(n):
+        if 0.0 < d[j] < MIN_NORM:
+            break
+    else:
+        return False
+    for j in range(n):
+        q_max = max(q_max, fabs(q[j]))
+    for j in range(n):
+        if not 0.0 < d[j] < MIN_NORM:
+            continue
+        factor = ldexp(1.0, -ilogb(sqrt(d[j])))
+        if q[j] != 0.0:
+            factor = min(factor, max(1.0, ldexp(1.0, ilogb(q_max / fabs(q[j])))))
+        D[j] = factor
+    for k in range(blocks):
+        a, t = block_start[k], block_start[k] + block_dim[k]
+        smallest = D[a]
+        for j in range(a, t):
+            smallest = min(smallest, D[j])
+        for j in range(a, t):
+            D[j] = smallest
+    return True
 
 
 cdef inline bint ruiz_factors(double* D, double* E, double* d, double* e, Py_ssize_t n,

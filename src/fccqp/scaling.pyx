@@ -109,6 +109,17 @@ cdef void _sparse_maxima(const double* P, const double* A, Py_ssize_t n, Py_ssiz
         row[i] = largest * E[i]
 
 
+cdef inline void _maxima(const double* P, const double* A, Py_ssize_t n, Py_ssize_t m,
+                         const Pattern* pattern, bint sparse, const double* D,
+                         const double* E, double* column, double* row) noexcept nogil:
+    """The scaled columns' norms into ``column``, the rows' into ``row``: on the nonzeros
+    where ``sparse``, else in four lanes (a running maximum does not vectorize by itself)."""
+    if sparse:
+        _sparse_maxima(P, A, n, m, pattern, D, E, column, row)
+    else:
+        fccqp_ruiz_maxima(P, A, <int>n, <int>m, D, E, column, row)
+
+
 cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n,
                         Py_ssize_t m, const Py_ssize_t* block_start,
                         const Py_ssize_t* block_dim, Py_ssize_t blocks, Py_ssize_t iterations,
@@ -120,7 +131,9 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
     (row ``i`` of ``D P D`` has norm ``D_i max_j |P_ij| D_j``), so the data is touched
     once per pass and rescaled once at the end. ``block_start``/``block_dim`` give the
     cone blocks in ``x``; ``d`` and ``e`` are scratch of sizes ``n`` and ``m``;
-    ``pattern`` receives the nonzeros of ``P`` and ``A`` (:func:`find_pattern`).
+    ``pattern`` receives the nonzeros of ``P`` and ``A`` (:func:`find_pattern`). Rows
+    and columns below ``MIN_NORM``, which the passes leave alone, are started first:
+    a row at norm 1, a column at the root of its norm (:func:`start_tiny_columns`).
 
     Everything after finding the nonzeros walks them alone: the scaling, the cost's
     normalization and, where at most ``SPARSE_PASSES`` of the entries are nonzero, the
@@ -147,12 +160,11 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
         E[i] = ldexp(1.0, -ilogb(value)) if 0.0 < value < MIN_NORM else 1.0
     while it < passes:
         it += 1
-        # the columns' norms into d, the rows' into e (dense data in four lanes: a
-        # running maximum does not vectorize by itself)
-        if sparse:
-            _sparse_maxima(P, A, n, m, pattern, D, E, d, e)
-        else:
-            fccqp_ruiz_maxima(P, A, <int>n, <int>m, D, E, d, e)
+        # the columns' norms into d, the rows' into e; a column the passes would leave
+        # alone is started first
+        _maxima(P, A, n, m, pattern, sparse, D, E, d, e)
+        if it == 1 and start_tiny_columns(D, d, q, n, block_start, block_dim, blocks):
+            _maxima(P, A, n, m, pattern, sparse, D, E, d, e)
         capped = ruiz_factors(D, E, d, e, n, m, block_start, block_dim, blocks)
         if capped and passes < iterations + CAPPED_PASSES:
             passes += 1

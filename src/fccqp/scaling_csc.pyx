@@ -17,7 +17,7 @@ from libc.math cimport fabs, ilogb, ldexp, log
 from fccqp.matrices cimport Matrix
 from fccqp.matrix_ops cimport Held
 from fccqp.scaling cimport (cost_scale, gauge_apply, gauge_shift, inverse_sqrt_norm,
-                            ruiz_factors, within_drift)
+                            ruiz_factors, start_tiny_columns, within_drift)
 from fccqp.tuning cimport CAPPED_PASSES, MAX_NORM, MIN_NORM
 
 
@@ -40,21 +40,9 @@ cdef double equilibrate_csc(Matrix* P, double* q, Matrix* A, double* b,
         E[i] = ldexp(1.0, -ilogb(value)) if 0.0 < value < MIN_NORM else 1.0
     while it < passes:
         it += 1
-        for j in range(n):
-            norm = 0.0
-            for k in range(P.colptr[j], P.colptr[j + 1]):
-                norm = max(norm, fabs(P.values[k]) * D[P.rowind[k]])
-            d[j] = norm * D[j]
-        for i in range(m):
-            e[i] = 0.0
-        for j in range(n):
-            for k in range(A.colptr[j], A.colptr[j + 1]):
-                i = A.rowind[k]
-                value = fabs(A.values[k]) * D[j]
-                d[j] = max(d[j], value * E[i])
-                e[i] = max(e[i], value)
-        for i in range(m):
-            e[i] *= E[i]
+        _maxima(P, A, D, E, d, e)
+        if it == 1 and start_tiny_columns(D, d, q, n, block_start, block_dim, blocks):
+            _maxima(P, A, D, E, d, e)   # as the dense pass: a tiny column is started first
         capped = ruiz_factors(D, E, d, e, n, m, block_start, block_dim, blocks)
         if capped and passes < iterations + CAPPED_PASSES:
             passes += 1
@@ -70,6 +58,29 @@ cdef double equilibrate_csc(Matrix* P, double* q, Matrix* A, double* b,
     for i in range(m):
         b[i] *= E[i]
     return _normalize_cost(P, q, n, d)
+
+
+cdef void _maxima(const Matrix* P, const Matrix* A, const double* D, const double* E,
+                  double* column, double* row) noexcept nogil:
+    """The scaled columns' norms into ``column``, the rows' into ``row``, in the dense
+    kernels' products."""
+    cdef Py_ssize_t n = P.cols, m = A.rows, i, j, k
+    cdef double value, norm
+    for j in range(n):
+        norm = 0.0
+        for k in range(P.colptr[j], P.colptr[j + 1]):
+            norm = max(norm, fabs(P.values[k]) * D[P.rowind[k]])
+        column[j] = norm * D[j]
+    for i in range(m):
+        row[i] = 0.0
+    for j in range(n):
+        for k in range(A.colptr[j], A.colptr[j + 1]):
+            i = A.rowind[k]
+            value = fabs(A.values[k]) * D[j]
+            column[j] = max(column[j], value * E[i])
+            row[i] = max(row[i], value)
+    for i in range(m):
+        row[i] *= E[i]
 
 
 cdef void _row_maxima(const Matrix* A, const double* weight, double* out) noexcept nogil:

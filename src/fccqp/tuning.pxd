@@ -20,7 +20,7 @@ cdef extern from *:
     #define FCCQP_INFINITE_BOUND 1e20
 
     /* ---- Scaling (fccqp.scaling) ---- */
-    /* column norms below this count as 1: OSQP's 1e-4 left a 1e-7 equality row unscaled */
+    /* a pass counts norms below this as 1 (tiny ones are started first): OSQP's 1e-4 left a 1e-7 row */
     #define FCCQP_MIN_NORM 1e-8
     /* column norms are capped here, so one Ruiz pass changes a scale by at most 100x */
     #define FCCQP_MAX_NORM 1e4
