@@ -51,7 +51,7 @@ SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),
     "feasible": (0,),
     "solver_reuse": (38,),
-    "extreme_data": (26, 100121, 900343, 1700359, 2500125, 2900030),
+    "extreme_data": (26, 100121, 900343, 1700359, 1900317, 2500125, 2900030),
     "qpsolvers": (100035,),
     "cvxpy": (7, 1700154, 1900171),
     "dual_infeasible": (1700072,),
@@ -69,8 +69,12 @@ by cleaning its candidate on ``A A'`` (uncleaned: MAX_ITER_REACHED after every r
 that ``qdldl``'s update did not report, ``dual_infeasible:1700072`` solves whose first
 block was left unrefined (both diverged to NUMERICAL_ERROR on unbounded problems);
 ``extreme_data:2900030`` the stall that the retry from a smaller rho answers, and
-``extreme_data:2500125`` the column below ``MIN_NORM``, as on the dense backends. Every
-case of :data:`SEEDS` on the sparse path took 100 s of CPU at
+``extreme_data:2500125`` the column below ``MIN_NORM``, as on the dense backends;
+``extreme_data:1900317`` a friction cone capped through a boxed copy of its normal force
+beside two nearly parallel rows of 2e10, infeasible, whose least-distance QP crawls
+equilibrated and is solved only unscaled (which needs the third, ``|A|^2``-scaled
+regularization of the sparse KKT matrix). Every case of :data:`SEEDS` on the sparse path
+took 100 s of CPU at
 b11793f (the whole module, four dense backends and these: 25 s of wall time at load
 8), with 5 failures: 4 stalls at MAX_ITER_REACHED that the dense backends' retries
 answer (extreme_data 100213, 1500043, 1700359, cvxpy 1), and ``extreme_data:900343``,

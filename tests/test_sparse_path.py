@@ -203,6 +203,23 @@ def test_nonconvex_objective_is_rejected():
     assert result.status is Status.SOLVED
 
 
+@pytest.mark.parametrize("seed", [1, 4, 5])
+def test_dependent_rows_of_1e10_unequilibrated_are_not_called_non_convex(seed):
+    """Two rows of 1e10, one a multiple of the other, in the user's units (no
+    equilibration) over entries that only ``sigma`` weighs: without pivoting the second
+    row's pivot is lost to the rounding of ``|A|^2 / sigma``, and only a regularization
+    scaled with ``|A|^2`` factors the KKT matrix of this convex QP."""
+    rng = np.random.default_rng(seed)
+    row = rng.standard_normal(6)
+    A = 1e10 * np.vstack([row, 0.9 * row])
+    b = A @ rng.standard_normal(6)
+    P = sp.diags([1.0, 1.0, 1.0, 0.0, 0.0, 0.0], format="csc")
+    problem = (P, np.zeros(6), sp.csc_matrix(A), b, None, None, ())
+    result = fccqp.solve(*problem, scaling=0, **SPARSE)
+    assert result.status is Status.SOLVED
+    verify_solution(problem, result)
+
+
 @pytest.mark.parametrize("args, error, message", [
     ((sp.csc_matrix(np.array([[1.0, 1.0], [0.0, 1.0]])), np.zeros(2)), ValueError,
      "P must be symmetric"),

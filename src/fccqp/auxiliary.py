@@ -44,7 +44,9 @@ there), and without equilibration. A forced ``kkt_backend`` keeps its form and g
 
 On the sparse path (a :attr:`fccqp.admm.Workspace.compressed` run) the auxiliary QPs
 are built with ``scipy.sparse`` and take the sparse path too, whatever their size;
-there is no other form to try there, and the other tries stay on the sparse path.
+there is no other form to try there: an auxiliary solve that is not SOLVED runs again
+without equilibration (:func:`_second_try`), and the other tries stay on the sparse
+path.
 """
 
 from __future__ import annotations
@@ -271,16 +273,33 @@ def _is_solved(result: object) -> bool:
     return result.status is Status.SOLVED
 
 
+def _second_try(settings: object, backend: str) -> object | None:
+    """``settings`` for solving an auxiliary problem again after a solve in ``backend``
+    gave no usable result: the other form (:func:`other_form`) on the dense path; on
+    the sparse path, which has one form, no equilibration (None when ``settings`` has
+    none already).
+
+    The least-distance QP of a friction cone capped through a boxed copy of its
+    normal force, beside two nearly parallel rows of 2e10, crawls in the full form
+    once equilibrated (rho at its floor, 20000 iterations on the sparse path, never
+    polished; ``ldl_full`` alike), where the reduced form solves it in 40 iterations;
+    in the user's units the full form's final polish solves it (``ldl_full`` in 250
+    iterations, the sparse path at its 4000), and its certificate passes."""
+    if backend != "sparse":
+        return other_form(settings, backend)
+    return settings.replace(scaling=0) if settings.scaling else None
+
+
 def _solved(solver_type: type, settings: object, problem: tuple, deadline: float,
             usable: object = _is_solved) -> tuple:
     """``(result, iterations, factorizations)`` of an auxiliary ``problem``: solved with
-    ``settings`` by ``deadline``, and again in the other form (:func:`other_form`) unless
-    that result is ``usable`` (by default: SOLVED); the counts are those of both solves."""
+    ``settings`` by ``deadline``, and again (:func:`_second_try`) unless that result is
+    ``usable`` (by default: SOLVED); the counts are those of both solves."""
     result = _auxiliary_solver(solver_type, settings, deadline).solve(*problem)
-    if usable(result) or result.backend == "sparse":   # no other form
+    again_settings = None if usable(result) else _second_try(settings, result.backend)
+    if again_settings is None:
         return result, result.iterations, result.factorizations
-    again = _auxiliary_solver(solver_type, other_form(settings, result.backend),
-                              deadline).solve(*problem)
+    again = _auxiliary_solver(solver_type, again_settings, deadline).solve(*problem)
     return (again, result.iterations + again.iterations,
             result.factorizations + again.factorizations)
 

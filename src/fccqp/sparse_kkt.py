@@ -52,7 +52,9 @@ that depend on each other, beside a ``P`` flat but for ``sigma`` (1e-6), make ``
 A')`` about 1e6 against ``delta = 1e-9``, and the second row's pivot, ``delta`` times a
 factor of order one, is lost to rounding (the fuzzer's ``cvxpy:7``, a rank-one ``P``:
 a zero pivot, reported as a non-convex QP). Refinement against the unregularized matrix
-removes the larger bias as it removes the smaller one."""
+removes the larger bias as it removes the smaller one. On rows larger than one (a run
+without equilibration) the third factorization scales it by the square of ``A``'s
+largest entry (:meth:`SparseKKT._deltas`)."""
 MAX_REFINE = 5
 """Most refinement steps per solve."""
 REFINE_TOLERANCE = 1e-13
@@ -136,14 +138,15 @@ class SparseKKT:
         and the penalties ``rho_vec`` on the constrained entries; return the number of
         negative pivots.
 
-        A zero pivot is retried with ``BROKEN_DELTA``; :class:`FactorizationError` when
-        that meets one too. So is a factorization whose pivots are not all finite and
-        nonzero or that has fewer than ``m`` negative ones, which no quasi-definite
-        matrix has (Sylvester's law: its inertia is ``(n, m)`` for a positive definite
-        ``P + sigma I + R``): ``qdldl``'s ``update`` reports no zero pivot, and after a
-        rho change a pivot of ``-delta`` lost to cancellation left 3 negative pivots of
-        9 and one of 0 (fuzz ``cvxpy:1700154``: every later solve wrong, the iterates
-        grew by 1e19 every 25 iterations to NUMERICAL_ERROR).
+        A zero pivot is retried with the larger regularizations of :meth:`_deltas`;
+        :class:`FactorizationError` when the last meets one too. So is a factorization
+        whose pivots are not all finite and nonzero or that has fewer than ``m``
+        negative ones, which no quasi-definite matrix has (Sylvester's law: its inertia
+        is ``(n, m)`` for a positive definite ``P + sigma I + R``): ``qdldl``'s
+        ``update`` reports no zero pivot, and after a rho change a pivot of ``-delta``
+        lost to cancellation left 3 negative pivots of 9 and one of 0 (fuzz
+        ``cvxpy:1700154``: every later solve wrong, the iterates grew by 1e19 every 25
+        iterations to NUMERICAL_ERROR).
         """
         n, upper = self.n, self._upper.shape[0]
         gathered = self._gathered
@@ -156,7 +159,8 @@ class SparseKKT:
         diagonal[self.constrained] += rho_vec
         self.abs_A = abs(self.A)
         self.abs_P = abs(self.P)
-        for self.delta in (DELTA, BROKEN_DELTA):
+        deltas = self._deltas()
+        for self.delta in deltas:
             diagonal[n:] = -self.delta
             K.data[self._diagonal] = diagonal
             try:
@@ -172,11 +176,30 @@ class SparseKKT:
             except RuntimeError as exn:   # qdldl's report of a zero pivot
                 failure = str(exn)
             self._solver = None
-            if self.delta == BROKEN_DELTA:
+            if self.delta == deltas[-1]:
                 raise FactorizationError(failure)
         self.penalty = np.full(n, sigma)
         self.penalty[self.constrained] += rho_vec
         return negative
+
+    def _deltas(self) -> tuple[float, ...]:
+        """The regularizations :meth:`factor` tries in turn: ``DELTA``, ``BROKEN_DELTA``,
+        and, where ``A`` has an entry larger than one, ``BROKEN_DELTA`` times its square.
+
+        Without pivoting, a row eliminated after its variables has the pivot ``-delta``
+        less ``A_i H^-1 A_i'`` (``H`` the eliminated block of ``P + sigma I + R``); of two
+        rows dependent to rounding, the second's is the difference of two such terms,
+        and their rounding, ``eps |A|^2 / sigma``, is below ``BROKEN_DELTA`` only for rows
+        of order one, as equilibration makes them. Unequilibrated rows of 2e10 nearly
+        parallel over entries that only ``sigma`` weighs (1e-6) left it at 1.7e10, of
+        either sign, whatever ``BROKEN_DELTA``: a zero pivot, reported as a non-convex QP
+        for a ``P`` positive semidefinite by construction. ``delta`` scaled with
+        ``|A|^2`` stays that far above the rounding, and the refinement against the
+        unregularized matrix removes its bias."""
+        largest = float(np.max(np.abs(self.A.data), initial=0.0))
+        if largest <= 1.0:
+            return DELTA, BROKEN_DELTA
+        return DELTA, BROKEN_DELTA, BROKEN_DELTA * largest * largest
 
     def _residual(self, rhs: np.ndarray, sol: np.ndarray, Ax: np.ndarray,
                   delta: float) -> np.ndarray:
