@@ -20,8 +20,9 @@ fill-reducing order; but without pivoting its rounding grows like ``1 / delta``,
 0``: the top-left block is ``delta I``) the solves of an active set that the dense
 backends' polish accepts were lost below it, and the polish's refinement against the
 unregularized system (``polish._solve``) removes the larger bias, factoring again with a
-smaller ``delta`` where a free block's curvature lies below it (that retry with SuperLU's
-partial pivoting, :func:`polish_csc_factor`).
+smaller ``delta`` where a free block's curvature lies below it. Where ``delta`` lies
+below the rounding of the largest entry, SuperLU factors the matrix with partial
+pivoting instead (:func:`polish_csc_factor`).
 
 Column ``c < |F|`` of the upper triangle is column ``F_c`` of ``P`` restricted to the
 free rows up to the diagonal (``P``'s full symmetric pattern makes its columns its
@@ -39,12 +40,12 @@ dense workspace has ``s x s`` (``s <= n`` constrained entries): ``polish`` point
 """
 
 from cpython.ref cimport PyObject
+from libc.float cimport DBL_EPSILON as EPSILON
 
 import numpy as np
 
 from fccqp._types cimport Problem
 from fccqp.matrices cimport Matrix
-from fccqp.tuning cimport POLISH_CSC_DELTA
 
 
 cdef class _Factor:
@@ -65,17 +66,20 @@ cdef class _Factor:
         self._colptr, self.indices, self.data, self._rhs = colptr, rowind, values, rhs
         self.indptr, self.shape, self.nnz, self._solver = colptr[:1], (0, 0), 0, None
 
-    cdef bint factor(self, Py_ssize_t size, bint pivoting) except -1:
-        """Factor the leading ``size`` columns, by qdldl or, with ``pivoting``, by
-        SuperLU on the whole symmetric matrix; False when the factorization meets a zero
-        pivot."""
+    cdef bint factor(self, Py_ssize_t size, double delta) except -1:
+        """Factor the leading ``size`` columns, regularized by ``delta``: by qdldl, or by
+        SuperLU with partial pivoting where ``delta`` lies below the rounding of the
+        largest entry (see :func:`polish_csc_factor`); False when the factorization
+        meets a zero pivot."""
         self.indptr = self._colptr[:size + 1]
         self.shape = (size, size)
         self.nnz = self._colptr[size]
         self._solver = None
         try:
-            self._solver = (self._pivoting_class(self._symmetric()) if pivoting
-                            else self._solver_class(self, upper=True))
+            if delta <= EPSILON * float(np.max(np.abs(self.data[:self.nnz]), initial=0.0)):
+                self._solver = self._pivoting_class(self._symmetric())
+            else:
+                self._solver = self._solver_class(self, upper=True)
         except RuntimeError:   # qdldl's or SuperLU's report of a zero pivot
             return False
         return True
@@ -234,15 +238,18 @@ cdef bint polish_csc_factor(PolishCSC* f, const Problem* p, Py_ssize_t nf,
     numbered by ``index``, boundary blocks ``boundary[:nb]`` with planes ``g`` as in
     :c:type:`fccqp.polish.Polish`, curvature in ``f.hess``) regularized by ``delta``
     (``POLISH_CSC_DELTA`` but where :mod:`fccqp.polish`'s refinement stalls); False when
-    the factorization meets a zero pivot. At ``POLISH_CSC_DELTA`` qdldl factors it
-    without pivoting; at a smaller ``delta`` (a stalled refinement's retry) SuperLU
-    factors it with partial pivoting, since the rounding of a factorization without
-    pivoting grows like ``1 / delta``: with ``P`` of 1e10 beside free entries that ``P``
-    does not touch, qdldl's corrections at a ``delta`` of 1e-11 made the residual grow
-    tenfold where SuperLU's reduced it to the rounding of ``P x``."""
+    the factorization meets a zero pivot.
+
+    qdldl factors without pivoting, its rounding growing like ``1 / delta`` beside the
+    entries: where ``delta`` lies at or below ``DBL_EPSILON`` times the largest entry,
+    the pivots ``-delta`` of rows eliminated before their columns are below the
+    rounding of the entries they meet, and SuperLU factors the whole symmetric matrix
+    with partial pivoting instead (``P`` of 1e10 unscaled beside free entries that
+    ``P`` does not touch, ``delta`` 1e-8: qdldl's corrections left the residual at the
+    size of the right-hand side, SuperLU's reduced it to ``P x``'s rounding)."""
     _assemble_csc(f, p, nf, free, index, boundary, nb, g, delta)
     with gil:
-        return (<_Factor>f.factor).factor(nf + p.m + nb, delta < POLISH_CSC_DELTA)
+        return (<_Factor>f.factor).factor(nf + p.m + nb, delta)
 
 
 cdef void polish_csc_solve(PolishCSC* f, Py_ssize_t size, double* v) noexcept nogil:
