@@ -69,7 +69,8 @@ block was left unrefined (both diverged to NUMERICAL_ERROR on unbounded problems
 dense backends; ``extreme_data:2900221`` (``P`` of 1.4e14 beside entries it does not
 touch, a dependent row in ``A``; 4 s of CPU: four runs) the stall that the unscaled
 retry answers only with KKT solves that cut ``delta`` below the equalities' curvature
-and a polish that pivots where ``delta`` lies below the rounding of ``P``. Every case of :data:`SEEDS` on the sparse path took 100 s of CPU at
+and a polish that pivots where ``delta`` lies below the rounding of ``P``. Every case
+of :data:`SEEDS` on the sparse path took 100 s of CPU at
 b11793f (the whole module, four dense backends and these: 25 s of wall time at load
 8), with 5 failures: 4 stalls at MAX_ITER_REACHED that the dense backends' retries
 answer (extreme_data 100213, 1500043, 1700359, cvxpy 1), and ``extreme_data:900343``,
