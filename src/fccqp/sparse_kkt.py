@@ -261,11 +261,12 @@ class SparseKKT:
             if not met and error >= 0.5 * last_error:
                 if previous is None and error < last_error:
                     previous = self._cut_regularization(error / last_error)
-                    r = 0 if previous is not None else r
-                elif previous is not None:   # the cut did not halve it either
-                    self._solver, self.delta = previous
-                    previous = None
-                if previous is None:
+                    if previous is None:
+                        return self._least_squares(rhs, sol - step)
+                    r = 0
+                else:
+                    if previous is not None and r == 1:   # the cut's first step failed
+                        self._solver, self.delta = previous
                     return self._least_squares(rhs, sol - step)
             last_error = error
             if r == MAX_REFINE:
