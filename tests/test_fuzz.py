@@ -51,7 +51,7 @@ SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),
     "feasible": (0,),
     "solver_reuse": (38,),
-    "extreme_data": (26, 100121, 900343, 1700359, 1900317, 2500125, 2900030),
+    "extreme_data": (26, 100121, 900343, 1700359, 1900317, 2500125, 2900030, 2900221),
     "qpsolvers": (100035,),
     "cvxpy": (7, 1700154, 1900171),
     "dual_infeasible": (1700072,),
@@ -73,8 +73,11 @@ block was left unrefined (both diverged to NUMERICAL_ERROR on unbounded problems
 ``extreme_data:1900317`` a friction cone capped through a boxed copy of its normal force
 beside two nearly parallel rows of 2e10, infeasible, whose least-distance QP crawls
 equilibrated and is solved only unscaled (which needs the third, ``|A|^2``-scaled
-regularization of the sparse KKT matrix). Every case of :data:`SEEDS` on the sparse path
-took 100 s of CPU at
+regularization of the sparse KKT matrix); ``extreme_data:2900221`` (``P`` of 1.4e14
+beside entries it does not touch, a dependent row in ``A``; 4 s of CPU: four runs) the
+stall that the unscaled retry answers only with KKT solves that cut ``delta`` below the
+equalities' curvature and a polish that pivots where ``delta`` lies below the rounding of
+``P``. Every case of :data:`SEEDS` on the sparse path took 100 s of CPU at
 b11793f (the whole module, four dense backends and these: 25 s of wall time at load
 8), with 5 failures: 4 stalls at MAX_ITER_REACHED that the dense backends' retries
 answer (extreme_data 100213, 1500043, 1700359, cvxpy 1), and ``extreme_data:900343``,

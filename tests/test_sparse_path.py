@@ -74,6 +74,38 @@ def test_polishing_gives_the_exact_optimum():
     assert plain.status is Status.SOLVED and not plain.polished
 
 
+def test_the_kkt_solve_meets_equalities_whose_curvature_lies_below_delta():
+    """``A (P + sigma I)^-1 A'`` of 1e-11 beside the (2, 2) block's ``-delta`` of 1e-9:
+    each refinement step recovers 1 % of its correction, which is no sign that ``A x =
+    b`` has no solution; the solve refactors with a smaller ``delta`` and meets it."""
+    from fccqp.sparse_kkt import DELTA, SparseKKT
+
+    P, A = sp.csc_matrix(np.diag([10.0, 10.0])), sp.csc_matrix(np.diag([1e-5, 1e-5]))
+    kkt = SparseKKT(P, A, np.zeros(0, dtype=np.intp), np.ones(2))
+    kkt.factor(1e-6, np.zeros(0))
+    assert kkt.delta == DELTA
+    sol = kkt.solve(np.array([0.0, 0.0, 1e-5, 2e-5]))
+    np.testing.assert_allclose(sol[:2], [1.0, 2.0], rtol=1e-9)
+    assert kkt.delta < 1e-2 * DELTA
+
+
+def test_the_polish_pivots_where_delta_lies_below_the_rounding_of_p():
+    """Unscaled, ``P`` of 1.4e14 on 15 of 19 entries and zero on the others, a dependent
+    row in ``A`` (the fuzzer's "P huge" class): the polished QP's matrix spans 1e10
+    (``P`` times the cost scale) to ``delta`` = 1e-8, where qdldl's pivots without
+    pivoting are lost to rounding; the polish factors it with pivoting and lands on the
+    dense backend's optimum."""
+    from fuzzing import Case
+
+    problem = Case.of("extreme_data", 2900221).scenario().problem.args()
+    unscaled = dict(scaling=0, max_iter=100)
+    result = fccqp.solve(*sparse_args(problem), **SPARSE, **unscaled)
+    assert result.status is Status.SOLVED and result.polished
+    verify_solution(problem, result, Tolerances(factor=1.0))
+    dense = fccqp.solve(*problem, kkt_backend="ldl_full", **unscaled)
+    np.testing.assert_allclose(result.x, dense.x, atol=1e-6)
+
+
 def test_rank_deficient_equalities():
     problem = random_problem(3, duplicate_rows=3)
     reference = clarabel_solve(*problem)

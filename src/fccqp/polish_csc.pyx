@@ -20,7 +20,9 @@ fill-reducing order; but without pivoting its rounding grows like ``1 / delta``,
 0``: the top-left block is ``delta I``) the solves of an active set that the dense
 backends' polish accepts were lost below it, and the polish's refinement against the
 unregularized system (``polish_kkt.refine``) removes the larger bias, factoring again with a
-smaller ``delta`` where a free block's curvature lies below it.
+smaller ``delta`` where a free block's curvature lies below it. Where ``delta`` lies
+below the rounding of the largest entry, SuperLU factors the matrix with partial
+pivoting instead (:func:`polish_csc_factor`).
 
 Column ``c < |F|`` of the upper triangle is column ``F_c`` of ``P`` restricted to the
 free rows up to the diagonal (``P``'s full symmetric pattern makes its columns its
@@ -38,6 +40,7 @@ dense workspace has ``s x s`` (``s <= n`` constrained entries): ``polish`` point
 """
 
 from cpython.ref cimport PyObject
+from libc.float cimport DBL_EPSILON as EPSILON
 
 import numpy as np
 
@@ -48,31 +51,47 @@ from fccqp.matrices cimport Matrix
 cdef class _Factor:
     """The assembled matrix as qdldl reads a ``scipy.sparse`` matrix (``data``,
     ``indices``, ``indptr``, ``shape``, ``nnz`` over :func:`arrays`' arrays, no copy),
-    the qdldl factorization of it (``None`` after a zero pivot) and the stride of the
-    curvature terms' storage."""
+    its factorization (qdldl's, or SuperLU's with pivoting; ``None`` after a zero pivot)
+    and the stride of the curvature terms' storage."""
 
     cdef readonly object data, indices, indptr, shape
     cdef readonly Py_ssize_t nnz, hess_stride
-    cdef object _colptr, _rhs, _solver, _solver_class
+    cdef object _colptr, _rhs, _solver, _solver_class, _pivoting_class
 
     def __init__(self, colptr, rowind, values, rhs, Py_ssize_t hess_stride):
         import qdldl
-        self._solver_class = qdldl.Solver
+        from scipy.sparse.linalg import splu
+        self._solver_class, self._pivoting_class = qdldl.Solver, splu
         self.hess_stride = hess_stride
         self._colptr, self.indices, self.data, self._rhs = colptr, rowind, values, rhs
         self.indptr, self.shape, self.nnz, self._solver = colptr[:1], (0, 0), 0, None
 
-    cdef bint factor(self, Py_ssize_t size) except -1:
-        """Factor the leading ``size`` columns; False when qdldl meets a zero pivot."""
+    cdef bint factor(self, Py_ssize_t size, double delta) except -1:
+        """Factor the leading ``size`` columns, regularized by ``delta``: by qdldl, or by
+        SuperLU with partial pivoting where ``delta`` lies below the rounding of the
+        largest entry (see :func:`polish_csc_factor`); False when the factorization
+        meets a zero pivot."""
         self.indptr = self._colptr[:size + 1]
         self.shape = (size, size)
         self.nnz = self._colptr[size]
         self._solver = None
         try:
-            self._solver = self._solver_class(self, upper=True)
-        except RuntimeError:   # qdldl's report of a zero pivot
+            if delta <= EPSILON * float(np.max(np.abs(self.data[:self.nnz]), initial=0.0)):
+                self._solver = self._pivoting_class(self._symmetric())
+            else:
+                self._solver = self._solver_class(self, upper=True)
+        except RuntimeError:   # qdldl's or SuperLU's report of a zero pivot
             return False
         return True
+
+    cdef object _symmetric(self):
+        """The whole symmetric matrix of the assembled upper triangle (``scipy.sparse``,
+        compressed columns, a copy)."""
+        import scipy.sparse as sp
+        upper = sp.csc_matrix((np.array(self.data[:self.nnz]),
+                               np.array(self.indices[:self.nnz]), np.array(self.indptr)),
+                              shape=self.shape)
+        return (upper + sp.triu(upper, 1, format="csc").T).tocsc()
 
     cdef void solve(self, Py_ssize_t size, double* v) except *:
         """``v`` := the factor's solution for the right-hand side in ``rhs[:size]``."""
@@ -219,10 +238,18 @@ cdef bint polish_csc_factor(PolishCSC* f, const Problem* p, Py_ssize_t nf,
     numbered by ``index``, boundary blocks ``boundary[:nb]`` with planes ``g`` as in
     :c:type:`fccqp.polish.Polish`, curvature in ``f.hess``) regularized by ``delta``
     (``POLISH_CSC_DELTA`` but where :mod:`fccqp.polish`'s refinement stalls); False when
-    qdldl meets a zero pivot."""
+    the factorization meets a zero pivot.
+
+    qdldl factors without pivoting, its rounding growing like ``1 / delta`` beside the
+    entries: where ``delta`` lies at or below ``DBL_EPSILON`` times the largest entry,
+    the pivots ``-delta`` of rows eliminated before their columns are below the
+    rounding of the entries they meet, and SuperLU factors the whole symmetric matrix
+    with partial pivoting instead (``P`` of 1e10 unscaled beside free entries that
+    ``P`` does not touch, ``delta`` 1e-8: qdldl's corrections left the residual at the
+    size of the right-hand side, SuperLU's reduced it to ``P x``'s rounding)."""
     _assemble_csc(f, p, nf, free, index, boundary, nb, g, delta)
     with gil:
-        return (<_Factor>f.factor).factor(nf + p.m + nb)
+        return (<_Factor>f.factor).factor(nf + p.m + nb, delta)
 
 
 cdef void polish_csc_solve(PolishCSC* f, Py_ssize_t size, double* v) noexcept nogil:

@@ -12,9 +12,12 @@ order, rank-deficient ``A`` included; ``qdldl`` factors it in its fill-reducing 
 order, without pivoting. Each solve is refined against the unregularized matrix until
 ``A x = b`` holds to ``REFINE_TOLERANCE`` of its terms in the user's units and the
 first block to ``STATIONARITY_TOLERANCE`` of its own; when a
-step stops halving that error, ``A x = b`` has no solution and the regularized
-(least-squares) solution is returned, refined against the factored matrix itself,
-which the equality certificate reads.
+step stops halving that error while still reducing it, the regularization may be what
+holds it back: the matrix is factored again, once, with a smaller ``delta`` read from
+the contraction (:meth:`SparseKKT._cut_regularization`), and the refinement goes on;
+when a step stops halving the error otherwise, ``A x = b`` has no solution and the
+regularized (least-squares) solution is returned, refined against the factored matrix
+itself, which the equality certificate reads.
 
 ``delta`` is larger than the dense backend's ``1e-13``: without pivoting, a row of
 ``A`` eliminated before its variables has the pivot ``-delta`` and adds ``A_i'A_i /
@@ -56,7 +59,10 @@ removes the larger bias as it removes the smaller one. On rows larger than one (
 without equilibration) the third factorization scales it by the square of ``A``'s
 largest entry (:meth:`SparseKKT._deltas`)."""
 MAX_REFINE = 5
-"""Most refinement steps per solve."""
+"""Most refinement steps per solve (and again after a cut of ``delta``)."""
+DELTA_CUT = 1e-2
+"""A refinement held back by ``delta`` refactors with this times the curvature its
+contraction shows (:meth:`SparseKKT._cut_regularization`)."""
 REFINE_TOLERANCE = 1e-13
 """Refine while ``||A x - b||`` (user's units) exceeds this times ``max(1, ||b||,
 || |A| |x| ||)``, the size of the terms of ``A x``: the rounding of ``A x`` itself is
@@ -131,6 +137,7 @@ class SparseKKT:
         self.abs_P = abs(P)
         self.penalty = np.zeros(n)   # sigma + rho on each entry of x, set by factor
         self.delta = DELTA   # the regularization factored, set by factor
+        self._cut_spent = False   # whether this factorization's delta was cut once
         self._gram = None   # the qdldl factor of A A', set by factor_gram
 
     def factor(self, sigma: float, rho_vec: np.ndarray) -> int:
@@ -159,25 +166,18 @@ class SparseKKT:
         diagonal[self.constrained] += rho_vec
         self.abs_A = abs(self.A)
         self.abs_P = abs(self.P)
+        self._cut_spent = False
         deltas = self._deltas()
         for self.delta in deltas:
             diagonal[n:] = -self.delta
             K.data[self._diagonal] = diagonal
             try:
-                if self._solver is None:
-                    self._solver = self._qdldl.Solver(K, upper=True)
-                else:
-                    self._solver.update(K, upper=True)
-                _, d, _ = self._solver.factors()
-                negative = int(np.count_nonzero(d < 0))
-                if negative >= self.m and np.all(np.isfinite(d)) and np.all(d != 0.0):
-                    break
-                failure = f"{negative} negative pivots of {self.m}, or a zero one"
-            except RuntimeError as exn:   # qdldl's report of a zero pivot
-                failure = str(exn)
-            self._solver = None
-            if self.delta == deltas[-1]:
-                raise FactorizationError(failure)
+                self._solver, negative = self._quasi_definite(K, self._solver)
+                break
+            except FactorizationError:
+                self._solver = None
+                if self.delta == deltas[-1]:
+                    raise
         self.penalty = np.full(n, sigma)
         self.penalty[self.constrained] += rho_vec
         return negative
@@ -200,6 +200,51 @@ class SparseKKT:
         if largest <= 1.0:
             return DELTA, BROKEN_DELTA
         return DELTA, BROKEN_DELTA, BROKEN_DELTA * largest * largest
+
+    def _quasi_definite(self, K: sp.csc_matrix, solver: object) -> tuple[object, int]:
+        """``qdldl``'s factorization of ``K`` (``solver`` updated, or a new one when None)
+        and its number of negative pivots; :class:`FactorizationError` unless its pivots
+        are those of a quasi-definite matrix (see :meth:`factor`)."""
+        try:
+            if solver is None:
+                solver = self._qdldl.Solver(K, upper=True)
+            else:
+                solver.update(K, upper=True)
+            _, d, _ = solver.factors()
+        except RuntimeError as exn:   # qdldl's report of a zero pivot
+            raise FactorizationError(str(exn)) from exn
+        negative = int(np.count_nonzero(d < 0))
+        if negative >= self.m and np.all(np.isfinite(d)) and np.all(d != 0.0):
+            return solver, negative
+        raise FactorizationError(f"{negative} negative pivots of {self.m}, or a zero one")
+
+    def _cut_regularization(self, rate: float) -> tuple[object, float] | None:
+        """Factor the current matrix again with ``delta`` cut to ``DELTA_CUT`` times the
+        curvature that a refinement contracting by ``rate`` shows, ``delta (1 - rate) /
+        rate``; the previous ``(factorization, delta)``, or None (nothing changed) when
+        the cut one is not quasi-definite or a cut was already spent on this
+        factorization.
+
+        A refinement against a factorization regularized by ``delta`` recovers, in a
+        direction where ``A (P + sigma I + R)^-1 A'`` has the curvature ``c``, ``c / (c
+        + delta)`` of the step a correction: where ``c`` lies below ``delta`` (``P``
+        huge beside columns it does not touch, which the equilibration scales down to
+        singular values of 1e-5 in ``A``, ``c`` about 1e-11) the correction contracts by
+        ``rate = delta / (c + delta)``, close to 1, and the equality error stays at the
+        size of its terms; that is no proof that ``A x = b`` has no solution."""
+        if self._cut_spent:
+            return None
+        self._cut_spent = True
+        delta = DELTA_CUT * self.delta * (1.0 - rate) / rate
+        K = self._K.copy()
+        K.data[self._diagonal[self.n:]] = -delta
+        try:
+            solver, _ = self._quasi_definite(K, None)
+        except FactorizationError:
+            return None
+        previous = (self._solver, self.delta)
+        self._solver, self.delta = solver, delta
+        return previous
 
     def _residual(self, rhs: np.ndarray, sol: np.ndarray, Ax: np.ndarray,
                   delta: float) -> np.ndarray:
@@ -226,8 +271,8 @@ class SparseKKT:
         sol = self._solver.solve(rhs)
         n, E = self.n, self.E
         b = rhs[n:]
-        last_error, step = np.inf, None
-        for r in range(MAX_REFINE + 1):
+        last_error, step, previous, r = np.inf, None, None, 0
+        while True:
             Ax = self.A @ sol[:n]
             residual = self._residual(rhs, sol, Ax, 0.0)
             error = float(np.max(np.abs(residual[n:]) / E, initial=0.0))
@@ -237,19 +282,29 @@ class SparseKKT:
             if met and self._stationary(rhs, sol, residual):
                 return sol
             if not met and error >= 0.5 * last_error:
-                # no progress: A x = b has no solution; undo the last step and refine
-                # against the regularized matrix, whose least-squares x the equality
-                # certificate reads
-                sol = sol - step
-                for _ in range(REGULARIZED_STEPS):
-                    sol = sol + self._solver.solve(
-                        self._residual(rhs, sol, self.A @ sol[:n], self.delta))
-                return sol
+                if previous is None and error < last_error:
+                    previous = self._cut_regularization(error / last_error)
+                    if previous is None:
+                        return self._least_squares(rhs, sol - step)
+                    r = 0
+                else:
+                    if previous is not None and r == 1:   # the cut's first step failed
+                        self._solver, self.delta = previous
+                    return self._least_squares(rhs, sol - step)
             last_error = error
             if r == MAX_REFINE:
                 return sol
+            r += 1
             step = self._solver.solve(residual)
             sol = sol + step
+
+    def _least_squares(self, rhs: np.ndarray, sol: np.ndarray) -> np.ndarray:
+        """``sol`` refined against the regularized matrix, whose least-squares ``x`` the
+        equality certificate reads: where refinement against the unregularized one stops
+        making progress, ``A x = b`` has no solution."""
+        for _ in range(REGULARIZED_STEPS):
+            sol = sol + self._solver.solve(
+                self._residual(rhs, sol, self.A @ sol[:self.n], self.delta))
         return sol
 
     def factor_gram(self) -> bool:
