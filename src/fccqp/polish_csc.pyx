@@ -66,17 +66,17 @@ cdef class _Factor:
         self._colptr, self.indices, self.data, self._rhs = colptr, rowind, values, rhs
         self.indptr, self.shape, self.nnz, self._solver = colptr[:1], (0, 0), 0, None
 
-    cdef bint factor(self, Py_ssize_t size, double delta) except -1:
+    cdef bint factor(self, Py_ssize_t size, Py_ssize_t nf, double delta) except -1:
         """Factor the leading ``size`` columns, regularized by ``delta``: by qdldl, or by
         SuperLU with partial pivoting where ``delta`` lies below the rounding of the
-        largest entry (see :func:`polish_csc_factor`); False when the factorization
-        meets a zero pivot."""
+        largest curvature entry, those of the first ``nf`` columns (see
+        :func:`polish_csc_factor`); False when the factorization meets a zero pivot."""
         self.indptr = self._colptr[:size + 1]
         self.shape = (size, size)
         self.nnz = self._colptr[size]
         self._solver = None
         try:
-            if delta <= EPSILON * float(np.max(np.abs(self.data[:self.nnz]), initial=0.0)):
+            if delta <= EPSILON * float(np.max(np.abs(self.data[:self._colptr[nf]]), initial=0.0)):
                 self._solver = self._pivoting_class(self._symmetric())
             else:
                 self._solver = self._solver_class(self, upper=True)
@@ -241,15 +241,19 @@ cdef bint polish_csc_factor(PolishCSC* f, const Problem* p, Py_ssize_t nf,
     the factorization meets a zero pivot.
 
     qdldl factors without pivoting, its rounding growing like ``1 / delta`` beside the
-    entries: where ``delta`` lies at or below ``DBL_EPSILON`` times the largest entry,
-    the pivots ``-delta`` of rows eliminated before their columns are below the
-    rounding of the entries they meet, and SuperLU factors the whole symmetric matrix
-    with partial pivoting instead (``P`` of 1e10 unscaled beside free entries that
-    ``P`` does not touch, ``delta`` 1e-8: qdldl's corrections left the residual at the
-    size of the right-hand side, SuperLU's reduced it to ``P x``'s rounding)."""
+    entries: where ``delta`` lies at or below ``DBL_EPSILON`` times the largest entry of
+    the free entries' curvature (the first ``nf`` columns), the pivots ``-delta`` of rows
+    eliminated before their columns are below the rounding of the entries they meet, and
+    SuperLU factors the whole symmetric matrix with partial pivoting instead (``P`` of
+    1e10 unscaled beside free entries that ``P`` does not touch, ``delta`` 1e-8: qdldl's
+    corrections left the residual at the size of the right-hand side, SuperLU's reduced
+    it to ``P x``'s rounding). Rows of ``A`` as large do not call for it: taken on the
+    whole matrix, the test sent an unscaled least-distance QP with rows of 2e10 and a
+    curvature of one to SuperLU, whose polish then lost an infeasibility certificate
+    that qdldl's finds."""
     _assemble_csc(f, p, nf, free, index, boundary, nb, g, delta)
     with gil:
-        return (<_Factor>f.factor).factor(nf + p.m + nb, delta)
+        return (<_Factor>f.factor).factor(nf + p.m + nb, nf, delta)
 
 
 cdef void polish_csc_solve(PolishCSC* f, Py_ssize_t size, double* v) noexcept nogil:
