@@ -173,6 +173,7 @@ cdef class Workspace:
         e.prev.exists = e.user.has_matrices = e.fact.certified = e.scaling.done = False
         e.prev.has_rho = False
         e.prev.polished = e.prev.from_polished = e.equalities_missed = False
+        e.prev.guessed = False
         e.unscaled.current = False
         e.fact.factored_rho = -1.0
         e.clock.final_reserve = e.clock.pass_time = 0.0
@@ -443,7 +444,7 @@ cdef class Workspace:
         copy(z0, e.prev.z, e.prob.n)
         if not e.prev.has_rho:
             e.prev.rho = e.opt.rho
-        e.prev.exists = e.prev.polished = True
+        e.prev.exists = e.prev.polished = e.prev.guessed = True
 
     cdef bint _same_structure(self, const double* lb, const double* ub) noexcept nogil:
         """Whether the user's new bounds bound, fix and leave free the entries they did at
