@@ -436,8 +436,10 @@ cdef class Workspace:
                           const double* z0) noexcept nogil:
         """Make the primal-dual guess ``(x0, y0, z0)`` (user's units) the previous
         solution, polished: the run then starts from it exactly as a warm start from
-        its own answer does, the warm polish trying the guess's active set first. Its
-        rho is the last one this workspace ran at, else ``settings.rho``."""
+        its own answer does, the warm polish trying the guess's active set first (if
+        that fails, ADMM starts from the guess or the cold start,
+        :func:`fccqp.iteration._nearer_start`). Its rho is the last one this workspace
+        ran at, else ``settings.rho``."""
         cdef Engine* e = &self.e
         copy(x0, e.prev.x, e.prob.n)
         copy(y0, e.prev.y, e.prob.m)
