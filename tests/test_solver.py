@@ -342,6 +342,22 @@ def test_dual_guess_overrides_the_previous_answer_without_warm_start_setting():
     np.testing.assert_allclose(again.x, first.x, rtol=1e-9, atol=1e-12)
 
 
+@pytest.mark.parametrize("seed", range(3))   # seed 3's far guess polishes to the answer
+def test_a_far_guess_whose_polish_fails_is_answered_from_the_cold_start(seed):
+    """When the warm polish from a caller's guess fails, ADMM starts from the guess or
+    from the cold start, whichever is nearer the termination test: a guess far from
+    the answer is then answered as the same problem without a guess is."""
+    problem = random_problem(seed)
+    cold = fccqp.solve(*problem)
+    rng = np.random.default_rng(seed)
+    n, m = problem[2].shape[1], problem[2].shape[0]
+    far = fccqp.solve(*problem, x0=1e3 * rng.standard_normal(n),
+                      y0=1e3 * rng.standard_normal(m), z0=1e3 * rng.standard_normal(n))
+    assert far.status is Status.SOLVED
+    assert far.iterations == cold.iterations
+    np.testing.assert_array_equal(far.x, cold.x)
+
+
 def test_box_infeasible():
     P = np.eye(3)
     q = np.zeros(3)

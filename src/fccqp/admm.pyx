@@ -173,6 +173,7 @@ cdef class Workspace:
         e.prev.exists = e.user.has_matrices = e.fact.certified = e.scaling.done = False
         e.prev.has_rho = False
         e.prev.polished = e.prev.from_polished = e.equalities_missed = False
+        e.prev.guessed = False
         e.unscaled.current = False
         e.fact.factored_rho = -1.0
         e.clock.final_reserve = e.clock.pass_time = 0.0
@@ -435,15 +436,17 @@ cdef class Workspace:
                           const double* z0) noexcept nogil:
         """Make the primal-dual guess ``(x0, y0, z0)`` (user's units) the previous
         solution, polished: the run then starts from it exactly as a warm start from
-        its own answer does, the warm polish trying the guess's active set first. Its
-        rho is the last one this workspace ran at, else ``settings.rho``."""
+        its own answer does, the warm polish trying the guess's active set first (if
+        that fails, ADMM starts from the guess or the cold start,
+        :func:`fccqp.iteration._nearer_start`). Its rho is the last one this workspace
+        ran at, else ``settings.rho``."""
         cdef Engine* e = &self.e
         copy(x0, e.prev.x, e.prob.n)
         copy(y0, e.prev.y, e.prob.m)
         copy(z0, e.prev.z, e.prob.n)
         if not e.prev.has_rho:
             e.prev.rho = e.opt.rho
-        e.prev.exists = e.prev.polished = True
+        e.prev.exists = e.prev.polished = e.prev.guessed = True
 
     cdef bint _same_structure(self, const double* lb, const double* ub) noexcept nogil:
         """Whether the user's new bounds bound, fix and leave free the entries they did at

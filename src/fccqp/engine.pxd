@@ -118,6 +118,7 @@ cdef struct Previous:
     bint polished               # and it was polished
     bint from_polished          # this solve starts from it
     bint has_rho                # rho is one some solve adapted (a cold start keeps it too)
+    bint guessed                # x, y, z are a caller's guess, not an answer
 
 
 cdef struct UserPoint:

@@ -38,6 +38,7 @@ from fccqp.factorization cimport budget, change_rho, equality_start, factor, red
 from fccqp.kkt cimport FACTORED, NOT_CONVEX, is_reduced, kkt_solve
 from fccqp.polish cimport guess_changes, polish_prepare
 from fccqp.projections cimport proj_set
+from fccqp.scaling cimport scale_start
 from fccqp.reduced cimport materialize, near_convergence, reduced_start, reduced_step
 from fccqp.rho_rule cimport TrialState, new_rho, trial_reset
 from fccqp.termination cimport Residuals, converged, distance, nearly_converged
@@ -113,6 +114,9 @@ cdef void iterate(Engine* e, Run* run, bint cold, double start_time) noexcept no
         return
     if not _factor_or_polish(e, &loop, run):      # the warm polish was, or no factorization
         return
+    if e.prev.guessed and e.prev.from_polished and e.opt.polish:   # its polish failed
+        if not _nearer_start(e, &loop, run):
+            return
     _prepare(e, &loop)
     while loop.status == RUNNING:
         loop.iteration += 1
@@ -284,6 +288,33 @@ cdef inline bint _factor_or_polish(Engine* e, Loop* L, Run* run) noexcept nogil:
     if e.prev.from_polished and e.opt.polish and L.cut != LONG_MAX:   # it failed
         L.cut = max(L.cut - _cut_polish_charge, 0)
     return True
+
+
+cdef bint _nearer_start(Engine* e, Loop* L, Run* run) noexcept nogil:
+    """After a caller's guess failed its warm polish, ADMM starts from the guess or from
+    the cold start (the equality-constrained QP, at a cold start's rho), whichever is
+    nearer the termination test (:func:`fccqp.termination.distance`); the guess is
+    scaled in again and factored for its rho when it wins. A carried guess across a
+    contact change is either a few iterations from the answer or far slower than the
+    cold start, and neither start wins everywhere (notes/performance-history.md,
+    "contactfall"). False when the run ended here."""
+    cdef Problem* p = &e.prob
+    cdef double guess_rho = run.rho, guess_distance
+    e.prev.from_polished = False   # not polished again below
+    measure(e)
+    guess_distance = distance(&e.res, e.opt.eps_abs, e.opt.eps_rel)
+    L.cold = True
+    run.rho = e.prev.rho if e.prev.has_rho and L.timed else e.opt.rho   # scaled_run's rule
+    if not _start(e, L, run):
+        return False
+    if distance(&e.res, e.opt.eps_abs, e.opt.eps_rel) > guess_distance:
+        L.cold = False
+        run.rho = guess_rho
+        scale_start(e.prev.x, e.prev.y, e.prev.z, e.prev.rho, p.D, p.E, p.c, p.n, p.m,
+                    p.s, p.constrained, p.lo, p.hi, p.cones, e.it.x, e.it.nu, e.it.y,
+                    e.it.z)
+        measure(e)
+    return _factor_or_polish(e, L, run)
 
 
 cdef inline void _prepare(Engine* e, Loop* L) noexcept nogil:

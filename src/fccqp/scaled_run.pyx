@@ -154,3 +154,4 @@ cdef void unscaled_answer(Engine* e, Run* run, double* x, double* y, double* z,
         e.prev.rho = run.rho
         e.prev.has_rho = True
     e.prev.polished = e.prev.exists and run.polished
+    e.prev.guessed = False
