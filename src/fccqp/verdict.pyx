@@ -19,14 +19,17 @@ from fccqp.certificates cimport (CERTIFIED, REJECTED, SEPARATED, clean_primal_ce
 from fccqp.engine cimport (DUAL_INFEASIBLE, INACCURATE, MAX_ITER, NUMERICAL_ERROR,
                            PRIMAL_INFEASIBLE, RUNNING, SOLVED, TIME_LIMIT, Engine, Run,
                            fccqp_now)
-from fccqp.kkt cimport kkt_solve
+from fccqp.kkt cimport is_reduced, kkt_solve
 from fccqp.matrices cimport entry, zero_column
+from fccqp.reduced cimport materialize_nu_prev, materialize_x_prev
 from fccqp.termination cimport Residuals, converged, nearly_converged
 from fccqp.tuning cimport CLEANING_GATE, CLEANING_HORIZON, EQUALITY_MISSED, INACCURATE_FACTOR
 
 
 cdef int check(Engine* e, long iteration, bint last) noexcept nogil:
-    """Termination and infeasibility tests after the residuals of ``iteration``."""
+    """Termination and infeasibility tests after the residuals of ``iteration``; in the
+    reduced form ``x_prev`` and ``nu_prev`` are formed here, by the tests that read
+    them."""
     cdef Problem* p = &e.prob
     cdef Iterates* it = &e.it
     cdef Residuals* r = &e.res
@@ -47,6 +50,8 @@ cdef int check(Engine* e, long iteration, bint last) noexcept nogil:
     if _may_separate(e, iteration):
         if e.certs.row_norm < 0.0:   # once per solve
             e.certs.row_norm = largest_row_norm(p, e.work.vec_n, e.work.vec_m2)
+        if is_reduced(e.fact.form):
+            materialize_nu_prev(&e.red, p, it)
         code = primal_infeasible(p, it, e.opt.eps_prim_inf, Ax, e.certs.row_norm,
                                  e.work.vec_m2, e.work.vec_s, e.work.vec_n, e.work.vec_n2)
     if code == CERTIFIED or (code == SEPARATED and iteration >= e.certs.next_cleaning
@@ -58,6 +63,8 @@ cdef int check(Engine* e, long iteration, bint last) noexcept nogil:
         for i in range(p.s):
             e.certs.cert[p.m + p.constrained[i]] = e.work.vec_s[i] / p.D[p.constrained[i]]
         return PRIMAL_INFEASIBLE
+    if is_reduced(e.fact.form):
+        materialize_x_prev(&e.red, p, it)
     for i in range(p.n):
         e.certs.direction[i] = it.x[i] - it.x_prev[i]
     if unbounded(e):
