@@ -40,7 +40,7 @@ from fccqp._dense cimport copy
 from fccqp._types cimport Iterates, Problem
 from fccqp.kkt_sparse cimport sparse_gram_factor, sparse_gram_solve
 from fccqp.matrices cimport (CSC, DENSE, Matrix, abs_product, product, product_row_norms,
-                             product_t_terms, subtract_product)
+                             product_t_terms, row_spans, subtract_product)
 from fccqp.projections cimport proj_block
 from fccqp.tuning cimport (BALANCE_RANGE, CLEANING_PASSES, CLEANING_SHRINK, DOMINANCE,
                            GRAM_REGULARIZATION, SEPARATION_FLOOR)
@@ -71,14 +71,15 @@ cdef void row_sizes(const Problem* p, const double* x, double* t, double* sizes)
 
 
 cdef int primal_infeasible(const Problem* p, const Iterates* it, double eps, const double* Ax,
-                           double row_norm, double* d_nu, double* d_y, double* lhs,
+                           double* row_norm, double* d_nu, double* d_y, double* lhs,
                            double* terms) noexcept nogil:
     """Test ``(nu - nu_prev, y - y_prev)``: ``CERTIFIED``, ``SEPARATED`` when it separates
     but its residual is too large (:func:`clean_primal_certificate` may pass it), else
     ``REJECTED``. ``Ax`` is ``A x`` at the iterate as the residuals formed it (NULL when
-    not at hand) and ``row_norm`` the largest row 1-norm of ``A``
-    (:func:`largest_row_norm`): with them a candidate that :func:`_explained_at_iterate`
-    rules out is ``SEPARATED`` without ``A'd_nu``, the outcome the full test gives it.
+    not at hand) and ``row_norm`` the largest row 1-norm of ``A`` (negative until
+    :func:`_explained_at_iterate` first needs it in a solve, which then sets it): with
+    them a candidate that :func:`_explained_at_iterate` rules out is ``SEPARATED``
+    without ``A'd_nu``, the outcome the full test gives it.
     ``d_nu`` (m), ``d_y`` (s), ``lhs`` and ``terms`` (n) are scratch, and hold the
     candidate (``d_y`` projected) afterwards."""
     cdef Py_ssize_t i, j
@@ -91,7 +92,8 @@ cdef int primal_infeasible(const Problem* p, const Iterates* it, double eps, con
     support = _separation(p, d_nu, d_y, &size)
     if not (support < -SEPARATION_FLOOR * size) or not isfinite(support):
         return REJECTED
-    if Ax != NULL and _explained_at_iterate(p, it.x, Ax, row_norm, d_nu, d_y, support):
+    if Ax != NULL and _explained_at_iterate(p, it.x, Ax, row_norm, d_nu, d_y, support,
+                                            lhs, terms):
         return SEPARATED
     return _residual_tests(p, it.x, d_nu, d_y, eps, support, size, lhs, terms)
 
@@ -202,8 +204,8 @@ cdef double SLACK = 1e-12
 
 
 cdef bint _explained_at_iterate(const Problem* p, const double* x, const double* Ax,
-                                double row_norm, const double* d_nu, const double* d_y,
-                                double support) noexcept nogil:
+                                double* row_norm, const double* d_nu, const double* d_y,
+                                double support, double* ones, double* norms) noexcept nogil:
     """Whether the residual ``lhs = A'd_nu + E_S d_y`` surely explains the separation at
     ``x``, known in ``O(n + m + s)`` from ``A x`` without ``A'd_nu``: ``lhs'x = d_nu'(A
     x) + d_y'x_S``, and :func:`_residual_tests`' ``explained = sum_i |lhs_i x_i|`` is
@@ -213,7 +215,9 @@ cdef bint _explained_at_iterate(const Problem* p, const double* x, const double*
     themselves), the test ``support < -explained`` fails however ``lhs`` is rounded,
     and the candidate is ``SEPARATED``. On whole-body-control QPs a feasible run's
     candidates separate at nearly every check and ``|lhs'x|`` exceeds ``-support`` at
-    96 % of them: the test had formed ``A'd_nu`` and ``|A|'|d_nu|`` for each."""
+    96 % of them: the test had formed ``A'd_nu`` and ``|A|'|d_nu|`` for each.
+    ``row_norm`` is formed (once per solve, ``ones``: n, ``norms``: m scratch) only
+    when the sums alone surely pass."""
     cdef Py_ssize_t i, j
     cdef double along = 0.0, terms = 0.0, nu_size = 0.0, x_max = 0.0, value, error
     for i in range(p.m):
@@ -227,18 +231,23 @@ cdef bint _explained_at_iterate(const Problem* p, const double* x, const double*
         terms += fabs(value)
     for i in range(p.n):
         x_max = max(x_max, fabs(x[i]))
-    error = (p.n + p.m + p.s + 4) * ROUNDING * (fabs(along) + terms
-                                                 + row_norm * x_max * nu_size)
+    error = (p.n + p.m + p.s + 4) * ROUNDING * (fabs(along) + terms)
+    if not (isfinite(error) and (fabs(along) - error) * (1.0 - SLACK) >= -support):
+        return False
+    if row_norm[0] < 0.0:
+        row_norm[0] = _largest_row_norm(p, ones, norms)
+    error += (p.n + p.m + p.s + 4) * ROUNDING * row_norm[0] * x_max * nu_size
     return isfinite(error) and (fabs(along) - error) * (1.0 - SLACK) >= -support
 
 
-cdef double largest_row_norm(const Problem* p, double* ones, double* norms) noexcept nogil:
-    """The largest 1-norm of a row of ``A`` (``ones``: n, ``norms``: m scratch)."""
+cdef double _largest_row_norm(const Problem* p, double* ones, double* norms) noexcept nogil:
+    """The largest 1-norm of a row of ``A``, summed in any order (``ones``: n, ``norms``:
+    m scratch)."""
     cdef Py_ssize_t i
     cdef double largest = 0.0
     for i in range(p.n):
         ones[i] = 1.0
-    abs_product(&p.A, ones, norms)
+    row_spans(&p.A, ones, norms)
     for i in range(p.m):
         largest = max(largest, norms[i])
     return largest

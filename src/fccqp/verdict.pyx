@@ -14,8 +14,7 @@ from fccqp._dense cimport copy, fill
 from fccqp._types cimport Iterates, Problem
 from fccqp.certificates cimport (CERTIFIED, REJECTED, SEPARATED, clean_primal_certificate,
                                  dual_infeasible, equality_direction, equality_inconsistent,
-                                 gram_factor, largest_row_norm, primal_infeasible,
-                                 row_sizes)
+                                 gram_factor, primal_infeasible, row_sizes)
 from fccqp.engine cimport (DUAL_INFEASIBLE, INACCURATE, MAX_ITER, NUMERICAL_ERROR,
                            PRIMAL_INFEASIBLE, RUNNING, SOLVED, TIME_LIMIT, Engine, Run,
                            fccqp_now)
@@ -48,11 +47,9 @@ cdef int check(Engine* e, long iteration, bint last) noexcept nogil:
         return SOLVED
     code = REJECTED
     if _may_separate(e, iteration):
-        if e.certs.row_norm < 0.0:   # once per solve
-            e.certs.row_norm = largest_row_norm(p, e.work.vec_n, e.work.vec_m2)
         if is_reduced(e.fact.form):
             materialize_nu_prev(&e.red, p, it)
-        code = primal_infeasible(p, it, e.opt.eps_prim_inf, Ax, e.certs.row_norm,
+        code = primal_infeasible(p, it, e.opt.eps_prim_inf, Ax, &e.certs.row_norm,
                                  e.work.vec_m2, e.work.vec_s, e.work.vec_n, e.work.vec_n2)
     if code == CERTIFIED or (code == SEPARATED and iteration >= e.certs.next_cleaning
                              and iteration % e.opt.adaptive_rho_interval == 0
