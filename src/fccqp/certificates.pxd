@@ -7,8 +7,9 @@ cdef enum:
     CERTIFIED = 1
     SEPARATED = 2   # it separates, but its residual is not small enough against that
 
-cdef int primal_infeasible(const Problem* p, const Iterates* it, double eps, double* d_nu,
-                           double* d_y, double* lhs, double* terms) noexcept nogil
+cdef int primal_infeasible(const Problem* p, const Iterates* it, double eps, const double* Ax,
+                           double* row_norm, double* d_nu, double* d_y, double* lhs,
+                           double* terms) noexcept nogil
 
 cdef int primal_candidate(const Problem* p, const double* x, const double* d_nu,
                           double* d_y, double eps, double* lhs, double* terms) noexcept nogil

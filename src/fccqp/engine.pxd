@@ -106,6 +106,7 @@ cdef struct Certificates:
     int stalled_checks          # checks in a row that could clean whose residual stalled
     long next_cleaning          # when the next cleaning may run
     long cleaning_wait          # and the wait after a failed one
+    double row_norm             # A's largest row 1-norm (primal test), < 0 until needed
 
 
 cdef struct Previous:

@@ -13,6 +13,8 @@ cdef struct Reduced:
     double* v_prev
     double* xs      # s scratch
     Py_ssize_t hint # the entry that failed near_convergence's gate last (tested first)
+    bint x_prev_due # x_prev, nu_prev not formed since the last materialize
+    bint nu_prev_due
 
 cdef bint reduced_table(Reduced* r, KKT* k, const Problem* p, const double* rho_vec) noexcept nogil
 cdef void reduced_start(Reduced* r, const Problem* p, Iterates* it) noexcept nogil
@@ -21,5 +23,7 @@ cdef void reduced_step(Reduced* r, const Problem* p, Iterates* it, double alpha,
 cdef bint near_convergence(Reduced* r, const Problem* p, Iterates* it, double eps_p,
                            double eps_d) noexcept nogil
 cdef void materialize(Reduced* r, const Problem* p, Iterates* it) noexcept nogil
+cdef void materialize_x_prev(Reduced* r, const Problem* p, Iterates* it) noexcept nogil
+cdef void materialize_nu_prev(Reduced* r, const Problem* p, Iterates* it) noexcept nogil
 cdef void reduced_rebase(Reduced* r, const Problem* p, const double* old_rho,
                          const double* new_rho) noexcept nogil

@@ -157,12 +157,30 @@ cdef inline void _combine(const Reduced* r, const double* c, double* out, Py_ssi
 
 
 cdef void materialize(Reduced* r, const Problem* p, Iterates* it) noexcept nogil:
-    """Form ``x, nu`` and their previous values from ``base + W (u, v)``."""
+    """Form ``x, nu`` from ``base + W (u, v)``; their previous values are due
+    (:func:`materialize_x_prev`, :func:`materialize_nu_prev`)."""
     cdef Py_ssize_t n = p.n, m = p.m, N = n + m, s = p.s
     _combine(r, r.u, it.x, 0, n, N, s)
-    _combine(r, r.u_prev, it.x_prev, 0, n, N, s)
     _combine(r, r.v, it.nu, n, m, N, s)
-    _combine(r, r.v_prev, it.nu_prev, n, m, N, s)
+    r.x_prev_due = r.nu_prev_due = True
+
+
+cdef void materialize_x_prev(Reduced* r, const Problem* p, Iterates* it) noexcept nogil:
+    """Form ``x_prev`` from ``base + W u_prev`` where the last :func:`materialize` left it
+    due: only the dual certificate's test reads it, and a check that passes or
+    certifies first never does."""
+    if r.x_prev_due:
+        _combine(r, r.u_prev, it.x_prev, 0, p.n, p.n + p.m, p.s)
+        r.x_prev_due = False
+
+
+cdef void materialize_nu_prev(Reduced* r, const Problem* p, Iterates* it) noexcept nogil:
+    """Form ``nu_prev`` from ``base + W v_prev`` where the last :func:`materialize` left
+    it due: only the primal certificate's test reads it, and it does not run at every
+    check (:func:`fccqp.verdict._may_separate`)."""
+    if r.nu_prev_due:
+        _combine(r, r.v_prev, it.nu_prev, p.n, p.m, p.n + p.m, p.s)
+        r.nu_prev_due = False
 
 
 cdef inline void _shift(Reduced* r, const Problem* p, double* c, const double* old_rho,

@@ -18,41 +18,50 @@ from fccqp.certificates cimport (CERTIFIED, REJECTED, SEPARATED, clean_primal_ce
 from fccqp.engine cimport (DUAL_INFEASIBLE, INACCURATE, MAX_ITER, NUMERICAL_ERROR,
                            PRIMAL_INFEASIBLE, RUNNING, SOLVED, TIME_LIMIT, Engine, Run,
                            fccqp_now)
-from fccqp.kkt cimport kkt_solve
+from fccqp.kkt cimport is_reduced, kkt_solve
 from fccqp.matrices cimport entry, zero_column
+from fccqp.reduced cimport materialize_nu_prev, materialize_x_prev
 from fccqp.termination cimport Residuals, converged, nearly_converged
 from fccqp.tuning cimport CLEANING_GATE, CLEANING_HORIZON, EQUALITY_MISSED, INACCURATE_FACTOR
 
 
 cdef int check(Engine* e, long iteration, bint last) noexcept nogil:
-    """Termination and infeasibility tests after the residuals of ``iteration``."""
+    """Termination and infeasibility tests after the residuals of ``iteration``; in the
+    reduced form ``x_prev`` and ``nu_prev`` are formed here, by the tests that read
+    them."""
     cdef Problem* p = &e.prob
     cdef Iterates* it = &e.it
     cdef Residuals* r = &e.res
     cdef Py_ssize_t i
     cdef int code
+    cdef const double* Ax = e.work.vec_m   # the residuals' A x
     if not r.finite:
         return NUMERICAL_ERROR
-    if (missed_by_data(e)
-            and inconsistent(e, iteration % e.opt.adaptive_rho_interval == 0)):
-        # A x = b has no solution: no point can be SOLVED (cleaned on the schedule
-        # of rho adaptation, a KKT solve each time)
-        return PRIMAL_INFEASIBLE
+    if missed_by_data(e):
+        if inconsistent(e, iteration % e.opt.adaptive_rho_interval == 0):
+            # A x = b has no solution: no point can be SOLVED (cleaned on the schedule
+            # of rho adaptation, a KKT solve each time)
+            return PRIMAL_INFEASIBLE
+        Ax = NULL   # the test's b - A x took its place
     if converged(r, e.tighten * e.opt.eps_abs, e.tighten * e.opt.eps_rel):
         return SOLVED
     code = REJECTED
     if _may_separate(e, iteration):
-        code = primal_infeasible(p, it, e.opt.eps_prim_inf, e.work.vec_m, e.work.vec_s,
-                                 e.work.vec_n, e.work.vec_n2)
+        if is_reduced(e.fact.form):
+            materialize_nu_prev(&e.red, p, it)
+        code = primal_infeasible(p, it, e.opt.eps_prim_inf, Ax, &e.certs.row_norm,
+                                 e.work.vec_m2, e.work.vec_s, e.work.vec_n, e.work.vec_n2)
     if code == CERTIFIED or (code == SEPARATED and iteration >= e.certs.next_cleaning
                              and iteration % e.opt.adaptive_rho_interval == 0
                              and _cleaned_certificate(e, iteration)):
         fill(e.certs.cert, 0.0, p.n + p.m)
         for i in range(p.m):   # in the user's units (the common factor 1/c dropped)
-            e.certs.cert[i] = e.work.vec_m[i] * p.E[i]
+            e.certs.cert[i] = e.work.vec_m2[i] * p.E[i]
         for i in range(p.s):
             e.certs.cert[p.m + p.constrained[i]] = e.work.vec_s[i] / p.D[p.constrained[i]]
         return PRIMAL_INFEASIBLE
+    if is_reduced(e.fact.form):
+        materialize_x_prev(&e.red, p, it)
     for i in range(p.n):
         e.certs.direction[i] = it.x[i] - it.x_prev[i]
     if unbounded(e):
@@ -81,7 +90,7 @@ cdef inline bint _may_separate(Engine* e, long iteration) noexcept nogil:
 
 
 cdef bint _cleaned_certificate(Engine* e, long iteration) noexcept nogil:
-    """Clean the primal certificate's candidate that the last test left in ``vec_m``,
+    """Clean the primal certificate's candidate that the last test left in ``vec_m2``,
     ``vec_s`` (:func:`fccqp.certificates.clean_primal_certificate`), on the schedule
     of rho adaptation, when the primal residual is above ``CLEANING_GATE`` times
     its tolerance and stalled over the last two such checks (:func:`_stalled`), and
@@ -104,7 +113,7 @@ cdef bint _cleaned_certificate(Engine* e, long iteration) noexcept nogil:
     if e.certs.gram_state == 0:   # once per solve: A A' of this solve's scaled rows
         e.certs.gram_state = 1 if gram_factor(p, e.fact.kkt.sparse, e.certs.gram) else -1
     if e.certs.gram_state == 1 and clean_primal_certificate(
-            p, e.it.x, e.certs.gram, e.fact.kkt.sparse, e.opt.eps_prim_inf, e.work.vec_m,
+            p, e.it.x, e.certs.gram, e.fact.kkt.sparse, e.opt.eps_prim_inf, e.work.vec_m2,
             e.work.vec_s, e.work.saved, e.work.vec_n3, e.work.vec_n, e.work.vec_n2):
         return True
     e.certs.cleaning_wait *= 2   # the next try waits twice as long
