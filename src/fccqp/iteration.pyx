@@ -251,6 +251,12 @@ cdef bint _least_squares_inconsistent(Engine* e) noexcept nogil:
     return False
 
 
+cdef inline void _charge_failed_polish(Loop* L) noexcept nogil:
+    """Charge a failed warm polish to the iteration cut (the clock's cut, when set)."""
+    if L.cut != LONG_MAX:
+        L.cut = max(L.cut - _cut_polish_charge, 0)
+
+
 cdef inline bint _factor_or_polish(Engine* e, Loop* L, Run* run) noexcept nogil:
     """Factor for the run's rho unless the factorization holds it, and the reduced
     form's ``base``; first, where it can, polish a polished warm start
@@ -277,6 +283,9 @@ cdef inline bint _factor_or_polish(Engine* e, Loop* L, Run* run) noexcept nogil:
             # a guess that failed the check would fail again; one that the Schur
             # complement could not solve goes to the table
             L.warm_polish = e.pol.schur_failed
+            if e.prev.guessed and not L.warm_polish:   # _nearer_start factors once
+                _charge_failed_polish(L)
+                return True
         code = factor(e, run, budget(e, 0))
         if code != FACTORED:
             run.status = NOT_CONVEX_QP if code == NOT_CONVEX else NUMERICAL_ERROR
@@ -286,9 +295,10 @@ cdef inline bint _factor_or_polish(Engine* e, Loop* L, Run* run) noexcept nogil:
         reduced_base(e)
     if L.warm_polish and warm_polish(e, run, L.start_time):
         return False
-    if e.prev.from_polished and e.opt.polish and L.cut != LONG_MAX:   # it failed
-        L.cut = max(L.cut - _cut_polish_charge, 0)
+    if e.prev.from_polished and e.opt.polish:   # it failed
+        _charge_failed_polish(L)
     return True
+
 
 
 cdef bint _nearer_start(Engine* e, Loop* L, Run* run) noexcept nogil:
