@@ -49,7 +49,8 @@ cdef int factor(Engine* e, Run* run, long solves) noexcept nogil:
     """Factor for the current rho with the backend the settings ask for, falling back
     in the order Schur, LDL' reduced, LDL' full ("auto" starts with Schur when the
     reduced table pays for itself within ``solves`` and the constrained entries are
-    at most half the KKT size, else with LDL' full). Certifies convexity when the
+    at most half the KKT size, else with LDL' full; every backend starts with LDL'
+    full after a cold start that missed ``A x = b``). Certifies convexity when the
     matrices are new. Returns FACTORED, NOT_CONVEX, or UNAVAILABLE (numerical
     breakdown); records the form and the rho it factored. Compressed columns have one
     backend, ``SPARSE_LDL`` (:func:`_factor_sparse`)."""
@@ -58,13 +59,16 @@ cdef int factor(Engine* e, Run* run, long solves) noexcept nogil:
     e.fact.table_ready = False
     if p.P.kind == CSC:
         return _factor_sparse(e, run)
-    if first == AUTO:
+    if e.equalities_missed:
         # rows the equality-constrained start could not meet (inconsistent, or
         # numerically dependent) go to the full form: its regularized solves give
         # least-squares iterates, on which the equality certificate is tested
-        # (a random test: the reduced form ran 4000 iterations uncertified)
-        first = (SCHUR_REDUCED if _reduced_pays(e, solves) and not e.equalities_missed
-                 else LDL_FULL)
+        # (a random test: the reduced form ran 4000 iterations uncertified); a forced
+        # reduced form too: its S is then nearly singular, and its final A x = b
+        # correction moves x along the rows' near-dependence
+        first = LDL_FULL
+    elif first == AUTO:
+        first = SCHUR_REDUCED if _reduced_pays(e, solves) else LDL_FULL
     for backend in range(first, LDL_FULL + 1):
         if not e.fact.certified and backend != SCHUR_REDUCED:
             # certify first: the certificate overwrites an LDL' factorization

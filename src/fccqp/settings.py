@@ -200,7 +200,10 @@ class Settings:
     sparse path: ``scipy.sparse`` data and a sparse LDL' from ``qdldl``, one KKT solve
     per iteration, :mod:`fccqp.kkt_sparse`) or ``"auto"`` (the first of the dense ones
     that applies and pays; see docs/algorithm.md). A forced dense backend that cannot
-    factor the matrix falls back to the next one in that order; a problem whose KKT
+    factor the matrix falls back to the next one in that order, and a reduced one takes
+    ``"ldl_full"`` when the cold start cannot meet ``A x = b`` (numerically dependent or
+    inconsistent rows, on which the reduced form's ``A (P + R)^-1 A'`` is nearly
+    singular and its final ``A x = b`` correction moves ``x``); a problem whose KKT
     matrix has more than :data:`MAX_DENSE_KKT_ROWS` rows takes the sparse path whatever
     this says. ``Result.backend`` says which ran."""
     warm_start: bool = True
