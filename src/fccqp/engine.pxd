@@ -7,6 +7,8 @@ one :c:type:`Engine`; the compiled steps (``scaled_run``, ``iteration``, ``facto
 hold pointers into the workspace's numpy arrays.
 """
 
+from libc.math cimport isfinite
+
 from fccqp._types cimport Iterates, Problem
 from fccqp.anderson cimport Anderson
 from fccqp.kkt cimport KKT
@@ -182,6 +184,15 @@ cdef struct Engine:
 cdef inline void measure(Engine* e) noexcept nogil:
     """The residuals of the scaled iterate (:func:`fccqp.termination.residuals`)."""
     residuals(&e.prob, &e.it, e.work.vec_m, e.work.vec_n, e.work.vec_n2, &e.res)
+
+
+cdef inline double cold_start_rho(const Engine* e) noexcept nogil:
+    """The rho of a cold start: under a time limit the one the last solve adapted (as
+    OSQP keeps its rho between solves: fewer iterations and factorizations on
+    talos_reduced's cold starts), else ``settings.rho`` (without a time limit keeping it
+    helped solo12 but cost talos_reduced and anymal_c iterations; notes/tuning.md, "The
+    rho of a cold start")."""
+    return e.prev.rho if e.prev.has_rho and isfinite(e.opt.time_limit) else e.opt.rho
 
 
 cdef inline void end_run(Engine* e, Run* run, int status, long iteration) noexcept nogil:

@@ -32,7 +32,8 @@ from fccqp.acceptance cimport keep_polished, keep_restored, restore_equalities, 
 from fccqp.anderson cimport anderson_reset, anderson_step
 from fccqp.engine cimport (DUAL_INFEASIBLE, INACCURATE, MAX_ITER, NOT_CONVEX_QP,
                            NUMERICAL_ERROR, PRIMAL_INFEASIBLE, RUNNING, SOLVED, TIME_LIMIT,
-                           Engine, Options, Run, end_run, fccqp_now, measure)
+                           Engine, Options, Run, cold_start_rho, end_run, fccqp_now,
+                           measure)
 from fccqp.equalities cimport hold_equalities
 from fccqp.factorization cimport budget, change_rho, equality_start, factor, reduced_base
 from fccqp.kkt cimport FACTORED, NOT_CONVEX, is_reduced, kkt_solve
@@ -300,7 +301,6 @@ cdef inline bint _factor_or_polish(Engine* e, Loop* L, Run* run) noexcept nogil:
     return True
 
 
-
 cdef bint _nearer_start(Engine* e, Loop* L, Run* run) noexcept nogil:
     """After a caller's guess failed its warm polish, ADMM starts from the guess or from
     the cold start (the equality-constrained QP, at a cold start's rho), whichever is
@@ -315,7 +315,7 @@ cdef bint _nearer_start(Engine* e, Loop* L, Run* run) noexcept nogil:
     measure(e)
     guess_distance = distance(&e.res, e.opt.eps_abs, e.opt.eps_rel)
     L.cold = True
-    run.rho = e.prev.rho if e.prev.has_rho and L.timed else e.opt.rho   # scaled_run's rule
+    run.rho = cold_start_rho(e)
     if not _start(e, L, run):
         return False
     if distance(&e.res, e.opt.eps_abs, e.opt.eps_rel) > guess_distance:

@@ -4,12 +4,11 @@ start, iterate (:mod:`fccqp.iteration`); then unscale the answer into the user's
 settle its status on its own residuals and keep it for the next warm start.
 """
 
-from libc.math cimport isfinite
-
 from fccqp._dense cimport copy, fill
 from fccqp._types cimport Problem
 from fccqp.acceptance cimport judge_rounding, user_residuals
-from fccqp.engine cimport DUAL_INFEASIBLE, PRIMAL_INFEASIBLE, Engine, Run, fccqp_now
+from fccqp.engine cimport (DUAL_INFEASIBLE, PRIMAL_INFEASIBLE, Engine, Run, cold_start_rho,
+                           fccqp_now)
 from fccqp.iteration cimport iterate
 from fccqp.matrices cimport DENSE
 from fccqp.projections cimport proj_set
@@ -34,12 +33,7 @@ cdef Run scaled_run(Engine* e, bint same_matrices, const double* x0, bint warm,
     _scale(e, reuse, warm)
     e.clock.marks[2] = fccqp_now()
     e.log.count = 0
-    # under a time limit a cold start too keeps the rho the last solve adapted (as
-    # OSQP keeps its rho between solves): fewer iterations and factorizations on
-    # talos_reduced's cold starts; without one it helped solo12 but cost talos_reduced
-    # and anymal_c iterations (notes/tuning.md, "The rho of a cold start")
-    run.rho = (e.prev.rho if warm or (e.prev.has_rho and isfinite(e.opt.time_limit))
-               else e.opt.rho)
+    run.rho = e.prev.rho if warm else cold_start_rho(e)
     if x0 != NULL:
         _start_from_guess(e, x0)
     elif warm:
