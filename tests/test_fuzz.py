@@ -78,7 +78,11 @@ regularization of the sparse KKT matrix); ``extreme_data:2900221`` (``P`` of 1.4
 beside entries it does not touch, a dependent row in ``A``; 4 s of CPU: four runs) the
 stall that the unscaled retry answers only with KKT solves that cut ``delta`` below the
 equalities' curvature and a polish that pivots where ``delta`` lies below the rounding of
-``P``. Every case of :data:`SEEDS` on the sparse path took 100 s of CPU at
+``P``; ``extreme_data:4100295`` (``P`` of 1.5e11 and a zero column beside five
+inconsistent rows of rank four; 2 s of CPU) the certificate that, as on the dense
+backends, only the unscaled retry's start finds, on least-squares points that ``qdldl``
+without pivoting could not give (SuperLU's pivoted factorization does). Every case of
+:data:`SEEDS` on the sparse path took 100 s of CPU at
 b11793f (the whole module, four dense backends and these: 25 s of wall time at load
 8), with 5 failures: 4 stalls at MAX_ITER_REACHED that the dense backends' retries
 answer (extreme_data 100213, 1500043, 1700359, cvxpy 1), and ``extreme_data:900343``,
@@ -86,16 +90,11 @@ kept here: SOLVED at the start on an infeasible problem (a friction cone pinned 
 itself by 1e-3, variables rescaled 1e-8..1e8) while ``POLISH_CSC_DELTA`` was 1e-9,
 certified since."""
 
-OPEN: dict[str, str] = {
-    "extreme_data:4100295": (
-        "P of 1.5e11 beside five rows of rank four, inconsistent: the dense backends certify "
-        "it PRIMAL_INFEASIBLE after their auxiliary tries (12000-16000 iterations), the "
-        "sparse path ends MAX_ITER_REACHED at a point 0.012 off A x = b"),
-}
+OPEN: dict[str, str] = {}
 """Reproducers of mechanisms still open (issues 26 and 28), each the reason it fails:
 expected to fail (strictly) on the backends of :data:`OPEN_BACKENDS`, so that a fix
 turns them red."""
-OPEN_BACKENDS: dict[str, tuple[str, ...]] = {"extreme_data:4100295": ("sparse",)}
+OPEN_BACKENDS: dict[str, tuple[str, ...]] = {}
 """Where an open case fails."""
 
 ROUNDING_DEPENDENT: dict[str, tuple[tuple[str, ...], str]] = {}

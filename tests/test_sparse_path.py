@@ -89,6 +89,44 @@ def test_the_kkt_solve_meets_equalities_whose_curvature_lies_below_delta():
     assert kkt.delta < 1e-2 * DELTA
 
 
+def _inconsistent_beside_huge_p():
+    """``P`` of 1e11 on three entries and 0 on the first, which only ``sigma`` weighs,
+    beside three rows of rank two whose right-hand sides miss each other by 0.01."""
+    P = np.diag([0.0, 1e11, 1e11, 1e11])
+    rows = np.array([[1.0, 1.0, -1.0, 2.0], [-1.0, 2.0, 1.0, -1.0]])
+    A = np.vstack([rows, rows[0] + rows[1]])
+    return P, A, np.array([1.0, 2.0, 3.01])
+
+
+def test_the_kkt_solve_leaves_the_least_squares_residual_beside_an_entry_only_sigma_weighs():
+    """Eliminated first in qdldl's order, the entry that only ``sigma`` (1e-6) weighs adds
+    ``a a' / sigma`` (1e6) to the rows' block, whose rounding buries their curvature
+    (6e-11) and ``delta``: the factorization solved neither its own matrix nor the
+    system (residuals of 2.6 off the least-squares ones). The solve pivots and returns
+    the least-squares residual, up to the bias of ``delta``."""
+    from fccqp.sparse_kkt import SparseKKT
+
+    P, A, b = _inconsistent_beside_huge_p()
+    kkt = SparseKKT(sp.csc_matrix(P), sp.csc_matrix(A), np.zeros(0, dtype=np.intp),
+                    np.ones(3))
+    kkt.factor(1e-6, np.zeros(0))
+    x = kkt.solve(np.concatenate([np.zeros(4), b]))[:4]
+    least_squares = b - A @ np.linalg.lstsq(A, b, rcond=None)[0]
+    np.testing.assert_allclose(b - A @ x, least_squares, atol=1e-2)
+
+
+def test_inconsistent_rows_beside_an_entry_only_sigma_weighs_are_certified_at_the_start():
+    """The same rows beside a boxed entry: the cold start's least-squares point carries
+    the equality certificate, as on the dense path (0 iterations), where the sparse path
+    needed its auxiliary tries (12063 iterations)."""
+    P, A, b = _inconsistent_beside_huge_p()
+    q = np.array([1.0, -1.0, 0.5, 0.2])
+    lb, ub = np.full(4, -np.inf), np.array([3.0, np.inf, np.inf, np.inf])
+    result = fccqp.solve(sp.csc_matrix(P), q, sp.csc_matrix(A), b, lb, ub, **SPARSE)
+    assert result.status is Status.PRIMAL_INFEASIBLE and result.iterations == 0
+    verify_solution((P, q, A, b, lb, ub, []), result)
+
+
 def test_the_polish_pivots_where_delta_lies_below_the_rounding_of_p():
     """Unscaled, ``P`` of 1.4e14 on 15 of 19 entries and zero on the others, a dependent
     row in ``A`` (the fuzzer's "P huge" class): the polished QP's matrix spans 1e10

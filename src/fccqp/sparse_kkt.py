@@ -17,7 +17,9 @@ holds it back: the matrix is factored again, once, with a smaller ``delta`` read
 the contraction (:meth:`SparseKKT._cut_regularization`), and the refinement goes on;
 when a step stops halving the error otherwise, ``A x = b`` has no solution and the
 regularized (least-squares) solution is returned, refined against the factored matrix
-itself, which the equality certificate reads.
+itself, which the equality certificate reads. A factorization that does not solve even
+that matrix (its order put a pivot lost to rounding first) is replaced, until the next
+factorization, by SuperLU's with partial pivoting (:meth:`SparseKKT._pivot`).
 
 ``delta`` is larger than the dense backend's ``1e-13``: without pivoting, a row of
 ``A`` eliminated before its variables has the pivot ``-delta`` and adds ``A_i'A_i /
@@ -45,7 +47,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from fccqp.tuning import GRAM_REGULARIZATION
+from fccqp.tuning import GRAM_REGULARIZATION, KKT_DELTA
 
 DELTA = 1e-9
 """Quasi-definite regularization of the (2, 2) block (scaled problem)."""
@@ -74,6 +76,9 @@ STATIONARITY_TOLERANCE = 1e-10
 :meth:`SparseKKT._stationary`)."""
 REGULARIZED_STEPS = 2
 """Refinement steps against the factored matrix when ``A x = b`` has no solution."""
+FACTORED_TOLERANCE = 1e-8
+"""A factorization whose refined solve misses the regularized matrix by more than this
+times the terms of a row is taken for inaccurate (:meth:`SparseKKT._pivot`)."""
 
 
 class FactorizationError(Exception):
@@ -132,7 +137,10 @@ class SparseKKT:
         self._K = K
         coo = K.tocoo()
         self._diagonal = np.flatnonzero(coo.row == coo.col)   # column order
-        self._solver = None
+        self._solver = None   # the factorization that solves: self._ldl or a pivoted one
+        self._ldl = None   # qdldl's, updated in place by each factor
+        self._pivoted = False   # whether this factorization is SuperLU's (_pivot)
+        self._unchecked = True   # whether _least_squares has yet to check the solver
         self.abs_A = abs(A)
         self.abs_P = abs(P)
         self.penalty = np.zeros(n)   # sigma + rho on each entry of x, set by factor
@@ -166,18 +174,20 @@ class SparseKKT:
         diagonal[self.constrained] += rho_vec
         self.abs_A = abs(self.A)
         self.abs_P = abs(self.P)
-        self._cut_spent = False
+        self._cut_spent = self._pivoted = False
+        self._unchecked = True
         deltas = self._deltas()
         for self.delta in deltas:
             diagonal[n:] = -self.delta
             K.data[self._diagonal] = diagonal
             try:
-                self._solver, negative = self._quasi_definite(K, self._solver)
+                self._ldl, negative = self._quasi_definite(K, self._ldl)
                 break
             except FactorizationError:
-                self._solver = None
+                self._solver = self._ldl = None
                 if self.delta == deltas[-1]:
                     raise
+        self._solver = self._ldl
         self.penalty = np.full(n, sigma)
         self.penalty[self.constrained] += rho_vec
         return negative
@@ -232,18 +242,16 @@ class SparseKKT:
         singular values of 1e-5 in ``A``, ``c`` about 1e-11) the correction contracts by
         ``rate = delta / (c + delta)``, close to 1, and the equality error stays at the
         size of its terms; that is no proof that ``A x = b`` has no solution."""
-        if self._cut_spent:
+        if self._cut_spent or self._pivoted:
             return None
         self._cut_spent = True
         delta = DELTA_CUT * self.delta * (1.0 - rate) / rate
-        K = self._K.copy()
-        K.data[self._diagonal[self.n:]] = -delta
         try:
-            solver, _ = self._quasi_definite(K, None)
+            solver, _ = self._quasi_definite(self._regularized(delta), None)
         except FactorizationError:
             return None
         previous = (self._solver, self.delta)
-        self._solver, self.delta = solver, delta
+        self._solver, self.delta, self._unchecked = solver, delta, True
         return previous
 
     def _residual(self, rhs: np.ndarray, sol: np.ndarray, Ax: np.ndarray,
@@ -301,11 +309,77 @@ class SparseKKT:
     def _least_squares(self, rhs: np.ndarray, sol: np.ndarray) -> np.ndarray:
         """``sol`` refined against the regularized matrix, whose least-squares ``x`` the
         equality certificate reads: where refinement against the unregularized one stops
-        making progress, ``A x = b`` has no solution."""
+        making progress, ``A x = b`` has no solution. Unless the factorization does not
+        solve the regularized matrix itself (:meth:`_solves_regularized`, checked once
+        per factorization): then the solve starts again on SuperLU's factorization of it
+        (:meth:`_pivot`)."""
         for _ in range(REGULARIZED_STEPS):
             sol = sol + self._solver.solve(
                 self._residual(rhs, sol, self.A @ sol[:self.n], self.delta))
+        if self._unchecked:
+            self._unchecked = False
+            if not self._solves_regularized(rhs, sol) and self._pivot():
+                return self.solve(rhs)
         return sol
+
+    def _solves_regularized(self, rhs: np.ndarray, sol: np.ndarray) -> bool:
+        """Whether ``sol`` solves the factored (regularized) matrix to
+        ``FACTORED_TOLERANCE`` of the terms of each row."""
+        n = self.n
+        x, nu = sol[:n], sol[n:]
+        residual = self._residual(rhs, sol, self.A @ x, self.delta)
+        terms = np.abs(rhs) + np.concatenate([
+            self.abs_P @ np.abs(x) + self.penalty * np.abs(x) + self.abs_A.T @ np.abs(nu),
+            self.abs_A @ np.abs(x) + self.delta * np.abs(nu)])
+        return bool(np.all(np.abs(residual) <= FACTORED_TOLERANCE * np.maximum(terms, 1.0)))
+
+    def _pivot(self) -> bool:
+        """Solve with SuperLU's factorization of the regularized matrix (partial
+        pivoting) until the next :meth:`factor`; False (nothing changed) when it meets
+        a zero pivot.
+
+        Without pivoting, ``qdldl`` eliminates in its fill-reducing order whatever the
+        pivots' sizes: an entry of ``x`` that only ``sigma`` weighs (1e-6; a zero
+        column of ``P``, no penalty at the cold start), eliminated before the rows it
+        meets, adds ``a a' / sigma`` (1e6) to their block, whose rounding (2e-10)
+        buries both ``delta`` and the curvature of the other columns (1e-10, where
+        ``P`` is huge and the equilibration scales its columns down): the factorization
+        then solves neither the regularized matrix nor, refined, the system (residuals
+        of the size of ``b``), and the point it leaves for inconsistent rows is not
+        their least-squares one. Partial pivoting eliminates that entry with a row.
+
+        Pivoted, the factorization's rounding no longer grows like ``1 / delta`` (see
+        the module docstring), and it takes the dense backend's ``KKT_DELTA``: at
+        ``DELTA`` the regularized point of rows whose curvature lies below it (2e-11
+        unscaled beside ``P`` of 1e11) stays far from the least-squares one, and
+        the equality certificate's cleaning step (:func:`fccqp.verdict.inconsistent`),
+        which shrinks what is not in the null space of ``A'`` by ``delta / (c +
+        delta)``, removes nothing; nor is ``delta`` cut (:meth:`_cut_regularization`)."""
+        delta = min(self.delta, KKT_DELTA)
+        try:
+            solver = self._pivoting(delta)
+        except FactorizationError:
+            return False
+        self._solver, self.delta, self._pivoted = solver, delta, True
+        return True
+
+    def _regularized(self, delta: float) -> sp.csc_matrix:
+        """The factored matrix's upper triangle with ``-delta I`` as its (2, 2) block (a
+        copy)."""
+        K = self._K.copy()
+        K.data[self._diagonal[self.n:]] = -delta
+        return K
+
+    def _pivoting(self, delta: float) -> object:
+        """SuperLU's factorization (partial pivoting) of the whole symmetric matrix with
+        ``-delta I`` as its (2, 2) block; :class:`FactorizationError` at a zero pivot."""
+        from scipy.sparse.linalg import splu
+
+        upper = self._regularized(delta)
+        try:
+            return splu((upper + sp.triu(upper, 1).T).tocsc())
+        except RuntimeError as exn:   # SuperLU's report of an exactly singular factor
+            raise FactorizationError(str(exn)) from exn
 
     def factor_gram(self) -> bool:
         """Factor ``A A'`` of the current scaled ``A`` plus ``GRAM_REGULARIZATION`` of its
