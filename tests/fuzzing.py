@@ -96,11 +96,14 @@ class Reuse:
     """Successive solves of one :class:`fccqp.Solver`, each judged like a fresh solve of
     the same data (the fresh solve decides whether an error is due). With ``in_place``
     every step is copied into the first step's arrays, which are passed again (the
-    control loop's refill); otherwise each step passes new arrays."""
+    control loop's refill); otherwise each step passes new arrays. ``truths`` holds the
+    status the construction proves for each step (``None``: not known; empty: none
+    known), as :attr:`Native.truth` does."""
 
     steps: tuple[Problem, ...]
     in_place: bool
     what: str
+    truths: tuple[str | None, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -749,6 +752,7 @@ def solver_reuse(rng: np.random.Generator) -> Reuse:
     P = psd(rng, n)
     A = rows(rng, _random_m(rng), n)
     first = _kkt_problem(rng, layout, P, A)
+    truths: tuple[str | None, ...] = ()
     if kind == "nonconvex":
         P2 = P.copy()
         P2[0, :] = P2[:, 0] = 0.0
@@ -759,15 +763,19 @@ def solver_reuse(rng: np.random.Generator) -> Reuse:
     elif kind == "rescaled":
         steps = [first, _rescaled(rng, first, layout)]
     elif kind == "unbounded":
-        ray = dual_infeasible(rng).problem
-        steps = [_kkt_problem(rng, _layout_of(ray), ray.P, ray.A), ray]
+        ray = dual_infeasible(rng)
+        steps = [_kkt_problem(rng, _layout_of(ray.problem), ray.problem.P, ray.problem.A),
+                 ray.problem]
+        truths = (None, ray.truth)
     elif kind == "infeasible":
-        bad = primal_infeasible(rng).problem
-        steps = [_kkt_problem(rng, _layout_of(bad), bad.P, bad.A), bad]
+        bad = primal_infeasible(rng)
+        steps = [_kkt_problem(rng, _layout_of(bad.problem), bad.problem.P, bad.problem.A),
+                 bad.problem]
+        truths = (None, bad.truth)
     else:
         moved = _moved_bounds(rng, layout)
         steps = [first, _kkt_problem(rng, moved, P, A), first]
-    return Reuse(tuple(steps), bool(rng.random() < 0.5), kind)
+    return Reuse(tuple(steps), bool(rng.random() < 0.5), kind, truths)
 
 
 def _kkt_problem(rng: np.random.Generator, layout: Layout, P: np.ndarray,
@@ -1194,7 +1202,7 @@ def _judge_reuse(s: Reuse, backend: str) -> Verdict:
         if fresh is not None:
             return Verdict(f"reuse: {where}: {outcome} where a fresh solve raises "
                            f"{_error(fresh)}", outcome, reference, conflict)
-        reference, conflict = _clarabel(step, None)
+        reference, conflict = _clarabel(step, s.truths[k] if s.truths else None)
         failure = _judge_result(step, result, settings, reference)
         if failure is not None:
             kind, text = failure.split(": ", 1)
