@@ -232,8 +232,8 @@ class SparseKKT:
         """Factor the current matrix again with ``delta`` cut to ``DELTA_CUT`` times the
         curvature that a refinement contracting by ``rate`` shows, ``delta (1 - rate) /
         rate``; the previous ``(factorization, delta)``, or None (nothing changed) when
-        the cut one is not quasi-definite or a cut was already spent on this
-        factorization.
+        the cut one is not quasi-definite, a cut was already spent on this
+        factorization, or it is pivoted (:meth:`_pivot`).
 
         A refinement against a factorization regularized by ``delta`` recovers, in a
         direction where ``A (P + sigma I + R)^-1 A'`` has the curvature ``c``, ``c / (c
@@ -354,7 +354,10 @@ class SparseKKT:
         unscaled beside ``P`` of 1e11) stays far from the least-squares one, and
         the equality certificate's cleaning step (:func:`fccqp.verdict.inconsistent`),
         which shrinks what is not in the null space of ``A'`` by ``delta / (c +
-        delta)``, removes nothing; nor is ``delta`` cut (:meth:`_cut_regularization`)."""
+        delta)``, removes nothing. Nor is a pivoted ``delta`` cut
+        (:meth:`_cut_regularization`): below ``KKT_DELTA`` a contraction stalled at
+        rounding reads as curvature, and cuts to 1e-17 and below made the solves
+        diverge."""
         delta = min(self.delta, KKT_DELTA)
         try:
             solver = self._pivoting(delta)
