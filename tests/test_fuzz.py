@@ -19,13 +19,13 @@ SEEDS = {
     "feasible": (0, 1, 2, 3, 4, 5, 2900227),
     "primal_infeasible": (0, 1, 2, 3, 80, 146, 177, 182, 350, 100094, 300345),
     "dual_infeasible": (0, 1, 2, 33, 166, 257, 368),
-    "solver_reuse": (0, 1, 2, 50, 164, 211, 100008, 100206, 500061, 700137),
+    "solver_reuse": (0, 1, 2, 50, 164, 211, 100008, 100206, 500061, 700137, 4700367),
     "extreme_data": (0, 1, 7, 9, 38, 47, 56, 108, 138, 149, 202, 214, 254, 302, 308, 316,
                      311, 326, 335, 337, 355, 363, 365, 489, 1182, 2244, 100082, 100121, 100180,
                      100213,
                      100228, 100233, 500030, 500064, 500099, 500322, 700281, 900343, 900360,
                      1100037, 1100057, 1100150, 1100253, 1300030, 1300300, 1500043, 1700106,
-                     1700359, 1900050, 2500125, 2900030),
+                     1700359, 1900050, 2500125, 2900030, 4700352),
     "qpsolvers": (0, 1, 2, 1700123),
     "cvxpy": (1, 2, 3),
 }
@@ -44,8 +44,9 @@ where the dual residual crawls, which the retry from a smaller rho answers; extr
 100121 a free friction cone flatter than the polish's regularization, whose refinement
 stalled with the step mostly unmade; extreme_data 2500125 a free entry in units of 1e-8
 whose columns lay below ``MIN_NORM``, which the equilibration left unscaled: its scaled
-curvature, 2.5e-18, stalled ADMM and the polish 3e6 short of the optimum; issues 26 and
-28)."""
+curvature, 2.5e-18, stalled ADMM and the polish 3e6 short of the optimum; solver_reuse
+4700367 a ray step that Clarabel calls solved, judged against its construction; issues
+26 and 28)."""
 
 SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),
@@ -90,11 +91,18 @@ kept here: SOLVED at the start on an infeasible problem (a friction cone pinned 
 itself by 1e-3, variables rescaled 1e-8..1e8) while ``POLISH_CSC_DELTA`` was 1e-9,
 certified since."""
 
-OPEN: dict[str, str] = {}
+OPEN: dict[str, str] = {
+    "extreme_data:4700352": (
+        "columns of 1e-10 to 1e6 beside P of 7.5e13, an optimum by construction: "
+        "PRIMAL_INFEASIBLE on every backend, whose certificate's residual A'dy + dz, "
+        "small against its largest terms, explains its separation at a feasible point "
+        "though not at the run's iterate"),
+}
 """Reproducers of mechanisms still open (issues 26 and 28), each the reason it fails:
 expected to fail (strictly) on the backends of :data:`OPEN_BACKENDS`, so that a fix
 turns them red."""
-OPEN_BACKENDS: dict[str, tuple[str, ...]] = {}
+OPEN_BACKENDS: dict[str, tuple[str, ...]] = {
+    "extreme_data:4700352": ("auto", "schur_reduced", "ldl_reduced", "ldl_full")}
 """Where an open case fails."""
 
 ROUNDING_DEPENDENT: dict[str, tuple[tuple[str, ...], str]] = {}
