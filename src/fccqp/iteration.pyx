@@ -44,9 +44,9 @@ from fccqp.reduced cimport materialize, near_convergence, reduced_start, reduced
 from fccqp.rho_rule cimport TrialState, new_rho, trial_reset
 from fccqp.termination cimport Residuals, converged, distance, nearly_converged
 from fccqp.tuning cimport (AUXILIARY_TIME, CLEANING_START, CONVERGING, EARLY_POLISH_GATE,
-                           EARLY_POLISH_TRIES, EQUALITY_MISSED, GATED_CHECK_WAIT, LOG_INTERVAL,
-                           POLISH_GATE, POLISH_RETRIES, RESERVE_PASSES, RESTART_MIN_ITER,
-                           STALL_FACTOR, STALLS, TIMED_EARLY_POLISH)
+                           EARLY_POLISH_TRIES, EQUALITY_MISSED, GATED_CHECK_WAIT, GUESS_LEAD,
+                           LOG_INTERVAL, POLISH_GATE, POLISH_RETRIES, RESERVE_PASSES,
+                           RESTART_MIN_ITER, STALL_FACTOR, STALLS, TIMED_EARLY_POLISH)
 from fccqp.verdict cimport check, classify, inconsistent, missed, missed_by_data, unbounded
 
 
@@ -302,13 +302,16 @@ cdef inline bint _factor_or_polish(Engine* e, Loop* L, Run* run) noexcept nogil:
 
 
 cdef bint _nearer_start(Engine* e, Loop* L, Run* run) noexcept nogil:
-    """After a caller's guess failed its warm polish, ADMM starts from the guess or from
-    the cold start (the equality-constrained QP, at a cold start's rho), whichever is
-    nearer the termination test (:func:`fccqp.termination.distance`); the guess is
-    scaled in again and factored for its rho when it wins. A carried guess across a
-    contact change is either a few iterations from the answer or far slower than the
-    cold start, and neither start wins everywhere (notes/performance-history.md,
-    "contactfall"). False when the run ended here."""
+    """After a caller's guess failed its warm polish, ADMM starts from the cold start
+    (the equality-constrained QP, at a cold start's rho) unless the guess is
+    ``GUESS_LEAD`` times nearer the termination test
+    (:func:`fccqp.termination.distance`); the guess is scaled in again and factored for
+    its rho when it wins. A carried guess across a contact change is either a few
+    iterations from the answer or far slower than the cold start, and neither start
+    wins everywhere. Its distance understates its cost: it is mostly the dual residual
+    and gap of multipliers carried from another problem, which ADMM corrects slowly,
+    while the cold start's is its primal residual alone, with multipliers at zero (notes/performance-history.md, "contactfall",
+    "contactstart"). False when the run ended here."""
     cdef Problem* p = &e.prob
     cdef double guess_rho = run.rho, guess_distance
     e.prev.from_polished = False   # not polished again below
@@ -318,7 +321,7 @@ cdef bint _nearer_start(Engine* e, Loop* L, Run* run) noexcept nogil:
     run.rho = cold_start_rho(e)
     if not _start(e, L, run):
         return False
-    if distance(&e.res, e.opt.eps_abs, e.opt.eps_rel) > guess_distance:
+    if distance(&e.res, e.opt.eps_abs, e.opt.eps_rel) > GUESS_LEAD * guess_distance:
         L.cold = False
         run.rho = guess_rho
         scale_start(e.prev.x, e.prev.y, e.prev.z, e.prev.rho, p.D, p.E, p.c, p.n, p.m,

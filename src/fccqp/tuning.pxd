@@ -59,6 +59,9 @@ cdef extern from *:
     /* a failed warm start restarts cold for the rest, and a run still converging at its
        cap is continued (fccqp.solver._resumed), only when max_iter is at least this */
     #define FCCQP_RESTART_MIN_ITER 200
+    /* a caller's guess whose warm polish failed starts ADMM only if the cold start is this
+       x farther from the tolerances: its stale multipliers cost more than they measure */
+    #define FCCQP_GUESS_LEAD 4.0
 
     /* ---- Rho adaptation (fccqp.rho_rule, fccqp.admm) ---- */
     /* range of the adaptive rho */
@@ -216,6 +219,7 @@ cdef extern from *:
     const double EQUALITY_START_LIMIT "FCCQP_EQUALITY_START_LIMIT"
     const double EQUALITY_MISSED "FCCQP_EQUALITY_MISSED"
     const long RESTART_MIN_ITER "FCCQP_RESTART_MIN_ITER"
+    const double GUESS_LEAD "FCCQP_GUESS_LEAD"
     # Rho adaptation
     const double RHO_MIN "FCCQP_RHO_MIN"
     const double RHO_MAX "FCCQP_RHO_MAX"
