@@ -248,8 +248,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--cache", type=Path, default=ROOT / "benchmarks" / ".cache")
     parser.add_argument("--save", type=Path)
     args = parser.parse_args(argv)
-    import fccqp
     from threadpoolctl import threadpool_limits
+
+    import fccqp
 
     threadpool_limits(1)
     print(f"fccqp: {Path(fccqp.__file__).parent}")
