@@ -47,11 +47,14 @@ def main() -> None:
         xc, yr = d["x_ref"][e.kept].copy(), np.zeros(e.rest.size)
         assert run(work.presolve, P, q, A, b) == 0
         assert run(work.recover, P, q, A, b, xc, yr, x, y) == 0
-        scale = 1 + np.abs(e.P).max()
-        print(f"QP {i}: n' {e.kept.size}, m' {e.rest.size}; P' {np.abs(work.Pr - e.P).max() / scale:.1e}, "
-              f"q'' {np.abs(work.qr - e.q).max() / (1 + np.abs(e.q).max()):.1e}, "
-              f"A' {np.abs(work.Ar - e.A).max(initial=0) / (1 + np.abs(e.A).max(initial=0)):.1e}, "
-              f"x {np.abs(x - d['x_ref']).max() / (1 + np.abs(d['x_ref']).max()):.1e}")
+        print(f"QP {i}: n' {e.kept.size}, m' {e.rest.size}; relative differences P' "
+              f"{gap(work.Pr, e.P):.1e}, q'' {gap(work.qr, e.q):.1e}, A' {gap(work.Ar, e.A):.1e}"
+              f", x {gap(x, d['x_ref']):.1e}")
+
+
+def gap(a: np.ndarray, b: np.ndarray) -> float:
+    """``max |a - b| / (1 + max |b|)``."""
+    return float(np.abs(a - b).max(initial=0) / (1 + np.abs(b).max(initial=0)))
 
 
 if __name__ == "__main__":
