@@ -187,9 +187,11 @@ def pass_indices(sequence: np.ndarray, mode: str, stride: int) -> np.ndarray:
     return np.arange(sequence.size)
 
 
-def run(fccqp, qps, sequence, preset: str, mode: str, kind: str, stride: int) -> dict:
+def run(fccqp, qps, sequence, preset: str, mode: str, kind: str, stride: int,
+        overrides: dict) -> dict:
     """One pass; per QP iterations, status, polished, torque error, KKT residuals."""
     settings = (fccqp.Settings.realtime(100.0) if preset == "realtime" else fccqp.Settings())
+    settings = settings.replace(**overrides) if overrides else settings
     solver = fccqp.Solver(settings)
     rows, previous = [], None
     for i in pass_indices(sequence, mode, stride):
@@ -246,8 +248,12 @@ def main(argv: list[str] | None = None) -> None:
                         "slack entries and their rows kept")
     parser.add_argument("--stride", type=int, default=10)
     parser.add_argument("--cache", type=Path, default=ROOT / "benchmarks" / ".cache")
+    parser.add_argument("--set", nargs="+", default=[], metavar="KEY=VALUE",
+                        help="settings overrides (numbers), e.g. scaling=0")
     parser.add_argument("--save", type=Path)
     args = parser.parse_args(argv)
+    overrides = {k: value(v)
+                 for k, v in (item.split("=") for item in args.set)}
     from threadpoolctl import threadpool_limits
 
     import fccqp
@@ -268,7 +274,8 @@ def main(argv: list[str] | None = None) -> None:
         for preset in args.presets:
             for mode in args.modes:
                 for kind in args.kinds:
-                    s = run(fccqp, qps, sequence, preset, mode, kind, args.stride)
+                    s = run(fccqp, qps, sequence, preset, mode, kind, args.stride,
+                            overrides)
                     out[f"{robot}-{preset}-{mode}-{kind}"] = s
                     print(f"| {robot} | {preset} | {mode} | {kind} | {s['qps']} | "
                           f"{s['iterations']} ({s['it_median']:g} / {s['it_p95']:g}) | "
@@ -277,6 +284,13 @@ def main(argv: list[str] | None = None) -> None:
                           f"{s['eq_res_max']:.1e} | {s['dual_res_max']:.1e} |", flush=True)
     if args.save:
         args.save.write_text(json.dumps(out, indent=1))
+
+
+def value(text: str) -> object:
+    """A setting's value from the command line: a bool, an int or a float."""
+    if text in ("True", "False"):
+        return text == "True"
+    return float(text) if any(c in text for c in ".e") else int(text)
 
 
 if __name__ == "__main__":
