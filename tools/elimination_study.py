@@ -287,10 +287,15 @@ def main(argv: list[str] | None = None) -> None:
 
 
 def value(text: str) -> object:
-    """A setting's value from the command line: a bool, an int or a float."""
+    """A setting's value from the command line: a bool, an int, a float or a string."""
     if text in ("True", "False"):
         return text == "True"
-    return float(text) if any(c in text for c in ".e") else int(text)
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text
 
 
 if __name__ == "__main__":
