@@ -7,7 +7,8 @@ gathers of the blocks from the full ``P`` and ``A`` by index, on preallocated ar
 
     presolve: gather K = A[rows, free], A_c = A[rows, kept], P_ff, P_fc, P_cc, the rest
               rows' A[rest, free], A[rest, kept]; dgetrf(K); dgetrs: [W | w] = K^-1 [A_c | b_rows];
-              T = P_ff [W | w] (dgemm); P' = P_cc + W' T_W - P_fc' W - W' P_fc (dgemm, dgemm);
+              T = P_ff [W | w] (dgemm); P' = P_cc + W' T_W - P_fc' W - W' P_fc (dgemm, dgemm;
+              both skipped when the gather found ``P_fc = 0``, as on the benchmark's QPs);
               q'' = q_c - W'(T_w + q_f) + P_fc' w; A' = A[rest, kept] - A[rest, free] W;
               b' = b_rest - A[rest, free] w.
     recover:  x_f = w - W x_c; r = b_rows - A[rows] x; x_f += K^-1 r (one refinement);
@@ -18,12 +19,16 @@ from scipy.linalg.cython_blas cimport dgemm, dgemv
 from scipy.linalg.cython_lapack cimport dgetrf, dgetrs
 
 
-cdef void gather(const double[::1, :] M, const int[::1] r, const int[::1] c,
+cdef bint gather(const double[::1, :] M, const int[::1] r, const int[::1] c,
                  double[::1, :] out) noexcept nogil:
+    """``out = M[r, c]``; True when a gathered entry is nonzero."""
     cdef int i, j
+    cdef bint nonzero = False
     for j in range(c.shape[0]):
         for i in range(r.shape[0]):
             out[i, j] = M[r[i], c[j]]
+            nonzero = nonzero or out[i, j] != 0.0
+    return nonzero
 
 
 cdef void gemm(char ta, char tb, int m, int n, int k, double alpha, double* a, int lda,
@@ -63,13 +68,14 @@ cdef class Presolve:
         cdef int[::1] piv = self.piv
         cdef int nf = self.nf, nk = self.nk, nr = self.nr, nrhs = nk + 1, info = 0, i, j
         cdef char nt = b'N'
+        cdef bint coupled
         with nogil:
             gather(A, rows, free, K)
             gather(A, rows, kept, Ww)
             for i in range(nf):
                 Ww[i, nk] = b[rows[i]]
             gather(P, free, free, Pff)
-            gather(P, free, kept, Pfc)
+            coupled = gather(P, free, kept, Pfc)
             gather(P, kept, kept, Pcc)
             gather(A, rest, free, Arf)
             gather(A, rest, kept, Ark)
@@ -83,8 +89,11 @@ cdef class Presolve:
                 for i in range(nk):
                     Pr[i, j] = Pcc[i, j]
             gemm(b'T', b'N', nk, nk, nf, 1.0, &Ww[0, 0], nf, &T[0, 0], nf, 1.0, &Pr[0, 0], nk)
-            gemm(b'T', b'N', nk, nk, nf, -1.0, &Pfc[0, 0], nf, &Ww[0, 0], nf, 1.0, &Pr[0, 0], nk)
-            gemm(b'T', b'N', nk, nk, nf, -1.0, &Ww[0, 0], nf, &Pfc[0, 0], nf, 1.0, &Pr[0, 0], nk)
+            if coupled:
+                gemm(b'T', b'N', nk, nk, nf, -1.0, &Pfc[0, 0], nf, &Ww[0, 0], nf, 1.0,
+                     &Pr[0, 0], nk)
+                gemm(b'T', b'N', nk, nk, nf, -1.0, &Ww[0, 0], nf, &Pfc[0, 0], nf, 1.0,
+                     &Pr[0, 0], nk)
             for i in range(nf):                  # T_w + q_f, then q'' = q_c - W'(.) + P_fc' w
                 T[i, nk] = T[i, nk] + q[free[i]]
             for j in range(nk):
