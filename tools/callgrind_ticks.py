@@ -57,6 +57,11 @@ How it counts:
   fixed costs (2 ms ~ 8M instructions on these machines). ``--cut 100 --cut-polish
   60`` put the talos realtime warm ticks that the cut ends at 5-17M instructions,
   median 8.2M (notes/performance-history.md, "clock").
+- ``--eliminate all|slacks``: the QPs reduced by the equalities' free block
+  (``tools/elimination_study.py``: every free entry and row, or the slack entries and
+  their rows kept) are solved instead; the reduction and the recovery of the original
+  ``x`` happen outside the counted calls (price them apart), the saved answers are the
+  recovered ``x``, judged as below.
 - Exactness: the parent judges each answer as the benchmark does
   (``benchmarks.metrics.exact_share``): SOLVED with every joint's torque within 5 % of
   its limit of the set's reference ``x_ref`` (a tight exact-cone solve); the table's
@@ -192,6 +197,9 @@ def child(args: argparse.Namespace) -> None:
                                None if np.allclose(n, flat) else tuple(map(float, n)))
             for s, mu, n in zip(starts, mus, normals, strict=True))
         data.append((P, q, A, b, lb, ub, cones))
+    reductions = [None] * len(raw)
+    if args.eliminate:
+        data, reductions = eliminated(raw, data, args.eliminate, fccqp)
     settings = (fccqp.Settings.realtime(args.budget) if args.preset == "realtime"
                 else fccqp.Settings())
     if args.cut is not None:
@@ -217,13 +225,14 @@ def child(args: argparse.Namespace) -> None:
         gc.disable()
         try:
             previous = None
-            for item, seq in zip(data, sequence, strict=True):
+            for item, seq, e, raw_qp in zip(data, sequence, reductions, raw, strict=True):
                 if args.mode == "cold" or seq != previous:   # coarse: warm as warm
                     solver.reset()
                     previous = seq
                 result = run(solver.solve, *item)       # counted
+                x = result.x if e is None else recovered(e, raw_qp, result)
                 rows.append((result.iterations, result.status.value, bool(result.polished),
-                             result.x.tobytes(), result.setup_time + result.solve_time))
+                             x.tobytes(), result.setup_time + result.solve_time))
                 del result
         finally:
             gc.enable()
@@ -242,6 +251,28 @@ def child(args: argparse.Namespace) -> None:
     }
     Path(args.json).write_text(json.dumps(out))
     np.savez(Path(args.json).with_suffix(".npz"), *(np.frombuffer(r[3]) for r in rows))
+
+
+def eliminated(raw: list, data: list, kind: str, fccqp: object) -> tuple[list, list]:
+    """``--eliminate``: each QP's arguments reduced by ``tools/elimination_study.py``
+    (``all``: every free entry and row; ``slacks``: the slack entries and their rows
+    kept), and the reductions to recover ``x``; a QP that does not reduce stays."""
+    from elimination_study import cones_of, eliminate
+
+    out, reductions = [], []
+    for qp, item in zip(raw, data, strict=True):
+        e = eliminate(*qp[:7], keep_slacks=kind == "slacks")
+        reductions.append(e)
+        out.append(item if e is None else
+                   (e.P, e.q, e.A, e.b, e.lb, e.ub, cones_of(fccqp, e.cone_starts, *qp[7:])))
+    return out, reductions
+
+
+def recovered(e: object, qp: tuple, result: object) -> np.ndarray:
+    """The original problem's ``x`` from a reduced answer (uncounted)."""
+    from elimination_study import recover
+
+    return recover(e, *qp[:4], result.x, result.y, result.z)[0]
 
 
 # --- the parent: launches valgrind, reads its counts ---------------------------------------
@@ -276,7 +307,7 @@ def measure(robot: str, preset: str, mode: str, path: Path, qps: str,
     """One callgrind run; its counts and the child's digest."""
     label = _key({"robot": robot, "preset": preset, "mode": mode, "stride": args.stride,
                   "cut": args.cut if preset == "realtime" else None,
-                  "cut_polish": args.cut_polish})
+                  "cut_polish": args.cut_polish, "eliminate": args.eliminate})
     out = out_dir / f"{label}.callgrind"
     js = out_dir / f"{label}.json"
     cmd = [args.valgrind, "--tool=callgrind", f"--callgrind-out-file={out}",
@@ -286,6 +317,7 @@ def measure(robot: str, preset: str, mode: str, path: Path, qps: str,
            "--robot", robot, "--preset", preset, "--mode", mode,
            "--n-qps", str(args.n_qps), "--stride", str(args.stride),
            "--budget", repr(args.budget), "--json", str(js),
+           *(["--eliminate", args.eliminate] if args.eliminate else []),
            *(["--cut", str(args.cut), "--cut-polish", str(args.cut_polish)]
              if args.cut is not None else [])]
     env = dict(os.environ, PYTHONHASHSEED="0", **dict.fromkeys(THREAD_ENV, "1"))
@@ -321,6 +353,7 @@ def measure(robot: str, preset: str, mode: str, path: Path, qps: str,
                 compiled = int(line.split()[0].replace(",", ""))
                 break
     result.update(robot=robot, preset=preset, mode=mode, stride=args.stride,
+                  eliminate=args.eliminate,
                   cut=args.cut if preset == "realtime" else None, cut_polish=args.cut_polish,
                   instructions=total,
                   compiled=compiled, seconds=seconds, cpu=usage.ru_utime + usage.ru_stime,
@@ -356,7 +389,8 @@ def _key(r: dict) -> str:
     stride = r.get("stride", 10) if r["mode"] == "coarse" else ""
     cut = f"-cut{r['cut']}" if r.get("cut") is not None else ""
     polish = f"p{r['cut_polish']}" if cut and r.get("cut_polish") else ""
-    return f"{r['robot']}-{r['preset']}-{r['mode']}{stride}{cut}{polish}"
+    eliminate = f"-elim{r['eliminate']}" if r.get("eliminate") else ""
+    return f"{r['robot']}-{r['preset']}-{r['mode']}{stride}{cut}{polish}{eliminate}"
 
 
 def _total(path: Path) -> int | None:
@@ -411,6 +445,10 @@ def main(argv: list[str] | None = None) -> None:
                         "clock would (fccqp.iteration.cut_after; default no cut)")
     parser.add_argument("--cut-polish", type=int, default=0,
                         help="with --cut: this many fewer after a failed warm polish")
+    parser.add_argument("--eliminate", choices=("all", "slacks"),
+                        help="solve the QPs reduced by tools/elimination_study.py (every free "
+                        "entry, or the slack entries and their rows kept); the reduction and "
+                        "the recovery of x are not counted")
     parser.add_argument("--jobs", type=int, default=1, help="callgrind runs at a time")
     parser.add_argument("--cache", type=Path, default=ROOT / "benchmarks" / ".cache",
                         help="cached test sets (default this checkout's benchmarks/.cache)")
