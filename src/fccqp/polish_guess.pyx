@@ -113,6 +113,30 @@ cdef Py_ssize_t guess(Polish* w, const Problem* p, const double* z, const double
     return nb
 
 
+cdef inline double _box_wrong(const Polish* w, const Problem* p, Py_ssize_t j) noexcept nogil:
+    """How far box entry ``j``'s multiplier is from the normal cone its code needs (0
+    when in it), in the user's units."""
+    cdef char code = w.active[j]
+    cdef double wrong = w.y[j] if code == LOWER else (-w.y[j] if code == UPPER else 0.0)
+    return wrong / (p.c * p.D[p.constrained[j]])
+
+
+cdef inline double _block_wrong(Polish* w, const Problem* p, Py_ssize_t k,
+                                Py_ssize_t* plane) noexcept nogil:
+    """The same for cone block ``k``: a boundary block's ``-lam`` (``plane`` counts the
+    boundary blocks before it, the index of its ``lam``), an apex block's distance of
+    ``y_block`` to the polar cone, a free block's 0."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t o = c.offset[k], d = c.dim[k]
+    cdef double wrong = 0.0
+    if w.active[o] == BOUNDARY:
+        wrong = -w.lam[plane[0]]
+        plane[0] += 1
+    elif w.active[o] == APEX:
+        wrong = cone_polar_distance(w.y + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
+    return wrong / (p.c * p.D[p.constrained[o]])
+
+
 cdef Py_ssize_t most_wrong(Polish* w, const Problem* p) noexcept nogil:
     """The held entry (its index ``j < s``) or held block (``s`` plus its cone's index)
     whose multiplier is farthest, in the user's units, from the normal cone its code
@@ -120,31 +144,34 @@ cdef Py_ssize_t most_wrong(Polish* w, const Problem* p) noexcept nogil:
     boundary block's ``-lam``, an apex block's distance of ``y_block`` to the polar cone
     (``||P_K(y_block)||``), each divided by ``c D_i`` as :func:`fccqp.scaling.unscale`
     does: what :func:`multiplier_violation` measures on the polished point."""
-    cdef const Cones* c = &p.cones
-    cdef Py_ssize_t j, k, o, d, old = 0, most = -1
+    cdef Py_ssize_t j, k, plane = 0, most = -1
     cdef double worst = 0.0, wrong
-    cdef char code
     for j in range(p.s):
         if p.in_cone[j]:
             continue
-        code = w.active[j]
-        wrong = w.y[j] if code == LOWER else (-w.y[j] if code == UPPER else 0.0)
-        wrong /= p.c * p.D[p.constrained[j]]
+        wrong = _box_wrong(w, p, j)
         if wrong > worst:
             worst, most = wrong, j
-    for k in range(c.count):
-        o, d = c.offset[k], c.dim[k]
-        wrong = 0.0
-        if w.active[o] == BOUNDARY:
-            wrong = -w.lam[old]
-            old += 1
-        elif w.active[o] == APEX:
-            wrong = cone_polar_distance(w.y + o, c.kind[k], d, c.mu[k], c.normal + 3 * k,
-                                        w.step)
-        wrong /= p.c * p.D[p.constrained[o]]
+    for k in range(p.cones.count):
+        wrong = _block_wrong(w, p, k, &plane)
         if wrong > worst:
             worst, most = wrong, p.s + k
     return most
+
+
+cdef Py_ssize_t wrong_signed(Polish* w, const Problem* p) noexcept nogil:
+    """How many held box entries and boundary blocks have a multiplier outside the normal
+    cone their code needs (of those :func:`most_wrong` chooses from, one a pass). Apex
+    blocks are not counted: counted too, the polish's give-up (``polish._hopeless``)
+    dropped a warm polish of talos that settled (notes/polish.md, "coarse")."""
+    cdef Py_ssize_t j, k, plane = 0, count = 0
+    for j in range(p.s):
+        if not p.in_cone[j] and _box_wrong(w, p, j) > 0.0:
+            count += 1
+    for k in range(p.cones.count):
+        if w.active[p.cones.offset[k]] != APEX and _block_wrong(w, p, k, &plane) > 0.0:
+            count += 1
+    return count
 
 
 cdef double step_length(Polish* w, const Problem* p, Py_ssize_t* blocking) noexcept nogil:
