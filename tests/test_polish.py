@@ -461,3 +461,12 @@ def test_warm_polish_places_a_block_a_zero_length_step_held_where_the_step_point
     polish's guesses, and the tick ran 17 ADMM iterations. Held from where the step
     pointed, the warm polish answers it."""
     assert _warm_ticks("go2", 200, 215)[-1].iterations == 0
+
+
+def test_warm_polish_may_take_more_guesses_than_a_cold_one():
+    """go2's second benchmark sequence, tick 107: the warm polish's guess settled at its
+    fourth pass, Newton's planes then moved a free constraint out of its set and the
+    corrections began again; at ``GUESS_PASSES`` guesses it had not settled, and the tick
+    ran 36 ADMM iterations. A warm polish may solve ``WARM_GUESS_PASSES`` guesses: it
+    answers the tick."""
+    assert _warm_ticks("go2", 100, 107)[-1].iterations == 0

@@ -1,9 +1,10 @@
 """Instructions per control tick of fccqp's solves, counted by callgrind.
 
 What: the instructions (callgrind's ``Ir``) that ``fccqp.Solver.solve`` executes per QP
-on the benchmark's whole-body-control QPs of go2 and talos_reduced, for the realtime and
-default presets, warm along the benchmark's sequences and cold; with a digest of the
-answers (iterations, statuses, polished flags, bit-exact ``x``).
+on the benchmark's whole-body-control QPs of go2 and talos_reduced (``--all``; solo12
+and anymal_c with ``--robot``), for the realtime and default presets, warm along the
+benchmark's sequences and cold; with a digest of the answers (iterations, statuses,
+polished flags, bit-exact ``x``).
 
 Why: wall time on a shared machine varies by 10-50 % between runs; instruction counts
 are deterministic, so they can hold a change to "within +3 % of before". Run this
@@ -106,6 +107,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 """The checkout this driver lives in: its ``benchmarks`` generates and caches the QPs."""
 ROBOTS = ("go2", "talos_reduced")
+"""The robots of ``--all``: a small quadruped and the humanoid."""
+EXTRA_ROBOTS = ("solo12", "anymal_c")
+"""Robots ``--robot`` also takes (the same cached mix sets), outside ``--all``'s 12 cells."""
 PRESETS = ("realtime", "default")
 MODES = ("warm", "cold", "coarse")
 SCENARIO, SEED, N_QPS, SEQ_LEN, DT = "mix", 0, 400, 100, 0.002
@@ -426,7 +430,7 @@ def line_of(r: dict, before: dict | None) -> str:
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--robot", choices=ROBOTS, default="go2")
+    parser.add_argument("--robot", choices=ROBOTS + EXTRA_ROBOTS, default="go2")
     parser.add_argument("--preset", choices=PRESETS, default="realtime")
     parser.add_argument("--mode", choices=MODES, default="warm")
     parser.add_argument("--all", action="store_true",

@@ -19,8 +19,9 @@ from fccqp.projections cimport proj_block, proj_set
 from fccqp.restoration cimport restore
 from fccqp.scaling cimport unscale
 from fccqp.termination cimport Residuals, box_entry_size, gap_scale
-from fccqp.tuning cimport (EQUALITY_EXACT, EQUALITY_MISSED, EQUALITY_SLACK, POLISH_EXACT,
-                           RESTORED_EQUALITY, SCALED_VIOLATION)
+from fccqp.tuning cimport (EQUALITY_EXACT, EQUALITY_MISSED, EQUALITY_SLACK, GUESS_PASSES,
+                           POLISH_EXACT, RESTORED_EQUALITY, SCALED_VIOLATION,
+                           WARM_GUESS_PASSES)
 from fccqp.verdict cimport classify, missed
 
 
@@ -136,9 +137,18 @@ cdef bint warm_polish(Engine* e, Run* run, double start_time) noexcept nogil:
     own KKT matrix by ``dsytrf`` instead was no cheaper than the table, and dearer when
     the guess fails; polishing from every previous solution, or from an unpolished one,
     did not pay either (notes/tuning.md, "The warm polish").
+
+    It may solve ``WARM_GUESS_PASSES`` guesses, more than another polish: the previous
+    tick's active set is a few corrections from this one's, and a warm polish that
+    stopped unsettled at ``GUESS_PASSES`` sent its tick to ADMM, dozens of iterations
+    dearer than the guesses it lacked (notes/performance-history.md, "warmp95").
     """
     cdef int status = RUNNING
-    if not keep_polished(e, &status, 0, start_time, True):
+    cdef bint kept
+    e.pol.guess_passes = WARM_GUESS_PASSES
+    kept = keep_polished(e, &status, 0, start_time, True)
+    e.pol.guess_passes = GUESS_PASSES
+    if not kept:
         return False
     run.polished = True
     e.unscaled.current = True   # keep_polished left them so

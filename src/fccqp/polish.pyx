@@ -73,9 +73,9 @@ from fccqp.polish_kkt cimport correct_once, kkt_residual, number_unknowns, refac
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.reduced cimport Reduced
-from fccqp.tuning cimport (CHORD_RATE, CHORD_STEPS, FEASIBLE_PASSES, GUESS_PASSES,
-                           GUESS_TOLERANCE, HOPELESS_RATE, MISS_FLOOR, NEWTON_TOLERANCE,
-                           POLISH_CSC_DELTA, POLISH_DELTA, POLISH_REFINE_TOLERANCE)
+from fccqp.tuning cimport (CHORD_RATE, CHORD_STEPS, FEASIBLE_PASSES, GUESS_TOLERANCE,
+                           HOPELESS_RATE, MISS_FLOOR, NEWTON_TOLERANCE, POLISH_CSC_DELTA,
+                           POLISH_DELTA, POLISH_REFINE_TOLERANCE)
 
 cdef extern from "fccqp_clock.h" nogil:
     double fccqp_now()
@@ -324,7 +324,7 @@ cdef inline bint _hopeless(Polish* w, const Problem* p, long passes) noexcept no
     (:func:`~fccqp.polish_guess.wrong_signed`) than ``HOPELESS_RATE`` times the guesses
     left: the polish releases one a guess, and such polishes ran out of guesses unsettled
     and were rejected on every tick measured (notes/polish.md, "coarse")."""
-    return wrong_signed(w, p) > HOPELESS_RATE * (GUESS_PASSES - passes)
+    return wrong_signed(w, p) > HOPELESS_RATE * (w.guess_passes - passes)
 
 
 cdef bint polish_prepare(Polish* w, const Problem* p) noexcept nogil:
@@ -348,7 +348,8 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
 
     Each guess is solved once (one Newton step, curvature included) and corrected from the
     polished point (:func:`~fccqp.polish_guess.renew`), until the guess stops changing or
-    ``GUESS_PASSES`` guesses were solved. A correction first only adds the violated
+    ``w.guess_passes`` guesses were solved (``GUESS_PASSES``; ``WARM_GUESS_PASSES`` for a
+    warm polish, see :func:`fccqp.acceptance.warm_polish`). A correction first only adds the violated
     constraints; a wrong-signed multiplier is released only from a point that violates
     nothing, and only one per pass, the most wrong (:func:`~fccqp.polish_guess.most_wrong`),
     as a primal active-set method drops one constraint at a time: changing both at once (a
@@ -364,13 +365,13 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     the boundary planes are then re-linearized up to ``newton_steps`` times (chord steps
     while they converge fast, see ``CHORD_RATE``), stopping early at the floor rounding
     leaves (:func:`_newton`); so are those of the last guess of a polish that did not
-    settle (``GUESS_PASSES`` guesses, or ``cycling``) where its multipliers fit it and its
+    settle (all its guesses, or ``cycling``) where its multipliers fit it and its
     first solve's point violates no free constraint, and the caller then judges the point: go2's and solo12's polishes had ended so on the right
     active set, its blocks off their cones by up to 3e-2 N at the first solve's planes, and
     been rejected. (Otherwise the guess is wrong: on talos' warm ticks those steps had cost
     5 % of the instructions, on go2's cold ones 2 %, for nothing.) A boundary block that a solve puts past the apex
     (:func:`~fccqp.polish_guess.drop_far_side`) is held at the apex instead and the
-    corrected guess solved, within the same ``GUESS_PASSES``; so is a settled guess whose
+    corrected guess solved, within the same guesses; so is a settled guess whose
     Newton steps left a multiplier wrong-signed (a plane's ``lam`` past 0: the release
     was judged on the guess's first solve), with that constraint released: polishes of
     go2's equality-constrained starts, whose planes begin with ``lam = 0``, had ended so
@@ -434,9 +435,9 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
             return False
         _multipliers(w, p, nf, nb)
         passes += 1
-        if feasible and passes < GUESS_PASSES and _hopeless(w, p, passes):
+        if feasible and passes < w.guess_passes and _hopeless(w, p, passes):
             return False
-        if passes == GUESS_PASSES or w.cycling:   # not settled: the caller judges this point
+        if passes == w.guess_passes or w.cycling:   # not settled: the caller judges this point
             if most_wrong(w, p) >= 0 or leaves_set(w, p):   # not its point: as it is
                 if not tabled:
                     refine(w, p, nf, nb, POLISH_REFINE_TOLERANCE * scale, factorizations)

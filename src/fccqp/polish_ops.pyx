@@ -18,6 +18,7 @@ from fccqp.matrices cimport CSC
 from fccqp.matrix_ops cimport Held
 from fccqp.polish cimport Polish, polish
 from fccqp.polish_csc cimport bind
+from fccqp.tuning cimport GUESS_PASSES
 
 from fccqp.polish_csc import arrays
 
@@ -99,6 +100,7 @@ def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5):
     w.chord_start = a.new(n + m + 2 * s)
     w.grad, w.ATnu, w.Ax = a.new(n), a.new(n), a.new(m)
     w.schur.ready = w.schur_only = w.schur_failed = False
+    w.guess_passes = GUESS_PASSES
     w.schur.L = NULL   # no Schur storage: every guess is assembled
     if Ph.M.kind == CSC:
         held = arrays(n, m, np.asarray(Ph.colptr), np.asarray(Ph.rowind),

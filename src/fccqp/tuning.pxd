@@ -141,6 +141,9 @@ cdef extern from *:
     #define FCCQP_GUESS_TOLERANCE 1e-10
     /* most active sets per polish: 6 accepted an unsettled one, 10 cost 6 % more per tick */
     #define FCCQP_GUESS_PASSES 8
+    /* most active sets per warm polish (from the previous tick's answer): 8 sent 3-9 % of
+       the warm ticks to ADMM, most of them a few guesses short of settling */
+    #define FCCQP_WARM_GUESS_PASSES 12
     /* a polish whose first this many guesses all violate a constraint gives up */
     #define FCCQP_FEASIBLE_PASSES 3
     /* a polish stepping from a feasible point gives up when more of its multipliers are
@@ -263,6 +266,7 @@ cdef extern from *:
     const double POLISH_REFINE_TOLERANCE "FCCQP_POLISH_REFINE_TOLERANCE"
     const double GUESS_TOLERANCE "FCCQP_GUESS_TOLERANCE"
     const int GUESS_PASSES "FCCQP_GUESS_PASSES"
+    const int WARM_GUESS_PASSES "FCCQP_WARM_GUESS_PASSES"
     const int FEASIBLE_PASSES "FCCQP_FEASIBLE_PASSES"
     const double HOPELESS_RATE "FCCQP_HOPELESS_RATE"
     const double ACTIVE_TOLERANCE "FCCQP_ACTIVE_TOLERANCE"

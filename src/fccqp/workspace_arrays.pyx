@@ -23,6 +23,7 @@ from fccqp.engine cimport Engine
 from fccqp.kkt cimport SPARSE_LDL
 from fccqp.matrices cimport csc, dense
 from fccqp.polish_csc cimport bind
+from fccqp.tuning cimport GUESS_PASSES
 
 from fccqp.polish_csc import arrays as polish_arrays
 
@@ -138,6 +139,7 @@ cdef void common_arrays(Arrays a, Engine* e, Py_ssize_t memory, Py_ssize_t log_r
     pol.tr, pol.du = a.new(2 * s), a.new(2 * s)
     pol.full, pol.dfull = a.new(N), a.new(N)
     pol.schur_only = pol.schur_failed = False
+    pol.guess_passes = GUESS_PASSES
     ps = &pol.schur
     ps.ready = False
     ps.order, ps.coupled = <Py_ssize_t*>a.new_int(n), <char*>a.new(n)
