@@ -310,8 +310,9 @@ cdef bint _nearer_start(Engine* e, Loop* L, Run* run) noexcept nogil:
     iterations from the answer or far slower than the cold start, and neither start
     wins everywhere. Its distance understates its cost: it is mostly the dual residual
     and gap of multipliers carried from another problem, which ADMM corrects slowly,
-    while the cold start's is its primal residual alone, with multipliers at zero (notes/performance-history.md, "contactfall",
-    "contactstart"). False when the run ended here."""
+    while the cold start's is its primal residual alone, with multipliers at zero
+    (notes/performance-history.md, "contactfall", "contactstart"). False when the run
+    ended here."""
     cdef Problem* p = &e.prob
     cdef double guess_rho = run.rho, guess_distance
     e.prev.from_polished = False   # not polished again below
