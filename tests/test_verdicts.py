@@ -125,6 +125,41 @@ def test_rows_just_outside_a_friction_cone_are_certified_infeasible(mu, gap, cur
     assert clarabel_solve(*problem.args()).status == "primal_infeasible"
 
 
+@pytest.mark.parametrize("asked", [1e-3, -2.0, 1e-7])
+@pytest.mark.parametrize("boxed", [False, True])
+def test_a_zero_row_asking_a_nonzero_right_hand_side_is_certified_infeasible(asked, boxed):
+    """``0 x = b_i`` beside a consistent row: the least-squares residual's rounding on
+    that row is the only term of ``A'r``, so ``A'r ~ 0`` relative to its terms never
+    held, and every backend ran 4000 iterations to MAX_ITER_REACHED; ``b`` on the zero
+    row alone is an exact certificate."""
+    A = np.array([[1.0, 1.0, 0.0], [0.0, 0.0, 0.0]])
+    lb, ub = (np.zeros(3), np.ones(3)) if boxed else (None, None)
+    problem = Problem.of(np.eye(3), np.ones(3), A, np.array([1.0, asked]), lb, ub)
+    result = solve_verified(problem)
+    assert result.status is Status.PRIMAL_INFEASIBLE
+    assert result.certificate[0] == 0.0 and result.certificate[1] * asked < 0.0
+
+
+def test_a_zero_row_asking_zero_is_no_constraint():
+    A = np.array([[1.0, 1.0, 0.0], [0.0, 0.0, 0.0]])
+    problem = Problem.of(np.eye(3), np.ones(3), A, np.array([1.0, 0.0]))
+    assert solve_verified(problem).status is Status.SOLVED
+
+
+def test_verify_accepts_a_certificate_on_zero_rows_alone():
+    """verify's side: ``dy`` on a row of ``A`` with no entry has no terms to be relative
+    to; ``A'dy = 0`` exactly and ``b'dy < 0`` prove."""
+    A = np.array([[1.0, 1.0, 0.0], [0.0, 0.0, 0.0]])
+    problem = Problem.of(np.eye(3), np.ones(3), A, np.array([1.0, 0.5]))
+    claim = fccqp.Result(x=np.zeros(3), y=np.zeros(2), z=np.zeros(3),
+                         status=Status.PRIMAL_INFEASIBLE, obj=np.nan, iterations=0,
+                         prim_res=np.inf, dual_res=np.inf, setup_time=0.0, solve_time=0.0,
+                         rho=np.nan, factorizations=0, gap=np.nan,
+                         certificate=np.array([0.0, -1.0, 0.0, 0.0, 0.0]))
+    assert check_solution(problem, claim).passed
+    zero = fccqp.Result(**{**claim.__dict__, "certificate": np.zeros(5)})
+    assert "certificate size" in check_solution(problem, zero).failures
+
 @pytest.mark.kkt_backends("sparse", reason="one case of the dense backends' twelve")
 def test_rows_just_outside_a_friction_cone_are_certified_on_the_sparse_path():
     A = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
