@@ -28,6 +28,7 @@ SEEDS = {
                      1700359, 1900050, 2500125, 2900030),
     "qpsolvers": (0, 1, 2, 1700123),
     "cvxpy": (1, 2, 3),
+    "degenerate": (0, 1, 2, 4, 7, 9, 11, 12, 21, 23, 30, 35, 43, 58, 150, 102753, 104299),
 }
 """Seeds per class run on every dense backend: a passing case or two per class and the
 reproducers of the failure mechanisms the campaign found at ed3b90e, 836ab4b, 5f3a658,
@@ -44,8 +45,14 @@ where the dual residual crawls, which the retry from a smaller rho answers; extr
 100121 a free friction cone flatter than the polish's regularization, whose refinement
 stalled with the step mostly unmade; extreme_data 2500125 a free entry in units of 1e-8
 whose columns lay below ``MIN_NORM``, which the equilibration left unscaled: its scaled
-curvature, 2.5e-18, stalled ADMM and the polish 3e6 short of the optimum; issues 26 and
-28)."""
+curvature, 2.5e-18, stalled ADMM and the polish 3e6 short of the optimum; degenerate 0 to 35
+one case of each of its structures and outcomes (2 passes its absent bounds as -1e30 and
+1e20), and 43, 58, 150 a row of ``A`` with no entry
+asking ``b_i != 0`` beside consistent rows (``equality_direction`` compared the other
+rows' rounding with itself: MAX_ITER_REACHED, or a certificate on that row alone that
+verify's relative test could not read), 102753 and 104299 LPs whose rows leave free
+entries free, on which a forced reduced form diverged (its LDL' pivot of that direction
+positive by rounding); issues 26 and 28)."""
 
 SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),
@@ -56,6 +63,7 @@ SPARSE_SEEDS = {
     "qpsolvers": (100035,),
     "cvxpy": (7, 1700154, 1900171),
     "dual_infeasible": (1700072,),
+    "degenerate": (0, 1, 43),
 }
 """Seeds per class run on the sparse path (each ends within a second of CPU);
 ``extreme_data:1700359`` a friction cone capped through a boxed copy of its normal
