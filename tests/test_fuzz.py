@@ -25,7 +25,7 @@ SEEDS = {
                      100213,
                      100228, 100233, 500030, 500064, 500099, 500322, 700281, 900343, 900360,
                      1100037, 1100057, 1100150, 1100253, 1300030, 1300300, 1500043, 1700106,
-                     1700359, 1900050, 2500125, 2900030),
+                     1700359, 1900050, 2500125, 2900030, 5300281),
     "qpsolvers": (0, 1, 2, 1700123),
     "cvxpy": (1, 2, 3),
     "degenerate": (0, 1, 2, 4, 7, 9, 11, 12, 21, 23, 30, 35, 43, 58, 150, 102753, 104299),
@@ -50,7 +50,9 @@ one case of each of its structures and outcomes (2 passes its absent bounds as -
 1e20), and 43, 58, 150 a row of ``A`` with no entry
 asking ``b_i != 0`` beside consistent rows (``equality_direction`` compared the other
 rows' rounding with itself: MAX_ITER_REACHED, or a certificate on that row alone that
-verify's relative test could not read), 102753 and 104299 LPs whose rows leave free
+verify's relative test could not read); extreme_data 5300281 a capped friction cone
+beside rows of 1e11, whose least-distance QP stalled until its rows were divided by
+their largest entries; degenerate 102753 and 104299 LPs whose rows leave free
 entries free, on which a forced reduced form diverged (its LDL' pivot of that direction
 positive by rounding); issues 26 and 28)."""
 

@@ -17,6 +17,7 @@ import pytest
 
 import fccqp
 from fccqp import FrictionCone, SecondOrderCone, Status, auxiliary
+from fuzzing import Case
 from reference import clarabel_solve
 from verify import Problem, check_solution, verify_solution
 
@@ -159,6 +160,16 @@ def test_verify_accepts_a_certificate_on_zero_rows_alone():
     assert check_solution(problem, claim).passed
     zero = fccqp.Result(**{**claim.__dict__, "certificate": np.zeros(5)})
     assert "certificate size" in check_solution(problem, zero).failures
+
+def test_a_capped_friction_cone_beside_rows_of_1e11_is_certified_infeasible():
+    """A friction cone capped through a boxed copy of its normal force, infeasible by
+    8e-4, with ``A`` and ``b`` scaled by 1.8e11 (the fuzzer's extreme data): ADMM
+    stalls, and the least-distance QP that certifies stalled runs ended
+    SOLVED_INACCURATE in every form with its multipliers 1e-14 short of its identity
+    (MAX_ITER_REACHED after every retry); with its rows divided by their largest
+    entries it is solved in a few dozen iterations, and its certificate passes."""
+    problem = Case.of("extreme_data", 5300281).scenario().problem
+    assert solve_verified(problem).status is Status.PRIMAL_INFEASIBLE
 
 @pytest.mark.kkt_backends("sparse", reason="one case of the dense backends' twelve")
 def test_rows_just_outside_a_friction_cone_are_certified_on_the_sparse_path():
