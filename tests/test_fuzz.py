@@ -18,7 +18,7 @@ SEEDS = {
     "bad_input": (0, 1, 2, 3, 4, 5),
     "feasible": (0, 1, 2, 3, 4, 5, 2900227),
     "primal_infeasible": (0, 1, 2, 3, 80, 146, 177, 182, 350, 100094, 300345),
-    "dual_infeasible": (0, 1, 2, 33, 166, 257, 368),
+    "dual_infeasible": (0, 1, 2, 33, 166, 257, 368, 5300159),
     "solver_reuse": (0, 1, 2, 50, 164, 211, 100008, 100206, 500061, 700137),
     "extreme_data": (0, 1, 7, 9, 38, 47, 56, 108, 138, 149, 202, 214, 254, 302, 308, 316,
                      311, 326, 335, 337, 355, 363, 365, 489, 1182, 2244, 100082, 100121, 100180,
@@ -52,9 +52,10 @@ asking ``b_i != 0`` beside consistent rows (``equality_direction`` compared the 
 rows' rounding with itself: MAX_ITER_REACHED, or a certificate on that row alone that
 verify's relative test could not read); extreme_data 5300281 a capped friction cone
 beside rows of 1e11, whose least-distance QP stalled until its rows were divided by
-their largest entries; degenerate 102753 and 104299 LPs whose rows leave free
-entries free, on which a forced reduced form diverged (its LDL' pivot of that direction
-positive by rounding); issues 26 and 28)."""
+their largest entries; dual_infeasible 5300159 a ray whose projection needs multipliers
+5000 times the ray, which only the sparse path's polish answers; degenerate 102753 and
+104299 LPs whose rows leave free entries free, on which a forced reduced form diverged
+(its LDL' pivot of that direction positive by rounding); issues 26 and 28)."""
 
 SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),

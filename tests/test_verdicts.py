@@ -161,6 +161,16 @@ def test_verify_accepts_a_certificate_on_zero_rows_alone():
     zero = fccqp.Result(**{**claim.__dict__, "certificate": np.zeros(5)})
     assert "certificate size" in check_solution(problem, zero).failures
 
+def test_a_ray_whose_projection_needs_large_multipliers_is_certified_unbounded():
+    """A ray inside a second-order cone, ``P`` of rank 9 (its rows, the ray QP's
+    equalities, with four singular values of 1e-14), a second cone and box entries that
+    the ray set pins: the projection of ``-q`` onto the rays has multipliers 5000 times
+    the ray, both dense forms crawl on it and the dense polish puts the pinned cone on
+    its boundary at 1e-11 where its apex is asked (MAX_ITER_REACHED after every retry);
+    the sparse path's polish finds the apex, and its ray passes."""
+    problem = Case.of("dual_infeasible", 5300159).scenario().problem
+    assert solve_verified(problem).status is Status.DUAL_INFEASIBLE
+
 def test_a_capped_friction_cone_beside_rows_of_1e11_is_certified_infeasible():
     """A friction cone capped through a boxed copy of its normal force, infeasible by
     8e-4, with ``A`` and ``b`` scaled by 1.8e11 (the fuzzer's extreme data): ADMM

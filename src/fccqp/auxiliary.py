@@ -38,7 +38,8 @@ constrained entries alone. A problem that stalls in one form often solves in the
 4000 iterations in the reduced form and solved in 30 in the full one; a feasible QP
 with ``P`` of 1e-12 stalled in the full form and solved in the reduced one). So an
 auxiliary solve that is not SOLVED runs again in the other form
-(:func:`other_form`), and :func:`solved_again` solves the stalled problem itself
+(:func:`other_form`), then on the sparse path (:func:`_further_tries`), and
+:func:`solved_again` solves the stalled problem itself
 again there when no certificate was found, and then, if it stalls there too, at a
 larger rho, at a smaller one (fixed below the floor when the stalled run's rho sat
 there), and without equilibration. A forced ``kkt_backend`` keeps its form and gets the other tries.
@@ -46,7 +47,7 @@ there), and without equilibration. A forced ``kkt_backend`` keeps its form and g
 On the sparse path (a :attr:`fccqp.admm.Workspace.compressed` run) the auxiliary QPs
 are built with ``scipy.sparse`` and take the sparse path too, whatever their size;
 there is no other form to try there: an auxiliary solve that is not SOLVED runs again
-without equilibration (:func:`_second_try`), and the other tries stay on the sparse
+without equilibration (:func:`_further_tries`), and the other tries stay on the sparse
 path.
 """
 
@@ -295,35 +296,44 @@ def _is_solved(result: object) -> bool:
     return result.status is Status.SOLVED
 
 
-def _second_try(settings: object, backend: str) -> object | None:
-    """``settings`` for solving an auxiliary problem again after a solve in ``backend``
-    gave no usable result: the other form (:func:`other_form`) on the dense path; on
-    the sparse path, which has one form, no equilibration (None when ``settings`` has
-    none already).
+def _further_tries(settings: object, backend: str) -> list:
+    """``settings`` for solving an auxiliary problem again, in order, after a solve in
+    ``backend`` gave no usable result: on the dense path the other form
+    (:func:`other_form`), then the sparse path; on the sparse path, which has one form,
+    no equilibration (nothing when ``settings`` has none already).
 
     The least-distance QP of a friction cone capped through a boxed copy of its
     normal force, beside two nearly parallel rows of 2e10, crawls in the full form
     once equilibrated (rho at its floor, 20000 iterations on the sparse path, never
     polished; ``ldl_full`` alike), where the reduced form solves it in 40 iterations;
     in the user's units the full form's final polish solves it (``ldl_full`` in 250
-    iterations, the sparse path at its 4000), and its certificate passes."""
+    iterations, the sparse path at its 4000), and its certificate passes. The
+    projection onto the rays of a second-order cone beside a box entry whose recession
+    cone pins it, in a null space of ``P`` and ``A`` of dimension 5 (``P``'s rows of
+    rank 9 with four singular values of 1e-14), has multipliers 5000 times the ray:
+    ADMM crawls in both dense forms (4000 iterations, the box missed by 4e-5, a cone
+    block 1e-2 off its apex), and the dense polish, regularized as the dense forms
+    are, puts that block on its boundary at 1e-11 where the multipliers ask its apex;
+    the sparse path's polish (qdldl, its own regularization) finds the apex, SOLVED
+    in 170 iterations."""
     if backend != "sparse":
-        return other_form(settings, backend)
-    return settings.replace(scaling=0) if settings.scaling else None
+        return [other_form(settings, backend), settings.replace(kkt_backend="sparse")]
+    return [settings.replace(scaling=0)] if settings.scaling else []
 
 
 def _solved(solver_type: type, settings: object, problem: tuple, deadline: float,
             usable: object = _is_solved) -> tuple:
     """``(result, iterations, factorizations)`` of an auxiliary ``problem``: solved with
-    ``settings`` by ``deadline``, and again (:func:`_second_try`) unless that result is
-    ``usable`` (by default: SOLVED); the counts are those of both solves."""
+    ``settings`` by ``deadline``, and again (:func:`_further_tries`, in turn) until a
+    result is ``usable`` (by default: SOLVED); the counts are those of every solve."""
     result = _auxiliary_solver(solver_type, settings, deadline).solve(*problem)
-    again_settings = None if usable(result) else _second_try(settings, result.backend)
-    if again_settings is None:
-        return result, result.iterations, result.factorizations
-    again = _auxiliary_solver(solver_type, again_settings, deadline).solve(*problem)
-    return (again, result.iterations + again.iterations,
-            result.factorizations + again.factorizations)
+    spent, factored = result.iterations, result.factorizations
+    for again_settings in [] if usable(result) else _further_tries(settings, result.backend):
+        result = _auxiliary_solver(solver_type, again_settings, deadline).solve(*problem)
+        spent, factored = spent + result.iterations, factored + result.factorizations
+        if usable(result):
+            break
+    return result, spent, factored
 
 
 ANSWERS = (Status.SOLVED, Status.SOLVED_INACCURATE, Status.PRIMAL_INFEASIBLE,
@@ -521,8 +531,8 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
     certificate of the least distance (when there are rows and constrained entries),
     else with ``dual`` the dual one of the projection onto the rays, each judged by
     ``workspace`` (sparse QPs when it holds compressed columns). The auxiliary solves use
-    ``settings`` in a ``solver_type`` (:func:`_auxiliary_solver`) by ``deadline``, in a
-    second form when the first did not solve them (:func:`_solved`)."""
+    ``settings`` in a ``solver_type`` (:func:`_auxiliary_solver`) by ``deadline``, in
+    other forms when the first did not solve them (:func:`_solved`)."""
     q = np.asarray(q, dtype=np.float64).reshape(-1)
     n = q.shape[0]
     sparse = workspace.compressed
