@@ -145,6 +145,7 @@ def _divided(A: object, norms: np.ndarray) -> object:
         return sp.csc_matrix(sp.diags(1.0 / norms) @ A)
     return A / norms[:, None]
 
+
 def relative_distance_problem(A: object, b: np.ndarray, lb: np.ndarray, ub: np.ndarray,
                               cones: tuple, x: np.ndarray) -> tuple[tuple, np.ndarray,
                                                                     np.ndarray]:
@@ -328,7 +329,8 @@ def _solved(solver_type: type, settings: object, problem: tuple, deadline: float
     result is ``usable`` (by default: SOLVED); the counts are those of every solve."""
     result = _auxiliary_solver(solver_type, settings, deadline).solve(*problem)
     spent, factored = result.iterations, result.factorizations
-    for again_settings in [] if usable(result) else _further_tries(settings, result.backend):
+    tries = [] if usable(result) else _further_tries(settings, result.backend)
+    for again_settings in tries:
         result = _auxiliary_solver(solver_type, again_settings, deadline).solve(*problem)
         spent, factored = spent + result.iterations, factored + result.factorizations
         if usable(result):

@@ -461,6 +461,7 @@ cdef bint zero_rows_inconsistent(const Problem* p, double* r, double* ones,
         r[i] = p.b[i] if norms[i] == 0.0 else 0.0
     return True
 
+
 cdef inline bint _near_zero(const Matrix* M, const double* dx, double dx_norm, double eps,
                             double* out, double* norms) noexcept nogil:
     """``M dx ~ 0`` (scaled) row by row: ``|M_i dx| <= eps ||M_i|| ||dx||`` with the row's
