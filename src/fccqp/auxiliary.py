@@ -10,8 +10,8 @@ directly, within the time left, each by a strongly posed QP that fccqp solves (w
 in a few dozen iterations on the fuzzing campaign's stalls):
 
 - primal: the least distance between ``{x: A x = b}`` and the constraint set,
-  ``min 1/2 ||x_S - u||^2`` s.t. ``A x = b`` (each row divided by its largest entry,
-  :func:`row_norms`), ``u`` in C (the box and the cones). Its
+  ``min 1/2 ||x_S - u||^2`` s.t. ``A x = b`` (last, each row divided by its largest
+  entry, :func:`row_norms`), ``u`` in C (the box and the cones). Its
   multipliers ``(y, z_u)`` satisfy ``A'y + E_S'z_u = 0`` and ``b'y + sigma_C(z_u) =
   -||x_S - u||^2``: a Farkas certificate whenever the distance is positive (the dual of
   the least-distance problem is the certificate problem), its separation weighed
@@ -127,12 +127,15 @@ def distance_problem(A: object, b: np.ndarray, lb: np.ndarray, ub: np.ndarray,
 def row_norms(A: object) -> np.ndarray:
     """The largest magnitude in each row of ``A`` (dense or CSC), 1 for a row with none.
 
-    The least distance's rows are divided by these: the affine set ``{x: A x = b}``,
-    and so the distance, does not depend on the rows' scale, while its QP does. Rows of
-    1e10 to 2e11 beside a friction cone capped through a boxed copy of its normal force
+    When the least distance in the user's rows certifies nothing, it is tried again
+    with its rows divided by these: the affine set ``{x: A x = b}``, and so the
+    distance, does not depend on the rows' scale, while its QP does. Rows of 1e10 to
+    2e11 beside a friction cone capped through a boxed copy of its normal force
     (infeasible by 8e-4) left the least-distance QP SOLVED_INACCURATE after 4000
     iterations in every form, its multipliers 1e-14 short of its identity; divided, it
-    is solved in 24 and certifies."""
+    is solved in 24 and certifies. Not first: a friction cone pinned outside itself by
+    two rows, variables rescaled by 1e-8..1e8, is certified on the sparse path in the
+    user's rows and not in the divided ones."""
     largest = abs(A).max(axis=1)
     largest = np.asarray(largest.toarray() if sp.issparse(largest) else largest,
                          dtype=np.float64).reshape(-1)
@@ -547,11 +550,10 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
     spent = factored = 0
     try:
         if primal and m > 0:
-            norms = row_norms(A)
-            problem, S = distance_problem(_divided(A, norms), b / norms, lb, ub, cones)
+            problem, S = distance_problem(A, b, lb, ub, cones)
             if S.size and _affordable(problem):
                 found, nearest, spent, factored = _distance_certificate(
-                    solver_type, settings, workspace, problem, S, norms, b, lb, ub,
+                    solver_type, settings, workspace, problem, S, np.ones(m), b, lb, ub,
                     deadline)
                 if found is None and _at_positive_distance(nearest, n):
                     relative, S, divisors = relative_distance_problem(
@@ -562,6 +564,14 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
                             solver_type, settings, workspace, relative, S, divisors, b,
                             lb, ub, deadline)
                         spent, factored = spent + iterations, factored + factorizations
+                norms = row_norms(A)
+                if found is None and np.any(norms != 1.0):
+                    divided, S = distance_problem(_divided(A, norms), b / norms, lb, ub,
+                                                  cones)
+                    found, _, iterations, factorizations = _distance_certificate(
+                        solver_type, settings, workspace, divided, S, norms, b, lb, ub,
+                        deadline)
+                    spent, factored = spent + iterations, factored + factorizations
                 if found is not None:
                     return Status.PRIMAL_INFEASIBLE, found, spent, factored
         if not dual:
