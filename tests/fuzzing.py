@@ -65,7 +65,8 @@ class Native:
     ``truth`` is the status the construction proves (``None``: not known); ``form``
     says how the arrays are passed (``"dense"``, ``"sparse"`` for ``scipy.sparse``
     ``P`` and ``A``, ``"none"`` for ``None`` in place of absent parts, ``"views"`` for
-    Fortran-ordered matrices and strided vectors). With
+    Fortran-ordered matrices and strided vectors, ``"sentinel"`` for absent bounds
+    written ``-1e30`` and ``1e20``). With
     ``may_reject`` (extreme data) a ``ValueError`` / ``TypeError`` naming an argument
     is an honest answer too, unless it calls the PSD-by-construction ``P`` non-convex.
     """
@@ -864,6 +865,167 @@ def extreme_data(rng: np.random.Generator) -> Native:
     return Native(p, truth, f"{base.what}; {kind}", base.form, may_reject=True)
 
 
+def degenerate(rng: np.random.Generator) -> Native:
+    """Class 8: structures the other classes seldom draw, each with its status known by
+    construction (:data:`_DEGENERATE`): an LP (``P = 0``) with a KKT point, a ray or no
+    feasible point; one variable; no rows; every box entry fixed (sometimes every entry);
+    rows repeated exactly or scaled, rows restating an entry, zero rows (``b`` consistent,
+    or one copy off by a gap: infeasible); second-order cones of dimension 2 only, or of 6
+    to 12; inactive bounds at 1e6 to 1e15; boxes 1e-9 to 1e-4 wide; 30 to 60 variables
+    with up to 20 rows. A quarter of the time the absent bounds are passed as ``-1e30``
+    and ``1e20``, which docs/api.md calls no bounds (the ``"sentinel"`` form)."""
+    kind = _DEGENERATE[int(rng.integers(len(_DEGENERATE)))]
+    problem, truth, what = kind(rng)
+    form = "sentinel" if rng.random() < 0.25 else _form(rng)
+    return Native(problem, truth, f"{kind.__name__[1:].replace('_', ' ')}: {what}", form)
+
+
+def _lp(rng: np.random.Generator) -> tuple[Problem, str, str]:
+    """``P = 0`` on a KKT point's problem, a ray's or an infeasible one (their status
+    does not depend on ``P`` when ``P d = 0`` already holds along the ray)."""
+    base = int(rng.integers(3))
+    if base == 0:
+        layout = random_layout(rng)
+        A = rows(rng, _random_m(rng), layout.n)
+        problem = _kkt_problem(rng, layout, np.zeros((layout.n, layout.n)), A)
+        return problem, "solved", f"KKT point, n={layout.n} m={A.shape[0]}"
+    made = (primal_infeasible, dual_infeasible)[base - 1](rng)
+    p = made.problem
+    return replace(p, P=np.zeros_like(p.P)), made.truth, made.what
+
+
+def _one_variable(rng: np.random.Generator) -> tuple[Problem, str, str]:
+    """``n = 1``: boxed or free, ``P`` zero or not, up to two (dependent) rows; free
+    with ``P = 0``, no rows and ``q != 0`` it is unbounded."""
+    layout = random_layout(rng, max_n=1, frictions=0, socs=0)
+    P = psd(rng, 1)
+    if layout.free and not P.any() and rng.random() < 0.3:
+        q = np.array([rng.choice([-1.0, 1.0]) * _log_uniform(rng, 1e-3, 1e3)])
+        empty = np.zeros((0, 1))
+        return Problem.of(P, q, empty, np.zeros(0)), "dual_infeasible", "free, P = 0, q != 0"
+    A = rows(rng, int(rng.integers(0, 3)), 1)
+    problem = _kkt_problem(rng, layout, P, A)
+    return problem, "solved", f"{next(iter(layout.box.values()), 'free')}, m={A.shape[0]}"
+
+
+def _no_rows(rng: np.random.Generator) -> tuple[Problem, str, str]:
+    """A KKT point's problem with ``m = 0``."""
+    layout = random_layout(rng)
+    problem = _kkt_problem(rng, layout, psd(rng, layout.n), np.zeros((0, layout.n)))
+    return problem, "solved", f"KKT point, n={layout.n}"
+
+
+def _all_fixed(rng: np.random.Generator) -> tuple[Problem, str, str]:
+    """Every entry outside the cones fixed (``lb = ub``); half of the time no cones,
+    so that the bounds alone decide ``x`` (rows consistent with it)."""
+    none = rng.random() < 0.5
+    layout = random_layout(rng, frictions=0 if none else None, socs=0 if none else None)
+    lb, ub, box = layout.lb.copy(), layout.ub.copy(), {}
+    for j in range(layout.n):
+        if j not in layout.members:
+            lb[j] = ub[j] = rng.uniform(-2, 2)
+            box[j] = "fixed"
+    layout = replace(layout, lb=lb, ub=ub, box=box, free=())
+    A = rows(rng, _random_m(rng), layout.n)
+    problem = _kkt_problem(rng, layout, psd(rng, layout.n), A)
+    return problem, "solved", f"{len(box)} of {layout.n} entries fixed, m={A.shape[0]}"
+
+
+def _repeated_rows(rng: np.random.Generator) -> tuple[Problem, str, str]:
+    """Rows repeated exactly or scaled by -1 or 1e-3 to 1e3, rows ``e_j`` restating an
+    entry (a cone's too) and zero rows, ``b`` consistent with a KKT point; a third of
+    the time the ``b`` of a row that the others span is moved by 1e-6 to 1 times
+    ``max(1, |b_i|)`` (infeasible)."""
+    layout = random_layout(rng)
+    n = layout.n
+    A = rows(rng, int(rng.integers(1, MAX_M // 2 + 1)), n)
+    extra = []
+    for _ in range(int(rng.integers(1, 5))):
+        pick = int(rng.integers(3))
+        if pick == 0:
+            scale = rng.choice([1.0, -1.0, _log_uniform(rng, 1e-3, 1e3)])
+            extra.append(scale * A[int(rng.integers(A.shape[0]))])
+        elif pick == 1:
+            extra.append(np.eye(n)[int(rng.integers(n))])
+        else:
+            extra.append(np.zeros(n))
+    copies = np.array(extra)
+    A = np.vstack([A, copies])
+    problem = _kkt_problem(rng, layout, psd(rng, n), A[rng.permutation(A.shape[0])])
+    what = f"{copies.shape[0]} repeated, restating or zero rows, n={n} m={A.shape[0]}"
+    dependent = [i for i in range(problem.A.shape[0]) if _dependent(problem.A, i)]
+    if not dependent or rng.random() >= 1 / 3:
+        return problem, "solved", what
+    i = int(rng.choice(dependent))
+    gap = _log_uniform(rng, 1e-6, 1.0)
+    b = problem.b.copy()
+    b[i] += gap * rng.choice([-1.0, 1.0]) * max(1.0, abs(b[i]))
+    return replace(problem, b=b), "primal_infeasible", f"{what}, row {i} off by {gap:.2g}"
+
+
+def _dependent(A: np.ndarray, i: int) -> bool:
+    """Whether row ``i`` of ``A`` is a combination of the others (a zero row is)."""
+    return np.linalg.matrix_rank(np.delete(A, i, axis=0)) == np.linalg.matrix_rank(A)
+
+
+def _cone_sizes(rng: np.random.Generator) -> tuple[Problem, str, str]:
+    """A KKT point's problem whose second-order cones all have dimension 2 (a wedge
+    ``t >= |v|``), or 6 to 12."""
+    dim = 2 if rng.random() < 0.5 else int(rng.integers(6, 13))
+    layout = random_layout(rng, max_n=MAX_N if dim == 2 else 40,
+                           socs=int(rng.integers(1, 4)), soc_dim=dim)
+    A = rows(rng, _random_m(rng), layout.n)
+    problem = _kkt_problem(rng, layout, psd(rng, layout.n), A)
+    return problem, "solved", f"second-order cones of dimension {dim}, n={layout.n}"
+
+
+def _far_bounds(rng: np.random.Generator) -> tuple[Problem, str, str]:
+    """A KKT point's problem whose inactive sides are moved to 1e6 to 1e15 (a one-sided
+    entry gets the other side there), beside the active ones."""
+    layout = random_layout(rng, boxed=int(rng.integers(1, 9)))
+    x, z = kkt_point(rng, layout)
+    lb, ub = layout.lb.copy(), layout.ub.copy()
+    for j in layout.box:
+        if lb[j] == ub[j]:
+            continue
+        if z[j] >= 0 and x[j] > lb[j]:   # the lower side is inactive
+            lb[j] = -_log_uniform(rng, 1e6, 1e15)
+        if z[j] <= 0 and x[j] < ub[j]:
+            ub[j] = _log_uniform(rng, 1e6, 1e15)
+    P, A = psd(rng, layout.n), rows(rng, _random_m(rng), layout.n)
+    q = -(P @ x + A.T @ rng.standard_normal(A.shape[0]) + z)
+    problem = Problem.of(P, q, A, A @ x, lb, ub, layout.cones)
+    return problem, "solved", f"KKT point, n={layout.n} m={A.shape[0]}"
+
+
+def _thin_boxes(rng: np.random.Generator) -> tuple[Problem, str, str]:
+    """A KKT point's problem whose two-sided boxes are 1e-9 to 1e-4 wide."""
+    layout = random_layout(rng, boxed=int(rng.integers(1, 9)))
+    ub = layout.ub.copy()
+    for j, side in layout.box.items():
+        if side == "both":
+            ub[j] = layout.lb[j] + _log_uniform(rng, 1e-9, 1e-4)
+    layout = replace(layout, ub=ub)
+    A = rows(rng, _random_m(rng), layout.n)
+    problem = _kkt_problem(rng, layout, psd(rng, layout.n), A)
+    return problem, "solved", f"KKT point, n={layout.n} m={A.shape[0]}"
+
+
+def _larger(rng: np.random.Generator) -> tuple[Problem, str, str]:
+    """A KKT point's problem of 30 to 60 variables (up to 10 friction cones) and up to
+    20 rows."""
+    layout = random_layout(rng, min_n=30, max_n=60, frictions=int(rng.integers(0, 11)),
+                           boxed=int(rng.integers(0, 25)))
+    A = rows(rng, int(rng.integers(0, 21)), layout.n)
+    problem = _kkt_problem(rng, layout, psd(rng, layout.n), A)
+    return problem, "solved", f"KKT point, n={layout.n} m={A.shape[0]}"
+
+
+_DEGENERATE = (_lp, _one_variable, _no_rows, _all_fixed, _repeated_rows, _cone_sizes,
+               _far_bounds, _thin_boxes, _larger)
+"""The structures of :func:`degenerate`, each ``rng -> (problem, truth, what)``."""
+
+
 def qpsolvers_problem(rng: np.random.Generator) -> Qpsolvers:
     """Class 7a: a random problem in qpsolvers' form (``G x <= h`` with some rows
     active at the feasible point, equalities, a box), ``P`` positive definite or, when
@@ -934,8 +1096,13 @@ CLASSES: dict[str, Callable[[np.random.Generator], object]] = {
     "extreme_data": extreme_data,
     "qpsolvers": qpsolvers_problem,
     "cvxpy": cvxpy_problem,
+    "degenerate": degenerate,
 }
-"""The failure classes of issue 26, in its order, by name."""
+"""The fuzzer's classes by name: issue 26's failure classes in its order, then the
+structures of :func:`degenerate`."""
+CAMPAIGN_CLASSES = tuple(CLASSES)[:8]
+"""The classes a campaign runs unless told otherwise: issue 26's, so that a campaign's
+seed names the same cases as before :func:`degenerate` existed (notes/verdicts.md)."""
 
 
 @dataclass(frozen=True)
@@ -1111,6 +1278,8 @@ def _arguments(problem: Problem, form: str) -> tuple:
     elif form == "views":
         P, A = np.asfortranarray(P), np.asfortranarray(A)
         q, b, lb, ub = (np.repeat(v, 2)[::2] for v in (q, b, lb, ub))
+    elif form == "sentinel":
+        lb, ub = np.where(np.isfinite(lb), lb, -1e30), np.where(np.isfinite(ub), ub, 1e20)
     elif form == "none":
         if A.shape[0] == 0:
             A = b = None

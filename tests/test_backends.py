@@ -10,8 +10,10 @@ import pytest
 
 import fccqp
 from fccqp import Status, schur
+from fuzzing import Case
 from problems import random_problem
 from reference import clarabel_solve
+from verify import verify_solution
 
 pytestmark = pytest.mark.kkt_backends(
     "schur_reduced", "ldl_reduced", "ldl_full", "sparse",
@@ -128,6 +130,20 @@ def test_a_cost_flat_to_rounding_on_entries_the_rows_tie_down_is_solved(kkt_back
     reference = clarabel_solve(P, q, A, b, lb, ub, [])
     np.testing.assert_allclose(result.x, reference.x, atol=1e-4 * (1 + np.abs(reference.x).max()))
 
+
+@pytest.mark.kkt_backends("schur_reduced", "ldl_reduced", reason="the reduced forms' fallback")
+@pytest.mark.parametrize("seed", [102753, 104299])
+def test_an_lp_whose_rows_leave_free_entries_free_leaves_the_reduced_form(kkt_backend, seed):
+    """``P = 0`` beside cones and fixed entries, with free entries that the rows do not
+    all tie down (the fuzzer's degenerate structures): ``P + R`` is singular on the null
+    space of ``A``, the reduced LDL' pivot of that direction came out positive by
+    rounding, and the reduced iteration diverged to 1e48 (MAX_ITER_REACHED after every
+    retry); the full form solves it."""
+    problem = Case.of("degenerate", seed).scenario().problem
+    result = fccqp.solve(*problem.args(), kkt_backend=kkt_backend)
+    assert result.status is Status.SOLVED
+    assert result.backend == "ldl_full"
+    verify_solution(problem, result)
 
 def test_nonconvex_cost_is_rejected_by_every_backend(kkt_backend):
     P, q, A, b, lb, ub, cones = random_problem(0, n_box=6)

@@ -18,16 +18,17 @@ SEEDS = {
     "bad_input": (0, 1, 2, 3, 4, 5),
     "feasible": (0, 1, 2, 3, 4, 5, 2900227),
     "primal_infeasible": (0, 1, 2, 3, 80, 146, 177, 182, 350, 100094, 300345),
-    "dual_infeasible": (0, 1, 2, 33, 166, 257, 368),
+    "dual_infeasible": (0, 1, 2, 33, 166, 257, 368, 5300159),
     "solver_reuse": (0, 1, 2, 50, 164, 211, 100008, 100206, 500061, 700137, 4700367),
     "extreme_data": (0, 1, 7, 9, 38, 47, 56, 108, 138, 149, 202, 214, 254, 302, 308, 316,
                      311, 326, 335, 337, 355, 363, 365, 489, 1182, 2244, 100082, 100121, 100180,
                      100213,
                      100228, 100233, 500030, 500064, 500099, 500322, 700281, 900343, 900360,
                      1100037, 1100057, 1100150, 1100253, 1300030, 1300300, 1500043, 1700106,
-                     1700359, 1900050, 2500125, 2900030, 4700352),
+                     1700359, 1900050, 2500125, 2900030, 4700352, 5300281),
     "qpsolvers": (0, 1, 2, 1700123),
     "cvxpy": (1, 2, 3),
+    "degenerate": (0, 1, 2, 4, 7, 9, 11, 12, 21, 23, 30, 35, 43, 58, 150, 102753, 104299),
 }
 """Seeds per class run on every dense backend: a passing case or two per class and the
 reproducers of the failure mechanisms the campaign found at ed3b90e, 836ab4b, 5f3a658,
@@ -45,8 +46,17 @@ where the dual residual crawls, which the retry from a smaller rho answers; extr
 stalled with the step mostly unmade; extreme_data 2500125 a free entry in units of 1e-8
 whose columns lay below ``MIN_NORM``, which the equilibration left unscaled: its scaled
 curvature, 2.5e-18, stalled ADMM and the polish 3e6 short of the optimum; solver_reuse
-4700367 a ray step that Clarabel calls solved, judged against its construction; issues
-26 and 28)."""
+4700367 a ray step that Clarabel calls solved, judged against its construction;
+degenerate 0 to 35 one case of each of its structures and outcomes (2 passes its absent
+bounds as -1e30 and 1e20), and 43, 58, 150 a row of ``A`` with no entry asking ``b_i !=
+0`` beside consistent rows (``equality_direction`` compared the other rows' rounding with
+itself: MAX_ITER_REACHED, or a certificate on that row alone that verify's relative test
+could not read); extreme_data 5300281 a capped friction cone beside rows of 1e11, whose
+least-distance QP stalled until its rows were divided by their largest entries;
+dual_infeasible 5300159 a ray whose projection needs multipliers 5000 times the ray,
+which only the sparse path's polish answers; degenerate 102753 and 104299 LPs whose rows
+leave free entries free, on which a forced reduced form diverged (its LDL' pivot of that
+direction positive by rounding); issues 26 and 28)."""
 
 SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),
@@ -57,6 +67,7 @@ SPARSE_SEEDS = {
     "qpsolvers": (100035,),
     "cvxpy": (7, 1700154, 1900171),
     "dual_infeasible": (1700072,),
+    "degenerate": (0, 1, 43),
 }
 """Seeds per class run on the sparse path (each ends within a second of CPU);
 ``extreme_data:1700359`` a friction cone capped through a boxed copy of its normal

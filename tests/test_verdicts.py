@@ -17,6 +17,7 @@ import pytest
 
 import fccqp
 from fccqp import FrictionCone, SecondOrderCone, Status, auxiliary
+from fuzzing import Case
 from reference import clarabel_solve
 from verify import Problem, check_solution, verify_solution
 
@@ -124,6 +125,61 @@ def test_rows_just_outside_a_friction_cone_are_certified_infeasible(mu, gap, cur
     assert solve_verified(problem).status is Status.PRIMAL_INFEASIBLE
     assert clarabel_solve(*problem.args()).status == "primal_infeasible"
 
+
+@pytest.mark.parametrize("asked", [1e-3, -2.0, 1e-7])
+@pytest.mark.parametrize("boxed", [False, True])
+def test_a_zero_row_asking_a_nonzero_right_hand_side_is_certified_infeasible(asked, boxed):
+    """``0 x = b_i`` beside a consistent row: the least-squares residual's rounding on
+    that row is the only term of ``A'r``, so ``A'r ~ 0`` relative to its terms never
+    held, and every backend ran 4000 iterations to MAX_ITER_REACHED; ``b`` on the zero
+    row alone is an exact certificate."""
+    A = np.array([[1.0, 1.0, 0.0], [0.0, 0.0, 0.0]])
+    lb, ub = (np.zeros(3), np.ones(3)) if boxed else (None, None)
+    problem = Problem.of(np.eye(3), np.ones(3), A, np.array([1.0, asked]), lb, ub)
+    result = solve_verified(problem)
+    assert result.status is Status.PRIMAL_INFEASIBLE
+    assert result.certificate[0] == 0.0 and result.certificate[1] * asked < 0.0
+
+
+def test_a_zero_row_asking_zero_is_no_constraint():
+    A = np.array([[1.0, 1.0, 0.0], [0.0, 0.0, 0.0]])
+    problem = Problem.of(np.eye(3), np.ones(3), A, np.array([1.0, 0.0]))
+    assert solve_verified(problem).status is Status.SOLVED
+
+
+def test_verify_accepts_a_certificate_on_zero_rows_alone():
+    """verify's side: ``dy`` on a row of ``A`` with no entry has no terms to be relative
+    to; ``A'dy = 0`` exactly and ``b'dy < 0`` prove."""
+    A = np.array([[1.0, 1.0, 0.0], [0.0, 0.0, 0.0]])
+    problem = Problem.of(np.eye(3), np.ones(3), A, np.array([1.0, 0.5]))
+    claim = fccqp.Result(x=np.zeros(3), y=np.zeros(2), z=np.zeros(3),
+                         status=Status.PRIMAL_INFEASIBLE, obj=np.nan, iterations=0,
+                         prim_res=np.inf, dual_res=np.inf, setup_time=0.0, solve_time=0.0,
+                         rho=np.nan, factorizations=0, gap=np.nan,
+                         certificate=np.array([0.0, -1.0, 0.0, 0.0, 0.0]))
+    assert check_solution(problem, claim).passed
+    zero = fccqp.Result(**{**claim.__dict__, "certificate": np.zeros(5)})
+    assert "certificate size" in check_solution(problem, zero).failures
+
+def test_a_ray_whose_projection_needs_large_multipliers_is_certified_unbounded():
+    """A ray inside a second-order cone, ``P`` of rank 9 (its rows, the ray QP's
+    equalities, with four singular values of 1e-14), a second cone and box entries that
+    the ray set pins: the projection of ``-q`` onto the rays has multipliers 5000 times
+    the ray, both dense forms crawl on it and the dense polish puts the pinned cone on
+    its boundary at 1e-11 where its apex is asked (MAX_ITER_REACHED after every retry);
+    the sparse path's polish finds the apex, and its ray passes."""
+    problem = Case.of("dual_infeasible", 5300159).scenario().problem
+    assert solve_verified(problem).status is Status.DUAL_INFEASIBLE
+
+def test_a_capped_friction_cone_beside_rows_of_1e11_is_certified_infeasible():
+    """A friction cone capped through a boxed copy of its normal force, infeasible by
+    8e-4, with ``A`` and ``b`` scaled by 1.8e11 (the fuzzer's extreme data): ADMM
+    stalls, and the least-distance QP that certifies stalled runs ended
+    SOLVED_INACCURATE in every form with its multipliers 1e-14 short of its identity
+    (MAX_ITER_REACHED after every retry); with its rows divided by their largest
+    entries it is solved in a few dozen iterations, and its certificate passes."""
+    problem = Case.of("extreme_data", 5300281).scenario().problem
+    assert solve_verified(problem).status is Status.PRIMAL_INFEASIBLE
 
 @pytest.mark.kkt_backends("sparse", reason="one case of the dense backends' twelve")
 def test_rows_just_outside_a_friction_cone_are_certified_on_the_sparse_path():

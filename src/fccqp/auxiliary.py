@@ -10,7 +10,8 @@ directly, within the time left, each by a strongly posed QP that fccqp solves (w
 in a few dozen iterations on the fuzzing campaign's stalls):
 
 - primal: the least distance between ``{x: A x = b}`` and the constraint set,
-  ``min 1/2 ||x_S - u||^2`` s.t. ``A x = b``, ``u`` in C (the box and the cones). Its
+  ``min 1/2 ||x_S - u||^2`` s.t. ``A x = b`` (last, each row divided by its largest
+  entry, :func:`row_norms`), ``u`` in C (the box and the cones). Its
   multipliers ``(y, z_u)`` satisfy ``A'y + E_S'z_u = 0`` and ``b'y + sigma_C(z_u) =
   -||x_S - u||^2``: a Farkas certificate whenever the distance is positive (the dual of
   the least-distance problem is the certificate problem), its separation weighed
@@ -37,7 +38,8 @@ constrained entries alone. A problem that stalls in one form often solves in the
 4000 iterations in the reduced form and solved in 30 in the full one; a feasible QP
 with ``P`` of 1e-12 stalled in the full form and solved in the reduced one). So an
 auxiliary solve that is not SOLVED runs again in the other form
-(:func:`other_form`), and :func:`solved_again` solves the stalled problem itself
+(:func:`other_form`), then on the sparse path (:func:`_further_tries`), and
+:func:`solved_again` solves the stalled problem itself
 again there when no certificate was found, and then, if it stalls there too, at a
 larger rho, at a smaller one (fixed below the floor when the stalled run's rho sat
 there), and without equilibration. A forced ``kkt_backend`` keeps its form and gets the other tries.
@@ -45,7 +47,7 @@ there), and without equilibration. A forced ``kkt_backend`` keeps its form and g
 On the sparse path (a :attr:`fccqp.admm.Workspace.compressed` run) the auxiliary QPs
 are built with ``scipy.sparse`` and take the sparse path too, whatever their size;
 there is no other form to try there: an auxiliary solve that is not SOLVED runs again
-without equilibration (:func:`_second_try`), and the other tries stay on the sparse
+without equilibration (:func:`_further_tries`), and the other tries stay on the sparse
 path.
 """
 
@@ -120,6 +122,31 @@ def distance_problem(A: object, b: np.ndarray, lb: np.ndarray, ub: np.ndarray,
     ub_ext = np.concatenate([np.full(n, np.inf), ub[S]])
     moved = [dataclasses.replace(c, start=n + int(position[c.start])) for c in cones]
     return (P, np.zeros(n + s), A_ext, b, lb_ext, ub_ext, moved), S
+
+
+def row_norms(A: object) -> np.ndarray:
+    """The largest magnitude in each row of ``A`` (dense or CSC), 1 for a row with none.
+
+    When the least distance in the user's rows certifies nothing, it is tried again
+    with its rows divided by these: the affine set ``{x: A x = b}``, and so the
+    distance, does not depend on the rows' scale, while its QP does. Rows of 1e10 to
+    2e11 beside a friction cone capped through a boxed copy of its normal force
+    (infeasible by 8e-4) left the least-distance QP SOLVED_INACCURATE after 4000
+    iterations in every form, its multipliers 1e-14 short of its identity; divided, it
+    is solved in 24 and certifies. Not first: a friction cone pinned outside itself by
+    two rows, variables rescaled by 1e-8..1e8, is certified on the sparse path in the
+    user's rows and not in the divided ones."""
+    largest = abs(A).max(axis=1)
+    largest = np.asarray(largest.toarray() if sp.issparse(largest) else largest,
+                         dtype=np.float64).reshape(-1)
+    return np.where(largest > 0.0, largest, 1.0)
+
+
+def _divided(A: object, norms: np.ndarray) -> object:
+    """``A`` with each row divided by its entry of ``norms`` (CSC stays CSC)."""
+    if sp.issparse(A):
+        return sp.csc_matrix(sp.diags(1.0 / norms) @ A)
+    return A / norms[:, None]
 
 
 def relative_distance_problem(A: object, b: np.ndarray, lb: np.ndarray, ub: np.ndarray,
@@ -273,35 +300,45 @@ def _is_solved(result: object) -> bool:
     return result.status is Status.SOLVED
 
 
-def _second_try(settings: object, backend: str) -> object | None:
-    """``settings`` for solving an auxiliary problem again after a solve in ``backend``
-    gave no usable result: the other form (:func:`other_form`) on the dense path; on
-    the sparse path, which has one form, no equilibration (None when ``settings`` has
-    none already).
+def _further_tries(settings: object, backend: str) -> list:
+    """``settings`` for solving an auxiliary problem again, in order, after a solve in
+    ``backend`` gave no usable result: on the dense path the other form
+    (:func:`other_form`), then the sparse path; on the sparse path, which has one form,
+    no equilibration (nothing when ``settings`` has none already).
 
     The least-distance QP of a friction cone capped through a boxed copy of its
     normal force, beside two nearly parallel rows of 2e10, crawls in the full form
     once equilibrated (rho at its floor, 20000 iterations on the sparse path, never
     polished; ``ldl_full`` alike), where the reduced form solves it in 40 iterations;
     in the user's units the full form's final polish solves it (``ldl_full`` in 250
-    iterations, the sparse path at its 4000), and its certificate passes."""
+    iterations, the sparse path at its 4000), and its certificate passes. The
+    projection onto the rays of a second-order cone beside a box entry whose recession
+    cone pins it, in a null space of ``P`` and ``A`` of dimension 5 (``P``'s rows of
+    rank 9 with four singular values of 1e-14), has multipliers 5000 times the ray:
+    ADMM crawls in both dense forms (4000 iterations, the box missed by 4e-5, a cone
+    block 1e-2 off its apex), and the dense polish, regularized as the dense forms
+    are, puts that block on its boundary at 1e-11 where the multipliers ask its apex;
+    the sparse path's polish (qdldl, its own regularization) finds the apex, SOLVED
+    in 170 iterations."""
     if backend != "sparse":
-        return other_form(settings, backend)
-    return settings.replace(scaling=0) if settings.scaling else None
+        return [other_form(settings, backend), settings.replace(kkt_backend="sparse")]
+    return [settings.replace(scaling=0)] if settings.scaling else []
 
 
 def _solved(solver_type: type, settings: object, problem: tuple, deadline: float,
             usable: object = _is_solved) -> tuple:
     """``(result, iterations, factorizations)`` of an auxiliary ``problem``: solved with
-    ``settings`` by ``deadline``, and again (:func:`_second_try`) unless that result is
-    ``usable`` (by default: SOLVED); the counts are those of both solves."""
+    ``settings`` by ``deadline``, and again (:func:`_further_tries`, in turn) until a
+    result is ``usable`` (by default: SOLVED); the counts are those of every solve."""
     result = _auxiliary_solver(solver_type, settings, deadline).solve(*problem)
-    again_settings = None if usable(result) else _second_try(settings, result.backend)
-    if again_settings is None:
-        return result, result.iterations, result.factorizations
-    again = _auxiliary_solver(solver_type, again_settings, deadline).solve(*problem)
-    return (again, result.iterations + again.iterations,
-            result.factorizations + again.factorizations)
+    spent, factored = result.iterations, result.factorizations
+    tries = [] if usable(result) else _further_tries(settings, result.backend)
+    for again_settings in tries:
+        result = _auxiliary_solver(solver_type, again_settings, deadline).solve(*problem)
+        spent, factored = spent + result.iterations, factored + result.factorizations
+        if usable(result):
+            break
+    return result, spent, factored
 
 
 ANSWERS = (Status.SOLVED, Status.SOLVED_INACCURATE, Status.PRIMAL_INFEASIBLE,
@@ -499,8 +536,8 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
     certificate of the least distance (when there are rows and constrained entries),
     else with ``dual`` the dual one of the projection onto the rays, each judged by
     ``workspace`` (sparse QPs when it holds compressed columns). The auxiliary solves use
-    ``settings`` in a ``solver_type`` (:func:`_auxiliary_solver`) by ``deadline``, in a
-    second form when the first did not solve them (:func:`_solved`)."""
+    ``settings`` in a ``solver_type`` (:func:`_auxiliary_solver`) by ``deadline``, in
+    other forms when the first did not solve them (:func:`_solved`)."""
     q = np.asarray(q, dtype=np.float64).reshape(-1)
     n = q.shape[0]
     sparse = workspace.compressed
@@ -527,6 +564,14 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
                             solver_type, settings, workspace, relative, S, divisors, b,
                             lb, ub, deadline)
                         spent, factored = spent + iterations, factored + factorizations
+                norms = row_norms(A)
+                if found is None and np.any(norms != 1.0):
+                    divided, S = distance_problem(_divided(A, norms), b / norms, lb, ub,
+                                                  cones)
+                    found, _, iterations, factorizations = _distance_certificate(
+                        solver_type, settings, workspace, divided, S, norms, b, lb, ub,
+                        deadline)
+                    spent, factored = spent + iterations, factored + factorizations
                 if found is not None:
                     return Status.PRIMAL_INFEASIBLE, found, spent, factored
         if not dual:

@@ -17,6 +17,8 @@ cdef int equality_inconsistent(const Problem* p, const Iterates* it, double eps,
                                double* ATr, double* terms, double* sizes) noexcept nogil
 cdef int equality_direction(const Problem* p, const double* r, const double* x, double eps,
                             double* ATr, double* terms, double* sizes) noexcept nogil
+cdef bint zero_rows_inconsistent(const Problem* p, double* r, double* ones,
+                                 double* norms) noexcept nogil
 cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double* Pdx,
                           double* terms, double* block, double* weights,
                           double* rows) noexcept nogil

@@ -436,6 +436,32 @@ cdef int equality_direction(const Problem* p, const double* r, const double* x, 
     return SEPARATED
 
 
+cdef bint zero_rows_inconsistent(const Problem* p, double* r, double* ones,
+                                 double* norms) noexcept nogil:
+    """Whether a row of ``A`` with no nonzero entry asks ``b_i != 0``; then ``r`` (m) holds
+    ``b`` on those rows and 0 elsewhere, the equality certificate with ``A'r = 0`` exactly
+    and ``b'r = sum b_i^2 > 0`` (``ones``: n, ``norms``: m scratch; ``r`` is left alone
+    otherwise).
+
+    :func:`equality_direction` judges ``A'r ~ 0`` against the terms ``|A|'|r|``, to
+    which such a row adds nothing: the least-squares residual's rounding on the other
+    rows (1e-16 of their terms) then meets itself as both residual and terms, and no
+    cleaning shrinks the ratio (``A = [e_1; 0]``, ``b = (1, 1e-3)``: 4000 iterations at
+    ``A x = b`` missed by 1e-3, on every backend)."""
+    cdef Py_ssize_t i
+    cdef bint found = False
+    for i in range(p.n):
+        ones[i] = 1.0
+    row_spans(&p.A, ones, norms)
+    for i in range(p.m):
+        found = found or (norms[i] == 0.0 and p.b[i] != 0.0)
+    if not found:
+        return False
+    for i in range(p.m):
+        r[i] = p.b[i] if norms[i] == 0.0 else 0.0
+    return True
+
+
 cdef inline bint _near_zero(const Matrix* M, const double* dx, double dx_norm, double eps,
                             double* out, double* norms) noexcept nogil:
     """``M dx ~ 0`` (scaled) row by row: ``|M_i dx| <= eps ||M_i|| ||dx||`` with the row's

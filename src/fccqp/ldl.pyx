@@ -20,6 +20,7 @@ right-hand side (refined); :func:`ldl_solve_many` for several, unrefined (level-
 ``dsytrs2``); callers refine those.
 """
 
+from libc.float cimport DBL_EPSILON
 from libc.math cimport INFINITY, fabs
 
 from scipy.linalg.cython_lapack cimport dsytrf, dsytrs, dsytrs2
@@ -33,7 +34,10 @@ from fccqp.tuning cimport KKT_DELTA, KKT_REFINE_TOLERANCE, MAX_REFINE
 cdef int ldl_factor(LDL* f, const Problem* p, double sigma, const double* rho_vec) noexcept nogil:
     """Assemble the lower triangle of the regularized KKT matrix and factor it.
 
-    Returns the number of negative eigenvalues, or -1 if the factorization broke down.
+    Returns the number of negative eigenvalues, or -1 if the factorization broke down,
+    or if, without ``sigma`` (the reduced form's matrix), a pivot is zero to rounding
+    (:func:`_singular_pivot`): ``P + R`` is then singular on the null space of ``A``,
+    which the reduced form cannot iterate on.
     """
     cdef Py_ssize_t n = p.n, m = p.m, N = f.N, i, j, k
     cdef double* K = f.K
@@ -57,6 +61,8 @@ cdef int ldl_factor(LDL* f, const Problem* p, double sigma, const double* rho_ve
         return -1
     cdef int negative = 0
     cdef double a, c, d, det
+    if sigma == 0.0 and _singular_pivot(f):
+        return -1
     k = 0
     while k < N:
         if f.ipiv[k] > 0:
@@ -72,6 +78,32 @@ cdef int ldl_factor(LDL* f, const Problem* p, double sigma, const double* rho_ve
                 negative += 2
             k += 2
     return negative
+
+
+cdef bint _singular_pivot(const LDL* f) noexcept nogil:
+    """Whether a pivot of the factored ``D`` (a 1x1 one, or the smaller eigenvalue of a
+    2x2 block, ``det / max entry``) is below ``N^2`` units of rounding of the largest
+    pivot entry: the eigenvalue of a direction ``v`` with ``(P + R) v = 0`` and ``A v =
+    0``, which the matrix maps to 0 whatever its ``-delta`` block, left to rounding's sign.
+    An LP's free entries that the rows leave free (``P = 0``, no ``R`` on them) came out
+    positive by rounding, the inertia passed, and the reduced form's solves, multiplied
+    by the inverse of that pivot, diverged to 1e48 over 4000 iterations where the full
+    form, with ``sigma`` on every entry, solves in 12."""
+    cdef Py_ssize_t N = f.N, k = 0
+    cdef double largest = 0.0, smallest = INFINITY, a, c, d, size
+    cdef const double* K = f.K
+    while k < N:
+        if f.ipiv[k] > 0:
+            largest = max(largest, fabs(K[k + k * N]))
+            smallest = min(smallest, fabs(K[k + k * N]))
+            k += 1
+        else:
+            a, c, d = K[k + k * N], K[k + 1 + k * N], K[k + 1 + (k + 1) * N]
+            size = max(fabs(a), max(fabs(c), fabs(d)))
+            largest = max(largest, size)
+            smallest = min(smallest, fabs(a * d - c * c) / size if size > 0.0 else 0.0)
+            k += 2
+    return smallest <= N * N * DBL_EPSILON * largest
 
 
 cdef void _solve_one(LDL* f, double* rhs) noexcept nogil:

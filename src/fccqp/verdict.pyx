@@ -14,7 +14,8 @@ from fccqp._dense cimport copy, fill
 from fccqp._types cimport Iterates, Problem
 from fccqp.certificates cimport (CERTIFIED, REJECTED, SEPARATED, clean_primal_certificate,
                                  dual_infeasible, equality_direction, equality_inconsistent,
-                                 gram_factor, primal_infeasible, row_sizes)
+                                 gram_factor, primal_infeasible, row_sizes,
+                                 zero_rows_inconsistent)
 from fccqp.engine cimport (DUAL_INFEASIBLE, INACCURATE, MAX_ITER, NUMERICAL_ERROR,
                            PRIMAL_INFEASIBLE, RUNNING, SOLVED, TIME_LIMIT, Engine, Run,
                            fccqp_now)
@@ -181,7 +182,9 @@ cdef bint inconsistent(Engine* e, bint clean) noexcept nogil:
     regularized solve for ``(0, r)`` returns ``nu`` with ``-delta nu`` equal to the
     part of ``r`` in the null space of ``A'`` and the rest shrunk by ``delta /
     lambda`` (``lambda`` the eigenvalues of ``A H^-1 A'`` off that null space): the
-    first problem's ``rho`` fell to 1e-17, the second's to 7e-17."""
+    first problem's ``rho`` fell to 1e-17, the second's to 7e-17. Failing those, rows
+    of ``A`` with no nonzero entry that ask ``b_i != 0`` are the certificate
+    (:func:`fccqp.certificates.zero_rows_inconsistent`)."""
     cdef Problem* p = &e.prob
     cdef Py_ssize_t n = p.n, m = p.m, i
     cdef double* r = e.work.vec_m
@@ -195,7 +198,7 @@ cdef bint inconsistent(Engine* e, bint clean) noexcept nogil:
             r[i] = -e.work.sol[n + i]
         code = equality_direction(p, r, e.it.x, e.opt.eps_prim_inf, e.work.vec_n,
                                   e.work.vec_n2, e.work.vec_m2)
-    if code != CERTIFIED:
+    if code != CERTIFIED and not zero_rows_inconsistent(p, r, e.work.vec_n, e.work.vec_m2):
         return False
     fill(e.certs.cert, 0.0, n + m)
     for i in range(m):
