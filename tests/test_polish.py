@@ -316,23 +316,6 @@ def test_polish_gives_up_when_its_first_guesses_violate_a_bound():
     assert not four["ok"] and four["factorizations"] == FEASIBLE_PASSES
 
 
-def test_polish_gives_up_when_more_multipliers_are_wrong_than_its_guesses_can_release():
-    """``min 1/2 ||x - 1||^2`` over 20 entries in ``[0, 10]`` with ``sum x = 3``, from an
-    iterate that holds 19 of them at 0: the first guess's point violates nothing, but 18
-    held entries still pull up after the first release, more than ``HOPELESS_RATE`` (2)
-    times the guesses left. Releasing one a guess, the polish would end unsettled after
-    ``GUESS_PASSES`` guesses with 12 still wrong; it gives up at the second instead."""
-    n = 20
-    z = np.zeros(n)
-    z[0] = 1.0
-    y = np.full(n, -1.0)
-    y[0] = 0.0
-    polished = polish_point(np.eye(n), -np.ones(n), np.ones((1, n)), np.array([3.0]),
-                            np.zeros(n), np.full(n, 10.0), flatten_cones((), n), z,
-                            np.zeros(1), y, z)
-    assert not polished["ok"] and polished["factorizations"] == 2 < GUESS_PASSES
-
-
 def _contacts(targets, total, mu=0.5):
     """``min 1/2 ||f - targets||^2`` over friction cones (``mu``, flat normal), one per row
     of ``targets``, with the normal forces summing to ``total``; polished from an

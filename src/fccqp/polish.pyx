@@ -68,14 +68,14 @@ from fccqp.kkt cimport KKT
 from fccqp.matrices cimport CSC, DENSE
 from fccqp.polish_guess cimport (boundary_entries, box_code, cone_code, drop_far_side, guess,
                                  keep_bare_plane, leaves_set, linearize, most_wrong, past_apex,
-                                 renew, step_length, wrong_signed)
+                                 renew, step_length)
 from fccqp.polish_kkt cimport correct_once, kkt_residual, number_unknowns, refactor, refine
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.reduced cimport Reduced
 from fccqp.tuning cimport (CHORD_RATE, CHORD_STEPS, FEASIBLE_PASSES, GUESS_TOLERANCE,
-                           HOPELESS_RATE, MISS_FLOOR, NEWTON_TOLERANCE, POLISH_CSC_DELTA,
-                           POLISH_DELTA, POLISH_REFINE_TOLERANCE)
+                           MISS_FLOOR, NEWTON_TOLERANCE, POLISH_CSC_DELTA, POLISH_DELTA,
+                           POLISH_REFINE_TOLERANCE)
 
 cdef extern from "fccqp_clock.h" nogil:
     double fccqp_now()
@@ -319,14 +319,6 @@ cdef int _newton(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t* nb, lon
     return 0
 
 
-cdef inline bint _hopeless(Polish* w, const Problem* p, long passes) noexcept nogil:
-    """Whether a guess stepped to from a feasible point has more wrong-signed multipliers
-    (:func:`~fccqp.polish_guess.wrong_signed`) than ``HOPELESS_RATE`` times the guesses
-    left: the polish releases one a guess, and such polishes ran out of guesses unsettled
-    and were rejected on every tick measured (notes/polish.md, "coarse")."""
-    return wrong_signed(w, p) > HOPELESS_RATE * (w.guess_passes - passes)
-
-
 cdef bint polish_prepare(Polish* w, const Problem* p) noexcept nogil:
     """Set up the Schur-complement solve of :mod:`fccqp.polish_schur` for this solve's
     ``P`` and ``A``; True when it applies, and then polishing needs no table. Never on
@@ -386,10 +378,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     (at most one pass per block): where the cone multipliers are too small for ADMM to
     resolve (solo12, 1e-5), its guess has every block free and the polish finds the
     boundary blocks one or two a pass, kept at its fourth or fifth (notes/polish.md,
-    "polishmiss"). A polish stepping from a feasible point gives up too when its guess has
-    more wrong-signed multipliers than ``HOPELESS_RATE`` times the guesses left
-    (:func:`_hopeless`): releasing one a guess, it would end unsettled and be rejected.
-    False then, when a
+    "polishmiss"). False then, when a
     factorization breaks down or the result is not finite, or when the clock (:func:`fccqp_now`) has
     passed ``deadline`` before a guess after the first (``INFINITY``: never); otherwise
     the caller judges the point.
@@ -435,8 +424,6 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
             return False
         _multipliers(w, p, nf, nb)
         passes += 1
-        if feasible and passes < w.guess_passes and _hopeless(w, p, passes):
-            return False
         if passes == w.guess_passes or w.cycling:   # not settled: the caller judges this point
             if most_wrong(w, p) >= 0 or leaves_set(w, p):   # not its point: as it is
                 if not tabled:

@@ -31,7 +31,6 @@ cdef Py_ssize_t guess(Polish* w, const Problem* p, const double* z, const double
                       Py_ssize_t* changed) noexcept nogil
 cdef void keep_bare_plane(Polish* w, const Problem* p, Py_ssize_t k) noexcept nogil
 cdef Py_ssize_t most_wrong(Polish* w, const Problem* p) noexcept nogil
-cdef Py_ssize_t wrong_signed(Polish* w, const Problem* p) noexcept nogil
 cdef double step_length(Polish* w, const Problem* p, Py_ssize_t* blocking) noexcept nogil
 cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
                       const double* ahead, Py_ssize_t* changed) noexcept nogil
