@@ -187,10 +187,11 @@ cdef int _residual_tests(const Problem* p, const double* x, const double* d_nu,
     # For every x with A x = b and x_S in C, b'd_nu + sigma_C(d_y) >= (A'd_nu + d_y)'x: a
     # separation no larger than what the residual explains at the iterate's own x proves
     # nothing (dependent rows let d_nu drift along null(A') with b'd_nu ~ 0), nor one
-    # that the residual's products with the box's bounds reach (:func:`_box_reach`)
+    # that its products reach with the box's bounds or the data's scale (:func:`_reach`,
+    # last: it reads all of A; ``terms`` is its scratch)
     if (lhs_max <= eps * terms_max and support < -explained
-            and support < -_box_reach(p, lhs)
-            and DOMINANCE * lhs_max * size <= -support * terms_max):
+            and DOMINANCE * lhs_max * size <= -support * terms_max
+            and support < -_reach(p, lhs, terms)):
         return CERTIFIED
     return SEPARATED
 
@@ -253,24 +254,58 @@ cdef double _largest_row_norm(const Problem* p, double* ones, double* norms) noe
     return largest
 
 
-cdef double _box_reach(const Problem* p, const double* lhs) noexcept nogil:
-    """``sigma_box(-lhs)`` over the box entries' finite sides (scaled): the most that
-    ``-lhs'x`` reaches with ``x`` in the box, which a primal certificate's separation
-    must exceed, as ``tests/verify.py`` asks. At a point alone the residual's products
-    proved too little: with columns scaled over 1e16 (bounds up to 4e7), feasible
-    problems had certificates whose residual was 3e-9 of its terms (a least distance's)
-    or 1e-13 (ADMM's own) and reached 23 and 45 times their separation in the box."""
+cdef double _reach(const Problem* p, const double* lhs, double* scales) noexcept nogil:
+    """The most that ``-lhs'x`` reaches at a point the data make plausible, which a
+    primal certificate's separation must exceed, whatever the iterate: on a box entry
+    with a finite side in the residual's direction the side itself (``sigma_box(-lhs)``,
+    a bound that holds at every feasible point, as ``tests/verify.py`` asks), on any
+    other entry (free, in a cone, or unbounded that way) :func:`_column_scales`' ``x_i``
+    (``scales``: n scratch). At the iterate alone the residual's products proved too
+    little: with columns scaled over 1e16 (bounds up to 4e7), feasible problems had
+    certificates whose residual was 3e-9 of its terms (a least distance's) or 1e-13
+    (ADMM's own) and reached 23 and 45 times their separation in the box; and one whose
+    residual on a cone's columns was their own size (1e-7 of the largest terms) explained
+    0.07 of its separation at an iterate 20 times smaller there than a feasible point."""
     cdef Py_ssize_t i, j
     cdef double reach = 0.0
+    _column_scales(p, scales)
     for j in range(p.s):
         if p.in_cone[j]:
             continue
         i = p.constrained[j]
         if lhs[i] < 0.0 and isfinite(p.hi[j]):
             reach -= lhs[i] * p.hi[j]
+            scales[i] = 0.0
         elif lhs[i] > 0.0 and isfinite(p.lo[j]):
             reach -= lhs[i] * p.lo[j]
+            scales[i] = 0.0
+    for i in range(p.n):
+        reach += fabs(lhs[i]) * scales[i]
     return reach
+
+
+cdef void _column_scales(const Problem* p, double* scales) noexcept nogil:
+    """``scales_i = max |b| / max_k |A_ki|`` (0 for an empty column): the size of ``x_i``
+    that meets the largest right-hand side with column ``i`` alone, the scale of a
+    feasible point's entry where no bound limits it (an iterate far from feasibility can
+    be orders of magnitude off it)."""
+    cdef const Matrix* A = &p.A
+    cdef Py_ssize_t i, k
+    cdef double b_max = 0.0
+    for k in range(p.m):
+        b_max = max(b_max, fabs(p.b[k]))
+    for i in range(p.n):
+        scales[i] = 0.0
+    if A.kind == DENSE:
+        for k in range(A.rows):
+            for i in range(A.cols):
+                scales[i] = max(scales[i], fabs(A.values[k * A.cols + i]))
+    else:
+        for i in range(A.cols):
+            for k in range(A.colptr[i], A.colptr[i + 1]):
+                scales[i] = max(scales[i], fabs(A.values[k]))
+    for i in range(p.n):
+        scales[i] = b_max / scales[i] if scales[i] > 0.0 else 0.0
 
 
 cdef bint gram_factor(const Problem* p, void* sparse, double* gram) noexcept nogil:
