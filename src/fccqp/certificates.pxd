@@ -11,8 +11,9 @@ cdef int primal_infeasible(const Problem* p, const Iterates* it, double eps, con
                            double* row_norm, double* d_nu, double* d_y, double* lhs,
                            double* terms) noexcept nogil
 
-cdef int primal_candidate(const Problem* p, const double* x, const double* d_nu,
-                          double* d_y, double eps, double* lhs, double* terms) noexcept nogil
+cdef int primal_candidate(const Problem* p, const double* x, bint at_iterate,
+                          const double* d_nu, double* d_y, double eps, double* lhs,
+                          double* terms) noexcept nogil
 cdef int equality_inconsistent(const Problem* p, const Iterates* it, double eps, double* r,
                                double* ATr, double* terms, double* sizes) noexcept nogil
 cdef int equality_direction(const Problem* p, const double* r, const double* x, double eps,

@@ -36,7 +36,7 @@ has no solution. The dual certificate keeps ``q'dx < -eps |q|'|dx|``.
 from libc.math cimport INFINITY, fabs, isfinite, sqrt
 
 from fccqp._blas cimport cholesky, cholesky_solve_vector, syrk_t
-from fccqp._dense cimport copy
+from fccqp._dense cimport copy, fill
 from fccqp._types cimport Iterates, Problem
 from fccqp.kkt_sparse cimport sparse_gram_factor, sparse_gram_solve
 from fccqp.matrices cimport (CSC, DENSE, Matrix, abs_product, product, product_row_norms,
@@ -95,15 +95,17 @@ cdef int primal_infeasible(const Problem* p, const Iterates* it, double eps, con
     if Ax != NULL and _explained_at_iterate(p, it.x, Ax, row_norm, d_nu, d_y, support,
                                             lhs, terms):
         return SEPARATED
-    return _residual_tests(p, it.x, d_nu, d_y, eps, support, size, lhs, terms)
+    return _residual_tests(p, it.x, True, d_nu, d_y, eps, support, size, lhs, terms)
 
 
-cdef int primal_candidate(const Problem* p, const double* x, const double* d_nu,
-                          double* d_y, double eps, double* lhs, double* terms) noexcept nogil:
+cdef int primal_candidate(const Problem* p, const double* x, bint at_iterate,
+                          const double* d_nu, double* d_y, double eps, double* lhs,
+                          double* terms) noexcept nogil:
     """:func:`primal_infeasible`'s tests on a candidate ``(d_nu, d_y)`` found otherwise
-    (scaled; ``d_y`` is projected onto the polar first), at the iterate ``x``."""
+    (scaled; ``d_y`` is projected onto the polar first), at ``x``: the iterate, or
+    (``at_iterate`` false) the solution of the problem that found the candidate."""
     _onto_polar(p, d_y, terms)
-    return _farkas(p, x, d_nu, d_y, eps, lhs, terms)
+    return _farkas(p, x, at_iterate, d_nu, d_y, eps, lhs, terms)
 
 
 cdef void _onto_polar(const Problem* p, double* d_y, double* scratch) noexcept nogil:
@@ -133,16 +135,16 @@ cdef void _shrink(const Problem* p, double* d_y, double tau, double* scratch) no
         d_y[j] -= min(max(d_y[j], low), high)
 
 
-cdef int _farkas(const Problem* p, const double* x, const double* d_nu, const double* d_y,
-                 double eps, double* lhs, double* terms) noexcept nogil:
+cdef int _farkas(const Problem* p, const double* x, bint at_iterate, const double* d_nu,
+                 const double* d_y, double eps, double* lhs, double* terms) noexcept nogil:
     """The tests of a primal certificate ``(d_nu, d_y)`` with ``d_y`` on the polar (see
-    the module docstring), at the iterate ``x``, as :func:`primal_infeasible` returns
-    them (``lhs``, ``terms``: n scratch)."""
+    the module docstring), at ``x`` (see :func:`_residual_tests`), as
+    :func:`primal_infeasible` returns them (``lhs``, ``terms``: n scratch)."""
     cdef double size
     cdef double support = _separation(p, d_nu, d_y, &size)
     if not (support < -SEPARATION_FLOOR * size) or not isfinite(support):
         return REJECTED
-    return _residual_tests(p, x, d_nu, d_y, eps, support, size, lhs, terms)
+    return _residual_tests(p, x, at_iterate, d_nu, d_y, eps, support, size, lhs, terms)
 
 
 cdef double _separation(const Problem* p, const double* d_nu, const double* d_y,
@@ -167,12 +169,16 @@ cdef double _separation(const Problem* p, const double* d_nu, const double* d_y,
     return support
 
 
-cdef int _residual_tests(const Problem* p, const double* x, const double* d_nu,
-                         const double* d_y, double eps, double support, double size,
-                         double* lhs, double* terms) noexcept nogil:
+cdef int _residual_tests(const Problem* p, const double* x, bint at_iterate,
+                         const double* d_nu, const double* d_y, double eps, double support,
+                         double size, double* lhs, double* terms) noexcept nogil:
     """The tests of a candidate that separates by ``support`` (its terms' magnitudes
     ``size``) on its residual ``A'd_nu + E_S d_y``: ``CERTIFIED`` or ``SEPARATED``
-    (``lhs``, ``terms``: n scratch)."""
+    (``lhs``, ``terms``: n scratch). What the residual explains is measured at ``x``; at
+    ADMM's iterate (``at_iterate``), which can lie far from every feasible point, also
+    at the data's scale (:func:`_reach`); a least distance's solution is the point of
+    the box and cones nearest to meeting the rows, where the residual's products are
+    those of its own identity."""
     cdef Py_ssize_t n = p.n, i, j
     cdef double lhs_max = 0.0, terms_max = 0.0, explained = 0.0
     product_t_terms(&p.A, d_nu, lhs, terms)
@@ -191,7 +197,7 @@ cdef int _residual_tests(const Problem* p, const double* x, const double* d_nu,
     # last: it reads all of A; ``terms`` is its scratch)
     if (lhs_max <= eps * terms_max and support < -explained
             and DOMINANCE * lhs_max * size <= -support * terms_max
-            and support < -_reach(p, lhs, terms)):
+            and support < -_reach(p, lhs, at_iterate, terms)):
         return CERTIFIED
     return SEPARATED
 
@@ -254,13 +260,14 @@ cdef double _largest_row_norm(const Problem* p, double* ones, double* norms) noe
     return largest
 
 
-cdef double _reach(const Problem* p, const double* lhs, double* scales) noexcept nogil:
+cdef double _reach(const Problem* p, const double* lhs, bint at_iterate,
+                   double* scales) noexcept nogil:
     """The most that ``-lhs'x`` reaches at a point the data make plausible, which a
     primal certificate's separation must exceed, whatever the iterate: on a box entry
     with a finite side in the residual's direction the side itself (``sigma_box(-lhs)``,
     a bound that holds at every feasible point, as ``tests/verify.py`` asks), on any
     other entry (free, in a cone, or unbounded that way) :func:`_column_scales`' ``x_i``
-    (``scales``: n scratch). At the iterate alone the residual's products proved too
+    when ``at_iterate``, else nothing (``scales``: n scratch). At the iterate alone the residual's products proved too
     little: with columns scaled over 1e16 (bounds up to 4e7), feasible problems had
     certificates whose residual was 3e-9 of its terms (a least distance's) or 1e-13
     (ADMM's own) and reached 23 and 45 times their separation in the box; and one whose
@@ -268,7 +275,10 @@ cdef double _reach(const Problem* p, const double* lhs, double* scales) noexcept
     0.07 of its separation at an iterate 20 times smaller there than a feasible point."""
     cdef Py_ssize_t i, j
     cdef double reach = 0.0
-    _column_scales(p, scales)
+    if at_iterate:
+        _column_scales(p, scales)
+    else:
+        fill(scales, 0.0, p.n)
     for j in range(p.s):
         if p.in_cone[j]:
             continue
@@ -412,7 +422,7 @@ cdef bint _alternate(const Problem* p, const double* x, const double* gram, void
             d_y[j] = -w[p.constrained[j]]
             size = max(size, fabs(d_y[j]))
         _shrink(p, d_y, shrink * size, terms)
-        code = _farkas(p, x, d_nu, d_y, eps, lhs, terms)
+        code = _farkas(p, x, True, d_nu, d_y, eps, lhs, terms)
         if code == CERTIFIED:
             return True
         # two passes in a row that do not even separate: the candidate of a feasible
