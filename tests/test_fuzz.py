@@ -45,8 +45,10 @@ where the dual residual crawls, which the retry from a smaller rho answers; extr
 stalled with the step mostly unmade; extreme_data 2500125 a free entry in units of 1e-8
 whose columns lay below ``MIN_NORM``, which the equilibration left unscaled: its scaled
 curvature, 2.5e-18, stalled ADMM and the polish 3e6 short of the optimum; solver_reuse
-4700367 a ray step that Clarabel calls solved, judged against its construction; issues
-26 and 28)."""
+4700367 a ray step that Clarabel calls solved, judged against its construction;
+extreme_data 4700352 columns of 1e-10 to 1e6 beside ``P`` of 7.5e13, an optimum by
+construction, whose run's candidate passed at its iterate though its residual reaches
+its separation at the data's scale; issues 26 and 28)."""
 
 SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),
@@ -91,18 +93,11 @@ kept here: SOLVED at the start on an infeasible problem (a friction cone pinned 
 itself by 1e-3, variables rescaled 1e-8..1e8) while ``POLISH_CSC_DELTA`` was 1e-9,
 certified since."""
 
-OPEN: dict[str, str] = {
-    "extreme_data:4700352": (
-        "columns of 1e-10 to 1e6 beside P of 7.5e13, an optimum by construction: "
-        "PRIMAL_INFEASIBLE on every backend, whose certificate's residual A'dy + dz, "
-        "small against its largest terms, explains its separation at a feasible point "
-        "though not at the run's iterate"),
-}
+OPEN: dict[str, str] = {}
 """Reproducers of mechanisms still open (issues 26 and 28), each the reason it fails:
 expected to fail (strictly) on the backends of :data:`OPEN_BACKENDS`, so that a fix
 turns them red."""
-OPEN_BACKENDS: dict[str, tuple[str, ...]] = {
-    "extreme_data:4700352": ("auto", "schur_reduced", "ldl_reduced", "ldl_full", "sparse")}
+OPEN_BACKENDS: dict[str, tuple[str, ...]] = {}
 """Where an open case fails."""
 
 ROUNDING_DEPENDENT: dict[str, tuple[tuple[str, ...], str]] = {}

@@ -74,7 +74,8 @@ cdef int primal_infeasible(const Problem* p, const Iterates* it, double eps, con
                            double* row_norm, double* d_nu, double* d_y, double* lhs,
                            double* terms) noexcept nogil:
     """Test ``(nu - nu_prev, y - y_prev)``: ``CERTIFIED``, ``SEPARATED`` when it separates
-    but its residual is too large (:func:`clean_primal_certificate` may pass it), else
+    but its residual is too large (:func:`clean_primal_certificate` may pass it),
+    ``WEAK`` when only the data's scale refutes it (:func:`_residual_tests`), else
     ``REJECTED``. ``Ax`` is ``A x`` at the iterate as the residuals formed it (NULL when
     not at hand) and ``row_norm`` the largest row 1-norm of ``A`` (negative until
     :func:`_explained_at_iterate` first needs it in a solve, which then sets it): with
@@ -173,12 +174,14 @@ cdef int _residual_tests(const Problem* p, const double* x, bint at_iterate,
                          const double* d_nu, const double* d_y, double eps, double support,
                          double size, double* lhs, double* terms) noexcept nogil:
     """The tests of a candidate that separates by ``support`` (its terms' magnitudes
-    ``size``) on its residual ``A'd_nu + E_S d_y``: ``CERTIFIED`` or ``SEPARATED``
-    (``lhs``, ``terms``: n scratch). What the residual explains is measured at ``x``; at
-    ADMM's iterate (``at_iterate``), which can lie far from every feasible point, also
-    at the data's scale (:func:`_reach`); a least distance's solution is the point of
-    the box and cones nearest to meeting the rows, where the residual's products are
-    those of its own identity."""
+    ``size``) on its residual ``A'd_nu + E_S d_y``: ``CERTIFIED``, ``WEAK`` or ``SEPARATED``
+    (``lhs``, ``terms``: n scratch). What the residual explains is measured at ``x``
+    and over the box (:func:`_reach`); at ADMM's iterate (``at_iterate``), which can lie
+    far from every feasible point, also at the data's scale, and a candidate that only
+    this last test rejects is ``WEAK`` (:func:`fccqp.verdict.check` certifies it only
+    at the run's last check, where no point was found). A least distance's solution
+    is the point of the box and cones nearest to meeting the rows, where the residual's
+    products are those of its own identity."""
     cdef Py_ssize_t n = p.n, i, j
     cdef double lhs_max = 0.0, terms_max = 0.0, explained = 0.0
     product_t_terms(&p.A, d_nu, lhs, terms)
@@ -195,11 +198,13 @@ cdef int _residual_tests(const Problem* p, const double* x, bint at_iterate,
     # nothing (dependent rows let d_nu drift along null(A') with b'd_nu ~ 0), nor one
     # that its products reach with the box's bounds or the data's scale (:func:`_reach`,
     # last: it reads all of A; ``terms`` is its scratch)
-    if (lhs_max <= eps * terms_max and support < -explained
+    if not (lhs_max <= eps * terms_max and support < -explained
             and DOMINANCE * lhs_max * size <= -support * terms_max
-            and support < -_reach(p, lhs, at_iterate, terms)):
-        return CERTIFIED
-    return SEPARATED
+            and support < -_reach(p, lhs, False, terms)):
+        return SEPARATED
+    if at_iterate and not support < -_reach(p, lhs, True, terms):
+        return WEAK
+    return CERTIFIED
 
 
 cdef double ROUNDING = 4.5e-16
@@ -260,14 +265,14 @@ cdef double _largest_row_norm(const Problem* p, double* ones, double* norms) noe
     return largest
 
 
-cdef double _reach(const Problem* p, const double* lhs, bint at_iterate,
+cdef double _reach(const Problem* p, const double* lhs, bint data_scale,
                    double* scales) noexcept nogil:
     """The most that ``-lhs'x`` reaches at a point the data make plausible, which a
     primal certificate's separation must exceed, whatever the iterate: on a box entry
     with a finite side in the residual's direction the side itself (``sigma_box(-lhs)``,
     a bound that holds at every feasible point, as ``tests/verify.py`` asks), on any
     other entry (free, in a cone, or unbounded that way) :func:`_column_scales`' ``x_i``
-    when ``at_iterate``, else nothing (``scales``: n scratch). At the iterate alone the residual's products proved too
+    with ``data_scale``, else nothing (``scales``: n scratch). At the iterate alone the residual's products proved too
     little: with columns scaled over 1e16 (bounds up to 4e7), feasible problems had
     certificates whose residual was 3e-9 of its terms (a least distance's) or 1e-13
     (ADMM's own) and reached 23 and 45 times their separation in the box; and one whose
@@ -275,7 +280,7 @@ cdef double _reach(const Problem* p, const double* lhs, bint at_iterate,
     0.07 of its separation at an iterate 20 times smaller there than a feasible point."""
     cdef Py_ssize_t i, j
     cdef double reach = 0.0
-    if at_iterate:
+    if data_scale:
         _column_scales(p, scales)
     else:
         fill(scales, 0.0, p.n)
@@ -357,17 +362,18 @@ cdef bint regularized_cholesky(double* gram, Py_ssize_t m) noexcept nogil:
     return cholesky(gram, <int>m, <int>m)
 
 
-cdef bint clean_primal_certificate(const Problem* p, const double* x, const double* gram,
-                                   void* sparse, double eps, double* d_nu, double* d_y,
-                                   double* saved, double* w, double* lhs,
-                                   double* terms) noexcept nogil:
+cdef int clean_primal_certificate(const Problem* p, const double* x, const double* gram,
+                                  void* sparse, double eps, double* d_nu, double* d_y,
+                                  double* saved, double* w, double* lhs,
+                                  double* terms) noexcept nogil:
     """Clean the candidate ``(d_nu, d_y)`` that :func:`primal_infeasible` left by
     alternating steps between the subspace ``A'd_nu + E_S'd_y = 0`` (``d_nu`` by least
     squares on :func:`gram_factor`'s factor, in ``gram`` or ``sparse``) and the polar
     (``d_y := -(A'd_nu)_S`` projected): ``CLEANING_PASSES`` plain projections, then as
     many again from the candidate with each projection preceded by :func:`_shrink`'s
-    proximal step on the box's support. True, with the certificate in ``(d_nu, d_y)``,
-    as soon as a pass's pair passes the tests (``saved``: m + s, ``w``, ``lhs``,
+    proximal step on the box's support. ``CERTIFIED`` (or ``WEAK``, see
+    :func:`_residual_tests`), with the certificate in ``(d_nu, d_y)``, as soon as a
+    pass's pair passes the tests, else ``REJECTED`` (``saved``: m + s, ``w``, ``lhs``,
     ``terms``: n scratch).
 
     On a curved cone boundary the differences of ADMM's multipliers reach the set of
@@ -381,6 +387,7 @@ cdef bint clean_primal_certificate(const Problem* p, const double* x, const doub
     a boxed entry kept a multiplier that only costs, which the shrinking removes."""
     cdef Py_ssize_t m = p.m, s = p.s, j
     cdef double bounds = 0.0
+    cdef int code
     for j in range(s):
         if not p.in_cone[j]:
             if isfinite(p.lo[j]):
@@ -389,23 +396,23 @@ cdef bint clean_primal_certificate(const Problem* p, const double* x, const doub
                 bounds = max(bounds, fabs(p.hi[j]))
     copy(d_nu, saved, m)
     copy(d_y, saved + m, s)
-    if _alternate(p, x, gram, sparse, eps, 0.0, d_nu, d_y, w, lhs, terms):
-        return True
-    if bounds == 0.0:
-        return False
+    code = _alternate(p, x, gram, sparse, eps, 0.0, d_nu, d_y, w, lhs, terms)
+    if code != REJECTED or bounds == 0.0:
+        return code
     copy(saved, d_nu, m)
     copy(saved + m, d_y, s)
     return _alternate(p, x, gram, sparse, eps, CLEANING_SHRINK / bounds, d_nu, d_y, w, lhs,
                       terms)
 
 
-cdef bint _alternate(const Problem* p, const double* x, const double* gram, void* sparse,
-                     double eps, double shrink, double* d_nu, double* d_y, double* w,
-                     double* lhs, double* terms) noexcept nogil:
+cdef int _alternate(const Problem* p, const double* x, const double* gram, void* sparse,
+                    double eps, double shrink, double* d_nu, double* d_y, double* w,
+                    double* lhs, double* terms) noexcept nogil:
     """At most ``CLEANING_PASSES`` passes of :func:`clean_primal_certificate`, each
     subspace step followed by :func:`_shrink` with ``tau = shrink ||d_y||`` (``tau = 0``:
-    the plain projection onto the polar) and the tests; stops after two passes in a
-    row that do not separate."""
+    the plain projection onto the polar) and the tests: the first pass's ``CERTIFIED``
+    or ``WEAK`` code, else ``REJECTED``; stops after two passes in a row that do not
+    separate."""
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j, pass_
     cdef double size
     cdef int code, rejected = 0
@@ -423,15 +430,15 @@ cdef bint _alternate(const Problem* p, const double* x, const double* gram, void
             size = max(size, fabs(d_y[j]))
         _shrink(p, d_y, shrink * size, terms)
         code = _farkas(p, x, True, d_nu, d_y, eps, lhs, terms)
-        if code == CERTIFIED:
-            return True
+        if code == CERTIFIED or code == WEAK:
+            return code
         # two passes in a row that do not even separate: the candidate of a feasible
         # problem (on go2's controller ticks the full rounds cost 2.6 % of the warm
         # solves' instructions)
         rejected = rejected + 1 if code == REJECTED else 0
         if rejected == 2:
-            return False
-    return False
+            return REJECTED
+    return REJECTED
 
 
 cdef int equality_inconsistent(const Problem* p, const Iterates* it, double eps, double* r,
