@@ -36,7 +36,7 @@ has no solution. The dual certificate keeps ``q'dx < -eps |q|'|dx|``.
 from libc.math cimport INFINITY, fabs, isfinite, sqrt
 
 from fccqp._blas cimport cholesky, cholesky_solve_vector, syrk_t
-from fccqp._dense cimport copy, fill
+from fccqp._dense cimport copy
 from fccqp._types cimport Iterates, Problem
 from fccqp.kkt_sparse cimport sparse_gram_factor, sparse_gram_solve
 from fccqp.matrices cimport (CSC, DENSE, Matrix, abs_product, product, product_row_norms,
@@ -174,11 +174,12 @@ cdef int _residual_tests(const Problem* p, const double* x, bint at_iterate,
                          const double* d_nu, const double* d_y, double eps, double support,
                          double size, double* lhs, double* terms) noexcept nogil:
     """The tests of a candidate that separates by ``support`` (its terms' magnitudes
-    ``size``) on its residual ``A'd_nu + E_S d_y``: ``CERTIFIED``, ``WEAK`` or ``SEPARATED``
+    ``size``) on its residual ``A'd_nu + E_S d_y``: ``CERTIFIED``, ``WEAK`` or
+    ``SEPARATED``
     (``lhs``, ``terms``: n scratch). What the residual explains is measured at ``x``
-    and over the box (:func:`_reach`); at ADMM's iterate (``at_iterate``), which can lie
-    far from every feasible point, also at the data's scale, and a candidate that only
-    this last test rejects is ``WEAK`` (:func:`fccqp.verdict.check` certifies it only
+    and over the box; at ADMM's iterate (``at_iterate``), which can lie far from every
+    feasible point, also at the data's scale, and a candidate that only this last test
+    rejects is ``WEAK`` (:func:`fccqp.verdict.check` certifies it only
     at the run's last check, where no point was found). A least distance's solution
     is the point of the box and cones nearest to meeting the rows, where the residual's
     products are those of its own identity."""
@@ -196,13 +197,14 @@ cdef int _residual_tests(const Problem* p, const double* x, bint at_iterate,
     # For every x with A x = b and x_S in C, b'd_nu + sigma_C(d_y) >= (A'd_nu + d_y)'x: a
     # separation no larger than what the residual explains at the iterate's own x proves
     # nothing (dependent rows let d_nu drift along null(A') with b'd_nu ~ 0), nor one
-    # that its products reach with the box's bounds or the data's scale (:func:`_reach`,
-    # last: it reads all of A; ``terms`` is its scratch)
+    # that the residual's products with the box's bounds reach (:func:`_box_reach`), nor,
+    # at an iterate, with the data's scale (:func:`_scale_reach`, last: it reads all of A;
+    # ``terms`` is its scratch)
     if not (lhs_max <= eps * terms_max and support < -explained
-            and DOMINANCE * lhs_max * size <= -support * terms_max
-            and support < -_reach(p, lhs, False, terms)):
+            and support < -_box_reach(p, lhs)
+            and DOMINANCE * lhs_max * size <= -support * terms_max):
         return SEPARATED
-    if at_iterate and not support < -_reach(p, lhs, True, terms):
+    if at_iterate and not support < -_box_reach(p, lhs) - _scale_reach(p, lhs, terms):
         return WEAK
     return CERTIFIED
 
@@ -265,34 +267,43 @@ cdef double _largest_row_norm(const Problem* p, double* ones, double* norms) noe
     return largest
 
 
-cdef double _reach(const Problem* p, const double* lhs, bint data_scale,
-                   double* scales) noexcept nogil:
-    """The most that ``-lhs'x`` reaches at a point the data make plausible, which a
-    primal certificate's separation must exceed, whatever the iterate: on a box entry
-    with a finite side in the residual's direction the side itself (``sigma_box(-lhs)``,
-    a bound that holds at every feasible point, as ``tests/verify.py`` asks), on any
-    other entry (free, in a cone, or unbounded that way) :func:`_column_scales`' ``x_i``
-    with ``data_scale``, else nothing (``scales``: n scratch). At the iterate alone the residual's products proved too
-    little: with columns scaled over 1e16 (bounds up to 4e7), feasible problems had
-    certificates whose residual was 3e-9 of its terms (a least distance's) or 1e-13
-    (ADMM's own) and reached 23 and 45 times their separation in the box; and one whose
-    residual on a cone's columns was their own size (1e-7 of the largest terms) explained
-    0.07 of its separation at an iterate 20 times smaller there than a feasible point."""
+cdef double _box_reach(const Problem* p, const double* lhs) noexcept nogil:
+    """``sigma_box(-lhs)`` over the box entries' finite sides (scaled): the most that
+    ``-lhs'x`` reaches with ``x`` in the box, which a primal certificate's separation
+    must exceed, as ``tests/verify.py`` asks. At a point alone the residual's products
+    proved too little: with columns scaled over 1e16 (bounds up to 4e7), feasible
+    problems had certificates whose residual was 3e-9 of its terms (a least distance's)
+    or 1e-13 (ADMM's own) and reached 23 and 45 times their separation in the box."""
     cdef Py_ssize_t i, j
     cdef double reach = 0.0
-    if data_scale:
-        _column_scales(p, scales)
-    else:
-        fill(scales, 0.0, p.n)
     for j in range(p.s):
         if p.in_cone[j]:
             continue
         i = p.constrained[j]
         if lhs[i] < 0.0 and isfinite(p.hi[j]):
             reach -= lhs[i] * p.hi[j]
-            scales[i] = 0.0
         elif lhs[i] > 0.0 and isfinite(p.lo[j]):
             reach -= lhs[i] * p.lo[j]
+    return reach
+
+
+cdef double _scale_reach(const Problem* p, const double* lhs, double* scales) noexcept nogil:
+    """``sum_i |lhs_i| scales_i`` over the entries whose products with ``lhs`` no finite
+    bound limits (free, in a cone, or a box entry unbounded in the residual's direction;
+    :func:`_box_reach` bounds the others), at :func:`_column_scales`' ``x_i``
+    (``scales``: n scratch): what the residual explains at a point of the data's scale,
+    whatever the iterate. At the iterate alone, a feasible problem's candidate whose
+    residual on a cone's columns was their own size (1e-7 of the largest terms)
+    explained 0.07 of its separation, where that cone's entries were 20 times smaller
+    than at the optimum (3.8 times it at the data's scale, 1.16 at the optimum)."""
+    cdef Py_ssize_t i, j
+    cdef double reach = 0.0
+    _column_scales(p, scales)
+    for j in range(p.s):
+        if p.in_cone[j]:
+            continue
+        i = p.constrained[j]
+        if (lhs[i] < 0.0 and isfinite(p.hi[j])) or (lhs[i] > 0.0 and isfinite(p.lo[j])):
             scales[i] = 0.0
     for i in range(p.n):
         reach += fabs(lhs[i]) * scales[i]
