@@ -175,13 +175,12 @@ cdef int _residual_tests(const Problem* p, const double* x, bint at_iterate,
                          double size, double* lhs, double* terms) noexcept nogil:
     """The tests of a candidate that separates by ``support`` (its terms' magnitudes
     ``size``) on its residual ``A'd_nu + E_S d_y``: ``CERTIFIED``, ``WEAK`` or
-    ``SEPARATED``
-    (``lhs``, ``terms``: n scratch). What the residual explains is measured at ``x``
-    and over the box; at ADMM's iterate (``at_iterate``), which can lie far from every
-    feasible point, also at the data's scale, and a candidate that only this last test
-    rejects is ``WEAK`` (:func:`fccqp.verdict.check` certifies it only
-    at the run's last check, where no point was found). A least distance's solution
-    is the point of the box and cones nearest to meeting the rows, where the residual's
+    ``SEPARATED`` (``lhs``, ``terms``: n scratch). What the residual explains is
+    measured at ``x`` and over the box; at ADMM's iterate (``at_iterate``), which can lie
+    far from every feasible point, also at the data's scale, and a candidate that only
+    this last test rejects is ``WEAK`` (:func:`fccqp.verdict.check` certifies it only at
+    the run's last check, where no point was found). A least distance's solution is the
+    point of the box and cones nearest to meeting the rows, where the residual's
     products are those of its own identity."""
     cdef Py_ssize_t n = p.n, i, j
     cdef double lhs_max = 0.0, terms_max = 0.0, explained = 0.0
