@@ -56,7 +56,9 @@ least-distance QP stalled until its rows were divided by their largest entries;
 dual_infeasible 5300159 a ray whose projection needs multipliers 5000 times the ray,
 which only the sparse path's polish answers; degenerate 102753 and 104299 LPs whose rows
 leave free entries free, on which a forced reduced form diverged (its LDL' pivot of that
-direction positive by rounding); issues 26 and 28)."""
+direction positive by rounding); extreme_data 4700352 columns of 1e-10 to 1e6 beside
+``P`` of 7.5e13, an optimum by construction, whose run's candidate passed at its iterate
+though its residual reaches its separation at the data's scale; issues 26 and 28)."""
 
 SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),
@@ -102,18 +104,11 @@ kept here: SOLVED at the start on an infeasible problem (a friction cone pinned 
 itself by 1e-3, variables rescaled 1e-8..1e8) while ``POLISH_CSC_DELTA`` was 1e-9,
 certified since."""
 
-OPEN: dict[str, str] = {
-    "extreme_data:4700352": (
-        "columns of 1e-10 to 1e6 beside P of 7.5e13, an optimum by construction: "
-        "PRIMAL_INFEASIBLE on every backend, whose certificate's residual A'dy + dz, "
-        "small against its largest terms, explains its separation at a feasible point "
-        "though not at the run's iterate"),
-}
+OPEN: dict[str, str] = {}
 """Reproducers of mechanisms still open (issues 26 and 28), each the reason it fails:
 expected to fail (strictly) on the backends of :data:`OPEN_BACKENDS`, so that a fix
 turns them red."""
-OPEN_BACKENDS: dict[str, tuple[str, ...]] = {
-    "extreme_data:4700352": ("auto", "schur_reduced", "ldl_reduced", "ldl_full", "sparse")}
+OPEN_BACKENDS: dict[str, tuple[str, ...]] = {}
 """Where an open case fails."""
 
 ROUNDING_DEPENDENT: dict[str, tuple[tuple[str, ...], str]] = {}

@@ -626,3 +626,26 @@ def test_a_least_distance_solution_that_misses_its_identity_is_solved_in_the_oth
     result = solve_verified(problem)
     assert result.status is Status.PRIMAL_INFEASIBLE
     assert clarabel_solve(*problem.args()).status == "primal_infeasible"
+
+
+def test_a_feasible_run_goes_past_a_candidate_the_data_scale_refutes():
+    """Columns of 1e-10 to 1e6 beside ``P`` of 7.5e13, an optimum by construction (fuzz
+    extreme_data:4700352): at 520 iterations the candidate's residual ``A'dy + dz`` is
+    1e-7 of its largest terms, but on a friction cone whose columns are 1e-7 of the
+    largest it is their own size, and explains 0.07 of the separation at the iterate,
+    3.8 times it where that cone's entries are at the data's scale (1.16 at the
+    optimum). Certified there on every backend; the run now goes on to the optimum."""
+    problem = Case.of("extreme_data", 4700352).scenario().problem
+    assert clarabel_solve(*problem.args()).status == "solved"
+    assert solve_verified(problem).status is Status.SOLVED
+
+
+def test_a_weak_candidate_is_certified_when_the_run_finds_no_point():
+    """A friction cone capped through a boxed copy of its normal force, 2e-4 outside,
+    variables rescaled by 1e-8..1e8 (fuzz extreme_data:1500043), unequilibrated: the
+    run's candidate explains 0.77 of its separation at the iterate and more than it at
+    the data's scale; kept, it certifies when the budget runs out."""
+    problem = Case.of("extreme_data", 1500043).scenario().problem
+    result = solve_verified(problem, scaling=0, max_iter=600)
+    assert result.status is Status.PRIMAL_INFEASIBLE
+    assert result.iterations == 600

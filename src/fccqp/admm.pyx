@@ -196,8 +196,8 @@ cdef class Workspace:
         ``dz`` projected onto the polar), or None. A primal certificate's separation
         must exceed what its residual explains at ``point`` (user's units, with ``A x =
         b``; default the run's iterate, which on a run that diverges along a ray, ``q``
-        of 4.5e14 beside a cone pinned outside itself, explained away an exact one) and
-        in the box."""
+        of 4.5e14 beside a cone pinned outside itself, explained away an exact one, and
+        which also asks what it explains at the data's scale) and in the box."""
         cdef Engine* e = &self.e
         cdef Problem* p = &e.prob
         cdef Py_ssize_t n = p.n, m = p.m, i, j
@@ -218,8 +218,8 @@ cdef class Workspace:
             for j in range(p.s):
                 i = p.constrained[j]
                 e.work.vec_s[j] = candidate[m + i] * p.D[i]
-            if primal_candidate(p, x, e.work.vec_m, e.work.vec_s, e.opt.eps_prim_inf,
-                                e.work.vec_n, e.work.vec_n2) != CERTIFIED:
+            if primal_candidate(p, x, point is None, e.work.vec_m, e.work.vec_s,
+                                e.opt.eps_prim_inf, e.work.vec_n, e.work.vec_n2) != CERTIFIED:
                 return None
             fill(e.certs.cert, 0.0, n + m)
             for i in range(m):

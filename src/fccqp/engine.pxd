@@ -109,6 +109,7 @@ cdef struct Certificates:
     long next_cleaning          # when the next cleaning may run
     long cleaning_wait          # and the wait after a failed one
     double row_norm             # A's largest row 1-norm (primal test), < 0 until needed
+    bint weak                   # cert holds this run's first WEAK primal candidate
 
 
 cdef struct Previous:

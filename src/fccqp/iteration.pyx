@@ -170,6 +170,7 @@ cdef inline void _begin(Engine* e, Loop* L, Run* run, bint cold, double start_ti
     e.certs.cleaning_wait = o.adaptive_rho_interval
     e.certs.gram_state = 0
     e.certs.row_norm = -1.0
+    e.certs.weak = False
     e.fact.table_ready = False   # base is for the previous q, b
     e.pol.schur.ready = False   # set up for the previous P, A
     e.fact.kkt.schur.free_ready = False   # likewise

@@ -12,10 +12,10 @@ from libc.math cimport isfinite, isinf, log
 
 from fccqp._dense cimport copy, fill
 from fccqp._types cimport Iterates, Problem
-from fccqp.certificates cimport (CERTIFIED, REJECTED, SEPARATED, clean_primal_certificate,
-                                 dual_infeasible, equality_direction, equality_inconsistent,
-                                 gram_factor, primal_infeasible, row_sizes,
-                                 zero_rows_inconsistent)
+from fccqp.certificates cimport (CERTIFIED, REJECTED, SEPARATED, WEAK,
+                                 clean_primal_certificate, dual_infeasible, equality_direction,
+                                 equality_inconsistent, gram_factor, primal_infeasible,
+                                 row_sizes, zero_rows_inconsistent)
 from fccqp.engine cimport (DUAL_INFEASIBLE, INACCURATE, MAX_ITER, NUMERICAL_ERROR,
                            PRIMAL_INFEASIBLE, RUNNING, SOLVED, TIME_LIMIT, Engine, Run,
                            fccqp_now)
@@ -52,14 +52,13 @@ cdef int check(Engine* e, long iteration, bint last) noexcept nogil:
             materialize_nu_prev(&e.red, p, it)
         code = primal_infeasible(p, it, e.opt.eps_prim_inf, Ax, &e.certs.row_norm,
                                  e.work.vec_m2, e.work.vec_s, e.work.vec_n, e.work.vec_n2)
-    if code == CERTIFIED or (code == SEPARATED and iteration >= e.certs.next_cleaning
+    if code == WEAK:
+        _keep_weak(e)
+    if code == CERTIFIED or ((code == SEPARATED or code == WEAK)
+                             and iteration >= e.certs.next_cleaning
                              and iteration % e.opt.adaptive_rho_interval == 0
                              and _cleaned_certificate(e, iteration)):
-        fill(e.certs.cert, 0.0, p.n + p.m)
-        for i in range(p.m):   # in the user's units (the common factor 1/c dropped)
-            e.certs.cert[i] = e.work.vec_m2[i] * p.E[i]
-        for i in range(p.s):
-            e.certs.cert[p.m + p.constrained[i]] = e.work.vec_s[i] / p.D[p.constrained[i]]
+        _keep_certificate(e)
         return PRIMAL_INFEASIBLE
     if is_reduced(e.fact.form):
         materialize_x_prev(&e.red, p, it)
@@ -68,8 +67,42 @@ cdef int check(Engine* e, long iteration, bint last) noexcept nogil:
     if unbounded(e):
         return DUAL_INFEASIBLE
     if last:
-        return classify(e, iteration, True)
+        return _last_status(e, iteration)
     return RUNNING
+
+
+cdef inline void _keep_certificate(Engine* e) noexcept nogil:
+    """The primal candidate in ``vec_m2``, ``vec_s`` into ``certs.cert``, in the user's
+    units (the common factor 1/c dropped)."""
+    cdef Problem* p = &e.prob
+    cdef Py_ssize_t i
+    fill(e.certs.cert, 0.0, p.n + p.m)
+    for i in range(p.m):
+        e.certs.cert[i] = e.work.vec_m2[i] * p.E[i]
+    for i in range(p.s):
+        e.certs.cert[p.m + p.constrained[i]] = e.work.vec_s[i] / p.D[p.constrained[i]]
+
+
+cdef inline void _keep_weak(Engine* e) noexcept nogil:
+    """Keep a ``WEAK`` primal candidate (:func:`_keep_certificate`) unless the run kept
+    one already."""
+    if not e.certs.weak:
+        _keep_certificate(e)
+        e.certs.weak = True
+
+
+cdef inline int _last_status(Engine* e, long iteration) noexcept nogil:
+    """:func:`classify` at the last check, but ``PRIMAL_INFEASIBLE`` with the run's first
+    ``WEAK`` candidate (kept in ``certs.cert``) where the budget ran out. A weak
+    candidate's residual passes at the iterate but reaches its separation at the
+    data's scale, so it certifies only when the run finds no point: a feasible
+    problem's run goes on to its solution (a cone's columns 1e-7 of the largest, its
+    entries 20 times the iterate's at the solution, was claimed infeasible at 520
+    iterations), an infeasible one ends certified as before."""
+    cdef int status = classify(e, iteration, True)
+    if e.certs.weak and (status == MAX_ITER or status == TIME_LIMIT):
+        return PRIMAL_INFEASIBLE
+    return status
 
 
 cdef inline bint _may_separate(Engine* e, long iteration) noexcept nogil:
@@ -100,12 +133,14 @@ cdef bint _cleaned_certificate(Engine* e, long iteration) noexcept nogil:
     iterations, and each failed try doubles the wait before the next: a try costs
     about a hundred of talos_reduced's iterations, and its slow feasible ticks
     stall and separate too (tried at every such check, cleaning took 20 % of the
-    realtime preset's warm instructions)."""
+    realtime preset's warm instructions). A cleaned candidate that comes out ``WEAK``
+    is kept for the last check (:func:`_keep_weak`) and counts as a failed try."""
     cdef Problem* p = &e.prob
     cdef Residuals* r = &e.res
     cdef double tolerance = e.opt.eps_abs + e.opt.eps_rel * r.prim_scale
     cdef bint stalled = _stalled(r.prim, e.certs.stalled_prim, iteration - e.certs.stalled_at,
                                  iteration, tolerance)
+    cdef int code
     e.certs.stalled_prim = r.prim
     e.certs.stalled_at = iteration
     e.certs.stalled_checks = e.certs.stalled_checks + 1 if stalled else 0
@@ -113,10 +148,14 @@ cdef bint _cleaned_certificate(Engine* e, long iteration) noexcept nogil:
         return False
     if e.certs.gram_state == 0:   # once per solve: A A' of this solve's scaled rows
         e.certs.gram_state = 1 if gram_factor(p, e.fact.kkt.sparse, e.certs.gram) else -1
-    if e.certs.gram_state == 1 and clean_primal_certificate(
+    if e.certs.gram_state == 1:
+        code = clean_primal_certificate(
             p, e.it.x, e.certs.gram, e.fact.kkt.sparse, e.opt.eps_prim_inf, e.work.vec_m2,
-            e.work.vec_s, e.work.saved, e.work.vec_n3, e.work.vec_n, e.work.vec_n2):
-        return True
+            e.work.vec_s, e.work.saved, e.work.vec_n3, e.work.vec_n, e.work.vec_n2)
+        if code == CERTIFIED:
+            return True
+        if code == WEAK:
+            _keep_weak(e)
     e.certs.cleaning_wait *= 2   # the next try waits twice as long
     e.certs.next_cleaning = iteration + e.certs.cleaning_wait
     return False
