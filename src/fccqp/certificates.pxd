@@ -22,9 +22,6 @@ cdef int equality_direction(const Problem* p, const double* r, const double* x, 
                             double* ATr, double* terms, double* sizes) noexcept nogil
 cdef bint zero_rows_inconsistent(const Problem* p, double* r, double* ones,
                                  double* norms) noexcept nogil
-cdef bint dual_infeasible(const Problem* p, const double* dx, double eps, double* Pdx,
-                          double* terms, double* block, double* weights,
-                          double* rows) noexcept nogil
 cdef void row_sizes(const Problem* p, const double* x, double* t, double* sizes) noexcept nogil
 cdef bint gram_factor(const Problem* p, void* sparse, double* gram) noexcept nogil
 cdef bint regularized_cholesky(double* gram, Py_ssize_t m) noexcept nogil

@@ -13,9 +13,10 @@ from libc.math cimport isfinite, isinf, log
 from fccqp._dense cimport copy, fill
 from fccqp._types cimport Iterates, Problem
 from fccqp.certificates cimport (CERTIFIED, REJECTED, SEPARATED, WEAK,
-                                 clean_primal_certificate, dual_infeasible, equality_direction,
+                                 clean_primal_certificate, equality_direction,
                                  equality_inconsistent, gram_factor, primal_infeasible,
                                  row_sizes, zero_rows_inconsistent)
+from fccqp.dual_certificate cimport dual_infeasible
 from fccqp.engine cimport (DUAL_INFEASIBLE, INACCURATE, MAX_ITER, NUMERICAL_ERROR,
                            PRIMAL_INFEASIBLE, RUNNING, SOLVED, TIME_LIMIT, Engine, Run,
                            fccqp_now)
