@@ -20,7 +20,7 @@ from fccqp.engine cimport (DUAL_INFEASIBLE, INACCURATE, MAX_ITER, NUMERICAL_ERRO
                            PRIMAL_INFEASIBLE, RUNNING, SOLVED, TIME_LIMIT, Engine, Run,
                            fccqp_now)
 from fccqp.kkt cimport is_reduced, kkt_solve
-from fccqp.matrices cimport entry, subtract_product, zero_column
+from fccqp.matrices cimport entry, zero_column
 from fccqp.reduced cimport materialize_nu_prev, materialize_x_prev
 from fccqp.termination cimport Residuals, converged, nearly_converged
 from fccqp.tuning cimport CLEANING_GATE, CLEANING_HORIZON, EQUALITY_MISSED, INACCURATE_FACTOR
@@ -207,24 +207,29 @@ cdef bint missed_by_data(Engine* e) noexcept nogil:
     return e.res.prim_eq > EQUALITY_MISSED * largest
 
 
-cdef bint row_missed_by_data(Engine* e) noexcept nogil:
+cdef bint row_missed_by_data(Engine* e, const double* Ax) noexcept nogil:
     """Some row misses ``A x = b`` beyond ``EQUALITY_MISSED`` of its own terms:
-    ``|b_i - A_i x|`` against ``max(|b_i|, sizes_i)`` (the row's terms at the magnitude
-    of the iterate and the box, :func:`fccqp.certificates.row_sizes`), each row in its
-    own units. :func:`missed_by_data` measures the largest miss against the largest
-    row: rows of 1e-36 to 1e-142 inconsistent among themselves beside a row of 1e-17
-    miss by 1e-38, far below 1e-9 of that row, and the equality certificate was never
-    tried at the start. Any row that :func:`missed_by_data` finds missed is missed
-    here too. Reads all of ``A``: for the start, not for every check."""
+    ``|b_i - A_i x|`` against ``max(|b_i|, |A_i x|)`` and against ``sizes_i`` (the row's
+    terms at the magnitude of the iterate and the box,
+    :func:`fccqp.certificates.row_sizes`), each row in its own units; ``Ax`` is ``A x``
+    at the iterate (scaled, as the residuals formed it). :func:`missed_by_data`
+    measures the largest miss against the largest row: rows of 1e-36 to 1e-142
+    inconsistent among themselves beside a row of 1e-17 missed by 1e-38, far below 1e-9
+    of that row, and the equality certificate was never tried at the start. A row
+    that :func:`missed_by_data` finds missed is missed here too. ``sizes`` (all of
+    ``A``) only once a row misses its own ``max(|b_i|, |A_i x|)``."""
     cdef Problem* p = &e.prob
     cdef Py_ssize_t i
-    cdef double* r = e.work.vec_m
     cdef double* sizes = e.work.vec_m2
-    copy(p.b, r, p.m)
-    subtract_product(&p.A, e.it.x, r)
+    for i in range(p.m):
+        if fabs(p.b[i] - Ax[i]) > EQUALITY_MISSED * max(fabs(p.b[i]), fabs(Ax[i])):
+            break
+    else:
+        return False
     row_sizes(p, e.it.x, e.work.vec_n, sizes)
     for i in range(p.m):
-        if fabs(r[i]) > EQUALITY_MISSED * max(fabs(p.b[i]), sizes[i]):
+        if fabs(p.b[i] - Ax[i]) > EQUALITY_MISSED * max(max(fabs(p.b[i]), fabs(Ax[i])),
+                                                        sizes[i]):
             return True
     return False
 
