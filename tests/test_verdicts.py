@@ -311,6 +311,34 @@ def test_equalities_of_tiny_rows_hold(scale, scaling):
     assert max(misses) < 1e-9
 
 
+def tiny_rows_inconsistent_beside_a_unit_row(seed: int, tiny: float) -> Problem:
+    """A strongly convex QP whose rows are a unit row and three rows of size ``tiny``,
+    the third the sum of the other two, its right-hand side off by 1e-2 of ``tiny``:
+    infeasible, the miss far below the unit row's."""
+    rng = np.random.default_rng(seed)
+    n = 6
+    M = rng.standard_normal((n, n))
+    B = rng.standard_normal((2, n))
+    A = np.vstack([rng.standard_normal(n), tiny * B, tiny * (B[0] + B[1])])
+    b = A @ rng.uniform(-1, 1, n)
+    b[3] += 0.01 * tiny
+    return Problem.of(M @ M.T / n, rng.standard_normal(n), A, b)
+
+
+@pytest.mark.parametrize("tiny", [1e-40, 1e-12])
+@pytest.mark.parametrize("seed", range(3))
+def test_rows_inconsistent_far_below_the_largest_row_are_certified_at_the_start(
+        seed, tiny):
+    """The start's gate measured the rows' largest miss against the largest row: a miss
+    of 1e-2 of rows of 1e-12 beside a unit row lay below factorization accuracy, the
+    equality certificate was never tried, and the run stalled (MAX_ITER_REACHED in
+    every form, or a certificate thousands of iterations later). Each row's miss is now
+    measured against that row's own terms."""
+    result = solve_verified(tiny_rows_inconsistent_beside_a_unit_row(seed, tiny))
+    assert result.status is Status.PRIMAL_INFEASIBLE
+    assert result.iterations == 0
+
+
 @pytest.mark.kkt_backends("auto", "ldl_full", "sparse", reason=(
     "every entry is boxed: the full form's problem; the reduced forms solve from this "
     "guess in 18 iterations, so that it never fails"))

@@ -47,7 +47,8 @@ from fccqp.tuning cimport (AUXILIARY_TIME, CLEANING_START, CONVERGING, EARLY_POL
                            EARLY_POLISH_TRIES, EQUALITY_MISSED, GATED_CHECK_WAIT, GUESS_LEAD,
                            LOG_INTERVAL, POLISH_GATE, POLISH_RETRIES, RESERVE_PASSES,
                            RESTART_MIN_ITER, STALL_FACTOR, STALLS, TIMED_EARLY_POLISH)
-from fccqp.verdict cimport check, classify, inconsistent, missed, missed_by_data, unbounded
+from fccqp.verdict cimport (check, classify, inconsistent, missed, row_missed_by_data,
+                            unbounded)
 
 
 cdef struct Loop:
@@ -207,7 +208,8 @@ cdef inline bint _start(Engine* e, Loop* L, Run* run) noexcept nogil:
         return False
     if at_start:   # not at factorization accuracy: inconsistent or dependent rows
         e.equalities_missed = r.prim_eq > EQUALITY_MISSED * max(r.prim_eq_scale, 1.0)
-        if missed_by_data(e) and (inconsistent(e, True) or _least_squares_inconsistent(e)):
+        if (row_missed_by_data(e, e.work.vec_m)   # the residuals' A x
+                and (inconsistent(e, True) or _least_squares_inconsistent(e))):
             # tested on the penalty-free start: with rho in the KKT matrix (up to 1e9
             # on fixed entries) the regularization's trace in A'r can hide it
             end_run(e, run, PRIMAL_INFEASIBLE, 0)

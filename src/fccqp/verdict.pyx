@@ -8,7 +8,7 @@ a point from its residuals alone; :func:`settle` the status of the returned poin
 The certificates found are left in ``Engine.certs.cert``, in the user's units.
 """
 
-from libc.math cimport isfinite, isinf, log
+from libc.math cimport fabs, isfinite, isinf, log
 
 from fccqp._dense cimport copy, fill
 from fccqp._types cimport Iterates, Problem
@@ -206,6 +206,33 @@ cdef bint missed_by_data(Engine* e) noexcept nogil:
     for i in range(p.m):
         largest = max(largest, e.work.vec_m2[i] / p.E[i])
     return e.res.prim_eq > EQUALITY_MISSED * largest
+
+
+cdef bint row_missed_by_data(Engine* e, const double* Ax) noexcept nogil:
+    """Some row misses ``A x = b`` beyond ``EQUALITY_MISSED`` of its own terms:
+    ``|b_i - A_i x|`` against ``max(|b_i|, |A_i x|)`` and against ``sizes_i`` (the row's
+    terms at the magnitude of the iterate and the box,
+    :func:`fccqp.certificates.row_sizes`), each row in its own units; ``Ax`` is ``A x``
+    at the iterate (scaled, as the residuals formed it). :func:`missed_by_data`
+    measures the largest miss against the largest row: rows of 1e-36 to 1e-142
+    inconsistent among themselves beside a row of 1e-17 missed by 1e-38, far below 1e-9
+    of that row, and the equality certificate was never tried at the start. A row
+    that :func:`missed_by_data` finds missed is missed here too. ``sizes`` (all of
+    ``A``) only once a row misses its own ``max(|b_i|, |A_i x|)``."""
+    cdef Problem* p = &e.prob
+    cdef Py_ssize_t i
+    cdef double* sizes = e.work.vec_m2
+    for i in range(p.m):
+        if fabs(p.b[i] - Ax[i]) > EQUALITY_MISSED * max(fabs(p.b[i]), fabs(Ax[i])):
+            break
+    else:
+        return False
+    row_sizes(p, e.it.x, e.work.vec_n, sizes)
+    for i in range(p.m):
+        if fabs(p.b[i] - Ax[i]) > EQUALITY_MISSED * max(max(fabs(p.b[i]), fabs(Ax[i])),
+                                                        sizes[i]):
+            return True
+    return False
 
 
 cdef bint inconsistent(Engine* e, bint clean) noexcept nogil:
