@@ -6,9 +6,9 @@ is tested (as in OSQP), but with every "approximately zero" of the primal certif
 judged against the size of the terms that must cancel, not in absolute terms (the dual
 certificate's against the size of the direction: :mod:`fccqp.dual_certificate`): a
 certificate is then invariant to the scale of the data, and the rounding noise of a sum
-(``1e-16`` of its terms) never passes for one. Concretely, for terms ``t_k`` of a sum ``S``, "``S ~ 0``" is ``|S| <= eps
-max |t_k|``, relative residual ``rho = |S| / max |t_k|``. All tests run on the scaled
-problem; norms are taken in the user's units.
+(``1e-16`` of its terms) never passes for one. Concretely, for terms ``t_k`` of a sum
+``S``, "``S ~ 0``" is ``|S| <= eps max |t_k|``, relative residual ``rho = |S| / max
+|t_k|``. All tests run on the scaled problem; norms are taken in the user's units.
 
 The strict inequality of a certificate (``b'dy + sigma_C(dz) < 0``, ``q'dx < 0``) is
 what proves; it is judged by ``delta``, the sum divided by the sum of the magnitudes

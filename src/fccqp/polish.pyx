@@ -341,8 +341,8 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     Each guess is solved once (one Newton step, curvature included) and corrected from the
     polished point (:func:`~fccqp.polish_guess.renew`), until the guess stops changing or
     ``w.guess_passes`` guesses were solved (``GUESS_PASSES``; ``WARM_GUESS_PASSES`` for a
-    warm polish, see :func:`fccqp.acceptance.warm_polish`). A correction first only adds the violated
-    constraints; a wrong-signed multiplier is released only from a point that violates
+    warm polish, see :func:`fccqp.acceptance.warm_polish`). A correction first only adds
+    the violated constraints; a wrong-signed multiplier is released only from a point that violates
     nothing, and only one per pass, the most wrong (:func:`~fccqp.polish_guess.most_wrong`),
     as a primal active-set method drops one constraint at a time: changing both at once (a
     plain primal-dual active-set step) diverged on whole-body control, where the cost is
