@@ -85,13 +85,17 @@ cdef double kkt_residual(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t 
     """Residual of the current ``(x, nu, lam)`` in the unregularized system (with the
     curvature terms) into ``rhs``; returns its infinity norm. Leaves the gradient of the
     Lagrangian without the boundary blocks' terms in ``grad`` (there it is minus the
-    multipliers of the held entries)."""
+    multipliers of the held entries) and ``A x`` in ``Ax``.
+
+    Where ``grad_current`` says ``x`` and ``nu`` have not moved since the last residual,
+    its ``grad`` and ``Ax`` are taken as they are and only the rows of the guess and its
+    planes are formed again: a Newton step or a chord step re-linearizes the planes at
+    the point the last refinement left, whose products with ``P`` and ``A`` (most of a
+    residual's instructions) are then already known."""
     cdef Py_ssize_t n = p.n, m = p.m, i, j, k, o, d, start, cone
     cdef double value, curved
-    product(&p.P, w.x, w.grad)
-    product_t(&p.A, w.nu, w.ATnu)
-    for i in range(n):
-        w.grad[i] += p.q[i] + w.ATnu[i]
+    if not w.grad_current:
+        _point_products(w, p)
     for i in range(nf):
         w.rhs[i] = -w.grad[w.free[i]]
     for k in range(nb):
@@ -107,11 +111,21 @@ cdef double kkt_residual(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t 
             w.rhs[w.index[start + j]] -= w.lam[k] * w.g[o + j] + curved
             value += w.g[o + j] * w.x[start + j]
         w.rhs[nf + m + k] = -value
-    product(&p.A, w.x, w.Ax)
     for i in range(m):
         w.rhs[nf + i] = p.b[i] - w.Ax[i]
-    w.grad_current = True
     return inf_norm(w.rhs, nf + m + nb)
+
+
+cdef void _point_products(Polish* w, const Problem* p) noexcept nogil:
+    """``grad := P x + q + A'nu`` and ``Ax := A x`` at the current point; sets
+    ``grad_current``."""
+    cdef Py_ssize_t i
+    product(&p.P, w.x, w.grad)
+    product_t(&p.A, w.nu, w.ATnu)
+    for i in range(p.n):
+        w.grad[i] += p.q[i] + w.ATnu[i]
+    product(&p.A, w.x, w.Ax)
+    w.grad_current = True
 
 
 cdef void _apply(Polish* w, Py_ssize_t nf, Py_ssize_t m, Py_ssize_t nb,
