@@ -133,14 +133,14 @@ cdef void _cost_product(Polish* w, const Problem* p) noexcept nogil:
     block diagonal: a dense block on the entries it couples (``schur.order``'s first
     ``schur.dense``), a diagonal elsewhere; then only the rows from the first coupled
     entry to the last are a product with ``P``'s rows and the others one multiplication
-    each. On the quadrupeds the coupled entries are the first 18 of 54, and a whole
-    product had been about a third of a residual's instructions.
+    each. On the quadrupeds the coupled entries are the first 18 of 54, and the whole
+    product is about a third of a residual's instructions.
 
     The rows taken by ``dgemv`` start and end at multiples of 4 (or at ``n``): OpenBLAS's
     kernels take the rows in fours and finish the remainder in another order, so rows cut
-    elsewhere rounded differently from the whole product; cut so, every row has the
-    whole product's bits (checked on its Haswell, SkylakeX and Sandybridge kernels), and
-    so do the diagonal rows (one nonzero term)."""
+    elsewhere round differently from the whole product; cut so, every row has the whole
+    product's bits (its Haswell, SkylakeX and Sandybridge kernels alike), and so do the
+    diagonal rows (one nonzero term)."""
     cdef Py_ssize_t n = p.n, i, first = n, end = 0
     cdef const double* P = p.P.values
     if not w.schur.ready:
