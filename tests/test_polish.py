@@ -264,7 +264,13 @@ def test_warm_polish_with_new_matrices_skips_admm_factorization(seed):
     and forces), the warm polish of a tick whose matrices moved solves its KKT system by
     Schur complement (fccqp.polish_schur) before any ADMM factorization: none is made,
     and the answer is as exact as a cold solve's."""
-    problem = _block_structured(_cone_problem(seed))
+    _assert_warm_polish_is_exact_without_factorization(_block_structured(_cone_problem(seed)),
+                                                       seed)
+
+
+def _assert_warm_polish_is_exact_without_factorization(problem, seed):
+    """The warm solve of ``problem`` with ``P`` and ``q`` moved a little is polished by
+    Schur complement (no iteration, no factorization) and exact."""
     P, q, A, b, lb, ub, cones = problem
     solver = fccqp.Solver(fccqp.Settings.realtime(float("inf")))
     assert solver.solve(*problem).polished
@@ -277,6 +283,31 @@ def test_warm_polish_with_new_matrices_skips_admm_factorization(seed):
     assert check_solution(Problem.of(*moved), warm, EXACT).passed
     reference = clarabel_solve(*moved, tol=1e-12)
     assert abs(warm.obj - reference.obj) <= 1e-8 * max(1.0, abs(reference.obj))
+
+
+def _boxes_among_free_entries(problem):
+    """``problem`` with its entries reordered so that the boxed ones sit between two
+    halves of the entries without a bound or a cone (the cone blocks stay first)."""
+    P, q, A, b, lb, ub, cones = problem
+    coned = np.zeros(q.size, bool)
+    for cone in cones:
+        coned[cone.start:cone.start + getattr(cone, "dim", 3)] = True
+    boxed = ~coned & (np.isfinite(lb) | np.isfinite(ub))
+    free = np.flatnonzero(~coned & ~boxed)
+    half = free.size // 2
+    order = np.concatenate([np.flatnonzero(coned), free[:half], np.flatnonzero(boxed),
+                            free[half:]])
+    return (P[np.ix_(order, order)], q[order], A[:, order], b, lb[order], ub[order], cones)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_warm_polish_is_exact_where_constrained_entries_split_the_coupled_ones(seed):
+    """The polish's residual takes ``P x`` on the rows that ``P`` couples from one
+    product over their span (fccqp.polish_kkt), the rest of the rows diagonal: with
+    boxed entries between the coupled ones the warm polish is as exact as with the
+    coupled entries together."""
+    problem = _boxes_among_free_entries(_block_structured(_cone_problem(seed)))
+    _assert_warm_polish_is_exact_without_factorization(problem, seed)
 
 
 def test_warm_polish_factors_where_p_couples_a_constrained_entry():

@@ -57,7 +57,7 @@ cdef struct Polish:
     double* nu_prev         # m: its equality multipliers
     double* chord_start     # n + m + 2 s: (x, nu, y, lam) before a chord step, to undo it
     double* grad            # n: scratch, the gradient of the Lagrangian
-    bint grad_current       # grad is that of the current (x, nu): _multipliers reuses it
+    bint grad_current       # grad and Ax are those of the current (x, nu): reused until they move
     double* ATnu            # n: scratch
     double* Ax              # m: scratch
     # the solve in the reduced form's coordinates (fccqp.polish_table)

@@ -225,11 +225,11 @@ cdef bint _solve_guess(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
     table's coordinates ends ``tabled`` for this polish. ``KEPT`` planes are dropped:
     they serve only the first solve of :func:`_newton`."""
     cdef Py_ssize_t k
-    w.grad_current = False
     for k in range(nb):   # a kept plane serves only the Newton step that follows it
         if w.bare[w.boundary[k]] == KEPT:
             w.bare[w.boundary[k]] = CURVED
     if tabled[0]:
+        w.grad_current = False   # the table's residuals use grad and Ax as scratch
         if table_factor(w, p, table, rho_vec, nb):
             table_solve(w, p, table, kkt, rho_vec, nb, scale)
             return True
@@ -312,7 +312,6 @@ cdef int _newton(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t* nb, lon
     if not refactored:   # refine the last chord step's (or the first solve's) point
         if tabled[0]:
             table_solve(w, p, table, kkt, rho_vec, nb[0], scale)
-            w.grad_current = False
         else:
             refine(w, p, nf, nb[0], POLISH_REFINE_TOLERANCE * scale, factorizations)
     _multipliers(w, p, nf, nb[0])

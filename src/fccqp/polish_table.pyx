@@ -220,15 +220,22 @@ cdef void table_solve(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
     ``REFINE_TOLERANCE * scale`` or stops halving (a correction that makes it grow is
     undone). With the factor of the current planes this solves the polished QP; after
     the planes moved (:func:`fccqp.polish._relinearize`) it is a chord step of Newton's
-    method, the Jacobian of the earlier planes standing in for the current one."""
+    method, the Jacobian of the earlier planes standing in for the current one. Where the
+    last residual is the returned point's, its products leave that point's ``grad`` and
+    ``Ax`` (``grad_current``) for :func:`fccqp.polish._multipliers`."""
     cdef double norm, last = INFINITY
+    cdef Py_ssize_t i
     cdef int r
+    w.grad_current = False   # _residual leaves P x alone in grad
     for r in range(MAX_REFINE + 2):
         norm = _residual(w, p, nb)
         if norm > last:
             _correct(w, p, t, kkt, rho, nb, -1.0, 0.0)
             return
         if norm <= POLISH_REFINE_TOLERANCE * scale or norm > 0.5 * last or r == MAX_REFINE + 1:
+            for i in range(p.n):   # as polish_kkt.kkt_residual forms it
+                w.grad[i] += p.q[i] + w.ATnu[i]
+            w.grad_current = True
             return
         last = norm
         _correct(w, p, t, kkt, rho, nb, 1.0, POLISH_REFINE_TOLERANCE * scale)
