@@ -17,7 +17,8 @@ Two storages (``Matrix.kind``):
 - ``DENSE``: ``values`` row-major, ``M_ij = values[i * cols + j]`` (``P`` is symmetric,
   so its order does not matter). Each operation keeps the kernel and the summation
   order that its caller had before the contract, so that answers stay bitwise
-  identical: ``M x`` by ``dgemv``, ``M' y`` and the row spans by ``fccqp_kernels.h``,
+  identical: ``M x`` by ``dgemv`` (a symmetric matrix's diagonal tail apart, in the same
+  bits: :func:`mark_diagonal_tail`), ``M' y`` and the row spans by ``fccqp_kernels.h``,
   the certificates' row sums as plain loops in column order.
 - ``CSC``: compressed columns, the entries of column ``j`` at ``colptr[j] <= k <
   colptr[j + 1]``, ``M_{rowind[k], j} = values[k]``, rows ascending in each column.
