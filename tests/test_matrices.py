@@ -9,7 +9,7 @@ four-lane products to rounding, and both to numpy.
 import numpy as np
 import pytest
 import scipy.sparse as sp
-from fccqp.matrix_ops import OPERATIONS, apply
+from fccqp.matrix_ops import OPERATIONS, apply, diagonal_from
 
 BITWISE = ("product_t_terms", "subtract_product", "abs_product", "product_row_norms")
 
@@ -79,3 +79,34 @@ def test_apply_rejects_bad_arguments():
         apply("inverse", np.eye(2), np.ones(2))
     with pytest.raises(ValueError, match="vector must have 3 entries"):
         apply("product", np.ones((2, 3)), np.ones(2))
+
+
+def _block_and_diagonal(n, block, seed):
+    """A symmetric ``n x n`` matrix as whole-body control's ``P``: a dense leading
+    ``block``, a diagonal after it with some zeros and negative entries."""
+    rng = np.random.default_rng(seed)
+    P = np.diag(rng.standard_normal(n) * (rng.random(n) > 0.2))
+    B = rng.standard_normal((block, block))
+    P[:block, :block] = B + B.T
+    return P
+
+
+@pytest.mark.parametrize(("n", "block", "expected"),
+                         [(54, 18, 20), (124, 38, 40), (48, 16, 16), (54, 52, 52),
+                          (54, 53, 54), (9, 9, 9), (7, 0, 0), (1, 1, 0)])
+def test_diagonal_tail_starts_after_the_last_coupled_row_rounded_up_to_four(n, block,
+                                                                             expected):
+    P = _block_and_diagonal(n, block, seed=n + block)
+    assert diagonal_from(P) == expected
+
+
+@pytest.mark.parametrize(("n", "block"), [(54, 18), (48, 18), (124, 38), (100, 38), (13, 5)])
+@pytest.mark.parametrize("seed", range(5))
+def test_product_over_a_diagonal_tail_has_the_whole_products_bits(n, block, seed):
+    P = _block_and_diagonal(n, block, seed)
+    rng = np.random.default_rng(seed + 100)
+    x = rng.standard_normal(n) * 10.0 ** rng.integers(-8, 8, size=n)
+    x[rng.random(n) < 0.3] = 0.0
+    x[rng.random(n) < 0.1] = -0.0
+    whole = apply("product", P, x)
+    assert apply("product", P, x, diagonal_tail=True).tobytes() == whole.tobytes()

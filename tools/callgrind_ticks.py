@@ -63,6 +63,12 @@ How it counts:
   their rows kept) are solved instead; the reduction and the recovery of the original
   ``x`` happen outside the counted calls (price them apart), the saved answers are the
   recovered ``x``, judged as below.
+- ``--cache-sim``: callgrind also simulates the caches and the branch predictors
+  (``--cache-sim=yes --branch-sim=yes``, about 2x slower), and the table gives per tick
+  the L1 data misses (reads plus writes, ``D1mr + D1mw``) and the mispredicted branches
+  (conditional plus indirect, ``Bcm + Bim``) beside the instructions: what wall time
+  pays beyond the instructions (a 32 KB L1, valgrind's model of the machine's caches).
+  ``callgrind_annotate --show=D1mr,D1mw,Bcm <file>`` gives them by function.
 - Exactness: the parent judges each answer as the benchmark does
   (``benchmarks.metrics.exact_share``): SOLVED with every joint's torque within 5 % of
   its limit of the set's reference ``x_ref`` (a tight exact-cone solve); the table's
@@ -317,6 +323,7 @@ def measure(robot: str, preset: str, mode: str, path: Path, qps: str,
     cmd = [args.valgrind, "--tool=callgrind", f"--callgrind-out-file={out}",
            "--collect-atstart=no", f"--toggle-collect={TOGGLE}",
            *([f"--dump-after={TOGGLE}"] if args.per_tick else []),
+           *(["--cache-sim=yes", "--branch-sim=yes"] if args.cache_sim else []),
            sys.executable, str(Path(__file__).resolve()), "--child", "--set", str(path),
            "--robot", robot, "--preset", preset, "--mode", mode,
            "--n-qps", str(args.n_qps), "--stride", str(args.stride),
@@ -338,13 +345,15 @@ def measure(robot: str, preset: str, mode: str, path: Path, qps: str,
         xs = [answers[f"arr_{k}"] for k in range(len(result["per_tick"]))]
     result["exact_ticks"] = exact_ticks(path, args, mode, result["per_tick"], xs)
     result["exact"] = sum(result["exact_ticks"])
-    total = _total(out)
+    events = _totals(out)
     if args.per_tick:   # out holds the rest after the last dump: nothing counted
-        counts = [_total(out.with_name(f"{out.name}.{k}"))
-                  for k in range(1, len(result["per_tick"]) + 1)]
-        total = sum(counts)
-        for row, count in zip(result["per_tick"], counts, strict=True):
-            row.append(count)
+        dumps = [_totals(out.with_name(f"{out.name}.{k}"))
+                 for k in range(1, len(result["per_tick"]) + 1)]
+        events = Counter()
+        for row, dump in zip(result["per_tick"], dumps, strict=True):
+            row.append(dump.get("Ir"))
+            events.update(dump)
+    total = events.get("Ir")
     if not total:
         raise SystemExit(f"{label}: no instructions collected in {out} (is {TOGGLE} "
                          "in this Python's symbols?)")
@@ -359,7 +368,7 @@ def measure(robot: str, preset: str, mode: str, path: Path, qps: str,
     result.update(robot=robot, preset=preset, mode=mode, stride=args.stride,
                   eliminate=args.eliminate,
                   cut=args.cut if preset == "realtime" else None, cut_polish=args.cut_polish,
-                  instructions=total,
+                  instructions=total, **_misses(events),
                   compiled=compiled, seconds=seconds, cpu=usage.ru_utime + usage.ru_stime,
                   qps=qps, callgrind=str(out))
     return result
@@ -397,13 +406,25 @@ def _key(r: dict) -> str:
     return f"{r['robot']}-{r['preset']}-{r['mode']}{stride}{cut}{polish}{eliminate}"
 
 
-def _total(path: Path) -> int | None:
-    """The instructions a callgrind file counted."""
-    total = None
+def _totals(path: Path) -> dict[str, int]:
+    """The events a callgrind file counted, by name (``Ir``; with ``--cache-sim`` also
+    ``D1mr``, ``Bcm``, ...)."""
+    names, totals = [], {}
     for line in path.read_text().splitlines():
-        if line.startswith(("summary:", "totals:")):
-            total = int(line.split()[1])
-    return total
+        if line.startswith("events:"):
+            names = line.split()[1:]
+        elif line.startswith(("summary:", "totals:")):
+            totals = dict(zip(names, (int(v) for v in line.split()[1:]), strict=False))
+    return totals
+
+
+def _misses(events: dict[str, int]) -> dict[str, int]:
+    """L1 data misses and mispredicted branches of ``--cache-sim``'s events (none
+    without it)."""
+    if "D1mr" not in events:
+        return {}
+    return {"d1_misses": events["D1mr"] + events["D1mw"],
+            "mispredicts": events["Bcm"] + events["Bim"]}
 
 
 def line_of(r: dict, before: dict | None) -> str:
@@ -415,6 +436,9 @@ def line_of(r: dict, before: dict | None) -> str:
              f"{r['iterations']} ({r['iterations'] / ticks:.2f})", statuses,
              str(r["polished"]), f"{r['exact']} ({100 * r['exact'] / ticks:.0f} %)",
              f"`{r['answers_digest']}`", f"`{r['x_digest']}`"]
+    if "d1_misses" in r:
+        cells[5:5] = [f"{r['d1_misses'] / ticks / 1e3:.2f}k",
+                      f"{r['mispredicts'] / ticks / 1e3:.2f}k"]
     if before is not None:
         old = before.get(_key(r))
         if old and old["ticks"] == ticks and old.get("qps") == r["qps"]:
@@ -453,6 +477,9 @@ def main(argv: list[str] | None = None) -> None:
                         help="solve the QPs reduced by tools/elimination_study.py (every free "
                         "entry, or the slack entries and their rows kept); the reduction and "
                         "the recovery of x are not counted")
+    parser.add_argument("--cache-sim", action="store_true",
+                        help="also count L1 data misses and mispredicted branches per tick "
+                        "(callgrind --cache-sim=yes --branch-sim=yes)")
     parser.add_argument("--jobs", type=int, default=1, help="callgrind runs at a time")
     parser.add_argument("--cache", type=Path, default=ROOT / "benchmarks" / ".cache",
                         help="cached test sets (default this checkout's benchmarks/.cache)")
@@ -516,6 +543,8 @@ def main(argv: list[str] | None = None) -> None:
     head = ["robot", "preset", "mode", "ticks", "instr./tick", "instructions",
             "Workspace.solve", "iterations (mean)", "statuses", "polished", "exact", "answers",
             "x"]
+    if args.cache_sim:
+        head[5:5] = ["D1 misses/tick", "mispredicts/tick"]
     if before is not None:
         head.append(f"vs {args.compare.name}")
     print()

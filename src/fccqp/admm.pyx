@@ -27,7 +27,7 @@ from fccqp.certificates cimport CERTIFIED, primal_candidate
 from fccqp.engine cimport CONE_ENTRY, Engine, Run, fccqp_now
 from fccqp.fast_checks cimport hold_dense, hold_float64
 from fccqp.kkt cimport AUTO, LDL_FULL, LDL_REDUCED, SCHUR_REDUCED, SPARSE_LDL
-from fccqp.matrices cimport Matrix, csc
+from fccqp.matrices cimport Matrix, csc, mark_diagonal_tail
 from fccqp.scaled_run cimport scaled_run, unscaled_answer
 from fccqp.termination cimport Residuals
 from fccqp.tuning cimport FIXED_RHO_SCALE, RESERVE_DECAY, RESTART_MIN_ITER
@@ -379,6 +379,8 @@ cdef class Workspace:
         if not self._same_structure(lb, ub):
             e.user.has_matrices = False
             return engine.NEW_STRUCTURE
+        if not (same or self.compressed):
+            mark_diagonal_tail(&e.user.P)
         if z0 != NULL:
             self._take_guess(x0, y0, z0)
             x0, warm = NULL, True

@@ -11,9 +11,9 @@ Not on any solve's path; ``scipy.sparse`` is imported when first needed.
 
 import numpy as np
 
-from fccqp.matrices cimport (DENSE, Matrix, abs_product, csc, dense, product,
-                             product_row_norms, product_t, product_t_terms, row_spans,
-                             subtract_product)
+from fccqp.matrices cimport (DENSE, Matrix, abs_product, csc, dense, mark_diagonal_tail,
+                             product, product_row_norms, product_t, product_t_terms,
+                             row_spans, subtract_product)
 
 OPERATIONS = ("product", "product_t", "product_t_terms", "subtract_product", "abs_product",
               "row_spans", "product_row_norms")
@@ -53,9 +53,19 @@ cdef class Held:
                               np.asarray(self.colptr).copy()), shape=(self.M.rows, self.M.cols))
 
 
-def apply(str operation, matrix, vector, out=None):
+def diagonal_from(matrix):
+    """:c:func:`mark_diagonal_tail`'s row of a dense symmetric ``matrix``: the first
+    row, a multiple of 4 or the size, from which the rows hold their diagonal only."""
+    cdef Held held = Held(np.asarray(matrix, dtype=np.float64))
+    mark_diagonal_tail(&held.M)
+    return held.M.diagonal_from
+
+
+def apply(str operation, matrix, vector, out=None, bint diagonal_tail=False):
     """Run ``operation`` on ``matrix`` (a 2-d array: dense storage; ``scipy.sparse``:
-    compressed columns) and ``vector`` (the operand: ``x``, ``y``, ``t`` or the width).
+    compressed columns) and ``vector`` (the operand: ``x``, ``y``, ``t`` or the width);
+    with ``diagonal_tail`` a dense symmetric ``matrix`` is marked first as the solver
+    marks ``P`` (:func:`diagonal_from`).
 
     Returns the result array, and for ``product_t_terms`` and ``product_row_norms``
     the pair (result, terms or norms); ``out`` is the starting ``out`` of
@@ -67,6 +77,8 @@ def apply(str operation, matrix, vector, out=None):
     cdef Held held = Held(matrix)
     cdef Matrix* M = &held.M
     cdef Py_ssize_t rows = M.rows, cols = M.cols
+    if diagonal_tail and M.kind == DENSE:
+        mark_diagonal_tail(M)
     transposed = operation in ("product_t", "product_t_terms")
     operand = np.array(vector, dtype=np.float64)
     if operand.shape != ((rows,) if transposed else (cols,)):

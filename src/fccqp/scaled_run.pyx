@@ -56,6 +56,7 @@ cdef void _scale(Engine* e, bint reuse, bint warm) noexcept nogil:
     :mod:`fccqp.scaling_csc`), one test per solve."""
     cdef Problem* p = &e.prob
     cdef Py_ssize_t n = p.n, m = p.m, i, j
+    p.P.diagonal_from = e.user.P.diagonal_from   # the scaling keeps every zero
     if reuse:
         for i in range(n):
             p.q[i] = p.c * p.D[i] * e.user.q[i]
