@@ -17,7 +17,7 @@ from libc.math cimport INFINITY
 
 from scipy.linalg.cython_lapack cimport dsytrf, dsytrs
 
-from fccqp._dense cimport copy, inf_norm, matvec
+from fccqp._dense cimport copy, inf_norm
 from fccqp._types cimport Problem
 from fccqp.matrices cimport CSC, product, product_t
 from fccqp.polish cimport APEX, FIXED, LOWER, UPPER, Polish
@@ -120,41 +120,12 @@ cdef void _point_products(Polish* w, const Problem* p) noexcept nogil:
     """``grad := P x + q + A'nu`` and ``Ax := A x`` at the current point; sets
     ``grad_current``."""
     cdef Py_ssize_t i
-    _cost_product(w, p)
+    product(&p.P, w.x, w.grad)
     product_t(&p.A, w.nu, w.ATnu)
     for i in range(p.n):
         w.grad[i] += p.q[i] + w.ATnu[i]
     product(&p.A, w.x, w.Ax)
     w.grad_current = True
-
-
-cdef void _cost_product(Polish* w, const Problem* p) noexcept nogil:
-    """``grad := P x``. Where the Schur solve is set up (``schur.ready``), ``P`` is known
-    block diagonal: a dense block on the entries it couples (``schur.order``'s first
-    ``schur.dense``), a diagonal elsewhere; then only the rows from the first coupled
-    entry to the last are a product with ``P``'s rows and the others one multiplication
-    each. On the quadrupeds the coupled entries are the first 18 of 54, and the whole
-    product is about a third of a residual's instructions.
-
-    The rows taken by ``dgemv`` start and end at multiples of 4 (or at ``n``): OpenBLAS's
-    kernels take the rows in fours and finish the remainder in another order, so rows cut
-    elsewhere round differently from the whole product; cut so, every row has the whole
-    product's bits (its Haswell, SkylakeX and Sandybridge kernels alike), and so do the
-    diagonal rows (one nonzero term)."""
-    cdef Py_ssize_t n = p.n, i, first = n, end = 0
-    cdef const double* P = p.P.values
-    if not w.schur.ready:
-        product(&p.P, w.x, w.grad)
-        return
-    for i in range(w.schur.dense):
-        first = min(first, w.schur.order[i])
-        end = max(end, w.schur.order[i] + 1)
-    for i in range(n):
-        w.grad[i] = P[i * n + i] * w.x[i]
-    if end > first:
-        first -= first % 4
-        end = min(n, end + (4 - end % 4) % 4)
-        matvec(P + first * n, w.x, w.grad + first, end - first, n)
 
 
 cdef void _apply(Polish* w, Py_ssize_t nf, Py_ssize_t m, Py_ssize_t nb,
