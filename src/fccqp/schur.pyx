@@ -34,7 +34,7 @@ rank-deficient ``A``. Solves are refined like :func:`fccqp.ldl.ldl_solve`.
 
 import numpy as np
 
-from libc.math cimport fabs, sqrt
+from libc.math cimport fabs, fma, sqrt
 
 from fccqp._blas cimport cholesky, cholesky_solve, cholesky_solve_vector, gemm, syrk_t, trsm
 from fccqp._types cimport Problem
@@ -149,8 +149,11 @@ cdef bint _factor_free(Schur* f, const Problem* p) noexcept nogil:
 
 cdef bint _factor_constrained(Schur* f, const Problem* p, const double* rho_vec) noexcept nogil:
     """The constrained rows of the diagonal tail of ``L`` and ``Y`` for ``rho_vec``, and
-    ``S = G + Y_S' Y_S``, over the free rows that :func:`_factor_free` left."""
-    cdef int n = <int>p.n, m = <int>p.m, s = <int>p.s, first = n - s, i, j
+    ``S = G + Y_S' Y_S``, over the free rows that :func:`_factor_free` left. A
+    constrained row of ``Y`` is a column of ``A`` over its pivot, as sparse as that
+    column (whole-body control: one entry for a torque, a few for a contact force), so
+    ``Y_S' Y_S`` is summed over the rows' nonzeros (:func:`_add_row_products`)."""
+    cdef int n = <int>p.n, m = <int>p.m, s = <int>p.s, first = n - s, i, j, count
     cdef Py_ssize_t column
     cdef double d, a, largest = f.free_largest
     for j in range(first, n):
@@ -162,16 +165,43 @@ cdef bint _factor_constrained(Schur* f, const Problem* p, const double* rho_vec)
         f.L[j + j * n] = sqrt(d)
     if m == 0:
         return True
-    for i in range(m):
-        for j in range(first, n):
-            a = p.A.values[i * n + f.order[j]]
+    for j in range(first, n):
+        column = f.order[j]
+        count = 0
+        for i in range(m):
+            a = p.A.values[i * n + column]
             largest = max(largest, fabs(a))
             f.Y[j + i * n] = a / f.L[j + j * n]
-    for i in range(m * m):
-        f.LS[i] = f.G[i]
-    if s > 0:
-        syrk_t(m, s, f.Y + first, n, 1.0, f.LS, m)
+            f.nonzeros[j * m + count] = i
+            count += f.Y[j + i * n] != 0.0
+        f.nonzero_count[j] = count
+    _add_row_products(f, first, n, m)
     return _factor_complement(f, m, largest)
+
+
+cdef void _add_row_products(Schur* f, int first, int last, int m) noexcept nogil:
+    """``LS = G + Y_R' Y_R`` (lower triangle) over the rows ``R = first:last`` of ``Y``,
+    from their nonzeros alone. Each entry's products are summed in ``dsyrk``'s way, a
+    fused multiply-add per row in the rows' order from zero, and the sum then added to
+    ``G``: a zero entry adds exactly nothing to a fused sum, so the entry is the one
+    ``dsyrk`` with ``beta = 1`` gives bit for bit where that kernel sums each entry
+    that way."""
+    cdef int j, k, l, a, b
+    cdef const int* index
+    cdef double y
+    cdef double* T = f.T
+    for k in range(m * m):
+        T[k] = 0.0
+    for j in range(first, last):
+        index = f.nonzeros + j * m
+        for k in range(f.nonzero_count[j]):
+            a = index[k]
+            y = f.Y[j + a * f.n]
+            for l in range(k + 1):
+                b = index[l]
+                T[a + b * m] = fma(y, f.Y[j + b * f.n], T[a + b * m])
+    for k in range(m * m):
+        f.LS[k] = f.G[k] + T[k]
 
 
 cdef bint _factor_whole(Schur* f, const Problem* p, const double* rho_vec) noexcept nogil:
