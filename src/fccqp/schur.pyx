@@ -144,7 +144,24 @@ cdef bint _factor_free(Schur* f, const Problem* p) noexcept nogil:
         for j in range(k, first):
             f.Y[j + i * n] /= f.L[j + j * n]
     syrk_t(m, first, f.Y, n, 0.0, f.G, m)
+    _find_nonzeros(f, p, first, n)
     return True
+
+
+cdef void _find_nonzeros(Schur* f, const Problem* p, int first, int last) noexcept nogil:
+    """Where the rows ``first:last`` of the diagonal tail of ``Y`` can be nonzero: row
+    ``j`` is column ``order[j]`` of ``A`` over a pivot, nonzero where that column is
+    (into ``nonzeros`` and ``nonzero_count``; branch-free: every row index is written,
+    kept where nonzero)."""
+    cdef int n = <int>p.n, m = <int>p.m, i, j, count
+    cdef Py_ssize_t column
+    for j in range(first, last):
+        column = f.order[j]
+        count = 0
+        for i in range(m):
+            f.nonzeros[j * m + count] = i
+            count += p.A.values[i * n + column] != 0.0
+        f.nonzero_count[j] = count
 
 
 cdef bint _factor_constrained(Schur* f, const Problem* p, const double* rho_vec) noexcept nogil:
@@ -152,8 +169,9 @@ cdef bint _factor_constrained(Schur* f, const Problem* p, const double* rho_vec)
     ``S = G + Y_S' Y_S``, over the free rows that :func:`_factor_free` left. A
     constrained row of ``Y`` is a column of ``A`` over its pivot, as sparse as that
     column (whole-body control: one entry for a torque, a few for a contact force), so
-    ``Y_S' Y_S`` is summed over the rows' nonzeros (:func:`_add_row_products`)."""
-    cdef int n = <int>p.n, m = <int>p.m, s = <int>p.s, first = n - s, i, j, count
+    ``Y_S' Y_S`` is summed over the rows' nonzeros (:func:`_add_row_products`; their
+    places are :func:`_find_nonzeros`', found once for ``P`` and ``A``)."""
+    cdef int n = <int>p.n, m = <int>p.m, s = <int>p.s, first = n - s, i, j
     cdef Py_ssize_t column
     cdef double d, a, largest = f.free_largest
     for j in range(first, n):
@@ -165,16 +183,11 @@ cdef bint _factor_constrained(Schur* f, const Problem* p, const double* rho_vec)
         f.L[j + j * n] = sqrt(d)
     if m == 0:
         return True
-    for j in range(first, n):
-        column = f.order[j]
-        count = 0
-        for i in range(m):
-            a = p.A.values[i * n + column]
+    for i in range(m):
+        for j in range(first, n):
+            a = p.A.values[i * n + f.order[j]]
             largest = max(largest, fabs(a))
             f.Y[j + i * n] = a / f.L[j + j * n]
-            f.nonzeros[j * m + count] = i
-            count += f.Y[j + i * n] != 0.0
-        f.nonzero_count[j] = count
     _add_row_products(f, first, n, m)
     return _factor_complement(f, m, largest)
 
@@ -182,26 +195,28 @@ cdef bint _factor_constrained(Schur* f, const Problem* p, const double* rho_vec)
 cdef void _add_row_products(Schur* f, int first, int last, int m) noexcept nogil:
     """``LS = G + Y_R' Y_R`` (lower triangle) over the rows ``R = first:last`` of ``Y``,
     from their nonzeros alone. Each entry's products are summed in ``dsyrk``'s way, a
-    fused multiply-add per row in the rows' order from zero, and the sum then added to
-    ``G``: a zero entry adds exactly nothing to a fused sum, so the entry is the one
-    ``dsyrk`` with ``beta = 1`` gives bit for bit where that kernel sums each entry
-    that way."""
-    cdef int j, k, l, a, b
+    fused multiply-add per row in the rows' order from zero, into ``T`` (zero between
+    calls), and the sum then added to ``G``: a zero term adds exactly nothing to a fused
+    sum, so the entry is the one ``dsyrk`` with ``beta = 1`` gives, bit for bit, where
+    that kernel sums each entry that way (OpenBLAS' Haswell and SkylakeX kernels do)."""
+    cdef int j, k, l, a
     cdef const int* index
     cdef double y
     cdef double* T = f.T
-    for k in range(m * m):
-        T[k] = 0.0
     for j in range(first, last):
         index = f.nonzeros + j * m
         for k in range(f.nonzero_count[j]):
             a = index[k]
             y = f.Y[j + a * f.n]
             for l in range(k + 1):
-                b = index[l]
-                T[a + b * m] = fma(y, f.Y[j + b * f.n], T[a + b * m])
+                T[a + index[l] * m] = fma(y, f.Y[j + index[l] * f.n], T[a + index[l] * m])
     for k in range(m * m):
         f.LS[k] = f.G[k] + T[k]
+    for j in range(first, last):
+        index = f.nonzeros + j * m
+        for k in range(f.nonzero_count[j]):
+            for l in range(k + 1):
+                T[index[k] + index[l] * m] = 0.0
 
 
 cdef bint _factor_whole(Schur* f, const Problem* p, const double* rho_vec) noexcept nogil:
