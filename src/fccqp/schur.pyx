@@ -34,13 +34,19 @@ rank-deficient ``A``. Solves are refined like :func:`fccqp.ldl.ldl_solve`.
 
 import numpy as np
 
-from libc.math cimport fabs, fma, sqrt
+from libc.math cimport fabs, sqrt
 
 from fccqp._blas cimport cholesky, cholesky_solve, cholesky_solve_vector, gemm, syrk_t, trsm
 from fccqp._types cimport Problem
 from fccqp.ldl cimport meets_equalities
 from fccqp.matrices cimport product, product_t
 from fccqp.tuning cimport MAX_REFINE, RANK_TOLERANCE, SCHUR_GROWTH
+
+cdef extern from "fccqp_kernels.h" nogil:
+    void fccqp_sparse_rank_update(const double* Y, int ld, int rows, const int* index,
+                                  const int* count, int m, double* T, double* values)
+    void fccqp_sparse_rank_clear(int rows, const int* index, const int* count, int m,
+                                 double* T)
 
 
 def ordering(n, constrained):
@@ -199,24 +205,13 @@ cdef void _add_row_products(Schur* f, int first, int last, int m) noexcept nogil
     calls), and the sum then added to ``G``: a zero term adds exactly nothing to a fused
     sum, so the entry is the one ``dsyrk`` with ``beta = 1`` gives, bit for bit, where
     that kernel sums each entry that way (OpenBLAS' Haswell and SkylakeX kernels do)."""
-    cdef int j, k, l, a
-    cdef const int* index
-    cdef double y
-    cdef double* T = f.T
-    for j in range(first, last):
-        index = f.nonzeros + j * m
-        for k in range(f.nonzero_count[j]):
-            a = index[k]
-            y = f.Y[j + a * f.n]
-            for l in range(k + 1):
-                T[a + index[l] * m] = fma(y, f.Y[j + index[l] * f.n], T[a + index[l] * m])
+    cdef int k
+    fccqp_sparse_rank_update(f.Y + first, f.n, last - first, f.nonzeros + first * m,
+                             f.nonzero_count + first, m, f.T, f.tail_values)
     for k in range(m * m):
-        f.LS[k] = f.G[k] + T[k]
-    for j in range(first, last):
-        index = f.nonzeros + j * m
-        for k in range(f.nonzero_count[j]):
-            for l in range(k + 1):
-                T[index[k] + index[l] * m] = 0.0
+        f.LS[k] = f.G[k] + f.T[k]
+    fccqp_sparse_rank_clear(last - first, f.nonzeros + first * m, f.nonzero_count + first,
+                            m, f.T)
 
 
 cdef bint _factor_whole(Schur* f, const Problem* p, const double* rho_vec) noexcept nogil:

@@ -185,7 +185,7 @@ cdef void dense_arrays(Arrays a, Engine* e, Py_ssize_t* order) except *:
     kk.schur.X, kk.schur.Wnu, kk.schur.M = a.new(n * s), a.new(m * s), a.new(s * s)
     kk.schur.nonzeros = <int*>a.new_int(n * m)
     kk.schur.nonzero_count = <int*>a.new_int(n)
-    kk.schur.T = a.new(m * m)
+    kk.schur.T, kk.schur.tail_values = a.new(m * m), a.new(m)
     kk.R = a.new(N * s)
     e.red.W, e.red.W_S = a.new(N * s), a.new(s * s)
     e.rest.W_T, e.rest.gram = a.new(N * s), a.new(s * s)
