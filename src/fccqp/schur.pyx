@@ -158,15 +158,19 @@ cdef void _find_nonzeros(Schur* f, const Problem* p, int first, int last) noexce
     """Where the rows ``first:last`` of the diagonal tail of ``Y`` can be nonzero: row
     ``j`` is column ``order[j]`` of ``A`` over a pivot, nonzero where that column is
     (into ``nonzeros`` and ``nonzero_count``; branch-free: every row index is written,
-    kept where nonzero)."""
+    kept where nonzero). The rows' zeros are written here (``A``'s own, signed zeros
+    as a division would leave them), and :func:`_factor_constrained` writes the rest."""
     cdef int n = <int>p.n, m = <int>p.m, i, j, count
     cdef Py_ssize_t column
+    cdef double a
     for j in range(first, last):
         column = f.order[j]
         count = 0
         for i in range(m):
+            a = p.A.values[i * n + column]
+            f.Y[j + i * n] = a
             f.nonzeros[j * m + count] = i
-            count += p.A.values[i * n + column] != 0.0
+            count += a != 0.0
         f.nonzero_count[j] = count
 
 
@@ -177,8 +181,9 @@ cdef bint _factor_constrained(Schur* f, const Problem* p, const double* rho_vec)
     column (whole-body control: one entry for a torque, a few for a contact force), so
     ``Y_S' Y_S`` is summed over the rows' nonzeros (:func:`_add_row_products`; their
     places are :func:`_find_nonzeros`', found once for ``P`` and ``A``)."""
-    cdef int n = <int>p.n, m = <int>p.m, s = <int>p.s, first = n - s, i, j
+    cdef int n = <int>p.n, m = <int>p.m, s = <int>p.s, first = n - s, i, j, k
     cdef Py_ssize_t column
+    cdef const int* index
     cdef double d, a, largest = f.free_largest
     for j in range(first, n):
         column = f.order[j]
@@ -189,9 +194,12 @@ cdef bint _factor_constrained(Schur* f, const Problem* p, const double* rho_vec)
         f.L[j + j * n] = sqrt(d)
     if m == 0:
         return True
-    for i in range(m):
-        for j in range(first, n):
-            a = p.A.values[i * n + f.order[j]]
+    for j in range(first, n):   # the zeros of Y's rows stay as _find_nonzeros wrote them
+        column = f.order[j]
+        index = f.nonzeros + j * m
+        for k in range(f.nonzero_count[j]):
+            i = index[k]
+            a = p.A.values[i * n + column]
             largest = max(largest, fabs(a))
             f.Y[j + i * n] = a / f.L[j + j * n]
     _add_row_products(f, first, n, m)
