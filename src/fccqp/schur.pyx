@@ -11,9 +11,9 @@ LS LS'``: ``nu = S^-1 (A H^-1 f - g)``, ``x = H^-1 (f - A' nu)``. With ``Y = L^-
 (one ``dtrsm``), ``S = Y'Y`` is one ``dsyrk`` (the constrained rows' share, which
 changes with rho, summed over their few nonzeros in ``dsyrk``'s bits). ``H`` is
 factored with its rows and columns in ``order``: free entries first, the ``s``
-constrained entries last. Then
-``L^-1`` maps a unit vector on a constrained entry into the trailing ``s`` rows only,
-and the reduced form's table (:func:`schur_unit_columns`) skips the leading rows; and
+constrained entries last. Then ``L^-1`` maps a unit vector on a constrained entry into
+the trailing ``s`` rows only, and the reduced form's table (:func:`schur_unit_columns`)
+skips the leading rows; and
 the leading block of ``L`` is the Cholesky factor of ``P`` on the free entries, which
 makes a convexity certificate cheap (:func:`schur_certifies_convexity`).
 
