@@ -13,9 +13,9 @@ changes with rho, summed over their few nonzeros in ``dsyrk``'s bits). ``H`` is
 factored with its rows and columns in ``order``: free entries first, the ``s``
 constrained entries last. Then ``L^-1`` maps a unit vector on a constrained entry into
 the trailing ``s`` rows only, and the reduced form's table (:func:`schur_unit_columns`)
-skips the leading rows; and
-the leading block of ``L`` is the Cholesky factor of ``P`` on the free entries, which
-makes a convexity certificate cheap (:func:`schur_certifies_convexity`).
+skips the leading rows; and the leading block of ``L`` is the Cholesky factor of ``P``
+on the free entries, which makes a convexity certificate cheap
+(:func:`schur_certifies_convexity`).
 
 Where ``P`` is diagonal on the constrained entries and on some free ones (no entry
 off its diagonal in their rows: the torques and forces of whole-body control), those
