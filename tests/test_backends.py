@@ -75,6 +75,28 @@ def test_backend_matches_clarabel_on_block_diagonal_costs(kkt_backend, shape):
     assert np.abs(A @ result.x - b).max() <= 1e-9 * (1 + np.abs(b).max())
 
 
+def test_new_nonzeros_in_the_constrained_columns_of_a_reused_solver_are_used():
+    """The Schur backend sums ``S`` over the nonzeros of ``A``'s constrained columns,
+    found once for each ``P`` and ``A``: after a QP with zeros there, a QP without them
+    is solved as a fresh solver would."""
+    problem = _block_diagonal(random_problem(4, n_box=6))
+    P, q, A, b, lb, ub, cones = problem
+    constrained = np.isfinite(lb) | np.isfinite(ub)
+    for cone in cones:
+        constrained[cone.start:cone.start + cone.dim] = True
+    feasible = fccqp.solve(*problem).x
+    sparser = A.copy()
+    sparser[:4, constrained] = 0.0
+    solver = fccqp.Solver(kkt_backend="schur_reduced", eps_abs=1e-8, eps_rel=1e-8)
+    assert solver.solve(P, q, sparser, sparser @ feasible, lb, ub, cones).backend == (
+        "schur_reduced")
+    solver.reset()
+    result = solver.solve(*problem)
+    assert result.status is Status.SOLVED and result.backend == "schur_reduced"
+    reference = clarabel_solve(*problem)
+    np.testing.assert_allclose(result.x, reference.x, atol=1e-5 * (1 + np.abs(reference.x).max()))
+
+
 @pytest.mark.parametrize("entry", ["free", "boxed"])
 def test_negative_curvature_on_the_diagonal_tail_is_rejected(entry):
     P, q, A, b, lb, ub, cones = _block_diagonal(random_problem(4, n_box=6))

@@ -24,6 +24,12 @@
  * stays with dgemv, whose dot-product kernel took 3.2k against 3.7k for a loop in four
  * explicit lanes. fccqp_cholesky also factors polish_schur's d x d cone blocks.
  *
+ * fccqp_sparse_rank_update: T += Y_R' Y_R (lower triangle) over a few sparse rows of
+ * Y, a fused multiply-add per nonzero pair, row after row (schur.pyx says why in that
+ * order); fccqp_sparse_rank_clear zeroes what it wrote. Fused multiply-adds are exact
+ * roundings, the same bits whether the AVX2 copy's instruction or the baseline's libm
+ * call computes them.
+ *
  * fccqp_symmetric_copy, fccqp_checked_copy, fccqp_scale_rows, fccqp_ruiz_maxima and
  * fccqp_row_spans: the per-solve passes over P and A of the validation scan, the
  * rescaling, the equilibration's passes and the rows' spans. They keep running maxima
@@ -346,6 +352,41 @@ static void fccqp_matvec_t(const double *restrict M, int ld, const double *restr
         double y0 = y[i];
         for (int j = 0; j < cols; j++)
             out[j] += y0 * r0[j];
+    }
+}
+
+/* For each row j < rows of the column-major Y (leading dimension ld) and each pair
+ * a >= b of its nonzero columns index[j m:j m + count[j]] (increasing): T[a + b m] =
+ * fma(Y[j, a], Y[j, b], T[a + b m]); values is scratch of m doubles. */
+FCCQP_CLONES
+static void fccqp_sparse_rank_update(const double *restrict Y, int ld, int rows,
+                                     const int *restrict index, const int *restrict count,
+                                     int m, double *restrict T, double *restrict values)
+{
+    for (int j = 0; j < rows; j++) {
+        const int *columns = index + (long)j * m;
+        for (int k = 0; k < count[j]; k++)
+            values[k] = Y[j + (long)columns[k] * ld];
+        for (int k = 0; k < count[j]; k++) {
+            double y = values[k];
+            double *row = T + columns[k];
+            for (int l = 0; l <= k; l++) {
+                long at = (long)columns[l] * m;
+                row[at] = fma(y, values[l], row[at]);
+            }
+        }
+    }
+}
+
+/* Zero the entries of T that fccqp_sparse_rank_update wrote for the same rows. */
+static void fccqp_sparse_rank_clear(int rows, const int *restrict index,
+                                    const int *restrict count, int m, double *restrict T)
+{
+    for (int j = 0; j < rows; j++) {
+        const int *columns = index + (long)j * m;
+        for (int k = 0; k < count[j]; k++)
+            for (int l = 0; l <= k; l++)
+                T[columns[k] + (long)columns[l] * m] = 0.0;
     }
 }
 

@@ -23,6 +23,10 @@ cdef struct Schur:
     double* X            # n x s scratch (unit columns)
     double* Wnu          # m x s scratch (unit columns)
     double* M            # s x s scratch (convexity test)
+    int* nonzeros        # n x m: where constrained row j of Y can be nonzero, at j * m
+    int* nonzero_count   # n: how many such places each constrained row has
+    double* T            # m x m scratch: the constrained rows' share of S (zero between uses)
+    double* tail_values  # m scratch: one row's nonzeros of Y
 
 cdef void mark_coupled(const double* P, Py_ssize_t n, char* coupled) noexcept nogil
 cdef bint schur_factor(Schur* f, const Problem* p, const double* rho_vec) noexcept nogil

@@ -8,12 +8,14 @@ When ``H = P + R`` is positive definite, the x-update's system
 
 is solved through two Cholesky factorizations, ``H = L L'`` and ``S = A H^-1 A' =
 LS LS'``: ``nu = S^-1 (A H^-1 f - g)``, ``x = H^-1 (f - A' nu)``. With ``Y = L^-1 A'``
-(one ``dtrsm``), ``S = Y'Y`` is one ``dsyrk``. ``H`` is factored with its rows and
-columns in ``order``: free entries first, the ``s`` constrained entries last. Then
-``L^-1`` maps a unit vector on a constrained entry into the trailing ``s`` rows only,
-and the reduced form's table (:func:`schur_unit_columns`) skips the leading rows; and
-the leading block of ``L`` is the Cholesky factor of ``P`` on the free entries, which
-makes a convexity certificate cheap (:func:`schur_certifies_convexity`).
+(one ``dtrsm``), ``S = Y'Y`` is one ``dsyrk`` (the constrained rows' share, which
+changes with rho, summed over their few nonzeros in ``dsyrk``'s bits). ``H`` is
+factored with its rows and columns in ``order``: free entries first, the ``s``
+constrained entries last. Then ``L^-1`` maps a unit vector on a constrained entry into
+the trailing ``s`` rows only, and the reduced form's table (:func:`schur_unit_columns`)
+skips the leading rows; and the leading block of ``L`` is the Cholesky factor of ``P``
+on the free entries, which makes a convexity certificate cheap
+(:func:`schur_certifies_convexity`).
 
 Where ``P`` is diagonal on the constrained entries and on some free ones (no entry
 off its diagonal in their rows: the torques and forces of whole-body control), those
@@ -41,6 +43,12 @@ from fccqp._types cimport Problem
 from fccqp.ldl cimport meets_equalities
 from fccqp.matrices cimport product, product_t
 from fccqp.tuning cimport MAX_REFINE, RANK_TOLERANCE, SCHUR_GROWTH
+
+cdef extern from "fccqp_kernels.h" nogil:
+    void fccqp_sparse_rank_update(const double* Y, int ld, int rows, const int* index,
+                                  const int* count, int m, double* T, double* values)
+    void fccqp_sparse_rank_clear(int rows, const int* index, const int* count, int m,
+                                 double* T)
 
 
 def ordering(n, constrained):
@@ -144,14 +152,40 @@ cdef bint _factor_free(Schur* f, const Problem* p) noexcept nogil:
         for j in range(k, first):
             f.Y[j + i * n] /= f.L[j + j * n]
     syrk_t(m, first, f.Y, n, 0.0, f.G, m)
+    _find_nonzeros(f, p, first, n)
     return True
+
+
+cdef void _find_nonzeros(Schur* f, const Problem* p, int first, int last) noexcept nogil:
+    """Where the rows ``first:last`` of the diagonal tail of ``Y`` can be nonzero: row
+    ``j`` is column ``order[j]`` of ``A`` over a pivot, nonzero where that column is
+    (into ``nonzeros`` and ``nonzero_count``; branch-free: every row index is written,
+    kept where nonzero). The rows' zeros are written here (``A``'s own, signed zeros
+    as a division would leave them), and :func:`_factor_constrained` writes the rest."""
+    cdef int n = <int>p.n, m = <int>p.m, i, j, count
+    cdef Py_ssize_t column
+    cdef double a
+    for j in range(first, last):
+        column = f.order[j]
+        count = 0
+        for i in range(m):
+            a = p.A.values[i * n + column]
+            f.Y[j + i * n] = a
+            f.nonzeros[j * m + count] = i
+            count += a != 0.0
+        f.nonzero_count[j] = count
 
 
 cdef bint _factor_constrained(Schur* f, const Problem* p, const double* rho_vec) noexcept nogil:
     """The constrained rows of the diagonal tail of ``L`` and ``Y`` for ``rho_vec``, and
-    ``S = G + Y_S' Y_S``, over the free rows that :func:`_factor_free` left."""
-    cdef int n = <int>p.n, m = <int>p.m, s = <int>p.s, first = n - s, i, j
+    ``S = G + Y_S' Y_S``, over the free rows that :func:`_factor_free` left. A
+    constrained row of ``Y`` is a column of ``A`` over its pivot, as sparse as that
+    column (whole-body control: one entry for a torque, a few for a contact force), so
+    ``Y_S' Y_S`` is summed over the rows' nonzeros (:func:`_add_row_products`; their
+    places are :func:`_find_nonzeros`', found once for ``P`` and ``A``)."""
+    cdef int n = <int>p.n, m = <int>p.m, s = <int>p.s, first = n - s, i, j, k
     cdef Py_ssize_t column
+    cdef const int* index
     cdef double d, a, largest = f.free_largest
     for j in range(first, n):
         column = f.order[j]
@@ -162,16 +196,32 @@ cdef bint _factor_constrained(Schur* f, const Problem* p, const double* rho_vec)
         f.L[j + j * n] = sqrt(d)
     if m == 0:
         return True
-    for i in range(m):
-        for j in range(first, n):
-            a = p.A.values[i * n + f.order[j]]
+    for j in range(first, n):   # the zeros of Y's rows stay as _find_nonzeros wrote them
+        column = f.order[j]
+        index = f.nonzeros + j * m
+        for k in range(f.nonzero_count[j]):
+            i = index[k]
+            a = p.A.values[i * n + column]
             largest = max(largest, fabs(a))
             f.Y[j + i * n] = a / f.L[j + j * n]
-    for i in range(m * m):
-        f.LS[i] = f.G[i]
-    if s > 0:
-        syrk_t(m, s, f.Y + first, n, 1.0, f.LS, m)
+    _add_row_products(f, first, n, m)
     return _factor_complement(f, m, largest)
+
+
+cdef void _add_row_products(Schur* f, int first, int last, int m) noexcept nogil:
+    """``LS = G + Y_R' Y_R`` (lower triangle) over the rows ``R = first:last`` of ``Y``,
+    from their nonzeros alone. Each entry's products are summed in ``dsyrk``'s way, a
+    fused multiply-add per row in the rows' order from zero, into ``T`` (zero between
+    calls), and the sum then added to ``G``: a zero term adds exactly nothing to a fused
+    sum, so the entry is the one ``dsyrk`` with ``beta = 1`` gives, bit for bit, where
+    that kernel sums each entry that way (OpenBLAS' Haswell and SkylakeX kernels do)."""
+    cdef int k
+    fccqp_sparse_rank_update(f.Y + first, f.n, last - first, f.nonzeros + first * m,
+                             f.nonzero_count + first, m, f.T, f.tail_values)
+    for k in range(m * m):
+        f.LS[k] = f.G[k] + f.T[k]
+    fccqp_sparse_rank_clear(last - first, f.nonzeros + first * m, f.nonzero_count + first,
+                            m, f.T)
 
 
 cdef bint _factor_whole(Schur* f, const Problem* p, const double* rho_vec) noexcept nogil:
