@@ -45,7 +45,7 @@ normalization of ``g`` (for friction ``(I - nn' - ee') / ||t||``, ``e`` the unit
 tangential direction; for second order ``(I - ee') / ||w||`` on ``w``). Homogeneity
 makes ``H x_k = 0`` at the linearization point, so the Newton step is the same
 equality-constrained QP with ``P + lam H`` on the block. ``H`` is taken on the cone at
-``x_k``'s axis part (the same ``e``, its ``||t||`` the cone's radius there: ``H x_k = 0``
+``x_k``'s axis part (the same ``e``, ``||t||`` the cone's radius there: ``H x_k = 0``
 still): ``x_k`` lies on the last plane, outside the cone, where the curvature is
 flatter than the constraint's (:func:`~fccqp.polish_guess.linearize_on_cone`). Without that term the
 iteration is a fixed point that diverges where ``P`` is flat on the forces and the
