@@ -44,13 +44,14 @@ Newton needs the curvature of the constraint: the Hessian of the Lagrangian adds
 normalization of ``g`` (for friction ``(I - nn' - ee') / ||t||``, ``e`` the unit
 tangential direction; for second order ``(I - ee') / ||w||`` on ``w``). Homogeneity
 makes ``H x_k = 0`` at the linearization point, so the Newton step is the same
-equality-constrained QP with ``P + lam H`` on the block. ``H`` is taken on the cone at
-``x_k``'s axis part (the same ``e``, ``||t||`` the cone's radius there: ``H x_k = 0``
-still): ``x_k`` lies on the last plane, outside the cone, where the curvature is
-flatter than the constraint's (:func:`~fccqp.polish_guess.linearize_on_cone`). Without that term the
+equality-constrained QP with ``P + lam H`` on the block. Without that term the
 iteration is a fixed point that diverges where ``P`` is flat on the forces and the
 multipliers are large, as in whole-body control (measured on random problems: the
-cone violation grew from 1e-7 to 2e-5 in one re-linearization).
+cone violation grew from 1e-7 to 2e-5 in one re-linearization). ``H`` is taken on the
+cone at ``x_k``'s axis part (the same ``e``, ``||t||`` the cone's radius there, so
+``H x_k = 0`` still): ``x_k`` lies on the last plane, outside the cone, where the
+curvature is flatter than the constraint's
+(:func:`~fccqp.polish_guess.linearize_on_cone`).
 
 Multipliers, in the sign convention of docs/formulation.md (``P x + q + A'nu + y = 0``,
 ``y`` in the normal cone of the set): a held entry's is minus the gradient of the
@@ -155,9 +156,9 @@ cdef bint _relinearize(Polish* w, const Problem* p, Py_ssize_t nb,
                        double* worst) noexcept nogil:
     """Move each boundary block's plane to the current ``x_block`` and its curvature to
     the cone there (:func:`~fccqp.polish_guess.linearize_on_cone`), unless every block
-    already meets ``NEWTON_TOLERANCE``: then return False and keep
-    the planes, with which ``(x, lam)`` were solved. ``worst`` receives the largest
-    ``|phi| / ||x_block||``."""
+    already meets ``NEWTON_TOLERANCE``: then return False and keep the planes, with
+    which ``(x, lam)`` were solved. ``worst`` receives the largest ``|phi| /
+    ||x_block||``."""
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t k, j, cone, start, d
     cdef double size, miss
