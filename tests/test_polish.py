@@ -484,3 +484,21 @@ def test_warm_polish_may_take_more_guesses_than_a_cold_one():
     ran 36 ADMM iterations. A warm polish may solve ``WARM_GUESS_PASSES`` guesses: it
     answers the tick."""
     assert _warm_ticks("go2", 100, 107)[-1].iterations == 0
+
+
+def test_warm_polish_puts_a_lightly_loaded_contact_on_its_cone():
+    """go2's second benchmark sequence, tick 158: a contact at a normal force of 0.006
+    with a multiplier of 1e-5. Newton's iterate lay on the last plane far outside the
+    cone, where the cone function's curvature is flatter than at the cone, and circled
+    round the axis for all its steps; the tick's answer had that contact 19 % of its
+    force off the cone (another by 1.6e-7). With the curvature taken on the cone both
+    lie on it."""
+    pytest.importorskip("pinocchio")
+    from benchmarks.testsets import generate_test_set
+
+    qp = generate_test_set("go2", "mix", 400, seed=0).qps[158]
+    x = _warm_ticks("go2", 100, 158)[-1].x
+    for start, mu, normal in zip(qp.cone_starts, qp.mus, qp.normals, strict=True):
+        force = x[start:start + 3]
+        along = np.dot(normal, force)
+        assert np.linalg.norm(force - along * normal) - mu * along <= 1e-9 * np.linalg.norm(force)

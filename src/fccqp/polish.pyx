@@ -47,7 +47,11 @@ makes ``H x_k = 0`` at the linearization point, so the Newton step is the same
 equality-constrained QP with ``P + lam H`` on the block. Without that term the
 iteration is a fixed point that diverges where ``P`` is flat on the forces and the
 multipliers are large, as in whole-body control (measured on random problems: the
-cone violation grew from 1e-7 to 2e-5 in one re-linearization).
+cone violation grew from 1e-7 to 2e-5 in one re-linearization). ``H`` is taken on the
+cone at ``x_k``'s axis part (the same ``e``, ``||t||`` the cone's radius there, so
+``H x_k = 0`` still): ``x_k`` lies on the last plane, outside the cone, where the
+curvature is flatter than the constraint's
+(:func:`~fccqp.polish_guess.linearize_on_cone`).
 
 Multipliers, in the sign convention of docs/formulation.md (``P x + q + A'nu + y = 0``,
 ``y`` in the normal cone of the set): a held entry's is minus the gradient of the
@@ -67,8 +71,8 @@ from fccqp.cone_dispatch cimport cone_phi, cone_plane
 from fccqp.kkt cimport KKT
 from fccqp.matrices cimport CSC, DENSE
 from fccqp.polish_guess cimport (boundary_entries, box_code, cone_code, drop_far_side, guess,
-                                 keep_bare_plane, leaves_set, linearize, most_wrong, past_apex,
-                                 renew, step_length)
+                                 keep_bare_plane, leaves_set, linearize_on_cone, most_wrong,
+                                 past_apex, renew, step_length)
 from fccqp.polish_kkt cimport correct_once, kkt_residual, number_unknowns, refactor, refine
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
@@ -150,10 +154,11 @@ cdef bint _chord_step(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
 
 cdef bint _relinearize(Polish* w, const Problem* p, Py_ssize_t nb,
                        double* worst) noexcept nogil:
-    """Move each boundary block's plane and curvature to the current ``x_block``,
-    unless every block already meets ``NEWTON_TOLERANCE``: then return False and keep
-    the planes, with which ``(x, lam)`` were solved. ``worst`` receives the largest
-    ``|phi| / ||x_block||``."""
+    """Move each boundary block's plane to the current ``x_block`` and its curvature to
+    the cone there (:func:`~fccqp.polish_guess.linearize_on_cone`), unless every block
+    already meets ``NEWTON_TOLERANCE``: then return False and keep the planes, with
+    which ``(x, lam)`` were solved. ``worst`` receives the largest ``|phi| /
+    ||x_block||``."""
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t k, j, cone, start, d
     cdef double size, miss
@@ -173,7 +178,7 @@ cdef bint _relinearize(Polish* w, const Problem* p, Py_ssize_t nb,
     if converged:
         return False
     for k in range(nb):
-        linearize(w, p, k, w.x + p.constrained[c.offset[w.boundary[k]]])
+        linearize_on_cone(w, p, k, w.x + p.constrained[c.offset[w.boundary[k]]])
     return True
 
 

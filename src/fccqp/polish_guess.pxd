@@ -27,6 +27,8 @@ cdef inline char cone_code(const Cones* c, Py_ssize_t k, const double* v) noexce
 
 
 cdef void linearize(Polish* w, const Problem* p, Py_ssize_t k, const double* v) noexcept nogil
+cdef void linearize_on_cone(Polish* w, const Problem* p, Py_ssize_t k,
+                           const double* x) noexcept nogil
 cdef Py_ssize_t guess(Polish* w, const Problem* p, const double* z, const double* y,
                       Py_ssize_t* changed) noexcept nogil
 cdef void keep_bare_plane(Polish* w, const Problem* p, Py_ssize_t k) noexcept nogil

@@ -34,12 +34,42 @@ cdef void linearize(Polish* w, const Problem* p, Py_ssize_t k, const double* v) 
     (:mod:`fccqp.polish_schur`) then no longer applies (every pass after the first of
     go2's cold polishes, whose planes start with ``lam = 0``, had fallen to ``dsytrf``).
     """
+    _place(w, p, k, v, 1.0)
+
+
+cdef void linearize_on_cone(Polish* w, const Problem* p, Py_ssize_t k,
+                            const double* x) noexcept nogil:
+    """:func:`linearize` at ``x`` (block ``k``'s entries), its curvature that of the cone
+    at ``x``'s axis part: the cone function's Hessian is ``1 / across`` times a
+    projector that depends on the direction of ``x``'s part across the axis only, so it
+    is scaled by ``across / (slope along)``, the point of the cone in that direction
+    (unscaled where ``x`` is not outside the cone).
+
+    A point of Newton's iterate lies on the last plane, outside the cone, its part
+    across the axis longer than the cone's radius at its axis part; the curvature there
+    is that much flatter than the constraint's, and where ``P`` is flat on the forces and
+    ``lam`` small the next step swung that part round the axis (go2: a contact at a
+    normal force of 0.006 circled for 20 steps, its relative miss 0.45-1.0). At the
+    answer both points coincide, so Newton's quadratic convergence is kept
+    (notes/polish.md, "newtonrate")."""
+    cdef const Cones* c = &p.cones
+    cdef Py_ssize_t cone = w.boundary[k]
+    cdef double across, radius
+    cdef double along = cone_split(x, c.kind[cone], c.dim[cone], c.mu[cone],
+                                   c.normal + 3 * cone, &across)
+    radius = cone_slope(c.kind[cone], c.mu[cone]) * along
+    _place(w, p, k, x, across / radius if radius > 0.0 and across > radius else 1.0)
+
+
+cdef inline void _place(Polish* w, const Problem* p, Py_ssize_t k, const double* v,
+                        double stiffen) noexcept nogil:
+    """:func:`linearize`, its curvature times ``stiffen``."""
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t cone = w.boundary[k], o = c.offset[cone], d = c.dim[cone]
     cdef double phi
     cone_plane(v, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, w.g + o, &phi)
-    cone_curvature(v, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone, max(w.lam[k], 0.0),
-                   w.hess + o * w.hess_stride)
+    cone_curvature(v, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone,
+                   stiffen * max(w.lam[k], 0.0), w.hess + o * w.hess_stride)
     if not w.lam[k] > 0.0:
         w.bare[cone] = BARE
 
