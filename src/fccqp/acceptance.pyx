@@ -19,9 +19,9 @@ from fccqp.projections cimport proj_block, proj_set
 from fccqp.restoration cimport restore
 from fccqp.scaling cimport unscale
 from fccqp.termination cimport Residuals, box_entry_size, gap_scale
-from fccqp.tuning cimport (EQUALITY_EXACT, EQUALITY_MISSED, EQUALITY_SLACK, GUESS_PASSES,
-                           POLISH_EXACT, RESTORED_EQUALITY, SCALED_VIOLATION,
-                           WARM_GUESS_PASSES)
+from fccqp.tuning cimport (CYCLED_GUESS_PASSES, EQUALITY_EXACT, EQUALITY_MISSED,
+                           EQUALITY_SLACK, GUESS_PASSES, POLISH_EXACT, RESTORED_EQUALITY,
+                           SCALED_VIOLATION, WARM_GUESS_PASSES)
 from fccqp.verdict cimport classify, missed
 
 
@@ -142,14 +142,15 @@ cdef bint warm_polish(Engine* e, Run* run, double start_time) noexcept nogil:
     tick's active set is a few corrections from this one's, and a warm polish that
     stopped unsettled at ``GUESS_PASSES`` sent its tick to ADMM, dozens of iterations
     dearer than the guesses it lacked (notes/performance-history.md, "warmp95").
-    A warm polish that ended cycling is polished once more from its own last point
-    (:func:`_polish_again`).
+    A warm polish that ended cycling is tried once more from its own last point, one
+    guess (``CYCLED_GUESS_PASSES``, :func:`_polish_again`).
     """
     cdef int status = RUNNING
     cdef bint kept
     e.pol.guess_passes = WARM_GUESS_PASSES
     kept = keep_polished(e, &status, 0, start_time, True)
     if not kept and e.pol.cycling:
+        e.pol.guess_passes = CYCLED_GUESS_PASSES
         kept = _polish_again(e, &status, start_time)
     e.pol.guess_passes = GUESS_PASSES
     if not kept:
@@ -167,10 +168,13 @@ cdef bint _polish_again(Engine* e, int* status, double start_time) noexcept nogi
     its guess comes from that point's slack and multipliers, and its planes are
     linearized there, no longer where the previous tick's answer put them. True when
     :func:`keep_polished` keeps the result; otherwise the iterate, ADMM's start, is put
-    back as it was. Most such ticks had run ADMM for a few iterations, after which a
-    polish settled at its first guess, the same boundary blocks as the cycling guess's:
-    ADMM's factorization and iterations were the price of new planes
-    (notes/performance-history.md, "talosadmm")."""
+    back as it was. Such ticks had run ADMM for a few iterations, after which a polish
+    mostly settled at its first guess on the cycling guess's boundary blocks: ADMM's
+    factorization and iterations were the price of new planes. From the cycling point
+    itself the guesses that were kept settled at the first one too, and those that did
+    not settle took 5-12 guesses at up to 0.5M each (go2) before the tick ran ADMM
+    anyway, so ``CYCLED_GUESS_PASSES`` is 1 (notes/performance-history.md,
+    "talosadmm")."""
     cdef Problem* p = &e.prob
     cdef Iterates* it = &e.it
     cdef double* saved = e.work.saved
