@@ -453,3 +453,12 @@ def test_warm_polish_may_take_more_guesses_than_a_cold_one():
     ran 36 ADMM iterations. A warm polish may solve ``WARM_GUESS_PASSES`` guesses: it
     answers the tick."""
     assert _warm_ticks("go2", 100, 107)[-1].iterations == 0
+
+
+def test_a_warm_polish_that_cycles_is_tried_again_from_its_own_point():
+    """go2's second benchmark sequence, tick 125: the warm polish from tick 124's answer
+    throws a contact block past its apex, holds it there, releases it and throws it
+    again, and ends cycling; its tick ran ADMM. One guess from the cycling polish's own
+    point, with its planes linearized there, settles: the tick runs no iteration."""
+    result = _warm_ticks("go2", 100, 125)[-1]
+    assert result.polished and result.iterations == 0
