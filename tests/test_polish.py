@@ -502,3 +502,12 @@ def test_warm_polish_puts_a_lightly_loaded_contact_on_its_cone():
         force = x[start:start + 3]
         along = np.dot(normal, force)
         assert np.linalg.norm(force - along * normal) - mu * along <= 1e-9 * np.linalg.norm(force)
+
+
+def test_a_warm_polish_that_cycles_is_tried_again_from_its_own_point():
+    """go2's second benchmark sequence, tick 125: the warm polish from tick 124's answer
+    throws a contact block past its apex, holds it there, releases it and throws it
+    again, and ends cycling; its tick ran ADMM. One guess from the cycling polish's own
+    point, with its planes linearized there, settles: the tick runs no iteration."""
+    result = _warm_ticks("go2", 100, 125)[-1]
+    assert result.polished and result.iterations == 0

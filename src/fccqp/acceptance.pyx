@@ -19,9 +19,9 @@ from fccqp.projections cimport proj_block, proj_set
 from fccqp.restoration cimport restore
 from fccqp.scaling cimport unscale
 from fccqp.termination cimport Residuals, box_entry_size, gap_scale
-from fccqp.tuning cimport (EQUALITY_EXACT, EQUALITY_MISSED, EQUALITY_SLACK, GUESS_PASSES,
-                           POLISH_EXACT, RESTORED_EQUALITY, SCALED_VIOLATION,
-                           WARM_GUESS_PASSES)
+from fccqp.tuning cimport (CYCLED_GUESS_PASSES, EQUALITY_EXACT, EQUALITY_MISSED,
+                           EQUALITY_SLACK, GUESS_PASSES, POLISH_EXACT, RESTORED_EQUALITY,
+                           SCALED_VIOLATION, WARM_GUESS_PASSES)
 from fccqp.verdict cimport classify, missed
 
 
@@ -142,11 +142,16 @@ cdef bint warm_polish(Engine* e, Run* run, double start_time) noexcept nogil:
     tick's active set is a few corrections from this one's, and a warm polish that
     stopped unsettled at ``GUESS_PASSES`` sent its tick to ADMM, dozens of iterations
     dearer than the guesses it lacked (notes/performance-history.md, "warmp95").
+    A warm polish that ended cycling is tried once more from its own last point, one
+    guess (``CYCLED_GUESS_PASSES``, :func:`_polish_again`).
     """
     cdef int status = RUNNING
     cdef bint kept
     e.pol.guess_passes = WARM_GUESS_PASSES
     kept = keep_polished(e, &status, 0, start_time, True)
+    if not kept and e.pol.cycling:
+        e.pol.guess_passes = CYCLED_GUESS_PASSES
+        kept = _polish_again(e, &status, start_time)
     e.pol.guess_passes = GUESS_PASSES
     if not kept:
         return False
@@ -155,6 +160,42 @@ cdef bint warm_polish(Engine* e, Run* run, double start_time) noexcept nogil:
     e.clock.marks[3] = e.clock.marks[4] = fccqp_now()
     end_run(e, run, SOLVED, 0)
     return True
+
+
+cdef bint _polish_again(Engine* e, int* status, double start_time) noexcept nogil:
+    """Polish from the polished point of a warm polish that ended cycling (a block
+    thrown past its apex, held there, released and thrown again) as from an iterate:
+    its guess comes from that point's slack and multipliers, and its planes are
+    linearized there, no longer where the previous tick's answer put them. True when
+    :func:`keep_polished` keeps the result; otherwise the iterate, ADMM's start, is put
+    back as it was. Such ticks had run ADMM for a few iterations, after which a polish
+    mostly settled at its first guess on the cycling guess's boundary blocks: ADMM's
+    factorization and iterations were the price of new planes. From the cycling point
+    itself the guesses that were kept settled at the first one too, and those that did
+    not settle took 5-12 guesses at up to 0.5M each (go2) before the tick ran ADMM
+    anyway, so ``CYCLED_GUESS_PASSES`` is 1 (notes/performance-history.md,
+    "talosadmm")."""
+    cdef Problem* p = &e.prob
+    cdef Iterates* it = &e.it
+    cdef double* saved = e.work.saved
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j
+    copy(it.x, saved, n)
+    copy(it.nu, saved + n, m)
+    copy(it.y, saved + n + m, s)
+    copy(it.z, it.z_prev, s)   # free until ADMM's first step writes it
+    copy(e.pol.x, it.x, n)
+    copy(e.pol.nu, it.nu, m)
+    copy(e.pol.y, it.y, s)
+    for j in range(s):
+        it.z[j] = it.x[p.constrained[j]]
+    proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
+    if keep_polished(e, status, 0, start_time, True):
+        return True
+    copy(saved, it.x, n)
+    copy(saved + n, it.nu, m)
+    copy(saved + n + m, it.y, s)
+    copy(it.z_prev, it.z, s)
+    return False
 
 
 cdef void restore_equalities(Engine* e) noexcept nogil:

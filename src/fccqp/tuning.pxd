@@ -144,6 +144,8 @@ cdef extern from *:
     /* most active sets per warm polish (from the previous tick's answer): 8 sent 3-9 % of
        the warm ticks to ADMM, most of them a few guesses short of settling */
     #define FCCQP_WARM_GUESS_PASSES 12
+    /* guesses of a warm polish tried again from its own cycling point: those kept took 1 */
+    #define FCCQP_CYCLED_GUESS_PASSES 1
     /* a polish whose first this many guesses all violate a constraint gives up */
     #define FCCQP_FEASIBLE_PASSES 3
     /* a free entry or block joins the active set when it violates by more than this */
@@ -264,6 +266,7 @@ cdef extern from *:
     const double GUESS_TOLERANCE "FCCQP_GUESS_TOLERANCE"
     const int GUESS_PASSES "FCCQP_GUESS_PASSES"
     const int WARM_GUESS_PASSES "FCCQP_WARM_GUESS_PASSES"
+    const int CYCLED_GUESS_PASSES "FCCQP_CYCLED_GUESS_PASSES"
     const int FEASIBLE_PASSES "FCCQP_FEASIBLE_PASSES"
     const double ACTIVE_TOLERANCE "FCCQP_ACTIVE_TOLERANCE"
     const double NEWTON_TOLERANCE "FCCQP_NEWTON_TOLERANCE"
