@@ -1,6 +1,11 @@
 # cython: language_level=3
 from fccqp._types cimport Problem
 
+cdef enum:
+    BASE_NONE = 0
+    BASE_READY = 1
+    BASE_REFUSED = 2
+
 cdef struct PolishSchur:
     # The polished QP's KKT system by Schur complement where P's structure allows it
     # (see polish_schur.pyx); set up once per solve, factored once per guess.
@@ -28,8 +33,9 @@ cdef struct PolishSchur:
     # The bordered factorization (polish_schur.pyx), which keeps the part of S that a
     # guess's boundary planes and curvature do not change:
     bint bordered           # the last factored guess is bordered: a solve reads S0..T
-    bint base_ready         # S0, W, WW belong to Y's rows [unconstrained, diag_end) and
-                            # the boundary blocks base_boundary[:base_nb]
+    char base               # BASE_NONE, or S0, W, WW belong to Y's rows [unconstrained,
+                            # diag_end) and the blocks base_boundary[:base_nb] (BASE_READY)
+                            # or S0 of those was refused (BASE_REFUSED)
     Py_ssize_t* base_boundary   # s: the boundary blocks of the base
     int base_nb             # their number
     int nbd                 # their entries: the boundary rows of the bordered system

@@ -73,7 +73,8 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j, r, c, lead = 0, rest
     cdef double largest = 0.0, pivot
     cdef int k
-    f.ready = f.base_ready = f.bordered = False
+    f.ready = f.bordered = False
+    f.base = BASE_NONE
     f.convex = True
     mark_coupled(p.P.values, n, f.coupled)
     for i in range(n):
@@ -269,10 +270,10 @@ cdef Py_ssize_t _walk_diagonal(PolishSchur* f, const Problem* p, const Py_ssize_
 
 cdef bint _same_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
                      const Py_ssize_t* boundary, Py_ssize_t nb) noexcept nogil:
-    """Whether ``S0``, ``W`` and ``W'W`` are those of the guess: the same free diagonal
+    """Whether the base (:func:`_build_base`) is the guess's: the same free diagonal
     rows and the same boundary blocks."""
     cdef Py_ssize_t kb
-    if not f.base_ready or nb != f.base_nb:
+    if f.base == BASE_NONE or nb != f.base_nb:
         return False
     for kb in range(nb):
         if boundary[kb] != f.base_boundary[kb]:
@@ -280,20 +281,27 @@ cdef bint _same_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
     return _walk_diagonal(f, p, index, boundary, nb, False) >= 0
 
 
-cdef bint _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
+cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
                       const Py_ssize_t* boundary, Py_ssize_t nb) noexcept nogil:
     """The guess's part of ``S`` that its planes and curvature leave alone: the free
     diagonal rows of ``Y``, the Cholesky factor ``L0`` of ``S0 = SU + Y_D'Y_D`` (the
     regularized Schur complement of every free entry but the boundary blocks'),
-    ``W = L0^-1 A_B'`` and ``W'W``. False where a row cannot be written or ``S0`` is too
-    near singular for the bordered solve (``POLISH_BORDER_TOLERANCE``)."""
+    ``W = L0^-1 A_B'`` and ``W'W``; ``BASE_NONE`` where a row cannot be written,
+    ``BASE_REFUSED`` where ``S0`` is too near singular for the bordered solve
+    (``POLISH_BORDER_TOLERANCE``: go2's rows that only boundary blocks span leave ``S0``
+    ``delta`` there), so that the guesses of that base go straight to
+    :func:`_factor_whole`, which writes the same rows of ``Y``."""
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, r, c, a, kb, o, d, start, e = 0, row
     cdef double largest = 0.0
-    f.base_ready = False
+    f.base = BASE_NONE
     row = _walk_diagonal(f, p, index, boundary, nb, True)
     if row < 0:
-        return False
+        return
     f.diag_end = <int>row
+    f.base_nb = <int>nb
+    for kb in range(nb):
+        f.base_boundary[kb] = boundary[kb]
+    f.base = BASE_REFUSED
     for c in range(m):
         for r in range(c, m):
             f.S0[r + c * m] = f.SU[r + c * m]
@@ -303,10 +311,10 @@ cdef bint _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
     for c in range(m):
         largest = max(largest, f.S0[c + c * m])
     if m > 0 and not fccqp_cholesky(f.S0, <int>m, <int>m):
-        return False
+        return
     for c in range(m):
         if f.S0[c + c * m] * f.S0[c + c * m] <= POLISH_BORDER_TOLERANCE * largest:
-            return False
+            return
     for kb in range(nb):   # the boundary entries: rows of the bordered system, columns of W
         o, d = p.cones.offset[boundary[kb]], p.cones.dim[boundary[kb]]
         start = p.constrained[o]
@@ -317,17 +325,16 @@ cdef bint _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
                 f.W[c + (e + a) * m] = p.A.values[c * n + start + a]
         row += d
         e += d
-        f.base_boundary[kb] = boundary[kb]
     if e > 0 and m > 0:
-        trsm(b"L", b"N", <int>m, <int>e, f.S0, <int>m, f.W, <int>m)
+        for a in range(e):   # a column at a time: dtrsm's set-up cost more at these sizes
+            forward_substitution(f.S0, <int>m, <int>m, f.W + a * m)
         syrk_t(<int>e, <int>m, f.W, <int>m, 0.0, f.WW, <int>s)
     else:
         for c in range(e):
             for r in range(c, e):
                 f.WW[r + c * s] = 0.0
-    f.nbd, f.base_nb, f.base_largest = <int>e, <int>nb, largest
-    f.base_ready = True
-    return True
+    f.nbd, f.base_largest = <int>e, largest
+    f.base = BASE_READY
 
 
 cdef bint _factor_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* boundary,
@@ -415,15 +422,16 @@ cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t
     factorizations of a polish: every ``renew`` and every re-linearization moves every
     plane) then refactors only ``K`` and ``T`` (``nb d`` and ``nb`` rows) and keeps
     ``S0``, ``W`` and ``W'W`` (notes/polish.md, "schurup"). Otherwise, or where ``S0`` is
-    too near singular for that order, the whole ``S`` (:func:`_factor_whole`)."""
+    too near singular for that order, the whole ``S`` (:func:`_factor_whole`: the rows
+    of ``Y`` it writes for a guess are the base's, so the base stays the guess's)."""
     f.bordered = False
-    if (_same_base(f, p, index, boundary, nb) or _build_base(f, p, index, boundary, nb)) \
-            and _factor_bordered(f, p, boundary, nb, g, hess, delta):
+    if not _same_base(f, p, index, boundary, nb):
+        _build_base(f, p, index, boundary, nb)
+    if f.base == BASE_READY and _factor_bordered(f, p, boundary, nb, g, hess, delta):
         f.bordered = True
         f.rows = f.diag_end + f.nbd
         f.size = <int>(p.m + nb)
         return True
-    f.base_ready = False   # the whole factorization writes Y's rows anew
     return _factor_whole(f, p, index, boundary, nb, g, hess, delta)
 
 
