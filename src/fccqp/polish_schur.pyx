@@ -326,8 +326,7 @@ cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
         row += d
         e += d
     if e > 0 and m > 0:
-        for a in range(e):   # a column at a time: dtrsm's set-up cost more at these sizes
-            forward_substitution(f.S0, <int>m, <int>m, f.W + a * m)
+        trsm(b"L", b"N", <int>m, <int>e, f.S0, <int>m, f.W, <int>m)
         syrk_t(<int>e, <int>m, f.W, <int>m, 0.0, f.WW, <int>s)
     else:
         for c in range(e):
