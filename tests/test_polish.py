@@ -511,3 +511,29 @@ def test_a_warm_polish_that_cycles_is_tried_again_from_its_own_point():
     point, with its planes linearized there, settles: the tick runs no iteration."""
     result = _warm_ticks("go2", 100, 125)[-1]
     assert result.polished and result.iterations == 0
+
+
+@pytest.mark.parametrize("iterations", [1, 2, 4])
+@pytest.mark.parametrize("seed", range(8))
+def test_schur_polish_over_guesses_and_newton_steps_is_the_assembled_polish(seed, iterations):
+    """Where ``P`` is diagonal, each guess and Newton step of a polish is solved by Schur
+    complement (fccqp.polish_schur), bordered: the part of ``S`` its planes and
+    curvature leave alone is kept from one factorization to the next. From a rough
+    iterate (several guesses and Newton steps) it takes the guesses and steps the
+    polish of the assembled matrix (``dsytrf``) takes, to the same point."""
+    P, q, A, b, lb, ub, cones = random_problem(seed, n=40, m=6, n_cones=8, n_box=8)
+    P = np.diag(np.diag(P))
+    it = fccqp.solve(P, q, A, b, lb, ub, cones, polish=False, kkt_backend="ldl_full",
+                     max_iter=iterations)
+    start = (it.x, it.y, it.z, it.x)
+    flat = flatten_cones(cones, P.shape[0])
+    assembled = polish_point(P, q, A, b, lb, ub, flat, *start)
+    schur = polish_point(P, q, A, b, lb, ub, flat, *start, schur=True)
+    assert assembled["ok"] and schur["ok"] and schur["schur"] and schur["bordered"]
+    assert np.array_equal(assembled["active"], schur["active"])
+    assert (assembled["passes"], assembled["factorizations"]) == (schur["passes"],
+                                                                   schur["factorizations"])
+    for name in ("x", "nu", "y"):
+        gap = np.abs(assembled[name] - schur[name]).max()
+        assert gap <= 1e-12 * max(1.0, np.abs(assembled[name]).max()), name
+    assert np.abs(A @ schur["x"] - b).max() <= 1e-12 * max(1.0, np.abs(b).max())

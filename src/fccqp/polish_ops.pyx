@@ -6,7 +6,8 @@ dense arrays (each guess assembled for ``dsytrf``) or ``scipy.sparse`` matrices 
 guess assembled in compressed columns for qdldl, :mod:`fccqp.polish_csc`), so that the
 tests hold the compressed-column arm to the dense arm on the same iterate. The problem is
 taken as the polish sees the scaled one (no equilibration), without the reduced form's
-table or the Schur-complement solve. Not on any solve's path.
+table; with ``schur``, each guess by the Schur complement of :mod:`fccqp.polish_schur`
+where it applies. Not on any solve's path.
 """
 
 from libc.math cimport INFINITY
@@ -16,7 +17,7 @@ import numpy as np
 from fccqp._types cimport Iterates, Problem
 from fccqp.matrices cimport CSC
 from fccqp.matrix_ops cimport Held
-from fccqp.polish cimport Polish, polish
+from fccqp.polish cimport Polish, polish, polish_prepare
 from fccqp.polish_csc cimport bind
 from fccqp.tuning cimport GUESS_PASSES
 
@@ -47,16 +48,19 @@ cdef class _Arrays:
         return &view[0]
 
 
-def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5):
+def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5, bint schur=False):
     """Polish the iterate ``(x, nu, z, y)`` of ``min 1/2 x'Px + q'x`` s.t. ``A x = b``,
     ``lb <= x <= ub``, ``x`` in ``cones`` (a :class:`fccqp.cones.ConeArrays` over ``x``).
 
     ``y`` and ``z`` (``n`` entries) are the multipliers and slacks of the entries of ``x``
     (read on the constrained entries: a finite bound or a cone). ``P`` and ``A`` are both
     dense arrays or both ``scipy.sparse`` matrices (``P`` with its full symmetric
-    pattern). Returns a dict: ``ok`` (the polish's verdict), ``x``, ``nu``, ``y``
-    (``n``, zero off the constrained entries), ``active`` (the final guess's code per
-    constrained entry), ``passes``, ``factorizations``.
+    pattern). With ``schur`` (dense ``P`` and ``A``), the Schur complement is set up
+    first. Returns a dict: ``ok`` (the polish's verdict), ``x``, ``nu``, ``y`` (``n``,
+    zero off the constrained entries), ``active`` (the final guess's code per
+    constrained entry), ``passes``, ``factorizations``, ``schur`` (whether the Schur
+    complement was set up) and ``bordered`` (whether the last factorization was its
+    bordered one).
     """
     cdef Held Ph = Held(P), Ah = Held(A)
     cdef Py_ssize_t n = Ph.M.rows, m = Ah.M.rows, j
@@ -102,6 +106,10 @@ def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5):
     w.schur.ready = w.schur_only = w.schur_failed = False
     w.guess_passes = GUESS_PASSES
     w.schur.L = NULL   # no Schur storage: every guess is assembled
+    w.schur.bordered = False
+    if schur:
+        _schur_storage(&w, a, n, m, s)
+        polish_prepare(&w, &p)
     if Ph.M.kind == CSC:
         held = arrays(n, m, np.asarray(Ph.colptr), np.asarray(Ph.rowind),
                       np.asarray(Ah.colptr), np.asarray(Ah.rowind), cones.dim)
@@ -113,4 +121,20 @@ def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5):
     return {"ok": bool(ok), "x": np.array([w.x[j] for j in range(n)]),
             "nu": np.array([w.nu[j] for j in range(m)]), "y": result_y,
             "active": np.array([w.active[j] for j in range(s)], np.int8),
-            "passes": w.passes, "factorizations": factorizations}
+            "passes": w.passes, "factorizations": factorizations,
+            "schur": bool(w.schur.ready), "bordered": bool(w.schur.bordered)}
+
+
+cdef void _schur_storage(Polish* w, _Arrays a, Py_ssize_t n, Py_ssize_t m, Py_ssize_t s):
+    """The arrays of :mod:`fccqp.polish_schur`, sized as ``workspace_arrays`` sizes them."""
+    ps = &w.schur
+    ps.order, ps.coupled = a.new_int(n), <char*>a.new(n)
+    ps.root, ps.inv_root = a.new(n), a.new(n)
+    ps.rowvar, ps.block_row = a.new_int(n), a.new_int(s)
+    ps.t, ps.t2, ps.u = a.new(n), a.new(n), a.new(m + s)
+    ps.L, ps.Y = a.new(n * n), a.new(n * (m + s))
+    ps.SU, ps.S = a.new(m * m), a.new((m + s) * (m + s))
+    ps.block = a.new(s * s)
+    ps.base_boundary = a.new_int(s)
+    ps.S0, ps.W = a.new(m * m), a.new(m * s)
+    ps.WW, ps.K, ps.Z, ps.T = a.new(s * s), a.new(s * s), a.new(s * s), a.new(s * s)

@@ -1,6 +1,11 @@
 # cython: language_level=3
 from fccqp._types cimport Problem
 
+cdef enum:
+    BASE_NONE = 0
+    BASE_READY = 1
+    BASE_REFUSED = 2
+
 cdef struct PolishSchur:
     # The polished QP's KKT system by Schur complement where P's structure allows it
     # (see polish_schur.pyx); set up once per solve, factored once per guess.
@@ -25,6 +30,22 @@ cdef struct PolishSchur:
     double* t2              # n scratch
     double* u               # m + s scratch
     int size                # m + nb of the last factored guess
+    # The bordered factorization (polish_schur.pyx), which keeps the part of S that a
+    # guess's boundary planes and curvature do not change:
+    bint bordered           # the last factored guess is bordered: a solve reads S0..T
+    char base               # BASE_NONE, or S0, W, WW belong to Y's rows [unconstrained,
+                            # diag_end) and the blocks base_boundary[:base_nb] (BASE_READY)
+                            # or S0 of those was refused (BASE_REFUSED)
+    Py_ssize_t* base_boundary   # s: the boundary blocks of the base
+    int base_nb             # their number
+    int nbd                 # their entries: the boundary rows of the bordered system
+    double base_largest     # S0's largest diagonal entry
+    double* S0              # m x m: Cholesky of SU + the free diagonal rows' Y'Y
+    double* W               # m x s: S0's factor^-1 A_B', a column per boundary entry
+    double* WW              # s x s: W'W
+    double* K               # s x s: Cholesky of H_B + W'W
+    double* Z               # s x s: K's factor^-1 G', a column per boundary block
+    double* T               # s x s: Cholesky of Z'Z + delta I (nb x nb)
 
 cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noexcept nogil
 cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t* index,

@@ -54,7 +54,7 @@ from fccqp._blas cimport (backward_substitution, cholesky_solve_vector, forward_
                           syrk_t, trsm)
 from fccqp._types cimport Problem
 from fccqp.schur cimport mark_coupled
-from fccqp.tuning cimport PIVOT_TOLERANCE, POLISH_RANK_TOLERANCE
+from fccqp.tuning cimport PIVOT_TOLERANCE, POLISH_BORDER_TOLERANCE, POLISH_RANK_TOLERANCE
 
 
 cdef extern from "fccqp_kernels.h" nogil:
@@ -73,7 +73,8 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j, r, c, lead = 0, rest
     cdef double largest = 0.0, pivot
     cdef int k
-    f.ready = False
+    f.ready = f.bordered = False
+    f.base = BASE_NONE
     f.convex = True
     mark_coupled(p.P.values, n, f.coupled)
     for i in range(n):
@@ -149,15 +150,14 @@ cdef inline bint _diagonal_row(PolishSchur* f, const Problem* p, Py_ssize_t i, P
     return True
 
 
-cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
-                              const Py_ssize_t* boundary, Py_ssize_t nb, const double* g,
-                              const double* hess, double delta) noexcept nogil:
-    """Factor ``S`` of the guess whose held entries have ``index`` -1 and whose boundary
-    blocks are ``boundary[:nb]`` (ascending), with planes ``g`` and curvature ``hess`` as
-    :mod:`fccqp.polish` keeps them, and keep ``Y = L^-1 C'`` for the solves. ``Y``'s
-    rows: the unconstrained entries (from the set-up), the free box entries and free
-    cone blocks (a diagonal entry of ``H`` each), then the boundary blocks. False where
-    the Schur complement does not apply."""
+cdef bint _factor_whole(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
+                        const Py_ssize_t* boundary, Py_ssize_t nb, const double* g,
+                        const double* hess, double delta) noexcept nogil:
+    """Factor the whole ``S`` (``m + nb`` rows) of the guess (see
+    :func:`polish_schur_factor`) and keep ``Y = L^-1 C'`` for the solves. ``Y``'s rows:
+    the unconstrained entries (from the set-up), the free box entries and free cone
+    blocks (a diagonal entry of ``H`` each), then the boundary blocks. False where the
+    Schur complement does not apply."""
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, size = m + nb, j, r, c, k, o, d
     cdef Py_ssize_t start, row = f.unconstrained, kb, a
     cdef double* S = f.S
@@ -231,6 +231,209 @@ cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t
     return True
 
 
+cdef inline bint _take_row(PolishSchur* f, const Problem* p, Py_ssize_t i, Py_ssize_t row,
+                           bint build) noexcept nogil:
+    """Row ``row`` of ``Y`` for the free entry ``i``: written in ``S0``'s ``m`` columns
+    (``build``), else whether ``Y`` holds it there."""
+    if build:
+        return _diagonal_row(f, p, i, row, p.m)
+    return row < f.diag_end and f.rowvar[row] == i
+
+
+cdef Py_ssize_t _walk_diagonal(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
+                               const Py_ssize_t* boundary, Py_ssize_t nb, bint build) noexcept nogil:
+    """The rows of ``Y`` after the unconstrained ones for the guess's free box entries and
+    free cone blocks, in :func:`_factor_whole`'s order: written (``build``) or compared
+    with those ``Y`` holds. Their end, or -1 where a row cannot be written, they differ
+    or a boundary block is held."""
+    cdef Py_ssize_t j, k, a, start, kb = 0, row = f.unconstrained
+    for j in range(p.s):
+        if not p.in_cone[j] and index[p.constrained[j]] >= 0:
+            if not _take_row(f, p, p.constrained[j], row, build):
+                return -1
+            row += 1
+    for k in range(p.cones.count):
+        start = p.constrained[p.cones.offset[k]]
+        if index[start] < 0:
+            continue
+        if kb < nb and boundary[kb] == k:
+            kb += 1
+            continue
+        for a in range(p.cones.dim[k]):
+            if not _take_row(f, p, start + a, row, build):
+                return -1
+            row += 1
+    if kb != nb or not (build or row == f.diag_end):
+        return -1
+    return row
+
+
+cdef bint _same_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
+                     const Py_ssize_t* boundary, Py_ssize_t nb) noexcept nogil:
+    """Whether the base (:func:`_build_base`) is the guess's: the same free diagonal
+    rows and the same boundary blocks."""
+    cdef Py_ssize_t kb
+    if f.base == BASE_NONE or nb != f.base_nb:
+        return False
+    for kb in range(nb):
+        if boundary[kb] != f.base_boundary[kb]:
+            return False
+    return _walk_diagonal(f, p, index, boundary, nb, False) >= 0
+
+
+cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
+                      const Py_ssize_t* boundary, Py_ssize_t nb) noexcept nogil:
+    """The guess's part of ``S`` that its planes and curvature leave alone: the free
+    diagonal rows of ``Y``, the Cholesky factor ``L0`` of ``S0 = SU + Y_D'Y_D`` (the
+    regularized Schur complement of every free entry but the boundary blocks'),
+    ``W = L0^-1 A_B'`` and ``W'W``; ``BASE_NONE`` where a row cannot be written,
+    ``BASE_REFUSED`` where ``S0`` is too near singular for the bordered solve
+    (``POLISH_BORDER_TOLERANCE``: go2's rows that only boundary blocks span leave ``S0``
+    ``delta`` there), so that the guesses of that base go straight to
+    :func:`_factor_whole`, which writes the same rows of ``Y``."""
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, r, c, a, kb, o, d, start, e = 0, row
+    cdef double largest = 0.0
+    f.base = BASE_NONE
+    row = _walk_diagonal(f, p, index, boundary, nb, True)
+    if row < 0:
+        return
+    f.diag_end = <int>row
+    f.base_nb = <int>nb
+    for kb in range(nb):
+        f.base_boundary[kb] = boundary[kb]
+    f.base = BASE_REFUSED
+    for c in range(m):
+        for r in range(c, m):
+            f.S0[r + c * m] = f.SU[r + c * m]
+    if m > 0 and row > f.unconstrained:
+        syrk_t(<int>m, <int>(row - f.unconstrained), f.Y + f.unconstrained, <int>n, 1.0, f.S0,
+               <int>m)
+    for c in range(m):
+        largest = max(largest, f.S0[c + c * m])
+    if m > 0 and not fccqp_cholesky(f.S0, <int>m, <int>m):
+        return
+    for c in range(m):
+        if f.S0[c + c * m] * f.S0[c + c * m] <= POLISH_BORDER_TOLERANCE * largest:
+            return
+    for kb in range(nb):   # the boundary entries: rows of the bordered system, columns of W
+        o, d = p.cones.offset[boundary[kb]], p.cones.dim[boundary[kb]]
+        start = p.constrained[o]
+        f.block_row[kb] = row
+        for a in range(d):
+            f.rowvar[row + a] = start + a
+            for c in range(m):
+                f.W[c + (e + a) * m] = p.A.values[c * n + start + a]
+        row += d
+        e += d
+    if e > 0 and m > 0:
+        trsm(b"L", b"N", <int>m, <int>e, f.S0, <int>m, f.W, <int>m)
+        syrk_t(<int>e, <int>m, f.W, <int>m, 0.0, f.WW, <int>s)
+    else:
+        for c in range(e):
+            for r in range(c, e):
+                f.WW[r + c * s] = 0.0
+    f.nbd, f.base_largest = <int>e, largest
+    f.base = BASE_READY
+
+
+cdef bint _factor_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* boundary,
+                           Py_ssize_t nb, const double* g, const double* hess,
+                           double delta) noexcept nogil:
+    """Factor the guess's planes and curvature against the base (:func:`_build_base`):
+    ``K = H_B + W'W`` on the boundary entries, ``Z = L_K^-1 G'`` and ``T = Z'Z + delta I``
+    on the planes. False where a boundary block of ``H`` or ``K`` is not positive
+    definite, or a pivot of ``T`` fails ``POLISH_RANK_TOLERANCE`` against the largest
+    diagonal entry of ``S0`` and of ``S``'s planes' part."""
+    cdef Py_ssize_t s = p.s, nbd = f.nbd, r, c, a, kb, o, d, start, e = 0
+    cdef double* B
+    cdef double* column
+    cdef double largest = f.base_largest, value
+    for c in range(nbd):
+        for r in range(c, nbd):
+            f.K[r + c * s] = f.WW[r + c * s]
+    for kb in range(nb):
+        o, d = p.cones.offset[boundary[kb]], p.cones.dim[boundary[kb]]
+        start = p.constrained[o]
+        B = f.block + o * s
+        for c in range(d):
+            if f.root[start + c] == 0.0:
+                return False
+            for r in range(c, d):
+                B[r + c * d] = hess[o * s + r * d + c]
+            B[c + c * d] += f.root[start + c] * f.root[start + c]
+            for r in range(c, d):
+                f.K[e + r + (e + c) * s] += B[r + c * d]
+        if not fccqp_cholesky(B, <int>d, <int>d):
+            return False
+        for a in range(d):   # S's diagonal entry of this plane: g' H_b^-1 g + delta
+            f.t2[a] = g[o + a]
+        forward_substitution(B, <int>d, <int>d, f.t2)
+        value = delta
+        for a in range(d):
+            value += f.t2[a] * f.t2[a]
+        largest = max(largest, value)
+        e += d
+    if nbd > 0 and not fccqp_cholesky(f.K, <int>nbd, <int>s):
+        return False
+    e = 0
+    for kb in range(nb):
+        o, d = p.cones.offset[boundary[kb]], p.cones.dim[boundary[kb]]
+        column = f.Z + kb * s
+        for r in range(nbd):
+            column[r] = 0.0
+        for a in range(d):
+            column[e + a] = g[o + a]
+        forward_substitution(f.K + e + e * s, <int>(nbd - e), <int>s, column + e)
+        e += d
+    for c in range(nb):
+        for r in range(c, nb):
+            f.T[r + c * s] = _dot(f.Z + r * s, f.Z + c * s, nbd)
+        f.T[c + c * s] += delta
+    if nb > 0 and not fccqp_cholesky(f.T, <int>nb, <int>s):
+        return False
+    for c in range(nb):
+        if f.T[c + c * s] * f.T[c + c * s] <= POLISH_RANK_TOLERANCE * largest:
+            return False
+    return True
+
+
+cdef inline double _dot(const double* a, const double* b, Py_ssize_t count) noexcept nogil:
+    cdef Py_ssize_t i
+    cdef double total = 0.0
+    for i in range(count):
+        total += a[i] * b[i]
+    return total
+
+
+cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
+                              const Py_ssize_t* boundary, Py_ssize_t nb, const double* g,
+                              const double* hess, double delta) noexcept nogil:
+    """Factor the polished KKT system of the guess whose held entries have ``index`` -1
+    and whose boundary blocks are ``boundary[:nb]`` (ascending), with planes ``g`` and
+    curvature ``hess`` as :mod:`fccqp.polish` keeps them. False where the Schur
+    complement does not apply.
+
+    Bordered where it can be: ``mu`` and the boundary entries ``x_B`` are eliminated
+    after the other free entries, through ``S0`` (the Schur complement without the
+    boundary blocks, ``m`` rows), then ``x_B`` through ``K = H_B + A_B' S0^-1 A_B``, the
+    planes last through ``T = G K^-1 G' + delta I``. A Newton step or a guess that keeps
+    the free entries and the boundary blocks but moves their planes and curvature (most
+    factorizations of a polish: every ``renew`` and every re-linearization moves every
+    plane) then refactors only ``K`` and ``T`` (``nb d`` and ``nb`` rows) and keeps
+    ``S0``, ``W`` and ``W'W`` (notes/polish.md, "schurup"). Otherwise, or where ``S0`` is
+    too near singular for that order, the whole ``S`` (:func:`_factor_whole`: the rows
+    of ``Y`` it writes for a guess are the base's, so the base stays the guess's)."""
+    f.bordered = False
+    if not _same_base(f, p, index, boundary, nb):
+        _build_base(f, p, index, boundary, nb)
+    if f.base == BASE_READY and _factor_bordered(f, p, boundary, nb, g, hess, delta):
+        f.bordered = True
+        f.rows = f.diag_end + f.nbd
+        f.size = <int>(p.m + nb)
+        return True
+    return _factor_whole(f, p, index, boundary, nb, g, hess, delta)
+
+
 cdef void _forward(PolishSchur* f, const Problem* p, const Py_ssize_t* boundary,
                    Py_ssize_t nb, double* w) noexcept nogil:
     """``w := L^-1 w``, ``w`` in the order of ``Y``'s rows."""
@@ -257,6 +460,59 @@ cdef void _backward(PolishSchur* f, const Problem* p, const Py_ssize_t* boundary
         backward_substitution(f.L, f.dense, <int>p.n, w)
 
 
+cdef void _solve_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
+                          Py_ssize_t nb, double* v) noexcept nogil:
+    """:func:`polish_schur_solve` for a bordered factorization: ``w_E = L_E^-1 r_E`` on
+    the free entries but the boundary blocks', ``rho = L0^-1 (Y_E'w_E - r_mu)``, then
+    ``K x_B + G'lam = r_B - W'rho`` and ``G x_B - delta lam = r_lam`` through ``K`` and
+    ``T``, ``mu = L0'^-1 (rho + W x_B)``, ``x_E = L_E'^-1 (w_E - Y_E mu)``."""
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, r, c, e, kb, nf = f.rows, nbd = f.nbd
+    cdef int end = f.diag_end, mm = <int>m, one = 1, ld = <int>p.n
+    cdef double* w = f.t
+    cdef double* xb = f.t + f.diag_end
+    cdef double* u = f.u
+    cdef double* lam = f.u + m
+    cdef double alpha = 1.0, zero = 0.0
+    cdef char trans = b"T"
+    for r in range(nf):
+        w[r] = v[index[f.rowvar[r]]]
+    if f.dense > 0:
+        forward_substitution(f.L, f.dense, <int>n, w)
+    for r in range(f.dense, end):
+        w[r] *= f.inv_root[r]
+    if m > 0:
+        dgemv(&trans, &end, &mm, &alpha, f.Y, &ld, w, &one, &zero, u, &one)
+        for c in range(m):
+            u[c] -= v[nf + c]
+        forward_substitution(f.S0, mm, mm, u)
+    for e in range(nbd):
+        xb[e] -= _dot(f.W + e * m, u, m)
+    forward_substitution(f.K, <int>nbd, <int>s, xb)
+    for kb in range(nb):
+        lam[kb] = _dot(f.Z + kb * s, xb, nbd) - v[nf + m + kb]
+    cholesky_solve_vector(f.T, <int>nb, <int>s, lam)
+    for kb in range(nb):
+        for e in range(nbd):
+            xb[e] -= f.Z[e + kb * s] * lam[kb]
+    backward_substitution(f.K, <int>nbd, <int>s, xb)
+    if m > 0:
+        for e in range(nbd):
+            for c in range(m):
+                u[c] += f.W[c + e * m] * xb[e]
+        backward_substitution(f.S0, mm, mm, u)
+        fccqp_matvec_t(f.Y, <int>n, u, f.t2, mm, end)   # Y_E mu
+        for r in range(end):
+            w[r] -= f.t2[r]
+    for r in range(f.dense, end):
+        w[r] *= f.inv_root[r]
+    if f.dense > 0:
+        backward_substitution(f.L, f.dense, <int>n, w)
+    for r in range(nf):
+        v[index[f.rowvar[r]]] = w[r]
+    for c in range(m + nb):
+        v[nf + c] = u[c]
+
+
 cdef void polish_schur_solve(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
                              const Py_ssize_t* boundary, Py_ssize_t nb, double* v) noexcept nogil:
     """``v := M^-1 v`` for the factored guess (its planes and curvature, also after
@@ -269,6 +525,9 @@ cdef void polish_schur_solve(PolishSchur* f, const Problem* p, const Py_ssize_t*
     cdef double* u = f.u
     cdef double alpha = 1.0, zero = 0.0
     cdef char trans = b"T"
+    if f.bordered:
+        _solve_bordered(f, p, index, nb, v)
+        return
     for r in range(rows):
         w[r] = v[index[f.rowvar[r]]]
     _forward(f, p, boundary, nb, w)

@@ -131,6 +131,8 @@ cdef extern from *:
     #define FCCQP_POLISH_CSC_DELTA 1e-8
     /* the polish's Schur complement is singular below this pivot^2 / largest diagonal */
     #define FCCQP_POLISH_RANK_TOLERANCE 1e-14
+    /* the bordered Schur factorization needs S0's pivot^2 / largest diagonal above this */
+    #define FCCQP_POLISH_BORDER_TOLERANCE 1e-8
     /* a refinement stalled above this times its tolerance refactors with a smaller delta */
     #define FCCQP_POLISH_STALL_RESIDUAL 1e3
     /* that delta: this times the curvature the stalled refinement's contraction shows */
@@ -260,6 +262,7 @@ cdef extern from *:
     const double POLISH_DELTA "FCCQP_POLISH_DELTA"
     const double POLISH_CSC_DELTA "FCCQP_POLISH_CSC_DELTA"
     const double POLISH_RANK_TOLERANCE "FCCQP_POLISH_RANK_TOLERANCE"
+    const double POLISH_BORDER_TOLERANCE "FCCQP_POLISH_BORDER_TOLERANCE"
     const double POLISH_STALL_RESIDUAL "FCCQP_POLISH_STALL_RESIDUAL"
     const double POLISH_DELTA_CUT "FCCQP_POLISH_DELTA_CUT"
     const double POLISH_REFINE_TOLERANCE "FCCQP_POLISH_REFINE_TOLERANCE"

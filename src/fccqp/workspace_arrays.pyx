@@ -199,6 +199,10 @@ cdef void dense_arrays(Arrays a, Engine* e, Py_ssize_t* order) except *:
     ps.L, ps.Y = a.new(n * n), a.new(n * (m + s))
     ps.SU, ps.S = a.new(m * m), a.new((m + s) * (m + s))
     ps.block = a.new(s * s)
+    ps.base, ps.bordered = 0, False   # BASE_NONE
+    ps.base_boundary = <Py_ssize_t*>a.new_int(s)
+    ps.S0, ps.W = a.new(m * m), a.new(m * s)
+    ps.WW, ps.K, ps.Z, ps.T = a.new(s * s), a.new(s * s), a.new(s * s), a.new(s * s)
 
 
 cdef Py_ssize_t* _index_copy(Arrays a, object values) except NULL:
