@@ -67,7 +67,7 @@ cdef bint _try_polished(Engine* e, int* status, long iteration, double start_tim
     cdef double* ux = e.unscaled.x
     cdef double* uy = e.unscaled.y
     cdef double* uz = e.unscaled.z
-    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s
     cdef double tol_p, tol_d, tol_g
     cdef int new_status, factorizations = 0   # of polishing's own matrix: not counted
     if not polish(&e.pol, p, it, o.polish_refine_iter, &factorizations,
@@ -107,12 +107,7 @@ cdef bint _try_polished(Engine* e, int* status, long iteration, double start_tim
             and not (_claimed(status[0]) and not _claimed(new_status))):
         e.res = before
         return False
-    copy(e.pol.x, it.x, n)
-    copy(e.pol.nu, it.nu, m)
-    copy(e.pol.y, it.y, s)
-    for j in range(s):
-        it.z[j] = it.x[p.constrained[j]]
-    proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
+    _take_polished_point(e)
     if _claimed(new_status):
         status[0] = new_status
     return True
@@ -162,6 +157,20 @@ cdef bint warm_polish(Engine* e, Run* run, double start_time) noexcept nogil:
     return True
 
 
+cdef void _take_polished_point(Engine* e) noexcept nogil:
+    """The polished point as the iterate: ``x``, ``nu``, ``y``, and ``z`` the projection
+    of ``x_S``."""
+    cdef Problem* p = &e.prob
+    cdef Iterates* it = &e.it
+    cdef Py_ssize_t j
+    copy(e.pol.x, it.x, p.n)
+    copy(e.pol.nu, it.nu, p.m)
+    copy(e.pol.y, it.y, p.s)
+    for j in range(p.s):
+        it.z[j] = it.x[p.constrained[j]]
+    proj_set(it.z, p.lo, p.hi, p.cones, p.s, it.z)
+
+
 cdef bint _polish_again(Engine* e, int* status, double start_time) noexcept nogil:
     """Polish from the polished point of a warm polish that ended cycling (a block
     thrown past its apex, held there, released and thrown again) as from an iterate:
@@ -178,17 +187,12 @@ cdef bint _polish_again(Engine* e, int* status, double start_time) noexcept nogi
     cdef Problem* p = &e.prob
     cdef Iterates* it = &e.it
     cdef double* saved = e.work.saved
-    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, j
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s
     copy(it.x, saved, n)
     copy(it.nu, saved + n, m)
     copy(it.y, saved + n + m, s)
     copy(it.z, it.z_prev, s)   # free until ADMM's first step writes it
-    copy(e.pol.x, it.x, n)
-    copy(e.pol.nu, it.nu, m)
-    copy(e.pol.y, it.y, s)
-    for j in range(s):
-        it.z[j] = it.x[p.constrained[j]]
-    proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
+    _take_polished_point(e)
     if keep_polished(e, status, 0, start_time, True):
         return True
     copy(saved, it.x, n)

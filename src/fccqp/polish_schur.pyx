@@ -192,13 +192,7 @@ cdef bint _factor_whole(PolishSchur* f, const Problem* p, const Py_ssize_t* inde
         o, d = p.cones.offset[k], p.cones.dim[k]
         start = p.constrained[o]
         B = f.block + o * s
-        for c in range(d):
-            if f.root[start + c] == 0.0:
-                return False
-            for r in range(c, d):
-                B[r + c * d] = hess[o * s + r * d + c]
-            B[c + c * d] += f.root[start + c] * f.root[start + c]
-        if not fccqp_cholesky(B, <int>d, <int>d):
+        if not _curved_block(f, p, o, d, start, hess) or not fccqp_cholesky(B, <int>d, <int>d):
             return False
         f.block_row[kb] = row
         for a in range(d):
@@ -336,6 +330,22 @@ cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
     f.base = BASE_READY
 
 
+cdef inline bint _curved_block(PolishSchur* f, const Problem* p, Py_ssize_t o, Py_ssize_t d,
+                               Py_ssize_t start, const double* hess) noexcept nogil:
+    """Lower triangle of a boundary block's ``H_b = diag(P) + curvature`` (cone entries
+    ``o .. o + d``, entries of ``x`` from ``start``) into its ``block``; False where a
+    diagonal entry of ``P`` is too small for the Schur complement."""
+    cdef Py_ssize_t r, c, s = p.s
+    cdef double* B = f.block + o * s
+    for c in range(d):
+        if f.root[start + c] == 0.0:
+            return False
+        for r in range(c, d):
+            B[r + c * d] = hess[o * s + r * d + c]
+        B[c + c * d] += f.root[start + c] * f.root[start + c]
+    return True
+
+
 cdef bint _factor_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* boundary,
                            Py_ssize_t nb, const double* g, const double* hess,
                            double delta) noexcept nogil:
@@ -355,12 +365,9 @@ cdef bint _factor_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* b
         o, d = p.cones.offset[boundary[kb]], p.cones.dim[boundary[kb]]
         start = p.constrained[o]
         B = f.block + o * s
+        if not _curved_block(f, p, o, d, start, hess):
+            return False
         for c in range(d):
-            if f.root[start + c] == 0.0:
-                return False
-            for r in range(c, d):
-                B[r + c * d] = hess[o * s + r * d + c]
-            B[c + c * d] += f.root[start + c] * f.root[start + c]
             for r in range(c, d):
                 f.K[e + r + (e + c) * s] += B[r + c * d]
         if not fccqp_cholesky(B, <int>d, <int>d):
