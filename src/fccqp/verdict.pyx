@@ -23,6 +23,7 @@ from fccqp.engine cimport (DUAL_INFEASIBLE, INACCURATE, MAX_ITER, NUMERICAL_ERRO
                            PRIMAL_INFEASIBLE, RUNNING, SOLVED, TIME_LIMIT, Engine, Run,
                            fccqp_now)
 from fccqp.kkt cimport is_reduced, kkt_solve
+from fccqp.kkt_sparse cimport sparse_column_gram_factor, sparse_column_gram_solve
 from fccqp.matrices cimport DENSE, entry, zero_column
 from fccqp.reduced cimport materialize_nu_prev, materialize_x_prev
 from fccqp.termination cimport Residuals, converged, nearly_converged
@@ -290,24 +291,32 @@ cdef int _column_gram_direction(Engine* e, double* r) noexcept nogil:
     weighs nothing): ``v := (G G' + eps I)^-1 v`` from ``v = b / rows``, ``r = v / rows``,
     tested after each of at most ``MAX_REFINE`` steps. Each step shrinks the part of
     ``v`` off the null space of ``G'`` (``A_s'r = 0``) by ``eps / (lambda + eps)``;
-    ``b'r = v_0'(eps (G G' + eps I)^-1)^k v_0 > 0`` whatever the rows. Dense rows only
-    (``REJECTED`` otherwise); ``e.certs.gram`` is its scratch, left to be factored again
-    for the primal certificates."""
+    ``b'r = v_0'(eps (G G' + eps I)^-1)^k v_0 > 0`` whatever the rows. On dense rows
+    ``e.certs.gram`` is the factor's scratch, left to be factored again for the primal
+    certificates; over compressed columns the sparse handle holds the factor
+    (:func:`fccqp.kkt_sparse.sparse_column_gram_factor`)."""
     cdef Problem* p = &e.prob
     cdef Py_ssize_t m = p.m, i, step
     cdef double* rows = e.work.rhs
     cdef double* v = e.work.sol
     cdef double size
     cdef int code = REJECTED
-    if p.A.kind != DENSE or m == 0:
+    cdef bint dense = p.A.kind == DENSE
+    if m == 0 or not (dense or e.fact.kkt.sparse != NULL):
         return REJECTED
-    e.certs.gram_state = 0   # the scratch below is not A A'
-    if not column_gram(p, e.work.vec_n, rows, e.certs.gram):
+    if dense:
+        e.certs.gram_state = 0   # the scratch below is not A A'
+        if not column_gram(p, e.work.vec_n, rows, e.certs.gram):
+            return REJECTED
+    elif not sparse_column_gram_factor(e.fact.kkt.sparse, m, rows):
         return REJECTED
     for i in range(m):
         v[i] = p.b[i] / rows[i]
     for step in range(MAX_REFINE):
-        cholesky_solve(e.certs.gram, <int>m, <int>m, v, 1, <int>m)
+        if dense:
+            cholesky_solve(e.certs.gram, <int>m, <int>m, v, 1, <int>m)
+        else:
+            sparse_column_gram_solve(e.fact.kkt.sparse, m, v)
         size = 0.0
         for i in range(m):
             size = max(size, fabs(v[i]))
