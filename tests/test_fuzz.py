@@ -26,7 +26,7 @@ SEEDS = {
                      100228, 100233, 500030, 500064, 500099, 500322, 700281, 900343, 900360,
                      1100037, 1100057, 1100150, 1100253, 1300030, 1300300, 1500043, 1700106,
                      1700359, 1900050, 2500125, 2900030, 4700215, 4700352,
-                     5300281),
+                     5300281, 6100225),
     "qpsolvers": (0, 1, 2, 1700123),
     "cvxpy": (1, 2, 3),
     "degenerate": (0, 1, 2, 4, 7, 9, 11, 12, 21, 23, 30, 35, 43, 58, 150, 102753, 104299),
@@ -61,15 +61,16 @@ direction positive by rounding); extreme_data 4700352 columns of 1e-10 to 1e6 be
 ``P`` of 7.5e13, an optimum by construction, whose run's candidate passed at its iterate
 though its residual reaches its separation at the data's scale; extreme_data 4700215
 rows of 1e-142 to 1e-17, inconsistent among the smallest, whose miss lay below the
-largest row's rounding and which the start's gate therefore never tested; issues 26 and
-28)."""
+largest row's rounding and which the start's gate therefore never tested; extreme_data
+6100225 rows inconsistent by 0.79 beside a ``P`` of 1e18, whose KKT solves' residual is
+orthogonal only to the columns ``P`` leaves unscaled; issues 26 and 28)."""
 
 SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),
     "feasible": (0,),
     "solver_reuse": (38,),
     "extreme_data": (26, 100121, 900343, 1700359, 1900317, 2500125, 2900030, 2900221,
-                     4100295, 4700215, 4700352),
+                     4100295, 4700215, 4700352, 6100225),
     "qpsolvers": (100035,),
     "cvxpy": (7, 1700154, 1900171),
     "dual_infeasible": (1700072,),

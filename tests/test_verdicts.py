@@ -339,6 +339,35 @@ def test_rows_inconsistent_far_below_the_largest_row_are_certified_at_the_start(
     assert result.iterations == 0
 
 
+def rows_inconsistent_beside_a_huge_cost(seed: int, scale: float) -> Problem:
+    """Five rows of rank 3, one off by 0.5 from the combination the others fix, beside a
+    ``P`` of ``scale`` on all but two entries (those two cost nothing): infeasible."""
+    rng = np.random.default_rng(seed)
+    n = 8
+    M = rng.standard_normal((n - 2, n - 2))
+    P = np.zeros((n, n))
+    P[2:, 2:] = scale * M @ M.T / n
+    B = rng.standard_normal((3, n))
+    A = np.vstack([B, B[0] + B[1], B[1] - B[2]])
+    b = A @ rng.uniform(-1, 1, n)
+    b[3] += 0.5
+    return Problem.of(P, rng.standard_normal(n), A, b)
+
+
+@pytest.mark.parametrize("scale", [1e15, 1e18])
+@pytest.mark.parametrize("seed", range(3))
+def test_rows_inconsistent_beside_a_huge_cost_are_certified_at_the_start(seed, scale):
+    """The equilibration gives the columns of a huge ``P`` entries of ``D`` near
+    ``1/sqrt(scale)``, and the KKT solves' residual ``b - A x`` is then orthogonal to the
+    other columns only, whatever ``delta``: the equality certificate failed at every
+    check (4000 iterations at ``P`` of 1e18, 12000 to 16000 at 1e15, every form). The
+    certificate is now also sought on a Gram matrix with the columns' scale taken
+    out."""
+    result = solve_verified(rows_inconsistent_beside_a_huge_cost(seed, scale))
+    assert result.status is Status.PRIMAL_INFEASIBLE
+    assert result.iterations == 0
+
+
 @pytest.mark.kkt_backends("auto", "ldl_full", "sparse", reason=(
     "every entry is boxed: the full form's problem; the reduced forms solve from this "
     "guess in 18 iterations, so that it never fails"))

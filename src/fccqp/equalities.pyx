@@ -52,7 +52,7 @@ cdef double _equality_error(const Problem* p, const double* x, double* r,
     return error
 
 
-cdef bint _gram(const Problem* p, double* w, double* rows, double* gram) noexcept nogil:
+cdef bint column_gram(const Problem* p, double* w, double* rows, double* gram) noexcept nogil:
     """``w`` := reciprocal column norms of ``A_s`` (1 on empty columns), ``rows`` := the
     row norms of ``A_s diag(w)`` (1 on empty rows), ``gram`` := the Cholesky factor of
     ``G G'`` (``G = diag(1/rows) A_s diag(w)``, column-major) plus
@@ -111,7 +111,7 @@ cdef void hold_equalities(Engine* e) noexcept nogil:
     if error <= EQUALITY_MISSED * scale:
         return
     e.certs.gram_state = 0   # the scratch below is not A A'
-    if not _gram(p, w, rows, e.certs.gram):
+    if not column_gram(p, w, rows, e.certs.gram):
         return
     for step in range(MAX_REFINE):
         copy(x, saved, n)

@@ -7,3 +7,5 @@ cdef void sparse_hold_equalities(void* handle, Py_ssize_t n, Py_ssize_t m, doubl
                                  const double* b) noexcept nogil
 cdef bint sparse_gram_factor(void* handle) noexcept nogil
 cdef void sparse_gram_solve(void* handle, Py_ssize_t m, double* v) noexcept nogil
+cdef bint sparse_column_gram_factor(void* handle, Py_ssize_t m, double* rows) noexcept nogil
+cdef void sparse_column_gram_solve(void* handle, Py_ssize_t m, double* v) noexcept nogil

@@ -58,3 +58,19 @@ cdef void sparse_gram_solve(void* handle, Py_ssize_t m, double* v) noexcept nogi
     with gil:
         view = np.asarray(<double[:m]>v)
         view[:] = (<object>handle).solve_gram(view)
+
+
+cdef bint sparse_column_gram_factor(void* handle, Py_ssize_t m, double* rows) noexcept nogil:
+    """Factor the handle's Gram matrix with the columns' scale taken out, ``rows`` (``m``
+    entries) := its row norms (:meth:`fccqp.sparse_kkt.SparseKKT.factor_column_gram`);
+    False when that fails."""
+    with gil:
+        return (<object>handle).factor_column_gram(np.asarray(<double[:m]>rows))
+
+
+cdef void sparse_column_gram_solve(void* handle, Py_ssize_t m, double* v) noexcept nogil:
+    """``v`` (``m`` entries) := the solve of the factor of
+    :func:`sparse_column_gram_factor` for ``v``."""
+    with gil:
+        view = np.asarray(<double[:m]>v)
+        view[:] = (<object>handle).solve_column_gram(view)

@@ -30,7 +30,7 @@ def _error(A: sp.csc_matrix, E: np.ndarray, x: np.ndarray,
     return r, float(np.max(np.abs(r) / E)), max(1.0, float(terms.max()))
 
 
-def _gram(A: sp.csc_matrix) -> tuple[np.ndarray, np.ndarray, sp.csc_matrix]:
+def column_gram(A: sp.csc_matrix) -> tuple[np.ndarray, np.ndarray, sp.csc_matrix]:
     """``(w, rows, G G' + GRAM_REGULARIZATION max diag)`` for ``G = diag(1/rows) A
     diag(w)`` (1 for an empty column's ``w`` and an empty row's norm)."""
     magnitude = abs(A)
@@ -57,7 +57,7 @@ def hold_equalities(A: sp.csc_matrix, E: np.ndarray, x: np.ndarray, b: np.ndarra
     if error <= EQUALITY_MISSED * scale:
         return
     import qdldl  # present: the sparse backend that ran uses it
-    w, rows, gram = _gram(A)
+    w, rows, gram = column_gram(A)
     try:
         factor = qdldl.Solver(gram, upper=True)
     except RuntimeError:   # a zero pivot: the rows' Gram matrix could not be factored

@@ -47,6 +47,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from fccqp.sparse_equalities import column_gram
 from fccqp.tuning import GRAM_REGULARIZATION, KKT_DELTA
 
 DELTA = 1e-9
@@ -147,6 +148,7 @@ class SparseKKT:
         self.delta = DELTA   # the regularization factored, set by factor
         self._cut_spent = False   # whether this factorization's delta was cut once
         self._gram = None   # the qdldl factor of A A', set by factor_gram
+        self._column_gram = None   # the qdldl factor of G G', set by factor_column_gram
 
     def factor(self, sigma: float, rho_vec: np.ndarray) -> int:
         """Factor for the current ``P`` and ``A``, ``sigma`` (on every entry of ``x``)
@@ -410,3 +412,26 @@ class SparseKKT:
     def solve_gram(self, v: np.ndarray) -> np.ndarray:
         """``(A A' + regularization)^-1 v`` on the factor of :meth:`factor_gram`."""
         return self._gram.solve(v)
+
+    def factor_column_gram(self, rows: np.ndarray) -> bool:
+        """Factor the Gram matrix ``G G'`` of :func:`fccqp.sparse_equalities.column_gram`
+        (``G = diag(1/rows) A diag(w)``, the columns of the scaled ``A`` divided by their
+        largest entries), the compressed-column counterpart of the dense path's
+        :func:`fccqp.equalities.column_gram`; ``rows`` (m) := the row norms. False when
+        ``qdldl`` meets a zero pivot or a pivot that is not positive and finite."""
+        self._column_gram = None
+        _, norms, gram = column_gram(self.A)
+        try:
+            solver = self._qdldl.Solver(gram, upper=True)
+        except RuntimeError:   # qdldl's report of a zero pivot
+            return False
+        _, d, _ = solver.factors()
+        if not np.all(np.isfinite(d) & (d > 0.0)):
+            return False
+        rows[:] = norms
+        self._column_gram = solver
+        return True
+
+    def solve_column_gram(self, v: np.ndarray) -> np.ndarray:
+        """``(G G' + regularization)^-1 v`` on the factor of :meth:`factor_column_gram`."""
+        return self._column_gram.solve(v)

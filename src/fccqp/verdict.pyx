@@ -10,6 +10,7 @@ The certificates found are left in ``Engine.certs.cert``, in the user's units.
 
 from libc.math cimport fabs, isfinite, isinf, log
 
+from fccqp._blas cimport cholesky_solve
 from fccqp._dense cimport copy, fill
 from fccqp._types cimport Iterates, Problem
 from fccqp.certificates cimport (CERTIFIED, REJECTED, SEPARATED, WEAK,
@@ -17,14 +18,17 @@ from fccqp.certificates cimport (CERTIFIED, REJECTED, SEPARATED, WEAK,
                                  equality_inconsistent, gram_factor, primal_infeasible,
                                  row_sizes, zero_rows_inconsistent)
 from fccqp.dual_certificate cimport dual_infeasible
+from fccqp.equalities cimport column_gram
 from fccqp.engine cimport (DUAL_INFEASIBLE, INACCURATE, MAX_ITER, NUMERICAL_ERROR,
                            PRIMAL_INFEASIBLE, RUNNING, SOLVED, TIME_LIMIT, Engine, Run,
                            fccqp_now)
 from fccqp.kkt cimport is_reduced, kkt_solve
-from fccqp.matrices cimport entry, zero_column
+from fccqp.kkt_sparse cimport sparse_column_gram_factor, sparse_column_gram_solve
+from fccqp.matrices cimport DENSE, entry, zero_column
 from fccqp.reduced cimport materialize_nu_prev, materialize_x_prev
 from fccqp.termination cimport Residuals, converged, nearly_converged
-from fccqp.tuning cimport CLEANING_GATE, CLEANING_HORIZON, EQUALITY_MISSED, INACCURATE_FACTOR
+from fccqp.tuning cimport (CLEANING_GATE, CLEANING_HORIZON, EQUALITY_MISSED, INACCURATE_FACTOR,
+                           MAX_REFINE)
 
 
 cdef int check(Engine* e, long iteration, bint last) noexcept nogil:
@@ -249,8 +253,12 @@ cdef bint inconsistent(Engine* e, bint clean) noexcept nogil:
     regularized solve for ``(0, r)`` returns ``nu`` with ``-delta nu`` equal to the
     part of ``r`` in the null space of ``A'`` and the rest shrunk by ``delta /
     lambda`` (``lambda`` the eigenvalues of ``A H^-1 A'`` off that null space): the
-    first problem's ``rho`` fell to 1e-17, the second's to 7e-17. Failing those, rows
-    of ``A`` with no nonzero entry that ask ``b_i != 0`` are the certificate
+    first problem's ``rho`` fell to 1e-17, the second's to 7e-17. That step weighs the
+    columns by ``H^-1``, though: next to a ``P`` of 1e18 (columns of ``A_s`` near 1e-9)
+    the KKT solves leave ``r`` orthogonal to the other columns only, and ``b - A x``
+    is no least-squares residual at any ``delta``, so ``clean`` also tries
+    :func:`_column_gram_direction`. Failing those, rows of ``A`` with no nonzero entry
+    that ask ``b_i != 0`` are the certificate
     (:func:`fccqp.certificates.zero_rows_inconsistent`)."""
     cdef Problem* p = &e.prob
     cdef Py_ssize_t n = p.n, m = p.m, i
@@ -265,12 +273,63 @@ cdef bint inconsistent(Engine* e, bint clean) noexcept nogil:
             r[i] = -e.work.sol[n + i]
         code = equality_direction(p, r, e.it.x, e.opt.eps_prim_inf, e.work.vec_n,
                                   e.work.vec_n2, e.work.vec_m2)
+    if code != CERTIFIED and clean:
+        code = _column_gram_direction(e, r)
     if code != CERTIFIED and not zero_rows_inconsistent(p, r, e.work.vec_n, e.work.vec_m2):
         return False
     fill(e.certs.cert, 0.0, n + m)
     for i in range(m):
         e.certs.cert[i] = -r[i] * p.E[i]
     return True
+
+
+cdef int _column_gram_direction(Engine* e, double* r) noexcept nogil:
+    """:func:`fccqp.certificates.equality_direction` for ``r`` (m, filled) from inverse
+    iteration on the Gram matrix ``G G'`` of ``G = diag(1/rows) A_s diag(w)``
+    (:func:`fccqp.equalities.column_gram`: each column of ``A_s`` divided by its
+    largest entry, so that the equilibration's column scale, which follows ``P``,
+    weighs nothing): ``v := (G G' + eps I)^-1 v`` from ``v = b / rows``, ``r = v / rows``,
+    tested after each of at most ``MAX_REFINE`` steps. Each step shrinks the part of
+    ``v`` off the null space of ``G'`` (``A_s'r = 0``) by ``eps / (lambda + eps)``;
+    ``b'r = v_0'(eps (G G' + eps I)^-1)^k v_0 > 0`` whatever the rows. On dense rows
+    ``e.certs.gram`` is the factor's scratch, left to be factored again for the primal
+    certificates; over compressed columns the sparse handle holds the factor
+    (:func:`fccqp.kkt_sparse.sparse_column_gram_factor`)."""
+    cdef Problem* p = &e.prob
+    cdef Py_ssize_t m = p.m, i, step
+    cdef double* rows = e.work.rhs
+    cdef double* v = e.work.sol
+    cdef double size
+    cdef int code = REJECTED
+    cdef bint dense = p.A.kind == DENSE
+    if m == 0 or not (dense or e.fact.kkt.sparse != NULL):
+        return REJECTED
+    if dense:
+        e.certs.gram_state = 0   # the scratch below is not A A'
+        if not column_gram(p, e.work.vec_n, rows, e.certs.gram):
+            return REJECTED
+    elif not sparse_column_gram_factor(e.fact.kkt.sparse, m, rows):
+        return REJECTED
+    for i in range(m):
+        v[i] = p.b[i] / rows[i]
+    for step in range(MAX_REFINE):
+        if dense:
+            cholesky_solve(e.certs.gram, <int>m, <int>m, v, 1, <int>m)
+        else:
+            sparse_column_gram_solve(e.fact.kkt.sparse, m, v)
+        size = 0.0
+        for i in range(m):
+            size = max(size, fabs(v[i]))
+        if not (size > 0.0 and isfinite(size)):
+            return REJECTED
+        for i in range(m):   # normalized: each step multiplies the null part by 1/eps
+            v[i] /= size
+            r[i] = v[i] / rows[i]
+        code = equality_direction(p, r, e.it.x, e.opt.eps_prim_inf, e.work.vec_n,
+                                  e.work.vec_n2, e.work.vec_m2)
+        if code != SEPARATED:
+            return code
+    return code
 
 
 cdef bint unbounded(Engine* e) noexcept nogil:
