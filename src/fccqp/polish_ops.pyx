@@ -20,6 +20,7 @@ from fccqp.matrix_ops cimport Held
 from fccqp.polish cimport Polish, polish, polish_prepare
 from fccqp.polish_csc cimport bind
 from fccqp.tuning cimport GUESS_PASSES
+from fccqp.workspace_arrays cimport Arrays, polish_schur_arrays
 
 from fccqp.polish_csc import arrays
 
@@ -63,6 +64,7 @@ def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5, bi
     bordered one).
     """
     cdef Held Ph = Held(P), Ah = Held(A)
+    cdef Arrays schur_storage = Arrays()   # the Schur polish's, kept to the end
     cdef Py_ssize_t n = Ph.M.rows, m = Ah.M.rows, j
     if Ph.M.cols != n or Ah.M.cols != n:
         raise ValueError(f"P must be n x n and A m x n, got {P.shape} and {A.shape}")
@@ -108,7 +110,7 @@ def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5, bi
     w.schur.L = NULL   # no Schur storage: every guess is assembled
     w.schur.bordered = False
     if schur:
-        _schur_storage(&w, a, n, m, s)
+        polish_schur_arrays(schur_storage, &w.schur, n, m, s)
         polish_prepare(&w, &p)
     if Ph.M.kind == CSC:
         held = arrays(n, m, np.asarray(Ph.colptr), np.asarray(Ph.rowind),
@@ -124,17 +126,3 @@ def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5, bi
             "passes": w.passes, "factorizations": factorizations,
             "schur": bool(w.schur.ready), "bordered": bool(w.schur.bordered)}
 
-
-cdef void _schur_storage(Polish* w, _Arrays a, Py_ssize_t n, Py_ssize_t m, Py_ssize_t s):
-    """The arrays of :mod:`fccqp.polish_schur`, sized as ``workspace_arrays`` sizes them."""
-    ps = &w.schur
-    ps.order, ps.coupled = a.new_int(n), <char*>a.new(n)
-    ps.root, ps.inv_root = a.new(n), a.new(n)
-    ps.rowvar, ps.block_row = a.new_int(n), a.new_int(s)
-    ps.t, ps.t2, ps.u = a.new(n), a.new(n), a.new(m + s)
-    ps.L, ps.Y = a.new(n * n), a.new(n * (m + s))
-    ps.SU, ps.S = a.new(m * m), a.new((m + s) * (m + s))
-    ps.block = a.new(s * s)
-    ps.base_boundary = a.new_int(s)
-    ps.S0, ps.W = a.new(m * m), a.new(m * s)
-    ps.WW, ps.K, ps.Z, ps.T = a.new(s * s), a.new(s * s), a.new(s * s), a.new(s * s)

@@ -1,5 +1,6 @@
 # cython: language_level=3
 from fccqp.engine cimport Engine
+from fccqp.polish_schur cimport PolishSchur
 
 
 cdef class Arrays:
@@ -13,4 +14,6 @@ cdef class Arrays:
 
 cdef void common_arrays(Arrays a, Engine* e, Py_ssize_t memory, Py_ssize_t log_rows) except *
 cdef void dense_arrays(Arrays a, Engine* e, Py_ssize_t* order) except *
+cdef void polish_schur_arrays(Arrays a, PolishSchur* ps, Py_ssize_t n, Py_ssize_t m,
+                              Py_ssize_t s) except *
 cdef object csc_arrays(Arrays a, Engine* e, object patterns, object constrained)

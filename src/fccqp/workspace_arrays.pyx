@@ -23,6 +23,7 @@ from fccqp.engine cimport Engine
 from fccqp.kkt cimport SPARSE_LDL
 from fccqp.matrices cimport csc, dense
 from fccqp.polish_csc cimport bind
+from fccqp.polish_schur cimport PolishSchur
 from fccqp.tuning cimport GUESS_PASSES
 
 from fccqp.polish_csc import arrays as polish_arrays
@@ -140,13 +141,7 @@ cdef void common_arrays(Arrays a, Engine* e, Py_ssize_t memory, Py_ssize_t log_r
     pol.full, pol.dfull = a.new(N), a.new(N)
     pol.schur_only = pol.schur_failed = False
     pol.guess_passes = GUESS_PASSES
-    ps = &pol.schur
-    ps.ready = False
-    ps.order, ps.coupled = <Py_ssize_t*>a.new_int(n), <char*>a.new(n)
-    ps.root = a.new(n)
-    ps.rowvar, ps.block_row = <Py_ssize_t*>a.new_int(n), <Py_ssize_t*>a.new_int(s)
-    ps.inv_root = a.new(n)
-    ps.t, ps.t2, ps.u = a.new(n), a.new(n), a.new(m + s)
+    pol.schur.ready = False   # dense_arrays gives it storage (polish_schur_arrays)
     e.unscaled.x, e.unscaled.y, e.unscaled.z = a.new(n), a.new(m), a.new(n)
     e.log.capacity = log_rows
     e.log.rows = a.new(5 * log_rows)
@@ -195,7 +190,17 @@ cdef void dense_arrays(Arrays a, Engine* e, Py_ssize_t* order) except *:
     pol.lwork = <int>(64 * (N + s))
     pol.work = a.new(64 * (N + s))
     pol.T = a.new(4 * s * s)
-    ps = &pol.schur
+    polish_schur_arrays(a, &pol.schur, n, m, s)
+
+
+cdef void polish_schur_arrays(Arrays a, PolishSchur* ps, Py_ssize_t n, Py_ssize_t m,
+                              Py_ssize_t s) except *:
+    """The storage of :mod:`fccqp.polish_schur`'s Schur-complement polish for ``n``
+    entries, ``m`` rows and ``s`` constrained entries (dense ``P`` and ``A`` only)."""
+    ps.order, ps.coupled = <Py_ssize_t*>a.new_int(n), <char*>a.new(n)
+    ps.root, ps.inv_root = a.new(n), a.new(n)
+    ps.rowvar, ps.block_row = <Py_ssize_t*>a.new_int(n), <Py_ssize_t*>a.new_int(s)
+    ps.t, ps.t2, ps.u = a.new(n), a.new(n), a.new(m + s)
     ps.L, ps.Y = a.new(n * n), a.new(n * (m + s))
     ps.SU, ps.S = a.new(m * m), a.new((m + s) * (m + s))
     ps.block = a.new(s * s)
