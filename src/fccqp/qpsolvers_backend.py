@@ -10,13 +10,23 @@ fccqp has no general inequalities, only equalities, a box and cones, so each row
 
 The equalities, ``G x = s`` included, hold to factorization accuracy at every
 iterate, and every inequality becomes a box bound, which ADMM handles by a clamp.
+
+Row scale. Each row of ``G`` and ``h`` is first multiplied by ``d_i``, the power of two
+nearest to ``1 / max_j |G_ij|`` (1 for a zero row, which then reads ``0 <= h_i``), so
+that every slack row ``[d_i G_i, -1]`` has entries of the slack's unit size. Without
+it the slack's ``-1`` sets the row's norm, the equilibration sees a balanced row
+whatever the size of ``G_i``, and a row far smaller than 1 couples ``x`` to its
+multiplier so weakly that ADMM needs tens of thousands of iterations to build the
+multiplier up. The feasible set is unchanged; powers of two scale without rounding.
+The solver's multipliers of the scaled rows are ``z_i / d_i``, so ``d_i`` multiplies
+them back into the user's units.
 The cost is size: ``m_G`` more variables and ``m_G`` more equality rows, so the
 dense KKT matrix grows from ``n + m_A`` to ``n + m_A + 2 m_G`` rows, and the
 factorization cost with its cube.
 
 Duals. fccqp returns ``(y_ext, z_ext)`` with ``P_ext v + q_ext + A_ext' y_ext +
 z_ext = 0``. Its rows for ``s`` read ``-y_G + z_s = 0``, so the multiplier of
-``G x <= h`` is ``z = z_s``, the box multiplier of the slack. It comes from the
+``G x <= h`` is ``z = d z_s``, the box multiplier of the slack in the user's units. It comes from the
 projection onto ``s <= h``, so it is zero on inactive rows and non-negative up to
 rounding in the unscaling (values like ``-4.8e-18`` occur); the backend clips it at
 0, so the returned ``z`` is exactly ``>= 0``. Its rows for ``x`` then give qpsolvers' convention
@@ -51,6 +61,7 @@ import numpy as np
 from fccqp._import_hooks import after_import
 from fccqp.problem import issparse, validate
 from fccqp.settings import MAX_DENSE_KKT_ROWS, Settings
+from fccqp.status import Status
 
 if TYPE_CHECKING:
     import scipy.sparse as sp
@@ -59,6 +70,8 @@ if TYPE_CHECKING:
 
 SOLVER_NAME = "fccqp"
 """Name of the solver in qpsolvers' registry."""
+MAX_ROW_EXPONENT = 1000
+"""Largest ``|log2|`` of a row scale of ``G``, so that the scale stays a normal double."""
 
 
 def _settings(verbose: bool, kwargs: dict[str, object]) -> Settings:
@@ -126,6 +139,58 @@ def _inequalities(G: object, h: object, n: int,
         i = int(np.flatnonzero(h == -np.inf)[0])
         raise ValueError(f"h[{i}] is -inf: the inequality G[{i}] x <= -inf cannot hold")
     return G, h
+
+
+def _row_scales(G: np.ndarray | sp.csc_matrix, h: np.ndarray) -> np.ndarray:
+    """The power of two ``d_i`` nearest to ``1 / max_j |G_ij|`` for each row of ``G``.
+
+    A zero row keeps ``d_i = 1`` (its inequality ``0 <= h_i`` needs no scale), and so
+    does a row whose ``d_i h_i`` would overflow a finite ``h_i`` (its scale cannot be
+    represented, and the row is then too small to bind anyway).
+    """
+    if issparse(G):
+        largest = abs(G).max(axis=1).toarray().reshape(-1)
+    else:
+        largest = np.abs(G).max(axis=1, initial=0.0)
+    exponents = np.zeros(largest.shape[0])
+    nonzero = largest > 0
+    exponents[nonzero] = -np.round(np.log2(largest[nonzero]))
+    scales = np.ldexp(1.0, np.clip(exponents, -MAX_ROW_EXPONENT, MAX_ROW_EXPONENT).astype(int))
+    with np.errstate(over="ignore"):
+        overflow = np.isfinite(h) & ~np.isfinite(scales * h)
+    scales[overflow] = 1.0
+    return scales
+
+
+def _scaled_rows(G: np.ndarray | sp.csc_matrix,
+                 scales: np.ndarray) -> np.ndarray | sp.csc_matrix:
+    """``diag(scales) G``, dense or CSC like ``G``."""
+    if issparse(G):
+        import scipy.sparse as sp
+
+        return sp.csc_matrix(sp.diags(scales) @ G)
+    return G * scales[:, None]
+
+
+def _user_certificate(result: object, n: int, m_A: int,
+                      scales: np.ndarray) -> np.ndarray | None:
+    """The slack form's certificate with the slack rows and entries in the user's units.
+
+    A primal certificate ``(y, z)`` of the scaled rows is multiplied by ``scales`` on
+    the slack rows of ``y`` and the slack entries of ``z``; a dual certificate ``dx``
+    (a direction over ``[x; s]``) is divided by it on the slack entries.
+    """
+    certificate = result.certificate
+    if certificate is None:
+        return None
+    certificate = certificate.copy()
+    m_G = scales.shape[0]
+    if result.status is Status.PRIMAL_INFEASIBLE:
+        certificate[m_A:m_A + m_G] *= scales
+        certificate[m_A + m_G + n:] *= scales
+    elif result.status is Status.DUAL_INFEASIBLE:
+        certificate[n:] /= scales
+    return certificate
 
 
 def _with_slacks(data: object, G: np.ndarray | sp.csc_matrix,
@@ -238,11 +303,12 @@ def fccqp_solve_problem(
     x0 = None if initvals is None else _initial_guess(initvals, data.n)
     if G is None:
         args = (data.P, data.q, data.A, data.b, data.lb, data.ub)
-        m_G = 0
+        scales = np.empty(0)
     else:
         G, h = _inequalities(G, h, data.n, sparse)
-        args = _with_slacks(data, G, h)
-        m_G = G.shape[0]
+        scales = _row_scales(G, h)
+        G = _scaled_rows(G, scales)
+        args = _with_slacks(data, G, scales * h)
         if x0 is not None:
             x0 = np.concatenate([x0, G @ x0])
     solve_start = time.perf_counter()
@@ -261,7 +327,7 @@ def fccqp_solve_problem(
         "rho": result.rho,
         "factorizations": result.factorizations,
         "backend": result.backend,
-        "certificate": result.certificate,
+        "certificate": _user_certificate(result, data.n, data.m, scales),
     }
     solution.build_time = solve_start - build_start
     solution.solve_time = solve_end - solve_start
@@ -271,7 +337,7 @@ def fccqp_solve_problem(
     solution.obj = result.obj
     solution.x = result.x[:n]
     solution.y = result.y[:m_A]
-    solution.z = np.maximum(result.z[n:], 0.0) if m_G else np.empty(0)
+    solution.z = np.maximum(result.z[n:], 0.0) * scales
     solution.z_box = result.z[:n] if lb is not None or ub is not None else np.empty(0)
     return solution
 
