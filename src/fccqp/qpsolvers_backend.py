@@ -11,26 +11,25 @@ fccqp has no general inequalities, only equalities, a box and cones, so each row
 The equalities, ``G x = s`` included, hold to factorization accuracy at every
 iterate, and every inequality becomes a box bound, which ADMM handles by a clamp.
 
-Row scale. Each row of ``G`` and ``h`` is first multiplied by ``d_i``, the power of two
-nearest to ``1 / max_j |G_ij|`` (1 for a zero row, which then reads ``0 <= h_i``), so
-that every slack row ``[d_i G_i, -1]`` has entries of the slack's unit size. Without
-it the slack's ``-1`` sets the row's norm, the equilibration sees a balanced row
-whatever the size of ``G_i``, and a row far smaller than 1 couples ``x`` to its
-multiplier so weakly that ADMM needs tens of thousands of iterations to build the
-multiplier up. The feasible set is unchanged; powers of two scale without rounding.
-The solver's multipliers of the scaled rows are ``z_i / d_i``, so ``d_i`` multiplies
-them back into the user's units.
-The cost is size: ``m_G`` more variables and ``m_G`` more equality rows, so the
-dense KKT matrix grows from ``n + m_A`` to ``n + m_A + 2 m_G`` rows, and the
-factorization cost with its cube.
+Row scale. Each row of ``G`` and ``h``, and of ``A`` and ``b``, is first multiplied by
+``d_i``, the power of two nearest to ``1 / max_j |M_ij|`` (1 for a zero row, which
+keeps its meaning: ``0 <= h_i`` holds or the problem is infeasible). A slack row ``[G_i,
+-1]`` needs it most: the slack's ``-1`` sets the row's norm, so the equilibration sees
+a balanced row whatever the size of ``G_i``, and a row far smaller than 1 couples
+``x`` to its multiplier so weakly that ADMM takes tens of thousands of iterations to
+build the multiplier up; the rows of ``A`` are equilibrated by fccqp, but only
+partly in its few Ruiz passes when their scales span orders of magnitude. The
+feasible set is unchanged, and powers of two scale without rounding. The multiplier
+of a scaled row is the user's divided by ``d_i``, so ``d_i`` multiplies it back.
 
 Duals. fccqp returns ``(y_ext, z_ext)`` with ``P_ext v + q_ext + A_ext' y_ext +
 z_ext = 0``. Its rows for ``s`` read ``-y_G + z_s = 0``, so the multiplier of
-``G x <= h`` is ``z = d z_s``, the box multiplier of the slack in the user's units. It comes from the
-projection onto ``s <= h``, so it is zero on inactive rows and non-negative up to
-rounding in the unscaling (values like ``-4.8e-18`` occur); the backend clips it at
-0, so the returned ``z`` is exactly ``>= 0``. Its rows for ``x`` then give qpsolvers' convention
-``P x + q + A'y + G'z + z_box = 0`` with ``y = y_A`` and ``z_box = z_x``
+``G x <= h`` is ``z = d z_s``, the slack's box multiplier times the row scale. It
+comes from the projection onto ``s <= h``, so it is zero on inactive rows and
+non-negative up to rounding in the unscaling (values like ``-4.8e-18`` occur); the
+backend clips it at 0, so the returned ``z`` is exactly ``>= 0``. Its rows for ``x``
+then give qpsolvers' convention ``P x + q + A'y + G'z + z_box = 0`` with ``y = d
+y_A`` and ``z_box = z_x``
 (negative at an active lower bound, positive at an active upper bound).
 
 fccqp's core is dense, meant for 30-300 variables: sparse ``P``, ``G``, ``A``
@@ -51,6 +50,7 @@ updates it right after ``import qpsolvers`` finishes, then removes itself.
 
 from __future__ import annotations
 
+import dataclasses
 import importlib.util
 import sys
 import time
@@ -141,55 +141,57 @@ def _inequalities(G: object, h: object, n: int,
     return G, h
 
 
-def _row_scales(G: np.ndarray | sp.csc_matrix, h: np.ndarray) -> np.ndarray:
-    """The power of two ``d_i`` nearest to ``1 / max_j |G_ij|`` for each row of ``G``.
+def _row_scales(M: np.ndarray | sp.csc_matrix, rhs: np.ndarray) -> np.ndarray:
+    """The power of two ``d_i`` nearest to ``1 / max_j |M_ij|`` for each row of ``M``.
 
-    A zero row keeps ``d_i = 1`` (its inequality ``0 <= h_i`` needs no scale), and so
-    does a row whose ``d_i h_i`` would overflow a finite ``h_i`` (its scale cannot be
-    represented, and the row is then too small to bind anyway).
+    A zero row keeps ``d_i = 1`` (its constraint ``0 <= h_i`` or ``0 = b_i`` needs no
+    scale), and so does a row whose ``d_i rhs_i`` would overflow a finite ``rhs_i``.
     """
-    if issparse(G):
-        largest = abs(G).max(axis=1).toarray().reshape(-1)
+    if issparse(M):
+        largest = abs(M).max(axis=1).toarray().reshape(-1)
     else:
-        largest = np.abs(G).max(axis=1, initial=0.0)
+        largest = np.abs(M).max(axis=1, initial=0.0)
     exponents = np.zeros(largest.shape[0])
     nonzero = largest > 0
     exponents[nonzero] = -np.round(np.log2(largest[nonzero]))
     scales = np.ldexp(1.0, np.clip(exponents, -MAX_ROW_EXPONENT, MAX_ROW_EXPONENT).astype(int))
     with np.errstate(over="ignore"):
-        overflow = np.isfinite(h) & ~np.isfinite(scales * h)
+        overflow = np.isfinite(rhs) & ~np.isfinite(scales * rhs)
     scales[overflow] = 1.0
     return scales
 
 
-def _scaled_rows(G: np.ndarray | sp.csc_matrix,
-                 scales: np.ndarray) -> np.ndarray | sp.csc_matrix:
-    """``diag(scales) G``, dense or CSC like ``G``."""
-    if issparse(G):
-        import scipy.sparse as sp
+def _normalized_rows(M: np.ndarray | sp.csc_matrix, rhs: np.ndarray) -> tuple[
+        np.ndarray | sp.csc_matrix, np.ndarray, np.ndarray]:
+    """``(diag(d) M, d * rhs, d)`` with the row scales ``d`` of :func:`_row_scales`;
+    the matrix dense or CSC like ``M``."""
+    scales = _row_scales(M, rhs)
+    if issparse(M):   # CSC: entry k lies in row indices[k]
+        M = M.copy()
+        M.data *= scales[M.indices]
+        return M, scales * rhs, scales
+    return M * scales[:, None], scales * rhs, scales
 
-        return sp.csc_matrix(sp.diags(scales) @ G)
-    return G * scales[:, None]
 
+def _user_certificate(result: object, n: int, scales_A: np.ndarray,
+                      scales_G: np.ndarray) -> np.ndarray | None:
+    """The slack form's certificate with its rows and slack entries in the user's units.
 
-def _user_certificate(result: object, n: int, m_A: int,
-                      scales: np.ndarray) -> np.ndarray | None:
-    """The slack form's certificate with the slack rows and entries in the user's units.
-
-    A primal certificate ``(y, z)`` of the scaled rows is multiplied by ``scales`` on
-    the slack rows of ``y`` and the slack entries of ``z``; a dual certificate ``dx``
-    (a direction over ``[x; s]``) is divided by it on the slack entries.
+    A primal certificate ``(y, z)`` of the scaled rows is multiplied by the row scales
+    on ``y`` (rows of ``A``, then the slack rows) and on the slack entries of ``z``; a
+    dual certificate ``dx`` (a direction over ``[x; s]``) is divided by them on the
+    slack entries.
     """
     certificate = result.certificate
     if certificate is None:
         return None
     certificate = certificate.copy()
-    m_G = scales.shape[0]
+    rows = np.concatenate([scales_A, scales_G])
     if result.status is Status.PRIMAL_INFEASIBLE:
-        certificate[m_A:m_A + m_G] *= scales
-        certificate[m_A + m_G + n:] *= scales
+        certificate[:rows.shape[0]] *= rows
+        certificate[rows.shape[0] + n:] *= scales_G
     elif result.status is Status.DUAL_INFEASIBLE:
-        certificate[n:] /= scales
+        certificate[n:] /= scales_G
     return certificate
 
 
@@ -301,14 +303,15 @@ def fccqp_solve_problem(
     else:
         data = validate(P, q, A, b, lb, ub)
     x0 = None if initvals is None else _initial_guess(initvals, data.n)
+    A, b, scales_A = _normalized_rows(data.A, data.b)
+    data = dataclasses.replace(data, A=A, b=b)
     if G is None:
         args = (data.P, data.q, data.A, data.b, data.lb, data.ub)
-        scales = np.empty(0)
+        scales_G = np.empty(0)
     else:
         G, h = _inequalities(G, h, data.n, sparse)
-        scales = _row_scales(G, h)
-        G = _scaled_rows(G, scales)
-        args = _with_slacks(data, G, scales * h)
+        G, h, scales_G = _normalized_rows(G, h)
+        args = _with_slacks(data, G, h)
         if x0 is not None:
             x0 = np.concatenate([x0, G @ x0])
     solve_start = time.perf_counter()
@@ -327,7 +330,7 @@ def fccqp_solve_problem(
         "rho": result.rho,
         "factorizations": result.factorizations,
         "backend": result.backend,
-        "certificate": _user_certificate(result, data.n, data.m, scales),
+        "certificate": _user_certificate(result, data.n, scales_A, scales_G),
     }
     solution.build_time = solve_start - build_start
     solution.solve_time = solve_end - solve_start
@@ -336,8 +339,8 @@ def fccqp_solve_problem(
     n, m_A = data.n, data.m
     solution.obj = result.obj
     solution.x = result.x[:n]
-    solution.y = result.y[:m_A]
-    solution.z = np.maximum(result.z[n:], 0.0) * scales
+    solution.y = result.y[:m_A] * scales_A
+    solution.z = np.maximum(result.z[n:], 0.0) * scales_G
     solution.z_box = result.z[:n] if lb is not None or ub is not None else np.empty(0)
     return solution
 
