@@ -12,15 +12,16 @@ The equalities, ``G x = s`` included, hold to factorization accuracy at every
 iterate, and every inequality becomes a box bound, which ADMM handles by a clamp.
 
 Row scale. Each row of ``G`` and ``h``, and of ``A`` and ``b``, is first multiplied by
-``d_i``, the power of two nearest to ``1 / max_j |M_ij|`` (1 for a zero row, which
-keeps its meaning: ``0 <= h_i`` holds or the problem is infeasible). A slack row ``[G_i,
--1]`` needs it most: the slack's ``-1`` sets the row's norm, so the equilibration sees
-a balanced row whatever the size of ``G_i``, and a row far smaller than 1 couples
-``x`` to its multiplier so weakly that ADMM takes tens of thousands of iterations to
-build the multiplier up; the rows of ``A`` are equilibrated by fccqp, but only
-partly in its few Ruiz passes when their scales span orders of magnitude. The
-feasible set is unchanged, and powers of two scale without rounding. The multiplier
-of a scaled row is the user's divided by ``d_i``, so ``d_i`` multiplies it back.
+``d_i = 1 / max_j |M_ij|`` (1 for a zero row, which keeps its meaning: ``0 <= h_i``
+holds or the problem is infeasible), so that the answer does not depend on the scale
+the user wrote a row in. A slack row ``[G_i, -1]`` needs it most: the slack's ``-1``
+sets the row's norm, so the equilibration sees a balanced row whatever the size of
+``G_i``, and a row far smaller than 1 couples ``x`` to its multiplier so weakly that
+ADMM takes tens of thousands of iterations to build the multiplier up. The rows of
+``A`` fccqp equilibrates itself, but only partly in its few Ruiz passes when their
+scales span orders of magnitude. The feasible set is unchanged (to the rounding of
+the products). The multiplier of a scaled row is the user's divided by ``d_i``, so
+``d_i`` multiplies it back.
 
 Duals. fccqp returns ``(y_ext, z_ext)`` with ``P_ext v + q_ext + A_ext' y_ext +
 z_ext = 0``. Its rows for ``s`` read ``-y_G + z_s = 0``, so the multiplier of
@@ -70,8 +71,6 @@ if TYPE_CHECKING:
 
 SOLVER_NAME = "fccqp"
 """Name of the solver in qpsolvers' registry."""
-MAX_ROW_EXPONENT = 1000
-"""Largest ``|log2|`` of a row scale of ``G``, so that the scale stays a normal double."""
 
 
 def _settings(verbose: bool, kwargs: dict[str, object]) -> Settings:
@@ -142,21 +141,19 @@ def _inequalities(G: object, h: object, n: int,
 
 
 def _row_scales(M: np.ndarray | sp.csc_matrix, rhs: np.ndarray) -> np.ndarray:
-    """The power of two ``d_i`` nearest to ``1 / max_j |M_ij|`` for each row of ``M``.
+    """``d_i = 1 / max_j |M_ij|`` for each row of ``M``.
 
     A zero row keeps ``d_i = 1`` (its constraint ``0 <= h_i`` or ``0 = b_i`` needs no
-    scale), and so does a row whose ``d_i rhs_i`` would overflow a finite ``rhs_i``.
+    scale), and so does a row whose ``d_i`` or ``d_i rhs_i`` would overflow.
     """
     if issparse(M):
         largest = abs(M).max(axis=1).toarray().reshape(-1)
     else:
         largest = np.abs(M).max(axis=1, initial=0.0)
-    exponents = np.zeros(largest.shape[0])
-    nonzero = largest > 0
-    exponents[nonzero] = -np.round(np.log2(largest[nonzero]))
-    scales = np.ldexp(1.0, np.clip(exponents, -MAX_ROW_EXPONENT, MAX_ROW_EXPONENT).astype(int))
-    with np.errstate(over="ignore"):
-        overflow = np.isfinite(rhs) & ~np.isfinite(scales * rhs)
+    scales = np.ones(largest.shape[0])
+    with np.errstate(divide="ignore", over="ignore"):
+        np.divide(1.0, largest, out=scales, where=largest > 0)
+        overflow = ~np.isfinite(scales) | (np.isfinite(rhs) & ~np.isfinite(scales * rhs))
     scales[overflow] = 1.0
     return scales
 
@@ -164,7 +161,7 @@ def _row_scales(M: np.ndarray | sp.csc_matrix, rhs: np.ndarray) -> np.ndarray:
 def _normalized_rows(M: np.ndarray | sp.csc_matrix, rhs: np.ndarray) -> tuple[
         np.ndarray | sp.csc_matrix, np.ndarray, np.ndarray]:
     """``(diag(d) M, d * rhs, d)`` with the row scales ``d`` of :func:`_row_scales`;
-    the matrix dense or CSC like ``M``."""
+    the matrix dense or CSC like ``M``, its entries the same products either way."""
     scales = _row_scales(M, rhs)
     if issparse(M):   # CSC: entry k lies in row indices[k]
         M = M.copy()
