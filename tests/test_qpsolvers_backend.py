@@ -309,13 +309,22 @@ def test_zero_row_of_g_keeps_its_meaning(h0, status):
         assert_close(solution.z, np.array([0.0, 1.5]), 1e-7, "z")
 
 
-def test_infeasibility_certificate_is_in_the_users_units():
-    """``x0 + x1 <= -1`` written at 1e-3 against ``x >= 0``: the certificate of the
-    slack form checks on the user's rows."""
-    problem = Problem(np.eye(2), np.ones(2), np.array([[1e-3, 1e-3], [1.0, 0.0]]),
-                      np.array([-1e-3, 5.0]), lb=np.zeros(2))
+@pytest.mark.parametrize(
+    "G, h, q, lb, status",
+    [
+        (np.array([[1e-3, 1e-3], [1.0, 0.0]]), np.array([-1e-3, 5.0]), np.ones(2),
+         np.zeros(2), fccqp.Status.PRIMAL_INFEASIBLE),
+        (np.array([[-1e3, 1e3], [0.0, 1e-3]]), np.array([1.0, 1.0]), -np.ones(2),
+         None, fccqp.Status.DUAL_INFEASIBLE),
+    ],
+    ids=["x0 + x1 <= -1 at 1e-3 against x >= 0", "x1 <= x0 at 1e3, unbounded along x0"],
+)
+def test_infeasibility_certificate_is_in_the_users_units(G, h, q, lb, status):
+    """Rows of ``G`` far from 1: the certificate of the slack form checks on the user's
+    rows."""
+    problem = Problem(np.zeros((2, 2)) if lb is None else np.eye(2), q, G, h, lb=lb)
     solution = solve_problem(problem, solver="fccqp")
-    assert solution.extras["status"] is fccqp.Status.PRIMAL_INFEASIBLE
+    assert solution.extras["status"] is status
     verify_solution(*from_qpsolvers(problem, solution))
 
 
