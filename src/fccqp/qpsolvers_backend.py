@@ -251,7 +251,7 @@ def fccqp_solve_problem(
         then the problem takes the sparse path). Inequalities become slack variables
         (see the module docstring).
     initvals : (n,) array_like, optional
-        Primal initial guess ``x0``; the slacks start at ``G x0``. Without it the
+        Primal initial guess ``x0``; the slacks start at their values at ``x0``. Without it the
         solve starts cold.
     verbose : bool
         Print fccqp's iteration log.
@@ -268,9 +268,10 @@ def fccqp_solve_problem(
         ``Status.NUMERICAL_ERROR``, ``x, y, z, z_box`` hold the last (finite) iterate
         and ``found`` is False; on infeasibility they are None. ``extras`` holds the
         fccqp ``status``, ``iterations``, ``prim_res``, ``dual_res`` (of the slack
-        form), ``setup_time``, ``solve_time``, ``rho``, ``factorizations``,
-        ``backend`` (the KKT backend that ran, ``"sparse"`` on the sparse path) and
-        ``certificate`` (of the slack form, see ``fccqp.Result``).
+        form with its rows scaled), ``setup_time``, ``solve_time``, ``rho``,
+        ``factorizations``, ``backend`` (the KKT backend that ran, ``"sparse"`` on the
+        sparse path) and ``certificate`` (of the slack form in the user's units, see
+        ``fccqp.Result``).
 
     Raises
     ------
