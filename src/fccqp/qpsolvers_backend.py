@@ -221,6 +221,23 @@ def _with_slacks(data: object, G: np.ndarray | sp.csc_matrix,
     )
 
 
+def slack_form(data: object, G: object, h: object, sparse: bool = False) -> tuple[
+        tuple[object, ...], np.ndarray, np.ndarray]:
+    """The problem fccqp solves for qpsolvers' ``data`` (:class:`fccqp.problem.ProblemData`,
+    or :class:`fccqp.sparse_problem.SparseData` with ``sparse``) and ``G x <= h``:
+    ``((P, q, A, b, lb, ub), d_A, d_G)``, the slack form of the module docstring with
+    the rows of ``A, b`` and ``G, h`` multiplied by the row scales ``d_A`` and ``d_G``
+    (:func:`_row_scales`). ``G`` may be None (then ``h`` too): no slacks, ``d_G``
+    empty."""
+    A, b, scales_A = _normalized_rows(data.A, data.b)
+    data = dataclasses.replace(data, A=A, b=b)
+    if G is None:
+        return (data.P, data.q, data.A, data.b, data.lb, data.ub), scales_A, np.empty(0)
+    G, h = _inequalities(G, h, data.n, sparse)
+    G, h, scales_G = _normalized_rows(G, h)
+    return _with_slacks(data, G, h), scales_A, scales_G
+
+
 def _initial_guess(initvals: object, n: int) -> np.ndarray:
     if np.iscomplexobj(initvals):
         raise TypeError("initvals must be real, got complex entries")
@@ -301,17 +318,9 @@ def fccqp_solve_problem(
     else:
         data = validate(P, q, A, b, lb, ub)
     x0 = None if initvals is None else _initial_guess(initvals, data.n)
-    A, b, scales_A = _normalized_rows(data.A, data.b)
-    data = dataclasses.replace(data, A=A, b=b)
-    if G is None:
-        args = (data.P, data.q, data.A, data.b, data.lb, data.ub)
-        scales_G = np.empty(0)
-    else:
-        G, h = _inequalities(G, h, data.n, sparse)
-        G, h, scales_G = _normalized_rows(G, h)
-        args = _with_slacks(data, G, h)
-        if x0 is not None:
-            x0 = np.concatenate([x0, G @ x0])
+    args, scales_A, scales_G = slack_form(data, G, h, sparse)
+    if G is not None and x0 is not None:
+        x0 = np.concatenate([x0, args[2][data.m:, :data.n] @ x0])   # the scaled G x0
     solve_start = time.perf_counter()
     result = Solver(settings).solve(*args, x0=x0)
     solve_end = time.perf_counter()
