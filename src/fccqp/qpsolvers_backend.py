@@ -18,8 +18,9 @@ the user wrote a row in. A slack row ``[G_i, -1]`` needs it most: the slack's ``
 sets the row's norm, so the equilibration sees a balanced row whatever the size of
 ``G_i``, and a row far smaller than 1 couples ``x`` to its multiplier so weakly that
 ADMM takes tens of thousands of iterations to build the multiplier up. The rows of
-``A`` fccqp equilibrates itself, but only partly in its few Ruiz passes when their
-scales span orders of magnitude. The feasible set is unchanged (to the rounding of
+``A`` reach the equilibration directly, yet runs still depend on their scale (rows
+times factors from 1e-4 to 1e4 took 2.5 times the iterations, at 4 Ruiz passes as at
+25), so they are scaled the same way. The feasible set is unchanged (to the rounding of
 the products). The multiplier of a scaled row is the user's divided by ``d_i``, so
 ``d_i`` multiplies it back.
 
