@@ -10,6 +10,9 @@ fccqp has no general inequalities, only equalities, a box and cones, so each row
 
 The equalities, ``G x = s`` included, hold to factorization accuracy at every
 iterate, and every inequality becomes a box bound, which ADMM handles by a clamp.
+The cost is size: ``m_G`` more variables and ``m_G`` more equality rows, so the
+dense KKT matrix grows from ``n + m_A`` to ``n + m_A + 2 m_G`` rows, and the
+factorization cost with its cube.
 
 Row scale. Each row of ``G`` and ``h``, and of ``A`` and ``b``, is first multiplied by
 ``d_i = 1 / max_j |M_ij|`` (1 for a zero row, which keeps its meaning: ``0 <= h_i``
@@ -269,8 +272,8 @@ def fccqp_solve_problem(
         then the problem takes the sparse path). Inequalities become slack variables
         (see the module docstring).
     initvals : (n,) array_like, optional
-        Primal initial guess ``x0``; the slacks start at their values at ``x0``. Without it the
-        solve starts cold.
+        Primal initial guess ``x0``; the slacks start at their values at ``x0``.
+        Without it the solve starts cold.
     verbose : bool
         Print fccqp's iteration log.
     **kwargs
