@@ -27,7 +27,7 @@ SEEDS = {
                      1100037, 1100057, 1100150, 1100253, 1300030, 1300300, 1500043, 1700106,
                      1700359, 1900050, 2500125, 2900030, 4700215, 4700352,
                      5300281, 6100225),
-    "qpsolvers": (0, 1, 2, 1700123),
+    "qpsolvers": (0, 1, 2, 1700123, 7900043),
     "cvxpy": (1, 2, 3),
     "degenerate": (0, 1, 2, 4, 7, 9, 11, 12, 21, 23, 30, 35, 43, 58, 150, 102753, 104299),
 }
@@ -63,7 +63,11 @@ though its residual reaches its separation at the data's scale; extreme_data 470
 rows of 1e-142 to 1e-17, inconsistent among the smallest, whose miss lay below the
 largest row's rounding and which the start's gate therefore never tested; extreme_data
 6100225 rows inconsistent by 0.79 beside a ``P`` of 1e18, whose KKT solves' residual is
-orthogonal only to the columns ``P`` leaves unscaled; issues 26 and 28)."""
+orthogonal only to the columns ``P`` leaves unscaled; qpsolvers 7900043 (also on the
+sparse path) an active row of ``G`` parallel to a slack one at 2e-3 of its size, whose
+slack row the equilibration saw balanced: MAX_ITER_REACHED, its multiplier a tenth
+built, until the qpsolvers backend scaled each row of ``G`` to entries of 1; issues 26,
+28 and 29)."""
 
 SPARSE_SEEDS = {
     "bad_input": (0, 1, 2),
@@ -71,7 +75,7 @@ SPARSE_SEEDS = {
     "solver_reuse": (38,),
     "extreme_data": (26, 100121, 900343, 1700359, 1900317, 2500125, 2900030, 2900221,
                      4100295, 4700215, 4700352, 6100225),
-    "qpsolvers": (100035,),
+    "qpsolvers": (100035, 7900043),
     "cvxpy": (7, 1700154, 1900171),
     "dual_infeasible": (1700072,),
     "degenerate": (0, 1, 43),

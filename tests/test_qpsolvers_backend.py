@@ -239,6 +239,96 @@ def test_every_bound_active_at_once():
     assert solution.is_optimal(1e-7)
 
 
+def parallel_rows(scale: float) -> Problem:
+    """``min 1/2 (x0^2 + x2^2) - x1`` in a box, under ``x0 + x1 <= 3`` and the same row
+    times ``scale``, ``scale (x0 + x1) <= scale``: only the small row is active, so
+    ``x = (-1, 2, 0)`` and its multiplier is ``1 / scale``."""
+    g = np.array([1.0, 1.0, 0.0])
+    return Problem(np.diag([1.0, 0.0, 1.0]), np.array([0.0, -1.0, 0.0]),
+                   np.vstack([g, scale * g]), np.array([3.0, scale]),
+                   lb=np.full(3, -5.0), ub=np.full(3, 5.0))
+
+
+@pytest.mark.parametrize("scale", [1e-3, 2e-3])
+def test_small_parallel_row_of_g_is_solved_with_its_large_multiplier(scale):
+    """A row of ``G`` far smaller than 1 needs a multiplier far larger than the cost:
+    solved at default settings to Clarabel's answer and duals."""
+    problem = parallel_rows(scale)
+    solution = solve_problem(problem, solver="fccqp")
+    assert solution.extras["status"] is fccqp.Status.SOLVED
+    verify_solution(*from_qpsolvers(problem, solution))
+    clarabel = solve_problem(problem, solver="clarabel", tol_gap_abs=1e-10,
+                             tol_gap_rel=1e-10, tol_feas=1e-10)
+    for name, exact, atol in (("x", [-1.0, 2.0, 0.0], 1e-6),
+                              ("z", [0.0, 1.0 / scale], 1e-6 / scale),
+                              ("z_box", [0.0, 0.0, 0.0], 1e-6)):
+        assert_close(getattr(solution, name), np.asarray(exact), atol, name)
+        assert_close(getattr(solution, name), getattr(clarabel, name), atol, name)
+
+
+@pytest.mark.parametrize("getter", [problems.get_qpsut01, problems.get_qpsut04, problems.get_qptest,
+                                    problems.get_qpgurdu, problems.get_qpgureq],
+                         ids=lambda g: g.__name__)
+@pytest.mark.parametrize("seed", [0, 1])
+def test_answer_does_not_depend_on_the_scale_of_the_rows(getter, seed):
+    """Rows of ``G, h`` and ``A, b`` times factors from 1e-4 to 1e4 describe the same
+    problem: the same iterations (the scaled problem is the same to rounding), the
+    same ``x`` and ``z_box``, and ``z``, ``y`` divided by the factors."""
+    problem, _ = getter()
+    P, q, G, h, A, b, lb, ub = problem.unpack()
+    rng = np.random.default_rng(seed)
+    d_G = np.empty(0) if G is None else 10.0 ** rng.uniform(-4, 4, G.shape[0])
+    d_A = np.empty(0) if A is None else 10.0 ** rng.uniform(-4, 4, A.shape[0])
+    scaled = Problem(P, q, None if G is None else d_G[:, None] * G,
+                     None if G is None else d_G * h, None if A is None else d_A[:, None] * A,
+                     None if A is None else d_A * b, lb, ub)
+    plain = solve_problem(problem, solver="fccqp")
+    solution = solve_problem(scaled, solver="fccqp")
+    assert plain.found and solution.found
+    assert solution.extras["iterations"] == plain.extras["iterations"]
+    verify_solution(*from_qpsolvers(scaled, solution))
+    scale = magnitude(problem, plain)
+    assert_close(solution.x, plain.x, 1e-9 * scale, "x")
+    assert_close(solution.z_box, plain.z_box, 1e-9 * scale, "z_box")
+    assert_close(solution.z * d_G, plain.z, 1e-9 * scale, "z")
+    assert_close(solution.y * d_A, plain.y, 1e-9 * scale, "y")
+
+
+@pytest.mark.parametrize("h0, status", [(0.5, fccqp.Status.SOLVED),
+                                        (-0.5, fccqp.Status.PRIMAL_INFEASIBLE)],
+                         ids=["0 <= h holds", "0 <= h fails"])
+def test_zero_row_of_g_keeps_its_meaning(h0, status):
+    """A zero row of ``G`` reads ``0 <= h``: no constraint when it holds (multiplier 0),
+    an infeasible problem when it fails."""
+    G = np.array([[0.0, 0.0], [1.0, 1.0]])
+    problem = Problem(np.eye(2), -np.array([2.0, 2.0]), G, np.array([h0, 1.0]))
+    solution = solve_problem(problem, solver="fccqp", **TIGHT)
+    assert solution.extras["status"] is status
+    verify_solution(*from_qpsolvers(problem, solution), Tolerances.of(**TIGHT))
+    if solution.found:
+        assert_close(solution.x, np.array([0.5, 0.5]), 1e-7, "x")
+        assert_close(solution.z, np.array([0.0, 1.5]), 1e-7, "z")
+
+
+@pytest.mark.parametrize(
+    "G, h, q, lb, status",
+    [
+        (np.array([[1e-3, 1e-3], [1.0, 0.0]]), np.array([-1e-3, 5.0]), np.ones(2),
+         np.zeros(2), fccqp.Status.PRIMAL_INFEASIBLE),
+        (np.array([[-1e3, 1e3], [0.0, 1e-3]]), np.array([1.0, 1.0]), -np.ones(2),
+         None, fccqp.Status.DUAL_INFEASIBLE),
+    ],
+    ids=["x0 + x1 <= -1 at 1e-3 against x >= 0", "x1 <= x0 at 1e3, unbounded along x0"],
+)
+def test_infeasibility_certificate_is_in_the_users_units(G, h, q, lb, status):
+    """Rows of ``G`` far from 1: the certificate of the slack form checks on the user's
+    rows."""
+    problem = Problem(np.zeros((2, 2)) if lb is None else np.eye(2), q, G, h, lb=lb)
+    solution = solve_problem(problem, solver="fccqp")
+    assert solution.extras["status"] is status
+    verify_solution(*from_qpsolvers(problem, solution))
+
+
 @pytest.mark.parametrize(
     "to_sparse", [sp.csc_matrix, sp.csc_array], ids=["csc_matrix", "csc_array"]
 )

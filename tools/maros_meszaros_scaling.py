@@ -5,7 +5,7 @@ Usage::
     python tools/maros_meszaros_scaling.py --data DIR [--passes 4] [--eps 1e-3] NAME ...
 
 For each problem, in the slack form the qpsolvers backend builds
-(:func:`fccqp.qpsolvers_backend._with_slacks`): the infinity norms of the columns of
+(:func:`fccqp.qpsolvers_backend.slack_form`): the infinity norms of the columns of
 ``[P; A]`` and of the rows of ``A`` before and after :func:`fccqp.scaling.equilibrate_py`
 (range and geometric mean), ``D`` and ``E``, the cost scale ``c``, the columns where
 ``P`` acts, and the scaled ``P``'s and ``q``'s sizes. Then Clarabel's solution of the
@@ -30,15 +30,11 @@ import maros_meszaros as mm  # noqa: E402
 
 def slack_form(problem):
     """``(P, q, A, b)`` dense over ``[x; s]``, as the qpsolvers backend poses it."""
+    from fccqp import qpsolvers_backend
     from fccqp.problem import validate
-    from fccqp.qpsolvers_backend import _inequalities, _with_slacks
 
     P, q, G, h, A, b, lb, ub = problem.unpack()
-    data = validate(P, q, A, b, lb, ub)
-    if G is None:
-        return data.P, data.q, data.A, data.b
-    G, h = _inequalities(G, h, data.n)
-    return _with_slacks(data, G, h)[:4]
+    return qpsolvers_backend.slack_form(validate(P, q, A, b, lb, ub), G, h)[0][:4]
 
 
 def norms(P: np.ndarray, A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
