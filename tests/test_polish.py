@@ -478,12 +478,13 @@ def test_warm_polish_places_a_block_a_zero_length_step_held_where_the_step_point
 
 
 def test_warm_polish_may_take_more_guesses_than_a_cold_one():
-    """go2's second benchmark sequence, tick 107: the warm polish's guess settled at its
-    fourth pass, Newton's planes then moved a free constraint out of its set and the
-    corrections began again; at ``GUESS_PASSES`` guesses it had not settled, and the tick
-    ran 36 ADMM iterations. A warm polish may solve ``WARM_GUESS_PASSES`` guesses: it
-    answers the tick."""
-    assert _warm_ticks("go2", 100, 107)[-1].iterations == 0
+    """solo12's second benchmark sequence, tick 192: the warm polish holds and releases a
+    torque limit and two contacts' planes one correction a pass, stopped by steps of
+    length 0 and 0.02-0.04, and settles at its tenth guess; at its eighth
+    (``GUESS_PASSES``) a contact's multiplier was still wrong-signed, and a polish ending
+    there sent its tick to ADMM. A warm polish may solve
+    ``WARM_GUESS_PASSES`` guesses: it answers the tick."""
+    assert _warm_ticks("solo12", 100, 192)[-1].iterations == 0
 
 
 def test_warm_polish_puts_a_lightly_loaded_contact_on_its_cone():
