@@ -478,12 +478,13 @@ def test_warm_polish_places_a_block_a_zero_length_step_held_where_the_step_point
 
 
 def test_warm_polish_may_take_more_guesses_than_a_cold_one():
-    """go2's second benchmark sequence, tick 107: the warm polish's guess settled at its
-    fourth pass, Newton's planes then moved a free constraint out of its set and the
-    corrections began again; at ``GUESS_PASSES`` guesses it had not settled, and the tick
-    ran 36 ADMM iterations. A warm polish may solve ``WARM_GUESS_PASSES`` guesses: it
-    answers the tick."""
-    assert _warm_ticks("go2", 100, 107)[-1].iterations == 0
+    """solo12's second benchmark sequence, tick 192: the warm polish holds and releases a
+    torque limit and two contacts' planes one correction a pass, stopped by steps of
+    length 0 and 0.02-0.04, and settles at its tenth guess; at its eighth
+    (``GUESS_PASSES``) a contact's multiplier was still wrong-signed, and a polish ending
+    there sent its tick to ADMM. A warm polish may solve
+    ``WARM_GUESS_PASSES`` guesses: it answers the tick."""
+    assert _warm_ticks("solo12", 100, 192)[-1].iterations == 0
 
 
 def test_warm_polish_puts_a_lightly_loaded_contact_on_its_cone():
@@ -511,6 +512,32 @@ def test_a_warm_polish_that_cycles_is_tried_again_from_its_own_point():
     point, with its planes linearized there, settles: the tick runs no iteration."""
     result = _warm_ticks("go2", 100, 125)[-1]
     assert result.polished and result.iterations == 0
+
+
+def test_polish_that_cycles_on_a_barely_loaded_contact_puts_its_last_guess_on_the_cones():
+    """go2's quick benchmark set (``mix``, seed 0, sequences of 15), QP 21, started at the
+    rho a previous cold solve handed over: one contact's optimal normal force is 0.17 N.
+    Every polish flips that block between its apex (its multiplier outside the polar
+    cone by a thousandth of the dual tolerance) and its boundary (Newton's steps throw it
+    past the apex) and ends cycling at the apex; that first solve left the loaded blocks
+    3e-5 off their cones, more than ADMM's point, and the tick ended unpolished, a torque
+    8 % of its limit off the reference. The multipliers fit the last guess within the
+    tolerance the acceptance allows them: Newton's steps put it on the cones, and the
+    answer is the reference's."""
+    pytest.importorskip("pinocchio")
+    from benchmarks.testsets import generate_test_set
+
+    tests = generate_test_set("go2", "mix", 22, seed=0, seq_len=15)
+    qp, x_ref = tests.qps[21], tests.x_ref[21]
+    cones = [fccqp.FrictionCone(int(start), float(mu), tuple(map(float, normal)))
+             for start, mu, normal in zip(qp.cone_starts, qp.mus, qp.normals, strict=True)]
+    settings = fccqp.Settings.realtime(100.0, rho=0.01809)
+    result = fccqp.Solver(settings).solve(qp.P, qp.q, qp.A, qp.b, qp.lb, qp.ub, cones)
+    assert result.status is Status.SOLVED and result.polished
+    verify_solution(Problem.of(qp.P, qp.q, qp.A, qp.b, qp.lb, qp.ub, cones), result,
+                    Tolerances.of(settings))
+    u = qp.layout["u"]
+    assert np.max(np.abs(result.x[u] - x_ref[u]) / qp.ub[u]) <= 0.01
 
 
 @pytest.mark.parametrize("iterations", [1, 2, 4])

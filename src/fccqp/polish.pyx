@@ -335,7 +335,8 @@ cdef bint polish_prepare(Polish* w, const Problem* p) noexcept nogil:
 
 cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_steps,
                  int* factorizations, const Reduced* table, KKT* kkt,
-                 const double* rho_vec, double deadline) noexcept nogil:
+                 const double* rho_vec, double deadline,
+                 double multiplier_slack) noexcept nogil:
     """Polish the iterate ``it`` into ``w.x``, ``w.nu``, ``w.y`` (scaled problem) and
     leave the final guess in ``w.active``; ``factorizations`` counts the ``dsytrf``
     calls. With ``table`` (the reduced form's, current for ``rho_vec`` and ``kkt``'s
@@ -361,14 +362,21 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     the boundary planes are then re-linearized up to ``newton_steps`` times (chord steps
     while they converge fast, see ``CHORD_RATE``), stopping early at the floor rounding
     leaves (:func:`_newton`); so are those of the last guess of a polish that did not
-    settle (all its guesses, or ``cycling``) where its multipliers fit it and its
-    first solve's point violates no free constraint, and the caller then judges the point: go2's and solo12's polishes had ended so on the right
-    active set, its blocks off their cones by up to 3e-2 N at the first solve's planes, and
-    been rejected. (Otherwise the guess is wrong: on talos' warm ticks those steps had cost
-    5 % of the instructions, on go2's cold ones 2 %, for nothing.) A boundary block that a solve puts past the apex
-    (:func:`~fccqp.polish_guess.drop_far_side`) is held at the apex instead and the
-    corrected guess solved, within the same guesses; so is a settled guess whose
-    Newton steps left a multiplier wrong-signed (a plane's ``lam`` past 0: the release
+    settle (all its guesses, or ``cycling``) where its multipliers fit it to within
+    ``multiplier_slack`` (the caller's tolerance on them, in the user's units) and its
+    first solve's point violates no free constraint, and the caller then judges the
+    point: go2's and solo12's polishes had ended so on the right active set, its blocks
+    off their cones by up to 3e-2 N at the first solve's planes, and been rejected
+    (otherwise the guess is wrong: on talos' warm ticks those steps had cost 5 % of the
+    instructions, on go2's cold ones 2 %, for nothing). The slack serves a contact whose
+    optimal force is all but 0: the guess flips its block between the apex, where its
+    multiplier lies outside the polar cone by a thousandth of the dual tolerance, and
+    the boundary, where Newton's steps throw it past the apex, and the polish ends
+    ``cycling`` at the apex, the other blocks off their cones by 3e-5 at the first
+    solve's planes (go2; notes/polish.md, "polishfail"). A boundary block that a solve
+    puts past the apex (:func:`~fccqp.polish_guess.drop_far_side`) is held at the apex
+    instead and the corrected guess solved, within the same guesses; so is a settled
+    guess whose Newton steps left a multiplier wrong-signed (a plane's ``lam`` past 0: the release
     was judged on the guess's first solve), with that constraint released: polishes of
     go2's equality-constrained starts, whose planes begin with ``lam = 0``, had ended so
     in 25 of 100 and failed the caller's check (notes/performance-history.md, "The cold
@@ -429,7 +437,8 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         _multipliers(w, p, nf, nb)
         passes += 1
         if passes == w.guess_passes or w.cycling:   # not settled: the caller judges this point
-            if most_wrong(w, p) >= 0 or leaves_set(w, p):   # not its point: as it is
+            if most_wrong(w, p, multiplier_slack) >= 0 or leaves_set(w, p):
+                # not its point: as it is
                 if not tabled:
                     refine(w, p, nf, nb, POLISH_REFINE_TOLERANCE * scale, factorizations)
                     _multipliers(w, p, nf, nb)
@@ -478,7 +487,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         if changed != 0:   # Newton's planes moved a free constraint out of its set: hold it
             feasible = False   # and solve the corrected guess from this point, without a step
             continue
-        if most_wrong(w, p) >= 0:   # Newton moved a plane's multiplier past 0: release it
+        if most_wrong(w, p, 0.0) >= 0:   # Newton moved a plane's multiplier past 0: release it
             nb = renew(w, p, False, False, NULL, &changed)
             continue
         break

@@ -167,15 +167,16 @@ cdef inline double _block_wrong(Polish* w, const Problem* p, Py_ssize_t k,
     return wrong / (p.c * p.D[p.constrained[o]])
 
 
-cdef Py_ssize_t most_wrong(Polish* w, const Problem* p) noexcept nogil:
+cdef Py_ssize_t most_wrong(Polish* w, const Problem* p, double slack) noexcept nogil:
     """The held entry (its index ``j < s``) or held block (``s`` plus its cone's index)
     whose multiplier is farthest, in the user's units, from the normal cone its code
-    needs; -1 when none is. The distance is a box entry's wrong-signed ``|y_j|``, a
-    boundary block's ``-lam``, an apex block's distance of ``y_block`` to the polar cone
-    (``||P_K(y_block)||``), each divided by ``c D_i`` as :func:`fccqp.scaling.unscale`
-    does: what :func:`multiplier_violation` measures on the polished point."""
+    needs; -1 when none is farther than ``slack``. The distance is a box entry's
+    wrong-signed ``|y_j|``, a boundary block's ``-lam``, an apex block's distance of
+    ``y_block`` to the polar cone (``||P_K(y_block)||``), each divided by ``c D_i`` as
+    :func:`fccqp.scaling.unscale` does: what :func:`multiplier_violation` measures on the
+    polished point."""
     cdef Py_ssize_t j, k, plane = 0, most = -1
-    cdef double worst = 0.0, wrong
+    cdef double worst = slack, wrong
     for j in range(p.s):
         if p.in_cone[j]:
             continue
@@ -309,7 +310,7 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
     cdef const double* point
     cdef bint held
     cdef char code, before
-    cdef Py_ssize_t released = -1 if adding else most_wrong(w, p)
+    cdef Py_ssize_t released = -1 if adding else most_wrong(w, p, 0.0)
     changed[0] = 0
     for j in range(p.s):
         if p.in_cone[j]:

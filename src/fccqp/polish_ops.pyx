@@ -117,7 +117,7 @@ def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5, bi
                       np.asarray(Ah.colptr), np.asarray(Ah.rowind), cones.dim)
         bind(&w.csc, held)
     cdef int factorizations = 0
-    ok = polish(&w, &p, &it, newton_steps, &factorizations, NULL, NULL, NULL, INFINITY)
+    ok = polish(&w, &p, &it, newton_steps, &factorizations, NULL, NULL, NULL, INFINITY, 0.0)
     result_y = np.zeros(n)
     result_y[constrained] = [w.y[j] for j in range(s)]
     return {"ok": bool(ok), "x": np.array([w.x[j] for j in range(n)]),
