@@ -165,6 +165,23 @@ def test_arrays_the_fast_path_does_not_take_are_converted(convert):
 
 
 @BEFORE_ANY_BACKEND
+def test_dense_vector_within_accepts_only_finite_contiguous_float64_within_the_limit():
+    from fccqp.fast_checks import dense_vector_within
+
+    v = np.array([1.0, -2.0, 0.5])
+    assert dense_vector_within(v, 3, 2.0)
+    assert dense_vector_within(np.zeros(0), 0, 2.0)
+    assert not dense_vector_within(v, 3, 1.5)   # -2 beyond the limit
+    assert not dense_vector_within(np.array([1.0, np.nan, 0.0]), 3, 2.0)
+    assert not dense_vector_within(np.array([np.inf, 0.0, 0.0]), 3, 1e20)
+    assert not dense_vector_within(v, 4, 2.0)   # another size
+    assert not dense_vector_within(np.zeros(6)[::2], 3, 2.0)
+    assert not dense_vector_within(v.astype(np.float32), 3, 2.0)
+    assert not dense_vector_within(v.reshape(3, 1), 3, 2.0)
+    assert not dense_vector_within(v.tolist(), 3, 2.0)
+
+
+@BEFORE_ANY_BACKEND
 def test_dense_arguments_recognizes_only_contiguous_float64_of_the_shapes():
     from fccqp.fast_checks import dense_arguments
 

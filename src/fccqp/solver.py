@@ -20,7 +20,7 @@ import numpy as np
 
 from fccqp import admm, auxiliary, schur
 from fccqp.cones import Cone, ConeArrays, flatten_cones
-from fccqp.fast_checks import dense_arguments, same_cones
+from fccqp.fast_checks import dense_arguments, dense_vector_within, same_cones
 from fccqp.problem import check_cone_bounds, convert, raise_finding
 from fccqp.result import Result
 from fccqp.settings import MAX_DENSE_KKT_ROWS, Settings
@@ -542,6 +542,8 @@ def _guess(x0: object, y0: object, z0: object, n: int, m: int) -> tuple:
 
 def _vector(value: object, name: str, size: int) -> np.ndarray:
     """The argument ``name`` as a finite float64 vector of ``size`` entries."""
+    if dense_vector_within(value, size, MAX_ENTRY):   # as it came (a control loop's)
+        return value
     try:
         vector = np.asarray(value)
     except (TypeError, ValueError) as exn:
