@@ -397,17 +397,18 @@ cdef class Workspace:
         # from other matrices a kept workspace rejected -3.9e-3 of curvature on the
         # null space of A (|P| up to 172) that a fresh solve's scaling accepts
         # (fuzz solver_reuse:211); a rejection there is decided again as a fresh solve
-        cdef bint kept_scaling = e.scaling.done and (same or (warm and e.prev.exists))
+        # (warm or cold, the first run may keep the workspace's scaling)
+        cdef bint kept_scaling = e.scaling.done
         enter()   # single-threaded BLAS for this solve (see fccqp.blas_threads)
         try:
             with nogil:
                 if restartable:
                     e.opt.max_iter = max_iter // 2
-                run = scaled_run(e, same, x0, warm and e.prev.exists, start_time)
+                run = scaled_run(e, same, x0, warm and e.prev.exists, True, start_time)
                 if run.status == engine.NOT_CONVEX_QP and kept_scaling:
                     e.opt.max_iter = max_iter
                     restartable = False
-                    run = scaled_run(e, False, NULL, False, start_time)
+                    run = scaled_run(e, False, NULL, False, False, start_time)
                 if run.status != engine.NOT_CONVEX_QP:
                     unscaled_answer(e, &run, x_out, y_out if m else NULL, z_out, cert_out)
                 e.opt.max_iter = max_iter
@@ -415,7 +416,7 @@ cdef class Workspace:
                                     or run.status == engine.NUMERICAL_ERROR):
                     e.opt.max_iter = max_iter - run.iterations
                     spent, factored = run.iterations, run.factorizations
-                    run = scaled_run(e, False, NULL, False, start_time)
+                    run = scaled_run(e, False, NULL, False, False, start_time)
                     e.opt.max_iter = max_iter
                     run.iterations += spent
                     run.factorizations += factored

@@ -19,8 +19,9 @@ from fccqp.verdict cimport settle
 
 
 cdef Run scaled_run(Engine* e, bint same_matrices, const double* x0, bint warm,
-                    double start_time) noexcept nogil:
-    """Scale (or reuse the scaling), start, run."""
+                    bint kept_scaling, double start_time) noexcept nogil:
+    """Scale (or reuse the scaling), start, run; with ``kept_scaling`` new matrices may
+    be scaled with the workspace's last equilibration (:func:`_scale`)."""
     cdef Problem* p = &e.prob
     cdef Run run
     cdef bint reuse = same_matrices and e.scaling.done
@@ -30,7 +31,7 @@ cdef Run scaled_run(Engine* e, bint same_matrices, const double* x0, bint warm,
     e.prev.from_polished = x0 == NULL and warm and e.prev.polished
     e.unscaled.current = False
     e.clock.marks[1] = fccqp_now()
-    _scale(e, reuse, warm)
+    _scale(e, reuse, kept_scaling)
     e.clock.marks[2] = fccqp_now()
     e.log.count = 0
     run.rho = e.prev.rho if warm else cold_start_rho(e)
@@ -47,13 +48,19 @@ cdef Run scaled_run(Engine* e, bint same_matrices, const double* x0, bint warm,
     return run
 
 
-cdef void _scale(Engine* e, bint reuse, bint warm) noexcept nogil:
+cdef void _scale(Engine* e, bint reuse, bint kept_scaling) noexcept nogil:
     """Equilibrate the user's data into the scaled problem; with ``reuse`` (unchanged
-    matrices) apply the scaling to the new vectors only, and with ``warm`` (a start
-    from the previous solution) scale the new data with the previous equilibration
-    (:func:`fccqp.scaling.rescale`); then the rows' spans over the (new) box. The
-    matrices' storage picks the passes (:mod:`fccqp.scaling` or
-    :mod:`fccqp.scaling_csc`), one test per solve."""
+    matrices) apply the scaling to the new vectors only, and with ``kept_scaling``
+    scale new matrices with the workspace's last equilibration
+    (:func:`fccqp.scaling.rescale`) unless they drifted from it; then the rows' spans
+    over the (new) box. The matrices' storage picks the passes (:mod:`fccqp.scaling`
+    or :mod:`fccqp.scaling_csc`), one test per solve.
+
+    The scaling is the structure's, not the last answer's: a cold start (after
+    ``Solver.reset()``) keeps it as a warm one does. Any positive ``D, E`` give the
+    same solution, and the drift test bounds how far this tick's norms stray from
+    those the equilibration gave (on go2 the Ruiz passes were 115k of a cold tick's
+    1.41M instructions, the rescaling a tenth of that)."""
     cdef Problem* p = &e.prob
     cdef Py_ssize_t n = p.n, m = p.m, i, j
     p.P.diagonal_from = e.user.P.diagonal_from   # the scaling keeps every zero
@@ -62,7 +69,7 @@ cdef void _scale(Engine* e, bint reuse, bint warm) noexcept nogil:
             p.q[i] = p.c * p.D[i] * e.user.q[i]
         for i in range(m):
             p.b[i] = p.E[i] * e.user.b[i]
-    elif not (warm and e.scaling.done and _rescale(e)):
+    elif not (kept_scaling and e.scaling.done and _rescale(e)):
         _equilibrate(e)
         e.scaling.done = True
     for j in range(p.s):
