@@ -250,6 +250,14 @@ cdef class Workspace:
                      for i in range(5))
 
     @property
+    def scaling(self):
+        """``(D, E, c)`` of the last solve's scaled problem (:mod:`fccqp.scaling`): new
+        arrays."""
+        cdef Problem* p = &self.e.prob
+        return (np.array(<double[:p.n]>p.D), np.array(<double[:p.m]>p.E) if p.m else
+                np.empty(0), p.c)
+
+    @property
     def log_lines(self):
         """Rows ``(iteration, prim, dual, gap, rho)`` of the last solve's log."""
         cdef Py_ssize_t i, j
