@@ -171,6 +171,7 @@ cdef class Workspace:
         o.polish, o.polish_refine_iter = settings.polish, settings.polish_refine_iter
         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
         e.prev.exists = e.user.has_matrices = e.fact.certified = e.scaling.done = False
+        e.scaling.kept = False
         e.prev.has_rho = False
         e.prev.polished = e.prev.from_polished = e.equalities_missed = False
         e.prev.guessed = False
@@ -401,19 +402,18 @@ cdef class Workspace:
         cdef bint restartable = ((x0 != NULL or (warm and e.prev.exists))
                                  and not isfinite(e.opt.time_limit)
                                  and max_iter >= RESTART_MIN_ITER)
-        # convexity is decided on P + sigma I in the scaled units: with a scaling kept
-        # from other matrices a kept workspace rejected -3.9e-3 of curvature on the
-        # null space of A (|P| up to 172) that a fresh solve's scaling accepts
-        # (fuzz solver_reuse:211); a rejection there is decided again as a fresh solve
-        # (warm or cold, the first run may keep the workspace's scaling)
-        cdef bint kept_scaling = e.scaling.done
         enter()   # single-threaded BLAS for this solve (see fccqp.blas_threads)
         try:
             with nogil:
                 if restartable:
                     e.opt.max_iter = max_iter // 2
                 run = scaled_run(e, same, x0, warm and e.prev.exists, True, start_time)
-                if run.status == engine.NOT_CONVEX_QP and kept_scaling:
+                # convexity is decided on P + sigma I in the scaled units: with a
+                # scaling kept from other matrices a kept workspace rejected -3.9e-3 of
+                # curvature on the null space of A (|P| up to 172) that a fresh solve's
+                # scaling accepts (fuzz solver_reuse:211); a rejection there is decided
+                # again as a fresh solve
+                if run.status == engine.NOT_CONVEX_QP and e.scaling.kept:
                     e.opt.max_iter = max_iter
                     restartable = False
                     run = scaled_run(e, False, NULL, False, False, start_time)
