@@ -86,9 +86,9 @@ cdef inline bint _rescale(Engine* e) noexcept nogil:
     :func:`fccqp.scaling.rescale`)."""
     cdef Problem* p = &e.prob
     if p.P.kind == DENSE:
-        return rescale(e.user.P.values, e.user.q, e.user.A.values, e.user.b, p.n, p.m, p.D,
-                       p.E, e.scaling.reference, e.scaling.norms, p.P.values, p.q,
-                       p.A.values, p.b, &p.c)
+        return rescale(e.user.P.values, e.user.q, e.user.A.values, e.user.b, p.n, p.m,
+                       e.user.P.diagonal_from, p.D, p.E, e.scaling.reference,
+                       e.scaling.norms, p.P.values, p.q, p.A.values, p.b, &p.c)
     return rescale_csc(&e.user.P, e.user.q, &e.user.A, e.user.b, p.D, p.E,
                        e.scaling.reference, e.scaling.norms, &p.P, p.q, &p.A, p.b, &p.c)
 
