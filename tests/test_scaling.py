@@ -261,6 +261,27 @@ def test_rescale_applies_an_earlier_scaling_and_normalizes_the_cost_anew():
     assert np.all(norms <= RESCALE_DRIFT * reference) and np.all(reference <= RESCALE_DRIFT * norms)
 
 
+@pytest.mark.parametrize("block", [0, 4, 7, 12])
+def test_rescale_over_a_diagonal_tail_gives_the_whole_scalings_bits(block):
+    # P a dense leading block and a diagonal after it (whole-body control's shape):
+    # the rows after the block are scaled on their diagonal alone, with the same bits
+    rng = np.random.default_rng(6)
+    n, m = 12, 5
+    G = rng.standard_normal((block, block)) * np.logspace(-2, 2, block)
+    P = np.diag(rng.uniform(0.1, 10.0, n))
+    P[:block, :block] = G @ G.T + np.eye(block)
+    A = rng.standard_normal((m, n))
+    q, b = rng.standard_normal(n), rng.standard_normal(m)
+    D, E, _, reference = _equilibrated(P, q, A, b)
+    P2, q2 = P * (1 + 0.02 * rng.standard_normal((n, n))), 8 * q
+    P2 = (P2 + P2.T) / 2
+    whole = rescale(P2, q2, A, b, D, E, reference)
+    tail = rescale(P2, q2, A, b, D, E, reference, diagonal_from=block)
+    assert whole[0] and tail[0] and whole[5] == tail[5]
+    for full, part in zip(whole[1:5], tail[1:5], strict=True):
+        np.testing.assert_array_equal(part.view(np.int64), full.view(np.int64))
+
+
 @pytest.mark.parametrize("where", ["P column", "A row"])
 def test_rescale_refuses_data_that_moved_beyond_the_drift(where):
     rng = np.random.default_rng(5)

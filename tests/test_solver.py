@@ -253,6 +253,29 @@ def test_after_a_reset_a_return_to_a_kept_structure_starts_cold():
     assert_as_after_a_reset(first, solver.solve(*first))
 
 
+@pytest.mark.kkt_backends(*DENSE_PATH_KEEPS, reason="the dense path's kept workspaces")
+def test_a_cold_start_after_a_reset_keeps_the_scaling_until_the_data_drift():
+    # the scaling is the structure's: a cold start rescales new data with the last
+    # equilibration as a warm one does, and equilibrates data that left its drift
+    P, q, A, b, lb, ub, cones = random_problem(9)
+    nearby = (P * 1.01, q, A * 0.99, b, lb, ub, cones)
+    far = (P * 1e3, q, A * 1e-3, b, lb, ub, cones)
+    solver = fccqp.Solver()
+    solver.solve(P, q, A, b, lb, ub, cones)
+    D, E, _ = solver._workspace.scaling
+    solver.reset()
+    assert solver.solve(*nearby).status is Status.SOLVED
+    kept_D, kept_E, _ = solver._workspace.scaling
+    np.testing.assert_array_equal(kept_D, D)
+    np.testing.assert_array_equal(kept_E, E)
+    solver.reset()
+    assert solver.solve(*far).status is Status.SOLVED
+    fresh = fccqp.Solver()
+    fresh.solve(*far)
+    np.testing.assert_array_equal(solver._workspace.scaling[0], fresh._workspace.scaling[0])
+    assert not np.array_equal(fresh._workspace.scaling[0], D)
+
+
 FACTORIZATIONS_AFTER_A_NEW_P = {"auto": 1, "schur_reduced": 1, "ldl_reduced": 2,
                                 "ldl_full": 2, "sparse": 2}
 """Factorizations of a warm solve whose ``P`` changed (problems.random_problem(9), measured

@@ -171,6 +171,7 @@ cdef class Workspace:
         o.polish, o.polish_refine_iter = settings.polish, settings.polish_refine_iter
         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
         e.prev.exists = e.user.has_matrices = e.fact.certified = e.scaling.done = False
+        e.scaling.kept = False
         e.prev.has_rho = False
         e.prev.polished = e.prev.from_polished = e.equalities_missed = False
         e.prev.guessed = False
@@ -248,6 +249,14 @@ cdef class Workspace:
         cdef int i
         return tuple(max(self.e.clock.marks[i + 1] - self.e.clock.marks[i], 0.0)
                      for i in range(5))
+
+    @property
+    def scaling(self):
+        """``(D, E, c)`` of the last solve's scaled problem (:mod:`fccqp.scaling`): new
+        arrays."""
+        cdef Problem* p = &self.e.prob
+        return (np.array(<double[:p.n]>p.D), np.array(<double[:p.m]>p.E) if p.m else
+                np.empty(0), p.c)
 
     @property
     def log_lines(self):
@@ -393,21 +402,21 @@ cdef class Workspace:
         cdef bint restartable = ((x0 != NULL or (warm and e.prev.exists))
                                  and not isfinite(e.opt.time_limit)
                                  and max_iter >= RESTART_MIN_ITER)
-        # convexity is decided on P + sigma I in the scaled units: with a scaling kept
-        # from other matrices a kept workspace rejected -3.9e-3 of curvature on the
-        # null space of A (|P| up to 172) that a fresh solve's scaling accepts
-        # (fuzz solver_reuse:211); a rejection there is decided again as a fresh solve
-        cdef bint kept_scaling = e.scaling.done and (same or (warm and e.prev.exists))
         enter()   # single-threaded BLAS for this solve (see fccqp.blas_threads)
         try:
             with nogil:
                 if restartable:
                     e.opt.max_iter = max_iter // 2
-                run = scaled_run(e, same, x0, warm and e.prev.exists, start_time)
-                if run.status == engine.NOT_CONVEX_QP and kept_scaling:
+                run = scaled_run(e, same, x0, warm and e.prev.exists, True, start_time)
+                # convexity is decided on P + sigma I in the scaled units: with a
+                # scaling kept from other matrices a kept workspace rejected -3.9e-3 of
+                # curvature on the null space of A (|P| up to 172) that a fresh solve's
+                # scaling accepts (fuzz solver_reuse:211); a rejection there is decided
+                # again as a fresh solve
+                if run.status == engine.NOT_CONVEX_QP and e.scaling.kept:
                     e.opt.max_iter = max_iter
                     restartable = False
-                    run = scaled_run(e, False, NULL, False, start_time)
+                    run = scaled_run(e, False, NULL, False, False, start_time)
                 if run.status != engine.NOT_CONVEX_QP:
                     unscaled_answer(e, &run, x_out, y_out if m else NULL, z_out, cert_out)
                 e.opt.max_iter = max_iter
@@ -415,7 +424,7 @@ cdef class Workspace:
                                     or run.status == engine.NUMERICAL_ERROR):
                     e.opt.max_iter = max_iter - run.iterations
                     spent, factored = run.iterations, run.factorizations
-                    run = scaled_run(e, False, NULL, False, start_time)
+                    run = scaled_run(e, False, NULL, False, False, start_time)
                     e.opt.max_iter = max_iter
                     run.iterations += spent
                     run.factorizations += factored

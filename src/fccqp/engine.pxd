@@ -83,6 +83,7 @@ cdef struct Scaling:
     double* e                   # m scratch
     Pattern pattern             # the nonzeros of the dense P and A at the last equilibration
     bint done                   # an equilibration ran for this workspace
+    bint kept                   # the last run's scaling is an earlier equilibration's
 
 
 cdef struct Factorization:

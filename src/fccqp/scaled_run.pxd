@@ -2,6 +2,6 @@
 from fccqp.engine cimport Engine, Run
 
 cdef Run scaled_run(Engine* e, bint same_matrices, const double* x0, bint warm,
-                    double start_time) noexcept nogil
+                    bint keep_scaling, double start_time) noexcept nogil
 cdef void unscaled_answer(Engine* e, Run* run, double* x, double* y, double* z,
                           double* cert) noexcept nogil

@@ -19,8 +19,9 @@ from fccqp.verdict cimport settle
 
 
 cdef Run scaled_run(Engine* e, bint same_matrices, const double* x0, bint warm,
-                    double start_time) noexcept nogil:
-    """Scale (or reuse the scaling), start, run."""
+                    bint keep_scaling, double start_time) noexcept nogil:
+    """Scale (or reuse the scaling), start, run; with ``keep_scaling`` new matrices may
+    be scaled with the workspace's last equilibration (:func:`_scale`)."""
     cdef Problem* p = &e.prob
     cdef Run run
     cdef bint reuse = same_matrices and e.scaling.done
@@ -30,7 +31,7 @@ cdef Run scaled_run(Engine* e, bint same_matrices, const double* x0, bint warm,
     e.prev.from_polished = x0 == NULL and warm and e.prev.polished
     e.unscaled.current = False
     e.clock.marks[1] = fccqp_now()
-    _scale(e, reuse, warm)
+    _scale(e, reuse, keep_scaling)
     e.clock.marks[2] = fccqp_now()
     e.log.count = 0
     run.rho = e.prev.rho if warm else cold_start_rho(e)
@@ -47,24 +48,32 @@ cdef Run scaled_run(Engine* e, bint same_matrices, const double* x0, bint warm,
     return run
 
 
-cdef void _scale(Engine* e, bint reuse, bint warm) noexcept nogil:
+cdef void _scale(Engine* e, bint reuse, bint keep_scaling) noexcept nogil:
     """Equilibrate the user's data into the scaled problem; with ``reuse`` (unchanged
-    matrices) apply the scaling to the new vectors only, and with ``warm`` (a start
-    from the previous solution) scale the new data with the previous equilibration
-    (:func:`fccqp.scaling.rescale`); then the rows' spans over the (new) box. The
-    matrices' storage picks the passes (:mod:`fccqp.scaling` or
-    :mod:`fccqp.scaling_csc`), one test per solve."""
+    matrices) apply the scaling to the new vectors only, and with ``keep_scaling``
+    scale new matrices with the workspace's last equilibration
+    (:func:`fccqp.scaling.rescale`) unless they drifted from it; then the rows' spans
+    over the (new) box. The matrices' storage picks the passes (:mod:`fccqp.scaling`
+    or :mod:`fccqp.scaling_csc`), one test per solve.
+
+    The scaling is the structure's, not the last answer's: a cold start (after
+    ``Solver.reset()``) keeps it as a warm one does, and saves the Ruiz passes, a
+    cold tick's largest fixed cost after its factorizations. Any positive ``D, E``
+    give the same solution, and the drift test bounds how far this tick's norms stray
+    from those the equilibration gave its own data."""
     cdef Problem* p = &e.prob
     cdef Py_ssize_t n = p.n, m = p.m, i, j
     p.P.diagonal_from = e.user.P.diagonal_from   # the scaling keeps every zero
+    e.scaling.kept = True
     if reuse:
         for i in range(n):
             p.q[i] = p.c * p.D[i] * e.user.q[i]
         for i in range(m):
             p.b[i] = p.E[i] * e.user.b[i]
-    elif not (warm and e.scaling.done and _rescale(e)):
+    elif not (keep_scaling and e.scaling.done and _rescale(e)):
         _equilibrate(e)
         e.scaling.done = True
+        e.scaling.kept = False
     for j in range(p.s):
         i = p.constrained[j]
         p.lo[j] = e.user.lb[i] / p.D[i]
@@ -77,9 +86,9 @@ cdef inline bint _rescale(Engine* e) noexcept nogil:
     :func:`fccqp.scaling.rescale`)."""
     cdef Problem* p = &e.prob
     if p.P.kind == DENSE:
-        return rescale(e.user.P.values, e.user.q, e.user.A.values, e.user.b, p.n, p.m, p.D,
-                       p.E, e.scaling.reference, e.scaling.norms, p.P.values, p.q,
-                       p.A.values, p.b, &p.c)
+        return rescale(e.user.P.values, e.user.q, e.user.A.values, e.user.b, p.n, p.m,
+                       e.user.P.diagonal_from, p.D, p.E, e.scaling.reference,
+                       e.scaling.norms, p.P.values, p.q, p.A.values, p.b, &p.c)
     return rescale_csc(&e.user.P, e.user.q, &e.user.A, e.user.b, p.D, p.E,
                        e.scaling.reference, e.scaling.norms, &p.P, p.q, &p.A, p.b, &p.c)
 

@@ -162,9 +162,9 @@ cdef double equilibrate(double* P, double* q, double* A, double* b, Py_ssize_t n
 cdef void scaled_norms(const double* P_s, const double* A_s, Py_ssize_t n, Py_ssize_t m,
                        double c, const Pattern* pattern, double* norms) noexcept nogil
 cdef bint rescale(const double* P, const double* q, const double* A, const double* b,
-                  Py_ssize_t n, Py_ssize_t m, const double* D, const double* E,
-                  const double* reference, double* norms, double* P_s, double* q_s,
-                  double* A_s, double* b_s, double* c) noexcept nogil
+                  Py_ssize_t n, Py_ssize_t m, Py_ssize_t diagonal_from, const double* D,
+                  const double* E, const double* reference, double* norms, double* P_s,
+                  double* q_s, double* A_s, double* b_s, double* c) noexcept nogil
 cdef void scale_start(const double* x, const double* y, const double* z, double rho,
                       const double* D, const double* E, double c, Py_ssize_t n, Py_ssize_t m,
                       Py_ssize_t s, const Py_ssize_t* constrained, const double* lo,

@@ -250,12 +250,13 @@ cdef void scaled_norms(const double* P_s, const double* A_s, Py_ssize_t n, Py_ss
 
 
 cdef bint rescale(const double* P, const double* q, const double* A, const double* b,
-                  Py_ssize_t n, Py_ssize_t m, const double* D, const double* E,
-                  const double* reference, double* norms, double* P_s, double* q_s,
-                  double* A_s, double* b_s, double* c) noexcept nogil:
+                  Py_ssize_t n, Py_ssize_t m, Py_ssize_t diagonal_from, const double* D,
+                  const double* E, const double* reference, double* norms, double* P_s,
+                  double* q_s, double* A_s, double* b_s, double* c) noexcept nogil:
     """Scale new data with the ``D, E`` of an earlier equilibration and normalize its
-    cost into ``c`` as :func:`equilibrate` does (two passes over ``P``, one over ``A``,
-    the norms found on the way); False when a column or row norm of the result (as
+    cost into ``c`` as :func:`equilibrate` does (two passes over ``P``'s rows before
+    ``diagonal_from``, a product of the diagonal after them, one pass over ``A``, the
+    norms found on the way); False when a column or row norm of the result (as
     :func:`scaled_norms` reads them, into ``norms``) left the factor ``RESCALE_DRIFT``
     around ``reference``, the norms that equilibration gave its own data: then the data
     moved too far for it and the caller equilibrates.
@@ -267,24 +268,43 @@ cdef bint rescale(const double* P, const double* q, const double* A, const doubl
     (8x between two solo12 ticks), so ``c`` is found anew. On go2 the four Ruiz passes
     are 0.22M of a 1.76M-instruction tick (callgrind).
     """
-    cdef Py_ssize_t i
-    cdef double mean_col = 0.0, q_norm = 0.0
+    cdef Py_ssize_t i, k = diagonal_from
+    cdef double mean_col = 0.0, q_norm = 0.0, cost
     # D P D and its rows' norms (its columns': it is symmetric), then the cost's size
-    fccqp_scale_rows(P, <int>n, <int>n, D, D, P_s, norms, NULL)
+    fccqp_scale_rows(P, <int>k, <int>n, D, D, P_s, norms, NULL)
+    _scale_diagonal_rows(P, n, k, D, P_s, norms)
     for i in range(n):
         mean_col += norms[i]
         q_s[i] = q[i] * D[i]
         q_norm = max(q_norm, fabs(q_s[i]))
-    c[0] = cost_scale(mean_col / n, q_norm)
-    for i in range(n * n):
-        P_s[i] *= c[0]
+    cost = c[0] = cost_scale(mean_col / n, q_norm)
+    for i in range(k * n):
+        P_s[i] *= cost
+    for i in range(k, n):
+        P_s[i * n + i] *= cost
     for i in range(n):
-        q_s[i] *= c[0]
+        q_s[i] *= cost
     if m:   # E A D, its rows' norms and its columns' beside D P D's
         fccqp_scale_rows(A, <int>m, <int>n, E, D, A_s, norms + n, norms)
     for i in range(m):
         b_s[i] = b[i] * E[i]
     return within_drift(norms, reference, n + m)
+
+
+cdef inline void _scale_diagonal_rows(const double* P, Py_ssize_t n, Py_ssize_t first,
+                                      const double* D, double* P_s,
+                                      double* norms) noexcept nogil:
+    """Rows ``first:n`` of ``D P D`` and their norms, where ``P`` holds only its diagonal
+    (``Matrix.diagonal_from``): the entry as ``fccqp_scale_rows`` forms it, ``(P_ii D_i)
+    D_i``, and zeros beside it (``+0.0``: the sign of a zero of ``P`` is not kept)."""
+    cdef Py_ssize_t i, j
+    cdef double* row
+    for i in range(first, n):
+        row = P_s + i * n
+        for j in range(n):
+            row[j] = 0.0
+        row[i] = P[i * n + i] * D[i] * D[i]
+        norms[i] = fabs(row[i])
 
 
 cdef void scale_start(const double* x, const double* y, const double* z, double rho,
@@ -361,16 +381,20 @@ def equilibrate_py(double[:, ::1] P, double[::1] q, double[:, ::1] A, double[::1
 
 
 def rescale_py(double[:, ::1] P, double[::1] q, double[:, ::1] A, double[::1] b,
-               double[::1] D, double[::1] E, double[::1] reference):
-    """:func:`rescale` on numpy arrays; returns ``(kept, P_s, q_s, A_s, b_s, c)``."""
+               double[::1] D, double[::1] E, double[::1] reference,
+               Py_ssize_t diagonal_from=-1):
+    """:func:`rescale` on numpy arrays (``P``'s rows from ``diagonal_from`` on hold their
+    diagonal only; default none); returns ``(kept, P_s, q_s, A_s, b_s, c)``."""
     cdef Py_ssize_t n = P.shape[0], m = A.shape[0]
+    if diagonal_from < 0:
+        diagonal_from = n
     P_s, q_s, A_s, b_s = np.empty((n, n)), np.empty(n), np.empty((m, n)), np.empty(m)
     cdef double[:, ::1] Pv = P_s, Av = A_s
     cdef double[::1] qv = q_s, bv = b_s, norms = np.empty(n + m)
     cdef double c = 0.0
-    cdef bint kept = rescale(&P[0, 0], &q[0], &A[0, 0] if m else NULL, _ptr(b), n, m, &D[0],
-                             _ptr(E), &reference[0], &norms[0], &Pv[0, 0], &qv[0],
-                             &Av[0, 0] if m else NULL, _ptr(bv), &c)
+    cdef bint kept = rescale(&P[0, 0], &q[0], &A[0, 0] if m else NULL, _ptr(b), n, m,
+                             diagonal_from, &D[0], _ptr(E), &reference[0], &norms[0],
+                             &Pv[0, 0], &qv[0], &Av[0, 0] if m else NULL, _ptr(bv), &c)
     return kept, P_s, q_s, A_s, b_s, c
 
 

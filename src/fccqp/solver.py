@@ -146,7 +146,9 @@ class Solver:
 
     def reset(self) -> None:
         """Forget the previous solves: the next one starts cold, and so does the first
-        solve of each structure left before (the kept workspaces' answers)."""
+        solve of each structure left before (the kept workspaces' answers). A workspace
+        keeps its scaling, which new data share while their norms stay within its drift
+        (:func:`fccqp.scaling.rescale`)."""
         if self._workspace is not None:
             self._workspace.forget()
         for _, w in self._kept.values():
