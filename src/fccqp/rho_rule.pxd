@@ -11,6 +11,7 @@ cdef struct TrialState:
     double old_rho    # the rho before the move on trial; 0 when none is
     bint locked       # a move was undone: none is tried again in this run
     double lowered_scale  # primal residual's scale when rho was last lowered; INFINITY: never
+    double lowered_prim   # relative primal residual then
 
 cdef double rho_trial(TrialState* trial, double rho, double new_rho, double worst,
                       double tolerance) noexcept nogil

@@ -53,7 +53,7 @@ cdef void trial_reset(TrialState* trial) noexcept nogil:
     trial.side = trial.count = 0
     trial.old_rho = trial.start = trial.progress = 0.0
     trial.locked = False
-    trial.lowered_scale = INFINITY
+    trial.lowered_scale = trial.lowered_prim = INFINITY
 
 
 cdef double new_rho(const Residuals* r, double rho, TrialState* trial,
@@ -62,18 +62,22 @@ cdef double new_rho(const Residuals* r, double rho, TrialState* trial,
     when that moves it by more than ``tolerance`` (``adaptive_rho_tolerance``); a
     smaller move that the rule keeps asking for is tried (:func:`rho_trial`).
 
-    Rho is not lowered while the primal residual's scale (the size of ``A x`` and
-    ``z``) is more than ``RHO_RUNAWAY`` times what it was when rho was last lowered.
-    The relative primal residual divides by that scale, so an iterate running away
-    along a near-recession direction makes a growing primal residual look small; the
-    rule then lowers rho, which weakens the constraints and lets the iterate run
-    further, until rho reaches its floor and the run orbits far from the solution."""
+    Rho is not lowered while the iterate runs away infeasibly: since rho was last
+    lowered, the primal residual's scale (the size of ``A x`` and ``z``) has grown
+    more than ``RHO_RUNAWAY``-fold and the primal residual at least as fast. The
+    relative primal residual divides by that scale, so an iterate running away along a
+    near-recession direction makes a growing primal residual look no larger; the rule
+    would go on lowering rho, which weakens the constraints and lets the iterate run
+    further, down to rho's floor, where the run orbits far from the solution. An
+    iterate that grows while its primal residual does not (an optimum far away, as
+    with a tiny ``P``) keeps the rule's rho."""
     cdef double prim = r.prim_s / max(r.prim_scale_s, 1e-30)
     cdef double dual = r.dual_s / max(r.dual_scale_s, 1e-30)
     cdef double proposal = min(max(rho * sqrt(prim / max(dual, 1e-30)), RHO_MIN), RHO_MAX)
-    if proposal < rho and r.prim_scale_s > RHO_RUNAWAY * trial.lowered_scale:
+    if (proposal < rho and r.prim_scale_s > RHO_RUNAWAY * trial.lowered_scale
+            and prim >= trial.lowered_prim):
         proposal = rho
     cdef double taken = rho_trial(trial, rho, proposal, max(prim, dual), tolerance)
     if taken < rho:
-        trial.lowered_scale = r.prim_scale_s
+        trial.lowered_scale, trial.lowered_prim = r.prim_scale_s, prim
     return taken
