@@ -20,7 +20,7 @@ SEEDS = {
     "primal_infeasible": (0, 1, 2, 3, 80, 146, 177, 182, 350, 100094, 300345),
     "dual_infeasible": (0, 1, 2, 33, 166, 257, 368, 5300159),
     "solver_reuse": (0, 1, 2, 50, 164, 211, 100008, 100206, 500061, 700137, 4700367),
-    "extreme_data": (0, 1, 7, 9, 38, 47, 56, 108, 138, 149, 202, 214, 254, 302, 308, 316,
+    "extreme_data": (0, 1, 7, 9, 38, 47, 56, 108, 138, 149, 202, 212, 214, 254, 302, 308, 316,
                      311, 326, 335, 337, 355, 363, 365, 489, 1182, 2244, 100082, 100121, 100180,
                      100213,
                      100228, 100233, 500030, 500064, 500099, 500322, 700281, 900343, 900360,
@@ -28,7 +28,7 @@ SEEDS = {
                      1700359, 1900050, 2500125, 2900030, 4700215, 4700352,
                      5300281, 6100225),
     "qpsolvers": (0, 1, 2, 1700123, 7900043),
-    "cvxpy": (1, 2, 3),
+    "cvxpy": (1, 2, 3, 9700197),
     "degenerate": (0, 1, 2, 4, 7, 9, 11, 12, 21, 23, 30, 35, 43, 58, 150, 102753, 104299),
 }
 """Seeds per class run on every dense backend: a passing case or two per class and the
@@ -66,7 +66,10 @@ largest row's rounding and which the start's gate therefore never tested; extrem
 orthogonal only to the columns ``P`` leaves unscaled; qpsolvers 7900043 (also on the
 sparse path) an active row of ``G`` parallel to a slack one at 2e-3 of its size, whose
 slack row the equilibration saw balanced: MAX_ITER_REACHED, its multiplier a tenth
-built, until the qpsolvers backend scaled each row of ``G`` to entries of 1; issues 26,
+built, until the qpsolvers backend scaled each row of ``G`` to entries of 1; cvxpy
+9700197 an iterate running away infeasibly while the rho rule lowered rho to its floor
+(``tuning.RHO_RUNAWAY``), and extreme_data 212 an iterate growing feasibly toward an
+optimum at 5e9 (``P`` of 1e-11), whose rho that guard must leave to the rule; issues 26,
 28 and 29)."""
 
 SPARSE_SEEDS = {

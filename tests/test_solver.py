@@ -454,6 +454,40 @@ def test_lp_solution_matches_clarabel():
     assert abs(result.obj - reference.obj) <= 1e-6 * (1 + abs(reference.obj))
 
 
+def test_rho_is_not_lowered_while_the_iterate_runs_away_infeasibly():
+    """An LP over two second-order cones (a CVXPY problem translated: two free slacks
+    ``x_0, x_1`` in ``P``, six variables, two nonnegative and four cone slacks) whose
+    iterate runs off along a near-recession direction. The primal residual grew with
+    the iterate's size, so relative to it it looked small, and OSQP's rule lowered rho
+    to its floor: MAX_ITER_REACHED on every backend, the iterate at 1e8 with the
+    optimum at 1e2. Not lowering rho while the residual grows with the iterate
+    (``tuning.RHO_RUNAWAY``) keeps the iterate where the polish answers."""
+    columns = np.array([[-0.063, 0.305, -0.315, 0.366, 0.049, -0.028],
+                        [0.065, -0.264, 0.047, -0.204, -0.061, -0.197],
+                        [-0.025, -0.095, -0.044, 0.013, 0.09, 0.105],
+                        [0.002, 0.006, 0.003, -0.001, -0.006, -0.007],
+                        [-1.137, -1.338, -1.104, 0.545, 0.468, 0.847],
+                        [-0.751, -0.156, -0.656, 0.951, -0.175, 1.252],
+                        [0.878, 0.877, 0.12, -0.873, 0.251, -0.279],
+                        [0.334, 1.394, 0.69, 0.373, 1.558, 1.224]])
+    A = np.zeros((8, 14))
+    A[:, 2:8] = columns
+    A[:2, :2] = -np.eye(2)
+    A[2:, 8:] = np.eye(6)
+    q = np.zeros(14)
+    q[2:8] = [-0.793, -0.327, 1.899, -0.46, -1.857, 0.828]
+    b = [0.0, 0.0, 0.633, 0.329, 2.687, 2.535, -0.433, -0.533]
+    lb = np.full(14, -np.inf)
+    lb[8:10] = 0.0
+    problem = (np.diag([1.0, 1.0] + [0.0] * 12), q, A, b, lb, np.full(14, np.inf),
+               (SecondOrderCone(3, 4), SecondOrderCone(10, 4)))
+    reference = clarabel_solve(*problem)
+    result = fccqp.solve(*problem)
+    assert result.status is Status.SOLVED
+    verify_solution(problem, result)
+    assert abs(result.obj - reference.obj) <= 1e-4 * (1 + abs(reference.obj))
+
+
 def test_budget_statuses():
     problem = random_problem(11, psd_rank=10)   # polishing solves it from 2 iterations
     result = fccqp.solve(*problem, max_iter=2, eps_abs=1e-12, eps_rel=0.0, polish=False)

@@ -1,12 +1,13 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
-"""Rho adaptation: OSQP's rule, and the trial of the small moves it keeps asking for
-(:mod:`fccqp.iteration` calls it, on either storage of the matrices).
+"""Rho adaptation: OSQP's rule, the trial of the small moves it keeps asking for, and
+a guard against lowering rho under a runaway iterate (:mod:`fccqp.iteration` calls it,
+on either storage of the matrices).
 """
 
-from libc.math cimport sqrt
+from libc.math cimport INFINITY, sqrt
 
 from fccqp.termination cimport Residuals
-from fccqp.tuning cimport RHO_MAX, RHO_MIN, RHO_PERSISTENCE
+from fccqp.tuning cimport RHO_MAX, RHO_MIN, RHO_PERSISTENCE, RHO_RUNAWAY
 
 
 cdef double rho_trial(TrialState* trial, double rho, double new_rho, double worst,
@@ -52,14 +53,31 @@ cdef void trial_reset(TrialState* trial) noexcept nogil:
     trial.side = trial.count = 0
     trial.old_rho = trial.start = trial.progress = 0.0
     trial.locked = False
+    trial.lowered_scale = trial.lowered_prim = INFINITY
 
 
 cdef double new_rho(const Residuals* r, double rho, TrialState* trial,
                     double tolerance) noexcept nogil:
     """OSQP's rule: rho *= sqrt(relative primal / relative dual residual), clipped,
     when that moves it by more than ``tolerance`` (``adaptive_rho_tolerance``); a
-    smaller move that the rule keeps asking for is tried (:func:`rho_trial`)."""
+    smaller move that the rule keeps asking for is tried (:func:`rho_trial`).
+
+    Rho is not lowered while the iterate runs away infeasibly: since rho was last
+    lowered, the primal residual's scale (the size of ``A x`` and ``z``) has grown
+    more than ``RHO_RUNAWAY``-fold and the primal residual at least as fast. The
+    relative primal residual divides by that scale, so an iterate running away along a
+    near-recession direction makes a growing primal residual look no larger; the rule
+    would go on lowering rho, which weakens the constraints and lets the iterate run
+    further, down to rho's floor, where the run orbits far from the solution. An
+    iterate that grows while its primal residual does not (an optimum far away, as
+    with a tiny ``P``) keeps the rule's rho."""
     cdef double prim = r.prim_s / max(r.prim_scale_s, 1e-30)
     cdef double dual = r.dual_s / max(r.dual_scale_s, 1e-30)
     cdef double proposal = min(max(rho * sqrt(prim / max(dual, 1e-30)), RHO_MIN), RHO_MAX)
-    return rho_trial(trial, rho, proposal, max(prim, dual), tolerance)
+    if (proposal < rho and r.prim_scale_s > RHO_RUNAWAY * trial.lowered_scale
+            and prim >= trial.lowered_prim):
+        proposal = rho
+    cdef double taken = rho_trial(trial, rho, proposal, max(prim, dual), tolerance)
+    if taken < rho:
+        trial.lowered_scale, trial.lowered_prim = r.prim_scale_s, prim
+    return taken

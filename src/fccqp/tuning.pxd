@@ -71,6 +71,8 @@ cdef extern from *:
     #define FCCQP_FIXED_RHO_SCALE 1e3
     /* a small rho move asked for this many updates in a row is tried (3 lost talos ticks) */
     #define FCCQP_RHO_PERSISTENCE 5
+    /* rho is not lowered while, since its last lowering, the primal residual's scale grew more than this x and the residual as fast */
+    #define FCCQP_RHO_RUNAWAY 4.0
 
     /* ---- Anderson acceleration (fccqp.anderson, fccqp.iteration) ---- */
     /* steps rejected by the safeguard before a run gives up accelerating */
@@ -232,6 +234,7 @@ cdef extern from *:
     const double RHO_MAX "FCCQP_RHO_MAX"
     const double FIXED_RHO_SCALE "FCCQP_FIXED_RHO_SCALE"
     const int RHO_PERSISTENCE "FCCQP_RHO_PERSISTENCE"
+    const double RHO_RUNAWAY "FCCQP_RHO_RUNAWAY"
     # Anderson acceleration
     const long MAX_REJECTIONS "FCCQP_MAX_REJECTIONS"
     const double REGULARIZATION "FCCQP_REGULARIZATION"
