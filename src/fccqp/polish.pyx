@@ -381,10 +381,11 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     polish"). Likewise a settled guess whose Newton steps moved a free entry or block out of
     its set (the first solve's planes, at the projections of points outside their cones,
     kept it inside) holds it and solves the corrected guess: solo12's cold polishes had
-    been rejected so, a free friction cone missed by 0.3 N. A polish none of whose first
-    ``FEASIBLE_PASSES`` guesses reached a point that violates nothing gives up: on talos'
-    cold ticks such polishes had run all their guesses and been rejected (notes/polish.md,
-    "zerostep"); not while each of its corrections only put free blocks on their boundary
+    been rejected so, a free friction cone missed by 0.3 N. Such a pass leaves the polish
+    at a point that violates a constraint, and jumping from there, a polish of
+    ``FEASIBLE_PASSES`` or more guesses that has not reached a point that violates nothing
+    again gives up: on talos' cold ticks polishes that jumped from the first guess on had
+    run all their guesses so and been rejected (notes/polish.md, "zerostep"); not while each of its corrections only put free blocks on their boundary
     (at most one pass per block): where the cone multipliers are too small for ADMM to
     resolve (solo12, 1e-5), its guess has every block free and the polish finds the
     boundary blocks one or two a pass, kept at its fourth or fifth (notes/polish.md,
