@@ -323,28 +323,39 @@ def test_warm_polish_factors_where_p_couples_a_constrained_entry():
     assert check_solution(Problem.of(*moved), warm, EXACT).passed
 
 
-def _chain(target, upper):
+def _chain(target, upper, from_iterate=False):
     """``min 1/2 ||x - target||^2`` s.t. ``sum x = 3``, ``-10 <= x <= upper``, polished
     from an iterate inside the box with no multiplier."""
     n = len(target)
     inside = np.zeros(n)
     return polish_point(np.eye(n), -np.asarray(target, float), np.ones((1, n)),
                         np.array([3.0]), np.full(n, -10.0), np.asarray(upper, float),
-                        flatten_cones((), n), inside, np.zeros(1), np.zeros(n), inside)
+                        flatten_cones((), n), inside, np.zeros(1), np.zeros(n), inside,
+                        from_iterate=from_iterate)
 
 
-def test_polish_steps_from_the_iterate_and_holds_each_bound_its_step_reaches():
-    """Each guess's solution puts the next entry past its bound. The passes step from
-    the iterate (inside the box), each only as far as the first bound it meets, which the
-    next guess holds: with three entries and with four the polish solves the QP
-    (``(1, 1.5, 0.5)`` and ``(1, 0.5, 2.3, -0.8)``). Jumping to each guess's solution
-    instead, the four-entry polish had its first ``FEASIBLE_PASSES`` points all infeasible
-    and gave up (the slides of ADMM along a face of the cones that this step cuts short
-    are in notes/performance-history.md, "talosslow")."""
+def test_polish_gives_up_when_its_first_guesses_violate_a_bound():
+    """Each guess holds the bound its predecessor's point crossed and puts the next entry
+    past its own: with three entries the third guess is feasible and solves the QP
+    (``(1, 1.5, 0.5)``); with four, the first ``FEASIBLE_PASSES`` (3) guesses are all
+    infeasible and the polish gives up rather than search on (such searches ended
+    rejected on the whole-body-control ticks; giving up after two lost polishes that
+    solo12's and go2's cold ticks had kept)."""
     three = _chain([3.0, 1.4, 0.0], [1.0, 1.5, 10.0])
-    assert three["ok"]
+    assert three["ok"] and three["factorizations"] == 3
     np.testing.assert_allclose(three["x"], [1.0, 1.5, 0.5], atol=1e-12)
     four = _chain([10.0, 0.0, -0.3, -5.0], [1.0, 0.5, 2.3, 10.0])
+    assert not four["ok"] and four["factorizations"] == FEASIBLE_PASSES
+
+
+def test_a_polish_of_admms_iterate_steps_and_holds_each_bound_its_step_reaches():
+    """The four-entry chain above, polished as ADMM's iterate is (``from_iterate``): each
+    pass steps from the previous point (the first from the iterate, inside the box) only
+    as far as the first bound it meets, which the next guess holds, and the polish solves
+    the QP, ``(1, 0.5, 2.3, -0.8)``, where jumping to each guess's solution gave up. ADMM's
+    slides along a face of the cones, which this step cuts short, are in
+    notes/performance-history.md, "talosslow"."""
+    four = _chain([10.0, 0.0, -0.3, -5.0], [1.0, 0.5, 2.3, 10.0], from_iterate=True)
     assert four["ok"] and four["factorizations"] > FEASIBLE_PASSES
     np.testing.assert_allclose(four["x"], [1.0, 0.5, 2.3, -0.8], atol=1e-12)
 

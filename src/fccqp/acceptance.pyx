@@ -72,7 +72,7 @@ cdef bint _try_polished(Engine* e, int* status, long iteration, double start_tim
     cdef int new_status, factorizations = 0   # of polishing's own matrix: not counted
     if not polish(&e.pol, p, it, o.polish_refine_iter, &factorizations,
                   &e.red if e.fact.table_ready else NULL, &e.fact.kkt, it.rho_vec,
-                  start_time + o.time_limit):
+                  start_time + o.time_limit, iteration > 0):
         return False
     unscale(e.pol.x, e.pol.nu, e.pol.y, p.D, p.E, p.c, n, m, s, p.constrained, ux, uy, uz)
     user_residuals(e, ux, uy, uz)

@@ -148,7 +148,7 @@ cdef extern from *:
     #define FCCQP_WARM_GUESS_PASSES 12
     /* guesses of a warm polish tried again from its own cycling point: those kept took 1 */
     #define FCCQP_CYCLED_GUESS_PASSES 1
-    /* a polish jumping from a point that violates a constraint gives up at this many guesses */
+    /* a polish whose first this many guesses all violate a constraint gives up */
     #define FCCQP_FEASIBLE_PASSES 3
     /* a free entry or block joins the active set when it violates by more than this */
     #define FCCQP_ACTIVE_TOLERANCE 1e-12
