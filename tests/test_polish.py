@@ -450,6 +450,25 @@ def _warm_ticks(robot, first, last):
     return results
 
 
+def test_a_cold_tick_whose_admm_slides_along_the_cones_is_polished_at_its_first_solved_check():
+    """talos_reduced's benchmark tick 265 from a fresh solver: ADMM meets the realtime
+    tolerance after about 100 iterations while its contact forces still slide from one foot
+    to another along a straight line (370 N off the answer), toward the apexes of four
+    blocks the answer has at 0. The polish of that iterate steps from it, holds each block
+    at the apex its step reaches, and settles there. Jumping to the first guess's solution,
+    past those apexes, it had failed, and the tick took the 1610 iterations of the slide."""
+    pytest.importorskip("pinocchio")
+    from benchmarks.testsets import generate_test_set
+
+    qp = generate_test_set("talos_reduced", "mix", 400, seed=0).qps[265]
+    cones = [fccqp.FrictionCone(int(start), float(mu), tuple(map(float, normal)))
+             for start, mu, normal in zip(qp.cone_starts, qp.mus, qp.normals, strict=True)]
+    result = fccqp.Solver(fccqp.Settings.realtime(100.0)).solve(qp.P, qp.q, qp.A, qp.b,
+                                                                qp.lb, qp.ub, cones)
+    assert result.status is Status.SOLVED and result.polished
+    assert result.iterations < 200
+
+
 def test_warm_polish_keeps_a_contact_a_chord_step_threw_past_its_apex():
     """solo12's third benchmark sequence, ticks 200-208: on ticks 205-208 the previous
     tick's active set holds, but the first Newton step of the warm polish, a chord step
