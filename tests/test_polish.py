@@ -323,14 +323,15 @@ def test_warm_polish_factors_where_p_couples_a_constrained_entry():
     assert check_solution(Problem.of(*moved), warm, EXACT).passed
 
 
-def _chain(target, upper):
+def _chain(target, upper, from_iterate=False):
     """``min 1/2 ||x - target||^2`` s.t. ``sum x = 3``, ``-10 <= x <= upper``, polished
     from an iterate inside the box with no multiplier."""
     n = len(target)
     inside = np.zeros(n)
     return polish_point(np.eye(n), -np.asarray(target, float), np.ones((1, n)),
                         np.array([3.0]), np.full(n, -10.0), np.asarray(upper, float),
-                        flatten_cones((), n), inside, np.zeros(1), np.zeros(n), inside)
+                        flatten_cones((), n), inside, np.zeros(1), np.zeros(n), inside,
+                        from_iterate=from_iterate)
 
 
 def test_polish_gives_up_when_its_first_guesses_violate_a_bound():
@@ -345,6 +346,18 @@ def test_polish_gives_up_when_its_first_guesses_violate_a_bound():
     np.testing.assert_allclose(three["x"], [1.0, 1.5, 0.5], atol=1e-12)
     four = _chain([10.0, 0.0, -0.3, -5.0], [1.0, 0.5, 2.3, 10.0])
     assert not four["ok"] and four["factorizations"] == FEASIBLE_PASSES
+
+
+def test_a_polish_of_admms_iterate_steps_and_holds_each_bound_its_step_reaches():
+    """The four-entry chain above, polished as ADMM's iterate is (``from_iterate``): each
+    pass steps from the previous point (the first from the iterate, inside the box) only
+    as far as the first bound it meets, which the next guess holds, and the polish solves
+    the QP, ``(1, 0.5, 2.3, -0.8)``, where jumping to each guess's solution gave up. ADMM's
+    slides along a face of the cones, which this step cuts short, are in
+    notes/performance-history.md, "talosslow"."""
+    four = _chain([10.0, 0.0, -0.3, -5.0], [1.0, 0.5, 2.3, 10.0], from_iterate=True)
+    assert four["ok"] and four["factorizations"] > FEASIBLE_PASSES
+    np.testing.assert_allclose(four["x"], [1.0, 0.5, 2.3, -0.8], atol=1e-12)
 
 
 def _contacts(targets, total, mu=0.5):
@@ -435,6 +448,25 @@ def _warm_ticks(robot, first, last):
                for qp in qps]
     assert all(r.status is Status.SOLVED for r in results)
     return results
+
+
+def test_a_cold_tick_whose_admm_slides_along_the_cones_is_polished_at_its_first_solved_check():
+    """talos_reduced's benchmark tick 265 from a fresh solver: ADMM meets the realtime
+    tolerance after about 100 iterations while its contact forces still slide from one foot
+    to another along a straight line (370 N off the answer), toward the apexes of four
+    blocks the answer has at 0. The polish of that iterate steps from it, holds each block
+    at the apex its step reaches, and settles there. Jumping to the first guess's solution,
+    past those apexes, it had failed, and the tick took the 1610 iterations of the slide."""
+    pytest.importorskip("pinocchio")
+    from benchmarks.testsets import generate_test_set
+
+    qp = generate_test_set("talos_reduced", "mix", 400, seed=0).qps[265]
+    cones = [fccqp.FrictionCone(int(start), float(mu), tuple(map(float, normal)))
+             for start, mu, normal in zip(qp.cone_starts, qp.mus, qp.normals, strict=True)]
+    result = fccqp.Solver(fccqp.Settings.realtime(100.0)).solve(qp.P, qp.q, qp.A, qp.b,
+                                                                qp.lb, qp.ub, cones)
+    assert result.status is Status.SOLVED and result.polished
+    assert result.iterations < 200
 
 
 def test_warm_polish_keeps_a_contact_a_chord_step_threw_past_its_apex():

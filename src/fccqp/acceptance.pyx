@@ -73,7 +73,7 @@ cdef bint _try_polished(Engine* e, int* status, long iteration, double start_tim
     if not polish(&e.pol, p, it, o.polish_refine_iter, &factorizations,
                   &e.red if e.fact.table_ready else NULL, &e.fact.kkt, it.rho_vec,
                   start_time + o.time_limit,
-                  POLISH_EXACT * (o.eps_abs + o.eps_rel * r.dual_scale)):
+                  POLISH_EXACT * (o.eps_abs + o.eps_rel * r.dual_scale), iteration > 0):
         return False
     unscale(e.pol.x, e.pol.nu, e.pol.y, p.D, p.E, p.c, n, m, s, p.constrained, ux, uy, uz)
     user_residuals(e, ux, uy, uz)

@@ -72,7 +72,7 @@ cdef struct Polish:
 cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_steps,
                  int* factorizations, const Reduced* table, KKT* kkt,
                  const double* rho_vec, double deadline,
-                 double multiplier_slack) noexcept nogil
+                 double multiplier_slack, bint from_iterate) noexcept nogil
 cdef bint polish_prepare(Polish* w, const Problem* p) noexcept nogil
 cdef Py_ssize_t guess_changes(const Problem* p, const double* z, const double* y,
                               double* point, char* codes) noexcept nogil

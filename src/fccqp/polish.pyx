@@ -336,7 +336,7 @@ cdef bint polish_prepare(Polish* w, const Problem* p) noexcept nogil:
 cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_steps,
                  int* factorizations, const Reduced* table, KKT* kkt,
                  const double* rho_vec, double deadline,
-                 double multiplier_slack) noexcept nogil:
+                 double multiplier_slack, bint from_iterate) noexcept nogil:
     """Polish the iterate ``it`` into ``w.x``, ``w.nu``, ``w.y`` (scaled problem) and
     leave the final guess in ``w.active``; ``factorizations`` counts the ``dsytrf``
     calls. With ``table`` (the reduced form's, current for ``rho_vec`` and ``kkt``'s
@@ -352,13 +352,19 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     as a primal active-set method drops one constraint at a time: changing both at once (a
     plain primal-dual active-set step) diverged on whole-body control, where the cost is
     flat on the torques and forces, and releasing every wrong-signed multiplier of a pass
-    together cycled on contact switches. Once a pass's point violates nothing, each next
-    pass is a step of a primal active-set method: from that point toward the new guess's
-    solution only as far as the first free constraint allows
-    (:func:`~fccqp.polish_guess.step_length`), which is then held, and a release only from
-    a full step: the polished QP of a wrong guess lies far out where the cost is flat on
-    the forces, and jumping there swung contact forces by hundreds of newtons from pass to
-    pass. (The measurements behind these rules are in notes/polish.md.) On a settled guess
+    together cycled on contact switches. Once a pass's point violates nothing, and with
+    ``from_iterate`` (an iterate ADMM leaves within its tolerance of ``C``) from the first
+    pass on, each pass is a step of a primal active-set method: from the previous point
+    toward the new guess's solution only as far as the first free constraint allows (:func:`~fccqp.polish_guess.step_length`), which is
+    then held, and a release only from a full step: the polished QP of a wrong guess lies
+    far out where the cost is flat on the forces, and jumping there swung contact forces by
+    hundreds of newtons from pass to pass. Stepping from ADMM's iterate is what ends its
+    slide along a face of ``C``: on talos' slowest cold ticks the iterate, solved at the
+    tolerance after about 100 iterations, moves contact forces from one foot to another
+    along a straight line for 500-1500 more iterations until cone blocks reach their apex;
+    the first guess's solution lies past those apexes, and the step stops at the first one
+    and holds it. (The measurements behind these rules are in notes/polish.md and
+    notes/performance-history.md, "talosslow".) On a settled guess
     the boundary planes are then re-linearized up to ``newton_steps`` times (chord steps
     while they converge fast, see ``CHORD_RATE``), stopping early at the floor rounding
     leaves (:func:`_newton`); so are those of the last guess of a polish that did not
@@ -383,9 +389,9 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     polish"). Likewise a settled guess whose Newton steps moved a free entry or block out of
     its set (the first solve's planes, at the projections of points outside their cones,
     kept it inside) holds it and solves the corrected guess: solo12's cold polishes had
-    been rejected so, a free friction cone missed by 0.3 N. A polish none of whose first
-    ``FEASIBLE_PASSES`` guesses reached a point that violates nothing gives up: on talos'
-    cold ticks such polishes had run all their guesses and been rejected (notes/polish.md,
+    been rejected so, a free friction cone missed by 0.3 N. A polish whose points violated
+    a constraint through its first ``FEASIBLE_PASSES`` guesses gives up: on talos' cold
+    ticks such polishes had run all their guesses and been rejected (notes/polish.md,
     "zerostep"); not while each of its corrections only put free blocks on their boundary
     (at most one pass per block): where the cone multipliers are too small for ADMM to
     resolve (solo12, 1e-5), its guess has every block free and the polish finds the
@@ -401,7 +407,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     cdef double total = 0.0
     cdef double scale = max(1.0, max(inf_norm(p.q, n), inf_norm(p.b, m)))
     cdef bint tabled = table != NULL and p.P.kind == DENSE   # the table reads dense storage
-    cdef bint feasible = False   # a pass's point violated nothing: from then on, steps
+    cdef bint feasible = from_iterate   # a pass's point violated nothing: from then on, steps
     cdef bint planes_only = True   # every infeasible pass only put free blocks on their boundary
     cdef Py_ssize_t held
     cdef Py_ssize_t blocking

@@ -49,7 +49,8 @@ cdef class _Arrays:
         return &view[0]
 
 
-def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5, bint schur=False):
+def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5, bint schur=False,
+                 bint from_iterate=False):
     """Polish the iterate ``(x, nu, z, y)`` of ``min 1/2 x'Px + q'x`` s.t. ``A x = b``,
     ``lb <= x <= ub``, ``x`` in ``cones`` (a :class:`fccqp.cones.ConeArrays` over ``x``).
 
@@ -57,7 +58,7 @@ def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5, bi
     (read on the constrained entries: a finite bound or a cone). ``P`` and ``A`` are both
     dense arrays or both ``scipy.sparse`` matrices (``P`` with its full symmetric
     pattern). With ``schur`` (dense ``P`` and ``A``), the Schur complement is set up
-    first. Returns a dict: ``ok`` (the polish's verdict), ``x``, ``nu``, ``y`` (``n``,
+    first; with ``from_iterate`` the passes step from ``x`` on, as from ADMM's iterate. Returns a dict: ``ok`` (the polish's verdict), ``x``, ``nu``, ``y`` (``n``,
     zero off the constrained entries), ``active`` (the final guess's code per
     constrained entry), ``passes``, ``factorizations``, ``schur`` (whether the Schur
     complement was set up) and ``bordered`` (whether the last factorization was its
@@ -117,7 +118,8 @@ def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5, bi
                       np.asarray(Ah.colptr), np.asarray(Ah.rowind), cones.dim)
         bind(&w.csc, held)
     cdef int factorizations = 0
-    ok = polish(&w, &p, &it, newton_steps, &factorizations, NULL, NULL, NULL, INFINITY, 0.0)
+    ok = polish(&w, &p, &it, newton_steps, &factorizations, NULL, NULL, NULL, INFINITY, 0.0,
+                from_iterate)
     result_y = np.zeros(n)
     result_y[constrained] = [w.y[j] for j in range(s)]
     return {"ok": bool(ok), "x": np.array([w.x[j] for j in range(n)]),
