@@ -237,8 +237,10 @@ class Solver:
         else:
             if sparse or _rows(P) + _rows(A) > MAX_DENSE_KKT_ROWS:
                 return self._solve_sparse(P, q, A, b, lb, ub, cones, (x0, y0, z0), start)
-            P, q, A, b, lb, ub = convert(P, q, A, b, lb, ub)
-            n, m = P.shape[0], A.shape[0]
+            n, m = _rows(P), _rows(A)   # a structure switch's arrays fit as they are
+            if not (n and dense_arguments(P, q, A, b, lb, ub, n, m)):
+                P, q, A, b, lb, ub = convert(P, q, A, b, lb, ub)
+                n, m = P.shape[0], A.shape[0]
         flat = flatten_cones(cones, n)   # memoized: the same object for the same cones
         self._cones = cones
         guess = _guess(x0, y0, z0, n, m)
