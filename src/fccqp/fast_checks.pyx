@@ -5,7 +5,8 @@ A controller calls :meth:`fccqp.Solver.solve` with the same kinds of arguments e
 tick: six contiguous float64 arrays of the workspace's sizes and a list of cone specs
 like the last one. :func:`dense_arguments` recognizes the arrays from their buffers
 without converting them, :func:`cone_key` builds :func:`fccqp.cones.flatten_cones`'
-memo key and :func:`same_cones` tells when the specs are those of the last solve; they
+memo key, :func:`same_cones` tells when the specs are those of the last solve and
+:func:`upright_friction_arrays` flattens new friction values (a contact change); they
 decide what :func:`fccqp.problem.convert`'s fast path and the memo's key
 function in Python did, without the interpreter's per-attribute work. After the compiled
 solve the interpreter runs from cold caches, and there the two Python versions took 6.7
