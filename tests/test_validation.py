@@ -203,6 +203,26 @@ def test_dense_arguments_recognizes_only_contiguous_float64_of_the_shapes():
 
 
 @BEFORE_ANY_BACKEND
+def test_upright_friction_arrays_flatten_only_valid_upright_friction_specs():
+    from fccqp.fast_checks import upright_friction_arrays
+
+    specs = (FrictionCone(6, 0.5), FrictionCone(0, 0.25), FrictionCone(3, 1.5))
+    expected = (np.zeros(3, np.int64), np.array([6, 0, 3]), np.full(3, 3),
+                np.array([0.5, 0.25, 1.5]), np.tile([0.0, 0.0, 1.0], (3, 1)))
+    got = upright_friction_arrays(specs, 9)
+    for array, value in zip(got, expected, strict=True):
+        assert array.dtype == value.dtype and array.shape == value.shape
+        assert np.array_equal(array, value) and not array.flags.writeable
+    for others in [(FrictionCone(0, 1),), (FrictionCone(0, 0.5, (0.0, 0.0, 1.0)),),
+                   (FrictionCone(True, 0.5),), (FrictionCone(0, np.float64(0.5)),),
+                   (FrictionCone(0, 0.0),), (FrictionCone(0, float("nan")),),
+                   (FrictionCone(0, float("inf")),), (FrictionCone(7, 0.5),),
+                   (FrictionCone(-1, 0.5),), (FrictionCone(2**70, 0.5),),
+                   (FrictionCone(0, 0.5), FrictionCone(2, 0.5)), (SecondOrderCone(0, 3),)]:
+        assert upright_friction_arrays(others, 9) is None
+
+
+@BEFORE_ANY_BACKEND
 @pytest.mark.parametrize(
     "overrides, message",
     [

@@ -26,7 +26,7 @@ from functools import cached_property
 
 import numpy as np
 
-from fccqp.fast_checks import cone_key
+from fccqp.fast_checks import cone_key, upright_friction_arrays
 
 FRICTION = 0
 """Kind code of a friction cone in :class:`ConeArrays` (``fccqp/cone_friction.pxd``)."""
@@ -245,7 +245,10 @@ MEMO_SIZE = 64
 _MEMO: dict[tuple, ConeArrays] = {}
 
 
-def _flatten(cones: Sequence[Cone], n: int) -> ConeArrays:
+def _flatten(cones: tuple[Cone, ...], n: int) -> ConeArrays:
+    arrays = upright_friction_arrays(cones, n)
+    if arrays is not None:   # the control loops' specs, checked in compiled code
+        return ConeArrays(*arrays)
     k = len(cones)
     kind = np.zeros(k, dtype=np.int64)
     offset = np.zeros(k, dtype=np.int64)

@@ -237,10 +237,13 @@ class Solver:
                                                             structure.m):
             n, m = structure.n, structure.m   # the arrays fit as they are
         else:
-            if sparse or _rows(P) + _rows(A) > MAX_DENSE_KKT_ROWS:
+            n, m = _rows(P), _rows(A)
+            if sparse or n + m > MAX_DENSE_KKT_ROWS:
                 return self._solve_sparse(P, q, A, b, lb, ub, cones, (x0, y0, z0), start)
-            P, q, A, b, lb, ub = convert(P, q, A, b, lb, ub)
-            n, m = P.shape[0], A.shape[0]
+            # a structure switch's arrays, taken as they are when they fit their own shapes
+            if not (n and dense_arguments(P, q, A, b, lb, ub, n, m)):
+                P, q, A, b, lb, ub = convert(P, q, A, b, lb, ub)
+                n, m = P.shape[0], A.shape[0]
         flat = flatten_cones(cones, n)   # memoized: the same object for the same cones
         self._cones = cones
         guess = _guess(x0, y0, z0, n, m)
