@@ -355,7 +355,8 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     together cycled on contact switches. Once a pass's point violates nothing, and with
     ``from_iterate`` (an iterate ADMM leaves within its tolerance of ``C``) from the first
     pass on, each pass is a step of a primal active-set method: from the previous point
-    toward the new guess's solution only as far as the first free constraint allows (:func:`~fccqp.polish_guess.step_length`), which is
+    toward the new guess's solution only as far as the first free constraint allows
+    (:func:`~fccqp.polish_guess.step_length`), which is
     then held, and a release only from a full step: the polished QP of a wrong guess lies
     far out where the cost is flat on the forces, and jumping there swung contact forces by
     hundreds of newtons from pass to pass. Stepping from ADMM's iterate is what ends its

@@ -58,7 +58,8 @@ def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5, bi
     (read on the constrained entries: a finite bound or a cone). ``P`` and ``A`` are both
     dense arrays or both ``scipy.sparse`` matrices (``P`` with its full symmetric
     pattern). With ``schur`` (dense ``P`` and ``A``), the Schur complement is set up
-    first; with ``from_iterate`` the passes step from ``x`` on, as from ADMM's iterate. Returns a dict: ``ok`` (the polish's verdict), ``x``, ``nu``, ``y`` (``n``,
+    first; with ``from_iterate`` the passes step from ``x`` on, as from ADMM's iterate.
+    Returns a dict: ``ok`` (the polish's verdict), ``x``, ``nu``, ``y`` (``n`` entries,
     zero off the constrained entries), ``active`` (the final guess's code per
     constrained entry), ``passes``, ``factorizations``, ``schur`` (whether the Schur
     complement was set up) and ``bordered`` (whether the last factorization was its

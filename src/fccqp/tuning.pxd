@@ -71,7 +71,8 @@ cdef extern from *:
     #define FCCQP_FIXED_RHO_SCALE 1e3
     /* a small rho move asked for this many updates in a row is tried (3 lost talos ticks) */
     #define FCCQP_RHO_PERSISTENCE 5
-    /* rho is not lowered while, since its last lowering, the primal residual's scale grew more than this x and the residual as fast */
+    /* rho is not lowered while, since its last lowering, the primal residual's scale
+       grew more than this x and the relative primal residual did not fall */
     #define FCCQP_RHO_RUNAWAY 4.0
 
     /* ---- Anderson acceleration (fccqp.anderson, fccqp.iteration) ---- */
