@@ -77,7 +77,7 @@ SPARSE_SEEDS = {
     "feasible": (0,),
     "solver_reuse": (38,),
     "extreme_data": (26, 100121, 900343, 1700359, 1900317, 2500125, 2900030, 2900221,
-                     4100295, 4700215, 4700352, 6100225),
+                     4100295, 4700215, 4700352, 6100225, 10300337),
     "qpsolvers": (100035, 7900043),
     "cvxpy": (7, 1700154, 1900171),
     "dual_infeasible": (1700072,),
@@ -107,7 +107,11 @@ equalities' curvature and a polish that pivots where ``delta`` lies below the ro
 ``P``; ``extreme_data:4100295`` (``P`` of 1.5e11 and a zero column beside five
 inconsistent rows of rank four; 2 s of CPU) the certificate that, as on the dense
 backends, only the unscaled retry's start finds, on least-squares points that ``qdldl``
-without pivoting could not give (SuperLU's pivoted factorization does). Every case of
+without pivoting could not give (SuperLU's pivoted factorization does);
+``extreme_data:10300337`` (``P`` of 1e17, PSD to its rounding, beside a free entry
+that ``P`` and ``A`` do not touch) a ray whose projection meets no tolerance on the
+sparse path, its point the ray all the same, which the unequilibrated retry then moved
+off (``auxiliary._ray_found``). Every case of
 :data:`SEEDS` on the sparse path took 100 s of CPU at
 b11793f (the whole module, four dense backends and these: 25 s of wall time at load
 8), with 5 failures: 4 stalls at MAX_ITER_REACHED that the dense backends' retries

@@ -494,6 +494,29 @@ def _certifying(workspace: object, b: np.ndarray, lb: np.ndarray, ub: np.ndarray
     return certifies
 
 
+def _ray(workspace: object, result: object, q: np.ndarray) -> np.ndarray | None:
+    """The dual certificate of a ray solve's ``result`` (``q`` its own cost) as
+    ``workspace`` judges it, or None when its point does not meet the identity of
+    :func:`_moreau` or the certificate fails."""
+    if not _moreau(result.x, q):
+        return None
+    return workspace.judge_certificate(np.ascontiguousarray(result.x), False)
+
+
+def _ray_found(workspace: object, q: np.ndarray) -> object:
+    """Whether a ray solve's result ends the search for its certificate: SOLVED, or
+    unsolved with a point that certifies (:func:`_ray`).
+
+    The projection onto the rays of rows of 1e17 (a ``P`` that huge, PSD to its
+    rounding) beside rows of 0.1 meets no tolerance in any form, yet its point after
+    4000 iterations is the ray, a free entry that ``P`` and ``A`` do not touch. On the
+    sparse path the next try, without equilibration, moved off it (``P d`` of 1e16)
+    and, as the last result, was the one judged: no certificate."""
+    def found(result: object) -> bool:
+        return _is_solved(result) or _ray(workspace, result, q) is not None
+    return found
+
+
 def _farkas_tolerances(settings: object, w: np.ndarray) -> object:
     """``settings`` whose termination meets the Farkas test of a least-distance solution
     with multipliers ``w``: its dual residual, ``A'y + z``, within ``eps_prim_inf``
@@ -579,11 +602,10 @@ def stalled_certificate(solver_type: type, settings: object, workspace: object,
         rays = ray_problem(P, q, A, lb, ub, cones)
         if not np.any(q) or not _affordable(rays):
             return None
-        result, iterations, factorizations = _solved(solver_type, settings, rays, deadline)
+        result, iterations, factorizations = _solved(solver_type, settings, rays, deadline,
+                                                     _ray_found(workspace, rays[1]))
         spent, factored = spent + iterations, factored + factorizations
-        if not _moreau(result.x, rays[1]):
-            return None
-        found = workspace.judge_certificate(np.ascontiguousarray(result.x), False)
+        found = _ray(workspace, result, rays[1])
         if found is None:
             return None
         return Status.DUAL_INFEASIBLE, found, spent, factored
