@@ -38,7 +38,8 @@ constrained entries alone. A problem that stalls in one form often solves in the
 4000 iterations in the reduced form and solved in 30 in the full one; a feasible QP
 with ``P`` of 1e-12 stalled in the full form and solved in the reduced one). So an
 auxiliary solve that is not SOLVED runs again in the other form
-(:func:`other_form`), then on the sparse path (:func:`_further_tries`), and
+(:func:`other_form`), then on the sparse path (:func:`_further_tries`), unless its
+point certifies already (:func:`_certifying`, :func:`_ray_found`), and
 :func:`solved_again` solves the stalled problem itself
 again there when no certificate was found, and then, if it stalls there too, at a
 larger rho, at a smaller one (fixed below the floor when the stalled run's rho sat
