@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 from fccqp.polish_ops import polish_point
-from fccqp.tuning import FEASIBLE_PASSES, GUESS_PASSES
+from fccqp.tuning import FEASIBLE_PASSES, GUESS_PASSES, WARM_GUESS_PASSES
 
 import fccqp
 from fccqp import Status
@@ -346,6 +346,31 @@ def test_polish_gives_up_when_its_first_guesses_violate_a_bound():
     np.testing.assert_allclose(three["x"], [1.0, 1.5, 0.5], atol=1e-12)
     four = _chain([10.0, 0.0, -0.3, -5.0], [1.0, 0.5, 2.3, 10.0])
     assert not four["ok"] and four["factorizations"] == FEASIBLE_PASSES
+
+
+def test_a_warm_polish_gives_up_when_more_multipliers_are_wrong_than_its_guesses_can_release():
+    """``min 1/2 ||x - 1||^2`` over 20 entries in ``[0, 10]`` with ``sum x = 3``, from a
+    point that holds 19 of them at 0: the first guess's point violates nothing, and each
+    later guess releases one held entry, the others still pulling up. As a warm polish
+    (the previous tick's answer) it gives up at the guess where more multipliers are
+    wrong-signed than ``HOPELESS_RATE`` (2) times the guesses left, the fifth, rather than
+    crawl through all ``WARM_GUESS_PASSES`` and be rejected unsettled; another polish
+    crawls through its ``GUESS_PASSES`` and leaves its point to the caller."""
+    n = 20
+    z = np.zeros(n)
+    z[0] = 1.0
+    y = np.full(n, -1.0)
+    y[0] = 0.0
+
+    def polished(warm):
+        return polish_point(np.eye(n), -np.ones(n), np.ones((1, n)), np.array([3.0]),
+                            np.zeros(n), np.full(n, 10.0), flatten_cones((), n), z,
+                            np.zeros(1), y, z, warm=warm)
+
+    warm = polished(True)
+    assert not warm["ok"] and warm["factorizations"] == 5 < WARM_GUESS_PASSES
+    cold = polished(False)
+    assert cold["ok"] and cold["factorizations"] == GUESS_PASSES
 
 
 def test_a_polish_of_admms_iterate_steps_and_holds_each_bound_its_step_reaches():

@@ -143,12 +143,16 @@ cdef bint warm_polish(Engine* e, Run* run, double start_time) noexcept nogil:
     stopped unsettled at ``GUESS_PASSES`` sent its tick to ADMM, dozens of iterations
     dearer than the guesses it lacked (notes/performance-history.md, "warmp95").
     A warm polish that ended cycling is tried once more from its own last point, one
-    guess (``CYCLED_GUESS_PASSES``, :func:`_polish_again`).
+    guess (``CYCLED_GUESS_PASSES``, :func:`_polish_again`). One whose crawl cannot release
+    its wrong-signed multipliers in the guesses left gives up (``e.pol.warm``,
+    ``HOPELESS_RATE``).
     """
     cdef int status = RUNNING
     cdef bint kept
     e.pol.guess_passes = WARM_GUESS_PASSES
+    e.pol.warm = True
     kept = keep_polished(e, &status, 0, start_time, True)
+    e.pol.warm = False
     if not kept and e.pol.cycling:
         e.pol.guess_passes = CYCLED_GUESS_PASSES
         kept = _polish_again(e, &status, start_time)

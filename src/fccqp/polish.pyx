@@ -72,14 +72,14 @@ from fccqp.kkt cimport KKT
 from fccqp.matrices cimport CSC, DENSE
 from fccqp.polish_guess cimport (boundary_entries, box_code, cone_code, drop_far_side, guess,
                                  keep_bare_plane, leaves_set, linearize_on_cone, most_wrong,
-                                 past_apex, renew, step_length)
+                                 past_apex, renew, step_length, wrong_signed)
 from fccqp.polish_kkt cimport correct_once, kkt_residual, number_unknowns, refactor, refine
 from fccqp.polish_schur cimport polish_schur_factor, polish_schur_setup
 from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.reduced cimport Reduced
 from fccqp.tuning cimport (CHORD_RATE, CHORD_STEPS, FEASIBLE_PASSES, GUESS_TOLERANCE,
-                           MISS_FLOOR, NEWTON_TOLERANCE, POLISH_CSC_DELTA, POLISH_DELTA,
-                           POLISH_REFINE_TOLERANCE)
+                           HOPELESS_RATE, MISS_FLOOR, NEWTON_TOLERANCE, POLISH_CSC_DELTA,
+                           POLISH_DELTA, POLISH_REFINE_TOLERANCE)
 
 cdef extern from "fccqp_clock.h" nogil:
     double fccqp_now()
@@ -323,6 +323,14 @@ cdef int _newton(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t* nb, lon
     return 0
 
 
+cdef inline bint _hopeless(Polish* w, const Problem* p, long passes) noexcept nogil:
+    """Whether a warm polish's guess, stepped to from a feasible point, has more
+    wrong-signed multipliers (:func:`~fccqp.polish_guess.wrong_signed`) than
+    ``HOPELESS_RATE`` times the guesses left: releasing one a guess, it would run out of
+    guesses unsettled and be rejected."""
+    return w.warm and wrong_signed(w, p) > HOPELESS_RATE * (w.guess_passes - passes)
+
+
 cdef bint polish_prepare(Polish* w, const Problem* p) noexcept nogil:
     """Set up the Schur-complement solve of :mod:`fccqp.polish_schur` for this solve's
     ``P`` and ``A``; True when it applies, and then polishing needs no table. Never on
@@ -397,7 +405,14 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     (at most one pass per block): where the cone multipliers are too small for ADMM to
     resolve (solo12, 1e-5), its guess has every block free and the polish finds the
     boundary blocks one or two a pass, kept at its fourth or fifth (notes/polish.md,
-    "polishmiss"). False then, when a
+    "polishmiss"). A warm polish (``w.warm``: the previous answer's active set, which a
+    tick 10 or 20 ms on changes in a dozen box entries and blocks) gives up too once a
+    guess it stepped to from a feasible point has more wrong-signed multipliers than
+    ``HOPELESS_RATE`` times its guesses left (:func:`_hopeless`): releasing one a guess,
+    it would end unsettled and be rejected, and ADMM, which follows a rejection anyway,
+    would start its guesses later (talos' every-10th ticks: 12 such polishes crawled
+    through all 12 guesses at 0.4-0.5M instructions each; notes/polish.md,
+    "talosexact"). False then, when a
     factorization breaks down or the result is not finite, or when the clock (:func:`fccqp_now`) has
     passed ``deadline`` before a guess after the first (``INFINITY``: never); otherwise
     the caller judges the point.
@@ -457,6 +472,8 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
             if settled > 0:   # the multipliers of the block now held at its apex
                 _multipliers(w, p, nf, nb)
             break
+        if feasible and _hopeless(w, p, passes):
+            return False
         if feasible:
             t = step_length(w, p, &blocking)
             if blocking >= 0:   # stop where the first constraint does, and hold it (all at t = 0)

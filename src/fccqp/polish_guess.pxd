@@ -32,6 +32,7 @@ cdef void linearize_on_cone(Polish* w, const Problem* p, Py_ssize_t k,
 cdef Py_ssize_t guess(Polish* w, const Problem* p, const double* z, const double* y,
                       Py_ssize_t* changed) noexcept nogil
 cdef void keep_bare_plane(Polish* w, const Problem* p, Py_ssize_t k) noexcept nogil
+cdef Py_ssize_t wrong_signed(Polish* w, const Problem* p) noexcept nogil
 cdef Py_ssize_t most_wrong(Polish* w, const Problem* p, double slack) noexcept nogil
 cdef double step_length(Polish* w, const Problem* p, Py_ssize_t* blocking) noexcept nogil
 cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,

@@ -190,6 +190,20 @@ cdef Py_ssize_t most_wrong(Polish* w, const Problem* p, double slack) noexcept n
     return most
 
 
+cdef Py_ssize_t wrong_signed(Polish* w, const Problem* p) noexcept nogil:
+    """How many held box entries and held blocks (boundary or apex) have a multiplier
+    outside the normal cone their code needs: those :func:`most_wrong` chooses from, one a
+    pass."""
+    cdef Py_ssize_t j, k, plane = 0, count = 0
+    for j in range(p.s):
+        if not p.in_cone[j] and _box_wrong(w, p, j) > 0.0:
+            count += 1
+    for k in range(p.cones.count):
+        if _block_wrong(w, p, k, &plane) > 0.0:
+            count += 1
+    return count
+
+
 cdef double step_length(Polish* w, const Problem* p, Py_ssize_t* blocking) noexcept nogil:
     """The largest ``t`` in ``[0, 1]`` such that ``x_prev + t (x - x_prev)`` keeps every
     free box entry within its bounds, every free cone block in its cone and every

@@ -19,7 +19,7 @@ from fccqp.matrices cimport CSC
 from fccqp.matrix_ops cimport Held
 from fccqp.polish cimport Polish, polish, polish_prepare
 from fccqp.polish_csc cimport bind
-from fccqp.tuning cimport GUESS_PASSES
+from fccqp.tuning cimport GUESS_PASSES, WARM_GUESS_PASSES
 from fccqp.workspace_arrays cimport Arrays, polish_schur_arrays
 
 from fccqp.polish_csc import arrays
@@ -50,7 +50,7 @@ cdef class _Arrays:
 
 
 def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5, bint schur=False,
-                 bint from_iterate=False):
+                 bint from_iterate=False, bint warm=False):
     """Polish the iterate ``(x, nu, z, y)`` of ``min 1/2 x'Px + q'x`` s.t. ``A x = b``,
     ``lb <= x <= ub``, ``x`` in ``cones`` (a :class:`fccqp.cones.ConeArrays` over ``x``).
 
@@ -58,7 +58,9 @@ def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5, bi
     (read on the constrained entries: a finite bound or a cone). ``P`` and ``A`` are both
     dense arrays or both ``scipy.sparse`` matrices (``P`` with its full symmetric
     pattern). With ``schur`` (dense ``P`` and ``A``), the Schur complement is set up
-    first; with ``from_iterate`` the passes step from ``x`` on, as from ADMM's iterate.
+    first; with ``from_iterate`` the passes step from ``x`` on, as from ADMM's iterate;
+    with ``warm`` it is polished as a warm polish is (``WARM_GUESS_PASSES`` guesses, the
+    hopeless crawl given up: :func:`fccqp.polish.polish`).
     Returns a dict: ``ok`` (the polish's verdict), ``x``, ``nu``, ``y`` (``n`` entries,
     zero off the constrained entries), ``active`` (the final guess's code per
     constrained entry), ``passes``, ``factorizations``, ``schur`` (whether the Schur
@@ -108,7 +110,8 @@ def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5, bi
     w.chord_start = a.new(n + m + 2 * s)
     w.grad, w.ATnu, w.Ax = a.new(n), a.new(n), a.new(m)
     w.schur.ready = w.schur_only = w.schur_failed = False
-    w.guess_passes = GUESS_PASSES
+    w.guess_passes = WARM_GUESS_PASSES if warm else GUESS_PASSES
+    w.warm = warm
     w.schur.L = NULL   # no Schur storage: every guess is assembled
     w.schur.bordered = False
     if schur:

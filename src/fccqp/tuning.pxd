@@ -153,6 +153,9 @@ cdef extern from *:
     #define FCCQP_CYCLED_GUESS_PASSES 1
     /* a polish whose first this many guesses all violate a constraint gives up */
     #define FCCQP_FEASIBLE_PASSES 3
+    /* a warm polish stepping from a feasible point gives up when more of its multipliers
+       are wrong-signed than this times its guesses left (one is released a guess) */
+    #define FCCQP_HOPELESS_RATE 2.0
     /* a free entry or block joins the active set when it violates by more than this */
     #define FCCQP_ACTIVE_TOLERANCE 1e-12
     /* Newton stops when every boundary block has |phi| <= this ||x_block|| */
@@ -275,6 +278,7 @@ cdef extern from *:
     const int WARM_GUESS_PASSES "FCCQP_WARM_GUESS_PASSES"
     const int CYCLED_GUESS_PASSES "FCCQP_CYCLED_GUESS_PASSES"
     const int FEASIBLE_PASSES "FCCQP_FEASIBLE_PASSES"
+    const double HOPELESS_RATE "FCCQP_HOPELESS_RATE"
     const double ACTIVE_TOLERANCE "FCCQP_ACTIVE_TOLERANCE"
     const double NEWTON_TOLERANCE "FCCQP_NEWTON_TOLERANCE"
     const double MISS_FLOOR "FCCQP_MISS_FLOOR"
