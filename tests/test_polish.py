@@ -353,9 +353,9 @@ def test_a_warm_polish_gives_up_when_more_multipliers_are_wrong_than_its_guesses
     point that holds 19 of them at 0: the first guess's point violates nothing, and each
     later guess releases one held entry, the others still pulling up. As a warm polish
     (the previous tick's answer) it gives up at the guess where more multipliers are
-    wrong-signed than ``HOPELESS_RATE`` (2) times the guesses left, the fifth, rather than
-    crawl through all ``WARM_GUESS_PASSES`` and be rejected unsettled; another polish
-    crawls through its ``GUESS_PASSES`` and leaves its point to the caller."""
+    wrong-signed than ``HOPELESS_RATE`` (2) times the guesses left, the fifth; another
+    polish crawls on and settles at its ``GUESS_PASSES``-th. The rule gives such a crawl up
+    (ADMM then answers the tick) for the warm crawls that never settle."""
     n = 20
     z = np.zeros(n)
     z[0] = 1.0
