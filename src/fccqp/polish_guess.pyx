@@ -80,11 +80,10 @@ cdef void keep_bare_plane(Polish* w, const Problem* p, Py_ssize_t k) noexcept no
     itself where that part is not positive or the plane lies on the axis).
 
     A plane placed with ``lam = 0`` (a free block that left its cone) is solved without
-    its curvature, and nothing held the block's tangential part
-    on the cone: moving the plane to that ``x_block`` had turned it 20-50 degrees away
-    from the answer's, and the next solve put the contact past its apex; the polish then
-    cycled between apex and boundary and the tick ran ADMM (warm polishes of contacts
-    being loaded; notes/performance-history.md, "warmtail2")."""
+    its curvature, and nothing held the block's tangential part on the cone: moving the
+    plane to that ``x_block`` had turned it 20-50 degrees away from the answer's, and the
+    next solve put the contact past its apex; the polish then cycled between apex and
+    boundary and the tick ran ADMM (notes/performance-history.md, "warmtail2")."""
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t cone = w.boundary[k], o = c.offset[cone]
     copy(w.kept_plane + o, w.g + o, c.dim[cone])
