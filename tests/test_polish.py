@@ -63,7 +63,7 @@ def test_polished_answer_is_exact(seed, kkt_backend):
     assert np.abs(plain.x - reference.x).max() > 2e-5
 
 
-@pytest.mark.parametrize("seed", [5, 18])
+@pytest.mark.parametrize("seed", [5, 20])
 def test_wrong_guess_keeps_the_admm_point(seed, kkt_backend):
     # two iterations of ADMM do not know the active set: the polished point fails the
     # check and the (restored) ADMM point is returned unchanged
