@@ -63,7 +63,7 @@ def test_polished_answer_is_exact(seed, kkt_backend):
     assert np.abs(plain.x - reference.x).max() > 2e-5
 
 
-@pytest.mark.parametrize("seed", [5, 18])
+@pytest.mark.parametrize("seed", [5, 20])
 def test_wrong_guess_keeps_the_admm_point(seed, kkt_backend):
     # two iterations of ADMM do not know the active set: the polished point fails the
     # check and the (restored) ADMM point is returned unchanged
@@ -512,6 +512,17 @@ def test_warm_polish_solves_a_released_contact_on_its_own_plane_first():
     answer's and every next solve put the contact past its apex, and the tick ran 46
     ADMM iterations. Newton's first solve now keeps that plane, with its curvature."""
     assert _warm_ticks("go2", 0, 38)[-1].iterations == 0
+
+
+def test_warm_polish_releases_a_contact_from_its_apex_with_its_curvature():
+    """go2's third benchmark sequence, tick 212, and solo12's, ticks 201-202: the warm
+    polish releases an apex block (a contact being loaded) to its boundary; placed with
+    ``lam = 0``, its first solve lacked the plane's curvature and threw the contact past
+    its apex, where it was held, released the same way and thrown again, and the ticks
+    ran ADMM. Released with the part of its multiplier off the cone as
+    ``lam``, the block is solved with its curvature and the warm polish answers them."""
+    assert _warm_ticks("go2", 200, 212)[-1].iterations == 0
+    assert all(r.polished and r.iterations == 0 for r in _warm_ticks("solo12", 200, 202)[1:])
 
 
 def test_warm_polish_solves_a_lifting_foot_by_schur_complement_without_admm_factorization():

@@ -134,12 +134,12 @@ cdef bint _chord_step(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
 
     The last factorization lacks the curvature of a plane that entered the guess with
     ``lam = 0`` (:func:`~fccqp.polish_guess.linearize`), and where ``P`` is flat on the
-    forces its step along that plane is all but unbounded: contacts that a warm polish
-    loaded (an apex block released to its boundary) were thrown past the apex by that
-    first chord step, held at the apex by :func:`~fccqp.polish_guess.drop_far_side`,
-    released again, and the polish ended cycling; the tick then ran ADMM. The Newton
-    step's factorization has the curvature; where it too crosses, ``drop_far_side``
-    holds the block as before (notes/polish.md, "warmtail")."""
+    forces its step along that plane is all but unbounded: contacts whose plane entered
+    so were thrown past the apex by that first chord step, held at the apex by
+    :func:`~fccqp.polish_guess.drop_far_side`, released again, and the polish ended
+    cycling; the tick then ran ADMM. The Newton step's factorization has the curvature;
+    where it too crosses, ``drop_far_side`` holds the block as before (notes/polish.md,
+    "warmtail")."""
     _keep_point(w, p, nb, False)
     if tabled:
         table_correct(w, p, table, kkt, rho_vec, nb, scale)

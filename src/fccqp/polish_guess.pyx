@@ -79,12 +79,11 @@ cdef void keep_bare_plane(Polish* w, const Problem* p, Py_ssize_t k) noexcept no
     the point of the plane's own touching ray with ``x_block``'s axis part (``x_block``
     itself where that part is not positive or the plane lies on the axis).
 
-    A plane placed with ``lam = 0`` (an apex block released, a free block that left its
-    cone) is solved without its curvature, and nothing held the block's tangential part
-    on the cone: moving the plane to that ``x_block`` had turned it 20-50 degrees away
-    from the answer's, and the next solve put the contact past its apex; the polish then
-    cycled between apex and boundary and the tick ran ADMM (warm polishes of contacts
-    being loaded; notes/performance-history.md, "warmtail2")."""
+    A plane placed with ``lam = 0`` (a free block that left its cone) is solved without
+    its curvature, and nothing held the block's tangential part on the cone: moving the
+    plane to that ``x_block`` had turned it 20-50 degrees away from the answer's, and the
+    next solve put the contact past its apex; the polish then cycled between apex and
+    boundary and the tick ran ADMM (notes/performance-history.md, "warmtail2")."""
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t cone = w.boundary[k], o = c.offset[cone]
     copy(w.kept_plane + o, w.g + o, c.dim[cone])
@@ -297,6 +296,18 @@ cdef bint leaves_set(const Polish* w, const Problem* p) noexcept nogil:
     return False
 
 
+cdef inline double _off_cone(const double* v, const double* projection,
+                             Py_ssize_t d) noexcept nogil:
+    """``||v - projection||``: with ``projection`` the projection of ``v`` onto its cone,
+    the part of ``v`` in the polar cone, which is ``v``'s component along the unit normal
+    of the cone's plane at ``projection`` (Moreau's decomposition)."""
+    cdef double total = 0.0
+    cdef Py_ssize_t j
+    for j in range(d):
+        total += (v[j] - projection[j]) * (v[j] - projection[j])
+    return sqrt(total)
+
+
 cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
                       const double* ahead, Py_ssize_t* changed) noexcept nogil:
     """Correct the guess from the polished point. With ``adding``, hold free entries
@@ -315,6 +326,14 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
     as in :func:`guess`. Returns the number of boundary blocks (planes and curvature at
     ``x_block``, or at the projection for a new one) and counts the changed entries in
     ``changed``.
+
+    An apex block released to its boundary starts, as in :func:`guess`, with its plane at
+    the projection of ``y_block`` and ``lam`` the part of ``y_block`` off the cone
+    (:func:`_off_cone`), so that its first solve has the curvature. Placed with ``lam =
+    0`` instead, nothing held the block's part across the axis where ``P`` is flat on the
+    forces: the solve that followed threw the contact past its apex, it was held there,
+    released the same way, and the polish ended ``cycling`` (warm polishes of contacts
+    being loaded: 7 of go2's 400 warm ticks, 16 of talos'; notes/polish.md, "apexplane").
 
     A ``BARE`` boundary block (its plane placed with ``lam = 0``) whose multiplier came
     out positive has that plane kept (``KEPT``) for :func:`keep_bare_plane`."""
@@ -367,6 +386,7 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
             along = cone_split(w.y + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
             code = FREE if across <= slope * along else BOUNDARY
             cone_project(w.y + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
+            lam = _off_cone(w.y + o, w.step, d)
         for j in range(o, o + d):
             changed[0] += code != before
             w.active[j] = code
