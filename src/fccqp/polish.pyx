@@ -379,7 +379,9 @@ cdef void _replane(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
     ticks 171 and 373: the answer's guess solved 4 and 6 times in 12, each step stopped
     at one of two contacts' apexes, the contact held, released, the other's apex next;
     notes/polish.md, "cycle"). Short of the apex the block's plane turns toward the
-    answer's."""
+    answer's. Not in a polish of ADMM's iterate, whose steps end the iterate's slide
+    along the cones (see :func:`polish`): there it cost go2's cold ticks 4 % more
+    iterations."""
     cdef Py_ssize_t j, k
     for j in range(p.n):
         w.x[j] = w.x_prev[j] + REPLANE_FRACTION * (w.x[j] - w.x_prev[j])
@@ -454,7 +456,10 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     (at most one pass per block): where the cone multipliers are too small for ADMM to
     resolve (solo12, 1e-5), its guess has every block free and the polish finds the
     boundary blocks one or two a pass, kept at its fourth or fifth (notes/polish.md,
-    "polishmiss"). False then, when a
+    "polishmiss"). A polish not of ADMM's iterate whose step on a guess it met before, every
+    multiplier signed, stops at a boundary block's apex does not hold that block: it solves
+    the guess again on planes short of the apex (:func:`_replane`, ``REPLANE_PASSES`` times
+    at most). False then, when a
     factorization breaks down or the result is not finite, or when the clock (:func:`fccqp_now`) has
     passed ``deadline`` before a guess after the first (``INFINITY``: never); otherwise
     the caller judges the point.
