@@ -376,10 +376,10 @@ cdef void _replane(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
     block's apex stops is mostly the answer's guess on planes that throw that block
     past its apex (placed where the previous tick's answer or a release put them):
     holding the block there sent the polish round the same guesses (anymal_c's warm
-    ticks 171 and 373: the answer's guess solved 4 and 6 times in 12, each step stopped
-    at one of two contacts' apexes, the contact held, released, the other's apex next;
-    notes/polish.md, "cycle"). Short of the apex the block's plane turns toward the
-    answer's. Not in a polish of ADMM's iterate, whose steps end the iterate's slide
+    tick 373: the answer's guess solved 6 times in 12, each step stopped at one of two
+    contacts' apexes, that contact held, then released, the other's apex next; 171: a
+    cycle of 4 guesses through such a stop; notes/polish.md, "cycle"). Short of the apex
+    the block's plane turns toward the answer's. Not in a polish of ADMM's iterate, whose steps end the iterate's slide
     along the cones (see :func:`polish`): there it cost go2's cold ticks 4 % more
     iterations."""
     cdef Py_ssize_t j, k
