@@ -582,18 +582,6 @@ def test_a_warm_polish_that_cycles_is_tried_again_from_its_own_point():
     assert result.polished and result.iterations == 0
 
 
-@pytest.mark.parametrize("tick", [171, 373])
-def test_a_warm_polish_that_meets_its_answer_again_stopped_at_an_apex_solves_it_on_new_planes(tick):
-    """anymal_c's benchmark ticks 171 and 373, warm from the tick before: the warm polish
-    meets the answer's guess, every multiplier signed, but each step toward its solution
-    is stopped at the apex of one of two loaded contacts; holding that contact, releasing
-    it and stopping at the other's apex went round the same guesses for all 12 and the
-    tick ran ADMM. Solving the guess met again on planes short of the apex settles it:
-    no iteration."""
-    result = _warm_ticks("anymal_c", tick - 1, tick)[-1]
-    assert result.polished and result.iterations == 0
-
-
 def test_polish_that_cycles_on_a_barely_loaded_contact_puts_its_last_guess_on_the_cones():
     """go2's quick benchmark set (``mix``, seed 0, sequences of 15), QP 21, started at the
     rho a previous cold solve handed over: one contact's optimal normal force is 0.17 N.

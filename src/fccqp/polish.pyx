@@ -79,14 +79,10 @@ from fccqp.polish_table cimport table_correct, table_factor, table_solve
 from fccqp.reduced cimport Reduced
 from fccqp.tuning cimport (CHORD_RATE, CHORD_STEPS, FEASIBLE_PASSES, GUESS_TOLERANCE,
                            HOPELESS_RATE, MISS_FLOOR, NEWTON_TOLERANCE, POLISH_CSC_DELTA,
-                           POLISH_DELTA, POLISH_REFINE_TOLERANCE, REPLANE_FRACTION,
-                           REPLANE_PASSES)
+                           POLISH_DELTA, POLISH_REFINE_TOLERANCE)
 
 cdef extern from "fccqp_clock.h" nogil:
     double fccqp_now()
-
-cdef enum:
-    GUESS_MEMORY = 16   # guesses a polish remembers to see one again (> WARM_GUESS_PASSES)
 
 
 cdef Py_ssize_t guess_changes(const Problem* p, const double* z, const double* y,
@@ -345,62 +341,6 @@ cdef bint polish_prepare(Polish* w, const Problem* p) noexcept nogil:
     return polish_schur_setup(&w.schur, p, POLISH_DELTA)
 
 
-cdef unsigned long long _guess_key(const Polish* w, const Problem* p) noexcept nogil:
-    """A 64-bit key of the guess ``active`` (FNV-1a over its codes): equal guesses, equal
-    keys; two different guesses of one polish share one with odds of about 1e-19."""
-    cdef unsigned long long key = 14695981039346656037ULL
-    cdef Py_ssize_t j
-    for j in range(p.s):
-        key = (key ^ <unsigned char>w.active[j]) * 1099511628211ULL
-    return key
-
-
-cdef bint _seen_before(unsigned long long* keys, long passes,
-                       unsigned long long key) noexcept nogil:
-    """Record ``key`` as that of the ``passes``-th guess of this polish and say whether
-    an earlier guess had it (past ``GUESS_MEMORY`` guesses: True)."""
-    cdef long j
-    if passes > GUESS_MEMORY:
-        return True
-    keys[passes - 1] = key
-    for j in range(passes - 1):
-        if keys[j] == key:
-            return True
-    return False
-
-
-cdef bint _stopped_at_apex(Polish* w, const Problem* p, Py_ssize_t blocking) noexcept nogil:
-    """Whether the step's ``blocking`` constraint is a boundary block reaching its apex
-    while every multiplier of the guess has its sign (:func:`~fccqp.polish_guess.most_wrong`)."""
-    return (blocking >= p.s and w.active[p.cones.offset[blocking - p.s]] == BOUNDARY
-            and most_wrong(w, p, 0.0) < 0)
-
-
-cdef void _replane(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
-    """Move the point ``REPLANE_FRACTION`` of the way from ``x_prev`` to the stopped step's
-    point and put every boundary block's plane and curvature on its cone there
-    (:func:`~fccqp.polish_guess.linearize_on_cone`), for the same guess to be solved again.
-
-    A guess met again whose multipliers all have their sign but whose step a boundary
-    block's apex stops is mostly the answer's guess on planes that throw that block
-    past its apex (placed where the previous tick's answer or a release put them):
-    holding the block there sent the polish round the same guesses (anymal_c's warm
-    tick 373: the answer's guess solved 6 times in 12, each step stopped at one of two
-    contacts' apexes, that contact held, then released, the other's apex next; 171: a
-    cycle of 4 guesses through such a stop; notes/polish.md, "cycle"). Short of the apex
-    the block's plane turns toward the answer's. Not in a polish of ADMM's iterate, whose steps end the iterate's slide
-    along the cones (see :func:`polish`): there it cost go2's cold ticks 4 % more
-    iterations."""
-    cdef Py_ssize_t j, k
-    for j in range(p.n):
-        w.x[j] = w.x_prev[j] + REPLANE_FRACTION * (w.x[j] - w.x_prev[j])
-    for j in range(p.m):
-        w.nu[j] = w.nu_prev[j] + REPLANE_FRACTION * (w.nu[j] - w.nu_prev[j])
-    for k in range(nb):
-        linearize_on_cone(w, p, k, w.x + p.constrained[p.cones.offset[w.boundary[k]]])
-    w.grad_current = False
-
-
 cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_steps,
                  int* factorizations, const Reduced* table, KKT* kkt,
                  const double* rho_vec, double deadline,
@@ -472,10 +412,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     it would end unsettled and be rejected, and ADMM, which follows a rejection anyway,
     would start its guesses later (talos' every-10th ticks: 12 such polishes crawled
     through all 12 guesses at 0.4-0.5M instructions each; notes/polish.md,
-    "talosexact"). A polish not of ADMM's iterate whose step on a guess it met before,
-    every multiplier signed, stops at a boundary block's apex does not hold that block: it
-    solves the guess again on planes short of the apex (:func:`_replane`,
-    ``REPLANE_PASSES`` times at most). False then, when a
+    "talosexact"). False then, when a
     factorization breaks down or the result is not finite, or when the clock (:func:`fccqp_now`) has
     passed ``deadline`` before a guess after the first (``INFINITY``: never); otherwise
     the caller judges the point.
@@ -492,9 +429,6 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     cdef Py_ssize_t blocking
     cdef const double* ahead
     cdef double t
-    cdef unsigned long long keys[GUESS_MEMORY]   # the guesses solved, for _seen_before
-    cdef bint seen   # the current guess was solved before in this polish
-    cdef long replanes = 0
     if p.P.kind == CSC:   # the curvature terms in PolishCSC's storage (n x the largest cone)
         w.hess, w.hess_stride = w.csc.hess, w.csc.hess_stride
     else:
@@ -524,7 +458,6 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
             return False
         _multipliers(w, p, nf, nb)
         passes += 1
-        seen = _seen_before(keys, passes, _guess_key(w, p))
         if passes == w.guess_passes or w.cycling:   # not settled: the caller judges this point
             if most_wrong(w, p, multiplier_slack) >= 0 or leaves_set(w, p):
                 # not its point: as it is
@@ -553,11 +486,6 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
                 for j in range(m):
                     w.nu[j] = w.nu_prev[j] + t * (w.nu[j] - w.nu_prev[j])
                 w.grad_current = False
-                if (seen and not from_iterate and t > 0.0 and replanes < REPLANE_PASSES
-                        and _stopped_at_apex(w, p, blocking)):
-                    replanes += 1   # the same guess on planes short of the apex, not a hold
-                    _replane(w, p, nb)
-                    continue
                 nb = renew(w, p, True, True, ahead, &changed)
                 continue
         held = boundary_entries(w, p, nb)

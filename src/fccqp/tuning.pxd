@@ -156,10 +156,6 @@ cdef extern from *:
     /* a warm polish stepping from a feasible point gives up when more of its multipliers
        are wrong-signed than this times its guesses left (one is released a guess) */
     #define FCCQP_HOPELESS_RATE 2.0
-    /* guesses a warm polish solves again on new planes (see REPLANE_FRACTION): 4 sent a go2 tick to ADMM */
-    #define FCCQP_REPLANE_PASSES 2
-    /* where: this fraction of the way to a repeated guess's apex stop (0.3 rescued neither anymal_c tick) */
-    #define FCCQP_REPLANE_FRACTION 0.75
     /* a free entry or block joins the active set when it violates by more than this */
     #define FCCQP_ACTIVE_TOLERANCE 1e-12
     /* Newton stops when every boundary block has |phi| <= this ||x_block|| */
@@ -283,8 +279,6 @@ cdef extern from *:
     const int CYCLED_GUESS_PASSES "FCCQP_CYCLED_GUESS_PASSES"
     const int FEASIBLE_PASSES "FCCQP_FEASIBLE_PASSES"
     const double HOPELESS_RATE "FCCQP_HOPELESS_RATE"
-    const int REPLANE_PASSES "FCCQP_REPLANE_PASSES"
-    const double REPLANE_FRACTION "FCCQP_REPLANE_FRACTION"
     const double ACTIVE_TOLERANCE "FCCQP_ACTIVE_TOLERANCE"
     const double NEWTON_TOLERANCE "FCCQP_NEWTON_TOLERANCE"
     const double MISS_FLOOR "FCCQP_MISS_FLOOR"
