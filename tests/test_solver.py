@@ -394,6 +394,27 @@ def test_a_neighbours_answer_whose_polish_fails_is_answered_from_the_cold_start(
     np.testing.assert_array_equal(guessed.x, cold.x)
 
 
+@pytest.mark.parametrize("seed", range(4))   # 4: on schur_reduced, 17 iterations
+def test_a_guess_holding_bounds_the_problem_releases_is_polished_without_iterations(seed):
+    """A caller's guess whose multipliers hold most bounds (the answer of the problem
+    pushed against them, as a contact change leaves the previous stance's torque limits)
+    is polished from nothing held, the bounds the problem needs added at once: the
+    problem's answer at 0 iterations, where releasing one held bound a guess ran out of
+    guesses and ADMM ran."""
+    rng = np.random.default_rng(seed)
+    n = 24
+    P, A, b = np.diag(1.0 + rng.random(n)), rng.standard_normal((2, n)), np.zeros(2)
+    lb, ub = -np.ones(n), np.ones(n)
+    pushed = fccqp.solve(P, 20 * np.ones(n), A, b, lb, ub)
+    q = 0.1 * rng.standard_normal(n)
+    q[:3] = -8.0   # three upper bounds active at the answer
+    plain = fccqp.solve(P, q, A, b, lb, ub)
+    guessed = fccqp.solve(P, q, A, b, lb, ub, x0=pushed.x, y0=pushed.y, z0=pushed.z)
+    assert np.sum(np.abs(pushed.x) == 1.0) > 12 and plain.iterations > 0
+    assert guessed.status is Status.SOLVED and guessed.iterations == 0
+    np.testing.assert_allclose(guessed.x, plain.x, rtol=0, atol=1e-12)
+
+
 def test_box_infeasible():
     P = np.eye(3)
     q = np.zeros(3)
