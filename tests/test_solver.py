@@ -361,7 +361,7 @@ def test_dual_guess_overrides_the_previous_answer_without_warm_start_setting():
     np.testing.assert_allclose(again.x, first.x, rtol=1e-9, atol=1e-12)
 
 
-@pytest.mark.parametrize("seed", [1, 7, 11])   # 0, 2, 3: the far guess polishes to the answer
+@pytest.mark.parametrize("seed", [20, 31, 38])   # most others: the polish is kept
 def test_a_far_guess_whose_polish_fails_is_answered_from_the_cold_start(seed):
     """When the warm polish from a caller's guess fails, ADMM starts from the cold start
     unless the guess is much nearer the termination test: a guess far from the answer
@@ -377,7 +377,7 @@ def test_a_far_guess_whose_polish_fails_is_answered_from_the_cold_start(seed):
     np.testing.assert_array_equal(far.x, cold.x)
 
 
-@pytest.mark.parametrize("seed", [172, 230, 270, 363])   # most other seeds: the guess polishes
+@pytest.mark.parametrize("seed", [172, 230, 271, 363])   # most other seeds: the guess polishes
 def test_a_neighbours_answer_whose_polish_fails_is_answered_from_the_cold_start(seed):
     """A guess that is the answer of a neighbouring problem (``q`` and ``b`` moved, as
     from the previous tick) and fails its warm polish is nearer the termination test
