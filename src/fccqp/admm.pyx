@@ -446,10 +446,10 @@ cdef class Workspace:
     cdef void _take_guess(self, const double* x0, const double* y0,
                           const double* z0) noexcept nogil:
         """Make the primal-dual guess ``(x0, y0, z0)`` (user's units) the previous
-        solution, polished: the run then starts from it exactly as a warm start from
-        its own answer does, the warm polish trying the guess's active set first (if
-        that fails, ADMM starts from the guess or the cold start,
-        :func:`fccqp.iteration._nearer_start`). Its rho is the last one this workspace
+        solution, polished: the run then starts from it as a warm start from its own
+        answer does, the warm polish first (from the guess's primal point with nothing
+        held, :func:`fccqp.acceptance._polish_start`; if that fails, ADMM starts from
+        the guess or the cold start, :func:`fccqp.iteration._nearer_start`). Its rho is the last one this workspace
         ran at, else ``settings.rho``."""
         cdef Engine* e = &self.e
         copy(x0, e.prev.x, e.prob.n)

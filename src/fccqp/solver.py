@@ -192,10 +192,11 @@ class Solver:
         y0, z0 : (m,) and (n,) array_like, optional
             Dual guesses beside ``x0``, in the conventions of :attr:`Result.y` and
             :attr:`Result.z` (a missing one is zero), as OSQP's ``warm_start(x, y)``:
-            the solve then starts from ``(x0, y0, z0)`` exactly as a warm start from
-            the previous answer does, trying first the polish on the guess's active
-            set, at the rho of this structure's last solve (``settings.rho`` on a new
-            one). Solving a problem again from its own :class:`Result`'s ``x, y, z``
+            the solve then starts from ``(x0, y0, z0)`` as a warm start from the
+            previous answer does, at the rho of this structure's last solve
+            (``settings.rho`` on a new one), trying first the polish from ``x0`` with
+            nothing held (the guess's multipliers serve ADMM's start, not the polish's
+            first guess). Solving a problem again from its own :class:`Result`'s ``x, y, z``
             takes no ADMM iteration when that result was polished. A caller whose
             problem changed size (a contact made or broken) passes the previous
             answer mapped onto the new variables and rows.
