@@ -24,6 +24,9 @@ from libc.math cimport sqrt
 from fccqp._types cimport Iterates
 from fccqp.tuning cimport MAX_REJECTIONS, MAX_WEIGHT_NORM, REGULARIZATION
 
+cdef extern from "fccqp_kernels.h" nogil:
+    int fccqp_spd_solve(double* M, double* b, int k)
+
 
 cdef void anderson_reset(Anderson* a, bint keep_rejections) noexcept nogil:
     """Forget the memory (after a change of rho, or at the start of a run)."""
@@ -38,35 +41,12 @@ cdef void anderson_reset(Anderson* a, bint keep_rejections) noexcept nogil:
 cdef bint solve_small_spd(double* M, double* b, int k) noexcept nogil:
     """Solve ``M x = b`` in place (``b`` becomes ``x``, ``M`` row-major its Cholesky
     factor) for the tiny positive definite Gram matrix; False if a pivot is not
-    positive. At size 10 this loop beats LAPACK's call overhead (0.5 us against 1.2 us
-    for ``dpotrf`` + ``dpotrs``, measured through numba), and it runs every iteration.
+    positive. ``fccqp_spd_solve`` (fccqp_kernels.h): loops unrolled for each ``k`` up to
+    10, which beat LAPACK's call overhead (0.5 us against 1.2 us for ``dpotrf`` +
+    ``dpotrs`` at size 10, measured through numba) and the rolled loops' mispredicted
+    exits; it runs every iteration.
     """
-    cdef int c, r, t
-    cdef double pivot, value
-    for c in range(k):
-        pivot = M[c * k + c]
-        for t in range(c):
-            pivot -= M[c * k + t] * M[c * k + t]
-        if not pivot > 0.0:
-            return False
-        pivot = sqrt(pivot)
-        M[c * k + c] = pivot
-        for r in range(c + 1, k):
-            value = M[r * k + c]
-            for t in range(c):
-                value -= M[r * k + t] * M[c * k + t]
-            M[r * k + c] = value / pivot
-    for r in range(k):
-        value = b[r]
-        for t in range(r):
-            value -= M[r * k + t] * b[t]
-        b[r] = value / M[r * k + r]
-    for r in range(k - 1, -1, -1):
-        value = b[r]
-        for t in range(r + 1, k):
-            value -= M[t * k + r] * b[t]
-        b[r] = value / M[r * k + r]
-    return True
+    return fccqp_spd_solve(M, b, k)
 
 
 cdef inline void _new_products(Anderson* a, const double* f, Py_ssize_t slot, int stored,

@@ -30,6 +30,16 @@
  * roundings, the same bits whether the AVX2 copy's instruction or the baseline's libm
  * call computes them.
  *
+ * fccqp_spd_solve: M x = b in place for a tiny k x k row-major positive definite M
+ * (Anderson's Gram matrix, k <= capacity): b becomes x, M its Cholesky factor (lower
+ * triangle, row-major); returns 0 at a pivot that is not positive. The operations and
+ * their order are anderson.pyx's former loops, so the bits are theirs; for k up to
+ * FCCQP_SPD_UNROLLED the loops are unrolled in full for that k (a copy per k, chosen by
+ * a switch), because their trip counts, 0 to k - 1 and changing at every row, cost a
+ * mispredicted branch per inner loop: 40 a call, 11 % of a cold go2 tick's
+ * mispredictions (callgrind's branch model; notes/performance-history.md, "ipc").
+ * Not cloned: a fused multiply-add would change the bits.
+ *
  * fccqp_symmetric_copy, fccqp_checked_copy, fccqp_scale_rows, fccqp_ruiz_maxima and
  * fccqp_row_spans: the per-solve passes over P and A of the validation scan, the
  * rescaling, the equilibration's passes and the rows' spans. They keep running maxima
@@ -586,6 +596,74 @@ static void fccqp_row_spans(const double *restrict A, int rows, int cols,
             if (row[j] != 0.0)
                 sum_1 += fabs(row[j]) * width[j];
         span[i] = fccqp_sum4(sum) + sum_1;
+    }
+}
+
+#define FCCQP_SPD_UNROLLED 10
+
+#if defined(__GNUC__) || defined(__clang__)
+#define FCCQP_FORCE_INLINE static inline __attribute__((always_inline))
+#define FCCQP_UNROLL _Pragma("GCC unroll 16")
+#else
+#define FCCQP_FORCE_INLINE static inline
+#define FCCQP_UNROLL
+#endif
+
+/* fccqp_spd_solve's body; a constant k (after inlining) lets the compiler unroll it */
+FCCQP_FORCE_INLINE int fccqp_spd_solve_k(double *restrict M, double *restrict b, const int k)
+{
+    FCCQP_UNROLL
+    for (int c = 0; c < k; c++) {
+        double pivot = M[c * k + c];
+        FCCQP_UNROLL
+        for (int t = 0; t < c; t++)
+            pivot -= M[c * k + t] * M[c * k + t];
+        if (!(pivot > 0.0))
+            return 0;
+        pivot = sqrt(pivot);
+        M[c * k + c] = pivot;
+        FCCQP_UNROLL
+        for (int r = c + 1; r < k; r++) {
+            double value = M[r * k + c];
+            FCCQP_UNROLL
+            for (int t = 0; t < c; t++)
+                value -= M[r * k + t] * M[c * k + t];
+            M[r * k + c] = value / pivot;
+        }
+    }
+    FCCQP_UNROLL
+    for (int r = 0; r < k; r++) {
+        double value = b[r];
+        FCCQP_UNROLL
+        for (int t = 0; t < r; t++)
+            value -= M[r * k + t] * b[t];
+        b[r] = value / M[r * k + r];
+    }
+    FCCQP_UNROLL
+    for (int r = k - 1; r >= 0; r--) {
+        double value = b[r];
+        FCCQP_UNROLL
+        for (int t = r + 1; t < k; t++)
+            value -= M[t * k + r] * b[t];
+        b[r] = value / M[r * k + r];
+    }
+    return 1;
+}
+
+static int fccqp_spd_solve(double *restrict M, double *restrict b, int k)
+{
+    switch (k) {
+    case 1: return fccqp_spd_solve_k(M, b, 1);
+    case 2: return fccqp_spd_solve_k(M, b, 2);
+    case 3: return fccqp_spd_solve_k(M, b, 3);
+    case 4: return fccqp_spd_solve_k(M, b, 4);
+    case 5: return fccqp_spd_solve_k(M, b, 5);
+    case 6: return fccqp_spd_solve_k(M, b, 6);
+    case 7: return fccqp_spd_solve_k(M, b, 7);
+    case 8: return fccqp_spd_solve_k(M, b, 8);
+    case 9: return fccqp_spd_solve_k(M, b, 9);
+    case 10: return fccqp_spd_solve_k(M, b, 10);
+    default: return fccqp_spd_solve_k(M, b, k);
     }
 }
 
