@@ -26,6 +26,8 @@ from fccqp.tuning cimport MAX_REJECTIONS, MAX_WEIGHT_NORM, REGULARIZATION
 
 cdef extern from "fccqp_kernels.h" nogil:
     int fccqp_spd_solve(double* M, double* b, int k)
+    void fccqp_slot_products(const double* df, long two_s, int stored, const double* newest,
+                             const double* f, double* to_new, double* to_f)
 
 
 cdef void anderson_reset(Anderson* a, bint keep_rejections) noexcept nogil:
@@ -52,24 +54,14 @@ cdef bint solve_small_spd(double* M, double* b, int k) noexcept nogil:
 cdef inline void _new_products(Anderson* a, const double* f, Py_ssize_t slot, int stored,
                                Py_ssize_t two_s) noexcept nogil:
     """The new slot's row of ``products`` (``df_slot' df_l``) and ``gamma = dF' f`` in one
-    pass over the stored slots: each of the two sums adds its terms in index order, as
-    two separate loops would, and ``df_l`` is read once for both."""
-    cdef Py_ssize_t l, j, cap = a.capacity
-    cdef const double* new = a.df + slot * two_s
-    cdef const double* row
-    cdef double to_new, to_f
+    pass over the stored slots (``fccqp_slot_products``: each sum adds its terms in index
+    order, four slots at a time); ``gram`` holds the row until it is copied into place
+    (``gram`` is scratch until :func:`anderson_step` fills it)."""
+    cdef Py_ssize_t l, cap = a.capacity
+    fccqp_slot_products(a.df, two_s, stored, a.df + slot * two_s, f, a.gram, a.gamma)
     for l in range(stored):
-        row = a.df + l * two_s
-        to_new = 0.0
-        to_f = 0.0
-        for j in range(0, two_s, 2):   # two_s is even
-            to_new += new[j] * row[j]
-            to_f += row[j] * f[j]
-            to_new += new[j + 1] * row[j + 1]
-            to_f += row[j + 1] * f[j + 1]
-        a.products[slot * cap + l] = to_new
-        a.products[l * cap + slot] = to_new
-        a.gamma[l] = to_f
+        a.products[slot * cap + l] = a.gram[l]
+        a.products[l * cap + slot] = a.gram[l]
 
 
 cdef void anderson_step(Anderson* a, Iterates* it, Py_ssize_t s) noexcept nogil:

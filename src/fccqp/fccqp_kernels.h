@@ -40,6 +40,14 @@
  * mispredictions (callgrind's branch model; notes/performance-history.md, "ipc").
  * Not cloned: a fused multiply-add would change the bits.
  *
+ * fccqp_slot_products: for each stored slot l (a row of Anderson's df, two_s entries),
+ * to_new[l] = newest' row_l and to_f[l] = row_l' f, each sum in index order from 0.0 as
+ * anderson.pyx's loop adds them, so the same bits; four slots at a time, whose eight
+ * sums are independent chains of additions that overlap in the pipeline, where one
+ * slot's two chains left it waiting on each addition's latency (a cold go2 tick spent
+ * about 15 % of its wall time in anderson_step, perf's samples; notes/performance-history.md,
+ * "ipc"). Not cloned: a fused multiply-add would change the bits.
+ *
  * fccqp_symmetric_copy, fccqp_checked_copy, fccqp_scale_rows, fccqp_ruiz_maxima and
  * fccqp_row_spans: the per-solve passes over P and A of the validation scan, the
  * rescaling, the equilibration's passes and the rows' spans. They keep running maxima
@@ -664,6 +672,50 @@ static int fccqp_spd_solve(double *restrict M, double *restrict b, int k)
     case 9: return fccqp_spd_solve_k(M, b, 9);
     case 10: return fccqp_spd_solve_k(M, b, 10);
     default: return fccqp_spd_solve_k(M, b, k);
+    }
+}
+
+/* fccqp_slot_products for slots [first, first + 4) */
+FCCQP_FORCE_INLINE void fccqp_four_slot_products(const double *restrict df, long two_s,
+                                                 int first, const double *restrict newest,
+                                                 const double *restrict f,
+                                                 double *restrict to_new,
+                                                 double *restrict to_f)
+{
+    const double *r0 = df + first * two_s, *r1 = r0 + two_s, *r2 = r1 + two_s;
+    const double *r3 = r2 + two_s;
+    double n0 = 0.0, n1 = 0.0, n2 = 0.0, n3 = 0.0, f0 = 0.0, f1 = 0.0, f2 = 0.0, f3 = 0.0;
+    for (long j = 0; j < two_s; j++) {
+        n0 += newest[j] * r0[j];
+        f0 += r0[j] * f[j];
+        n1 += newest[j] * r1[j];
+        f1 += r1[j] * f[j];
+        n2 += newest[j] * r2[j];
+        f2 += r2[j] * f[j];
+        n3 += newest[j] * r3[j];
+        f3 += r3[j] * f[j];
+    }
+    to_new[first] = n0, to_new[first + 1] = n1, to_new[first + 2] = n2;
+    to_new[first + 3] = n3;
+    to_f[first] = f0, to_f[first + 1] = f1, to_f[first + 2] = f2, to_f[first + 3] = f3;
+}
+
+static void fccqp_slot_products(const double *restrict df, long two_s, int stored,
+                                const double *restrict newest, const double *restrict f,
+                                double *restrict to_new, double *restrict to_f)
+{
+    int l = 0;
+    for (; l + 4 <= stored; l += 4)
+        fccqp_four_slot_products(df, two_s, l, newest, f, to_new, to_f);
+    for (; l < stored; l++) {
+        const double *row = df + l * two_s;
+        double n0 = 0.0, f0 = 0.0;
+        for (long j = 0; j < two_s; j++) {
+            n0 += newest[j] * row[j];
+            f0 += row[j] * f[j];
+        }
+        to_new[l] = n0;
+        to_f[l] = f0;
     }
 }
 
