@@ -67,9 +67,9 @@ cdef inline void backward_substitution(const double* L, int n, int ld, double* b
     """``b := L'^-1 b`` for the column-major lower triangle ``L``, from the last entry
     up: each entry, once solved, is subtracted from the entries above it (row ``k`` of
     ``L``, read with a stride of ``ld``). The entries above are independent sums, so a
-    step waits for one division, multiplication and subtraction; a dot product per row
-    of ``L'`` waited for each of its subtractions in turn, the latest entry first
-    (go2's ``H`` solves: 920 against 380 cycles of latency at n = 20)."""
+    step waits for one division, multiplication and subtraction, where a dot product per
+    row of ``L'`` would wait for each of its subtractions in turn, the latest entry's
+    first (about 920 against 380 cycles at n = 20, go2's ``H``)."""
     cdef int i, k
     cdef double value
     for k in range(n - 1, -1, -1):

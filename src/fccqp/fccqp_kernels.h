@@ -31,22 +31,22 @@
  * call computes them.
  *
  * fccqp_spd_solve: M x = b in place for a tiny k x k row-major positive definite M
- * (Anderson's Gram matrix, k <= capacity): b becomes x, M its Cholesky factor (lower
+ * (Anderson's Gram matrix, k <= its memory): b becomes x, M its Cholesky factor (lower
  * triangle, row-major); returns 0 at a pivot that is not positive. The operations and
- * their order are anderson.pyx's former loops, so the bits are theirs; for k up to
- * FCCQP_SPD_UNROLLED the loops are unrolled in full for that k (a copy per k, chosen by
- * a switch), because their trip counts, 0 to k - 1 and changing at every row, cost a
- * mispredicted branch per inner loop: 40 a call, 11 % of a cold go2 tick's
- * mispredictions (callgrind's branch model; notes/performance-history.md, "ipc").
- * Not cloned: a fused multiply-add would change the bits.
+ * their order are those of plain loops (tests/test_anderson.py holds them), whatever k;
+ * for k up to 10 (the default memory) the loops are unrolled in full for that k (a copy
+ * per k, chosen by a switch): rolled, their trip counts (0 to k - 1, changing at every
+ * row) cost a mispredicted branch per inner loop in callgrind's model, 40 a call, and
+ * the solve took a quarter more time in perf's samples of a cold go2 tick
+ * (notes/performance-history.md, "ipc"). Not cloned: a fused multiply-add would change
+ * the bits.
  *
  * fccqp_slot_products: for each stored slot l (a row of Anderson's df, two_s entries),
- * to_new[l] = newest' row_l and to_f[l] = row_l' f, each sum in index order from 0.0 as
- * anderson.pyx's loop adds them, so the same bits; four slots at a time, whose eight
- * sums are independent chains of additions that overlap in the pipeline, where one
- * slot's two chains left it waiting on each addition's latency (a cold go2 tick spent
- * about 15 % of its wall time in anderson_step, perf's samples; notes/performance-history.md,
- * "ipc"). Not cloned: a fused multiply-add would change the bits.
+ * to_new[l] = newest' row_l and to_f[l] = row_l' f, each sum in index order from 0.0;
+ * four slots at a time, whose eight sums are independent chains of additions that
+ * overlap in the pipeline (one slot at a time waits on each addition's latency: a
+ * fifth of anderson_step's time on a cold go2 tick, perf's samples). Not cloned: a
+ * fused multiply-add would change the bits.
  *
  * fccqp_symmetric_copy, fccqp_checked_copy, fccqp_scale_rows, fccqp_ruiz_maxima and
  * fccqp_row_spans: the per-solve passes over P and A of the validation scan, the
@@ -607,7 +607,6 @@ static void fccqp_row_spans(const double *restrict A, int rows, int cols,
     }
 }
 
-#define FCCQP_SPD_UNROLLED 10
 
 #if defined(__GNUC__) || defined(__clang__)
 #define FCCQP_FORCE_INLINE static inline __attribute__((always_inline))
