@@ -51,14 +51,16 @@ cdef inline void cholesky_solve(const double* L, int n, int ld, double* B, int c
 
 cdef inline void forward_substitution(const double* L, int n, int ld, double* b) noexcept nogil:
     """``b := L^-1 b`` for the column-major lower triangle ``L``, column by column (each
-    an update of contiguous entries)."""
+    an update of contiguous entries). Each entry is multiplied by its pivot's
+    reciprocal, which does not wait for ``b``: the division leaves the chain of
+    dependent steps (see :func:`backward_substitution`)."""
     cdef int i, k
     cdef double value
     cdef const double* column
     for k in range(n):
-        value = b[k] / L[k + k * ld]
-        b[k] = value
         column = L + k * ld
+        value = b[k] * (1.0 / column[k])
+        b[k] = value
         for i in range(k + 1, n):
             b[i] -= column[i] * value
 
@@ -67,13 +69,14 @@ cdef inline void backward_substitution(const double* L, int n, int ld, double* b
     """``b := L'^-1 b`` for the column-major lower triangle ``L``, from the last entry
     up: each entry, once solved, is subtracted from the entries above it (row ``k`` of
     ``L``, read with a stride of ``ld``). The entries above are independent sums, so a
-    step waits for one division, multiplication and subtraction, where a dot product per
-    row of ``L'`` would wait for each of its subtractions in turn, the latest entry's
-    first (about 920 against 380 cycles at n = 20, go2's ``H``)."""
+    step waits for two multiplications and a subtraction (the pivot's reciprocal does
+    not wait for ``b``), where a dot product per row of ``L'`` would wait for each of
+    its subtractions in turn, the latest entry's first, and a division (go2's ``H``, n =
+    20: about 920 cycles of latency, 380 with the division in the chain, 180 without)."""
     cdef int i, k
     cdef double value
     for k in range(n - 1, -1, -1):
-        value = b[k] / L[k + k * ld]
+        value = b[k] * (1.0 / L[k + k * ld])
         b[k] = value
         for i in range(k):
             b[i] -= L[k + i * ld] * value
