@@ -37,7 +37,7 @@
  * for k up to 10 (the default memory) the loops are unrolled in full for that k (a copy
  * per k, chosen by a switch): rolled, their trip counts (0 to k - 1, changing at every
  * row) cost a mispredicted branch per inner loop in callgrind's model, 40 a call, and
- * the solve took a quarter more time in perf's samples of a cold go2 tick
+ * the solve took a third more time in perf's samples of a cold go2 tick
  * (notes/performance-history.md, "ipc"). Not cloned: a fused multiply-add would change
  * the bits.
  *
