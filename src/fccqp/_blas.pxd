@@ -50,31 +50,78 @@ cdef inline void cholesky_solve(const double* L, int n, int ld, double* B, int c
 
 
 cdef inline void forward_substitution(const double* L, int n, int ld, double* b) noexcept nogil:
-    """``b := L^-1 b`` for the column-major lower triangle ``L``, column by column (each
-    an update of contiguous entries)."""
-    cdef int i, k
-    cdef double value
-    cdef const double* column
-    for k in range(n):
-        value = b[k] / L[k + k * ld]
-        b[k] = value
-        column = L + k * ld
+    """``b := L^-1 b`` for the column-major lower triangle ``L``, column by column: each
+    solved entry, multiplied by its pivot's reciprocal (which does not wait for ``b``,
+    so that the division leaves the chain of dependent steps), is subtracted from the
+    entries below it. Four columns at a time: their entries are solved in turn, then
+    the four subtractions from each entry below them in one pass (each entry's in
+    column order, as one column at a time would), which loads and stores it once."""
+    cdef int i, k = 0
+    cdef double v0, v1, v2, v3
+    cdef const double* c0
+    cdef const double* c1
+    cdef const double* c2
+    cdef const double* c3
+    while k + 4 <= n:
+        c0 = L + k * ld
+        c1 = c0 + ld
+        c2 = c1 + ld
+        c3 = c2 + ld
+        v0 = b[k] * (1.0 / c0[k])
+        b[k + 1] -= c0[k + 1] * v0
+        b[k + 2] -= c0[k + 2] * v0
+        b[k + 3] -= c0[k + 3] * v0
+        v1 = b[k + 1] * (1.0 / c1[k + 1])
+        b[k + 2] -= c1[k + 2] * v1
+        b[k + 3] -= c1[k + 3] * v1
+        v2 = b[k + 2] * (1.0 / c2[k + 2])
+        b[k + 3] -= c2[k + 3] * v2
+        v3 = b[k + 3] * (1.0 / c3[k + 3])
+        b[k], b[k + 1], b[k + 2], b[k + 3] = v0, v1, v2, v3
+        for i in range(k + 4, n):
+            b[i] = b[i] - c0[i] * v0 - c1[i] * v1 - c2[i] * v2 - c3[i] * v3
+        k += 4
+    for k in range(k, n):
+        c0 = L + k * ld
+        v0 = b[k] * (1.0 / c0[k])
+        b[k] = v0
         for i in range(k + 1, n):
-            b[i] -= column[i] * value
+            b[i] -= c0[i] * v0
 
 
 cdef inline void backward_substitution(const double* L, int n, int ld, double* b) noexcept nogil:
-    """``b := L'^-1 b`` for the column-major lower triangle ``L``, a dot product per row
-    of ``L'``."""
-    cdef int i, k
-    cdef double value
+    """``b := L'^-1 b`` for the column-major lower triangle ``L``, from the last entry
+    up: each solved entry, multiplied by its pivot's reciprocal, is subtracted from the
+    entries above it (row ``k`` of ``L``). The entries above are independent sums, so a
+    step waits for two multiplications and a subtraction, where a dot product per row of
+    ``L'`` would wait for each of its subtractions in turn, the latest entry's first, and
+    a division (go2's ``H``, n = 20: about 920 cycles of latency, 380 with the division
+    in the chain, 180 without). Four rows at a time, as in
+    :func:`forward_substitution`: their four entries of column ``i`` are adjacent."""
+    cdef int i, k = n
+    cdef double v0, v1, v2, v3
     cdef const double* column
-    for k in range(n - 1, -1, -1):
-        column = L + k * ld
-        value = b[k]
-        for i in range(k + 1, n):
-            value -= column[i] * b[i]
-        b[k] = value / column[k]
+    while k >= 4:
+        k -= 4   # rows k + 3 (solved first) down to k
+        v3 = b[k + 3] * (1.0 / L[k + 3 + (k + 3) * ld])
+        b[k + 2] -= L[k + 3 + (k + 2) * ld] * v3
+        b[k + 1] -= L[k + 3 + (k + 1) * ld] * v3
+        b[k] -= L[k + 3 + k * ld] * v3
+        v2 = b[k + 2] * (1.0 / L[k + 2 + (k + 2) * ld])
+        b[k + 1] -= L[k + 2 + (k + 1) * ld] * v2
+        b[k] -= L[k + 2 + k * ld] * v2
+        v1 = b[k + 1] * (1.0 / L[k + 1 + (k + 1) * ld])
+        b[k] -= L[k + 1 + k * ld] * v1
+        v0 = b[k] * (1.0 / L[k + k * ld])
+        b[k], b[k + 1], b[k + 2], b[k + 3] = v0, v1, v2, v3
+        for i in range(k):
+            column = L + k + i * ld
+            b[i] = b[i] - column[3] * v3 - column[2] * v2 - column[1] * v1 - column[0] * v0
+    for k in range(k - 1, -1, -1):
+        v0 = b[k] * (1.0 / L[k + k * ld])
+        b[k] = v0
+        for i in range(k):
+            b[i] -= L[k + i * ld] * v0
 
 
 cdef inline void cholesky_solve_vector(const double* L, int n, int ld, double* b) noexcept nogil:

@@ -24,6 +24,11 @@ from libc.math cimport sqrt
 from fccqp._types cimport Iterates
 from fccqp.tuning cimport MAX_REJECTIONS, MAX_WEIGHT_NORM, REGULARIZATION
 
+cdef extern from "fccqp_kernels.h" nogil:
+    int fccqp_spd_solve(double* M, double* b, int k)
+    void fccqp_slot_products(const double* df, long two_s, int stored, const double* newest,
+                             const double* f, double* to_new, double* to_f)
+
 
 cdef void anderson_reset(Anderson* a, bint keep_rejections) noexcept nogil:
     """Forget the memory (after a change of rho, or at the start of a run)."""
@@ -38,58 +43,25 @@ cdef void anderson_reset(Anderson* a, bint keep_rejections) noexcept nogil:
 cdef bint solve_small_spd(double* M, double* b, int k) noexcept nogil:
     """Solve ``M x = b`` in place (``b`` becomes ``x``, ``M`` row-major its Cholesky
     factor) for the tiny positive definite Gram matrix; False if a pivot is not
-    positive. At size 10 this loop beats LAPACK's call overhead (0.5 us against 1.2 us
-    for ``dpotrf`` + ``dpotrs``, measured through numba), and it runs every iteration.
+    positive. ``fccqp_spd_solve`` (fccqp_kernels.h): loops unrolled for each ``k`` up to
+    10, which beat LAPACK's call overhead (0.5 us against 1.2 us for ``dpotrf`` +
+    ``dpotrs`` at size 10, measured through numba) and the rolled loops' mispredicted
+    exits; it runs every iteration.
     """
-    cdef int c, r, t
-    cdef double pivot, value
-    for c in range(k):
-        pivot = M[c * k + c]
-        for t in range(c):
-            pivot -= M[c * k + t] * M[c * k + t]
-        if not pivot > 0.0:
-            return False
-        pivot = sqrt(pivot)
-        M[c * k + c] = pivot
-        for r in range(c + 1, k):
-            value = M[r * k + c]
-            for t in range(c):
-                value -= M[r * k + t] * M[c * k + t]
-            M[r * k + c] = value / pivot
-    for r in range(k):
-        value = b[r]
-        for t in range(r):
-            value -= M[r * k + t] * b[t]
-        b[r] = value / M[r * k + r]
-    for r in range(k - 1, -1, -1):
-        value = b[r]
-        for t in range(r + 1, k):
-            value -= M[t * k + r] * b[t]
-        b[r] = value / M[r * k + r]
-    return True
+    return fccqp_spd_solve(M, b, k)
 
 
 cdef inline void _new_products(Anderson* a, const double* f, Py_ssize_t slot, int stored,
                                Py_ssize_t two_s) noexcept nogil:
     """The new slot's row of ``products`` (``df_slot' df_l``) and ``gamma = dF' f`` in one
-    pass over the stored slots: each of the two sums adds its terms in index order, as
-    two separate loops would, and ``df_l`` is read once for both."""
-    cdef Py_ssize_t l, j, cap = a.capacity
-    cdef const double* new = a.df + slot * two_s
-    cdef const double* row
-    cdef double to_new, to_f
+    pass over the stored slots (``fccqp_slot_products``: each sum adds its terms in index
+    order, four slots at a time); ``gram`` holds the row until it is copied into place
+    (``gram`` is scratch until :func:`anderson_step` fills it)."""
+    cdef Py_ssize_t l, cap = a.capacity
+    fccqp_slot_products(a.df, two_s, stored, a.df + slot * two_s, f, a.gram, a.gamma)
     for l in range(stored):
-        row = a.df + l * two_s
-        to_new = 0.0
-        to_f = 0.0
-        for j in range(0, two_s, 2):   # two_s is even
-            to_new += new[j] * row[j]
-            to_f += row[j] * f[j]
-            to_new += new[j + 1] * row[j + 1]
-            to_f += row[j + 1] * f[j + 1]
-        a.products[slot * cap + l] = to_new
-        a.products[l * cap + slot] = to_new
-        a.gamma[l] = to_f
+        a.products[slot * cap + l] = a.gram[l]
+        a.products[l * cap + slot] = a.gram[l]
 
 
 cdef void anderson_step(Anderson* a, Iterates* it, Py_ssize_t s) noexcept nogil:

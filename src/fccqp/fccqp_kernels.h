@@ -30,6 +30,24 @@
  * roundings, the same bits whether the AVX2 copy's instruction or the baseline's libm
  * call computes them.
  *
+ * fccqp_spd_solve: M x = b in place for a tiny k x k row-major positive definite M
+ * (Anderson's Gram matrix, k <= its memory): b becomes x, M its Cholesky factor (lower
+ * triangle, row-major); returns 0 at a pivot that is not positive. The operations and
+ * their order are those of plain loops (tests/test_anderson.py holds them), whatever k;
+ * for k up to 10 (the default memory) the loops are unrolled in full for that k (a copy
+ * per k, chosen by a switch): rolled, their trip counts (0 to k - 1, changing at every
+ * row) cost a mispredicted branch per inner loop in callgrind's model, 40 a call, and
+ * the solve took a third more time in perf's samples of a cold go2 tick
+ * (notes/performance-history.md, "ipc"). Not cloned: a fused multiply-add would change
+ * the bits.
+ *
+ * fccqp_slot_products: for each stored slot l (a row of Anderson's df, two_s entries),
+ * to_new[l] = newest' row_l and to_f[l] = row_l' f, each sum in index order from 0.0;
+ * four slots at a time, whose eight sums are independent chains of additions that
+ * overlap in the pipeline (one slot at a time waits on each addition's latency: a
+ * fifth of anderson_step's time on a cold go2 tick, perf's samples). Not cloned: a
+ * fused multiply-add would change the bits.
+ *
  * fccqp_symmetric_copy, fccqp_checked_copy, fccqp_scale_rows, fccqp_ruiz_maxima and
  * fccqp_row_spans: the per-solve passes over P and A of the validation scan, the
  * rescaling, the equilibration's passes and the rows' spans. They keep running maxima
@@ -586,6 +604,117 @@ static void fccqp_row_spans(const double *restrict A, int rows, int cols,
             if (row[j] != 0.0)
                 sum_1 += fabs(row[j]) * width[j];
         span[i] = fccqp_sum4(sum) + sum_1;
+    }
+}
+
+
+#if defined(__GNUC__) || defined(__clang__)
+#define FCCQP_FORCE_INLINE static inline __attribute__((always_inline))
+#define FCCQP_UNROLL _Pragma("GCC unroll 16")
+#else
+#define FCCQP_FORCE_INLINE static inline
+#define FCCQP_UNROLL
+#endif
+
+/* fccqp_spd_solve's body; a constant k (after inlining) lets the compiler unroll it */
+FCCQP_FORCE_INLINE int fccqp_spd_solve_k(double *restrict M, double *restrict b, const int k)
+{
+    FCCQP_UNROLL
+    for (int c = 0; c < k; c++) {
+        double pivot = M[c * k + c];
+        FCCQP_UNROLL
+        for (int t = 0; t < c; t++)
+            pivot -= M[c * k + t] * M[c * k + t];
+        if (!(pivot > 0.0))
+            return 0;
+        pivot = sqrt(pivot);
+        M[c * k + c] = pivot;
+        FCCQP_UNROLL
+        for (int r = c + 1; r < k; r++) {
+            double value = M[r * k + c];
+            FCCQP_UNROLL
+            for (int t = 0; t < c; t++)
+                value -= M[r * k + t] * M[c * k + t];
+            M[r * k + c] = value / pivot;
+        }
+    }
+    FCCQP_UNROLL
+    for (int r = 0; r < k; r++) {
+        double value = b[r];
+        FCCQP_UNROLL
+        for (int t = 0; t < r; t++)
+            value -= M[r * k + t] * b[t];
+        b[r] = value / M[r * k + r];
+    }
+    FCCQP_UNROLL
+    for (int r = k - 1; r >= 0; r--) {
+        double value = b[r];
+        FCCQP_UNROLL
+        for (int t = r + 1; t < k; t++)
+            value -= M[t * k + r] * b[t];
+        b[r] = value / M[r * k + r];
+    }
+    return 1;
+}
+
+static int fccqp_spd_solve(double *restrict M, double *restrict b, int k)
+{
+    switch (k) {
+    case 1: return fccqp_spd_solve_k(M, b, 1);
+    case 2: return fccqp_spd_solve_k(M, b, 2);
+    case 3: return fccqp_spd_solve_k(M, b, 3);
+    case 4: return fccqp_spd_solve_k(M, b, 4);
+    case 5: return fccqp_spd_solve_k(M, b, 5);
+    case 6: return fccqp_spd_solve_k(M, b, 6);
+    case 7: return fccqp_spd_solve_k(M, b, 7);
+    case 8: return fccqp_spd_solve_k(M, b, 8);
+    case 9: return fccqp_spd_solve_k(M, b, 9);
+    case 10: return fccqp_spd_solve_k(M, b, 10);
+    default: return fccqp_spd_solve_k(M, b, k);
+    }
+}
+
+/* fccqp_slot_products for slots [first, first + 4) */
+FCCQP_FORCE_INLINE void fccqp_four_slot_products(const double *restrict df, long two_s,
+                                                 int first, const double *restrict newest,
+                                                 const double *restrict f,
+                                                 double *restrict to_new,
+                                                 double *restrict to_f)
+{
+    const double *r0 = df + first * two_s, *r1 = r0 + two_s, *r2 = r1 + two_s;
+    const double *r3 = r2 + two_s;
+    double n0 = 0.0, n1 = 0.0, n2 = 0.0, n3 = 0.0, f0 = 0.0, f1 = 0.0, f2 = 0.0, f3 = 0.0;
+    for (long j = 0; j < two_s; j++) {
+        n0 += newest[j] * r0[j];
+        f0 += r0[j] * f[j];
+        n1 += newest[j] * r1[j];
+        f1 += r1[j] * f[j];
+        n2 += newest[j] * r2[j];
+        f2 += r2[j] * f[j];
+        n3 += newest[j] * r3[j];
+        f3 += r3[j] * f[j];
+    }
+    to_new[first] = n0, to_new[first + 1] = n1, to_new[first + 2] = n2;
+    to_new[first + 3] = n3;
+    to_f[first] = f0, to_f[first + 1] = f1, to_f[first + 2] = f2, to_f[first + 3] = f3;
+}
+
+static void fccqp_slot_products(const double *restrict df, long two_s, int stored,
+                                const double *restrict newest, const double *restrict f,
+                                double *restrict to_new, double *restrict to_f)
+{
+    int l = 0;
+    for (; l + 4 <= stored; l += 4)
+        fccqp_four_slot_products(df, two_s, l, newest, f, to_new, to_f);
+    for (; l < stored; l++) {
+        const double *row = df + l * two_s;
+        double n0 = 0.0, f0 = 0.0;
+        for (long j = 0; j < two_s; j++) {
+            n0 += newest[j] * row[j];
+            f0 += row[j] * f[j];
+        }
+        to_new[l] = n0;
+        to_f[l] = f0;
     }
 }
 
