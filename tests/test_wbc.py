@@ -77,3 +77,21 @@ def test_a_settled_active_set_is_polished_before_admm_converges(test_set):
         gap = qp.objective(result.x) - qp.objective(x_ref)
         assert gap <= 1e-7 * (1 + abs(qp.objective(x_ref)))
     assert early <= 0.85 * plain   # 320 against 418 iterations
+
+
+def test_a_cold_control_tick_polishes_its_active_set_once_it_has_settled(test_set):
+    """Under a time limit a cold tick's ADMM iterate points to its final active set well
+    before the tolerances pass; the run polishes that set once it has held as long as it
+    took to form (tuning.SETTLE_ITERATIONS) and ends there, instead of at the check that
+    the tolerances pass, where a run without polishing stops. The answers are exact."""
+    timed = fccqp.Settings.realtime(10.0)   # a time limit that never binds here
+    early = plain = 0
+    for qp in test_set.qps:
+        args = (qp.P, qp.q, qp.A, qp.b, qp.lb, qp.ub, cones_of(qp))
+        result = fccqp.Solver(timed).solve(*args)
+        early += result.iterations
+        plain += fccqp.Solver(fccqp.Settings.realtime(10.0, polish=False)).solve(*args).iterations
+        assert result.status is fccqp.Status.SOLVED and result.polished
+        verify_solution(problem_of(qp), result, Tolerances.of(timed))
+        assert qp.equality_residual(result.x) <= 1e-9
+    assert early <= 0.8 * plain

@@ -46,7 +46,8 @@ from fccqp.termination cimport Residuals, converged, distance, nearly_converged
 from fccqp.tuning cimport (AUXILIARY_TIME, CLEANING_START, CONVERGING, EARLY_POLISH_GATE,
                            EARLY_POLISH_TRIES, EQUALITY_MISSED, GATED_CHECK_WAIT, GUESS_LEAD,
                            LOG_INTERVAL, POLISH_GATE, POLISH_RETRIES, RESERVE_PASSES,
-                           RESTART_MIN_ITER, STALL_FACTOR, STALLS, TIMED_EARLY_POLISH)
+                           RESTART_MIN_ITER, SETTLE_ITERATIONS, SETTLE_TRIES, STALL_FACTOR,
+                           STALLS, TIMED_EARLY_POLISH)
 from fccqp.verdict cimport (check, classify, inconsistent, missed, row_missed_by_data,
                             unbounded)
 
@@ -71,6 +72,9 @@ cdef struct Loop:
     int early_tries         # early polishes tried (EARLY_POLISH_TRIES)
     bint guess_polished     # the settled active set was polished early already
     bint first_check        # no early-polish check has run yet
+    long settled_from       # a timed run's active set counts as settled from this iteration
+    bint settle_polished    # that active set was polished already
+    int settle_tries        # settled active sets polished (SETTLE_TRIES)
     bint accelerate         # Anderson acceleration is on
     int stalls              # scheduled checks in a row whose primal residual stalled
     double periodic_prim    # the primal residual at the last scheduled check
@@ -123,6 +127,7 @@ cdef void iterate(Engine* e, Run* run, bint cold, double start_time) noexcept no
     while loop.status == RUNNING:
         loop.iteration += 1
         _step(e, &loop)                           # update_x, update_z, update_y
+        _track_settling(e, &loop)                 # when the active set last changed
         _schedule(e, &loop)                       # check, adapt rho, or neither
         if loop.check:
             _check(e, &loop, run)                 # residuals, termination, certificates
@@ -148,6 +153,9 @@ cdef inline void _begin(Engine* e, Loop* L, Run* run, bint cold, double start_ti
     L.retries = L.early_tries = 0
     L.guess_polished = False
     L.first_check = True
+    L.settled_from = LONG_MAX   # until the first look (_track_settling)
+    L.settle_polished = False
+    L.settle_tries = 0
     L.unbounded_start = False
     L.timed = isfinite(o.time_limit)
     L.cap = o.max_iter
@@ -411,12 +419,40 @@ cdef inline void _check(Engine* e, Loop* L, Run* run) noexcept nogil:
         L.next_gated = L.iteration + L.wait
 
 
+cdef inline void _track_settling(Engine* e, Loop* L) noexcept nogil:
+    """Under a time limit, before ``TIMED_EARLY_POLISH`` iterations, every
+    ``SETTLE_ITERATIONS`` steps: whether the active set ADMM's iterate points to
+    (:func:`fccqp.polish.guess_changes`) changed; a new one counts as settled once it
+    has held for as many iterations as the run took to reach it (:func:`_settled`). A
+    cold control tick's set settles 13-47 iterations (the robots' means) before the
+    check that the tolerances pass, where it used to be polished first; an early polish
+    of a set that changes again later fails, and costs up to ``GUESS_PASSES`` guesses
+    (talos: a guess costs about 20 iterations), so the wait grows with the run. Sampled,
+    not at every step: one look costs about a tenth of one of talos' iterations."""
+    if not L.timed or L.iteration >= TIMED_EARLY_POLISH or L.iteration % SETTLE_ITERATIONS:
+        return
+    if (guess_changes(&e.prob, e.it.z, e.it.y, e.work.guess_point, e.work.guess_codes) != 0
+            or L.iteration == SETTLE_ITERATIONS):   # the first look compares with another run
+        L.settled_from = 2 * L.iteration
+        L.settle_polished = False
+
+
+cdef inline bint _settled(const Loop* L) noexcept nogil:
+    """Whether a timed run's active set has settled (:func:`_track_settling`) and is
+    not polished yet, with tries left (``SETTLE_TRIES``)."""
+    return (L.timed and L.iteration < TIMED_EARLY_POLISH and L.iteration >= L.settled_from
+            and not L.settle_polished and L.settle_tries < SETTLE_TRIES)
+
+
 cdef inline void _polish_attempts(Engine* e, Loop* L, Run* run) noexcept nogil:
     """Polish a SOLVED iterate (a failure goes on at tighter tolerances, closer to the
     active set, ``POLISH_RETRIES`` times); also polish an active set that settled near
-    convergence (``EARLY_POLISH_GATE``), under a time limit only from
-    ``TIMED_EARLY_POLISH`` iterations on: a control tick's budget has no room for it, a
-    long run needs it (PRIMALC1 of Maros-Meszaros: its gap stays at 1.6 without it)."""
+    convergence (``EARLY_POLISH_GATE``): between two scheduled checks (every
+    ``adaptive_rho_interval`` iterations), under a time limit only from
+    ``TIMED_EARLY_POLISH`` iterations on (a long run needs it: PRIMALC1 of
+    Maros-Meszaros, whose gap stays at 1.6 without it); before that, at a check once it
+    held as long as it took to form (:func:`_settled`): a control tick's budget has no
+    room for polishes of a set that moves again."""
     cdef Options* o = &e.opt
     if L.status == SOLVED and o.polish and not L.last and L.retries < POLISH_RETRIES:
         L.polished_at = L.iteration
@@ -437,6 +473,12 @@ cdef inline void _polish_attempts(Engine* e, Loop* L, Run* run) noexcept nogil:
             L.early_tries += 1
             L.polished_at = L.iteration
             run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, True)
+    if (L.status == RUNNING and o.polish and not L.last and _settled(L)
+            and nearly_converged(&e.res, o.eps_abs, o.eps_rel, EARLY_POLISH_GATE)):
+        L.settle_polished = True
+        L.settle_tries += 1
+        L.polished_at = L.iteration
+        run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, True)
     if L.cap_polish and L.status == RUNNING and o.polish and not L.last:
         # an extended cap (_extend): where an untimed run ends and polishes whatever its
         # distance, this one polishes too and goes on unless that solved it

@@ -181,8 +181,8 @@ class Settings:
     1.1e-3 to 9e-9 and 4e-7 (docs/performance.md has its current cost). A warm start
     from a polished solution polishes its active set first, before any iteration, and
     without a time limit a run polishes early once the active set its iterate points
-    to has settled (``fccqp.tuning.EARLY_POLISH_GATE``); under a time limit only
-    from ``fccqp.tuning.TIMED_EARLY_POLISH`` iterations on."""
+    to has settled (``fccqp.tuning.EARLY_POLISH_GATE``); under a time limit, once it
+    has held as long as it took to form (``fccqp.tuning.SETTLE_ITERATIONS``)."""
     polish_refine_iter: int = 20
     """Most re-linearizations of the boundary cones' tangent planes in polishing (Newton
     steps, taken only until the cone function is met to 1e-13 or stops improving; a

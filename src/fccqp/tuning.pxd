@@ -202,6 +202,11 @@ cdef extern from *:
     #define FCCQP_RESERVE_PASSES 2.0
     /* with a time limit the early polish runs from this iteration (no control tick runs so long) */
     #define FCCQP_TIMED_EARLY_POLISH 1000
+    /* below that, a timed run looks at its active set every this many iterations and polishes
+       one that held as long as it took to form: 1 and 3 equal cold iterations, 3 cheaper */
+    #define FCCQP_SETTLE_ITERATIONS 3
+    /* at most this many times a run (a failed try costs up to GUESS_PASSES guesses) */
+    #define FCCQP_SETTLE_TRIES 3
     /* with a time limit max_iter grows by half while the distance to tolerance shrinks this much */
     #define FCCQP_CONVERGING 0.5
     /* a stalled timed run gets its certificates and retries only with this many seconds left */
@@ -302,5 +307,7 @@ cdef extern from *:
     const double RESERVE_DECAY "FCCQP_RESERVE_DECAY"
     const double RESERVE_PASSES "FCCQP_RESERVE_PASSES"
     const long TIMED_EARLY_POLISH "FCCQP_TIMED_EARLY_POLISH"
+    const long SETTLE_ITERATIONS "FCCQP_SETTLE_ITERATIONS"
+    const int SETTLE_TRIES "FCCQP_SETTLE_TRIES"
     const double CONVERGING "FCCQP_CONVERGING"
     const double AUXILIARY_TIME "FCCQP_AUXILIARY_TIME"
