@@ -449,8 +449,8 @@ cdef class Workspace:
         solution, polished: the run then starts from it as a warm start from its own
         answer does, the warm polish first (from the guess's primal point with nothing
         held, :func:`fccqp.acceptance._polish_start`; if that fails, ADMM starts from
-        the guess or the cold start, :func:`fccqp.iteration._nearer_start`). Its rho is the last one this workspace
-        ran at, else ``settings.rho``."""
+        the guess or the cold start, :func:`fccqp.iteration._nearer_start`). Its rho is
+        the last one this workspace ran at, else ``settings.rho``."""
         cdef Engine* e = &self.e
         copy(x0, e.prev.x, e.prob.n)
         copy(y0, e.prev.y, e.prob.m)
