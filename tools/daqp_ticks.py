@@ -4,7 +4,10 @@ What: the instructions (callgrind's ``Ir``) of each DAQP solve of a robot's benc
 test set (the ``--full`` preset's, cached in ``benchmarks/.cache``), warm along its
 sequences as the benchmark runs DAQP (``benchmarks.pyramid_solvers.DaqpAdapter``: the
 4-facet inner pyramid, the previous QP's multipliers as ``dual_start``, carried across a
-contact change; a new adapter at each sequence start); p50 / p90 / p95 / p99 / max over
+contact change; a new adapter at each sequence start), or with ``--stride K`` only every
+K-th QP of each sequence from its first, each warm from the previous kept one (the
+benchmark's "every K-th" view, ``benchmarks.views.coarse_path``, as
+``callgrind_ticks.py --mode coarse --stride K``); p50 / p90 / p95 / p99 / max over
 the ticks (nearest rank, numpy ``inverted_cdf``), and with ``--fccqp`` the same of a
 ``tools/callgrind_ticks.py --per-tick --save`` file and the ratios.
 
@@ -28,14 +31,14 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-from callgrind_ticks import ROOT, THREAD_ENV, TOGGLE, WARMUP_QPS, _totals, set_path
+from callgrind_ticks import ROOT, THREAD_ENV, TOGGLE, WARMUP_QPS, _totals, set_path, tick_positions
 
 PERCENTILES = (50, 90, 95, 99)
 
 
-def child(set_path_: Path, rows_file: Path) -> None:
-    """Solve the set warm (the counted pass) and write each solve's iterations and
-    success to ``rows_file``."""
+def child(set_path_: Path, rows_file: Path, stride: int) -> None:
+    """Solve every ``stride``-th QP of each sequence warm (the counted pass) and write
+    each solve's iterations and success to ``rows_file``."""
     sys.path.insert(0, str(ROOT))
     from benchmarks import testsets
     from benchmarks.pyramid_solvers import DaqpAdapter
@@ -48,7 +51,9 @@ def child(set_path_: Path, rows_file: Path) -> None:
         for qp in ts.qps[:WARMUP_QPS]:
             warmup.solve(warmup.prepare(qp))
         adapter, sequence = None, None
-        for i, qp in enumerate(ts.qps):
+        kept = np.flatnonzero(tick_positions(np.asarray(ts.sequence)) % stride == 0)
+        for i in kept:
+            qp = ts.qps[i]
             if ts.sequence[i] != sequence:
                 adapter, sequence = DaqpAdapter("daqp"), ts.sequence[i]
             data = adapter.prepare(qp)
@@ -57,14 +62,16 @@ def child(set_path_: Path, rows_file: Path) -> None:
     rows_file.write_text(json.dumps(rows))
 
 
-def measure(robot: str, cache: Path, out_dir: Path, valgrind: str) -> tuple[np.ndarray, list]:
+def measure(robot: str, cache: Path, out_dir: Path, valgrind: str,
+            stride: int) -> tuple[np.ndarray, list]:
     """One callgrind run of :func:`child`; instructions per tick and the child's rows."""
     out = out_dir / f"daqp-{robot}.callgrind"
     rows_file = out_dir / f"daqp-{robot}.json"
     cmd = [valgrind, "--tool=callgrind", f"--callgrind-out-file={out}",
            "--collect-atstart=no", f"--toggle-collect={TOGGLE}", f"--dump-after={TOGGLE}",
            sys.executable, str(Path(__file__).resolve()), "--child", "--robot", robot,
-           "--set", str(set_path(robot, cache)), "--rows", str(rows_file)]
+           "--set", str(set_path(robot, cache)), "--rows", str(rows_file),
+           "--stride", str(stride)]
     env = dict(os.environ, PYTHONHASHSEED="0", **dict.fromkeys(THREAD_ENV, "1"))
     run = subprocess.run(cmd, env=env, capture_output=True, text=True)
     if run.returncode:
@@ -85,21 +92,31 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--robot", required=True)
     parser.add_argument("--cache", type=Path, default=ROOT / "benchmarks" / ".cache")
+    parser.add_argument("--stride", type=int, default=1,
+                        help="solve every STRIDE-th QP of each sequence, each warm from the "
+                        "previous kept one (default 1: every QP)")
     parser.add_argument("--fccqp", type=Path, help="a callgrind_ticks.py --per-tick --save "
-                        "file of the same robot's warm pass, to compare")
+                        "file of the same robot's pass (warm, or coarse at the same "
+                        "--stride), to compare")
+    parser.add_argument("--save", type=Path, help="write each tick's instructions, DAQP "
+                        "iterations and success to this JSON file")
     parser.add_argument("--valgrind", default="valgrind")
     parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--set", type=Path, help=argparse.SUPPRESS)
     parser.add_argument("--rows", type=Path, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.child:
-        child(args.set, args.rows)
+        child(args.set, args.rows, args.stride)
         return
     with tempfile.TemporaryDirectory(prefix="daqp_ticks-") as tmp:
-        ticks, rows = measure(args.robot, args.cache, Path(tmp), args.valgrind)
-    print(f"{args.robot} DAQP warm, {len(ticks)} ticks, p50 / p90 / p95 / p99 / max: "
+        ticks, rows = measure(args.robot, args.cache, Path(tmp), args.valgrind, args.stride)
+    view = "warm" if args.stride == 1 else f"every {args.stride}th"
+    print(f"{args.robot} DAQP {view}, {len(ticks)} ticks, p50 / p90 / p95 / p99 / max: "
           f"{spread(ticks)}, mean {ticks.mean() / 1e6:.4f}M; solved "
           f"{sum(ok for _, ok in rows)}, iterations {sum(it for it, _ in rows)}")
+    if args.save:
+        args.save.write_text(json.dumps(
+            [[int(ir), it, ok] for ir, (it, ok) in zip(ticks, rows, strict=True)]))
     if args.fccqp:
         saved = next(iter(json.loads(args.fccqp.read_text()).values()))
         ours = np.array([row[3] for row in saved["per_tick"]], dtype=float)
