@@ -42,11 +42,17 @@
  * the bits.
  *
  * fccqp_slot_products: for each stored slot l (a row of Anderson's df, two_s entries),
- * to_new[l] = newest' row_l and to_f[l] = row_l' f, each sum in index order from 0.0;
- * four slots at a time, whose eight sums are independent chains of additions that
- * overlap in the pipeline (one slot at a time waits on each addition's latency: a
- * fifth of anderson_step's time on a cold go2 tick, perf's samples). Not cloned: a
- * fused multiply-add would change the bits.
+ * to_new[l] = newest' row_l and to_f[l] = row_l' f; each sum in four lanes over the
+ * entries (explicit lanes, so the same bits on every CPU), two slots per pass sharing the
+ * loads of newest and f. In index order, one chain of additions per sum, they took 1.9k
+ * of anderson_step's 5.9k instructions a call on a cold go2 tick (callgrind; eight
+ * chains side by side, four slots a pass). fccqp_sum_squares sums v'v the same way.
+ *
+ * fccqp_slot_combination: out = sum over the stored slots l of coefficient[l] row_l,
+ * each entry's terms added in slot order from 0.0 (the bits of one pass per slot), four
+ * slots per pass over out, which is loaded and stored once per pass: Anderson's step
+ * (dG + dF) gamma, 1.3k instructions a call one slot per pass. Not cloned: a fused
+ * multiply-add would change the bits.
  *
  * fccqp_symmetric_copy, fccqp_checked_copy, fccqp_scale_rows, fccqp_ruiz_maxima and
  * fccqp_row_spans: the per-solve passes over P and A of the validation scan, the
@@ -674,48 +680,91 @@ static int fccqp_spd_solve(double *restrict M, double *restrict b, int k)
     }
 }
 
-/* fccqp_slot_products for slots [first, first + 4) */
-FCCQP_FORCE_INLINE void fccqp_four_slot_products(const double *restrict df, long two_s,
-                                                 int first, const double *restrict newest,
-                                                 const double *restrict f,
-                                                 double *restrict to_new,
-                                                 double *restrict to_f)
+/* fccqp_slot_products for the rows r0 and r1 (out: newest' r0, r0' f, newest' r1, r1' f) */
+FCCQP_FORCE_INLINE void fccqp_slot_pair_products(const double *restrict r0,
+                                                 const double *restrict r1, long two_s,
+                                                 const double *restrict newest,
+                                                 const double *restrict f, double out[4])
 {
-    const double *r0 = df + first * two_s, *r1 = r0 + two_s, *r2 = r1 + two_s;
-    const double *r3 = r2 + two_s;
-    double n0 = 0.0, n1 = 0.0, n2 = 0.0, n3 = 0.0, f0 = 0.0, f1 = 0.0, f2 = 0.0, f3 = 0.0;
-    for (long j = 0; j < two_s; j++) {
-        n0 += newest[j] * r0[j];
-        f0 += r0[j] * f[j];
-        n1 += newest[j] * r1[j];
-        f1 += r1[j] * f[j];
-        n2 += newest[j] * r2[j];
-        f2 += r2[j] * f[j];
-        n3 += newest[j] * r3[j];
-        f3 += r3[j] * f[j];
+    fccqp_v4 n0 = fccqp_splat4(0.0), f0 = n0, n1 = n0, f1 = n0;
+    long j = 0;
+    for (; j + 4 <= two_s; j += 4) {
+        fccqp_v4 w = fccqp_load4(newest + j), v = fccqp_load4(f + j);
+        fccqp_v4 a = fccqp_load4(r0 + j), b = fccqp_load4(r1 + j);
+        n0 = fccqp_add4(n0, fccqp_mul4(w, a));
+        f0 = fccqp_add4(f0, fccqp_mul4(a, v));
+        n1 = fccqp_add4(n1, fccqp_mul4(w, b));
+        f1 = fccqp_add4(f1, fccqp_mul4(b, v));
     }
-    to_new[first] = n0, to_new[first + 1] = n1, to_new[first + 2] = n2;
-    to_new[first + 3] = n3;
-    to_f[first] = f0, to_f[first + 1] = f1, to_f[first + 2] = f2, to_f[first + 3] = f3;
+    out[0] = fccqp_sum4(n0), out[1] = fccqp_sum4(f0);
+    out[2] = fccqp_sum4(n1), out[3] = fccqp_sum4(f1);
+    for (; j < two_s; j++) {
+        out[0] += newest[j] * r0[j];
+        out[1] += r0[j] * f[j];
+        out[2] += newest[j] * r1[j];
+        out[3] += r1[j] * f[j];
+    }
 }
 
 static void fccqp_slot_products(const double *restrict df, long two_s, int stored,
                                 const double *restrict newest, const double *restrict f,
                                 double *restrict to_new, double *restrict to_f)
 {
-    int l = 0;
-    for (; l + 4 <= stored; l += 4)
-        fccqp_four_slot_products(df, two_s, l, newest, f, to_new, to_f);
-    for (; l < stored; l++) {
+    double out[4];
+    for (int l = 0; l < stored; l += 2) {
         const double *row = df + l * two_s;
-        double n0 = 0.0, f0 = 0.0;
-        for (long j = 0; j < two_s; j++) {
-            n0 += newest[j] * row[j];
-            f0 += row[j] * f[j];
-        }
-        to_new[l] = n0;
-        to_f[l] = f0;
+        /* an odd last slot is paired with itself */
+        fccqp_slot_pair_products(row, l + 1 < stored ? row + two_s : row, two_s, newest, f,
+                                 out);
+        to_new[l] = out[0], to_f[l] = out[1];
+        if (l + 1 < stored)
+            to_new[l + 1] = out[2], to_f[l + 1] = out[3];
     }
+}
+
+/* fccqp_slot_combination's pass over count (1 to 4, constant once inlined) slots */
+FCCQP_FORCE_INLINE void fccqp_add_slots(double *restrict out, const double *restrict rows,
+                                        long two_s, const double *restrict coefficient,
+                                        const int count)
+{
+    for (long j = 0; j < two_s; j++) {
+        double value = out[j];
+        FCCQP_UNROLL
+        for (int i = 0; i < count; i++)
+            value += rows[i * two_s + j] * coefficient[i];
+        out[j] = value;
+    }
+}
+
+static void fccqp_slot_combination(const double *restrict rows, long two_s, int stored,
+                                   const double *restrict coefficient, double *restrict out)
+{
+    for (long j = 0; j < two_s; j++)
+        out[j] = 0.0;
+    for (int l = 0; l < stored; l += 4) {
+        const double *first = rows + l * two_s;
+        switch (stored - l) {
+        case 1: fccqp_add_slots(out, first, two_s, coefficient + l, 1); break;
+        case 2: fccqp_add_slots(out, first, two_s, coefficient + l, 2); break;
+        case 3: fccqp_add_slots(out, first, two_s, coefficient + l, 3); break;
+        default: fccqp_add_slots(out, first, two_s, coefficient + l, 4);
+        }
+    }
+}
+
+/* v'v in four lanes (as fccqp_slot_pair_products sums) */
+static double fccqp_sum_squares(const double *restrict v, long k)
+{
+    fccqp_v4 lanes = fccqp_splat4(0.0);
+    long j = 0;
+    for (; j + 4 <= k; j += 4) {
+        fccqp_v4 x = fccqp_load4(v + j);
+        lanes = fccqp_add4(lanes, fccqp_mul4(x, x));
+    }
+    double total = fccqp_sum4(lanes);
+    for (; j < k; j++)
+        total += v[j] * v[j];
+    return total;
 }
 
 #endif
