@@ -31,6 +31,13 @@ cdef extern from "fccqp_kernels.h" nogil:
     void fccqp_slot_combination(const double* rows, long two_s, int stored,
                                 const double* coefficient, double* out)
     double fccqp_sum_squares(const double* v, long k)
+    void fccqp_fixed_point_residual(const double* z_prev, const double* y_prev,
+                                    const double* z, const double* y, const double* rho,
+                                    long s, double* g, double* f)
+    void fccqp_point_differences(const double* g_new, const double* f_new, const double* g,
+                                 const double* f, long two_s, double* df, double* dgf)
+    void fccqp_extrapolate(double* z, double* y, const double* rho, const double* step,
+                           long s, double* plain)
 
 
 cdef void anderson_reset(Anderson* a, bint keep_rejections) noexcept nogil:
@@ -70,26 +77,17 @@ cdef inline void _new_products(Anderson* a, const double* f, Py_ssize_t slot, in
 cdef inline double _residual(Anderson* a, const Iterates* it, Py_ssize_t s) noexcept nogil:
     """``g_new = (z_prev, y_prev / rho)`` and its residual ``f_new = (z, y / rho) - g_new``;
     returns ``|f_new|``."""
-    cdef Py_ssize_t j
-    cdef double* g = a.g_new
-    cdef double* f = a.f_new
-    for j in range(s):
-        g[j] = it.z_prev[j]
-        g[s + j] = it.y_prev[j] / it.rho_vec[j]
-        f[j] = it.z[j] - g[j]
-        f[s + j] = it.y[j] / it.rho_vec[j] - g[s + j]
-    return sqrt(fccqp_sum_squares(f, 2 * s))
+    fccqp_fixed_point_residual(it.z_prev, it.y_prev, it.z, it.y, it.rho_vec, s, a.g_new,
+                               a.f_new)
+    return sqrt(fccqp_sum_squares(a.f_new, 2 * s))
 
 
 cdef inline void _record(Anderson* a, Py_ssize_t two_s) noexcept nogil:
     """Store the differences from the previous point to the new one (``g``, ``f`` to
     ``g_new``, ``f_new``) in the next slot, and the new slot's products."""
-    cdef Py_ssize_t j, slot = a.stored % a.capacity
-    cdef double* df = a.df + slot * two_s
-    cdef double* dgf = a.dgf + slot * two_s
-    for j in range(two_s):
-        df[j] = a.f_new[j] - a.f[j]
-        dgf[j] = (a.g_new[j] - a.g[j]) + df[j]
+    cdef Py_ssize_t slot = a.stored % a.capacity
+    fccqp_point_differences(a.g_new, a.f_new, a.g, a.f, two_s, a.df + slot * two_s,
+                            a.dgf + slot * two_s)
     a.stored += 1
     # only the new slot's products change: O(capacity s) instead of O(capacity^2 s)
     _new_products(a, a.f_new, slot, <int>min(a.stored, <long>a.capacity), two_s)
@@ -107,7 +105,6 @@ cdef void anderson_step(Anderson* a, Iterates* it, Py_ssize_t s) noexcept nogil:
     cdef Py_ssize_t j, i, l, two_s = 2 * s
     cdef int stored, cap = a.capacity
     cdef double f_norm, ridge, acc
-    cdef double* step
     if a.wait > 0:   # plain steps only (a rejection cleared ``accelerated``)
         a.wait -= 1
         return
@@ -147,13 +144,8 @@ cdef void anderson_step(Anderson* a, Iterates* it, Py_ssize_t s) noexcept nogil:
         return
     # the step (dG + dF) gamma into the scratch g_new (fccqp_slot_combination: each
     # entry's terms in slot order, four slots per pass)
-    step = a.g_new
-    fccqp_slot_combination(a.dgf, two_s, stored, a.gamma, step)
-    for j in range(s):
-        a.plain[j] = it.z[j]
-        a.plain[s + j] = it.y[j] / it.rho_vec[j]
-        it.z[j] -= step[j]
-        it.y[j] -= step[s + j] * it.rho_vec[j]
+    fccqp_slot_combination(a.dgf, two_s, stored, a.gamma, a.g_new)
+    fccqp_extrapolate(it.z, it.y, it.rho_vec, a.g_new, s, a.plain)
     a.accelerated = True
 
 
