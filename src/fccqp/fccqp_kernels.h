@@ -680,24 +680,66 @@ static int fccqp_spd_solve(double *restrict M, double *restrict b, int k)
     }
 }
 
+/* Four lanes in one 32-byte vector for Anderson's kernels (GCC / clang vector
+ * extensions): one AVX2 instruction each in the AVX2 copy, two SSE2 ones in the
+ * baseline (they add, multiply and move, never compare). Elsewhere a struct. */
+#if defined(__GNUC__) || defined(__clang__)
+typedef double fccqp_d4 __attribute__((vector_size(32)));
+FCCQP_LANE_OP fccqp_d4 fccqp_dload(const double *p)
+{
+    fccqp_d4 v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
+FCCQP_LANE_OP void fccqp_dstore(double *p, fccqp_d4 v) { memcpy(p, &v, sizeof v); }
+FCCQP_LANE_OP fccqp_d4 fccqp_dsplat(double x)
+{
+    fccqp_d4 r = {x, x, x, x};
+    return r;
+}
+FCCQP_LANE_OP fccqp_d4 fccqp_dadd(fccqp_d4 a, fccqp_d4 b) { return a + b; }
+FCCQP_LANE_OP fccqp_d4 fccqp_dmul(fccqp_d4 a, fccqp_d4 b) { return a * b; }
+FCCQP_LANE_OP double fccqp_dsum(fccqp_d4 v) { return (v[0] + v[1]) + (v[2] + v[3]); }
+#else
+typedef struct { double lane[4]; } fccqp_d4;
+FCCQP_LANE_OP fccqp_d4 fccqp_dload(const double *p) { FCCQP_LANEWISE(fccqp_d4, p[k]) }
+FCCQP_LANE_OP void fccqp_dstore(double *p, fccqp_d4 v)
+{
+    for (int k = 0; k < 4; k++)
+        p[k] = v.lane[k];
+}
+FCCQP_LANE_OP fccqp_d4 fccqp_dsplat(double x) { FCCQP_LANEWISE(fccqp_d4, x) }
+FCCQP_LANE_OP fccqp_d4 fccqp_dadd(fccqp_d4 a, fccqp_d4 b) { FCCQP_LANEWISE(fccqp_d4, a.lane[k] + b.lane[k]) }
+FCCQP_LANE_OP fccqp_d4 fccqp_dmul(fccqp_d4 a, fccqp_d4 b) { FCCQP_LANEWISE(fccqp_d4, a.lane[k] * b.lane[k]) }
+FCCQP_LANE_OP double fccqp_dsum(fccqp_d4 v) { return (v.lane[0] + v.lane[1]) + (v.lane[2] + v.lane[3]); }
+#endif
+
+/* Anderson's kernels get the AVX2 copy with GCC only, where it can be built without
+ * fused multiply-adds: both copies round alike */
+#if defined(__GNUC__) && !defined(__clang__)
+#define FCCQP_EXACT_CLONES FCCQP_CLONES __attribute__((optimize("fp-contract=off")))
+#else
+#define FCCQP_EXACT_CLONES
+#endif
+
 /* fccqp_slot_products for the rows r0 and r1 (out: newest' r0, r0' f, newest' r1, r1' f) */
 FCCQP_FORCE_INLINE void fccqp_slot_pair_products(const double *restrict r0,
                                                  const double *restrict r1, long two_s,
                                                  const double *restrict newest,
                                                  const double *restrict f, double out[4])
 {
-    fccqp_v4 n0 = fccqp_splat4(0.0), f0 = n0, n1 = n0, f1 = n0;
+    fccqp_d4 n0 = fccqp_dsplat(0.0), f0 = n0, n1 = n0, f1 = n0;
     long j = 0;
     for (; j + 4 <= two_s; j += 4) {
-        fccqp_v4 w = fccqp_load4(newest + j), v = fccqp_load4(f + j);
-        fccqp_v4 a = fccqp_load4(r0 + j), b = fccqp_load4(r1 + j);
-        n0 = fccqp_add4(n0, fccqp_mul4(w, a));
-        f0 = fccqp_add4(f0, fccqp_mul4(a, v));
-        n1 = fccqp_add4(n1, fccqp_mul4(w, b));
-        f1 = fccqp_add4(f1, fccqp_mul4(b, v));
+        fccqp_d4 w = fccqp_dload(newest + j), v = fccqp_dload(f + j);
+        fccqp_d4 a = fccqp_dload(r0 + j), b = fccqp_dload(r1 + j);
+        n0 = fccqp_dadd(n0, fccqp_dmul(w, a));
+        f0 = fccqp_dadd(f0, fccqp_dmul(a, v));
+        n1 = fccqp_dadd(n1, fccqp_dmul(w, b));
+        f1 = fccqp_dadd(f1, fccqp_dmul(b, v));
     }
-    out[0] = fccqp_sum4(n0), out[1] = fccqp_sum4(f0);
-    out[2] = fccqp_sum4(n1), out[3] = fccqp_sum4(f1);
+    out[0] = fccqp_dsum(n0), out[1] = fccqp_dsum(f0);
+    out[2] = fccqp_dsum(n1), out[3] = fccqp_dsum(f1);
     for (; j < two_s; j++) {
         out[0] += newest[j] * r0[j];
         out[1] += r0[j] * f[j];
@@ -706,6 +748,7 @@ FCCQP_FORCE_INLINE void fccqp_slot_pair_products(const double *restrict r0,
     }
 }
 
+FCCQP_EXACT_CLONES
 static void fccqp_slot_products(const double *restrict df, long two_s, int stored,
                                 const double *restrict newest, const double *restrict f,
                                 double *restrict to_new, double *restrict to_f)
@@ -723,19 +766,19 @@ static void fccqp_slot_products(const double *restrict df, long two_s, int store
 }
 
 /* fccqp_slot_combination's pass over count (1 to 4, constant once inlined) slots:
- * four entries at a time in explicit lanes, each entry's terms added in slot order */
+ * four entries at a time in lanes, each entry's terms added in slot order */
 FCCQP_FORCE_INLINE void fccqp_add_slots(double *restrict out, const double *restrict rows,
                                         long two_s, const double *restrict coefficient,
                                         const int count)
 {
     long j = 0;
     for (; j + 4 <= two_s; j += 4) {
-        fccqp_v4 value = fccqp_load4(out + j);
+        fccqp_d4 value = fccqp_dload(out + j);
         FCCQP_UNROLL
         for (int i = 0; i < count; i++)
-            value = fccqp_add4(value, fccqp_mul4(fccqp_load4(rows + i * two_s + j),
-                                                 fccqp_splat4(coefficient[i])));
-        fccqp_store4(out + j, value);
+            value = fccqp_dadd(value, fccqp_dmul(fccqp_dload(rows + i * two_s + j),
+                                                 fccqp_dsplat(coefficient[i])));
+        fccqp_dstore(out + j, value);
     }
     for (; j < two_s; j++) {
         double value = out[j];
@@ -746,6 +789,7 @@ FCCQP_FORCE_INLINE void fccqp_add_slots(double *restrict out, const double *rest
     }
 }
 
+FCCQP_EXACT_CLONES
 static void fccqp_slot_combination(const double *restrict rows, long two_s, int stored,
                                    const double *restrict coefficient, double *restrict out)
 {
@@ -764,6 +808,7 @@ static void fccqp_slot_combination(const double *restrict rows, long two_s, int 
 
 /* Anderson's point after an ADMM step (s entries of z, of y): g = (z_prev, y_prev / rho)
  * and f = (z, y / rho) - g */
+FCCQP_EXACT_CLONES
 static void fccqp_fixed_point_residual(const double *restrict z_prev,
                                        const double *restrict y_prev,
                                        const double *restrict z, const double *restrict y,
@@ -781,6 +826,7 @@ static void fccqp_fixed_point_residual(const double *restrict z_prev,
 }
 
 /* Anderson's differences between two points: df = f_new - f, dgf = (g_new - g) + df */
+FCCQP_EXACT_CLONES
 static void fccqp_point_differences(const double *restrict g_new,
                                     const double *restrict f_new, const double *restrict g,
                                     const double *restrict f, long two_s,
@@ -794,6 +840,7 @@ static void fccqp_point_differences(const double *restrict g_new,
 }
 
 /* Anderson's extrapolation: plain = (z, y / rho), then (z, y) -= (step_z, step_y rho) */
+FCCQP_EXACT_CLONES
 static void fccqp_extrapolate(double *restrict z, double *restrict y,
                               const double *restrict rho, const double *restrict step,
                               long s, double *restrict plain)
@@ -809,15 +856,16 @@ static void fccqp_extrapolate(double *restrict z, double *restrict y,
 }
 
 /* v'v in four lanes (as fccqp_slot_pair_products sums) */
+FCCQP_EXACT_CLONES
 static double fccqp_sum_squares(const double *restrict v, long k)
 {
-    fccqp_v4 lanes = fccqp_splat4(0.0);
+    fccqp_d4 lanes = fccqp_dsplat(0.0);
     long j = 0;
     for (; j + 4 <= k; j += 4) {
-        fccqp_v4 x = fccqp_load4(v + j);
-        lanes = fccqp_add4(lanes, fccqp_mul4(x, x));
+        fccqp_d4 x = fccqp_dload(v + j);
+        lanes = fccqp_dadd(lanes, fccqp_dmul(x, x));
     }
-    double total = fccqp_sum4(lanes);
+    double total = fccqp_dsum(lanes);
     for (; j < k; j++)
         total += v[j] * v[j];
     return total;
