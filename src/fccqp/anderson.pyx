@@ -25,7 +25,7 @@ from fccqp._types cimport Iterates
 from fccqp.tuning cimport MAX_REJECTIONS, MAX_WEIGHT_NORM, REGULARIZATION
 
 cdef extern from "fccqp_kernels.h" nogil:
-    int fccqp_spd_solve(double* M, double* b, int k)
+    int fccqp_spd_solve(const double* A, int lda, double shift, double* M, double* b, int k)
     void fccqp_slot_products(const double* df, long two_s, int stored, const double* newest,
                              const double* f, double* to_new, double* to_f)
     void fccqp_slot_combination(const double* rows, long two_s, int stored,
@@ -56,9 +56,10 @@ cdef bint solve_small_spd(double* M, double* b, int k) noexcept nogil:
     positive. ``fccqp_spd_solve`` (fccqp_kernels.h): loops unrolled for each ``k`` up to
     10, which beat LAPACK's call overhead (0.5 us against 1.2 us for ``dpotrf`` +
     ``dpotrs`` at size 10, measured through numba) and the rolled loops' mispredicted
-    exits; it runs every iteration.
+    exits. :func:`anderson_step` calls the same kernel on the products in place, every
+    iteration.
     """
-    return fccqp_spd_solve(M, b, k)
+    return fccqp_spd_solve(M, k, 0.0, M, b, k)
 
 
 cdef inline void _new_products(Anderson* a, const double* f, Py_ssize_t slot, int stored,
@@ -102,7 +103,7 @@ cdef inline void _keep_new_point(Anderson* a) noexcept nogil:
 
 cdef void anderson_step(Anderson* a, Iterates* it, Py_ssize_t s) noexcept nogil:
     """Record the step just taken and extrapolate ``(z, y)`` in ``it`` when possible."""
-    cdef Py_ssize_t j, i, l, two_s = 2 * s
+    cdef Py_ssize_t j, i, two_s = 2 * s
     cdef int stored, cap = a.capacity
     cdef double f_norm, ridge, acc
     if a.wait > 0:   # plain steps only (a rejection cleared ``accelerated``)
@@ -129,12 +130,10 @@ cdef void anderson_step(Anderson* a, Iterates* it, Py_ssize_t s) noexcept nogil:
         return
     ridge = 0.0
     for i in range(stored):
-        for l in range(stored):
-            a.gram[i * stored + l] = a.products[i * cap + l]
-        ridge = max(ridge, a.gram[i * stored + i])
-    for i in range(stored):
-        a.gram[i * stored + i] += REGULARIZATION * ridge + 1e-300
-    if not solve_small_spd(a.gram, a.gamma, stored):
+        ridge = max(ridge, a.products[i * cap + i])
+    # the Gram matrix plus the ridge, factored where its products are kept
+    if not fccqp_spd_solve(a.products, cap, REGULARIZATION * ridge + 1e-300, a.gram, a.gamma,
+                           stored):
         return
     acc = 0.0
     for i in range(stored):

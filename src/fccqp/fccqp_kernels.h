@@ -30,10 +30,11 @@
  * roundings, the same bits whether the AVX2 copy's instruction or the baseline's libm
  * call computes them.
  *
- * fccqp_spd_solve: M x = b in place for a tiny k x k row-major positive definite M
- * (Anderson's Gram matrix, k <= its memory): b becomes x, M its Cholesky factor (lower
- * triangle, row-major); returns 0 at a pivot that is not positive. The operations and
- * their order are those of plain loops (tests/test_anderson.py holds them), whatever k;
+ * fccqp_spd_solve: (A + shift I) x = b for a tiny k x k positive definite A, row-major
+ * with leading dimension lda (Anderson's Gram matrix, k <= its memory, read where its
+ * products are kept, no copy): b becomes x, M (k x k, row-major; A itself with lda = k)
+ * the Cholesky factor's lower triangle; returns 0 at a pivot that is not positive. The
+ * operations and their order are those of plain loops (tests/test_anderson.py holds them), whatever k;
  * for k up to 10 (the default memory) the loops are unrolled in full for that k (a copy
  * per k, chosen by a switch): rolled, their trip counts (0 to k - 1, changing at every
  * row) cost a mispredicted branch per inner loop in callgrind's model, 40 a call, and
@@ -622,12 +623,14 @@ static void fccqp_row_spans(const double *restrict A, int rows, int cols,
 #define FCCQP_UNROLL
 #endif
 
-/* fccqp_spd_solve's body; a constant k (after inlining) lets the compiler unroll it */
-FCCQP_FORCE_INLINE int fccqp_spd_solve_k(double *restrict M, double *restrict b, const int k)
+/* fccqp_spd_solve's body; a constant k (after inlining) lets the compiler unroll it. Each
+ * entry of A is read before the entry of M at its place is written: A may be M. */
+FCCQP_FORCE_INLINE int fccqp_spd_solve_k(const double *A, int lda, double shift, double *M,
+                                         double *restrict b, const int k)
 {
     FCCQP_UNROLL
     for (int c = 0; c < k; c++) {
-        double pivot = M[c * k + c];
+        double pivot = A[c * lda + c] + shift;
         FCCQP_UNROLL
         for (int t = 0; t < c; t++)
             pivot -= M[c * k + t] * M[c * k + t];
@@ -637,7 +640,7 @@ FCCQP_FORCE_INLINE int fccqp_spd_solve_k(double *restrict M, double *restrict b,
         M[c * k + c] = pivot;
         FCCQP_UNROLL
         for (int r = c + 1; r < k; r++) {
-            double value = M[r * k + c];
+            double value = A[r * lda + c];
             FCCQP_UNROLL
             for (int t = 0; t < c; t++)
                 value -= M[r * k + t] * M[c * k + t];
@@ -663,20 +666,21 @@ FCCQP_FORCE_INLINE int fccqp_spd_solve_k(double *restrict M, double *restrict b,
     return 1;
 }
 
-static int fccqp_spd_solve(double *restrict M, double *restrict b, int k)
+static int fccqp_spd_solve(const double *A, int lda, double shift, double *M,
+                           double *restrict b, int k)
 {
     switch (k) {
-    case 1: return fccqp_spd_solve_k(M, b, 1);
-    case 2: return fccqp_spd_solve_k(M, b, 2);
-    case 3: return fccqp_spd_solve_k(M, b, 3);
-    case 4: return fccqp_spd_solve_k(M, b, 4);
-    case 5: return fccqp_spd_solve_k(M, b, 5);
-    case 6: return fccqp_spd_solve_k(M, b, 6);
-    case 7: return fccqp_spd_solve_k(M, b, 7);
-    case 8: return fccqp_spd_solve_k(M, b, 8);
-    case 9: return fccqp_spd_solve_k(M, b, 9);
-    case 10: return fccqp_spd_solve_k(M, b, 10);
-    default: return fccqp_spd_solve_k(M, b, k);
+    case 1: return fccqp_spd_solve_k(A, lda, shift, M, b, 1);
+    case 2: return fccqp_spd_solve_k(A, lda, shift, M, b, 2);
+    case 3: return fccqp_spd_solve_k(A, lda, shift, M, b, 3);
+    case 4: return fccqp_spd_solve_k(A, lda, shift, M, b, 4);
+    case 5: return fccqp_spd_solve_k(A, lda, shift, M, b, 5);
+    case 6: return fccqp_spd_solve_k(A, lda, shift, M, b, 6);
+    case 7: return fccqp_spd_solve_k(A, lda, shift, M, b, 7);
+    case 8: return fccqp_spd_solve_k(A, lda, shift, M, b, 8);
+    case 9: return fccqp_spd_solve_k(A, lda, shift, M, b, 9);
+    case 10: return fccqp_spd_solve_k(A, lda, shift, M, b, 10);
+    default: return fccqp_spd_solve_k(A, lda, shift, M, b, k);
     }
 }
 
