@@ -52,8 +52,16 @@
  * fccqp_slot_combination: out = sum over the stored slots l of coefficient[l] row_l,
  * each entry's terms added in slot order from 0.0 (the bits of one pass per slot), four
  * slots per pass over out, which is loaded and stored once per pass: Anderson's step
- * (dG + dF) gamma, 1.3k instructions a call one slot per pass. Not cloned: a fused
- * multiply-add would change the bits.
+ * (dG + dF) gamma, 1.3k instructions a call one slot per pass.
+ *
+ * fccqp_fixed_point_residual, fccqp_point_differences, fccqp_extrapolate: Anderson's
+ * loops over the 2s entries of its point, in C for the restrict pointers that let them
+ * vectorize (Cython's pointers into its structs may alias, and stayed scalar).
+ *
+ * Anderson's kernels above (not fccqp_spd_solve, whose unrolled chains gain nothing from
+ * vectors) have an AVX2 copy built without contraction into fused multiply-adds
+ * (FCCQP_EXACT_CLONES), so both copies round alike. On a cold go2 tick anderson_step
+ * went from 5.9k to 2.9k instructions a call with them (notes/tuning.md, "anderson3").
  *
  * fccqp_symmetric_copy, fccqp_checked_copy, fccqp_scale_rows, fccqp_ruiz_maxima and
  * fccqp_row_spans: the per-solve passes over P and A of the validation scan, the
