@@ -377,7 +377,7 @@ def test_a_far_guess_whose_polish_fails_is_answered_from_the_cold_start(seed):
     np.testing.assert_array_equal(far.x, cold.x)
 
 
-@pytest.mark.parametrize("seed", [168, 202, 326, 532])   # most other seeds: the guess polishes
+@pytest.mark.parametrize("seed", [168, 326, 532, 552])   # most other seeds: the guess polishes
 def test_a_neighbours_answer_whose_polish_fails_is_answered_from_the_cold_start(seed):
     """A guess that is the answer of a neighbouring problem (``q`` and ``b`` moved, as
     from the previous tick) and fails its warm polish is nearer the termination test

@@ -30,10 +30,11 @@
  * roundings, the same bits whether the AVX2 copy's instruction or the baseline's libm
  * call computes them.
  *
- * fccqp_spd_solve: M x = b in place for a tiny k x k row-major positive definite M
- * (Anderson's Gram matrix, k <= its memory): b becomes x, M its Cholesky factor (lower
- * triangle, row-major); returns 0 at a pivot that is not positive. The operations and
- * their order are those of plain loops (tests/test_anderson.py holds them), whatever k;
+ * fccqp_spd_solve: (A + shift I) x = b for a tiny k x k positive definite A, row-major
+ * with leading dimension lda (Anderson's Gram matrix, k <= its memory, read where its
+ * products are kept, no copy): b becomes x, M (k x k, row-major; A itself with lda = k)
+ * the Cholesky factor's lower triangle; returns 0 at a pivot that is not positive. The
+ * operations and their order are those of plain loops (tests/test_anderson.py holds them), whatever k;
  * for k up to 10 (the default memory) the loops are unrolled in full for that k (a copy
  * per k, chosen by a switch): rolled, their trip counts (0 to k - 1, changing at every
  * row) cost a mispredicted branch per inner loop in callgrind's model, 40 a call, and
@@ -42,11 +43,25 @@
  * the bits.
  *
  * fccqp_slot_products: for each stored slot l (a row of Anderson's df, two_s entries),
- * to_new[l] = newest' row_l and to_f[l] = row_l' f, each sum in index order from 0.0;
- * four slots at a time, whose eight sums are independent chains of additions that
- * overlap in the pipeline (one slot at a time waits on each addition's latency: a
- * fifth of anderson_step's time on a cold go2 tick, perf's samples). Not cloned: a
- * fused multiply-add would change the bits.
+ * to_new[l] = newest' row_l and to_f[l] = row_l' f; each sum in four lanes over the
+ * entries (explicit lanes, so the same bits on every CPU), two slots per pass sharing the
+ * loads of newest and f. In index order, one chain of additions per sum, they took 1.9k
+ * of anderson_step's 5.9k instructions a call on a cold go2 tick (callgrind; eight
+ * chains side by side, four slots a pass). fccqp_sum_squares sums v'v the same way.
+ *
+ * fccqp_slot_combination: out = sum over the stored slots l of coefficient[l] row_l,
+ * each entry's terms added in slot order from 0.0 (the bits of one pass per slot), four
+ * slots per pass over out, which is loaded and stored once per pass: Anderson's step
+ * (dG + dF) gamma, 1.3k instructions a call one slot per pass.
+ *
+ * fccqp_fixed_point_residual, fccqp_point_differences, fccqp_extrapolate: Anderson's
+ * loops over the 2s entries of its point, in C for the restrict pointers that let them
+ * vectorize (Cython's pointers into its structs may alias, and stayed scalar).
+ *
+ * Anderson's kernels above (not fccqp_spd_solve, whose unrolled chains gain nothing from
+ * vectors) have an AVX2 copy built without contraction into fused multiply-adds
+ * (FCCQP_EXACT_CLONES), so both copies round alike. On a cold go2 tick anderson_step
+ * went from 5.9k to 2.9k instructions a call with them (notes/tuning.md, "anderson3").
  *
  * fccqp_symmetric_copy, fccqp_checked_copy, fccqp_scale_rows, fccqp_ruiz_maxima and
  * fccqp_row_spans: the per-solve passes over P and A of the validation scan, the
@@ -616,12 +631,14 @@ static void fccqp_row_spans(const double *restrict A, int rows, int cols,
 #define FCCQP_UNROLL
 #endif
 
-/* fccqp_spd_solve's body; a constant k (after inlining) lets the compiler unroll it */
-FCCQP_FORCE_INLINE int fccqp_spd_solve_k(double *restrict M, double *restrict b, const int k)
+/* fccqp_spd_solve's body; a constant k (after inlining) lets the compiler unroll it. Each
+ * entry of A is read before the entry of M at its place is written: A may be M. */
+FCCQP_FORCE_INLINE int fccqp_spd_solve_k(const double *A, int lda, double shift, double *M,
+                                         double *restrict b, const int k)
 {
     FCCQP_UNROLL
     for (int c = 0; c < k; c++) {
-        double pivot = M[c * k + c];
+        double pivot = A[c * lda + c] + shift;
         FCCQP_UNROLL
         for (int t = 0; t < c; t++)
             pivot -= M[c * k + t] * M[c * k + t];
@@ -631,7 +648,7 @@ FCCQP_FORCE_INLINE int fccqp_spd_solve_k(double *restrict M, double *restrict b,
         M[c * k + c] = pivot;
         FCCQP_UNROLL
         for (int r = c + 1; r < k; r++) {
-            double value = M[r * k + c];
+            double value = A[r * lda + c];
             FCCQP_UNROLL
             for (int t = 0; t < c; t++)
                 value -= M[r * k + t] * M[c * k + t];
@@ -657,65 +674,213 @@ FCCQP_FORCE_INLINE int fccqp_spd_solve_k(double *restrict M, double *restrict b,
     return 1;
 }
 
-static int fccqp_spd_solve(double *restrict M, double *restrict b, int k)
+static int fccqp_spd_solve(const double *A, int lda, double shift, double *M,
+                           double *restrict b, int k)
 {
     switch (k) {
-    case 1: return fccqp_spd_solve_k(M, b, 1);
-    case 2: return fccqp_spd_solve_k(M, b, 2);
-    case 3: return fccqp_spd_solve_k(M, b, 3);
-    case 4: return fccqp_spd_solve_k(M, b, 4);
-    case 5: return fccqp_spd_solve_k(M, b, 5);
-    case 6: return fccqp_spd_solve_k(M, b, 6);
-    case 7: return fccqp_spd_solve_k(M, b, 7);
-    case 8: return fccqp_spd_solve_k(M, b, 8);
-    case 9: return fccqp_spd_solve_k(M, b, 9);
-    case 10: return fccqp_spd_solve_k(M, b, 10);
-    default: return fccqp_spd_solve_k(M, b, k);
+    case 1: return fccqp_spd_solve_k(A, lda, shift, M, b, 1);
+    case 2: return fccqp_spd_solve_k(A, lda, shift, M, b, 2);
+    case 3: return fccqp_spd_solve_k(A, lda, shift, M, b, 3);
+    case 4: return fccqp_spd_solve_k(A, lda, shift, M, b, 4);
+    case 5: return fccqp_spd_solve_k(A, lda, shift, M, b, 5);
+    case 6: return fccqp_spd_solve_k(A, lda, shift, M, b, 6);
+    case 7: return fccqp_spd_solve_k(A, lda, shift, M, b, 7);
+    case 8: return fccqp_spd_solve_k(A, lda, shift, M, b, 8);
+    case 9: return fccqp_spd_solve_k(A, lda, shift, M, b, 9);
+    case 10: return fccqp_spd_solve_k(A, lda, shift, M, b, 10);
+    default: return fccqp_spd_solve_k(A, lda, shift, M, b, k);
     }
 }
 
-/* fccqp_slot_products for slots [first, first + 4) */
-FCCQP_FORCE_INLINE void fccqp_four_slot_products(const double *restrict df, long two_s,
-                                                 int first, const double *restrict newest,
-                                                 const double *restrict f,
-                                                 double *restrict to_new,
-                                                 double *restrict to_f)
+/* Four lanes in one 32-byte vector for Anderson's kernels (GCC / clang vector
+ * extensions): one AVX2 instruction each in the AVX2 copy, two SSE2 ones in the
+ * baseline (they add, multiply and move, never compare). Elsewhere a struct. */
+#if defined(__GNUC__) || defined(__clang__)
+typedef double fccqp_d4 __attribute__((vector_size(32)));
+FCCQP_LANE_OP fccqp_d4 fccqp_dload(const double *p)
 {
-    const double *r0 = df + first * two_s, *r1 = r0 + two_s, *r2 = r1 + two_s;
-    const double *r3 = r2 + two_s;
-    double n0 = 0.0, n1 = 0.0, n2 = 0.0, n3 = 0.0, f0 = 0.0, f1 = 0.0, f2 = 0.0, f3 = 0.0;
-    for (long j = 0; j < two_s; j++) {
-        n0 += newest[j] * r0[j];
-        f0 += r0[j] * f[j];
-        n1 += newest[j] * r1[j];
-        f1 += r1[j] * f[j];
-        n2 += newest[j] * r2[j];
-        f2 += r2[j] * f[j];
-        n3 += newest[j] * r3[j];
-        f3 += r3[j] * f[j];
+    fccqp_d4 v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
+FCCQP_LANE_OP void fccqp_dstore(double *p, fccqp_d4 v) { memcpy(p, &v, sizeof v); }
+FCCQP_LANE_OP fccqp_d4 fccqp_dsplat(double x)
+{
+    fccqp_d4 r = {x, x, x, x};
+    return r;
+}
+FCCQP_LANE_OP fccqp_d4 fccqp_dadd(fccqp_d4 a, fccqp_d4 b) { return a + b; }
+FCCQP_LANE_OP fccqp_d4 fccqp_dmul(fccqp_d4 a, fccqp_d4 b) { return a * b; }
+FCCQP_LANE_OP double fccqp_dsum(fccqp_d4 v) { return (v[0] + v[1]) + (v[2] + v[3]); }
+#else
+typedef struct { double lane[4]; } fccqp_d4;
+FCCQP_LANE_OP fccqp_d4 fccqp_dload(const double *p) { FCCQP_LANEWISE(fccqp_d4, p[k]) }
+FCCQP_LANE_OP void fccqp_dstore(double *p, fccqp_d4 v)
+{
+    for (int k = 0; k < 4; k++)
+        p[k] = v.lane[k];
+}
+FCCQP_LANE_OP fccqp_d4 fccqp_dsplat(double x) { FCCQP_LANEWISE(fccqp_d4, x) }
+FCCQP_LANE_OP fccqp_d4 fccqp_dadd(fccqp_d4 a, fccqp_d4 b) { FCCQP_LANEWISE(fccqp_d4, a.lane[k] + b.lane[k]) }
+FCCQP_LANE_OP fccqp_d4 fccqp_dmul(fccqp_d4 a, fccqp_d4 b) { FCCQP_LANEWISE(fccqp_d4, a.lane[k] * b.lane[k]) }
+FCCQP_LANE_OP double fccqp_dsum(fccqp_d4 v) { return (v.lane[0] + v.lane[1]) + (v.lane[2] + v.lane[3]); }
+#endif
+
+/* Anderson's kernels get the AVX2 copy with GCC only, where it can be built without
+ * fused multiply-adds: both copies round alike */
+#if defined(__GNUC__) && !defined(__clang__)
+#define FCCQP_EXACT_CLONES FCCQP_CLONES __attribute__((optimize("fp-contract=off")))
+#else
+#define FCCQP_EXACT_CLONES
+#endif
+
+/* fccqp_slot_products for the rows r0 and r1 (out: newest' r0, r0' f, newest' r1, r1' f) */
+FCCQP_FORCE_INLINE void fccqp_slot_pair_products(const double *restrict r0,
+                                                 const double *restrict r1, long two_s,
+                                                 const double *restrict newest,
+                                                 const double *restrict f, double out[4])
+{
+    fccqp_d4 n0 = fccqp_dsplat(0.0), f0 = n0, n1 = n0, f1 = n0;
+    long j = 0;
+    for (; j + 4 <= two_s; j += 4) {
+        fccqp_d4 w = fccqp_dload(newest + j), v = fccqp_dload(f + j);
+        fccqp_d4 a = fccqp_dload(r0 + j), b = fccqp_dload(r1 + j);
+        n0 = fccqp_dadd(n0, fccqp_dmul(w, a));
+        f0 = fccqp_dadd(f0, fccqp_dmul(a, v));
+        n1 = fccqp_dadd(n1, fccqp_dmul(w, b));
+        f1 = fccqp_dadd(f1, fccqp_dmul(b, v));
     }
-    to_new[first] = n0, to_new[first + 1] = n1, to_new[first + 2] = n2;
-    to_new[first + 3] = n3;
-    to_f[first] = f0, to_f[first + 1] = f1, to_f[first + 2] = f2, to_f[first + 3] = f3;
+    out[0] = fccqp_dsum(n0), out[1] = fccqp_dsum(f0);
+    out[2] = fccqp_dsum(n1), out[3] = fccqp_dsum(f1);
+    for (; j < two_s; j++) {
+        out[0] += newest[j] * r0[j];
+        out[1] += r0[j] * f[j];
+        out[2] += newest[j] * r1[j];
+        out[3] += r1[j] * f[j];
+    }
 }
 
+FCCQP_EXACT_CLONES
 static void fccqp_slot_products(const double *restrict df, long two_s, int stored,
                                 const double *restrict newest, const double *restrict f,
                                 double *restrict to_new, double *restrict to_f)
 {
-    int l = 0;
-    for (; l + 4 <= stored; l += 4)
-        fccqp_four_slot_products(df, two_s, l, newest, f, to_new, to_f);
-    for (; l < stored; l++) {
+    double out[4];
+    for (int l = 0; l < stored; l += 2) {
         const double *row = df + l * two_s;
-        double n0 = 0.0, f0 = 0.0;
-        for (long j = 0; j < two_s; j++) {
-            n0 += newest[j] * row[j];
-            f0 += row[j] * f[j];
-        }
-        to_new[l] = n0;
-        to_f[l] = f0;
+        /* an odd last slot is paired with itself */
+        fccqp_slot_pair_products(row, l + 1 < stored ? row + two_s : row, two_s, newest, f,
+                                 out);
+        to_new[l] = out[0], to_f[l] = out[1];
+        if (l + 1 < stored)
+            to_new[l + 1] = out[2], to_f[l + 1] = out[3];
     }
+}
+
+/* fccqp_slot_combination's pass over count (1 to 4, constant once inlined) slots:
+ * four entries at a time in lanes, each entry's terms added in slot order */
+FCCQP_FORCE_INLINE void fccqp_add_slots(double *restrict out, const double *restrict rows,
+                                        long two_s, const double *restrict coefficient,
+                                        const int count)
+{
+    long j = 0;
+    for (; j + 4 <= two_s; j += 4) {
+        fccqp_d4 value = fccqp_dload(out + j);
+        FCCQP_UNROLL
+        for (int i = 0; i < count; i++)
+            value = fccqp_dadd(value, fccqp_dmul(fccqp_dload(rows + i * two_s + j),
+                                                 fccqp_dsplat(coefficient[i])));
+        fccqp_dstore(out + j, value);
+    }
+    for (; j < two_s; j++) {
+        double value = out[j];
+        FCCQP_UNROLL
+        for (int i = 0; i < count; i++)
+            value += rows[i * two_s + j] * coefficient[i];
+        out[j] = value;
+    }
+}
+
+FCCQP_EXACT_CLONES
+static void fccqp_slot_combination(const double *restrict rows, long two_s, int stored,
+                                   const double *restrict coefficient, double *restrict out)
+{
+    for (long j = 0; j < two_s; j++)
+        out[j] = 0.0;
+    for (int l = 0; l < stored; l += 4) {
+        const double *first = rows + l * two_s;
+        switch (stored - l) {
+        case 1: fccqp_add_slots(out, first, two_s, coefficient + l, 1); break;
+        case 2: fccqp_add_slots(out, first, two_s, coefficient + l, 2); break;
+        case 3: fccqp_add_slots(out, first, two_s, coefficient + l, 3); break;
+        default: fccqp_add_slots(out, first, two_s, coefficient + l, 4);
+        }
+    }
+}
+
+/* Anderson's point after an ADMM step (s entries of z, of y): g = (z_prev, y_prev / rho)
+ * and f = (z, y / rho) - g */
+FCCQP_EXACT_CLONES
+static void fccqp_fixed_point_residual(const double *restrict z_prev,
+                                       const double *restrict y_prev,
+                                       const double *restrict z, const double *restrict y,
+                                       const double *restrict rho, long s,
+                                       double *restrict g, double *restrict f)
+{
+    for (long j = 0; j < s; j++) {
+        g[j] = z_prev[j];
+        f[j] = z[j] - z_prev[j];
+    }
+    for (long j = 0; j < s; j++) {
+        g[s + j] = y_prev[j] / rho[j];
+        f[s + j] = y[j] / rho[j] - g[s + j];
+    }
+}
+
+/* Anderson's differences between two points: df = f_new - f, dgf = (g_new - g) + df */
+FCCQP_EXACT_CLONES
+static void fccqp_point_differences(const double *restrict g_new,
+                                    const double *restrict f_new, const double *restrict g,
+                                    const double *restrict f, long two_s,
+                                    double *restrict df, double *restrict dgf)
+{
+    for (long j = 0; j < two_s; j++) {
+        double difference = f_new[j] - f[j];
+        df[j] = difference;
+        dgf[j] = (g_new[j] - g[j]) + difference;
+    }
+}
+
+/* Anderson's extrapolation: plain = (z, y / rho), then (z, y) -= (step_z, step_y rho) */
+FCCQP_EXACT_CLONES
+static void fccqp_extrapolate(double *restrict z, double *restrict y,
+                              const double *restrict rho, const double *restrict step,
+                              long s, double *restrict plain)
+{
+    for (long j = 0; j < s; j++) {
+        plain[j] = z[j];
+        z[j] -= step[j];
+    }
+    for (long j = 0; j < s; j++) {
+        plain[s + j] = y[j] / rho[j];
+        y[j] -= step[s + j] * rho[j];
+    }
+}
+
+/* v'v in four lanes (as fccqp_slot_pair_products sums) */
+FCCQP_EXACT_CLONES
+static double fccqp_sum_squares(const double *restrict v, long k)
+{
+    fccqp_d4 lanes = fccqp_dsplat(0.0);
+    long j = 0;
+    for (; j + 4 <= k; j += 4) {
+        fccqp_d4 x = fccqp_dload(v + j);
+        lanes = fccqp_dadd(lanes, fccqp_dmul(x, x));
+    }
+    double total = fccqp_dsum(lanes);
+    for (; j < k; j++)
+        total += v[j] * v[j];
+    return total;
 }
 
 #endif
