@@ -183,7 +183,8 @@ cdef class Workspace:
         """New friction coefficients and normals (one row of three per cone) for the same
         cone blocks, written into the workspace's own copies, which the kernels read. A
         contact change onto other friction calls it once, with the interpreter's and
-        numpy's code cold: numpy's slice assignments took 8 us there, a loop takes none."""
+        numpy's code cold, where numpy's slice assignments took 8-9 us of a solo12 or go2
+        tick (notes/performance-history.md, "contactwall")."""
         cdef Cones* cones = &self.e.prob.cones
         cdef double* mu_out = <double*>cones.mu   # the writable arrays of self._keep
         cdef double* normal_out = <double*>cones.normal

@@ -290,11 +290,12 @@ class Solver:
         :meth:`_returning` makes one current, with the friction coefficients and normals
         of ``cones`` (the terrain's may differ); None when no kept workspace is such. A
         contact change with a caller's guess, or onto other friction, lands here. The
-        general path (a new structure's arrays, its scan, two keys) costs 10 us when the
-        interpreter runs it warm, 35 us when it runs once after a stretch of ticks of
-        another structure (notes/performance-history.md, "contactwall"). The solve
-        checks the bounds against the workspace's structure, and ``STRUCTURE_CHANGED``
-        leads to the general path's new structure (:meth:`_result`)."""
+        general path (a new structure's arrays, its scan, two keys, numpy's writes of the
+        friction) costs solo12 6 us when the interpreter runs it warm, 38 us when it runs
+        once after a stretch of ticks of another structure, as a contact change does
+        (notes/performance-history.md, "contactwall"). The solve checks the bounds
+        against the workspace's structure, and ``STRUCTURE_CHANGED`` leads to the general
+        path's new structure (:meth:`_result`)."""
         for key, (structure, w) in self._kept.items():
             if dense_arguments(P, q, A, b, lb, ub, structure.n, structure.m):
                 flat = flatten_cones(cones, structure.n)
