@@ -241,6 +241,62 @@ def test_a_contact_set_that_comes_back_takes_its_kept_workspace_directly(monkeyp
     verify_solution(second, back)
 
 
+def other_friction(problem, scale):
+    """``problem`` with every friction coefficient times ``scale`` (new terrain)."""
+    cones = tuple(FrictionCone(c.start, c.mu * scale, c.normal) for c in problem[6])
+    return (*problem[:6], cones)
+
+
+def carried(solver, problem, last):
+    """``solver``'s answer to ``problem`` from the guess of the previous answer ``last``
+    cut or padded to its sizes, as a caller carries it across a contact change."""
+    n, m = problem[0].shape[0], problem[2].shape[0]
+    return solver.solve(*problem, x0=np.resize(last.x, n), y0=np.resize(last.y, m),
+                        z0=np.resize(last.z, n))
+
+
+@pytest.mark.kkt_backends(*DENSE_PATH_KEEPS, reason="the dense path's kept workspaces")
+def test_a_guessed_switch_onto_other_friction_takes_the_kept_workspace_without_a_scan(
+        monkeypatch):
+    # contact changes onto other terrain, the caller's guess given: the kept workspace
+    # of the same sizes and cone blocks is made current with the new friction, without
+    # the general path's new structure and scan, and answers bit for bit as the general
+    # path does; when it was made for other bounded entries (a fixed one), its solve
+    # asks for a rescan and the general path's new workspace answers
+    first, second = two_structures()
+    P, q, A, b, lb, ub, cones = first
+    lb_fixed, ub_fixed = lb.copy(), ub.copy()
+    boxed = np.flatnonzero(np.isfinite(lb))[0]
+    lb_fixed[boxed] = ub_fixed[boxed] = 0.5 * (lb[boxed] + ub[boxed])
+    switches = (other_friction(first, 0.8), other_friction(second, 1.2),
+                (P, q, A, b, lb_fixed, ub_fixed, cones))
+    general = fccqp.Solver()
+    monkeypatch.setattr(general, "_switch", lambda *arguments: None)
+    expected = [carried(general, second, general.solve(*first))]
+    for problem in switches:
+        expected.append(carried(general, problem, expected[-1]))
+    monkeypatch.undo()
+
+    def no_scan(*arguments):
+        raise AssertionError("the switch scanned the bounds")
+
+    solver = fccqp.Solver()
+    answers = [carried(solver, second, solver.solve(*first))]
+    made = [solver._workspace, *(w for _, w in solver._kept.values())]
+    monkeypatch.setattr(fccqp.solver, "structure_scan", no_scan)
+    for problem in switches[:2]:
+        answers.append(carried(solver, problem, answers[-1]))
+        assert any(w is solver._workspace for w in made)
+    monkeypatch.undo()
+    answers.append(carried(solver, switches[2], answers[-1]))
+    for problem, answer, reference in zip((second, *switches), answers, expected,
+                                          strict=True):
+        assert answer.status is Status.SOLVED
+        assert answer.iterations == reference.iterations
+        np.testing.assert_array_equal(answer.x, reference.x)
+        verify_solution(problem, answer)
+
+
 @pytest.mark.kkt_backends(*DENSE_PATH_KEEPS, reason="the dense path's kept workspaces")
 def test_after_a_reset_a_return_to_a_kept_structure_starts_cold():
     # the cold view resets before every QP: reset() forgets the kept workspaces'

@@ -18,8 +18,10 @@ How: each worker loads the set (``benchmarks/.cache`` of the build's own checkou
 generated there when missing), prepares every QP, warms each solver up with one pass,
 freezes the garbage collector's objects and waits; a pass walks the QPs in order,
 ``cold`` resetting the solver before every QP (the benchmark's cold view), ``warm``
-at each sequence start (its warm view), with the collector off. Times are per tick the
-median over ``--rounds``. One BLAS thread. Run::
+at each sequence start (its warm view), with the collector off; ``contact`` walks as
+``warm`` and keeps the times of its contact-change ticks only (the benchmark's contact
+change view: one tick per robot, whose wall time the rest of the walk's leaves cold
+caches for). Times are per tick the median over ``--rounds``. One BLAS thread. Run::
 
     python tools/wall_ab.py /tmp/base /tmp/branch --robot go2 --mode cold --rounds 30
 
@@ -43,12 +45,13 @@ import gc, json, sys
 from threadpoolctl import threadpool_limits
 from benchmarks.cache import DEFAULT_CACHE, cached_test_set
 from benchmarks.solvers import make_adapter
-from benchmarks.views import cold_path, warm_path
+from benchmarks.views import cold_path, contact_changes, warm_path
 
 mode, robot, names = sys.argv[1], sys.argv[2], sys.argv[3:]
 test_set, _ = cached_test_set(DEFAULT_CACHE, robot, "mix", 400, 0, seq_len=100, dt=0.002,
                               report=lambda line: print(line, file=sys.stderr))
 path = (cold_path if mode == "cold" else warm_path)(test_set)
+shown = [True] * len(path) if mode != "contact" else list(contact_changes(path))
 adapters = {name: make_adapter(name) for name in names}
 prepared = {name: [a.prepare(test_set.qps[i]) for i in path.indices]
             for name, a in adapters.items()}
@@ -74,7 +77,7 @@ with threadpool_limits(1):
         gc.disable()
         times = one_pass(line.strip())
         gc.enable()
-        print(json.dumps(times), flush=True)
+        print(json.dumps([t for t, s in zip(times, shown) if s]), flush=True)
 '''
 """The worker: one build's solvers, a pass per line of stdin, its times on stdout."""
 REFERENCE = "daqp-pyr4"
@@ -132,7 +135,8 @@ def main() -> None:
     parser.add_argument("a", type=Path, help="checkout of build A (the baseline), built")
     parser.add_argument("b", type=Path, help="checkout of build B, built")
     parser.add_argument("--robot", default="go2")
-    parser.add_argument("--mode", choices=("cold", "warm"), default="cold")
+    parser.add_argument("--mode", choices=("cold", "warm", "contact"), default="cold",
+                        help="contact: the warm walk, timed at its contact-change ticks only")
     parser.add_argument("--rounds", type=int, default=30)
     parser.add_argument("--variant", default="fccqp-realtime", help="the fccqp variant")
     args = parser.parse_args()

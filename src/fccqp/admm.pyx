@@ -20,7 +20,7 @@ from libc.math cimport isfinite
 
 from fccqp cimport engine
 from fccqp._dense cimport copy, fill
-from fccqp._types cimport Problem
+from fccqp._types cimport Cones, Problem
 from fccqp.anderson cimport anderson_reset
 from fccqp.blas_threads cimport enter, leave
 from fccqp.certificates cimport CERTIFIED, primal_candidate
@@ -179,10 +179,23 @@ cdef class Workspace:
         e.fact.factored_rho = -1.0
         e.clock.final_reserve = e.clock.pass_time = 0.0
 
-    def update_cones(self, mu, normal):
-        """New friction coefficients and normals for the same cone blocks."""
-        self._keep[4][:] = mu
-        self._keep[5][:] = np.asarray(normal, dtype=np.float64).reshape(-1)
+    def update_cones(self, const double[::1] mu, const double[:, ::1] normal):
+        """New friction coefficients and normals (one row of three per cone) for the same
+        cone blocks, written into the workspace's own copies, which the kernels read. A
+        contact change onto other friction calls it once, with the interpreter's and
+        numpy's code cold, where numpy's slice assignments took 8-9 us of a solo12 or go2
+        tick (notes/performance-history.md, "contactwall")."""
+        cdef Cones* cones = &self.e.prob.cones
+        cdef double* mu_out = <double*>cones.mu   # the writable arrays of self._keep
+        cdef double* normal_out = <double*>cones.normal
+        cdef Py_ssize_t k, j
+        if mu.shape[0] != cones.count or normal.shape[0] != cones.count or normal.shape[1] != 3:
+            raise ValueError(f"expected {cones.count} friction coefficients and "
+                             f"{cones.count} x 3 normals")
+        for k in range(cones.count):
+            mu_out[k] = mu[k]
+            for j in range(3):
+                normal_out[3 * k + j] = normal[k, j]
 
     def forget(self):
         """Drop the previous solution, so that the next solve starts cold."""

@@ -234,9 +234,13 @@ class Solver:
                 if type(out) is Result or out != admm.NOT_DENSE:
                     return self._result(out, P, q, A, b, lb, ub, NO_GUESS, start)
             w, structure = self._workspace, self._structure
-        if w is not None and not sparse and dense_arguments(P, q, A, b, lb, ub, structure.n,
-                                                            structure.m):
+        dense = w is not None and not sparse
+        if dense and dense_arguments(P, q, A, b, lb, ub, structure.n, structure.m):
             n, m = structure.n, structure.m   # the arrays fit as they are
+            flat = flatten_cones(cones, n)   # memoized: the same object for the same cones
+        elif dense and (flat := self._switch(cones, P, q, A, b, lb, ub)) is not None:
+            w, structure = self._workspace, self._structure   # a kept one they fit
+            n, m = structure.n, structure.m
         else:
             n, m = _rows(P), _rows(A)
             if sparse or n + m > MAX_DENSE_KKT_ROWS:
@@ -245,7 +249,7 @@ class Solver:
             if not (n and dense_arguments(P, q, A, b, lb, ub, n, m)):
                 P, q, A, b, lb, ub = convert(P, q, A, b, lb, ub)
                 n, m = P.shape[0], A.shape[0]
-        flat = flatten_cones(cones, n)   # memoized: the same object for the same cones
+            flat = flatten_cones(cones, n)
         self._cones = cones
         guess = _guess(x0, y0, z0, n, m)
         if w is None or (structure.n, structure.m) != (n, m) or not flat.same_blocks(
@@ -278,6 +282,32 @@ class Solver:
                 self._structure, self._workspace, self._cones = structure, w, cones
                 return w, structure
         return None, None
+
+    def _switch(self, cones: object, P: object, q: object, A: object, b: object,
+                lb: object, ub: object) -> ConeArrays | None:
+        """The flattened ``cones`` once the kept workspace whose shapes the arguments fit
+        as they came and whose cone blocks are those of ``cones`` is made current, as
+        :meth:`_returning` makes one current, with the friction coefficients and normals
+        of ``cones`` (the terrain's may differ); None when no kept workspace is such. A
+        contact change with a caller's guess, or onto other friction, lands here. The
+        general path (a new structure's arrays, its scan, two keys, numpy's writes of the
+        friction) costs solo12 6 us when the interpreter runs it warm, 38 us when it runs
+        once after a stretch of ticks of another structure, as a contact change does
+        (notes/performance-history.md, "contactwall"). The solve checks the bounds
+        against the workspace's structure, and ``STRUCTURE_CHANGED`` leads to the general
+        path's new structure (:meth:`_result`)."""
+        for key, (structure, w) in self._kept.items():
+            if dense_arguments(P, q, A, b, lb, ub, structure.n, structure.m):
+                flat = flatten_cones(cones, structure.n)
+                if flat.same_blocks(structure.cones):
+                    del self._kept[key]
+                    self._keep_current()
+                    self._structure, self._workspace = structure, w
+                    if flat is not structure.cones:
+                        w.update_cones(flat.mu, flat.normal)
+                        structure.cones = flat
+                    return flat
+        return None
 
     def _keep_current(self) -> None:
         """Keep the current workspace with its structure (:data:`KEPT_WORKSPACES`)."""
