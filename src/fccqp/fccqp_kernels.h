@@ -408,29 +408,6 @@ static void fccqp_sparse_rank_clear(int rows, const int *restrict index,
     }
 }
 
-/* Asks for the cache lines of bytes from p (at most FCCQP_PREFETCH_BYTES of them) ahead of
- * a pass that reads them: the validation scan's first read of the caller's arrays, which
- * are often not in cache (the benchmark's 400 QPs are 15 MB). The prefetchers follow a
- * stream only once it has started, and one stream at a time, P's then A's; asked for
- * together, P, A and the vectors come from memory side by side. go2's arrays flushed from
- * every cache (C, clflush): the scan 7.2 -> 5.8 us; from L3 2.06 -> 2.17 us (a prefetch
- * instruction per line, 600 a go2 solve; notes/performance-history.md, "ipc2"). */
-#define FCCQP_PREFETCH_BYTES (256L * 1024)
-static void fccqp_prefetch(const void *p, long bytes)
-{
-    const char *start = (const char *)p;
-    if (bytes > FCCQP_PREFETCH_BYTES)
-        bytes = FCCQP_PREFETCH_BYTES;
-#if defined(__GNUC__) || defined(__clang__)
-    for (long k = 0; k < bytes; k += 64)
-        __builtin_prefetch(start + k);
-    if (bytes > 0)
-        __builtin_prefetch(start + bytes - 1);   /* the last line, where p is not aligned */
-#else
-    (void)start;   /* no portable prefetch: the scan reads the arrays as they come */
-#endif
-}
-
 /* What fccqp_symmetric_copy and fccqp_checked_copy found: bits of their result */
 #define FCCQP_NOT_FINITE 1   /* an entry NaN or infinite (symmetric copy), or beyond the limit */
 #define FCCQP_CHANGED 2      /* out did not hold the result already */

@@ -23,7 +23,6 @@ cdef extern from "fccqp_kernels.h" nogil:
     int FCCQP_NOT_FINITE, FCCQP_CHANGED
     int fccqp_symmetric_copy(const double* P, int n, double* out, double* sizes)
     int fccqp_checked_copy(const double* v, long k, double limit, double* out)
-    void fccqp_prefetch(const void* p, long bytes)
 
 
 cdef inline Finding _found(int code, int argument, Py_ssize_t index, double value) noexcept nogil:
@@ -68,16 +67,13 @@ cdef Finding scan_and_copy(const double* P, const double* q, const double* A, co
     ``P`` goes through ``fccqp_symmetric_copy`` (four pairs ``(i, j), (j, i)`` of the
     upper triangle a step) and ``A`` through ``fccqp_checked_copy`` (fccqp_kernels.h),
     passes that do not branch on the data; what went wrong is looked up only when
-    something did. Every array's cache lines are asked for first (``fccqp_prefetch``),
-    so that those not in cache come from memory together.
+    something did.
     """
     cdef Py_ssize_t i
     cdef double sizes[2]   # the largest entry and asymmetry of P
     cdef bint same = same_matrices[0], differs
-    cdef int found
+    cdef int found = fccqp_symmetric_copy(P, <int>n, P_out, sizes)
     cdef Finding f
-    _prefetch_inputs(P, q, A, b, lb, ub, n, m)
-    found = fccqp_symmetric_copy(P, <int>n, P_out, sizes)
     if found & FCCQP_NOT_FINITE or sizes[0] > MAX_ENTRY:
         return _first_bad_entry(P, n)
     if sizes[1] > SYMMETRY_TOLERANCE * sizes[0]:
@@ -99,19 +95,6 @@ cdef Finding scan_and_copy(const double* P, const double* q, const double* A, co
     if f.code != SCAN_OK:
         return f
     return _check_bounds(lb, ub, n, lb_out, ub_out)
-
-
-cdef inline void _prefetch_inputs(const double* P, const double* q, const double* A,
-                                  const double* b, const double* lb, const double* ub,
-                                  Py_ssize_t n, Py_ssize_t m) noexcept nogil:
-    """Ask for the caller's arrays in the order the scan reads them."""
-    cdef long size = sizeof(double)
-    fccqp_prefetch(P, n * n * size)
-    fccqp_prefetch(A, m * n * size)
-    fccqp_prefetch(q, n * size)
-    fccqp_prefetch(b, m * size)
-    fccqp_prefetch(lb, n * size)
-    fccqp_prefetch(ub, n * size)
 
 
 cdef inline Finding _check_bounds(const double* lb, const double* ub, Py_ssize_t n,
