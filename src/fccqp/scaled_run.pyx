@@ -137,7 +137,7 @@ cdef void unscaled_answer(Engine* e, Run* run, double* x, double* y, double* z,
     the point for a warm start."""
     cdef Problem* p = &e.prob
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s
-    if e.unscaled.current:   # a warm polish's point: unscaled and measured already
+    if e.unscaled.current:   # a kept polish's point: unscaled and measured already
         copy(e.unscaled.x, x, n)
         if m:
             copy(e.unscaled.y, y, m)
