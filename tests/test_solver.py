@@ -417,7 +417,7 @@ def test_dual_guess_overrides_the_previous_answer_without_warm_start_setting():
     np.testing.assert_allclose(again.x, first.x, rtol=1e-9, atol=1e-12)
 
 
-@pytest.mark.parametrize("seed", [20, 38, 168])   # most others: the polish is kept
+@pytest.mark.parametrize("seed", [7, 11, 15])   # most others: the polish is kept
 def test_a_far_guess_whose_polish_fails_is_answered_from_the_cold_start(seed):
     """When the warm polish from a caller's guess fails, ADMM starts from the cold start
     unless the guess is much nearer the termination test: a guess far from the answer
@@ -433,7 +433,7 @@ def test_a_far_guess_whose_polish_fails_is_answered_from_the_cold_start(seed):
     np.testing.assert_array_equal(far.x, cold.x)
 
 
-@pytest.mark.parametrize("seed", [168, 326, 532, 552])   # most other seeds: the guess polishes
+@pytest.mark.parametrize("seed", [425, 712])   # most other seeds: the guess polishes
 def test_a_neighbours_answer_whose_polish_fails_is_answered_from_the_cold_start(seed):
     """A guess that is the answer of a neighbouring problem (``q`` and ``b`` moved, as
     from the previous tick) and fails its warm polish is nearer the termination test
@@ -451,12 +451,14 @@ def test_a_neighbours_answer_whose_polish_fails_is_answered_from_the_cold_start(
 
 
 @pytest.mark.parametrize("seed", range(4))   # 4: on schur_reduced, 17 iterations
-def test_a_guess_holding_bounds_the_problem_releases_is_polished_without_iterations(seed):
-    """A caller's guess whose multipliers hold most bounds (the answer of the problem
-    pushed against them, as a contact change leaves the previous stance's torque limits)
-    is polished from nothing held, the bounds the problem needs added at once: the
-    problem's answer at 0 iterations, where releasing one held bound a guess ran out of
-    guesses and ADMM ran."""
+def test_a_carried_guess_holding_bounds_the_problem_releases_is_polished_without_iterations(
+        seed):
+    """A caller's guess carried from another structure (the solver's last solve had other
+    sizes, as across a contact change) whose multipliers hold most bounds (the answer of
+    the problem pushed against them, as a contact change leaves the previous stance's
+    torque limits) is polished from nothing held, the bounds the problem needs added at
+    once: the problem's answer at 0 iterations, where releasing one held bound a guess ran
+    out of guesses and ADMM ran (as it does for the same guess in the same structure)."""
     rng = np.random.default_rng(seed)
     n = 24
     P, A, b = np.diag(1.0 + rng.random(n)), rng.standard_normal((2, n)), np.zeros(2)
@@ -465,10 +467,14 @@ def test_a_guess_holding_bounds_the_problem_releases_is_polished_without_iterati
     q = 0.1 * rng.standard_normal(n)
     q[:3] = -8.0   # three upper bounds active at the answer
     plain = fccqp.solve(P, q, A, b, lb, ub)
-    guessed = fccqp.solve(P, q, A, b, lb, ub, x0=pushed.x, y0=pushed.y, z0=pushed.z)
+    solver = fccqp.Solver()
+    solver.solve(P[1:, 1:], q[1:], A[:, 1:], b, lb[1:], ub[1:])   # another structure
+    guessed = solver.solve(P, q, A, b, lb, ub, x0=pushed.x, y0=pushed.y, z0=pushed.z)
     assert np.sum(np.abs(pushed.x) == 1.0) > 12 and plain.iterations > 0
     assert guessed.status is Status.SOLVED and guessed.iterations == 0
     np.testing.assert_allclose(guessed.x, plain.x, rtol=0, atol=1e-12)
+    same = fccqp.solve(P, q, A, b, lb, ub, x0=pushed.x, y0=pushed.y, z0=pushed.z)
+    assert same.status is Status.SOLVED and same.iterations > 0
 
 
 def test_box_infeasible():

@@ -150,8 +150,8 @@ cdef bint warm_polish(Engine* e, Run* run, double start_time) noexcept nogil:
     A warm polish that ended cycling is tried once more from its own last point, one
     guess (``CYCLED_GUESS_PASSES``, :func:`_polish_again`). One whose crawl cannot release
     its wrong-signed multipliers in the guesses left gives up (``e.pol.warm``,
-    ``HOPELESS_RATE``). A caller's guess is polished without its multipliers
-    (:func:`_polish_start`).
+    ``HOPELESS_RATE``). A caller's guess carried from another structure is polished
+    without its multipliers (:func:`_polish_start`).
     """
     cdef int status = RUNNING
     cdef bint kept
@@ -172,24 +172,31 @@ cdef bint warm_polish(Engine* e, Run* run, double start_time) noexcept nogil:
 
 
 cdef bint _polish_start(Engine* e, int* status, double start_time) noexcept nogil:
-    """:func:`keep_polished` on the warm start, a caller's guess (``e.prev.guessed``)
-    with its constraint multipliers ``y`` set to zero and put back when the polish fails
-    (ADMM may start from them, :func:`fccqp.iteration._nearer_start`).
+    """:func:`keep_polished` on the warm start; on a caller's guess carried from another
+    structure (``e.prev.carried``) with its constraint multipliers ``y`` set to zero and
+    put back when the polish fails (ADMM may start from them,
+    :func:`fccqp.iteration._nearer_start`).
 
-    The guess then holds nothing its slack does not lie outside of (``z`` is in ``C``):
-    the first solve is the equality-constrained QP and the corrections add the violated
-    bounds and cone blocks together. With the multipliers, the guess held the previous
-    answer's active set; a guess carried across a contact change holds torque bounds
-    and loaded feet that the new stance releases, and the polish releases one wrong
-    multiplier a pass. On 16 of the benchmark's 184 contact-change ticks (mix and
+    Such a guess then holds nothing its slack does not lie outside of (``z`` is in
+    ``C``): the first solve is the equality-constrained QP and the corrections add the
+    violated bounds and cone blocks together. With the multipliers, the guess held the
+    previous answer's active set; a guess carried across a contact change holds torque
+    bounds and loaded feet that the new stance releases, and the polish releases one
+    wrong multiplier a pass. On 16 of the benchmark's 184 contact-change ticks (mix and
     generated ``contact_switch`` sets, every one a quadruped's) that polish failed and
     ADMM ran 5-80 iterations, where the polish from nothing is kept at 0 (go2's quick
     tick 54: 3.9M instructions -> 1.5M); it loses one talos tick whose carried active
-    set settled at its eleventh guess (notes/performance-history.md, "contact6")."""
+    set settled at its eleventh guess (notes/performance-history.md, "contact6"). A guess
+    for the same structure (a caller passing its previous answer, as OSQP's
+    ``warm_start(x, y)`` is used) keeps its multipliers, as the solver's own warm start
+    does: from nothing, the polish of the benchmark's warm walks failed often enough that
+    such a caller ran 10x the warm start's ADMM iterations, and a problem's own polished
+    answer given back took an iteration on 16-92 % of the ticks (notes/polish.md,
+    "guessheld")."""
     cdef double* held = e.work.saved   # s of it: _polish_again's scratch, not yet in use
     cdef Py_ssize_t s = e.prob.s
     cdef bint kept
-    if not e.prev.guessed:
+    if not (e.prev.guessed and e.prev.carried):
         return keep_polished(e, status, 0, start_time, True)
     copy(e.it.y, held, s)
     fill(e.it.y, 0.0, s)

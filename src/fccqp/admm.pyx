@@ -103,6 +103,11 @@ cdef class Workspace:
     cdef readonly bint converging
     """The last run stopped at ``max_iter`` while still converging: its distance to
     tolerance shrank by ``fccqp.tuning.CONVERGING`` over the last half of the cap."""
+    cdef public bint arrived
+    """Set by :class:`fccqp.Solver` when this workspace becomes current after a solve of
+    another structure, cleared by each solve: a primal-dual guess given to the next
+    solve was carried from that structure (a contact change), and its polish starts from
+    nothing held (:func:`fccqp.acceptance._polish_start`)."""
 
     def __init__(self, Py_ssize_t n, Py_ssize_t m, constrained, cones, fixed, order,
                  settings, Py_ssize_t log_rows, patterns=None):
@@ -406,6 +411,7 @@ cdef class Workspace:
         if z0 != NULL:
             self._take_guess(x0, y0, z0)
             x0, warm = NULL, True
+        self.arrived = False
         cdef long max_iter = e.opt.max_iter
         # a start from the previous solution (or x0), with the previous scaling, that
         # has not succeeded in half the iterations gets a cold start with a new scaling
@@ -460,10 +466,11 @@ cdef class Workspace:
                           const double* z0) noexcept nogil:
         """Make the primal-dual guess ``(x0, y0, z0)`` (user's units) the previous
         solution, polished: the run then starts from it as a warm start from its own
-        answer does, the warm polish first (from the guess's primal point with nothing
-        held, :func:`fccqp.acceptance._polish_start`; if that fails, ADMM starts from
-        the guess or the cold start, :func:`fccqp.iteration._nearer_start`). Its rho is
-        the last one this workspace ran at, else ``settings.rho``."""
+        answer does, the warm polish first (on the guess's active set, or from its primal
+        point with nothing held when the guess was carried from another structure,
+        :attr:`arrived`, :func:`fccqp.acceptance._polish_start`; if that fails, ADMM
+        starts from the guess or the cold start, :func:`fccqp.iteration._nearer_start`).
+        Its rho is the last one this workspace ran at, else ``settings.rho``."""
         cdef Engine* e = &self.e
         copy(x0, e.prev.x, e.prob.n)
         copy(y0, e.prev.y, e.prob.m)
@@ -471,6 +478,7 @@ cdef class Workspace:
         if not e.prev.has_rho:
             e.prev.rho = e.opt.rho
         e.prev.exists = e.prev.polished = e.prev.guessed = True
+        e.prev.carried = self.arrived
 
     cdef bint _same_structure(self, const double* lb, const double* ub) noexcept nogil:
         """Whether the user's new bounds bound, fix and leave free the entries they did at

@@ -124,6 +124,7 @@ cdef struct Previous:
     bint from_polished          # this solve starts from it
     bint has_rho                # rho is one some solve adapted (a cold start keeps it too)
     bint guessed                # x, y, z are a caller's guess, not an answer
+    bint carried                # and carried from another structure (a contact change)
 
 
 cdef struct UserPoint:

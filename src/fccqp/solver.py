@@ -194,12 +194,14 @@ class Solver:
             :attr:`Result.z` (a missing one is zero), as OSQP's ``warm_start(x, y)``:
             the solve then starts from ``(x0, y0, z0)`` as a warm start from the
             previous answer does, at the rho of this structure's last solve
-            (``settings.rho`` on a new one), trying first the polish from ``x0`` with
-            nothing held (the guess's multipliers serve ADMM's start, not the polish's
-            first guess). Solving a problem again from its own :class:`Result`'s ``x, y, z``
-            takes no ADMM iteration when that result was polished. A caller whose
+            (``settings.rho`` on a new one), trying first the polish on the guess's
+            active set. Solving a problem again from its own :class:`Result`'s ``x, y,
+            z`` takes no ADMM iteration when that result was polished. A caller whose
             problem changed size (a contact made or broken) passes the previous
-            answer mapped onto the new variables and rows.
+            answer mapped onto the new variables and rows; such a guess, carried from
+            another structure than the last solve's, is polished first from ``x0`` with
+            nothing held (its multipliers serve ADMM's start, not the polish's first
+            guess: the new stance releases some of what they hold).
 
         Returns
         -------
@@ -280,6 +282,7 @@ class Solver:
                 del self._kept[key]
                 self._keep_current()
                 self._structure, self._workspace, self._cones = structure, w, cones
+                w.arrived = True
                 return w, structure
         return None, None
 
@@ -303,6 +306,7 @@ class Solver:
                     del self._kept[key]
                     self._keep_current()
                     self._structure, self._workspace = structure, w
+                    w.arrived = True
                     if flat is not structure.cones:
                         w.update_cones(flat.mu, flat.normal)
                         structure.cones = flat
@@ -413,7 +417,10 @@ class Solver:
         """Make ``structure`` and a workspace for it current, keeping the current one
         (:data:`KEPT_WORKSPACES`): a kept workspace of the same structure is reused
         (with ``settings.warm_start`` it starts from its last answer, as a return through
-        :meth:`_returning` does), otherwise a new one is allocated."""
+        :meth:`_returning` does), otherwise a new one is allocated. A guess given to its
+        next solve came from the current one's structure (``Workspace.arrived``), when
+        there was one."""
+        arrived = self._workspace is not None
         self._keep_current()
         kept = self._kept.pop(structure.key(), None)
         if kept is None:
@@ -421,6 +428,7 @@ class Solver:
         else:
             w = kept[1]
             w.update_cones(structure.cones.mu, structure.cones.normal)
+        w.arrived = arrived
         self._structure, self._workspace = structure, w
         return w
 
@@ -463,7 +471,9 @@ class Solver:
     def _sparse_workspace(self, data: object, renew: bool) -> admm.Workspace:
         """The compressed-column workspace for ``data`` (a
         :class:`fccqp.sparse_problem.SparseData`): the last one when its structure and
-        its matrices' patterns are ``data``'s (and not ``renew``), else a new one."""
+        its matrices' patterns are ``data``'s (and not ``renew``), else a new one, to
+        which a guess comes from another structure (``Workspace.arrived``) when a
+        workspace solved before it."""
         cones = data.cones
         key = (data.n, data.m, data.constrained.tobytes(), data.fixed.tobytes(),
                cones.kind.tobytes(), cones.offset.tobytes(), cones.dim.tobytes(),
@@ -476,6 +486,7 @@ class Solver:
                 data.n, data.m, data.constrained, (cones.kind, cones.offset, cones.dim,
                                                    cones.mu, cones.normal),
                 data.fixed, None, self._settings, log_rows, patterns)
+            workspace.arrived = self._sparse is not None or self._workspace is not None
             self._sparse = (key, workspace)
         workspace = self._sparse[1]
         workspace.update_cones(cones.mu, cones.normal)
