@@ -607,10 +607,12 @@ cdef bint _final_polish(Engine* e, Loop* L) noexcept nogil:
     an iteration toward 1e4 times that step, the primal iterate held on a face of other
     bounds meanwhile) that takes more than ``GUESS_PASSES``, and nothing after the cap
     would use the time better. Runs stopped earlier (converged, or by the clock) keep
-    ``GUESS_PASSES``."""
+    ``GUESS_PASSES``, and so do runs capped below ``RESTART_MIN_ITER`` iterations: a cap
+    that small is a budget (2 iterations from a random start, the polish of 32 guesses
+    reached the optimum), not room for a walk."""
     cdef long passes = e.pol.guess_passes
     cdef bint kept
-    if L.status != MAX_ITER:
+    if L.status != MAX_ITER or L.iteration < RESTART_MIN_ITER:
         return keep_polished(e, &L.status, L.iteration, L.start_time, False)
     e.pol.guess_passes = STALLED_GUESS_PASSES
     kept = keep_polished(e, &L.status, L.iteration, L.start_time, False)

@@ -149,8 +149,8 @@ cdef extern from *:
     /* most active sets per warm polish (from the previous tick's answer): 8 sent 3-9 % of
        the warm ticks to ADMM, most of them a few guesses short of settling */
     #define FCCQP_WARM_GUESS_PASSES 12
-    /* most active sets for the final polish of a run stopped at max_iter: stepping from a
-       stalled iterate, a primal active-set walk may need more than GUESS_PASSES */
+    /* most active sets for the final polish of a run stopped at max_iter (of at least
+       RESTART_MIN_ITER): from a stalled iterate its active-set walk may need more */
     #define FCCQP_STALLED_GUESS_PASSES 32
     /* guesses of a warm polish tried again from its own cycling point: those kept took 1 */
     #define FCCQP_CYCLED_GUESS_PASSES 1
