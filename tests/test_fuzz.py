@@ -27,7 +27,7 @@ SEEDS = {
                      1100037, 1100057, 1100150, 1100253, 1300030, 1300300, 1500043, 1700106,
                      1700359, 1900050, 2500125, 2900030, 4700215, 4700352,
                      5300281, 6100225),
-    "qpsolvers": (0, 1, 2, 1700123, 7900043),
+    "qpsolvers": (0, 1, 2, 1700123, 7900043, 8500350),
     "cvxpy": (1, 2, 3, 9700197),
     "degenerate": (0, 1, 2, 4, 7, 9, 11, 12, 21, 23, 30, 35, 43, 58, 150, 102753, 104299),
 }
@@ -66,7 +66,11 @@ largest row's rounding and which the start's gate therefore never tested; extrem
 orthogonal only to the columns ``P`` leaves unscaled; qpsolvers 7900043 (also on the
 sparse path) an active row of ``G`` parallel to a slack one at 2e-3 of its size, whose
 slack row the equilibration saw balanced: MAX_ITER_REACHED, its multiplier a tenth
-built, until the qpsolvers backend scaled each row of ``G`` to entries of 1; cvxpy
+built, until the qpsolvers backend scaled each row of ``G`` to entries of 1; qpsolvers
+8500350 two nearly antiparallel active rows of ``G`` (an implicit equality) whose
+multipliers ADMM builds by a fixed step an iteration, 2e7 iterations from the optimum's,
+its iterate on another face at the cap: MAX_ITER_REACHED until the final polish of a run
+stopped at ``max_iter`` could take more guesses than a converged run's; cvxpy
 9700197 an iterate running away infeasibly while the rho rule lowered rho to its floor
 (``tuning.RHO_RUNAWAY``), and extreme_data 212 an iterate growing feasibly toward an
 optimum at 5e9 (``P`` of 1e-11), whose rho that guard must leave to the rule; issues 26,

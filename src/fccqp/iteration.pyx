@@ -47,7 +47,7 @@ from fccqp.tuning cimport (AUXILIARY_TIME, CLEANING_START, CONVERGING, EARLY_POL
                            EARLY_POLISH_TRIES, EQUALITY_MISSED, GATED_CHECK_WAIT, GUESS_LEAD,
                            LOG_INTERVAL, POLISH_GATE, POLISH_RETRIES, RESERVE_PASSES,
                            RESTART_MIN_ITER, SETTLE_ITERATIONS, SETTLE_TRIES, STALL_FACTOR,
-                           STALLS, TIMED_EARLY_POLISH)
+                           STALLED_GUESS_PASSES, STALLS, TIMED_EARLY_POLISH)
 from fccqp.verdict cimport (check, classify, inconsistent, missed, row_missed_by_data,
                             unbounded)
 
@@ -585,7 +585,7 @@ cdef inline void _final_step(Engine* e, Loop* L, Run* run) noexcept nogil:
             and L.polished_at != L.iteration
             and (not L.timed or L.iteration >= L.cap
                  or nearly_converged(&e.res, o.eps_abs, o.eps_rel, POLISH_GATE))):
-        run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, False)
+        run.polished = _final_polish(e, L)
     if not run.polished:   # a polished point is feasible already: nothing to restore
         if o.restore_feasibility and SOLVED <= L.status <= TIME_LIMIT:
             L.status = keep_restored(e, L.status, L.iteration, L.reduced)
@@ -594,6 +594,30 @@ cdef inline void _final_step(Engine* e, Loop* L, Run* run) noexcept nogil:
     if L.status == MAX_ITER or L.status == TIME_LIMIT:
         hold_equalities(e)   # where the KKT solves could not (fccqp.equalities)
     end_run(e, run, L.status, L.iteration)
+
+
+cdef bint _final_polish(Engine* e, Loop* L) noexcept nogil:
+    """Polish the final iterate (:func:`fccqp.acceptance.keep_polished`); whether the
+    polished point was kept. A run stopped at ``max_iter`` may take up to
+    ``STALLED_GUESS_PASSES`` guesses: its iterate is feasible to its tolerance, and each
+    guess after the first is a step of a primal active-set method from it, which ends
+    only once it has made every change of the active set between the iterate's face and
+    the optimum's, one a guess. Where ADMM stalls far from the optimum (the multipliers
+    of two nearly antiparallel active rows, an implicit equality, grow by a fixed step
+    an iteration toward 1e4 times that step, the primal iterate held on a face of other
+    bounds meanwhile) that takes more than ``GUESS_PASSES``, and nothing after the cap
+    would use the time better. Runs stopped earlier (converged, or by the clock) keep
+    ``GUESS_PASSES``, and so do runs capped below ``RESTART_MIN_ITER`` iterations: a cap
+    that small is a budget (2 iterations from a random start, the polish of 32 guesses
+    reached the optimum), not room for a walk."""
+    cdef long passes = e.pol.guess_passes
+    cdef bint kept
+    if L.status != MAX_ITER or L.iteration < RESTART_MIN_ITER:
+        return keep_polished(e, &L.status, L.iteration, L.start_time, False)
+    e.pol.guess_passes = STALLED_GUESS_PASSES
+    kept = keep_polished(e, &L.status, L.iteration, L.start_time, False)
+    e.pol.guess_passes = passes
+    return kept
 
 
 cdef void _full_step(Engine* e, bint relax_x) noexcept nogil:

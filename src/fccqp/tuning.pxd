@@ -149,6 +149,9 @@ cdef extern from *:
     /* most active sets per warm polish (from the previous tick's answer): 8 sent 3-9 % of
        the warm ticks to ADMM, most of them a few guesses short of settling */
     #define FCCQP_WARM_GUESS_PASSES 12
+    /* most active sets for the final polish of a run stopped at max_iter (of at least
+       RESTART_MIN_ITER): from a stalled iterate its active-set walk may need more */
+    #define FCCQP_STALLED_GUESS_PASSES 32
     /* guesses of a warm polish tried again from its own cycling point: those kept took 1 */
     #define FCCQP_CYCLED_GUESS_PASSES 1
     /* a polish whose first this many guesses all violate a constraint gives up */
@@ -281,6 +284,7 @@ cdef extern from *:
     const double GUESS_TOLERANCE "FCCQP_GUESS_TOLERANCE"
     const int GUESS_PASSES "FCCQP_GUESS_PASSES"
     const int WARM_GUESS_PASSES "FCCQP_WARM_GUESS_PASSES"
+    const int STALLED_GUESS_PASSES "FCCQP_STALLED_GUESS_PASSES"
     const int CYCLED_GUESS_PASSES "FCCQP_CYCLED_GUESS_PASSES"
     const int FEASIBLE_PASSES "FCCQP_FEASIBLE_PASSES"
     const double HOPELESS_RATE "FCCQP_HOPELESS_RATE"
