@@ -141,8 +141,9 @@ cdef void iterate(Engine* e, Run* run, bint cold, double start_time) noexcept no
 
 
 cdef inline void _begin(Engine* e, Loop* L, Run* run, bint cold, double start_time) noexcept nogil:
-    """Reset the run's state; the iterations stop early enough for the final polish or
-    restoration to fit in the time limit."""
+    """Reset the run's state; the iterations stop early enough for the final step to fit
+    in the time limit: its recent duration, or ``RESERVE_PASSES`` guesses of a polish
+    and what follows one that fails (restoration, ``A x = b``, unscaling, the result)."""
     cdef Options* o = &e.opt
     L.start_time = start_time
     L.cold = cold
@@ -165,7 +166,8 @@ cdef inline void _begin(Engine* e, Loop* L, Run* run, bint cold, double start_ti
     L.trend_from = LONG_MAX
     L.cut = _cut_iterations
     L.deadline = o.time_limit - min(
-        max(e.clock.final_reserve, RESERVE_PASSES * e.clock.pass_time), 0.5 * o.time_limit)
+        max(e.clock.final_reserve, RESERVE_PASSES * e.clock.pass_time + e.clock.tail_time),
+        0.5 * o.time_limit)
     run.factorizations = 0
     run.backend = e.fact.form
     trial_reset(&L.trial)
