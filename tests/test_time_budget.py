@@ -155,3 +155,18 @@ def test_an_extended_cap_polishes_as_an_untimed_run_at_its_cap():
     assert timed.status is Status.SOLVED and timed.polished, timed.status
     assert timed.iterations == 200
     verify_solution(problem, timed, Tolerances.of(**EPS))
+
+
+def test_iterations_past_the_time_limit_run_at_the_rho_they_reached():
+    """The iterations that ``min_iter`` forces past the time limit change rho no more: a
+    change there (a factorization) ends after the run's deadline and only lengthens the
+    overrun. They factor as often as a run that never adapts rho; untimed, this QP's
+    run changes rho within them."""
+    problem = flat_qp(3)
+    settings = dict(polish=False, max_iter=200, **EPS)
+    fixed = fccqp.solve(*problem, adaptive_rho=False, **settings)
+    untimed = fccqp.solve(*problem, **settings)
+    assert untimed.factorizations > fixed.factorizations
+    late = fccqp.solve(*problem, min_iter=200, time_limit=1e-9, **settings)
+    assert late.status is Status.SOLVED
+    assert late.factorizations == fixed.factorizations

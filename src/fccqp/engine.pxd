@@ -138,7 +138,10 @@ cdef struct UserPoint:
 cdef struct Clock:
     double marks[6]             # phase boundaries of the last solve (Workspace.phase_times)
     double final_reserve        # seconds the final polish or restoration took lately
-    double pass_time            # seconds per guess of the last polish, its check included
+    double pass_time            # seconds per guess of the last polish of an iterate, its check included
+    double polish_end           # when the final step's polish ended (or was skipped)
+    double tail_time            # seconds unpolished final steps took after their polish lately
+    double rho_time             # seconds the last change of rho took (its factorization)
 
 
 cdef struct Log:

@@ -141,8 +141,9 @@ cdef void iterate(Engine* e, Run* run, bint cold, double start_time) noexcept no
 
 
 cdef inline void _begin(Engine* e, Loop* L, Run* run, bint cold, double start_time) noexcept nogil:
-    """Reset the run's state; the iterations stop early enough for the final polish or
-    restoration to fit in the time limit."""
+    """Reset the run's state; the iterations stop early enough for the final step to fit
+    in the time limit: its recent duration, or ``RESERVE_PASSES`` guesses of a polish
+    and what follows one that fails (restoration, ``A x = b``, unscaling, the result)."""
     cdef Options* o = &e.opt
     L.start_time = start_time
     L.cold = cold
@@ -165,7 +166,8 @@ cdef inline void _begin(Engine* e, Loop* L, Run* run, bint cold, double start_ti
     L.trend_from = LONG_MAX
     L.cut = _cut_iterations
     L.deadline = o.time_limit - min(
-        max(e.clock.final_reserve, RESERVE_PASSES * e.clock.pass_time), 0.5 * o.time_limit)
+        max(e.clock.final_reserve, RESERVE_PASSES * e.clock.pass_time + e.clock.tail_time),
+        0.5 * o.time_limit)
     run.factorizations = 0
     run.backend = e.fact.form
     trial_reset(&L.trial)
@@ -552,13 +554,16 @@ cdef inline void _stall_rule(Engine* e, Loop* L) noexcept nogil:
 
 cdef inline bint _adapt_rho(Engine* e, Loop* L, Run* run) noexcept nogil:
     """Adapt rho on its schedule (:func:`fccqp.rho_rule.new_rho`) and refactor for a
-    new one; False, the run ended, when that factorization fails."""
-    cdef double rho
+    new one (:func:`_rho_change_fits`); False, the run ended, when that factorization
+    fails."""
+    cdef double rho, began
     cdef int code
-    if L.status == RUNNING and L.adapt:
+    if L.status == RUNNING and L.adapt and _rho_change_fits(e, L):
         rho = new_rho(&e.res, run.rho, &L.trial, e.opt.adaptive_rho_tolerance)
         if rho != run.rho:
+            began = fccqp_now()
             code = change_rho(e, run, rho, L.iteration, L.reduced)
+            e.clock.rho_time = fccqp_now() - began
             if code != FACTORED:
                 run.status = NOT_CONVEX_QP if code == NOT_CONVEX else NUMERICAL_ERROR
                 return False
@@ -566,6 +571,22 @@ cdef inline bint _adapt_rho(Engine* e, Loop* L, Run* run) noexcept nogil:
             L.fresh = True
             L.wait = L.next_gated = 0
     return True
+
+
+cdef inline bint _rho_change_fits(Engine* e, const Loop* L) noexcept nogil:
+    """Whether a change of rho, at what the last one took (its factorization), ends
+    before a timed run's iterations stop: one that would not leaves no iteration at the
+    new rho, and ran talos' last iteration 0.1 ms past their deadline."""
+    return (not L.timed
+            or fccqp_now() - L.start_time + e.clock.rho_time < L.deadline)
+
+
+cdef inline bint _polish_fits(Engine* e, const Loop* L) noexcept nogil:
+    """Whether the final polish may start: not under a time limit once an earlier
+    polish of the run ran to the end of the polishes' budget (``Clock.tail_time``, see
+    :func:`fccqp.acceptance.keep_polished`), which the final step's restoration needs."""
+    return (not L.timed or L.polished_at < 0
+            or fccqp_now() - L.start_time < e.opt.time_limit - e.clock.tail_time)
 
 
 cdef inline void _final_step(Engine* e, Loop* L, Run* run) noexcept nogil:
@@ -582,10 +603,11 @@ cdef inline void _final_step(Engine* e, Loop* L, Run* run) noexcept nogil:
     run.converging = (L.iteration >= L.cap and o.max_iter >= RESTART_MIN_ITER
                       and _converging(L, L.last_distance))   # halves worth judging
     if (not run.polished and o.polish and SOLVED <= L.status <= TIME_LIMIT
-            and L.polished_at != L.iteration
+            and L.polished_at != L.iteration and _polish_fits(e, L)
             and (not L.timed or L.iteration >= L.cap
                  or nearly_converged(&e.res, o.eps_abs, o.eps_rel, POLISH_GATE))):
         run.polished = _final_polish(e, L)
+    e.clock.polish_end = fccqp_now()
     if not run.polished:   # a polished point is feasible already: nothing to restore
         if o.restore_feasibility and SOLVED <= L.status <= TIME_LIMIT:
             L.status = keep_restored(e, L.status, L.iteration, L.reduced)
