@@ -189,9 +189,9 @@ cdef int _table_start(Engine* e, Run* run) noexcept nogil:
     Schur with ``rho`` on the constrained entries, its table ``W`` and ``base``, which
     the iteration needs anyway. Returns FACTORED (``x``, ``nu`` set, the factorization
     left for the iteration, ``table_ready``), NOT_CONVEX, or UNAVAILABLE (the caller's
-    start serves: no Schur form, a factorization or small system that failed, or a
-    candidate ray, whose direction test needs the accuracy the small system lacks
-    near a ray).
+    start serves: no Schur form or constrained entry, a factorization or small system
+    that failed, or a candidate ray, whose direction test needs the accuracy the small
+    system lacks near a ray).
 
     With ``R`` the rho entries and ``D = R - sigma``, a step ``(P + sigma_S) x + A'nu =
     -q + sigma x_prev`` is ``(P + R_S) x + A'nu = -q + u``, ``u = sigma x_prev_S + D x_S``,
@@ -210,7 +210,7 @@ cdef int _table_start(Engine* e, Run* run) noexcept nogil:
     cdef double* xs = e.work.vec_s2      # x_S
     cdef double* u = e.work.rhs
     cdef double* sol = e.work.sol
-    if e.equalities_missed or not _schur_start(e):
+    if s == 0 or e.equalities_missed or not _schur_start(e):
         return UNAVAILABLE
     for j in range(s):
         it.rho_vec[j] = run.rho * e.fact.rho_scale[j]
