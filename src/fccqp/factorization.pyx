@@ -229,9 +229,6 @@ cdef int _table_start(Engine* e, Run* run) noexcept nogil:
         M[j + j * s] += 1.0 / gap[j]
     if not cholesky(M, <int>s, <int>s):
         return UNAVAILABLE
-    e.fact.form = SCHUR_REDUCED
-    run.backend = SCHUR_REDUCED
-    e.fact.factored_rho = run.rho
     reduced_base(e)
     fill(xs, 0.0, s)
     for step in range(EQUALITY_START_STEPS):
@@ -248,6 +245,9 @@ cdef int _table_start(Engine* e, Run* run) noexcept nogil:
         return UNAVAILABLE
     copy(sol, it.x, n)
     copy(sol + n, it.nu, p.m)
+    e.fact.form = SCHUR_REDUCED
+    run.backend = SCHUR_REDUCED
+    e.fact.factored_rho = run.rho
     return FACTORED
 
 
