@@ -37,6 +37,17 @@ def test_backend_matches_clarabel(kkt_backend, seed):
     assert np.abs(A @ result.x - b).max() <= 1e-9 * (1 + np.abs(b).max())
 
 
+def test_schur_cold_start_leaves_its_factorization_to_the_iterations():
+    """The cold start's proximal steps run on the iteration's Schur factorization for
+    rho (its table's coordinates), so a cold run that keeps its rho factors once."""
+    problem = random_problem(0, n_box=6)
+    result = fccqp.solve(*problem, kkt_backend="schur_reduced", adaptive_rho=False)
+    assert result.status is Status.SOLVED and result.iterations > 0
+    assert result.backend == "schur_reduced" and result.factorizations == 1
+    reference = clarabel_solve(*problem)
+    np.testing.assert_allclose(result.x, reference.x, atol=1e-3 * (1 + np.abs(reference.x).max()))
+
+
 def _block_diagonal(problem, coupled_constrained=False, flat_free=False):
     """``problem`` with the cost of whole-body control's shape: dense on the first
     free entries, diagonal on the other free ones and on every constrained entry (the

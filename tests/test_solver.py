@@ -352,7 +352,8 @@ def test_reuses_factorization_when_matrices_unchanged(kkt_backend):
 
 
 def test_reuse_after_a_solve_that_needed_no_iteration():
-    """The cold start's equality-only factorization must not be mistaken for rho's."""
+    """The cold start's equality-only factorization (LDL') must not be mistaken for
+    rho's; the Schur start's is rho's own, which the next solve reuses."""
     P, q, A, b, lb, ub, cones = random_problem(7, n_cones=0)
     solver = fccqp.Solver()
     boxed = np.isfinite(lb)
@@ -361,7 +362,8 @@ def test_reuse_after_a_solve_that_needed_no_iteration():
     tight = solver.solve(P, q, A, b, lb, ub, cones)  # same structure, active bounds now
     assert tight.status is Status.SOLVED
     verify_solution((P, q, A, b, lb, ub, cones), tight)
-    assert tight.factorizations >= 1
+    if first.backend != "schur_reduced":
+        assert tight.factorizations >= 1
     reference = clarabel_solve(P, q, A, b, lb, ub, cones)
     assert abs(tight.obj - reference.obj) <= 1e-4 * (1 + abs(reference.obj))
 

@@ -157,6 +157,7 @@ cdef struct Scratch:
     double* vec_n3
     double* vec_s
     double* vec_s2
+    double* mat_s               # s x s: the equality start's small system (column-major)
     double* vec_m
     double* vec_m2
     double* saved               # n + m + s: an iterate kept while a replacement is tried

@@ -6,4 +6,4 @@ cdef int factor(Engine* e, Run* run, long solves) noexcept nogil
 cdef void reduced_base(Engine* e) noexcept nogil
 cdef int change_rho(Engine* e, Run* run, double new_rho, long iteration,
                     bint reduced) noexcept nogil
-cdef int equality_start(Engine* e, bint* unbounded) noexcept nogil
+cdef int equality_start(Engine* e, Run* run, bint* unbounded) noexcept nogil

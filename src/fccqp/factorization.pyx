@@ -8,7 +8,8 @@ and ``base`` in step with the factorization, and records what it holds
 (:c:type:`fccqp.engine.Factorization`).
 """
 
-from fccqp._dense cimport copy, fill, inf_norm
+from fccqp._blas cimport cholesky, cholesky_solve_vector
+from fccqp._dense cimport colmatvec, copy, fill, inf_norm, matvec
 from fccqp._types cimport Iterates, Problem
 from fccqp.anderson cimport anderson_reset
 from fccqp.engine cimport Engine, Run
@@ -167,9 +168,7 @@ cdef int _start_factor(Engine* e) noexcept nogil:
     Cholesky cannot factor on the free entries, fall back to LDL', whose inertia
     decides convexity and whose regularized solves the inconsistency test reads.
     Compressed columns start with ``SPARSE_LDL``, their only backend."""
-    cdef int backend = e.opt.backend
-    if e.prob.P.kind == DENSE and (backend == SCHUR_REDUCED or (
-            backend == AUTO and _reduced_pays(e, budget(e, 0)))):
+    if _schur_start(e):
         fill(e.it.rho_vec, e.opt.sigma, e.prob.s)
         if kkt_factor(&e.fact.kkt, &e.prob, SCHUR_REDUCED, 0.0, e.it.rho_vec) == FACTORED:
             return FACTORED
@@ -178,9 +177,87 @@ cdef int _start_factor(Engine* e) noexcept nogil:
                                   e.it.rho_vec) == FACTORED else NOT_CONVEX
 
 
-cdef int equality_start(Engine* e, bint* unbounded) noexcept nogil:
+cdef inline bint _schur_start(const Engine* e) noexcept nogil:
+    """Whether the cold start factors with the Schur backend: where the iteration will."""
+    cdef int backend = e.opt.backend
+    return e.prob.P.kind == DENSE and (backend == SCHUR_REDUCED or (
+        backend == AUTO and _reduced_pays(e, budget(e, 0))))
+
+
+cdef int _table_start(Engine* e, Run* run) noexcept nogil:
+    """:func:`equality_start`'s proximal steps on the iteration's own factorization:
+    Schur with ``rho`` on the constrained entries, its table ``W`` and ``base``, which
+    the iteration needs anyway. Returns FACTORED (``x``, ``nu`` set, the factorization
+    left for the iteration, ``table_ready``), NOT_CONVEX, or UNAVAILABLE (the caller's
+    start serves: no Schur form or constrained entry, a factorization or small system
+    that failed, or a candidate ray, whose direction test needs the accuracy the small
+    system lacks near a ray).
+
+    With ``R`` the rho entries and ``D = R - sigma``, a step ``(P + sigma_S) x + A'nu =
+    -q + sigma x_prev`` is ``(P + R_S) x + A'nu = -q + u``, ``u = sigma x_prev_S + D x_S``,
+    so ``x = base + W u`` and ``(D^-1 - W_SS) u = D^-1 sigma x_prev_S + base_S``:
+    ``W_SS`` is below ``R^-1`` where ``P`` is positive semidefinite (the constrained
+    block of ``(C + R)^-1``, ``C`` the Schur complement of ``P`` on them), so the ``s x s``
+    matrix is positive definite, factored once; ``A x = b`` holds as for ``base``
+    (``A W_x = 0``). Only ``x_S`` is carried between steps; ``x`` and ``nu`` are formed
+    once."""
+    cdef Problem* p = &e.prob
+    cdef Iterates* it = &e.it
+    cdef Py_ssize_t n = p.n, s = p.s, i, j, step
+    cdef double sigma = e.opt.sigma
+    cdef double* M = e.work.mat_s
+    cdef double* gap = e.work.vec_s      # D
+    cdef double* xs = e.work.vec_s2      # x_S
+    cdef double* u = e.work.rhs
+    cdef double* sol = e.work.sol
+    if s == 0 or e.equalities_missed or not _schur_start(e):
+        return UNAVAILABLE
+    for j in range(s):
+        it.rho_vec[j] = run.rho * e.fact.rho_scale[j]
+        gap[j] = it.rho_vec[j] - sigma
+        if not gap[j] > 0.0:
+            return UNAVAILABLE
+    if kkt_factor(&e.fact.kkt, p, SCHUR_REDUCED, 0.0, it.rho_vec) != FACTORED:
+        return UNAVAILABLE
+    if not e.fact.certified and _certify(e, True) == NOT_CONVEX:
+        return NOT_CONVEX
+    if not reduced_table(&e.red, &e.fact.kkt, p, it.rho_vec):
+        return UNAVAILABLE
+    for j in range(s):
+        for i in range(s):
+            M[i + j * s] = -e.red.W_S[j * s + i]
+        M[j + j * s] += 1.0 / gap[j]
+    if not cholesky(M, <int>s, <int>s):
+        return UNAVAILABLE
+    reduced_base(e)
+    fill(xs, 0.0, s)
+    for step in range(EQUALITY_START_STEPS):
+        for j in range(s):
+            u[j] = sigma * xs[j] / gap[j] + e.red.base[p.constrained[j]]
+        cholesky_solve_vector(M, <int>s, <int>s, u)
+        matvec(e.red.W_S, u, xs, s, s)
+        for j in range(s):
+            xs[j] += e.red.base[p.constrained[j]]
+    colmatvec(e.red.W, <int>(n + p.m), u, sol, n + p.m, s, 0.0)
+    for i in range(n + p.m):
+        sol[i] += e.red.base[i]
+    if sigma * inf_norm(sol, n) > EQUALITY_START_LIMIT * max(1.0, inf_norm(p.q, n)):
+        return UNAVAILABLE
+    copy(sol, it.x, n)
+    copy(sol + n, it.nu, p.m)
+    e.fact.form = SCHUR_REDUCED
+    run.backend = SCHUR_REDUCED
+    e.fact.factored_rho = run.rho
+    return FACTORED
+
+
+cdef int equality_start(Engine* e, Run* run, bint* unbounded) noexcept nogil:
     """Paper's cold start: ``x`` solves the QP with equalities only, ``z = P_C(x_S)``,
     ``y = 0``.
+
+    Where the iteration uses the Schur backend the steps run on its own factorization
+    for ``run.rho`` (:func:`_table_start`), which stays for the iteration; elsewhere,
+    and for a candidate ray, as follows.
 
     The factorization (:func:`_start_factor`) carries the proximal term ``sigma`` (on
     every entry, or on the constrained ones where ``P`` is definite on the others) and
@@ -207,6 +284,13 @@ cdef int equality_start(Engine* e, bint* unbounded) noexcept nogil:
     cdef Py_ssize_t n = p.n, m = p.m, i, step
     cdef double sigma = e.opt.sigma, free_sigma
     cdef bint schur_start
+    cdef int code = _table_start(e, run)
+    unbounded[0] = False
+    if code == NOT_CONVEX:
+        return NOT_CONVEX
+    if code == FACTORED:
+        _iterates_from_x(e)
+        return FACTORED
     e.fact.factored_rho = -1.0  # the KKT matrix now holds no rho factorization
     e.fact.form = full_form(p)
     e.fact.table_ready = False
@@ -238,11 +322,19 @@ cdef int equality_start(Engine* e, bint* unbounded) noexcept nogil:
         kkt_solve(&e.fact.kkt, p, it.rho_vec, rhs, sol)
         copy(sol, it.x, n)
         fill(it.nu, 0.0, m)
+    _iterates_from_x(e)
+    return FACTORED
+
+
+cdef void _iterates_from_x(Engine* e) noexcept nogil:
+    """The start's ``z = P_C(x_S)``, ``y = 0``, and the previous iterates."""
+    cdef Problem* p = &e.prob
+    cdef Iterates* it = &e.it
+    cdef Py_ssize_t i
     for i in range(p.s):
         it.z[i] = it.x[p.constrained[i]]
     proj_set(it.z, p.lo, p.hi, p.cones, p.s, it.z)
     fill(it.y, 0.0, p.s)
-    copy(it.x, it.x_prev, n)
-    copy(it.nu, it.nu_prev, m)
+    copy(it.x, it.x_prev, p.n)
+    copy(it.nu, it.nu_prev, p.m)
     copy(it.y, it.y_prev, p.s)
-    return FACTORED

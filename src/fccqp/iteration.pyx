@@ -206,7 +206,7 @@ cdef inline bint _start(Engine* e, Loop* L, Run* run) noexcept nogil:
     cdef bint at_start = L.cold or e.prob.s == 0
     cdef int status
     if at_start:
-        status = equality_start(e, &L.unbounded_start)
+        status = equality_start(e, run, &L.unbounded_start)
         run.factorizations += 1
         if status == NOT_CONVEX:
             run.status = NOT_CONVEX_QP
@@ -271,6 +271,12 @@ cdef inline void _charge_failed_polish(Loop* L) noexcept nogil:
         L.cut = max(L.cut - _cut_polish_charge, 0)
 
 
+cdef inline bint _start_factored(const Engine* e, const Run* run) noexcept nogil:
+    """Whether the cold start left the factorization for the run's rho, its table and
+    ``base`` (:func:`fccqp.factorization.equality_start`), and its equalities held."""
+    return e.fact.table_ready and e.fact.factored_rho == run.rho and not e.equalities_missed
+
+
 cdef inline bint _factor_or_polish(Engine* e, Loop* L, Run* run) noexcept nogil:
     """Factor for the run's rho unless the factorization holds it, and the reduced
     form's ``base``; first, where it can, polish a polished warm start
@@ -282,7 +288,7 @@ cdef inline bint _factor_or_polish(Engine* e, Loop* L, Run* run) noexcept nogil:
     for j in range(p.s):
         e.it.rho_vec[j] = run.rho * e.fact.rho_scale[j]
     L.warm_polish = e.prev.from_polished and e.opt.polish
-    if e.fact.factored_rho != run.rho or L.cold:
+    if not _start_factored(e, run) and (e.fact.factored_rho != run.rho or L.cold):
         if (L.warm_polish and polish_prepare(&e.pol, p)
                 and (e.fact.certified or e.pol.schur.convex)):
             # polish before ADMM's factorization, which it does not need; new
@@ -305,7 +311,7 @@ cdef inline bint _factor_or_polish(Engine* e, Loop* L, Run* run) noexcept nogil:
             run.status = NOT_CONVEX_QP if code == NOT_CONVEX else NUMERICAL_ERROR
             return False
     L.reduced = is_reduced(e.fact.form)
-    if L.reduced:
+    if L.reduced and not e.fact.table_ready:
         reduced_base(e)
     if L.warm_polish and warm_polish(e, run, L.start_time):
         return False
