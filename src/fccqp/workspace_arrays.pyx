@@ -100,7 +100,7 @@ cdef void common_arrays(Arrays a, Engine* e, Py_ssize_t memory, Py_ssize_t log_r
     w.rhs, w.sol = a.new(N), a.new(N)
     w.vec_n, w.vec_n2, w.vec_n3 = a.new(wide), a.new(wide), a.new(wide)
     w.vec_s, w.vec_s2, w.vec_m = a.new(s), a.new(s), a.new(m)
-    w.vec_m2, w.mat_s = a.new(m), a.new(s * s)
+    w.vec_m2 = a.new(m)
     w.guess_point, w.guess_codes = a.new(s), <char*>a.new(s)
     e.certs.direction, w.saved, e.certs.cert = a.new(n), a.new(N + s), a.new(N)
     e.prev.x, e.prev.y, e.prev.z = a.new(n), a.new(m), a.new(n)
@@ -184,6 +184,7 @@ cdef void dense_arrays(Arrays a, Engine* e, Py_ssize_t* order) except *:
     kk.schur.T, kk.schur.tail_values = a.new(m * m), a.new(m)
     kk.R = a.new(N * s)
     e.red.W, e.red.W_S = a.new(N * s), a.new(s * s)
+    e.work.mat_s = a.new(s * s)   # the cold start's small system (dense Schur only)
     e.rest.W_T, e.rest.gram = a.new(N * s), a.new(s * s)
     pol = &e.pol
     pol.hess = a.new(s * s)
