@@ -279,10 +279,8 @@ class Solver:
         for key, (structure, w) in self._kept.items():
             if (same_cones(cones, structure.last_cones)
                     and dense_arguments(P, q, A, b, lb, ub, structure.n, structure.m)):
-                del self._kept[key]
-                self._keep_current()
-                self._structure, self._workspace, self._cones = structure, w, cones
-                w.arrived = True
+                self._make_current(key, structure, w)
+                self._cones = cones
                 return w, structure
         return None, None
 
@@ -303,15 +301,21 @@ class Solver:
             if dense_arguments(P, q, A, b, lb, ub, structure.n, structure.m):
                 flat = flatten_cones(cones, structure.n)
                 if flat.same_blocks(structure.cones):
-                    del self._kept[key]
-                    self._keep_current()
-                    self._structure, self._workspace = structure, w
-                    w.arrived = True
+                    self._make_current(key, structure, w)
                     if flat is not structure.cones:
                         w.update_cones(flat.mu, flat.normal)
                         structure.cones = flat
                     return flat
         return None
+
+    def _make_current(self, key: tuple, structure: _Structure, w: admm.Workspace) -> None:
+        """Make the kept workspace ``w`` of ``structure`` (kept under ``key``) current,
+        keeping the current one; a guess given to its next solve comes from another
+        structure (``Workspace.arrived``)."""
+        del self._kept[key]
+        self._keep_current()
+        self._structure, self._workspace = structure, w
+        w.arrived = True
 
     def _keep_current(self) -> None:
         """Keep the current workspace with its structure (:data:`KEPT_WORKSPACES`)."""
