@@ -883,4 +883,142 @@ static double fccqp_sum_squares(const double *restrict v, long k)
     return total;
 }
 
+/* polish_schur's kernels (and schur's mark_coupled).
+ *
+ * fccqp_mark_coupled: coupled[i] = 1 where row i of the row-major n x n P has a nonzero
+ * (or NaN) entry off its diagonal, else 0. The entries' bits shifted past the sign (so
+ * that -0.0 counts as zero) or-ed over the row, a loop GCC vectorizes: a Cython loop with
+ * a test per entry took 15.3k instructions a call on go2 (54 rows, 36 of them diagonal,
+ * so scanned in full), lanes of comparisons 9.7k.
+ *
+ * fccqp_trsm_lower: B := L^-1 B for the column-major lower n x n L (leading dimension
+ * ld) and cols columns of B (leading dimension ldb), each column by
+ * _blas.forward_substitution's steps (four pivots solved, then their four subtractions
+ * from each entry below, in that order), four pivots at a time for every column, so
+ * that their reciprocals and the block's entries are loaded once. dtrsm took 21.5k
+ * instructions for polish_schur_setup's 18 x 18 L and 30 columns (go2), most of it its
+ * packing and set-up.
+ *
+ * fccqp_syrk_t: the lower triangle of C = A'A + beta C (beta 0 or 1) for the
+ * column-major k x n A (leading dimension lda): each entry a dot product of two columns
+ * of A in four lanes, four entries of two columns of C per pass over k. For
+ * polish_schur_setup's 30 x 30 SU from 30 rows (go2) dsyrk took 21k instructions;
+ * with few rows (the guesses' S0 and S, 5-20 rows) dsyrk's packed kernel is cheaper,
+ * so those stay with it.
+ */
+FCCQP_FORCE_INLINE int fccqp_any_nonzero(const double *v, int count)
+{
+    unsigned long long bits = 0;
+    for (int j = 0; j < count; j++) {
+        unsigned long long w;
+        memcpy(&w, v + j, sizeof w);
+        bits |= w << 1;
+    }
+    return bits != 0;
+}
+
+FCCQP_CLONES
+static void fccqp_mark_coupled(const double *P, int n, char *coupled)
+{
+    for (int i = 0; i < n; i++) {
+        const double *row = P + (long)i * n;
+        coupled[i] = (char)(fccqp_any_nonzero(row, i)
+                            || fccqp_any_nonzero(row + i + 1, n - i - 1));
+    }
+}
+
+FCCQP_CLONES
+static void fccqp_trsm_lower(const double *restrict L, int n, int ld, double *restrict B,
+                             int cols, int ldb)
+{
+    int k = 0;
+    for (; k + 4 <= n; k += 4) {
+        const double *c0 = L + (long)k * ld, *c1 = c0 + ld, *c2 = c1 + ld, *c3 = c2 + ld;
+        double r0 = 1.0 / c0[k], r1 = 1.0 / c1[k + 1], r2 = 1.0 / c2[k + 2];
+        double r3 = 1.0 / c3[k + 3];
+        for (int c = 0; c < cols; c++) {
+            double *b = B + (long)c * ldb;
+            double v0 = b[k] * r0;
+            double b1 = b[k + 1] - c0[k + 1] * v0;
+            double b2 = b[k + 2] - c0[k + 2] * v0;
+            double b3 = b[k + 3] - c0[k + 3] * v0;
+            double v1 = b1 * r1;
+            b2 = b2 - c1[k + 2] * v1;
+            b3 = b3 - c1[k + 3] * v1;
+            double v2 = b2 * r2;
+            b3 = b3 - c2[k + 3] * v2;
+            double v3 = b3 * r3;
+            b[k] = v0, b[k + 1] = v1, b[k + 2] = v2, b[k + 3] = v3;
+            for (int i = k + 4; i < n; i++)
+                b[i] = b[i] - c0[i] * v0 - c1[i] * v1 - c2[i] * v2 - c3[i] * v3;
+        }
+    }
+    for (; k < n; k++) {
+        const double *c0 = L + (long)k * ld;
+        double r0 = 1.0 / c0[k];
+        for (int c = 0; c < cols; c++) {
+            double *b = B + (long)c * ldb;
+            double v0 = b[k] * r0;
+            b[k] = v0;
+            for (int i = k + 1; i < n; i++)
+                b[i] -= c0[i] * v0;
+        }
+    }
+}
+
+/* the dot products of the columns a0..a3 with b0 and b1 (k entries each) into
+ * out[2 i + j] (a_i with b_j) */
+FCCQP_FORCE_INLINE void fccqp_dots_4x2(const double *a0, const double *a1, const double *a2,
+                                       const double *a3, const double *b0, const double *b1,
+                                       int k, double out[8])
+{
+    fccqp_d4 s00 = fccqp_dsplat(0.0), s01 = s00, s10 = s00, s11 = s00, s20 = s00;
+    fccqp_d4 s21 = s00, s30 = s00, s31 = s00;
+    int r = 0;
+    for (; r + 4 <= k; r += 4) {
+        fccqp_d4 x0 = fccqp_dload(b0 + r), x1 = fccqp_dload(b1 + r), y;
+        y = fccqp_dload(a0 + r);
+        s00 = fccqp_dadd(s00, fccqp_dmul(y, x0)), s01 = fccqp_dadd(s01, fccqp_dmul(y, x1));
+        y = fccqp_dload(a1 + r);
+        s10 = fccqp_dadd(s10, fccqp_dmul(y, x0)), s11 = fccqp_dadd(s11, fccqp_dmul(y, x1));
+        y = fccqp_dload(a2 + r);
+        s20 = fccqp_dadd(s20, fccqp_dmul(y, x0)), s21 = fccqp_dadd(s21, fccqp_dmul(y, x1));
+        y = fccqp_dload(a3 + r);
+        s30 = fccqp_dadd(s30, fccqp_dmul(y, x0)), s31 = fccqp_dadd(s31, fccqp_dmul(y, x1));
+    }
+    out[0] = fccqp_dsum(s00), out[1] = fccqp_dsum(s01), out[2] = fccqp_dsum(s10);
+    out[3] = fccqp_dsum(s11), out[4] = fccqp_dsum(s20), out[5] = fccqp_dsum(s21);
+    out[6] = fccqp_dsum(s30), out[7] = fccqp_dsum(s31);
+    for (; r < k; r++) {
+        out[0] += a0[r] * b0[r], out[1] += a0[r] * b1[r];
+        out[2] += a1[r] * b0[r], out[3] += a1[r] * b1[r];
+        out[4] += a2[r] * b0[r], out[5] += a2[r] * b1[r];
+        out[6] += a3[r] * b0[r], out[7] += a3[r] * b1[r];
+    }
+}
+
+FCCQP_CLONES
+static void fccqp_syrk_t(int n, int k, const double *restrict A, int lda, double beta,
+                         double *restrict C, int ldc)
+{
+    double out[8];
+    for (int b = 0; b < n; b += 2) {
+        /* a column past the last is read as the last one, its sums dropped */
+        const double *b0 = A + (long)b * lda, *b1 = b + 1 < n ? b0 + lda : b0;
+        for (int a = b; a < n; a += 4) {
+            const double *a0 = A + (long)a * lda;
+            const double *a1 = a + 1 < n ? a0 + lda : a0;
+            const double *a2 = a + 2 < n ? a0 + 2 * (long)lda : a0;
+            const double *a3 = a + 3 < n ? a0 + 3 * (long)lda : a0;
+            fccqp_dots_4x2(a0, a1, a2, a3, b0, b1, k, out);
+            for (int i = 0; i < 4 && a + i < n; i++) {
+                double *entry = C + a + i + (long)b * ldc;
+                entry[0] = beta == 0.0 ? out[2 * i] : entry[0] + out[2 * i];
+                if (b + 1 < n && a + i > b)
+                    entry[ldc] = beta == 0.0 ? out[2 * i + 1] : entry[ldc] + out[2 * i + 1];
+            }
+        }
+    }
+}
+
 #endif

@@ -51,7 +51,7 @@ from libc.math cimport sqrt
 from scipy.linalg.cython_blas cimport dgemv
 
 from fccqp._blas cimport (backward_substitution, cholesky_solve_vector, forward_substitution,
-                          syrk_t, trsm)
+                          syrk_t)
 from fccqp._types cimport Problem
 from fccqp.schur cimport mark_coupled
 from fccqp.tuning cimport PIVOT_TOLERANCE, POLISH_BORDER_TOLERANCE, POLISH_RANK_TOLERANCE
@@ -61,6 +61,8 @@ cdef extern from "fccqp_kernels.h" nogil:
     int fccqp_cholesky(double* M, int n, int ld)
     void fccqp_matvec_t(const double* M, int ld, const double* y, double* out, int rows,
                         int cols)
+    void fccqp_trsm_lower(const double* L, int n, int ld, double* B, int cols, int ldb)
+    void fccqp_syrk_t(int n, int k, const double* A, int lda, double beta, double* C, int ldc)
 
 
 cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noexcept nogil:
@@ -123,8 +125,8 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
             f.Y[r + c * n] *= f.inv_root[r]
     if m > 0:
         if k > 0:
-            trsm(b"L", b"N", k, <int>m, f.L, <int>n, f.Y, <int>n)
-        syrk_t(<int>m, <int>rest, f.Y, <int>n, 0.0, f.SU, <int>m)
+            fccqp_trsm_lower(f.L, k, <int>n, f.Y, <int>m, <int>n)
+        fccqp_syrk_t(<int>m, <int>rest, f.Y, <int>n, 0.0, f.SU, <int>m)
         for c in range(m):
             f.SU[c + c * m] += delta
     f.ready = True
@@ -320,8 +322,8 @@ cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
         row += d
         e += d
     if e > 0 and m > 0:
-        trsm(b"L", b"N", <int>m, <int>e, f.S0, <int>m, f.W, <int>m)
-        syrk_t(<int>e, <int>m, f.W, <int>m, 0.0, f.WW, <int>s)
+        fccqp_trsm_lower(f.S0, <int>m, <int>m, f.W, <int>e, <int>m)
+        fccqp_syrk_t(<int>e, <int>m, f.W, <int>m, 0.0, f.WW, <int>s)
     else:
         for c in range(e):
             for r in range(c, e):

@@ -49,6 +49,7 @@ cdef extern from "fccqp_kernels.h" nogil:
                                   const int* count, int m, double* T, double* values)
     void fccqp_sparse_rank_clear(int rows, const int* index, const int* count, int m,
                                  double* T)
+    void fccqp_mark_coupled(const double* P, int n, char* coupled)
 
 
 def ordering(n, constrained):
@@ -59,14 +60,9 @@ def ordering(n, constrained):
 
 
 cdef void mark_coupled(const double* P, Py_ssize_t n, char* coupled) noexcept nogil:
-    """``coupled[i]`` = 1 where row ``i`` of ``P`` has an entry off its diagonal, else 0."""
-    cdef Py_ssize_t i, j
-    for i in range(n):
-        coupled[i] = 0
-        for j in range(n):
-            if j != i and P[i * n + j] != 0.0:
-                coupled[i] = 1
-                break
+    """``coupled[i]`` = 1 where row ``i`` of ``P`` has an entry off its diagonal, else 0
+    (``fccqp_mark_coupled``: the comparisons in lanes)."""
+    fccqp_mark_coupled(P, <int>n, coupled)
 
 
 cdef void _order(Schur* f, const Problem* p) noexcept nogil:
