@@ -889,22 +889,24 @@ static double fccqp_sum_squares(const double *restrict v, long k)
  * (or NaN) entry off its diagonal, else 0. The entries' bits shifted past the sign (so
  * that -0.0 counts as zero) or-ed over the row, a loop GCC vectorizes: a Cython loop with
  * a test per entry took 15.3k instructions a call on go2 (54 rows, 36 of them diagonal,
- * so scanned in full), lanes of comparisons 9.7k.
+ * so scanned in full), lanes of comparisons 9.7k, this loop 6.4k (callgrind).
  *
  * fccqp_trsm_lower: B := L^-1 B for the column-major lower n x n L (leading dimension
  * ld) and cols columns of B (leading dimension ldb), each column by
  * _blas.forward_substitution's steps (four pivots solved, then their four subtractions
  * from each entry below, in that order), four pivots at a time for every column, so
- * that their reciprocals and the block's entries are loaded once. dtrsm took 21.5k
- * instructions for polish_schur_setup's 18 x 18 L and 30 columns (go2), most of it its
- * packing and set-up.
+ * that their reciprocals and the block's entries are loaded once. go2 (callgrind, a
+ * call): polish_schur_setup's 18 x 18 L and 30 columns 12.7k instructions against
+ * dtrsm's 21.5k (most of it packing and set-up), the base's 30 x 30 S0 and 3-12
+ * columns 4.5k against 10.5k.
  *
  * fccqp_syrk_t: the lower triangle of C = A'A + beta C (beta 0 or 1) for the
  * column-major k x n A (leading dimension lda): each entry a dot product of two columns
- * of A in four lanes, four entries of two columns of C per pass over k. For
- * polish_schur_setup's 30 x 30 SU from 30 rows (go2) dsyrk took 21k instructions;
- * with few rows (the guesses' S0 and S, 5-20 rows) dsyrk's packed kernel is cheaper,
- * so those stay with it.
+ * of A in four lanes, four entries of two columns of C per pass over k. For few columns
+ * of many rows (polish_schur's W'W: go2 3-12 columns of 30 rows) 1.2k instructions a
+ * call against dsyrk's 3.4k; for many columns its reductions and stores cost more
+ * than dsyrk's packed kernel (set-up's 30 x 30 SU from 30 rows: 22.1k against 21.1k),
+ * so those stay with dsyrk.
  */
 FCCQP_FORCE_INLINE int fccqp_any_nonzero(const double *v, int count)
 {

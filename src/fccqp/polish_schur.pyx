@@ -18,7 +18,7 @@ or, on the boundary, ``diag(P) + curvature`` (``d x d``). So
 and ``S = Y'Y + delta I`` with ``Y = L^-1 C'`` by blocks of ``H = L L'``. The
 unconstrained entries' rows of ``Y`` and their part of ``S`` depend on ``P`` and ``A``
 only: :func:`polish_schur_setup` computes them once per solve (one Cholesky of the
-``D x D`` block, one ``dtrsm``, one ``dsyrk``), and each guess adds its free
+``D x D`` block, one triangular solve, one ``dsyrk``), and each guess adds its free
 constrained entries' rows (:func:`polish_schur_factor`: a ``dsyrk`` of about ``s``
 rows and a Cholesky of ``m + nb`` rows). On go2 (``n, m, s`` = 54, 30, 24, ``D`` = 18)
 that is a few tens of thousands of multiply-adds a guess, against the ``dsytrf`` of the
@@ -126,7 +126,7 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
     if m > 0:
         if k > 0:
             fccqp_trsm_lower(f.L, k, <int>n, f.Y, <int>m, <int>n)
-        fccqp_syrk_t(<int>m, <int>rest, f.Y, <int>n, 0.0, f.SU, <int>m)
+        syrk_t(<int>m, <int>rest, f.Y, <int>n, 0.0, f.SU, <int>m)
         for c in range(m):
             f.SU[c + c * m] += delta
     f.ready = True
@@ -323,7 +323,7 @@ cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
         e += d
     if e > 0 and m > 0:
         fccqp_trsm_lower(f.S0, <int>m, <int>m, f.W, <int>e, <int>m)
-        fccqp_syrk_t(<int>e, <int>m, f.W, <int>m, 0.0, f.WW, <int>s)
+        fccqp_syrk_t(<int>e, <int>m, f.W, <int>m, 0.0, f.WW, <int>s)   # few columns: see the kernel
     else:
         for c in range(e):
             for r in range(c, e):
