@@ -381,7 +381,11 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
             point = (ahead if held and ahead != NULL else w.x) + start
             if _left_cone(c, k, point, &along, &across, &size) or held:
                 code = APEX if slope * across <= -along or size == 0.0 else BOUNDARY
-                cone_project(point, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
+                if code == APEX and not stepped and across > 0.0:
+                    code = BOUNDARY   # the plane through the ray on its side of the axis
+                    copy(point, w.step, d)
+                else:
+                    cone_project(point, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
         elif released == p.s + k:   # an apex block whose y left the polar
             along = cone_split(w.y + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
             code = FREE if across <= slope * along else BOUNDARY
