@@ -188,14 +188,20 @@ cdef bint _relinearize(Polish* w, const Problem* p, Py_ssize_t nb,
 
 
 cdef bint _planes_first(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
-    """Whether a feasible pass should run Newton's steps on its guess before releasing
-    its most wrong multiplier: it is a boundary block's ``lam`` while some boundary
-    block still misses its cone (:func:`_plane_miss`), its plane not yet where Newton's
-    steps put it. A plane placed where a free block left its cone has no curvature
-    (``lam = 0``), and a ``lam`` solved on such planes says little about the sign it
-    has at the answer; Newton's steps settle the planes first and release the block
-    after them if its ``lam`` is still wrong (see :func:`polish`)."""
-    cdef Py_ssize_t most = most_wrong(w, p, 0.0)
+    """Whether a feasible pass of a polish from no multipliers (``bare_start``) runs
+    Newton's steps on its guess before releasing its most wrong multiplier: it is a
+    boundary block's ``lam`` while some boundary block still misses its cone
+    (:func:`_plane_miss`). Such a polish places every plane where a free block left its
+    cone, with no curvature (``lam = 0``), and a ``lam`` solved on those planes says
+    little about its sign at the answer; Newton's steps settle the planes first and the
+    block is released after them if its ``lam`` is still wrong (see :func:`polish`).
+    Not in other polishes, whose planes come with the multipliers of ADMM's iterate or
+    of the previous answer: there Newton's steps before a release cost solo12's every-10th
+    ticks 5.5 % more instructions (notes/performance-history.md, "guesses")."""
+    cdef Py_ssize_t most
+    if not w.bare_start:
+        return False
+    most = most_wrong(w, p, 0.0)
     return (most >= p.s and w.active[p.cones.offset[most - p.s]] == BOUNDARY
             and _plane_miss(w, p, nb) > 0.0)
 
@@ -433,7 +439,9 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     "talosexact"). False then, when a
     factorization breaks down or the result is not finite, or when the clock (:func:`fccqp_now`) has
     passed ``deadline`` before a guess after the first (``INFINITY``: never); otherwise
-    the caller judges the point.
+    the caller judges the point. A polish from no multipliers (``bare_start``) settles
+    its planes by Newton's steps before it releases a boundary block's wrong ``lam``
+    (:func:`_planes_first`).
     """
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, nb, nf = 0, j, changed
     cdef long passes = 0
