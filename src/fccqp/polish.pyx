@@ -196,8 +196,9 @@ cdef bint _planes_first(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nog
     little about its sign at the answer; Newton's steps settle the planes first and the
     block is released after them if its ``lam`` is still wrong (see :func:`polish`).
     Not in other polishes, whose planes come with the multipliers of ADMM's iterate or
-    of the previous answer: there Newton's steps before a release cost solo12's every-10th
-    ticks 5.5 % more instructions (notes/performance-history.md, "guesses")."""
+    of the previous answer: there this rule and ``renew``'s polar one together cost
+    solo12's every-10th ticks 5.5 % more instructions (notes/performance-history.md,
+    "guesses")."""
     cdef Py_ssize_t most
     if not w.bare_start:
         return False
