@@ -657,3 +657,34 @@ def test_schur_polish_over_guesses_and_newton_steps_is_the_assembled_polish(seed
         gap = np.abs(assembled[name] - schur[name]).max()
         assert gap <= 1e-12 * max(1.0, np.abs(assembled[name]).max()), name
     assert np.abs(A @ schur["x"] - b).max() <= 1e-12 * max(1.0, np.abs(b).max())
+
+
+def test_a_contact_change_polished_from_nothing_settles_its_planes_before_a_release():
+    """anymal_c's benchmark tick 360 (``mix``, seed 0: a fourth foot put down), warm along
+    its sequence from tick 300, started from tick 359's answer carried onto the new
+    contacts: the polish starts from nothing held. Its first solve throws one loaded
+    foot's force into the polar cone; held at the apex there, the polish gave up
+    infeasible after three guesses and ADMM ran. On the plane on its side of the axis
+    instead, and with Newton's steps settling the planes (placed with no curvature)
+    before a plane's wrong-signed multiplier is released, the polish settles: no
+    iteration, and the reference's answer."""
+    pytest.importorskip("pinocchio")
+    from benchmarks.contact_map import ContactMaps
+    from benchmarks.exact_solvers import carried_guess, fccqp_arguments
+    from benchmarks.testsets import generate_test_set
+
+    tests = generate_test_set("anymal_c", "mix", 400, seed=0)
+    solver = fccqp.Solver(fccqp.Settings.realtime(100.0))
+    for tick in range(300, 360):
+        before = solver.solve(*fccqp_arguments(tests.qps[tick]))
+    qp, x_ref = tests.qps[360], tests.x_ref[360]
+    assert len(tests.stance[360]) == len(tests.stance[359]) + 1
+    result = solver.solve(*fccqp_arguments(qp),
+                          **carried_guess(ContactMaps(), (tests.qps[359], before), qp))
+    assert result.status is Status.SOLVED and result.polished and result.iterations == 0
+    cones = [fccqp.FrictionCone(int(start), float(mu), tuple(map(float, normal)))
+             for start, mu, normal in zip(qp.cone_starts, qp.mus, qp.normals, strict=True)]
+    verify_solution(Problem.of(qp.P, qp.q, qp.A, qp.b, qp.lb, qp.ub, cones), result,
+                    Tolerances.of(fccqp.Settings.realtime(100.0)))
+    u = qp.layout["u"]
+    assert np.max(np.abs(result.x[u] - x_ref[u]) / qp.ub[u]) <= 0.01

@@ -200,7 +200,9 @@ cdef bint _polish_start(Engine* e, int* status, double start_time) noexcept nogi
     does: from nothing, the polish of the benchmark's warm walks failed often enough that
     such a caller ran 10x the warm start's ADMM iterations, and a problem's own polished
     answer given back took an iteration on 16-92 % of the ticks (notes/polish.md,
-    "guessheld")."""
+    "guessheld"). The polish from nothing is marked ``bare_start``: its planes start
+    without curvature, and two of its rules differ (:func:`fccqp.polish_guess.renew`,
+    ``fccqp.polish._planes_first``)."""
     cdef double* held = e.work.saved   # s of it: _polish_again's scratch, not yet in use
     cdef Py_ssize_t s = e.prob.s
     cdef bint kept
@@ -208,7 +210,9 @@ cdef bint _polish_start(Engine* e, int* status, double start_time) noexcept nogi
         return keep_polished(e, status, 0, start_time, True)
     copy(e.it.y, held, s)
     fill(e.it.y, 0.0, s)
+    e.pol.bare_start = True
     kept = keep_polished(e, status, 0, start_time, True)
+    e.pol.bare_start = False
     if not kept:
         copy(held, e.it.y, s)
     return kept

@@ -41,6 +41,7 @@ cdef struct Polish:
     long passes             # the guesses the last polish solved
     long guess_passes       # the most guesses a polish solves (GUESS_PASSES; a warm polish WARM_GUESS_PASSES)
     bint warm               # a warm polish (the previous answer's active set): it gives up a hopeless crawl
+    bint bare_start         # a polish from no multipliers (a carried guess): its planes start without curvature
     char* dropped           # cone count: the block went past its apex in this polish
     char* bare              # cone count: BARE, the block's plane was placed without its curvature (lam <= 0); KEPT, and that plane is in kept_plane
     double* kept_plane      # s: a KEPT block's curvature-less plane, where Newton's first solve puts it back

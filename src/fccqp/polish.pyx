@@ -152,18 +152,12 @@ cdef bint _chord_step(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
     return True
 
 
-cdef bint _relinearize(Polish* w, const Problem* p, Py_ssize_t nb,
-                       double* worst) noexcept nogil:
-    """Move each boundary block's plane to the current ``x_block`` and its curvature to
-    the cone there (:func:`~fccqp.polish_guess.linearize_on_cone`), unless every block
-    already meets ``NEWTON_TOLERANCE``: then return False and keep the planes, with
-    which ``(x, lam)`` were solved. ``worst`` receives the largest ``|phi| /
-    ||x_block||``."""
+cdef double _plane_miss(const Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
+    """The largest ``|phi| / ||x_block||`` of the ``nb`` boundary blocks that miss
+    their cone by more than ``NEWTON_TOLERANCE`` of their size; 0 when none does."""
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t k, j, cone, start, d
-    cdef double size, miss
-    cdef bint converged = True
-    worst[0] = 0.0
+    cdef double size, miss, worst = 0.0
     for k in range(nb):
         cone = w.boundary[k]
         d = c.dim[cone]
@@ -173,13 +167,44 @@ cdef bint _relinearize(Polish* w, const Problem* p, Py_ssize_t nb,
             size += w.x[start + j] * w.x[start + j]
         miss = fabs(cone_phi(w.x + start, c.kind[cone], d, c.mu[cone], c.normal + 3 * cone))
         if miss > NEWTON_TOLERANCE * sqrt(size):
-            converged = False
-            worst[0] = max(worst[0], miss / sqrt(size))
-    if converged:
+            worst = max(worst, miss / sqrt(size))
+    return worst
+
+
+cdef bint _relinearize(Polish* w, const Problem* p, Py_ssize_t nb,
+                       double* worst) noexcept nogil:
+    """Move each boundary block's plane to the current ``x_block`` and its curvature to
+    the cone there (:func:`~fccqp.polish_guess.linearize_on_cone`), unless every block
+    already meets ``NEWTON_TOLERANCE``: then return False and keep the planes, with
+    which ``(x, lam)`` were solved. ``worst`` receives the largest ``|phi| /
+    ||x_block||`` (:func:`_plane_miss`)."""
+    cdef Py_ssize_t k
+    worst[0] = _plane_miss(w, p, nb)
+    if worst[0] == 0.0:
         return False
     for k in range(nb):
-        linearize_on_cone(w, p, k, w.x + p.constrained[c.offset[w.boundary[k]]])
+        linearize_on_cone(w, p, k, w.x + p.constrained[p.cones.offset[w.boundary[k]]])
     return True
+
+
+cdef bint _planes_first(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
+    """Whether a feasible pass of a polish from no multipliers (``bare_start``) runs
+    Newton's steps on its guess before releasing its most wrong multiplier: it is a
+    boundary block's ``lam`` while some boundary block still misses its cone
+    (:func:`_plane_miss`). Such a polish places every plane where a free block left its
+    cone, with no curvature (``lam = 0``), and a ``lam`` solved on those planes says
+    little about its sign at the answer; Newton's steps settle the planes first and the
+    block is released after them if its ``lam`` is still wrong (see :func:`polish`).
+    Not in other polishes, whose planes come with the multipliers of ADMM's iterate or
+    of the previous answer: there this rule and ``renew``'s polar one together cost
+    solo12's every-10th ticks 5.5 % more instructions (notes/performance-history.md,
+    "guesses")."""
+    cdef Py_ssize_t most
+    if not w.bare_start:
+        return False
+    most = most_wrong(w, p, 0.0)
+    return (most >= p.s and w.active[p.cones.offset[most - p.s]] == BOUNDARY
+            and _plane_miss(w, p, nb) > 0.0)
 
 
 cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
@@ -415,7 +440,9 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     "talosexact"). False then, when a
     factorization breaks down or the result is not finite, or when the clock (:func:`fccqp_now`) has
     passed ``deadline`` before a guess after the first (``INFINITY``: never); otherwise
-    the caller judges the point.
+    the caller judges the point. A polish from no multipliers (``bare_start``) settles
+    its planes by Newton's steps before it releases a boundary block's wrong ``lam``
+    (:func:`_planes_first`).
     """
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, nb, nf = 0, j, changed
     cdef long passes = 0
@@ -492,7 +519,8 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         nb = renew(w, p, True, False, NULL, &changed)
         if changed == 0:
             feasible = True
-            nb = renew(w, p, False, False, NULL, &changed)
+            if not _planes_first(w, p, nb):
+                nb = renew(w, p, False, False, NULL, &changed)
         elif not feasible:
             planes_only = planes_only and changed == boundary_entries(w, p, nb) - held
             if passes >= FEASIBLE_PASSES and not planes_only:

@@ -336,7 +336,16 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
     being loaded: 7 of go2's 400 warm ticks, 16 of talos'; notes/polish.md, "apexplane").
 
     A ``BARE`` boundary block (its plane placed with ``lam = 0``) whose multiplier came
-    out positive has that plane kept (``KEPT``) for :func:`keep_bare_plane`."""
+    out positive has that plane kept (``KEPT``) for :func:`keep_bare_plane`.
+
+    In a polish from no multipliers (``bare_start``, a carried guess) a free block that
+    a solve threw into its polar cone, off the axis, goes on its boundary with the plane
+    through the cone's ray on its side of the axis (the plane of ``x_block`` itself),
+    not to the apex: nothing held the block in that solve, so where its part across the
+    axis points says more than the sign of its part along it. anymal_c's contact tick 360
+    put a foot that carries 0.12 of the answer's multipliers at its apex so, gave up
+    infeasible after three guesses and ran ADMM (notes/performance-history.md,
+    "guesses")."""
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t j, k, o, d, start, nb = 0, old = 0
     cdef double value, size, along, across, slope, lam
@@ -381,7 +390,11 @@ cdef Py_ssize_t renew(Polish* w, const Problem* p, bint adding, bint stepped,
             point = (ahead if held and ahead != NULL else w.x) + start
             if _left_cone(c, k, point, &along, &across, &size) or held:
                 code = APEX if slope * across <= -along or size == 0.0 else BOUNDARY
-                cone_project(point, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
+                if code == APEX and w.bare_start and not stepped and across > 0.0:
+                    code = BOUNDARY   # the plane through the ray on its side of the axis
+                    copy(point, w.step, d)
+                else:
+                    cone_project(point, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
         elif released == p.s + k:   # an apex block whose y left the polar
             along = cone_split(w.y + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, &across)
             code = FREE if across <= slope * along else BOUNDARY

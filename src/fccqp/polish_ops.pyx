@@ -112,6 +112,7 @@ def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5, bi
     w.schur.ready = w.schur_only = w.schur_failed = False
     w.guess_passes = WARM_GUESS_PASSES if warm else GUESS_PASSES
     w.warm = warm
+    w.bare_start = False
     w.schur.L = NULL   # no Schur storage: every guess is assembled
     w.schur.bordered = False
     if schur:

@@ -141,7 +141,7 @@ cdef void common_arrays(Arrays a, Engine* e, Py_ssize_t memory, Py_ssize_t log_r
     pol.full, pol.dfull = a.new(N), a.new(N)
     pol.schur_only = pol.schur_failed = False
     pol.guess_passes = GUESS_PASSES
-    pol.warm = False
+    pol.warm = pol.bare_start = False
     pol.schur.ready = False   # dense_arrays gives it storage (polish_schur_arrays)
     e.unscaled.x, e.unscaled.y, e.unscaled.z = a.new(n), a.new(m), a.new(n)
     e.log.capacity = log_rows
