@@ -201,9 +201,8 @@ cdef int _table_start(Engine* e, Run* run) noexcept nogil:
     the one before: along a ray each step adds the same multiple of it (a ray has
     entries in ``S``: ``P`` is definite on the free ones), while the steps of a bounded
     QP shrink, each of its modes by ``sigma / (lambda + sigma)``. Measured (steps 3
-    over 2, infinity norms): the suite's rays 0.999-1.02, talos' huge bounded starts
-    0.47-0.70 (31 of the cell's 101 cold starts, redone with ``sigma`` before), the
-    suite's 0.002-0.19.
+    over 2, infinity norms): the suite's rays 1.000, talos' huge bounded starts
+    0.47-0.70 (31 of its cold cell's 101), the suite's bounded ones 0.002-0.19.
 
     With ``R`` the rho entries and ``D = R - sigma``, a step ``(P + sigma_S) x + A'nu =
     -q + sigma x_prev`` is ``(P + R_S) x + A'nu = -q + u``, ``u = sigma x_prev_S + D x_S``,
