@@ -48,6 +48,24 @@ def test_schur_cold_start_leaves_its_factorization_to_the_iterations():
     np.testing.assert_allclose(result.x, reference.x, atol=1e-3 * (1 + np.abs(reference.x).max()))
 
 
+def test_schur_cold_start_keeps_a_huge_bounded_start():
+    """A bounded QP whose equality-constrained start is huge (a curvature of 1e-5 along
+    the direction ``q`` pulls, between two boxed entries) is no candidate ray: its
+    proximal steps shrink (by ``sigma / (lambda + sigma)``), so the Schur start is kept
+    and the run factors once, not once more for a start with ``sigma`` and again for
+    rho."""
+    a, b = 0.5 + 5e-6, 0.5 - 5e-6
+    P = np.array([[1.0, 0.0, 0.0], [0.0, a, b], [0.0, b, a]])
+    q = np.array([0.0, -1.0, 1.0])
+    A, rhs = np.array([[1.0, 0.0, 0.0]]), np.array([1.0])
+    lb, ub = np.array([-np.inf, -10.0, -10.0]), np.array([np.inf, 10.0, 10.0])
+    result = fccqp.solve(P, q, A, rhs, lb, ub, (), kkt_backend="schur_reduced",
+                         adaptive_rho=False)
+    assert result.status is Status.SOLVED
+    assert result.backend == "schur_reduced" and result.factorizations == 1
+    np.testing.assert_allclose(result.x, [1.0, 10.0, -10.0], atol=1e-6)
+
+
 def _block_diagonal(problem, coupled_constrained=False, flat_free=False):
     """``problem`` with the cost of whole-body control's shape: dense on the first
     free entries, diagonal on the other free ones and on every constrained entry (the

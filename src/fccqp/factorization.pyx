@@ -8,6 +8,8 @@ and ``base`` in step with the factorization, and records what it holds
 (:c:type:`fccqp.engine.Factorization`).
 """
 
+from libc.math cimport fabs
+
 from fccqp._blas cimport cholesky, cholesky_solve_vector
 from fccqp._dense cimport colmatvec, copy, fill, inf_norm, matvec
 from fccqp._types cimport Iterates, Problem
@@ -19,7 +21,8 @@ from fccqp.kkt cimport (AUTO, FACTORED, LDL_FULL, NOT_CONVEX, SCHUR_REDUCED, SPA
 from fccqp.matrices cimport CSC, DENSE
 from fccqp.projections cimport proj_set
 from fccqp.reduced cimport reduced_rebase, reduced_table
-from fccqp.tuning cimport EQUALITY_START_LIMIT, EQUALITY_START_STEPS, REDUCED_COST
+from fccqp.tuning cimport (EQUALITY_START_LIMIT, EQUALITY_START_RAY_STEP, EQUALITY_START_STEPS,
+                           REDUCED_COST)
 
 
 cdef long budget(const Engine* e, long iteration) noexcept nogil:
@@ -193,6 +196,14 @@ cdef int _table_start(Engine* e, Run* run) noexcept nogil:
     that failed, or a candidate ray, whose direction test needs the accuracy the small
     system lacks near a ray).
 
+    A candidate ray is a huge ``x`` (``sigma ||x|| > EQUALITY_START_LIMIT max(1,
+    ||q||)``) whose last step on ``x_S`` keeps at least ``EQUALITY_START_RAY_STEP`` of
+    the one before: along a ray each step adds the same multiple of it (a ray has
+    entries in ``S``: ``P`` is definite on the free ones), while the steps of a bounded
+    QP shrink, each of its modes by ``sigma / (lambda + sigma)``. Measured (steps 3
+    over 2, infinity norms): the suite's rays 1.000, talos' huge bounded starts
+    0.47-0.70 (31 of its cold cell's 101), the suite's bounded ones 0.002-0.19.
+
     With ``R`` the rho entries and ``D = R - sigma``, a step ``(P + sigma_S) x + A'nu =
     -q + sigma x_prev`` is ``(P + R_S) x + A'nu = -q + u``, ``u = sigma x_prev_S + D x_S``,
     so ``x = base + W u`` and ``(D^-1 - W_SS) u = D^-1 sigma x_prev_S + base_S``:
@@ -210,6 +221,7 @@ cdef int _table_start(Engine* e, Run* run) noexcept nogil:
     cdef double* xs = e.work.vec_s2      # x_S
     cdef double* u = e.work.rhs
     cdef double* sol = e.work.sol
+    cdef double step_before = 0.0, step_last = 0.0
     if s == 0 or e.equalities_missed or not _schur_start(e):
         return UNAVAILABLE
     for j in range(s):
@@ -234,14 +246,19 @@ cdef int _table_start(Engine* e, Run* run) noexcept nogil:
     for step in range(EQUALITY_START_STEPS):
         for j in range(s):
             u[j] = sigma * xs[j] / gap[j] + e.red.base[p.constrained[j]]
+            sol[j] = xs[j]   # the previous x_S (sol is free until x is formed)
         cholesky_solve_vector(M, <int>s, <int>s, u)
         matvec(e.red.W_S, u, xs, s, s)
+        step_before = step_last
+        step_last = 0.0
         for j in range(s):
             xs[j] += e.red.base[p.constrained[j]]
+            step_last = max(step_last, fabs(xs[j] - sol[j]))
     colmatvec(e.red.W, <int>(n + p.m), u, sol, n + p.m, s, 0.0)
     for i in range(n + p.m):
         sol[i] += e.red.base[i]
-    if sigma * inf_norm(sol, n) > EQUALITY_START_LIMIT * max(1.0, inf_norm(p.q, n)):
+    if (sigma * inf_norm(sol, n) > EQUALITY_START_LIMIT * max(1.0, inf_norm(p.q, n))
+            and step_last >= EQUALITY_START_RAY_STEP * step_before):
         return UNAVAILABLE
     copy(sol, it.x, n)
     copy(sol + n, it.nu, p.m)

@@ -54,6 +54,8 @@ cdef extern from *:
     #define FCCQP_EQUALITY_START_STEPS 3
     /* that QP is unbounded when sigma ||x_eq|| > this max(1, ||q||): test it as a direction */
     #define FCCQP_EQUALITY_START_LIMIT 1e-3
+    /* beyond that limit, a ray only when the Schur start's last step keeps this of the one before */
+    #define FCCQP_EQUALITY_START_RAY_STEP 0.9
     /* the cold start missing A x = b by more than this (relative): "auto" takes full form */
     #define FCCQP_EQUALITY_MISSED 1e-9
     /* a failed warm start restarts cold for the rest, and a run still converging at its
@@ -238,6 +240,7 @@ cdef extern from *:
     # Cold start and equalities
     const long EQUALITY_START_STEPS "FCCQP_EQUALITY_START_STEPS"
     const double EQUALITY_START_LIMIT "FCCQP_EQUALITY_START_LIMIT"
+    const double EQUALITY_START_RAY_STEP "FCCQP_EQUALITY_START_RAY_STEP"
     const double EQUALITY_MISSED "FCCQP_EQUALITY_MISSED"
     const long RESTART_MIN_ITER "FCCQP_RESTART_MIN_ITER"
     const double GUESS_LEAD "FCCQP_GUESS_LEAD"
