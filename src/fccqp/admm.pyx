@@ -16,6 +16,7 @@ from fccqp.result import Result
 from fccqp.status import Status
 
 from cpython.buffer cimport PyBuffer_Release
+from cpython.object cimport PyObject_GenericSetAttr
 from libc.math cimport isfinite
 
 from fccqp cimport engine
@@ -76,6 +77,15 @@ BACKENDS = {"schur_reduced": SCHUR_REDUCED, "ldl_reduced": LDL_REDUCED, "ldl_ful
             "auto": AUTO, "sparse": SPARSE_LDL}
 """``Settings.kkt_backend`` names and their codes (see :mod:`fccqp.kkt`)."""
 BACKEND_NAMES = {code: name for name, code in BACKENDS.items()}
+
+
+cdef object _new_result(dict fields):
+    """A :class:`fccqp.Result` whose attributes are ``fields`` (all of them), as
+    ``Result._of`` makes one but without an interpreted frame: the dict becomes the
+    result's own, not copied into it."""
+    result = object.__new__(Result)
+    PyObject_GenericSetAttr(result, "__dict__", fields)
+    return result
 
 
 cdef class Workspace:
@@ -379,7 +389,7 @@ cdef class Workspace:
             certificate = cert_out.copy()
         elif run.status == engine.DUAL_INFEASIBLE:
             certificate = cert_out[:self.e.prob.n].copy()
-        return Result._of({
+        return _new_result({
             "x": x, "y": y, "z": z, "status": STATUS_BY_CODE[run.status],
             "obj": r.objective, "iterations": run.iterations, "prim_res": r.prim,
             "dual_res": r.dual, "setup_time": run.setup_time,
