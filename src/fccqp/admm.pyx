@@ -535,7 +535,8 @@ def kept_switch(kept, P, q, A, b, lb, ub, cones, x0, y0, z0):
     path's, which flattens the cones and raises the errors. One compiled call instead of
     the interpreter's checks, flattening, comparisons and friction writes, which a
     contact change runs once after a stretch of ticks of another structure: there they
-    took 25 us of solo12's 100 us tick (notes/performance-history.md, "switchentry")."""
+    took 23 us of solo12's 100 us tick, this call 7 us (notes/performance-history.md,
+    "switchentry")."""
     cdef Workspace w
     cdef Py_ssize_t n, m
     cdef Cones* blocks
