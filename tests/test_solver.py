@@ -272,6 +272,7 @@ def test_a_guessed_switch_onto_other_friction_takes_the_kept_workspace_without_a
                 (P, q, A, b, lb_fixed, ub_fixed, cones))
     general = fccqp.Solver()
     monkeypatch.setattr(general, "_switch", lambda *arguments: None)
+    monkeypatch.setattr(fccqp.admm, "kept_switch", lambda *arguments: None)
     expected = [carried(general, second, general.solve(*first))]
     for problem in switches:
         expected.append(carried(general, problem, expected[-1]))
@@ -290,6 +291,47 @@ def test_a_guessed_switch_onto_other_friction_takes_the_kept_workspace_without_a
     monkeypatch.undo()
     answers.append(carried(solver, switches[2], answers[-1]))
     for problem, answer, reference in zip((second, *switches), answers, expected,
+                                          strict=True):
+        assert answer.status is Status.SOLVED
+        assert answer.iterations == reference.iterations
+        np.testing.assert_array_equal(answer.x, reference.x)
+        verify_solution(problem, answer)
+
+
+def upright(problem):
+    """``problem`` with its friction cones upright (no normal), as a walking robot's
+    control loop passes them."""
+    return (*problem[:6], tuple(FrictionCone(c.start, c.mu) for c in problem[6]))
+
+
+@pytest.mark.kkt_backends(*DENSE_PATH_KEEPS, reason="the dense path's kept workspaces")
+def test_a_guessed_switch_onto_upright_friction_builds_no_flat_cones(monkeypatch):
+    # contact changes as a walking robot's controller makes them (upright friction cones
+    # of Python numbers, the caller's guess) onto kept workspaces with other friction:
+    # one compiled call chooses the workspace and writes the friction, without the flat
+    # form of the cones; the answers, and that of a later solve of the same workspace
+    # with its first friction again (the general path, which then needs the flat form
+    # of the friction the switch wrote), are the general path's bit for bit
+    first, second = (upright(problem) for problem in two_structures())
+    switches = (other_friction(first, 0.8), other_friction(second, 1.2))
+    general = fccqp.Solver()
+    monkeypatch.setattr(fccqp.admm, "kept_switch", lambda *arguments: None)
+    expected = [carried(general, second, general.solve(*first))]
+    for problem in (*switches, second):
+        expected.append(carried(general, problem, expected[-1]))
+    monkeypatch.undo()
+
+    def no_flattening(*arguments):
+        raise AssertionError("the switch flattened the cones")
+
+    solver = fccqp.Solver()
+    answers = [carried(solver, second, solver.solve(*first))]
+    monkeypatch.setattr(fccqp.solver, "flatten_cones", no_flattening)
+    for problem in switches:
+        answers.append(carried(solver, problem, answers[-1]))
+    monkeypatch.undo()
+    answers.append(carried(solver, second, answers[-1]))
+    for problem, answer, reference in zip((second, *switches, second), answers, expected,
                                           strict=True):
         assert answer.status is Status.SOLVED
         assert answer.iterations == reference.iterations

@@ -16,6 +16,7 @@ from fccqp.result import Result
 from fccqp.status import Status
 
 from cpython.buffer cimport PyBuffer_Release
+from cpython.object cimport PyObject_GenericSetAttr
 from libc.math cimport isfinite
 
 from fccqp cimport engine
@@ -25,12 +26,13 @@ from fccqp.anderson cimport anderson_reset
 from fccqp.blas_threads cimport enter, leave
 from fccqp.certificates cimport CERTIFIED, primal_candidate
 from fccqp.engine cimport CONE_ENTRY, Clock, Engine, Run, fccqp_now
-from fccqp.fast_checks cimport hold_dense, hold_float64
+from fccqp.fast_checks cimport (dense_shapes, hold_dense, hold_float64, upright_friction_on,
+                                vector_within)
 from fccqp.kkt cimport AUTO, LDL_FULL, LDL_REDUCED, SCHUR_REDUCED, SPARSE_LDL
 from fccqp.matrices cimport Matrix, csc, mark_diagonal_tail
 from fccqp.scaled_run cimport scaled_run, unscaled_answer
 from fccqp.termination cimport Residuals
-from fccqp.tuning cimport FIXED_RHO_SCALE, RESERVE_DECAY, RESTART_MIN_ITER
+from fccqp.tuning cimport FIXED_RHO_SCALE, MAX_ENTRY, RESERVE_DECAY, RESTART_MIN_ITER
 from fccqp.validation cimport (BOUNDED, FIXED_BOUND, NEW_PATTERN, SCAN_OK, UNBOUNDED, Finding,
                                bound_kind, scan_and_copy, scan_and_copy_csc)
 from fccqp.verdict cimport unbounded
@@ -75,6 +77,15 @@ BACKENDS = {"schur_reduced": SCHUR_REDUCED, "ldl_reduced": LDL_REDUCED, "ldl_ful
             "auto": AUTO, "sparse": SPARSE_LDL}
 """``Settings.kkt_backend`` names and their codes (see :mod:`fccqp.kkt`)."""
 BACKEND_NAMES = {code: name for name, code in BACKENDS.items()}
+
+
+cdef object _new_result(dict fields):
+    """A :class:`fccqp.Result` whose attributes are ``fields`` (all of them), as
+    ``Result._of`` makes one but without an interpreted frame: the dict becomes the
+    result's own, not copied into it."""
+    result = object.__new__(Result)
+    PyObject_GenericSetAttr(result, "__dict__", fields)
+    return result
 
 
 cdef class Workspace:
@@ -378,7 +389,7 @@ cdef class Workspace:
             certificate = cert_out.copy()
         elif run.status == engine.DUAL_INFEASIBLE:
             certificate = cert_out[:self.e.prob.n].copy()
-        return Result._of({
+        return _new_result({
             "x": x, "y": y, "z": z, "status": STATUS_BY_CODE[run.status],
             "obj": r.objective, "iterations": run.iterations, "prim_res": r.prim,
             "dual_res": r.dual, "setup_time": run.setup_time,
@@ -506,3 +517,53 @@ cdef class Workspace:
             if kind != self.e.user.entry_kind[i]:
                 return False
         return True
+
+
+def kept_switch(kept, P, q, A, b, lb, ub, cones, x0, y0, z0):
+    """The entry ``(structure, workspace)`` of ``kept`` (a solver's kept dense workspaces
+    with their structures, oldest first) that a switch onto the arguments takes without
+    the general path, its workspace given the friction of ``cones``; None when the
+    general path decides (:meth:`fccqp.Solver.solve`).
+
+    A switch (arrays that do not fit the current workspace's shapes) takes the first
+    kept workspace whose shapes the arrays fit as they came
+    (:func:`fccqp.fast_checks.dense_arguments`) when ``cones`` are upright friction
+    cones on its blocks (:func:`fccqp.fast_checks.upright_friction_on`) and when the guess is none, ``x0``
+    alone or all of ``x0, y0, z0``, each within ``MAX_ENTRY`` (as
+    :func:`fccqp.solver._guess` returns it unconverted). Anything else, a kept
+    workspace of other blocks first among those the shapes fit included, is the general
+    path's, which flattens the cones and raises the errors. One compiled call instead of
+    the interpreter's checks, flattening, comparisons and friction writes, which a
+    contact change runs once after a stretch of ticks of another structure: there they
+    took 23 us of solo12's 100 us tick, this call 7 us (notes/performance-history.md,
+    "switchentry")."""
+    cdef Workspace w
+    cdef Py_ssize_t n, m
+    cdef Cones* blocks
+    for entry in kept:
+        w = entry[1]
+        n, m = w.e.prob.n, w.e.prob.m
+        if not dense_shapes(P, q, A, b, lb, ub, n, m):
+            continue
+        if not _guess_as_given(x0, y0, z0, n, m):
+            return None
+        blocks = &w.e.prob.cones
+        if not upright_friction_on(cones, blocks.count, blocks.kind, w.e.user.block_start,
+                                   <double*>blocks.mu, <double*>blocks.normal):
+            return None
+        return entry
+    return None
+
+
+cdef bint _guess_as_given(x0, y0, z0, Py_ssize_t n, Py_ssize_t m):
+    """Whether the guess ``(x0, y0, z0)`` of a solve in ``n`` variables and ``m`` rows
+    is none, ``x0`` alone or all three, each a vector :func:`fccqp.solver._guess` takes
+    as it came."""
+    if x0 is None:
+        return y0 is None and z0 is None
+    if not vector_within(x0, n, MAX_ENTRY):
+        return False
+    if y0 is None and z0 is None:
+        return True
+    return (y0 is not None and z0 is not None and vector_within(y0, m, MAX_ENTRY)
+            and vector_within(z0, n, MAX_ENTRY))

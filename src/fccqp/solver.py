@@ -58,16 +58,34 @@ class _Structure:
     workspace checks the bounds against it in every solve and asks for a rescan
     (``admm.STRUCTURE_CHANGED``) when they moved."""
 
-    __slots__ = ("n", "m", "count", "constrained", "fixed", "relocated", "cones", "certificate",
-                 "last_cones", "_key")
+    __slots__ = ("n", "m", "count", "constrained", "fixed", "relocated", "_cones",
+                 "certificate", "last_cones", "_key")
 
     def __init__(self, n: int, m: int, cones: ConeArrays) -> None:
-        self.n, self.m, self.count, self.cones = n, m, 0, cones
+        self.n, self.m, self.count, self._cones = n, m, 0, cones
         self.constrained, self.fixed = np.empty(n, np.intp), np.empty(n, np.uint8)
         self.relocated = np.empty(cones.count, np.intp)
         self.certificate = np.empty(n + m)  # copied into the Result only when infeasible
         self.last_cones: object = None   # the cones argument last solved in its workspace
         self._key: tuple[object, ...] | None = None
+
+    @property
+    def cones(self) -> ConeArrays:
+        """The cone blocks with the friction of the workspace's last solve: those of
+        :attr:`last_cones`, flattened when first asked for after :meth:`friction_of`."""
+        if self._cones is None:
+            self._cones = flatten_cones(self.last_cones, self.n)
+        return self._cones
+
+    @cones.setter
+    def cones(self, flat: ConeArrays) -> None:
+        self._cones = flat
+
+    def friction_of(self, cones: object) -> None:
+        """Record that the workspace now holds the friction of ``cones``, validated cone
+        specs on its blocks (:func:`fccqp.admm.kept_switch`), flattened only when
+        :attr:`cones` is asked for: a switch that solves needs no flat form."""
+        self._cones, self.last_cones = None, cones
 
     def update(self, lb: np.ndarray, ub: np.ndarray) -> bool:
         """Scan the bounds; True when the constrained or fixed entries changed."""
@@ -240,6 +258,9 @@ class Solver:
         if dense and dense_arguments(P, q, A, b, lb, ub, structure.n, structure.m):
             n, m = structure.n, structure.m   # the arrays fit as they are
             flat = flatten_cones(cones, n)   # memoized: the same object for the same cones
+        elif dense and (entry := admm.kept_switch(self._kept.values(), P, q, A, b, lb, ub,
+                                                  cones, x0, y0, z0)) is not None:
+            return self._switched(entry, cones, P, q, A, b, lb, ub, x0, y0, z0, start)
         elif dense and (flat := self._switch(cones, P, q, A, b, lb, ub)) is not None:
             w, structure = self._workspace, self._structure   # a kept one they fit
             n, m = structure.n, structure.m
@@ -283,6 +304,28 @@ class Solver:
                 self._cones = cones
                 return w, structure
         return None, None
+
+    def _switched(self, entry: tuple[_Structure, admm.Workspace], cones: object, P: object,
+                  q: object, A: object, b: object, lb: object, ub: object, x0: object,
+                  y0: object, z0: object, start: float) -> Result:
+        """The solve of a switch onto the kept ``entry`` that
+        :func:`fccqp.admm.kept_switch` chose (in one compiled call: the shapes, the
+        guess, upright friction cones on its blocks, whose friction it wrote), made
+        current with the friction of ``cones`` (their flat form left to
+        :attr:`_Structure.cones` until asked for); the arguments are those the general
+        path would solve (a guess as :func:`_guess` returns it), and a solved answer
+        returns without :meth:`_result`, as the control loop's does."""
+        structure, w = entry
+        self._make_current(structure.key(), structure, w)
+        structure.friction_of(cones)
+        self._cones = cones
+        out = w.solve(P, q, A, b, lb, ub, x0, self._settings.warm_start, start,
+                      structure.certificate, True, y0, z0)
+        if (type(out) is Result and out.status is Status.SOLVED and not w.doubt
+                and not self._settings.verbose):
+            return out
+        guess = NO_GUESS if x0 is None else (x0, y0, z0)
+        return self._result(out, P, q, A, b, lb, ub, guess, start)
 
     def _switch(self, cones: object, P: object, q: object, A: object, b: object,
                 lb: object, ub: object) -> ConeArrays | None:
