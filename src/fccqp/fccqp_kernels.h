@@ -95,6 +95,14 @@
 #define FCCQP_CLONES
 #endif
 
+/* Kernels with sums of products (Anderson's, the rows' spans) get the AVX2 copy with GCC
+ * only, where it can be built without fused multiply-adds: both copies round alike */
+#if defined(__GNUC__) && !defined(__clang__)
+#define FCCQP_EXACT_CLONES FCCQP_CLONES __attribute__((optimize("fp-contract=off")))
+#else
+#define FCCQP_EXACT_CLONES
+#endif
+
 #define FCCQP_LU_PANEL 4
 
 /* Four lanes of doubles for the per-solve passes (fccqp_symmetric_copy and the three
@@ -523,6 +531,7 @@ static int fccqp_checked_copy(const double *restrict v, long k, double limit,
 /* out = diag(left) M diag(right) for a row-major rows x cols M (out aliases nothing);
  * row_max[i] = max_j |out_ij|, and where column_max is not NULL column_max[j] becomes
  * max(column_max[j], max_i |out_ij|). M, left and right are finite. */
+FCCQP_CLONES
 static void fccqp_scale_rows(const double *restrict M, int rows, int cols,
                              const double *restrict left, const double *restrict right,
                              double *restrict out, double *restrict row_max,
@@ -602,6 +611,7 @@ static void fccqp_ruiz_maxima(const double *restrict P, const double *restrict A
 
 /* span[i] = sum_j |A_ij| width_j over the entries with A_ij != 0 for a row-major rows x
  * cols A (a zero entry adds nothing even where the width is infinite) */
+FCCQP_EXACT_CLONES
 static void fccqp_row_spans(const double *restrict A, int rows, int cols,
                             const double *restrict width, double *restrict span)
 {
@@ -726,13 +736,6 @@ FCCQP_LANE_OP fccqp_d4 fccqp_dmul(fccqp_d4 a, fccqp_d4 b) { FCCQP_LANEWISE(fccqp
 FCCQP_LANE_OP double fccqp_dsum(fccqp_d4 v) { return (v.lane[0] + v.lane[1]) + (v.lane[2] + v.lane[3]); }
 #endif
 
-/* Anderson's kernels get the AVX2 copy with GCC only, where it can be built without
- * fused multiply-adds: both copies round alike */
-#if defined(__GNUC__) && !defined(__clang__)
-#define FCCQP_EXACT_CLONES FCCQP_CLONES __attribute__((optimize("fp-contract=off")))
-#else
-#define FCCQP_EXACT_CLONES
-#endif
 
 /* fccqp_slot_products for the rows r0 and r1 (out: newest' r0, r0' f, newest' r1, r1' f) */
 FCCQP_FORCE_INLINE void fccqp_slot_pair_products(const double *restrict r0,
@@ -881,6 +884,149 @@ static double fccqp_sum_squares(const double *restrict v, long k)
     for (; j < k; j++)
         total += v[j] * v[j];
     return total;
+}
+
+
+/* The validation scan's two passes (fccqp_symmetric_copy, fccqp_checked_copy) in one
+ * 32-byte vector of four lanes where the CPU has AVX2, picked at each call
+ * (fccqp_scan_symmetric, fccqp_scan_copy). The same operations lane by lane as the
+ * two-halves kernels, so the same bits and flags: only the instruction count differs.
+ * Per go2 warm tick (callgrind, 100 ticks): the scan took 46.4k instructions in the
+ * baseline copy, 35.5k in target_clones' AVX2 copy of the halves and 24.8k here
+ * (notes/performance-history.md, "scan"). */
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#define FCCQP_WIDE_SCAN 1
+#define FCCQP_WIDE static inline __attribute__((target("avx2"), always_inline))
+
+FCCQP_WIDE __m256d fccqp_wide_abs(__m256d x)
+{
+    return _mm256_and_pd(x, _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffffLL)));
+}
+
+/* max(x, lanes of v), v never NaN */
+FCCQP_WIDE double fccqp_wide_largest(__m256d v, double x)
+{
+    double lanes[4];
+    _mm256_storeu_pd(lanes, v);
+    for (int k = 0; k < 4; k++)
+        x = lanes[k] > x ? lanes[k] : x;
+    return x;
+}
+
+/* fccqp_symmetric_copy in 32-byte vectors; the mirror's column is walked by pointers */
+__attribute__((target("avx2")))
+static int fccqp_symmetric_copy_wide(const double *restrict P, int n, double *restrict out,
+                                     double sizes[2])
+{
+    const __m256d half = _mm256_set1_pd(0.5), limit = _mm256_set1_pd(1.7976931348623157e308);
+    __m256d largest = _mm256_setzero_pd(), largest_b = largest, asymmetry = largest;
+    __m256d not_finite = largest, changed = largest;
+    double largest_1 = 0.0, asymmetry_1 = 0.0;
+    int found = 0;
+    long k = 0, entries = (long)n * n, stride = n, step = 4 * (long)n;
+    for (; k + 8 <= entries; k += 8) {   /* two accumulators: one max a cycle */
+        largest = _mm256_max_pd(fccqp_wide_abs(_mm256_loadu_pd(P + k)), largest);
+        largest_b = _mm256_max_pd(fccqp_wide_abs(_mm256_loadu_pd(P + k + 4)), largest_b);
+    }
+    for (; k + 4 <= entries; k += 4)
+        largest = _mm256_max_pd(fccqp_wide_abs(_mm256_loadu_pd(P + k)), largest);
+    for (; k < entries; k++)
+        largest_1 = fabs(P[k]) > largest_1 ? fabs(P[k]) : largest_1;
+    largest = _mm256_max_pd(largest_b, largest);
+    for (int i = 0; i < n; i++) {
+        const double *row = P + (long)i * n;
+        double *out_row = out + (long)i * n;
+        double v = row[i];
+        if (!(fabs(v) <= 1.7976931348623157e308))
+            found |= FCCQP_NOT_FINITE;
+        if (out_row[i] != v)
+            found |= FCCQP_CHANGED;
+        out_row[i] = v;
+        int j = i + 1;
+        const double *column = P + (long)j * n + i;
+        double *mirror = out + (long)j * n + i;
+        for (; j + 4 <= n; j += 4, column += step, mirror += step) {
+            __m256d upper = _mm256_loadu_pd(row + j);
+            __m256d lower = _mm256_set_pd(column[3 * stride], column[2 * stride], column[stride],
+                                          column[0]);
+            __m256d difference = fccqp_wide_abs(_mm256_sub_pd(upper, lower));
+            __m256d value = _mm256_mul_pd(half, _mm256_add_pd(upper, lower));
+            not_finite = _mm256_or_pd(not_finite, _mm256_cmp_pd(difference, limit, _CMP_NLE_UQ));
+            asymmetry = _mm256_max_pd(difference, asymmetry);
+            changed = _mm256_or_pd(changed, _mm256_cmp_pd(_mm256_loadu_pd(out_row + j), value,
+                                                          _CMP_NEQ_UQ));
+            _mm256_storeu_pd(out_row + j, value);
+            __m128d low = _mm256_castpd256_pd128(value), high = _mm256_extractf128_pd(value, 1);
+            _mm_storel_pd(mirror, low);
+            _mm_storeh_pd(mirror + stride, low);
+            _mm_storel_pd(mirror + 2 * stride, high);
+            _mm_storeh_pd(mirror + 3 * stride, high);
+        }
+        for (; j < n; j++) {
+            double u = row[j], l = P[(long)j * n + i], value = 0.5 * (u + l);
+            double difference = fabs(u - l);
+            if (!(difference <= 1.7976931348623157e308))
+                found |= FCCQP_NOT_FINITE;
+            asymmetry_1 = difference > asymmetry_1 ? difference : asymmetry_1;
+            if (out_row[j] != value)
+                found |= FCCQP_CHANGED;
+            out_row[j] = value;
+            out[(long)j * n + i] = value;
+        }
+    }
+    sizes[0] = fccqp_wide_largest(largest, largest_1);
+    sizes[1] = fccqp_wide_largest(asymmetry, asymmetry_1);
+    return found | (_mm256_movemask_pd(not_finite) ? FCCQP_NOT_FINITE : 0)
+           | (_mm256_movemask_pd(changed) ? FCCQP_CHANGED : 0);
+}
+
+/* fccqp_checked_copy in 32-byte vectors */
+__attribute__((target("avx2")))
+static int fccqp_checked_copy_wide(const double *restrict v, long k, double limit,
+                                   double *restrict out)
+{
+    const __m256d bound = _mm256_set1_pd(limit);
+    __m256d beyond = _mm256_setzero_pd(), changed = beyond;
+    int found = 0;
+    long i = 0;
+    for (; i + 4 <= k; i += 4) {
+        __m256d value = _mm256_loadu_pd(v + i);
+        beyond = _mm256_or_pd(beyond, _mm256_cmp_pd(fccqp_wide_abs(value), bound, _CMP_NLE_UQ));
+        changed = _mm256_or_pd(changed, _mm256_cmp_pd(_mm256_loadu_pd(out + i), value,
+                                                      _CMP_NEQ_UQ));
+        _mm256_storeu_pd(out + i, value);
+    }
+    for (; i < k; i++) {
+        if (!(fabs(v[i]) <= limit))
+            found |= FCCQP_NOT_FINITE;
+        if (out[i] != v[i])
+            found |= FCCQP_CHANGED;
+        out[i] = v[i];
+    }
+    return found | (_mm256_movemask_pd(beyond) ? FCCQP_NOT_FINITE : 0)
+           | (_mm256_movemask_pd(changed) ? FCCQP_CHANGED : 0);
+}
+#endif
+
+/* fccqp_symmetric_copy, in 32-byte vectors where the CPU has AVX2 */
+static inline int fccqp_scan_symmetric(const double *P, int n, double *out, double sizes[2])
+{
+#ifdef FCCQP_WIDE_SCAN
+    if (__builtin_cpu_supports("avx2"))
+        return fccqp_symmetric_copy_wide(P, n, out, sizes);
+#endif
+    return fccqp_symmetric_copy(P, n, out, sizes);
+}
+
+/* fccqp_checked_copy, in 32-byte vectors where the CPU has AVX2 */
+static inline int fccqp_scan_copy(const double *v, long k, double limit, double *out)
+{
+#ifdef FCCQP_WIDE_SCAN
+    if (__builtin_cpu_supports("avx2"))
+        return fccqp_checked_copy_wide(v, k, limit, out);
+#endif
+    return fccqp_checked_copy(v, k, limit, out);
 }
 
 #endif
