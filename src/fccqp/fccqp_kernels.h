@@ -531,7 +531,6 @@ static int fccqp_checked_copy(const double *restrict v, long k, double limit,
 /* out = diag(left) M diag(right) for a row-major rows x cols M (out aliases nothing);
  * row_max[i] = max_j |out_ij|, and where column_max is not NULL column_max[j] becomes
  * max(column_max[j], max_i |out_ij|). M, left and right are finite. */
-FCCQP_CLONES
 static void fccqp_scale_rows(const double *restrict M, int rows, int cols,
                              const double *restrict left, const double *restrict right,
                              double *restrict out, double *restrict row_max,
@@ -1007,7 +1006,79 @@ static int fccqp_checked_copy_wide(const double *restrict v, long k, double limi
     return found | (_mm256_movemask_pd(beyond) ? FCCQP_NOT_FINITE : 0)
            | (_mm256_movemask_pd(changed) ? FCCQP_CHANGED : 0);
 }
+/* fccqp_scale_rows in 32-byte vectors */
+__attribute__((target("avx2")))
+static void fccqp_scale_rows_wide(const double *restrict M, int rows, int cols,
+                                  const double *restrict left, const double *restrict right,
+                                  double *restrict out, double *restrict row_max,
+                                  double *restrict column_max)
+{
+    for (int i = 0; i < rows; i++) {
+        const double *row = M + (long)i * cols;
+        double *out_row = out + (long)i * cols;
+        __m256d factor = _mm256_set1_pd(left[i]), largest = _mm256_setzero_pd();
+        double largest_1 = 0.0;
+        int j = 0;
+        for (; j + 4 <= cols; j += 4) {
+            __m256d value = _mm256_mul_pd(_mm256_mul_pd(_mm256_loadu_pd(row + j), factor),
+                                          _mm256_loadu_pd(right + j));
+            __m256d size = fccqp_wide_abs(value);
+            _mm256_storeu_pd(out_row + j, value);
+            largest = _mm256_max_pd(size, largest);
+            if (column_max)
+                _mm256_storeu_pd(column_max + j,
+                                 _mm256_max_pd(size, _mm256_loadu_pd(column_max + j)));
+        }
+        for (; j < cols; j++) {
+            double value = row[j] * left[i] * right[j], size = fabs(value);
+            out_row[j] = value;
+            largest_1 = size > largest_1 ? size : largest_1;
+            if (column_max)
+                column_max[j] = size > column_max[j] ? size : column_max[j];
+        }
+        row_max[i] = fccqp_wide_largest(largest, largest_1);
+    }
+}
+
+/* v *= factor for k entries, in 32-byte vectors */
+__attribute__((target("avx2")))
+static void fccqp_multiply_wide(double *restrict v, long k, double factor)
+{
+    __m256d f = _mm256_set1_pd(factor);
+    long i = 0;
+    for (; i + 4 <= k; i += 4)
+        _mm256_storeu_pd(v + i, _mm256_mul_pd(_mm256_loadu_pd(v + i), f));
+    for (; i < k; i++)
+        v[i] *= factor;
+}
 #endif
+
+/* fccqp_scale_rows, in 32-byte vectors where the CPU has AVX2 */
+static inline void fccqp_rescale_rows(const double *M, int rows, int cols, const double *left,
+                                      const double *right, double *out, double *row_max,
+                                      double *column_max)
+{
+#ifdef FCCQP_WIDE_SCAN
+    if (__builtin_cpu_supports("avx2")) {
+        fccqp_scale_rows_wide(M, rows, cols, left, right, out, row_max, column_max);
+        return;
+    }
+#endif
+    fccqp_scale_rows(M, rows, cols, left, right, out, row_max, column_max);
+}
+
+/* v *= factor for k entries, in 32-byte vectors where the CPU has AVX2 */
+static inline void fccqp_rescale_multiply(double *v, long k, double factor)
+{
+#ifdef FCCQP_WIDE_SCAN
+    if (__builtin_cpu_supports("avx2")) {
+        fccqp_multiply_wide(v, k, factor);
+        return;
+    }
+#endif
+    for (long i = 0; i < k; i++)
+        v[i] *= factor;
+}
 
 /* fccqp_symmetric_copy, in 32-byte vectors where the CPU has AVX2 */
 static inline int fccqp_scan_symmetric(const double *P, int n, double *out, double sizes[2])
