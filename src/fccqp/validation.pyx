@@ -64,10 +64,10 @@ cdef Finding scan_and_copy(const double* P, const double* q, const double* A, co
     """Check and copy; ``same_matrices`` becomes False as soon as ``P`` or ``A`` differs
     from what ``P_out``, ``A_out`` held.
 
-    ``P`` goes through ``fccqp_symmetric_copy`` (four pairs ``(i, j), (j, i)`` of the
-    upper triangle a step) and ``A`` through ``fccqp_checked_copy`` (fccqp_kernels.h),
-    passes that do not branch on the data; what went wrong is looked up only when
-    something did.
+    ``P`` goes through ``fccqp_scan_symmetric`` (four pairs ``(i, j), (j, i)`` of the
+    upper triangle a step) and ``A`` through ``fccqp_scan_copy`` (fccqp_kernels.h: one
+    32-byte vector a step where the CPU has AVX2, two halves else), passes that do not
+    branch on the data; what went wrong is looked up only when something did.
     """
     cdef Py_ssize_t i
     cdef double sizes[2]   # the largest entry and asymmetry of P
