@@ -611,10 +611,11 @@ static void fccqp_ruiz_maxima(const double *restrict P, const double *restrict A
 }
 
 /* span[i] = sum_j |A_ij| width_j over the entries with A_ij != 0 for a row-major rows x
- * cols A (a zero entry adds nothing even where the width is infinite) */
+ * cols A (a zero entry adds nothing even where the width is infinite); fccqp_row_spans
+ * picks it or its 32-byte copy */
 FCCQP_EXACT_CLONES
-static void fccqp_row_spans(const double *restrict A, int rows, int cols,
-                            const double *restrict width, double *restrict span)
+static void fccqp_row_spans_halves(const double *restrict A, int rows, int cols,
+                                   const double *restrict width, double *restrict span)
 {
     for (int i = 0; i < rows; i++) {
         const double *row = A + (long)i * cols;
@@ -1046,6 +1047,31 @@ static void fccqp_scale_rows_wide(const double *restrict M, int rows, int cols,
     }
 }
 
+/* fccqp_row_spans_halves in 32-byte vectors */
+__attribute__((target("avx2")))
+static void fccqp_row_spans_wide(const double *restrict A, int rows, int cols,
+                                 const double *restrict width, double *restrict span)
+{
+    const __m256d zero = _mm256_setzero_pd();
+    double lanes[4];
+    for (int i = 0; i < rows; i++) {
+        const double *row = A + (long)i * cols;
+        __m256d sum = zero;
+        double sum_1 = 0.0;
+        int j = 0;
+        for (; j + 4 <= cols; j += 4) {
+            __m256d a = _mm256_loadu_pd(row + j);
+            __m256d term = _mm256_mul_pd(fccqp_wide_abs(a), _mm256_loadu_pd(width + j));
+            sum = _mm256_add_pd(sum, _mm256_and_pd(term, _mm256_cmp_pd(a, zero, _CMP_NEQ_UQ)));
+        }
+        for (; j < cols; j++)
+            if (row[j] != 0.0)
+                sum_1 += fabs(row[j]) * width[j];
+        _mm256_storeu_pd(lanes, sum);
+        span[i] = ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) + sum_1;
+    }
+}
+
 /* v *= factor for k entries, in 32-byte vectors */
 __attribute__((target("avx2")))
 static void fccqp_multiply_wide(double *restrict v, long k, double factor)
@@ -1084,6 +1110,20 @@ static inline void fccqp_rescale_multiply(double *v, long k, double factor)
 #endif
     for (long i = 0; i < k; i++)
         v[i] *= factor;
+}
+
+/* span[i] = sum_j |A_ij| width_j over the entries with A_ij != 0 (fccqp_row_spans_halves),
+ * in 32-byte vectors where the CPU has AVX2 */
+static inline void fccqp_row_spans(const double *A, int rows, int cols, const double *width,
+                                   double *span)
+{
+#ifdef FCCQP_WIDE_SCAN
+    if (__builtin_cpu_supports("avx2")) {
+        fccqp_row_spans_wide(A, rows, cols, width, span);
+        return;
+    }
+#endif
+    fccqp_row_spans_halves(A, rows, cols, width, span);
 }
 
 /* fccqp_symmetric_copy, in 32-byte vectors where the CPU has AVX2 */
