@@ -74,6 +74,8 @@
  * which is the first read of the caller's arrays, stayed at 10-11 us. fccqp_ruiz_maxima,
  * run 4 times per equilibration, is also cloned: a go2 pass took about 35k instructions
  * in Cython's loops, 34k in the baseline copy and 24k in the AVX2 one (callgrind).
+ * The scan's, the rescaling's and the spans' passes have a 32-byte copy where the CPU
+ * has AVX2 (the block "Every solve's passes" below); the spans' halves are cloned too.
  */
 #ifndef FCCQP_KERNELS_H
 #define FCCQP_KERNELS_H
@@ -93,6 +95,14 @@
 #define FCCQP_CLONES __attribute__((target_clones("avx2", "default")))
 #else
 #define FCCQP_CLONES
+#endif
+
+/* Kernels with sums of products (Anderson's, the rows' spans) get the AVX2 copy with GCC
+ * only, where it can be built without fused multiply-adds: both copies round alike */
+#if defined(__GNUC__) && !defined(__clang__)
+#define FCCQP_EXACT_CLONES FCCQP_CLONES __attribute__((optimize("fp-contract=off")))
+#else
+#define FCCQP_EXACT_CLONES
 #endif
 
 #define FCCQP_LU_PANEL 4
@@ -601,9 +611,11 @@ static void fccqp_ruiz_maxima(const double *restrict P, const double *restrict A
 }
 
 /* span[i] = sum_j |A_ij| width_j over the entries with A_ij != 0 for a row-major rows x
- * cols A (a zero entry adds nothing even where the width is infinite) */
-static void fccqp_row_spans(const double *restrict A, int rows, int cols,
-                            const double *restrict width, double *restrict span)
+ * cols A (a zero entry adds nothing even where the width is infinite); fccqp_row_spans
+ * picks it or its 32-byte copy */
+FCCQP_EXACT_CLONES
+static void fccqp_row_spans_halves(const double *restrict A, int rows, int cols,
+                                   const double *restrict width, double *restrict span)
 {
     for (int i = 0; i < rows; i++) {
         const double *row = A + (long)i * cols;
@@ -726,13 +738,6 @@ FCCQP_LANE_OP fccqp_d4 fccqp_dmul(fccqp_d4 a, fccqp_d4 b) { FCCQP_LANEWISE(fccqp
 FCCQP_LANE_OP double fccqp_dsum(fccqp_d4 v) { return (v.lane[0] + v.lane[1]) + (v.lane[2] + v.lane[3]); }
 #endif
 
-/* Anderson's kernels get the AVX2 copy with GCC only, where it can be built without
- * fused multiply-adds: both copies round alike */
-#if defined(__GNUC__) && !defined(__clang__)
-#define FCCQP_EXACT_CLONES FCCQP_CLONES __attribute__((optimize("fp-contract=off")))
-#else
-#define FCCQP_EXACT_CLONES
-#endif
 
 /* fccqp_slot_products for the rows r0 and r1 (out: newest' r0, r0' f, newest' r1, r1' f) */
 FCCQP_FORCE_INLINE void fccqp_slot_pair_products(const double *restrict r0,
@@ -1021,6 +1026,264 @@ static void fccqp_syrk_t(int n, int k, const double *restrict A, int lda, double
             }
         }
     }
+}
+
+/* Every solve's passes over the caller's data, in one 32-byte vector of four lanes where
+ * the CPU has AVX2, picked at each call: the validation scan's (fccqp_scan_symmetric,
+ * fccqp_scan_copy for fccqp_symmetric_copy, fccqp_checked_copy) and the rescaling's
+ * (fccqp_rescale_rows, fccqp_rescale_multiply for fccqp_scale_rows and a product by the
+ * cost's factor) and the rows' spans (fccqp_row_spans for fccqp_row_spans_halves: 9.9k
+ * -> 6.3k a go2 tick). The same operations lane by lane as the two-halves kernels, and none
+ * that a compiler may fuse (target "avx2" has no FMA), so the same bits and flags: only
+ * the instruction count differs. The halves in an AVX2 clone (target_clones) keep two
+ * 16-byte operations and their moves a step. Per go2 warm tick (callgrind, 100 ticks):
+ * the scan 46.4k instructions in the baseline copy, 35.5k in the clone of the halves and
+ * 24.8k here; the rescaling 31.9k, 25.2k and 16.6k (notes/performance-history.md,
+ * "scan"). */
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#define FCCQP_WIDE_SCAN 1
+#define FCCQP_WIDE static inline __attribute__((target("avx2"), always_inline))
+
+FCCQP_WIDE __m256d fccqp_wide_abs(__m256d x)
+{
+    return _mm256_and_pd(x, _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffffLL)));
+}
+
+/* max(x, lanes of v), v never NaN */
+FCCQP_WIDE double fccqp_wide_largest(__m256d v, double x)
+{
+    double lanes[4];
+    _mm256_storeu_pd(lanes, v);
+    for (int k = 0; k < 4; k++)
+        x = lanes[k] > x ? lanes[k] : x;
+    return x;
+}
+
+/* fccqp_symmetric_copy in 32-byte vectors; the mirror's column is walked by pointers */
+__attribute__((target("avx2")))
+static int fccqp_symmetric_copy_wide(const double *restrict P, int n, double *restrict out,
+                                     double sizes[2])
+{
+    const __m256d half = _mm256_set1_pd(0.5), limit = _mm256_set1_pd(1.7976931348623157e308);
+    __m256d largest = _mm256_setzero_pd(), largest_b = largest, asymmetry = largest;
+    __m256d not_finite = largest, changed = largest;
+    double largest_1 = 0.0, asymmetry_1 = 0.0;
+    int found = 0;
+    long k = 0, entries = (long)n * n, stride = n, step = 4 * (long)n;
+    for (; k + 8 <= entries; k += 8) {   /* two accumulators: one max a cycle */
+        largest = _mm256_max_pd(fccqp_wide_abs(_mm256_loadu_pd(P + k)), largest);
+        largest_b = _mm256_max_pd(fccqp_wide_abs(_mm256_loadu_pd(P + k + 4)), largest_b);
+    }
+    for (; k + 4 <= entries; k += 4)
+        largest = _mm256_max_pd(fccqp_wide_abs(_mm256_loadu_pd(P + k)), largest);
+    for (; k < entries; k++)
+        largest_1 = fabs(P[k]) > largest_1 ? fabs(P[k]) : largest_1;
+    largest = _mm256_max_pd(largest_b, largest);
+    for (int i = 0; i < n; i++) {
+        const double *row = P + (long)i * n;
+        double *out_row = out + (long)i * n;
+        double v = row[i];
+        if (!(fabs(v) <= 1.7976931348623157e308))
+            found |= FCCQP_NOT_FINITE;
+        if (out_row[i] != v)
+            found |= FCCQP_CHANGED;
+        out_row[i] = v;
+        int j = i + 1;
+        const double *column = P + (long)j * n + i;
+        double *mirror = out + (long)j * n + i;
+        for (; j + 4 <= n; j += 4, column += step, mirror += step) {
+            __m256d upper = _mm256_loadu_pd(row + j);
+            __m256d lower = _mm256_set_pd(column[3 * stride], column[2 * stride], column[stride],
+                                          column[0]);
+            __m256d difference = fccqp_wide_abs(_mm256_sub_pd(upper, lower));
+            __m256d value = _mm256_mul_pd(half, _mm256_add_pd(upper, lower));
+            not_finite = _mm256_or_pd(not_finite, _mm256_cmp_pd(difference, limit, _CMP_NLE_UQ));
+            asymmetry = _mm256_max_pd(difference, asymmetry);
+            changed = _mm256_or_pd(changed, _mm256_cmp_pd(_mm256_loadu_pd(out_row + j), value,
+                                                          _CMP_NEQ_UQ));
+            _mm256_storeu_pd(out_row + j, value);
+            __m128d low = _mm256_castpd256_pd128(value), high = _mm256_extractf128_pd(value, 1);
+            _mm_storel_pd(mirror, low);
+            _mm_storeh_pd(mirror + stride, low);
+            _mm_storel_pd(mirror + 2 * stride, high);
+            _mm_storeh_pd(mirror + 3 * stride, high);
+        }
+        for (; j < n; j++) {
+            double u = row[j], l = P[(long)j * n + i], value = 0.5 * (u + l);
+            double difference = fabs(u - l);
+            if (!(difference <= 1.7976931348623157e308))
+                found |= FCCQP_NOT_FINITE;
+            asymmetry_1 = difference > asymmetry_1 ? difference : asymmetry_1;
+            if (out_row[j] != value)
+                found |= FCCQP_CHANGED;
+            out_row[j] = value;
+            out[(long)j * n + i] = value;
+        }
+    }
+    sizes[0] = fccqp_wide_largest(largest, largest_1);
+    sizes[1] = fccqp_wide_largest(asymmetry, asymmetry_1);
+    return found | (_mm256_movemask_pd(not_finite) ? FCCQP_NOT_FINITE : 0)
+           | (_mm256_movemask_pd(changed) ? FCCQP_CHANGED : 0);
+}
+
+/* fccqp_checked_copy in 32-byte vectors */
+__attribute__((target("avx2")))
+static int fccqp_checked_copy_wide(const double *restrict v, long k, double limit,
+                                   double *restrict out)
+{
+    const __m256d bound = _mm256_set1_pd(limit);
+    __m256d beyond = _mm256_setzero_pd(), changed = beyond;
+    int found = 0;
+    long i = 0;
+    for (; i + 4 <= k; i += 4) {
+        __m256d value = _mm256_loadu_pd(v + i);
+        beyond = _mm256_or_pd(beyond, _mm256_cmp_pd(fccqp_wide_abs(value), bound, _CMP_NLE_UQ));
+        changed = _mm256_or_pd(changed, _mm256_cmp_pd(_mm256_loadu_pd(out + i), value,
+                                                      _CMP_NEQ_UQ));
+        _mm256_storeu_pd(out + i, value);
+    }
+    for (; i < k; i++) {
+        if (!(fabs(v[i]) <= limit))
+            found |= FCCQP_NOT_FINITE;
+        if (out[i] != v[i])
+            found |= FCCQP_CHANGED;
+        out[i] = v[i];
+    }
+    return found | (_mm256_movemask_pd(beyond) ? FCCQP_NOT_FINITE : 0)
+           | (_mm256_movemask_pd(changed) ? FCCQP_CHANGED : 0);
+}
+/* fccqp_scale_rows in 32-byte vectors */
+__attribute__((target("avx2")))
+static void fccqp_scale_rows_wide(const double *restrict M, int rows, int cols,
+                                  const double *restrict left, const double *restrict right,
+                                  double *restrict out, double *restrict row_max,
+                                  double *restrict column_max)
+{
+    for (int i = 0; i < rows; i++) {
+        const double *row = M + (long)i * cols;
+        double *out_row = out + (long)i * cols;
+        __m256d factor = _mm256_set1_pd(left[i]), largest = _mm256_setzero_pd();
+        double largest_1 = 0.0;
+        int j = 0;
+        for (; j + 4 <= cols; j += 4) {
+            __m256d value = _mm256_mul_pd(_mm256_mul_pd(_mm256_loadu_pd(row + j), factor),
+                                          _mm256_loadu_pd(right + j));
+            __m256d size = fccqp_wide_abs(value);
+            _mm256_storeu_pd(out_row + j, value);
+            largest = _mm256_max_pd(size, largest);
+            if (column_max)
+                _mm256_storeu_pd(column_max + j,
+                                 _mm256_max_pd(size, _mm256_loadu_pd(column_max + j)));
+        }
+        for (; j < cols; j++) {
+            double value = row[j] * left[i] * right[j], size = fabs(value);
+            out_row[j] = value;
+            largest_1 = size > largest_1 ? size : largest_1;
+            if (column_max)
+                column_max[j] = size > column_max[j] ? size : column_max[j];
+        }
+        row_max[i] = fccqp_wide_largest(largest, largest_1);
+    }
+}
+
+/* fccqp_row_spans_halves in 32-byte vectors */
+__attribute__((target("avx2")))
+static void fccqp_row_spans_wide(const double *restrict A, int rows, int cols,
+                                 const double *restrict width, double *restrict span)
+{
+    const __m256d zero = _mm256_setzero_pd();
+    double lanes[4];
+    for (int i = 0; i < rows; i++) {
+        const double *row = A + (long)i * cols;
+        __m256d sum = zero;
+        double sum_1 = 0.0;
+        int j = 0;
+        for (; j + 4 <= cols; j += 4) {
+            __m256d a = _mm256_loadu_pd(row + j);
+            __m256d term = _mm256_mul_pd(fccqp_wide_abs(a), _mm256_loadu_pd(width + j));
+            sum = _mm256_add_pd(sum, _mm256_and_pd(term, _mm256_cmp_pd(a, zero, _CMP_NEQ_UQ)));
+        }
+        for (; j < cols; j++)
+            if (row[j] != 0.0)
+                sum_1 += fabs(row[j]) * width[j];
+        _mm256_storeu_pd(lanes, sum);
+        span[i] = ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) + sum_1;
+    }
+}
+
+/* v *= factor for k entries, in 32-byte vectors */
+__attribute__((target("avx2")))
+static void fccqp_multiply_wide(double *restrict v, long k, double factor)
+{
+    __m256d f = _mm256_set1_pd(factor);
+    long i = 0;
+    for (; i + 4 <= k; i += 4)
+        _mm256_storeu_pd(v + i, _mm256_mul_pd(_mm256_loadu_pd(v + i), f));
+    for (; i < k; i++)
+        v[i] *= factor;
+}
+#endif
+
+/* fccqp_scale_rows, in 32-byte vectors where the CPU has AVX2 */
+static inline void fccqp_rescale_rows(const double *M, int rows, int cols, const double *left,
+                                      const double *right, double *out, double *row_max,
+                                      double *column_max)
+{
+#ifdef FCCQP_WIDE_SCAN
+    if (__builtin_cpu_supports("avx2")) {
+        fccqp_scale_rows_wide(M, rows, cols, left, right, out, row_max, column_max);
+        return;
+    }
+#endif
+    fccqp_scale_rows(M, rows, cols, left, right, out, row_max, column_max);
+}
+
+/* v *= factor for k entries, in 32-byte vectors where the CPU has AVX2 */
+static inline void fccqp_rescale_multiply(double *v, long k, double factor)
+{
+#ifdef FCCQP_WIDE_SCAN
+    if (__builtin_cpu_supports("avx2")) {
+        fccqp_multiply_wide(v, k, factor);
+        return;
+    }
+#endif
+    for (long i = 0; i < k; i++)
+        v[i] *= factor;
+}
+
+/* span[i] = sum_j |A_ij| width_j over the entries with A_ij != 0 (fccqp_row_spans_halves),
+ * in 32-byte vectors where the CPU has AVX2 */
+static inline void fccqp_row_spans(const double *A, int rows, int cols, const double *width,
+                                   double *span)
+{
+#ifdef FCCQP_WIDE_SCAN
+    if (__builtin_cpu_supports("avx2")) {
+        fccqp_row_spans_wide(A, rows, cols, width, span);
+        return;
+    }
+#endif
+    fccqp_row_spans_halves(A, rows, cols, width, span);
+}
+
+/* fccqp_symmetric_copy, in 32-byte vectors where the CPU has AVX2 */
+static inline int fccqp_scan_symmetric(const double *P, int n, double *out, double sizes[2])
+{
+#ifdef FCCQP_WIDE_SCAN
+    if (__builtin_cpu_supports("avx2"))
+        return fccqp_symmetric_copy_wide(P, n, out, sizes);
+#endif
+    return fccqp_symmetric_copy(P, n, out, sizes);
+}
+
+/* fccqp_checked_copy, in 32-byte vectors where the CPU has AVX2 */
+static inline int fccqp_scan_copy(const double *v, long k, double limit, double *out)
+{
+#ifdef FCCQP_WIDE_SCAN
+    if (__builtin_cpu_supports("avx2"))
+        return fccqp_checked_copy_wide(v, k, limit, out);
+#endif
+    return fccqp_checked_copy(v, k, limit, out);
 }
 
 #endif

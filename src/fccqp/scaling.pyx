@@ -25,9 +25,10 @@ from fccqp.projections cimport proj_set
 from fccqp.tuning cimport CAPPED_PASSES, SPARSE_PASSES
 
 cdef extern from "fccqp_kernels.h" nogil:
-    void fccqp_scale_rows(const double* M, int rows, int cols, const double* left,
-                          const double* right, double* out, double* row_max,
-                          double* column_max)
+    void fccqp_rescale_rows(const double* M, int rows, int cols, const double* left,
+                            const double* right, double* out, double* row_max,
+                            double* column_max)
+    void fccqp_rescale_multiply(double* v, long k, double factor)
     void fccqp_ruiz_maxima(const double* P, const double* A, int n, int m, const double* D,
                            const double* E, double* column, double* row)
 
@@ -271,21 +272,19 @@ cdef bint rescale(const double* P, const double* q, const double* A, const doubl
     cdef Py_ssize_t i, k = diagonal_from
     cdef double mean_col = 0.0, q_norm = 0.0, cost
     # D P D and its rows' norms (its columns': it is symmetric), then the cost's size
-    fccqp_scale_rows(P, <int>k, <int>n, D, D, P_s, norms, NULL)
+    fccqp_rescale_rows(P, <int>k, <int>n, D, D, P_s, norms, NULL)
     _scale_diagonal_rows(P, n, k, D, P_s, norms)
     for i in range(n):
         mean_col += norms[i]
         q_s[i] = q[i] * D[i]
         q_norm = max(q_norm, fabs(q_s[i]))
     cost = c[0] = cost_scale(mean_col / n, q_norm)
-    for i in range(k * n):
-        P_s[i] *= cost
+    fccqp_rescale_multiply(P_s, k * n, cost)
     for i in range(k, n):
         P_s[i * n + i] *= cost
-    for i in range(n):
-        q_s[i] *= cost
+    fccqp_rescale_multiply(q_s, n, cost)
     if m:   # E A D, its rows' norms and its columns' beside D P D's
-        fccqp_scale_rows(A, <int>m, <int>n, E, D, A_s, norms + n, norms)
+        fccqp_rescale_rows(A, <int>m, <int>n, E, D, A_s, norms + n, norms)
     for i in range(m):
         b_s[i] = b[i] * E[i]
     return within_drift(norms, reference, n + m)
@@ -295,7 +294,7 @@ cdef inline void _scale_diagonal_rows(const double* P, Py_ssize_t n, Py_ssize_t 
                                       const double* D, double* P_s,
                                       double* norms) noexcept nogil:
     """Rows ``first:n`` of ``D P D`` and their norms, where ``P`` holds only its diagonal
-    (``Matrix.diagonal_from``): the entry as ``fccqp_scale_rows`` forms it, ``(P_ii D_i)
+    (``Matrix.diagonal_from``): the entry as ``fccqp_rescale_rows`` forms it, ``(P_ii D_i)
     D_i``, and zeros beside it (``+0.0``: the sign of a zero of ``P`` is not kept)."""
     cdef Py_ssize_t i, j
     cdef double* row

@@ -21,8 +21,8 @@ from fccqp.tuning cimport INFINITE_BOUND, MAX_ENTRY, SYMMETRY_TOLERANCE
 
 cdef extern from "fccqp_kernels.h" nogil:
     int FCCQP_NOT_FINITE, FCCQP_CHANGED
-    int fccqp_symmetric_copy(const double* P, int n, double* out, double* sizes)
-    int fccqp_checked_copy(const double* v, long k, double limit, double* out)
+    int fccqp_scan_symmetric(const double* P, int n, double* out, double* sizes)
+    int fccqp_scan_copy(const double* v, long k, double limit, double* out)
 
 
 cdef inline Finding _found(int code, int argument, Py_ssize_t index, double value) noexcept nogil:
@@ -64,22 +64,22 @@ cdef Finding scan_and_copy(const double* P, const double* q, const double* A, co
     """Check and copy; ``same_matrices`` becomes False as soon as ``P`` or ``A`` differs
     from what ``P_out``, ``A_out`` held.
 
-    ``P`` goes through ``fccqp_symmetric_copy`` (four pairs ``(i, j), (j, i)`` of the
-    upper triangle a step) and ``A`` through ``fccqp_checked_copy`` (fccqp_kernels.h),
-    passes that do not branch on the data; what went wrong is looked up only when
-    something did.
+    ``P`` goes through ``fccqp_scan_symmetric`` (four pairs ``(i, j), (j, i)`` of the
+    upper triangle a step) and ``A`` through ``fccqp_scan_copy`` (fccqp_kernels.h: one
+    32-byte vector a step where the CPU has AVX2, two halves else), passes that do not
+    branch on the data; what went wrong is looked up only when something did.
     """
     cdef Py_ssize_t i
     cdef double sizes[2]   # the largest entry and asymmetry of P
     cdef bint same = same_matrices[0], differs
-    cdef int found = fccqp_symmetric_copy(P, <int>n, P_out, sizes)
+    cdef int found = fccqp_scan_symmetric(P, <int>n, P_out, sizes)
     cdef Finding f
     if found & FCCQP_NOT_FINITE or sizes[0] > MAX_ENTRY:
         return _first_bad_entry(P, n)
     if sizes[1] > SYMMETRY_TOLERANCE * sizes[0]:
         return _found(P_ASYMMETRIC, -1, -1, sizes[1])
     differs = found & FCCQP_CHANGED
-    found = fccqp_checked_copy(A, m * n, MAX_ENTRY, A_out)
+    found = fccqp_scan_copy(A, m * n, MAX_ENTRY, A_out)
     differs |= found & FCCQP_CHANGED
     if found & FCCQP_NOT_FINITE:   # NaN, infinite or too large
         for i in range(m * n):
