@@ -388,6 +388,120 @@ static void fccqp_matvec_t(const double *restrict M, int ld, const double *restr
     }
 }
 
+/* fccqp_matvec: out = M x for a row-major rows x cols M with leading dimension ld, where
+ * the CPU has AVX2 and FMA (returns 1; else 0 and does nothing: the caller uses dgemv).
+ * Four rows a pass sharing the loads of x, each row's dot product in four lanes of one
+ * 32-byte vector (fused multiply-adds), the lanes summed (0 + 1) + (2 + 3), the last
+ * cols % 4 entries added in order. A row's sum depends on that row and x only. Not a
+ * target_clones pair: the same source with two 16-byte halves ran slower than dgemv in
+ * both copies (go2's 30 x 54 A: 168 and 188 ns against 164), and 32-byte vectors in the
+ * baseline copy 3x slower (484 ns). Natively (Zen 4, one thread, loop of calls,
+ * /tmp/fusedcheck/bench.c) against scipy's dgemv: go2's A 30 x 54 125 against 164 ns,
+ * P's block 20 x 54 83 against 121, the reduced table's 24 x 24 48 against 75; talos'
+ * 68 x 124 578 against 618, 88 x 124 759 against 798. The instructions per call are
+ * about dgemv's kernel's; what goes is the interface and driver (about 1.5k a call). */
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+typedef double fccqp_wide4 __attribute__((vector_size(32)));
+#define FCCQP_WIDE_LOAD(v, p) memcpy(&(v), (p), sizeof(v))
+#define FCCQP_WIDE_SUM(v) (((v)[0] + (v)[1]) + ((v)[2] + (v)[3]))
+
+__attribute__((target("avx2,fma")))
+static void fccqp_matvec_wide(const double *restrict M, int ld, const double *restrict x,
+                              double *restrict out, int rows, int cols)
+{
+    int c4 = cols & ~3;
+    int i = 0;
+    fccqp_wide4 xv, m0, m1, m2, m3;
+    for (; i + 4 <= rows; i += 4) {
+        const double *r0 = M + (long)i * ld, *r1 = r0 + ld, *r2 = r1 + ld, *r3 = r2 + ld;
+        fccqp_wide4 a0 = {0.0}, a1 = {0.0}, a2 = {0.0}, a3 = {0.0};
+        for (int j = 0; j < c4; j += 4) {
+            FCCQP_WIDE_LOAD(xv, x + j);
+            FCCQP_WIDE_LOAD(m0, r0 + j);
+            FCCQP_WIDE_LOAD(m1, r1 + j);
+            FCCQP_WIDE_LOAD(m2, r2 + j);
+            FCCQP_WIDE_LOAD(m3, r3 + j);
+            a0 += m0 * xv;
+            a1 += m1 * xv;
+            a2 += m2 * xv;
+            a3 += m3 * xv;
+        }
+        double s0 = FCCQP_WIDE_SUM(a0), s1 = FCCQP_WIDE_SUM(a1);
+        double s2 = FCCQP_WIDE_SUM(a2), s3 = FCCQP_WIDE_SUM(a3);
+        for (int j = c4; j < cols; j++) {
+            s0 += r0[j] * x[j];
+            s1 += r1[j] * x[j];
+            s2 += r2[j] * x[j];
+            s3 += r3[j] * x[j];
+        }
+        out[i] = s0;
+        out[i + 1] = s1;
+        out[i + 2] = s2;
+        out[i + 3] = s3;
+    }
+    for (; i < rows; i++) {
+        const double *r0 = M + (long)i * ld;
+        fccqp_wide4 a0 = {0.0};
+        for (int j = 0; j < c4; j += 4) {
+            FCCQP_WIDE_LOAD(xv, x + j);
+            FCCQP_WIDE_LOAD(m0, r0 + j);
+            a0 += m0 * xv;
+        }
+        double s0 = FCCQP_WIDE_SUM(a0);
+        for (int j = c4; j < cols; j++)
+            s0 += r0[j] * x[j];
+        out[i] = s0;
+    }
+}
+
+static inline int fccqp_matvec(const double *M, int ld, const double *x, double *out,
+                               int rows, int cols)
+{
+    if (!(__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")))
+        return 0;
+    fccqp_matvec_wide(M, ld, x, out, rows, cols);
+    return 1;
+}
+#else
+static inline int fccqp_matvec(const double *M, int ld, const double *x, double *out,
+                               int rows, int cols)
+{
+    (void)M, (void)ld, (void)x, (void)out, (void)rows, (void)cols;
+    return 0;
+}
+#endif
+
+/* fccqp_colmatvec: out = M x + beta out for a column-major rows x cols M with leading
+ * dimension ld (beta 0: out is not read), four scaled columns added per pass as
+ * fccqp_matvec_t adds rows. Against dgemv ("N"), natively (bench.c above): the reduced
+ * table's 84 x 24 115 against 242 ns (baseline copy 203), 24 x 24 46 against 95, talos'
+ * 192 x 56 736 against 949. */
+FCCQP_CLONES
+static void fccqp_colmatvec(const double *restrict M, int ld, const double *restrict x,
+                            double *restrict out, int rows, int cols, double beta)
+{
+    if (beta == 0.0) {
+        for (int i = 0; i < rows; i++)
+            out[i] = 0.0;
+    } else if (beta != 1.0) {
+        for (int i = 0; i < rows; i++)
+            out[i] *= beta;
+    }
+    int j = 0;
+    for (; j + 4 <= cols; j += 4) {
+        const double *c0 = M + (long)j * ld, *c1 = c0 + ld, *c2 = c1 + ld, *c3 = c2 + ld;
+        double x0 = x[j], x1 = x[j + 1], x2 = x[j + 2], x3 = x[j + 3];
+        for (int i = 0; i < rows; i++)
+            out[i] += (x0 * c0[i] + x1 * c1[i]) + (x2 * c2[i] + x3 * c3[i]);
+    }
+    for (; j < cols; j++) {
+        const double *c0 = M + (long)j * ld;
+        double x0 = x[j];
+        for (int i = 0; i < rows; i++)
+            out[i] += x0 * c0[i];
+    }
+}
+
 /* For each row j < rows of the column-major Y (leading dimension ld) and each pair
  * a >= b of its nonzero columns index[j m:j m + count[j]] (increasing): T[a + b m] =
  * fma(Y[j, a], Y[j, b], T[a + b m]); values is scratch of m doubles. */
