@@ -401,9 +401,20 @@ static void fccqp_matvec_t(const double *restrict M, int ld, const double *restr
  * 68 x 124 578 against 618, 88 x 124 759 against 798. The instructions per call are
  * about dgemv's kernel's; what goes is the interface and driver (about 1.5k a call). */
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-typedef double fccqp_wide4 __attribute__((vector_size(32)));
-#define FCCQP_WIDE_LOAD(v, p) memcpy(&(v), (p), sizeof(v))
-#define FCCQP_WIDE_SUM(v) (((v)[0] + (v)[1]) + ((v)[2] + (v)[3]))
+#include <immintrin.h>
+
+/* the four lanes' sum (0 + 1) + (2 + 3), then fma(row[j], x[j], sum) over the columns
+ * from c4 on: intrinsics and fma() so that every row, four at a time or alone, rounds
+ * the same (GCC vectorized the products of a plain tail in one place only) */
+#define FCCQP_WIDE_ROW(acc, row, x, c4, cols, result)                                   \
+    do {                                                                                \
+        __m128d lo_ = _mm256_castpd256_pd128(acc), hi_ = _mm256_extractf128_pd(acc, 1); \
+        double s_ = (_mm_cvtsd_f64(lo_) + _mm_cvtsd_f64(_mm_unpackhi_pd(lo_, lo_)))     \
+                    + (_mm_cvtsd_f64(hi_) + _mm_cvtsd_f64(_mm_unpackhi_pd(hi_, hi_)));  \
+        for (int j_ = (c4); j_ < (cols); j_++)                                          \
+            s_ = fma((row)[j_], (x)[j_], s_);                                           \
+        (result) = s_;                                                                  \
+    } while (0)
 
 __attribute__((target("avx2,fma")))
 static void fccqp_matvec_wide(const double *restrict M, int ld, const double *restrict x,
@@ -411,46 +422,27 @@ static void fccqp_matvec_wide(const double *restrict M, int ld, const double *re
 {
     int c4 = cols & ~3;
     int i = 0;
-    fccqp_wide4 xv, m0, m1, m2, m3;
     for (; i + 4 <= rows; i += 4) {
         const double *r0 = M + (long)i * ld, *r1 = r0 + ld, *r2 = r1 + ld, *r3 = r2 + ld;
-        fccqp_wide4 a0 = {0.0}, a1 = {0.0}, a2 = {0.0}, a3 = {0.0};
+        __m256d a0 = _mm256_setzero_pd(), a1 = a0, a2 = a0, a3 = a0;
         for (int j = 0; j < c4; j += 4) {
-            FCCQP_WIDE_LOAD(xv, x + j);
-            FCCQP_WIDE_LOAD(m0, r0 + j);
-            FCCQP_WIDE_LOAD(m1, r1 + j);
-            FCCQP_WIDE_LOAD(m2, r2 + j);
-            FCCQP_WIDE_LOAD(m3, r3 + j);
-            a0 += m0 * xv;
-            a1 += m1 * xv;
-            a2 += m2 * xv;
-            a3 += m3 * xv;
+            __m256d xv = _mm256_loadu_pd(x + j);
+            a0 = _mm256_fmadd_pd(_mm256_loadu_pd(r0 + j), xv, a0);
+            a1 = _mm256_fmadd_pd(_mm256_loadu_pd(r1 + j), xv, a1);
+            a2 = _mm256_fmadd_pd(_mm256_loadu_pd(r2 + j), xv, a2);
+            a3 = _mm256_fmadd_pd(_mm256_loadu_pd(r3 + j), xv, a3);
         }
-        double s0 = FCCQP_WIDE_SUM(a0), s1 = FCCQP_WIDE_SUM(a1);
-        double s2 = FCCQP_WIDE_SUM(a2), s3 = FCCQP_WIDE_SUM(a3);
-        for (int j = c4; j < cols; j++) {
-            s0 += r0[j] * x[j];
-            s1 += r1[j] * x[j];
-            s2 += r2[j] * x[j];
-            s3 += r3[j] * x[j];
-        }
-        out[i] = s0;
-        out[i + 1] = s1;
-        out[i + 2] = s2;
-        out[i + 3] = s3;
+        FCCQP_WIDE_ROW(a0, r0, x, c4, cols, out[i]);
+        FCCQP_WIDE_ROW(a1, r1, x, c4, cols, out[i + 1]);
+        FCCQP_WIDE_ROW(a2, r2, x, c4, cols, out[i + 2]);
+        FCCQP_WIDE_ROW(a3, r3, x, c4, cols, out[i + 3]);
     }
     for (; i < rows; i++) {
         const double *r0 = M + (long)i * ld;
-        fccqp_wide4 a0 = {0.0};
-        for (int j = 0; j < c4; j += 4) {
-            FCCQP_WIDE_LOAD(xv, x + j);
-            FCCQP_WIDE_LOAD(m0, r0 + j);
-            a0 += m0 * xv;
-        }
-        double s0 = FCCQP_WIDE_SUM(a0);
-        for (int j = c4; j < cols; j++)
-            s0 += r0[j] * x[j];
-        out[i] = s0;
+        __m256d a0 = _mm256_setzero_pd();
+        for (int j = 0; j < c4; j += 4)
+            a0 = _mm256_fmadd_pd(_mm256_loadu_pd(r0 + j), _mm256_loadu_pd(x + j), a0);
+        FCCQP_WIDE_ROW(a0, r0, x, c4, cols, out[i]);
     }
 }
 
