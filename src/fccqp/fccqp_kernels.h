@@ -21,8 +21,9 @@
  * (out aliases neither input, as BLAS requires): four scaled rows of M added to out per
  * pass, a loop over contiguous entries that vectorizes without reassociating a sum.
  * 2.1k instructions a call against dgemv's 2.8k on go2's A' y and P y (callgrind); M x
- * stays with dgemv, whose dot-product kernel took 3.2k against 3.7k for a loop in four
- * explicit lanes. fccqp_cholesky also factors polish_schur's d x d cone blocks.
+ * goes to fccqp_matvec below (dgemv's dot-product kernel took 3.2k against 3.7k for a
+ * loop in four explicit lanes, but its interface and driver cost more than that).
+ * fccqp_cholesky also factors polish_schur's d x d cone blocks.
  *
  * fccqp_sparse_rank_update: T += Y_R' Y_R (lower triangle) over a few sparse rows of
  * Y, a fused multiply-add per nonzero pair, row after row (schur.pyx says why in that
