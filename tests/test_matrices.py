@@ -110,3 +110,30 @@ def test_product_over_a_diagonal_tail_has_the_whole_products_bits(n, block, seed
     x[rng.random(n) < 0.1] = -0.0
     whole = apply("product", P, x)
     assert apply("product", P, x, diagonal_tail=True).tobytes() == whole.tobytes()
+
+
+def _wide_vectors():
+    """Whether this x86-64 CPU has AVX2 and FMA (``fccqp_matvec`` runs; else ``dgemv``)."""
+    try:
+        with open("/proc/cpuinfo") as info:
+            flags = next((line.split() for line in info if line.startswith("flags")), [])
+    except OSError:
+        return False
+    return "avx2" in flags and "fma" in flags
+
+
+@pytest.mark.skipif(not _wide_vectors(), reason="the dense M x is dgemv's without AVX2 + FMA")
+@pytest.mark.parametrize(("rows", "cols"), [(30, 54), (20, 54), (24, 24), (68, 124), (7, 13),
+                                            (5, 3), (3, 1)])
+@pytest.mark.parametrize("seed", range(3))
+def test_each_row_of_the_dense_product_is_summed_on_its_own(rows, cols, seed):
+    """A row of ``M x`` has the same bits as that row alone times ``x``, wherever it sits
+    among the rows (four at a time or in the remainder): dgemv's kernels sum rows in
+    fours and the remainder apart, in other orders."""
+    rng = np.random.default_rng(seed)
+    M = rng.standard_normal((rows, cols)) * 10.0 ** rng.integers(-4, 4, size=(rows, cols))
+    x = rng.standard_normal(cols)
+    whole = apply("product", M, x)
+    alone = np.array([apply("product", M[i:i + 1], x)[0] for i in range(rows)])
+    assert whole.tobytes() == alone.tobytes()
+    assert np.all(np.abs(whole - M @ x) <= 1e-13 * (np.abs(M) @ np.abs(x)))

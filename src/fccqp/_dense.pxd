@@ -1,14 +1,18 @@
 # cython: language_level=3
 """Vector loops and matrix-vector products for the small dense matrices of a WBC QP.
 
-``M x`` goes to BLAS ``dgemv``: a dot product per row is a chain of dependent
-additions that the compiler may not reorder (no fast-math), and plain loops measured
-slower than ``dgemv`` on these sizes (go2 realtime 329 us with loops against the numba
-kernels' 290 us, which called BLAS); ``dgemv`` never goes multithreaded below 460,800
-entries (OpenBLAS's threshold). ``M' y`` adds scaled rows, which vectorizes as written:
-``fccqp_matvec_t`` (fccqp_kernels.h) beats ``dgemv`` there (2.1k against 2.8k
-instructions a call on go2). The vector loops stay loops: a BLAS call costs more than
-the arithmetic at these lengths.
+``M x`` goes to ``fccqp_matvec`` (fccqp_kernels.h) where the CPU has AVX2 and FMA: a dot
+product per row is a chain of dependent additions that the compiler may not reorder (no
+fast-math), so the kernel keeps four rows in four explicit lanes each. Through scipy's
+``dgemv`` each call paid OpenBLAS' interface and driver, about 1.5k instructions a call
+beside the kernel's (ipc2, notes/performance-history.md), and the kernel took 125 ns
+against ``dgemv``'s 164 on go2's ``A`` (natively, a loop of calls). Without AVX2 ``dgemv``
+stays: the kernel in 16-byte halves was slower than it. ``M' y`` and the column-major
+``M x`` add scaled rows (columns), which vectorize as written: ``fccqp_matvec_t`` and
+``fccqp_colmatvec`` in both copies (2.1k against 2.8k instructions a call for ``M' y`` on
+go2; 115 against 242 ns for the reduced table's ``84 x 24`` block). ``dgemv`` never goes
+multithreaded below 460,800 entries (OpenBLAS's threshold). The vector loops stay loops:
+a BLAS call costs more than the arithmetic at these lengths.
 """
 
 from libc.math cimport fabs
@@ -47,11 +51,16 @@ cdef inline void fill(double* dst, double value, Py_ssize_t k) noexcept nogil:
 cdef extern from "fccqp_kernels.h" nogil:
     void fccqp_matvec_t(const double* M, int ld, const double* y, double* out, int rows,
                         int cols)
+    int fccqp_matvec(const double* M, int ld, const double* x, double* out, int rows,
+                     int cols)
+    void fccqp_colmatvec(const double* M, int ld, const double* x, double* out, int rows,
+                         int cols, double beta)
 
 
 cdef inline void matvec(const double* M, const double* x, double* out,
                         Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
-    """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``dgemv``)."""
+    """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``fccqp_matvec``, else
+    ``dgemv``)."""
     cdef int r = <int>rows, c = <int>cols, one = 1
     cdef double alpha = 1.0, beta = 0.0
     cdef char trans = b"T"
@@ -60,7 +69,8 @@ cdef inline void matvec(const double* M, const double* x, double* out,
     if cols == 0:
         fill(out, 0.0, rows)
         return
-    dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>x, &one, &beta, out, &one)
+    if not fccqp_matvec(M, c, x, out, r, c):
+        dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>x, &one, &beta, out, &one)
 
 
 cdef inline void matvec_t(const double* M, const double* y, double* out,
@@ -72,14 +82,5 @@ cdef inline void matvec_t(const double* M, const double* y, double* out,
 cdef inline void colmatvec(const double* M, int ld, const double* x, double* out,
                            Py_ssize_t rows, Py_ssize_t cols, double beta) noexcept nogil:
     """``out = M x + beta out`` for a column-major ``rows x cols`` block ``M`` with
-    leading dimension ``ld`` (``dgemv``)."""
-    cdef int r = <int>rows, c = <int>cols, one = 1
-    cdef double alpha = 1.0
-    cdef char trans = b"N"
-    if rows == 0:
-        return
-    if cols == 0:
-        if beta == 0.0:
-            fill(out, 0.0, rows)
-        return
-    dgemv(&trans, &r, &c, &alpha, <double*>M, &ld, <double*>x, &one, &beta, out, &one)
+    leading dimension ``ld`` (``fccqp_colmatvec``; beta 0: ``out`` is not read)."""
+    fccqp_colmatvec(M, ld, x, out, <int>rows, <int>cols, beta)

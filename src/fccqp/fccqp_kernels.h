@@ -21,8 +21,10 @@
  * (out aliases neither input, as BLAS requires): four scaled rows of M added to out per
  * pass, a loop over contiguous entries that vectorizes without reassociating a sum.
  * 2.1k instructions a call against dgemv's 2.8k on go2's A' y and P y (callgrind); M x
- * stays with dgemv, whose dot-product kernel took 3.2k against 3.7k for a loop in four
- * explicit lanes. fccqp_cholesky also factors polish_schur's d x d cone blocks.
+ * goes to fccqp_matvec below (dgemv's dot-product kernel took 3.2k against 3.7k for a
+ * loop in four explicit lanes, but its interface and driver cost more than that).
+ * fccqp_cholesky also factors polish_schur's d x d cone blocks and every factor of
+ * _blas.cholesky (the Schur backend's, the reduced table's, the Gram matrices').
  *
  * fccqp_sparse_rank_update: T += Y_R' Y_R (lower triangle) over a few sparse rows of
  * Y, a fused multiply-add per nonzero pair, row after row (schur.pyx says why in that
@@ -395,6 +397,112 @@ static void fccqp_matvec_t(const double *restrict M, int ld, const double *restr
         double y0 = y[i];
         for (int j = 0; j < cols; j++)
             out[j] += y0 * r0[j];
+    }
+}
+
+/* fccqp_matvec: out = M x for a row-major rows x cols M with leading dimension ld, where
+ * the CPU has AVX2 and FMA (returns 1; else 0 and does nothing: the caller uses dgemv).
+ * Four rows a pass sharing the loads of x, each row's dot product in four lanes of one
+ * 32-byte vector (fused multiply-adds), the lanes summed (0 + 1) + (2 + 3), the last
+ * cols % 4 entries added in order. A row's sum depends on that row and x only. Not a
+ * target_clones pair: the same source with two 16-byte halves ran slower than dgemv in
+ * both copies (go2's 30 x 54 A: 168 and 188 ns against 164), and 32-byte vectors in the
+ * baseline copy 3x slower (484 ns). Natively (Zen 4, one thread, loop of calls,
+ * /tmp/fusedcheck/bench.c) against scipy's dgemv: go2's A 30 x 54 125 against 164 ns,
+ * P's block 20 x 54 83 against 121, the reduced table's 24 x 24 48 against 75; talos'
+ * 68 x 124 578 against 618, 88 x 124 759 against 798. The instructions per call are
+ * about dgemv's kernel's; what goes is the interface and driver (about 1.5k a call). */
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+
+/* the four lanes' sum (0 + 1) + (2 + 3), then fma(row[j], x[j], sum) over the columns
+ * from c4 on: intrinsics and fma() so that every row, four at a time or alone, rounds
+ * the same (GCC vectorized the products of a plain tail in one place only) */
+#define FCCQP_WIDE_ROW(acc, row, x, c4, cols, result)                                   \
+    do {                                                                                \
+        __m128d lo_ = _mm256_castpd256_pd128(acc), hi_ = _mm256_extractf128_pd(acc, 1); \
+        double s_ = (_mm_cvtsd_f64(lo_) + _mm_cvtsd_f64(_mm_unpackhi_pd(lo_, lo_)))     \
+                    + (_mm_cvtsd_f64(hi_) + _mm_cvtsd_f64(_mm_unpackhi_pd(hi_, hi_)));  \
+        for (int j_ = (c4); j_ < (cols); j_++)                                          \
+            s_ = fma((row)[j_], (x)[j_], s_);                                           \
+        (result) = s_;                                                                  \
+    } while (0)
+
+__attribute__((target("avx2,fma")))
+static void fccqp_matvec_wide(const double *restrict M, int ld, const double *restrict x,
+                              double *restrict out, int rows, int cols)
+{
+    int c4 = cols & ~3;
+    int i = 0;
+    for (; i + 4 <= rows; i += 4) {
+        const double *r0 = M + (long)i * ld, *r1 = r0 + ld, *r2 = r1 + ld, *r3 = r2 + ld;
+        __m256d a0 = _mm256_setzero_pd(), a1 = a0, a2 = a0, a3 = a0;
+        for (int j = 0; j < c4; j += 4) {
+            __m256d xv = _mm256_loadu_pd(x + j);
+            a0 = _mm256_fmadd_pd(_mm256_loadu_pd(r0 + j), xv, a0);
+            a1 = _mm256_fmadd_pd(_mm256_loadu_pd(r1 + j), xv, a1);
+            a2 = _mm256_fmadd_pd(_mm256_loadu_pd(r2 + j), xv, a2);
+            a3 = _mm256_fmadd_pd(_mm256_loadu_pd(r3 + j), xv, a3);
+        }
+        FCCQP_WIDE_ROW(a0, r0, x, c4, cols, out[i]);
+        FCCQP_WIDE_ROW(a1, r1, x, c4, cols, out[i + 1]);
+        FCCQP_WIDE_ROW(a2, r2, x, c4, cols, out[i + 2]);
+        FCCQP_WIDE_ROW(a3, r3, x, c4, cols, out[i + 3]);
+    }
+    for (; i < rows; i++) {
+        const double *r0 = M + (long)i * ld;
+        __m256d a0 = _mm256_setzero_pd();
+        for (int j = 0; j < c4; j += 4)
+            a0 = _mm256_fmadd_pd(_mm256_loadu_pd(r0 + j), _mm256_loadu_pd(x + j), a0);
+        FCCQP_WIDE_ROW(a0, r0, x, c4, cols, out[i]);
+    }
+}
+
+static inline int fccqp_matvec(const double *M, int ld, const double *x, double *out,
+                               int rows, int cols)
+{
+    if (!(__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")))
+        return 0;
+    fccqp_matvec_wide(M, ld, x, out, rows, cols);
+    return 1;
+}
+#else
+static inline int fccqp_matvec(const double *M, int ld, const double *x, double *out,
+                               int rows, int cols)
+{
+    (void)M, (void)ld, (void)x, (void)out, (void)rows, (void)cols;
+    return 0;
+}
+#endif
+
+/* fccqp_colmatvec: out = M x + beta out for a column-major rows x cols M with leading
+ * dimension ld (beta 0: out is not read), four scaled columns added per pass as
+ * fccqp_matvec_t adds rows. Against dgemv ("N"), natively (bench.c above): the reduced
+ * table's 84 x 24 115 against 242 ns (baseline copy 203), 24 x 24 46 against 95, talos'
+ * 192 x 56 736 against 949. */
+FCCQP_CLONES
+static void fccqp_colmatvec(const double *restrict M, int ld, const double *restrict x,
+                            double *restrict out, int rows, int cols, double beta)
+{
+    if (beta == 0.0) {
+        for (int i = 0; i < rows; i++)
+            out[i] = 0.0;
+    } else if (beta != 1.0) {
+        for (int i = 0; i < rows; i++)
+            out[i] *= beta;
+    }
+    int j = 0;
+    for (; j + 4 <= cols; j += 4) {
+        const double *c0 = M + (long)j * ld, *c1 = c0 + ld, *c2 = c1 + ld, *c3 = c2 + ld;
+        double x0 = x[j], x1 = x[j + 1], x2 = x[j + 2], x3 = x[j + 3];
+        for (int i = 0; i < rows; i++)
+            out[i] += (x0 * c0[i] + x1 * c1[i]) + (x2 * c2[i] + x3 * c3[i]);
+    }
+    for (; j < cols; j++) {
+        const double *c0 = M + (long)j * ld;
+        double x0 = x[j];
+        for (int i = 0; i < rows; i++)
+            out[i] += x0 * c0[i];
     }
 }
 

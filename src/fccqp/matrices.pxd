@@ -17,8 +17,9 @@ Two storages (``Matrix.kind``):
 - ``DENSE``: ``values`` row-major, ``M_ij = values[i * cols + j]`` (``P`` is symmetric,
   so its order does not matter). Each operation keeps the kernel and the summation
   order that its caller had before the contract, so that answers stay bitwise
-  identical: ``M x`` by ``dgemv`` (a symmetric matrix's diagonal tail apart, in the same
-  bits: :func:`mark_diagonal_tail`), ``M' y`` and the row spans by ``fccqp_kernels.h``,
+  identical: ``M x`` by ``_dense.matvec`` (a symmetric matrix's diagonal tail apart, in
+  the same bits: :func:`mark_diagonal_tail`), ``M' y`` and the row spans by
+  ``fccqp_kernels.h``,
   the certificates' row sums as plain loops in column order.
 - ``CSC``: compressed columns, the entries of column ``j`` at ``colptr[j] <= k <
   colptr[j + 1]``, ``M_{rowind[k], j} = values[k]``, rows ascending in each column.
@@ -109,9 +110,10 @@ cdef inline void mark_diagonal_tail(Matrix* M) noexcept nogil:
     Whole-body control's ``P`` is a dense block on the accelerations and a diagonal on
     the torques and forces (go2: 18 of 54 rows, talos_reduced 38 of 124): :func:`product`
     then sweeps the block's rows only, a third of the matrix, and multiplies the
-    diagonal. ``dgemv`` forms its output rows in fours, so that a multiple of 4 leaves
-    each leading row summed as the whole product sums it, bit for bit (checked on
-    OpenBLAS' Haswell and SkylakeX kernels). The rows are read from the last up, each
+    diagonal. ``fccqp_matvec`` sums each row on its own and ``dgemv`` forms its output
+    rows in fours, so that a multiple of 4 leaves each leading row summed as the whole
+    product sums it, bit for bit (``dgemv`` checked on OpenBLAS' Haswell and SkylakeX
+    kernels). The rows are read from the last up, each
     below its diagonal (``M`` is symmetric), until one has an entry off it."""
     cdef Py_ssize_t n = M.rows, i = n, j
     cdef bint coupled = False
@@ -124,14 +126,14 @@ cdef inline void mark_diagonal_tail(Matrix* M) noexcept nogil:
 
 
 cdef inline void product(const Matrix* M, const double* x, double* out) noexcept nogil:
-    """``out = M x`` (``dgemv`` over the rows before ``M.diagonal_from``, a product of
-    the diagonal after them; CSC: a column sweep)."""
+    """``out = M x`` (``_dense.matvec`` over the rows before ``M.diagonal_from``, a
+    product of the diagonal after them; CSC: a column sweep)."""
     cdef Py_ssize_t i, j, k
     cdef double xj
     if M.kind == DENSE:
         matvec(M.values, x, out, M.diagonal_from, M.cols)
         for i in range(M.diagonal_from, M.rows):
-            out[i] = 0.0 + M.values[i * M.cols + i] * x[i]   # dgemv's +0 for a zero sum
+            out[i] = 0.0 + M.values[i * M.cols + i] * x[i]   # matvec's +0 for a zero sum
         return
     for i in range(M.rows):
         out[i] = 0.0
