@@ -46,8 +46,8 @@ from fccqp.termination cimport Residuals, converged, distance, nearly_converged
 from fccqp.tuning cimport (AUXILIARY_TIME, CLEANING_START, CONVERGING, EARLY_POLISH_GATE,
                            EARLY_POLISH_TRIES, EQUALITY_MISSED, GATED_CHECK_WAIT, GUESS_LEAD,
                            LOG_INTERVAL, POLISH_GATE, POLISH_RETRIES, RESERVE_PASSES,
-                           RESTART_MIN_ITER, SETTLE_ITERATIONS, SETTLE_TRIES, STALL_FACTOR,
-                           STALLED_GUESS_PASSES, STALLS, TIMED_EARLY_POLISH)
+                           RESTART_MIN_ITER, RHO_TIME_SHARE, SETTLE_ITERATIONS, SETTLE_TRIES,
+                           STALL_FACTOR, STALLED_GUESS_PASSES, STALLS, TIMED_EARLY_POLISH)
 from fccqp.verdict cimport (check, classify, inconsistent, missed, row_missed_by_data,
                             unbounded)
 
@@ -92,6 +92,7 @@ cdef struct Loop:
 
 cdef long _cut_iterations = LONG_MAX
 cdef long _cut_polish_charge = 0
+cdef double _rho_change_charge = 0.0
 
 
 def cut_after(long iterations, long failed_polish_charge=0):
@@ -110,6 +111,15 @@ def cut_after(long iterations, long failed_polish_charge=0):
         _cut_iterations, _cut_polish_charge = LONG_MAX, 0
     else:
         _cut_iterations, _cut_polish_charge = iterations, max(failed_polish_charge, 0)
+
+
+def charge_rho_changes(double seconds):
+    """Test hook: from now on, in this process, every change of rho counts as taking
+    ``seconds`` longer than it did (``Clock.rho_time``), as one that a preemption or a
+    first touch of its memory interrupted does; ``charge_rho_changes(0)`` removes the
+    charge. The change itself and the answers are those of an uncharged run."""
+    global _rho_change_charge
+    _rho_change_charge = max(seconds, 0.0)
 
 
 cdef void iterate(Engine* e, Run* run, bint cold, double start_time) noexcept nogil:
@@ -569,7 +579,7 @@ cdef inline bint _adapt_rho(Engine* e, Loop* L, Run* run) noexcept nogil:
         if rho != run.rho:
             began = fccqp_now()
             code = change_rho(e, run, rho, L.iteration, L.reduced)
-            e.clock.rho_time = fccqp_now() - began
+            e.clock.rho_time = fccqp_now() - began + _rho_change_charge
             if code != FACTORED:
                 run.status = NOT_CONVEX_QP if code == NOT_CONVEX else NUMERICAL_ERROR
                 return False
@@ -582,9 +592,16 @@ cdef inline bint _adapt_rho(Engine* e, Loop* L, Run* run) noexcept nogil:
 cdef inline bint _rho_change_fits(Engine* e, const Loop* L) noexcept nogil:
     """Whether a change of rho, at what the last one took (its factorization), ends
     before a timed run's iterations stop: one that would not leaves no iteration at the
-    new rho, and ran talos' last iteration 0.1 ms past their deadline."""
+    new rho, and ran talos' last iteration 0.1 ms past their deadline.
+
+    The last change counts at most ``RHO_TIME_SHARE`` of the iterations' time: only a
+    change measures ``Clock.rho_time`` again, and one interrupted by a preemption or
+    the first touch of a new workspace's memory (talos: 4-16 ms against 0.11-0.17)
+    would bar every later change of the workspace, every solve left at the rho it
+    started from (notes/performance-history.md, "talosedge")."""
     return (not L.timed
-            or fccqp_now() - L.start_time + e.clock.rho_time < L.deadline)
+            or fccqp_now() - L.start_time + min(e.clock.rho_time, RHO_TIME_SHARE * L.deadline)
+            < L.deadline)
 
 
 cdef inline bint _polish_fits(Engine* e, const Loop* L) noexcept nogil:
