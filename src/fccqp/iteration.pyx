@@ -492,7 +492,7 @@ cdef inline void _polish_attempts(Engine* e, Loop* L, Run* run) noexcept nogil:
             L.polished_at = L.iteration
             run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, True)
     if (L.status == RUNNING and o.polish and not L.last and _settled(L)
-            and _near(e, EARLY_POLISH_GATE)):
+            and nearly_converged(&e.res, o.eps_abs, o.eps_rel, EARLY_POLISH_GATE)):
         L.settle_polished = True
         L.settle_tries += 1
         L.polished_at = L.iteration
@@ -506,14 +506,15 @@ cdef inline void _polish_attempts(Engine* e, Loop* L, Run* run) noexcept nogil:
 
 
 cdef inline bint _near(Engine* e, double factor) noexcept nogil:
-    """Whether a timed run's iterate is worth a polish: its four tolerance tests pass at
-    ``factor`` times the tolerances (:func:`fccqp.termination.distance`). The guards
-    that :func:`fccqp.termination.nearly_converged` adds whatever the factor (``x_S``
-    within 1 % of its size from C in the scaled units) keep a status from promising
-    the tolerances; a polished point is judged on its own (:mod:`fccqp.acceptance`),
-    and the polish solves the active set exactly. On talos an entry boxed to +-1
-    held at 1.07 kept every polish of a run back for 150 iterations (every 5th, QP 75:
-    the four tests passed at iteration 280, the guard at 427)."""
+    """Whether the iterate of a run that the clock stopped is worth its final polish:
+    its four tolerance tests pass at ``factor`` times the tolerances
+    (:func:`fccqp.termination.distance`). The guards that
+    :func:`fccqp.termination.nearly_converged` adds whatever the factor (``x_S`` within
+    1 % of its size from C in the scaled units) keep a status from promising the
+    tolerances; a polished point is judged on its own (:mod:`fccqp.acceptance`), and
+    the polish solves the active set exactly. On talos an entry boxed to +-1 held at
+    1.07 failed the guard for 150 iterations after the four tests passed (every 5th,
+    QP 75: iterations 280 to 427), where a clock stop left the run unpolished."""
     return distance(&e.res, e.opt.eps_abs, e.opt.eps_rel) <= factor
 
 
