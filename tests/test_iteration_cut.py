@@ -9,6 +9,7 @@ iterations unpolished.
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 from fccqp.iteration import cut_after
 
@@ -51,3 +52,36 @@ def test_removing_the_cut_gives_the_uncut_run(cut):
     after = fccqp.solve(*problem, polish=False, time_limit=100.0, **EPS)
     assert after.status is Status.SOLVED and after.iterations == before.iterations
     assert (after.x == before.x).all()
+
+
+def boxed_beside_a_large_entry(seed: int) -> tuple[np.ndarray, ...]:
+    """``(P, q, A, b, lb, ub)``: 11 entries boxed to +-1 and one to +-1e4 whose optimum
+    lies near 5000, two equalities on the small entries. The large entry sets the
+    scale of the set residual's relative tolerance, so a small entry 5 % outside its box
+    passes the four tolerance tests at a factor far below ``POLISH_GATE`` while it fails
+    the scaled guard of 1 % of its box."""
+    rng = np.random.default_rng(seed)
+    n = 12
+    F = rng.standard_normal((n, n))
+    P = F @ F.T + 0.01 * np.eye(n)
+    q = rng.standard_normal(n) * 5
+    q[-1] = -5e3 * P[-1, -1]
+    A = rng.standard_normal((2, n))
+    A[:, -1] = 0
+    b = A @ rng.uniform(-0.5, 0.5, n)
+    lb, ub = -np.ones(n), np.ones(n)
+    lb[-1], ub[-1] = -1e4, 1e4
+    return P, q, A, b, lb, ub
+
+
+def test_a_clock_stop_near_convergence_is_polished_though_a_box_entry_misses_its_guard(cut):
+    """Cut at 60 iterations, the iterate passes its four tolerance tests within
+    ``POLISH_GATE`` while a small box entry is more than 1 % of its box outside it: the
+    final polish runs (it used to wait for the guard, which only a status needs) and
+    its answer is solved."""
+    problem = boxed_beside_a_large_entry(0)
+    cut(60)
+    result = fccqp.Solver(fccqp.Settings.realtime(10.0)).solve(*problem)
+    assert result.iterations == 60
+    assert result.polished and result.status is Status.SOLVED
+    verify_solution(problem, result, Tolerances.of(eps_abs=1e-4, eps_rel=1e-4))

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from fccqp.iteration import charge_rho_changes
 from fccqp.tuning import AUXILIARY_TIME, TIMED_EARLY_POLISH
 
 import fccqp
@@ -170,3 +171,29 @@ def test_iterations_past_the_time_limit_run_at_the_rho_they_reached():
     late = fccqp.solve(*problem, min_iter=200, time_limit=1e-9, **settings)
     assert late.status is Status.SOLVED
     assert late.factorizations == fixed.factorizations
+
+
+def test_a_change_of_rho_that_overran_the_time_limit_bars_no_later_change():
+    """Each change of rho counted 100 s longer than it took (a preempted factorization,
+    ``charge_rho_changes``) past a 10 s limit: rho still changes in the runs' early
+    iterations, and the answers, iterations and factorizations are those of uncharged
+    runs, in the same run and after a ``reset()``. Counted whole, the first change's
+    time barred every later change of the workspace."""
+    problem = flat_qp(3)
+    settings = dict(polish=False, max_iter=200, time_limit=10.0, **EPS)
+    runs = []
+    for charge in (0.0, 100.0):
+        solver = fccqp.Solver(**settings)
+        charge_rho_changes(charge)
+        try:
+            first = solver.solve(*problem)
+            solver.reset()
+            runs.append((first, solver.solve(*problem)))
+        finally:
+            charge_rho_changes(0.0)
+    assert runs[0][0].factorizations >= 3   # two changes at least: the second one is barred
+    for plain, charged in zip(*runs, strict=True):
+        assert charged.status is plain.status is Status.SOLVED
+        assert (charged.iterations, charged.factorizations) == (plain.iterations,
+                                                                plain.factorizations)
+        np.testing.assert_array_equal(charged.x, plain.x)

@@ -212,6 +212,8 @@ cdef extern from *:
     #define FCCQP_SETTLE_ITERATIONS 3
     /* at most this many times a run (a failed try costs up to GUESS_PASSES guesses) */
     #define FCCQP_SETTLE_TRIES 3
+    /* a change of rho counts at most this share of a timed run's iterations' time */
+    #define FCCQP_RHO_TIME_SHARE 0.25
     /* with a time limit max_iter grows by half while the distance to tolerance shrinks this much */
     #define FCCQP_CONVERGING 0.5
     /* a stalled timed run gets its certificates and retries only with this many seconds left */
@@ -316,5 +318,6 @@ cdef extern from *:
     const long TIMED_EARLY_POLISH "FCCQP_TIMED_EARLY_POLISH"
     const long SETTLE_ITERATIONS "FCCQP_SETTLE_ITERATIONS"
     const int SETTLE_TRIES "FCCQP_SETTLE_TRIES"
+    const double RHO_TIME_SHARE "FCCQP_RHO_TIME_SHARE"
     const double CONVERGING "FCCQP_CONVERGING"
     const double AUXILIARY_TIME "FCCQP_AUXILIARY_TIME"
