@@ -7,6 +7,7 @@ positive definite) are checked through ``Result.backend``.
 
 import numpy as np
 import pytest
+from fccqp.tuning import CHOLESKY_LOOP_ROWS
 
 import fccqp
 from fccqp import Status, schur
@@ -86,6 +87,18 @@ def _block_diagonal(problem, coupled_constrained=False, flat_free=False):
     if flat_free:
         P2[free[-1], free[-1]] = 0.0
     return P2, q, A, b, lb, ub, cones
+
+
+@pytest.mark.parametrize("n", [CHOLESKY_LOOP_ROWS, 2 * CHOLESKY_LOOP_ROWS])
+def test_backend_matches_clarabel_on_either_side_of_the_cholesky_loop(kkt_backend, n):
+    """The Schur backend factors ``P + R`` (order ``n``) by the loop up to
+    ``CHOLESKY_LOOP_ROWS`` and by LAPACK's ``dpotrf`` above: both give Clarabel's answer."""
+    problem = random_problem(7, n=n, m=12, n_box=10)
+    result = fccqp.solve(*problem, kkt_backend=kkt_backend, eps_abs=1e-8, eps_rel=1e-8)
+    assert result.status is Status.SOLVED
+    assert result.backend == kkt_backend
+    reference = clarabel_solve(*problem)
+    np.testing.assert_allclose(result.x, reference.x, atol=1e-5 * (1 + np.abs(reference.x).max()))
 
 
 @pytest.mark.parametrize("shape", ["diagonal tail", "coupled constrained", "flat free"])

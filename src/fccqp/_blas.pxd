@@ -7,7 +7,9 @@ times slower at our sizes; single vectors go through the loops of ``fccqp._dense
 """
 
 from scipy.linalg.cython_blas cimport dgemm, dsyrk, dtrsm
-from scipy.linalg.cython_lapack cimport dpotrs
+from scipy.linalg.cython_lapack cimport dpotrf, dpotrs
+
+from fccqp.tuning cimport CHOLESKY_LOOP_ROWS
 
 cdef extern from "fccqp_kernels.h" nogil:
     int fccqp_cholesky(double* M, int n, int ld)
@@ -39,10 +41,18 @@ cdef inline void syrk_t(int n, int k, const double* a, int lda, double beta, dou
 cdef inline bint cholesky(double* M, int n, int ld) noexcept nogil:
     """Factor the lower triangle of ``M`` in place; False if not positive definite.
 
-    ``fccqp_cholesky`` (fccqp_kernels.h) rather than ``dpotrf``: on a cold go2 tick the
-    304 ``dpotrf`` calls per 100 ticks took 4.7M instructions, most of them in its
-    unblocked ``dpotf2``'s ``dgemv`` and ``dscal`` calls (callgrind)."""
-    return fccqp_cholesky(M, n, ld) != 0
+    ``fccqp_cholesky`` (fccqp_kernels.h) up to order ``CHOLESKY_LOOP_ROWS``, ``dpotrf``
+    above: on a cold go2 tick the 304 ``dpotrf`` calls per 100 ticks took 4.7M
+    instructions, most of them in its unblocked ``dpotf2``'s ``dgemv`` and ``dscal``
+    calls (callgrind); natively, one thread, the loop takes 0.58-0.70x ``dpotrf``'s time
+    up to order 64, 0.95x at 128, 1.02x at 192 and 1.6x at 1024, where ``dpotrf``'s
+    blocking keeps the trailing matrix in cache."""
+    cdef char lower = b"L"
+    cdef int info = 0
+    if n <= CHOLESKY_LOOP_ROWS:
+        return fccqp_cholesky(M, n, ld) != 0
+    dpotrf(&lower, &n, M, &ld, &info)
+    return info == 0
 
 
 cdef inline void cholesky_solve(const double* L, int n, int ld, double* B, int columns,
