@@ -23,8 +23,9 @@
  * 2.1k instructions a call against dgemv's 2.8k on go2's A' y and P y (callgrind); M x
  * goes to fccqp_matvec below (dgemv's dot-product kernel took 3.2k against 3.7k for a
  * loop in four explicit lanes, but its interface and driver cost more than that).
- * fccqp_cholesky also factors polish_schur's d x d cone blocks and every factor of
- * _blas.cholesky (the Schur backend's, the reduced table's, the Gram matrices').
+ * fccqp_cholesky also factors, through _blas.cholesky up to order CHOLESKY_LOOP_ROWS
+ * (dpotrf above), the Schur backend's, the reduced table's, the Gram matrices' and
+ * polish_schur's factors.
  *
  * fccqp_sparse_rank_update: T += Y_R' Y_R (lower triangle) over a few sparse rows of
  * Y, a fused multiply-add per nonzero pair, row after row (schur.pyx says why in that

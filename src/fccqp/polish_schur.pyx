@@ -50,15 +50,14 @@ from libc.math cimport sqrt
 
 from scipy.linalg.cython_blas cimport dgemv
 
-from fccqp._blas cimport (backward_substitution, cholesky_solve_vector, forward_substitution,
-                          syrk_t)
+from fccqp._blas cimport (backward_substitution, cholesky, cholesky_solve_vector,
+                          forward_substitution, syrk_t)
 from fccqp._types cimport Problem
 from fccqp.schur cimport mark_coupled
 from fccqp.tuning cimport PIVOT_TOLERANCE, POLISH_BORDER_TOLERANCE, POLISH_RANK_TOLERANCE
 
 
 cdef extern from "fccqp_kernels.h" nogil:
-    int fccqp_cholesky(double* M, int n, int ld)
     void fccqp_matvec_t(const double* M, int ld, const double* y, double* out, int rows,
                         int cols)
     void fccqp_trsm_lower(const double* L, int n, int ld, double* B, int cols, int ldb)
@@ -112,7 +111,7 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
         for r in range(c, k):
             f.L[r + c * n] = p.P.values[f.order[r] * n + f.order[c]]
         f.L[c + c * n] += delta
-    if k > 0 and not fccqp_cholesky(f.L, k, <int>n):
+    if k > 0 and not cholesky(f.L, k, <int>n):
         return False
     for c in range(k):
         pivot = f.L[c + c * n]
@@ -194,7 +193,7 @@ cdef bint _factor_whole(PolishSchur* f, const Problem* p, const Py_ssize_t* inde
         o, d = p.cones.offset[k], p.cones.dim[k]
         start = p.constrained[o]
         B = f.block + o * s
-        if not _curved_block(f, p, o, d, start, hess) or not fccqp_cholesky(B, <int>d, <int>d):
+        if not _curved_block(f, p, o, d, start, hess) or not cholesky(B, <int>d, <int>d):
             return False
         f.block_row[kb] = row
         for a in range(d):
@@ -218,7 +217,7 @@ cdef bint _factor_whole(PolishSchur* f, const Problem* p, const Py_ssize_t* inde
                <int>size)
     for c in range(size):
         largest = max(largest, S[c + c * size])
-    if size > 0 and not fccqp_cholesky(S, <int>size, <int>size):
+    if size > 0 and not cholesky(S, <int>size, <int>size):
         return False
     for c in range(size):
         if S[c + c * size] * S[c + c * size] <= POLISH_RANK_TOLERANCE * largest:
@@ -306,7 +305,7 @@ cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
                <int>m)
     for c in range(m):
         largest = max(largest, f.S0[c + c * m])
-    if m > 0 and not fccqp_cholesky(f.S0, <int>m, <int>m):
+    if m > 0 and not cholesky(f.S0, <int>m, <int>m):
         return
     for c in range(m):
         if f.S0[c + c * m] * f.S0[c + c * m] <= POLISH_BORDER_TOLERANCE * largest:
@@ -372,7 +371,7 @@ cdef bint _factor_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* b
         for c in range(d):
             for r in range(c, d):
                 f.K[e + r + (e + c) * s] += B[r + c * d]
-        if not fccqp_cholesky(B, <int>d, <int>d):
+        if not cholesky(B, <int>d, <int>d):
             return False
         for a in range(d):   # S's diagonal entry of this plane: g' H_b^-1 g + delta
             f.t2[a] = g[o + a]
@@ -382,7 +381,7 @@ cdef bint _factor_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* b
             value += f.t2[a] * f.t2[a]
         largest = max(largest, value)
         e += d
-    if nbd > 0 and not fccqp_cholesky(f.K, <int>nbd, <int>s):
+    if nbd > 0 and not cholesky(f.K, <int>nbd, <int>s):
         return False
     e = 0
     for kb in range(nb):
@@ -398,7 +397,7 @@ cdef bint _factor_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* b
         for r in range(c, nb):
             f.T[r + c * s] = _dot(f.Z + r * s, f.Z + c * s, nbd)
         f.T[c + c * s] += delta
-    if nb > 0 and not fccqp_cholesky(f.T, <int>nb, <int>s):
+    if nb > 0 and not cholesky(f.T, <int>nb, <int>s):
         return False
     for c in range(nb):
         if f.T[c + c * s] * f.T[c + c * s] <= POLISH_RANK_TOLERANCE * largest:
