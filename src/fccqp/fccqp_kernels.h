@@ -546,6 +546,43 @@ static void fccqp_sparse_rank_clear(int rows, const int *restrict index,
 #define FCCQP_NOT_FINITE 1   /* an entry NaN or infinite (symmetric copy), or beyond the limit */
 #define FCCQP_CHANGED 2      /* out did not hold the result already */
 
+/* The symmetric copy's scalar steps, shared by its two-lane and 32-byte kernels: the
+ * diagonal entry of row i, and the pairs (i, j), (j, i) from j on past the vector steps
+ * (FCCQP_NOT_FINITE, FCCQP_CHANGED as fccqp_symmetric_copy; *asymmetry the running
+ * largest |P_ij - P_ji|). */
+static inline __attribute__((always_inline)) int fccqp_symmetric_diagonal(
+    const double *restrict row, double *restrict out_row, int i)
+{
+    int found = 0;
+    double v = row[i];
+    if (!(fabs(v) <= 1.7976931348623157e308))
+        found |= FCCQP_NOT_FINITE;
+    if (out_row[i] != v)
+        found |= FCCQP_CHANGED;
+    out_row[i] = v;
+    return found;
+}
+
+static inline __attribute__((always_inline)) int fccqp_symmetric_tail(
+    const double *restrict P, int n, int i, int j, double *restrict out, double *asymmetry)
+{
+    const double *row = P + (long)i * n;
+    double *out_row = out + (long)i * n;
+    int found = 0;
+    for (; j < n; j++) {
+        double u = row[j], l = P[(long)j * n + i], value = 0.5 * (u + l);
+        double difference = fabs(u - l);
+        if (!(difference <= 1.7976931348623157e308))
+            found |= FCCQP_NOT_FINITE;
+        *asymmetry = difference > *asymmetry ? difference : *asymmetry;
+        if (out_row[j] != value)
+            found |= FCCQP_CHANGED;
+        out_row[j] = value;
+        out[(long)j * n + i] = value;
+    }
+    return found;
+}
+
 /* out = (P + P') / 2 for a row-major n x n P; sizes[0] becomes the largest |entry| and
  * sizes[1] the largest |P_ij - P_ji|. FCCQP_NOT_FINITE flags an entry NaN or infinite,
  * or a pair whose difference is not finite (both beyond 1e308). out is symmetric on
@@ -572,12 +609,7 @@ static int fccqp_symmetric_copy(const double *restrict P, int n, double *restric
     for (int i = 0; i < n; i++) {
         const double *row = P + (long)i * n;
         double *out_row = out + (long)i * n;
-        double v = row[i];
-        if (!(fabs(v) <= 1.7976931348623157e308))
-            found |= FCCQP_NOT_FINITE;
-        if (out_row[i] != v)
-            found |= FCCQP_CHANGED;
-        out_row[i] = v;
+        found |= fccqp_symmetric_diagonal(row, out_row, i);
         int j = i + 1;
         for (; j + 4 <= n; j += 4) {
             const double *column = P + (long)j * n + i;
@@ -596,17 +628,7 @@ static int fccqp_symmetric_copy(const double *restrict P, int n, double *restric
             mirror[2 * (long)n] = FCCQP_LANE(value, 2);
             mirror[3 * (long)n] = FCCQP_LANE(value, 3);
         }
-        for (; j < n; j++) {
-            double u = row[j], l = P[(long)j * n + i], value = 0.5 * (u + l);
-            double difference = fabs(u - l);
-            if (!(difference <= 1.7976931348623157e308))
-                found |= FCCQP_NOT_FINITE;
-            asymmetry_1 = difference > asymmetry_1 ? difference : asymmetry_1;
-            if (out_row[j] != value)
-                found |= FCCQP_CHANGED;
-            out_row[j] = value;
-            out[(long)j * n + i] = value;
-        }
+        found |= fccqp_symmetric_tail(P, n, i, j, out, &asymmetry_1);
     }
     sizes[0] = fccqp_largest4(largest, largest_1);
     sizes[1] = fccqp_largest4(asymmetry, asymmetry_1);
@@ -1192,12 +1214,7 @@ static int fccqp_symmetric_copy_wide(const double *restrict P, int n, double *re
     for (int i = 0; i < n; i++) {
         const double *row = P + (long)i * n;
         double *out_row = out + (long)i * n;
-        double v = row[i];
-        if (!(fabs(v) <= 1.7976931348623157e308))
-            found |= FCCQP_NOT_FINITE;
-        if (out_row[i] != v)
-            found |= FCCQP_CHANGED;
-        out_row[i] = v;
+        found |= fccqp_symmetric_diagonal(row, out_row, i);
         int j = i + 1;
         const double *column = P + (long)j * n + i;
         double *mirror = out + (long)j * n + i;
@@ -1218,17 +1235,7 @@ static int fccqp_symmetric_copy_wide(const double *restrict P, int n, double *re
             _mm_storel_pd(mirror + 2 * stride, high);
             _mm_storeh_pd(mirror + 3 * stride, high);
         }
-        for (; j < n; j++) {
-            double u = row[j], l = P[(long)j * n + i], value = 0.5 * (u + l);
-            double difference = fabs(u - l);
-            if (!(difference <= 1.7976931348623157e308))
-                found |= FCCQP_NOT_FINITE;
-            asymmetry_1 = difference > asymmetry_1 ? difference : asymmetry_1;
-            if (out_row[j] != value)
-                found |= FCCQP_CHANGED;
-            out_row[j] = value;
-            out[(long)j * n + i] = value;
-        }
+        found |= fccqp_symmetric_tail(P, n, i, j, out, &asymmetry_1);
     }
     sizes[0] = fccqp_wide_largest(largest, largest_1);
     sizes[1] = fccqp_wide_largest(asymmetry, asymmetry_1);
