@@ -380,12 +380,13 @@ static int fccqp_cholesky(double *M, int n, int ld)
 }
 
 
-FCCQP_CLONES
-static void fccqp_matvec_t(const double *restrict M, int ld, const double *restrict y,
-                           double *restrict out, int rows, int cols)
+/* out += M' y for a row-major rows x cols M (leading dimension ld): four scaled rows
+ * added per pass; the core of fccqp_matvec_t and fccqp_colmatvec (a column-major M's
+ * columns are a row-major M's rows). */
+static inline __attribute__((always_inline)) void fccqp_add_scaled_rows(
+    const double *restrict M, int ld, const double *restrict y, double *restrict out,
+    int rows, int cols)
 {
-    for (int j = 0; j < cols; j++)
-        out[j] = 0.0;
     int i = 0;
     for (; i + 4 <= rows; i += 4) {
         const double *r0 = M + (long)i * ld, *r1 = r0 + ld, *r2 = r1 + ld, *r3 = r2 + ld;
@@ -399,6 +400,15 @@ static void fccqp_matvec_t(const double *restrict M, int ld, const double *restr
         for (int j = 0; j < cols; j++)
             out[j] += y0 * r0[j];
     }
+}
+
+FCCQP_CLONES
+static void fccqp_matvec_t(const double *restrict M, int ld, const double *restrict y,
+                           double *restrict out, int rows, int cols)
+{
+    for (int j = 0; j < cols; j++)
+        out[j] = 0.0;
+    fccqp_add_scaled_rows(M, ld, y, out, rows, cols);
 }
 
 /* fccqp_matvec: out = M x for a row-major rows x cols M with leading dimension ld, where
@@ -492,19 +502,7 @@ static void fccqp_colmatvec(const double *restrict M, int ld, const double *rest
         for (int i = 0; i < rows; i++)
             out[i] *= beta;
     }
-    int j = 0;
-    for (; j + 4 <= cols; j += 4) {
-        const double *c0 = M + (long)j * ld, *c1 = c0 + ld, *c2 = c1 + ld, *c3 = c2 + ld;
-        double x0 = x[j], x1 = x[j + 1], x2 = x[j + 2], x3 = x[j + 3];
-        for (int i = 0; i < rows; i++)
-            out[i] += (x0 * c0[i] + x1 * c1[i]) + (x2 * c2[i] + x3 * c3[i]);
-    }
-    for (; j < cols; j++) {
-        const double *c0 = M + (long)j * ld;
-        double x0 = x[j];
-        for (int i = 0; i < rows; i++)
-            out[i] += x0 * c0[i];
-    }
+    fccqp_add_scaled_rows(M, ld, x, out, cols, rows);
 }
 
 /* For each row j < rows of the column-major Y (leading dimension ld) and each pair
