@@ -544,6 +544,23 @@ static void fccqp_sparse_rank_clear(int rows, const int *restrict index,
 #define FCCQP_NOT_FINITE 1   /* an entry NaN or infinite (symmetric copy), or beyond the limit */
 #define FCCQP_CHANGED 2      /* out did not hold the result already */
 
+/* The checked copy's scalar steps past the vector ones (entries i..k-1), shared by its
+ * two-lane and 32-byte kernels: FCCQP_NOT_FINITE beyond limit, FCCQP_CHANGED where out
+ * held another value. */
+static inline __attribute__((always_inline)) int fccqp_checked_tail(
+    const double *restrict v, long i, long k, double limit, double *restrict out)
+{
+    int found = 0;
+    for (; i < k; i++) {
+        if (!(fabs(v[i]) <= limit))
+            found |= FCCQP_NOT_FINITE;
+        if (out[i] != v[i])
+            found |= FCCQP_CHANGED;
+        out[i] = v[i];
+    }
+    return found;
+}
+
 /* The symmetric copy's scalar steps, shared by its two-lane and 32-byte kernels: the
  * diagonal entry of row i, and the pairs (i, j), (j, i) from j on past the vector steps
  * (FCCQP_NOT_FINITE, FCCQP_CHANGED as fccqp_symmetric_copy; *asymmetry the running
@@ -648,13 +665,7 @@ static int fccqp_checked_copy(const double *restrict v, long k, double limit,
         changed = fccqp_flag_unequal4(changed, fccqp_load4(out + i), value);
         fccqp_store4(out + i, value);
     }
-    for (; i < k; i++) {
-        if (!(fabs(v[i]) <= limit))
-            found |= FCCQP_NOT_FINITE;
-        if (out[i] != v[i])
-            found |= FCCQP_CHANGED;
-        out[i] = v[i];
-    }
+    found |= fccqp_checked_tail(v, i, k, limit, out);
     return found | (fccqp_any4(beyond) ? FCCQP_NOT_FINITE : 0)
            | (fccqp_any4(changed) ? FCCQP_CHANGED : 0);
 }
@@ -1257,13 +1268,7 @@ static int fccqp_checked_copy_wide(const double *restrict v, long k, double limi
                                                       _CMP_NEQ_UQ));
         _mm256_storeu_pd(out + i, value);
     }
-    for (; i < k; i++) {
-        if (!(fabs(v[i]) <= limit))
-            found |= FCCQP_NOT_FINITE;
-        if (out[i] != v[i])
-            found |= FCCQP_CHANGED;
-        out[i] = v[i];
-    }
+    found |= fccqp_checked_tail(v, i, k, limit, out);
     return found | (_mm256_movemask_pd(beyond) ? FCCQP_NOT_FINITE : 0)
            | (_mm256_movemask_pd(changed) ? FCCQP_CHANGED : 0);
 }
