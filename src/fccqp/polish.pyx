@@ -143,7 +143,6 @@ cdef bint _chord_step(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
     _keep_point(w, p, nb, False)
     if tabled:
         table_correct(w, p, table, kkt, rho_vec, nb, scale)
-        w.grad_current = False
     else:
         correct_once(w, p, nf, nb)
     if past_apex(w, p, nb):
@@ -259,7 +258,6 @@ cdef bint _solve_guess(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
         if w.bare[w.boundary[k]] == KEPT:
             w.bare[w.boundary[k]] = CURVED
     if tabled[0]:
-        w.grad_current = False   # the table's residuals use grad and Ax as scratch
         if table_factor(w, p, table, rho_vec, nb):
             table_solve(w, p, table, kkt, rho_vec, nb, scale)
             return True

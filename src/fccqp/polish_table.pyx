@@ -25,8 +25,8 @@ factorization of the ``(n + m)``-sized KKT matrix, which is what the polishing o
 The system is solved as corrections of the current point against the residual of the
 polished QP's full, unregularized KKT conditions (each correction one KKT solve with
 the factorization ADMM already has, unrefined with the Schur backend since this loop
-refines, one combination with ``W`` and one ``dgetrs``), so the table's rounding errors
-are refined away.
+refines, one combination with ``W`` and one solve with the LU factor), so the table's
+rounding errors are refined away.
 
 The system is singular exactly when the polished QP's solution or its multipliers are
 not unique (a cost flat on the free entries, active constraints that depend on each
@@ -36,7 +36,7 @@ with the regularized KKT matrix instead.
 
 from libc.math cimport INFINITY, fabs
 
-from scipy.linalg.cython_lapack cimport dgetrf, dgetrs
+from scipy.linalg.cython_lapack cimport dgetrf
 
 from fccqp._dense cimport colmatvec, fill, inf_norm
 from fccqp._types cimport Problem
@@ -45,6 +45,13 @@ from fccqp.matrices cimport product, product_t
 from fccqp.polish cimport APEX, FIXED, LOWER, UPPER, Polish
 from fccqp.reduced cimport Reduced
 from fccqp.tuning cimport LU_LOOP_ROWS, MAX_REFINE, MINOR_PART, PIVOT_RATIO, POLISH_REFINE_TOLERANCE
+
+# LU with partial pivoting in place, LAPACK's pivots, and the solve with its factor: the
+# loop LU_LOOP_ROWS speaks of and dgetrs' replacement, in C so that they can be built
+# for AVX2 beside the baseline (see fccqp_kernels.h)
+cdef extern from "fccqp_kernels.h" nogil:
+    int fccqp_lu(double* T, int n, int* piv)
+    void fccqp_lu_solve(const double* T, int n, const int* piv, double* b)
 
 
 cdef inline double _held_value(const Problem* p, Py_ssize_t j, char code) noexcept nogil:
@@ -62,14 +69,19 @@ cdef inline bint _held(char code) noexcept nogil:
 cdef void _assemble(Polish* w, const Problem* p, const Reduced* t, const double* rho,
                     Py_ssize_t nb) noexcept nogil:
     """The system's matrix ``T`` (column-major, ``s + nb`` square) in the unknowns
-    ``(du, dlam)``; ``dx_S = d0_S + W_S du`` and ``dy = R dx_S - du``."""
+    ``(du, dlam)``; ``dx_S = d0_S + W_S du`` and ``dy = R dx_S - du``. Only the entries
+    that the loops below do not set are zeroed first (zeroing all of ``T`` took 4.9k
+    instructions a call in ``memset`` on go2's 24-28 rows, callgrind)."""
     cdef Py_ssize_t s = p.s, S2 = s + nb, j, l, k, o, d, a, b, cone
     cdef double* T = w.T
     cdef const double* WS = t.W_S
     cdef const double* H
     cdef double value
     cdef char code
-    for j in range(S2 * S2):
+    for l in range(s):   # the planes' rows, which accumulate from 0
+        for j in range(s, S2):
+            T[j + l * S2] = 0.0
+    for j in range(s * S2, S2 * S2):   # the planes' columns
         T[j] = 0.0
     for j in range(s):
         code = w.active[j]
@@ -95,21 +107,36 @@ cdef void _assemble(Polish* w, const Problem* p, const Reduced* t, const double*
             T[j + (s + k) * S2] = -w.g[j]
 
 
+cdef void _products(Polish* w, const Problem* p) noexcept nogil:
+    """``grad := P x + q + A'nu`` and ``Ax := A x`` at the current point, summed as
+    :mod:`fccqp.polish_kkt` sums them; sets ``grad_current``."""
+    cdef Py_ssize_t i
+    product(&p.P, w.x, w.grad)
+    product_t(&p.A, w.nu, w.ATnu)
+    for i in range(p.n):
+        w.grad[i] += p.q[i] + w.ATnu[i]
+    product(&p.A, w.x, w.Ax)
+    w.grad_current = True
+
+
 cdef double _residual(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
     """Residual of ``(x, nu, y, lam)`` in the polished QP's conditions: the KKT part
     ``(-(P x + q + A'nu + E_S y), b - A x)`` into ``full``, the constraints' part into
-    ``tr``; returns the infinity norm of both."""
+    ``tr``; returns the infinity norm of both. The products with ``P`` and ``A`` (most
+    of its instructions) are taken from ``grad`` and ``Ax`` where ``grad_current`` says
+    the point has not moved since they were formed: a Newton step, a chord step or a
+    guess that only releases a constraint or places a plane starts from the point the
+    last solve left."""
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j, k, o, d, a, b, start, cone
     cdef double value, curved
     cdef const double* H
     cdef char code
-    product(&p.P, w.x, w.grad)
-    product_t(&p.A, w.nu, w.ATnu)
+    if not w.grad_current:
+        _products(w, p)
     for i in range(n):
-        w.full[i] = -(w.grad[i] + p.q[i] + w.ATnu[i])
+        w.full[i] = -w.grad[i]
     for j in range(s):
         w.full[p.constrained[j]] -= w.y[j]
-    product(&p.A, w.x, w.Ax)
     for i in range(m):
         w.full[n + i] = p.b[i] - w.Ax[i]
     for j in range(s):
@@ -148,11 +175,11 @@ cdef void _correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
     solve; correcting them, at most 1.1e-11, and the 400 ticks took 3 % fewer
     instructions (go2 +0.1 %, solo12 +0.4 %, ``Settings.realtime(1.0)``, callgrind)."""
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, N = n + m, i, j, k, o, d, a, b, start, cone
-    cdef int size = <int>(s + nb), one = 1, info = 0
-    cdef char trans = b"N"
+    cdef int size = <int>(s + nb)
     cdef const double* H
     cdef double value
     cdef char code
+    w.grad_current = False
     if sign > 0.0:
         if w.kkt_norm > max(tiny, MINOR_PART * inf_norm(w.tr, s + nb)):
             kkt_solve_once(kkt, p, rho, w.full, w.dfull)   # d0 = K_R^-1 (r1, r2)
@@ -171,8 +198,7 @@ cdef void _correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
                 for b in range(d):
                     w.tr[o + a] += H[a * d + b] * w.dfull[start + b]
                 w.tr[s + k] -= w.g[o + a] * w.dfull[start + a]
-        if size > 0:   # no constrained entry nor plane: nothing to solve (LAPACK refuses)
-            dgetrs(&trans, &size, &one, w.T, &size, w.tpiv, w.tr, &size, &info)
+        fccqp_lu_solve(w.T, size, w.tpiv, w.tr)
         for j in range(s + nb):
             w.du[j] = w.tr[j]
         colmatvec(t.W, <int>N, w.du, w.dfull, N, s, 1.0)   # dx = d0 + W du
@@ -184,12 +210,6 @@ cdef void _correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
         w.y[j] += sign * (rho[j] * w.dfull[p.constrained[j]] - w.du[j])
     for k in range(nb):
         w.lam[k] += sign * w.du[s + k]
-
-
-# LU with partial pivoting in place, LAPACK's pivots: the loop LU_LOOP_ROWS speaks of,
-# in C so that it can be built for AVX2 beside the baseline (see fccqp_kernels.h)
-cdef extern from "fccqp_kernels.h" nogil:
-    int fccqp_lu(double* T, int n, int* piv)
 
 
 cdef bint table_factor(Polish* w, const Problem* p, const Reduced* t, const double* rho,
@@ -222,20 +242,16 @@ cdef void table_solve(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
     the planes moved (:func:`fccqp.polish._relinearize`) it is a chord step of Newton's
     method, the Jacobian of the earlier planes standing in for the current one. Where the
     last residual is the returned point's, its products leave that point's ``grad`` and
-    ``Ax`` (``grad_current``) for :func:`fccqp.polish._multipliers`."""
+    ``Ax`` (``grad_current``) for :func:`fccqp.polish._multipliers` and the next
+    residual."""
     cdef double norm, last = INFINITY
-    cdef Py_ssize_t i
     cdef int r
-    w.grad_current = False   # _residual leaves P x alone in grad
     for r in range(MAX_REFINE + 2):
         norm = _residual(w, p, nb)
         if norm > last:
             _correct(w, p, t, kkt, rho, nb, -1.0, 0.0)
             return
         if norm <= POLISH_REFINE_TOLERANCE * scale or norm > 0.5 * last or r == MAX_REFINE + 1:
-            for i in range(p.n):   # as polish_kkt.kkt_residual forms it
-                w.grad[i] += p.q[i] + w.ATnu[i]
-            w.grad_current = True
             return
         last = norm
         _correct(w, p, t, kkt, rho, nb, 1.0, POLISH_REFINE_TOLERANCE * scale)
