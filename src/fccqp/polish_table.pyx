@@ -162,18 +162,50 @@ cdef double _residual(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil
     return max(w.kkt_norm, inf_norm(w.tr, s + nb))
 
 
+cdef double _off_table_norm(Polish* w, const Problem* p) noexcept nogil:
+    """The infinity norm of ``full`` outside the constrained entries' rows (``full``
+    unchanged: their entries are set aside, zeroed for the norm and put back)."""
+    cdef Py_ssize_t j, s = p.s
+    cdef double norm
+    for j in range(s):   # du is free until the correction's solve writes it
+        w.du[j] = w.full[p.constrained[j]]
+        w.full[p.constrained[j]] = 0.0
+    norm = inf_norm(w.full, p.n + p.m)
+    for j in range(s):
+        w.full[p.constrained[j]] = w.du[j]
+    return norm
+
+
+cdef void _kkt_part(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
+                    const double* rho, Py_ssize_t nb, double tiny) noexcept nogil:
+    """``dfull := K_R^-1 full``, the correction of the residual's KKT part. Below
+    ``tiny`` or ``MINOR_PART`` times the constraints' part it counts as 0, which saves
+    the KKT solve. Where only its rows of the constrained entries ``S`` are more than
+    that (``MINOR_PART`` of the KKT part: a point a solve left, whose multipliers
+    ``y`` or planes were set anew, or a step between two such points), ``K_R^-1 E_S
+    v = W v`` with the table's columns: one combination of them for the KKT solve
+    (go2: 1.7k against 13.7k instructions; 65 of the 177 KKT solves of 100 cold ticks,
+    solo12 118 of 234, anymal_c 100 of 231). One that an earlier KKT solve left is
+    corrected: the Schur backend's unrefined solve leaves a relative error, not a
+    rounding floor. Skipping KKT parts within 2x of that (tried until c6c2454) left
+    talos' ``A x = b`` at 4.7e-10 in one polished tick against 2.7e-12 for a direct KKT
+    solve; correcting them, at most 1.1e-11, and the 400 ticks took 3 % fewer
+    instructions (go2 +0.1 %, solo12 +0.4 %, ``Settings.realtime(1.0)``, callgrind)."""
+    cdef Py_ssize_t N = p.n + p.m
+    if w.kkt_norm <= max(tiny, MINOR_PART * inf_norm(w.tr, p.s + nb)):
+        fill(w.dfull, 0.0, N)
+    elif _off_table_norm(w, p) <= max(tiny, MINOR_PART * w.kkt_norm):
+        colmatvec(t.W, <int>N, w.du, w.dfull, N, p.s, 0.0)   # v = full_S, left in du
+    else:
+        kkt_solve_once(kkt, p, rho, w.full, w.dfull)
+
+
 cdef void _correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
                    const double* rho, Py_ssize_t nb, double sign, double tiny) noexcept nogil:
     """Solve for the correction of the residual in ``full``/``tr`` into ``dfull``
     (``dx, dnu``) and ``du`` (``du, dlam``) and add ``sign`` times it; with ``sign ==
-    -1`` undo the last one, which ``dfull`` and ``du`` still hold. A KKT part of the
-    residual below ``tiny`` or below ``MINOR_PART`` times the constraints' part counts as
-    0 for this correction, which saves the KKT solve. One that an earlier KKT solve
-    left is corrected: the Schur backend's unrefined solve leaves a relative error, not
-    a rounding floor. Skipping KKT parts within 2x of that (tried until c6c2454) left
-    talos' ``A x = b`` at 4.7e-10 in one polished tick against 2.7e-12 for a direct KKT
-    solve; correcting them, at most 1.1e-11, and the 400 ticks took 3 % fewer
-    instructions (go2 +0.1 %, solo12 +0.4 %, ``Settings.realtime(1.0)``, callgrind)."""
+    -1`` undo the last one, which ``dfull`` and ``du`` still hold. The KKT part's
+    correction (``d0``) is :func:`_kkt_part`'s."""
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, N = n + m, i, j, k, o, d, a, b, start, cone
     cdef int size = <int>(s + nb)
     cdef const double* H
@@ -181,10 +213,7 @@ cdef void _correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
     cdef char code
     w.grad_current = False
     if sign > 0.0:
-        if w.kkt_norm > max(tiny, MINOR_PART * inf_norm(w.tr, s + nb)):
-            kkt_solve_once(kkt, p, rho, w.full, w.dfull)   # d0 = K_R^-1 (r1, r2)
-        else:   # the KKT part holds already or is minor
-            fill(w.dfull, 0.0, N)
+        _kkt_part(w, p, t, kkt, rho, nb, tiny)   # d0 = K_R^-1 (r1, r2)
         for j in range(s):
             code = w.active[j]
             value = w.dfull[p.constrained[j]]
