@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 from fccqp.polish_ops import polish_point
+from fccqp.polish_table import factor_solve
 from fccqp.tuning import FEASIBLE_PASSES, GUESS_PASSES, WARM_GUESS_PASSES
 
 import fccqp
@@ -162,6 +163,25 @@ def test_polish_is_on_in_both_presets():
     assert fccqp.Settings.realtime().polish is True
     assert fccqp.solve(*_cone_problem(0)).polished is True
     assert fccqp.solve(*_cone_problem(0), polish=False).polished is False
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 4, 5, 7, 8, 26, 27, 28, 63, 64, 65, 66, 90])
+def test_the_table_polish_lu_solves_pivoted_systems_on_both_sides_of_the_loop_bound(n):
+    """fccqp.polish_table's LU (the loop up to LU_LOOP_ROWS = 64 rows, dgetrf above) and
+    its hand-written solve: every size of the last panel of four, rows swapped."""
+    rng = np.random.default_rng(n)
+    matrix = rng.standard_normal((n, n))
+    matrix[0, 0] = 0.0 if n > 1 else 2.0   # a zero leading entry: the first pivot swaps rows
+    matrix[:, n // 2] *= 1e-3   # a small column: pivots further down
+    rhs = rng.standard_normal(n)
+    x = factor_solve(matrix, rhs)
+    assert np.abs(matrix @ x - rhs).max() <= 1e-10 * max(1.0, np.abs(rhs).max())
+    assert np.allclose(x, np.linalg.solve(matrix, rhs), rtol=1e-8, atol=1e-10)
+
+
+def test_the_table_polish_lu_reports_a_zero_pivot():
+    matrix = np.ones((6, 6))
+    assert factor_solve(matrix, np.ones(6)) is None
 
 
 @pytest.mark.parametrize("seed", range(4))

@@ -36,6 +36,8 @@ with the regularized KKT matrix instead.
 
 from libc.math cimport INFINITY, fabs
 
+import numpy as np
+
 from scipy.linalg.cython_lapack cimport dgetrf
 
 from fccqp._dense cimport colmatvec, fill, inf_norm
@@ -291,3 +293,23 @@ cdef void table_correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
     """One correction of the current point with the last factor (a chord step)."""
     _residual(w, p, nb)
     _correct(w, p, t, kkt, rho, nb, 1.0, POLISH_REFINE_TOLERANCE * scale)
+
+
+def factor_solve(matrix, rhs):
+    """``matrix^-1 rhs`` through :func:`table_factor`'s LU (the loop up to
+    ``LU_LOOP_ROWS`` rows, ``dgetrf`` above) and the correction's solve with its
+    factor, for the tests; None at a zero pivot."""
+    cdef double[::1, :] T = np.array(matrix, dtype=np.float64, order="F", copy=True)
+    cdef double[::1] b = np.array(rhs, dtype=np.float64, copy=True)
+    cdef int[::1] piv = np.zeros(max(b.shape[0], 1), dtype=np.intc)
+    cdef int size = <int>b.shape[0], info = 0
+    if size == 0:
+        return np.asarray(b)
+    if size <= LU_LOOP_ROWS:
+        info = 0 if fccqp_lu(&T[0, 0], size, &piv[0]) else 1
+    else:
+        dgetrf(&size, &size, &T[0, 0], &size, &piv[0], &info)
+    if info != 0:
+        return None
+    fccqp_lu_solve(&T[0, 0], size, &piv[0], &b[0])
+    return np.asarray(b)
