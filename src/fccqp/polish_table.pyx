@@ -78,7 +78,9 @@ cdef void _assemble(Polish* w, const Problem* p, const Reduced* t, const double*
     cdef double* T = w.T
     cdef const double* WS = t.W_S
     cdef const double* H
-    cdef double value
+    cdef const double* row
+    cdef double* acc = w.tr   # scratch: _residual sets tr before a correction reads it
+    cdef double h
     cdef char code
     for l in range(s):   # the planes' rows, which accumulate from 0
         for j in range(s, S2):
@@ -98,15 +100,21 @@ cdef void _assemble(Polish* w, const Problem* p, const Reduced* t, const double*
         cone = w.boundary[k]
         o, d = p.cones.offset[cone], p.cones.dim[cone]
         H = w.hess + o * s
-        for a in range(d):
-            j = o + a
+        for a in range(d):   # row a of H W_S summed along W_S's rows, which vectorizes: go2's
+            j = o + a        # table_factor 7.5k -> 6.2k instructions a call without the LU (callgrind)
             for l in range(s):
-                value = 0.0
-                for b in range(d):
-                    value += H[a * d + b] * WS[(o + b) * s + l]
-                T[j + l * S2] -= value
-                T[s + k + l * S2] += w.g[j] * WS[j * s + l]
-            T[j + (s + k) * S2] = -w.g[j]
+                acc[l] = 0.0
+            for b in range(d):
+                h = H[a * d + b]
+                row = WS + (o + b) * s
+                for l in range(s):
+                    acc[l] += h * row[l]
+            h = w.g[j]
+            row = WS + j * s
+            for l in range(s):
+                T[j + l * S2] -= acc[l]
+                T[s + k + l * S2] += h * row[l]
+            T[j + (s + k) * S2] = -h
 
 
 cdef void _products(Polish* w, const Problem* p) noexcept nogil:
