@@ -695,9 +695,9 @@ def test_a_polish_from_nothing_gives_up_where_its_first_feasible_guess_cannot_se
     put down), polished as a carried guess is (no multipliers, the warm polish's
     guesses): its curvature-less planes' points pass a dozen torque bounds, and at its
     first point that violates nothing more of their multipliers are wrong-signed than
-    guesses are left. Releasing one a guess, it crawled by steps of length 0-0.05 to the
-    hopeless test at its eighth guess; it gives up at that first feasible point instead
-    (ADMM follows either way)."""
+    guesses are left. Releasing one a guess it cannot settle, so it gives up there, within
+    ``FEASIBLE_PASSES`` guesses, rather than crawl by steps of length 0-0.05 to the
+    hopeless test (8 guesses without the rule; ADMM follows either way)."""
     pytest.importorskip("pinocchio")
     from benchmarks.contact_map import ContactMaps
     from benchmarks.exact_solvers import carried_guess, fccqp_arguments

@@ -361,11 +361,12 @@ cdef inline bint _bare_crawl(Polish* w, const Problem* p, long passes) noexcept 
     violates nothing, has more wrong-signed multipliers
     (:func:`~fccqp.polish_guess.wrong_signed`) than guesses left: releasing one a guess,
     it cannot settle. Such a polish holds every bound and block its curvature-less
-    planes' points passed, and the multipliers of that first feasible guess were 0-2
-    wrong on the quadrupeds' 21 contact-change ticks it settled and 11-18 on talos'
-    failing ones, whose crawl (steps of length 0.002-0.1, one release a guess) then ran
-    to the warm polish's hopeless test (talos' quick tick 54: 6 more guesses, 0.3 ms;
-    notes/performance-history.md, "contactguess")."""
+    planes' points passed. At that first feasible guess 0 or 1 multipliers were wrong on
+    the 18 quadruped contact-change ticks of the benchmark's sets that it settled, and
+    11-18 on the three talos ticks that reached one, whose crawl (steps of length
+    0-0.1, one release a guess) then ran to the warm polish's hopeless test and failed
+    (talos' quick tick 54: 6 more guesses, 0.3 ms; notes/performance-history.md,
+    "contactguess")."""
     return w.bare_start and wrong_signed(w, p) > w.guess_passes - passes
 
 
