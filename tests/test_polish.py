@@ -708,3 +708,40 @@ def test_a_contact_change_polished_from_nothing_settles_its_planes_before_a_rele
                     Tolerances.of(fccqp.Settings.realtime(100.0)))
     u = qp.layout["u"]
     assert np.max(np.abs(result.x[u] - x_ref[u]) / qp.ub[u]) <= 0.01
+
+
+def test_a_polish_from_nothing_gives_up_where_its_first_feasible_guess_cannot_settle():
+    """talos' quick benchmark tick 54 (``mix``, 60 QPs in sequences of 15: the right foot
+    put down), polished as a carried guess is (no multipliers, the warm polish's
+    guesses): its curvature-less planes' points pass a dozen torque bounds, and at its
+    first point that violates nothing more of their multipliers are wrong-signed than
+    guesses are left. Releasing one a guess it cannot settle, so it gives up there, within
+    ``FEASIBLE_PASSES`` guesses, rather than crawl by steps of length 0-0.05 to the
+    hopeless test (8 guesses without the rule; ADMM follows either way)."""
+    pytest.importorskip("pinocchio")
+    from benchmarks.contact_map import ContactMaps
+    from benchmarks.exact_solvers import carried_guess, fccqp_arguments
+    from benchmarks.testsets import generate_test_set
+
+    tests = generate_test_set("talos_reduced", "mix", 60, seed=0, seq_len=15)
+    solver = fccqp.Solver(fccqp.Settings.realtime(100.0))
+    for tick in range(45, 54):
+        before = solver.solve(*fccqp_arguments(tests.qps[tick]))
+    qp = tests.qps[54]
+    guess = carried_guess(ContactMaps(), (tests.qps[53], before), qp)
+    P, q, A, b, lb, ub, cones = fccqp_arguments(qp)[:7]
+    flat = flatten_cones(cones, P.shape[0])
+    x = guess["x0"]
+    z = np.clip(x, lb, ub)
+    for k in range(flat.count):   # z: the projection of x onto C, as the solver's guess has it
+        o, normal, mu = flat.offset[k], np.asarray(flat.normal[k]), flat.mu[k]
+        along = z[o:o + 3] @ normal
+        tangent = z[o:o + 3] - along * normal
+        across = np.linalg.norm(tangent)
+        if across > mu * along:
+            on = max(0.0, (along + mu * across) / (1 + mu * mu))
+            z[o:o + 3] = on * normal + mu * on / across * tangent
+    polished = polish_point(P, q, A, b, lb, ub, flat, x, guess["y0"], np.zeros_like(x), z,
+                            schur=True, warm=True, bare=True)
+    assert not polished["ok"]
+    assert polished["passes"] <= FEASIBLE_PASSES

@@ -354,6 +354,20 @@ cdef inline bint _hopeless(Polish* w, const Problem* p, long passes) noexcept no
     return w.warm and wrong_signed(w, p) > HOPELESS_RATE * (w.guess_passes - passes)
 
 
+cdef inline bint _bare_crawl(Polish* w, const Problem* p, long passes) noexcept nogil:
+    """Whether a polish from no multipliers (``bare_start``), at its first point that
+    violates nothing, has more wrong-signed multipliers
+    (:func:`~fccqp.polish_guess.wrong_signed`) than guesses left: releasing one a guess,
+    it cannot settle. Such a polish holds every bound and block its curvature-less
+    planes' points passed. At that first feasible guess 0 or 1 multipliers were wrong on
+    the 18 quadruped contact-change ticks of the benchmark's sets that it settled, and
+    11-18 on the three talos ticks that reached one, whose crawl (steps of length
+    0-0.1, one release a guess) then ran to the warm polish's hopeless test and failed
+    (talos' quick tick 54: 6 more guesses, 0.3 ms; notes/performance-history.md,
+    "contactguess")."""
+    return w.bare_start and wrong_signed(w, p) > w.guess_passes - passes
+
+
 cdef bint polish_prepare(Polish* w, const Problem* p) noexcept nogil:
     """Set up the Schur-complement solve of :mod:`fccqp.polish_schur` for this solve's
     ``P`` and ``A``; True when it applies, and then polishing needs no table. Never on
@@ -440,7 +454,8 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
     passed ``deadline`` before a guess after the first (``INFINITY``: never); otherwise
     the caller judges the point. A polish from no multipliers (``bare_start``) settles
     its planes by Newton's steps before it releases a boundary block's wrong ``lam``
-    (:func:`_planes_first`).
+    (:func:`_planes_first`), and gives up at its first point that violates nothing when
+    that point has more wrong-signed multipliers than guesses left (:func:`_bare_crawl`).
     """
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, nb, nf = 0, j, changed
     cdef long passes = 0
@@ -516,6 +531,8 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         held = boundary_entries(w, p, nb)
         nb = renew(w, p, True, False, NULL, &changed)
         if changed == 0:
+            if not feasible and _bare_crawl(w, p, passes):
+                return False
             feasible = True
             if not _planes_first(w, p, nb):
                 nb = renew(w, p, False, False, NULL, &changed)

@@ -50,7 +50,7 @@ cdef class _Arrays:
 
 
 def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5, bint schur=False,
-                 bint from_iterate=False, bint warm=False):
+                 bint from_iterate=False, bint warm=False, bint bare=False):
     """Polish the iterate ``(x, nu, z, y)`` of ``min 1/2 x'Px + q'x`` s.t. ``A x = b``,
     ``lb <= x <= ub``, ``x`` in ``cones`` (a :class:`fccqp.cones.ConeArrays` over ``x``).
 
@@ -60,7 +60,8 @@ def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5, bi
     pattern). With ``schur`` (dense ``P`` and ``A``), the Schur complement is set up
     first; with ``from_iterate`` the passes step from ``x`` on, as from ADMM's iterate;
     with ``warm`` it is polished as a warm polish is (``WARM_GUESS_PASSES`` guesses, the
-    hopeless crawl given up: :func:`fccqp.polish.polish`).
+    hopeless crawl given up: :func:`fccqp.polish.polish`); with ``bare`` as a polish from
+    no multipliers is (``bare_start``: a carried guess's, whose ``y`` the caller zeroes).
     Returns a dict: ``ok`` (the polish's verdict), ``x``, ``nu``, ``y`` (``n`` entries,
     zero off the constrained entries), ``active`` (the final guess's code per
     constrained entry), ``passes``, ``factorizations``, ``schur`` (whether the Schur
@@ -112,7 +113,7 @@ def polish_point(P, q, A, b, lb, ub, cones, x, nu, y, z, long newton_steps=5, bi
     w.schur.ready = w.schur_only = w.schur_failed = False
     w.guess_passes = WARM_GUESS_PASSES if warm else GUESS_PASSES
     w.warm = warm
-    w.bare_start = False
+    w.bare_start = bare
     w.schur.L = NULL   # no Schur storage: every guess is assembled
     w.schur.bordered = False
     if schur:
