@@ -97,24 +97,6 @@ def test_a_cold_control_tick_polishes_its_active_set_once_it_has_settled(test_se
     assert early <= 0.8 * plain
 
 
-def test_a_cold_control_tick_whose_active_set_held_polishes_at_its_first_check(test_set):
-    """From a cold start the polish of an early iterate finds a control tick's answer; a
-    cold tick whose active set held over the last look before its first scheduled check
-    (``adaptive_rho_interval`` iterations) is polished there, not once the set has held
-    as long as it took to form (solo12: three of these seven ticks at 10 iterations,
-    20-36 before). The answers are exact."""
-    timed = fccqp.Settings.realtime(10.0)   # a time limit that never binds here
-    at_first_check = 0
-    for qp in test_set.qps:
-        args = (qp.P, qp.q, qp.A, qp.b, qp.lb, qp.ub, cones_of(qp))
-        result = fccqp.Solver(timed).solve(*args)
-        assert result.status is fccqp.Status.SOLVED and result.polished
-        verify_solution(problem_of(qp), result, Tolerances.of(timed))
-        assert qp.equality_residual(result.x) <= 1e-9
-        at_first_check += result.iterations == timed.adaptive_rho_interval
-    assert at_first_check >= 2
-
-
 def test_a_ticks_own_answer_given_back_as_the_guess_takes_no_iteration(test_set):
     """A control tick's polished answer given back as ``(x0, y0, z0)`` keeps its active
     set for the polish's first guess, as the solver's own warm start does: the same

@@ -462,18 +462,6 @@ cdef inline bint _settled(const Loop* L) noexcept nogil:
             and not L.settle_polished and L.settle_tries < SETTLE_TRIES)
 
 
-cdef inline bint _held_at_first_check(const Engine* e, const Loop* L) noexcept nogil:
-    """Whether a cold timed run is at its first scheduled check (``adaptive_rho_interval``
-    iterations) with the active set its iterate points to unchanged at the last look
-    (:func:`_track_settling`). From a cold start the polish of an early iterate finds
-    the quadrupeds' answers (go2: from the first iteration's in 91 of 95 cold ticks),
-    but each guess it needs beyond a settled set's costs about eight iterations, and
-    the set held over one look needs few more; talos' sets still move at this check."""
-    cdef long last_look = L.iteration - L.iteration % SETTLE_ITERATIONS
-    return (L.cold and L.timed and L.iteration == e.opt.adaptive_rho_interval
-            and L.settled_from <= 2 * (last_look - SETTLE_ITERATIONS))
-
-
 cdef inline void _polish_attempts(Engine* e, Loop* L, Run* run) noexcept nogil:
     """Polish a SOLVED iterate (a failure goes on at tighter tolerances, closer to the
     active set, ``POLISH_RETRIES`` times); also polish an active set that settled near
@@ -482,9 +470,7 @@ cdef inline void _polish_attempts(Engine* e, Loop* L, Run* run) noexcept nogil:
     ``TIMED_EARLY_POLISH`` iterations on (a long run needs it: PRIMALC1 of
     Maros-Meszaros, whose gap stays at 1.6 without it); before that, at a check once it
     held as long as it took to form (:func:`_settled`): a control tick's budget has no
-    room for polishes of a set that moves again; and a cold run's set held over one
-    look at its first scheduled check, within ``POLISH_GATE`` of the tolerances
-    (:func:`_held_at_first_check`)."""
+    room for polishes of a set that moves again."""
     cdef Options* o = &e.opt
     if L.status == SOLVED and o.polish and not L.last and L.retries < POLISH_RETRIES:
         L.polished_at = L.iteration
@@ -505,10 +491,6 @@ cdef inline void _polish_attempts(Engine* e, Loop* L, Run* run) noexcept nogil:
             L.early_tries += 1
             L.polished_at = L.iteration
             run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, True)
-    if (L.status == RUNNING and o.polish and not L.last and _held_at_first_check(e, L)
-            and _near(e, POLISH_GATE)):
-        L.polished_at = L.iteration
-        run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, True)
     if (L.status == RUNNING and o.polish and not L.last and _settled(L)
             and nearly_converged(&e.res, o.eps_abs, o.eps_rel, EARLY_POLISH_GATE)):
         L.settle_polished = True
