@@ -1044,14 +1044,6 @@ static double fccqp_sum_squares(const double *restrict v, long k)
  * call): polish_schur_setup's 18 x 18 L and 30 columns 12.7k instructions against
  * dtrsm's 21.5k (most of it packing and set-up), the base's 30 x 30 S0 and 3-12
  * columns 4.5k against 10.5k.
- *
- * fccqp_syrk_t: the lower triangle of C = A'A + beta C (beta 0 or 1) for the
- * column-major k x n A (leading dimension lda): each entry a dot product of two columns
- * of A in four lanes, four entries of two columns of C per pass over k. For few columns
- * of many rows (polish_schur's W'W: go2 3-12 columns of 30 rows) 1.2k instructions a
- * call against dsyrk's 3.4k; for many columns its reductions and stores cost more
- * than dsyrk's packed kernel (set-up's 30 x 30 SU from 30 rows: 22.1k against 21.1k),
- * so those stay with dsyrk.
  */
 FCCQP_FORCE_INLINE int fccqp_any_nonzero(const double *v, int count)
 {
@@ -1109,61 +1101,6 @@ static void fccqp_trsm_lower(const double *restrict L, int n, int ld, double *re
             b[k] = v0;
             for (int i = k + 1; i < n; i++)
                 b[i] -= c0[i] * v0;
-        }
-    }
-}
-
-/* the dot products of the columns a0..a3 with b0 and b1 (k entries each) into
- * out[2 i + j] (a_i with b_j) */
-FCCQP_FORCE_INLINE void fccqp_dots_4x2(const double *a0, const double *a1, const double *a2,
-                                       const double *a3, const double *b0, const double *b1,
-                                       int k, double out[8])
-{
-    fccqp_d4 s00 = fccqp_dsplat(0.0), s01 = s00, s10 = s00, s11 = s00, s20 = s00;
-    fccqp_d4 s21 = s00, s30 = s00, s31 = s00;
-    int r = 0;
-    for (; r + 4 <= k; r += 4) {
-        fccqp_d4 x0 = fccqp_dload(b0 + r), x1 = fccqp_dload(b1 + r), y;
-        y = fccqp_dload(a0 + r);
-        s00 = fccqp_dadd(s00, fccqp_dmul(y, x0)), s01 = fccqp_dadd(s01, fccqp_dmul(y, x1));
-        y = fccqp_dload(a1 + r);
-        s10 = fccqp_dadd(s10, fccqp_dmul(y, x0)), s11 = fccqp_dadd(s11, fccqp_dmul(y, x1));
-        y = fccqp_dload(a2 + r);
-        s20 = fccqp_dadd(s20, fccqp_dmul(y, x0)), s21 = fccqp_dadd(s21, fccqp_dmul(y, x1));
-        y = fccqp_dload(a3 + r);
-        s30 = fccqp_dadd(s30, fccqp_dmul(y, x0)), s31 = fccqp_dadd(s31, fccqp_dmul(y, x1));
-    }
-    out[0] = fccqp_dsum(s00), out[1] = fccqp_dsum(s01), out[2] = fccqp_dsum(s10);
-    out[3] = fccqp_dsum(s11), out[4] = fccqp_dsum(s20), out[5] = fccqp_dsum(s21);
-    out[6] = fccqp_dsum(s30), out[7] = fccqp_dsum(s31);
-    for (; r < k; r++) {
-        out[0] += a0[r] * b0[r], out[1] += a0[r] * b1[r];
-        out[2] += a1[r] * b0[r], out[3] += a1[r] * b1[r];
-        out[4] += a2[r] * b0[r], out[5] += a2[r] * b1[r];
-        out[6] += a3[r] * b0[r], out[7] += a3[r] * b1[r];
-    }
-}
-
-FCCQP_CLONES
-static void fccqp_syrk_t(int n, int k, const double *restrict A, int lda, double beta,
-                         double *restrict C, int ldc)
-{
-    double out[8];
-    for (int b = 0; b < n; b += 2) {
-        /* a column past the last is read as the last one, its sums dropped */
-        const double *b0 = A + (long)b * lda, *b1 = b + 1 < n ? b0 + lda : b0;
-        for (int a = b; a < n; a += 4) {
-            const double *a0 = A + (long)a * lda;
-            const double *a1 = a + 1 < n ? a0 + lda : a0;
-            const double *a2 = a + 2 < n ? a0 + 2 * (long)lda : a0;
-            const double *a3 = a + 3 < n ? a0 + 3 * (long)lda : a0;
-            fccqp_dots_4x2(a0, a1, a2, a3, b0, b1, k, out);
-            for (int i = 0; i < 4 && a + i < n; i++) {
-                double *entry = C + a + i + (long)b * ldc;
-                entry[0] = beta == 0.0 ? out[2 * i] : entry[0] + out[2 * i];
-                if (b + 1 < n && a + i > b)
-                    entry[ldc] = beta == 0.0 ? out[2 * i + 1] : entry[ldc] + out[2 * i + 1];
-            }
         }
     }
 }
@@ -1415,18 +1352,23 @@ static inline int fccqp_scan_copy(const double *v, long k, double limit, double 
  * four others: the 16 ymm registers), a column's four sums reduced together by two
  * horizontal additions and a lane swap, stored as four adjacent entries of C; the first
  * tile of a block of three columns starts at its diagonal, whose entries above are
- * stored back unchanged. Natively (AMD Zen 4, one thread, /tmp/gemm/bench.c: CPU time
- * per call, best of 60 batches) against scipy's OpenBLAS dsyrk, which runs its SkylakeX
- * kernels and packs A on every call: go2's 30 x 30 from 30 rows 0.90 against 2.07 us,
- * 30 x 30 from 14 0.64 against 1.06, talos' 68 x 68 from 68 6.9 against 12.0, 68 x 68 from
- * 27 3.9 against 5.1, from 8 2.24 against 2.16; in 4 x 4 tiles (spills) 0.77-1.08x
- * dsyrk, in 4 x 2 0.57-0.97x. The tiles' fixed cost (reductions, stores) grows with n
- * against dsyrk's blocking: from 4 rows, 0.8x dsyrk at n = 128 and 1.4x at 160, so
- * _blas.syrk_t calls it up to tuning.SYRK_LOOP_ORDER only (notes/tuning.md). Where the
- * CPU lacks AVX2 or FMA it returns 0 and the caller goes to dsyrk. */
+ * stored back unchanged.
+ * Natively (AMD Zen 4, one thread, /tmp/gemm/bench2.c: CPU time per call, best of 60
+ * batches) against scipy's OpenBLAS dsyrk, which runs its SkylakeX kernels and packs A
+ * on every call: go2's 30 x 30 from 30 rows 0.88 against 2.10 us, from 14 rows 0.62
+ * against 1.07; talos' 68 x 68 from 68 rows 6.9 against 12.1, from 27 3.9 against 5.1;
+ * polish_schur's W'W (3-12 columns of 30 rows) 26-191 ns against 183-523 (its earlier
+ * loop of dot products in 4 x 2 tiles with scalar reductions: 40-235). In 4 x 4 tiles
+ * (spills) 0.77-1.08x dsyrk's time, in 4 x 2 0.57-0.97x. A tile's fixed cost (three
+ * reductions, stores: about 30 cycles) does not shrink with k, while dsyrk's time does:
+ * order 68 breaks even from 4 rows, 96 from 8, 128 from 14, 160 from 16, so the kernel
+ * declines (returns 0) below n / FCCQP_SYRK_ORDER_PER_ROW rows, and _blas.syrk_t calls it
+ * up to order tuning.SYRK_LOOP_ORDER (notes/tuning.md). It returns 0 as well where the
+ * CPU lacks AVX2 or FMA: the caller goes to dsyrk. */
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include <immintrin.h>
 #define FCCQP_SYRK_COLUMNS 3
+#define FCCQP_SYRK_ORDER_PER_ROW 8
 #define FCCQP_L3 static inline __attribute__((target("avx2,fma"), always_inline))
 
 /* lanes 0 .. r - 1 set (all for r >= 4, none for r <= 0) */
@@ -1528,7 +1470,8 @@ static void fccqp_syrk_wide(int n, int k, const double *A, int lda, double beta,
 static inline int fccqp_syrk_lower(int n, int k, const double *A, int lda, double beta,
                                    double *C, int ldc)
 {
-    if (!(__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")))
+    if (n > FCCQP_SYRK_ORDER_PER_ROW * k
+        || !(__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")))
         return 0;
     fccqp_syrk_wide(n, k, A, lda, beta, C, ldc);
     return 1;
