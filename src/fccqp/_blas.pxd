@@ -37,9 +37,10 @@ cdef inline void syrk_t(int n, int k, const double* a, int lda, double beta, dou
     """Lower triangle of ``C = A' A + beta C`` (``A`` is ``k x n``).
 
     ``fccqp_syrk_lower`` (fccqp_kernels.h) up to order ``SYRK_LOOP_ORDER`` where the CPU
-    has AVX2 and FMA, ``dsyrk`` otherwise: at these sizes OpenBLAS packs ``A`` on every
-    call, and natively its SkylakeX ``dsyrk`` took 2.1 us for go2's 30 x 30 Schur
-    complements from 30 rows against the kernel's 0.9 (12.0 against 6.9 for talos' 68 x 68)."""
+    has AVX2 and FMA and ``A`` at least an eighth as many rows as the order, ``dsyrk``
+    otherwise: at these sizes OpenBLAS packs ``A`` on every call, and natively its
+    SkylakeX ``dsyrk`` took 2.1 us for go2's 30 x 30 Schur complements from 30 rows
+    against the kernel's 0.9 (12.0 against 6.9 for talos' 68 x 68)."""
     cdef char lower = b"L", trans = b"T"
     cdef double one = 1.0
     if n <= SYRK_LOOP_ORDER and fccqp_syrk_lower(n, k, a, lda, beta, c, ldc):
