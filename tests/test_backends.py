@@ -7,7 +7,7 @@ positive definite) are checked through ``Result.backend``.
 
 import numpy as np
 import pytest
-from fccqp.tuning import CHOLESKY_LOOP_ROWS
+from fccqp.tuning import CHOLESKY_LOOP_ROWS, SYRK_LOOP_ORDER
 
 import fccqp
 from fccqp import Status, schur
@@ -99,6 +99,22 @@ def test_backend_matches_clarabel_on_either_side_of_the_cholesky_loop(kkt_backen
     assert result.backend == kkt_backend
     reference = clarabel_solve(*problem)
     np.testing.assert_allclose(result.x, reference.x, atol=1e-5 * (1 + np.abs(reference.x).max()))
+
+
+@pytest.mark.parametrize("m", [SYRK_LOOP_ORDER - 1, SYRK_LOOP_ORDER + 1])
+def test_backend_matches_clarabel_on_either_side_of_the_syrk_loop(kkt_backend, m):
+    """``S = Y'Y`` (order ``m``), the Gram matrix ``A A'`` and the Schur polish's
+    complements are summed by the AVX2 tiles of ``fccqp_syrk_lower`` up to order
+    ``SYRK_LOOP_ORDER`` and by BLAS' ``dsyrk`` above (``m`` odd: a last tile with fewer
+    than four rows): both give Clarabel's answer, with ``A x = b`` held."""
+    problem = random_problem(9, n=m + 40, m=m, n_box=10)
+    result = fccqp.solve(*problem, kkt_backend=kkt_backend, eps_abs=1e-8, eps_rel=1e-8)
+    assert result.status is Status.SOLVED
+    assert result.backend == kkt_backend
+    reference = clarabel_solve(*problem)
+    np.testing.assert_allclose(result.x, reference.x, atol=1e-5 * (1 + np.abs(reference.x).max()))
+    A, b = problem[2:4]
+    assert np.abs(A @ result.x - b).max() <= 1e-9 * (1 + np.abs(b).max())
 
 
 @pytest.mark.parametrize("shape", ["diagonal tail", "coupled constrained", "flat free"])

@@ -1039,14 +1039,6 @@ static double fccqp_sum_squares(const double *restrict v, long k)
  * call): polish_schur_setup's 18 x 18 L and 30 columns 12.7k instructions against
  * dtrsm's 21.5k (most of it packing and set-up), the base's 30 x 30 S0 and 3-12
  * columns 4.5k against 10.5k.
- *
- * fccqp_syrk_t: the lower triangle of C = A'A + beta C (beta 0 or 1) for the
- * column-major k x n A (leading dimension lda): each entry a dot product of two columns
- * of A in four lanes, four entries of two columns of C per pass over k. For few columns
- * of many rows (polish_schur's W'W: go2 3-12 columns of 30 rows) 1.2k instructions a
- * call against dsyrk's 3.4k; for many columns its reductions and stores cost more
- * than dsyrk's packed kernel (set-up's 30 x 30 SU from 30 rows: 22.1k against 21.1k),
- * so those stay with dsyrk.
  */
 FCCQP_FORCE_INLINE int fccqp_any_nonzero(const double *v, int count)
 {
@@ -1104,61 +1096,6 @@ static void fccqp_trsm_lower(const double *restrict L, int n, int ld, double *re
             b[k] = v0;
             for (int i = k + 1; i < n; i++)
                 b[i] -= c0[i] * v0;
-        }
-    }
-}
-
-/* the dot products of the columns a0..a3 with b0 and b1 (k entries each) into
- * out[2 i + j] (a_i with b_j) */
-FCCQP_FORCE_INLINE void fccqp_dots_4x2(const double *a0, const double *a1, const double *a2,
-                                       const double *a3, const double *b0, const double *b1,
-                                       int k, double out[8])
-{
-    fccqp_d4 s00 = fccqp_dsplat(0.0), s01 = s00, s10 = s00, s11 = s00, s20 = s00;
-    fccqp_d4 s21 = s00, s30 = s00, s31 = s00;
-    int r = 0;
-    for (; r + 4 <= k; r += 4) {
-        fccqp_d4 x0 = fccqp_dload(b0 + r), x1 = fccqp_dload(b1 + r), y;
-        y = fccqp_dload(a0 + r);
-        s00 = fccqp_dadd(s00, fccqp_dmul(y, x0)), s01 = fccqp_dadd(s01, fccqp_dmul(y, x1));
-        y = fccqp_dload(a1 + r);
-        s10 = fccqp_dadd(s10, fccqp_dmul(y, x0)), s11 = fccqp_dadd(s11, fccqp_dmul(y, x1));
-        y = fccqp_dload(a2 + r);
-        s20 = fccqp_dadd(s20, fccqp_dmul(y, x0)), s21 = fccqp_dadd(s21, fccqp_dmul(y, x1));
-        y = fccqp_dload(a3 + r);
-        s30 = fccqp_dadd(s30, fccqp_dmul(y, x0)), s31 = fccqp_dadd(s31, fccqp_dmul(y, x1));
-    }
-    out[0] = fccqp_dsum(s00), out[1] = fccqp_dsum(s01), out[2] = fccqp_dsum(s10);
-    out[3] = fccqp_dsum(s11), out[4] = fccqp_dsum(s20), out[5] = fccqp_dsum(s21);
-    out[6] = fccqp_dsum(s30), out[7] = fccqp_dsum(s31);
-    for (; r < k; r++) {
-        out[0] += a0[r] * b0[r], out[1] += a0[r] * b1[r];
-        out[2] += a1[r] * b0[r], out[3] += a1[r] * b1[r];
-        out[4] += a2[r] * b0[r], out[5] += a2[r] * b1[r];
-        out[6] += a3[r] * b0[r], out[7] += a3[r] * b1[r];
-    }
-}
-
-FCCQP_CLONES
-static void fccqp_syrk_t(int n, int k, const double *restrict A, int lda, double beta,
-                         double *restrict C, int ldc)
-{
-    double out[8];
-    for (int b = 0; b < n; b += 2) {
-        /* a column past the last is read as the last one, its sums dropped */
-        const double *b0 = A + (long)b * lda, *b1 = b + 1 < n ? b0 + lda : b0;
-        for (int a = b; a < n; a += 4) {
-            const double *a0 = A + (long)a * lda;
-            const double *a1 = a + 1 < n ? a0 + lda : a0;
-            const double *a2 = a + 2 < n ? a0 + 2 * (long)lda : a0;
-            const double *a3 = a + 3 < n ? a0 + 3 * (long)lda : a0;
-            fccqp_dots_4x2(a0, a1, a2, a3, b0, b1, k, out);
-            for (int i = 0; i < 4 && a + i < n; i++) {
-                double *entry = C + a + i + (long)b * ldc;
-                entry[0] = beta == 0.0 ? out[2 * i] : entry[0] + out[2 * i];
-                if (b + 1 < n && a + i > b)
-                    entry[ldc] = beta == 0.0 ? out[2 * i + 1] : entry[ldc] + out[2 * i + 1];
-            }
         }
     }
 }
@@ -1454,5 +1391,148 @@ static void fccqp_lu_solve(const double *restrict T, int n, const int *restrict 
             b[i] -= c0[i] * b[k - 1];
     }
 }
+
+/* fccqp_syrk_lower: the lower triangle of C = A' A + beta C for a column-major k x n A
+ * (leading dimension lda) and n x n C (ldc), beta 0 (C not read) or any other; A and C do
+ * not overlap. Entry (a, b) is the dot product of columns a and b: row r of them in lane
+ * r mod 4 of a 32-byte vector, fused multiply-adds in row order from 0.0 (the last k mod
+ * 4 rows through a masked load), the lanes summed (0 + 1) + (2 + 3), then beta C added:
+ * its bits depend on the two columns only, wherever the entry sits among the tiles.
+ * Tiles of 4 x 3 entries (12 accumulators, the three columns' vectors and one of the
+ * four others: the 16 ymm registers), a column's four sums reduced together by two
+ * horizontal additions and a lane swap, stored as four adjacent entries of C; the first
+ * tile of a block of three columns starts at its diagonal, whose entries above are
+ * stored back unchanged.
+ * Natively (AMD Zen 4, one thread, /tmp/gemm/bench2.c: CPU time per call, best of 60
+ * batches) against scipy's OpenBLAS dsyrk, which runs its SkylakeX kernels and packs A
+ * on every call: go2's 30 x 30 from 30 rows 0.88 against 2.10 us, from 14 rows 0.62
+ * against 1.07; talos' 68 x 68 from 68 rows 6.9 against 12.1, from 27 3.9 against 5.1;
+ * polish_schur's W'W (3-12 columns of 30 rows) 26-191 ns against 183-523 (its earlier
+ * loop of dot products in 4 x 2 tiles with scalar reductions: 40-235). In 4 x 4 tiles
+ * (spills) 0.77-1.08x dsyrk's time, in 4 x 2 0.57-0.97x. A tile's fixed cost (three
+ * reductions, stores: about 30 cycles) does not shrink with k, while dsyrk's time does:
+ * order 68 breaks even from 4 rows, 96 from 8, 128 from 14, 160 from 16, so the kernel
+ * declines (returns 0) below n / FCCQP_SYRK_ORDER_PER_ROW rows, and _blas.syrk_t calls it
+ * up to order tuning.SYRK_LOOP_ORDER (notes/tuning.md). It returns 0 as well where the
+ * CPU lacks AVX2 or FMA: the caller goes to dsyrk. */
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#define FCCQP_SYRK_COLUMNS 3
+#define FCCQP_SYRK_ORDER_PER_ROW 8
+#define FCCQP_L3 static inline __attribute__((target("avx2,fma"), always_inline))
+
+/* lanes 0 .. r - 1 set (all for r >= 4, none for r <= 0) */
+FCCQP_L3 __m256i fccqp_first_lanes(long r)
+{
+    return _mm256_cmpgt_epi64(_mm256_set1_epi64x(r), _mm256_setr_epi64x(0, 1, 2, 3));
+}
+
+/* the lane sums (0 + 1) + (2 + 3) of a0 .. a3, in that order in one vector */
+FCCQP_L3 __m256d fccqp_lane_sums(__m256d a0, __m256d a1, __m256d a2, __m256d a3)
+{
+    __m256d t0 = _mm256_hadd_pd(a0, a1), t1 = _mm256_hadd_pd(a2, a3);
+    return _mm256_add_pd(_mm256_permute2f128_pd(t0, t1, 0x20),
+                         _mm256_permute2f128_pd(t0, t1, 0x31));
+}
+
+/* s + beta old (beta 0: s) */
+FCCQP_L3 __m256d fccqp_plus_beta(__m256d s, __m256d old, double beta)
+{
+    if (beta == 1.0)
+        return _mm256_add_pd(old, s);
+    return _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(beta), old), s);
+}
+
+/* C[i + r, j + c] for r < 4, c < FCCQP_SYRK_COLUMNS, the entries with i + r < n and
+ * i + r >= j + c; a column or row past n is read as column i or j, its sums dropped */
+FCCQP_L3 void fccqp_syrk_tile(const double *A, long lda, int i, int j, int n, int k,
+                              double beta, double *C, long ldc)
+{
+    enum { J = FCCQP_SYRK_COLUMNS };
+    const double *a[4], *b[J];
+    __m256d acc[4][J];
+    for (int r = 0; r < 4; r++)
+        a[r] = A + (i + r < n ? i + r : i) * lda;
+    for (int c = 0; c < J; c++)
+        b[c] = A + (j + c < n ? j + c : j) * lda;
+    for (int r = 0; r < 4; r++)
+        for (int c = 0; c < J; c++)
+            acc[r][c] = _mm256_setzero_pd();
+    int l = 0;
+    for (; l + 4 <= k; l += 4) {
+        __m256d y[J];
+        for (int c = 0; c < J; c++)
+            y[c] = _mm256_loadu_pd(b[c] + l);
+        for (int r = 0; r < 4; r++) {
+            __m256d x = _mm256_loadu_pd(a[r] + l);
+            for (int c = 0; c < J; c++)
+                acc[r][c] = _mm256_fmadd_pd(x, y[c], acc[r][c]);
+        }
+    }
+    if (l < k) {
+        __m256i rows = fccqp_first_lanes(k - l);
+        __m256d y[J];
+        for (int c = 0; c < J; c++)
+            y[c] = _mm256_maskload_pd(b[c] + l, rows);
+        for (int r = 0; r < 4; r++) {
+            __m256d x = _mm256_maskload_pd(a[r] + l, rows);
+            for (int c = 0; c < J; c++)
+                acc[r][c] = _mm256_fmadd_pd(x, y[c], acc[r][c]);
+        }
+    }
+    __m256i index = _mm256_setr_epi64x(i, i + 1, i + 2, i + 3);
+    __m256i inside = _mm256_cmpgt_epi64(_mm256_set1_epi64x(n), index);
+    for (int c = 0; c < J && j + c < n; c++) {
+        double *out = C + i + (j + c) * ldc;
+        __m256d s = fccqp_lane_sums(acc[0][c], acc[1][c], acc[2][c], acc[3][c]);
+        __m256i above = _mm256_cmpgt_epi64(_mm256_set1_epi64x(j + c), index);
+        if (i + 4 <= n) {   /* four rows of C: stored whole, those above the diagonal as read */
+            __m256d old = i >= j + c && beta == 0.0 ? s : _mm256_loadu_pd(out);
+            if (beta != 0.0)
+                s = fccqp_plus_beta(s, old, beta);
+            if (i < j + c)
+                s = _mm256_blendv_pd(s, old, _mm256_castsi256_pd(above));
+            _mm256_storeu_pd(out, s);
+        } else {   /* the last rows of C, one at a time: vmaskmovpd's store is slow on AMD */
+            __m256i keep = _mm256_andnot_si256(above, inside);
+            double lanes[4];
+            long long kept[4];
+            if (beta != 0.0)
+                s = fccqp_plus_beta(s, _mm256_maskload_pd(out, keep), beta);
+            _mm256_storeu_pd(lanes, s);
+            _mm256_storeu_si256((__m256i *)kept, keep);
+            for (int r = 0; r < 4; r++)
+                if (kept[r])
+                    out[r] = lanes[r];
+        }
+    }
+}
+
+__attribute__((target("avx2,fma")))
+static void fccqp_syrk_wide(int n, int k, const double *A, int lda, double beta, double *C,
+                            int ldc)
+{
+    for (int j = 0; j < n; j += FCCQP_SYRK_COLUMNS)
+        for (int i = j; i < n; i += 4)
+            fccqp_syrk_tile(A, lda, i, j, n, k, beta, C, ldc);
+}
+
+static inline int fccqp_syrk_lower(int n, int k, const double *A, int lda, double beta,
+                                   double *C, int ldc)
+{
+    if (n > FCCQP_SYRK_ORDER_PER_ROW * k
+        || !(__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")))
+        return 0;
+    fccqp_syrk_wide(n, k, A, lda, beta, C, ldc);
+    return 1;
+}
+#else
+static inline int fccqp_syrk_lower(int n, int k, const double *A, int lda, double beta,
+                                   double *C, int ldc)
+{
+    (void)n, (void)k, (void)A, (void)lda, (void)beta, (void)C, (void)ldc;
+    return 0;
+}
+#endif
 
 #endif

@@ -61,7 +61,6 @@ cdef extern from "fccqp_kernels.h" nogil:
     void fccqp_matvec_t(const double* M, int ld, const double* y, double* out, int rows,
                         int cols)
     void fccqp_trsm_lower(const double* L, int n, int ld, double* B, int cols, int ldb)
-    void fccqp_syrk_t(int n, int k, const double* A, int lda, double beta, double* C, int ldc)
 
 
 cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noexcept nogil:
@@ -322,7 +321,7 @@ cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
         e += d
     if e > 0 and m > 0:
         fccqp_trsm_lower(f.S0, <int>m, <int>m, f.W, <int>e, <int>m)
-        fccqp_syrk_t(<int>e, <int>m, f.W, <int>m, 0.0, f.WW, <int>s)   # few columns: see the kernel
+        syrk_t(<int>e, <int>m, f.W, <int>m, 0.0, f.WW, <int>s)
     else:
         for c in range(e):
             for r in range(c, e):
