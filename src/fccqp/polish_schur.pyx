@@ -184,10 +184,12 @@ cdef void _add_sparse_rows(PolishSchur* f, const Problem* p, Py_ssize_t first,
     of ``Y``, from the nonzeros that :func:`_write_row` and :func:`_find_row` recorded:
     a fused multiply-add per nonzero pair, row after row, which is how ``dsyrk`` sums
     each entry (a zero term adds exactly nothing), so ``T`` holds the bits ``dsyrk``
-    would (as :func:`fccqp.schur._add_row_products`; the same x digests under valgrind's
-    Haswell kernels). These rows are a column of ``A`` over a pivot (a torque, a slack:
-    one entry; a contact force: a few) or a boundary block's few columns: on talos'
-    warm ticks ``dsyrk`` over them took 60-130k instructions a call (callgrind)."""
+    would where its kernel sums that way (as :func:`fccqp.schur._add_row_products`:
+    OpenBLAS' Haswell kernels do, its SkylakeX kernels do not; the sums here are then
+    the same on every machine). These rows are a column of ``A`` over a pivot (a
+    torque, a slack: one entry; a contact force: a few) or a boundary block's few
+    columns: on talos' warm ticks ``dsyrk`` over them took 60-130k instructions a call
+    (callgrind)."""
     cdef Py_ssize_t j, ld = p.m + p.s
     for j in range(first, last):
         if f.row_count[j] > 0:
@@ -477,8 +479,8 @@ cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t
     factorizations of a polish: every ``renew`` and every re-linearization moves every
     plane) then refactors only ``K`` and ``T`` (``nb d`` and ``nb`` rows) and keeps
     ``S0``, ``W`` and ``W'W`` (notes/polish.md, "schurup"). Otherwise, or where ``S0`` is
-    too near singular for that order, the whole ``S`` (:func:`_factor_whole`: the rows
-    of ``Y`` it writes for a guess are the base's, so the base stays the guess's)."""
+    too near singular for that order, the whole ``S`` (:func:`_factor_whole`, from the
+    base's rows of ``Y`` and their sums, so the base stays the guess's)."""
     f.bordered = False
     if not _same_base(f, p, index, boundary, nb):
         _build_base(f, p, index, boundary, nb)
