@@ -29,6 +29,9 @@ cdef struct PolishSchur:
     double* t               # n scratch
     double* t2              # n scratch
     double* u               # m + s scratch
+    int* row_nz             # n x (m + s): each row of Y's nonzero columns, increasing
+    int* row_count          # n: how many (the diagonal and boundary rows)
+    double* nz_values       # m + s scratch: a row's nonzero entries
     int size                # m + nb of the last factored guess
     # The bordered factorization (polish_schur.pyx), which keeps the part of S that a
     # guess's boundary planes and curvature do not change:
@@ -41,6 +44,7 @@ cdef struct PolishSchur:
     int nbd                 # their entries: the boundary rows of the bordered system
     double base_largest     # S0's largest diagonal entry
     double* S0              # m x m: Cholesky of SU + the free diagonal rows' Y'Y
+    double* DD              # m x m: the free diagonal rows' Y'Y (lower), summed as dsyrk sums
     double* W               # m x s: S0's factor^-1 A_B', a column per boundary entry
     double* WW              # s x s: W'W
     double* K               # s x s: Cholesky of H_B + W'W

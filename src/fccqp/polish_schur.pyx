@@ -61,6 +61,8 @@ cdef extern from "fccqp_kernels.h" nogil:
     void fccqp_matvec_t(const double* M, int ld, const double* y, double* out, int rows,
                         int cols)
     void fccqp_trsm_lower(const double* L, int n, int ld, double* B, int cols, int ldb)
+    void fccqp_sparse_rank_update(const double* Y, int ld, int rows, const int* index,
+                                  const int* count, int m, double* T, double* values)
 
 
 cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noexcept nogil:
@@ -117,18 +119,81 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
         if not pivot * pivot > PIVOT_TOLERANCE * largest:
             return False
     for c in range(m):
-        for r in range(rest):
+        for r in range(k):
             f.Y[r + c * n] = p.A.values[c * n + f.order[r]]
-        for r in range(k, rest):
-            f.Y[r + c * n] *= f.inv_root[r]
+    for r in range(k, rest):
+        _write_row(f, p, f.order[r], r, f.inv_root[r])
     if m > 0:
         if k > 0:
             fccqp_trsm_lower(f.L, k, <int>n, f.Y, <int>m, <int>n)
-        syrk_t(<int>m, <int>rest, f.Y, <int>n, 0.0, f.SU, <int>m)
+            syrk_t(<int>m, k, f.Y, <int>n, 0.0, f.SU, <int>m)
+        else:
+            _zero_lower(f.SU, m)
+        _add_sparse_rows(f, p, k, rest, m, f.SU)   # the diagonal rows go on with dsyrk's sums
         for c in range(m):
             f.SU[c + c * m] += delta
     f.ready = True
     return True
+
+
+cdef inline void _zero_lower(double* T, Py_ssize_t size) noexcept nogil:
+    """Zero the lower triangle of the ``size x size`` column-major ``T``."""
+    cdef Py_ssize_t r, c
+    for c in range(size):
+        for r in range(c, size):
+            T[r + c * size] = 0.0
+
+
+cdef inline void _write_row(PolishSchur* f, const Problem* p, Py_ssize_t i, Py_ssize_t row,
+                            double inverse) noexcept nogil:
+    """Row ``row`` of ``Y``'s first ``m`` columns: column ``i`` of ``A`` times
+    ``inverse``, and where it is nonzero (``row_nz``, ``row_count``; branch-free: every
+    column is written, kept where nonzero)."""
+    cdef Py_ssize_t c, n = p.n, m = p.m
+    cdef double* y = f.Y + row
+    cdef const double* a = p.A.values + i
+    cdef int* nz = f.row_nz + row * (m + p.s)
+    cdef int count = 0
+    cdef double value
+    for c in range(m):
+        value = a[c * n] * inverse
+        y[c * n] = value
+        nz[count] = <int>c
+        count += value != 0.0
+    f.row_count[row] = count
+
+
+cdef inline void _find_row(PolishSchur* f, const Problem* p, Py_ssize_t row,
+                           Py_ssize_t size) noexcept nogil:
+    """Where row ``row`` of ``Y``'s first ``size`` columns is nonzero (as
+    :func:`_write_row` records it)."""
+    cdef Py_ssize_t c, n = p.n
+    cdef const double* y = f.Y + row
+    cdef int* nz = f.row_nz + row * (p.m + p.s)
+    cdef int count = 0
+    for c in range(size):
+        nz[count] = <int>c
+        count += y[c * n] != 0.0
+    f.row_count[row] = count
+
+
+cdef void _add_sparse_rows(PolishSchur* f, const Problem* p, Py_ssize_t first,
+                           Py_ssize_t last, Py_ssize_t size, double* T) noexcept nogil:
+    """``T += Y_R' Y_R`` (lower triangle, ``size x size``) over the rows ``R = first:last``
+    of ``Y``, from the nonzeros that :func:`_write_row` and :func:`_find_row` recorded:
+    a fused multiply-add per nonzero pair, row after row, which is how ``dsyrk`` sums
+    each entry (a zero term adds exactly nothing), so ``T`` holds the bits ``dsyrk``
+    would where its kernel sums that way (as :func:`fccqp.schur._add_row_products`:
+    OpenBLAS' Haswell kernels do, its SkylakeX kernels do not; the sums here are then
+    the same on every machine). These rows are a column of ``A`` over a pivot (a
+    torque, a slack: one entry; a contact force: a few) or a boundary block's few
+    columns: on talos' warm ticks ``dsyrk`` over them took 60-130k instructions a call
+    (callgrind)."""
+    cdef Py_ssize_t j, ld = p.m + p.s
+    for j in range(first, last):
+        if f.row_count[j] > 0:
+            fccqp_sparse_rank_update(f.Y + j, <int>p.n, 1, f.row_nz + j * ld, f.row_count + j,
+                                     <int>size, T, f.nz_values)
 
 
 cdef inline bint _diagonal_row(PolishSchur* f, const Problem* p, Py_ssize_t i, Py_ssize_t row,
@@ -141,8 +206,7 @@ cdef inline bint _diagonal_row(PolishSchur* f, const Problem* p, Py_ssize_t i, P
     if f.root[i] == 0.0:
         return False
     inverse = 1.0 / f.root[i]
-    for c in range(m):
-        f.Y[row + c * n] = p.A.values[c * n + i] * inverse
+    _write_row(f, p, i, row, inverse)
     for c in range(m, size):
         f.Y[row + c * n] = 0.0
     f.rowvar[row] = i
@@ -156,37 +220,20 @@ cdef bint _factor_whole(PolishSchur* f, const Problem* p, const Py_ssize_t* inde
     """Factor the whole ``S`` (``m + nb`` rows) of the guess (see
     :func:`polish_schur_factor`) and keep ``Y = L^-1 C'`` for the solves. ``Y``'s rows:
     the unconstrained entries (from the set-up), the free box entries and free cone
-    blocks (a diagonal entry of ``H`` each), then the boundary blocks. False where the
-    Schur complement does not apply."""
-    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, size = m + nb, j, r, c, k, o, d
-    cdef Py_ssize_t start, row = f.unconstrained, kb, a
+    blocks (a diagonal entry of ``H`` each; written with their sums ``DD`` by
+    :func:`_build_base`, whose base is the guess's here), then the boundary blocks.
+    False where the Schur complement does not apply."""
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, size = m + nb, r, c, k, o, d
+    cdef Py_ssize_t start, row = f.diag_end, kb, a
     cdef double* S = f.S
     cdef double* Y = f.Y
     cdef double* B
     cdef double largest = 0.0
-    for c in range(m, size):   # the unconstrained entries have no plane
-        for r in range(f.unconstrained):
+    if f.base == BASE_NONE:
+        return False   # a free row of the guess could not be written (_build_base)
+    for c in range(m, size):   # the rows above the boundary blocks have no plane
+        for r in range(row):
             Y[r + c * n] = 0.0
-    for j in range(s):   # free box entries and free cone blocks: divided by sqrt(P_ii)
-        if not p.in_cone[j] and index[p.constrained[j]] >= 0:
-            if not _diagonal_row(f, p, p.constrained[j], row, size):
-                return False
-            row += 1
-    kb = 0
-    for k in range(p.cones.count):
-        start = p.constrained[p.cones.offset[k]]
-        if index[start] < 0:
-            continue   # at the apex: held
-        if kb < nb and boundary[kb] == k:
-            kb += 1    # on the boundary: below
-            continue
-        for a in range(p.cones.dim[k]):
-            if not _diagonal_row(f, p, start + a, row, size):
-                return False
-            row += 1
-    if kb != nb:
-        return False   # a boundary block that is held: not a guess this solves
-    f.diag_end = <int>row
     for kb in range(nb):   # boundary blocks: diag(P) + curvature, a Cholesky of d rows
         k = boundary[kb]
         o, d = p.cones.offset[k], p.cones.dim[k]
@@ -204,16 +251,19 @@ cdef bint _factor_whole(PolishSchur* f, const Problem* p, const Py_ssize_t* inde
             Y[row + a + (m + kb) * n] = g[o + a]
         for c in range(size):   # Y_block := B^-1 Y_block
             forward_substitution(B, <int>d, <int>d, Y + row + c * n)
+        for a in range(d):
+            _find_row(f, p, row + a, size)
         row += d
     f.rows = <int>row
-    for c in range(size):
+    for c in range(size):   # the base's sums over the rows above, continued below
         for r in range(c, size):
-            S[r + c * size] = f.SU[r + c * m] if r < m else 0.0
+            S[r + c * size] = f.DD[r + c * m] if r < m else 0.0
+    _add_sparse_rows(f, p, f.diag_end, row, size, S)
+    for c in range(size):
+        for r in range(c, m):
+            S[r + c * size] += f.SU[r + c * m]
         if c >= m:
-            S[c + c * size] = delta
-    if size > 0 and row > f.unconstrained:   # BLAS rejects a leading dimension of 0
-        syrk_t(<int>size, <int>(row - f.unconstrained), Y + f.unconstrained, <int>n, 1.0, S,
-               <int>size)
+            S[c + c * size] += delta
     for c in range(size):
         largest = max(largest, S[c + c * size])
     if size > 0 and not cholesky(S, <int>size, <int>size):
@@ -284,7 +334,8 @@ cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
     ``BASE_REFUSED`` where ``S0`` is too near singular for the bordered solve
     (``POLISH_BORDER_TOLERANCE``: go2's rows that only boundary blocks span leave ``S0``
     ``delta`` there), so that the guesses of that base go straight to
-    :func:`_factor_whole`, which writes the same rows of ``Y``."""
+    :func:`_factor_whole`, which starts from the same rows of ``Y`` and their sums
+    ``DD``."""
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, r, c, a, kb, o, d, start, e = 0, row
     cdef double largest = 0.0
     f.base = BASE_NONE
@@ -296,12 +347,11 @@ cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
     for kb in range(nb):
         f.base_boundary[kb] = boundary[kb]
     f.base = BASE_REFUSED
+    _zero_lower(f.DD, m)
+    _add_sparse_rows(f, p, f.unconstrained, row, m, f.DD)
     for c in range(m):
         for r in range(c, m):
-            f.S0[r + c * m] = f.SU[r + c * m]
-    if m > 0 and row > f.unconstrained:
-        syrk_t(<int>m, <int>(row - f.unconstrained), f.Y + f.unconstrained, <int>n, 1.0, f.S0,
-               <int>m)
+            f.S0[r + c * m] = f.DD[r + c * m] + f.SU[r + c * m]
     for c in range(m):
         largest = max(largest, f.S0[c + c * m])
     if m > 0 and not cholesky(f.S0, <int>m, <int>m):
@@ -428,8 +478,8 @@ cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t
     factorizations of a polish: every ``renew`` and every re-linearization moves every
     plane) then refactors only ``K`` and ``T`` (``nb d`` and ``nb`` rows) and keeps
     ``S0``, ``W`` and ``W'W`` (notes/polish.md, "schurup"). Otherwise, or where ``S0`` is
-    too near singular for that order, the whole ``S`` (:func:`_factor_whole`: the rows
-    of ``Y`` it writes for a guess are the base's, so the base stays the guess's)."""
+    too near singular for that order, the whole ``S`` (:func:`_factor_whole`, from the
+    base's rows of ``Y`` and their sums, so the base stays the guess's)."""
     f.bordered = False
     if not _same_base(f, p, index, boundary, nb):
         _build_base(f, p, index, boundary, nb)

@@ -210,7 +210,8 @@ cdef void _add_row_products(Schur* f, int first, int last, int m) noexcept nogil
     fused multiply-add per row in the rows' order from zero, into ``T`` (zero between
     calls), and the sum then added to ``G``: a zero term adds exactly nothing to a fused
     sum, so the entry is the one ``dsyrk`` with ``beta = 1`` gives, bit for bit, where
-    that kernel sums each entry that way (OpenBLAS' Haswell and SkylakeX kernels do)."""
+    that kernel sums each entry that way (OpenBLAS' Haswell kernels do; its SkylakeX
+    kernels, natively on AVX-512 machines, round 5 % of such entries otherwise)."""
     cdef int k
     fccqp_sparse_rank_update(f.Y + first, f.n, last - first, f.nonzeros + first * m,
                              f.nonzero_count + first, m, f.T, f.tail_values)

@@ -203,12 +203,14 @@ cdef void polish_schur_arrays(Arrays a, PolishSchur* ps, Py_ssize_t n, Py_ssize_
     ps.root, ps.inv_root = a.new(n), a.new(n)
     ps.rowvar, ps.block_row = <Py_ssize_t*>a.new_int(n), <Py_ssize_t*>a.new_int(s)
     ps.t, ps.t2, ps.u = a.new(n), a.new(n), a.new(m + s)
+    ps.row_nz, ps.row_count = <int*>a.new_int(n * (m + s)), <int*>a.new_int(n)
+    ps.nz_values = a.new(m + s)
     ps.L, ps.Y = a.new(n * n), a.new(n * (m + s))
     ps.SU, ps.S = a.new(m * m), a.new((m + s) * (m + s))
     ps.block = a.new(s * s)
     ps.base, ps.bordered = 0, False   # BASE_NONE
     ps.base_boundary = <Py_ssize_t*>a.new_int(s)
-    ps.S0, ps.W = a.new(m * m), a.new(m * s)
+    ps.S0, ps.DD, ps.W = a.new(m * m), a.new(m * m), a.new(m * s)
     ps.WW, ps.K, ps.Z, ps.T = a.new(s * s), a.new(s * s), a.new(s * s), a.new(s * s)
 
 
