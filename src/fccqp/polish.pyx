@@ -315,8 +315,10 @@ cdef int _newton(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t* nb, lon
     A refactored step is refined only to ``GUESS_TOLERANCE`` (:func:`_solve_guess`) and
     the point to ``POLISH_REFINE_TOLERANCE`` once, after the last step: the next step's
     residual, against the moved planes, repeats a refactored step's last corrections.
-    Refining every step to ``POLISH_REFINE_TOLERANCE`` takes one KKT residual and solve
-    more a step for the same passes and steps (notes/performance-history.md, "tail10")."""
+    Refining every step to ``POLISH_REFINE_TOLERANCE`` takes a KKT residual and a solve
+    more wherever a step's first correction leaves more than that (on whole-body control
+    about 1e-9 of the scale, from a step far off), for the same passes and steps
+    (notes/performance-history.md, "tail10")."""
     cdef double miss, rate, last_miss = INFINITY
     cdef bint refactored = False
     cdef bint loose = False   # the point is a refactored step's, refined to GUESS_TOLERANCE
