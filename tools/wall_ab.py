@@ -21,7 +21,10 @@ freezes the garbage collector's objects and waits; a pass walks the QPs in order
 at each sequence start (its warm view), with the collector off; ``contact`` walks as
 ``warm`` and keeps the times of its contact-change ticks only (the benchmark's contact
 change view: one tick per robot, whose wall time the rest of the walk's leaves cold
-caches for). Times are per tick the median over ``--rounds``. One BLAS thread. Run::
+caches for); ``coarse`` walks every ``--stride``-th QP of each sequence, each warm from
+the previous kept one and reset at each sequence start (the report's "every 10th" view,
+``benchmarks.views.coarse_path``). Times are per tick the median over ``--rounds``. One
+BLAS thread. Run::
 
     python tools/wall_ab.py /tmp/base /tmp/branch --robot go2 --mode cold --rounds 30
 
@@ -45,12 +48,13 @@ import gc, json, sys
 from threadpoolctl import threadpool_limits
 from benchmarks.cache import DEFAULT_CACHE, cached_test_set
 from benchmarks.solvers import make_adapter
-from benchmarks.views import cold_path, contact_changes, warm_path
+from benchmarks.views import coarse_path, cold_path, contact_changes, warm_path
 
-mode, robot, names = sys.argv[1], sys.argv[2], sys.argv[3:]
+mode, robot, stride, names = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4:]
 test_set, _ = cached_test_set(DEFAULT_CACHE, robot, "mix", 400, 0, seq_len=100, dt=0.002,
                               report=lambda line: print(line, file=sys.stderr))
-path = (cold_path if mode == "cold" else warm_path)(test_set)
+path = (cold_path(test_set) if mode == "cold" else
+        coarse_path(test_set, stride) if mode == "coarse" else warm_path(test_set))
 shown = [True] * len(path) if mode != "contact" else list(contact_changes(path))
 adapters = {name: make_adapter(name) for name in names}
 prepared = {name: [a.prepare(test_set.qps[i]) for i in path.indices]
@@ -85,12 +89,13 @@ REFERENCE = "daqp-pyr4"
 THREAD_ENV = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 
 
-def start_worker(root: Path, mode: str, robot: str, names: list[str]) -> subprocess.Popen:
+def start_worker(root: Path, mode: str, robot: str, stride: int,
+                 names: list[str]) -> subprocess.Popen:
     """A worker on the build at ``root``, warmed up and waiting for passes."""
     env = dict(os.environ, PYTHONPATH=f"{root / 'src'}{os.pathsep}{root}",
                **dict.fromkeys(THREAD_ENV, "1"))
-    worker = subprocess.Popen([sys.executable, "-c", WORKER, mode, robot, *names], cwd=root,
-                              env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+    worker = subprocess.Popen([sys.executable, "-c", WORKER, mode, robot, str(stride), *names],
+                              cwd=root, env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                               text=True)
     if worker.stdout.readline().strip() != "ready":
         raise SystemExit(f"the worker on {root} failed (its errors are above)")
@@ -135,14 +140,16 @@ def main() -> None:
     parser.add_argument("a", type=Path, help="checkout of build A (the baseline), built")
     parser.add_argument("b", type=Path, help="checkout of build B, built")
     parser.add_argument("--robot", default="go2")
-    parser.add_argument("--mode", choices=("cold", "warm", "contact"), default="cold",
-                        help="contact: the warm walk, timed at its contact-change ticks only")
+    parser.add_argument("--mode", choices=("cold", "warm", "contact", "coarse"), default="cold",
+                        help="contact: the warm walk, timed at its contact-change ticks only; "
+                             "coarse: every --stride-th QP, warm from the previous kept one")
+    parser.add_argument("--stride", type=int, default=10, help="the coarse mode's step")
     parser.add_argument("--rounds", type=int, default=30)
     parser.add_argument("--variant", default="fccqp-realtime", help="the fccqp variant")
     args = parser.parse_args()
     roots = {"A": args.a.resolve(), "B": args.b.resolve()}
     names = [args.variant, REFERENCE]
-    workers = {build: start_worker(root, args.mode, args.robot, names)
+    workers = {build: start_worker(root, args.mode, args.robot, args.stride, names)
                for build, root in roots.items()}
     try:
         times = lockstep(workers, names, args.rounds)
@@ -150,7 +157,8 @@ def main() -> None:
         for worker in workers.values():
             worker.stdin.close()
             worker.wait()
-    print(f"{args.robot}, {args.mode}, {args.rounds} rounds, per-tick medians")
+    mode = f"every {args.stride}th" if args.mode == "coarse" else args.mode
+    print(f"{args.robot}, {mode}, {args.rounds} rounds, per-tick medians")
     report({key: np.median(value, axis=0) for key, value in times.items()}, roots,
            args.variant)
 

@@ -247,12 +247,14 @@ cdef bint _factor_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t n
 
 cdef bint _solve_guess(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb,
                       double scale, int* factorizations, const Reduced* table, KKT* kkt,
-                      const double* rho_vec, bint* tabled, bint first) noexcept nogil:
+                      const double* rho_vec, bint* tabled) noexcept nogil:
     """Solve the polished QP of the current guess in the reduced form's coordinates
-    while ``tabled`` (:mod:`fccqp.polish_table`), else with its own KKT matrix (refined
-    to ``GUESS_TOLERANCE`` on a guess's ``first`` solve); a singular system in the
-    table's coordinates ends ``tabled`` for this polish. ``KEPT`` planes are dropped:
-    they serve only the first solve of :func:`_newton`."""
+    while ``tabled`` (:mod:`fccqp.polish_table`), else with its own KKT matrix, refined
+    only to ``GUESS_TOLERANCE``: the point moves on from there (the guess's
+    corrections, Newton's next step), and the point a polish returns is refined to
+    ``POLISH_REFINE_TOLERANCE`` by :func:`_newton` or at the end of :func:`polish`. A
+    singular system in the table's coordinates ends ``tabled`` for this polish. ``KEPT``
+    planes are dropped: they serve only the first solve of :func:`_newton`."""
     cdef Py_ssize_t k
     for k in range(nb):   # a kept plane serves only the Newton step that follows it
         if w.bare[w.boundary[k]] == KEPT:
@@ -262,9 +264,7 @@ cdef bint _solve_guess(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb
             table_solve(w, p, table, kkt, rho_vec, nb, scale)
             return True
         tabled[0] = False
-    return _factor_solve(w, p, nf, nb,
-                         (GUESS_TOLERANCE if first else POLISH_REFINE_TOLERANCE) * scale,
-                         factorizations)
+    return _factor_solve(w, p, nf, nb, GUESS_TOLERANCE * scale, factorizations)
 
 
 cdef void _multipliers(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t nb) noexcept nogil:
@@ -308,16 +308,26 @@ cdef int _newton(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t* nb, lon
     they converge fast), then refine the point and set its multipliers: 0. 1 when a block
     went past its apex (held there now, ``nb`` the blocks left, the point not re-solved);
     -1 when a factorization broke down. Where planes were ``KEPT``
-    (:func:`~fccqp.polish_guess.keep_bare_plane`), the first step solves them there."""
+    (:func:`~fccqp.polish_guess.keep_bare_plane`), the first step solves them there.
+
+    A refactored step is refined only to ``GUESS_TOLERANCE`` (:func:`_solve_guess`) and
+    the point to ``POLISH_REFINE_TOLERANCE`` once, after the last step: the next step's
+    residual, against the moved planes, repeats a refactored step's last corrections.
+    Refining every step to ``POLISH_REFINE_TOLERANCE`` takes a KKT residual and a solve
+    more wherever a step's first correction leaves more than that (on whole-body control
+    about 1e-9 of the scale, from a step far off), for the same passes and steps
+    (notes/performance-history.md, "tail10")."""
     cdef double miss, rate, last_miss = INFINITY
     cdef bint refactored = False
+    cdef bint loose = False   # the point is a refactored step's, refined to GUESS_TOLERANCE
     cdef Py_ssize_t changed
     cdef long step
     if _restore_kept_planes(w, p, nb[0]):
         if not _solve_guess(w, p, nf, nb[0], scale, factorizations, table, kkt, rho_vec,
-                            tabled, False):
+                            tabled):
             return -1
         refactored = True
+        loose = not tabled[0]
         nb[0] = drop_far_side(w, p, nb[0], &changed)
         if changed != 0:
             return 1
@@ -331,13 +341,14 @@ cdef int _newton(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t* nb, lon
                                               tabled[0]):
             refactored = True   # the chord step crossed an apex: a Newton step instead
         if refactored and not _solve_guess(w, p, nf, nb[0], scale, factorizations, table,
-                                           kkt, rho_vec, tabled, False):
+                                           kkt, rho_vec, tabled):
             return -1
+        loose = refactored and not tabled[0]
         last_miss = miss
         nb[0] = drop_far_side(w, p, nb[0], &changed)
         if changed != 0:
             return 1
-    if not refactored:   # refine the last chord step's (or the first solve's) point
+    if loose or not refactored:   # refine the last step's (or the first solve's) point
         if tabled[0]:
             table_solve(w, p, table, kkt, rho_vec, nb[0], scale)
         else:
@@ -493,8 +504,7 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         if feasible:
             copy(w.x, w.x_prev, n)
             copy(w.nu, w.nu_prev, m)
-        if not _solve_guess(w, p, nf, nb, scale, factorizations, table, kkt, rho_vec, &tabled,
-                            True):
+        if not _solve_guess(w, p, nf, nb, scale, factorizations, table, kkt, rho_vec, &tabled):
             return False
         _multipliers(w, p, nf, nb)
         passes += 1

@@ -144,7 +144,7 @@ cdef extern from *:
     #define FCCQP_POLISH_DELTA_CUT 1e-2
     /* refine the returned point while the KKT residual > this max(1, ||q||, ||b||) */
     #define FCCQP_POLISH_REFINE_TOLERANCE 1e-14
-    /* a guess's first solve is refined only to this: the next chord step repeats the work */
+    /* a guess's solve and a Newton step's are refined only to this: the next step repeats the work */
     #define FCCQP_GUESS_TOLERANCE 1e-10
     /* most active sets per polish: 6 accepted an unsettled one, 10 cost 6 % more per tick */
     #define FCCQP_GUESS_PASSES 8
