@@ -1405,4 +1405,265 @@ static inline int fccqp_scan_copy(const double *v, long k, double limit, double 
     return fccqp_checked_copy(v, k, limit, out);
 }
 
+/* Triangular solves with many right-hand sides for _blas.trsm and _blas.cholesky_solve:
+ * fccqp_trsm_left(trans, L, n, ld, B, cols, ldb) is B := L^-1 B (trans 'N') or L'^-1 B
+ * ('T') for the column-major lower n x n L (leading dimension ld) and the n x cols B
+ * (leading dimension ldb). OpenBLAS' dtrsm at these sizes (go2: 18 and 30 rows, 24-30
+ * columns; talos 38 and 68 rows, 56-68 columns) spends most of its time packing L and
+ * B, and natively runs SkylakeX's generic-C trsm kernels around its dgemm kernel (8-11 %
+ * of a cold go2 tick's samples with their copies, notes/performance-history.md,
+ * "coldwall"); one column at a time through the substitution loops lost to it (wall
+ * 1.011): each entry of L has to serve several columns of B from a register.
+ *
+ * Where the CPU has AVX2 and FMA (picked at each call), both are left-looking: every
+ * entry of the result is one chain of fused multiply-adds over the solved entries in
+ * their order (L^-1: rows k < i, from k = 0; L'^-1: rows k > i, the chain's terms
+ * summed in four lanes over k, the lanes added (0 + 1) + (2 + 3)), then times the
+ * pivot's reciprocal, so a column's result does not depend on the other columns or
+ * their count.
+ * - L^-1 B: eight rows of B (two vectors, rows of L's columns loaded once) by four
+ *   columns (broadcasts of their solved entries) in eight accumulators per pass over
+ *   the solved rows; the block's own triangle in scalar fused steps.
+ * - L'^-1 B: from the bottom, blocks of four rows (the top one holds n % 4) by two
+ *   columns, each entry a dot product of a column of L below the block with a column
+ *   of B, so the loads are contiguous; the block's triangle in scalar fused steps.
+ * Elsewhere fccqp_trsm_lower (above) and a dot product per entry. */
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define FCCQP_WIDE_TRSM 1
+#define FCCQP_TRSM_OP static inline __attribute__((target("avx2,fma"), always_inline))
+
+/* lanes below `rows` (0-4) set */
+FCCQP_TRSM_OP __m256i fccqp_rows_mask(int rows)
+{
+    return _mm256_cmpgt_epi64(_mm256_set1_epi64x(rows), _mm256_setr_epi64x(0, 1, 2, 3));
+}
+
+FCCQP_TRSM_OP __m256d fccqp_rows_load(const double *p, int rows, int full, __m256i mask)
+{
+    return full ? _mm256_loadu_pd(p) : (rows > 0 ? _mm256_maskload_pd(p, mask)
+                                                 : _mm256_setzero_pd());
+}
+
+FCCQP_TRSM_OP void fccqp_rows_store(double *p, __m256d v, int rows, int full, __m256i mask)
+{
+    if (full)
+        _mm256_storeu_pd(p, v);
+    else if (rows > 0)
+        _mm256_maskstore_pd(p, mask, v);
+}
+
+/* The triangle of a block of L^-1's rows i0:i0 + rows (1-8), shared by its columns:
+ * column r of the block below its diagonal (lanes r + 1 on of the block's two vectors,
+ * zero elsewhere), the pivot's reciprocal, and the index that broadcasts lane r. */
+typedef struct {
+    __m256d below[8][2], recip[8];
+    __m256i lane[8];
+    __m256i mask[2];
+    int rows;
+} fccqp_forward_triangle;
+
+FCCQP_TRSM_OP void fccqp_forward_setup(const double *L, int ld, int i0, int rows,
+                                       fccqp_forward_triangle *t)
+{
+    int rows1 = rows > 4 ? rows - 4 : 0;
+    t->rows = rows;
+    t->mask[0] = fccqp_rows_mask(rows - rows1);
+    t->mask[1] = fccqp_rows_mask(rows1);
+    for (int r = 0; r < rows; r++) {
+        const double *l = L + i0 + (long)(i0 + r) * ld;
+        __m256i after = _mm256_cmpgt_epi64(_mm256_setr_epi64x(0, 1, 2, 3),
+                                           _mm256_set1_epi64x(r));
+        __m256i after1 = _mm256_cmpgt_epi64(_mm256_setr_epi64x(4, 5, 6, 7),
+                                            _mm256_set1_epi64x(r));
+        t->below[r][0] = _mm256_and_pd(_mm256_maskload_pd(l, t->mask[0]),
+                                       _mm256_castsi256_pd(after));
+        t->below[r][1] = rows1 > 0 ? _mm256_and_pd(_mm256_maskload_pd(l + 4, t->mask[1]),
+                                                   _mm256_castsi256_pd(after1))
+                                   : _mm256_setzero_pd();
+        t->recip[r] = _mm256_set1_pd(1.0 / l[r]);
+        t->lane[r] = _mm256_set1_epi64x((long long)(2 * (r & 3)) | ((long long)(2 * (r & 3) + 1) << 32));
+    }
+}
+
+/* the lanes of v (each lane's value in both 32-bit halves' order) at lane[r] */
+FCCQP_TRSM_OP __m256d fccqp_broadcast_lane(__m256d v, __m256i index)
+{
+    return _mm256_castps_pd(_mm256_permutevar8x32_ps(_mm256_castpd_ps(v), index));
+}
+
+/* the block's rows (a0: rows 0-3, a1: 4-7, the updates of the rows above applied)
+ * solved in place: lane r becomes its chain times the pivot's reciprocal, then its
+ * product with column r of the block is subtracted from the lanes below */
+FCCQP_TRSM_OP void fccqp_forward_solve(const fccqp_forward_triangle *t, __m256d *a0,
+                                       __m256d *a1)
+{
+    __m256d s0 = *a0, s1 = *a1;
+    for (int r = 0; r < t->rows; r++) {
+        __m256d x = _mm256_mul_pd(fccqp_broadcast_lane(r < 4 ? s0 : s1, t->lane[r]),
+                                  t->recip[r]);
+        __m256d here = _mm256_castsi256_pd(_mm256_cmpeq_epi64(
+            _mm256_set1_epi64x(r & 3), _mm256_setr_epi64x(0, 1, 2, 3)));
+        if (r < 4) {
+            s0 = _mm256_blendv_pd(_mm256_fnmadd_pd(t->below[r][0], x, s0), x, here);
+            s1 = _mm256_fnmadd_pd(t->below[r][1], x, s1);
+        } else {
+            s1 = _mm256_blendv_pd(_mm256_fnmadd_pd(t->below[r][1], x, s1), x, here);
+        }
+    }
+    *a0 = s0, *a1 = s1;
+}
+
+/* rows i0:i0 + t->rows of columns 0:C of B (L^-1 B), the rows above solved */
+FCCQP_TRSM_OP void fccqp_forward_block(const double *restrict L, int ld, double *restrict B,
+                                       int ldb, int i0, int C,
+                                       const fccqp_forward_triangle *t, int full)
+{
+    int rows1 = t->rows > 4 ? t->rows - 4 : 0, rows0 = t->rows - rows1;
+    __m256i m0 = t->mask[0], m1 = t->mask[1];
+    __m256d a0[4], a1[4];
+    for (int c = 0; c < C; c++) {
+        a0[c] = fccqp_rows_load(B + i0 + (long)c * ldb, rows0, full, m0);
+        a1[c] = fccqp_rows_load(B + i0 + 4 + (long)c * ldb, rows1, full, m1);
+    }
+    for (int k = 0; k < i0; k++) {
+        const double *l = L + i0 + (long)k * ld;
+        __m256d l0 = fccqp_rows_load(l, rows0, full, m0);
+        __m256d l1 = fccqp_rows_load(l + 4, rows1, full, m1);
+        for (int c = 0; c < C; c++) {
+            __m256d x = _mm256_broadcast_sd(B + k + (long)c * ldb);
+            a0[c] = _mm256_fnmadd_pd(l0, x, a0[c]);
+            if (full || rows1 > 0)
+                a1[c] = _mm256_fnmadd_pd(l1, x, a1[c]);
+        }
+    }
+    for (int c = 0; c < C; c++) {
+        double *b = B + i0 + (long)c * ldb;
+        fccqp_forward_solve(t, &a0[c], &a1[c]);
+        fccqp_rows_store(b, a0[c], rows0, full, m0);
+        fccqp_rows_store(b + 4, a1[c], rows1, full, m1);
+    }
+}
+
+__attribute__((target("avx2,fma")))
+static void fccqp_forward_wide(const double *restrict L, int n, int ld, double *restrict B,
+                               int cols, int ldb)
+{
+    fccqp_forward_triangle t;
+    for (int i0 = 0; i0 < n; i0 += 8) {
+        int c = 0;
+        fccqp_forward_setup(L, ld, i0, n - i0 < 8 ? n - i0 : 8, &t);
+        if (t.rows == 8) {
+            for (; c + 4 <= cols; c += 4)
+                fccqp_forward_block(L, ld, B + (long)c * ldb, ldb, i0, 4, &t, 1);
+            for (; c < cols; c++)
+                fccqp_forward_block(L, ld, B + (long)c * ldb, ldb, i0, 1, &t, 1);
+        } else {
+            for (; c + 4 <= cols; c += 4)
+                fccqp_forward_block(L, ld, B + (long)c * ldb, ldb, i0, 4, &t, 0);
+            for (; c < cols; c++)
+                fccqp_forward_block(L, ld, B + (long)c * ldb, ldb, i0, 1, &t, 0);
+        }
+    }
+}
+
+/* rows i0:i0 + rows (1-4) of columns 0:C of B (L'^-1 B), the rows below solved up to n
+ * (n - i0 - rows a multiple of 4) */
+FCCQP_TRSM_OP void fccqp_backward_block(const double *restrict L, int n, int ld,
+                                        double *restrict B, int ldb, int i0, int rows,
+                                        int C, const double *recip)
+{
+    __m256d acc[4][2];
+    for (int r = 0; r < 4; r++)
+        for (int c = 0; c < C; c++)
+            acc[r][c] = _mm256_setzero_pd();
+    for (int k = i0 + rows; k < n; k += 4) {
+        __m256d x[2];
+        for (int c = 0; c < C; c++)
+            x[c] = _mm256_loadu_pd(B + k + (long)c * ldb);
+        for (int r = 0; r < rows; r++) {
+            __m256d l = _mm256_loadu_pd(L + k + (long)(i0 + r) * ld);
+            for (int c = 0; c < C; c++)
+                acc[r][c] = _mm256_fmadd_pd(l, x[c], acc[r][c]);
+        }
+    }
+    __m256i mask = fccqp_rows_mask(rows);
+    for (int c = 0; c < C; c++) {
+        /* lane r of `dots`: (0 + 1) + (2 + 3) of acc[r][c] */
+        __m256d t0 = _mm256_hadd_pd(acc[0][c], acc[1][c]);
+        __m256d t1 = _mm256_hadd_pd(acc[2][c], acc[3][c]);
+        __m256d dots = _mm256_add_pd(_mm256_permute2f128_pd(t0, t1, 0x20),
+                                     _mm256_permute2f128_pd(t0, t1, 0x31));
+        double *b = B + i0 + (long)c * ldb;
+        int full = rows == 4;
+        fccqp_rows_store(b, _mm256_sub_pd(fccqp_rows_load(b, rows, full, mask), dots), rows,
+                         full, mask);
+        for (int r = rows - 1; r >= 0; r--) {
+            const double *l = L + i0 + (long)(i0 + r) * ld;
+            double s = b[r];
+            for (int j = rows - 1; j > r; j--)
+                s = fma(-l[j], b[j], s);
+            b[r] = s * recip[r];
+        }
+    }
+}
+
+__attribute__((target("avx2,fma")))
+static void fccqp_backward_wide(const double *restrict L, int n, int ld, double *restrict B,
+                                int cols, int ldb)
+{
+    double recip[4];
+    for (int i0 = n - 4; i0 > -4; i0 -= 4) {
+        int rows = i0 < 0 ? i0 + 4 : 4, c = 0;
+        i0 = i0 < 0 ? 0 : i0;
+        for (int r = 0; r < rows; r++)
+            recip[r] = 1.0 / L[i0 + r + (long)(i0 + r) * ld];
+        if (rows == 4) {
+            for (; c + 2 <= cols; c += 2)
+                fccqp_backward_block(L, n, ld, B + (long)c * ldb, ldb, i0, 4, 2, recip);
+            for (; c < cols; c++)
+                fccqp_backward_block(L, n, ld, B + (long)c * ldb, ldb, i0, 4, 1, recip);
+        } else {
+            for (; c + 2 <= cols; c += 2)
+                fccqp_backward_block(L, n, ld, B + (long)c * ldb, ldb, i0, rows, 2, recip);
+            for (; c < cols; c++)
+                fccqp_backward_block(L, n, ld, B + (long)c * ldb, ldb, i0, rows, 1, recip);
+        }
+    }
+}
+#endif
+
+/* B := L'^-1 B, one dot product per entry (the portable path) */
+static void fccqp_backward_dots(const double *restrict L, int n, int ld, double *restrict B,
+                                int cols, int ldb)
+{
+    for (int c = 0; c < cols; c++) {
+        double *b = B + (long)c * ldb;
+        for (int i = n - 1; i >= 0; i--) {
+            const double *l = L + (long)i * ld;
+            double s = b[i];
+            for (int k = i + 1; k < n; k++)
+                s -= l[k] * b[k];
+            b[i] = s * (1.0 / l[i]);
+        }
+    }
+}
+
+static inline void fccqp_trsm_left(char trans, const double *L, int n, int ld, double *B,
+                                   int cols, int ldb)
+{
+#ifdef FCCQP_WIDE_TRSM
+    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
+        if (trans == 'N')
+            fccqp_forward_wide(L, n, ld, B, cols, ldb);
+        else
+            fccqp_backward_wide(L, n, ld, B, cols, ldb);
+        return;
+    }
+#endif
+    if (trans == 'N')
+        fccqp_trsm_lower(L, n, ld, B, cols, ldb);
+    else
+        fccqp_backward_dots(L, n, ld, B, cols, ldb);
+}
+
 #endif

@@ -179,6 +179,8 @@ cdef extern from *:
     #define FCCQP_LU_LOOP_ROWS 64
     /* Cholesky by the loop up to this order, dpotrf above: the loop 0.58-0.95x up to 128 */
     #define FCCQP_CHOLESKY_LOOP_ROWS 128
+    /* triangular solves by the loops up to this order, dtrsm / dpotrs above: 0.1-0.7x up to 128 */
+    #define FCCQP_TRSM_LOOP_ROWS 128
     /* a correction skips the KKT solve when that residual is below this x the constraints' */
     #define FCCQP_MINOR_PART 1e-2
     /* a rejected polish: ADMM goes on at 10x tighter tolerances at most this many times */
@@ -304,6 +306,7 @@ cdef extern from *:
     const double PIVOT_RATIO "FCCQP_PIVOT_RATIO"
     const int LU_LOOP_ROWS "FCCQP_LU_LOOP_ROWS"
     const int CHOLESKY_LOOP_ROWS "FCCQP_CHOLESKY_LOOP_ROWS"
+    const int TRSM_LOOP_ROWS "FCCQP_TRSM_LOOP_ROWS"
     const double MINOR_PART "FCCQP_MINOR_PART"
     const int POLISH_RETRIES "FCCQP_POLISH_RETRIES"
     const double POLISH_EXACT "FCCQP_POLISH_EXACT"
