@@ -1591,14 +1591,15 @@ FCCQP_TRSM_OP void fccqp_backward_setup(const double *L, int ld, int i0, int row
     }
 }
 
-/* rows i0:i0 + t->rows of columns 0:C of B (L'^-1 B), the rows below solved up to n
- * (n - i0 - rows a multiple of 4): each entry's sum over those rows is a dot product
- * of a column of L with a column of B in four lanes, four rows by two columns per pass */
+/* rows i0:i0 + rows (= t->rows) of columns 0:C of B (L'^-1 B), the rows below solved
+ * up to n (n - i0 - rows a multiple of 4): each entry's sum over those rows is a dot
+ * product of a column of L with a column of B in four lanes, four rows by two columns
+ * per pass */
 FCCQP_TRSM_OP void fccqp_backward_block(const double *restrict L, int n, int ld,
-                                        double *restrict B, int ldb, int i0, int C,
-                                        const fccqp_triangle *t)
+                                        double *restrict B, int ldb, int i0, int rows,
+                                        int C, const fccqp_triangle *t)
 {
-    int rows = t->rows, full = rows == 4;
+    int full = rows == 4;
     __m256d acc[4][2];
     for (int r = 0; r < 4; r++)
         for (int c = 0; c < C; c++)
@@ -1635,16 +1636,16 @@ static void fccqp_backward_wide(const double *restrict L, int n, int ld, double 
     for (int top = n; top > 0; top -= 4) {   /* the block of rows top - 4:top, or 0:top */
         int i0 = top >= 4 ? top - 4 : 0, c = 0;
         fccqp_backward_setup(L, ld, i0, top - i0, &t);
-        if (t.rows == 4) {
+        if (t.rows == 4) {   /* a constant 4 rows: the loops over them unrolled */
             for (; c + 2 <= cols; c += 2)
-                fccqp_backward_block(L, n, ld, B + (long)c * ldb, ldb, i0, 2, &t);
+                fccqp_backward_block(L, n, ld, B + (long)c * ldb, ldb, i0, 4, 2, &t);
             for (; c < cols; c++)
-                fccqp_backward_block(L, n, ld, B + (long)c * ldb, ldb, i0, 1, &t);
+                fccqp_backward_block(L, n, ld, B + (long)c * ldb, ldb, i0, 4, 1, &t);
         } else {
             for (; c + 2 <= cols; c += 2)
-                fccqp_backward_block(L, n, ld, B + (long)c * ldb, ldb, i0, 2, &t);
+                fccqp_backward_block(L, n, ld, B + (long)c * ldb, ldb, i0, t.rows, 2, &t);
             for (; c < cols; c++)
-                fccqp_backward_block(L, n, ld, B + (long)c * ldb, ldb, i0, 1, &t);
+                fccqp_backward_block(L, n, ld, B + (long)c * ldb, ldb, i0, t.rows, 1, &t);
         }
     }
 }
