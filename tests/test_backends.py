@@ -7,7 +7,7 @@ positive definite) are checked through ``Result.backend``.
 
 import numpy as np
 import pytest
-from fccqp.tuning import CHOLESKY_LOOP_ROWS, SYRK_LOOP_ORDER
+from fccqp.tuning import CHOLESKY_LOOP_ROWS, SYRK_LOOP_ORDER, TRSM_LOOP_ROWS
 
 import fccqp
 from fccqp import Status, schur
@@ -115,6 +115,20 @@ def test_backend_matches_clarabel_on_either_side_of_the_syrk_loop(kkt_backend, m
     np.testing.assert_allclose(result.x, reference.x, atol=1e-5 * (1 + np.abs(reference.x).max()))
     A, b = problem[2:4]
     assert np.abs(A @ result.x - b).max() <= 1e-9 * (1 + np.abs(b).max())
+
+
+@pytest.mark.parametrize("n", [TRSM_LOOP_ROWS, 2 * TRSM_LOOP_ROWS])
+def test_backend_matches_clarabel_on_either_side_of_the_triangular_loops(kkt_backend, n):
+    """The Schur backend's triangular solves (``Y = L^-1 A'`` over the ``n - 15`` free
+    rows, ``S^-1`` on its ``n / 2 + 8`` rows) go through the loops up to
+    ``TRSM_LOOP_ROWS`` and through ``dtrsm`` / ``dpotrs`` above: both give Clarabel's
+    answer."""
+    problem = random_problem(11, n=n, m=n // 2 + 8, n_box=6)
+    result = fccqp.solve(*problem, kkt_backend=kkt_backend, eps_abs=1e-8, eps_rel=1e-8)
+    assert result.status is Status.SOLVED
+    assert result.backend == kkt_backend
+    reference = clarabel_solve(*problem)
+    np.testing.assert_allclose(result.x, reference.x, atol=1e-5 * (1 + np.abs(reference.x).max()))
 
 
 @pytest.mark.parametrize("shape", ["diagonal tail", "coupled constrained", "flat free"])

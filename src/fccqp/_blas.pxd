@@ -9,12 +9,14 @@ times slower at our sizes; single vectors go through the loops of ``fccqp._dense
 from scipy.linalg.cython_blas cimport dgemm, dsyrk, dtrsm
 from scipy.linalg.cython_lapack cimport dpotrf, dpotrs
 
-from fccqp.tuning cimport CHOLESKY_LOOP_ROWS, SYRK_LOOP_ORDER
+from fccqp.tuning cimport CHOLESKY_LOOP_ROWS, SYRK_LOOP_ORDER, TRSM_LOOP_ROWS
 
 cdef extern from "fccqp_kernels.h" nogil:
     int fccqp_cholesky(double* M, int n, int ld)
     int fccqp_syrk_lower(int n, int k, const double* A, int lda, double beta, double* C,
                          int ldc)
+    void fccqp_trsm_left(char trans, const double* L, int n, int ld, double* B, int cols,
+                         int ldb)
 
 
 cdef inline void gemm(char ta, char tb, int m, int n, int k, double alpha, const double* a,
@@ -26,9 +28,17 @@ cdef inline void gemm(char ta, char tb, int m, int n, int k, double alpha, const
 
 cdef inline void trsm(char side, char trans, int m, int n, const double* L, int ldl,
                       double* B, int ldb) noexcept nogil:
-    """``B := op(L)^-1 B`` (side ``L``) or ``B op(L)^-1`` (side ``R``), ``L`` lower."""
+    """``B := op(L)^-1 B`` (side ``L``) or ``B op(L)^-1`` (side ``R``), ``L`` lower.
+
+    Side ``L`` up to order ``TRSM_LOOP_ROWS`` by ``fccqp_trsm_left`` (fccqp_kernels.h):
+    natively (one thread) 0.1-0.6x ``dtrsm``'s time at the Schur backend's shapes
+    (go2's 18 and 30 rows, talos' 38 and 68), whose packing and SkylakeX kernels
+    cost more than the solve; ``dtrsm`` above, where its blocking keeps ``L`` in cache."""
     cdef char lower = b"L", non_unit = b"N"
     cdef double one = 1.0
+    if side == b"L" and m <= TRSM_LOOP_ROWS:
+        fccqp_trsm_left(trans, L, m, ldl, B, n, ldb)
+        return
     dtrsm(&side, &lower, &trans, &non_unit, &m, &n, &one, <double*>L, &ldl, B, &ldb)
 
 
@@ -63,14 +73,6 @@ cdef inline bint cholesky(double* M, int n, int ld) noexcept nogil:
         return fccqp_cholesky(M, n, ld) != 0
     dpotrf(&lower, &n, M, &ld, &info)
     return info == 0
-
-
-cdef inline void cholesky_solve(const double* L, int n, int ld, double* B, int columns,
-                                int ldb) noexcept nogil:
-    """``B := (L L')^-1 B`` for ``L`` from :func:`cholesky`."""
-    cdef char lower = b"L"
-    cdef int info = 0
-    dpotrs(&lower, &n, &columns, <double*>L, &ld, B, &ldb, &info)
 
 
 cdef inline void forward_substitution(const double* L, int n, int ld, double* b) noexcept nogil:
@@ -156,3 +158,20 @@ cdef inline void cholesky_solve_vector(const double* L, int n, int ld, double* b
     the Schur backend's instructions)."""
     forward_substitution(L, n, ld, b)
     backward_substitution(L, n, ld, b)
+
+
+cdef inline void cholesky_solve(const double* L, int n, int ld, double* B, int columns,
+                                int ldb) noexcept nogil:
+    """``B := (L L')^-1 B`` for ``L`` from :func:`cholesky`: up to order
+    ``TRSM_LOOP_ROWS`` one column by :func:`cholesky_solve_vector` and more by
+    ``fccqp_trsm_left`` (``L^-1``, then ``L'^-1``), ``dpotrs`` above (see :func:`trsm`)."""
+    cdef char lower = b"L"
+    cdef int info = 0
+    if n <= TRSM_LOOP_ROWS:
+        if columns == 1:
+            cholesky_solve_vector(L, n, ld, B)
+        else:
+            fccqp_trsm_left(b"N", L, n, ld, B, columns, ldb)
+            fccqp_trsm_left(b"T", L, n, ld, B, columns, ldb)
+        return
+    dpotrs(&lower, &n, &columns, <double*>L, &ld, B, &ldb, &info)

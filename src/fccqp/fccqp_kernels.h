@@ -1554,4 +1554,284 @@ static inline int fccqp_syrk_lower(int n, int k, const double *A, int lda, doubl
 }
 #endif
 
+/* Triangular solves with many right-hand sides for _blas.trsm and _blas.cholesky_solve:
+ * fccqp_trsm_left(trans, L, n, ld, B, cols, ldb) is B := L^-1 B (trans 'N') or L'^-1 B
+ * ('T') for the column-major lower n x n L (leading dimension ld) and the n x cols B
+ * (leading dimension ldb). At the Schur backend's sizes (go2: 18 and 30 rows, 24-30
+ * columns; talos: 38 and 68 rows, 56-68 columns) OpenBLAS' dtrsm spends most of its
+ * time packing L and B, and natively runs SkylakeX's generic-C trsm kernels around its
+ * dgemm kernel (8-11 % of a cold go2 tick's samples with their copies,
+ * notes/performance-history.md, "coldwall"); one column at a time through the
+ * substitution loops lost to it (wall 1.011): an entry of L has to serve several
+ * columns of B from a register.
+ *
+ * Where the CPU has AVX2 and FMA (picked at each call), both solves are left-looking,
+ * in blocks of rows whose triangle is solved in registers (fccqp_triangle):
+ * - L^-1 B: blocks of eight rows (two vectors; the n % 8 rows first) by four columns,
+ *   eight accumulators of fused multiply-adds over the solved rows above, a column of
+ *   L loaded once for the four columns of B (a broadcast of each solved entry).
+ * - L'^-1 B: blocks of four rows from the bottom (the n % 4 rows last) by two columns,
+ *   each entry's sum over the solved rows below a dot product of a column of L with a
+ *   column of B in four lanes (contiguous loads), the lanes added (0 + 1) + (2 + 3).
+ * Every column of B goes through the same operations whatever the others, so its
+ * result does not depend on the number of columns solved with it. Natively (Zen 4, one
+ * thread, /tmp/trsm/bench.c in notes/performance-history.md, "trsm") against dtrsm:
+ * go2's shapes 0.57-1.15 us against 3.1-3.5 us, talos' 3.3-9.9 us against 11-22 us.
+ * Elsewhere fccqp_trsm_lower (above) and a dot product per entry. */
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define FCCQP_WIDE_TRSM 1
+#define FCCQP_TRSM_OP static inline __attribute__((target("avx2,fma"), always_inline))
+
+/* lanes below `rows` (0-4) set */
+FCCQP_TRSM_OP __m256i fccqp_rows_mask(int rows)
+{
+    return _mm256_cmpgt_epi64(_mm256_set1_epi64x(rows), _mm256_setr_epi64x(0, 1, 2, 3));
+}
+
+FCCQP_TRSM_OP __m256d fccqp_rows_load(const double *p, int rows, int full, __m256i mask)
+{
+    return full ? _mm256_loadu_pd(p) : (rows > 0 ? _mm256_maskload_pd(p, mask)
+                                                 : _mm256_setzero_pd());
+}
+
+FCCQP_TRSM_OP void fccqp_rows_store(double *p, __m256d v, int rows, int full, __m256i mask)
+{
+    if (full)
+        _mm256_storeu_pd(p, v);
+    else if (rows > 0)
+        _mm256_maskstore_pd(p, mask, v);
+}
+
+/* the index (of 32-bit halves) that broadcasts lane r % 4 of a vector of doubles */
+FCCQP_TRSM_OP __m256i fccqp_lane_index(int r)
+{
+    return _mm256_set1_epi64x((long long)(2 * (r & 3)) | ((long long)(2 * (r & 3) + 1) << 32));
+}
+
+FCCQP_TRSM_OP __m256d fccqp_broadcast_lane(__m256d v, __m256i index)
+{
+    return _mm256_castps_pd(_mm256_permutevar8x32_ps(_mm256_castpd_ps(v), index));
+}
+
+/* A block of rows (1-8) of the solve, shared by all the columns of B: in scaled[r] the
+ * coupling of row r to the block's other rows that it updates, over its pivot (zero in
+ * the lanes it does not update), the pivots' reciprocals, and the lanes' masks. The
+ * block's triangle is then solved in registers: lane r is final when its turn comes,
+ * its multiple of scaled[r] is subtracted from the lanes it updates (one broadcast and
+ * one fused multiply-add on the chain), and the lanes are multiplied by their pivots'
+ * reciprocals at the end. */
+typedef struct {
+    __m256d scaled[8][2], recip[2];
+    __m256i lane[8], mask[2];
+    int rows;
+} fccqp_triangle;
+
+/* rows i0:i0 + rows (1-8) of L^-1: row r updates the rows below it in the block (column
+ * i0 + r of L below the diagonal) */
+FCCQP_TRSM_OP void fccqp_forward_setup(const double *L, int ld, int i0, int rows,
+                                       fccqp_triangle *t)
+{
+    int rows1 = rows > 4 ? rows - 4 : 0;
+    double recip[8] = {1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0};
+    t->rows = rows;
+    t->mask[0] = fccqp_rows_mask(rows - rows1);
+    t->mask[1] = fccqp_rows_mask(rows1);
+    for (int r = 0; r < rows; r++)
+        recip[r] = 1.0 / L[i0 + r + (long)(i0 + r) * ld];
+    t->recip[0] = _mm256_loadu_pd(recip);
+    t->recip[1] = _mm256_loadu_pd(recip + 4);
+    for (int r = 0; r < rows; r++) {
+        const double *l = L + i0 + (long)(i0 + r) * ld;
+        __m256d below0 = _mm256_castsi256_pd(_mm256_cmpgt_epi64(
+            _mm256_setr_epi64x(0, 1, 2, 3), _mm256_set1_epi64x(r)));
+        __m256d below1 = _mm256_castsi256_pd(_mm256_cmpgt_epi64(
+            _mm256_setr_epi64x(4, 5, 6, 7), _mm256_set1_epi64x(r)));
+        __m256d x = _mm256_set1_pd(recip[r]);
+        t->scaled[r][0] = _mm256_mul_pd(_mm256_and_pd(_mm256_maskload_pd(l, t->mask[0]),
+                                                      below0), x);
+        t->scaled[r][1] = rows1 > 0 ? _mm256_mul_pd(_mm256_and_pd(
+                                          _mm256_maskload_pd(l + 4, t->mask[1]), below1), x)
+                                    : _mm256_setzero_pd();
+        t->lane[r] = fccqp_lane_index(r);
+    }
+}
+
+/* rows i0:i0 + t->rows of columns 0:C of B (L^-1 B), the rows above solved: eight rows
+ * (two vectors) by four columns in eight accumulators over the solved rows k, each
+ * column of L loaded once for the four columns of B */
+FCCQP_TRSM_OP void fccqp_forward_block(const double *restrict L, int ld, double *restrict B,
+                                       int ldb, int i0, int C, const fccqp_triangle *t,
+                                       int full)
+{
+    int rows1 = t->rows > 4 ? t->rows - 4 : 0, rows0 = t->rows - rows1;
+    __m256i m0 = t->mask[0], m1 = t->mask[1];
+    __m256d a0[4], a1[4];
+    for (int c = 0; c < C; c++) {
+        a0[c] = fccqp_rows_load(B + i0 + (long)c * ldb, rows0, full, m0);
+        a1[c] = fccqp_rows_load(B + i0 + 4 + (long)c * ldb, rows1, full, m1);
+    }
+    for (int k = 0; k < i0; k++) {
+        const double *l = L + i0 + (long)k * ld;
+        __m256d l0 = fccqp_rows_load(l, rows0, full, m0);
+        __m256d l1 = fccqp_rows_load(l + 4, rows1, full, m1);
+        for (int c = 0; c < C; c++) {
+            __m256d x = _mm256_broadcast_sd(B + k + (long)c * ldb);
+            a0[c] = _mm256_fnmadd_pd(l0, x, a0[c]);
+            if (full || rows1 > 0)
+                a1[c] = _mm256_fnmadd_pd(l1, x, a1[c]);
+        }
+    }
+    for (int r = 0; r < t->rows; r++) {
+        for (int c = 0; c < C; c++) {
+            __m256d x = fccqp_broadcast_lane(r < 4 ? a0[c] : a1[c], t->lane[r]);
+            if (r < 4)
+                a0[c] = _mm256_fnmadd_pd(t->scaled[r][0], x, a0[c]);
+            a1[c] = _mm256_fnmadd_pd(t->scaled[r][1], x, a1[c]);
+        }
+    }
+    for (int c = 0; c < C; c++) {
+        double *b = B + i0 + (long)c * ldb;
+        fccqp_rows_store(b, _mm256_mul_pd(a0[c], t->recip[0]), rows0, full, m0);
+        fccqp_rows_store(b + 4, _mm256_mul_pd(a1[c], t->recip[1]), rows1, full, m1);
+    }
+}
+
+__attribute__((target("avx2,fma")))
+static void fccqp_forward_wide(const double *restrict L, int n, int ld, double *restrict B,
+                               int cols, int ldb)
+{
+    fccqp_triangle t;
+    /* n % 8 rows first (if any): their block has no rows above it, so the masked loads
+       of a partial block stay out of the loop over the solved rows */
+    for (int i0 = 0, rows = n % 8 ? n % 8 : 8; i0 < n; i0 += rows, rows = 8) {
+        int c = 0;
+        fccqp_forward_setup(L, ld, i0, rows, &t);
+        if (t.rows == 8) {
+            for (; c + 4 <= cols; c += 4)
+                fccqp_forward_block(L, ld, B + (long)c * ldb, ldb, i0, 4, &t, 1);
+            for (; c < cols; c++)
+                fccqp_forward_block(L, ld, B + (long)c * ldb, ldb, i0, 1, &t, 1);
+        } else {
+            for (; c + 4 <= cols; c += 4)
+                fccqp_forward_block(L, ld, B + (long)c * ldb, ldb, i0, 4, &t, 0);
+            for (; c < cols; c++)
+                fccqp_forward_block(L, ld, B + (long)c * ldb, ldb, i0, 1, &t, 0);
+        }
+    }
+}
+
+/* rows i0:i0 + rows (1-4) of L'^-1: row r updates the rows above it in the block (row
+ * i0 + r of L left of the diagonal) */
+FCCQP_TRSM_OP void fccqp_backward_setup(const double *L, int ld, int i0, int rows,
+                                        fccqp_triangle *t)
+{
+    double recip[4] = {1.0, 1.0, 1.0, 1.0};
+    t->rows = rows;
+    t->mask[0] = fccqp_rows_mask(rows);
+    for (int r = 0; r < rows; r++)
+        recip[r] = 1.0 / L[i0 + r + (long)(i0 + r) * ld];
+    t->recip[0] = _mm256_loadu_pd(recip);
+    for (int r = 0; r < rows; r++) {
+        double row[4] = {0.0, 0.0, 0.0, 0.0};
+        for (int j = 0; j < r; j++)
+            row[j] = L[i0 + r + (long)(i0 + j) * ld];
+        t->scaled[r][0] = _mm256_mul_pd(_mm256_loadu_pd(row), _mm256_set1_pd(recip[r]));
+        t->lane[r] = fccqp_lane_index(r);
+    }
+}
+
+/* rows i0:i0 + rows (= t->rows) of columns 0:C of B (L'^-1 B), the rows below solved
+ * up to n (n - i0 - rows a multiple of 4): each entry's sum over those rows is a dot
+ * product of a column of L with a column of B in four lanes, four rows by two columns
+ * per pass */
+FCCQP_TRSM_OP void fccqp_backward_block(const double *restrict L, int n, int ld,
+                                        double *restrict B, int ldb, int i0, int rows,
+                                        int C, const fccqp_triangle *t)
+{
+    int full = rows == 4;
+    __m256d acc[4][2];
+    for (int r = 0; r < 4; r++)
+        for (int c = 0; c < C; c++)
+            acc[r][c] = _mm256_setzero_pd();
+    for (int k = i0 + rows; k < n; k += 4) {
+        __m256d x[2];
+        for (int c = 0; c < C; c++)
+            x[c] = _mm256_loadu_pd(B + k + (long)c * ldb);
+        for (int r = 0; r < rows; r++) {
+            __m256d l = _mm256_loadu_pd(L + k + (long)(i0 + r) * ld);
+            for (int c = 0; c < C; c++)
+                acc[r][c] = _mm256_fmadd_pd(l, x[c], acc[r][c]);
+        }
+    }
+    for (int c = 0; c < C; c++) {
+        /* lane r of `dots`: (0 + 1) + (2 + 3) of acc[r][c] */
+        __m256d t0 = _mm256_hadd_pd(acc[0][c], acc[1][c]);
+        __m256d t1 = _mm256_hadd_pd(acc[2][c], acc[3][c]);
+        __m256d dots = _mm256_add_pd(_mm256_permute2f128_pd(t0, t1, 0x20),
+                                     _mm256_permute2f128_pd(t0, t1, 0x31));
+        double *b = B + i0 + (long)c * ldb;
+        __m256d s = _mm256_sub_pd(fccqp_rows_load(b, rows, full, t->mask[0]), dots);
+        for (int r = rows - 1; r > 0; r--)
+            s = _mm256_fnmadd_pd(t->scaled[r][0], fccqp_broadcast_lane(s, t->lane[r]), s);
+        fccqp_rows_store(b, _mm256_mul_pd(s, t->recip[0]), rows, full, t->mask[0]);
+    }
+}
+
+__attribute__((target("avx2,fma")))
+static void fccqp_backward_wide(const double *restrict L, int n, int ld, double *restrict B,
+                                int cols, int ldb)
+{
+    fccqp_triangle t;
+    for (int top = n; top > 0; top -= 4) {   /* the block of rows top - 4:top, or 0:top */
+        int i0 = top >= 4 ? top - 4 : 0, c = 0;
+        fccqp_backward_setup(L, ld, i0, top - i0, &t);
+        if (t.rows == 4) {   /* a constant 4 rows: the loops over them unrolled */
+            for (; c + 2 <= cols; c += 2)
+                fccqp_backward_block(L, n, ld, B + (long)c * ldb, ldb, i0, 4, 2, &t);
+            for (; c < cols; c++)
+                fccqp_backward_block(L, n, ld, B + (long)c * ldb, ldb, i0, 4, 1, &t);
+        } else {
+            for (; c + 2 <= cols; c += 2)
+                fccqp_backward_block(L, n, ld, B + (long)c * ldb, ldb, i0, t.rows, 2, &t);
+            for (; c < cols; c++)
+                fccqp_backward_block(L, n, ld, B + (long)c * ldb, ldb, i0, t.rows, 1, &t);
+        }
+    }
+}
+#endif
+
+/* B := L'^-1 B, one dot product per entry (the portable path) */
+static void fccqp_backward_dots(const double *restrict L, int n, int ld, double *restrict B,
+                                int cols, int ldb)
+{
+    for (int c = 0; c < cols; c++) {
+        double *b = B + (long)c * ldb;
+        for (int i = n - 1; i >= 0; i--) {
+            const double *l = L + (long)i * ld;
+            double s = b[i];
+            for (int k = i + 1; k < n; k++)
+                s -= l[k] * b[k];
+            b[i] = s * (1.0 / l[i]);
+        }
+    }
+}
+
+static inline void fccqp_trsm_left(char trans, const double *L, int n, int ld, double *B,
+                                   int cols, int ldb)
+{
+#ifdef FCCQP_WIDE_TRSM
+    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
+        if (trans == 'N')
+            fccqp_forward_wide(L, n, ld, B, cols, ldb);
+        else
+            fccqp_backward_wide(L, n, ld, B, cols, ldb);
+        return;
+    }
+#endif
+    if (trans == 'N')
+        fccqp_trsm_lower(L, n, ld, B, cols, ldb);
+    else
+        fccqp_backward_dots(L, n, ld, B, cols, ldb);
+}
+
 #endif

@@ -181,6 +181,8 @@ cdef extern from *:
     #define FCCQP_CHOLESKY_LOOP_ROWS 128
     /* A'A by the AVX2 tiles up to this order (from order / 8 rows), dsyrk above: 0.45-0.95x */
     #define FCCQP_SYRK_LOOP_ORDER 128
+    /* triangular solves by the loops up to this order, dtrsm / dpotrs above: 0.1-0.7x up to 128 */
+    #define FCCQP_TRSM_LOOP_ROWS 128
     /* a correction skips the KKT solve when that residual is below this x the constraints' */
     #define FCCQP_MINOR_PART 1e-2
     /* a rejected polish: ADMM goes on at 10x tighter tolerances at most this many times */
@@ -307,6 +309,7 @@ cdef extern from *:
     const int LU_LOOP_ROWS "FCCQP_LU_LOOP_ROWS"
     const int CHOLESKY_LOOP_ROWS "FCCQP_CHOLESKY_LOOP_ROWS"
     const int SYRK_LOOP_ORDER "FCCQP_SYRK_LOOP_ORDER"
+    const int TRSM_LOOP_ROWS "FCCQP_TRSM_LOOP_ROWS"
     const double MINOR_PART "FCCQP_MINOR_PART"
     const int POLISH_RETRIES "FCCQP_POLISH_RETRIES"
     const double POLISH_EXACT "FCCQP_POLISH_EXACT"
