@@ -2,7 +2,8 @@
 
 LAPACK and BLAS come from ``scipy.linalg.cython_lapack`` / ``cython_blas`` at run time,
 so nothing is linked here; a C compiler, Cython, scipy's .pxd files and numpy's headers
-(read by ``fast_checks`` and ``admm``) are needed at build time (pyproject.toml's build requirements).
+(read by ``fast_checks`` and ``admm``) are needed at build time (pyproject.toml's build
+requirements).
 """
 
 from pathlib import Path
