@@ -203,6 +203,32 @@ def test_dense_arguments_recognizes_only_contiguous_float64_of_the_shapes():
 
 
 @BEFORE_ANY_BACKEND
+def test_held_arrays_are_released_and_read_only_ones_read():
+    """The solve holds its plain numpy arguments from their fields (fast_checks'
+    _hold_plain_ndarray): each hold's reference is given back, a read-only argument is
+    read as a writable one, and answers do not depend on which way an array was held."""
+    import sys
+
+    P, q = np.array([[2.0, 0.5], [0.5, 1.0]]), np.array([1.0, -1.0])
+    A, b = np.array([[1.0, 1.0]]), np.array([1.0])
+    lb, ub = np.full(2, -10.0), np.full(2, 10.0)
+    solver = fccqp.Solver()
+    first = solver.solve(P, q, A, b, lb, ub, [])
+    counts = [sys.getrefcount(v) for v in (P, q, A, b, lb, ub)]
+    for _ in range(20):
+        solver.solve(P, q, A, b, lb, ub, [], x0=first.x, y0=first.y, z0=first.z)
+    assert [sys.getrefcount(v) for v in (P, q, A, b, lb, ub)] == counts
+    frozen = [v.copy() for v in (P, q, A, b, lb, ub)]
+    for v in frozen:
+        v.flags.writeable = False
+    held = fccqp.Solver().solve(*frozen, [])
+    swapped = fccqp.Solver().solve(P.astype(">f8"), q, A.astype(">f8"), b, lb, ub, [])
+    assert held.status == swapped.status == first.status == fccqp.Status.SOLVED
+    np.testing.assert_array_equal(held.x, first.x)
+    np.testing.assert_array_equal(swapped.x, first.x)
+
+
+@BEFORE_ANY_BACKEND
 def test_upright_friction_arrays_flatten_only_valid_upright_friction_specs():
     from fccqp.fast_checks import upright_friction_arrays
 

@@ -15,6 +15,7 @@ import numpy as np
 from fccqp.result import Result
 from fccqp.status import Status
 
+cimport numpy as cnp
 from cpython.buffer cimport PyBuffer_Release
 from cpython.object cimport PyObject_GenericSetAttr
 from libc.math cimport isfinite
@@ -37,6 +38,8 @@ from fccqp.validation cimport (BOUNDED, FIXED_BOUND, NEW_PATTERN, SCAN_OK, UNBOU
                                bound_kind, scan_and_copy, scan_and_copy_csc)
 from fccqp.verdict cimport unbounded
 from fccqp.workspace_arrays cimport Arrays, common_arrays, csc_arrays, dense_arrays
+
+cnp.import_array()
 
 # Run codes, mapped to fccqp.Status in fccqp.solver (one table).
 SOLVED, SOLVED_INACCURATE = engine.SOLVED, engine.INACCURATE
@@ -77,6 +80,14 @@ BACKENDS = {"schur_reduced": SCHUR_REDUCED, "ldl_reduced": LDL_REDUCED, "ldl_ful
             "auto": AUTO, "sparse": SPARSE_LDL}
 """``Settings.kkt_backend`` names and their codes (see :mod:`fccqp.kkt`)."""
 BACKEND_NAMES = {code: name for name, code in BACKENDS.items()}
+
+
+cdef inline cnp.ndarray _empty(Py_ssize_t size):
+    """``np.empty(size)`` through numpy's C API: the call through the module's attribute
+    and its argument parsing took about 1k instructions an array, three a solve."""
+    cdef cnp.npy_intp dims[1]
+    dims[0] = size
+    return cnp.PyArray_EMPTY(1, dims, cnp.NPY_DOUBLE, 0)
 
 
 cdef object _new_result(dict fields):
@@ -323,7 +334,8 @@ cdef class Workspace:
         result is built here, not in Python from a tuple of the run's figures: the
         interpreter runs from cold caches after the compiled solve, and there that took
         7-10 us of a 100 us go2 or solo12 tick (in flow); built here, a go2 tick
-        counts 7k fewer instructions of 706k (callgrind).
+        counts 7k fewer instructions of 706k (callgrind). A plain numpy array is held
+        from its fields (``fast_checks.hold_float64``), not through numpy's buffer.
         """
         cdef Py_ssize_t n = self.e.prob.n, m = self.e.prob.m
         cdef Py_buffer views[13]
@@ -331,7 +343,7 @@ cdef class Workspace:
         cdef Py_ssize_t columns[13]
         cdef int held = 0, count = 10 if x0 is None else (11 if z0 is None else 13), i, code
         cdef Run run
-        x_out, y_out, z_out = np.empty(n), np.empty(m), np.empty(n)
+        x_out, y_out, z_out = _empty(n), _empty(m), _empty(n)
         cdef tuple arrays = (P, q, A, b, lb, ub, x_out, y_out, z_out, cert_out, x0, y0, z0)
         rows[:] = [n, n, m, m, n, n, n, m, n, n + m, n, m, n]
         columns[:] = [n, -1, n, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1]   # -1: a vector
