@@ -95,7 +95,7 @@ cdef double kkt_residual(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t 
     cdef Py_ssize_t n = p.n, m = p.m, i, j, k, o, d, start, cone
     cdef double value, curved
     if not w.grad_current:
-        _point_products(w, p)
+        point_products(w, p)
     for i in range(nf):
         w.rhs[i] = -w.grad[w.free[i]]
     for k in range(nb):
@@ -116,7 +116,7 @@ cdef double kkt_residual(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t 
     return inf_norm(w.rhs, nf + m + nb)
 
 
-cdef void _point_products(Polish* w, const Problem* p) noexcept nogil:
+cdef void point_products(Polish* w, const Problem* p) noexcept nogil:
     """``grad := P x + q + A'nu`` and ``Ax := A x`` at the current point; sets
     ``grad_current``."""
     cdef Py_ssize_t i

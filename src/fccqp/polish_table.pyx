@@ -43,8 +43,8 @@ from scipy.linalg.cython_lapack cimport dgetrf
 from fccqp._dense cimport colmatvec, fill, inf_norm
 from fccqp._types cimport Problem
 from fccqp.kkt cimport KKT, kkt_solve_once
-from fccqp.matrices cimport product, product_t
 from fccqp.polish cimport APEX, FIXED, LOWER, UPPER, Polish
+from fccqp.polish_kkt cimport point_products
 from fccqp.reduced cimport Reduced
 from fccqp.tuning cimport LU_LOOP_ROWS, MAX_REFINE, MINOR_PART, PIVOT_RATIO, POLISH_REFINE_TOLERANCE
 
@@ -117,18 +117,6 @@ cdef void _assemble(Polish* w, const Problem* p, const Reduced* t, const double*
             T[j + (s + k) * S2] = -h
 
 
-cdef void _products(Polish* w, const Problem* p) noexcept nogil:
-    """``grad := P x + q + A'nu`` and ``Ax := A x`` at the current point, summed as
-    :mod:`fccqp.polish_kkt` sums them; sets ``grad_current``."""
-    cdef Py_ssize_t i
-    product(&p.P, w.x, w.grad)
-    product_t(&p.A, w.nu, w.ATnu)
-    for i in range(p.n):
-        w.grad[i] += p.q[i] + w.ATnu[i]
-    product(&p.A, w.x, w.Ax)
-    w.grad_current = True
-
-
 cdef double _residual(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil:
     """Residual of ``(x, nu, y, lam)`` in the polished QP's conditions: the KKT part
     ``(-(P x + q + A'nu + E_S y), b - A x)`` into ``full``, the constraints' part into
@@ -142,7 +130,7 @@ cdef double _residual(Polish* w, const Problem* p, Py_ssize_t nb) noexcept nogil
     cdef const double* H
     cdef char code
     if not w.grad_current:
-        _products(w, p)
+        point_products(w, p)   # summed as polish_kkt's residual sums them
     for i in range(n):
         w.full[i] = -w.grad[i]
     for j in range(s):
