@@ -51,7 +51,7 @@ from libc.math cimport sqrt
 from scipy.linalg.cython_blas cimport dgemv
 
 from fccqp._blas cimport (backward_substitution, cholesky, cholesky_solve_vector,
-                          forward_substitution, syrk_t)
+                          forward_substitution, syrk_t, trsm)
 from fccqp._types cimport Problem
 from fccqp.schur cimport mark_coupled
 from fccqp.tuning cimport PIVOT_TOLERANCE, POLISH_BORDER_TOLERANCE, POLISH_RANK_TOLERANCE
@@ -60,7 +60,6 @@ from fccqp.tuning cimport PIVOT_TOLERANCE, POLISH_BORDER_TOLERANCE, POLISH_RANK_
 cdef extern from "fccqp_kernels.h" nogil:
     void fccqp_matvec_t(const double* M, int ld, const double* y, double* out, int rows,
                         int cols)
-    void fccqp_trsm_lower(const double* L, int n, int ld, double* B, int cols, int ldb)
     void fccqp_sparse_rank_update(const double* Y, int ld, int rows, const int* index,
                                   const int* count, int m, double* T, double* values)
 
@@ -125,7 +124,7 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
         _write_row(f, p, f.order[r], r, f.inv_root[r])
     if m > 0:
         if k > 0:
-            fccqp_trsm_lower(f.L, k, <int>n, f.Y, <int>m, <int>n)
+            trsm(b"L", b"N", k, <int>m, f.L, <int>n, f.Y, <int>n)
             syrk_t(<int>m, k, f.Y, <int>n, 0.0, f.SU, <int>m)
         else:
             _zero_lower(f.SU, m)
@@ -370,7 +369,7 @@ cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
         row += d
         e += d
     if e > 0 and m > 0:
-        fccqp_trsm_lower(f.S0, <int>m, <int>m, f.W, <int>e, <int>m)
+        trsm(b"L", b"N", <int>m, <int>e, f.S0, <int>m, f.W, <int>m)
         syrk_t(<int>e, <int>m, f.W, <int>m, 0.0, f.WW, <int>s)
     else:
         for c in range(e):
