@@ -1,9 +1,12 @@
 # cython: language_level=3
-"""Column-major (Fortran) level-3 BLAS and Cholesky through scipy's LAPACK, as one-line
-calls: ``scipy.linalg.cython_blas`` / ``cython_lapack`` are pointers into scipy's own
-OpenBLAS, so nothing is linked at build time. Used for the factorizations and the
-many-column products of the KKT backends, where a hand-written loop would be several
-times slower at our sizes; single vectors go through the loops of ``fccqp._dense``.
+"""Column-major (Fortran) level-3 operations and Cholesky for the factorizations and
+many-column products of the KKT backends, as one-line calls. Up to a measured order
+(``TRSM_LOOP_ROWS``, ``SYRK_LOOP_ORDER``, ``CHOLESKY_LOOP_ROWS``) they run
+``fccqp_kernels.h``'s blocked loops, since at whole-body control's sizes OpenBLAS'
+packing and call set-up cost more than the arithmetic; above it, and for ``gemm``, they
+call scipy's own OpenBLAS through ``scipy.linalg.cython_blas`` / ``cython_lapack``
+(pointers, so nothing is linked at build time). Single vectors go through the loops of
+``fccqp._dense``.
 """
 
 from scipy.linalg.cython_blas cimport dgemm, dsyrk, dtrsm
