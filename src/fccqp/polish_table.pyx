@@ -239,21 +239,27 @@ cdef void _correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
         w.lam[k] += sign * w.du[s + k]
 
 
+cdef bint _lu_factor(double* T, int size, int* piv) noexcept nogil:
+    """LU-factor the column-major ``size`` square ``T`` in place with partial pivoting
+    (LAPACK's pivots in ``piv``): the loop up to ``LU_LOOP_ROWS`` rows, ``dgetrf``
+    above; False at a zero pivot."""
+    cdef int info = 0
+    if size <= LU_LOOP_ROWS:
+        return fccqp_lu(T, size, piv) != 0
+    dgetrf(&size, &size, T, &size, piv, &info)
+    return info == 0
+
+
 cdef bint table_factor(Polish* w, const Problem* p, const Reduced* t, const double* rho,
                        Py_ssize_t nb) noexcept nogil:
     """Assemble and LU-factor the system of the current active set and planes; False
     when it is singular (see the module's docstring)."""
-    cdef int size = <int>(p.s + nb), info = 0
+    cdef int size = <int>(p.s + nb)
     cdef Py_ssize_t i
     cdef double big = 0.0, small = INFINITY, pivot
     _assemble(w, p, t, rho, nb)
-    if size <= LU_LOOP_ROWS:
-        if not fccqp_lu(w.T, size, w.tpiv):
-            return False
-    else:
-        dgetrf(&size, &size, w.T, &size, w.tpiv, &info)
-        if info != 0:
-            return False
+    if not _lu_factor(w.T, size, w.tpiv):
+        return False
     for i in range(size):
         pivot = fabs(w.T[i + i * size])
         big = max(big, pivot)
@@ -292,20 +298,15 @@ cdef void table_correct(Polish* w, const Problem* p, const Reduced* t, KKT* kkt,
 
 
 def factor_solve(matrix, rhs):
-    """``matrix^-1 rhs`` through :func:`table_factor`'s LU (the loop up to
-    ``LU_LOOP_ROWS`` rows, ``dgetrf`` above) and the correction's solve with its
-    factor, for the tests; None at a zero pivot."""
+    """``matrix^-1 rhs`` through :func:`table_factor`'s LU (:func:`_lu_factor`) and the
+    correction's solve with its factor, for the tests; None at a zero pivot."""
     cdef double[::1, :] T = np.array(matrix, dtype=np.float64, order="F", copy=True)
     cdef double[::1] b = np.array(rhs, dtype=np.float64, copy=True)
     cdef int[::1] piv = np.zeros(max(b.shape[0], 1), dtype=np.intc)
-    cdef int size = <int>b.shape[0], info = 0
+    cdef int size = <int>b.shape[0]
     if size == 0:
         return np.asarray(b)
-    if size <= LU_LOOP_ROWS:
-        info = 0 if fccqp_lu(&T[0, 0], size, &piv[0]) else 1
-    else:
-        dgetrf(&size, &size, &T[0, 0], &size, &piv[0], &info)
-    if info != 0:
+    if not _lu_factor(&T[0, 0], size, &piv[0]):
         return None
     fccqp_lu_solve(&T[0, 0], size, &piv[0], &b[0])
     return np.asarray(b)
