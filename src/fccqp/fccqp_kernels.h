@@ -1580,21 +1580,15 @@ static inline int fccqp_syrk_lower(int n, int k, const double *A, int lda, doubl
  * Elsewhere fccqp_trsm_lower (above) and a dot product per entry. */
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define FCCQP_WIDE_TRSM 1
-#define FCCQP_TRSM_OP static inline __attribute__((target("avx2,fma"), always_inline))
+/* FCCQP_L3 and fccqp_first_lanes: the A'A kernel's, above */
 
-/* lanes below `rows` (0-4) set */
-FCCQP_TRSM_OP __m256i fccqp_rows_mask(int rows)
-{
-    return _mm256_cmpgt_epi64(_mm256_set1_epi64x(rows), _mm256_setr_epi64x(0, 1, 2, 3));
-}
-
-FCCQP_TRSM_OP __m256d fccqp_rows_load(const double *p, int rows, int full, __m256i mask)
+FCCQP_L3 __m256d fccqp_rows_load(const double *p, int rows, int full, __m256i mask)
 {
     return full ? _mm256_loadu_pd(p) : (rows > 0 ? _mm256_maskload_pd(p, mask)
                                                  : _mm256_setzero_pd());
 }
 
-FCCQP_TRSM_OP void fccqp_rows_store(double *p, __m256d v, int rows, int full, __m256i mask)
+FCCQP_L3 void fccqp_rows_store(double *p, __m256d v, int rows, int full, __m256i mask)
 {
     if (full)
         _mm256_storeu_pd(p, v);
@@ -1603,12 +1597,12 @@ FCCQP_TRSM_OP void fccqp_rows_store(double *p, __m256d v, int rows, int full, __
 }
 
 /* the index (of 32-bit halves) that broadcasts lane r % 4 of a vector of doubles */
-FCCQP_TRSM_OP __m256i fccqp_lane_index(int r)
+FCCQP_L3 __m256i fccqp_lane_index(int r)
 {
     return _mm256_set1_epi64x((long long)(2 * (r & 3)) | ((long long)(2 * (r & 3) + 1) << 32));
 }
 
-FCCQP_TRSM_OP __m256d fccqp_broadcast_lane(__m256d v, __m256i index)
+FCCQP_L3 __m256d fccqp_broadcast_lane(__m256d v, __m256i index)
 {
     return _mm256_castps_pd(_mm256_permutevar8x32_ps(_mm256_castpd_ps(v), index));
 }
@@ -1628,14 +1622,14 @@ typedef struct {
 
 /* rows i0:i0 + rows (1-8) of L^-1: row r updates the rows below it in the block (column
  * i0 + r of L below the diagonal) */
-FCCQP_TRSM_OP void fccqp_forward_setup(const double *L, int ld, int i0, int rows,
+FCCQP_L3 void fccqp_forward_setup(const double *L, int ld, int i0, int rows,
                                        fccqp_triangle *t)
 {
     int rows1 = rows > 4 ? rows - 4 : 0;
     double recip[8] = {1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0};
     t->rows = rows;
-    t->mask[0] = fccqp_rows_mask(rows - rows1);
-    t->mask[1] = fccqp_rows_mask(rows1);
+    t->mask[0] = fccqp_first_lanes(rows - rows1);
+    t->mask[1] = fccqp_first_lanes(rows1);
     for (int r = 0; r < rows; r++)
         recip[r] = 1.0 / L[i0 + r + (long)(i0 + r) * ld];
     t->recip[0] = _mm256_loadu_pd(recip);
@@ -1659,7 +1653,7 @@ FCCQP_TRSM_OP void fccqp_forward_setup(const double *L, int ld, int i0, int rows
 /* rows i0:i0 + t->rows of columns 0:C of B (L^-1 B), the rows above solved: eight rows
  * (two vectors) by four columns in eight accumulators over the solved rows k, each
  * column of L loaded once for the four columns of B */
-FCCQP_TRSM_OP void fccqp_forward_block(const double *restrict L, int ld, double *restrict B,
+FCCQP_L3 void fccqp_forward_block(const double *restrict L, int ld, double *restrict B,
                                        int ldb, int i0, int C, const fccqp_triangle *t,
                                        int full)
 {
@@ -1722,12 +1716,12 @@ static void fccqp_forward_wide(const double *restrict L, int n, int ld, double *
 
 /* rows i0:i0 + rows (1-4) of L'^-1: row r updates the rows above it in the block (row
  * i0 + r of L left of the diagonal) */
-FCCQP_TRSM_OP void fccqp_backward_setup(const double *L, int ld, int i0, int rows,
+FCCQP_L3 void fccqp_backward_setup(const double *L, int ld, int i0, int rows,
                                         fccqp_triangle *t)
 {
     double recip[4] = {1.0, 1.0, 1.0, 1.0};
     t->rows = rows;
-    t->mask[0] = fccqp_rows_mask(rows);
+    t->mask[0] = fccqp_first_lanes(rows);
     for (int r = 0; r < rows; r++)
         recip[r] = 1.0 / L[i0 + r + (long)(i0 + r) * ld];
     t->recip[0] = _mm256_loadu_pd(recip);
@@ -1744,7 +1738,7 @@ FCCQP_TRSM_OP void fccqp_backward_setup(const double *L, int ld, int i0, int row
  * up to n (n - i0 - rows a multiple of 4): each entry's sum over those rows is a dot
  * product of a column of L with a column of B in four lanes, four rows by two columns
  * per pass */
-FCCQP_TRSM_OP void fccqp_backward_block(const double *restrict L, int n, int ld,
+FCCQP_L3 void fccqp_backward_block(const double *restrict L, int n, int ld,
                                         double *restrict B, int ldb, int i0, int rows,
                                         int C, const fccqp_triangle *t)
 {
