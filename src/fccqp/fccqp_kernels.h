@@ -9,7 +9,9 @@
  * Right-looking in panels of FCCQP_LU_PANEL columns, as dgetrf blocks: a panel is
  * factored one column at a time (rows swapped in full), then each trailing column gets
  * the panel's four updates in one pass, which loads and stores it once instead of four
- * times (callgrind, talos' 64-row systems: see tuning.LU_LOOP_ROWS and notes/tuning.md).
+ * times (callgrind, talos' 64-row systems: see tuning.LU_LOOP_ROWS and notes/tuning.md),
+ * and two trailing columns at a time as fccqp_cholesky's (fccqp_rank4_update2, the same
+ * bits; a column with nothing to subtract is skipped and pairs with the next one).
  *
  * fccqp_cholesky: Cholesky factor L L' of the lower triangle of a column-major n x n
  * matrix (leading dimension ld) in place; returns 0 at a pivot that is not positive.
@@ -293,6 +295,26 @@ static inline void fccqp_rank4_update2(double *restrict c0, double *restrict c1,
     }
 }
 
+/* U12 of one trailing column of fccqp_lu's panel: its four entries at the panel's rows
+ * (u, updated in place) solved with the panel's unit lower triangle, copied into v */
+static inline __attribute__((always_inline)) void fccqp_lu_u12(
+    double *u, double a10, double a20, double a30, double a21, double a31, double a32,
+    double v[4])
+{
+    v[0] = u[0];
+    v[1] = u[1] - a10 * v[0];
+    v[2] = u[2] - a20 * v[0] - a21 * v[1];
+    v[3] = u[3] - a30 * v[0] - a31 * v[1] - a32 * v[2];
+    u[1] = v[1], u[2] = v[2], u[3] = v[3];
+}
+
+/* whether a column's U12 has anything to subtract (a zero one is skipped, which keeps
+ * the sign of a zero entry) */
+static inline int fccqp_nonzero4(const double v[4])
+{
+    return v[0] != 0.0 || v[1] != 0.0 || v[2] != 0.0 || v[3] != 0.0;
+}
+
 FCCQP_CLONES
 static int fccqp_lu(double *T, int n, int *piv)
 {
@@ -338,15 +360,25 @@ static int fccqp_lu(double *T, int n, int *piv)
         const double *l0 = T + (long)k0 * n, *l1 = l0 + n, *l2 = l1 + n;
         double a10 = l0[k0 + 1], a20 = l0[k0 + 2], a30 = l0[k0 + 3];
         double a21 = l1[k0 + 2], a31 = l1[k0 + 3], a32 = l2[k0 + 3];
-        for (int j = end; j < n; j++) {
+        int j = end;
+        for (; j + 1 < n; j += 2) {
+            double *c0 = T + (long)j * n, *c1 = c0 + n;
+            double a[4], b[4];
+            fccqp_lu_u12(c0 + k0, a10, a20, a30, a21, a31, a32, a);
+            fccqp_lu_u12(c1 + k0, a10, a20, a30, a21, a31, a32, b);
+            if (fccqp_nonzero4(a) && fccqp_nonzero4(b))
+                fccqp_rank4_update2(c0, c1, l0, l1, l2, l2 + n, a, b, end, n);
+            else if (fccqp_nonzero4(a))
+                fccqp_rank4_update(c0, l0, l1, l2, l2 + n, a[0], a[1], a[2], a[3], end, n);
+            else if (fccqp_nonzero4(b))
+                fccqp_rank4_update(c1, l0, l1, l2, l2 + n, b[0], b[1], b[2], b[3], end, n);
+        }
+        if (j < n) {
             double *column = T + (long)j * n;
-            double u0 = column[k0];
-            double u1 = column[k0 + 1] - a10 * u0;
-            double u2 = column[k0 + 2] - a20 * u0 - a21 * u1;
-            double u3 = column[k0 + 3] - a30 * u0 - a31 * u1 - a32 * u2;
-            column[k0 + 1] = u1, column[k0 + 2] = u2, column[k0 + 3] = u3;
-            if (u0 != 0.0 || u1 != 0.0 || u2 != 0.0 || u3 != 0.0)
-                fccqp_rank4_update(column, l0, l1, l2, l2 + n, u0, u1, u2, u3, end, n);
+            double a[4];
+            fccqp_lu_u12(column + k0, a10, a20, a30, a21, a31, a32, a);
+            if (fccqp_nonzero4(a))
+                fccqp_rank4_update(column, l0, l1, l2, l2 + n, a[0], a[1], a[2], a[3], end, n);
         }
     }
     return 1;
