@@ -179,6 +179,22 @@ def test_the_table_polish_lu_solves_pivoted_systems_on_both_sides_of_the_loop_bo
     assert np.allclose(x, np.linalg.solve(matrix, rhs), rtol=1e-8, atol=1e-10)
 
 
+@pytest.mark.parametrize("n", [10, 11])
+def test_the_table_polish_lu_pairs_trailing_columns_with_nothing_to_subtract(n):
+    """fccqp_lu updates the trailing columns two at a time and skips a column whose
+    panel rows are 0: a pair whose first, second or both columns are skipped, and an odd
+    last column."""
+    rng = np.random.default_rng(n)
+    matrix = np.zeros((n, n))
+    matrix[:4, :4] = rng.standard_normal((4, 4))   # the first panel's pivots come from its rows
+    matrix[4:, 4:] = rng.standard_normal((n - 4, n - 4))
+    for column in (4, 7, n - 1):   # nonzero in the first panel's rows: 5, 6, 8 and 9 are not
+        matrix[:4, column] = rng.standard_normal(4)
+    rhs = rng.standard_normal(n)
+    x = factor_solve(matrix, rhs)
+    assert np.allclose(x, np.linalg.solve(matrix, rhs), rtol=1e-8, atol=1e-10)
+
+
 def test_the_table_polish_lu_reports_a_zero_pivot():
     matrix = np.ones((6, 6))
     assert factor_solve(matrix, np.ones(6)) is None
