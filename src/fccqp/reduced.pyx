@@ -15,7 +15,19 @@ coordinate ``u + (R' - R) x_S`` in the new table (:func:`reduced_rebase`).
 from fccqp._dense cimport colmatvec, copy, matvec
 from fccqp._types cimport Iterates, Problem
 from fccqp.kkt cimport KKT, kkt_unit_columns
-from fccqp.projections cimport proj_set
+from fccqp.projections cimport proj_cones
+
+cdef extern from "fccqp_kernels.h" nogil:
+    void fccqp_step_start(const double* z, const double* y, const double* rho, long s,
+                          double* z_prev, double* y_prev, double* v, double* v_prev,
+                          double* u, double* u_prev)
+    void fccqp_step_relax(const double* base, const Py_ssize_t* constrained,
+                          const double* xs, const double* z_prev, const double* v,
+                          const double* u_prev, const double* y, const double* rho,
+                          const double* lo, const double* hi, double alpha, double alpha_x,
+                          long s, double* relaxed, double* u, double* z)
+    void fccqp_step_multipliers(const double* rho, const double* relaxed, const double* z,
+                                long s, double* y)
 
 
 cdef bint reduced_table(Reduced* r, KKT* k, const Problem* p, const double* rho_vec) noexcept nogil:
@@ -50,23 +62,19 @@ cdef inline void _table_product(const Reduced* r, const double* c, double* out,
 
 cdef void reduced_step(Reduced* r, const Problem* p, Iterates* it, double alpha,
                        bint relax_x) noexcept nogil:
-    """One ADMM iteration with ``x = base + W u`` kept implicit through ``u``."""
-    cdef Py_ssize_t s = p.s, j
+    """One ADMM iteration with ``x = base + W u`` kept implicit through ``u``: the loops
+    around the product are ``fccqp_kernels.h``'s (``fccqp_step_*``), and the box's clip
+    is fused into the z-update (:func:`fccqp.projections.proj_cones` projects the cones'
+    blocks after it)."""
+    cdef Py_ssize_t s = p.s
     cdef double alpha_x = alpha if relax_x else 1.0
-    for j in range(s):
-        it.z_prev[j] = it.z[j]
-        it.y_prev[j] = it.y[j]
-        r.v_prev[j] = r.v[j]
-        r.u_prev[j] = r.u[j]
-        r.v[j] = it.rho_vec[j] * it.z[j] - it.y[j]
+    fccqp_step_start(it.z, it.y, it.rho_vec, s, it.z_prev, it.y_prev, r.v, r.v_prev, r.u,
+                     r.u_prev)
     _table_product(r, r.v, r.xs, s)
-    for j in range(s):
-        it.relaxed[j] = alpha * (r.base[p.constrained[j]] + r.xs[j]) + (1.0 - alpha) * it.z_prev[j]
-        r.u[j] = alpha_x * r.v[j] + (1.0 - alpha_x) * r.u_prev[j]
-        it.z[j] = it.relaxed[j] + it.y[j] / it.rho_vec[j]
-    proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
-    for j in range(s):
-        it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])
+    fccqp_step_relax(r.base, p.constrained, r.xs, it.z_prev, r.v, r.u_prev, it.y,
+                     it.rho_vec, p.lo, p.hi, alpha, alpha_x, s, it.relaxed, r.u, it.z)
+    proj_cones(it.z, p.cones)
+    fccqp_step_multipliers(it.rho_vec, it.relaxed, it.z, s, it.y)
 
 
 cdef double ROUNDING = 4.5e-16
