@@ -1906,7 +1906,7 @@ FCCQP_LANE_OP double fccqp_larger(double acc, double x) { return x > acc ? x : a
 
 /* The rows: out = (max |Ax - b| / E, max max(|Ax|, |b|) / E, max |Ax - b|,
  * max capped(max(|Ax|, |b|), span), sum |Ax - b|) */
-FCCQP_CLONES
+FCCQP_EXACT_CLONES
 static void fccqp_row_residuals(const double *restrict Ax, const double *restrict b,
                                 const double *restrict E, const double *restrict span,
                                 long m, double out[5])
@@ -1941,7 +1941,7 @@ static void fccqp_row_residuals(const double *restrict Ax, const double *restric
  * z| D, max max(|x_S|, |z|) D, max |x_S - z|, max capped(max(|x_S|, |z|), hi - lo),
  * max max(|x_S|, |z|), the box entries' max |x_S - z| - violation box_entry_size,
  * sum |x_S - z| + |y|); out[5] is -inf without a box entry */
-FCCQP_CLONES
+FCCQP_EXACT_CLONES
 static void fccqp_set_residuals(const double *restrict x, const double *restrict D,
                                 const long *restrict constrained, const double *restrict z,
                                 const double *restrict y, const double *restrict lo,
@@ -1998,7 +1998,7 @@ static void fccqp_set_residuals(const double *restrict x, const double *restrict
 
 /* The variables, before the multipliers of the constrained entries: out = (x'Px, q'x,
  * max max(|Px|, |q|) / (c D), max max(|Px|, |q|, |A'nu|)); Px becomes Px + (q + A'nu) */
-FCCQP_CLONES
+FCCQP_EXACT_CLONES
 static void fccqp_dual_scales(double *restrict Px, const double *restrict q,
                               const double *restrict ATnu, const double *restrict x,
                               const double *restrict D, double c, long n, double out[4])
@@ -2030,7 +2030,7 @@ static void fccqp_dual_scales(double *restrict Px, const double *restrict q,
 
 /* The gradient of the Lagrangian: out = (max |grad| / (c D), max |grad|,
  * sum |grad| + |x|) */
-FCCQP_CLONES
+FCCQP_EXACT_CLONES
 static void fccqp_dual_residual(const double *restrict grad, const double *restrict x,
                                 const double *restrict D, double c, long n, double out[3])
 {
@@ -2050,6 +2050,39 @@ static void fccqp_dual_residual(const double *restrict grad, const double *restr
         out[0] = fccqp_larger(out[0], value / (c * D[i]));
         out[1] = fccqp_larger(out[1], value);
         out[2] += value + fabs(x[i]);
+    }
+}
+
+/* reduced.near_convergence's row gate: out = (row' u, |row|' |u|), each sum in four lanes
+ * (the gate's rounding bound holds for any order of the sums): a quarter of the
+ * instructions of two scalar chains */
+#if defined(__GNUC__) || defined(__clang__)
+typedef long long fccqp_i4 __attribute__((vector_size(32)));
+FCCQP_LANE_OP fccqp_d4 fccqp_dabs(fccqp_d4 a)
+{
+    fccqp_i4 magnitude = {0x7fffffffffffffffLL, 0x7fffffffffffffffLL, 0x7fffffffffffffffLL,
+                          0x7fffffffffffffffLL};
+    return (fccqp_d4)((fccqp_i4)a & magnitude);
+}
+#else
+FCCQP_LANE_OP fccqp_d4 fccqp_dabs(fccqp_d4 a) { FCCQP_LANEWISE(fccqp_d4, fabs(a.lane[k])) }
+#endif
+FCCQP_EXACT_CLONES
+static void fccqp_row_gate_sums(const double *restrict row, const double *restrict u, long s,
+                                double out[2])
+{
+    fccqp_d4 sum = fccqp_dsplat(0.0), size = sum;
+    long l = 0;
+    for (; l + 4 <= s; l += 4) {
+        fccqp_d4 term = fccqp_dmul(fccqp_dload(row + l), fccqp_dload(u + l));
+        sum = fccqp_dadd(sum, term);
+        size = fccqp_dadd(size, fccqp_dabs(term));
+    }
+    out[0] = fccqp_dsum(sum), out[1] = fccqp_dsum(size);
+    for (; l < s; l++) {
+        double term = row[l] * u[l];
+        out[0] += term;
+        out[1] += fabs(term);
     }
 }
 

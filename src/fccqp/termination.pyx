@@ -220,3 +220,26 @@ cdef double distance(const Residuals* r, double eps_abs, double eps_rel) noexcep
                    r.prim_set / (eps_abs + eps_rel * r.prim_set_scale)),
                max(r.dual / (eps_abs + eps_rel * r.dual_scale),
                    r.gap / (eps_abs + eps_rel * r.gap_scale)))
+
+
+def residual_passes_py(const double[::1] Ax, const double[::1] b, const double[::1] E,
+                       const double[::1] span, const double[::1] x, const double[::1] D,
+                       const Py_ssize_t[::1] constrained, const double[::1] z,
+                       const double[::1] y, const double[::1] lo, const double[::1] hi,
+                       const signed char[::1] in_cone, double[::1] Px, const double[::1] q,
+                       const double[::1] ATnu, double c):
+    """Test hook: :func:`residuals`' four kernels on numpy arrays (at least one row, one
+    constrained entry, one variable), ``Px`` overwritten by ``Px + (q + A'nu)``; returns
+    their outputs (the rows', the constrained entries', the variables' and the gradient's)
+    as four lists."""
+    cdef double rows[5]
+    cdef double entries[7]
+    cdef double variables[4]
+    cdef double dual[3]
+    cdef long m = Ax.shape[0], s = z.shape[0], n = x.shape[0]
+    fccqp_row_residuals(&Ax[0], &b[0], &E[0], &span[0], m, rows)
+    fccqp_set_residuals(&x[0], &D[0], &constrained[0], &z[0], &y[0], &lo[0], &hi[0],
+                        <const char*>&in_cone[0], SCALED_VIOLATION, s, entries)
+    fccqp_dual_scales(&Px[0], &q[0], &ATnu[0], &x[0], &D[0], c, n, variables)
+    fccqp_dual_residual(&Px[0], &x[0], &D[0], c, n, dual)
+    return list(rows), list(entries), list(variables), list(dual)
