@@ -1860,4 +1860,323 @@ static inline void fccqp_trsm_left(char trans, const double *L, int n, int ld, d
         fccqp_backward_dots(L, n, ld, B, cols, ldb);
 }
 
+/* termination.residuals' passes over the rows, the constrained entries and the variables:
+ * their running maxima in four lanes (fccqp_v4; each lane's maximum skips NaN as the
+ * loops' max did, so the lanes' maximum is the loops' maximum, whatever the order) and
+ * divisions, comparisons and selections entry by entry as the loops had them. The sum
+ * whose finiteness the residuals report (Residuals.finite) is summed in the lanes too:
+ * its terms are magnitudes, so it is NaN or infinite in every order alike but within the
+ * rounding of the largest double. The dual residual's sums (x'Px, q'x) stay in their
+ * order, one chain each. Cython's loops took 14.7k of residuals' 30k instructions a call
+ * on talos (callgrind, its realtime cold cell). */
+#if defined(__GNUC__) || defined(__clang__)
+#if defined(__SSE2__)
+FCCQP_LANE_OP fccqp_v2 fccqp_min2(fccqp_v2 acc, fccqp_v2 x)
+{
+    return (fccqp_v2)_mm_min_pd((__m128d)x, (__m128d)acc);   /* x < acc ? x : acc */
+}
+#else
+FCCQP_LANE_OP fccqp_v2 fccqp_min2(fccqp_v2 acc, fccqp_v2 x)
+{
+    fccqp_m2 smaller = x < acc;
+    return (fccqp_v2)(((fccqp_m2)x & smaller) | ((fccqp_m2)acc & ~smaller));
+}
+#endif
+FCCQP_LANE_OP fccqp_v2 fccqp_select2(fccqp_m2 mask, fccqp_v2 a, fccqp_v2 other)
+{
+    return (fccqp_v2)(((fccqp_m2)a & mask) | ((fccqp_m2)other & ~mask));
+}
+FCCQP_LANE_OP fccqp_v2 fccqp_positive_or2(fccqp_v2 a, fccqp_v2 other)   /* a > 0 ? a : other */
+{
+    fccqp_v2 zero = {0.0, 0.0};
+    return fccqp_select2(a > zero, a, other);
+}
+FCCQP_LANE_OP fccqp_v2 fccqp_finite_or2(fccqp_v2 a, fccqp_v2 other)   /* a finite ? a : other */
+{
+    fccqp_v2 infinite = {INFINITY, INFINITY};
+    return fccqp_select2(fccqp_abs2(a) < infinite, a, other);
+}
+FCCQP_LANE_OP fccqp_v4 fccqp_div4(fccqp_v4 a, fccqp_v4 b) { FCCQP_HALVES(a.lo / b.lo, a.hi / b.hi) }
+FCCQP_LANE_OP fccqp_v4 fccqp_min4(fccqp_v4 acc, fccqp_v4 x)
+{
+    FCCQP_HALVES(fccqp_min2(acc.lo, x.lo), fccqp_min2(acc.hi, x.hi))
+}
+FCCQP_LANE_OP fccqp_v4 fccqp_positive_or4(fccqp_v4 a, fccqp_v4 other)
+{
+    FCCQP_HALVES(fccqp_positive_or2(a.lo, other.lo), fccqp_positive_or2(a.hi, other.hi))
+}
+FCCQP_LANE_OP fccqp_v4 fccqp_finite_or4(fccqp_v4 a, fccqp_v4 other)
+{
+    FCCQP_HALVES(fccqp_finite_or2(a.lo, other.lo), fccqp_finite_or2(a.hi, other.hi))
+}
+#else
+FCCQP_LANE_OP fccqp_v4 fccqp_div4(fccqp_v4 a, fccqp_v4 b) { FCCQP_LANEWISE(fccqp_v4, a.lane[k] / b.lane[k]) }
+FCCQP_LANE_OP fccqp_v4 fccqp_min4(fccqp_v4 acc, fccqp_v4 x)
+{
+    FCCQP_LANEWISE(fccqp_v4, x.lane[k] < acc.lane[k] ? x.lane[k] : acc.lane[k])
+}
+FCCQP_LANE_OP fccqp_v4 fccqp_positive_or4(fccqp_v4 a, fccqp_v4 other)
+{
+    FCCQP_LANEWISE(fccqp_v4, a.lane[k] > 0.0 ? a.lane[k] : other.lane[k])
+}
+FCCQP_LANE_OP fccqp_v4 fccqp_finite_or4(fccqp_v4 a, fccqp_v4 other)
+{
+    FCCQP_LANEWISE(fccqp_v4, isfinite(a.lane[k]) ? a.lane[k] : other.lane[k])
+}
+#endif
+
+/* a size capped by a positive span (termination._capped): min(size, span) where span > 0 */
+FCCQP_LANE_OP fccqp_v4 fccqp_capped4(fccqp_v4 size, fccqp_v4 span)
+{
+    return fccqp_min4(size, fccqp_positive_or4(span, fccqp_splat4(INFINITY)));
+}
+FCCQP_LANE_OP double fccqp_capped(double size, double span)
+{
+    return span > 0.0 && span < size ? span : size;
+}
+FCCQP_LANE_OP double fccqp_larger(double acc, double x) { return x > acc ? x : acc; }
+
+/* The rows: out = (max |Ax - b| / E, max max(|Ax|, |b|) / E, max |Ax - b|,
+ * max capped(max(|Ax|, |b|), span), sum |Ax - b|) */
+FCCQP_EXACT_CLONES
+static void fccqp_row_residuals(const double *restrict Ax, const double *restrict b,
+                                const double *restrict E, const double *restrict span,
+                                long m, double out[5])
+{
+    fccqp_v4 zero = fccqp_splat4(0.0), eq = zero, eq_scale = zero, prim = zero;
+    fccqp_v4 prim_scale = zero, total = zero;
+    long i = 0;
+    for (; i + 4 <= m; i += 4) {
+        fccqp_v4 ax = fccqp_load4(Ax + i), bi = fccqp_load4(b + i), e = fccqp_load4(E + i);
+        fccqp_v4 value = fccqp_abs4(fccqp_sub4(ax, bi));
+        fccqp_v4 scale = fccqp_max4(fccqp_abs4(ax), fccqp_abs4(bi));
+        eq = fccqp_max4(eq, fccqp_div4(value, e));
+        eq_scale = fccqp_max4(eq_scale, fccqp_div4(scale, e));
+        prim = fccqp_max4(prim, value);
+        prim_scale = fccqp_max4(prim_scale, fccqp_capped4(scale, fccqp_load4(span + i)));
+        total = fccqp_add4(total, value);
+    }
+    out[0] = fccqp_largest4(eq, 0.0), out[1] = fccqp_largest4(eq_scale, 0.0);
+    out[2] = fccqp_largest4(prim, 0.0), out[3] = fccqp_largest4(prim_scale, 0.0);
+    out[4] = fccqp_sum4(total);
+    for (; i < m; i++) {
+        double value = fabs(Ax[i] - b[i]), scale = fccqp_larger(fabs(Ax[i]), fabs(b[i]));
+        out[0] = fccqp_larger(out[0], value / E[i]);
+        out[1] = fccqp_larger(out[1], scale / E[i]);
+        out[2] = fccqp_larger(out[2], value);
+        out[3] = fccqp_larger(out[3], fccqp_capped(scale, span[i]));
+        out[4] += value;
+    }
+}
+
+/* The constrained entries (x_S = x[constrained] against the slack z): out = (max |x_S -
+ * z| D, max max(|x_S|, |z|) D, max |x_S - z|, max capped(max(|x_S|, |z|), hi - lo),
+ * max max(|x_S|, |z|), the box entries' max |x_S - z| - violation box_entry_size,
+ * sum |x_S - z| + |y|); out[5] is -inf without a box entry */
+FCCQP_EXACT_CLONES
+static void fccqp_set_residuals(const double *restrict x, const double *restrict D,
+                                const long *restrict constrained, const double *restrict z,
+                                const double *restrict y, const double *restrict lo,
+                                const double *restrict hi, const char *restrict in_cone,
+                                double violation, long s, double out[7])
+{
+    fccqp_v4 zero = fccqp_splat4(0.0), set = zero, set_scale = zero, prim = zero;
+    fccqp_v4 prim_scale = zero, size = zero, excess = fccqp_splat4(-INFINITY), total = zero;
+    fccqp_v4 fraction = fccqp_splat4(violation);
+    long j = 0;
+    for (; j + 4 <= s; j += 4) {
+        const long *c = constrained + j;
+        fccqp_v4 xs = fccqp_set4(x[c[0]], x[c[1]], x[c[2]], x[c[3]]);
+        fccqp_v4 d = fccqp_set4(D[c[0]], D[c[1]], D[c[2]], D[c[3]]);
+        fccqp_v4 zj = fccqp_load4(z + j);
+        fccqp_v4 width = fccqp_sub4(fccqp_load4(hi + j), fccqp_load4(lo + j));
+        fccqp_v4 value = fccqp_abs4(fccqp_sub4(xs, zj));
+        fccqp_v4 scale = fccqp_max4(fccqp_abs4(xs), fccqp_abs4(zj));
+        /* box_entry_size: max(scale, width) where the width is finite, else scale; the
+         * cones' entries give -inf (never the maximum) */
+        fccqp_v4 entry = fccqp_max4(scale, fccqp_finite_or4(width, fccqp_splat4(-INFINITY)));
+        fccqp_v4 cone = fccqp_set4(in_cone[j] ? -INFINITY : INFINITY,
+                                   in_cone[j + 1] ? -INFINITY : INFINITY,
+                                   in_cone[j + 2] ? -INFINITY : INFINITY,
+                                   in_cone[j + 3] ? -INFINITY : INFINITY);
+        set = fccqp_max4(set, fccqp_mul4(value, d));
+        set_scale = fccqp_max4(set_scale, fccqp_mul4(scale, d));
+        prim = fccqp_max4(prim, value);
+        prim_scale = fccqp_max4(prim_scale, fccqp_capped4(scale, width));
+        size = fccqp_max4(size, scale);
+        excess = fccqp_max4(excess, fccqp_min4(fccqp_sub4(value, fccqp_mul4(fraction, entry)),
+                                               cone));
+        total = fccqp_add4(total, fccqp_add4(value, fccqp_abs4(fccqp_load4(y + j))));
+    }
+    out[0] = fccqp_largest4(set, 0.0), out[1] = fccqp_largest4(set_scale, 0.0);
+    out[2] = fccqp_largest4(prim, 0.0), out[3] = fccqp_largest4(prim_scale, 0.0);
+    out[4] = fccqp_largest4(size, 0.0), out[5] = fccqp_largest4(excess, -INFINITY);
+    out[6] = fccqp_sum4(total);
+    for (; j < s; j++) {
+        double xj = x[constrained[j]], d = D[constrained[j]], width = hi[j] - lo[j];
+        double value = fabs(xj - z[j]), scale = fccqp_larger(fabs(xj), fabs(z[j]));
+        out[0] = fccqp_larger(out[0], value * d);
+        out[1] = fccqp_larger(out[1], scale * d);
+        out[2] = fccqp_larger(out[2], value);
+        out[3] = fccqp_larger(out[3], fccqp_capped(scale, width));
+        out[4] = fccqp_larger(out[4], scale);
+        if (!in_cone[j])
+            out[5] = fccqp_larger(out[5], value - violation * (isfinite(width)
+                                                               ? fccqp_larger(scale, width)
+                                                               : scale));
+        out[6] += value + fabs(y[j]);
+    }
+}
+
+/* The variables, before the multipliers of the constrained entries: out = (x'Px, q'x,
+ * max max(|Px|, |q|) / (c D), max max(|Px|, |q|, |A'nu|)); Px becomes Px + (q + A'nu) */
+FCCQP_EXACT_CLONES
+static void fccqp_dual_scales(double *restrict Px, const double *restrict q,
+                              const double *restrict ATnu, const double *restrict x,
+                              const double *restrict D, double c, long n, double out[4])
+{
+    fccqp_v4 zero = fccqp_splat4(0.0), scale = zero, scale_s = zero, one = fccqp_splat4(1.0);
+    fccqp_v4 cc = fccqp_splat4(c);
+    double xPx = 0.0, qx = 0.0;
+    long i = 0;
+    for (i = 0; i < n; i++) {
+        xPx += x[i] * Px[i];
+        qx += q[i] * x[i];
+    }
+    for (i = 0; i + 4 <= n; i += 4) {
+        fccqp_v4 px = fccqp_load4(Px + i), qi = fccqp_load4(q + i), at = fccqp_load4(ATnu + i);
+        fccqp_v4 terms = fccqp_max4(fccqp_abs4(px), fccqp_abs4(qi));
+        scale = fccqp_max4(scale, fccqp_mul4(terms, fccqp_div4(one, fccqp_mul4(cc, fccqp_load4(D + i)))));
+        scale_s = fccqp_max4(scale_s, fccqp_max4(terms, fccqp_abs4(at)));
+        fccqp_store4(Px + i, fccqp_add4(px, fccqp_add4(qi, at)));
+    }
+    out[0] = xPx, out[1] = qx;
+    out[2] = fccqp_largest4(scale, 0.0), out[3] = fccqp_largest4(scale_s, 0.0);
+    for (; i < n; i++) {
+        double terms = fccqp_larger(fabs(Px[i]), fabs(q[i]));
+        out[2] = fccqp_larger(out[2], terms * (1.0 / (c * D[i])));
+        out[3] = fccqp_larger(out[3], fccqp_larger(terms, fabs(ATnu[i])));
+        Px[i] += q[i] + ATnu[i];
+    }
+}
+
+/* The gradient of the Lagrangian: out = (max |grad| / (c D), max |grad|,
+ * sum |grad| + |x|) */
+FCCQP_EXACT_CLONES
+static void fccqp_dual_residual(const double *restrict grad, const double *restrict x,
+                                const double *restrict D, double c, long n, double out[3])
+{
+    fccqp_v4 zero = fccqp_splat4(0.0), dual = zero, dual_s = zero, total = zero;
+    fccqp_v4 cc = fccqp_splat4(c);
+    long i = 0;
+    for (; i + 4 <= n; i += 4) {
+        fccqp_v4 value = fccqp_abs4(fccqp_load4(grad + i));
+        dual = fccqp_max4(dual, fccqp_div4(value, fccqp_mul4(cc, fccqp_load4(D + i))));
+        dual_s = fccqp_max4(dual_s, value);
+        total = fccqp_add4(total, fccqp_add4(value, fccqp_abs4(fccqp_load4(x + i))));
+    }
+    out[0] = fccqp_largest4(dual, 0.0), out[1] = fccqp_largest4(dual_s, 0.0);
+    out[2] = fccqp_sum4(total);
+    for (; i < n; i++) {
+        double value = fabs(grad[i]);
+        out[0] = fccqp_larger(out[0], value / (c * D[i]));
+        out[1] = fccqp_larger(out[1], value);
+        out[2] += value + fabs(x[i]);
+    }
+}
+
+/* reduced.near_convergence's row gate: out = (row' u, |row|' |u|), each sum in four lanes
+ * (the gate's rounding bound holds for any order of the sums): a quarter of the
+ * instructions of two scalar chains */
+#if defined(__GNUC__) || defined(__clang__)
+typedef long long fccqp_i4 __attribute__((vector_size(32)));
+FCCQP_LANE_OP fccqp_d4 fccqp_dabs(fccqp_d4 a)
+{
+    fccqp_i4 magnitude = {0x7fffffffffffffffLL, 0x7fffffffffffffffLL, 0x7fffffffffffffffLL,
+                          0x7fffffffffffffffLL};
+    return (fccqp_d4)((fccqp_i4)a & magnitude);
+}
+#else
+FCCQP_LANE_OP fccqp_d4 fccqp_dabs(fccqp_d4 a) { FCCQP_LANEWISE(fccqp_d4, fabs(a.lane[k])) }
+#endif
+FCCQP_EXACT_CLONES
+static void fccqp_row_gate_sums(const double *restrict row, const double *restrict u, long s,
+                                double out[2])
+{
+    fccqp_d4 sum = fccqp_dsplat(0.0), size = sum;
+    long l = 0;
+    for (; l + 4 <= s; l += 4) {
+        fccqp_d4 term = fccqp_dmul(fccqp_dload(row + l), fccqp_dload(u + l));
+        sum = fccqp_dadd(sum, term);
+        size = fccqp_dadd(size, fccqp_dabs(term));
+    }
+    out[0] = fccqp_dsum(sum), out[1] = fccqp_dsum(size);
+    for (; l < s; l++) {
+        double term = row[l] * u[l];
+        out[0] += term;
+        out[1] += fabs(term);
+    }
+}
+
+/* The reduced form's ADMM step (reduced.reduced_step) around its product x~_S = W_S v,
+ * in C for the restrict pointers that let its loops vectorize (Cython's pointers into its
+ * structs may alias, and its loops stayed scalar: 2.4k instructions a step on talos' 56
+ * constrained entries, besides the product). Element by element, each entry's operations
+ * in the order of the loops they replace, built without contraction into fused
+ * multiply-adds (FCCQP_EXACT_CLONES): the same bits in both copies and as before.
+ *
+ * fccqp_step_start: the previous z, y, v, u kept, and v = rho z - y.
+ * fccqp_step_relax: relaxed = alpha (base_S + x~_S) + (1 - alpha) z_prev (base_S
+ * gathered through constrained), u = alpha_x v + (1 - alpha_x) u_prev, and z = relaxed
+ * + y / rho clipped to [lo, hi] as projections.proj_set's box clips it (a cone entry's
+ * infinite bounds leave it; its block is projected after).
+ * fccqp_step_multipliers: y += rho (relaxed - z), after the cones' projection. */
+FCCQP_EXACT_CLONES
+static void fccqp_step_start(const double *restrict z, const double *restrict y,
+                             const double *restrict rho, long s, double *restrict z_prev,
+                             double *restrict y_prev, double *restrict v,
+                             double *restrict v_prev, double *restrict u,
+                             double *restrict u_prev)
+{
+    for (long j = 0; j < s; j++) {
+        z_prev[j] = z[j];
+        y_prev[j] = y[j];
+        v_prev[j] = v[j];
+        u_prev[j] = u[j];
+        v[j] = rho[j] * z[j] - y[j];
+    }
+}
+
+FCCQP_EXACT_CLONES
+static void fccqp_step_relax(const double *restrict base, const long *restrict constrained,
+                             const double *restrict xs, const double *restrict z_prev,
+                             const double *restrict v, const double *restrict u_prev,
+                             const double *restrict y, const double *restrict rho,
+                             const double *restrict lo, const double *restrict hi,
+                             double alpha, double alpha_x, long s,
+                             double *restrict relaxed, double *restrict u, double *restrict z)
+{
+    double keep = 1.0 - alpha, keep_x = 1.0 - alpha_x;
+    for (long j = 0; j < s; j++) {
+        double r = alpha * (base[constrained[j]] + xs[j]) + keep * z_prev[j];
+        double value = r + y[j] / rho[j];
+        relaxed[j] = r;
+        u[j] = alpha_x * v[j] + keep_x * u_prev[j];
+        if (value < lo[j])
+            value = lo[j];
+        if (value > hi[j])
+            value = hi[j];
+        z[j] = value;
+    }
+}
+
+FCCQP_EXACT_CLONES
+static void fccqp_step_multipliers(const double *restrict rho,
+                                   const double *restrict relaxed, const double *restrict z,
+                                   long s, double *restrict y)
+{
+    for (long j = 0; j < s; j++)
+        y[j] += rho[j] * (relaxed[j] - z[j]);
+}
+
 #endif

@@ -11,3 +11,4 @@ cdef inline void proj_block(const double* v, Py_ssize_t kind, Py_ssize_t dim, do
 
 cdef void proj_set(const double* v, const double* lo, const double* hi, Cones cones,
                    Py_ssize_t s, double* out) noexcept nogil
+cdef void proj_cones(double* v, Cones cones) noexcept nogil

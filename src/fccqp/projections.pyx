@@ -30,7 +30,7 @@ cdef void proj_set(const double* v, const double* lo, const double* hi, Cones co
                    Py_ssize_t s, double* out) noexcept nogil:
     """Project ``v`` (``s`` entries) onto the box ``[lo, hi]`` times the cones into ``out``,
     which may be ``v``."""
-    cdef Py_ssize_t i, k, o
+    cdef Py_ssize_t i
     cdef double value
     for i in range(s):
         value = v[i]
@@ -39,10 +39,23 @@ cdef void proj_set(const double* v, const double* lo, const double* hi, Cones co
         if value > hi[i]:
             value = hi[i]
         out[i] = value
+    _cone_blocks(v, cones, out)
+
+
+cdef inline void _cone_blocks(const double* v, Cones cones, double* out) noexcept nogil:
+    """Project each cone block of ``v`` onto its cone into ``out`` (which may be ``v``)."""
+    cdef Py_ssize_t k, o
     for k in range(cones.count):
         o = cones.offset[k]
         proj_block(v + o, cones.kind[k], cones.dim[k], cones.mu[k], cones.normal + 3 * k,
                    out + o)
+
+
+cdef void proj_cones(double* v, Cones cones) noexcept nogil:
+    """Project each cone block of ``v`` onto its cone in place, the box entries left: the
+    second half of :func:`proj_set`, where its caller clipped the box already (the
+    reduced step's fused z-update, :func:`fccqp.reduced.reduced_step`)."""
+    _cone_blocks(v, cones, v)
 
 
 def project_friction_cone(v, double mu, normal, double[::1] out):

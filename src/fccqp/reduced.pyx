@@ -12,10 +12,25 @@ the right-hand side ``(-q + E_S u, b)``. After a change of ``R`` the same ``x`` 
 coordinate ``u + (R' - R) x_S`` in the new table (:func:`reduced_rebase`).
 """
 
+import numpy as np
+
 from fccqp._dense cimport colmatvec, copy, matvec
 from fccqp._types cimport Iterates, Problem
 from fccqp.kkt cimport KKT, kkt_unit_columns
-from fccqp.projections cimport proj_set
+from fccqp.projections cimport proj_cones
+
+cdef extern from "fccqp_kernels.h" nogil:
+    void fccqp_step_start(const double* z, const double* y, const double* rho, long s,
+                          double* z_prev, double* y_prev, double* v, double* v_prev,
+                          double* u, double* u_prev)
+    void fccqp_step_relax(const double* base, const Py_ssize_t* constrained,
+                          const double* xs, const double* z_prev, const double* v,
+                          const double* u_prev, const double* y, const double* rho,
+                          const double* lo, const double* hi, double alpha, double alpha_x,
+                          long s, double* relaxed, double* u, double* z)
+    void fccqp_step_multipliers(const double* rho, const double* relaxed, const double* z,
+                                long s, double* y)
+    void fccqp_row_gate_sums(const double* row, const double* u, long s, double* out)
 
 
 cdef bint reduced_table(Reduced* r, KKT* k, const Problem* p, const double* rho_vec) noexcept nogil:
@@ -50,23 +65,19 @@ cdef inline void _table_product(const Reduced* r, const double* c, double* out,
 
 cdef void reduced_step(Reduced* r, const Problem* p, Iterates* it, double alpha,
                        bint relax_x) noexcept nogil:
-    """One ADMM iteration with ``x = base + W u`` kept implicit through ``u``."""
-    cdef Py_ssize_t s = p.s, j
+    """One ADMM iteration with ``x = base + W u`` kept implicit through ``u``: the loops
+    around the product are ``fccqp_kernels.h``'s (``fccqp_step_*``), and the box's clip
+    is fused into the z-update (:func:`fccqp.projections.proj_cones` projects the cones'
+    blocks after it)."""
+    cdef Py_ssize_t s = p.s
     cdef double alpha_x = alpha if relax_x else 1.0
-    for j in range(s):
-        it.z_prev[j] = it.z[j]
-        it.y_prev[j] = it.y[j]
-        r.v_prev[j] = r.v[j]
-        r.u_prev[j] = r.u[j]
-        r.v[j] = it.rho_vec[j] * it.z[j] - it.y[j]
+    fccqp_step_start(it.z, it.y, it.rho_vec, s, it.z_prev, it.y_prev, r.v, r.v_prev, r.u,
+                     r.u_prev)
     _table_product(r, r.v, r.xs, s)
-    for j in range(s):
-        it.relaxed[j] = alpha * (r.base[p.constrained[j]] + r.xs[j]) + (1.0 - alpha) * it.z_prev[j]
-        r.u[j] = alpha_x * r.v[j] + (1.0 - alpha_x) * r.u_prev[j]
-        it.z[j] = it.relaxed[j] + it.y[j] / it.rho_vec[j]
-    proj_set(it.z, p.lo, p.hi, p.cones, s, it.z)
-    for j in range(s):
-        it.y[j] += it.rho_vec[j] * (it.relaxed[j] - it.z[j])
+    fccqp_step_relax(r.base, p.constrained, r.xs, it.z_prev, r.v, r.u_prev, it.y,
+                     it.rho_vec, p.lo, p.hi, alpha, alpha_x, s, it.relaxed, r.u, it.z)
+    proj_cones(it.z, p.cones)
+    fccqp_step_multipliers(it.rho_vec, it.relaxed, it.z, s, it.y)
 
 
 cdef double ROUNDING = 4.5e-16
@@ -91,22 +102,16 @@ cdef inline int _surely(double value, double error, double tolerance) noexcept n
 cdef inline int _row_gate(Reduced* r, const Problem* p, Iterates* it, Py_ssize_t j,
                           double eps_p, double eps_d) noexcept nogil:
     """The gate's two tests on constrained entry ``j`` alone, from one row of ``W_S``
-    summed in this loop's order: 1 when one of them surely fails whatever the order
-    of :func:`_table_product`'s sums, 0 when both surely pass, -1 undecided."""
-    cdef Py_ssize_t s = p.s, i = p.constrained[j], l
-    cdef const double* row = r.W_S + j * s
-    cdef double d0 = 0.0, d1 = 0.0, a0 = 0.0, a1 = 0.0, x, error, w
+    (``fccqp_row_gate_sums``: the row's product and the sum of its terms' magnitudes, in
+    four lanes): 1 when one of them surely fails whatever the order of
+    :func:`_table_product`'s sums, 0 when both surely pass, -1 undecided."""
+    cdef Py_ssize_t s = p.s, i = p.constrained[j]
+    cdef double sums[2]
+    cdef double x, error, w
     cdef int primal
-    for l in range(0, s - 1, 2):   # two sums each: the compiler pairs them in vectors
-        d0 += row[l] * r.u[l]
-        d1 += row[l + 1] * r.u[l + 1]
-        a0 += abs(row[l] * r.u[l])
-        a1 += abs(row[l + 1] * r.u[l + 1])
-    if s % 2:
-        d0 += row[s - 1] * r.u[s - 1]
-        a0 += abs(row[s - 1] * r.u[s - 1])
-    x = r.base[i] + (d0 + d1)
-    error = (s + 4) * ROUNDING * ((a0 + a1) + abs(r.base[i]) + abs(x))
+    fccqp_row_gate_sums(r.W_S + j * s, r.u, s, sums)
+    x = r.base[i] + sums[0]
+    error = (s + 4) * ROUNDING * (sums[1] + abs(r.base[i]) + abs(x))
     primal = _surely((x - it.z[j]) * p.D[i], error * p.D[i], eps_p)
     if primal != 0:
         return primal
@@ -201,3 +206,23 @@ cdef void reduced_rebase(Reduced* r, const Problem* p, const double* old_rho,
     _shift(r, p, r.u_prev, old_rho, new_rho)
     _shift(r, p, r.v, old_rho, new_rho)
     _shift(r, p, r.v_prev, old_rho, new_rho)
+
+
+def step_kernels_py(double[::1] z, double[::1] y, const double[::1] rho, double[::1] v,
+                    double[::1] u, const double[::1] base, const Py_ssize_t[::1] constrained,
+                    const double[::1] xs, const double[::1] lo, const double[::1] hi,
+                    double alpha, double alpha_x):
+    """Test hook: :func:`reduced_step`'s kernels on numpy arrays with the product ``xs``
+    given (no cones, at least one entry): ``z, y, v, u`` updated in place; returns
+    ``(z_prev, y_prev, v_prev, u_prev, relaxed)``."""
+    cdef long s = z.shape[0]
+    cdef double[::1] z_prev = np.empty(s), y_prev = np.empty(s), v_prev = np.empty(s)
+    cdef double[::1] u_prev = np.empty(s), relaxed = np.empty(s)
+    fccqp_step_start(&z[0], &y[0], &rho[0], s, &z_prev[0], &y_prev[0], &v[0], &v_prev[0],
+                     &u[0], &u_prev[0])
+    fccqp_step_relax(&base[0], &constrained[0], &xs[0], &z_prev[0], &v[0], &u_prev[0],
+                     &y[0], &rho[0], &lo[0], &hi[0], alpha, alpha_x, s, &relaxed[0], &u[0],
+                     &z[0])
+    fccqp_step_multipliers(&rho[0], &relaxed[0], &z[0], s, &y[0])
+    return (np.asarray(z_prev), np.asarray(y_prev), np.asarray(v_prev), np.asarray(u_prev),
+            np.asarray(relaxed))

@@ -76,6 +76,18 @@ from fccqp.matrices cimport product, product_t
 from fccqp.matrices cimport row_spans as matrix_row_spans
 from fccqp.tuning cimport COMPLEMENTARITY_FACTOR, GAP_TERMS_CAP, SCALED_VIOLATION
 
+cdef extern from "fccqp_kernels.h" nogil:
+    void fccqp_row_residuals(const double* Ax, const double* b, const double* E,
+                             const double* span, long m, double* out)
+    void fccqp_set_residuals(const double* x, const double* D, const Py_ssize_t* constrained,
+                             const double* z, const double* y, const double* lo,
+                             const double* hi, const char* in_cone, double violation, long s,
+                             double* out)
+    void fccqp_dual_scales(double* Px, const double* q, const double* ATnu, const double* x,
+                           const double* D, double c, long n, double* out)
+    void fccqp_dual_residual(const double* grad, const double* x, const double* D, double c,
+                             long n, double* out)
+
 
 cdef void row_spans(Problem* p, double* width) noexcept nogil:
     """``span``: for each row ``i``, ``sum_j |A_ij| (hi_j - lo_j)``, the range of ``(A x)_i``
@@ -87,11 +99,6 @@ cdef void row_spans(Problem* p, double* width) noexcept nogil:
     for j in range(p.s):
         width[p.constrained[j]] = p.hi[j] - p.lo[j]
     matrix_row_spans(&p.A, width, p.span)
-
-
-cdef inline double _capped(double size, double span) noexcept nogil:
-    """``size`` capped by a positive ``span`` (see the module docstring)."""
-    return min(size, span) if span > 0.0 else size
 
 
 cdef double box_support(const Problem* p, const double* y, double* terms) noexcept nogil:
@@ -121,60 +128,42 @@ cdef double gap_scale(double xPx, double qx, double terms) noexcept nogil:
 
 cdef void residuals(const Problem* p, const Iterates* it, double* Ax, double* ATnu,
                     double* Px, Residuals* r) noexcept nogil:
-    """Fill ``r`` for the iterate ``it`` (``Ax``, ``ATnu``, ``Px``: scratch of sizes m, n, n)."""
+    """Fill ``r`` for the iterate ``it`` (``Ax``, ``ATnu``, ``Px``: scratch of sizes m, n, n).
+    The passes over the rows, the constrained entries and the variables are
+    ``fccqp_kernels.h``'s (``fccqp_row_residuals`` and the three after it)."""
     cdef Py_ssize_t n = p.n, m = p.m, i, j
-    cdef double c = p.c, value, scale, xPx, qx, bnu, support, terms, total = 0.0
-    r.prim_eq = r.prim_eq_scale = r.prim_set = r.prim_set_scale = 0.0
-    r.prim_s = r.prim_scale_s = r.set_s = r.set_scale_s = 0.0
+    cdef double c = p.c, xPx, qx, bnu, support, terms, total
+    cdef double rows[5]
+    cdef double entries[7]
+    cdef double variables[4]
+    cdef double dual[3]
     r.compl = r.compl_scale = 0.0   # measured on the returned point only
     r.eq_rounding = False
-    r.box_excess = -INFINITY
     product(&p.A, it.x, Ax)
     product_t(&p.A, it.nu, ATnu)
     product(&p.P, it.x, Px)
-    for i in range(m):
-        value = fabs(Ax[i] - p.b[i])
-        scale = max(fabs(Ax[i]), fabs(p.b[i]))
-        r.prim_eq = max(r.prim_eq, value / p.E[i])
-        r.prim_eq_scale = max(r.prim_eq_scale, scale / p.E[i])
-        r.prim_s = max(r.prim_s, value)
-        r.prim_scale_s = max(r.prim_scale_s, _capped(scale, p.span[i]))
-        total += value
-    for j in range(p.s):
-        i = p.constrained[j]
-        value = fabs(it.x[i] - it.z[j])
-        scale = max(fabs(it.x[i]), fabs(it.z[j]))
-        r.prim_set = max(r.prim_set, value * p.D[i])
-        r.prim_set_scale = max(r.prim_set_scale, scale * p.D[i])
-        r.prim_s = max(r.prim_s, value)
-        r.prim_scale_s = max(r.prim_scale_s, _capped(scale, p.hi[j] - p.lo[j]))
-        r.set_s = max(r.set_s, value)
-        r.set_scale_s = max(r.set_scale_s, scale)
-        if not p.in_cone[j]:
-            r.box_excess = max(r.box_excess, value - SCALED_VIOLATION * box_entry_size(
-                scale, p.hi[j] - p.lo[j]))
-        total += value + fabs(it.y[j])
+    fccqp_row_residuals(Ax, p.b, p.E, p.span, m, rows)
+    fccqp_set_residuals(it.x, p.D, p.constrained, it.z, it.y, p.lo, p.hi, p.in_cone,
+                        SCALED_VIOLATION, p.s, entries)
+    r.prim_eq, r.prim_eq_scale = rows[0], rows[1]
+    r.prim_set, r.prim_set_scale = entries[0], entries[1]
+    r.prim_s = max(rows[2], entries[2])
+    r.prim_scale_s = max(rows[3], entries[3])
+    r.set_s, r.set_scale_s = entries[2], entries[4]
+    r.box_excess = entries[5]
+    total = rows[4] + entries[6]
     r.prim = max(r.prim_eq, r.prim_set)
     r.prim_scale = max(r.prim_eq_scale, r.prim_set_scale)
-    r.dual = r.dual_scale = r.dual_s = r.dual_scale_s = 0.0
-    xPx = qx = 0.0
-    for i in range(n):
-        xPx += it.x[i] * Px[i]
-        qx += p.q[i] * it.x[i]
-        scale = 1.0 / (c * p.D[i])
-        r.dual_scale = max(r.dual_scale, max(fabs(Px[i]), fabs(p.q[i])) * scale)
-        # rho adaptation balances the scaled residuals against all their terms, as OSQP
-        r.dual_scale_s = max(r.dual_scale_s, max(max(fabs(Px[i]), fabs(p.q[i])), fabs(ATnu[i])))
-        Px[i] += p.q[i] + ATnu[i]   # Px now holds the gradient of the Lagrangian
-    for j in range(p.s):
+    fccqp_dual_scales(Px, p.q, ATnu, it.x, p.D, c, n, variables)
+    xPx, qx = variables[0], variables[1]
+    r.dual_scale, r.dual_scale_s = variables[2], variables[3]
+    for j in range(p.s):   # Px now holds the gradient of the Lagrangian
         i = p.constrained[j]
         Px[i] += it.y[j]
         r.dual_scale_s = max(r.dual_scale_s, fabs(it.y[j]))
-    for i in range(n):
-        value = fabs(Px[i])
-        r.dual = max(r.dual, value / (c * p.D[i]))
-        r.dual_s = max(r.dual_s, value)
-        total += value + fabs(it.x[i])
+    fccqp_dual_residual(Px, it.x, p.D, c, n, dual)
+    r.dual, r.dual_s = dual[0], dual[1]
+    total += dual[2]
     bnu = terms = 0.0
     for i in range(m):
         bnu += p.b[i] * it.nu[i]
@@ -231,3 +220,26 @@ cdef double distance(const Residuals* r, double eps_abs, double eps_rel) noexcep
                    r.prim_set / (eps_abs + eps_rel * r.prim_set_scale)),
                max(r.dual / (eps_abs + eps_rel * r.dual_scale),
                    r.gap / (eps_abs + eps_rel * r.gap_scale)))
+
+
+def residual_passes_py(const double[::1] Ax, const double[::1] b, const double[::1] E,
+                       const double[::1] span, const double[::1] x, const double[::1] D,
+                       const Py_ssize_t[::1] constrained, const double[::1] z,
+                       const double[::1] y, const double[::1] lo, const double[::1] hi,
+                       const signed char[::1] in_cone, double[::1] Px, const double[::1] q,
+                       const double[::1] ATnu, double c):
+    """Test hook: :func:`residuals`' four kernels on numpy arrays (at least one row, one
+    constrained entry, one variable), ``Px`` overwritten by ``Px + (q + A'nu)``; returns
+    their outputs (the rows', the constrained entries', the variables' and the gradient's)
+    as four lists."""
+    cdef double rows[5]
+    cdef double entries[7]
+    cdef double variables[4]
+    cdef double dual[3]
+    cdef long m = Ax.shape[0], s = z.shape[0], n = x.shape[0]
+    fccqp_row_residuals(&Ax[0], &b[0], &E[0], &span[0], m, rows)
+    fccqp_set_residuals(&x[0], &D[0], &constrained[0], &z[0], &y[0], &lo[0], &hi[0],
+                        <const char*>&in_cone[0], SCALED_VIOLATION, s, entries)
+    fccqp_dual_scales(&Px[0], &q[0], &ATnu[0], &x[0], &D[0], c, n, variables)
+    fccqp_dual_residual(&Px[0], &x[0], &D[0], c, n, dual)
+    return list(rows), list(entries), list(variables), list(dual)
