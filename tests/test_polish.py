@@ -473,6 +473,39 @@ def test_polish_holds_a_free_block_that_newton_moved_out_of_its_cone():
     np.testing.assert_allclose(polished["x"], reference.x, atol=1e-7)
 
 
+
+def test_newton_stops_where_a_fresh_factorization_left_the_point_unmoved():
+    """Seven contacts pulled every way against a flat cost (``P = w I``, ``w`` 1.3e-4),
+    beside an equality of size 6.7e4 that sets the solve's tolerance (``GUESS_TOLERANCE``
+    times the scale), polished from no multipliers: Newton's steps on a guess with a
+    wrong-signed plane (no curvature there) refactor where the planes still miss their
+    cones by 2.9e-8 of ``x_block``, within that tolerance, so the solve leaves the point
+    where it was and every later step would repeat it. Newton stops there with the same
+    answer (25 factorizations without the stop, 9 with it; 627 of 6000 random polishes
+    of this family stalled so)."""
+    rng = np.random.default_rng(3)
+    k = int(rng.integers(2, 9))
+    targets = rng.normal(size=(k, 3)) * 3 + rng.normal(size=3) * rng.uniform(0, 5)
+    total, mu = rng.uniform(1, 20), rng.uniform(0.3, 0.8)
+    w, big = 10.0 ** rng.uniform(-4, 0), 10.0 ** rng.uniform(2, 6)
+    n = 3 * k + 1
+    cones = tuple(fccqp.FrictionCone(3 * i, mu) for i in range(k))
+    A = np.zeros((2, n))
+    A[0, 2:n - 1:3] = 1.0
+    A[1, n - 1] = 1.0
+    P = w * np.eye(n)
+    P[-1, -1] = 1.0
+    q = np.append(-w * np.ravel(targets), 0.0)
+    start = np.append(np.tile([0.0, 0.0, 1.0], k) * rng.uniform(0, 10)
+                      + rng.normal(size=3 * k) * rng.uniform(0, 3), 0.0)
+    b, free = np.array([total, big]), np.full(n, np.inf)
+    polished = polish_point(P, q, A, b, -free, free, flatten_cones(cones, n), start,
+                            np.zeros(2), np.zeros(n), start, newton_steps=20, warm=True,
+                            bare=True, schur=True)
+    reference = clarabel_solve(P, q, A, b, cones=cones)
+    assert polished["ok"] and polished["factorizations"] <= 12
+    np.testing.assert_allclose(polished["x"], reference.x, atol=1e-6 * big)
+
 def test_polish_puts_its_last_guess_on_the_cones():
     """This polish uses all ``GUESS_PASSES`` guesses, and its last one is the optimal
     active set; its first solve, at the planes of the previous point, is 0.12 off the

@@ -300,6 +300,19 @@ cdef bint _restore_kept_planes(Polish* w, const Problem* p, Py_ssize_t nb) noexc
     return any
 
 
+cdef inline bint _stalled(double miss, double last_miss) noexcept nogil:
+    """Whether a fresh factorization's step left the planes' miss where :func:`_newton`
+    stops: not below ``last_miss`` and at the floor rounding leaves (``MISS_FLOOR``), or
+    exactly ``last_miss``, the point unmoved. A step solves from the current point and
+    corrects it only where the residual on the moved planes exceeds ``GUESS_TOLERANCE``;
+    a point whose planes miss by less than that (in ``x_block``'s units) but more than
+    ``NEWTON_TOLERANCE`` is left as it is, the same planes are placed again and every
+    later step repeats the same factorization: solo12's polish of a carried guess at a
+    contact switch refactored 16 times at a miss of 3.2e-10 and ended with the point it
+    had (notes/performance-history.md, "contactray")."""
+    return miss >= last_miss and (miss <= MISS_FLOOR or miss == last_miss)
+
+
 cdef int _newton(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t* nb, long newton_steps,
                  double scale, int* factorizations, const Reduced* table, KKT* kkt,
                  const double* rho_vec, bint* tabled) noexcept nogil:
@@ -332,9 +345,8 @@ cdef int _newton(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t* nb, lon
         if changed != 0:
             return 1
     for step in range(newton_steps):
-        if not _relinearize(w, p, nb[0], &miss) or (
-                refactored and miss >= last_miss and miss <= MISS_FLOOR):
-            break   # converged, or at the floor that rounding leaves
+        if not _relinearize(w, p, nb[0], &miss) or (refactored and _stalled(miss, last_miss)):
+            break   # converged, at the floor that rounding leaves, or unmoved
         rate = miss / last_miss   # 0 at the first step: a chord step
         refactored = rate > CHORD_RATE or pow(rate, CHORD_STEPS) * miss > NEWTON_TOLERANCE
         if not refactored and not _chord_step(w, p, nf, nb[0], scale, table, kkt, rho_vec,
