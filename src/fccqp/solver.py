@@ -353,10 +353,16 @@ class Solver:
 
     def _make_current(self, key: tuple, structure: _Structure, w: admm.Workspace) -> None:
         """Make the kept workspace ``w`` of ``structure`` (kept under ``key``) current,
-        keeping the current one; a guess given to its next solve comes from another
-        structure (``Workspace.arrived``)."""
-        del self._kept[key]
-        self._keep_current()
+        keeping the current one (a switch: there is one) in its place, so that the
+        number kept stays within :data:`KEPT_WORKSPACES`; a guess given to its next solve
+        comes from another structure (``Workspace.arrived``). The swap is spelled out
+        here, without :meth:`_keep_current`'s frame and bound: on a contact change the
+        interpreter runs this once after a stretch of ticks of another structure, cold,
+        where each frame costs about 0.5 us (notes/performance-history.md,
+        "contactentry")."""
+        kept = self._kept
+        del kept[key]
+        kept[self._structure.key()] = (self._structure, self._workspace)
         self._structure, self._workspace = structure, w
         w.arrived = True
 
