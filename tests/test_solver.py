@@ -1,6 +1,10 @@
 """The solver against Clarabel, the KKT conditions, and its statuses."""
 
 import math
+import os
+import subprocess
+import sys
+import textwrap
 
 import numpy as np
 import pytest
@@ -752,3 +756,35 @@ def test_settings_of_a_solver_cannot_be_replaced():
     with pytest.raises(AttributeError, match="Solver.settings"):
         solver.settings = fccqp.Settings(max_iter=5)
     assert solver.settings.max_iter == 50
+
+
+@pytest.mark.kkt_backends("auto", reason="the workspaces' memory, in a new Python process")
+@pytest.mark.skipif(not os.path.isdir("/sys/kernel/mm/transparent_hugepage"),
+                    reason="transparent huge pages (Linux's madvise) are not available")
+def test_workspaces_are_carved_from_one_shared_huge_page_pool():
+    """The arrays of a process's workspaces are carved from 2 MB pools marked for
+    transparent huge pages (fccqp.workspace_arrays._Pool): a new process whose numpy
+    marks none of its own has one such mapping after the first solve, and two small
+    solvers share it."""
+    code = """
+        import re
+        import numpy as np
+        np._core.multiarray._set_madvise_hugepage(False)
+        import fccqp
+
+        def marked_kb():
+            text = open("/proc/self/smaps").read()
+            blocks = re.split(r"\\n(?=[0-9a-f]+-[0-9a-f]+ )", text)
+            return sum(int(re.search(r"^Size:\\s+(\\d+) kB", block, re.M).group(1))
+                       for block in blocks if re.search(r"^VmFlags:.* hg", block, re.M))
+
+        before = marked_kb()
+        first, second = fccqp.Solver(), fccqp.Solver()
+        first.solve(np.eye(3), np.ones(3), lb=-np.ones(3), ub=np.ones(3))
+        second.solve(np.eye(4), np.ones(4), lb=-np.ones(4), ub=np.ones(4))
+        print(before, marked_kb())
+    """
+    result = subprocess.run([sys.executable, "-c", textwrap.dedent(code)],
+                            capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.split() == ["0", "2048"]

@@ -203,6 +203,34 @@ def test_dense_arguments_recognizes_only_contiguous_float64_of_the_shapes():
 
 
 @BEFORE_ANY_BACKEND
+def test_plain_arrays_of_other_shapes_are_refused_without_numpy_buffers():
+    """A contact switch tries the caller's arrays against workspaces of other sizes
+    (fast_checks' _hold_plain_ndarray refuses them from their fields): numpy's buffer,
+    which caches a format record on the array it serves, is not asked for them."""
+    import tracemalloc
+
+    from fccqp.fast_checks import dense_arguments
+
+    def arrays() -> tuple[np.ndarray, ...]:
+        return np.zeros((5, 5)), np.zeros(5), np.zeros((2, 5)), np.zeros(2), np.zeros(5), \
+            np.zeros(5)
+
+    def kept_by(n: int, m: int) -> int:   # bytes a call leaves allocated
+        fresh = arrays()
+        before = tracemalloc.get_traced_memory()[0]
+        dense_arguments(*fresh, n, m)
+        return tracemalloc.get_traced_memory()[0] - before
+
+    tracemalloc.start()
+    try:
+        fitting = [kept_by(5, 2) for _ in range(3)]
+        others = [kept_by(4, 2) for _ in range(3)] + [kept_by(5, 3) for _ in range(3)]
+    finally:
+        tracemalloc.stop()
+    assert set(others) == set(fitting)
+
+
+@BEFORE_ANY_BACKEND
 def test_held_arrays_are_released_and_read_only_ones_read():
     """The solve holds its plain numpy arguments from their fields (fast_checks'
     _hold_plain_ndarray): each hold's reference is given back, a read-only argument is

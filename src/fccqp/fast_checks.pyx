@@ -64,27 +64,42 @@ cdef bint _NDARRAY_RELEASES = (<BufferType*>ndarray).tp_as_buffer.bf_releasebuff
 """Whether numpy's arrays release their buffers themselves (then every hold asks numpy)."""
 
 
-cdef bint _hold_plain_ndarray(object array, Py_buffer* view, Py_ssize_t rows,
-                              Py_ssize_t columns, bint writable):
-    """Fill ``view`` from the fields of ``array`` and return True when it is a numpy array
-    (not a subclass) that :func:`hold_float64` accepts, on which numpy's own buffer would
-    succeed: C-contiguous native float64 of the shape asked for and, when writable,
-    writeable and owning its data (a view may warn on write, which numpy's buffer does).
-    False, holding nothing, for anything else. ``PyBuffer_Release`` releases it as it
-    releases numpy's (numpy keeps no per-buffer state: ``_NDARRAY_RELEASES``). numpy's
-    buffer costs about 500 instructions a hold (its cached format record), and a solve
-    holds 10 to 13 arrays, a contact switch 23: 13.9k of go2's contact tick (callgrind)."""
+cdef enum:
+    # _hold_plain_ndarray's answers
+    PLAIN_HELD = 1
+    PLAIN_REFUSED = 0   # a plain array numpy would give a buffer of, of another shape
+    PLAIN_ASK = -1      # anything else: numpy's buffer decides
+
+
+cdef int _hold_plain_ndarray(object array, Py_buffer* view, Py_ssize_t rows,
+                             Py_ssize_t columns, bint writable):
+    """Fill ``view`` from the fields of ``array`` and return ``PLAIN_HELD`` when it is a
+    numpy array (not a subclass) that :func:`hold_float64` accepts, on which numpy's own
+    buffer would succeed: C-contiguous native float64 of the shape asked for and, when
+    writable, writeable and owning its data (a view may warn on write, which numpy's
+    buffer does). ``PLAIN_REFUSED``, holding nothing, for such an array of another
+    number of dimensions or shape, which numpy's buffer would give and
+    :func:`hold_float64` then refuse; ``PLAIN_ASK`` for anything else. ``PyBuffer_Release``
+    releases a held view as it releases numpy's (numpy keeps no per-buffer state:
+    ``_NDARRAY_RELEASES``). numpy's buffer costs about 500 instructions a hold (its cached
+    format record), and a solve holds 10 to 13 arrays, a contact switch 23: 13.9k of go2's
+    contact tick (callgrind). A switch tries the arrays against workspaces of other sizes
+    first, and there numpy's buffer code, which no other tick runs, took about 30 cache
+    lines of code fetched cold (callgrind's cache model, notes/performance-history.md,
+    "contactentry")."""
     if _NDARRAY_RELEASES or type(array) is not ndarray:
-        return False
+        return PLAIN_ASK
     cdef cnp.ndarray a = <cnp.ndarray>array
     cdef int flags = cnp.PyArray_FLAGS(a), ndim = cnp.PyArray_NDIM(a)
     cdef cnp.npy_intp* dims = cnp.PyArray_DIMS(a)
     if not (flags & cnp.NPY_ARRAY_C_CONTIGUOUS and cnp.PyArray_TYPE(a) == cnp.NPY_DOUBLE
-            and cnp.PyArray_ISNOTSWAPPED(a) and ndim == (1 if columns < 0 else 2)
-            and dims[0] == rows and (columns < 0 or dims[1] == columns)):
-        return False
+            and cnp.PyArray_ISNOTSWAPPED(a)):
+        return PLAIN_ASK
     if writable and not (flags & cnp.NPY_ARRAY_WRITEABLE and flags & cnp.NPY_ARRAY_OWNDATA):
-        return False
+        return PLAIN_ASK
+    if not (ndim == (1 if columns < 0 else 2) and dims[0] == rows
+            and (columns < 0 or dims[1] == columns)):
+        return PLAIN_REFUSED
     fccqp_buffer_owner(view, array)
     view.buf = cnp.PyArray_DATA(a)
     view.len = rows * (1 if columns < 0 else columns) * 8
@@ -94,7 +109,7 @@ cdef bint _hold_plain_ndarray(object array, Py_buffer* view, Py_ssize_t rows,
     view.format = b"d"
     view.shape = view.strides = view.suboffsets = NULL
     view.internal = NULL
-    return True
+    return PLAIN_HELD
 
 
 cdef bint hold_float64(object array, Py_buffer* view, Py_ssize_t rows, Py_ssize_t columns,
@@ -104,9 +119,11 @@ cdef bint hold_float64(object array, Py_buffer* view, Py_ssize_t rows, Py_ssize_
     ``columns >= 0``; otherwise release it and return False. Raises where ``array`` has
     no such buffer (``TypeError``, ``BufferError``). The one rule for
     :func:`dense_arguments` and the buffers ``fccqp.admm.Workspace.solve`` holds; a
-    plain numpy array that fits is held from its fields (:func:`_hold_plain_ndarray`)."""
-    if _hold_plain_ndarray(array, view, rows, columns, writable):
-        return True
+    plain numpy array is held, or refused for its shape, from its fields
+    (:func:`_hold_plain_ndarray`)."""
+    cdef int plain = _hold_plain_ndarray(array, view, rows, columns, writable)
+    if plain != PLAIN_ASK:
+        return plain == PLAIN_HELD
     PyObject_GetBuffer(array, view,
                        PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (PyBUF_WRITABLE if writable else 0))
     if (view.itemsize == 8 and view.format != NULL and view.format[0] == b"d"

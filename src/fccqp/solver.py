@@ -56,10 +56,16 @@ class _Structure:
     :func:`fccqp.validation.structure_scan`: the constrained entries, the fixed ones
     and the cone blocks' offsets among them, for ``n`` variables and ``m`` rows. The
     workspace checks the bounds against it in every solve and asks for a rescan
-    (``admm.STRUCTURE_CHANGED``) when they moved."""
+    (``admm.STRUCTURE_CHANGED``) when they moved.
+
+    :attr:`key` is what a workspace for it is made of (a solver's settings are fixed):
+    equal keys, interchangeable workspaces. It is made by each :meth:`update` (the cone
+    blocks, the rest of it, do not change) and read as an attribute: a contact change
+    reads two, and a method's frame there, run cold after a stretch of ticks of another
+    structure, cost about 0.5 us each (notes/performance-history.md, "contactentry")."""
 
     __slots__ = ("n", "m", "count", "constrained", "fixed", "relocated", "_cones",
-                 "certificate", "last_cones", "_key")
+                 "certificate", "last_cones", "key")
 
     def __init__(self, n: int, m: int, cones: ConeArrays) -> None:
         self.n, self.m, self.count, self._cones = n, m, 0, cones
@@ -67,7 +73,7 @@ class _Structure:
         self.relocated = np.empty(cones.count, np.intp)
         self.certificate = np.empty(n + m)  # copied into the Result only when infeasible
         self.last_cones: object = None   # the cones argument last solved in its workspace
-        self._key: tuple[object, ...] | None = None
+        self.key: tuple[object, ...] = ()   # made by update
 
     @property
     def cones(self) -> ConeArrays:
@@ -88,24 +94,17 @@ class _Structure:
         self._cones, self.last_cones = None, cones
 
     def update(self, lb: np.ndarray, ub: np.ndarray) -> bool:
-        """Scan the bounds; True when the constrained or fixed entries changed."""
+        """Scan the bounds and make :attr:`key`; True when the constrained or fixed
+        entries changed."""
         count, changed, member = structure_scan(
             lb, ub, self.cones.offset, self.cones.dim, self.constrained, self.fixed,
             self.relocated, self.count)
         check_cone_bounds(member, lb, ub)
-        self.count, self._key = count, None
+        cones, self.count = self.cones, count
+        self.key = (self.n, self.m, self.constrained[:count].tobytes(),
+                    self.fixed[:count].tobytes(), cones.kind.tobytes(),
+                    cones.offset.tobytes(), cones.dim.tobytes())
         return changed
-
-    def key(self) -> tuple[object, ...]:
-        """What a workspace for this structure is made of (a solver's settings are
-        fixed): equal keys, interchangeable workspaces. Kept until the next
-        :meth:`update` (the cone blocks, the rest of it, do not change)."""
-        if self._key is None:
-            cones, count = self.cones, self.count
-            self._key = (self.n, self.m, self.constrained[:count].tobytes(),
-                         self.fixed[:count].tobytes(), cones.kind.tobytes(),
-                         cones.offset.tobytes(), cones.dim.tobytes())
-        return self._key
 
     def workspace(self, settings: Settings) -> admm.Workspace:
         """A workspace for this structure."""
@@ -316,7 +315,7 @@ class Solver:
         path would solve (a guess as :func:`_guess` returns it), and a solved answer
         returns without :meth:`_result`, as the control loop's does."""
         structure, w = entry
-        self._make_current(structure.key(), structure, w)
+        self._make_current(structure.key, structure, w)
         structure.friction_of(cones)
         self._cones = cones
         out = w.solve(P, q, A, b, lb, ub, x0, self._settings.warm_start, start,
@@ -353,17 +352,23 @@ class Solver:
 
     def _make_current(self, key: tuple, structure: _Structure, w: admm.Workspace) -> None:
         """Make the kept workspace ``w`` of ``structure`` (kept under ``key``) current,
-        keeping the current one; a guess given to its next solve comes from another
-        structure (``Workspace.arrived``)."""
-        del self._kept[key]
-        self._keep_current()
+        keeping the current one (a switch: there is one) in its place, so that the
+        number kept stays within :data:`KEPT_WORKSPACES`; a guess given to its next solve
+        comes from another structure (``Workspace.arrived``). The swap is spelled out
+        here, without :meth:`_keep_current`'s frame and bound: on a contact change the
+        interpreter runs this once after a stretch of ticks of another structure, cold,
+        where each frame costs about 0.5 us (notes/performance-history.md,
+        "contactentry")."""
+        kept = self._kept
+        del kept[key]
+        kept[self._structure.key] = (self._structure, self._workspace)
         self._structure, self._workspace = structure, w
         w.arrived = True
 
     def _keep_current(self) -> None:
         """Keep the current workspace with its structure (:data:`KEPT_WORKSPACES`)."""
         if self._workspace is not None:
-            self._kept[self._structure.key()] = (self._structure, self._workspace)
+            self._kept[self._structure.key] = (self._structure, self._workspace)
             while len(self._kept) > KEPT_WORKSPACES:
                 del self._kept[next(iter(self._kept))]
 
@@ -469,7 +474,7 @@ class Solver:
         there was one."""
         arrived = self._workspace is not None
         self._keep_current()
-        kept = self._kept.pop(structure.key(), None)
+        kept = self._kept.pop(structure.key, None)
         if kept is None:
             w = structure.workspace(self._settings)
         else:
