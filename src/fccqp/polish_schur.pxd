@@ -52,8 +52,16 @@ cdef struct PolishSchur:
     double lead_largest     # S0's largest diagonal entry in its leading block
     double lead_min         # S0's smallest squared pivot in its leading block
     double* S0              # m x m: Cholesky of SU + the free diagonal rows' Y'Y
-    double* SC              # (m - lead)^2: S0's Schur complement of its leading block
-    double* DD              # m x m: the free diagonal rows' Y'Y (lower), summed as dsyrk sums
+    double* SC              # m x m (trailing block): S0's Schur complement of its leading
+                            # block: LSC + the other free diagonal rows' Y'Y
+    # S0's leading block, shared by the bases whose free diagonal rows that reach it
+    # (lead_rows) are the same (_build_lead):
+    bint lead_valid         # S0's leading columns, LSC and diag0 hold lead_rows' factor
+    Py_ssize_t* lead_rows   # n: the entries of x of those rows, in Y's order
+    int lead_count          # their number
+    double* LSC             # m x m (trailing block): Schur complement of the leading block
+                            # of SU + those rows' Y'Y (lower)
+    double* diag0           # m: the diagonal of SU + those rows' Y'Y
     double* W               # (m - lead) x s: S0's factor^-1 A_B', a column per boundary
                             # entry, its trailing rows (the leading ones are zero)
     double* WW              # s x s: W'W

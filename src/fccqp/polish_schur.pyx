@@ -79,7 +79,7 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j, r, c, lead = 0, rest
     cdef double largest = 0.0, pivot
     cdef int k
-    f.ready = f.bordered = False
+    f.ready = f.bordered = f.lead_valid = False
     f.base = BASE_NONE
     f.convex = True
     mark_coupled(p.P.values, n, f.coupled)
@@ -298,12 +298,12 @@ cdef bint _factor_whole(PolishSchur* f, const Problem* p, const Py_ssize_t* inde
     f.rows = <int>row
     for c in range(t):   # the base's Schur complement, the boundary rows' sums added
         for r in range(c, t):
-            S[r + c * t] = f.SC[r + c * rest] if r < rest else 0.0
+            S[r + c * t] = f.SC[(lead + r) + (lead + c) * m] if r < rest else 0.0
     _add_sparse_rows(f, p, f.diag_end, row, lead, t, S)
-    for c in range(t):   # S's diagonal: S0's where S0 has one
+    for c in range(t):   # S's diagonal: diag0 and the sums since
         if c < rest:
-            largest = max(largest, f.DD[(lead + c) * (m + 1)] + f.SU[(lead + c) * (m + 1)]
-                          + S[c + c * t] - f.SC[c + c * rest])
+            largest = max(largest, f.diag0[lead + c] + S[c + c * t]
+                          - f.LSC[(lead + c) * (m + 1)])
         else:
             S[c + c * t] += delta
             largest = max(largest, S[c + c * t])
@@ -368,6 +368,77 @@ cdef bint _same_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
     return _walk_diagonal(f, p, index, boundary, nb, False) >= 0
 
 
+cdef inline bint _reaches_lead(PolishSchur* f, const Problem* p, Py_ssize_t j) noexcept nogil:
+    """Whether row ``j`` of ``Y`` (a diagonal row, as :func:`_write_row` records it) is
+    nonzero in ``S``'s leading ``lead`` columns."""
+    return f.row_count[j] > 0 and f.row_nz[j * (p.m + p.s)] < f.lead
+
+
+cdef bint _same_lead(PolishSchur* f, const Problem* p, Py_ssize_t end) noexcept nogil:
+    """Whether the free diagonal rows ``unconstrained .. end`` of ``Y`` that reach ``S``'s
+    leading columns are those whose factor :func:`_build_lead` keeps."""
+    cdef Py_ssize_t j, k = 0
+    if not f.lead_valid:
+        return False
+    for j in range(f.unconstrained, end):
+        if _reaches_lead(f, p, j):
+            if k == f.lead_count or f.lead_rows[k] != f.rowvar[j]:
+                return False
+            k += 1
+    return k == f.lead_count
+
+
+cdef void _add_rows(PolishSchur* f, const Problem* p, Py_ssize_t end, bint reaching,
+                    double* T) noexcept nogil:
+    """``T += Y_R' Y_R`` (lower triangle, ``m x m``) over the free diagonal rows
+    ``unconstrained .. end`` of ``Y`` that reach ``S``'s leading columns (``reaching``)
+    or that do not, as :func:`_add_sparse_rows` sums."""
+    cdef Py_ssize_t j, ld = p.m + p.s
+    for j in range(f.unconstrained, end):
+        if f.row_count[j] > 0 and _reaches_lead(f, p, j) == reaching:
+            fccqp_sparse_rank_update(f.Y + j, <int>p.n, 1, f.row_nz + j * ld, f.row_count + j,
+                                     <int>p.m, T, f.nz_values)
+
+
+cdef bint _build_lead(PolishSchur* f, const Problem* p, Py_ssize_t end) noexcept nogil:
+    """Factor the leading ``lead`` columns of ``SU`` plus the sums of the free diagonal
+    rows ``unconstrained .. end`` that reach them, into ``S0``'s leading columns; keep
+    the rest's Schur complement ``LSC``, the diagonal ``diag0``, the leading block's
+    largest diagonal entry and smallest squared pivot, and those rows (``lead_rows``).
+    The other rows add only to ``LSC``'s block, so every base with the same rows
+    shares this (:func:`_build_base`): on talos the rows that reach it are the free
+    torques of the joints without a contact force. False where the leading block is not
+    positive definite."""
+    cdef Py_ssize_t m = p.m, lead = f.lead, r, c, j
+    cdef double smallest
+    f.lead_valid = False
+    for c in range(m):
+        for r in range(c, m):
+            f.S0[r + c * m] = f.SU[r + c * m]
+    _add_rows(f, p, end, True, f.S0)
+    f.lead_largest = 0.0
+    for c in range(m):
+        f.diag0[c] = f.S0[c * (m + 1)]
+        if c < lead:
+            f.lead_largest = max(f.lead_largest, f.diag0[c])
+    if lead > 0 and not fccqp_cholesky_lead(f.S0, <int>m, <int>m, <int>lead):
+        return False
+    smallest = f.lead_largest
+    for c in range(lead):
+        smallest = min(smallest, f.S0[c * (m + 1)] * f.S0[c * (m + 1)])
+    f.lead_min = smallest
+    for c in range(lead, m):
+        for r in range(c, m):
+            f.LSC[r + c * m] = f.S0[r + c * m]
+    f.lead_count = 0
+    for j in range(f.unconstrained, end):
+        if _reaches_lead(f, p, j):
+            f.lead_rows[f.lead_count] = f.rowvar[j]
+            f.lead_count += 1
+    f.lead_valid = True
+    return True
+
+
 cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
                       const Py_ssize_t* boundary, Py_ssize_t nb) noexcept nogil:
     """The guess's part of ``S`` that its planes and curvature leave alone: the free
@@ -377,13 +448,14 @@ cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
     ``BASE_REFUSED`` where ``S0`` is too near singular for the bordered solve
     (``POLISH_BORDER_TOLERANCE``: go2's rows that only boundary blocks span leave ``S0``
     ``delta`` there), so that the guesses of that base go straight to
-    :func:`_factor_whole`. ``S0``'s leading ``lead`` columns are factored first and
-    their Schur complement ``SC`` kept: they are the whole ``S``'s too, so that
+    :func:`_factor_whole`. ``S0``'s leading ``lead`` columns come from
+    :func:`_build_lead` (kept while the free diagonal rows that reach them stay), and
+    their Schur complement ``SC`` is kept: they are the whole ``S``'s too, so that
     :func:`_factor_whole` factors only the rest for each guess of the base, a refused
     ``S0``'s included."""
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, r, c, a, kb, o, d, start, e = 0, row
     cdef Py_ssize_t lead = f.lead, rest = m - lead
-    cdef double largest = 0.0, smallest
+    cdef double largest
     cdef double* trailing = f.S0 + lead * (m + 1)
     f.base = BASE_NONE
     row = _walk_diagonal(f, p, index, boundary, nb, True)
@@ -394,26 +466,17 @@ cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
     for kb in range(nb):
         f.base_boundary[kb] = boundary[kb]
     f.base = BASE_SINGULAR
-    _zero_lower(f.DD, m)
-    _add_sparse_rows(f, p, f.unconstrained, row, 0, m, f.DD)
-    for c in range(m):
-        for r in range(c, m):
-            f.S0[r + c * m] = f.DD[r + c * m] + f.SU[r + c * m]
-    for c in range(m):
-        largest = max(largest, f.S0[c + c * m])
-        if c + 1 == lead:
-            f.lead_largest = largest
-    if lead > 0 and not fccqp_cholesky_lead(f.S0, <int>m, <int>m, <int>lead):
+    if not _same_lead(f, p, row) and not _build_lead(f, p, row):
         return
-    smallest = largest
-    for c in range(lead):
-        smallest = min(smallest, f.S0[c + c * m] * f.S0[c + c * m])
-    f.lead_min = smallest
-    if lead == 0:
-        f.lead_largest = 0.0
-    for c in range(rest):
-        for r in range(c, rest):
-            f.SC[r + c * rest] = trailing[r + c * m]
+    for c in range(lead, m):   # SC: LSC and the other free diagonal rows' sums
+        for r in range(c, m):
+            f.SC[r + c * m] = f.LSC[r + c * m]
+    _add_rows(f, p, row, False, f.SC)
+    largest = f.lead_largest
+    for c in range(lead, m):   # S0's diagonal: diag0 and the sums since
+        largest = max(largest, f.diag0[c] + f.SC[c * (m + 1)] - f.LSC[c * (m + 1)])
+        for r in range(c, m):
+            f.S0[r + c * m] = f.SC[r + c * m]
     f.base = BASE_REFUSED
     if rest > 0 and not cholesky(trailing, <int>rest, <int>m):
         return
