@@ -156,14 +156,18 @@ cdef void _order_rows(PolishSchur* f, const Problem* p) noexcept nogil:
     (that count rounded down to the Cholesky's panel of ``FCCQP_LU_PANEL``), and every
     guess of a base shares their factor (:func:`_build_base`). ``lead`` is 0 where ``m``
     takes ``dpotrf`` (``CHOLESKY_LOOP_ROWS``)."""
-    cdef Py_ssize_t n = p.n, m = p.m, c, j, untouched = 0, last = m
-    cdef double* touched = f.u   # scratch: 1 where a cone entry's column of A is nonzero
+    cdef Py_ssize_t n = p.n, m = p.m, c, k, a, d, untouched = 0, last
+    cdef double* touched = f.u   # scratch: the count of cone entries' nonzeros in a row
+    cdef const double* row
     for c in range(m):
         touched[c] = 0.0
-        for j in range(p.s):
-            if p.in_cone[j] and p.A.values[c * n + p.constrained[j]] != 0.0:
-                touched[c] = 1.0
-                break
+    for k in range(p.cones.count):   # a cone's entries are consecutive entries of x
+        d = p.cones.dim[k]
+        row = p.A.values + p.constrained[p.cones.offset[k]]
+        for c in range(m):
+            for a in range(d):
+                touched[c] += row[c * n + a] != 0.0
+    for c in range(m):
         untouched += touched[c] == 0.0
     last = untouched
     untouched = 0
