@@ -728,6 +728,34 @@ def test_schur_polish_over_guesses_and_newton_steps_is_the_assembled_polish(seed
     assert np.abs(A @ schur["x"] - b).max() <= 1e-12 * max(1.0, np.abs(b).max())
 
 
+@pytest.mark.parametrize("iterations", [1, 4])
+@pytest.mark.parametrize("seed", range(8))
+def test_schur_polish_with_rows_no_cone_touches_is_the_assembled_polish(seed, iterations):
+    """Rows of ``A`` that no cone entry touches come first in ``S`` (fccqp.polish_schur):
+    their block is factored once for every base whose free rows that reach it are the
+    same (here the free box entries: the guesses hold and release them), and a guess
+    factors only the rows past it. From a rough iterate the Schur polish takes the
+    guesses and steps of the assembled matrix's polish, to the same point."""
+    P, q, A, b, lb, ub, cones = random_problem(seed, n=40, m=8, n_cones=8, n_box=8)
+    P = np.diag(np.diag(P))
+    A[3:, :24] = 0.0   # rows 3-7: no cone entry, the first four of them S's leading block
+    b = A @ fccqp.solve(P, q, A, b, lb, ub, cones).x
+    it = fccqp.solve(P, q, A, b, lb, ub, cones, polish=False, kkt_backend="ldl_full",
+                     max_iter=iterations)
+    start = (it.x, it.y, it.z, it.x)
+    flat = flatten_cones(cones, P.shape[0])
+    assembled = polish_point(P, q, A, b, lb, ub, flat, *start)
+    schur = polish_point(P, q, A, b, lb, ub, flat, *start, schur=True)
+    assert assembled["ok"] and schur["ok"] and schur["schur"]
+    assert np.array_equal(assembled["active"], schur["active"])
+    assert (assembled["passes"], assembled["factorizations"]) == (schur["passes"],
+                                                                   schur["factorizations"])
+    for name in ("x", "nu", "y"):
+        gap = np.abs(assembled[name] - schur[name]).max()
+        assert gap <= 1e-12 * max(1.0, np.abs(assembled[name]).max()), name
+    assert np.abs(A @ schur["x"] - b).max() <= 1e-12 * max(1.0, np.abs(b).max())
+
+
 def test_a_contact_change_polished_from_nothing_settles_its_planes_before_a_release():
     """anymal_c's benchmark tick 360 (``mix``, seed 0: a fourth foot put down), warm along
     its sequence from tick 300, started from tick 359's answer carried onto the new

@@ -384,10 +384,13 @@ static int fccqp_lu(double *T, int n, int *piv)
     return 1;
 }
 
-FCCQP_CLONES
-static int fccqp_cholesky(double *M, int n, int ld)
+/* fccqp_cholesky's columns [0, stop) (stop a multiple of FCCQP_LU_PANEL, or n), their
+ * updates applied to the trailing columns: these then hold the Schur complement of the
+ * leading block, ready for fccqp_cholesky. */
+static inline __attribute__((always_inline)) int fccqp_cholesky_columns(double *M, int n,
+                                                                        int ld, int stop)
 {
-    for (int k0 = 0; k0 < n; k0 += FCCQP_LU_PANEL) {
+    for (int k0 = 0; k0 < stop; k0 += FCCQP_LU_PANEL) {
         int end = k0 + FCCQP_LU_PANEL < n ? k0 + FCCQP_LU_PANEL : n;
         for (int k = k0; k < end; k++) {   /* the panel, one column at a time */
             double *pivot_column = M + (long)k * ld;
@@ -423,6 +426,21 @@ static int fccqp_cholesky(double *M, int n, int ld)
                                j, n);
     }
     return 1;
+}
+
+FCCQP_CLONES
+static int fccqp_cholesky(double *M, int n, int ld)
+{
+    return fccqp_cholesky_columns(M, n, ld, n);
+}
+
+/* fccqp_cholesky_columns as a function: polish_schur factors the rows that every guess
+ * of a base shares once (fccqp_cholesky_lead), then only the rows its boundary blocks
+ * touch, per guess. */
+FCCQP_CLONES
+static int fccqp_cholesky_lead(double *M, int n, int ld, int stop)
+{
+    return fccqp_cholesky_columns(M, n, ld, stop);
 }
 
 

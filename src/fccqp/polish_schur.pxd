@@ -5,6 +5,7 @@ cdef enum:
     BASE_NONE = 0
     BASE_READY = 1
     BASE_REFUSED = 2
+    BASE_SINGULAR = 3
 
 cdef struct PolishSchur:
     # The polished QP's KKT system by Schur complement where P's structure allows it
@@ -24,7 +25,11 @@ cdef struct PolishSchur:
     int diag_end            # rows of Y before the boundary blocks'
     int rows                # rows of Y: the free entries of the factored guess
     double* SU              # m x m: the unconstrained entries' part of S, + delta I
-    double* S               # (m + s)^2: S of the last factored guess, then its Cholesky
+    Py_ssize_t* arow        # m: the row of A of each of S's first m columns
+    int lead                # S's leading columns, rows of A no cone entry touches (a
+                            # multiple of 4): factored once per base (_build_base)
+    double* S               # (m + s)^2: S of the last factored guess past S0's leading
+                            # block, then its Cholesky (the leading block's is S0's)
     double* block           # s x s: a boundary block's Cholesky factor at block + offset * s
     double* t               # n scratch
     double* t2              # n scratch
@@ -38,14 +43,27 @@ cdef struct PolishSchur:
     bint bordered           # the last factored guess is bordered: a solve reads S0..T
     char base               # BASE_NONE, or S0, W, WW belong to Y's rows [unconstrained,
                             # diag_end) and the blocks base_boundary[:base_nb] (BASE_READY)
-                            # or S0 of those was refused (BASE_REFUSED)
+                            # or S0 of those was refused (BASE_REFUSED) or its
+                            # leading block is not positive definite (BASE_SINGULAR)
     Py_ssize_t* base_boundary   # s: the boundary blocks of the base
     int base_nb             # their number
     int nbd                 # their entries: the boundary rows of the bordered system
     double base_largest     # S0's largest diagonal entry
+    double lead_largest     # S0's largest diagonal entry in its leading block
+    double lead_min         # S0's smallest squared pivot in its leading block
     double* S0              # m x m: Cholesky of SU + the free diagonal rows' Y'Y
-    double* DD              # m x m: the free diagonal rows' Y'Y (lower), summed as dsyrk sums
-    double* W               # m x s: S0's factor^-1 A_B', a column per boundary entry
+    double* SC              # m x m (trailing block): S0's Schur complement of its leading
+                            # block: LSC + the other free diagonal rows' Y'Y
+    # S0's leading block, shared by the bases whose free diagonal rows that reach it
+    # (lead_rows) are the same (_build_lead):
+    bint lead_valid         # S0's leading columns, LSC and diag0 hold lead_rows' factor
+    Py_ssize_t* lead_rows   # n: the entries of x of those rows, in Y's order
+    int lead_count          # their number
+    double* LSC             # m x m (trailing block): Schur complement of the leading block
+                            # of SU + those rows' Y'Y (lower)
+    double* diag0           # m: the diagonal of SU + those rows' Y'Y
+    double* W               # (m - lead) x s: S0's factor^-1 A_B', a column per boundary
+                            # entry, its trailing rows (the leading ones are zero)
     double* WW              # s x s: W'W
     double* K               # s x s: Cholesky of H_B + W'W
     double* Z               # s x s: K's factor^-1 G', a column per boundary block

@@ -26,7 +26,9 @@ that is a few tens of thousands of multiply-adds a guess, against the ``dsytrf``
 factorization and no reduced table, which the table polish (:mod:`fccqp.polish_table`)
 is built on. So a warm polish that succeeds skips both (see ``Workspace._iterate``).
 
-A solve keeps ``Y``: ``w = L^-1 r_x``, ``mu = S^-1 (Y'w - r_c)``, ``x_F = L'^-1 (w -
+``S``'s first ``m`` columns take ``A``'s rows in the order :func:`_order_rows` gives
+them (the rows that cone entries touch last), so that the guesses of one base share
+the factor of ``S``'s leading block. A solve keeps ``Y``: ``w = L^-1 r_x``, ``mu = S^-1 (Y'w - r_c)``, ``x_F = L'^-1 (w -
 Y mu)``, two products with ``Y`` and the triangular solves of ``H``'s blocks. The
 caller refines against the unregularized system, as with ``dsytrf``. Where ``P``
 couples a constrained entry, a block is not positive definite or ``S`` loses a pivot
@@ -54,7 +56,8 @@ from fccqp._blas cimport (backward_substitution, cholesky, cholesky_solve_vector
                           forward_substitution, syrk_t, trsm)
 from fccqp._types cimport Problem
 from fccqp.schur cimport mark_coupled
-from fccqp.tuning cimport PIVOT_TOLERANCE, POLISH_BORDER_TOLERANCE, POLISH_RANK_TOLERANCE
+from fccqp.tuning cimport (CHOLESKY_LOOP_ROWS, PIVOT_TOLERANCE, POLISH_BORDER_TOLERANCE,
+                           POLISH_RANK_TOLERANCE)
 
 
 cdef extern from "fccqp_kernels.h" nogil:
@@ -62,6 +65,8 @@ cdef extern from "fccqp_kernels.h" nogil:
                         int cols)
     void fccqp_sparse_rank_update(const double* Y, int ld, int rows, const int* index,
                                   const int* count, int m, double* T, double* values)
+    int fccqp_cholesky_lead(double* M, int n, int ld, int stop)
+    enum: FCCQP_LU_PANEL
 
 
 cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noexcept nogil:
@@ -74,7 +79,7 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, i, j, r, c, lead = 0, rest
     cdef double largest = 0.0, pivot
     cdef int k
-    f.ready = f.bordered = False
+    f.ready = f.bordered = f.lead_valid = False
     f.base = BASE_NONE
     f.convex = True
     mark_coupled(p.P.values, n, f.coupled)
@@ -117,9 +122,10 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
         pivot = f.L[c + c * n]
         if not pivot * pivot > PIVOT_TOLERANCE * largest:
             return False
+    _order_rows(f, p)
     for c in range(m):
         for r in range(k):
-            f.Y[r + c * n] = p.A.values[c * n + f.order[r]]
+            f.Y[r + c * n] = p.A.values[f.arow[c] * n + f.order[r]]
     for r in range(k, rest):
         _write_row(f, p, f.order[r], r, f.inv_root[r])
     if m > 0:
@@ -128,7 +134,7 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
             syrk_t(<int>m, k, f.Y, <int>n, 0.0, f.SU, <int>m)
         else:
             _zero_lower(f.SU, m)
-        _add_sparse_rows(f, p, k, rest, m, f.SU)   # the diagonal rows go on with dsyrk's sums
+        _add_sparse_rows(f, p, k, rest, 0, m, f.SU)   # the diagonal rows go on with dsyrk's sums
         for c in range(m):
             f.SU[c + c * m] += delta
     f.ready = True
@@ -143,11 +149,43 @@ cdef inline void _zero_lower(double* T, Py_ssize_t size) noexcept nogil:
             T[r + c * size] = 0.0
 
 
+cdef void _order_rows(PolishSchur* f, const Problem* p) noexcept nogil:
+    """``S``'s first ``m`` columns (``arow``): the rows of ``A`` that no cone entry
+    touches, then those it does, each in ``A``'s order. A boundary block's rows of ``Y``
+    are zero in the former, so ``S`` and ``S0`` agree on their leading ``lead`` columns
+    (that count rounded down to the Cholesky's panel of ``FCCQP_LU_PANEL``), and every
+    guess of a base shares their factor (:func:`_build_base`). ``lead`` is 0 where ``m``
+    takes ``dpotrf`` (``CHOLESKY_LOOP_ROWS``)."""
+    cdef Py_ssize_t n = p.n, m = p.m, c, k, a, d, untouched = 0, last
+    cdef double* touched = f.u   # scratch: the count of cone entries' nonzeros in a row
+    cdef const double* row
+    for c in range(m):
+        touched[c] = 0.0
+    for k in range(p.cones.count):   # a cone's entries are consecutive entries of x
+        d = p.cones.dim[k]
+        row = p.A.values + p.constrained[p.cones.offset[k]]
+        for c in range(m):
+            for a in range(d):
+                touched[c] += row[c * n + a] != 0.0
+    for c in range(m):
+        untouched += touched[c] == 0.0
+    last = untouched
+    untouched = 0
+    for c in range(m):
+        if touched[c] == 0.0:
+            f.arow[untouched] = c
+            untouched += 1
+        else:
+            f.arow[last] = c
+            last += 1
+    f.lead = <int>(untouched - untouched % FCCQP_LU_PANEL) if m <= CHOLESKY_LOOP_ROWS else 0
+
+
 cdef inline void _write_row(PolishSchur* f, const Problem* p, Py_ssize_t i, Py_ssize_t row,
                             double inverse) noexcept nogil:
-    """Row ``row`` of ``Y``'s first ``m`` columns: column ``i`` of ``A`` times
-    ``inverse``, and where it is nonzero (``row_nz``, ``row_count``; branch-free: every
-    column is written, kept where nonzero)."""
+    """Row ``row`` of ``Y``'s first ``m`` columns: column ``i`` of ``A`` in ``arow``'s
+    order times ``inverse``, and where it is nonzero (``row_nz``, ``row_count``;
+    branch-free: every column is written, kept where nonzero)."""
     cdef Py_ssize_t c, n = p.n, m = p.m
     cdef double* y = f.Y + row
     cdef const double* a = p.A.values + i
@@ -155,7 +193,7 @@ cdef inline void _write_row(PolishSchur* f, const Problem* p, Py_ssize_t i, Py_s
     cdef int count = 0
     cdef double value
     for c in range(m):
-        value = a[c * n] * inverse
+        value = a[f.arow[c] * n] * inverse
         y[c * n] = value
         nz[count] = <int>c
         count += value != 0.0
@@ -163,23 +201,25 @@ cdef inline void _write_row(PolishSchur* f, const Problem* p, Py_ssize_t i, Py_s
 
 
 cdef inline void _find_row(PolishSchur* f, const Problem* p, Py_ssize_t row,
-                           Py_ssize_t size) noexcept nogil:
-    """Where row ``row`` of ``Y``'s first ``size`` columns is nonzero (as
-    :func:`_write_row` records it)."""
+                           Py_ssize_t first, Py_ssize_t size) noexcept nogil:
+    """Where row ``row`` of ``Y``'s columns ``first .. size`` is nonzero (as
+    :func:`_write_row` records it, counted from ``first``)."""
     cdef Py_ssize_t c, n = p.n
     cdef const double* y = f.Y + row
     cdef int* nz = f.row_nz + row * (p.m + p.s)
     cdef int count = 0
-    for c in range(size):
-        nz[count] = <int>c
+    for c in range(first, size):
+        nz[count] = <int>(c - first)
         count += y[c * n] != 0.0
     f.row_count[row] = count
 
 
 cdef void _add_sparse_rows(PolishSchur* f, const Problem* p, Py_ssize_t first,
-                           Py_ssize_t last, Py_ssize_t size, double* T) noexcept nogil:
+                           Py_ssize_t last, Py_ssize_t column, Py_ssize_t size,
+                           double* T) noexcept nogil:
     """``T += Y_R' Y_R`` (lower triangle, ``size x size``) over the rows ``R = first:last``
-    of ``Y``, from the nonzeros that :func:`_write_row` and :func:`_find_row` recorded:
+    of ``Y`` from its column ``column`` on, from the nonzeros that :func:`_write_row` and
+    :func:`_find_row` recorded (counted from that column):
     a fused multiply-add per nonzero pair, row after row, which is how ``dsyrk`` sums
     each entry (a zero term adds exactly nothing), so ``T`` holds the bits ``dsyrk``
     would where its kernel sums that way (as :func:`fccqp.schur._add_row_products`:
@@ -191,8 +231,8 @@ cdef void _add_sparse_rows(PolishSchur* f, const Problem* p, Py_ssize_t first,
     cdef Py_ssize_t j, ld = p.m + p.s
     for j in range(first, last):
         if f.row_count[j] > 0:
-            fccqp_sparse_rank_update(f.Y + j, <int>p.n, 1, f.row_nz + j * ld, f.row_count + j,
-                                     <int>size, T, f.nz_values)
+            fccqp_sparse_rank_update(f.Y + j + column * p.n, <int>p.n, 1, f.row_nz + j * ld,
+                                     f.row_count + j, <int>size, T, f.nz_values)
 
 
 cdef inline bint _diagonal_row(PolishSchur* f, const Problem* p, Py_ssize_t i, Py_ssize_t row,
@@ -219,17 +259,21 @@ cdef bint _factor_whole(PolishSchur* f, const Problem* p, const Py_ssize_t* inde
     """Factor the whole ``S`` (``m + nb`` rows) of the guess (see
     :func:`polish_schur_factor`) and keep ``Y = L^-1 C'`` for the solves. ``Y``'s rows:
     the unconstrained entries (from the set-up), the free box entries and free cone
-    blocks (a diagonal entry of ``H`` each; written with their sums ``DD`` by
-    :func:`_build_base`, whose base is the guess's here), then the boundary blocks.
-    False where the Schur complement does not apply."""
+    blocks (a diagonal entry of ``H`` each; written by :func:`_build_base`, whose base
+    is the guess's here), then the boundary blocks. These are zero in ``S``'s leading
+    ``lead`` columns, where ``S`` is ``S0`` and the base holds its factor: only the
+    rest, the base's Schur complement ``SC`` plus the boundary rows' sums, is factored
+    (into ``S``, ``m + nb - lead`` rows). False where the Schur complement does not
+    apply."""
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, size = m + nb, r, c, k, o, d
-    cdef Py_ssize_t start, row = f.diag_end, kb, a
+    cdef Py_ssize_t start, row = f.diag_end, kb, a, lead = f.lead, rest = m - lead
+    cdef Py_ssize_t t = size - lead
     cdef double* S = f.S
     cdef double* Y = f.Y
     cdef double* B
-    cdef double largest = 0.0
-    if f.base == BASE_NONE:
-        return False   # a free row of the guess could not be written (_build_base)
+    cdef double largest = f.lead_largest
+    if f.base == BASE_NONE or f.base == BASE_SINGULAR:
+        return False   # a free row could not be written, or S0's leading block failed
     for c in range(m, size):   # the rows above the boundary blocks have no plane
         for r in range(row):
             Y[r + c * n] = 0.0
@@ -243,32 +287,36 @@ cdef bint _factor_whole(PolishSchur* f, const Problem* p, const Py_ssize_t* inde
         f.block_row[kb] = row
         for a in range(d):
             f.rowvar[row + a] = start + a
-            for c in range(m):
-                Y[row + a + c * n] = p.A.values[c * n + start + a]
+            for c in range(lead):
+                Y[row + a + c * n] = 0.0
+            for c in range(lead, m):
+                Y[row + a + c * n] = p.A.values[f.arow[c] * n + start + a]
             for c in range(m, size):
                 Y[row + a + c * n] = 0.0
             Y[row + a + (m + kb) * n] = g[o + a]
-        for c in range(size):   # Y_block := B^-1 Y_block
+        for c in range(lead, size):   # Y_block := B^-1 Y_block
             forward_substitution(B, <int>d, <int>d, Y + row + c * n)
         for a in range(d):
-            _find_row(f, p, row + a, size)
+            _find_row(f, p, row + a, lead, size)
         row += d
     f.rows = <int>row
-    for c in range(size):   # the base's sums over the rows above, continued below
-        for r in range(c, size):
-            S[r + c * size] = f.DD[r + c * m] if r < m else 0.0
-    _add_sparse_rows(f, p, f.diag_end, row, size, S)
-    for c in range(size):
-        for r in range(c, m):
-            S[r + c * size] += f.SU[r + c * m]
-        if c >= m:
-            S[c + c * size] += delta
-    for c in range(size):
-        largest = max(largest, S[c + c * size])
-    if size > 0 and not cholesky(S, <int>size, <int>size):
+    for c in range(t):   # the base's Schur complement, the boundary rows' sums added
+        for r in range(c, t):
+            S[r + c * t] = f.SC[(lead + r) + (lead + c) * m] if r < rest else 0.0
+    _add_sparse_rows(f, p, f.diag_end, row, lead, t, S)
+    for c in range(t):   # S's diagonal: diag0 and the sums since
+        if c < rest:
+            largest = max(largest, f.diag0[lead + c] + S[c + c * t]
+                          - f.LSC[(lead + c) * (m + 1)])
+        else:
+            S[c + c * t] += delta
+            largest = max(largest, S[c + c * t])
+    if t > 0 and not cholesky(S, <int>t, <int>t):
         return False
-    for c in range(size):
-        if S[c + c * size] * S[c + c * size] <= POLISH_RANK_TOLERANCE * largest:
+    if lead > 0 and f.lead_min <= POLISH_RANK_TOLERANCE * largest:
+        return False
+    for c in range(t):
+        if S[c + c * t] * S[c + c * t] <= POLISH_RANK_TOLERANCE * largest:
             return False
     f.size = <int>size
     return True
@@ -324,6 +372,77 @@ cdef bint _same_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
     return _walk_diagonal(f, p, index, boundary, nb, False) >= 0
 
 
+cdef inline bint _reaches_lead(PolishSchur* f, const Problem* p, Py_ssize_t j) noexcept nogil:
+    """Whether row ``j`` of ``Y`` (a diagonal row, as :func:`_write_row` records it) is
+    nonzero in ``S``'s leading ``lead`` columns."""
+    return f.row_count[j] > 0 and f.row_nz[j * (p.m + p.s)] < f.lead
+
+
+cdef bint _same_lead(PolishSchur* f, const Problem* p, Py_ssize_t end) noexcept nogil:
+    """Whether the free diagonal rows ``unconstrained .. end`` of ``Y`` that reach ``S``'s
+    leading columns are those whose factor :func:`_build_lead` keeps."""
+    cdef Py_ssize_t j, k = 0
+    if not f.lead_valid:
+        return False
+    for j in range(f.unconstrained, end):
+        if _reaches_lead(f, p, j):
+            if k == f.lead_count or f.lead_rows[k] != f.rowvar[j]:
+                return False
+            k += 1
+    return k == f.lead_count
+
+
+cdef void _add_rows(PolishSchur* f, const Problem* p, Py_ssize_t end, bint reaching,
+                    double* T) noexcept nogil:
+    """``T += Y_R' Y_R`` (lower triangle, ``m x m``) over the free diagonal rows
+    ``unconstrained .. end`` of ``Y`` that reach ``S``'s leading columns (``reaching``)
+    or that do not, as :func:`_add_sparse_rows` sums."""
+    cdef Py_ssize_t j, ld = p.m + p.s
+    for j in range(f.unconstrained, end):
+        if f.row_count[j] > 0 and _reaches_lead(f, p, j) == reaching:
+            fccqp_sparse_rank_update(f.Y + j, <int>p.n, 1, f.row_nz + j * ld, f.row_count + j,
+                                     <int>p.m, T, f.nz_values)
+
+
+cdef bint _build_lead(PolishSchur* f, const Problem* p, Py_ssize_t end) noexcept nogil:
+    """Factor the leading ``lead`` columns of ``SU`` plus the sums of the free diagonal
+    rows ``unconstrained .. end`` that reach them, into ``S0``'s leading columns; keep
+    the rest's Schur complement ``LSC``, the diagonal ``diag0``, the leading block's
+    largest diagonal entry and smallest squared pivot, and those rows (``lead_rows``).
+    The other rows add only to ``LSC``'s block, so every base with the same rows
+    shares this (:func:`_build_base`): on talos the rows that reach it are the free
+    torques of the joints without a contact force. False where the leading block is not
+    positive definite."""
+    cdef Py_ssize_t m = p.m, lead = f.lead, r, c, j
+    cdef double smallest
+    f.lead_valid = False
+    for c in range(m):
+        for r in range(c, m):
+            f.S0[r + c * m] = f.SU[r + c * m]
+    _add_rows(f, p, end, True, f.S0)
+    f.lead_largest = 0.0
+    for c in range(m):
+        f.diag0[c] = f.S0[c * (m + 1)]
+        if c < lead:
+            f.lead_largest = max(f.lead_largest, f.diag0[c])
+    if lead > 0 and not fccqp_cholesky_lead(f.S0, <int>m, <int>m, <int>lead):
+        return False
+    smallest = f.lead_largest
+    for c in range(lead):
+        smallest = min(smallest, f.S0[c * (m + 1)] * f.S0[c * (m + 1)])
+    f.lead_min = smallest
+    for c in range(lead, m):
+        for r in range(c, m):
+            f.LSC[r + c * m] = f.S0[r + c * m]
+    f.lead_count = 0
+    for j in range(f.unconstrained, end):
+        if _reaches_lead(f, p, j):
+            f.lead_rows[f.lead_count] = f.rowvar[j]
+            f.lead_count += 1
+    f.lead_valid = True
+    return True
+
+
 cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
                       const Py_ssize_t* boundary, Py_ssize_t nb) noexcept nogil:
     """The guess's part of ``S`` that its planes and curvature leave alone: the free
@@ -333,10 +452,15 @@ cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
     ``BASE_REFUSED`` where ``S0`` is too near singular for the bordered solve
     (``POLISH_BORDER_TOLERANCE``: go2's rows that only boundary blocks span leave ``S0``
     ``delta`` there), so that the guesses of that base go straight to
-    :func:`_factor_whole`, which starts from the same rows of ``Y`` and their sums
-    ``DD``."""
+    :func:`_factor_whole`. ``S0``'s leading ``lead`` columns come from
+    :func:`_build_lead` (kept while the free diagonal rows that reach them stay), and
+    their Schur complement ``SC`` is kept: they are the whole ``S``'s too, so that
+    :func:`_factor_whole` factors only the rest for each guess of the base, a refused
+    ``S0``'s included."""
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, r, c, a, kb, o, d, start, e = 0, row
-    cdef double largest = 0.0
+    cdef Py_ssize_t lead = f.lead, rest = m - lead
+    cdef double largest
+    cdef double* trailing = f.S0 + lead * (m + 1)
     f.base = BASE_NONE
     row = _walk_diagonal(f, p, index, boundary, nb, True)
     if row < 0:
@@ -345,15 +469,20 @@ cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
     f.base_nb = <int>nb
     for kb in range(nb):
         f.base_boundary[kb] = boundary[kb]
-    f.base = BASE_REFUSED
-    _zero_lower(f.DD, m)
-    _add_sparse_rows(f, p, f.unconstrained, row, m, f.DD)
-    for c in range(m):
+    f.base = BASE_SINGULAR
+    if not _same_lead(f, p, row) and not _build_lead(f, p, row):
+        return
+    for c in range(lead, m):   # SC: LSC and the other free diagonal rows' sums
         for r in range(c, m):
-            f.S0[r + c * m] = f.DD[r + c * m] + f.SU[r + c * m]
-    for c in range(m):
-        largest = max(largest, f.S0[c + c * m])
-    if m > 0 and not cholesky(f.S0, <int>m, <int>m):
+            f.SC[r + c * m] = f.LSC[r + c * m]
+    _add_rows(f, p, row, False, f.SC)
+    largest = f.lead_largest
+    for c in range(lead, m):   # S0's diagonal: diag0 and the sums since
+        largest = max(largest, f.diag0[c] + f.SC[c * (m + 1)] - f.LSC[c * (m + 1)])
+        for r in range(c, m):
+            f.S0[r + c * m] = f.SC[r + c * m]
+    f.base = BASE_REFUSED
+    if rest > 0 and not cholesky(trailing, <int>rest, <int>m):
         return
     for c in range(m):
         if f.S0[c + c * m] * f.S0[c + c * m] <= POLISH_BORDER_TOLERANCE * largest:
@@ -364,13 +493,13 @@ cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
         f.block_row[kb] = row
         for a in range(d):
             f.rowvar[row + a] = start + a
-            for c in range(m):
-                f.W[c + (e + a) * m] = p.A.values[c * n + start + a]
+            for c in range(rest):
+                f.W[c + (e + a) * rest] = p.A.values[f.arow[lead + c] * n + start + a]
         row += d
         e += d
-    if e > 0 and m > 0:
-        trsm(b"L", b"N", <int>m, <int>e, f.S0, <int>m, f.W, <int>m)
-        syrk_t(<int>e, <int>m, f.W, <int>m, 0.0, f.WW, <int>s)
+    if e > 0 and rest > 0:   # W's leading rows are zero: A_B' is
+        trsm(b"L", b"N", <int>rest, <int>e, trailing, <int>m, f.W, <int>rest)
+        syrk_t(<int>e, <int>rest, f.W, <int>rest, 0.0, f.WW, <int>s)
     else:
         for c in range(e):
             for r in range(c, e):
@@ -478,7 +607,9 @@ cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t
     plane) then refactors only ``K`` and ``T`` (``nb d`` and ``nb`` rows) and keeps
     ``S0``, ``W`` and ``W'W`` (notes/polish.md, "schurup"). Otherwise, or where ``S0`` is
     too near singular for that order, the whole ``S`` (:func:`_factor_whole`, from the
-    base's rows of ``Y`` and their sums, so the base stays the guess's)."""
+    base's rows of ``Y`` and their sums, so the base stays the guess's); its columns
+    are ``A``'s rows that no cone entry touches first (``arow``), so that a guess
+    factors only the rows past the base's leading block (talos: 20 + nb of 68 + nb)."""
     f.bordered = False
     if not _same_base(f, p, index, boundary, nb):
         _build_base(f, p, index, boundary, nb)
@@ -516,6 +647,43 @@ cdef void _backward(PolishSchur* f, const Problem* p, const Py_ssize_t* boundary
         backward_substitution(f.L, f.dense, <int>p.n, w)
 
 
+cdef inline void _subtract_rows(PolishSchur* f, Py_ssize_t m, const double* r,
+                                double* u) noexcept nogil:
+    """``u[c] -= r[arow[c]]`` over ``S``'s first ``m`` columns: the right-hand side of
+    ``A``'s rows in ``S``'s order."""
+    cdef Py_ssize_t c
+    for c in range(m):
+        u[c] -= r[f.arow[c]]
+
+
+cdef inline void _put_rows(PolishSchur* f, Py_ssize_t m, Py_ssize_t size, const double* u,
+                           double* out) noexcept nogil:
+    """``out`` := ``u`` (``size`` entries), the first ``m`` back in ``A``'s row order."""
+    cdef Py_ssize_t c
+    for c in range(m):
+        out[f.arow[c]] = u[c]
+    for c in range(m, size):
+        out[c] = u[c]
+
+
+cdef void _solve_whole(PolishSchur* f, Py_ssize_t m, Py_ssize_t size, double* u) noexcept nogil:
+    """``u := S^-1 u`` for :func:`_factor_whole`'s ``S``: its leading ``lead`` columns'
+    factor ``[L11; L21]`` is ``S0``'s (rows past ``m``: zero), the rest's ``S``'s."""
+    cdef Py_ssize_t lead = f.lead, rest = m - lead, r, c
+    cdef const double* column
+    if lead > 0:
+        forward_substitution(f.S0, <int>lead, <int>m, u)
+        for c in range(lead):   # u_2 -= L21 u_1
+            column = f.S0 + c * m
+            for r in range(lead, m):
+                u[r] -= column[r] * u[c]
+    cholesky_solve_vector(f.S, <int>(size - lead), <int>(size - lead), u + lead)
+    if lead > 0:
+        for c in range(lead):   # u_1 -= L21' u_2
+            u[c] -= _dot(f.S0 + lead + c * m, u + lead, rest)
+        backward_substitution(f.S0, <int>lead, <int>m, u)
+
+
 cdef void _solve_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
                           Py_ssize_t nb, double* v) noexcept nogil:
     """:func:`polish_schur_solve` for a bordered factorization: ``w_E = L_E^-1 r_E`` on
@@ -523,6 +691,7 @@ cdef void _solve_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* in
     ``K x_B + G'lam = r_B - W'rho`` and ``G x_B - delta lam = r_lam`` through ``K`` and
     ``T``, ``mu = L0'^-1 (rho + W x_B)``, ``x_E = L_E'^-1 (w_E - Y_E mu)``."""
     cdef Py_ssize_t n = p.n, m = p.m, s = p.s, r, c, e, kb, nf = f.rows, nbd = f.nbd
+    cdef Py_ssize_t lead = f.lead, rest = m - lead
     cdef int end = f.diag_end, mm = <int>m, one = 1, ld = <int>p.n
     cdef double* w = f.t
     cdef double* xb = f.t + f.diag_end
@@ -538,11 +707,10 @@ cdef void _solve_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* in
         w[r] *= f.inv_root[r]
     if m > 0:
         dgemv(&trans, &end, &mm, &alpha, f.Y, &ld, w, &one, &zero, u, &one)
-        for c in range(m):
-            u[c] -= v[nf + c]
+        _subtract_rows(f, m, v + nf, u)
         forward_substitution(f.S0, mm, mm, u)
     for e in range(nbd):
-        xb[e] -= _dot(f.W + e * m, u, m)
+        xb[e] -= _dot(f.W + e * rest, u + lead, rest)
     forward_substitution(f.K, <int>nbd, <int>s, xb)
     for kb in range(nb):
         lam[kb] = _dot(f.Z + kb * s, xb, nbd) - v[nf + m + kb]
@@ -553,8 +721,8 @@ cdef void _solve_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* in
     backward_substitution(f.K, <int>nbd, <int>s, xb)
     if m > 0:
         for e in range(nbd):
-            for c in range(m):
-                u[c] += f.W[c + e * m] * xb[e]
+            for c in range(rest):
+                u[lead + c] += f.W[c + e * rest] * xb[e]
         backward_substitution(f.S0, mm, mm, u)
         fccqp_matvec_t(f.Y, <int>n, u, f.t2, mm, end)   # Y_E mu
         for r in range(end):
@@ -565,8 +733,7 @@ cdef void _solve_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* in
         backward_substitution(f.L, f.dense, <int>n, w)
     for r in range(nf):
         v[index[f.rowvar[r]]] = w[r]
-    for c in range(m + nb):
-        v[nf + c] = u[c]
+    _put_rows(f, m, m + nb, u, v + nf)
 
 
 cdef void polish_schur_solve(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
@@ -589,14 +756,14 @@ cdef void polish_schur_solve(PolishSchur* f, const Problem* p, const Py_ssize_t*
     _forward(f, p, boundary, nb, w)
     if size > 0:
         dgemv(&trans, &rows, &size, &alpha, f.Y, &ld, w, &one, &zero, u, &one)
-        for c in range(size):
+        _subtract_rows(f, p.m, v + nf, u)
+        for c in range(p.m, size):
             u[c] -= v[nf + c]
-        cholesky_solve_vector(f.S, size, size, u)
+        _solve_whole(f, p.m, size, u)
         fccqp_matvec_t(f.Y, <int>n, u, f.t2, size, rows)   # Y u: columns of Y
         for r in range(rows):
             w[r] -= f.t2[r]
     _backward(f, p, boundary, nb, w)
     for r in range(rows):
         v[index[f.rowvar[r]]] = w[r]
-    for c in range(size):
-        v[nf + c] = u[c]
+    _put_rows(f, p.m, size, u, v + nf)

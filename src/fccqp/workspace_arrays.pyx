@@ -292,7 +292,9 @@ cdef void polish_schur_arrays(Arrays a, PolishSchur* ps, Py_ssize_t n, Py_ssize_
     ps.block = a.new(s * s)
     ps.base, ps.bordered = 0, False   # BASE_NONE
     ps.base_boundary = <Py_ssize_t*>a.new_int(s)
-    ps.S0, ps.DD, ps.W = a.new(m * m), a.new(m * m), a.new(m * s)
+    ps.S0, ps.LSC, ps.W = a.new(m * m), a.new(m * m), a.new(m * s)
+    ps.arow, ps.SC, ps.diag0 = <Py_ssize_t*>a.new_int(m), a.new(m * m), a.new(m)
+    ps.lead_rows, ps.lead_valid = <Py_ssize_t*>a.new_int(n), False
     ps.WW, ps.K, ps.Z, ps.T = a.new(s * s), a.new(s * s), a.new(s * s), a.new(s * s)
 
 
