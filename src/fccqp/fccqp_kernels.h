@@ -1850,7 +1850,7 @@ static void fccqp_mark_coupled(const double *P, int n, char *coupled)
  * z = 1 / L[j, j] at c = j - unit (a constrained row's unit column) and 0 elsewhere, WT
  * from fccqp_transpose: each entry's terms subtracted from z in the nonzeros' order. The
  * rows j >= unit go also to rows[(j - unit) s + c] where rows is not NULL. Where
- * the CPU has AVX2 and FMA (picked at each call) a row's columns go in blocks of four
+ * the CPU has AVX2 and FMA (picked at each call) a row's columns go in blocks of six
  * vectors held in registers, fused; the portable loops otherwise. */
 #include <stddef.h>
 
@@ -1932,6 +1932,10 @@ FCCQP_L3 void fccqp_store_strided(double *out, long ld, __m256d v, int width)
         _mm_storeh_pd(out + 3 * ld, hi);
 }
 
+/* Columns per block of fccqp_sparse_table_rows_wide: six vectors of accumulators, the
+ * broadcast factor and a loaded row fill the 16 registers (go2's s = 24 in one block) */
+#define FCCQP_TABLE_VECTORS 6
+
 /* fccqp_sparse_table_rows' columns c0 .. c0 + 4 V - 1 of row j, V vectors (a constant
  * where it is inlined), the last one's lanes masked by `last` (width `last_width`);
  * also at row[c0 ...] where row is not NULL */
@@ -1940,18 +1944,19 @@ FCCQP_L3 void fccqp_table_block(const double *Y, long ldy, int j, const int *col
                                 __m256i last, int last_width, int diag, double pivot,
                                 double *out, long ldw, double *row)
 {
-    __m256d acc[4], unit = _mm256_set1_pd(1.0 / pivot), p = _mm256_set1_pd(pivot);
-    for (int q = 0; q < V; q++) {
-        __m256i lane = _mm256_setr_epi64x(0, 1, 2, 3);
-        __m256i at = _mm256_set1_epi64x((long long)diag - c0 - 4 * q);
+    __m256d acc[FCCQP_TABLE_VECTORS], p = _mm256_set1_pd(pivot);
+    __m256d unit = _mm256_set1_pd(1.0 / pivot);
+    __m256i at = _mm256_set1_epi64x((long long)diag - c0);
+    for (int q = 0; q < V; q++) {   /* 1 / pivot in the lane of column diag, else 0 */
+        __m256i lane = _mm256_setr_epi64x(4 * q, 4 * q + 1, 4 * q + 2, 4 * q + 3);
         acc[q] = _mm256_and_pd(unit, _mm256_castsi256_pd(_mm256_cmpeq_epi64(at, lane)));
     }
     for (int k = 0; k < count; k++) {
         __m256d y = _mm256_set1_pd(Y[j + (long)columns[k] * ldy]);
-        const double *row = WT + (long)columns[k] * s + c0;
+        const double *w = WT + (long)columns[k] * s + c0;
         for (int q = 0; q < V - 1; q++)
-            acc[q] = _mm256_fnmadd_pd(y, _mm256_loadu_pd(row + 4 * q), acc[q]);
-        acc[V - 1] = _mm256_fnmadd_pd(y, _mm256_maskload_pd(row + 4 * (V - 1), last),
+            acc[q] = _mm256_fnmadd_pd(y, _mm256_loadu_pd(w + 4 * q), acc[q]);
+        acc[V - 1] = _mm256_fnmadd_pd(y, _mm256_maskload_pd(w + 4 * (V - 1), last),
                                       acc[V - 1]);
     }
     for (int q = 0; q < V; q++) {
@@ -1975,32 +1980,28 @@ static void fccqp_sparse_table_rows_wide(const double *restrict Y, int ldy, int 
                                          double *restrict W, long ldw,
                                          double *restrict rows)
 {
+    enum { C = 4 * FCCQP_TABLE_VECTORS };
     for (int j = first; j < last; j++) {
         const int *columns = index + (long)j * m;
         double pivot = L[j + (long)j * ldl];
         double *out = W + dest[j];
         double *row = rows && j >= unit ? rows + (long)(j - unit) * s : NULL;
-        for (int c0 = 0; c0 < s; c0 += 16) {
-            int width = s - c0 < 16 ? s - c0 : 16, V = (width + 3) / 4;
+        for (int c0 = 0; c0 < s; c0 += C) {
+            int width = s - c0 < C ? s - c0 : C, V = (width + 3) / 4;
             int last_width = width - 4 * (V - 1);
             __m256i mask = fccqp_first_lanes(last_width);
+#define FCCQP_TABLE_BLOCK(vectors)                                                       \
+    fccqp_table_block(Y, ldy, j, columns, count[j], WT, s, c0, vectors, mask, last_width, \
+                      j - unit, pivot, out, ldw, row)
             switch (V) {
-            case 4:
-                fccqp_table_block(Y, ldy, j, columns, count[j], WT, s, c0, 4, mask,
-                                  last_width, j - unit, pivot, out, ldw, row);
-                break;
-            case 3:
-                fccqp_table_block(Y, ldy, j, columns, count[j], WT, s, c0, 3, mask,
-                                  last_width, j - unit, pivot, out, ldw, row);
-                break;
-            case 2:
-                fccqp_table_block(Y, ldy, j, columns, count[j], WT, s, c0, 2, mask,
-                                  last_width, j - unit, pivot, out, ldw, row);
-                break;
-            default:
-                fccqp_table_block(Y, ldy, j, columns, count[j], WT, s, c0, 1, mask,
-                                  last_width, j - unit, pivot, out, ldw, row);
+            case 6: FCCQP_TABLE_BLOCK(6); break;
+            case 5: FCCQP_TABLE_BLOCK(5); break;
+            case 4: FCCQP_TABLE_BLOCK(4); break;
+            case 3: FCCQP_TABLE_BLOCK(3); break;
+            case 2: FCCQP_TABLE_BLOCK(2); break;
+            default: FCCQP_TABLE_BLOCK(1);
             }
+#undef FCCQP_TABLE_BLOCK
         }
     }
 }
