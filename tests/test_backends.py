@@ -169,6 +169,41 @@ def test_new_nonzeros_in_the_constrained_columns_of_a_reused_solver_are_used():
     np.testing.assert_allclose(result.x, reference.x, atol=1e-5 * (1 + np.abs(reference.x).max()))
 
 
+def test_schur_table_with_the_dense_block_in_two_runs_and_sparse_free_columns():
+    """The Schur backend forms the table's rows on its diagonal tail from the nonzeros of
+    ``A``'s columns there (found for each ``P`` and ``A``, the free tail's as the
+    constrained entries'), and writes the dense block's rows in place only where they are
+    one run of ``x``: with the dense block in two runs, and a reused solver whose QP before
+    had zeros in the free tail's columns, the answers are Clarabel's."""
+    _, q, A, b, lb, ub, cones = random_problem(4, n_box=6)
+    n = A.shape[1]
+    constrained = np.isfinite(lb) | np.isfinite(ub)
+    for cone in cones:
+        constrained[cone.start:cone.start + cone.dim] = True
+    free = np.flatnonzero(~constrained)
+    dense = free[[0, 1, 2, 6, 7, 8]]   # two runs, diagonal free entries between them
+    P = np.diag(np.linspace(0.5, 2.0, n))
+    rng = np.random.default_rng(0)
+    M = rng.standard_normal((6, 6))
+    P[np.ix_(dense, dense)] = M @ M.T / 6 + np.eye(6)
+    tail = np.setdiff1d(free, dense)
+    sparser = A.copy()
+    sparser[:5, tail] = 0.0
+    sparser[5:, tail[::2]] = 0.0
+    feasible = clarabel_solve(P, q, A, b, lb, ub, cones).x
+    solver = fccqp.Solver(kkt_backend="schur_reduced", eps_abs=1e-8, eps_rel=1e-8)
+    for matrix, reset in ((sparser, False), (A, True)):
+        if reset:
+            solver.reset()
+        rhs = matrix @ feasible
+        result = solver.solve(P, q, matrix, rhs, lb, ub, cones)
+        assert result.status is Status.SOLVED and result.backend == "schur_reduced"
+        reference = clarabel_solve(P, q, matrix, rhs, lb, ub, cones)
+        np.testing.assert_allclose(result.x, reference.x,
+                                   atol=1e-5 * (1 + np.abs(reference.x).max()))
+        assert np.abs(matrix @ result.x - rhs).max() <= 1e-9 * (1 + np.abs(rhs).max())
+
+
 @pytest.mark.parametrize("entry", ["free", "boxed"])
 def test_negative_curvature_on_the_diagonal_tail_is_rejected(entry):
     P, q, A, b, lb, ub, cones = _block_diagonal(random_problem(4, n_box=6))

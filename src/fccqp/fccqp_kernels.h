@@ -1092,13 +1092,7 @@ static double fccqp_sum_squares(const double *restrict v, long k)
     return total;
 }
 
-/* polish_schur's kernels (and schur's mark_coupled).
- *
- * fccqp_mark_coupled: coupled[i] = 1 where row i of the row-major n x n P has a nonzero
- * (or NaN) entry off its diagonal, else 0. The entries' bits shifted past the sign (so
- * that -0.0 counts as zero) or-ed over the row, a loop GCC vectorizes: a Cython loop with
- * a test per entry took 15.3k instructions a call on go2 (54 rows, 36 of them diagonal,
- * so scanned in full), lanes of comparisons 9.7k, this loop 6.4k (callgrind).
+/* polish_schur's kernel.
  *
  * fccqp_trsm_lower: B := L^-1 B for the column-major lower n x n L (leading dimension
  * ld) and cols columns of B (leading dimension ldb), each column by
@@ -1109,27 +1103,6 @@ static double fccqp_sum_squares(const double *restrict v, long k)
  * dtrsm's 21.5k (most of it packing and set-up), the base's 30 x 30 S0 and 3-12
  * columns 4.5k against 10.5k.
  */
-FCCQP_FORCE_INLINE int fccqp_any_nonzero(const double *v, int count)
-{
-    unsigned long long bits = 0;
-    for (int j = 0; j < count; j++) {
-        unsigned long long w;
-        memcpy(&w, v + j, sizeof w);
-        bits |= w << 1;
-    }
-    return bits != 0;
-}
-
-FCCQP_CLONES
-static void fccqp_mark_coupled(const double *P, int n, char *coupled)
-{
-    for (int i = 0; i < n; i++) {
-        const double *row = P + (long)i * n;
-        coupled[i] = (char)(fccqp_any_nonzero(row, i)
-                            || fccqp_any_nonzero(row + i + 1, n - i - 1));
-    }
-}
-
 FCCQP_CLONES
 static void fccqp_trsm_lower(const double *restrict L, int n, int ld, double *restrict B,
                              int cols, int ldb)
@@ -2195,6 +2168,240 @@ static void fccqp_step_multipliers(const double *restrict rho,
 {
     for (long j = 0; j < s; j++)
         y[j] += rho[j] * (relaxed[j] - z[j]);
+}
+
+/* fccqp_mark_coupled (schur.pyx's mark_coupled, for the Schur backend and polish_schur):
+ * coupled[i] = 1 where row i of the row-major n x n symmetric P has a nonzero (or NaN)
+ * entry off its diagonal, else 0. From the strict lower triangle alone: row i's entries
+ * left of the diagonal mark row i, and, P being symmetric, each one marks its column's
+ * row too. The entries' bits shifted past the sign (so that -0.0 counts as zero) are
+ * or-ed, by row and by column (FCCQP_COUPLED_CHUNK columns at a time on the stack), in
+ * loops GCC vectorizes: go2 (54 rows) 6.6k instructions a call when every row was
+ * scanned in full, talos (124) 24.3k (callgrind). */
+#define FCCQP_COUPLED_CHUNK 256
+FCCQP_CLONES
+static void fccqp_mark_coupled(const double *P, int n, char *coupled)
+{
+    unsigned long long columns[FCCQP_COUPLED_CHUNK];
+    memset(coupled, 0, (size_t)n);
+    for (int c0 = 0; c0 < n; c0 += FCCQP_COUPLED_CHUNK) {
+        int width = n - c0 < FCCQP_COUPLED_CHUNK ? n - c0 : FCCQP_COUPLED_CHUNK;
+        memset(columns, 0, sizeof columns);
+        for (int i = c0 + 1; i < n; i++) {
+            const double *row = P + (long)i * n + c0;
+            int count = i - c0 < width ? i - c0 : width;
+            unsigned long long bits = 0;
+            for (int j = 0; j < count; j++) {
+                unsigned long long w;
+                memcpy(&w, row + j, sizeof w);
+                columns[j] |= w;
+                bits |= w;
+            }
+            coupled[i] |= (char)((bits << 1) != 0);
+        }
+        for (int j = 0; j < width; j++)
+            coupled[c0 + j] |= (char)((columns[j] << 1) != 0);
+    }
+}
+
+/* The Schur backend's reduced table on the diagonal tail of H (schur.pyx,
+ * _sparse_unit_columns): the rows of W_x whose rows of Y = L^-1 A' are as sparse as A's
+ * columns (whole-body control: a torque's or slack's column has one nonzero, a contact
+ * force's 5-12), formed from their nonzeros instead of the dense product Y W_nu: go2's 36
+ * such rows have 92 nonzeros of 1080 (s = 24), talos' 86 have 303 of 5848 (s = 56).
+ *
+ * fccqp_transpose: T[i s + c] = M[i + c ld] for i < m, c < s (T row-major, m x s), so that
+ * a row of W_nu is contiguous for the rows' sums.
+ *
+ * fccqp_sparse_table_rows: for each row j in [first, last) of the column-major Y (leading
+ * dimension ldy), nonzero in the columns index[j m : j m + count[j]], and each c < s,
+ *     W[dest[j] + c ldw] = (z - sum_k Y[j, i_k] WT[i_k s + c]) / L[j, j],
+ * z = 1 / L[j, j] at c = j - unit (a constrained row's unit column) and 0 elsewhere, WT
+ * from fccqp_transpose: each entry's terms subtracted from z in the nonzeros' order. The
+ * rows j >= unit go also to rows[(j - unit) s + c] where rows is not NULL. Where
+ * the CPU has AVX2 and FMA (picked at each call) a row's columns go in blocks of six
+ * vectors held in registers, fused; the portable loops otherwise. */
+#include <stddef.h>
+
+static void fccqp_transpose_loop(const double *restrict M, long ld, int m, int s,
+                                 double *restrict T)
+{
+    for (int i = 0; i < m; i++)
+        for (int c = 0; c < s; c++)
+            T[(long)i * s + c] = M[i + (long)c * ld];
+}
+
+static void fccqp_sparse_table_rows_loop(const double *restrict Y, int ldy, int first,
+                                         int last, const int *restrict index,
+                                         const int *restrict count, int m,
+                                         const double *restrict WT, int s,
+                                         const double *restrict L, int ldl, int unit,
+                                         const ptrdiff_t *restrict dest,
+                                         double *restrict W, long ldw,
+                                         double *restrict rows)
+{
+    for (int j = first; j < last; j++) {
+        const int *columns = index + (long)j * m;
+        double pivot = L[j + (long)j * ldl];
+        for (int c = 0; c < s; c++) {
+            double acc = c == j - unit ? 1.0 / pivot : 0.0;
+            for (int k = 0; k < count[j]; k++)
+                acc -= Y[j + (long)columns[k] * ldy] * WT[(long)columns[k] * s + c];
+            W[dest[j] + (long)c * ldw] = acc / pivot;
+            if (rows && j >= unit)
+                rows[(long)(j - unit) * s + c] = acc / pivot;
+        }
+    }
+}
+
+#ifdef FCCQP_WIDE_TRSM
+#define FCCQP_WIDE_TABLE 1
+/* FCCQP_L3 and fccqp_first_lanes: the A'A kernel's, above */
+
+__attribute__((target("avx2,fma")))
+static void fccqp_transpose_wide(const double *restrict M, long ld, int m, int s,
+                                 double *restrict T)
+{
+    int i = 0;
+    for (; i + 4 <= m; i += 4) {   /* 4 x 4 blocks: four columns in, four rows out */
+        int c = 0;
+        for (; c + 4 <= s; c += 4) {
+            const double *p = M + i + (long)c * ld;
+            __m256d t0 = _mm256_unpacklo_pd(_mm256_loadu_pd(p), _mm256_loadu_pd(p + ld));
+            __m256d t1 = _mm256_unpackhi_pd(_mm256_loadu_pd(p), _mm256_loadu_pd(p + ld));
+            __m256d t2 = _mm256_unpacklo_pd(_mm256_loadu_pd(p + 2 * ld),
+                                            _mm256_loadu_pd(p + 3 * ld));
+            __m256d t3 = _mm256_unpackhi_pd(_mm256_loadu_pd(p + 2 * ld),
+                                            _mm256_loadu_pd(p + 3 * ld));
+            double *q = T + (long)i * s + c;
+            _mm256_storeu_pd(q, _mm256_permute2f128_pd(t0, t2, 0x20));
+            _mm256_storeu_pd(q + s, _mm256_permute2f128_pd(t1, t3, 0x20));
+            _mm256_storeu_pd(q + 2 * s, _mm256_permute2f128_pd(t0, t2, 0x31));
+            _mm256_storeu_pd(q + 3 * s, _mm256_permute2f128_pd(t1, t3, 0x31));
+        }
+        for (; c < s; c++)
+            for (int r = 0; r < 4; r++)
+                T[(long)(i + r) * s + c] = M[i + r + (long)c * ld];
+    }
+    for (; i < m; i++)
+        for (int c = 0; c < s; c++)
+            T[(long)i * s + c] = M[i + (long)c * ld];
+}
+
+/* lanes 0 .. width - 1 of v at out[0], out[ld], ... (width 1 to 4) */
+FCCQP_L3 void fccqp_store_strided(double *out, long ld, __m256d v, int width)
+{
+    __m128d lo = _mm256_castpd256_pd128(v), hi = _mm256_extractf128_pd(v, 1);
+    _mm_storel_pd(out, lo);
+    if (width > 1)
+        _mm_storeh_pd(out + ld, lo);
+    if (width > 2)
+        _mm_storel_pd(out + 2 * ld, hi);
+    if (width > 3)
+        _mm_storeh_pd(out + 3 * ld, hi);
+}
+
+/* Columns per block of fccqp_sparse_table_rows_wide: six vectors of accumulators, the
+ * broadcast factor and a loaded row fill the 16 registers (go2's s = 24 in one block) */
+#define FCCQP_TABLE_VECTORS 6
+
+/* fccqp_sparse_table_rows' columns c0 .. c0 + 4 V - 1 of row j, V vectors (a constant
+ * where it is inlined), the last one's lanes masked by `last` (width `last_width`);
+ * also at row[c0 ...] where row is not NULL */
+FCCQP_L3 void fccqp_table_block(const double *Y, long ldy, int j, const int *columns,
+                                int count, const double *WT, long s, int c0, int V,
+                                __m256i last, int last_width, int diag, double pivot,
+                                double *out, long ldw, double *row)
+{
+    __m256d acc[FCCQP_TABLE_VECTORS], p = _mm256_set1_pd(pivot);
+    __m256d unit = _mm256_set1_pd(1.0 / pivot);
+    __m256i at = _mm256_set1_epi64x((long long)diag - c0);
+    for (int q = 0; q < V; q++) {   /* 1 / pivot in the lane of column diag, else 0 */
+        __m256i lane = _mm256_setr_epi64x(4 * q, 4 * q + 1, 4 * q + 2, 4 * q + 3);
+        acc[q] = _mm256_and_pd(unit, _mm256_castsi256_pd(_mm256_cmpeq_epi64(at, lane)));
+    }
+    for (int k = 0; k < count; k++) {
+        __m256d y = _mm256_set1_pd(Y[j + (long)columns[k] * ldy]);
+        const double *w = WT + (long)columns[k] * s + c0;
+        for (int q = 0; q < V - 1; q++)
+            acc[q] = _mm256_fnmadd_pd(y, _mm256_loadu_pd(w + 4 * q), acc[q]);
+        acc[V - 1] = _mm256_fnmadd_pd(y, _mm256_maskload_pd(w + 4 * (V - 1), last),
+                                      acc[V - 1]);
+    }
+    for (int q = 0; q < V; q++) {
+        __m256d v = _mm256_div_pd(acc[q], p);
+        int width = q < V - 1 ? 4 : last_width;
+        fccqp_store_strided(out + (long)(c0 + 4 * q) * ldw, ldw, v, width);
+        if (row && width == 4)
+            _mm256_storeu_pd(row + c0 + 4 * q, v);
+        else if (row)
+            fccqp_store_strided(row + c0 + 4 * q, 1, v, width);
+    }
+}
+
+__attribute__((target("avx2,fma")))
+static void fccqp_sparse_table_rows_wide(const double *restrict Y, int ldy, int first,
+                                         int last, const int *restrict index,
+                                         const int *restrict count, int m,
+                                         const double *restrict WT, int s,
+                                         const double *restrict L, int ldl, int unit,
+                                         const ptrdiff_t *restrict dest,
+                                         double *restrict W, long ldw,
+                                         double *restrict rows)
+{
+    enum { C = 4 * FCCQP_TABLE_VECTORS };
+    for (int j = first; j < last; j++) {
+        const int *columns = index + (long)j * m;
+        double pivot = L[j + (long)j * ldl];
+        double *out = W + dest[j];
+        double *row = rows && j >= unit ? rows + (long)(j - unit) * s : NULL;
+        for (int c0 = 0; c0 < s; c0 += C) {
+            int width = s - c0 < C ? s - c0 : C, V = (width + 3) / 4;
+            int last_width = width - 4 * (V - 1);
+            __m256i mask = fccqp_first_lanes(last_width);
+#define FCCQP_TABLE_BLOCK(vectors)                                                       \
+    fccqp_table_block(Y, ldy, j, columns, count[j], WT, s, c0, vectors, mask, last_width, \
+                      j - unit, pivot, out, ldw, row)
+            switch (V) {
+            case 6: FCCQP_TABLE_BLOCK(6); break;
+            case 5: FCCQP_TABLE_BLOCK(5); break;
+            case 4: FCCQP_TABLE_BLOCK(4); break;
+            case 3: FCCQP_TABLE_BLOCK(3); break;
+            case 2: FCCQP_TABLE_BLOCK(2); break;
+            default: FCCQP_TABLE_BLOCK(1);
+            }
+#undef FCCQP_TABLE_BLOCK
+        }
+    }
+}
+#endif
+
+static inline void fccqp_transpose(const double *M, long ld, int m, int s, double *T)
+{
+#ifdef FCCQP_WIDE_TABLE
+    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
+        fccqp_transpose_wide(M, ld, m, s, T);
+        return;
+    }
+#endif
+    fccqp_transpose_loop(M, ld, m, s, T);
+}
+
+static inline void fccqp_sparse_table_rows(const double *Y, int ldy, int first, int last,
+                                           const int *index, const int *count, int m,
+                                           const double *WT, int s, const double *L,
+                                           int ldl, int unit, const ptrdiff_t *dest,
+                                           double *W, long ldw, double *rows)
+{
+#ifdef FCCQP_WIDE_TABLE
+    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
+        fccqp_sparse_table_rows_wide(Y, ldy, first, last, index, count, m, WT, s, L, ldl,
+                                     unit, dest, W, ldw, rows);
+        return;
+    }
+#endif
+    fccqp_sparse_table_rows_loop(Y, ldy, first, last, index, count, m, WT, s, L, ldl, unit,
+                                 dest, W, ldw, rows);
 }
 
 #endif

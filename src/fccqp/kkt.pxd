@@ -35,6 +35,8 @@ cdef void kkt_solve_once(KKT* k, const Problem* p, const double* rho_vec, const 
                          double* sol) noexcept nogil
 cdef bint kkt_unit_columns(KKT* k, const Problem* p, const double* rho_vec,
                            const Py_ssize_t* entries, int count, double* W) noexcept nogil
+cdef bint kkt_table(KKT* k, const Problem* p, const double* rho_vec, double* W,
+                    double* W_S) noexcept nogil
 cdef int kkt_convexity(KKT* k, const Problem* p, double sigma, const double* rho_vec,
                        bint schur_factored) noexcept nogil
 

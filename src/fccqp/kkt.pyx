@@ -10,8 +10,8 @@ Every backend solves the KKT system of the x-update,
 through four calls: :func:`kkt_factor` (for given P, A, sigma, rho), :func:`kkt_solve`
 (one refined right-hand side; :func:`kkt_solve_once` for callers that refine),
 :func:`kkt_unit_columns` (responses to unit right-hand sides on chosen entries, the
-reduced form's table and the restoration's columns) and :func:`kkt_convexity` (is the
-QP convex?). The backends are :mod:`fccqp.schur`
+restoration's columns; :func:`kkt_table` on the constrained ones, the reduced form's
+table) and :func:`kkt_convexity` (is the QP convex?). The backends are :mod:`fccqp.schur`
 (Cholesky, needs ``P + R`` positive definite and ``A`` of full row rank; the reduced
 form, and the cold start of a run that will iterate in it) and :mod:`fccqp.ldl`
 (quasi-definite LDL', any ``A``), and for compressed columns :mod:`fccqp.kkt_sparse`
@@ -78,11 +78,28 @@ cdef bint kkt_unit_columns(KKT* k, const Problem* p, const double* rho_vec,
     constrained entries, in order; ``SPARSE_LDL`` none (False, ``W`` untouched). False
     when refinement missed its tolerance."""
     if k.backend == SCHUR_REDUCED:
-        schur_unit_columns(&k.schur, p, W)
+        schur_unit_columns(&k.schur, p, W, NULL)
         return True
     if k.backend == SPARSE_LDL:
         return False
     return ldl_unit_columns(&k.ldl, p, k.sigma, rho_vec, entries, count, W, k.R, k.work)
+
+
+cdef bint kkt_table(KKT* k, const Problem* p, const double* rho_vec, double* W,
+                    double* W_S) noexcept nogil:
+    """:func:`kkt_unit_columns` on the constrained entries into ``W``, and ``W``'s rows on
+    them into ``W_S`` (row-major ``s x s``: the Schur backend writes them as it forms
+    them). False as :func:`kkt_unit_columns`."""
+    cdef Py_ssize_t s = p.s, N = p.n + p.m, i, j
+    if k.backend == SCHUR_REDUCED:
+        schur_unit_columns(&k.schur, p, W, W_S)
+        return True
+    if not kkt_unit_columns(k, p, rho_vec, p.constrained, <int>s, W):
+        return False
+    for j in range(s):
+        for i in range(s):
+            W_S[j * s + i] = W[p.constrained[j] + i * N]
+    return True
 
 
 cdef int kkt_convexity(KKT* k, const Problem* p, double sigma, const double* rho_vec,

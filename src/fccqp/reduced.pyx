@@ -16,7 +16,7 @@ import numpy as np
 
 from fccqp._dense cimport colmatvec, copy, matvec
 from fccqp._types cimport Iterates, Problem
-from fccqp.kkt cimport KKT, kkt_unit_columns
+from fccqp.kkt cimport KKT, kkt_table
 from fccqp.projections cimport proj_cones
 
 cdef extern from "fccqp_kernels.h" nogil:
@@ -37,13 +37,7 @@ cdef bint reduced_table(Reduced* r, KKT* k, const Problem* p, const double* rho_
     """Tabulate ``W`` and ``W_S`` with the factorization in ``k``; False when the columns
     missed the refinement tolerance. ``base``, which follows ``q`` and ``b``, is the
     caller's (:func:`fccqp.factorization.reduced_base`, after every factorization)."""
-    cdef Py_ssize_t s = p.s, N = p.n + p.m, i, j
-    if not kkt_unit_columns(k, p, rho_vec, p.constrained, <int>s, r.W):
-        return False
-    for j in range(s):
-        for i in range(s):
-            r.W_S[j * s + i] = r.W[p.constrained[j] + i * N]
-    return True
+    return kkt_table(k, p, rho_vec, r.W, r.W_S)
 
 
 cdef void reduced_start(Reduced* r, const Problem* p, Iterates* it) noexcept nogil:

@@ -21,7 +21,7 @@ cdef struct Schur:
     double* dnu          # m scratch
     double* Ax           # m scratch
     double* X            # n x s scratch (unit columns)
-    double* Wnu          # m x s scratch (unit columns)
+    double* Wnu          # m x s scratch (unit columns; on the diagonal tail W_nu transposed)
     double* M            # s x s scratch (convexity test)
     int* nonzeros        # n x m: where constrained row j of Y can be nonzero, at j * m
     int* nonzero_count   # n: how many such places each constrained row has
@@ -36,4 +36,4 @@ cdef void schur_solve_once(Schur* f, const Problem* p, const double* rhs,
                            double* sol) noexcept nogil
 cdef void schur_solve(Schur* f, const Problem* p, const double* rho_vec, const double* rhs,
                       double* sol) noexcept nogil
-cdef void schur_unit_columns(Schur* f, const Problem* p, double* W) noexcept nogil
+cdef void schur_unit_columns(Schur* f, const Problem* p, double* W, double* W_S) noexcept nogil

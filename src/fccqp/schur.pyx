@@ -50,6 +50,11 @@ cdef extern from "fccqp_kernels.h" nogil:
     void fccqp_sparse_rank_clear(int rows, const int* index, const int* count, int m,
                                  double* T)
     void fccqp_mark_coupled(const double* P, int n, char* coupled)
+    void fccqp_transpose(const double* M, long ld, int m, int s, double* T)
+    void fccqp_sparse_table_rows(const double* Y, int ldy, int first, int last,
+                                 const int* index, const int* count, int m, const double* WT,
+                                 int s, const double* L, int ldl, int unit,
+                                 const Py_ssize_t* dest, double* W, long ldw, double* rows)
 
 
 def ordering(n, constrained):
@@ -61,7 +66,7 @@ def ordering(n, constrained):
 
 cdef void mark_coupled(const double* P, Py_ssize_t n, char* coupled) noexcept nogil:
     """``coupled[i]`` = 1 where row ``i`` of ``P`` has an entry off its diagonal, else 0
-    (``fccqp_mark_coupled``: the comparisons in lanes)."""
+    (``fccqp_mark_coupled``: the strict lower triangle, ``P`` being symmetric)."""
     fccqp_mark_coupled(P, <int>n, coupled)
 
 
@@ -116,7 +121,10 @@ cdef bint schur_factor(Schur* f, const Problem* p, const double* rho_vec) noexce
 
 cdef bint _factor_free(Schur* f, const Problem* p) noexcept nogil:
     """The free rows (the ``first = n - s`` leading ones in ``order``) of ``L`` and
-    ``Y``, and ``G = Y_F' Y_F``; False when ``P`` is not positive definite on them."""
+    ``Y``, and ``G = Y_F' Y_F``; False when ``P`` is not positive definite on them.
+    The diagonal tail's rows of ``Y`` are ``A``'s columns over their pivots, as sparse as
+    those columns (:func:`_find_nonzeros`): ``G`` sums the dense block's rows by
+    ``syrk_t`` and the free tail's from their nonzeros (``fccqp_sparse_rank_update``)."""
     cdef int n = <int>p.n, m = <int>p.m, first = n - <int>p.s, k = f.dense, i, j
     cdef Py_ssize_t column
     cdef double largest = 0.0
@@ -136,28 +144,46 @@ cdef bint _factor_free(Schur* f, const Problem* p) noexcept nogil:
         f.L[j + j * n] = sqrt(f.L[j + j * n])
     if m == 0:
         return True
-    for j in range(first):
+    for j in range(k):
         column = f.order[j]
         for i in range(m):
             f.Y[j + i * n] = p.A.values[i * n + column]
             largest = max(largest, fabs(f.Y[j + i * n]))
-    f.free_largest = largest
+    _find_nonzeros(f, p, k, n)
+    f.free_largest = _pivot_free_tail(f, k, first, m, largest)
     if k > 0:
         trsm(b"L", b"N", k, m, f.L, n, f.Y, n)
-    for i in range(m):
-        for j in range(k, first):
-            f.Y[j + i * n] /= f.L[j + j * n]
-    syrk_t(m, first, f.Y, n, 0.0, f.G, m)
-    _find_nonzeros(f, p, first, n)
+        syrk_t(m, k, f.Y, n, 0.0, f.G, m)
+    else:
+        for i in range(m * m):
+            f.G[i] = 0.0
+    fccqp_sparse_rank_update(f.Y + k, n, first - k, f.nonzeros + k * m,
+                             f.nonzero_count + k, m, f.G, f.tail_values)
     return True
+
+
+cdef double _pivot_free_tail(Schur* f, int k, int first, int m, double largest) noexcept nogil:
+    """Divide the free tail's rows ``k:first`` of ``Y`` (``A``'s columns, from
+    :func:`_find_nonzeros`) by their pivots at their nonzeros; returns ``largest`` raised
+    to their largest ``|A|`` entry."""
+    cdef int n = f.n, i, j, l
+    cdef double a
+    for j in range(k, first):
+        for l in range(f.nonzero_count[j]):
+            i = f.nonzeros[j * m + l]
+            a = f.Y[j + i * n]
+            largest = max(largest, fabs(a))
+            f.Y[j + i * n] = a / f.L[j + j * n]
+    return largest
 
 
 cdef void _find_nonzeros(Schur* f, const Problem* p, int first, int last) noexcept nogil:
     """Where the rows ``first:last`` of the diagonal tail of ``Y`` can be nonzero: row
     ``j`` is column ``order[j]`` of ``A`` over a pivot, nonzero where that column is
     (into ``nonzeros`` and ``nonzero_count``; branch-free: every row index is written,
-    kept where nonzero). The rows' zeros are written here (``A``'s own, signed zeros
-    as a division would leave them), and :func:`_factor_constrained` writes the rest."""
+    kept where nonzero). The rows get ``A``'s column here (its zeros are the row's,
+    signed as a division would leave them); their nonzeros are divided by the pivot by
+    :func:`_pivot_free_tail` (free rows) and :func:`_factor_constrained`."""
     cdef int n = <int>p.n, m = <int>p.m, i, j, count
     cdef Py_ssize_t column
     cdef double a
@@ -379,25 +405,83 @@ cdef void schur_solve(Schur* f, const Problem* p, const double* rho_vec, const d
             nu[i] += f.dnu[i]
 
 
-cdef void schur_unit_columns(Schur* f, const Problem* p, double* W) noexcept nogil:
+cdef void schur_unit_columns(Schur* f, const Problem* p, double* W, double* W_S) noexcept nogil:
     """Fill ``W`` (Fortran, ``(n + m) x s``) with the responses of ``(x, nu)`` to unit
-    right-hand sides ``[e_i; 0]`` on the last ``s`` entries of ``order``.
+    right-hand sides ``[e_i; 0]`` on the last ``s`` entries of ``order``, and, where
+    ``W_S`` is not NULL, ``W``'s rows on them into ``W_S`` (row-major ``s x s``).
 
     In the permuted order ``Z = L^-1 E_S`` is ``[0; L22^-1]``, so ``W_nu = S^-1 Y'Z =
     LS^-T LS^-1 Y2' L22^-1`` and ``W_x = L^-T (Z - Y W_nu)``: about half the work of
-    ``s`` general solves (``n, m, s`` = 124, 68, 56 on talos).
+    ``s`` general solves (``n, m, s`` = 124, 68, 56 on talos). Where ``H`` has a diagonal
+    tail (:func:`_sparse_unit_columns`) the tail's rows of ``Y W_nu`` are summed from their
+    nonzeros.
     """
+    cdef Py_ssize_t s = p.s, N = p.n + p.m, first = p.n - p.s, i, j
+    if f.dense <= first and p.m > 0:
+        _sparse_unit_columns(f, p, W, W_S)
+        return
+    _dense_unit_columns(f, p, W)
+    if W_S != NULL:
+        for j in range(s):
+            for i in range(s):
+                W_S[j * s + i] = W[f.order[first + j] + i * N]
+
+
+cdef void _sparse_unit_columns(Schur* f, const Problem* p, double* W, double* W_S) noexcept nogil:
+    """:func:`schur_unit_columns` where ``L`` is its dense block and a diagonal tail
+    (``m > 0``). ``W_nu`` is solved in place in ``W``; the dense block's rows are
+    ``L11^-T (-Y1 W_nu)`` (``gemm``, ``trsm``), written in place where ``order`` keeps
+    them in one run of ``x``; each tail row ``j`` is ``(Z_j - Y_j W_nu) / L_jj`` from
+    ``Y_j``'s nonzeros (``fccqp_sparse_table_rows``; go2: 2.2k multiply-adds where the
+    dense product took 26k on these rows)."""
+    cdef int n = <int>p.n, m = <int>p.m, s = <int>p.s, first = n - s, N = n + m
+    cdef int k = f.dense, i, j, l
+    cdef bint in_place = _in_one_run(f.order, k)
+    cdef double* Wnu = W + n
+    cdef double* dense_rows = W + f.order[0] if in_place else f.X
+    cdef int ld = N if in_place else n
+    cdef const int* index
+    cdef double d
+    for j in range(s):
+        for i in range(m):
+            Wnu[i + j * N] = 0.0
+        d = 1.0 / f.L[first + j + (first + j) * n]
+        index = f.nonzeros + (first + j) * m
+        for l in range(f.nonzero_count[first + j]):
+            i = index[l]
+            Wnu[i + j * N] = f.Y[first + j + i * n] * d
+    cholesky_solve(f.LS, m, m, Wnu, s, N)
+    if k > 0:
+        gemm(b"N", b"N", k, s, m, -1.0, f.Y, n, Wnu, N, 0.0, dense_rows, ld)
+        trsm(b"L", b"T", k, s, f.L, n, dense_rows, ld)
+        if not in_place:
+            for j in range(s):
+                for i in range(k):
+                    W[f.order[i] + j * N] = f.X[i + j * n]
+    fccqp_transpose(Wnu, N, m, s, f.Wnu)
+    fccqp_sparse_table_rows(f.Y, n, k, n, f.nonzeros, f.nonzero_count, m, f.Wnu, s, f.L,
+                            n, first, f.order, W, N, W_S)
+
+
+cdef inline bint _in_one_run(const Py_ssize_t* order, int k) noexcept nogil:
+    """Whether ``order[:k]`` is one run of consecutive entries."""
+    cdef int i
+    for i in range(1, k):
+        if order[i] != order[0] + i:
+            return False
+    return True
+
+
+cdef void _dense_unit_columns(Schur* f, const Problem* p, double* W) noexcept nogil:
+    """:func:`schur_unit_columns` by dense products: ``L`` dense (a coupled constrained
+    entry), or no equality row."""
     cdef int n = <int>p.n, m = <int>p.m, s = <int>p.s, first = n - s, N = n + m, i, j
     cdef double* X = f.X
-    cdef double d
     for i in range(n * s):
         X[i] = 0.0
-    if f.dense <= first:   # L22 is diagonal, and so is Z's block
+    if f.dense <= first:   # L22 is diagonal, and so is Z's block (here m = 0)
         for j in range(s):
-            d = 1.0 / f.L[first + j + (first + j) * n]
-            X[first + j + j * n] = d
-            for i in range(m):
-                f.Wnu[i + j * m] = f.Y[first + j + i * n] * d
+            X[first + j + j * n] = 1.0 / f.L[first + j + (first + j) * n]
     else:
         for j in range(s):
             X[first + j + j * n] = 1.0
