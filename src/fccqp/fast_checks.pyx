@@ -239,10 +239,13 @@ def same_cones(cones, previous):
     False when unsure."""
     if type(cones) is not tuple or type(previous) is not tuple:
         return False
-    if len(<tuple>cones) != len(<tuple>previous):
+    cdef tuple now = <tuple>cones, before = <tuple>previous
+    cdef Py_ssize_t k, count = len(now)
+    if count != len(before):
         return False
     _load_kinds()
-    for a, b in zip(<tuple>cones, <tuple>previous):
+    for k in range(count):   # by index: zip's call and iteration took 1.4k instructions
+        a, b = now[k], before[k]
         if type(a) is not type(b):
             return False
         if type(a) is _FRICTION:
