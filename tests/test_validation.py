@@ -492,3 +492,58 @@ def test_the_compiled_scan_sees_every_entry(n):
     if n > 1:
         with pytest.raises(ValueError, match="P must be symmetric"):
             solver.solve(asymmetric, q0, A0, b0)
+
+
+def _with(v, i, value):
+    changed = v.copy()
+    changed[i] = value
+    return changed
+
+
+@BEFORE_ANY_BACKEND
+@pytest.mark.parametrize("n", [1, 5, 9])
+def test_the_compiled_scan_names_a_bad_vector_or_bound_entry_wherever_it_sits(n):
+    """The scan's copies of ``q``, ``b`` and the bounds (fccqp_kernels.h: no branch on the
+    data, the entry looked up afterwards) name the first bad entry at any position, and
+    each bound's case as before."""
+    P0, q0, A0, b0 = np.eye(n), np.ones(n), np.eye(n), np.zeros(n)
+    lb0, ub0 = -np.ones(n), np.ones(n)
+    solver = fccqp.Solver()
+    solver.solve(P0, q0, A0, b0, lb0, ub0)
+
+    def fails(message, q=q0, b=b0, lb=lb0, ub=ub0):
+        with pytest.raises(ValueError, match=message):
+            solver.solve(P0, q, A0, b, lb, ub)
+
+    for i in range(n):
+        fails(rf"q contains NaN or inf \(at index {i}\)", q=_with(q0, i, np.nan))
+        fails(rf"q has an entry of magnitude 1e\+21 \(at index {i}\)", q=_with(q0, i, -1e21))
+        fails(rf"b contains NaN or inf \(at index {i}\)", b=_with(b0, i, np.inf))
+        fails(rf"lb contains NaN \(at index {i}\)", lb=_with(lb0, i, np.nan))
+        fails(rf"ub contains NaN \(at index {i}\)", ub=_with(ub0, i, np.nan))
+        fails(rf"lb > ub at index {i}", lb=_with(lb0, i, 2.0))
+        fails(rf"lb\[{i}\] = inf", lb=_with(lb0, i, np.inf), ub=_with(ub0, i, np.inf))
+        fails(rf"ub\[{i}\] = -inf", lb=_with(lb0, i, -np.inf), ub=_with(ub0, i, -np.inf))
+        fails(rf"q contains NaN or inf \(at index {i}\)",
+              q=_with(_with(q0, i, np.inf), n - 1, np.nan if i == n - 1 else 1e21))
+    assert solver.solve(P0, q0, A0, b0, lb0, ub0).status is fccqp.Status.SOLVED
+
+
+@BEFORE_ANY_BACKEND
+def test_the_compiled_scan_sees_a_change_anywhere_in_a_long_A():
+    """A change of any one entry of an ``A`` longer than the stretch the scan compares
+    before it checks for a change (fccqp_kernels.h: it copies without comparing once one
+    was seen) is seen: a missed one would solve the old problem."""
+    rng = np.random.default_rng(3)
+    n, m = 12, 8
+    P0, q0 = np.eye(n), rng.standard_normal(n)
+    A0, b0 = rng.standard_normal((m, n)), rng.standard_normal(m)
+    solver = fccqp.Solver(eps_abs=1e-9, eps_rel=1e-9, polish=False)
+    for k in range(m * n):
+        changed = A0.copy()
+        changed.flat[k] += 1.0
+        solver.solve(P0, q0, A0, b0)   # the workspace holds A0
+        result = solver.solve(P0, q0, changed, b0)
+        reference = fccqp.solve(P0, q0, changed, b0, eps_abs=1e-9, eps_rel=1e-9).x
+        assert result.status is fccqp.Status.SOLVED
+        np.testing.assert_allclose(result.x, reference, atol=1e-6)

@@ -397,16 +397,18 @@ cdef void user_residuals(Engine* e, const double* x, const double* y,
     cdef double* proj = e.work.vec_s
     cdef double xPx = 0.0, qx = 0.0, by = 0.0, support = 0.0, terms = 0.0, total = 0.0
     cdef double value, size
+    # the maxima in locals, not in r's fields: a store through proj or a load of x may
+    # alias a field, so each field was loaded and stored again every step
+    cdef double prim_eq = 0.0, prim_eq_scale = 0.0, prim_set = 0.0, prim_set_scale = 0.0
+    cdef double set_s = 0.0, set_scale_s = 0.0, compl = 0.0, box_excess = -INFINITY
+    cdef double dual = 0.0, dual_scale = 0.0
+    cdef bint set_lent = False
     product(&e.user.A, x, Ax)
     product_t(&e.user.A, y, ATy)
     product(&e.user.P, x, grad)
-    r.prim_eq = r.prim_eq_scale = r.prim_set = r.prim_set_scale = 0.0
-    r.set_s = r.set_scale_s = r.compl = 0.0
-    r.box_excess = -INFINITY
-    r.set_lent = False
     for i in range(m):
-        r.prim_eq = max(r.prim_eq, fabs(Ax[i] - b[i]))
-        r.prim_eq_scale = max(r.prim_eq_scale, max(fabs(Ax[i]), fabs(b[i])))
+        prim_eq = max(prim_eq, fabs(Ax[i] - b[i]))
+        prim_eq_scale = max(prim_eq_scale, max(fabs(Ax[i]), fabs(b[i])))
         by += b[i] * y[i]
         terms += fabs(b[i] * y[i])
     r.eq_rounding = False   # judge_rounding's, for the returned point
@@ -427,46 +429,48 @@ cdef void user_residuals(Engine* e, const double* x, const double* y,
             miss = max(miss, fabs(x[p.constrained[k]] - proj[k]))
             block = max(block, max(fabs(x[p.constrained[k]]), fabs(proj[k])))
             value += x[p.constrained[k]] * z[p.constrained[k]]
-        r.set_lent |= _lent(miss, block, p.D[p.constrained[i]], eps_abs, eps_rel)
-        r.compl = max(r.compl, fabs(value))
-    r.dual_scale = 0.0
+        set_lent |= _lent(miss, block, p.D[p.constrained[i]], eps_abs, eps_rel)
+        compl = max(compl, fabs(value))
     for j in range(s):
         i = p.constrained[j]
-        r.prim_set = max(r.prim_set, fabs(x[i] - proj[j]))
-        r.prim_set_scale = max(r.prim_set_scale, fabs(x[i]))
-        r.set_s = max(r.set_s, fabs(x[i] - proj[j]) / p.D[i])
-        r.set_scale_s = max(r.set_scale_s, max(fabs(x[i]), fabs(proj[j])) / p.D[i])
+        prim_set = max(prim_set, fabs(x[i] - proj[j]))
+        prim_set_scale = max(prim_set_scale, fabs(x[i]))
+        set_s = max(set_s, fabs(x[i] - proj[j]) / p.D[i])
+        set_scale_s = max(set_scale_s, max(fabs(x[i]), fabs(proj[j])) / p.D[i])
         if not p.in_cone[j]:
             size = box_entry_size(max(fabs(x[i]), fabs(proj[j])), ub[i] - lb[i])
-            r.box_excess = max(r.box_excess,
-                               (fabs(x[i] - proj[j]) - SCALED_VIOLATION * size) / p.D[i])
-            r.set_lent |= _lent(fabs(x[i] - proj[j]), size, p.D[i], eps_abs, eps_rel)
+            box_excess = max(box_excess,
+                             (fabs(x[i] - proj[j]) - SCALED_VIOLATION * size) / p.D[i])
+            set_lent |= _lent(fabs(x[i] - proj[j]), size, p.D[i], eps_abs, eps_rel)
         if z[i] > 0.0 and isfinite(ub[i]):
             support += ub[i] * z[i]
             terms += fabs(ub[i] * z[i])
-            r.compl = max(r.compl, z[i] * fabs(ub[i] - x[i]))
+            compl = max(compl, z[i] * fabs(ub[i] - x[i]))
         elif z[i] < 0.0 and isfinite(lb[i]):
             support += lb[i] * z[i]
             terms += fabs(lb[i] * z[i])
-            r.compl = max(r.compl, -z[i] * fabs(x[i] - lb[i]))
-    r.dual = 0.0
+            compl = max(compl, -z[i] * fabs(x[i] - lb[i]))
     for i in range(n):
         xPx += x[i] * grad[i]
         qx += q[i] * x[i]
-        r.dual_scale = max(r.dual_scale, max(fabs(grad[i]), fabs(q[i])))
+        dual_scale = max(dual_scale, max(fabs(grad[i]), fabs(q[i])))
         value = grad[i] + q[i] + ATy[i] + z[i]
-        r.dual = max(r.dual, fabs(value))
+        dual = max(dual, fabs(value))
         total += fabs(value) + fabs(x[i]) + fabs(z[i])
     for i in range(m):
         total += fabs(y[i])
+    r.prim_eq, r.prim_eq_scale, r.prim_set, r.prim_set_scale = (prim_eq, prim_eq_scale,
+                                                                prim_set, prim_set_scale)
+    r.set_s, r.set_scale_s, r.compl, r.box_excess = set_s, set_scale_s, compl, box_excess
+    r.set_lent, r.dual, r.dual_scale = set_lent, dual, dual_scale
     r.objective = 0.5 * xPx + qx
     r.gap = fabs(xPx + qx + by + support)
     r.gap_scale = gap_scale(xPx, qx, terms)
     r.compl_scale = max(fabs(xPx), fabs(qx))
-    r.prim = max(r.prim_eq, r.prim_set)
-    r.prim_scale = max(r.prim_eq_scale, r.prim_set_scale)
+    r.prim = max(prim_eq, prim_set)
+    r.prim_scale = max(prim_eq_scale, prim_set_scale)
     r.finite = isfinite(total) and isfinite(r.gap) and isfinite(r.prim)
-    r.dual_lent = r.dual_scale < eps_abs and r.dual > eps_rel * r.dual_scale
+    r.dual_lent = dual_scale < eps_abs and dual > eps_rel * dual_scale
 
 
 cdef inline bint _lent(double miss, double size, double D, double eps_abs,

@@ -1174,17 +1174,53 @@ FCCQP_WIDE double fccqp_wide_largest(__m256d v, double x)
     return x;
 }
 
+/* The pairs (i, j), (j, i) of row i from j = i + 1 while four remain, for
+ * fccqp_symmetric_copy_wide; returns the j past them. With compare, the result is also
+ * compared with what out held (*changed); once a change was found the caller's later rows
+ * skip that comparison, a load, compare and or of a step's 30 instructions (a control
+ * loop's P changes every tick). */
+FCCQP_WIDE int fccqp_wide_pairs(const double *restrict P, int n, int i, double *restrict out,
+                                __m256d *not_finite, __m256d *asymmetry, __m256d *changed,
+                                const int compare)
+{
+    const __m256d half = _mm256_set1_pd(0.5), limit = _mm256_set1_pd(1.7976931348623157e308);
+    const double *row = P + (long)i * n;
+    double *out_row = out + (long)i * n;
+    long stride = n, step = 4 * (long)n;
+    int j = i + 1;
+    const double *column = P + (long)j * n + i;
+    double *mirror = out + (long)j * n + i;
+    for (; j + 4 <= n; j += 4, column += step, mirror += step) {
+        __m256d upper = _mm256_loadu_pd(row + j);
+        __m256d lower = _mm256_set_pd(column[3 * stride], column[2 * stride], column[stride],
+                                      column[0]);
+        __m256d difference = fccqp_wide_abs(_mm256_sub_pd(upper, lower));
+        __m256d value = _mm256_mul_pd(half, _mm256_add_pd(upper, lower));
+        *not_finite = _mm256_or_pd(*not_finite, _mm256_cmp_pd(difference, limit, _CMP_NLE_UQ));
+        *asymmetry = _mm256_max_pd(difference, *asymmetry);
+        if (compare)
+            *changed = _mm256_or_pd(*changed, _mm256_cmp_pd(_mm256_loadu_pd(out_row + j), value,
+                                                            _CMP_NEQ_UQ));
+        _mm256_storeu_pd(out_row + j, value);
+        __m128d low = _mm256_castpd256_pd128(value), high = _mm256_extractf128_pd(value, 1);
+        _mm_storel_pd(mirror, low);
+        _mm_storeh_pd(mirror + stride, low);
+        _mm_storel_pd(mirror + 2 * stride, high);
+        _mm_storeh_pd(mirror + 3 * stride, high);
+    }
+    return j;
+}
+
 /* fccqp_symmetric_copy in 32-byte vectors; the mirror's column is walked by pointers */
 __attribute__((target("avx2")))
 static int fccqp_symmetric_copy_wide(const double *restrict P, int n, double *restrict out,
                                      double sizes[2])
 {
-    const __m256d half = _mm256_set1_pd(0.5), limit = _mm256_set1_pd(1.7976931348623157e308);
     __m256d largest = _mm256_setzero_pd(), largest_b = largest, asymmetry = largest;
     __m256d not_finite = largest, changed = largest;
     double largest_1 = 0.0, asymmetry_1 = 0.0;
     int found = 0;
-    long k = 0, entries = (long)n * n, stride = n, step = 4 * (long)n;
+    long k = 0, entries = (long)n * n;
     for (; k + 8 <= entries; k += 8) {   /* two accumulators: one max a cycle */
         largest = _mm256_max_pd(fccqp_wide_abs(_mm256_loadu_pd(P + k)), largest);
         largest_b = _mm256_max_pd(fccqp_wide_abs(_mm256_loadu_pd(P + k + 4)), largest_b);
@@ -1195,29 +1231,12 @@ static int fccqp_symmetric_copy_wide(const double *restrict P, int n, double *re
         largest_1 = fabs(P[k]) > largest_1 ? fabs(P[k]) : largest_1;
     largest = _mm256_max_pd(largest_b, largest);
     for (int i = 0; i < n; i++) {
-        const double *row = P + (long)i * n;
-        double *out_row = out + (long)i * n;
-        found |= fccqp_symmetric_diagonal(row, out_row, i);
-        int j = i + 1;
-        const double *column = P + (long)j * n + i;
-        double *mirror = out + (long)j * n + i;
-        for (; j + 4 <= n; j += 4, column += step, mirror += step) {
-            __m256d upper = _mm256_loadu_pd(row + j);
-            __m256d lower = _mm256_set_pd(column[3 * stride], column[2 * stride], column[stride],
-                                          column[0]);
-            __m256d difference = fccqp_wide_abs(_mm256_sub_pd(upper, lower));
-            __m256d value = _mm256_mul_pd(half, _mm256_add_pd(upper, lower));
-            not_finite = _mm256_or_pd(not_finite, _mm256_cmp_pd(difference, limit, _CMP_NLE_UQ));
-            asymmetry = _mm256_max_pd(difference, asymmetry);
-            changed = _mm256_or_pd(changed, _mm256_cmp_pd(_mm256_loadu_pd(out_row + j), value,
-                                                          _CMP_NEQ_UQ));
-            _mm256_storeu_pd(out_row + j, value);
-            __m128d low = _mm256_castpd256_pd128(value), high = _mm256_extractf128_pd(value, 1);
-            _mm_storel_pd(mirror, low);
-            _mm_storeh_pd(mirror + stride, low);
-            _mm_storel_pd(mirror + 2 * stride, high);
-            _mm_storeh_pd(mirror + 3 * stride, high);
-        }
+        int j;
+        found |= fccqp_symmetric_diagonal(P + (long)i * n, out + (long)i * n, i);
+        if (found & FCCQP_CHANGED || _mm256_movemask_pd(changed))
+            j = fccqp_wide_pairs(P, n, i, out, &not_finite, &asymmetry, &changed, 0);
+        else
+            j = fccqp_wide_pairs(P, n, i, out, &not_finite, &asymmetry, &changed, 1);
         found |= fccqp_symmetric_tail(P, n, i, j, out, &asymmetry_1);
     }
     sizes[0] = fccqp_wide_largest(largest, largest_1);
@@ -1226,7 +1245,9 @@ static int fccqp_symmetric_copy_wide(const double *restrict P, int n, double *re
            | (_mm256_movemask_pd(changed) ? FCCQP_CHANGED : 0);
 }
 
-/* fccqp_checked_copy in 32-byte vectors */
+/* fccqp_checked_copy in 32-byte vectors; out's old values are compared with v until a
+ * change is found (tested every FCCQP_COMPARED entries), then only copied */
+#define FCCQP_COMPARED 64
 __attribute__((target("avx2")))
 static int fccqp_checked_copy_wide(const double *restrict v, long k, double limit,
                                    double *restrict out)
@@ -1235,17 +1256,27 @@ static int fccqp_checked_copy_wide(const double *restrict v, long k, double limi
     __m256d beyond = _mm256_setzero_pd(), changed = beyond;
     int found = 0;
     long i = 0;
+    while (i + 4 <= k && !_mm256_movemask_pd(changed)) {
+        long end = i + FCCQP_COMPARED < k ? i + FCCQP_COMPARED : k;
+        for (; i + 4 <= end; i += 4) {
+            __m256d value = _mm256_loadu_pd(v + i);
+            beyond = _mm256_or_pd(beyond, _mm256_cmp_pd(fccqp_wide_abs(value), bound,
+                                                        _CMP_NLE_UQ));
+            changed = _mm256_or_pd(changed, _mm256_cmp_pd(_mm256_loadu_pd(out + i), value,
+                                                          _CMP_NEQ_UQ));
+            _mm256_storeu_pd(out + i, value);
+        }
+    }
     for (; i + 4 <= k; i += 4) {
         __m256d value = _mm256_loadu_pd(v + i);
         beyond = _mm256_or_pd(beyond, _mm256_cmp_pd(fccqp_wide_abs(value), bound, _CMP_NLE_UQ));
-        changed = _mm256_or_pd(changed, _mm256_cmp_pd(_mm256_loadu_pd(out + i), value,
-                                                      _CMP_NEQ_UQ));
         _mm256_storeu_pd(out + i, value);
     }
     found |= fccqp_checked_tail(v, i, k, limit, out);
     return found | (_mm256_movemask_pd(beyond) ? FCCQP_NOT_FINITE : 0)
            | (_mm256_movemask_pd(changed) ? FCCQP_CHANGED : 0);
 }
+
 /* fccqp_scale_rows in 32-byte vectors */
 __attribute__((target("avx2")))
 static void fccqp_scale_rows_wide(const double *restrict M, int rows, int cols,
@@ -2402,6 +2433,55 @@ static inline void fccqp_sparse_table_rows(const double *Y, int ldy, int first, 
 #endif
     fccqp_sparse_table_rows_loop(Y, ldy, first, last, index, count, m, WT, s, L, ldl, unit,
                                  dest, W, ldw, rows);
+}
+
+/* Per-solve intake (fixedcost).
+ *
+ * fccqp_last_coupled_row: mark_diagonal_tail's search (matrices.pxd), the last row i of
+ * the row-major n x n M with a nonzero (or NaN) entry left of its diagonal, -1 where no
+ * row has one; each row's entries or-ed as fccqp_any_nonzero does (-0.0 is zero). The
+ * Cython loop with a test per entry took 10.7k instructions a go2 tick (19 rows of
+ * 35-53 entries read).
+ */
+/* Whether any of count doubles is nonzero (or NaN): their bits shifted past the sign
+ * (so that -0.0 counts as zero) or-ed, with no branch per entry. */
+FCCQP_FORCE_INLINE int fccqp_any_nonzero(const double *v, int count)
+{
+    unsigned long long bits = 0;
+    for (int j = 0; j < count; j++) {
+        unsigned long long w;
+        memcpy(&w, v + j, sizeof w);
+        bits |= w << 1;
+    }
+    return bits != 0;
+}
+
+FCCQP_CLONES
+static int fccqp_last_coupled_row(const double *M, int n)
+{
+    for (int i = n - 1; i > 0; i--)
+        if (fccqp_any_nonzero(M + (long)i * n, i))
+            return i;
+    return -1;
+}
+
+/* lb_out, ub_out = lb, ub (n entries), bounds of magnitude big or more as infinite; 1
+ * where an entry's pair is not lb <= ub (a NaN, crossed) or has lb = +inf or ub = -inf,
+ * which the validation then looks up (validation.pyx, _check_bounds), else 0. No branch
+ * on the data: a test and a branch for each of the five cases took 1.1k instructions a
+ * go2 tick. */
+FCCQP_CLONES
+static int fccqp_bounds_copy(const double *restrict lb, const double *restrict ub, long n,
+                             double big, double *restrict lb_out, double *restrict ub_out)
+{
+    long bad = 0;
+    for (long i = 0; i < n; i++) {
+        double l = lb[i], u = ub[i];
+        bad |= !(l <= u) | (l == INFINITY) | (u == -INFINITY);
+        lb_out[i] = l > -big ? l : -INFINITY;
+        ub_out[i] = u < big ? u : INFINITY;
+    }
+    return bad != 0;
 }
 
 #endif

@@ -41,6 +41,7 @@ from fccqp._dense cimport matvec, matvec_t
 cdef extern from "fccqp_kernels.h" nogil:
     void fccqp_row_spans(const double* A, int rows, int cols, const double* width,
                          double* span)
+    int fccqp_last_coupled_row(const double* M, int n)
 
 
 cdef enum:
@@ -114,15 +115,10 @@ cdef inline void mark_diagonal_tail(Matrix* M) noexcept nogil:
     rows in fours, so that a multiple of 4 leaves each leading row summed as the whole
     product sums it, bit for bit (``dgemv`` checked on OpenBLAS' Haswell and SkylakeX
     kernels). The rows are read from the last up, each
-    below its diagonal (``M`` is symmetric), until one has an entry off it."""
-    cdef Py_ssize_t n = M.rows, i = n, j
-    cdef bint coupled = False
-    while i > 0 and not coupled:
-        i -= 1
-        for j in range(i):
-            coupled |= M.values[i * n + j] != 0.0
-    i = (i + 4) // 4 * 4 if coupled else 0
-    M.diagonal_from = min(i, n)
+    below its diagonal (``M`` is symmetric), until one has an entry off it
+    (``fccqp_last_coupled_row``)."""
+    cdef Py_ssize_t n = M.rows, i = fccqp_last_coupled_row(M.values, <int>n)
+    M.diagonal_from = min((i + 4) // 4 * 4, n) if i > 0 else 0
 
 
 cdef inline void product(const Matrix* M, const double* x, double* out) noexcept nogil:

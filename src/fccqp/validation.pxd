@@ -1,5 +1,6 @@
 # cython: language_level=3
 from fccqp.matrices cimport Matrix
+from fccqp.tuning cimport INFINITE_BOUND
 
 cdef enum:
     # Codes of scan_and_copy's findings, turned into messages by fccqp.problem.
@@ -34,4 +35,10 @@ cdef Finding scan_and_copy_csc(const Matrix* P, const double* q, const Matrix* A
                                Matrix* P_out, double* q_out, Matrix* A_out, double* b_out,
                                double* lb_out, double* ub_out,
                                bint* same_matrices) noexcept nogil
-cdef int bound_kind(double lb, double ub) noexcept nogil
+cdef inline int bound_kind(double lb, double ub) noexcept nogil:
+    """How the bounds ``lb, ub`` of one entry constrain it: ``UNBOUNDED`` (both beyond
+    ``INFINITE_BOUND``), ``FIXED_BOUND`` (``lb == ub``) or ``BOUNDED``. The one rule for
+    :func:`structure_scan` and the workspace's check of each solve's bounds."""
+    if lb > -INFINITE_BOUND or ub < INFINITE_BOUND:
+        return FIXED_BOUND if lb == ub else BOUNDED
+    return UNBOUNDED

@@ -23,6 +23,8 @@ cdef extern from "fccqp_kernels.h" nogil:
     int FCCQP_NOT_FINITE, FCCQP_CHANGED
     int fccqp_scan_symmetric(const double* P, int n, double* out, double* sizes)
     int fccqp_scan_copy(const double* v, long k, double limit, double* out)
+    int fccqp_bounds_copy(const double* lb, const double* ub, long n, double big,
+                          double* lb_out, double* ub_out)
 
 
 cdef inline Finding _found(int code, int argument, Py_ssize_t index, double value) noexcept nogil:
@@ -33,13 +35,15 @@ cdef inline Finding _found(int code, int argument, Py_ssize_t index, double valu
 
 cdef inline Finding _check_vector(const double* v, double* out, Py_ssize_t k,
                                   int argument) noexcept nogil:
+    """Check and copy the vector ``v`` (``fccqp_scan_copy``); its first entry that is not
+    finite or exceeds ``MAX_ENTRY`` is looked up only when there is one."""
     cdef Py_ssize_t i
-    for i in range(k):
-        if not isfinite(v[i]):
-            return _found(NOT_FINITE, argument, i, v[i])
-        if fabs(v[i]) > MAX_ENTRY:
-            return _found(TOO_LARGE, argument, i, v[i])
-        out[i] = v[i]
+    if fccqp_scan_copy(v, k, MAX_ENTRY, out) & FCCQP_NOT_FINITE:
+        for i in range(k):
+            if not isfinite(v[i]):
+                return _found(NOT_FINITE, argument, i, v[i])
+            if fabs(v[i]) > MAX_ENTRY:
+                return _found(TOO_LARGE, argument, i, v[i])
     return _found(SCAN_OK, -1, -1, 0.0)
 
 
@@ -100,21 +104,21 @@ cdef Finding scan_and_copy(const double* P, const double* q, const double* A, co
 cdef inline Finding _check_bounds(const double* lb, const double* ub, Py_ssize_t n,
                                   double* lb_out, double* ub_out) noexcept nogil:
     """Check and copy the bounds (both storages' last step), magnitudes of
-    ``INFINITE_BOUND`` or more stored as infinite."""
+    ``INFINITE_BOUND`` or more stored as infinite (``fccqp_bounds_copy``); the first bad
+    entry is looked up only when there is one."""
     cdef Py_ssize_t i
-    for i in range(n):
-        if isnan(lb[i]):
-            return _found(NAN_BOUND, 3, i, lb[i])
-        if isnan(ub[i]):
-            return _found(NAN_BOUND, 4, i, ub[i])
-        if lb[i] > ub[i]:
-            return _found(CROSSED, 3, i, lb[i])
-        if lb[i] == INFINITY:
-            return _found(INFINITE_SIDE, 3, i, lb[i])
-        if ub[i] == -INFINITY:
-            return _found(INFINITE_SIDE, 4, i, ub[i])
-        lb_out[i] = lb[i] if lb[i] > -INFINITE_BOUND else -INFINITY
-        ub_out[i] = ub[i] if ub[i] < INFINITE_BOUND else INFINITY
+    if fccqp_bounds_copy(lb, ub, n, INFINITE_BOUND, lb_out, ub_out):
+        for i in range(n):
+            if isnan(lb[i]):
+                return _found(NAN_BOUND, 3, i, lb[i])
+            if isnan(ub[i]):
+                return _found(NAN_BOUND, 4, i, ub[i])
+            if lb[i] > ub[i]:
+                return _found(CROSSED, 3, i, lb[i])
+            if lb[i] == INFINITY:
+                return _found(INFINITE_SIDE, 3, i, lb[i])
+            if ub[i] == -INFINITY:
+                return _found(INFINITE_SIDE, 4, i, ub[i])
     return _found(SCAN_OK, -1, -1, 0.0)
 
 
@@ -194,15 +198,6 @@ cdef Finding _first_bad_csc(const Matrix* M, int argument) noexcept nogil:
             return _found(P_NOT_FINITE, -1, row, bad)
         return _found(NOT_FINITE if not isfinite(bad) else TOO_LARGE, argument, row, bad)
     return _found(TOO_LARGE, argument, largest_row, largest)
-
-
-cdef int bound_kind(double lb, double ub) noexcept nogil:
-    """How the bounds ``lb, ub`` of one entry constrain it: ``UNBOUNDED`` (both beyond
-    ``INFINITE_BOUND``), ``FIXED_BOUND`` (``lb == ub``) or ``BOUNDED``. The one rule for
-    :func:`structure_scan` and the workspace's check of each solve's bounds."""
-    if lb > -INFINITE_BOUND or ub < INFINITE_BOUND:
-        return FIXED_BOUND if lb == ub else BOUNDED
-    return UNBOUNDED
 
 
 def structure_scan(const double[::1] lb, const double[::1] ub, const Py_ssize_t[::1] offset,
