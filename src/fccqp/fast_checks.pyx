@@ -248,67 +248,32 @@ cdef bint _same_normal(object a, object b):
     return True
 
 
-cdef tuple _read = (None, None)
-"""The last ``previous`` whose values :func:`same_cones` read, and those values
-(:func:`_spec_values`): a control loop's ``previous`` is the tuple of the solve that last
-flattened its cones, the same object tick after tick, whose values then need no
-attribute reads (164 instructions each, 12 a go2 tick)."""
-
-
-cdef list _spec_values(tuple cones):
-    """Each spec's kind and values in order, four entries a spec (a friction cone's
-    ``start, mu, normal``, a second-order cone's ``start, dim`` and None); None when a spec
-    is of another kind."""
-    cdef list values = []
-    for cone in cones:
-        kind = type(cone)
-        values.append(kind)
-        if kind is _FRICTION:
-            values.append(cone.start)
-            values.append(cone.mu)
-            values.append(cone.normal)
-        elif kind is _SECOND_ORDER:
-            values.append(cone.start)
-            values.append(cone.dim)
-            values.append(None)
-        else:
-            return None
-    return values
-
-
 def same_cones(cones, previous):
     """Whether the tuple ``cones`` holds specs of the same kinds and the same int and
     float values as the tuple ``previous`` (the last solve's, already validated): then
     its :func:`fccqp.cones.flatten_cones` is the last one, with no key to build and hash
     (a control loop rebuilds equal specs every tick; 3-5 us of a go2 tick in flow).
-    False when unsure. The values of ``previous`` are kept for the next call (``_read``):
-    the specs are frozen dataclasses and a tuple cannot change."""
-    global _read
+    False when unsure."""
     if type(cones) is not tuple or type(previous) is not tuple:
         return False
-    cdef tuple now = <tuple>cones, before = <tuple>previous, read = _read
-    cdef list old
-    cdef Py_ssize_t k
-    if len(now) != len(before):
+    cdef tuple now = <tuple>cones, before = <tuple>previous
+    cdef Py_ssize_t k, count = len(now)
+    if count != len(before):
         return False
     _load_kinds()
-    if read[0] is before:
-        old = read[1]
-    else:
-        old = _spec_values(before)
-        if old is None:
-            return False
-        _read = (before, old)
-    for k in range(len(now)):
-        a = now[k]
-        if type(a) is not old[4 * k]:
+    for k in range(count):   # by index: zip's call and iteration took 1.4k instructions
+        a, b = now[k], before[k]
+        if type(a) is not type(b):
             return False
         if type(a) is _FRICTION:
-            if not (_same_number(a.start, old[4 * k + 1]) and _same_number(a.mu, old[4 * k + 2])
-                    and _same_normal(a.normal, old[4 * k + 3])):
+            if not (_same_number(a.start, b.start) and _same_number(a.mu, b.mu)
+                    and _same_normal(a.normal, b.normal)):
                 return False
-        elif not (_same_number(a.start, old[4 * k + 1]) and _same_number(a.dim, old[4 * k + 2])):
-            return False   # a second-order cone's (_spec_values knows no other kind)
+        elif type(a) is _SECOND_ORDER:
+            if not (_same_number(a.start, b.start) and _same_number(a.dim, b.dim)):
+                return False
+        else:
+            return False
     return True
 
 
