@@ -711,35 +711,14 @@ def test_schur_polish_over_guesses_and_newton_steps_is_the_assembled_polish(seed
     iterate (several guesses and Newton steps) it takes the guesses and steps the
     polish of the assembled matrix (``dsytrf``) takes, to the same point."""
     P, q, A, b, lb, ub, cones = random_problem(seed, n=40, m=6, n_cones=8, n_box=8)
-    P = np.diag(np.diag(P))
-    it = fccqp.solve(P, q, A, b, lb, ub, cones, polish=False, kkt_backend="ldl_full",
-                     max_iter=iterations)
-    start = (it.x, it.y, it.z, it.x)
-    flat = flatten_cones(cones, P.shape[0])
-    assembled = polish_point(P, q, A, b, lb, ub, flat, *start)
-    schur = polish_point(P, q, A, b, lb, ub, flat, *start, schur=True)
-    assert assembled["ok"] and schur["ok"] and schur["schur"] and schur["bordered"]
-    assert np.array_equal(assembled["active"], schur["active"])
-    assert (assembled["passes"], assembled["factorizations"]) == (schur["passes"],
-                                                                   schur["factorizations"])
-    for name in ("x", "nu", "y"):
-        gap = np.abs(assembled[name] - schur[name]).max()
-        assert gap <= 1e-12 * max(1.0, np.abs(assembled[name]).max()), name
-    assert np.abs(A @ schur["x"] - b).max() <= 1e-12 * max(1.0, np.abs(b).max())
+    schur = _schur_polish_matching_the_assembled(np.diag(np.diag(P)), q, A, b, lb, ub, cones,
+                                                 iterations)
+    assert schur["bordered"]
 
 
-@pytest.mark.parametrize("iterations", [1, 4])
-@pytest.mark.parametrize("seed", range(8))
-def test_schur_polish_with_rows_no_cone_touches_is_the_assembled_polish(seed, iterations):
-    """Rows of ``A`` that no cone entry touches come first in ``S`` (fccqp.polish_schur):
-    their block is factored once for every base whose free rows that reach it are the
-    same (here the free box entries: the guesses hold and release them), and a guess
-    factors only the rows past it. From a rough iterate the Schur polish takes the
-    guesses and steps of the assembled matrix's polish, to the same point."""
-    P, q, A, b, lb, ub, cones = random_problem(seed, n=40, m=8, n_cones=8, n_box=8)
-    P = np.diag(np.diag(P))
-    A[3:, :24] = 0.0   # rows 3-7: no cone entry, the first four of them S's leading block
-    b = A @ fccqp.solve(P, q, A, b, lb, ub, cones).x
+def _schur_polish_matching_the_assembled(P, q, A, b, lb, ub, cones, iterations):
+    """The Schur polish of ``iterations`` unpolished ADMM iterations' iterate, checked to
+    take the assembled polish's guesses and steps to the same point; returned."""
     it = fccqp.solve(P, q, A, b, lb, ub, cones, polish=False, kkt_backend="ldl_full",
                      max_iter=iterations)
     start = (it.x, it.y, it.z, it.x)
@@ -754,6 +733,22 @@ def test_schur_polish_with_rows_no_cone_touches_is_the_assembled_polish(seed, it
         gap = np.abs(assembled[name] - schur[name]).max()
         assert gap <= 1e-12 * max(1.0, np.abs(assembled[name]).max()), name
     assert np.abs(A @ schur["x"] - b).max() <= 1e-12 * max(1.0, np.abs(b).max())
+    return schur
+
+
+@pytest.mark.parametrize("iterations", [1, 4])
+@pytest.mark.parametrize("seed", range(8))
+def test_schur_polish_with_rows_no_cone_touches_is_the_assembled_polish(seed, iterations):
+    """Rows of ``A`` that no cone entry touches come first in ``S`` (fccqp.polish_schur):
+    their block is factored once for every base whose free rows that reach it are the
+    same (here the free box entries: the guesses hold and release them), and a guess
+    factors only the rows past it. From a rough iterate the Schur polish takes the
+    guesses and steps of the assembled matrix's polish, to the same point."""
+    P, q, A, b, lb, ub, cones = random_problem(seed, n=40, m=8, n_cones=8, n_box=8)
+    P = np.diag(np.diag(P))
+    A[3:, :24] = 0.0   # rows 3-7: no cone entry, the first four of them S's leading block
+    b = A @ fccqp.solve(P, q, A, b, lb, ub, cones).x
+    _schur_polish_matching_the_assembled(P, q, A, b, lb, ub, cones, iterations)
 
 
 def test_a_contact_change_polished_from_nothing_settles_its_planes_before_a_release():
