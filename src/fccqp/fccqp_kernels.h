@@ -1947,7 +1947,7 @@ FCCQP_LANE_OP fccqp_v4 fccqp_finite_or4(fccqp_v4 a, fccqp_v4 other)
 }
 #endif
 
-/* a size capped by a positive span (termination._capped): min(size, span) where span > 0 */
+/* a size capped by a positive span (termination.pyx's docstring): min(size, span) where span > 0 */
 FCCQP_LANE_OP fccqp_v4 fccqp_capped4(fccqp_v4 size, fccqp_v4 span)
 {
     return fccqp_min4(size, fccqp_positive_or4(span, fccqp_splat4(INFINITY)));
