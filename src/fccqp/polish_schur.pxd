@@ -24,6 +24,8 @@ cdef struct PolishSchur:
     Py_ssize_t* block_row   # s: the first row of Y of each boundary block
     int diag_end            # rows of Y before the boundary blocks'
     int rows                # rows of Y: the free entries of the factored guess
+    int kept_rows           # Y's rows [unconstrained, kept_rows) hold the diagonal rows of
+                            # rowvar's entries (written by a base of this solve, kept)
     double* SU              # m x m: the unconstrained entries' part of S, + delta I
     Py_ssize_t* arow        # m: the row of A of each of S's first m columns
     int lead                # S's leading columns, rows of A no cone entry touches (a

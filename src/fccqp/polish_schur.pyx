@@ -108,7 +108,7 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
             f.order[rest] = i
             rest += 1
     k = <int>lead
-    f.dense, f.unconstrained = k, rest
+    f.dense, f.unconstrained, f.kept_rows = k, rest, <int>rest
     for r in range(rest):
         f.rowvar[r] = f.order[r]
         f.inv_root[r] = 1.0 / f.root[f.order[r]] if r >= k else 0.0
@@ -325,9 +325,17 @@ cdef bint _factor_whole(PolishSchur* f, const Problem* p, const Py_ssize_t* inde
 cdef inline bint _take_row(PolishSchur* f, const Problem* p, Py_ssize_t i, Py_ssize_t row,
                            bint build) noexcept nogil:
     """Row ``row`` of ``Y`` for the free entry ``i``: written in ``S0``'s ``m`` columns
-    (``build``), else whether ``Y`` holds it there."""
+    where ``Y`` does not hold it yet (``build``: rows below ``kept_rows`` that an
+    earlier base of the solve wrote for the same entry are kept), else whether ``Y``
+    holds it there."""
     if build:
-        return _diagonal_row(f, p, i, row, p.m)
+        if row < f.kept_rows and f.rowvar[row] == i:
+            return True
+        if not _diagonal_row(f, p, i, row, p.m):
+            return False
+        if row == f.kept_rows:
+            f.kept_rows += 1
+        return True
     return row < f.diag_end and f.rowvar[row] == i
 
 
@@ -465,7 +473,7 @@ cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
     row = _walk_diagonal(f, p, index, boundary, nb, True)
     if row < 0:
         return
-    f.diag_end = <int>row
+    f.diag_end = f.kept_rows = <int>row   # the rows past it take the boundary entries
     f.base_nb = <int>nb
     for kb in range(nb):
         f.base_boundary[kb] = boundary[kb]
