@@ -751,6 +751,20 @@ def test_schur_polish_with_rows_no_cone_touches_is_the_assembled_polish(seed, it
     _schur_polish_matching_the_assembled(P, q, A, b, lb, ub, cones, iterations)
 
 
+@pytest.mark.parametrize("iterations", [1, 2])
+@pytest.mark.parametrize("seed", range(8))
+def test_schur_polish_with_rows_moved_between_bases_is_the_assembled_polish(seed, iterations):
+    """A base of the Schur polish (fccqp.polish_schur) keeps the rows of ``Y`` that an
+    earlier base of the solve wrote for the same free entries at the same rows, and
+    copies an entry's row, kept from its first writing, where it moved (a box entry
+    before it held or released, a cone block before it on or off its boundary). From a
+    rough iterate with many box entries and cones, whose guesses move their rows, the
+    Schur polish takes the assembled polish's guesses and steps to the same point."""
+    P, q, A, b, lb, ub, cones = random_problem(seed, n=50, m=6, n_cones=10, n_box=14)
+    _schur_polish_matching_the_assembled(np.diag(np.diag(P)), q, A, b, lb, ub, cones,
+                                         iterations)
+
+
 def test_a_contact_change_polished_from_nothing_settles_its_planes_before_a_release():
     """anymal_c's benchmark tick 360 (``mix``, seed 0: a fourth foot put down), warm along
     its sequence from tick 300, started from tick 359's answer carried onto the new

@@ -38,6 +38,9 @@ cdef struct PolishSchur:
     double* u               # m + s scratch
     int* row_nz             # n x (m + s): each row of Y's nonzero columns, increasing
     int* row_count          # n: how many (the diagonal and boundary rows)
+    int* entry_nz           # n x m: a constrained entry's diagonal row's nonzero columns,
+    double* entry_values    # n x m: and their values, kept from its first row in the solve
+    int* entry_count        # n: their number, -1 before the solve writes the entry's row
     double* nz_values       # m + s scratch: a row's nonzero entries
     int size                # m + nb of the last factored guess
     # The bordered factorization (polish_schur.pyx), which keeps the part of S that a

@@ -287,6 +287,8 @@ cdef void polish_schur_arrays(Arrays a, PolishSchur* ps, Py_ssize_t n, Py_ssize_
     ps.t, ps.t2, ps.u = a.new(n), a.new(n), a.new(m + s)
     ps.row_nz, ps.row_count = <int*>a.new_int(n * (m + s)), <int*>a.new_int(n)
     ps.nz_values = a.new(m + s)
+    ps.entry_nz, ps.entry_values = <int*>a.new_int(n * m), a.new(n * m)
+    ps.entry_count = <int*>a.new_int(n)
     ps.L, ps.Y = a.new(n * n), a.new(n * (m + s))
     ps.SU, ps.S = a.new(m * m), a.new((m + s) * (m + s))
     ps.block = a.new(s * s)
