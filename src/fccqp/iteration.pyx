@@ -511,10 +511,10 @@ cdef bint _solved_polish(Engine* e, Loop* L) noexcept nogil:
     whether the polished point was kept. Under a time limit it may take up to
     ``SOLVED_GUESS_PASSES`` guesses (the polish still stops between guesses at the
     budget): from an iterate within the tolerances each guess after the first is a step
-    of a primal active-set method, and talos' cold ticks walk 9-15 of them, so that 8
-    guesses failed there and a failed polish left the run to iterate, retry and, near
-    the deadline, end at ADMM's tolerance unpolished, torques 10-30 % of a joint's limit
-    off (notes/performance-history.md, "talosexact: ...")."""
+    of a primal active-set method, and talos' cold ticks walk up to 19 of them: with 8
+    the polish failed, and the run iterated, failed its retries and ended at ADMM's
+    tolerance unpolished, torques 10-30 % of a joint's limit off, or reached the
+    deadline (notes/performance-history.md, "talosexact: a SOLVED iterate's polish")."""
     cdef long passes = e.pol.guess_passes
     cdef bint kept
     if not L.timed:

@@ -155,7 +155,7 @@ cdef extern from *:
        RESTART_MIN_ITER): from a stalled iterate its active-set walk may need more */
     #define FCCQP_STALLED_GUESS_PASSES 32
     /* most active sets for the polish of an iterate that earned SOLVED under a time limit */
-    #define FCCQP_SOLVED_GUESS_PASSES 32
+    #define FCCQP_SOLVED_GUESS_PASSES 16
     /* guesses of a warm polish tried again from its own cycling point: those kept took 1 */
     #define FCCQP_CYCLED_GUESS_PASSES 1
     /* a polish whose first this many guesses all violate a constraint gives up */
