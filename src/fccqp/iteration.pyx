@@ -47,7 +47,8 @@ from fccqp.tuning cimport (AUXILIARY_TIME, CLEANING_START, CONVERGING, EARLY_POL
                            EARLY_POLISH_TRIES, EQUALITY_MISSED, GATED_CHECK_WAIT, GUESS_LEAD,
                            LOG_INTERVAL, POLISH_GATE, POLISH_RETRIES, RESERVE_PASSES,
                            RESTART_MIN_ITER, RHO_TIME_SHARE, SETTLE_ITERATIONS, SETTLE_TRIES,
-                           STALL_FACTOR, STALLED_GUESS_PASSES, STALLS, TIMED_EARLY_POLISH)
+                           SOLVED_GUESS_PASSES, STALL_FACTOR, STALLED_GUESS_PASSES, STALLS,
+                           TIMED_EARLY_POLISH)
 from fccqp.verdict cimport (check, classify, inconsistent, missed, row_missed_by_data,
                             unbounded)
 
@@ -474,7 +475,7 @@ cdef inline void _polish_attempts(Engine* e, Loop* L, Run* run) noexcept nogil:
     cdef Options* o = &e.opt
     if L.status == SOLVED and o.polish and not L.last and L.retries < POLISH_RETRIES:
         L.polished_at = L.iteration
-        run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, False)
+        run.polished = _solved_polish(e, L)
         if not run.polished:   # go on, closer to the active set
             L.retries += 1
             e.tighten *= 0.1
@@ -503,6 +504,25 @@ cdef inline void _polish_attempts(Engine* e, Loop* L, Run* run) noexcept nogil:
         L.cap_polish = False
         L.polished_at = L.iteration
         run.polished = keep_polished(e, &L.status, L.iteration, L.start_time, True)
+
+
+cdef bint _solved_polish(Engine* e, Loop* L) noexcept nogil:
+    """Polish an iterate that earned SOLVED (:func:`fccqp.acceptance.keep_polished`);
+    whether the polished point was kept. Under a time limit it may take up to
+    ``SOLVED_GUESS_PASSES`` guesses (the polish still stops between guesses at the
+    budget): from an iterate within the tolerances each guess after the first is a step
+    of a primal active-set method, and talos' cold ticks walk up to 19 of them: with 8
+    the polish failed, and the run iterated, failed its retries and ended at ADMM's
+    tolerance unpolished, torques 10-30 % of a joint's limit off, or reached the
+    deadline (notes/performance-history.md, "talosexact: a SOLVED iterate's polish")."""
+    cdef long passes = e.pol.guess_passes
+    cdef bint kept
+    if not L.timed:
+        return keep_polished(e, &L.status, L.iteration, L.start_time, False)
+    e.pol.guess_passes = SOLVED_GUESS_PASSES
+    kept = keep_polished(e, &L.status, L.iteration, L.start_time, False)
+    e.pol.guess_passes = passes
+    return kept
 
 
 cdef inline bint _near(Engine* e, double factor) noexcept nogil:

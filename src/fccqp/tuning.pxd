@@ -154,6 +154,8 @@ cdef extern from *:
     /* most active sets for the final polish of a run stopped at max_iter (of at least
        RESTART_MIN_ITER): from a stalled iterate its active-set walk may need more */
     #define FCCQP_STALLED_GUESS_PASSES 32
+    /* most active sets for the polish of an iterate that earned SOLVED under a time limit */
+    #define FCCQP_SOLVED_GUESS_PASSES 16
     /* guesses of a warm polish tried again from its own cycling point: those kept took 1 */
     #define FCCQP_CYCLED_GUESS_PASSES 1
     /* a polish whose first this many guesses all violate a constraint gives up */
@@ -296,6 +298,7 @@ cdef extern from *:
     const int GUESS_PASSES "FCCQP_GUESS_PASSES"
     const int WARM_GUESS_PASSES "FCCQP_WARM_GUESS_PASSES"
     const int STALLED_GUESS_PASSES "FCCQP_STALLED_GUESS_PASSES"
+    const int SOLVED_GUESS_PASSES "FCCQP_SOLVED_GUESS_PASSES"
     const int CYCLED_GUESS_PASSES "FCCQP_CYCLED_GUESS_PASSES"
     const int FEASIBLE_PASSES "FCCQP_FEASIBLE_PASSES"
     const double HOPELESS_RATE "FCCQP_HOPELESS_RATE"
