@@ -200,12 +200,13 @@ cdef inline double cold_start_rho(const Engine* e) noexcept nogil:
     ended at where that is larger (as OSQP keeps its rho between solves: talos_reduced's
     rule raises rho 4x above the data's, and its next cold start gains from it), while a
     lowered one is not kept (solo12's cost it 40 % more iterations); before the data's
-    is known the last solve's, else ``settings.rho``. Without a time limit
-    ``settings.rho`` (keeping the last rho there helped solo12 but cost talos_reduced
-    and anymal_c iterations; notes/tuning.md, "The rho of a cold start")."""
+    is known, or with a fixed rho (``adaptive_rho`` off), the last solve's, else
+    ``settings.rho``. Without a time limit ``settings.rho`` (keeping the last rho there
+    helped solo12 but cost talos_reduced and anymal_c iterations; notes/tuning.md, "The
+    rho of a cold start")."""
     if not isfinite(e.opt.time_limit):
         return e.opt.rho
-    if e.scaling.cold_rho > 0.0:
+    if e.scaling.cold_rho > 0.0 and e.opt.adaptive_rho:
         return max(e.scaling.cold_rho, e.prev.rho) if e.prev.has_rho else e.scaling.cold_rho
     return e.prev.rho if e.prev.has_rho else e.opt.rho
 

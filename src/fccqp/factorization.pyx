@@ -22,8 +22,8 @@ from fccqp.matrices cimport CSC, DENSE
 from fccqp.projections cimport proj_set
 from fccqp.reduced cimport reduced_rebase, reduced_table
 from fccqp.rho_rule cimport curvature_rho
-from fccqp.tuning cimport (EQUALITY_START_LIMIT, EQUALITY_START_RAY_STEP, EQUALITY_START_STEPS,
-                           REDUCED_COST)
+from fccqp.tuning cimport (COLD_RHO_RANGE, EQUALITY_START_LIMIT, EQUALITY_START_RAY_STEP,
+                           EQUALITY_START_STEPS, REDUCED_COST)
 
 
 cdef long budget(const Engine* e, long iteration) noexcept nogil:
@@ -287,18 +287,26 @@ cdef int _factor_table(Engine* e, Run* run) noexcept nogil:
 
 
 cdef bint _data_rho(Engine* e, Run* run) noexcept nogil:
-    """Under a time limit, the first table start of an equilibration finds the data's
-    cold rho (:func:`fccqp.rho_rule.curvature_rho`, ``Scaling.cold_rho``) in the table
-    just made; True when the run's cold start rho (:func:`fccqp.engine.cold_start_rho`)
-    changes with it, ``run.rho`` then set to it: the caller factors again, once per
-    equilibration."""
+    """Under a time limit and an adaptive rho, the first table start of an equilibration
+    finds the data's cold rho (:func:`fccqp.rho_rule.curvature_rho`,
+    ``Scaling.cold_rho``) in the table just made; True when the run's cold start rho
+    (:func:`fccqp.engine.cold_start_rho`) changes with it, ``run.rho`` then set to it:
+    the caller factors again, once per equilibration.
+
+    The rule is a fit on the benchmark's whole-body-control QPs, whose curvatures on
+    the constrained entries are 1e4-1e8 (their rhos 4e-4 to 0.5); a QP of curvature
+    near 1 would get 1e-8. A data's rho more than ``COLD_RHO_RANGE`` times from
+    ``settings.rho`` is not taken: such QPs start as before."""
     cdef Problem* p = &e.prob
     cdef double rho
-    if e.scaling.cold_rho != 0.0 or not isfinite(e.opt.time_limit):
+    if e.scaling.cold_rho != 0.0 or not (isfinite(e.opt.time_limit) and e.opt.adaptive_rho):
         return False
     rho = curvature_rho(e.red.W_S, p.s, e.it.rho_vec, e.fact.rho_scale, p.c,
                         e.work.mat_s, e.work.vec_s2)
-    e.scaling.cold_rho = rho if rho > 0.0 else -1.0   # -1: the data have none
+    if e.opt.rho / COLD_RHO_RANGE <= rho <= e.opt.rho * COLD_RHO_RANGE:
+        e.scaling.cold_rho = rho
+    else:
+        e.scaling.cold_rho = -1.0   # none, or outside the rule's fit
     rho = cold_start_rho(e)
     if rho == run.rho:
         return False

@@ -81,6 +81,8 @@ cdef extern from *:
     #define FCCQP_COLD_RHO_CURVATURE 1e-8
     /* curvatures within this fraction of their penalty's inverse are rounding */
     #define FCCQP_CURVATURE_ROUNDING 1e-12
+    /* a data's rho more than this x from settings.rho is not taken (outside the fit) */
+    #define FCCQP_COLD_RHO_RANGE 1e3
 
     /* ---- Anderson acceleration (fccqp.anderson, fccqp.iteration) ---- */
     /* steps rejected by the safeguard before a run gives up accelerating */
@@ -265,6 +267,7 @@ cdef extern from *:
     const double RHO_RUNAWAY "FCCQP_RHO_RUNAWAY"
     const double COLD_RHO_CURVATURE "FCCQP_COLD_RHO_CURVATURE"
     const double CURVATURE_ROUNDING "FCCQP_CURVATURE_ROUNDING"
+    const double COLD_RHO_RANGE "FCCQP_COLD_RHO_RANGE"
     # Anderson acceleration
     const long MAX_REJECTIONS "FCCQP_MAX_REJECTIONS"
     const double REGULARIZATION "FCCQP_REGULARIZATION"
