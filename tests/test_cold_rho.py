@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from fccqp.tuning import COLD_RHO_CURVATURE
+from fccqp.tuning import COLD_RHO_CURVATURE, COLD_RHO_RANGE
 
 import fccqp
 
@@ -65,8 +65,10 @@ def test_an_untimed_or_fixed_rho_run_begins_at_settings_rho(settings, capsys):
     assert started_at(task_qp(0), **settings)[0] == RHO
 
 
-def test_a_datas_rho_far_outside_the_fit_is_not_taken(capsys):
-    """At a task weight of 1e-2 against the forces' 1e-4 the rule gives about 1e-10."""
-    start, rule = started_at(task_qp(0, weight=1e-2), time_limit=100.0)
-    assert rule < RHO / 1e3
+@pytest.mark.parametrize("weight", [1e-2, 1e4])
+def test_a_datas_rho_outside_the_fit_is_not_taken(weight, capsys):
+    """At a task weight of 1e-2 against the forces' 1e-4 the rule gives about 1e-10; at
+    1e4 about 2e-4, below ``settings.rho / COLD_RHO_RANGE`` as talos_reduced's 3.75e-4."""
+    start, rule = started_at(task_qp(0, weight=weight), time_limit=100.0)
+    assert rule < RHO / COLD_RHO_RANGE
     assert start == RHO

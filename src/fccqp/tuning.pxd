@@ -82,7 +82,7 @@ cdef extern from *:
     /* curvatures within this fraction of their penalty's inverse are rounding */
     #define FCCQP_CURVATURE_ROUNDING 1e-12
     /* a data's rho more than this x from settings.rho is not taken (outside the fit) */
-    #define FCCQP_COLD_RHO_RANGE 1e3
+    #define FCCQP_COLD_RHO_RANGE 1e2
 
     /* ---- Anderson acceleration (fccqp.anderson, fccqp.iteration) ---- */
     /* steps rejected by the safeguard before a run gives up accelerating */
