@@ -197,9 +197,9 @@ cdef inline void measure(Engine* e) noexcept nogil:
 cdef inline double cold_start_rho(const Engine* e) noexcept nogil:
     """The rho of a cold start: under a time limit the data's (``Scaling.cold_rho``,
     once the first cold start of the equilibration found it), or the one the last solve
-    ended at where that is larger (as OSQP keeps its rho between solves: talos_reduced's
-    rule raises rho 4x above the data's, and its next cold start gains from it), while a
-    lowered one is not kept (solo12's cost it 40 % more iterations); before the data's
+    ended at where that is larger (as OSQP keeps its rho between solves: the quadrupeds'
+    cold census takes 2-3 % fewer iterations than from the data's rho every time), while
+    a lowered one is not kept (solo12's cost it 40 % more iterations); before the data's
     is known, or with a fixed rho (``adaptive_rho`` off), the last solve's, else
     ``settings.rho``. Without a time limit ``settings.rho`` (keeping the last rho there
     helped solo12 but cost talos_reduced and anymal_c iterations; notes/tuning.md, "The
