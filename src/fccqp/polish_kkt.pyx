@@ -17,13 +17,16 @@ from libc.math cimport INFINITY
 
 from scipy.linalg.cython_lapack cimport dsytrf, dsytrs
 
-from fccqp._dense cimport copy, inf_norm
+from fccqp._dense cimport copy
 from fccqp._types cimport Problem
 from fccqp.matrices cimport CSC, product, product_t
 from fccqp.polish cimport APEX, FIXED, LOWER, UPPER, Polish
 from fccqp.polish_csc cimport polish_csc_factor, polish_csc_solve
 from fccqp.polish_schur cimport polish_schur_solve
 from fccqp.tuning cimport MAX_REFINE, POLISH_DELTA_CUT, POLISH_STALL_RESIDUAL
+
+cdef extern from "fccqp_kernels.h" nogil:
+    double fccqp_abs_max(const double* v, long n)
 
 
 cdef inline bint _same_bits(double a, double b) noexcept nogil:
@@ -127,7 +130,7 @@ cdef double kkt_residual(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t 
         w.rhs[nf + m + k] = -value
     for i in range(m):
         w.rhs[nf + i] = p.b[i] - w.Ax[i]
-    return inf_norm(w.rhs, nf + m + nb)
+    return fccqp_abs_max(w.rhs, nf + m + nb)   # inf_norm's value in vectors
 
 
 cdef void point_products(Polish* w, const Problem* p) noexcept nogil:
