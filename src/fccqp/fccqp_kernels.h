@@ -2621,4 +2621,46 @@ static void fccqp_backward_vector(const double *restrict L, int n, int ld, doubl
     }
 }
 
+
+/* fccqp_abs_max: the largest |v[i]| of n entries (0 for none), NaN entries skipped as
+ * _dense.inf_norm skips them (maxpd keeps its second operand, the running maximum, where
+ * the first is NaN): the same value in any order, a maximum rounds nothing. Four entries
+ * a compare where the CPU has AVX2, against inf_norm's compare and branch an entry: the
+ * polish's KKT residual norm (polish_kkt.kkt_residual, about 90 entries on anymal_c). */
+static inline double fccqp_abs_max_one(double a, double m)
+{
+    return fabs(a) > m ? fabs(a) : m;
+}
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+__attribute__((target("avx2")))
+static double fccqp_abs_max_wide(const double *restrict v, long n)
+{
+    __m256d sign = _mm256_set1_pd(-0.0), m = _mm256_setzero_pd();
+    double lanes[4], out;
+    long i = 0;
+    for (; i + 4 <= n; i += 4)
+        m = _mm256_max_pd(_mm256_andnot_pd(sign, _mm256_loadu_pd(v + i)), m);
+    _mm256_storeu_pd(lanes, m);
+    out = fccqp_abs_max_one(lanes[1], lanes[0]);
+    out = fccqp_abs_max_one(lanes[2], out);
+    out = fccqp_abs_max_one(lanes[3], out);
+    for (; i < n; i++)
+        out = fccqp_abs_max_one(v[i], out);
+    return out;
+}
+#endif
+
+static inline double fccqp_abs_max(const double *restrict v, long n)
+{
+    double out = 0.0;
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+    if (__builtin_cpu_supports("avx2"))
+        return fccqp_abs_max_wide(v, n);
+#endif
+    for (long i = 0; i < n; i++)
+        out = fccqp_abs_max_one(v[i], out);
+    return out;
+}
+
 #endif
