@@ -199,7 +199,6 @@ cdef class Workspace:
         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
         e.prev.exists = e.user.has_matrices = e.fact.certified = e.scaling.done = False
         e.scaling.kept = False
-        e.scaling.cold_rho = 0.0
         e.prev.has_rho = False
         e.prev.polished = e.prev.from_polished = e.equalities_missed = False
         e.prev.guessed = False

@@ -84,7 +84,6 @@ cdef struct Scaling:
     Pattern pattern             # the nonzeros of the dense P and A at the last equilibration
     bint done                   # an equilibration ran for this workspace
     bint kept                   # the last run's scaling is an earlier equilibration's
-    double cold_rho             # the data's rho of a timed cold start (rho_rule.curvature_rho); 0: not sought yet, -1: none
 
 
 cdef struct Factorization:
@@ -195,20 +194,12 @@ cdef inline void measure(Engine* e) noexcept nogil:
 
 
 cdef inline double cold_start_rho(const Engine* e) noexcept nogil:
-    """The rho of a cold start: under a time limit the data's (``Scaling.cold_rho``,
-    once the first cold start of the equilibration found it), or the one the last solve
-    ended at where that is larger (as OSQP keeps its rho between solves: the quadrupeds'
-    cold census takes 2-3 % fewer iterations than from the data's rho every time), while
-    a lowered one is not kept (solo12's cost it 40 % more iterations); before the data's
-    is known, or with a fixed rho (``adaptive_rho`` off), the last solve's, else
-    ``settings.rho``. Without a time limit ``settings.rho`` (keeping the last rho there
+    """The rho of a cold start: under a time limit the one the last solve adapted (as
+    OSQP keeps its rho between solves: fewer iterations and factorizations on
+    talos_reduced's cold starts), else ``settings.rho`` (without a time limit keeping it
     helped solo12 but cost talos_reduced and anymal_c iterations; notes/tuning.md, "The
     rho of a cold start")."""
-    if not isfinite(e.opt.time_limit):
-        return e.opt.rho
-    if e.scaling.cold_rho > 0.0 and e.opt.adaptive_rho:
-        return max(e.scaling.cold_rho, e.prev.rho) if e.prev.has_rho else e.scaling.cold_rho
-    return e.prev.rho if e.prev.has_rho else e.opt.rho
+    return e.prev.rho if e.prev.has_rho and isfinite(e.opt.time_limit) else e.opt.rho
 
 
 cdef inline void end_run(Engine* e, Run* run, int status, long iteration) noexcept nogil:

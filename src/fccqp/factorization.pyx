@@ -8,22 +8,21 @@ and ``base`` in step with the factorization, and records what it holds
 (:c:type:`fccqp.engine.Factorization`).
 """
 
-from libc.math cimport fabs, isfinite
+from libc.math cimport fabs
 
 from fccqp._blas cimport cholesky, cholesky_solve_vector
 from fccqp._dense cimport colmatvec, copy, fill, inf_norm, matvec
 from fccqp._types cimport Iterates, Problem
 from fccqp.anderson cimport anderson_reset
-from fccqp.engine cimport Engine, Run, cold_start_rho
+from fccqp.engine cimport Engine, Run
 from fccqp.kkt cimport (AUTO, FACTORED, LDL_FULL, NOT_CONVEX, SCHUR_REDUCED, SPARSE_LDL,
                         UNAVAILABLE, full_form, is_reduced, kkt_convexity, kkt_factor,
                         kkt_solve)
 from fccqp.matrices cimport CSC, DENSE
 from fccqp.projections cimport proj_set
 from fccqp.reduced cimport reduced_rebase, reduced_table
-from fccqp.rho_rule cimport curvature_rho
-from fccqp.tuning cimport (COLD_RHO_RANGE, EQUALITY_START_LIMIT, EQUALITY_START_RAY_STEP,
-                           EQUALITY_START_STEPS, REDUCED_COST)
+from fccqp.tuning cimport (EQUALITY_START_LIMIT, EQUALITY_START_RAY_STEP, EQUALITY_START_STEPS,
+                           REDUCED_COST)
 
 
 cdef long budget(const Engine* e, long iteration) noexcept nogil:
@@ -223,16 +222,19 @@ cdef int _table_start(Engine* e, Run* run) noexcept nogil:
     cdef double* u = e.work.rhs
     cdef double* sol = e.work.sol
     cdef double step_before = 0.0, step_last = 0.0
-    cdef int code
     if s == 0 or e.equalities_missed or not _schur_start(e):
         return UNAVAILABLE
-    code = _factor_table(e, run)
-    if code == FACTORED and _data_rho(e, run):   # the run starts at the data's rho
-        code = _factor_table(e, run)
-    if code != FACTORED:
-        return code
     for j in range(s):
+        it.rho_vec[j] = run.rho * e.fact.rho_scale[j]
         gap[j] = it.rho_vec[j] - sigma
+        if not gap[j] > 0.0:
+            return UNAVAILABLE
+    if kkt_factor(&e.fact.kkt, p, SCHUR_REDUCED, 0.0, it.rho_vec) != FACTORED:
+        return UNAVAILABLE
+    if not e.fact.certified and _certify(e, True) == NOT_CONVEX:
+        return NOT_CONVEX
+    if not reduced_table(&e.red, &e.fact.kkt, p, it.rho_vec):
+        return UNAVAILABLE
     for j in range(s):
         for i in range(s):
             M[i + j * s] = -e.red.W_S[j * s + i]
@@ -264,54 +266,6 @@ cdef int _table_start(Engine* e, Run* run) noexcept nogil:
     run.backend = SCHUR_REDUCED
     e.fact.factored_rho = run.rho
     return FACTORED
-
-
-cdef int _factor_table(Engine* e, Run* run) noexcept nogil:
-    """:func:`_table_start`'s factorization: Schur with ``run.rho`` on the constrained
-    entries (convexity certified on the way) and the reduced table. FACTORED,
-    NOT_CONVEX, or UNAVAILABLE (rho not above sigma, a factorization or table that
-    failed)."""
-    cdef Problem* p = &e.prob
-    cdef Py_ssize_t j
-    for j in range(p.s):
-        e.it.rho_vec[j] = run.rho * e.fact.rho_scale[j]
-        if not e.it.rho_vec[j] > e.opt.sigma:
-            return UNAVAILABLE
-    if kkt_factor(&e.fact.kkt, p, SCHUR_REDUCED, 0.0, e.it.rho_vec) != FACTORED:
-        return UNAVAILABLE
-    if not e.fact.certified and _certify(e, True) == NOT_CONVEX:
-        return NOT_CONVEX
-    if not reduced_table(&e.red, &e.fact.kkt, p, e.it.rho_vec):
-        return UNAVAILABLE
-    return FACTORED
-
-
-cdef bint _data_rho(Engine* e, Run* run) noexcept nogil:
-    """Under a time limit and an adaptive rho, the first table start of an equilibration
-    finds the data's cold rho (:func:`fccqp.rho_rule.curvature_rho`,
-    ``Scaling.cold_rho``) in the table just made; True when the run's cold start rho
-    (:func:`fccqp.engine.cold_start_rho`) changes with it, ``run.rho`` then set to it:
-    the caller factors again, once per equilibration.
-
-    The rule is a fit on the benchmark's whole-body-control QPs, whose curvatures on
-    the constrained entries are 1e4-1e8 (their rhos 4e-4 to 0.5); a QP of curvature
-    near 1 would get 1e-8. A data's rho more than ``COLD_RHO_RANGE`` times from
-    ``settings.rho`` is not taken: such QPs start as before."""
-    cdef Problem* p = &e.prob
-    cdef double rho
-    if e.scaling.cold_rho != 0.0 or not (isfinite(e.opt.time_limit) and e.opt.adaptive_rho):
-        return False
-    rho = curvature_rho(e.red.W_S, p.s, e.it.rho_vec, e.fact.rho_scale, p.c,
-                        e.work.mat_s, e.work.vec_s2)
-    if e.opt.rho / COLD_RHO_RANGE <= rho <= e.opt.rho * COLD_RHO_RANGE:
-        e.scaling.cold_rho = rho
-    else:
-        e.scaling.cold_rho = -1.0   # none, or outside the rule's fit
-    rho = cold_start_rho(e)
-    if rho == run.rho:
-        return False
-    run.rho = rho
-    return True
 
 
 cdef int equality_start(Engine* e, Run* run, bint* unbounded) noexcept nogil:

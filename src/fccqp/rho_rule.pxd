@@ -18,6 +18,3 @@ cdef double rho_trial(TrialState* trial, double rho, double new_rho, double wors
 cdef void trial_reset(TrialState* trial) noexcept nogil
 cdef double new_rho(const Residuals* r, double rho, TrialState* trial,
                     double tolerance) noexcept nogil
-cdef double curvature_rho(const double* W_S, Py_ssize_t s, const double* rho_vec,
-                          const double* rho_scale, double c, double* L,
-                          double* column) noexcept nogil

@@ -1,17 +1,13 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
 """Rho adaptation: OSQP's rule, the trial of the small moves it keeps asking for, and
 a guard against lowering rho under a runaway iterate (:mod:`fccqp.iteration` calls it,
-on either storage of the matrices); and the data's rho of a cold start
-(:func:`curvature_rho`, from :mod:`fccqp.factorization`).
+on either storage of the matrices).
 """
 
-from libc.math cimport INFINITY, exp, log, sqrt
+from libc.math cimport INFINITY, sqrt
 
-from fccqp._blas cimport cholesky, forward_substitution
-from fccqp._dense cimport copy, fill
 from fccqp.termination cimport Residuals
-from fccqp.tuning cimport (COLD_RHO_CURVATURE, CURVATURE_ROUNDING, RHO_MAX, RHO_MIN,
-                           RHO_PERSISTENCE, RHO_RUNAWAY)
+from fccqp.tuning cimport RHO_MAX, RHO_MIN, RHO_PERSISTENCE, RHO_RUNAWAY
 
 
 cdef double rho_trial(TrialState* trial, double rho, double new_rho, double worst,
@@ -85,42 +81,3 @@ cdef double new_rho(const Residuals* r, double rho, TrialState* trial,
     if taken < rho:
         trial.lowered_scale, trial.lowered_prim = r.prim_scale_s, prim
     return taken
-
-
-cdef double curvature_rho(const double* W_S, Py_ssize_t s, const double* rho_vec,
-                          const double* rho_scale, double c, double* L,
-                          double* column) noexcept nogil:
-    """The data's rho of a timed cold start: ``COLD_RHO_CURVATURE`` times the geometric
-    mean, over the constrained entries that are not fixed, of the cost's curvature on
-    each once the equalities and the free entries are eliminated, in the scaled units
-    before the cost's normalization ``c``; 0 when none has any.
-
-    That curvature is the diagonal of ``C``, the Schur complement of the KKT matrix on
-    the constrained entries, and the reduced table's block ``W_S = (C + R)^-1`` gives
-    it: ``C_jj = (W_S^-1)_jj - R_j`` (``R = rho_vec``), ``(W_S^-1)_jj`` the squared norm
-    of ``L^-1 e_j`` (``W_S = L L'``). Entries whose curvature is within rounding of
-    their penalty (``CURVATURE_ROUNDING``) do not count. The best fixed cold rho of the
-    benchmark's robots, 0.001 (talos_reduced) to 0.6 (solo12), follows this mean, which
-    is the same on every QP of a robot (``c`` follows ``q``) and spans the same 1000x
-    (notes/performance-history.md, "coldrho"). ``L`` (``s x s``) and ``column`` (``s``)
-    are scratch."""
-    cdef Py_ssize_t i, j, count = 0
-    cdef double total = 0.0, inverse
-    copy(W_S, L, s * s)   # symmetric: its rows are its columns
-    if not cholesky(L, <int>s, <int>s):
-        return 0.0
-    for j in range(s):
-        if rho_scale[j] != 1.0:   # a fixed entry: an equality
-            continue
-        fill(column, 0.0, s)
-        column[j] = 1.0
-        forward_substitution(L, <int>s, <int>s, column)
-        inverse = 0.0
-        for i in range(j, s):
-            inverse += column[i] * column[i]
-        if inverse - rho_vec[j] > CURVATURE_ROUNDING * inverse:
-            total += log(inverse - rho_vec[j])
-            count += 1
-    if count == 0:
-        return 0.0
-    return min(max(COLD_RHO_CURVATURE * exp(total / count) / c, RHO_MIN), RHO_MAX)

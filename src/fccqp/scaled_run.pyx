@@ -74,7 +74,6 @@ cdef void _scale(Engine* e, bint reuse, bint keep_scaling) noexcept nogil:
         _equilibrate(e)
         e.scaling.done = True
         e.scaling.kept = False
-        e.scaling.cold_rho = 0.0   # the data's cold rho follows the equilibration
     for j in range(p.s):
         i = p.constrained[j]
         p.lo[j] = e.user.lb[i] / p.D[i]

@@ -110,9 +110,8 @@ class Settings:
 
     rho: float = 0.1
     """Initial ADMM penalty on the box and cone constraints (scaled problem) of a cold
-    start; a warm start begins at the rho the last solve adapted, and under a time limit
-    with an adaptive rho a cold start at the data's rho (or the last solve's where
-    larger; docs/algorithm.md)."""
+    start; a warm start, and under a time limit a cold start after an earlier solve of
+    the workspace, begins at the rho the last solve adapted (docs/algorithm.md)."""
     sigma: float = 1e-6
     """Proximal regularization of the x-update's full form (unused by the reduced form)."""
     alpha: float = 1.6

@@ -76,13 +76,6 @@ cdef extern from *:
     /* rho is not lowered while, since its last lowering, the primal residual's scale
        grew more than this x and the relative primal residual did not fall */
     #define FCCQP_RHO_RUNAWAY 4.0
-    /* a timed cold start's rho: this x the geometric mean of the cost's curvature on the
-       constrained entries (fccqp.rho_rule.curvature_rho; fit on the four robots) */
-    #define FCCQP_COLD_RHO_CURVATURE 1e-8
-    /* curvatures within this fraction of their penalty's inverse are rounding */
-    #define FCCQP_CURVATURE_ROUNDING 1e-12
-    /* a data's rho more than this x from settings.rho is not taken (outside the fit) */
-    #define FCCQP_COLD_RHO_RANGE 1e2
 
     /* ---- Anderson acceleration (fccqp.anderson, fccqp.iteration) ---- */
     /* steps rejected by the safeguard before a run gives up accelerating */
@@ -267,9 +260,6 @@ cdef extern from *:
     const double FIXED_RHO_SCALE "FCCQP_FIXED_RHO_SCALE"
     const int RHO_PERSISTENCE "FCCQP_RHO_PERSISTENCE"
     const double RHO_RUNAWAY "FCCQP_RHO_RUNAWAY"
-    const double COLD_RHO_CURVATURE "FCCQP_COLD_RHO_CURVATURE"
-    const double CURVATURE_ROUNDING "FCCQP_CURVATURE_ROUNDING"
-    const double COLD_RHO_RANGE "FCCQP_COLD_RHO_RANGE"
     # Anderson acceleration
     const long MAX_REJECTIONS "FCCQP_MAX_REJECTIONS"
     const double REGULARIZATION "FCCQP_REGULARIZATION"
