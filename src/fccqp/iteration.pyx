@@ -515,11 +515,15 @@ cdef bint _solved_polish(Engine* e, Loop* L) noexcept nogil:
     the polish failed, and the run iterated, failed its retries and ended at ADMM's
     tolerance unpolished, torques 10-30 % of a joint's limit off, or reached the
     deadline (notes/performance-history.md, "talosexact: a SOLVED iterate's polish")."""
+    return _polish_within(e, L, SOLVED_GUESS_PASSES if L.timed else e.pol.guess_passes)
+
+
+cdef bint _polish_within(Engine* e, Loop* L, long guesses) noexcept nogil:
+    """:func:`fccqp.acceptance.keep_polished` of the iterate with at most ``guesses``
+    guesses; the workspace's own cap is put back after it."""
     cdef long passes = e.pol.guess_passes
     cdef bint kept
-    if not L.timed:
-        return keep_polished(e, &L.status, L.iteration, L.start_time, False)
-    e.pol.guess_passes = SOLVED_GUESS_PASSES
+    e.pol.guess_passes = guesses
     kept = keep_polished(e, &L.status, L.iteration, L.start_time, False)
     e.pol.guess_passes = passes
     return kept
@@ -688,14 +692,9 @@ cdef bint _final_polish(Engine* e, Loop* L) noexcept nogil:
     ``GUESS_PASSES``, and so do runs capped below ``RESTART_MIN_ITER`` iterations: a cap
     that small is a budget (2 iterations from a random start, the polish of 32 guesses
     reached the optimum), not room for a walk."""
-    cdef long passes = e.pol.guess_passes
-    cdef bint kept
     if L.status != MAX_ITER or L.iteration < RESTART_MIN_ITER:
-        return keep_polished(e, &L.status, L.iteration, L.start_time, False)
-    e.pol.guess_passes = STALLED_GUESS_PASSES
-    kept = keep_polished(e, &L.status, L.iteration, L.start_time, False)
-    e.pol.guess_passes = passes
-    return kept
+        return _polish_within(e, L, e.pol.guess_passes)
+    return _polish_within(e, L, STALLED_GUESS_PASSES)
 
 
 cdef void _full_step(Engine* e, bint relax_x) noexcept nogil:
