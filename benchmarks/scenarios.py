@@ -35,7 +35,13 @@ import numpy as np
 import pinocchio as pin
 
 from benchmarks.robots import LoadedRobot
-from benchmarks.wbc_qp import TaskCommands, WbcQP, build_wbc_qp, solve_reference
+from benchmarks.wbc_qp import (
+    TaskCommands,
+    WbcQP,
+    build_wbc_qp,
+    solve_reference,
+    solve_tight_reference,
+)
 
 __all__ = ["SCENARIOS", "Gains", "Phase", "SequenceSpec", "make_sequence", "rollout"]
 
@@ -324,8 +330,9 @@ def rollout(
     tol: float = 1e-9,
     progress: Callable[[], None] | None = None,
 ) -> tuple[list[WbcQP], list[np.ndarray], list[tuple[str, ...]]]:
-    """Run the controller loop of ``spec``; return the recorded QPs, their solutions and
-    the feet in contact at each (the phase's ``stance``, sorted).
+    """Run the controller loop of ``spec``; return the recorded QPs, their reference
+    solutions (:func:`~benchmarks.wbc_qp.solve_tight_reference`) and the feet in contact
+    at each (the phase's ``stance``, sorted).
 
     Parameters
     ----------
@@ -338,7 +345,8 @@ def rollout(
     gains
         Task and contact PD gains; :class:`Gains` defaults if ``None``.
     tol
-        Clarabel tolerance of the reference solutions.
+        Clarabel tolerance of the controller's own solve, whose accelerations drive the
+        robot (the recorded references are solved tighter).
     progress
         Called once per recorded QP (e.g. a progress bar's update).
 
@@ -446,7 +454,7 @@ def rollout(
         x = solve_reference(qp, tol)
         if phase.record:
             qs.append(qp)
-            xs.append(x)
+            xs.append(solve_tight_reference(qp))
             stances.append(tuple(sorted(phase.stance)))
             if progress is not None:
                 progress()

@@ -30,12 +30,14 @@ __all__ = [
     "save",
 ]
 
-GENERATOR_VERSION = 2
+GENERATOR_VERSION = 3
 """Version of the generator's output: bump it with any change to ``robots``, ``wbc_qp``,
 ``scenarios``, this module or, for the ``closedloop`` set, ``benchmarks/closedloop``
 that changes the generated QPs, references or records, so
 that cached test sets (:mod:`benchmarks.cache`) are generated anew. Version 2 records
-each QP's stance (the QPs and references are those of version 1)."""
+each QP's stance (the QPs and references are those of version 1); version 3 keeps
+version 2's QPs and solves their references tighter (1e-12 to 1e-11 where version 2
+stopped at 1e-9)."""
 
 MIX = "mix"
 """Scenario name of the default mix: sequence ``j`` runs ``SCENARIOS[j % 4]``."""
@@ -61,7 +63,8 @@ class TestSet:
     qps
         The QPs.
     x_ref
-        Clarabel reference solution of each QP (tolerance 1e-9).
+        Clarabel reference solution of each QP, at the tightest tolerance it reaches
+        (:func:`benchmarks.wbc_qp.solve_tight_reference`).
     sequence
         Index of the sequence each QP belongs to: a new index is where a controller
         (and a warm start) would restart from rest.

@@ -44,6 +44,7 @@ __all__ = [
     "build_wbc_qp",
     "clarabel_problem",
     "solve_reference",
+    "solve_tight_reference",
     "tangent_basis",
 ]
 
@@ -388,6 +389,10 @@ _RETRIES: tuple[dict[str, object], ...] = (
 )
 
 
+# Tolerances a test set's reference is solved to, tightest first (solve_tight_reference).
+REFERENCE_TOLERANCES = (1e-12, 1e-11, 1e-10, 1e-9)
+
+
 class ReferenceSolveError(RuntimeError):
     """Clarabel did not solve a QP to the requested tolerance."""
 
@@ -446,3 +451,27 @@ def solve_reference(qp: WbcQP, tol: float = 1e-9) -> np.ndarray:
             return np.array(sol.x)
         statuses.append(str(sol.status))
     raise ReferenceSolveError(f"Clarabel statuses {statuses} at tol {tol}")
+
+
+def solve_tight_reference(qp: WbcQP) -> np.ndarray:
+    """``qp`` solved by :func:`solve_reference` at the tightest of
+    :data:`REFERENCE_TOLERANCES` that Clarabel reaches: the reference a test set's answers
+    are judged against.
+
+    The WBC cost regularizes contact forces and torques lightly, so an objective within
+    1e-6 of the optimum can hold torques several percent of a joint's limit away from the
+    optimum's. Clarabel stopped at 1e-9 is that far on some solo12 QPs, farther than the
+    solvers it judges; at 1e-10 to 1e-12, which it reaches on every QP of the benchmark's
+    sets, it agrees with an exact active-set solution to 0.15 % of the limits.
+
+    Raises
+    ------
+    ReferenceSolveError
+        If not even the loosest tolerance is reached.
+    """
+    for tol in REFERENCE_TOLERANCES[:-1]:
+        try:
+            return solve_reference(qp, tol)
+        except ReferenceSolveError:
+            continue
+    return solve_reference(qp, REFERENCE_TOLERANCES[-1])

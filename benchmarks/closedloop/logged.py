@@ -11,7 +11,7 @@ Sequence ``j`` draws from ``numpy.random.default_rng([seed, j])``: a floor frict
 event of the scenario (a push, a lift-off, a touch-down, a CoM shift); scenarios cycle
 through :data:`CYCLE`. The loop is driven by Clarabel (exact cones, its default
 tolerance) from the robot's rest state; each recorded QP gets the reference solution
-of the open-loop sets (:func:`benchmarks.wbc_qp.solve_reference`, Clarabel at 1e-9).
+of the open-loop sets (:func:`benchmarks.wbc_qp.solve_tight_reference`).
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from benchmarks.closedloop.model import build_sim_model
 from benchmarks.closedloop.scenarios import Scenario, make_scenario
 from benchmarks.closedloop.simulate import run
 from benchmarks.robots import load_robot
-from benchmarks.wbc_qp import WbcQP, solve_reference
+from benchmarks.wbc_qp import WbcQP, solve_tight_reference
 
 __all__ = ["CYCLE", "DRIVER", "logged_sequences"]
 
@@ -74,7 +74,7 @@ def logged_sequences(
                     ticks=first + length)
         for qp, stance in zip(trace.qps[first:], trace.stances[first:], strict=True):
             qps.append(qp)
-            xs.append(solve_reference(qp))
+            xs.append(solve_tight_reference(qp))
             stances.append(stance)
             seq.append(j)
             if progress is not None:
