@@ -26,6 +26,33 @@ def test_ordering_puts_constrained_entries_last():
     np.testing.assert_array_equal(order, [1, 2, 3, 5, 4, 0])
 
 
+@pytest.mark.kkt_backends("schur_reduced", "ldl_reduced", "ldl_full",
+                            reason="the dense workspaces' Schur order")
+def test_a_workspace_without_an_order_orders_the_schur_entries_as_ordering_does(kkt_backend):
+    """A dense workspace given no Schur order (``order=None``, as ``fccqp.Solver``
+    builds them) takes the free entries ascending, then the constrained ones, the
+    order of :func:`fccqp.schur.ordering`: its answers are those of a workspace given
+    that order, bit for bit, on a problem with free, boxed and cone entries."""
+    from fccqp import admm
+
+    P, q, A, b, lb, ub, cones = random_problem(7, n=20, m=4, n_cones=2, n_box=5)
+    settings = fccqp.Settings(kkt_backend=kkt_backend)
+    solver = fccqp.Solver(settings)
+    solver.solve(P, q, A, b, lb, ub, cones)
+    structure = solver._structure
+    constrained = structure.constrained[: structure.count].copy()
+    flat = structure.cones
+    arrays = (flat.kind, structure.relocated.copy(), flat.dim, flat.mu, flat.normal)
+    fixed = structure.fixed[: structure.count].astype(bool)
+    answers = []
+    for order in (None, schur.ordering(20, constrained)):
+        w = admm.Workspace(20, 4, constrained, arrays, fixed, order, settings, 0)
+        out = w.solve(P, q, A, b, lb, ub, None, False, 0.0, np.empty(24), True)
+        assert out.status is Status.SOLVED
+        answers.append(out.x.tobytes())
+    assert answers[0] == answers[1]
+
+
 @pytest.mark.parametrize("seed", range(3))
 def test_backend_matches_clarabel(kkt_backend, seed):
     problem = random_problem(seed, n_box=6, soc_dim=4 if seed == 2 else 0)

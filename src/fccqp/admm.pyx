@@ -19,6 +19,7 @@ cimport numpy as cnp
 from cpython.buffer cimport PyBuffer_Release
 from cpython.object cimport PyObject_GenericSetAttr
 from libc.math cimport isfinite
+from libc.string cimport memcpy
 
 from fccqp cimport engine
 from fccqp._dense cimport copy, fill
@@ -90,6 +91,54 @@ cdef inline cnp.ndarray _empty(Py_ssize_t size):
     return cnp.PyArray_EMPTY(1, dims, cnp.NPY_DOUBLE, 0)
 
 
+cdef cnp.ndarray _contiguous(object values, int typenum):
+    """``values`` as a C-contiguous numpy array of ``typenum``: itself when it is one (a
+    uint8 array stands for a bool one), else a converted copy. A new workspace reads
+    seven such arrays; ``np.array`` and a typed memoryview each took about 5k
+    instructions of a go2 workspace's 123k (callgrind)."""
+    cdef int kind
+    if cnp.PyArray_Check(values) and cnp.PyArray_IS_C_CONTIGUOUS(values):
+        kind = cnp.PyArray_TYPE(values)
+        if kind == typenum or (typenum == cnp.NPY_BOOL and kind == cnp.NPY_UINT8):
+            return values
+    return np.ascontiguousarray(values, dtype=cnp.PyArray_DescrFromType(typenum))
+
+
+cdef double* _copy(Arrays a, cnp.ndarray values, Py_ssize_t size) except NULL:
+    """A copy, carved from ``a``, of the first ``size`` entries of ``values`` (8-byte
+    entries: doubles or intp; at least one entry carved)."""
+    cdef double* out = a.new(size)
+    if cnp.PyArray_SIZE(values) < size:
+        raise ValueError("cone arrays of different lengths")
+    if size:
+        memcpy(out, cnp.PyArray_DATA(values), size * sizeof(double))
+    return out
+
+
+cdef Py_ssize_t* _base_order(Arrays a, Py_ssize_t n, const Py_ssize_t* constrained,
+                             Py_ssize_t s, object order) except NULL:
+    """The Schur backend's base order of the ``n`` entries, carved from ``a``: ``order``
+    copied, or where it is None the free entries ascending, then the ``s`` entries of
+    ``constrained`` (:func:`fccqp.schur.ordering`, whose numpy calls took 35k
+    instructions of a go2 workspace's 123k)."""
+    cdef Py_ssize_t* out = <Py_ssize_t*>a.new_int(n)
+    cdef char* taken
+    cdef Py_ssize_t k, lead = 0
+    if order is not None:
+        held = _contiguous(order, cnp.NPY_INTP)
+        return <Py_ssize_t*>_copy(a, held, n)
+    taken = <char*>a.new(n)
+    for k in range(s):
+        taken[constrained[k]] = 1
+    for k in range(n):
+        if not taken[k]:
+            out[lead] = k
+            lead += 1
+    for k in range(s):
+        out[lead + k] = constrained[k]
+    return out
+
+
 cdef object _new_result(dict fields):
     """A :class:`fccqp.Result` whose attributes are ``fields`` (all of them), as
     ``Result._of`` makes one but without an interpreted frame: the dict becomes the
@@ -111,7 +160,6 @@ cdef class Workspace:
     cdef Arrays _arrays
     cdef Engine e
     cdef Finding found
-    cdef object _keep
     cdef object _sparse_kkt   # SPARSE_LDL's SparseKKT, which e.fact.kkt.sparse points to
     cdef readonly bint compressed
     """``P`` and ``A`` are held in compressed columns (the sparse backend)."""
@@ -134,56 +182,58 @@ cdef class Workspace:
     def __init__(self, Py_ssize_t n, Py_ssize_t m, constrained, cones, fixed, order,
                  settings, Py_ssize_t log_rows, patterns=None):
         """Allocate for ``n`` variables, ``m`` rows, the ``constrained`` entries (intp,
-        ascending), ``cones`` (the tuple of :class:`fccqp.cones.ConeArrays` with offsets
-        into ``constrained``), the boolean mask ``fixed`` of constrained entries with
-        ``lb == ub``, the Schur ``order`` and a :class:`fccqp.Settings`. With
+        ascending), ``cones`` (the tuple of :class:`fccqp.cones.ConeArrays`' arrays with
+        offsets into ``constrained``), the boolean mask ``fixed`` of constrained entries
+        with ``lb == ub`` (or its uint8 form), the Schur ``order`` (None: the free entries
+        ascending, then ``constrained``, as :func:`fccqp.schur.ordering` gives it) and a
+        :class:`fccqp.Settings`; copied into the workspace's own arrays. With
         ``patterns``, ``(P colptr, P rowind, A colptr, A rowind)``, ``P`` (its full
         symmetric pattern) and ``A`` are held in compressed columns and factored by
         ``SPARSE_LDL`` (``order`` is then unused); :meth:`solve` takes their values."""
-        cdef Py_ssize_t s = len(constrained)
-        cdef Py_ssize_t k, j
         cdef Engine* e = &self.e
-        self._arrays = Arrays()
+        cdef Arrays a = Arrays()
+        self._arrays = a
         self.compressed = patterns is not None
         kind, offset, dim, mu, normal = cones
-        # private copies: update_cones writes into them, and the caller's arrays may be
-        # shared (fccqp.cones memoizes one ConeArrays per distinct set of cones)
-        self._keep = (np.array(constrained, dtype=np.intp),
-                      np.array(kind, dtype=np.intp),
-                      np.array(offset, dtype=np.intp),
-                      np.array(dim, dtype=np.intp),
-                      np.array(mu, dtype=np.float64),
-                      np.array(normal, dtype=np.float64).reshape(-1),
-                      np.array(order if order is not None else (0,), dtype=np.intp),
-                      np.zeros(max(len(kind), 1), dtype=np.intp))
-        cdef Py_ssize_t[::1] c_view = self._keep[0], kind_v = self._keep[1]
-        cdef Py_ssize_t[::1] offset_v = self._keep[2], dim_v = self._keep[3]
-        cdef Py_ssize_t[::1] order_v = self._keep[6], start_v = self._keep[7]
-        cdef double[::1] mu_v = self._keep[4], normal_v = self._keep[5]
+        held = [_contiguous(v, t) for v, t in zip(
+            (constrained, kind, offset, dim, mu, normal, fixed),
+            (cnp.NPY_INTP, cnp.NPY_INTP, cnp.NPY_INTP, cnp.NPY_INTP, cnp.NPY_DOUBLE,
+             cnp.NPY_DOUBLE, cnp.NPY_BOOL))]
+        cdef Py_ssize_t s = cnp.PyArray_SIZE(held[0]), count = cnp.PyArray_SIZE(held[1])
+        cdef Py_ssize_t k, j
+        cdef const char* fixed_v = <const char*>cnp.PyArray_DATA(held[6])
+        if cnp.PyArray_SIZE(held[6]) != s:
+            raise ValueError("a fixed mask of another size than the constrained entries")
         p = &e.prob
         p.n, p.m, p.s = n, m, s
-        p.constrained = &c_view[0] if s else NULL
-        p.cones.count = len(kind)
-        if p.cones.count:
-            p.cones.kind, p.cones.offset, p.cones.dim = &kind_v[0], &offset_v[0], &dim_v[0]
-            p.cones.mu, p.cones.normal = &mu_v[0], &normal_v[0]
-            for k in range(p.cones.count):
-                start_v[k] = c_view[offset_v[k]]
-        e.user.block_start = &start_v[0]
-        cdef char* in_cone = <char*>self._arrays.new(s)
-        for k in range(p.cones.count):
-            for j in range(offset_v[k], offset_v[k] + dim_v[k]):
+        # private copies: update_cones writes into them, and the caller's arrays may be
+        # shared (fccqp.cones memoizes one ConeArrays per distinct set of cones)
+        cdef Py_ssize_t* c_view = <Py_ssize_t*>_copy(a, held[0], s)
+        p.constrained = c_view if s else NULL
+        p.cones.count = count
+        p.cones.kind = <Py_ssize_t*>_copy(a, held[1], count)
+        p.cones.offset = <Py_ssize_t*>_copy(a, held[2], count)
+        p.cones.dim = <Py_ssize_t*>_copy(a, held[3], count)
+        p.cones.mu, p.cones.normal = _copy(a, held[4], count), _copy(a, held[5], 3 * count)
+        cdef Py_ssize_t* start_v = <Py_ssize_t*>a.new_int(count)
+        for k in range(count):
+            start_v[k] = c_view[p.cones.offset[k]]
+        e.user.block_start = start_v
+        cdef char* in_cone = <char*>a.new(s)
+        for k in range(count):
+            for j in range(p.cones.offset[k], p.cones.offset[k] + p.cones.dim[k]):
                 in_cone[j] = 1
         p.in_cone = in_cone
         common_arrays(self._arrays, e, settings.anderson_memory, log_rows)
         if self.compressed:
-            self._sparse_kkt = csc_arrays(self._arrays, e, patterns, self._keep[0])
+            self._sparse_kkt = csc_arrays(self._arrays, e, patterns,
+                                          np.array(held[0], dtype=np.intp))
         else:
-            dense_arrays(self._arrays, e, &order_v[0])
+            dense_arrays(self._arrays, e, _base_order(a, n, c_view, s, order))
         for k in range(s):
-            e.fact.rho_scale[k] = FIXED_RHO_SCALE if fixed[k] else 1.0
+            e.fact.rho_scale[k] = FIXED_RHO_SCALE if fixed_v[k] else 1.0
             e.user.entry_kind[c_view[k]] = (CONE_ENTRY if in_cone[k] else
-                                            FIXED_BOUND if fixed[k] else BOUNDED)
+                                            FIXED_BOUND if fixed_v[k] else BOUNDED)
         anderson_reset(&e.aa, False)
         o = &e.opt
         o.rho, o.sigma, o.alpha = settings.rho, settings.sigma, settings.alpha
@@ -214,7 +264,7 @@ cdef class Workspace:
         numpy's code cold, where numpy's slice assignments took 8-9 us of a solo12 or go2
         tick (notes/performance-history.md, "contactwall")."""
         cdef Cones* cones = &self.e.prob.cones
-        cdef double* mu_out = <double*>cones.mu   # the writable arrays of self._keep
+        cdef double* mu_out = <double*>cones.mu   # the workspace's own copies
         cdef double* normal_out = <double*>cones.normal
         cdef Py_ssize_t k, j
         if mu.shape[0] != cones.count or normal.shape[0] != cones.count or normal.shape[1] != 3:

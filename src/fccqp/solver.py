@@ -18,7 +18,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from fccqp import admm, auxiliary, schur
+from fccqp import admm, auxiliary
 from fccqp.cones import Cone, ConeArrays, flatten_cones
 from fccqp.fast_checks import dense_arguments, dense_vector_within, same_cones
 from fccqp.problem import check_cone_bounds, convert, raise_finding
@@ -107,14 +107,13 @@ class _Structure:
         return changed
 
     def workspace(self, settings: Settings) -> admm.Workspace:
-        """A workspace for this structure."""
-        constrained = self.constrained[: self.count].copy()
+        """A workspace for this structure: it copies the arrays it is given, and orders
+        the Schur backend's entries itself."""
         cones = self.cones
-        cone_arrays = (cones.kind, self.relocated.copy(), cones.dim, cones.mu, cones.normal)
+        cone_arrays = (cones.kind, self.relocated, cones.dim, cones.mu, cones.normal)
         log_rows = LOG_ROWS if settings.verbose else 0
-        return admm.Workspace(self.n, self.m, constrained, cone_arrays,
-                              self.fixed[: self.count].astype(bool),
-                              schur.ordering(self.n, constrained), settings, log_rows)
+        return admm.Workspace(self.n, self.m, self.constrained[: self.count], cone_arrays,
+                              self.fixed[: self.count], None, settings, log_rows)
 
 
 class Solver:
