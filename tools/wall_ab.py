@@ -1,7 +1,9 @@
 """Wall time of two fccqp builds on the benchmark's ticks, measured in lockstep.
 
 What: per tick of a robot's cached test set (the ``--full`` preset's: scenario ``mix``,
-seed 0, 400 QPs in 4 sequences of 100 ticks), the wall time of ``fccqp-realtime`` (or
+seed 0, 400 QPs in 4 sequences of 100 ticks; with ``--scenario contact_switch`` the set of
+800 QPs in 4 sequences of 200 ticks whose every sequence makes and breaks contacts, seven
+contact-change ticks a quadruped), the wall time of ``fccqp-realtime`` (or
 ``--variant``) and of ``daqp-pyr4`` through the benchmark's own adapters
 (:mod:`benchmarks.solvers`), each timed as the harness times it, for two builds ``A``
 and ``B`` of fccqp; the median and p95 over the ticks of each, the fccqp/DAQP ratios,
@@ -50,9 +52,11 @@ from benchmarks.cache import DEFAULT_CACHE, cached_test_set
 from benchmarks.solvers import make_adapter
 from benchmarks.views import coarse_path, cold_path, contact_changes, warm_path
 
-mode, robot, stride, names = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4:]
-test_set, _ = cached_test_set(DEFAULT_CACHE, robot, "mix", 400, 0, seq_len=100, dt=0.002,
-                              report=lambda line: print(line, file=sys.stderr))
+mode, robot, stride, scenario = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4]
+names = sys.argv[5:]
+n_qps, seq_len = (800, 200) if scenario == "contact_switch" else (400, 100)
+test_set, _ = cached_test_set(DEFAULT_CACHE, robot, scenario, n_qps, 0, seq_len=seq_len,
+                              dt=0.002, report=lambda line: print(line, file=sys.stderr))
 path = (cold_path(test_set) if mode == "cold" else
         coarse_path(test_set, stride) if mode == "coarse" else warm_path(test_set))
 shown = [True] * len(path) if mode != "contact" else list(contact_changes(path))
@@ -89,12 +93,13 @@ REFERENCE = "daqp-pyr4"
 THREAD_ENV = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 
 
-def start_worker(root: Path, mode: str, robot: str, stride: int,
+def start_worker(root: Path, mode: str, robot: str, stride: int, scenario: str,
                  names: list[str]) -> subprocess.Popen:
     """A worker on the build at ``root``, warmed up and waiting for passes."""
     env = dict(os.environ, PYTHONPATH=f"{root / 'src'}{os.pathsep}{root}",
                **dict.fromkeys(THREAD_ENV, "1"))
-    worker = subprocess.Popen([sys.executable, "-c", WORKER, mode, robot, str(stride), *names],
+    worker = subprocess.Popen([sys.executable, "-c", WORKER, mode, robot, str(stride), scenario,
+                               *names],
                               cwd=root, env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                               text=True)
     if worker.stdout.readline().strip() != "ready":
@@ -143,13 +148,16 @@ def main() -> None:
     parser.add_argument("--mode", choices=("cold", "warm", "contact", "coarse"), default="cold",
                         help="contact: the warm walk, timed at its contact-change ticks only; "
                              "coarse: every --stride-th QP, warm from the previous kept one")
+    parser.add_argument("--scenario", choices=("mix", "contact_switch"), default="mix",
+                        help="the test set: the --full preset's, or the contact_switch set")
     parser.add_argument("--stride", type=int, default=10, help="the coarse mode's step")
     parser.add_argument("--rounds", type=int, default=30)
     parser.add_argument("--variant", default="fccqp-realtime", help="the fccqp variant")
     args = parser.parse_args()
     roots = {"A": args.a.resolve(), "B": args.b.resolve()}
     names = [args.variant, REFERENCE]
-    workers = {build: start_worker(root, args.mode, args.robot, args.stride, names)
+    workers = {build: start_worker(root, args.mode, args.robot, args.stride,
+                                         args.scenario, names)
                for build, root in roots.items()}
     try:
         times = lockstep(workers, names, args.rounds)
@@ -158,7 +166,7 @@ def main() -> None:
             worker.stdin.close()
             worker.wait()
     mode = f"every {args.stride}th" if args.mode == "coarse" else args.mode
-    print(f"{args.robot}, {mode}, {args.rounds} rounds, per-tick medians")
+    print(f"{args.robot}, {args.scenario}, {mode}, {args.rounds} rounds, per-tick medians")
     report({key: np.median(value, axis=0) for key, value in times.items()}, roots,
            args.variant)
 
