@@ -276,7 +276,7 @@ def test_a_guessed_switch_onto_other_friction_takes_the_kept_workspace_without_a
                 (P, q, A, b, lb_fixed, ub_fixed, cones))
     general = fccqp.Solver()
     monkeypatch.setattr(general, "_switch", lambda *arguments: None)
-    monkeypatch.setattr(fccqp.admm, "kept_switch", lambda *arguments: None)
+    monkeypatch.setattr(fccqp.admm, "switch_solve", lambda *arguments: None)
     expected = [carried(general, second, general.solve(*first))]
     for problem in switches:
         expected.append(carried(general, problem, expected[-1]))
@@ -319,7 +319,7 @@ def test_a_guessed_switch_onto_upright_friction_builds_no_flat_cones(monkeypatch
     first, second = (upright(problem) for problem in two_structures())
     switches = (other_friction(first, 0.8), other_friction(second, 1.2))
     general = fccqp.Solver()
-    monkeypatch.setattr(fccqp.admm, "kept_switch", lambda *arguments: None)
+    monkeypatch.setattr(fccqp.admm, "switch_solve", lambda *arguments: None)
     expected = [carried(general, second, general.solve(*first))]
     for problem in (*switches, second):
         expected.append(carried(general, problem, expected[-1]))

@@ -27,8 +27,8 @@ from fccqp.anderson cimport anderson_reset
 from fccqp.blas_threads cimport enter, leave
 from fccqp.certificates cimport CERTIFIED, primal_candidate
 from fccqp.engine cimport CONE_ENTRY, Clock, Engine, Run, fccqp_now
-from fccqp.fast_checks cimport (dense_shapes, hold_dense, hold_float64, upright_friction_on,
-                                vector_within)
+from fccqp.fast_checks cimport (dense_shapes, hold_dense, hold_float64, hold_within,
+                                upright_friction_on)
 from fccqp.kkt cimport AUTO, LDL_FULL, LDL_REDUCED, SCHUR_REDUCED, SPARSE_LDL
 from fccqp.matrices cimport Matrix, csc, mark_diagonal_tail
 from fccqp.scaled_run cimport scaled_run, unscaled_answer
@@ -345,11 +345,7 @@ cdef class Workspace:
         cdef Run run
         x_out, y_out, z_out = _empty(n), _empty(m), _empty(n)
         cdef tuple arrays = (P, q, A, b, lb, ub, x_out, y_out, z_out, cert_out, x0, y0, z0)
-        rows[:] = [n, n, m, m, n, n, n, m, n, n + m, n, m, n]
-        columns[:] = [n, -1, n, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1]   # -1: a vector
-        if self.compressed:   # P and A: the values of the patterns
-            rows[0], rows[2] = self.e.user.P.colptr[n], self.e.user.A.colptr[n]
-            columns[0] = columns[2] = -1
+        self._shapes(rows, columns)
         try:
             for i in range(count):   # the outputs, 6 to 9, are written
                 if i < 6 and not checked:
@@ -358,20 +354,44 @@ cdef class Workspace:
                 elif not hold_float64(arrays[i], &views[i], rows[i], columns[i], 6 <= i <= 9):
                     raise ValueError(f"expected a C-contiguous float64 array of {rows[i]} rows")
                 held += 1
-            code = self._run(<const double*>views[0].buf, <const double*>views[1].buf,
-                             <const double*>views[2].buf, <const double*>views[3].buf,
-                             <const double*>views[4].buf, <const double*>views[5].buf,
-                             <const double*>views[10].buf if x0 is not None else NULL,
-                             <const double*>views[11].buf if count == 13 else NULL,
-                             <const double*>views[12].buf if count == 13 else NULL, warm,
-                             start_time, <double*>views[6].buf, <double*>views[7].buf,
-                             <double*>views[8].buf, <double*>views[9].buf, &run)
+            code = self._run_held(views, count, warm, start_time, &run)
         finally:
             for i in range(held):
                 PyBuffer_Release(&views[i])
+        return self._answer(code, &run, x_out, y_out, z_out, cert_out, start_time)
+
+    cdef void _shapes(self, Py_ssize_t* rows, Py_ssize_t* columns) noexcept:
+        """The rows and columns (-1: a vector) of :meth:`solve`'s thirteen arrays, in the
+        order ``P, q, A, b, lb, ub``, the outputs ``x, y, z, certificate``, the guess
+        ``x0, y0, z0``."""
+        cdef Py_ssize_t n = self.e.prob.n, m = self.e.prob.m
+        rows[:13] = [n, n, m, m, n, n, n, m, n, n + m, n, m, n]
+        columns[:13] = [n, -1, n, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1]
+        if self.compressed:   # P and A: the values of the patterns
+            rows[0], rows[2] = self.e.user.P.colptr[n], self.e.user.A.colptr[n]
+            columns[0] = columns[2] = -1
+
+    cdef int _run_held(self, Py_buffer* views, int count, bint warm, double start_time,
+                       Run* run) except -9:
+        """:meth:`_run` on the buffers of :meth:`solve`'s arrays held in ``views`` (in
+        :meth:`_shapes`' order; ``count``: 10 without a guess, 11 with ``x0`` alone, 13
+        with all three)."""
+        return self._run(<const double*>views[0].buf, <const double*>views[1].buf,
+                         <const double*>views[2].buf, <const double*>views[3].buf,
+                         <const double*>views[4].buf, <const double*>views[5].buf,
+                         <const double*>views[10].buf if count > 10 else NULL,
+                         <const double*>views[11].buf if count == 13 else NULL,
+                         <const double*>views[12].buf if count == 13 else NULL, warm,
+                         start_time, <double*>views[6].buf, <double*>views[7].buf,
+                         <double*>views[8].buf, <double*>views[9].buf, run)
+
+    cdef object _answer(self, int code, const Run* run, x_out, y_out, z_out, cert_out,
+                        double start_time):
+        """What :meth:`solve` returns for a run that ended with ``code``: the code below
+        ``SOLVED``, else the result of the run (its buffers released)."""
         if code < engine.SOLVED:
             return code
-        result = self._result(&run, x_out, y_out, z_out, cert_out, start_time)
+        result = self._result(run, x_out, y_out, z_out, cert_out, start_time)
         self._learn_final_step(run.polished)
         return result
 
@@ -531,51 +551,106 @@ cdef class Workspace:
         return True
 
 
-def kept_switch(kept, P, q, A, b, lb, ub, cones, x0, y0, z0):
-    """The entry ``(structure, workspace)`` of ``kept`` (a solver's kept dense workspaces
-    with their structures, oldest first) that a switch onto the arguments takes without
-    the general path, its workspace given the friction of ``cones``; None when the
-    general path decides (:meth:`fccqp.Solver.solve`).
+FITS_CURRENT = True
+""":func:`switch_solve`'s answer when the arguments fit the current workspace's shapes."""
 
-    A switch (arrays that do not fit the current workspace's shapes) takes the first
-    kept workspace whose shapes the arrays fit as they came
+
+def switch_solve(Workspace current, dict kept, P, q, A, b, lb, ub, cones, x0, y0, z0,
+                 bint warm, double start_time):
+    """The solve of a structure switch onto a kept workspace, in one compiled call:
+    ``(entry, out)``, ``entry`` the ``(structure, workspace)`` of ``kept`` (a solver's
+    kept dense workspaces by key, oldest first) that took it, ``out`` what
+    :meth:`Workspace.solve` returns; ``FITS_CURRENT`` when the arrays fit the shapes of
+    ``current`` (no switch); None when the general path decides
+    (:meth:`fccqp.Solver.solve`), nothing solved or written.
+
+    A switch takes the first kept workspace whose shapes the arrays fit as they came
     (:func:`fccqp.fast_checks.dense_arguments`) when ``cones`` are upright friction
-    cones on its blocks (:func:`fccqp.fast_checks.upright_friction_on`) and when the guess is none, ``x0``
-    alone or all of ``x0, y0, z0``, each within ``MAX_ENTRY`` (as
-    :func:`fccqp.solver._guess` returns it unconverted). Anything else, a kept
-    workspace of other blocks first among those the shapes fit included, is the general
-    path's, which flattens the cones and raises the errors. One compiled call instead of
-    the interpreter's checks, flattening, comparisons and friction writes, which a
-    contact change runs once after a stretch of ticks of another structure: there they
-    took 23 us of solo12's 100 us tick, this call 7 us (notes/performance-history.md,
-    "switchentry")."""
+    cones on its blocks (:func:`fccqp.fast_checks.upright_friction_on`, which writes
+    their friction into it) and when the guess is none, ``x0`` alone or all of ``x0,
+    y0, z0``, each within ``MAX_ENTRY`` (as :func:`fccqp.solver._guess` returns it
+    unconverted); the workspace is marked ``arrived`` and solves from the buffers held
+    for those checks, its structure's ``certificate`` the certificate's output. Anything
+    else, a kept workspace of other blocks first among those the shapes fit included, is
+    the general path's, which flattens the cones and raises the errors. The caller makes
+    the entry current after the answer. A contact change runs this once after a stretch
+    of ticks of another structure: there each interpreted frame and each compiled call's
+    argument parsing ran cold, and the guess's and the arrays' buffers were held twice
+    (notes/performance-history.md, "switchlayer")."""
     cdef Workspace w
-    cdef Py_ssize_t n, m
+    cdef Py_buffer views[13]
+    cdef Py_ssize_t rows[13]
+    cdef Py_ssize_t columns[13]
+    cdef int count = 10 if x0 is None else (11 if z0 is None else 13), held = 6, i, code
+    cdef bint guessed = False
+    cdef Run run
     cdef Cones* blocks
-    for entry in kept:
-        w = entry[1]
-        n, m = w.e.prob.n, w.e.prob.m
-        if not dense_shapes(P, q, A, b, lb, ub, n, m):
-            continue
-        if not _guess_as_given(x0, y0, z0, n, m):
+    cdef tuple arrays = (P, q, A, b, lb, ub)
+    if dense_shapes(P, q, A, b, lb, ub, current.e.prob.n, current.e.prob.m):
+        return FITS_CURRENT
+    for entry in kept.values():
+        w = (<tuple>entry)[1]
+        w._shapes(rows, columns)
+        if _hold_inputs(arrays, views, rows, columns):
+            break
+    else:
+        return None
+    try:   # views 0 to 5 held, then the guess's (10 to 12), then the outputs' (6 to 9)
+        guessed = _hold_guess(x0, y0, z0, views, rows)
+        if not guessed:
             return None
+        x_out, y_out, z_out = _empty(rows[6]), _empty(rows[7]), _empty(rows[8])
+        cert_out = (<tuple>entry)[0].certificate
+        outputs = (x_out, y_out, z_out, cert_out)
+        for i in range(6, 10):
+            if not hold_float64(outputs[i - 6], &views[i], rows[i], -1, True):
+                raise ValueError(f"expected a C-contiguous float64 array of {rows[i]} rows")
+            held += 1
         blocks = &w.e.prob.cones
         if not upright_friction_on(cones, blocks.count, blocks.kind, w.e.user.block_start,
                                    <double*>blocks.mu, <double*>blocks.normal):
             return None
-        return entry
-    return None
+        w.arrived = True
+        code = w._run_held(views, count, warm, start_time, &run)
+    finally:
+        for i in range(held):
+            PyBuffer_Release(&views[i])
+        if guessed:
+            for i in range(10, count):
+                PyBuffer_Release(&views[i])
+    return entry, w._answer(code, &run, x_out, y_out, z_out, cert_out, start_time)
 
 
-cdef bint _guess_as_given(x0, y0, z0, Py_ssize_t n, Py_ssize_t m):
-    """Whether the guess ``(x0, y0, z0)`` of a solve in ``n`` variables and ``m`` rows
-    is none, ``x0`` alone or all three, each a vector :func:`fccqp.solver._guess` takes
-    as it came."""
+cdef bint _hold_inputs(tuple arrays, Py_buffer* views, const Py_ssize_t* rows,
+                       const Py_ssize_t* columns):
+    """Hold ``P, q, A, b, lb, ub`` (``arrays``) in ``views[:6]`` and return True when
+    each is a dense array of the shape ``rows``, ``columns`` give it
+    (:func:`fccqp.fast_checks.hold_dense`); False, holding nothing, otherwise."""
+    cdef int i, k
+    for i in range(6):
+        if not hold_dense(arrays[i], &views[i], rows[i], columns[i]):
+            for k in range(i):
+                PyBuffer_Release(&views[k])
+            return False
+    return True
+
+
+cdef bint _hold_guess(x0, y0, z0, Py_buffer* views, const Py_ssize_t* rows):
+    """Hold the guess ``(x0, y0, z0)`` in ``views[10:13]`` (as many as given) and return
+    True when it is none, ``x0`` alone or all three, each a vector
+    :func:`fccqp.solver._guess` takes as it came (its sizes ``rows[10:13]``); False,
+    holding nothing, otherwise."""
     if x0 is None:
         return y0 is None and z0 is None
-    if not vector_within(x0, n, MAX_ENTRY):
-        return False
     if y0 is None and z0 is None:
-        return True
-    return (y0 is not None and z0 is not None and vector_within(y0, m, MAX_ENTRY)
-            and vector_within(z0, n, MAX_ENTRY))
+        return hold_within(x0, &views[10], rows[10], MAX_ENTRY)
+    if y0 is None or z0 is None or not hold_within(x0, &views[10], rows[10], MAX_ENTRY):
+        return False
+    if not hold_within(y0, &views[11], rows[11], MAX_ENTRY):
+        PyBuffer_Release(&views[10])
+        return False
+    if not hold_within(z0, &views[12], rows[12], MAX_ENTRY):
+        PyBuffer_Release(&views[10])
+        PyBuffer_Release(&views[11])
+        return False
+    return True

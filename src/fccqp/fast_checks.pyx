@@ -166,18 +166,27 @@ def dense_vector_within(value, Py_ssize_t size, double limit):
 cdef bint vector_within(object value, Py_ssize_t size, double limit):
     """:func:`dense_vector_within` for compiled callers."""
     cdef Py_buffer view
+    if not hold_within(value, &view, size, limit):
+        return False
+    PyBuffer_Release(&view)
+    return True
+
+
+cdef bint hold_within(object value, Py_buffer* view, Py_ssize_t size, double limit):
+    """Hold the buffer of ``value`` in ``view`` and return True when it is a vector that
+    :func:`hold_dense` accepts, of ``size`` entries, none beyond ``limit`` in magnitude;
+    False, holding nothing, otherwise. A solve that takes a guess so reads its buffer
+    once for the check and the run."""
     cdef const double* entries
     cdef Py_ssize_t i
-    cdef bint within = True
-    if not hold_dense(value, &view, size, -1):
+    if not hold_dense(value, view, size, -1):
         return False
     entries = <const double*>view.buf
     for i in range(size):
         if not fabs(entries[i]) <= limit:
-            within = False
-            break
-    PyBuffer_Release(&view)
-    return within
+            PyBuffer_Release(view)
+            return False
+    return True
 
 
 def dense_arguments(P, q, A, b, lb, ub, Py_ssize_t n, Py_ssize_t m):
