@@ -89,7 +89,7 @@ class _Structure:
 
     def friction_of(self, cones: object) -> None:
         """Record that the workspace now holds the friction of ``cones``, validated cone
-        specs on its blocks (:func:`fccqp.admm.switch_solve`), flattened only when
+        specs on its blocks (:meth:`fccqp.admm.Workspace.switch`), flattened only when
         :attr:`cones` is asked for: a switch that solves needs no flat form."""
         self._cones, self.last_cones = None, cones
 
@@ -254,8 +254,8 @@ class Solver:
                     return self._result(out, P, q, A, b, lb, ub, NO_GUESS, start)
             w, structure = self._workspace, self._structure
         dense = w is not None and not sparse
-        switched = admm.switch_solve(w, self._kept, P, q, A, b, lb, ub, cones, x0, y0, z0,
-                                     settings.warm_start, start) if dense else None
+        switched = w.switch(self._kept, P, q, A, b, lb, ub, cones, x0, y0, z0,
+                            settings.warm_start, start) if dense else None
         if switched is admm.FITS_CURRENT:
             n, m = structure.n, structure.m   # the arrays fit as they are
             flat = flatten_cones(cones, n)   # memoized: the same object for the same cones
@@ -301,7 +301,6 @@ class Solver:
             if (same_cones(cones, structure.last_cones)
                     and dense_arguments(P, q, A, b, lb, ub, structure.n, structure.m)):
                 self._make_current(key, structure, w)
-                w.arrived = True
                 self._cones = cones
                 return w, structure
         return None, None
@@ -309,7 +308,7 @@ class Solver:
     def _switched(self, switched: tuple, cones: object, P: object, q: object, A: object,
                   b: object, lb: object, ub: object, x0: object, y0: object, z0: object,
                   start: float) -> Result:
-        """The answer of a switch that :func:`fccqp.admm.switch_solve` solved on a kept
+        """The answer of a switch that :meth:`fccqp.admm.Workspace.switch` solved on a kept
         entry (``switched``: the entry ``(structure, workspace)`` and what the solve
         returned), once that entry is made current with the friction of ``cones``
         (their flat form left to :attr:`_Structure.cones` until asked for); the
@@ -317,9 +316,12 @@ class Solver:
         returns it), and a solved answer returns without :meth:`_result`, as the
         control loop's does."""
         (structure, w), out = switched
-        self._make_current(structure.key, structure, w)
+        kept = self._kept   # _make_current's swap without its frame (the solve cleared
+        # arrived, which it would set again)
+        del kept[structure.key]
+        kept[self._structure.key] = (self._structure, self._workspace)
+        self._structure, self._workspace, self._cones = structure, w, cones
         structure.friction_of(cones)
-        self._cones = cones
         if (type(out) is Result and out.status is Status.SOLVED and not w.doubt
                 and not self._settings.verbose):
             return out
@@ -344,7 +346,6 @@ class Solver:
                 flat = flatten_cones(cones, structure.n)
                 if flat.same_blocks(structure.cones):
                     self._make_current(key, structure, w)
-                    w.arrived = True
                     if flat is not structure.cones:
                         w.update_cones(flat.mu, flat.normal)
                         structure.cones = flat
@@ -354,9 +355,8 @@ class Solver:
     def _make_current(self, key: tuple, structure: _Structure, w: admm.Workspace) -> None:
         """Make the kept workspace ``w`` of ``structure`` (kept under ``key``) current,
         keeping the current one (a switch: there is one) in its place, so that the
-        number kept stays within :data:`KEPT_WORKSPACES`. Its caller marks ``w``
-        ``arrived`` before its next solve (a guess given to it comes from another
-        structure), :func:`fccqp.admm.switch_solve` itself. The swap is spelled out
+        number kept stays within :data:`KEPT_WORKSPACES`; a guess given to its next solve
+        comes from another structure (``Workspace.arrived``). The swap is spelled out
         here, without :meth:`_keep_current`'s frame and bound: on a contact change the
         interpreter runs this once after a stretch of ticks of another structure, cold,
         where each frame costs about 0.5 us (notes/performance-history.md,
@@ -365,6 +365,7 @@ class Solver:
         del kept[key]
         kept[self._structure.key] = (self._structure, self._workspace)
         self._structure, self._workspace = structure, w
+        w.arrived = True
 
     def _keep_current(self) -> None:
         """Keep the current workspace with its structure (:data:`KEPT_WORKSPACES`)."""
