@@ -5,6 +5,7 @@ import os
 import subprocess
 import sys
 import textwrap
+import time
 
 import numpy as np
 import pytest
@@ -251,6 +252,12 @@ def other_friction(problem, scale):
     return (*problem[:6], cones)
 
 
+def general_path(problem):
+    """``problem`` with its cones in a list: the general path takes any sequence of
+    specs, the compiled switch (``Workspace.switch``) only the control loop's tuple."""
+    return (*problem[:6], list(problem[6]))
+
+
 def carried(solver, problem, last):
     """``solver``'s answer to ``problem`` from the guess of the previous answer ``last``
     cut or padded to its sizes, as a caller carries it across a contact change."""
@@ -276,10 +283,9 @@ def test_a_guessed_switch_onto_other_friction_takes_the_kept_workspace_without_a
                 (P, q, A, b, lb_fixed, ub_fixed, cones))
     general = fccqp.Solver()
     monkeypatch.setattr(general, "_switch", lambda *arguments: None)
-    monkeypatch.setattr(fccqp.admm, "kept_switch", lambda *arguments: None)
-    expected = [carried(general, second, general.solve(*first))]
+    expected = [carried(general, general_path(second), general.solve(*first))]
     for problem in switches:
-        expected.append(carried(general, problem, expected[-1]))
+        expected.append(carried(general, general_path(problem), expected[-1]))
     monkeypatch.undo()
 
     def no_scan(*arguments):
@@ -319,11 +325,9 @@ def test_a_guessed_switch_onto_upright_friction_builds_no_flat_cones(monkeypatch
     first, second = (upright(problem) for problem in two_structures())
     switches = (other_friction(first, 0.8), other_friction(second, 1.2))
     general = fccqp.Solver()
-    monkeypatch.setattr(fccqp.admm, "kept_switch", lambda *arguments: None)
-    expected = [carried(general, second, general.solve(*first))]
+    expected = [carried(general, general_path(second), general.solve(*first))]
     for problem in (*switches, second):
-        expected.append(carried(general, problem, expected[-1]))
-    monkeypatch.undo()
+        expected.append(carried(general, general_path(problem), expected[-1]))
 
     def no_flattening(*arguments):
         raise AssertionError("the switch flattened the cones")
@@ -341,6 +345,72 @@ def test_a_guessed_switch_onto_upright_friction_builds_no_flat_cones(monkeypatch
         assert answer.iterations == reference.iterations
         np.testing.assert_array_equal(answer.x, reference.x)
         verify_solution(problem, answer)
+
+
+@pytest.mark.kkt_backends(*DENSE_PATH_KEEPS, reason="the dense path's kept workspaces")
+def test_a_guessed_switch_is_checked_and_solved_in_one_compiled_call():
+    # a contact change with the caller's guess onto a kept workspace: one compiled call
+    # on the current workspace (Workspace.switch) checks the arrays, the guess and the
+    # cones, solves, and returns the kept entry with its answer, the general path's bit
+    # for bit; arrays of the current shapes fit it, and anything the call does not take
+    # as it came (a guess beyond MAX_ENTRY, cones in a list) is left to the general path
+    first, second = (upright(problem) for problem in two_structures())
+    general = fccqp.Solver()
+    expected = carried(general, general_path(first),
+                       carried(general, general_path(second), general.solve(*first)))
+    solver = fccqp.Solver()
+    last = carried(solver, second, solver.solve(*first))
+    current, entry = solver._workspace, next(iter(solver._kept.values()))
+    x0, y0, z0 = np.resize(last.x, 30), np.resize(last.y, 8), np.resize(last.z, 30)
+
+    def switch(problem, *guess):
+        return current.switch(solver._kept, *problem, *guess, True, time.perf_counter())
+
+    assert switch(first, np.full_like(x0, 1e21), y0, z0) is None
+    assert switch(general_path(first), x0, y0, z0) is None
+    assert switch(second, None, None, None) is fccqp.admm.FITS_CURRENT
+    found, answer = switch(first, x0, y0, z0)
+    assert found is entry and not entry[1].arrived
+    assert answer.status is Status.SOLVED and answer.iterations == expected.iterations
+    np.testing.assert_array_equal(answer.x, expected.x)
+
+
+@pytest.mark.kkt_backends(*DENSE_PATH_KEEPS, reason="the dense path's kept workspaces")
+@pytest.mark.parametrize("bad, error, message", [
+    ({"x0": np.nan}, ValueError, "x0 must be a finite vector of 24 entries"),
+    ({"y0": 1e21}, ValueError, r"y0 has an entry beyond 1e\+20"),
+    ({"z0": None}, None, None),   # a dual guess without z0: zero, as documented
+])
+def test_a_guessed_switch_checks_the_guess_before_it_writes_the_friction(bad, error,
+                                                                        message):
+    # a switch's guess that the compiled call does not take as it came goes to the
+    # general path, which raises the error naming the argument (or takes it) before
+    # the kept workspace is touched: a later switch onto other friction answers as a
+    # solver that never saw the bad guess
+    first, second = (upright(problem) for problem in two_structures())
+    other = other_friction(second, 0.8)
+
+    def guessed(last, **change):
+        guess = {"x0": np.resize(last.x, 24), "y0": np.resize(last.y, 6),
+                 "z0": np.resize(last.z, 24)}
+        for name, value in change.items():
+            guess[name] = None if value is None else np.full_like(guess[name], value)
+        return guess
+
+    reference = fccqp.Solver()
+    carried(reference, second, reference.solve(*first))
+    expected = reference.solve(*other, **guessed(reference.solve(*first)))
+    solver = fccqp.Solver()
+    carried(solver, second, solver.solve(*first))
+    answer = solver.solve(*first)
+    if error is None:
+        assert solver.solve(*second, **guessed(answer, **bad)).status is Status.SOLVED
+        return
+    with pytest.raises(error, match=message):
+        solver.solve(*second, **guessed(answer, **bad))
+    again = solver.solve(*other, **guessed(answer))
+    assert again.iterations == expected.iterations
+    np.testing.assert_array_equal(again.x, expected.x)
 
 
 @pytest.mark.kkt_backends(*DENSE_PATH_KEEPS, reason="the dense path's kept workspaces")

@@ -12,13 +12,14 @@ role); :meth:`Workspace.solve` validates the numbers, then scales, runs and unsc
 
 import numpy as np
 
+from fccqp.cones import FrictionCone
 from fccqp.result import Result
 from fccqp.status import Status
 
 cimport numpy as cnp
 from cpython.buffer cimport PyBuffer_Release
 from cpython.object cimport PyObject_GenericSetAttr
-from libc.math cimport isfinite
+from libc.math cimport INFINITY, fabs, isfinite
 from libc.string cimport memcpy
 
 from fccqp cimport engine
@@ -28,8 +29,8 @@ from fccqp.anderson cimport anderson_reset
 from fccqp.blas_threads cimport enter, leave
 from fccqp.certificates cimport CERTIFIED, primal_candidate
 from fccqp.engine cimport CONE_ENTRY, Clock, Engine, Run, fccqp_now
-from fccqp.fast_checks cimport (dense_shapes, hold_dense, hold_float64, upright_friction_on,
-                                vector_within)
+from fccqp.cone_dispatch cimport FRICTION
+from fccqp.fast_checks cimport hold_dense, hold_float64
 from fccqp.kkt cimport AUTO, LDL_FULL, LDL_REDUCED, SCHUR_REDUCED, SPARSE_LDL
 from fccqp.matrices cimport Matrix, csc, mark_diagonal_tail
 from fccqp.scaled_run cimport scaled_run, unscaled_answer
@@ -59,6 +60,8 @@ and ``A`` another pattern: the caller rescans them
 NOT_DENSE = -4
 """An input array is not a C-contiguous float64 numpy array of the workspace's shape
 (:meth:`Workspace.solve` with ``checked=False``): the caller converts the arguments."""
+FITS_CURRENT = True
+""":meth:`Workspace.switch`'s answer when the arguments fit the workspace's own shapes."""
 
 cdef enum:
     # Workspace.doubt's bits
@@ -395,11 +398,7 @@ cdef class Workspace:
         cdef Run run
         x_out, y_out, z_out = _empty(n), _empty(m), _empty(n)
         cdef tuple arrays = (P, q, A, b, lb, ub, x_out, y_out, z_out, cert_out, x0, y0, z0)
-        rows[:] = [n, n, m, m, n, n, n, m, n, n + m, n, m, n]
-        columns[:] = [n, -1, n, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1]   # -1: a vector
-        if self.compressed:   # P and A: the values of the patterns
-            rows[0], rows[2] = self.e.user.P.colptr[n], self.e.user.A.colptr[n]
-            columns[0] = columns[2] = -1
+        self._shapes(rows, columns)
         try:
             for i in range(count):   # the outputs, 6 to 9, are written
                 if i < 6 and not checked:
@@ -408,20 +407,110 @@ cdef class Workspace:
                 elif not hold_float64(arrays[i], &views[i], rows[i], columns[i], 6 <= i <= 9):
                     raise ValueError(f"expected a C-contiguous float64 array of {rows[i]} rows")
                 held += 1
-            code = self._run(<const double*>views[0].buf, <const double*>views[1].buf,
-                             <const double*>views[2].buf, <const double*>views[3].buf,
-                             <const double*>views[4].buf, <const double*>views[5].buf,
-                             <const double*>views[10].buf if x0 is not None else NULL,
-                             <const double*>views[11].buf if count == 13 else NULL,
-                             <const double*>views[12].buf if count == 13 else NULL, warm,
-                             start_time, <double*>views[6].buf, <double*>views[7].buf,
-                             <double*>views[8].buf, <double*>views[9].buf, &run)
+            code = self._run_held(views, count, warm, start_time, &run)
         finally:
             for i in range(held):
                 PyBuffer_Release(&views[i])
+        return self._answer(code, &run, x_out, y_out, z_out, cert_out, start_time)
+
+    def switch(self, dict kept, P, q, A, b, lb, ub, cones, x0, y0, z0, bint warm,
+               double start_time):
+        """The solve of a structure switch from this (the current) workspace onto a kept
+        one, in one compiled call: ``(entry, out)``, ``entry`` the ``(structure,
+        workspace)`` of ``kept`` (a solver's kept dense workspaces by key, oldest first)
+        that took it, ``out`` what :meth:`solve` returns; ``FITS_CURRENT`` when the
+        arrays fit this workspace's shapes (no switch); None when the general path
+        decides (:meth:`fccqp.Solver.solve`), nothing solved or written.
+
+        A switch takes the first kept workspace whose shapes the arrays fit as they came
+        (:func:`fccqp.fast_checks.dense_arguments`) when ``cones`` are upright friction
+        cones on its blocks (:func:`_upright_friction`, which writes their friction into
+        it) and when the guess is none, ``x0`` alone or all of ``x0, y0, z0``, each
+        within ``MAX_ENTRY`` (as :func:`fccqp.solver._guess` returns it unconverted);
+        the workspace is marked ``arrived`` and solves from the buffers held for those
+        checks, its structure's ``certificate`` the certificate's output. Anything else,
+        a kept workspace of other blocks first among those the shapes fit included, is
+        the general path's, which flattens the cones and raises the errors. The caller
+        makes the entry current after the answer. A contact change runs this once after
+        a stretch of ticks of another structure, with its code cold: it is a method
+        beside :meth:`solve` and runs the holds every tick runs, its checks inlined,
+        where a separate call choosing the workspace and then :meth:`solve` cost about
+        5 us more of anymal_c's 90 us contact tick (notes/performance-history.md,
+        "switchlayer")."""
+        cdef Workspace w = self
+        cdef Py_buffer views[13]
+        cdef Py_ssize_t rows[13]
+        cdef Py_ssize_t columns[13]
+        cdef int count = 10 if x0 is None else (11 if z0 is None else 13), held = 6, i, code
+        cdef bint guessed = False
+        cdef Run run
+        cdef tuple arrays = (P, q, A, b, lb, ub)
+        self._shapes(rows, columns)
+        if _hold_inputs(arrays, views, rows, columns):
+            for i in range(6):
+                PyBuffer_Release(&views[i])
+            return FITS_CURRENT
+        for entry in kept.values():
+            w = (<tuple>entry)[1]
+            w._shapes(rows, columns)
+            if _hold_inputs(arrays, views, rows, columns):
+                break
+        else:
+            return None
+        try:   # views 0 to 5 held, then the guess's (10 to 12), then the outputs' (6 to 9)
+            guessed = _hold_guess(x0, y0, z0, views, rows)
+            if not guessed:
+                return None
+            x_out, y_out, z_out = _empty(rows[6]), _empty(rows[7]), _empty(rows[8])
+            outputs = (x_out, y_out, z_out, (<tuple>entry)[0].certificate)
+            for i in range(6, 10):
+                if not hold_float64(outputs[i - 6], &views[i], rows[i], -1, True):
+                    raise ValueError(f"expected a C-contiguous float64 array of {rows[i]} rows")
+                held += 1
+            if not _upright_friction(cones, &w.e.prob.cones, w.e.user.block_start):
+                return None
+            w.arrived = True
+            code = w._run_held(views, count, warm, start_time, &run)
+        finally:
+            for i in range(held):
+                PyBuffer_Release(&views[i])
+            if guessed:
+                for i in range(10, count):
+                    PyBuffer_Release(&views[i])
+        return entry, w._answer(code, &run, x_out, y_out, z_out, outputs[3], start_time)
+
+    cdef void _shapes(self, Py_ssize_t* rows, Py_ssize_t* columns) noexcept:
+        """The rows and columns (-1: a vector) of :meth:`solve`'s thirteen arrays, in the
+        order ``P, q, A, b, lb, ub``, the outputs ``x, y, z, certificate``, the guess
+        ``x0, y0, z0``."""
+        cdef Py_ssize_t n = self.e.prob.n, m = self.e.prob.m
+        rows[:13] = [n, n, m, m, n, n, n, m, n, n + m, n, m, n]
+        columns[:13] = [n, -1, n, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1]
+        if self.compressed:   # P and A: the values of the patterns
+            rows[0], rows[2] = self.e.user.P.colptr[n], self.e.user.A.colptr[n]
+            columns[0] = columns[2] = -1
+
+    cdef int _run_held(self, Py_buffer* views, int count, bint warm, double start_time,
+                       Run* run) except -9:
+        """:meth:`_run` on the buffers of :meth:`solve`'s arrays held in ``views`` (in
+        :meth:`_shapes`' order; ``count``: 10 without a guess, 11 with ``x0`` alone, 13
+        with all three)."""
+        return self._run(<const double*>views[0].buf, <const double*>views[1].buf,
+                         <const double*>views[2].buf, <const double*>views[3].buf,
+                         <const double*>views[4].buf, <const double*>views[5].buf,
+                         <const double*>views[10].buf if count > 10 else NULL,
+                         <const double*>views[11].buf if count == 13 else NULL,
+                         <const double*>views[12].buf if count == 13 else NULL, warm,
+                         start_time, <double*>views[6].buf, <double*>views[7].buf,
+                         <double*>views[8].buf, <double*>views[9].buf, run)
+
+    cdef object _answer(self, int code, const Run* run, x_out, y_out, z_out, cert_out,
+                        double start_time):
+        """What :meth:`solve` returns for a run that ended with ``code``: the code below
+        ``SOLVED``, else the result of the run (its buffers released)."""
         if code < engine.SOLVED:
             return code
-        result = self._result(&run, x_out, y_out, z_out, cert_out, start_time)
+        result = self._result(run, x_out, y_out, z_out, cert_out, start_time)
         self._learn_final_step(run.polished)
         return result
 
@@ -581,51 +670,83 @@ cdef class Workspace:
         return True
 
 
-def kept_switch(kept, P, q, A, b, lb, ub, cones, x0, y0, z0):
-    """The entry ``(structure, workspace)`` of ``kept`` (a solver's kept dense workspaces
-    with their structures, oldest first) that a switch onto the arguments takes without
-    the general path, its workspace given the friction of ``cones``; None when the
-    general path decides (:meth:`fccqp.Solver.solve`).
-
-    A switch (arrays that do not fit the current workspace's shapes) takes the first
-    kept workspace whose shapes the arrays fit as they came
-    (:func:`fccqp.fast_checks.dense_arguments`) when ``cones`` are upright friction
-    cones on its blocks (:func:`fccqp.fast_checks.upright_friction_on`) and when the guess is none, ``x0``
-    alone or all of ``x0, y0, z0``, each within ``MAX_ENTRY`` (as
-    :func:`fccqp.solver._guess` returns it unconverted). Anything else, a kept
-    workspace of other blocks first among those the shapes fit included, is the general
-    path's, which flattens the cones and raises the errors. One compiled call instead of
-    the interpreter's checks, flattening, comparisons and friction writes, which a
-    contact change runs once after a stretch of ticks of another structure: there they
-    took 23 us of solo12's 100 us tick, this call 7 us (notes/performance-history.md,
-    "switchentry")."""
-    cdef Workspace w
-    cdef Py_ssize_t n, m
-    cdef Cones* blocks
-    for entry in kept:
-        w = entry[1]
-        n, m = w.e.prob.n, w.e.prob.m
-        if not dense_shapes(P, q, A, b, lb, ub, n, m):
-            continue
-        if not _guess_as_given(x0, y0, z0, n, m):
-            return None
-        blocks = &w.e.prob.cones
-        if not upright_friction_on(cones, blocks.count, blocks.kind, w.e.user.block_start,
-                                   <double*>blocks.mu, <double*>blocks.normal):
-            return None
-        return entry
-    return None
+cdef inline bint _hold_inputs(tuple arrays, Py_buffer* views, const Py_ssize_t* rows,
+                              const Py_ssize_t* columns):
+    """Hold ``P, q, A, b, lb, ub`` (``arrays``) in ``views[:6]`` and return True when
+    each is a dense array of the shape ``rows``, ``columns`` give it
+    (:func:`fccqp.fast_checks.hold_dense`); False, holding nothing, otherwise."""
+    cdef int i, k
+    for i in range(6):
+        if not hold_dense(arrays[i], &views[i], rows[i], columns[i]):
+            for k in range(i):
+                PyBuffer_Release(&views[k])
+            return False
+    return True
 
 
-cdef bint _guess_as_given(x0, y0, z0, Py_ssize_t n, Py_ssize_t m):
-    """Whether the guess ``(x0, y0, z0)`` of a solve in ``n`` variables and ``m`` rows
-    is none, ``x0`` alone or all three, each a vector :func:`fccqp.solver._guess` takes
-    as it came."""
+cdef inline bint _hold_within(object value, Py_buffer* view, Py_ssize_t size):
+    """Hold ``value`` in ``view`` and return True when it is a vector
+    :func:`fccqp.fast_checks.hold_dense` accepts, of ``size`` entries, each within
+    ``MAX_ENTRY`` (a NaN is not); False, holding nothing, otherwise."""
+    cdef const double* entries
+    cdef Py_ssize_t i
+    if not hold_dense(value, view, size, -1):
+        return False
+    entries = <const double*>view.buf
+    for i in range(size):
+        if not fabs(entries[i]) <= MAX_ENTRY:
+            PyBuffer_Release(view)
+            return False
+    return True
+
+
+cdef inline bint _hold_guess(x0, y0, z0, Py_buffer* views, const Py_ssize_t* rows):
+    """Hold the guess ``(x0, y0, z0)`` in ``views[10:13]`` (as many as given) and return
+    True when it is none, ``x0`` alone or all three, each a vector
+    :func:`fccqp.solver._guess` takes as it came (its sizes ``rows[10:13]``); False,
+    holding nothing, otherwise."""
     if x0 is None:
         return y0 is None and z0 is None
-    if not vector_within(x0, n, MAX_ENTRY):
-        return False
     if y0 is None and z0 is None:
-        return True
-    return (y0 is not None and z0 is not None and vector_within(y0, m, MAX_ENTRY)
-            and vector_within(z0, n, MAX_ENTRY))
+        return _hold_within(x0, &views[10], rows[10])
+    if y0 is None or z0 is None or not _hold_within(x0, &views[10], rows[10]):
+        return False
+    if not _hold_within(y0, &views[11], rows[11]):
+        PyBuffer_Release(&views[10])
+        return False
+    if not _hold_within(z0, &views[12], rows[12]):
+        PyBuffer_Release(&views[10])
+        PyBuffer_Release(&views[11])
+        return False
+    return True
+
+
+cdef inline bint _upright_friction(object cones, Cones* blocks, const Py_ssize_t* start):
+    """Write the friction coefficients of ``cones`` into ``blocks`` with upright normals
+    and return True when ``cones`` is a tuple of ``blocks.count`` friction cones as
+    :func:`fccqp.fast_checks.upright_friction_arrays` takes them (an int ``start``, a
+    float ``mu``, finite and positive, no normal), the ``k``-th starting at ``start[k]``
+    where ``blocks`` has a friction cone: a workspace's blocks, already checked to lie
+    inside ``x`` without overlap, which ``cones`` then has. False, nothing written, for
+    anything else (the Python flattening takes it)."""
+    cdef Py_ssize_t k, count = blocks.count
+    cdef double value
+    cdef double* mu = <double*>blocks.mu
+    cdef double* normal = <double*>blocks.normal
+    if type(cones) is not tuple or len(<tuple>cones) != count:
+        return False
+    for k in range(count):
+        cone = (<tuple>cones)[k]
+        if (type(cone) is not FrictionCone or cone.normal is not None
+                or blocks.kind[k] != FRICTION):
+            return False
+        given_start, given_mu = cone.start, cone.mu
+        if type(given_start) is not int or type(given_mu) is not float:
+            return False
+        value = given_mu
+        if given_start != start[k] or not (value > 0 and value < INFINITY):
+            return False
+    for k in range(count):
+        mu[k] = (<tuple>cones)[k].mu
+        normal[3 * k], normal[3 * k + 1], normal[3 * k + 2] = 0.0, 0.0, 1.0
+    return True

@@ -21,8 +21,6 @@ from cpython.buffer cimport (PyBUF_C_CONTIGUOUS, PyBUF_FORMAT, PyBUF_WRITABLE, P
 from libc.math cimport INFINITY, fabs
 from libc.stdint cimport int64_t
 
-from fccqp.cone_dispatch cimport FRICTION
-
 cimport numpy as cnp
 
 import numpy as np
@@ -164,7 +162,7 @@ def dense_vector_within(value, Py_ssize_t size, double limit):
 
 
 cdef bint vector_within(object value, Py_ssize_t size, double limit):
-    """:func:`dense_vector_within` for compiled callers."""
+    """:func:`dense_vector_within`'s check, without its Python call."""
     cdef Py_buffer view
     cdef const double* entries
     cdef Py_ssize_t i
@@ -189,7 +187,7 @@ def dense_arguments(P, q, A, b, lb, ub, Py_ssize_t n, Py_ssize_t m):
 
 cdef bint dense_shapes(object P, object q, object A, object b, object lb, object ub,
                        Py_ssize_t n, Py_ssize_t m):
-    """:func:`dense_arguments` for compiled callers."""
+    """:func:`dense_arguments`'s check, without its Python call."""
     return (_is_dense(P, n, n) and _is_dense(q, n, -1) and _is_dense(A, m, n)
             and _is_dense(b, m, -1) and _is_dense(lb, n, -1) and _is_dense(ub, n, -1))
 
@@ -310,33 +308,3 @@ def upright_friction_arrays(tuple cones, Py_ssize_t n):
         values[i], values[k + 3 * i + 2] = mu, 1.0
     integers.flags.writeable = reals.flags.writeable = False
     return integers[0], integers[1], integers[2], reals[:k], reals[k:].reshape(k, 3)
-
-
-cdef bint upright_friction_on(object cones, Py_ssize_t count, const Py_ssize_t* kind,
-                              const Py_ssize_t* start, double* mu, double* normal):
-    """Write the friction coefficients of ``cones`` into ``mu`` and upright normals into
-    ``normal`` (three per cone) and return True when ``cones`` is a tuple of ``count``
-    friction cones as :func:`upright_friction_arrays` takes them (an int ``start``, a
-    float ``mu``, finite and positive, no normal), the ``k``-th starting at
-    ``start[k]`` where ``kind[k]`` is a friction cone's: the blocks of a workspace,
-    already checked to lie inside ``x`` without overlap, which ``cones`` then has.
-    False, nothing written, for anything else (the Python flattening takes it)."""
-    cdef Py_ssize_t k
-    cdef double value
-    _load_kinds()
-    if type(cones) is not tuple or len(<tuple>cones) != count:
-        return False
-    for k in range(count):
-        cone = (<tuple>cones)[k]
-        if type(cone) is not _FRICTION or cone.normal is not None or kind[k] != FRICTION:
-            return False
-        given_start, given_mu = cone.start, cone.mu
-        if type(given_start) is not int or type(given_mu) is not float:
-            return False
-        value = given_mu
-        if given_start != start[k] or not (value > 0 and value < INFINITY):
-            return False
-    for k in range(count):
-        mu[k] = (<tuple>cones)[k].mu
-        normal[3 * k], normal[3 * k + 1], normal[3 * k + 2] = 0.0, 0.0, 1.0
-    return True

@@ -89,7 +89,7 @@ class _Structure:
 
     def friction_of(self, cones: object) -> None:
         """Record that the workspace now holds the friction of ``cones``, validated cone
-        specs on its blocks (:func:`fccqp.admm.kept_switch`), flattened only when
+        specs on its blocks (:meth:`fccqp.admm.Workspace.switch`), flattened only when
         :attr:`cones` is asked for: a switch that solves needs no flat form."""
         self._cones, self.last_cones = None, cones
 
@@ -253,12 +253,13 @@ class Solver:
                     return self._result(out, P, q, A, b, lb, ub, NO_GUESS, start)
             w, structure = self._workspace, self._structure
         dense = w is not None and not sparse
-        if dense and dense_arguments(P, q, A, b, lb, ub, structure.n, structure.m):
+        switched = w.switch(self._kept, P, q, A, b, lb, ub, cones, x0, y0, z0,
+                            settings.warm_start, start) if dense else None
+        if switched is admm.FITS_CURRENT:
             n, m = structure.n, structure.m   # the arrays fit as they are
             flat = flatten_cones(cones, n)   # memoized: the same object for the same cones
-        elif dense and (entry := admm.kept_switch(self._kept.values(), P, q, A, b, lb, ub,
-                                                  cones, x0, y0, z0)) is not None:
-            return self._switched(entry, cones, P, q, A, b, lb, ub, x0, y0, z0, start)
+        elif switched is not None:
+            return self._switched(switched, cones, P, q, A, b, lb, ub, x0, y0, z0, start)
         elif dense and (flat := self._switch(cones, P, q, A, b, lb, ub)) is not None:
             w, structure = self._workspace, self._structure   # a kept one they fit
             n, m = structure.n, structure.m
@@ -303,22 +304,23 @@ class Solver:
                 return w, structure
         return None, None
 
-    def _switched(self, entry: tuple[_Structure, admm.Workspace], cones: object, P: object,
-                  q: object, A: object, b: object, lb: object, ub: object, x0: object,
-                  y0: object, z0: object, start: float) -> Result:
-        """The solve of a switch onto the kept ``entry`` that
-        :func:`fccqp.admm.kept_switch` chose (in one compiled call: the shapes, the
-        guess, upright friction cones on its blocks, whose friction it wrote), made
-        current with the friction of ``cones`` (their flat form left to
-        :attr:`_Structure.cones` until asked for); the arguments are those the general
-        path would solve (a guess as :func:`_guess` returns it), and a solved answer
-        returns without :meth:`_result`, as the control loop's does."""
-        structure, w = entry
-        self._make_current(structure.key, structure, w)
+    def _switched(self, switched: tuple, cones: object, P: object, q: object, A: object,
+                  b: object, lb: object, ub: object, x0: object, y0: object, z0: object,
+                  start: float) -> Result:
+        """The answer of a switch that :meth:`fccqp.admm.Workspace.switch` solved on a kept
+        entry (``switched``: the entry ``(structure, workspace)`` and what the solve
+        returned), once that entry is made current with the friction of ``cones``
+        (their flat form left to :attr:`_Structure.cones` until asked for); the
+        arguments are those the general path would solve (a guess as :func:`_guess`
+        returns it), and a solved answer returns without :meth:`_result`, as the
+        control loop's does."""
+        (structure, w), out = switched
+        kept = self._kept   # _make_current's swap without its frame (the solve cleared
+        # arrived, which it would set again)
+        del kept[structure.key]
+        kept[self._structure.key] = (self._structure, self._workspace)
+        self._structure, self._workspace, self._cones = structure, w, cones
         structure.friction_of(cones)
-        self._cones = cones
-        out = w.solve(P, q, A, b, lb, ub, x0, self._settings.warm_start, start,
-                      structure.certificate, True, y0, z0)
         if (type(out) is Result and out.status is Status.SOLVED and not w.doubt
                 and not self._settings.verbose):
             return out
