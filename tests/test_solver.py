@@ -1,6 +1,10 @@
 """The solver against Clarabel, the KKT conditions, and its statuses."""
 
 import math
+import os
+import subprocess
+import sys
+import textwrap
 import time
 
 import numpy as np
@@ -822,3 +826,80 @@ def test_settings_of_a_solver_cannot_be_replaced():
     with pytest.raises(AttributeError, match="Solver.settings"):
         solver.settings = fccqp.Settings(max_iter=5)
     assert solver.settings.max_iter == 50
+
+
+_MARKED_KB = """
+    import re
+    import numpy as np
+    np._core.multiarray._set_madvise_hugepage(False)
+    import fccqp
+
+    def marked_kb(field="Size"):
+        text = open("/proc/self/smaps").read()
+        blocks = re.split(r"\\n(?=[0-9a-f]+-[0-9a-f]+ )", text)
+        return sum(int(re.search(rf"^{field}:\\s+(\\d+) kB", block, re.M).group(1))
+                   for block in blocks if re.search(r"^VmFlags:.* hg", block, re.M))
+"""
+"""The start of the pool tests' programs: fccqp imported in a process whose numpy marks
+none of its own memory for huge pages, and ``marked_kb``, the kB of the marked mappings
+(``field``: their ``Size`` or their resident ``Rss``)."""
+
+
+def _run_marked(code):
+    """The stdout of ``code`` run after :data:`_MARKED_KB` in a new Python process."""
+    program = textwrap.dedent(_MARKED_KB) + textwrap.dedent(code)
+    result = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True,
+                            timeout=300)
+    assert result.returncode == 0, result.stderr
+    return result.stdout.split()
+
+
+@pytest.mark.kkt_backends("auto", reason="the workspaces' memory, in a new Python process")
+@pytest.mark.skipif(not os.path.isdir("/sys/kernel/mm/transparent_hugepage"),
+                    reason="transparent huge pages (Linux's madvise) are not available")
+def test_workspaces_are_carved_from_one_shared_huge_page_pool_faulted_in_at_import():
+    """The arrays of a process's workspaces are carved from 2 MB pools marked for
+    transparent huge pages (fccqp.workspace_arrays._Pool): the first is mapped and its
+    pages written when the solver's modules are imported (``fccqp.Solver``'s first
+    use), resident before any solve, and two small solvers share it."""
+    out = _run_marked("""
+        first, second = fccqp.Solver(), fccqp.Solver()
+        before, resident = marked_kb(), marked_kb("Rss")
+        first.solve(np.eye(3), np.ones(3), lb=-np.ones(3), ub=np.ones(3))
+        second.solve(np.eye(4), np.ones(4), lb=-np.ones(4), ub=np.ones(4))
+        print(before, resident, marked_kb())
+    """)
+    assert out == ["2048", "2048", "2048"]
+
+
+@pytest.mark.kkt_backends("auto", reason="the workspaces' memory, in a new Python process")
+@pytest.mark.skipif(not os.path.isdir("/sys/kernel/mm/transparent_hugepage"),
+                    reason="transparent huge pages (Linux's madvise) are not available")
+def test_released_pools_are_kept_zeroed_for_the_next_workspaces():
+    """A pool whose workspaces are all gone is kept (two at most, zeroed), not unmapped,
+    and the next pools are taken from it: after solvers that filled four pools are
+    dropped, three stay mapped (the current one and two spares), the same solvers
+    again map no more and give the same answers bit for bit (the spares were zeroed)."""
+    out = _run_marked("""
+        rng = np.random.default_rng(5)
+        problems = []
+        for k in range(12):
+            n = 40 + k
+            M = rng.standard_normal((n, n))
+            problems.append((M @ M.T + np.eye(n), rng.standard_normal(n),
+                             rng.standard_normal((3, n)), rng.standard_normal(3),
+                             -np.ones(n), np.ones(n)))
+
+        def answers():
+            solvers = [fccqp.Solver() for _ in problems]
+            xs = [s.solve(*p).x.tobytes() for s, p in zip(solvers, problems)]
+            return xs, marked_kb()
+
+        first, filled = answers()
+        dropped = marked_kb()
+        again, refilled = answers()
+        print(filled >= 8192, dropped, refilled == filled, first == again)
+    """)
+    assert out == ["True", "6144", "True", "True"]
+
+

@@ -9,12 +9,13 @@ every time that QP is solved so; then it walks 30 ticks across the set's contact
 set, the carried guess); a few of those solvers are kept alive for a while and dropped out
 of order, so that workspaces are released while others are made.
 
-Why: session 35 found with this loop that main's workspaces of then (arrays carved from
-shared 2 MB pools that were unmapped when the last workspace carved from them went)
-crashed in a new talos workspace's first solve after 600-2750 rounds (its arrays in an
-unmapped page), and, with released pools reused, answered a convex QP "not convex"
-instead; without the pools (or without their unmapping) 3000 rounds ran clean. A
-run takes about 30 s per 1000 rounds. Run::
+Why: session 35 found with this loop that the workspaces' shared 2 MB pools
+(``fccqp.workspace_arrays``) were freed while a workspace's arrays were in them: a
+segmentation fault in a new talos workspace's first solve after 600-2750 rounds, or,
+with released pools reused, a convex QP answered "not convex". The cause was
+``owner.kept[-1]`` under the module's ``wraparound=False``: it read the word before the
+list's items, and where that word happened to be the current pool the pool was not kept.
+A run takes about 30 s per 1000 rounds. Run::
 
     python tools/stress_workspaces.py --iterations 3000
 

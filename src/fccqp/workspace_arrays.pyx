@@ -19,6 +19,8 @@ On large_friction (5002 KKT rows) the dense set was 3.2 GB, the compressed one 8
 
 import numpy as np
 
+from libc.string cimport memset
+
 from fccqp.engine cimport Engine
 from fccqp.kkt cimport SPARSE_LDL
 from fccqp.matrices cimport csc, dense
@@ -32,14 +34,140 @@ from fccqp.polish_csc import arrays as polish_arrays
 cdef enum:
     ALIGNMENT = 8   # doubles: each array starts on a 64-byte boundary (a cache line)
     CHUNK = 4096    # doubles (32 KB) per chunk of zeros the smaller arrays are carved from
+    POOL = 262144   # doubles (2 MB, a huge page) per pool the chunks are carved from
+    POOLED = 32768  # doubles (256 KB): the largest array taken from a pool
+    SPARE_POOLS = 2  # released pools kept zeroed for the next workspaces: 4 MB at most
+
+cdef extern from *:
+    """
+    #if defined(__linux__)
+    #include <stdint.h>
+    #include <sys/mman.h>
+    /* size bytes of zeros on a 2 MB boundary, on a transparent huge page where the
+       kernel gives one; NULL where none can be mapped */
+    static void *fccqp_huge_region(size_t size)
+    {
+        size_t huge = (size_t)2 << 20;
+        char *raw = mmap(NULL, size + huge, PROT_READ | PROT_WRITE,
+                         MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+        char *aligned;
+        if (raw == MAP_FAILED)
+            return NULL;
+        aligned = (char *)(((uintptr_t)raw + huge - 1) & ~(uintptr_t)(huge - 1));
+        if (aligned > raw)
+            munmap(raw, aligned - raw);
+        if (raw + huge > aligned)
+            munmap(aligned + size, raw + huge - aligned);
+    #ifdef MADV_HUGEPAGE
+        madvise(aligned, size, MADV_HUGEPAGE);
+    #endif
+        return aligned;
+    }
+    static void fccqp_huge_free(void *region, size_t size) { munmap(region, size); }
+    #else
+    static void *fccqp_huge_region(size_t size) { (void)size; return NULL; }
+    static void fccqp_huge_free(void *region, size_t size) { (void)region; (void)size; }
+    #endif
+    """
+    void* fccqp_huge_region(size_t size)
+    void fccqp_huge_free(void* region, size_t size)
+
+
+cdef class _Pool:
+    """``POOL`` zeroed doubles on a 2 MB boundary (a transparent huge page where the
+    kernel gives one), from which the arrays of workspaces are carved in turn, never
+    twice: released when the last :class:`Arrays` carved from it goes, to the spares
+    (zeroed again, at most ``SPARE_POOLS``) that the next pools are taken from, else
+    unmapped.
+
+    A contact change solves in a workspace that the ticks of the other contact set have
+    not touched for a while; on pages of 4 KB its arrays spread over dozens of pages,
+    each a TLB miss (a nested page walk under a hypervisor). On one huge page shared
+    with the other workspaces of the process, go2's contact tick took about 5 us less
+    (notes/performance-history.md, "contactentry"). A new region's first write faults
+    its huge page in: the kernel zeroes 2 MB, and where the THP ``defrag`` policy is
+    ``madvise`` (this machine) it may compact memory first, 0.2-16 ms inside the solve
+    that wrote it (notes/performance-history.md, "firstsolve"). A spare was faulted in
+    before; zeroing what was carved of it on release is a ``memset``."""
+
+    cdef double* start
+    cdef Py_ssize_t used   # doubles carved
+
+    def __dealloc__(self):
+        global _spare_count
+        if self.start == NULL:
+            return
+        if _spare_count < SPARE_POOLS:
+            memset(self.start, 0, self.used * sizeof(double))
+            _spare[_spare_count] = self.start
+            _spare_count += 1
+        else:
+            fccqp_huge_free(self.start, POOL * sizeof(double))
+
+
+cdef double* _spare[SPARE_POOLS]   # zeroed regions of released pools
+cdef int _spare_count = 0
+cdef _Pool _pool = None   # the pool new arrays are carved from
+
+
+cdef _Pool _new_pool():
+    """A pool over a spare region when there is one, else over a new mapping; None
+    where none can be mapped (not Linux, or ``mmap`` refused)."""
+    global _spare_count
+    cdef _Pool pool = _Pool()
+    if _spare_count:
+        _spare_count -= 1
+        pool.start = _spare[_spare_count]
+    else:
+        pool.start = <double*>fccqp_huge_region(POOL * sizeof(double))
+        if pool.start == NULL:
+            return None
+    return pool
+
+
+cdef void _fault_in(_Pool pool) noexcept:
+    """Write a zero into every 4 KB page of ``pool``: its pages (its huge page, where
+    the kernel gives one) are faulted in now rather than by the first solve that
+    carves it."""
+    cdef volatile double* start = pool.start
+    cdef Py_ssize_t k
+    for k in range(0, POOL, 512):
+        start[k] = 0.0
+
+
+cdef double* _pooled(Arrays owner, Py_ssize_t size) except? NULL:
+    """``size`` zeroed doubles (at most ``POOL``) from the current pool, a new one when
+    it has no room for them (:func:`_new_pool`), kept alive by ``owner``; NULL where no
+    pool can be mapped."""
+    global _pool
+    cdef _Pool pool = _pool
+    cdef double* out
+    if pool is None or pool.used + size > POOL:
+        pool = _new_pool()
+        if pool is None:
+            return NULL
+        _pool = pool
+    cdef list kept = owner.kept
+    # the last item by its index: under wraparound=False, kept[-1] reads before the list
+    if not kept or kept[len(kept) - 1] is not pool:
+        kept.append(pool)
+    out = pool.start + pool.used
+    pool.used += size
+    return out
+
+
+_pool = _new_pool()   # at import (fccqp.Solver's first use): faulted in outside any solve
+if _pool is not None:
+    _fault_in(_pool)
 
 
 cdef class Arrays:
-    """The numpy arrays a workspace's C state points into, kept alive with it.
+    """The numpy arrays and pools a workspace's C state points into, kept alive with it.
 
     The arrays of :func:`common_arrays` and :func:`dense_arrays` (about 150) are carved
     from a few zeroed chunks instead of one ``np.zeros`` each (an array larger than a
-    chunk has its own): a new go2 workspace took
+    chunk has its own), the chunks from pools shared by the process's workspaces
+    (:class:`_Pool`): a new go2 workspace took
     1.12M instructions, 0.77M of them in numpy's allocation and a typed memoryview per
     array, beside a 1.43M cold solve (callgrind, the first solve of a contact set)."""
 
@@ -48,12 +176,15 @@ cdef class Arrays:
         self.free, self.left = NULL, 0
 
     cdef double* new(self, Py_ssize_t size) except NULL:
-        """A zeroed array of ``size`` doubles (at least one), aligned to a cache line."""
+        """A zeroed array of ``size`` doubles (at least one), aligned to a cache line; its
+        chunk from a huge page's pool (:class:`_Pool`) up to ``POOLED`` doubles."""
         cdef Py_ssize_t need = (max(size, 1) + ALIGNMENT - 1) // ALIGNMENT * ALIGNMENT
         cdef Py_ssize_t total = (need if need > CHUNK else CHUNK) + ALIGNMENT, skip
         cdef double* out
         if need > self.left:
-            out = self.adopt(np.zeros(total))
+            out = _pooled(self, total) if total <= POOLED else NULL
+            if out == NULL:
+                out = self.adopt(np.zeros(total))
             skip = (ALIGNMENT - (<size_t>out // sizeof(double)) % ALIGNMENT) % ALIGNMENT
             if need > CHUNK:   # an array of its own: the chunk in use keeps its room
                 return out + skip
