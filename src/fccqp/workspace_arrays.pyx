@@ -147,10 +147,7 @@ cdef double* _pooled(Arrays owner, Py_ssize_t size) except? NULL:
         if pool is None:
             return NULL
         _pool = pool
-    cdef list kept = owner.kept
-    # the last item by its index: under wraparound=False, kept[-1] reads before the list
-    if not kept or kept[len(kept) - 1] is not pool:
-        kept.append(pool)
+    owner.kept.append(pool)   # once per chunk carved: a pool may be listed several times
     out = pool.start + pool.used
     pool.used += size
     return out
