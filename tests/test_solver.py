@@ -448,6 +448,47 @@ def test_a_cold_start_after_a_reset_keeps_the_scaling_until_the_data_drift():
     assert not np.array_equal(fresh._workspace.scaling[0], D)
 
 
+@pytest.mark.kkt_backends(*DENSE_PATH_KEEPS, reason="the dense path's kept workspaces")
+def test_data_that_come_back_take_the_other_kept_scaling():
+    # two stances of one structure (a trot's) alternate: each rescales with the
+    # equilibration its own data gave, kept beside the current one; a third stance
+    # equilibrates anew and the last one becomes the other. Each stance comes back a
+    # little moved (``near``), so that only a kept scaling gives its first D, E bit
+    # for bit
+    P, q, A, b, lb, ub, cones = random_problem(9)
+
+    def stance(factor, moved=1.0):
+        return (P * factor * moved, q, A / factor / moved, b, lb, ub, cones)
+
+    solver = fccqp.Solver()
+
+    def scaling_after(problem):
+        result = solver.solve(*problem)
+        assert result.status is Status.SOLVED
+        verify_solution(problem, result)
+        return solver._workspace.scaling[:2]
+
+    def fresh_scaling(problem):
+        fresh = fccqp.Solver()
+        fresh.solve(*problem)
+        return fresh._workspace.scaling[:2]
+
+    first, second = scaling_after(stance(1.0)), scaling_after(stance(1e3))
+    assert not np.array_equal(first[0], second[0])
+    for problem, kept in [(stance(1.0, 1.01), first), (stance(1e3, 0.99), second),
+                          (stance(1.0, 0.98), first)]:
+        for got, expected in zip(scaling_after(problem), kept, strict=True):
+            np.testing.assert_array_equal(got, expected)
+    third = stance(1e-3)
+    np.testing.assert_array_equal(scaling_after(third)[0], fresh_scaling(third)[0])
+    np.testing.assert_array_equal(scaling_after(stance(1.0, 1.02))[0], first[0])
+    again = stance(1e3, 1.02)   # the second's was dropped: equilibrated anew
+    np.testing.assert_array_equal(scaling_after(again)[0], fresh_scaling(again)[0])
+    assert not np.array_equal(fresh_scaling(again)[0], second[0])
+    solver.reset()   # a reset keeps the structure's scalings, as it keeps the current one
+    np.testing.assert_array_equal(scaling_after(stance(1.0, 0.99))[0], first[0])
+
+
 FACTORIZATIONS_AFTER_A_NEW_P = {"auto": 1, "schur_reduced": 1, "ldl_reduced": 2,
                                 "ldl_full": 2, "sparse": 2}
 """Factorizations of a warm solve whose ``P`` changed (problems.random_problem(9), measured

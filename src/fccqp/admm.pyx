@@ -251,7 +251,7 @@ cdef class Workspace:
         o.polish, o.polish_refine_iter = settings.polish, settings.polish_refine_iter
         o.backend, o.anderson_memory = BACKENDS[settings.kkt_backend], settings.anderson_memory
         e.prev.exists = e.user.has_matrices = e.fact.certified = e.scaling.done = False
-        e.scaling.kept = False
+        e.scaling.kept = e.scaling.other_done = False
         e.prev.has_rho = False
         e.prev.polished = e.prev.from_polished = e.equalities_missed = False
         e.prev.guessed = False

@@ -84,6 +84,13 @@ cdef struct Scaling:
     Pattern pattern             # the nonzeros of the dense P and A at the last equilibration
     bint done                   # an equilibration ran for this workspace
     bint kept                   # the last run's scaling is an earlier equilibration's
+    # The equilibration in use before the current one (its D, E and reference), tried
+    # when new data drift from the current one: a trot's two stances share a structure
+    # and drift 30-40x from each other's scaling (fccqp.scaled_run._scale).
+    double* other_D             # n
+    double* other_E             # m
+    double* other_reference     # n + m
+    bint other_done             # the three above hold an equilibration
 
 
 cdef struct Factorization:

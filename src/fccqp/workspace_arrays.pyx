@@ -219,6 +219,9 @@ cdef void common_arrays(Arrays a, Engine* e, Py_ssize_t memory, Py_ssize_t log_r
     u.entry_kind = <char*>a.new(n)
     e.scaling.d, e.scaling.e = a.new(n), a.new(m)
     e.scaling.reference, e.scaling.norms = a.new(N), a.new(N)
+    e.scaling.other_D, e.scaling.other_E = a.new(n), a.new(m)
+    e.scaling.other_reference = a.new(N)
+    e.scaling.other_done = False
     it = &e.it
     it.x, it.nu, it.z, it.y = a.new(n), a.new(m), a.new(s), a.new(s)
     it.x_prev, it.nu_prev = a.new(n), a.new(m)
