@@ -352,8 +352,10 @@ def test_a_guessed_switch_is_checked_and_solved_in_one_compiled_call():
     # a contact change with the caller's guess onto a kept workspace: one compiled call
     # on the current workspace (Workspace.switch) checks the arrays, the guess and the
     # cones, solves, and returns the kept entry with its answer, the general path's bit
-    # for bit; arrays of the current shapes fit it, and anything the call does not take
-    # as it came (a guess beyond MAX_ENTRY, cones in a list) is left to the general path
+    # for bit; arrays of the current shapes are solved on it (no entry returned), and
+    # anything the call does not take as it came (a guess beyond MAX_ENTRY, cones in a
+    # list) is left to the general path: FITS_CURRENT where the arrays fit the current
+    # workspace, None otherwise
     first, second = (upright(problem) for problem in two_structures())
     general = fccqp.Solver()
     expected = carried(general, general_path(first),
@@ -364,15 +366,43 @@ def test_a_guessed_switch_is_checked_and_solved_in_one_compiled_call():
     x0, y0, z0 = np.resize(last.x, 30), np.resize(last.y, 8), np.resize(last.z, 30)
 
     def switch(problem, *guess):
-        return current.switch(solver._kept, *problem, *guess, True, time.perf_counter())
+        return current.switch(solver._structure, solver._kept, *problem, *guess, True,
+                              time.perf_counter())
 
     assert switch(first, np.full_like(x0, 1e21), y0, z0) is None
     assert switch(general_path(first), x0, y0, z0) is None
-    assert switch(second, None, None, None) is fccqp.admm.FITS_CURRENT
+    far = np.full_like(last.x, 1e21)
+    assert switch(second, far, last.y, last.z) is fccqp.admm.FITS_CURRENT
+    assert switch(general_path(second), last.x, last.y, last.z) is fccqp.admm.FITS_CURRENT
+    found, answer = switch(second, last.x, last.y, last.z)
+    assert found is None and answer.status is Status.SOLVED
+    np.testing.assert_array_equal(answer.x, last.x)   # its own polished answer again
     found, answer = switch(first, x0, y0, z0)
     assert found is entry and not entry[1].arrived
     assert answer.status is Status.SOLVED and answer.iterations == expected.iterations
     np.testing.assert_array_equal(answer.x, expected.x)
+
+
+@pytest.mark.kkt_backends(*DENSE_PATH_KEEPS, reason="the dense path's kept workspaces")
+def test_a_guessed_tick_of_the_current_shapes_answers_as_the_general_path():
+    # a trot's swap of stances keeps the sizes: the caller's guess on the current
+    # workspace is solved by the compiled call (Workspace.switch) without the general
+    # path's flattening and checks, with its answers bit for bit, onto other friction
+    # too; a reset between them changes nothing either
+    problem = upright(two_structures()[1])
+    moved = (problem[0], problem[1] + 0.05, *problem[2:])
+    other = other_friction(moved, 0.8)
+    solvers = fccqp.Solver(), fccqp.Solver()
+    answers = []
+    for solver, path in zip(solvers, (lambda p: p, general_path), strict=True):
+        last = solver.solve(*path(problem))
+        answers.append([carried(solver, path(p), last) for p in (moved, other, problem)])
+    for fast, general in zip(*answers, strict=True):
+        assert fast.status is Status.SOLVED
+        assert fast.iterations == general.iterations
+        np.testing.assert_array_equal(fast.x, general.x)
+        np.testing.assert_array_equal(fast.y, general.y)
+        np.testing.assert_array_equal(fast.z, general.z)
 
 
 @pytest.mark.kkt_backends(*DENSE_PATH_KEEPS, reason="the dense path's kept workspaces")

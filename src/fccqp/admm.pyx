@@ -413,30 +413,35 @@ cdef class Workspace:
                 PyBuffer_Release(&views[i])
         return self._answer(code, &run, x_out, y_out, z_out, cert_out, start_time)
 
-    def switch(self, dict kept, P, q, A, b, lb, ub, cones, x0, y0, z0, bint warm,
+    def switch(self, current, dict kept, P, q, A, b, lb, ub, cones, x0, y0, z0, bint warm,
                double start_time):
-        """The solve of a structure switch from this (the current) workspace onto a kept
-        one, in one compiled call: ``(entry, out)``, ``entry`` the ``(structure,
-        workspace)`` of ``kept`` (a solver's kept dense workspaces by key, oldest first)
-        that took it, ``out`` what :meth:`solve` returns; ``FITS_CURRENT`` when the
-        arrays fit this workspace's shapes (no switch); None when the general path
-        decides (:meth:`fccqp.Solver.solve`), nothing solved or written.
+        """The solve of a tick with a guess in one compiled call, on this (the current)
+        workspace or, for a structure switch, on a kept one: ``(entry, out)``, ``out``
+        what :meth:`solve` returns and ``entry`` the ``(structure, workspace)`` of
+        ``kept`` (a solver's kept dense workspaces by key, oldest first) that took it,
+        None where this one did (``current``: its structure); ``FITS_CURRENT`` when the
+        arrays fit this workspace's shapes and the guess or the cones are for the
+        general path; None when the general path decides (:meth:`fccqp.Solver.solve`),
+        nothing solved or written.
 
-        A switch takes the first kept workspace whose shapes the arrays fit as they came
-        (:func:`fccqp.fast_checks.dense_arguments`) when ``cones`` are upright friction
-        cones on its blocks (:func:`_upright_friction`, which writes their friction into
-        it) and when the guess is none, ``x0`` alone or all of ``x0, y0, z0``, each
-        within ``MAX_ENTRY`` (as :func:`fccqp.solver._guess` returns it unconverted);
-        the workspace is marked ``arrived`` and solves from the buffers held for those
-        checks, its structure's ``certificate`` the certificate's output. Anything else,
-        a kept workspace of other blocks first among those the shapes fit included, is
-        the general path's, which flattens the cones and raises the errors. The caller
-        makes the entry current after the answer. A contact change runs this once after
-        a stretch of ticks of another structure, with its code cold: it is a method
-        beside :meth:`solve` and runs the holds every tick runs, its checks inlined,
-        where a separate call choosing the workspace and then :meth:`solve` cost about
-        5 us more of anymal_c's 90 us contact tick (notes/performance-history.md,
-        "switchlayer")."""
+        This workspace takes the arrays that fit its shapes as they came
+        (:func:`fccqp.fast_checks.dense_arguments`), else the first kept workspace whose
+        shapes they fit, when ``cones`` are upright friction cones on its blocks
+        (:func:`_upright_friction`, which writes their friction into it) and when the
+        guess is none, ``x0`` alone or all of ``x0, y0, z0``, each within ``MAX_ENTRY``
+        (as :func:`fccqp.solver._guess` returns it unconverted); a kept workspace is
+        marked ``arrived``; the workspace solves from the buffers held for those checks,
+        its structure's ``certificate`` the certificate's output. Anything else, a kept
+        workspace of other blocks first among those the shapes fit included, is the
+        general path's, which flattens the cones and raises the errors. The caller
+        makes a kept entry current after the answer. A contact change runs this once
+        after a stretch of ticks of another structure, with its code cold: it is a
+        method beside :meth:`solve` and runs the holds every tick runs, its checks
+        inlined, where a separate call choosing the workspace and then :meth:`solve`
+        cost about 5 us more of anymal_c's 90 us contact tick, and where the general
+        path's flattening, guess checks and :meth:`solve` took 6-10 us of a trot's 40-50
+        us contact tick on the current workspace (notes/performance-history.md,
+        "switchlayer", "End of session 36")."""
         cdef Workspace w = self
         cdef Py_buffer views[13]
         cdef Py_ssize_t rows[13]
@@ -445,31 +450,34 @@ cdef class Workspace:
         cdef bint guessed = False
         cdef Run run
         cdef tuple arrays = (P, q, A, b, lb, ub)
+        cdef object entry = None
         self._shapes(rows, columns)
-        if _hold_inputs(arrays, views, rows, columns):
-            for i in range(6):
-                PyBuffer_Release(&views[i])
-            return FITS_CURRENT
-        for entry in kept.values():
-            w = (<tuple>entry)[1]
-            w._shapes(rows, columns)
-            if _hold_inputs(arrays, views, rows, columns):
-                break
-        else:
-            return None
+        if not _hold_inputs(arrays, views, rows, columns):
+            for entry in kept.values():
+                w = (<tuple>entry)[1]
+                w._shapes(rows, columns)
+                if _hold_inputs(arrays, views, rows, columns):
+                    break
+            else:
+                return None
+        # the general path for what this one does not take: for this workspace, as the
+        # arrays fit it, the path that keeps it (FITS_CURRENT)
+        declined = FITS_CURRENT if w is self else None
         try:   # views 0 to 5 held, then the guess's (10 to 12), then the outputs' (6 to 9)
             guessed = _hold_guess(x0, y0, z0, views, rows)
             if not guessed:
-                return None
+                return declined
             x_out, y_out, z_out = _empty(rows[6]), _empty(rows[7]), _empty(rows[8])
-            outputs = (x_out, y_out, z_out, (<tuple>entry)[0].certificate)
+            certificate = current.certificate if w is self else (<tuple>entry)[0].certificate
+            outputs = (x_out, y_out, z_out, certificate)
             for i in range(6, 10):
                 if not hold_float64(outputs[i - 6], &views[i], rows[i], -1, True):
                     raise ValueError(f"expected a C-contiguous float64 array of {rows[i]} rows")
                 held += 1
             if not _upright_friction(cones, &w.e.prob.cones, w.e.user.block_start):
-                return None
-            w.arrived = True
+                return declined
+            if w is not self:
+                w.arrived = True
             code = w._run_held(views, count, warm, start_time, &run)
         finally:
             for i in range(held):

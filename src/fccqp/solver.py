@@ -253,7 +253,7 @@ class Solver:
                     return self._result(out, P, q, A, b, lb, ub, NO_GUESS, start)
             w, structure = self._workspace, self._structure
         dense = w is not None and not sparse
-        switched = w.switch(self._kept, P, q, A, b, lb, ub, cones, x0, y0, z0,
+        switched = w.switch(structure, self._kept, P, q, A, b, lb, ub, cones, x0, y0, z0,
                             settings.warm_start, start) if dense else None
         if switched is admm.FITS_CURRENT:
             n, m = structure.n, structure.m   # the arrays fit as they are
@@ -307,19 +307,24 @@ class Solver:
     def _switched(self, switched: tuple, cones: object, P: object, q: object, A: object,
                   b: object, lb: object, ub: object, x0: object, y0: object, z0: object,
                   start: float) -> Result:
-        """The answer of a switch that :meth:`fccqp.admm.Workspace.switch` solved on a kept
-        entry (``switched``: the entry ``(structure, workspace)`` and what the solve
-        returned), once that entry is made current with the friction of ``cones``
-        (their flat form left to :attr:`_Structure.cones` until asked for); the
-        arguments are those the general path would solve (a guess as :func:`_guess`
-        returns it), and a solved answer returns without :meth:`_result`, as the
-        control loop's does."""
-        (structure, w), out = switched
-        kept = self._kept   # _make_current's swap without its frame (the solve cleared
-        # arrived, which it would set again)
-        del kept[structure.key]
-        kept[self._structure.key] = (self._structure, self._workspace)
-        self._structure, self._workspace, self._cones = structure, w, cones
+        """The answer of a solve that :meth:`fccqp.admm.Workspace.switch` made on the
+        current workspace or on a kept entry (``switched``: that entry ``(structure,
+        workspace)``, None for the current one, and what the solve returned), once that
+        entry is made current, with the friction of ``cones`` (their flat form left to
+        :attr:`_Structure.cones` until asked for); the arguments are those the general
+        path would solve (a guess as :func:`_guess` returns it), and a solved answer
+        returns without :meth:`_result`, as the control loop's does."""
+        entry, out = switched
+        if entry is None:
+            structure, w = self._structure, self._workspace
+        else:
+            structure, w = entry
+            kept = self._kept   # _make_current's swap without its frame (the solve
+            # cleared arrived, which it would set again)
+            del kept[structure.key]
+            kept[self._structure.key] = (self._structure, self._workspace)
+            self._structure, self._workspace = structure, w
+        self._cones = cones
         structure.friction_of(cones)
         if (type(out) is Result and out.status is Status.SOLVED and not w.doubt
                 and not self._settings.verbose):
