@@ -831,3 +831,26 @@ def test_a_polish_from_nothing_gives_up_where_its_first_feasible_guess_cannot_se
                             schur=True, warm=True, bare=True)
     assert not polished["ok"]
     assert polished["passes"] <= FEASIBLE_PASSES
+
+
+def test_a_carried_point_on_its_cone_to_rounding_starts_free():
+    """A polish from no multipliers (a carried guess) starts from the equality-
+    constrained solve: blocks whose carried point lies on its cone's surface, one ulp
+    outside or inside of it by the rounding of the previous answer, start free alike.
+    On solo12's contact_switch tick 320 two feet on their cones with multipliers of
+    1e-7 had started on their planes or not with the BLAS kernel's rounding, 13
+    factorizations against 5; here both contacts' optimum lies inside their cones and
+    the first solve is the answer."""
+    mu, n = 0.75, 6
+    cones = (fccqp.FrictionCone(0, mu), fccqp.FrictionCone(3, mu))
+    target = np.array([0.5, 0.0, 4.0, 0.0, -0.5, 4.0])   # inside both cones
+    A, b = np.array([[0.0, 0.0, 1.0, 0.0, 0.0, 1.0]]), np.array([8.0])
+    free = np.full(n, np.inf)
+    for side in (np.inf, -np.inf):   # just outside, just inside: |f_t| = mu f_n = 3
+        z = np.array([np.nextafter(3.0, side), 0.0, 4.0, 0.0, -np.nextafter(3.0, side), 4.0])
+        polished = polish_point(np.eye(n), -target, A, b, -free, free,
+                                flatten_cones(cones, n), z, np.zeros(1), np.zeros(n), z,
+                                warm=True, bare=True, schur=True)
+        assert polished["ok"]
+        assert polished["factorizations"] == 1 and polished["passes"] == 1
+        np.testing.assert_allclose(polished["x"], target, atol=1e-12)

@@ -124,8 +124,16 @@ def lockstep(workers: dict[str, subprocess.Popen], names: list[str],
 
 
 def report(medians: dict[tuple[str, str], np.ndarray], roots: dict[str, Path],
-           variant: str) -> None:
-    """Median and p95 per build and solver, fccqp/DAQP, and B / A per tick."""
+           variant: str, per_tick: bool) -> None:
+    """Median and p95 per build and solver, fccqp/DAQP, and B / A per tick (with
+    ``per_tick``, each tick's medians and ratios too, in the walk's order)."""
+    if per_tick:
+        print(f"tick: {variant} A, B, B / A; {REFERENCE} A, B, B / A (us)")
+        for k in range(len(medians["A", variant])):
+            ours_a, ours_b = medians["A", variant][k], medians["B", variant][k]
+            peer_a, peer_b = medians["A", REFERENCE][k], medians["B", REFERENCE][k]
+            print(f"{k:4d}: {ours_a * 1e6:7.1f} {ours_b * 1e6:7.1f} {ours_b / ours_a:6.3f}; "
+                  f"{peer_a * 1e6:7.1f} {peer_b * 1e6:7.1f} {peer_b / peer_a:6.3f}")
     for build, root in roots.items():
         ours, peer = medians[build, variant], medians[build, REFERENCE]
         print(f"{build} {root}: {variant} median {np.median(ours) * 1e6:.1f} us, p95 "
@@ -153,6 +161,8 @@ def main() -> None:
     parser.add_argument("--stride", type=int, default=10, help="the coarse mode's step")
     parser.add_argument("--rounds", type=int, default=30)
     parser.add_argument("--variant", default="fccqp-realtime", help="the fccqp variant")
+    parser.add_argument("--per-tick", action="store_true",
+                        help="each timed tick's medians and ratios (for --mode contact)")
     args = parser.parse_args()
     roots = {"A": args.a.resolve(), "B": args.b.resolve()}
     names = [args.variant, REFERENCE]
@@ -168,7 +178,7 @@ def main() -> None:
     mode = f"every {args.stride}th" if args.mode == "coarse" else args.mode
     print(f"{args.robot}, {args.scenario}, {mode}, {args.rounds} rounds, per-tick medians")
     report({key: np.median(value, axis=0) for key, value in times.items()}, roots,
-           args.variant)
+           args.variant, args.per_tick)
 
 
 if __name__ == "__main__":

@@ -17,8 +17,8 @@ from libc.math cimport fabs, sqrt
 
 from fccqp._dense cimport copy
 from fccqp._types cimport Cones, Problem
-from fccqp.cone_dispatch cimport (cone_curvature, cone_plane, cone_polar_distance, cone_project,
-                                  cone_slope, cone_split, cone_step, cone_touch)
+from fccqp.cone_dispatch cimport (cone_curvature, cone_inside, cone_plane, cone_polar_distance,
+                                  cone_project, cone_slope, cone_split, cone_step, cone_touch)
 from fccqp.polish cimport APEX, BARE, BOUNDARY, FREE, KEPT, LOWER, UPPER, Polish
 from fccqp.tuning cimport ACTIVE_TOLERANCE
 
@@ -110,7 +110,15 @@ cdef Py_ssize_t guess(Polish* w, const Problem* p, const double* z, const double
     and each boundary block's multiplier ``lam`` (the component of ``y`` along the
     plane's normal), plane and curvature at the projection of ``z + y`` onto the cone;
     return the number of boundary blocks and count in ``changed`` the constrained
-    entries whose code changed."""
+    entries whose code changed.
+
+    A polish from no multipliers (``bare_start``: ``y`` is zero, ``z`` the carried
+    point's projection onto ``C``) starts a block free where ``z`` lies in its cone to
+    ``ACTIVE_TOLERANCE``: a foot on its cone in the previous answer is there to the
+    rounding of that answer, one ulp outside or inside by the BLAS kernels' order of
+    sums, and started on its plane or not accordingly (solo12's contact_switch tick
+    320: 13 factorizations with SkylakeX's ``dgemv``, 5 with Haswell's; 5 with either
+    now, notes/performance-history.md, "End of session 36")."""
     cdef const Cones* c = &p.cones
     cdef Py_ssize_t j, k, o, d, nb = 0
     cdef double phi, lam
@@ -126,6 +134,10 @@ cdef Py_ssize_t guess(Polish* w, const Problem* p, const double* z, const double
         for j in range(o, o + d):
             w.g[j] = z[j] + y[j]
         code = cone_code(c, k, w.g + o)
+        if (code == BOUNDARY and w.bare_start
+                and cone_inside(w.g + o, c.kind[k], d, c.mu[k], c.normal + 3 * k,
+                                ACTIVE_TOLERANCE)):
+            code = FREE   # on its cone to rounding: the previous answer's, carried
         if code == BOUNDARY:
             cone_project(w.g + o, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.step)
             cone_plane(w.step, c.kind[k], d, c.mu[k], c.normal + 3 * k, w.g + o, &phi)
