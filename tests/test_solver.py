@@ -388,7 +388,7 @@ def test_a_guessed_tick_of_the_current_shapes_answers_as_the_general_path():
     # a trot's swap of stances keeps the sizes: the caller's guess on the current
     # workspace is solved by the compiled call (Workspace.switch) without the general
     # path's flattening and checks, with its answers bit for bit, onto other friction
-    # too; a reset between them changes nothing either
+    # too
     problem = upright(two_structures()[1])
     moved = (problem[0], problem[1] + 0.05, *problem[2:])
     other = other_friction(moved, 0.8)
@@ -483,8 +483,7 @@ def test_data_that_come_back_take_the_other_kept_scaling():
     # two stances of one structure (a trot's) alternate: each rescales with the
     # equilibration its own data gave, kept beside the current one; a third stance
     # equilibrates anew and the last one becomes the other. Each stance comes back a
-    # little moved (``near``), so that only a kept scaling gives its first D, E bit
-    # for bit
+    # little moved, so that only a kept scaling gives its first D, E bit for bit
     P, q, A, b, lb, ub, cones = random_problem(9)
 
     def stance(factor, moved=1.0):
