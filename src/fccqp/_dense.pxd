@@ -59,9 +59,15 @@ cdef extern from "fccqp_kernels.h" nogil:
 
 cdef inline void matvec(const double* M, const double* x, double* out,
                         Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
-    """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (``fccqp_matvec``, else
-    ``dgemv``)."""
-    cdef int r = <int>rows, c = <int>cols, one = 1
+    """``out = M x`` for a row-major ``rows x cols`` matrix ``M`` (:func:`matvec_ld`)."""
+    matvec_ld(M, cols, x, out, rows, cols)
+
+
+cdef inline void matvec_ld(const double* M, Py_ssize_t ld, const double* x, double* out,
+                           Py_ssize_t rows, Py_ssize_t cols) noexcept nogil:
+    """``out = M x`` for a row-major ``rows x cols`` block ``M`` whose rows lie ``ld``
+    apart (``fccqp_matvec``, else ``dgemv``)."""
+    cdef int r = <int>rows, c = <int>cols, lda = <int>ld, one = 1
     cdef double alpha = 1.0, beta = 0.0
     cdef char trans = b"T"
     if rows == 0:
@@ -69,8 +75,8 @@ cdef inline void matvec(const double* M, const double* x, double* out,
     if cols == 0:
         fill(out, 0.0, rows)
         return
-    if not fccqp_matvec(M, c, x, out, r, c):
-        dgemv(&trans, &c, &r, &alpha, <double*>M, &c, <double*>x, &one, &beta, out, &one)
+    if not fccqp_matvec(M, lda, x, out, r, c):
+        dgemv(&trans, &c, &r, &alpha, <double*>M, &lda, <double*>x, &one, &beta, out, &one)
 
 
 cdef inline void matvec_t(const double* M, const double* y, double* out,

@@ -50,11 +50,9 @@ unchanged on the four robots' sets).
 
 from libc.math cimport sqrt
 
-from scipy.linalg.cython_blas cimport dgemv
-
 from fccqp._blas cimport (backward_substitution, cholesky, cholesky_solve_vector,
                           forward_substitution, syrk_t, trsm)
-from fccqp._dense cimport fccqp_matvec
+from fccqp._dense cimport matvec_ld
 from fccqp._types cimport Problem
 from fccqp.schur cimport mark_coupled
 from fccqp.tuning cimport (CHOLESKY_LOOP_ROWS, PIVOT_TOLERANCE, POLISH_BORDER_TOLERANCE,
@@ -736,23 +734,6 @@ cdef void _solve_whole(PolishSchur* f, Py_ssize_t m, Py_ssize_t size, double* u)
         fccqp_backward_vector(f.S0, <int>lead, <int>m, u)
 
 
-cdef inline void _rows_times(const double* Y, int ld, const double* w, double* u, int count,
-                             int length) noexcept nogil:
-    """``u[c] = Y[c ld : c ld + length] . w`` for ``c < count`` (``Y' w`` of the solves'
-    formulas): ``fccqp_matvec`` where the CPU has AVX2, else ``dgemv``. Measured faster
-    than OpenBLAS' ``dgemv`` at these sizes (go2's warm ticks 0.966x in wall time, in
-    lockstep; -0.5 % instructions), and its sums do not depend on the kernel OpenBLAS
-    picks for the CPU (SkylakeX's and Haswell's sum in other orders; the polish's path
-    once followed that: solo12's contact_switch tick 320, notes/performance-history.md,
-    "End of session 36")."""
-    cdef int one = 1
-    cdef double alpha = 1.0, zero = 0.0
-    cdef char trans = b"T"
-    if not fccqp_matvec(Y, ld, w, u, count, length):
-        dgemv(&trans, &length, &count, &alpha, <double*>Y, &ld, <double*>w, &one, &zero, u,
-              &one)
-
-
 cdef void _solve_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
                           Py_ssize_t nb, double* v) noexcept nogil:
     """:func:`polish_schur_solve` for a bordered factorization: ``w_E = L_E^-1 r_E`` on
@@ -773,7 +754,7 @@ cdef void _solve_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* in
     for r in range(f.dense, end):
         w[r] *= f.inv_root[r]
     if m > 0:
-        _rows_times(f.Y, ld, w, u, mm, end)
+        matvec_ld(f.Y, ld, w, u, mm, end)   # Y_E'w_E
         _subtract_rows(f, m, v + nf, u)
         fccqp_forward_vector(f.S0, mm, mm, u)
     for e in range(nbd):
@@ -820,7 +801,10 @@ cdef void polish_schur_solve(PolishSchur* f, const Problem* p, const Py_ssize_t*
         w[r] = v[index[f.rowvar[r]]]
     _forward(f, p, boundary, nb, w)
     if size > 0:
-        _rows_times(f.Y, ld, w, u, size, rows)
+        # Y'w in fccqp's kernel: go2's warm ticks 0.966x OpenBLAS dgemv's wall time (in
+        # lockstep), and sums that do not follow the kernel OpenBLAS picks for the CPU
+        # (notes/performance-history.md, "End of session 36")
+        matvec_ld(f.Y, ld, w, u, size, rows)
         _subtract_rows(f, p.m, v + nf, u)
         for c in range(p.m, size):
             u[c] -= v[nf + c]
