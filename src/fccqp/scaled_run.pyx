@@ -52,9 +52,18 @@ cdef void _scale(Engine* e, bint reuse, bint keep_scaling) noexcept nogil:
     """Equilibrate the user's data into the scaled problem; with ``reuse`` (unchanged
     matrices) apply the scaling to the new vectors only, and with ``keep_scaling``
     scale new matrices with the workspace's last equilibration
-    (:func:`fccqp.scaling.rescale`) unless they drifted from it; then the rows' spans
-    over the (new) box. The matrices' storage picks the passes (:mod:`fccqp.scaling`
-    or :mod:`fccqp.scaling_csc`), one test per solve.
+    (:func:`fccqp.scaling.rescale`) unless they drifted from it, then with the one
+    before it (which becomes the current one) unless they drifted from that one too,
+    else equilibrate them (the current one becoming the one before); then the rows'
+    spans over the (new) box. The matrices' storage picks the passes
+    (:mod:`fccqp.scaling` or :mod:`fccqp.scaling_csc`), one test per solve.
+
+    The workspace of a structure serves every stance of its size: a trot's two
+    diagonal pairs of feet, a walk's stances on three feet. Their matrices drift 30-40x
+    from each other's scaling (a leg joint's column with its contact rows or without)
+    and within 1.2-1.35 of the scaling their own stance gave a step earlier (solo12's
+    contact_switch set), so a stance coming back rescales instead of running the Ruiz
+    passes: 17k instructions instead of 90k of a 386k-instruction trot tick (callgrind).
 
     The scaling is the structure's, not the last answer's: a cold start (after
     ``Solver.reset()``) keeps it as a warm one does, and saves the Ruiz passes, a
@@ -63,6 +72,7 @@ cdef void _scale(Engine* e, bint reuse, bint keep_scaling) noexcept nogil:
     from those the equilibration gave its own data."""
     cdef Problem* p = &e.prob
     cdef Py_ssize_t n = p.n, m = p.m, i, j
+    cdef bint other
     p.P.diagonal_from = e.user.P.diagonal_from   # the scaling keeps every zero
     e.scaling.kept = True
     if reuse:
@@ -70,14 +80,15 @@ cdef void _scale(Engine* e, bint reuse, bint keep_scaling) noexcept nogil:
             p.q[i] = p.c * p.D[i] * e.user.q[i]
         for i in range(m):
             p.b[i] = p.E[i] * e.user.b[i]
-    elif not (keep_scaling and e.scaling.done
-              and (_rescale(e) or (e.scaling.other_done and _rescale_other(e)))):
+    elif not (keep_scaling and e.scaling.done and _rescale(e)):
+        other = keep_scaling and e.scaling.other_done
         if e.scaling.done:   # the current equilibration becomes the other one
             _swap_scalings(e)
             e.scaling.other_done = True
-        _equilibrate(e)
-        e.scaling.done = True
-        e.scaling.kept = False
+        if not (other and _rescale(e)):
+            _equilibrate(e)
+            e.scaling.done = True
+            e.scaling.kept = False
     for j in range(p.s):
         i = p.constrained[j]
         p.lo[j] = e.user.lb[i] / p.D[i]
@@ -95,23 +106,6 @@ cdef inline bint _rescale(Engine* e) noexcept nogil:
                        e.scaling.norms, p.P.values, p.q, p.A.values, p.b, &p.c)
     return rescale_csc(&e.user.P, e.user.q, &e.user.A, e.user.b, p.D, p.E,
                        e.scaling.reference, e.scaling.norms, &p.P, p.q, &p.A, p.b, &p.c)
-
-
-cdef bint _rescale_other(Engine* e) noexcept nogil:
-    """:func:`_rescale` with the other kept equilibration, which becomes the current
-    one where the data are within its drift (and stays the other one where not).
-
-    The workspace of a structure serves every stance of its size: a trot's two
-    diagonal pairs of feet, a walk's stances on three feet. Their matrices drift 30-40x
-    from each other's scaling (a leg joint's column with its contact rows or without),
-    and within 1.2-1.35 of the scaling their own stance gave a step earlier (solo12's
-    contact_switch set), so a stance coming back rescales instead of running the Ruiz
-    passes: 17k instructions instead of 90k of a 386k-instruction trot tick (callgrind)."""
-    _swap_scalings(e)
-    if _rescale(e):
-        return True
-    _swap_scalings(e)
-    return False
 
 
 cdef void _swap_scalings(Engine* e) noexcept nogil:
