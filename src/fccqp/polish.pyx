@@ -507,6 +507,8 @@ cdef bint polish(Polish* w, const Problem* p, const Iterates* it, long newton_st
         w.dropped[j] = False
         w.bare[j] = CURVED
     w.cycling = False
+    if w.bare_start:   # its guesses move cone blocks pass by pass (see polish_schur._build_base)
+        w.schur.border_all = True
     nb = guess(w, p, it.z, it.y, &changed)
     while True:
         w.passes = passes

@@ -244,7 +244,7 @@ cdef void _factored_solve(Polish* w, const Problem* p, Py_ssize_t nf, Py_ssize_t
     cdef int size = <int>(nf + p.m + nb), one = 1, info = 0
     copy(w.rhs, w.step, size)
     if w.structured:
-        polish_schur_solve(&w.schur, p, w.index, w.boundary, nb, w.step)
+        polish_schur_solve(&w.schur, p, w.index, nb, w.step)
     elif p.P.kind == CSC:
         polish_csc_solve(&w.csc, size, w.step)
     else:

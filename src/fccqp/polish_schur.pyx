@@ -26,9 +26,14 @@ that is a few tens of thousands of multiply-adds a guess, against the ``dsytrf``
 factorization and no reduced table, which the table polish (:mod:`fccqp.polish_table`)
 is built on. So a warm polish that succeeds skips both (see ``Workspace._iterate``).
 
-``S``'s first ``m`` columns take ``A``'s rows in the order :func:`_order_rows` gives
-them (the rows that cone entries touch last), so that the guesses of one base share
-the factor of ``S``'s leading block. A solve keeps ``Y``: ``w = L^-1 r_x``, ``mu = S^-1 (Y'w - r_c)``, ``x_F = L'^-1 (w -
+The cone blocks off their apex are bordered (:func:`polish_schur_factor`): a base
+(:func:`_build_base`) factors ``S0``, the part of ``S`` of the unconstrained and free
+box entries, once for every guess that holds the same box entries, and each guess
+factors only its cone blocks against it (``K``, ``nb`` planes in ``T``), so that a
+polish whose guesses move contacts between free, boundary and apex (a contact change's)
+builds one base. ``S``'s first ``m`` columns take ``A``'s rows in the order
+:func:`_order_rows` gives them (the rows that cone entries touch last), so that the
+bases of one solve share the factor of ``S``'s leading block. A solve keeps ``Y``: ``w = L^-1 r_x``, ``mu = S^-1 (Y'w - r_c)``, ``x_F = L'^-1 (w -
 Y mu)``, two products with ``Y`` and the triangular solves of ``H``'s blocks. The
 caller refines against the unregularized system, as with ``dsytrf``. Where ``P``
 couples a constrained entry, a block is not positive definite or ``S`` loses a pivot
@@ -82,6 +87,7 @@ cdef bint polish_schur_setup(PolishSchur* f, const Problem* p, double delta) noe
     cdef int k
     f.ready = f.bordered = f.lead_valid = False
     f.base = BASE_NONE
+    f.border_all = False
     f.convex = True
     mark_coupled(p.P.values, n, f.coupled)
     for i in range(n):
@@ -294,20 +300,22 @@ cdef inline bint _diagonal_row(PolishSchur* f, const Problem* p, Py_ssize_t i, P
     return True
 
 
-cdef bint _factor_whole(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
-                        const Py_ssize_t* boundary, Py_ssize_t nb, const double* g,
-                        const double* hess, double delta) noexcept nogil:
+cdef bint _factor_whole(PolishSchur* f, const Problem* p, const Py_ssize_t* boundary,
+                        Py_ssize_t nb, const double* g, const double* hess,
+                        double delta) noexcept nogil:
     """Factor the whole ``S`` (``m + nb`` rows) of the guess (see
     :func:`polish_schur_factor`) and keep ``Y = L^-1 C'`` for the solves. ``Y``'s rows:
-    the unconstrained entries (from the set-up), the free box entries and free cone
-    blocks (a diagonal entry of ``H`` each; written by :func:`_build_base`, whose base
-    is the guess's here), then the boundary blocks. These are zero in ``S``'s leading
-    ``lead`` columns, where ``S`` is ``S0`` and the base holds its factor: only the
-    rest, the base's Schur complement ``SC`` plus the boundary rows' sums, is factored
-    (into ``S``, ``m + nb - lead`` rows). False where the Schur complement does not
-    apply."""
-    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, size = m + nb, r, c, k, o, d
-    cdef Py_ssize_t start, row = f.diag_end, kb, a, lead = f.lead, rest = m - lead
+    the unconstrained entries (from the set-up), the free box entries and the base's
+    diagonal cone blocks (a diagonal entry of ``H`` each; written by :func:`_build_base`),
+    then the bordered blocks (:func:`_border`), each a Cholesky of ``d`` rows of
+    ``diag(P)``, plus the curvature and a column for the plane where the block is on its
+    boundary. These
+    are zero in ``S``'s leading ``lead`` columns, where ``S`` is ``S0`` and the base holds
+    its factor: only the rest, the base's Schur complement ``SC`` plus the bordered rows'
+    sums, is factored (into ``S``, ``m + nb - lead`` rows). False where the Schur
+    complement does not apply."""
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, size = m + nb, r, c, k, o, d, b, plane
+    cdef Py_ssize_t start, row = f.diag_end, kb = 0, a, lead = f.lead, rest = m - lead
     cdef Py_ssize_t t = size - lead
     cdef double* S = f.S
     cdef double* Y = f.Y
@@ -315,33 +323,38 @@ cdef bint _factor_whole(PolishSchur* f, const Problem* p, const Py_ssize_t* inde
     cdef double largest = f.lead_largest
     if f.base == BASE_NONE or f.base == BASE_SINGULAR:
         return False   # a free row could not be written, or S0's leading block failed
-    for c in range(m, size):   # the rows above the boundary blocks have no plane
+    for c in range(m, size):   # the rows above the bordered blocks have no plane
         for r in range(row):
             Y[r + c * n] = 0.0
-    for kb in range(nb):   # boundary blocks: diag(P) + curvature, a Cholesky of d rows
-        k = boundary[kb]
+    for b in range(f.nborder):   # diag(P) (+ curvature): a Cholesky of d rows each
+        k = f.border[b]
         o, d = p.cones.offset[k], p.cones.dim[k]
         start = p.constrained[o]
         B = f.block + o * s
-        if not _curved_block(f, p, o, d, start, hess) or not cholesky(B, <int>d, <int>d):
+        plane = -1
+        if kb < nb and boundary[kb] == k:
+            plane, kb = kb, kb + 1
+        if (not _curved_block(f, p, o, d, start, hess if plane >= 0 else NULL)
+                or not cholesky(B, <int>d, <int>d)):
             return False
-        f.block_row[kb] = row
         for a in range(d):
-            f.rowvar[row + a] = start + a
             for c in range(lead):
                 Y[row + a + c * n] = 0.0
             for c in range(lead, m):
                 Y[row + a + c * n] = p.A.values[f.arow[c] * n + start + a]
             for c in range(m, size):
                 Y[row + a + c * n] = 0.0
-            Y[row + a + (m + kb) * n] = g[o + a]
+            if plane >= 0:
+                Y[row + a + (m + plane) * n] = g[o + a]
         for c in range(lead, size):   # Y_block := B^-1 Y_block
             forward_substitution(B, <int>d, <int>d, Y + row + c * n)
         for a in range(d):
             _find_row(f, p, row + a, lead, size)
         row += d
+    if kb != nb:   # a boundary block held at its apex: not the guess the polish keeps
+        return False
     f.rows = <int>row
-    for c in range(t):   # the base's Schur complement, the boundary rows' sums added
+    for c in range(t):   # the base's Schur complement, the bordered rows' sums added
         for r in range(c, t):
             S[r + c * t] = f.SC[(lead + r) + (lead + c) * m] if r < rest else 0.0
     _add_sparse_rows(f, p, f.diag_end, row, lead, t, S)
@@ -381,44 +394,71 @@ cdef inline bint _take_row(PolishSchur* f, const Problem* p, Py_ssize_t i, Py_ss
 
 
 cdef Py_ssize_t _walk_diagonal(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
-                               const Py_ssize_t* boundary, Py_ssize_t nb, bint build) noexcept nogil:
+                               bint build) noexcept nogil:
     """The rows of ``Y`` after the unconstrained ones for the guess's free box entries and
-    free cone blocks, in :func:`_factor_whole`'s order: written (``build``) or compared
-    with those ``Y`` holds. Their end, or -1 where a row cannot be written, they differ
-    or a boundary block is held."""
-    cdef Py_ssize_t j, k, a, start, kb = 0, row = f.unconstrained
+    the base's diagonal cone blocks (``CONE_DIAGONAL``), in :func:`_build_base`'s order:
+    written (``build``) or compared with those ``Y`` holds. Their end, or -1 where a row
+    cannot be written or they differ."""
+    cdef Py_ssize_t j, k, a, start, row = f.unconstrained
     for j in range(p.s):
         if not p.in_cone[j] and index[p.constrained[j]] >= 0:
             if not _take_row(f, p, p.constrained[j], row, build):
                 return -1
             row += 1
     for k in range(p.cones.count):
-        start = p.constrained[p.cones.offset[k]]
-        if index[start] < 0:
-            continue
-        if kb < nb and boundary[kb] == k:
-            kb += 1
-            continue
-        for a in range(p.cones.dim[k]):
-            if not _take_row(f, p, start + a, row, build):
-                return -1
-            row += 1
-    if kb != nb or not (build or row == f.diag_end):
+        if f.cone_base[k] == CONE_DIAGONAL:
+            start = p.constrained[p.cones.offset[k]]
+            for a in range(p.cones.dim[k]):
+                if not _take_row(f, p, start + a, row, build):
+                    return -1
+                row += 1
+    if not (build or row == f.diag_end):
         return -1
     return row
 
 
 cdef bint _same_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
                      const Py_ssize_t* boundary, Py_ssize_t nb) noexcept nogil:
-    """Whether the base (:func:`_build_base`) is the guess's: the same free diagonal
-    rows and the same boundary blocks."""
-    cdef Py_ssize_t kb
-    if f.base == BASE_NONE or nb != f.base_nb:
+    """Whether the base (:func:`_build_base`) is the guess's: the same free box entries,
+    its diagonal cone blocks free in the guess and its held ones at their apex (its
+    bordered ones may be free, on their boundary or at their apex)."""
+    cdef Py_ssize_t k, kb = 0
+    cdef bint on_boundary, at_apex
+    cdef char kept
+    if f.base == BASE_NONE:
         return False
-    for kb in range(nb):
-        if boundary[kb] != f.base_boundary[kb]:
+    for k in range(p.cones.count):
+        on_boundary = kb < nb and boundary[kb] == k
+        kb += on_boundary
+        at_apex = index[p.constrained[p.cones.offset[k]]] < 0
+        kept = f.cone_base[k]
+        if ((kept == CONE_DIAGONAL and (on_boundary or at_apex))
+                or (kept == CONE_HELD and not at_apex)):
             return False
-    return _walk_diagonal(f, p, index, boundary, nb, False) >= 0
+    return _walk_diagonal(f, p, index, False) >= 0
+
+
+cdef void _border(PolishSchur* f, const Problem* p, const Py_ssize_t* index) noexcept nogil:
+    """The guess's bordered blocks: the base's bordered cone blocks off their apex (their
+    entries' ``index`` not -1), ascending in ``border``, with their rows of ``Y`` after
+    the base's (``block_row``, ``rowvar``) and their entries' columns of ``W``
+    (``border_col``)."""
+    cdef Py_ssize_t k, a, d, start, row = f.diag_end, column = 0, count = 0
+    for k in range(p.cones.count):
+        if f.cone_base[k] != CONE_BORDERED:
+            continue
+        d = p.cones.dim[k]
+        start = p.constrained[p.cones.offset[k]]
+        if index[start] >= 0:
+            f.border[count] = k
+            f.block_row[count] = row
+            count += 1
+            for a in range(d):
+                f.rowvar[row + a] = start + a
+                f.border_col[row - f.diag_end + a] = column + a
+            row += d
+        column += d
+    f.nborder, f.nbd = <int>count, <int>(row - f.diag_end)
 
 
 cdef inline bint _reaches_lead(PolishSchur* f, const Problem* p, Py_ssize_t j) noexcept nogil:
@@ -494,10 +534,11 @@ cdef bint _build_lead(PolishSchur* f, const Problem* p, Py_ssize_t end) noexcept
 
 cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
                       const Py_ssize_t* boundary, Py_ssize_t nb) noexcept nogil:
-    """The guess's part of ``S`` that its planes and curvature leave alone: the free
-    diagonal rows of ``Y``, the Cholesky factor ``L0`` of ``S0 = SU + Y_D'Y_D`` (the
-    regularized Schur complement of every free entry but the boundary blocks'),
-    ``W = L0^-1 A_B'`` and ``W'W``; ``BASE_NONE`` where a row cannot be written,
+    """The guess's part of ``S`` that its bordered cone blocks leave alone: the rows of
+    ``Y`` of its free box entries and of its diagonal cone blocks (``cone_base``), the
+    Cholesky factor ``L0`` of ``S0 = SU + Y_D'Y_D`` (the regularized Schur complement of
+    every free entry but the bordered blocks'), ``W = L0^-1 A_B'`` on the bordered
+    blocks' entries and ``W'W``; ``BASE_NONE`` where a row cannot be written,
     ``BASE_REFUSED`` where ``S0`` is too near singular for the bordered solve
     (``POLISH_BORDER_TOLERANCE``: go2's rows that only boundary blocks span leave ``S0``
     ``delta`` there), so that the guesses of that base go straight to
@@ -505,19 +546,39 @@ cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
     :func:`_build_lead` (kept while the free diagonal rows that reach them stay), and
     their Schur complement ``SC`` is kept: they are the whole ``S``'s too, so that
     :func:`_factor_whole` factors only the rest for each guess of the base, a refused
-    ``S0``'s included."""
-    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, r, c, a, kb, o, d, start, e = 0, row
+    ``S0``'s included.
+
+    The first base of a solve keeps its free cone blocks diagonal, borders its boundary
+    blocks and holds its apex blocks, as the guess has them: a warm polish's guess
+    usually settles on its first base. A later one, and the first of a polish from no
+    multipliers (``border_all``), borders every cone block, so that it serves every
+    guess that holds the same box entries, whichever of free, boundary or apex each
+    cone block takes: a polish whose guesses move contacts between those (a contact
+    change's, a block or two a pass) builds one base for them, where it had built one a
+    guess (anymal_c's contact tick 360: 22k instructions each, six bases;
+    notes/performance-history.md, "bordercones"). Bordering every block costs a warm
+    tick's single base about 7 % of its instructions (go2), so a warm polish's first
+    base does not."""
+    cdef Py_ssize_t n = p.n, m = p.m, s = p.s, r, c, a, k, d, start, e = 0, row
     cdef Py_ssize_t lead = f.lead, rest = m - lead
     cdef double largest
     cdef double* trailing = f.S0 + lead * (m + 1)
+    cdef Py_ssize_t kb = 0
+    cdef bint on_boundary
     f.base = BASE_NONE
-    row = _walk_diagonal(f, p, index, boundary, nb, True)
+    for k in range(p.cones.count):
+        on_boundary = kb < nb and boundary[kb] == k
+        kb += on_boundary
+        if f.border_all or on_boundary:
+            f.cone_base[k] = CONE_BORDERED
+        else:
+            f.cone_base[k] = (CONE_HELD if index[p.constrained[p.cones.offset[k]]] < 0
+                              else CONE_DIAGONAL)
+    f.border_all = True
+    row = _walk_diagonal(f, p, index, True)
     if row < 0:
         return
-    f.diag_end = f.kept_rows = <int>row   # the rows past it take the boundary entries
-    f.base_nb = <int>nb
-    for kb in range(nb):
-        f.base_boundary[kb] = boundary[kb]
+    f.diag_end = f.kept_rows = <int>row   # the rows past it take the bordered entries
     f.base = BASE_SINGULAR
     if not _same_lead(f, p, row) and not _build_lead(f, p, row):
         return
@@ -536,15 +597,14 @@ cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
     for c in range(m):
         if f.S0[c + c * m] * f.S0[c + c * m] <= POLISH_BORDER_TOLERANCE * largest:
             return
-    for kb in range(nb):   # the boundary entries: rows of the bordered system, columns of W
-        o, d = p.cones.offset[boundary[kb]], p.cones.dim[boundary[kb]]
-        start = p.constrained[o]
-        f.block_row[kb] = row
+    for k in range(p.cones.count):   # the bordered blocks' entries: columns of W
+        if f.cone_base[k] != CONE_BORDERED:
+            continue
+        d = p.cones.dim[k]
+        start = p.constrained[p.cones.offset[k]]
         for a in range(d):
-            f.rowvar[row + a] = start + a
             for c in range(rest):
                 f.W[c + (e + a) * rest] = p.A.values[f.arow[lead + c] * n + start + a]
-        row += d
         e += d
     if e > 0 and rest > 0:   # W's leading rows are zero: A_B' is
         trsm(b"L", b"N", <int>rest, <int>e, trailing, <int>m, f.W, <int>rest)
@@ -553,22 +613,23 @@ cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
         for c in range(e):
             for r in range(c, e):
                 f.WW[r + c * s] = 0.0
-    f.nbd, f.base_largest = <int>e, largest
+    f.base_largest = largest
     f.base = BASE_READY
 
 
 cdef inline bint _curved_block(PolishSchur* f, const Problem* p, Py_ssize_t o, Py_ssize_t d,
                                Py_ssize_t start, const double* hess) noexcept nogil:
-    """Lower triangle of a boundary block's ``H_b = diag(P) + curvature`` (cone entries
-    ``o .. o + d``, entries of ``x`` from ``start``) into its ``block``; False where a
-    diagonal entry of ``P`` is too small for the Schur complement."""
+    """Lower triangle of a bordered block's ``H_b = diag(P)`` plus its curvature ``hess``
+    (NULL for a free block) into its ``block`` (cone entries ``o .. o + d``, entries of
+    ``x`` from ``start``); False where a diagonal entry of ``P`` is too small for the
+    Schur complement."""
     cdef Py_ssize_t r, c, s = p.s
     cdef double* B = f.block + o * s
     for c in range(d):
         if f.root[start + c] == 0.0:
             return False
         for r in range(c, d):
-            B[r + c * d] = hess[o * s + r * d + c]
+            B[r + c * d] = hess[o * s + r * d + c] if hess != NULL else 0.0
         B[c + c * d] += f.root[start + c] * f.root[start + c]
     return True
 
@@ -576,48 +637,59 @@ cdef inline bint _curved_block(PolishSchur* f, const Problem* p, Py_ssize_t o, P
 cdef bint _factor_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* boundary,
                            Py_ssize_t nb, const double* g, const double* hess,
                            double delta) noexcept nogil:
-    """Factor the guess's planes and curvature against the base (:func:`_build_base`):
-    ``K = H_B + W'W`` on the boundary entries, ``Z = L_K^-1 G'`` and ``T = Z'Z + delta I``
-    on the planes. False where a boundary block of ``H`` or ``K`` is not positive
-    definite, or a pivot of ``T`` fails ``POLISH_RANK_TOLERANCE`` against the largest
-    diagonal entry of ``S0`` and of ``S``'s planes' part."""
-    cdef Py_ssize_t s = p.s, nbd = f.nbd, r, c, a, kb, o, d, start, e = 0
+    """Factor the guess's cone blocks against the base (:func:`_build_base`): ``K = H_B +
+    W'W`` on the bordered entries (``H_B``: ``diag(P)``, plus the curvature on the
+    boundary blocks), ``Z = L_K^-1 G'`` and ``T = Z'Z + delta I`` on the planes. False
+    where a boundary block of ``H`` or ``K`` is not positive definite, or a pivot of
+    ``T`` fails ``POLISH_RANK_TOLERANCE`` against the largest diagonal entry of ``S0``
+    and of ``S``'s planes' part."""
+    cdef Py_ssize_t s = p.s, nbd = f.nbd, r, c, a, b, k, kb = 0, o, d, start, e = 0
+    cdef bint curved
     cdef double* B
     cdef double* column
     cdef double largest = f.base_largest, value
     for c in range(nbd):
         for r in range(c, nbd):
-            f.K[r + c * s] = f.WW[r + c * s]
-    for kb in range(nb):
-        o, d = p.cones.offset[boundary[kb]], p.cones.dim[boundary[kb]]
+            f.K[r + c * s] = f.WW[f.border_col[r] + f.border_col[c] * s]
+    for b in range(f.nborder):
+        k = f.border[b]
+        o, d = p.cones.offset[k], p.cones.dim[k]
         start = p.constrained[o]
         B = f.block + o * s
-        if not _curved_block(f, p, o, d, start, hess):
+        curved = kb < nb and boundary[kb] == k
+        if not _curved_block(f, p, o, d, start, hess if curved else NULL):
             return False
         for c in range(d):
             for r in range(c, d):
                 f.K[e + r + (e + c) * s] += B[r + c * d]
-        if not cholesky(B, <int>d, <int>d):
-            return False
-        for a in range(d):   # S's diagonal entry of this plane: g' H_b^-1 g + delta
-            f.t2[a] = g[o + a]
-        forward_substitution(B, <int>d, <int>d, f.t2)
-        value = delta
-        for a in range(d):
-            value += f.t2[a] * f.t2[a]
-        largest = max(largest, value)
+        if curved:
+            kb += 1
+            if not cholesky(B, <int>d, <int>d):
+                return False
+            for a in range(d):   # S's diagonal entry of this plane: g' H_b^-1 g + delta
+                f.t2[a] = g[o + a]
+            forward_substitution(B, <int>d, <int>d, f.t2)
+            value = delta
+            for a in range(d):
+                value += f.t2[a] * f.t2[a]
+            largest = max(largest, value)
         e += d
+    if kb != nb:   # a boundary block held at its apex: not the guess the polish keeps
+        return False
     if nbd > 0 and not cholesky(f.K, <int>nbd, <int>s):
         return False
-    e = 0
-    for kb in range(nb):
-        o, d = p.cones.offset[boundary[kb]], p.cones.dim[boundary[kb]]
-        column = f.Z + kb * s
-        for r in range(nbd):
-            column[r] = 0.0
-        for a in range(d):
-            column[e + a] = g[o + a]
-        fccqp_forward_vector(f.K + e + e * s, <int>(nbd - e), <int>s, column + e)
+    e = kb = 0
+    for b in range(f.nborder):
+        k = f.border[b]
+        o, d = p.cones.offset[k], p.cones.dim[k]
+        if kb < nb and boundary[kb] == k:
+            column = f.Z + kb * s
+            for r in range(nbd):
+                column[r] = 0.0
+            for a in range(d):
+                column[e + a] = g[o + a]
+            fccqp_forward_vector(f.K + e + e * s, <int>(nbd - e), <int>s, column + e)
+            kb += 1
         e += d
     for c in range(nb):
         for r in range(c, nb):
@@ -647,13 +719,13 @@ cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t
     curvature ``hess`` as :mod:`fccqp.polish` keeps them. False where the Schur
     complement does not apply.
 
-    Bordered where it can be: ``mu`` and the boundary entries ``x_B`` are eliminated
-    after the other free entries, through ``S0`` (the Schur complement without the
-    boundary blocks, ``m`` rows), then ``x_B`` through ``K = H_B + A_B' S0^-1 A_B``, the
-    planes last through ``T = G K^-1 G' + delta I``. A Newton step or a guess that keeps
-    the free entries and the boundary blocks but moves their planes and curvature (most
-    factorizations of a polish: every ``renew`` and every re-linearization moves every
-    plane) then refactors only ``K`` and ``T`` (``nb d`` and ``nb`` rows) and keeps
+    Bordered where it can be: ``mu`` and the entries ``x_B`` of the cone blocks off their
+    apex are eliminated after the other free entries, through ``S0`` (the Schur
+    complement without the cone blocks, ``m`` rows), then ``x_B`` through ``K = H_B + A_B'
+    S0^-1 A_B``, the planes last through ``T = G K^-1 G' + delta I``. A guess that keeps
+    the free box entries (most factorizations of a polish: every Newton step, every
+    ``renew`` that moves the planes or moves cone blocks between free, boundary and apex)
+    then refactors only ``K`` and ``T`` (the bordered entries and ``nb`` rows) and keeps
     ``S0``, ``W`` and ``W'W`` (notes/polish.md, "schurup"). Otherwise, or where ``S0`` is
     too near singular for that order, the whole ``S`` (:func:`_factor_whole`, from the
     base's rows of ``Y`` and their sums, so the base stays the guess's); its columns
@@ -662,34 +734,37 @@ cdef bint polish_schur_factor(PolishSchur* f, const Problem* p, const Py_ssize_t
     f.bordered = False
     if not _same_base(f, p, index, boundary, nb):
         _build_base(f, p, index, boundary, nb)
+    if f.base == BASE_NONE or f.base == BASE_SINGULAR:
+        return False   # a free row could not be written, or S0's leading block failed
+    _border(f, p, index)
     if f.base == BASE_READY and _factor_bordered(f, p, boundary, nb, g, hess, delta):
         f.bordered = True
         f.rows = f.diag_end + f.nbd
         f.size = <int>(p.m + nb)
         return True
-    return _factor_whole(f, p, index, boundary, nb, g, hess, delta)
+    return _factor_whole(f, p, boundary, nb, g, hess, delta)
 
 
-cdef void _forward(PolishSchur* f, const Problem* p, const Py_ssize_t* boundary,
-                   Py_ssize_t nb, double* w) noexcept nogil:
+cdef void _forward(PolishSchur* f, const Problem* p, double* w) noexcept nogil:
     """``w := L^-1 w``, ``w`` in the order of ``Y``'s rows."""
-    cdef Py_ssize_t r, kb, d, o
+    cdef Py_ssize_t r, b, k
     if f.dense > 0:
         fccqp_forward_vector(f.L, f.dense, <int>p.n, w)
     for r in range(f.dense, f.diag_end):
         w[r] *= f.inv_root[r]
-    for kb in range(nb):
-        o, d = p.cones.offset[boundary[kb]], p.cones.dim[boundary[kb]]
-        forward_substitution(f.block + o * p.s, <int>d, <int>d, w + f.block_row[kb])
+    for b in range(f.nborder):
+        k = f.border[b]
+        forward_substitution(f.block + p.cones.offset[k] * p.s, <int>p.cones.dim[k],
+                             <int>p.cones.dim[k], w + f.block_row[b])
 
 
-cdef void _backward(PolishSchur* f, const Problem* p, const Py_ssize_t* boundary,
-                    Py_ssize_t nb, double* w) noexcept nogil:
+cdef void _backward(PolishSchur* f, const Problem* p, double* w) noexcept nogil:
     """``w := L'^-1 w``, ``w`` in the order of ``Y``'s rows."""
-    cdef Py_ssize_t r, kb, d, o
-    for kb in range(nb):
-        o, d = p.cones.offset[boundary[kb]], p.cones.dim[boundary[kb]]
-        backward_substitution(f.block + o * p.s, <int>d, <int>d, w + f.block_row[kb])
+    cdef Py_ssize_t r, b, k
+    for b in range(f.nborder):
+        k = f.border[b]
+        backward_substitution(f.block + p.cones.offset[k] * p.s, <int>p.cones.dim[k],
+                              <int>p.cones.dim[k], w + f.block_row[b])
     for r in range(f.dense, f.diag_end):
         w[r] *= f.inv_root[r]
     if f.dense > 0:
@@ -758,7 +833,7 @@ cdef void _solve_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* in
         _subtract_rows(f, m, v + nf, u)
         fccqp_forward_vector(f.S0, mm, mm, u)
     for e in range(nbd):
-        xb[e] -= _dot(f.W + e * rest, u + lead, rest)
+        xb[e] -= _dot(f.W + f.border_col[e] * rest, u + lead, rest)
     fccqp_forward_vector(f.K, <int>nbd, <int>s, xb)
     for kb in range(nb):
         lam[kb] = _dot(f.Z + kb * s, xb, nbd) - v[nf + m + kb]
@@ -770,7 +845,7 @@ cdef void _solve_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* in
     if m > 0:
         for e in range(nbd):
             for c in range(rest):
-                u[lead + c] += f.W[c + e * rest] * xb[e]
+                u[lead + c] += f.W[c + f.border_col[e] * rest] * xb[e]
         fccqp_backward_vector(f.S0, mm, mm, u)
         fccqp_matvec_t(f.Y, <int>n, u, f.t2, mm, end)   # Y_E mu
         for r in range(end):
@@ -785,7 +860,7 @@ cdef void _solve_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* in
 
 
 cdef void polish_schur_solve(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
-                             const Py_ssize_t* boundary, Py_ssize_t nb, double* v) noexcept nogil:
+                             Py_ssize_t nb, double* v) noexcept nogil:
     """``v := M^-1 v`` for the factored guess (its planes and curvature, also after
     they moved: a chord step), ``v = [x_F; nu; lam]`` as :mod:`fccqp.polish` lays out
     its unknowns (free entries by ``index``, the rows, the planes):
@@ -799,7 +874,7 @@ cdef void polish_schur_solve(PolishSchur* f, const Problem* p, const Py_ssize_t*
         return
     for r in range(rows):
         w[r] = v[index[f.rowvar[r]]]
-    _forward(f, p, boundary, nb, w)
+    _forward(f, p, w)
     if size > 0:
         # Y'w in fccqp's kernel: go2's warm ticks 0.966x OpenBLAS dgemv's wall time (in
         # lockstep), and sums that do not follow the kernel OpenBLAS picks for the CPU
@@ -812,7 +887,7 @@ cdef void polish_schur_solve(PolishSchur* f, const Problem* p, const Py_ssize_t*
         fccqp_matvec_t(f.Y, <int>n, u, f.t2, size, rows)   # Y u: columns of Y
         for r in range(rows):
             w[r] -= f.t2[r]
-    _backward(f, p, boundary, nb, w)
+    _backward(f, p, w)
     for r in range(rows):
         v[index[f.rowvar[r]]] = w[r]
     _put_rows(f, p.m, size, u, v + nf)

@@ -342,7 +342,8 @@ cdef void polish_schur_arrays(Arrays a, PolishSchur* ps, Py_ssize_t n, Py_ssize_
     ps.SU, ps.S = a.new(m * m), a.new((m + s) * (m + s))
     ps.block = a.new(s * s)
     ps.base, ps.bordered = 0, False   # BASE_NONE
-    ps.base_boundary = <Py_ssize_t*>a.new_int(s)
+    ps.border, ps.border_col = <Py_ssize_t*>a.new_int(s), <Py_ssize_t*>a.new_int(s)
+    ps.cone_base = <char*>a.new(s)
     ps.S0, ps.LSC, ps.W = a.new(m * m), a.new(m * m), a.new(m * s)
     ps.arow, ps.SC, ps.diag0 = <Py_ssize_t*>a.new_int(m), a.new(m * m), a.new(m)
     ps.lead_rows, ps.lead_valid = <Py_ssize_t*>a.new_int(n), False
