@@ -36,7 +36,7 @@ same way in a solve).
 
 from libc.math cimport fabs
 
-from fccqp._dense cimport matvec, matvec_t
+from fccqp._dense cimport matvec_ld, matvec_t
 
 cdef extern from "fccqp_kernels.h" nogil:
     void fccqp_row_spans(const double* A, int rows, int cols, const double* width,
@@ -122,12 +122,17 @@ cdef inline void mark_diagonal_tail(Matrix* M) noexcept nogil:
 
 
 cdef inline void product(const Matrix* M, const double* x, double* out) noexcept nogil:
-    """``out = M x`` (``_dense.matvec`` over the rows before ``M.diagonal_from``, a
-    product of the diagonal after them; CSC: a column sweep)."""
+    """``out = M x`` (``_dense.matvec_ld`` over the rows before ``M.diagonal_from``, a
+    product of the diagonal after them; CSC: a column sweep). Where a symmetric ``M``
+    has a diagonal tail (:func:`mark_diagonal_tail`) its leading rows are zero past
+    their first ``diagonal_from`` columns, which the product leaves out: their lanes
+    only ever added zeros, so the sums keep their bits (anymal_c's ``P``: 20 of 54
+    columns)."""
     cdef Py_ssize_t i, j, k
     cdef double xj
     if M.kind == DENSE:
-        matvec(M.values, x, out, M.diagonal_from, M.cols)
+        matvec_ld(M.values, M.cols, x, out, M.diagonal_from,
+                  M.diagonal_from if M.diagonal_from < M.rows else M.cols)
         for i in range(M.diagonal_from, M.rows):
             out[i] = 0.0 + M.values[i * M.cols + i] * x[i]   # matvec's +0 for a zero sum
         return

@@ -57,6 +57,7 @@ cdef struct PolishSchur:
     int nborder             # their number
     int nbd                 # their entries: the bordered rows of Y
     Py_ssize_t* border_col  # s: the column of W of each bordered entry
+    int ncone               # W's columns: the entries of the base's bordered cone blocks
     # The bordered factorization, which keeps the part of S that a guess's cone blocks
     # (free, on their boundary with their planes and curvature) do not change:
     bint bordered           # the last factored guess is bordered: a solve reads S0..T

@@ -57,7 +57,7 @@ from libc.math cimport sqrt
 
 from fccqp._blas cimport (backward_substitution, cholesky, cholesky_solve_vector,
                           forward_substitution, syrk_t, trsm)
-from fccqp._dense cimport matvec_ld
+from fccqp._dense cimport colmatvec, fill, matvec_ld
 from fccqp._types cimport Problem
 from fccqp.schur cimport mark_coupled
 from fccqp.tuning cimport (CHOLESKY_LOOP_ROWS, PIVOT_TOLERANCE, POLISH_BORDER_TOLERANCE,
@@ -613,7 +613,7 @@ cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
         for c in range(e):
             for r in range(c, e):
                 f.WW[r + c * s] = 0.0
-    f.base_largest = largest
+    f.ncone, f.base_largest = <int>e, largest
     f.base = BASE_READY
 
 
@@ -832,8 +832,9 @@ cdef void _solve_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* in
         matvec_ld(f.Y, ld, w, u, mm, end)   # Y_E'w_E
         _subtract_rows(f, m, v + nf, u)
         fccqp_forward_vector(f.S0, mm, mm, u)
+    matvec_ld(f.W, rest, u + lead, f.t2, f.ncone, rest)   # W'rho: W's columns are rows of W'
     for e in range(nbd):
-        xb[e] -= _dot(f.W + f.border_col[e] * rest, u + lead, rest)
+        xb[e] -= f.t2[f.border_col[e]]
     fccqp_forward_vector(f.K, <int>nbd, <int>s, xb)
     for kb in range(nb):
         lam[kb] = _dot(f.Z + kb * s, xb, nbd) - v[nf + m + kb]
@@ -843,9 +844,10 @@ cdef void _solve_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* in
             xb[e] -= f.Z[e + kb * s] * lam[kb]
     fccqp_backward_vector(f.K, <int>nbd, <int>s, xb)
     if m > 0:
+        fill(f.t2, 0.0, f.ncone)   # x_B in W's columns, the apex blocks' zero
         for e in range(nbd):
-            for c in range(rest):
-                u[lead + c] += f.W[c + f.border_col[e] * rest] * xb[e]
+            f.t2[f.border_col[e]] = xb[e]
+        colmatvec(f.W, <int>rest, f.t2, u + lead, rest, f.ncone, 1.0)
         fccqp_backward_vector(f.S0, mm, mm, u)
         fccqp_matvec_t(f.Y, <int>n, u, f.t2, mm, end)   # Y_E mu
         for r in range(end):
