@@ -433,8 +433,10 @@ cdef class Workspace:
         marked ``arrived``; the workspace solves from the buffers held for those checks,
         its structure's ``certificate`` the certificate's output. Anything else, a kept
         workspace of other blocks first among those the shapes fit included, is the
-        general path's, which flattens the cones and raises the errors. The caller
-        makes a kept entry current after the answer. A contact change runs this once
+        general path's, which flattens the cones and raises the errors. A kept entry
+        that solved leaves ``kept`` and this workspace takes its place (under
+        ``current``'s key), for the caller to make the entry current. A contact change
+        runs this once
         after a stretch of ticks of another structure, with its code cold: it is a
         method beside :meth:`solve` and runs the holds every tick runs, its checks
         inlined, where a separate call choosing the workspace and then :meth:`solve`
@@ -485,7 +487,11 @@ cdef class Workspace:
             if guessed:
                 for i in range(10, count):
                     PyBuffer_Release(&views[i])
-        return entry, w._answer(code, &run, x_out, y_out, z_out, outputs[3], start_time)
+        out = w._answer(code, &run, x_out, y_out, z_out, outputs[3], start_time)
+        if w is not self:   # the entry leaves kept, this workspace takes its place
+            del kept[(<tuple>entry)[0].key]
+            kept[current.key] = (current, self)
+        return entry, out
 
     cdef void _shapes(self, Py_ssize_t* rows, Py_ssize_t* columns) noexcept:
         """The rows and columns (-1: a vector) of :meth:`solve`'s thirteen arrays, in the

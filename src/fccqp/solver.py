@@ -258,8 +258,18 @@ class Solver:
         if switched is admm.FITS_CURRENT:
             n, m = structure.n, structure.m   # the arrays fit as they are
             flat = flatten_cones(cones, n)   # memoized: the same object for the same cones
-        elif switched is not None:
-            return self._switched(switched, cones, P, q, A, b, lb, ub, x0, y0, z0, start)
+        elif switched is not None:   # solved on this workspace or on a kept one
+            entry, out = switched
+            if entry is not None:   # a kept one: the switch kept the current one in its place
+                structure, w = entry
+                self._structure, self._workspace = entry
+            self._cones = cones
+            structure.friction_of(cones)   # their flat form made when asked for
+            if (type(out) is Result and out.status is Status.SOLVED and not w.doubt
+                    and not settings.verbose):
+                return out   # as the control loop's answer, without _result
+            return self._result(out, P, q, A, b, lb, ub, NO_GUESS if x0 is None
+                                else (x0, y0, z0), start)
         elif dense and (flat := self._switch(cones, P, q, A, b, lb, ub)) is not None:
             w, structure = self._workspace, self._structure   # a kept one they fit
             n, m = structure.n, structure.m
@@ -303,34 +313,6 @@ class Solver:
                 self._cones = cones
                 return w, structure
         return None, None
-
-    def _switched(self, switched: tuple, cones: object, P: object, q: object, A: object,
-                  b: object, lb: object, ub: object, x0: object, y0: object, z0: object,
-                  start: float) -> Result:
-        """The answer of a solve that :meth:`fccqp.admm.Workspace.switch` made on the
-        current workspace or on a kept entry (``switched``: that entry ``(structure,
-        workspace)``, None for the current one, and what the solve returned), once that
-        entry is made current, with the friction of ``cones`` (their flat form left to
-        :attr:`_Structure.cones` until asked for); the arguments are those the general
-        path would solve (a guess as :func:`_guess` returns it), and a solved answer
-        returns without :meth:`_result`, as the control loop's does."""
-        entry, out = switched
-        if entry is None:
-            structure, w = self._structure, self._workspace
-        else:
-            structure, w = entry
-            kept = self._kept   # _make_current's swap without its frame (the solve
-            # cleared arrived, which it would set again)
-            del kept[structure.key]
-            kept[self._structure.key] = (self._structure, self._workspace)
-            self._structure, self._workspace = structure, w
-        self._cones = cones
-        structure.friction_of(cones)
-        if (type(out) is Result and out.status is Status.SOLVED and not w.doubt
-                and not self._settings.verbose):
-            return out
-        guess = NO_GUESS if x0 is None else (x0, y0, z0)
-        return self._result(out, P, q, A, b, lb, ub, guess, start)
 
     def _switch(self, cones: object, P: object, q: object, A: object, b: object,
                 lb: object, ub: object) -> ConeArrays | None:
