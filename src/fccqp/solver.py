@@ -239,22 +239,27 @@ class Solver:
         settings = self._settings
         w, structure = self._workspace, self._structure
         sparse = settings.kkt_backend == "sparse"
-        if w is not None and x0 is None and y0 is None and z0 is None and not sparse:
-            if not same_cones(cones, self._cones):   # a contact change, or other cones
-                w, structure = self._returning(cones, P, q, A, b, lb, ub)
-            if w is not None:
-                # the control loop: the caller's arrays as they came, checked by the solve
+        guessless = x0 is None and y0 is None and z0 is None
+        switched = None
+        dense = w is not None and not sparse
+        if dense:
+            if guessless and not same_cones(cones, self._cones):   # a contact change, or
+                returning, kept = self._returning(cones, P, q, A, b, lb, ub)   # other cones
+                if returning is not None:
+                    w, structure = returning, kept
+            # every tick through the compiled call a contact change's guess takes, so that
+            # its code runs warm there (anymal_c's contact tick 5 % faster in lockstep, the
+            # warm ticks unchanged; notes/performance-history.md, "onecall")
+            switched = w.switch(structure, self._kept, P, q, A, b, lb, ub, cones, x0, y0, z0,
+                                settings.warm_start, start)
+            if switched is admm.FITS_CURRENT and guessless and same_cones(cones, self._cones):
+                # the control loop with other cones than upright friction: as they came
                 out = w.solve(P, q, A, b, lb, ub, None, settings.warm_start, start,
                               structure.certificate, False)
                 if (type(out) is Result and not settings.verbose
                         and out.status not in UNANSWERED and not w.doubt):
                     return out
-                if type(out) is Result or out != admm.NOT_DENSE:
-                    return self._result(out, P, q, A, b, lb, ub, NO_GUESS, start)
-            w, structure = self._workspace, self._structure
-        dense = w is not None and not sparse
-        switched = w.switch(structure, self._kept, P, q, A, b, lb, ub, cones, x0, y0, z0,
-                            settings.warm_start, start) if dense else None
+                return self._result(out, P, q, A, b, lb, ub, NO_GUESS, start)
         if switched is admm.FITS_CURRENT:
             n, m = structure.n, structure.m   # the arrays fit as they are
             flat = flatten_cones(cones, n)   # memoized: the same object for the same cones
@@ -265,9 +270,10 @@ class Solver:
                 self._structure, self._workspace = entry
             self._cones = cones
             structure.friction_of(cones)   # their flat form made when asked for
-            if (type(out) is Result and out.status is Status.SOLVED and not w.doubt
-                    and not settings.verbose):
-                return out   # as the control loop's answer, without _result
+            if (type(out) is Result and not w.doubt and not settings.verbose
+                    and (out.status is Status.SOLVED
+                         or guessless and out.status not in UNANSWERED)):
+                return out   # the control loop's answer, without _result
             return self._result(out, P, q, A, b, lb, ub, NO_GUESS if x0 is None
                                 else (x0, y0, z0), start)
         elif dense and (flat := self._switch(cones, P, q, A, b, lb, ub)) is not None:
