@@ -736,6 +736,32 @@ def _schur_polish_matching_the_assembled(P, q, A, b, lb, ub, cones, iterations):
     return schur
 
 
+@pytest.mark.parametrize("seed", range(8))
+def test_schur_polish_from_no_multipliers_is_the_assembled_polish(seed):
+    """A polish from no multipliers (a contact change's carried guess) borders every cone
+    block in its Schur complement's bases (fccqp.polish_schur): its guesses move blocks
+    between free, boundary and apex and share a base while they hold the same box
+    entries. From another problem's answer, as a carried guess, it takes the assembled
+    polish's guesses and steps, to the same point, which is the reference's."""
+    P, q, A, b, lb, ub, cones = random_problem(seed, n=40, m=6, n_cones=8, n_box=8)
+    P = np.diag(np.diag(P))
+    rng = np.random.default_rng(seed)
+    carried = fccqp.solve(P, q + rng.normal(size=q.size) * np.abs(q).max(), A, b, lb, ub,
+                          cones).x
+    flat = flatten_cones(cones, P.shape[0])
+    start = (carried, np.zeros(A.shape[0]), np.zeros(P.shape[0]), carried)
+    assembled = polish_point(P, q, A, b, lb, ub, flat, *start, newton_steps=20, bare=True)
+    schur = polish_point(P, q, A, b, lb, ub, flat, *start, newton_steps=20, bare=True,
+                         schur=True)
+    assert schur["schur"] and schur["bordered"]
+    assert np.array_equal(assembled["active"], schur["active"])
+    assert (assembled["ok"], assembled["passes"], assembled["factorizations"]) == (
+        schur["ok"], schur["passes"], schur["factorizations"])
+    for name in ("x", "nu", "y"):
+        gap = np.abs(assembled[name] - schur[name]).max()
+        assert gap <= 1e-10 * max(1.0, np.abs(assembled[name]).max()), name
+
+
 @pytest.mark.parametrize("iterations", [1, 4])
 @pytest.mark.parametrize("seed", range(8))
 def test_schur_polish_with_rows_no_cone_touches_is_the_assembled_polish(seed, iterations):
