@@ -271,8 +271,8 @@ class Solver:
             self._cones = cones
             structure.friction_of(cones)   # their flat form made when asked for
             if (type(out) is Result and not w.doubt and not settings.verbose
-                    and (out.status is Status.SOLVED
-                         or guessless and out.status not in UNANSWERED)):
+                    and (out.status is Status.SOLVED or guessless and entry is None
+                         and out.status not in UNANSWERED)):
                 return out   # the control loop's answer, without _result
             return self._result(out, P, q, A, b, lb, ub, NO_GUESS if x0 is None
                                 else (x0, y0, z0), start)
