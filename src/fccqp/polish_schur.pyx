@@ -300,6 +300,16 @@ cdef inline bint _diagonal_row(PolishSchur* f, const Problem* p, Py_ssize_t i, P
     return True
 
 
+cdef inline bint _next_boundary(const Py_ssize_t* boundary, Py_ssize_t nb, Py_ssize_t k,
+                                Py_ssize_t* kb) noexcept nogil:
+    """Whether cone block ``k`` is ``boundary[kb]`` (the ascending ``boundary[:nb]``
+    walked beside the cone blocks in order), ``kb`` then moved past it."""
+    if kb[0] < nb and boundary[kb[0]] == k:
+        kb[0] += 1
+        return True
+    return False
+
+
 cdef bint _factor_whole(PolishSchur* f, const Problem* p, const Py_ssize_t* boundary,
                         Py_ssize_t nb, const double* g, const double* hess,
                         double delta) noexcept nogil:
@@ -331,9 +341,9 @@ cdef bint _factor_whole(PolishSchur* f, const Problem* p, const Py_ssize_t* boun
         o, d = p.cones.offset[k], p.cones.dim[k]
         start = p.constrained[o]
         B = f.block + o * s
-        plane = -1
-        if kb < nb and boundary[kb] == k:
-            plane, kb = kb, kb + 1
+        plane = kb   # its plane's column, where it is on its boundary
+        if not _next_boundary(boundary, nb, k, &kb):
+            plane = -1
         if (not _curved_block(f, p, o, d, start, hess if plane >= 0 else NULL)
                 or not cholesky(B, <int>d, <int>d)):
             return False
@@ -428,8 +438,7 @@ cdef bint _same_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
     if f.base == BASE_NONE:
         return False
     for k in range(p.cones.count):
-        on_boundary = kb < nb and boundary[kb] == k
-        kb += on_boundary
+        on_boundary = _next_boundary(boundary, nb, k, &kb)
         at_apex = index[p.constrained[p.cones.offset[k]]] < 0
         kept = f.cone_base[k]
         if ((kept == CONE_DIAGONAL and (on_boundary or at_apex))
@@ -564,12 +573,9 @@ cdef void _build_base(PolishSchur* f, const Problem* p, const Py_ssize_t* index,
     cdef double largest
     cdef double* trailing = f.S0 + lead * (m + 1)
     cdef Py_ssize_t kb = 0
-    cdef bint on_boundary
     f.base = BASE_NONE
     for k in range(p.cones.count):
-        on_boundary = kb < nb and boundary[kb] == k
-        kb += on_boundary
-        if f.border_all or on_boundary:
+        if _next_boundary(boundary, nb, k, &kb) or f.border_all:
             f.cone_base[k] = CONE_BORDERED
         else:
             f.cone_base[k] = (CONE_HELD if index[p.constrained[p.cones.offset[k]]] < 0
@@ -656,14 +662,13 @@ cdef bint _factor_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* b
         o, d = p.cones.offset[k], p.cones.dim[k]
         start = p.constrained[o]
         B = f.block + o * s
-        curved = kb < nb and boundary[kb] == k
+        curved = _next_boundary(boundary, nb, k, &kb)
         if not _curved_block(f, p, o, d, start, hess if curved else NULL):
             return False
         for c in range(d):
             for r in range(c, d):
                 f.K[e + r + (e + c) * s] += B[r + c * d]
         if curved:
-            kb += 1
             if not cholesky(B, <int>d, <int>d):
                 return False
             for a in range(d):   # S's diagonal entry of this plane: g' H_b^-1 g + delta
@@ -682,14 +687,13 @@ cdef bint _factor_bordered(PolishSchur* f, const Problem* p, const Py_ssize_t* b
     for b in range(f.nborder):
         k = f.border[b]
         o, d = p.cones.offset[k], p.cones.dim[k]
-        if kb < nb and boundary[kb] == k:
-            column = f.Z + kb * s
+        if _next_boundary(boundary, nb, k, &kb):
+            column = f.Z + (kb - 1) * s
             for r in range(nbd):
                 column[r] = 0.0
             for a in range(d):
                 column[e + a] = g[o + a]
             fccqp_forward_vector(f.K + e + e * s, <int>(nbd - e), <int>s, column + e)
-            kb += 1
         e += d
     for c in range(nb):
         for r in range(c, nb):

@@ -244,9 +244,10 @@ class Solver:
         dense = w is not None and not sparse
         if dense:
             if guessless and not same_cones(cones, self._cones):   # a contact change, or
-                returning, kept = self._returning(cones, P, q, A, b, lb, ub)   # other cones
+                # other cones: the kept workspace whose last solve had these, if one did
+                returning, its_structure = self._returning(cones, P, q, A, b, lb, ub)
                 if returning is not None:
-                    w, structure = returning, kept
+                    w, structure = returning, its_structure
             # every tick through the compiled call a contact change's guess takes, so that
             # its code runs warm there (anymal_c's contact tick 5 % faster in lockstep, the
             # warm ticks unchanged; notes/performance-history.md, "onecall")
